@@ -1,0 +1,62 @@
+"""Input checking: one-line errors that name the parameter and what was expected."""
+
+from __future__ import annotations
+
+import math
+
+__all__ = ["ParameterError", "SolverError", "check_finite", "check_int", "check_nonnegative",
+           "check_positive"]
+
+
+class ParameterError(ValueError):
+    """A user-supplied parameter is invalid; the message names it and what was expected."""
+
+
+class SolverError(RuntimeError):
+    """Raised only when the caller asks for it (``throw=True``) and a solver did not converge."""
+
+
+def _as_float(name: str, value) -> float:
+    try:
+        x = float(value)
+    except (TypeError, ValueError):
+        raise ParameterError(f"{name}: expected a number, got {value!r}") from None
+    if not math.isfinite(x):
+        raise ParameterError(f"{name}: expected a finite number, got {value!r}")
+    return x
+
+
+def check_finite(name: str, value) -> float:
+    """Return ``value`` as a float, or raise if it is not a finite number."""
+    return _as_float(name, value)
+
+
+def check_positive(name: str, value) -> float:
+    """Return ``value`` as a float, or raise unless it is finite and > 0."""
+    x = _as_float(name, value)
+    if x <= 0:
+        raise ParameterError(f"{name}: expected a number > 0, got {value!r}")
+    return x
+
+
+def check_nonnegative(name: str, value) -> float:
+    """Return ``value`` as a float, or raise unless it is finite and >= 0."""
+    x = _as_float(name, value)
+    if x < 0:
+        raise ParameterError(f"{name}: expected a number >= 0, got {value!r}")
+    return x
+
+
+def check_int(name: str, value, minimum: int = 1, maximum: int | None = None) -> int:
+    """Return ``value`` as an int, or raise unless it is an integer in [minimum, maximum]."""
+    try:
+        ok = int(value) == value
+    except (TypeError, ValueError, OverflowError):
+        ok = False
+    if not ok or isinstance(value, bool):
+        raise ParameterError(f"{name}: expected an integer >= {minimum}, got {value!r}")
+    n = int(value)
+    if n < minimum or (maximum is not None and n > maximum):
+        rng = f">= {minimum}" if maximum is None else f"in [{minimum}, {maximum}]"
+        raise ParameterError(f"{name}: expected an integer {rng}, got {value!r}")
+    return n

@@ -1,0 +1,454 @@
+"""Base excitations ``q(t)``: base acceleration over g, periodic with period ``2*pi/omega``.
+
+Every excitation is, internally, a Fourier series in the phase ``s = omega*t``::
+
+    q(s) = Re( sum_{k=0}^{K} Q[k] * exp(1j*k*s) )          (one-sided spectrum Q)
+
+which is exact for the harmonic, two-harmonic and Fourier-series excitations, exact to
+rounding for the tanh-smoothed square wave of Eq. 26 (closed-form coefficients, truncated
+where they fall below 1e-17 of the first), and the trigonometric interpolant of the samples
+for a sampled (CSV) excitation. The optimizers only ever need this spectrum; the square wave
+also evaluates ``q`` and ``dq/dt`` from its own formula.
+
+Each excitation gives ``q``, ``dq`` (= dq/dt, non-dimensional time), its extrema within one
+period and its total variation over one period (the quantity that sets the gamma -> 0
+limit of extractable power, see :mod:`parapend.optimal.limit`).
+"""
+
+from __future__ import annotations
+
+import csv
+import math
+from dataclasses import dataclass, field
+from functools import cached_property
+from pathlib import Path
+
+import numpy as np
+from scipy.optimize import brentq
+
+from .errors import ParameterError, check_finite, check_positive
+
+__all__ = [
+    "Excitation",
+    "Extrema",
+    "FourierExcitation",
+    "SampledExcitation",
+    "SquareExcitation",
+    "fourier",
+    "from_csv",
+    "harmonic",
+    "parse_fourier_terms",
+    "square",
+    "two_harmonic",
+]
+
+
+@dataclass(frozen=True)
+class Extrema:
+    """Extrema of ``q`` within one period, in increasing time.
+
+    Attributes
+    ----------
+    t : ndarray, shape (m,)
+        Times in ``[0, 2*pi/omega)``.
+    q : ndarray, shape (m,)
+        Values of ``q`` there.
+    is_max : ndarray of bool, shape (m,)
+        True at a maximum, False at a minimum; maxima and minima alternate.
+    """
+
+    t: np.ndarray
+    q: np.ndarray
+    is_max: np.ndarray
+
+
+class Excitation:
+    """Common interface of all excitations (see module docstring for the spectral form)."""
+
+    omega: float
+    name: str
+
+    # -- spectrum ------------------------------------------------------------------------
+    @property
+    def spectrum(self) -> np.ndarray:
+        """One-sided complex spectrum ``Q[k]``, k = 0..K, of ``q`` in the phase ``s``."""
+        raise NotImplementedError
+
+    @property
+    def period(self) -> float:
+        """Forcing period ``2*pi/omega`` (non-dimensional time)."""
+        return 2.0 * math.pi / self.omega
+
+    def dq_spectrum(self) -> np.ndarray:
+        """One-sided spectrum of ``dq/dt`` (non-dimensional time): ``1j*k*omega*Q[k]``."""
+        q = self.spectrum
+        return 1j * self.omega * np.arange(q.size) * q
+
+    def dq_grid(self, m: int) -> np.ndarray:
+        """``dq/dt`` at ``s_j = 2*pi*j/m``, j = 0..m-1, band-limited to harmonics < m/2.
+
+        Band-limiting (rather than sampling a sharp ``dq/dt`` and letting it alias) keeps
+        the periodic trapezoidal rule exact for products with any trigonometric polynomial
+        of degree below ``m/2``.
+        """
+        return _synthesize(self.dq_spectrum(), m)
+
+    def q_grid(self, m: int) -> np.ndarray:
+        """``q`` at ``s_j = 2*pi*j/m``, band-limited to harmonics < m/2."""
+        return _synthesize(self.spectrum, m)
+
+    # -- pointwise -------------------------------------------------------------------------
+    def q(self, t):
+        """Base acceleration over g at time(s) ``t``."""
+        return _evaluate(self.spectrum, self.omega * np.asarray(t, dtype=float))
+
+    def dq(self, t):
+        """Time derivative ``dq/dt`` at time(s) ``t``."""
+        return _evaluate(self.dq_spectrum(), self.omega * np.asarray(t, dtype=float))
+
+    # -- extrema and total variation -------------------------------------------------------
+    @cached_property
+    def extrema(self) -> Extrema:
+        """Maxima and minima of ``q`` in one period (roots of ``dq/dt`` with a sign change)."""
+        return _extrema_from_roots(self)
+
+    @property
+    def total_variation(self) -> float:
+        """Total variation of ``q`` over one period: sum of |q| differences of successive extrema."""
+        e = self.extrema
+        if e.q.size < 2:
+            return 0.0
+        return float(np.sum(np.abs(np.diff(np.append(e.q, e.q[0])))))
+
+    @property
+    def first_harmonic(self) -> complex:
+        """Complex amplitude ``Q[1]`` of the first harmonic (sets the best uniform rotation)."""
+        q = self.spectrum
+        return complex(q[1]) if q.size > 1 else 0j
+
+    def describe(self) -> dict:
+        """Parameters that define this excitation (JSON-ready)."""
+        raise NotImplementedError
+
+
+def _synthesize(spec: np.ndarray, m: int) -> np.ndarray:
+    """Real samples on ``m`` uniform points of ``Re sum Q[k] exp(iks)``, truncated at k < m/2."""
+    kmax = min(spec.size, (m + 1) // 2)
+    x = np.zeros(m // 2 + 1, dtype=complex)
+    x[0] = spec[0].real * m
+    x[1:kmax] = spec[1:kmax] * (m / 2.0)
+    return np.fft.irfft(x, m)
+
+
+def _evaluate(spec: np.ndarray, s: np.ndarray) -> np.ndarray:
+    k = np.arange(spec.size)
+    out = np.exp(1j * np.multiply.outer(s, k)) @ spec
+    return out.real
+
+
+def _extrema_from_roots(exc: Excitation) -> Extrema:
+    """Locate sign changes of ``dq`` on a fine grid, then refine each by Brent's method."""
+    spec = exc.spectrum
+    kmax = spec.size - 1
+    if kmax == 0 or np.max(np.abs(spec[1:])) == 0.0:
+        return Extrema(np.empty(0), np.empty(0), np.empty(0, dtype=bool))
+    m = int(max(4096, 64 * kmax))
+    s = 2 * np.pi * np.arange(m) / m
+    d = exc.dq_grid(m)
+    scale = np.max(np.abs(d))
+    d = np.where(np.abs(d) < 1e-13 * scale, 0.0, d)
+    sign = np.sign(d)
+    # carry signs forward over exact zeros so a root on a grid point is counted once
+    nz = np.flatnonzero(sign)
+    sign = sign[nz]
+    idx = nz
+    change = np.flatnonzero(sign != np.roll(sign, -1))
+    ts, qs, ismax = [], [], []
+    period = exc.period
+
+    def f(t):
+        return float(exc.dq(t))
+
+    for c in change:
+        i0, i1 = idx[c], idx[(c + 1) % idx.size]
+        t0 = s[i0] / exc.omega
+        t1 = s[i1] / exc.omega if i1 > i0 else (s[i1] + 2 * np.pi) / exc.omega
+        f0, f1 = f(t0), f(t1)
+        if f0 == 0.0:
+            r = t0
+        elif f1 == 0.0:
+            r = t1
+        elif f0 * f1 > 0:  # grid sign flip not confirmed by the exact derivative
+            continue
+        else:
+            r = brentq(f, t0, t1, xtol=1e-15)
+        ts.append(r % period)
+        qs.append(float(exc.q(r)))
+        ismax.append(sign[c] > 0)
+    order = np.argsort(ts)
+    return Extrema(np.asarray(ts)[order], np.asarray(qs)[order], np.asarray(ismax)[order])
+
+
+# ---------------------------------------------------------------------------------------
+@dataclass(frozen=True, eq=False)
+class FourierExcitation(Excitation):
+    """``q(t) = mean + sum_k amp_k * sin(k*omega*t + phase_k)`` (harmonic is k = 1 only).
+
+    Parameters
+    ----------
+    omega : float
+        Forcing frequency (> 0), non-dimensional (unit ``sqrt(g/l)``).
+    terms : tuple of (int, float, float)
+        ``(k, amp_k, phase_k)`` with harmonic number k >= 1, phase in radians.
+    mean : float
+        Constant part of ``q`` (it does not change the extracted power).
+    name : str
+        Label used in output ("harmonic", "two-harmonic", "fourier").
+    """
+
+    omega: float
+    terms: tuple = ()
+    mean: float = 0.0
+    name: str = "fourier"
+    _spec: np.ndarray = field(init=False, repr=False, compare=False)
+
+    def __post_init__(self):
+        check_positive("omega", self.omega)
+        check_finite("mean", self.mean)
+        if not self.terms:
+            raise ParameterError("fourier: expected at least one term k:amp:phase, got none")
+        kmax = 0
+        for k, amp, ph in self.terms:
+            if int(k) != k or k < 1:
+                raise ParameterError(f"fourier: harmonic number must be an integer >= 1, got {k}")
+            check_finite("fourier amplitude", amp)
+            check_finite("fourier phase", ph)
+            kmax = max(kmax, int(k))
+        spec = np.zeros(kmax + 1, dtype=complex)
+        spec[0] = self.mean
+        for k, amp, ph in self.terms:
+            # amp*sin(k s + ph) = Re(-1j*amp*exp(1j*ph) * exp(1j*k*s))
+            spec[int(k)] += -1j * amp * np.exp(1j * ph)
+        object.__setattr__(self, "_spec", spec)
+
+    @property
+    def spectrum(self) -> np.ndarray:
+        return self._spec
+
+    def describe(self) -> dict:
+        d = {"excitation": self.name, "omega": self.omega}
+        if self.name == "harmonic":
+            d["delta"] = self.terms[0][1]
+        elif self.name == "two-harmonic":
+            d["delta"] = self.terms[0][1]
+        else:
+            d["terms"] = [list(map(float, t)) for t in self.terms]
+            d["mean"] = self.mean
+        return d
+
+
+def harmonic(delta: float = -0.3, omega: float = 1.8) -> FourierExcitation:
+    """Harmonic excitation ``q = delta*sin(omega*t)`` (paper Eq. 2)."""
+    check_finite("delta", delta)
+    return FourierExcitation(omega, ((1, float(delta), 0.0),), name="harmonic")
+
+
+def two_harmonic(delta: float = -0.3, omega: float = 1.8) -> FourierExcitation:
+    """Two-harmonic excitation ``q = delta*(sin(omega t) + sin(2 omega t)/4)`` (paper Eq. 23)."""
+    check_finite("delta", delta)
+    return FourierExcitation(
+        omega, ((1, float(delta), 0.0), (2, float(delta) / 4.0, 0.0)), name="two-harmonic"
+    )
+
+
+def fourier(terms, omega: float = 1.8, mean: float = 0.0) -> FourierExcitation:
+    """General Fourier-series excitation ``q = mean + sum amp_k sin(k omega t + phase_k)``."""
+    return FourierExcitation(omega, tuple((int(k), float(a), float(p)) for k, a, p in terms),
+                             mean=float(mean), name="fourier")
+
+
+def parse_fourier_terms(text: str) -> tuple:
+    """Parse ``"k:amp:phase,k:amp:phase"`` (phase optional, radians) into terms."""
+    terms = []
+    for item in text.split(","):
+        item = item.strip()
+        if not item:
+            continue
+        parts = item.split(":")
+        if len(parts) not in (2, 3):
+            raise ParameterError(f"--fourier: expected terms 'k:amp[:phase]', got {item!r}")
+        try:
+            k = int(parts[0])
+            amp = float(parts[1])
+            ph = float(parts[2]) if len(parts) == 3 else 0.0
+        except ValueError:
+            raise ParameterError(
+                f"--fourier: expected integer k and numbers amp, phase, got {item!r}"
+            ) from None
+        terms.append((k, amp, ph))
+    if not terms:
+        raise ParameterError("--fourier: expected at least one term 'k:amp[:phase]', got none")
+    return tuple(terms)
+
+
+# ---------------------------------------------------------------------------------------
+@dataclass(frozen=True, eq=False)
+class SquareExcitation(Excitation):
+    """tanh-smoothed square wave ``q = delta*H(t)`` of paper Eq. 26 (Eq. 30 scales it by delta).
+
+    On one period ``0 <= t < T = 2*pi/omega``::
+
+        H(t) = tanh((t-T)/alpha) - tanh((t-T/2)/alpha) + tanh(t/alpha)/2 - tanh(-t/alpha)/2
+
+    which is about +1 on the first half period and -1 on the second. Its spectrum is
+    closed-form: with ``F(nu) = pi*nu*alpha/sinh(pi*nu*alpha/2)`` (the Fourier transform of
+    ``sech(u/alpha)**2/alpha``), ``Q[k] = -4j*delta*F(k*omega)/(2*pi*k)`` for odd k, 0 for
+    even k; exact up to terms of order ``exp(-T/alpha)``.
+    """
+
+    omega: float
+    delta: float = -0.3
+    alpha: float = 0.001
+    name: str = "square"
+
+    def __post_init__(self):
+        check_positive("omega", self.omega)
+        check_finite("delta", self.delta)
+        check_positive("square-alpha", self.alpha)
+        if self.alpha > self.period / 8:
+            raise ParameterError(
+                f"square-alpha: expected a smoothing width below T/8 = {self.period / 8:.4g}, "
+                f"got {self.alpha}"
+            )
+
+    @cached_property
+    def spectrum(self) -> np.ndarray:
+        # |Q_k| ~ 4|delta|/(pi k) * exp(-pi k omega alpha/2): keep k while above 1e-17 of Q_1
+        kmax = int(math.ceil(2 * 40.0 / (math.pi * self.omega * self.alpha))) | 1
+        k = np.arange(kmax + 1, dtype=float)
+        x = math.pi * k * self.omega * self.alpha
+        with np.errstate(divide="ignore", invalid="ignore"):
+            f = np.where(k > 0, x / np.sinh(x / 2), 2.0)
+            spec = np.where(k % 2 == 1, -4j * self.delta * f / (2 * np.pi * np.maximum(k, 1)), 0)
+        return spec.astype(complex)
+
+    def q(self, t):
+        T, a = self.period, self.alpha
+        t = np.mod(np.asarray(t, dtype=float), T)
+        h = (np.tanh((t - T) / a) - np.tanh((t - T / 2) / a)
+             + 0.5 * np.tanh(t / a) - 0.5 * np.tanh(-t / a))
+        return self.delta * h
+
+    def dq(self, t):
+        T, a = self.period, self.alpha
+        t = np.mod(np.asarray(t, dtype=float), T)
+
+        def sech2(x):
+            return 1.0 / np.cosh(np.clip(x, -350, 350)) ** 2
+
+        return self.delta / a * (sech2((t - T) / a) - sech2((t - T / 2) / a) + sech2(t / a))
+
+    @cached_property
+    def extrema(self) -> Extrema:
+        # dq/dt vanishes (to exp(-T/alpha)) on the plateaus; by symmetry of Eq. 26 the extrema
+        # are at T/4 and 3T/4.
+        t = np.array([self.period / 4, 3 * self.period / 4])
+        return Extrema(t, np.asarray(self.q(t)), np.array([self.delta > 0, self.delta <= 0]))
+
+    def describe(self) -> dict:
+        return {"excitation": "square", "omega": self.omega, "delta": self.delta,
+                "square_alpha": self.alpha}
+
+
+def square(delta: float = -0.3, omega: float = 1.8, alpha: float = 0.001) -> SquareExcitation:
+    """tanh-smoothed square-wave excitation of paper Eq. 26, amplitude ``delta``."""
+    return SquareExcitation(float(omega), float(delta), float(alpha))
+
+
+# ---------------------------------------------------------------------------------------
+@dataclass(frozen=True, eq=False)
+class SampledExcitation(Excitation):
+    """One period of ``q`` given by samples at ``tau = omega*t/(2*pi)`` in ``[0, 1)``.
+
+    Uniform samples define the trigonometric interpolant (band-limited to half the sample
+    count); non-uniform samples are first interpolated by a periodic cubic spline and
+    resampled on 4096 uniform points.
+    """
+
+    omega: float
+    tau: tuple
+    values: tuple
+    source: str = ""
+    name: str = "file"
+
+    def __post_init__(self):
+        check_positive("omega", self.omega)
+        tau = np.asarray(self.tau, dtype=float)
+        q = np.asarray(self.values, dtype=float)
+        where = f" in {self.source}" if self.source else ""
+        if tau.ndim != 1 or tau.size != q.size:
+            raise ParameterError(f"file: expected equal-length tau and q columns{where}")
+        if tau.size < 16:
+            raise ParameterError(f"file: expected at least 16 samples of one period{where}, "
+                                 f"got {tau.size}")
+        if not (np.all(np.isfinite(tau)) and np.all(np.isfinite(q))):
+            raise ParameterError(f"file: expected finite numbers in tau and q{where}")
+        if tau[0] < 0 or tau[-1] >= 1:
+            raise ParameterError(
+                f"file: expected tau in [0, 1) (one period, endpoint not repeated){where}, "
+                f"got tau from {tau[0]:g} to {tau[-1]:g}")
+        if np.any(np.diff(tau) <= 0):
+            raise ParameterError(f"file: expected strictly increasing tau{where}")
+
+    @cached_property
+    def spectrum(self) -> np.ndarray:
+        tau = np.asarray(self.tau, dtype=float)
+        q = np.asarray(self.values, dtype=float)
+        n = tau.size
+        h = 1.0 / n
+        uniform = np.allclose(tau, tau[0] + h * np.arange(n), rtol=0, atol=1e-9 * h)
+        if not uniform:
+            from scipy.interpolate import CubicSpline
+
+            spline = CubicSpline(np.append(tau, tau[0] + 1.0), np.append(q, q[0]),
+                                 bc_type="periodic")
+            n = 4096
+            grid = tau[0] + np.arange(n) / n
+            q = spline(grid)
+        x = np.fft.rfft(q) / n
+        spec = 2 * x
+        spec[0] = x[0]
+        if n % 2 == 0:
+            spec[-1] = x[-1].real  # Nyquist term enters once: the real (cosine) interpolant
+        # the samples start at tau[0], not at 0: shift the phase
+        k = np.arange(spec.size)
+        spec = spec * np.exp(-2j * np.pi * k * tau[0])
+        return spec
+
+    def describe(self) -> dict:
+        return {"excitation": "file", "omega": self.omega, "file": self.source,
+                "samples": len(self.tau)}
+
+
+def from_csv(path, omega: float = 1.8) -> SampledExcitation:
+    """Read one period of ``q`` from a CSV file with header ``tau,q`` (DESIGN.md section 4)."""
+    path = Path(path)
+    try:
+        text = path.read_text()
+    except (OSError, UnicodeDecodeError) as exc:
+        raise ParameterError(f"file: cannot read {path}: {exc.strerror or exc}") from None
+    rows = list(csv.reader(text.splitlines()))
+    rows = [r for r in rows if r and any(c.strip() for c in r)]
+    if not rows or [c.strip().lower() for c in rows[0]] != ["tau", "q"]:
+        raise ParameterError(f"file: expected a CSV header 'tau,q' in {path}")
+    tau, q = [], []
+    for i, r in enumerate(rows[1:], start=2):
+        try:
+            if len(r) != 2:
+                raise ValueError
+            tau.append(float(r[0]))
+            q.append(float(r[1]))
+        except ValueError:
+            raise ParameterError(f"file: expected two numbers on line {i} of {path}, "
+                                 f"got {','.join(r)!r}") from None
+    return SampledExcitation(float(omega), tuple(tau), tuple(q), source=str(path))

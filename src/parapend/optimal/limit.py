@@ -1,0 +1,110 @@
+r"""The gamma -> 0 limit for any periodic excitation (paper Eqs. 9, 19, 21, 24, 32 generalized).
+
+Integrating the power by parts (see :mod:`parapend.power`), for gamma = 0::
+
+    P = <q'(t) cos(theta(t))> <= <|q'(t)|> = (omega / 2 pi) * TV(q)
+
+where TV(q) is the total variation of ``q`` over one period. The bound is approached by
+``cos(theta) = sign(q')``: the pendulum stands upright (theta = 0 mod 2 pi) while ``q``
+rises and hangs down (theta = pi mod 2 pi) while ``q`` falls, with an instantaneous
+half-turn at every extremum of ``q`` (the Euler-Lagrange condition ``q' sin(theta) = 0``,
+Eq. 21). With extrema ``t_1 < ... < t_{2m}``::
+
+    P_limit = (omega / 2 pi) * sum_i |q(t_{i+1}) - q(t_i)|
+
+Harmonic ``q = delta sin(omega t)``: TV = 4|delta|, ``P = 2 omega |delta| / pi`` (Eq. 19).
+Two extrema ``t_1, t_2`` of Eq. 23: ``P = (omega/pi)|q(t_2) - q(t_1)|``, which is Eq. 24.
+Square wave of amplitude delta: TV = 4|delta|, Eq. 32.
+
+Directions. Each extremum needs a half-turn (+pi or -pi: either flips cos(theta)); the
+period-1 condition (Eq. 3) needs them to sum to +2 pi. With one maximum and one minimum per
+period both are forward. With m > 1 maxima the limit power does not depend on which m - 1
+are reversed (the limit motion is non-unique); this module's canonical choice turns forward
+at the global minimum and the global maximum, and alternates backward/forward at the others,
+so that the pendulum rocks between the same upright and hanging positions during the smaller
+swings of ``q``.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..trajectory import FourierMotion, PiecewiseConstantMotion
+
+__all__ = ["LimitResult", "limit", "limit_seed"]
+
+
+@dataclass(frozen=True, eq=False)
+class LimitResult:
+    """Supremum of extractable power as gamma -> 0 and the motion that approaches it.
+
+    Attributes
+    ----------
+    power : float
+        ``omega * TV(q) / (2 pi)``, the supremum for gamma -> 0.
+    total_variation : float
+        Total variation of q over one period.
+    motion : PiecewiseConstantMotion
+        Switching instants (the extrema of q), direction of each half-turn, start angle.
+    """
+
+    power: float
+    total_variation: float
+    motion: PiecewiseConstantMotion
+
+    @property
+    def switch_times(self) -> np.ndarray:
+        return self.motion.switch_times
+
+    @property
+    def directions(self) -> np.ndarray:
+        return self.motion.directions
+
+
+def limit(excitation) -> LimitResult:
+    """Closed-form gamma -> 0 limit of paper Eqs. 19/24/32 for any periodic excitation."""
+    ext = excitation.extrema
+    tv = excitation.total_variation
+    power = excitation.omega * tv / (2 * math.pi)
+    m = ext.t.size
+    if m == 0:  # constant q: no power can be extracted; the limit motion is uniform-like
+        motion = PiecewiseConstantMotion(excitation.omega, np.array([0.0, excitation.period / 2]),
+                                         np.array([1, 1]), 0.0)
+        return LimitResult(0.0, 0.0, motion)
+    directions = np.empty(m, dtype=int)
+    i_min = int(np.argmin(ext.q))
+    i_max = int(np.argmax(ext.q))
+    # forward at global min and max; between them (cyclically) alternate -1, +1, ...
+    directions[i_min] = directions[i_max] = 1
+    for start, stop in ((i_min, i_max), (i_max, i_min)):
+        j, sgn = (start + 1) % m, -1
+        while j != stop:
+            directions[j] = sgn
+            sgn = -sgn
+            j = (j + 1) % m
+    # dwell before the first extremum: q rises into a maximum (upright, 0) or falls into a
+    # minimum (hanging, pi)
+    theta_start = 0.0 if ext.is_max[0] else math.pi
+    motion = PiecewiseConstantMotion(excitation.omega, ext.t.copy(), directions, theta_start)
+    return LimitResult(power, tv, motion)
+
+
+def limit_seed(lim: LimitResult, harmonics: int) -> FourierMotion:
+    """Project the limit motion onto ``harmonics`` Fourier terms (Eq. 10), Lanczos-smoothed.
+
+    A starting point for the Fourier optimizer near the basin of the global optimum.
+    """
+    omega = lim.motion.omega
+    m = max(1024, 32 * harmonics)
+    t = (2 * math.pi / omega) * (np.arange(m) + 0.5) / m
+    s = omega * t
+    x = np.fft.rfft(lim.motion.theta(t) - s) / m
+    n = np.arange(1, harmonics + 1)
+    # the samples sit at half-steps: undo that phase
+    c = 2 * x[1:harmonics + 1] * np.exp(1j * n * math.pi / m)
+    sigma = np.sinc(n / (harmonics + 1))
+    a0 = float((x[0] * 1).real)
+    return FourierMotion(omega, a0, -c.imag * sigma, c.real * sigma)

@@ -1,0 +1,117 @@
+"""Frozen result objects; their field names are the JSON keys of the command line."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field, fields
+
+import numpy as np
+
+__all__ = ["CONVENTION", "OptimizeResult", "ThresholdResult", "to_jsonable"]
+
+CONVENTION = ("theta from the upright; non-dimensional time (unit sqrt(l/g)); power positive "
+              "when harvested, P = -<T theta'> (paper Eqs. 14-16; the paper's tables list -P "
+              "of its Eq. 8)")
+
+
+def to_jsonable(value):
+    """Convert numpy scalars/arrays and nested containers to plain JSON types (NaN -> None)."""
+    if isinstance(value, dict):
+        return {k: to_jsonable(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [to_jsonable(v) for v in value]
+    if isinstance(value, np.ndarray):
+        return [to_jsonable(v) for v in value.tolist()]
+    if isinstance(value, (np.bool_, bool)):
+        return bool(value)
+    if isinstance(value, (np.integer,)):
+        return int(value)
+    if isinstance(value, (float, np.floating)):
+        v = float(value)
+        return v if math.isfinite(v) else None
+    return value
+
+
+class _Result:
+    """Mixin: ``to_dict`` over the public dataclass fields (private ``_`` fields skipped)."""
+
+    def to_dict(self) -> dict:
+        return {f.name: to_jsonable(getattr(self, f.name)) for f in fields(self)
+                if not f.name.startswith("_")}
+
+
+@dataclass(frozen=True, eq=False)
+class OptimizeResult(_Result):
+    """Optimal period-1 rotation for one excitation and damping.
+
+    Attributes
+    ----------
+    power : float
+        Mean extracted power of the optimum (Eq. 15; positive = harvested).
+    uniform_power : float
+        Best uniform rotation (Eq. 17, phase optimized), same damping.
+    limit_power : float
+        gamma -> 0 supremum ``omega*TV(q)/(2 pi)`` (Eqs. 19/24/32 generalized).
+    gain_over_uniform : float or None
+        ``power/uniform_power - 1``; None when the uniform rotation extracts nothing.
+    harmonics, damping, omega : the problem.
+    success, status, message, iterations : convergence (status "converged", "stalled",
+        "max_iterations" or "nonfinite"); iterations of the winning Newton run.
+    coefficients : dict
+        ``{"a0": float, "a": [N], "b": [N]}`` of Eq. 10.
+    peak_torque : float
+        ``max |T(t)|`` over the period (Eq. 14).
+    """
+
+    power: float
+    uniform_power: float
+    limit_power: float
+    gain_over_uniform: float | None
+    harmonics: int
+    damping: float
+    omega: float
+    success: bool
+    status: str
+    message: str
+    iterations: int
+    coefficients: dict
+    peak_torque: float
+    method: str = "fourier"
+    found_by: str = ""
+    local_maxima: list = field(default_factory=list)
+    gradient_norm: float = float("nan")
+    strict_maximum: bool = False
+    quadrature_points: int = 0
+    mean_square_speed: float = float("nan")
+    excitation: dict = field(default_factory=dict)
+    convention: str = CONVENTION
+    _motion: object = field(default=None, repr=False)
+    _excitation: object = field(default=None, repr=False)
+
+    @property
+    def motion(self):
+        """The optimal motion (a :class:`~parapend.trajectory.FourierMotion`)."""
+        return self._motion
+
+
+@dataclass(frozen=True, eq=False)
+class ThresholdResult(_Result):
+    """Damping ``gamma*`` beyond which no period-1 rotation extracts power.
+
+    ``power_at_threshold`` is the optimal power at ``damping_threshold`` (zero to the
+    solver's tolerance); ``uniform_threshold`` is ``|Q1|/(2 omega)``, where the best uniform
+    rotation stops extracting.
+    """
+
+    damping_threshold: float
+    uniform_threshold: float
+    power_at_threshold: float
+    harmonics: int
+    omega: float
+    success: bool
+    status: str
+    message: str
+    iterations: int
+    mean_square_speed: float = float("nan")
+    excitation: dict = field(default_factory=dict)
+    convention: str = CONVENTION
