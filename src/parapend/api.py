@@ -24,8 +24,8 @@ from .power import uniform_power
 from .results import OptimizeResult, ThresholdResult
 from .trajectory import FourierMotion
 
-__all__ = ["EXCITATIONS", "build_excitation", "damping_sweep", "harmonic_table", "optimize",
-           "threshold"]
+__all__ = ["EXCITATIONS", "build_excitation", "damping_sweep", "harmonic_table",
+           "motion_samples", "optimize", "threshold"]
 
 log = logging.getLogger(__name__)
 
@@ -135,7 +135,8 @@ def optimize(*, omega: float = 1.8, delta: float = -0.3, gamma: float = 0.0, har
     return res
 
 
-def harmonic_table(harmonics=range(2, 65), *, gamma: float = 0.0, **excitation_args) -> xr.Dataset:
+def harmonic_table(harmonics=range(2, 65), *, gamma: float = 0.0, progress=None,
+                   **excitation_args) -> xr.Dataset:
     """Optimal power against N, by continuation in N (each solve warm-started from the last).
 
     Because the warm start embeds the (N-1)-harmonic optimum, whose power is already reached,
@@ -146,12 +147,14 @@ def harmonic_table(harmonics=range(2, 65), *, gamma: float = 0.0, **excitation_a
     ns = [check_int("harmonics", n, 1, MAX_HARMONICS) for n in harmonics]
     powers, status, found = [], [], []
     warm = None
-    for n in ns:
+    for i, n in enumerate(ns):
         best, _ = solve_fourier(exc, n, gamma, warm=warm)
         warm = best.x
         powers.append(best.power)
         status.append(best.status)
         found.append(best.seed)
+        if progress is not None:
+            progress(i + 1, len(ns))
     pu, _ = uniform_power(exc, gamma)
     return xr.Dataset(
         {"power": ("harmonics", np.array(powers)), "status": ("harmonics", status),
@@ -228,7 +231,7 @@ def threshold(*, omega: float = 1.8, delta: float = -0.3, harmonics=None, excita
 
 def damping_sweep(*, omega: float = 1.8, delta: float = -0.3, harmonics: int = 32,
                   excitation="harmonic", square_alpha: float = 0.001, fourier=None, file=None,
-                  gamma_max=None, points: int = 41) -> xr.Dataset:
+                  gamma_max=None, points: int = 41, progress=None) -> xr.Dataset:
     """Optimal and uniform power against damping (paper Fig. 6), with the threshold gamma*.
 
     ``gamma_max=None`` sweeps to 1.25 gamma*. Solves run from the largest damping down,
@@ -255,6 +258,8 @@ def damping_sweep(*, omega: float = 1.8, delta: float = -0.3, harmonics: int = 3
         kin[i] = motion.mean_square_speed()
         torque[i] = _peak_torque(motion, exc, float(gammas[i]))
         status.append(best.status)
+        if progress is not None:
+            progress(npts - i, npts)
     status.reverse()
     pu = np.array([uniform_power(exc, float(g))[0] for g in gammas])
     return xr.Dataset(
@@ -266,3 +271,18 @@ def damping_sweep(*, omega: float = 1.8, delta: float = -0.3, harmonics: int = 3
                "uniform_threshold": thr.uniform_threshold, "limit_power": limit(exc).power,
                "harmonics": n, **{k: str(v) for k, v in exc.describe().items()}},
     )
+
+
+def motion_samples(result, points: int = 1000) -> dict:
+    """One period of an optimum on ``points`` uniform times: t, tau, theta, theta_dot, torque.
+
+    ``torque`` is Eq. 14 solved for T with the result's damping.
+    """
+    from .model import torque
+
+    npts = check_int("points", points, 2)
+    exc = result._excitation
+    motion = result.motion
+    t = exc.period * np.arange(npts) / npts
+    return {"t": t, "tau": t / exc.period, "theta": motion.theta(t),
+            "theta_dot": motion.theta_dot(t), "torque": torque(motion, exc, result.damping, t)}

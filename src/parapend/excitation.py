@@ -114,7 +114,7 @@ class Excitation:
 
     @property
     def total_variation(self) -> float:
-        """Total variation of ``q`` over one period: sum of |q| differences of successive extrema."""
+        """Total variation of ``q`` over one period (sum of |jumps| between successive extrema)."""
         e = self.extrema
         if e.q.size < 2:
             return 0.0

@@ -1,0 +1,110 @@
+"""The command line: output, JSON keys, files, one-line errors with exit code 2."""
+
+import csv
+import json
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+from parapend.cli import main
+
+KEYS = {"power", "uniform_power", "limit_power", "gain_over_uniform", "harmonics", "damping",
+        "omega", "success", "status", "message", "iterations", "coefficients", "peak_torque"}
+
+
+def run(capsys, *args):
+    code = main(list(args))
+    out, err = capsys.readouterr()
+    return code, out, err
+
+
+def test_optimize_text_defaults_paper_case(capsys):
+    code, out, _ = run(capsys, "optimize")
+    assert code == 0
+    assert "0.270000" in out and "0.343468" in out and "0.343775" in out
+
+
+def test_optimize_json_keys(capsys):
+    code, out, _ = run(capsys, "optimize", "--json", "--harmonics", "8")
+    d = json.loads(out)
+    assert code == 0 and KEYS <= set(d)
+    assert set(d["coefficients"]) == {"a0", "a", "b"} and len(d["coefficients"]["a"]) == 8
+    assert d["success"] is True and d["harmonics"] == 8
+
+
+def test_save_and_plot(tmp_path, capsys):
+    csvp, png = tmp_path / "m.csv", tmp_path / "m.png"
+    code, _, _ = run(capsys, "optimize", "--harmonics", "12", "--gamma", "0.01",
+                     "--save", str(csvp), "--plot", str(png))
+    assert code == 0
+    rows = list(csv.reader(csvp.read_text().splitlines()))
+    assert rows[0] == ["t", "tau", "theta", "theta_dot", "torque"]
+    data = np.array(rows[1:], dtype=float)
+    assert data.shape[1] == 5 and data[-1, 1] < 1.0
+    # theta advances by one turn per period (Eq. 3) on the saved samples
+    assert data[-1, 2] - data[0, 2] == pytest.approx(2 * np.pi, abs=0.1)
+    assert png.read_bytes()[:4] == b"\x89PNG"
+
+
+def test_threshold_and_sweep_json(tmp_path, capsys):
+    code, out, _ = run(capsys, "threshold", "--json")
+    assert code == 0 and round(json.loads(out)["damping_threshold"], 4) == 0.0856
+    code, out, _ = run(capsys, "damping-sweep", "--json", "--points", "5", "--harmonics", "8",
+                       "--plot", str(tmp_path / "s.svg"))
+    d = json.loads(out)
+    assert code == 0 and len(d["power"]) == 5 and "damping_threshold" in d
+    assert (tmp_path / "s.svg").read_text().lstrip().startswith("<?xml")
+
+
+def test_harmonics_command(capsys):
+    code, out, _ = run(capsys, "harmonics", "--from", "2", "--to", "6", "--json")
+    d = json.loads(out)
+    assert code == 0 and d["harmonics"] == [2, 3, 4, 5, 6]
+    assert all(b >= a for a, b in zip(d["power"], d["power"][1:]))
+
+
+@pytest.mark.parametrize("args, word", [
+    (["optimize", "--omega", "nan"], "omega"),
+    (["optimize", "--omega", "0"], "omega"),
+    (["optimize", "--omega", "-1"], "omega"),
+    (["optimize", "--harmonics", "0"], "harmonics"),
+    (["optimize", "--harmonics", "2.5"], "harmonics"),
+    (["optimize", "--gamma", "-0.1"], "gamma"),
+    (["optimize", "--excitation", "sawtooth"], "excitation"),
+    (["optimize", "--excitation", "file", "--file", "/nonexistent.csv"], "cannot read"),
+    (["optimize", "--excitation", "fourier"], "fourier"),
+    (["optimize", "--excitation", "fourier", "--fourier", "x:1"], "fourier"),
+    (["optimize", "--excitation", "square", "--square-alpha", "0"], "square-alpha"),
+    (["optimize", "--save", "/nonexistent-dir/m.csv"], "save"),
+    (["threshold", "--delta", "inf"], "delta"),
+    (["bogus"], "invalid choice"),
+])
+def test_bad_input_one_line_exit_2(capsys, args, word):
+    with pytest.raises(SystemExit) as e:
+        code = main(args)
+        raise SystemExit(code)
+    assert e.value.code == 2
+    _, err = capsys.readouterr()
+    assert err.count("\n") == 1 and word in err and "Traceback" not in err
+
+
+def test_non_periodic_file(tmp_path, capsys):
+    p = tmp_path / "q.csv"
+    p.write_text("tau,q\n" + "\n".join(f"{i / 16},{np.sin(i / 16)}" for i in range(17)))
+    code, _, err = run(capsys, "optimize", "--excitation", "file", "--file", str(p))
+    assert code == 2 and "[0, 1)" in err
+
+
+def test_failed_run_keeps_existing_output(tmp_path, capsys):
+    out = tmp_path / "m.csv"
+    out.write_text("precious\n")
+    code, _, _ = run(capsys, "optimize", "--omega", "-1", "--save", str(out))
+    assert code == 2 and out.read_text() == "precious\n"
+
+
+def test_entry_point_runs_as_module():
+    r = subprocess.run([sys.executable, "-m", "parapend.cli", "threshold", "--json"],
+                       capture_output=True, text=True, timeout=120)
+    assert r.returncode == 0 and "damping_threshold" in r.stdout

@@ -1,0 +1,123 @@
+"""Excitations: spectra against their defining formulas, extrema, total variation, files."""
+
+import math
+
+import numpy as np
+import pytest
+
+import parapend
+from parapend import excitation as E
+from parapend.errors import ParameterError
+
+
+def test_harmonic_extrema_and_total_variation(paper):
+    e = paper.extrema
+    # q = -0.3 sin(1.8 t): minimum at tau = 1/4, maximum at tau = 3/4
+    np.testing.assert_allclose(e.t * paper.omega / (2 * np.pi), [0.25, 0.75], atol=1e-13)
+    np.testing.assert_allclose(e.q, [-0.3, 0.3], atol=1e-15)
+    assert list(e.is_max) == [False, True]
+    assert paper.total_variation == pytest.approx(1.2, abs=1e-14)
+
+
+def test_two_harmonic_switching_instants_of_paper():
+    """Paper Section 7.1: q' vanishes at omega t / 2 pi = 0.1903 and 0.8096 for Eq. 23."""
+    e = parapend.two_harmonic(-0.3, 1.8)
+    tau = e.extrema.t * 1.8 / (2 * np.pi)
+    np.testing.assert_allclose(tau, [0.1903, 0.8096], atol=1e-4)
+    # exact: cos s + cos(2s)/2 = 0 -> cos s = (-1 + sqrt 3)/2
+    s1 = math.acos((math.sqrt(3) - 1) / 2)
+    np.testing.assert_allclose(tau, [s1 / (2 * np.pi), 1 - s1 / (2 * np.pi)], atol=1e-12)
+    np.testing.assert_allclose(e.dq(e.extrema.t), 0, atol=1e-13)
+
+
+def test_fourier_series_matches_definition():
+    terms = [(1, -0.3, 0.2), (3, 0.15, 1.0), (5, 0.05, -0.4)]
+    e = parapend.fourier(terms, omega=2.1)
+    t = np.linspace(0, 3, 57)
+    q = sum(a * np.sin(k * 2.1 * t + p) for k, a, p in terms)
+    dq = sum(a * k * 2.1 * np.cos(k * 2.1 * t + p) for k, a, p in terms)
+    np.testing.assert_allclose(e.q(t), q, atol=1e-14)
+    np.testing.assert_allclose(e.dq(t), dq, atol=1e-13)
+    # extrema alternate and are roots of q'
+    ex = e.extrema
+    assert np.all(ex.is_max[1:] != ex.is_max[:-1])
+    np.testing.assert_allclose(e.dq(ex.t), 0, atol=1e-12)
+    # total variation equals the integral of |q'| over a period (independent quadrature)
+    tt = np.linspace(0, e.period, 400001)
+    tv = np.trapezoid(np.abs(e.dq(tt)), tt)
+    assert e.total_variation == pytest.approx(tv, rel=1e-8)
+
+
+def test_square_wave_spectrum_matches_eq26_formula():
+    e = parapend.square(-0.3, 1.8, alpha=0.01)
+    m = 1 << 15
+    t = e.period * np.arange(m) / m
+    np.testing.assert_allclose(e.q_grid(m), e.q(t), atol=1e-12)
+    np.testing.assert_allclose(e.dq_grid(m), e.dq(t), atol=1e-9 * np.max(np.abs(e.dq(t))))
+    # plateaus at -delta*... : q = delta on the first half (H = +1), -delta on the second
+    assert e.q(e.period / 4) == pytest.approx(-0.3, abs=1e-12)
+    assert e.q(3 * e.period / 4) == pytest.approx(0.3, abs=1e-12)
+    assert e.total_variation == pytest.approx(1.2, abs=1e-12)
+
+
+def _csv(tau, q):
+    return "tau,q\n" + "\n".join(f"{float(a)!r},{float(b)!r}" for a, b in zip(tau, q))
+
+
+def _write(tmp_path, text, name="q.csv"):
+    p = tmp_path / name
+    p.write_text(text)
+    return p
+
+
+def test_csv_uniform_samples_reproduce_trig_polynomial(tmp_path):
+    tau = np.arange(32) / 32
+    q = 0.2 * np.sin(2 * np.pi * tau + 0.3) - 0.1 * np.cos(4 * np.pi * tau)
+    p = _write(tmp_path, _csv(tau, q))
+    e = parapend.from_csv(p, omega=1.5)
+    t = np.linspace(0, e.period, 101)
+    s = 1.5 * t
+    np.testing.assert_allclose(e.q(t), 0.2 * np.sin(s + 0.3) - 0.1 * np.cos(2 * s), atol=1e-14)
+
+
+def test_csv_nonuniform_samples_are_splined(tmp_path):
+    rng = np.random.default_rng(3)
+    tau = np.sort(rng.uniform(0, 1, 80))
+    q = 0.3 * np.sin(2 * np.pi * tau)
+    p = _write(tmp_path, _csv(tau, q))
+    e = parapend.from_csv(p, omega=1.8)
+    assert e.total_variation == pytest.approx(1.2, rel=2e-3)
+
+
+@pytest.mark.parametrize("text, match", [
+    ("t,q\n" + "0,1\n" * 20, "header"),
+    ("tau,q\n" + "\n".join(f"{i / 10},{i}" for i in range(10)), "at least 16"),
+    ("tau,q\n" + "\n".join(f"{i / 16},{i}" for i in range(17)), r"\[0, 1\)"),
+    ("tau,q\n" + "\n".join(f"{(i % 8) / 16},{i}" for i in range(16)), "increasing"),
+    ("tau,q\n" + "\n".join(f"{i / 16},x" for i in range(16)), "two numbers"),
+    ("tau,q\n" + "\n".join(f"{i / 16},nan" for i in range(16)), "finite"),
+])
+def test_csv_errors(tmp_path, text, match):
+    with pytest.raises(ParameterError, match=match):
+        parapend.from_csv(_write(tmp_path, text))
+
+
+def test_csv_unreadable(tmp_path):
+    with pytest.raises(ParameterError, match="cannot read"):
+        parapend.from_csv(tmp_path / "missing.csv")
+
+
+@pytest.mark.parametrize("kwargs, match", [
+    ({"omega": 0.0}, "omega"), ({"omega": float("nan")}, "omega"),
+    ({"delta": float("inf")}, "delta"),
+])
+def test_parameter_errors(kwargs, match):
+    with pytest.raises(ParameterError, match=match):
+        parapend.harmonic(**kwargs)
+
+
+def test_fourier_terms_parse_and_errors():
+    assert E.parse_fourier_terms("1:-0.3, 3:0.1:0.5") == ((1, -0.3, 0.0), (3, 0.1, 0.5))
+    for bad in ["", "1", "a:1", "0:1:0", "1.5:1"]:
+        with pytest.raises(ParameterError):
+            parapend.fourier(E.parse_fourier_terms(bad))
