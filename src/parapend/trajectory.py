@@ -69,6 +69,26 @@ class FourierMotion:
         _, n, sn, cn = self._trig(t)
         return -self.omega**2 * (sn @ (n * n * self.a) + cn @ (n * n * self.b))
 
+    def on_grid(self, points: int):
+        """``theta, theta', theta''`` at ``t_j = j T / points`` by inverse FFTs (O(M log M)).
+
+        ``points`` must exceed ``2 N``.
+        """
+        n, m = self.harmonics, points
+        if m <= 2 * n:
+            raise ValueError(f"points: expected more than 2N = {2 * n}, got {m}")
+        k = np.arange(1, n + 1)
+        c = np.zeros(m // 2 + 1, dtype=complex)
+        c[1:n + 1] = (0.5 * m) * (self.b - 1j * self.a)  # Re((b - ia) e^{iks})
+        s = 2 * np.pi * np.arange(m) / m
+        theta = s + self.a0 + np.fft.irfft(c, m)
+        d = np.zeros_like(c)
+        d[1:n + 1] = c[1:n + 1] * (1j * k)
+        theta_dot = self.omega * (1.0 + np.fft.irfft(d, m))
+        d[1:n + 1] *= 1j * k
+        theta_ddot = self.omega**2 * np.fft.irfft(d, m)
+        return theta, theta_dot, theta_ddot
+
     def mean_square_speed(self) -> float:
         """``<theta'^2> = omega^2 (1 + sum n^2 (a_n^2 + b_n^2)/2)`` (Parseval, exact)."""
         n = np.arange(1, self.harmonics + 1)

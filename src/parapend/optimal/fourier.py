@@ -44,7 +44,8 @@ from dataclasses import dataclass
 from functools import lru_cache
 
 import numpy as np
-from scipy.linalg import LinAlgError, cho_factor, cho_solve, eigh
+from scipy.linalg import eigh
+from scipy.linalg.lapack import dpotrf, dpotrs
 
 from ..power import uniform_power
 from .limit import limit, limit_seed
@@ -53,9 +54,9 @@ __all__ = ["FourierProblem", "LocalSolution", "solve_fourier"]
 
 
 def _grid_size(harmonics: int, excitation) -> int:
-    """Initial quadrature grid: a power of two with at least 16 points per top harmonic."""
+    """Initial quadrature grid: a power of two with at least 8 points per top harmonic."""
     k = max(harmonics, min(excitation.spectrum.size - 1, 4 * harmonics))
-    return max(64, 1 << int(math.ceil(math.log2(16 * (k + 1)))))
+    return max(64, 1 << int(math.ceil(math.log2(8 * (k + 1)))))
 
 
 @lru_cache(maxsize=64)
@@ -161,7 +162,7 @@ class FourierProblem:
         g -= gw * self._k2 * x
         X = np.concatenate((V.real, -V.imag))
         h = -(self._coef[0] * X[self._idx[0]] + self._coef[1] * X[self._idx[1]])
-        h[np.diag_indices_from(h)] -= gw * self._k2
+        h.flat[:: h.shape[0] + 1] -= gw * self._k2
         return float(p), g, h
 
 
@@ -179,6 +180,18 @@ class LocalSolution:
     strict_maximum: bool = False  # -H positive definite at the solution
 
 
+def _cholesky_solve(a: np.ndarray, g: np.ndarray) -> np.ndarray | None:
+    """Solve ``a p = g`` by Cholesky (LAPACK potrf/potrs); None if ``a`` is not positive definite.
+
+    Called directly: for these small systems the wrappers' checks cost more than the work.
+    """
+    c, info = dpotrf(a, lower=0, clean=0, overwrite_a=0)
+    if info != 0:
+        return None
+    p, info = dpotrs(c, g, lower=0)
+    return p if info == 0 else None
+
+
 def _ascent_direction(g: np.ndarray, h: np.ndarray) -> np.ndarray:
     """Ascent step: Newton where ``-H`` is positive definite, else a shifted Newton step.
 
@@ -188,10 +201,9 @@ def _ascent_direction(g: np.ndarray, h: np.ndarray) -> np.ndarray:
     of ``P`` instead, since a gradient-based step would not move.
     """
     a = -h
-    try:
-        return cho_solve(cho_factor(a, check_finite=False), g, check_finite=False)
-    except LinAlgError:
-        pass
+    p = _cholesky_solve(a, g)
+    if p is not None:
+        return p
     scale = max(float(np.max(np.abs(np.diag(a)))), 1e-12)
     if float(np.max(np.abs(g))) <= 1e-8 * scale:
         lam, vec = eigh(a, check_finite=False)
@@ -200,20 +212,15 @@ def _ascent_direction(g: np.ndarray, h: np.ndarray) -> np.ndarray:
     mu = 1e-3 * scale
     eye = np.eye(a.shape[0])
     while True:
-        try:
-            return cho_solve(cho_factor(a + mu * eye, check_finite=False), g,
-                             check_finite=False)
-        except LinAlgError:
-            mu *= 4.0
+        p = _cholesky_solve(a + mu * eye, g)
+        if p is not None:
+            return p
+        mu *= 4.0
 
 
 def _is_maximum(h: np.ndarray) -> bool:
     """True when ``-H`` is positive definite (a strict local maximum)."""
-    try:
-        cho_factor(-h, check_finite=False)
-        return True
-    except LinAlgError:
-        return False
+    return dpotrf(-h, lower=0, clean=0)[1] == 0
 
 
 def newton_maximize(problem: FourierProblem, x0: np.ndarray, seed: str, *,
