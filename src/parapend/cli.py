@@ -126,6 +126,14 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--to", dest="n_to", type=_int, default=64, help="largest N (default 64)")
     p.add_argument("--plot", metavar="PNG", help="draw power against N (PNG or SVG)")
     p.add_argument("--json", action="store_true", help="print one JSON object")
+
+    p = sub.add_parser("reproduce", help="regenerate the paper's tables and figures, with a report",
+                       description="Recompute every table and figure of the paper, compare each "
+                                   "number with the paper's and write DIR/report.html, "
+                                   "DIR/figures/, DIR/tables/ and DIR/results.json.")
+    p.add_argument("--out", default="parapend-report", metavar="DIR",
+                   help="output directory (default: parapend-report)")
+    p.add_argument("--json", action="store_true", help="print results.json to stdout")
     return parser
 
 
@@ -301,8 +309,32 @@ def _cmd_harmonics(a) -> dict | str:
     return "\n".join(out)
 
 
+def _cmd_reproduce(a) -> dict | str:
+    from .report import reproduce
+
+    out = Path(a.out)
+    if out.exists() and not out.is_dir():
+        raise ParameterError(f"--out: expected a directory, got the file {a.out!r}")
+    if not out.parent.is_dir():
+        raise ParameterError(f"--out: parent directory {str(out.parent)!r} does not exist")
+    bar = _Progress("reproduce")
+    res = reproduce(out, progress=lambda done, total, label: bar(done, total))
+    if a.json:
+        return res
+    rows = []
+    for key in ("table1", "table2", "table3", "scalars"):
+        for r in res["tables"][key]:
+            rows.append([key, r["quantity"], _fmt(r["paper"], 4), _fmt(r["parapend"]),
+                         _fmt(r["difference"])])
+    return "\n".join([_table(rows, ["table", "quantity", "paper", "parapend", "difference"]),
+                      "", f"report: {out / 'report.html'}",
+                      f"figures: {out / 'figures'}  tables: {out / 'tables'}  "
+                      f"numbers: {out / 'results.json'}"])
+
+
 COMMANDS = {"optimize": _cmd_optimize, "threshold": _cmd_threshold,
-            "damping-sweep": _cmd_damping_sweep, "harmonics": _cmd_harmonics}
+            "damping-sweep": _cmd_damping_sweep, "harmonics": _cmd_harmonics,
+            "reproduce": _cmd_reproduce}
 
 
 def main(argv=None) -> int:

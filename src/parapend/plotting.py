@@ -35,6 +35,11 @@ def save_figure(fig, path) -> Path:
     return path
 
 
+def _pi_label(v: float) -> str:
+    k = int(round(v / np.pi))
+    return {0: "0", 1: "π", -1: "-π"}.get(k, f"{k}π")
+
+
 def _tau(omega, t):
     return omega * np.asarray(t) / (2 * math.pi)
 
@@ -63,7 +68,7 @@ def plot_optimum(result, path=None, points: int = 2000):
              label=f"best uniform: P = {result.uniform_power:.5f}")
     ax1.set_ylabel("theta (rad, from upright)")
     ax1.set_yticks(np.pi * np.arange(0, 5))
-    ax1.set_yticklabels(["0", "π", "2π", "3π", "4π"])
+    ax1.set_yticklabels([_pi_label(np.pi * k) for k in range(5)])
     ax1.grid(alpha=0.3)
     ax1.legend(loc="upper left", fontsize=8)
     desc = ", ".join(f"{k}={v}" for k, v in result.excitation.items() if k != "terms")
@@ -113,6 +118,65 @@ def plot_harmonic_table(ds, path=None):
     ax.set_ylabel("mean extracted power P")
     ax.grid(alpha=0.3)
     ax.legend()
+    fig.tight_layout()
+    if path is not None:
+        save_figure(fig, path)
+    return fig
+
+
+def plot_theta_panels(panels, path=None, ncols: int | None = None):
+    """Families of motions theta(tau), one panel each (paper Figs. 4, 5, 7, 9, 10).
+
+    Parameters
+    ----------
+    panels : list of dict
+        ``{"title": str, "curves": [(label, tau, theta), ...], "limit": (tau, theta) or None}``
+        with ``tau = omega t / 2 pi`` over one period and theta in radians.
+    """
+    n = len(panels)
+    ncols = ncols or min(n, 2)
+    nrows = int(math.ceil(n / ncols))
+    fig, axes = plt.subplots(nrows, ncols, figsize=(5.2 * ncols, 3.9 * nrows), squeeze=False)
+    for ax, panel in zip(axes.flat, panels):
+        for label, tau, theta in panel["curves"]:
+            ax.plot(tau, theta, lw=1.3, label=label)
+        if panel.get("limit") is not None:
+            ax.plot(*panel["limit"], "k--", lw=0.9, label="limit gamma -> 0")
+        ax.set_title(panel["title"], fontsize=9)
+        ax.set_xlabel("tau = omega t / 2 pi")
+        ax.set_ylabel("theta (rad)")
+        ax.set_xlim(0, 1)
+        lo, hi = ax.get_ylim()
+        ticks = np.pi * np.arange(math.floor(lo / np.pi), math.ceil(hi / np.pi) + 1)
+        ax.set_yticks(ticks)
+        ax.set_yticklabels([_pi_label(v) for v in ticks])
+        ax.grid(alpha=0.3)
+        ax.legend(fontsize=7, loc="upper left")
+    for ax in list(axes.flat)[n:]:
+        ax.set_visible(False)
+    fig.tight_layout()
+    if path is not None:
+        save_figure(fig, path)
+    return fig
+
+
+def plot_square_approximations(omega: float, alphas, path=None):
+    """Unit square wave and its tanh approximations of Eq. 26 (paper Fig. 8 right)."""
+    from .excitation import square
+
+    fig, ax = plt.subplots(figsize=(7, 3.8))
+    period = 2 * np.pi / omega
+    t = np.linspace(0, period, 4001)
+    ax.plot(t, np.where(t < period / 2, 1.0, -1.0), "k-", lw=2.2, alpha=0.35,
+            label="unit square wave")
+    for a in alphas:
+        ax.plot(t, square(1.0, omega, a).q(t), lw=1.1, label=f"Eq. 26, alpha = {a:g}")
+    ax.set_xlabel("t")
+    ax.set_ylabel("H(t)")
+    ax.set_title(f"Square wave and tanh approximations over one period (omega = {omega:g})",
+                 fontsize=9)
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=8)
     fig.tight_layout()
     if path is not None:
         save_figure(fig, path)
