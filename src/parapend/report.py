@@ -56,40 +56,40 @@ def _save(fig, figdir: Path, name: str) -> dict:
 def _figures():
     return [
         ("fig4", "Figure 4: Fourier optima approach a piecewise-constant motion",
-         "Paper: optima for increasing N at four (delta, omega) near the 1:2 resonance "
+         "Optima for increasing N at four (delta, omega) near the 1:2 resonance "
          "(values not listed).",
          "We use (delta, omega) = " + ", ".join(f"({d:g}, {w:g})" for d, w in paper.FIG4_CASES)
          + "; each N is solved to a gradient below 1e-11 by Newton's method, continuing in N.",
          lambda: _panels_fig(paper.fig4(), "panels")),
         ("fig5", "Figure 5: penalized Euler-Lagrange solutions (Eq. 13)",
-         "Paper: bvp4c solutions for progressively smaller epsilon, down to 1e-4.",
+         "bvp4c solutions for progressively smaller epsilon, down to 1e-4.",
          "Our BVP solver reaches epsilon = 1e-6 with automatic continuation and an adaptive "
          "mesh; large epsilon gives the uniform rotation omega t + pi, as the paper notes.",
          lambda: _panels_fig(paper.fig5(), "panel")),
         ("fig6", "Figure 6: power against damping",
-         "Paper: net power output against gamma; none beyond gamma = 0.0856.",
+         "Net power output against gamma; none beyond gamma = 0.0856.",
          "Same curve (sign: positive = harvested); gamma* from Newton's method on the convex "
          "optimal-power curve.",
          _fig6),
         ("fig7", "Figure 7: two-harmonic excitation (Eq. 23)",
-         "Paper: left, Fourier optima for increasing N; right, Eq. 22 at epsilon = 1e-4; "
+         "Left, Fourier optima for increasing N; right, Eq. 22 at epsilon = 1e-4; "
          "transitions at the zeros of q'.",
          "Both panels recomputed; the jumps sit at the exact zeros tau = 0.19036, 0.80964.",
          _fig7),
         ("fig8", "Figure 8 (right): tanh approximation of the square wave (Eq. 26)",
-         "Paper: Eq. 26 for decreasing alpha at omega = 1.8.",
+         "Eq. 26 for decreasing alpha at omega = 1.8.",
          "Same construction.",
          lambda: (plot_square_approximations(1.8, (0.2, 0.05, 0.001)), {"omega": 1.8,
                                                                        "alphas": [0.2, 0.05,
                                                                                   0.001]})),
         ("fig9", "Figure 9: non-unique optima for the square wave",
-         "Paper: three different N = 40 optima (alpha = 0.001) of equal power (to 6 decimals), "
+         "Three different N = 40 optima (alpha = 0.001) of equal power (to 6 decimals), "
          "all through (0.5, 2 pi).",
          "Distinct optima from seeded random starts: equal power to about 1e-10, all through "
          "theta = 2 pi at tau = 0.5.",
          lambda: _panels_fig(paper.fig9(), "panel")),
         ("fig10", "Figure 10: the penalty selects the uniform rotation (square wave)",
-         "Paper: Eq. 27 at epsilon = 0.001 for decreasing alpha approaches omega t + pi.",
+         "Eq. 27 at epsilon = 0.001 for decreasing alpha approaches omega t + pi.",
          "Same; the table below gives the distance to the uniform rotation.",
          lambda: _panels_fig(paper.fig10(), "panel")),
     ]

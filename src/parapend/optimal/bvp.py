@@ -136,9 +136,10 @@ def _gauss(m: int):
 class _Mesh:
     """Periodic spectral-element mesh: element ends ``edges`` (E+1,), degree ``p``.
 
-    Global unknowns are the values of ``u`` at the ``n = E p`` distinct GLL nodes
+    The unknowns are the angles at the ``n = E p`` distinct GLL nodes
     ``t[0] = 0 < t[1] < ... < t[n-1] < Tp``; element ``e`` uses nodes ``e p .. e p + p``
-    (modulo ``n``).
+    (modulo ``n``), and its last node in the last element is the first node plus one turn
+    (Eq. 3), recorded in ``wrap`` (in units of pi).
     """
 
     def __init__(self, edges: np.ndarray, p: int):
@@ -146,15 +147,17 @@ class _Mesh:
         self.p = p
         self.E = e = self.edges.size - 1
         self.n = n = e * p
-        x, w, dmat, lam = _gll(p)
+        x, w, dmat, _ = _gll(p)
         self.h = h = np.diff(self.edges)
         self.t_el = self.edges[:-1, None] + 0.5 * h[:, None] * (x + 1.0)  # (E, p+1)
         self.t = self.t_el[:, :p].ravel()
         self.idx = (np.arange(e)[:, None] * p + np.arange(p + 1)[None, :]) % n
+        self.wrap = np.zeros((e, p + 1), dtype=np.int64)
+        self.wrap[-1, -1] = 2
         self.W = np.bincount(self.idx.ravel(), weights=(0.5 * h[:, None] * w).ravel(),
                              minlength=n)
         self.kref = dmat.T @ (w[:, None] * dmat)
-        # interleaved ordering turns the cyclic band into a plain band
+        # interleaved ordering 0, n-1, 1, n-2, ... turns the cyclic band into a plain band
         order = np.empty(n, dtype=int)
         half = (n + 1) // 2
         order[0::2] = np.arange(half)
@@ -169,22 +172,46 @@ class _Mesh:
         cols = np.broadcast_to(pj, lower.shape)[lower]
         self.bw = int(rows.max())
         kband = np.zeros((self.bw + 1, n))
-        np.add.at(kband, (rows, cols), vals[lower])
+        np.add.at(kband, (rows, cols), np.broadcast_to(vals, lower.shape)[lower])
         self.kband = kband
 
-    @property
-    def nodes(self) -> int:
-        return self.n
+    def local(self, n: np.ndarray, z: np.ndarray):
+        """Element values relative to their first node: ``(base (E,), local (E, p+1))``.
 
-    def stiffness_product(self, u: np.ndarray) -> np.ndarray:
-        """``K u`` (shape (n,)), with ``u^T K u = int u'^2 dt``."""
-        ue = u[self.idx]
-        ke = (2.0 / self.h)[:, None] * (ue @ self.kref)
+        ``theta = pi * base + local`` on each element; subtracting the integer multiple of
+        pi keeps the values small where the pendulum dwells, so that derivatives of the
+        element polynomials do not amplify rounding (see the module docstring).
+        """
+        big = n[self.idx] + self.wrap
+        base = big[:, 0]
+        return base, math.pi * (big - base[:, None]) + z[self.idx]
+
+    def stiffness_apply(self, loc: np.ndarray) -> np.ndarray:
+        """Assembled ``K theta`` (n,) from element values (E, p+1)."""
+        ke = (2.0 / self.h)[:, None] * (loc @ self.kref)
         return np.bincount(self.idx.ravel(), weights=ke.ravel(), minlength=self.n)
 
-    def element_values(self, u: np.ndarray) -> np.ndarray:
-        """Nodal values per element, shape (E, p+1)."""
-        return u[self.idx]
+    def kinetic(self, loc: np.ndarray) -> float:
+        """``int_0^Tp theta'^2 dt`` (exact for the element polynomials)."""
+        return float(np.sum((2.0 / self.h)[:, None] * loc * (loc @ self.kref)))
+
+
+def _sign(n: np.ndarray) -> np.ndarray:
+    """``(-1)**n`` for integer arrays."""
+    return 1.0 - 2.0 * (n & 1)
+
+
+def _split_angle(theta: np.ndarray):
+    """``theta = pi * n + z`` with integer ``n`` and ``|z| <= pi/2``."""
+    k = np.rint(theta / math.pi)
+    return k.astype(np.int64), theta - math.pi * k
+
+
+def _rebase(n: np.ndarray, z: np.ndarray):
+    k = np.rint(z / math.pi)
+    if not np.any(k):
+        return n, z
+    return n + k.astype(np.int64), z - math.pi * k
 
 
 def _equidistribute(edges: np.ndarray, density: np.ndarray, min_elements: int) -> np.ndarray:
@@ -212,32 +239,30 @@ def _grade(rho: np.ndarray, ratio: float = 2.0) -> np.ndarray:
 
 # ---------------------------------------------------------------------------------------
 class _Problem:
-    """Discrete functional ``P_h`` on one mesh for one ``epsilon`` (module docstring)."""
+    """Discrete functional ``P_h`` on one mesh for one damping (module docstring).
+
+    The state is ``theta_j = pi n_j + z_j`` at the nodes; ``n`` is fixed, ``z`` varies.
+    """
 
     def __init__(self, mesh: _Mesh, excitation, damping: float):
         self.mesh = mesh
-        self.exc = excitation
         self.gamma = damping
-        self.omega = excitation.omega
         self.period = excitation.period
         self.wq = mesh.W * np.asarray(excitation.dq(mesh.t), dtype=float)
-        self.phase = self.omega * mesh.t
         self.kband2 = 2.0 * damping * mesh.kband
 
-    def power(self, u: np.ndarray) -> float:
-        th = self.phase + u
-        ku = self.mesh.stiffness_product(u)
-        return (float(self.wq @ np.cos(th)) - self.gamma * float(u @ ku)) / self.period \
-            - self.gamma * self.omega**2
+    def power(self, n: np.ndarray, z: np.ndarray) -> float:
+        _, loc = self.mesh.local(n, z)
+        c = float(self.wq @ (_sign(n) * np.cos(z)))
+        return (c - self.gamma * self.mesh.kinetic(loc)) / self.period
 
-    def parts(self, u: np.ndarray):
+    def parts(self, n: np.ndarray, z: np.ndarray):
         """``(P_h, rhs, diag)``: rhs = Tp * gradient, diag = W q' cos(theta)."""
-        th = self.phase + u
-        ku = self.mesh.stiffness_product(u)
-        c = self.wq * np.cos(th)
-        p = (float(c.sum()) - self.gamma * float(u @ ku)) / self.period \
-            - self.gamma * self.omega**2
-        rhs = -self.wq * np.sin(th) - 2.0 * self.gamma * ku
+        _, loc = self.mesh.local(n, z)
+        sg = _sign(n)
+        c = self.wq * sg * np.cos(z)
+        p = (float(c.sum()) - self.gamma * self.mesh.kinetic(loc)) / self.period
+        rhs = -self.wq * sg * np.sin(z) - 2.0 * self.gamma * self.mesh.stiffness_apply(loc)
         return p, rhs, c
 
     def band(self, diag: np.ndarray, shift: float = 0.0, scale=None) -> np.ndarray:
@@ -249,19 +274,17 @@ class _Problem:
             ab[0, pos] += shift * scale
         return ab
 
+    def apply(self, diag: np.ndarray, v: np.ndarray) -> np.ndarray:
+        """``A v`` with ``A = -Tp H``."""
+        loc = v[self.mesh.idx]
+        return diag * v + 2.0 * self.gamma * self.mesh.stiffness_apply(loc)
+
 
 def _solve_band(chol: np.ndarray, b: np.ndarray, pos: np.ndarray) -> np.ndarray:
     bp = np.empty_like(b)
     bp[pos] = b
     x = cho_solve_banded((chol, True), bp, check_finite=False)
     return x[pos]
-
-
-@dataclass
-class _NewtonInfo:
-    iterations: int = 0
-    status: str = "converged"
-    maximum: bool = False
 
 
 def _factor(ab: np.ndarray):
@@ -271,31 +294,37 @@ def _factor(ab: np.ndarray):
         return None
 
 
-def _negative_curvature(prob: _Problem, diag: np.ndarray, scale: np.ndarray,
-                        shift: float) -> tuple[np.ndarray, float]:
+@dataclass
+class _NewtonInfo:
+    iterations: int = 0
+    status: str = "converged"
+    maximum: bool = False
+
+
+def _negative_curvature(prob: _Problem, diag: np.ndarray, chol: np.ndarray,
+                        scale: np.ndarray) -> tuple[np.ndarray, float]:
     """Direction ``v`` of most positive curvature of ``P_h`` (most negative of ``A``).
 
-    Inverse iteration with the shifted (positive definite) factor ``A + shift*S``.
-    Returns ``(v, rayleigh)`` with ``rayleigh = v^T A v / v^T S v``.
+    Inverse iteration with the shifted, positive definite factor ``chol`` of
+    ``A + shift * diag(scale)``. Returns ``(v, v^T A v / v^T S v)``.
     """
     pos = prob.mesh.pos
-    chol = _factor(prob.band(diag, shift, scale))
-    rng = np.random.default_rng(12345)
+    rng = np.random.default_rng(20120101)
     v = rng.standard_normal(diag.size)
     for _ in range(30):
         v = _solve_band(chol, scale * v, pos)
         v /= np.max(np.abs(v))
-    av = 2.0 * prob.gamma * prob.mesh.stiffness_product(v) + diag * v
-    return v, float(v @ av) / float(v @ (scale * v))
+    return v, float(v @ prob.apply(diag, v)) / float(v @ (scale * v))
 
 
-def _newton(prob: _Problem, u0: np.ndarray, maxiter: int = _NEWTON_MAXITER):
-    """Safeguarded Newton ascent on ``P_h``; returns ``(u, P_h, info)``."""
-    u = np.array(u0, dtype=float)
+def _newton(prob: _Problem, n: np.ndarray, z0: np.ndarray, maxiter: int = _NEWTON_MAXITER):
+    """Safeguarded Newton ascent on ``P_h`` over ``z``; returns ``(z, P_h, info)``."""
+    z = np.array(z0, dtype=float)
     pos = prob.mesh.pos
-    p, rhs, diag = prob.parts(u)
+    p, rhs, diag = prob.parts(n, z)
     info = _NewtonInfo(status="max_iterations")
     for it in range(1, maxiter + 1):
+        info.iterations = it
         if not (math.isfinite(p) and np.all(np.isfinite(rhs))):
             info.status = "nonfinite"
             break
@@ -306,65 +335,65 @@ def _newton(prob: _Problem, u0: np.ndarray, maxiter: int = _NEWTON_MAXITER):
         else:
             scale = np.maximum(np.abs(prob.band(diag)[0][pos]), 1e-300)
             shift = 1e-4
-            while True:
+            while chol is None:
                 chol = _factor(prob.band(diag, shift, scale))
-                if chol is not None:
-                    break
                 shift *= 10.0
                 if shift > 1e12:
                     info.status = "nonfinite"
-                    return u, p, info
+                    return z, p, info
             d = _solve_band(chol, rhs, pos)
-            if float(np.max(np.abs(d))) < 1e-6:
-                # (near) saddle: the gradient hardly moves us; follow negative curvature
-                v, ray = _negative_curvature(prob, diag, scale, shift)
+            if float(np.max(np.abs(d))) < 1e-3:
+                # near a saddle the shifted gradient step hardly moves: add the direction
+                # of most positive curvature (DESIGN.md section 5: never stop at a saddle)
+                v, ray = _negative_curvature(prob, diag, chol, scale)
                 if ray < 0:
-                    v = v * (0.5 if float(rhs @ v) >= 0 else -0.5)
-                    d = d + v
+                    d = d + v * (0.5 if float(rhs @ v) >= 0 else -0.5)
         step = float(np.max(np.abs(d)))
-        if step > 1.0:  # trust region of one radian
+        if step > 1.0:  # at most one radian per step
             d *= 1.0 / step
-        slope = float(rhs @ d) / prob.period
         if newton and step <= _STEP_TOL:
-            u = u + d
-            p, rhs, diag = prob.parts(u)
+            z = z + d
+            p, rhs, diag = prob.parts(n, z)
             info.status = "converged"
-            info.iterations = it
             break
+        slope = float(rhs @ d) / prob.period
         t = 1.0
         accepted = False
         for _ in range(50):
-            un = u + t * d
-            pn = prob.power(un)
+            zn = z + t * d
+            pn = prob.power(n, zn)
             if pn >= p + 1e-4 * t * slope or (newton and t == 1.0 and step < 1e-6
-                                              and pn >= p - 1e-15):
+                                              and pn >= p - 1e-15 * max(1.0, abs(p))):
                 accepted = True
                 break
             t *= 0.5
         if not accepted:
-            # no measurable increase: accept a maximum up to rounding, else stalled
+            # no measurable increase: a maximum up to rounding, or stalled
             info.status = "converged" if newton and step < 1e-8 else "stalled"
-            info.iterations = it
             break
-        u = un
-        p, rhs, diag = prob.parts(u)
-        info.iterations = it
+        z = zn
+        p, rhs, diag = prob.parts(n, z)
     info.maximum = _factor(prob.band(diag)) is not None
-    return u, p, info
+    return z, p, info
 
 
 # ---------------------------------------------------------------------------------------
-def _eval_elements(mesh: _Mesh, u: np.ndarray, t: np.ndarray, derivs: int = 2):
-    """``u``, ``u'``, ``u''`` of the piecewise polynomial at times ``t`` in ``[0, Tp]``."""
+def _eval_elements(mesh: _Mesh, n: np.ndarray, z: np.ndarray, t: np.ndarray,
+                   derivs: int = 2):
+    """``(base, local, theta', theta'')`` of the element polynomials at ``t`` in ``[0, Tp]``.
+
+    ``theta = pi * base + local``; ``derivs`` limits the derivatives computed.
+    """
     x, _, dmat, lam = _gll(mesh.p)
     e = np.clip(np.searchsorted(mesh.edges, t, side="right") - 1, 0, mesh.E - 1)
     h = mesh.h[e]
     xe = 2.0 * (t - mesh.edges[e]) / h - 1.0
     lmat = _lagrange_matrix(xe, x, lam)
-    ue = mesh.element_values(u)[e]
-    out = [np.einsum("ij,ij->i", lmat, ue)]
+    base, loc = mesh.local(n, z)
+    le = loc[e]
+    out = [base[e], np.einsum("ij,ij->i", lmat, le)]
     if derivs >= 1:
-        d1 = ue @ dmat.T
+        d1 = le @ dmat.T
         out.append(np.einsum("ij,ij->i", lmat, d1) * (2.0 / h))
     if derivs >= 2:
         d2 = d1 @ dmat.T
@@ -373,7 +402,7 @@ def _eval_elements(mesh: _Mesh, u: np.ndarray, t: np.ndarray, derivs: int = 2):
 
 
 def _element_points(mesh: _Mesh, m: int):
-    """Gauss-Legendre points (E, m), weights (E, m) (in t) and the interpolation matrices."""
+    """Gauss-Legendre points (E, m), weights (m,) and interpolation matrices (m, p+1)."""
     xg, wg = _gauss(m)
     x, _, dmat, lam = _gll(mesh.p)
     lmat = _lagrange_matrix(xg, x, lam)
@@ -381,65 +410,68 @@ def _element_points(mesh: _Mesh, m: int):
     return tg, wg, lmat, lmat @ dmat, lmat @ dmat @ dmat
 
 
-def _residuals(mesh: _Mesh, u: np.ndarray, excitation, epsilon: float) -> np.ndarray:
+def _residuals(mesh: _Mesh, n: np.ndarray, z: np.ndarray, excitation,
+               epsilon: float) -> np.ndarray:
     """RMS over each element of ``(theta_h'' - f)/(1 + |f|)``, ``f = q' sin(theta_h)/eps``.
 
-    The relative residual of the first-order system as in SciPy's ``solve_bvp``; the first
-    component (``theta_h' - y_2``) vanishes identically. Shape (E,).
+    The relative residual of the first-order system as in SciPy's ``solve_bvp``, by
+    ``(p+1)``-point Gauss-Legendre quadrature; the first component (``theta_h' - y_2``)
+    vanishes identically. Shape (E,).
     """
-    m = mesh.p + 1
-    tg, wg, lmat, _, l2 = _element_points(mesh, m)
-    ue = mesh.element_values(u)
-    th = excitation.omega * tg + ue @ lmat.T
-    thdd = (ue @ l2.T) * (2.0 / mesh.h[:, None]) ** 2
-    f = np.asarray(excitation.dq(tg.ravel()), dtype=float).reshape(tg.shape) * np.sin(th) \
-        / epsilon
+    tg, wg, lmat, _, l2 = _element_points(mesh, mesh.p + 1)
+    base, loc = mesh.local(n, z)
+    sin_th = _sign(base)[:, None] * np.sin(loc @ lmat.T)
+    thdd = (loc @ l2.T) * (2.0 / mesh.h[:, None]) ** 2
+    dq = np.asarray(excitation.dq(tg.ravel()), dtype=float).reshape(tg.shape)
+    f = dq * sin_th / epsilon
     r = (thdd - f) / (1.0 + np.abs(f))
     return np.sqrt(0.5 * (r * r) @ wg)
 
 
-def _accurate_power(mesh: _Mesh, u: np.ndarray, excitation, damping: float):
+def _accurate_power(mesh: _Mesh, n: np.ndarray, z: np.ndarray, excitation, damping: float):
     """``(P_eq15, P_by_parts, <theta'^2>)`` by 2p-point Gauss-Legendre per element."""
-    m = 2 * mesh.p
-    tg, wg, lmat, l1, _ = _element_points(mesh, m)
-    ue = mesh.element_values(u)
-    om = excitation.omega
-    th = om * tg + ue @ lmat.T
-    thd = om + (ue @ l1.T) * (2.0 / mesh.h[:, None])
+    tg, wg, lmat, l1, _ = _element_points(mesh, 2 * mesh.p)
+    base, loc = mesh.local(n, z)
+    sg = _sign(base)[:, None]
+    th = loc @ lmat.T
+    thd = (loc @ l1.T) * (2.0 / mesh.h[:, None])
     tf = tg.ravel()
     q = np.asarray(excitation.q(tf), dtype=float).reshape(tg.shape)
     dq = np.asarray(excitation.dq(tf), dtype=float).reshape(tg.shape)
     jac = 0.5 * mesh.h[:, None] * wg[None, :]
     period = excitation.period
-    kin = om * om + float(u @ mesh.stiffness_product(u)) / period
-    p15 = float(np.sum(jac * (1.0 + q) * np.sin(th) * thd)) / period - damping * kin
-    pbp = float(np.sum(jac * dq * np.cos(th))) / period - damping * kin
+    kin = mesh.kinetic(loc) / period
+    p15 = float(np.sum(jac * (1.0 + q) * sg * np.sin(th) * thd)) / period - damping * kin
+    pbp = float(np.sum(jac * dq * sg * np.cos(th))) / period - damping * kin
     return p15, pbp, kin
 
 
-def _interpolate(mesh: _Mesh, u: np.ndarray, new: _Mesh) -> np.ndarray:
-    return _eval_elements(mesh, u, new.t, derivs=0)[0]
+def _interpolate(mesh: _Mesh, n: np.ndarray, z: np.ndarray, new: _Mesh):
+    base, loc = _eval_elements(mesh, n, z, new.t, derivs=0)
+    k, zz = _split_angle(loc)
+    return base + k, zz
 
 
-def _slope_jump(mesh: _Mesh, u: np.ndarray, omega: float) -> float:
+def _slope_jump(mesh: _Mesh, n: np.ndarray, z: np.ndarray) -> float:
     """Largest jump of ``theta_h'`` across element ends, relative to ``max |theta_h'|``."""
     _, _, dmat, _ = _gll(mesh.p)
-    ue = mesh.element_values(u)
-    d = (ue @ dmat.T) * (2.0 / mesh.h[:, None])
+    _, loc = mesh.local(n, z)
+    d = (loc @ dmat.T) * (2.0 / mesh.h[:, None])
     jump = d[:, -1] - np.roll(d[:, 0], -1)
-    return float(np.max(np.abs(jump))) / float(np.max(np.abs(omega + d)))
+    return float(np.max(np.abs(jump))) / float(np.max(np.abs(d)))
 
 
 # ---------------------------------------------------------------------------------------
 @dataclass(frozen=True, eq=False)
 class SpectralElementMotion:
-    """The BVP optimum as a motion: ``theta = omega t + u(t)``, ``u`` piecewise polynomial.
+    """The BVP optimum as a motion: on each element ``theta`` is a polynomial of degree p.
 
-    ``u`` is the spectral-element solution (degree ``p`` on each element, continuous);
-    ``theta'`` and ``theta''`` are its exact derivatives inside elements (at an element end
-    the element to the right is used; ``theta'`` jumps there by at most
-    :attr:`BVPSolution.slope_jump` relative to ``max|theta'|``). Period-1 extension
-    ``theta(t + Tp) = theta(t) + 2 pi`` (Eq. 3) holds for any ``t``.
+    ``theta`` is continuous; ``theta'`` and ``theta''`` are the exact derivatives of the
+    element polynomials (at an element end the element to the right is used; ``theta'``
+    jumps there by at most :attr:`BVPSolution.slope_jump` relative to ``max|theta'|``).
+    The period-1 extension ``theta(t + Tp) = theta(t) + 2 pi`` (Eq. 3) holds for any ``t``.
+    Inside the period the interpolation error is that of the solution itself: the ODE
+    residual is at most ``max_residual`` relative to ``1 + |theta''|``.
 
     Parameters
     ----------
@@ -450,7 +482,7 @@ class SpectralElementMotion:
     degree : int
         Polynomial degree ``p``.
     values : ndarray, shape (E, p+1)
-        ``u`` at the GLL points of each element (radians).
+        ``theta`` at the GLL points of each element (radians).
     """
 
     omega: float
@@ -458,49 +490,49 @@ class SpectralElementMotion:
     degree: int
     values: np.ndarray
     _mesh: _Mesh = field(repr=False, compare=False, default=None)
-    _u: np.ndarray = field(repr=False, compare=False, default=None)
+    _n: np.ndarray = field(repr=False, compare=False, default=None)
+    _z: np.ndarray = field(repr=False, compare=False, default=None)
 
     @classmethod
-    def _from_mesh(cls, omega: float, mesh: _Mesh, u: np.ndarray) -> SpectralElementMotion:
-        return cls(omega, mesh.edges.copy(), mesh.p, mesh.element_values(u).copy(), mesh,
-                   u.copy())
+    def _from_state(cls, omega: float, mesh: _Mesh, n: np.ndarray,
+                    z: np.ndarray) -> SpectralElementMotion:
+        base, loc = mesh.local(n, z)
+        values = math.pi * base[:, None] + loc
+        return cls(omega, mesh.edges.copy(), mesh.p, values, mesh, n.copy(), z.copy())
 
     @property
     def period(self) -> float:
         return 2 * math.pi / self.omega
 
-    def _split(self, t):
-        t = np.asarray(t, dtype=float)
-        period = self.period
-        turns = np.floor(t / period)
-        return t, turns, t - turns * period
-
     def _eval(self, t, k: int):
-        t, turns, tm = self._split(t)
-        vals = _eval_elements(self._mesh, self._u, np.atleast_1d(tm).ravel(), derivs=k)[k]
-        return vals.reshape(t.shape), turns, t
+        t = np.asarray(t, dtype=float)
+        turns = np.floor(t / self.period)
+        tm = np.atleast_1d(t - turns * self.period).ravel()
+        out = _eval_elements(self._mesh, self._n, self._z, tm, derivs=k)
+        return out, turns, t.shape
 
     def theta(self, t):
-        """``theta(t)`` (radians)."""
-        u, turns, t = self._eval(t, 0)
-        out = self.omega * t + u
-        return out if out.ndim else float(out)
+        """``theta(t)`` (radians), any ``t`` (array_like)."""
+        (base, loc), turns, shape = self._eval(t, 0)
+        val = (math.pi * base + loc).reshape(shape) + 2 * math.pi * turns
+        return val if val.ndim else float(val)
 
     def theta_dot(self, t):
         """``theta'(t)``."""
-        du, _, _ = self._eval(t, 1)
-        out = self.omega + du
-        return out if out.ndim else float(out)
+        out, _, shape = self._eval(t, 1)
+        val = out[2].reshape(shape)
+        return val if val.ndim else float(val)
 
     def theta_ddot(self, t):
         """``theta''(t)``."""
-        ddu, _, _ = self._eval(t, 2)
-        return ddu if ddu.ndim else float(ddu)
+        out, _, shape = self._eval(t, 2)
+        val = out[3].reshape(shape)
+        return val if val.ndim else float(val)
 
     def mean_square_speed(self) -> float:
-        """``<theta'^2> = omega^2 + <u'^2>`` (exact for the polynomial solution)."""
-        u = self._u
-        return self.omega**2 + float(u @ self._mesh.stiffness_product(u)) / self.period
+        """``<theta'^2>`` (exact for the element polynomials)."""
+        _, loc = self._mesh.local(self._n, self._z)
+        return self._mesh.kinetic(loc) / self.period
 
 
 @dataclass(frozen=True, eq=False)
@@ -523,36 +555,40 @@ class BVPSolution:
         Forcing frequency.
     t : ndarray, shape (mesh_nodes + 1,)
         Mesh nodes over one period, ``t[0] = 0``, ``t[-1] = Tp`` (the GLL points of all
-        elements, element ends once).
+        elements, shared element ends once).
     theta, theta_dot : ndarray, shape (mesh_nodes + 1,)
-        ``theta`` and ``theta'`` at ``t`` (``theta[-1] = theta[0] + 2 pi``).
+        ``theta`` and ``theta'`` at ``t`` (``theta[-1] = theta[0] + 2 pi``; ``theta'`` from
+        the element to the right of a node).
     mesh_nodes : int
-        Distinct nodes per period (unknowns), ``elements * degree``.
+        Distinct nodes (unknowns) per period, ``elements * degree``.
     elements, degree : int
         Number of spectral elements and their polynomial degree.
     max_residual : float
-        Largest element RMS of the relative residual ``(theta'' - f)/(1 + |f|)`` of the
-        first-order system (SciPy ``solve_bvp`` convention); ``<= tol`` on success.
+        Largest element RMS of the relative residual ``(theta'' - f)/(1 + |f|)``,
+        ``f = q' sin(theta)/epsilon``, of the first-order system (SciPy ``solve_bvp``
+        convention); ``<= tol`` on success.
     slope_jump : float
         Largest jump of ``theta'`` across element ends, relative to ``max|theta'|``.
     continuation_steps : int
-        Number of epsilon values solved along the winning continuation path.
+        Number of epsilon values solved along the winning path (1: solved directly).
     success : bool
     status : str
         ``"converged"``, ``"max_nodes"`` (mesh limit reached before ``tol``),
         ``"not_converged"`` (Newton or mesh adaptation failed), ``"not_maximum"``.
     message : str
     iterations : int
-        Newton iterations in total (all candidates, all continuation steps and meshes).
+        Newton iterations in total (all starts, continuation steps and meshes).
     strict_maximum : bool
         The discrete Hessian is negative definite at the solution.
     found_by : str
-        ``"uniform"`` (continuation from the best uniform rotation) or ``"limit"`` (smoothed
-        gamma -> 0 motion).
+        ``"uniform"`` (continuation from the best uniform rotation) or ``"limit"`` (the
+        smoothed gamma -> 0 motion).
     candidates : dict
-        Power reached from each start (for the record).
+        Power reached from each start, for the record.
     uniform_power, limit_power : float
         Best uniform rotation (Eq. 17) at this damping and the gamma -> 0 supremum.
+    mean_square_speed : float
+        ``<theta'^2>``.
     """
 
     power: float
@@ -590,7 +626,8 @@ class BVPSolution:
 @dataclass
 class _Candidate:
     mesh: _Mesh
-    u: np.ndarray
+    n: np.ndarray
+    z: np.ndarray
     power: float
     eta: float
     status: str
@@ -600,24 +637,28 @@ class _Candidate:
     seed: str
 
 
-def _adapt_solve(exc, damping: float, mesh: _Mesh, u: np.ndarray, tol: float,
-                 max_nodes: int):
-    """Newton + residual-driven re-meshing at one epsilon until every element meets tol."""
+def _adapt_solve(exc, damping: float, mesh: _Mesh, n: np.ndarray, z: np.ndarray,
+                 tol: float, max_nodes: int):
+    """Newton + residual-driven re-meshing at one damping until every element meets tol.
+
+    Returns ``(mesh, n, z, P_h, max_residual, status, strict_maximum, iterations)``.
+    """
     eps = 2.0 * damping
     its = 0
     status = "not_converged"
     info = _NewtonInfo()
     p_h = math.nan
-    eta = np.array([math.inf])
+    emax = math.inf
     p = mesh.p
     for _ in range(_MAX_PASSES):
         prob = _Problem(mesh, exc, damping)
-        u, p_h, info = _newton(prob, u)
+        z, p_h, info = _newton(prob, n, z)
         its += info.iterations
-        if info.status not in ("converged",):
+        n, z = _rebase(n, z)
+        if info.status != "converged":
             status = "not_converged"
             break
-        eta = _residuals(mesh, u, exc, eps)
+        eta = _residuals(mesh, n, z, exc, eps)
         emax = float(np.max(eta))
         if emax <= tol:
             status = "converged"
@@ -626,18 +667,15 @@ def _adapt_solve(exc, damping: float, mesh: _Mesh, u: np.ndarray, tol: float,
         rho = _grade(r / mesh.h)
         edges = _equidistribute(mesh.edges, rho, _MIN_ELEMENTS)
         if (edges.size - 1) * p > max_nodes:
-            # try the largest mesh allowed once, then stop
-            if mesh.n >= max_nodes * 0.9:
+            if mesh.n >= 0.9 * max_nodes:
                 status = "max_nodes"
                 break
-            scale = max_nodes / ((edges.size - 1) * p)
-            edges = _equidistribute(mesh.edges, rho * scale, _MIN_ELEMENTS)
+            edges = _equidistribute(mesh.edges, rho * (max_nodes / ((edges.size - 1) * p)),
+                                    _MIN_ELEMENTS)
         new = _Mesh(edges, p)
-        u = _interpolate(mesh, u, new)
+        n, z = _interpolate(mesh, n, z, new)
         mesh = new
-    else:
-        status = "not_converged"
-    return mesh, u, p_h, float(np.max(eta)), status, info.maximum, its
+    return mesh, n, z, p_h, emax, status, info.maximum, its
 
 
 def _uniform_branch(exc, damping: float, tol: float, max_nodes: int, p: int) -> _Candidate:
@@ -645,33 +683,39 @@ def _uniform_branch(exc, damping: float, tol: float, max_nodes: int, p: int) -> 
     eps_target = 2.0 * damping
     _, phi = uniform_power(exc, damping)
     tp = exc.period
-    tgrid = tp * np.arange(512) / 512
+    tgrid = tp * np.arange(1024) / 1024
     dqmax = float(np.max(np.abs(exc.dq(tgrid))))
-    eps0 = max(eps_target, 2.0 * dqmax / exc.omega**2)
+    eps = max(eps_target, 2.0 * dqmax / exc.omega**2)
     mesh = _Mesh(np.linspace(0.0, tp, 17), p)
-    u = np.full(mesh.n, phi)
-    eps = eps0
+    n, z = _split_angle(exc.omega * mesh.t + phi)
     factor = 0.1
     its = steps = 0
     tol_mid = max(tol, 1e-5)
+    state = (mesh, n, z)
+    eps_prev = eps
     while True:
         final = eps <= eps_target * (1 + 1e-12)
-        res = _adapt_solve(exc, 0.5 * eps, mesh, u, tol if final else tol_mid, max_nodes)
+        res = _adapt_solve(exc, 0.5 * eps, *state, tol if final else tol_mid, max_nodes)
         its += res[-1]
-        if res[4] == "converged" or final:
-            mesh, u, p_h, eta, status, maximum, _ = res
+        ok = res[5] == "converged"
+        if ok or final or steps == 0:
             steps += 1
-            if final or status != "converged":
-                return _Candidate(mesh, u, p_h, eta, status, maximum, steps, its, "uniform")
-            factor = max(factor * factor, 1e-3) if res[-1] <= 12 else factor
+            if final or not ok:
+                mesh, n, z, p_h, eta, status, maximum, _ = res
+                return _Candidate(mesh, n, z, p_h, eta, status, maximum, steps, its,
+                                  "uniform")
+            state = res[:3]
+            if res[-1] <= 12:
+                factor = max(factor * factor, 1e-3)
             eps_prev = eps
             eps = max(eps * factor, eps_target)
         else:
-            # retreat: smaller step from the last accepted epsilon
+            # retreat: a smaller step from the last accepted epsilon
             factor = math.sqrt(factor)
-            if factor > 0.9 or steps == 0:
-                mesh, u, p_h, eta, status, maximum, _ = res
-                return _Candidate(mesh, u, p_h, eta, status, maximum, steps, its, "uniform")
+            if factor > 0.9:
+                mesh, n, z, p_h, eta, status, maximum, _ = res
+                return _Candidate(mesh, n, z, p_h, eta, status, maximum, steps, its,
+                                  "uniform")
             eps = max(eps_prev * factor, eps_target)
 
 
@@ -690,8 +734,8 @@ def _limit_seed(exc, epsilon: float, p: int):
     rho = np.full(fine.size, 16.0 / tp)
     for t0, w in zip(tk, wk, strict=True):
         for shift in (-tp, 0.0, tp):
-            z = (fine - t0 - shift) / w
-            rho += (1.5 / w) / (1.0 + (z / 4.0) ** 2)
+            zz = (fine - t0 - shift) / w
+            rho += (1.5 / w) / (1.0 + (zz / 4.0) ** 2)
     cum = np.concatenate(([0.0], np.cumsum(0.5 * (rho[1:] + rho[:-1]) * np.diff(fine))))
     m = max(_MIN_ELEMENTS, int(math.ceil(cum[-1])))
     edges = np.interp(cum[-1] * np.arange(m + 1) / m, cum, fine)
@@ -702,17 +746,18 @@ def _limit_seed(exc, epsilon: float, p: int):
     for t0, w, d in zip(tk, wk, dk, strict=True):
         s = -1.0
         for shift in (-tp, 0.0, tp):
-            z = np.clip((t - t0 - shift) / w, -50, 50)
-            s = s + (2.0 / math.pi) * np.arctan(np.exp(1.5 * z))
+            zz = np.clip((t - t0 - shift) / w, -50, 50)
+            s = s + (2.0 / math.pi) * np.arctan(np.exp(1.5 * zz))
         theta += d * math.pi * s
-    return mesh, theta - exc.omega * t
+    n, z = _split_angle(theta)
+    return mesh, n, z
 
 
 def _limit_branch(exc, damping: float, tol: float, max_nodes: int, p: int) -> _Candidate:
-    mesh, u = _limit_seed(exc, 2.0 * damping, p)
-    mesh, u, p_h, eta, status, maximum, its = _adapt_solve(exc, damping, mesh, u, tol,
-                                                          max_nodes)
-    return _Candidate(mesh, u, p_h, eta, status, maximum, 1, its, "limit")
+    mesh, n, z = _limit_seed(exc, 2.0 * damping, p)
+    mesh, n, z, p_h, eta, status, maximum, its = _adapt_solve(exc, damping, mesh, n, z, tol,
+                                                             max_nodes)
+    return _Candidate(mesh, n, z, p_h, eta, status, maximum, 1, its, "limit")
 
 
 _MESSAGES = {
@@ -784,13 +829,13 @@ def solve_bvp_optimum(excitation, damping: float, *, tol: float = 1e-8,
     status = best.status
     if status == "converged" and not best.maximum:
         status = "not_maximum"
-    mesh, u = best.mesh, best.u
-    p15, pbp, kin = _accurate_power(mesh, u, excitation, gamma)
+    mesh, n, z = best.mesh, best.n, best.z
+    p15, pbp, kin = _accurate_power(mesh, n, z, excitation, gamma)
     om = excitation.omega
     t = np.append(mesh.t, excitation.period)
-    uu = np.append(u, u[0])
-    _, du = _eval_elements(mesh, u, mesh.t, derivs=1)
-    motion = SpectralElementMotion._from_mesh(om, mesh, u)
+    th_nodes = math.pi * n + z
+    _, _, dth = _eval_elements(mesh, n, z, mesh.t, derivs=1)
+    motion = SpectralElementMotion._from_state(om, mesh, n, z)
     sol = BVPSolution(
         power=p15,
         power_by_parts=pbp,
@@ -798,13 +843,13 @@ def solve_bvp_optimum(excitation, damping: float, *, tol: float = 1e-8,
         damping=gamma,
         omega=om,
         t=t,
-        theta=om * t + uu,
-        theta_dot=om + np.append(du, du[0]),
+        theta=np.append(th_nodes, th_nodes[0] + 2 * math.pi),
+        theta_dot=np.append(dth, dth[0]),
         mesh_nodes=mesh.n,
         elements=mesh.E,
         degree=p,
         max_residual=best.eta,
-        slope_jump=_slope_jump(mesh, u, om),
+        slope_jump=_slope_jump(mesh, n, z),
         continuation_steps=best.steps,
         success=status == "converged",
         status=status,
