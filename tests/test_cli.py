@@ -108,3 +108,27 @@ def test_entry_point_runs_as_module():
     r = subprocess.run([sys.executable, "-m", "parapend.cli", "threshold", "--json"],
                        capture_output=True, text=True, timeout=120)
     assert r.returncode == 0 and "damping_threshold" in r.stdout
+
+
+def test_method_bvp_json_and_all(capsys):
+    code, out, _ = run(capsys, "optimize", "--method", "bvp", "--gamma", "5e-4", "--json")
+    d = json.loads(out)
+    assert code == 0 and KEYS | {"mesh_nodes", "max_residual"} <= set(d)
+    assert d["method"] == "bvp" and d["success"] is True and d["max_residual"] <= 1e-8
+    code, out, _ = run(capsys, "optimize", "--method", "all", "--gamma", "5e-4",
+                       "--harmonics", "64", "--json")
+    d = json.loads(out)
+    assert code == 0 and abs(d["fourier"]["power"] - d["bvp"]["power"]) < 1e-9
+    code, out, _ = run(capsys, "optimize", "--method", "all")
+    assert code == 0 and "needs gamma > 0" in out
+
+
+def test_method_bvp_needs_damping(capsys):
+    code, _, err = run(capsys, "optimize", "--method", "bvp")
+    assert code == 2 and "gamma" in err and err.count("\n") == 1
+
+
+def test_figure_command(tmp_path, capsys):
+    png = tmp_path / "f8.png"
+    code, out, _ = run(capsys, "figure", "8", "--plot", str(png))
+    assert code == 0 and png.read_bytes()[:4] == b"\x89PNG"

@@ -24,7 +24,7 @@ from .power import uniform_power
 from .results import OptimizeResult, ThresholdResult
 from .trajectory import FourierMotion
 
-__all__ = ["EXCITATIONS", "build_excitation", "damping_sweep", "harmonic_table",
+__all__ = ["EXCITATIONS", "METHODS", "build_excitation", "damping_sweep", "harmonic_table",
            "motion_samples", "optimize", "threshold"]
 
 log = logging.getLogger(__name__)
@@ -85,54 +85,102 @@ def _message(status: str) -> str:
     }[status]
 
 
+METHODS = ("fourier", "bvp")
+
+
 def optimize(*, omega: float = 1.8, delta: float = -0.3, gamma: float = 0.0, harmonics: int = 24,
              excitation="harmonic", square_alpha: float = 0.001, fourier=None, file=None,
-             warm=None, throw: bool = False) -> OptimizeResult:
-    """Optimal period-1 rotation by truncated Fourier series (Eqs. 10-11) for any excitation.
+             method: str = "fourier", warm=None, throw: bool = False) -> OptimizeResult:
+    """Optimal period-1 rotation for any excitation.
 
-    Parameters mirror ``parapend optimize``. ``gamma`` is the viscous damping (>= 0),
-    ``harmonics`` the number N of Eq. 10. ``warm`` is an optional packed coefficient vector
-    ``[a0, a_1..a_K, b_1..b_K]`` to start from (continuation). With ``throw=True`` a
-    non-converged solve raises :class:`~parapend.errors.SolverError`; otherwise it is reported
-    in ``success``/``status``.
+    Parameters mirror ``parapend optimize``. ``gamma`` is the viscous damping (>= 0).
+    ``method="fourier"`` optimizes the truncated Fourier series of Eqs. 10-11 with
+    ``harmonics`` = N terms; ``method="bvp"`` solves the penalized Euler-Lagrange equation
+    (Eqs. 13, 22, 27, epsilon = 2 gamma, needs gamma > 0) and reports the N-harmonic Fourier
+    projection of its motion as ``coefficients``. ``warm`` is an optional packed coefficient
+    vector ``[a0, a_1..a_K, b_1..b_K]`` to start the Fourier method from (continuation). With
+    ``throw=True`` a non-converged solve raises :class:`~parapend.errors.SolverError`;
+    otherwise it is reported in ``success``/``status``.
     """
     exc = build_excitation(excitation, omega=omega, delta=delta, square_alpha=square_alpha,
                            fourier=fourier, file=file)
     gamma = check_nonnegative("gamma", gamma)
     n = check_int("harmonics", harmonics, 1, MAX_HARMONICS)
-    best, runs = solve_fourier(exc, n, gamma, warm=warm)
-    motion = FourierMotion.from_vector(exc.omega, best.x)
+    if method not in METHODS:
+        raise ParameterError(f"method: expected one of {', '.join(METHODS)}, got {method!r}")
     pu, _ = uniform_power(exc, gamma)
     lim = limit(exc)
-    success = best.status == "converged"
-    maxima = sorted({round(r.power, 12) for r in runs if r.status == "converged"}, reverse=True)
-    res = OptimizeResult(
-        power=best.power,
-        uniform_power=pu,
-        limit_power=lim.power,
-        gain_over_uniform=(best.power / pu - 1.0) if pu > 0 else None,
-        harmonics=n,
-        damping=gamma,
-        omega=exc.omega,
-        success=success,
-        status=best.status,
-        message=_message(best.status),
-        iterations=best.iterations,
-        coefficients={"a0": motion.a0, "a": motion.a.tolist(), "b": motion.b.tolist()},
-        peak_torque=_peak_torque(motion, exc, gamma),
-        found_by=best.seed,
-        local_maxima=maxima,
-        gradient_norm=best.gradient_norm,
-        strict_maximum=best.strict_maximum,
-        quadrature_points=best.points,
-        mean_square_speed=motion.mean_square_speed(),
-        excitation=exc.describe(),
-        _motion=motion,
-        _excitation=exc,
-    )
-    if throw and not success:
+    common = {"uniform_power": pu, "limit_power": lim.power, "harmonics": n, "damping": gamma,
+              "omega": exc.omega, "excitation": exc.describe(), "_excitation": exc}
+    if method == "bvp":
+        res = _optimize_bvp(exc, gamma, n, common)
+    else:
+        best, runs = solve_fourier(exc, n, gamma, warm=warm)
+        motion = FourierMotion.from_vector(exc.omega, best.x)
+        maxima = sorted({round(r.power, 12) for r in runs if r.status == "converged"},
+                        reverse=True)
+        res = OptimizeResult(
+            power=best.power,
+            gain_over_uniform=(best.power / pu - 1.0) if pu > 0 else None,
+            success=best.status == "converged",
+            status=best.status,
+            message=_message(best.status),
+            iterations=best.iterations,
+            coefficients=_coefficients(motion),
+            peak_torque=_peak_torque(motion, exc, gamma),
+            found_by=best.seed,
+            local_maxima=maxima,
+            gradient_norm=best.gradient_norm,
+            strict_maximum=best.strict_maximum,
+            quadrature_points=best.points,
+            mean_square_speed=motion.mean_square_speed(),
+            _motion=motion,
+            **common,
+        )
+    if throw and not res.success:
         raise SolverError(f"optimize: {res.message}")
     return res
+
+
+def _coefficients(motion: FourierMotion) -> dict:
+    return {"a0": motion.a0, "a": motion.a.tolist(), "b": motion.b.tolist()}
+
+
+def _optimize_bvp(exc, gamma: float, n: int, common: dict) -> OptimizeResult:
+    from .optimal.bvp import solve_bvp_optimum
+    from .trajectory import SampledMotion
+
+    if gamma <= 0:
+        raise ParameterError("gamma: expected a number > 0 with method 'bvp' (epsilon = 2 "
+                             "gamma; gamma = 0 has no smooth optimum), got 0")
+    sol = solve_bvp_optimum(exc, gamma)
+    motion = sol.motion()
+    m = max(4096, 8 * n)
+    t = exc.period * np.arange(m) / m
+    proj = SampledMotion(exc.omega, motion.theta(t)).to_fourier()
+    proj = FourierMotion(exc.omega, proj.a0, proj.a[:n], proj.b[:n])
+    pu = common["uniform_power"]
+    return OptimizeResult(
+        power=sol.power,
+        gain_over_uniform=(sol.power / pu - 1.0) if pu > 0 else None,
+        success=sol.success,
+        status=sol.status,
+        message=sol.message,
+        iterations=sol.iterations,
+        coefficients=_coefficients(proj),
+        peak_torque=_peak_torque(motion, exc, gamma),
+        method="bvp",
+        found_by=sol.found_by,
+        local_maxima=sorted({round(v, 12) for v in sol.candidates.values()
+                             if v is not None and math.isfinite(v)}, reverse=True),
+        strict_maximum=sol.strict_maximum,
+        mean_square_speed=sol.mean_square_speed,
+        mesh_nodes=sol.mesh_nodes,
+        max_residual=sol.max_residual,
+        continuation_steps=sol.continuation_steps,
+        _motion=motion,
+        **common,
+    )
 
 
 def harmonic_table(harmonics=range(2, 65), *, gamma: float = 0.0, progress=None,

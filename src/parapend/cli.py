@@ -92,6 +92,10 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--gamma", type=_finite_float("gamma"), default=0.0,
                    help="viscous damping gamma >= 0 (default 0)")
     p.add_argument("--harmonics", type=_int, default=24, help="number N of harmonics (default 24)")
+    p.add_argument("--method", choices=["fourier", "bvp", "all"], default="fourier",
+                   help="fourier: Eq. 10 with N harmonics; bvp: Euler-Lagrange BVP (Eqs. 13, "
+                        "22, 27; needs gamma > 0); all: uniform, Fourier, BVP and limit side "
+                        "by side (default fourier)")
     p.add_argument("--plot", metavar="PNG", help="draw theta(tau) and torque (PNG or SVG)")
     p.add_argument("--save", metavar="CSV",
                    help="write one period of the motion: t,tau,theta,theta_dot,torque")
@@ -126,6 +130,14 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--to", dest="n_to", type=_int, default=64, help="largest N (default 64)")
     p.add_argument("--plot", metavar="PNG", help="draw power against N (PNG or SVG)")
     p.add_argument("--json", action="store_true", help="print one JSON object")
+
+    p = sub.add_parser("figure", help="recompute one of the paper's figures 4-10",
+                       description="Recompute one of the paper's figures (4-10; 5, 7 and 10 "
+                                   "are the Euler-Lagrange BVP solutions) and save it.")
+    p.add_argument("number", choices=["4", "5", "6", "7", "8", "9", "10"],
+                   help="figure number in the paper")
+    p.add_argument("--plot", metavar="PNG", required=True, help="output file (PNG or SVG)")
+    p.add_argument("--json", action="store_true", help="print the figure's numbers as JSON")
 
     p = sub.add_parser("reproduce", help="regenerate the paper's tables and figures, with a report",
                        description="Recompute every table and figure of the paper, compare each "
@@ -189,11 +201,21 @@ def _fmt(x, digits=6):
     return f"{x:.{digits}f}"
 
 
+def _is_number(text: str) -> bool:
+    try:
+        float(text.replace("%", "").replace("+", ""))
+        return True
+    except ValueError:
+        return text in ("", "-")
+
+
 def _table(rows, header) -> str:
+    """Plain-text table: numeric columns right-aligned, text columns left-aligned."""
     cols = [header] + rows
     widths = [max(len(str(r[i])) for r in cols) for i in range(len(header))]
-    lines = ["  ".join(str(v).rjust(w) if j else str(v).ljust(w)
-                       for j, (v, w) in enumerate(zip(r, widths))) for r in cols]
+    numeric = [all(_is_number(str(r[i])) for r in rows) for i in range(len(header))]
+    lines = ["  ".join(str(v).rjust(w) if num else str(v).ljust(w)
+                       for v, w, num in zip(r, widths, numeric)).rstrip() for r in cols]
     lines.insert(1, "  ".join("-" * w for w in widths))
     return "\n".join(lines)
 
@@ -208,7 +230,10 @@ def _cmd_optimize(a) -> dict | str:
 
     _check_output(a.plot, "--plot", (".png", ".svg"))
     _check_output(a.save, "--save", (".csv",))
-    r = optimize(gamma=a.gamma, harmonics=a.harmonics, **_excitation_kwargs(a))
+    kw = {"gamma": a.gamma, "harmonics": a.harmonics, **_excitation_kwargs(a)}
+    if a.method == "all":
+        return _optimize_all(a, kw)
+    r = optimize(method=a.method, **kw)
     if a.save:
         s = motion_samples(r)
         buf = io.StringIO()
@@ -223,23 +248,62 @@ def _cmd_optimize(a) -> dict | str:
         plot_optimum(r, a.plot)
     if a.json:
         return r.to_dict()
-    gain = "-" if r.gain_over_uniform is None else f"{100 * r.gain_over_uniform:+.2f} %"
+    name = (f"Fourier optimum, N = {r.harmonics} (Eq. 10)" if r.method == "fourier"
+            else f"BVP optimum, epsilon = {2 * r.damping:g} (Eq. 22)")
     rows = [
         ["best uniform rotation (Eq. 17)", _fmt(r.uniform_power), ""],
-        [f"Fourier optimum, N = {r.harmonics} (Eq. 10)", _fmt(r.power), gain],
+        [name, _fmt(r.power), _gain(r.power, r.uniform_power)],
         ["limit gamma -> 0 (Eqs. 19/24/32)", _fmt(r.limit_power),
-         f"{100 * (r.limit_power / r.uniform_power - 1):+.2f} %" if r.uniform_power > 0 else "-"],
+         _gain(r.limit_power, r.uniform_power)],
     ]
+    how = (f"{r.iterations} Newton iterations, found from the {r.found_by} seed, "
+           f"{len(r.local_maxima)} distinct local maxima" if r.method == "fourier" else
+           f"{r.mesh_nodes} mesh nodes, max residual {r.max_residual:.2g}, "
+           f"{r.continuation_steps} continuation steps, found from the {r.found_by} start")
     out = [f"excitation: {_describe(r.excitation)}; damping gamma = {r.damping:g}", "",
            _table(rows, ["motion", "power P", "vs uniform"]), "",
-           f"status: {r.status} ({r.iterations} Newton iterations, found from the "
-           f"{r.found_by} seed, {len(r.local_maxima)} distinct local maxima)",
+           f"status: {r.status} ({how})",
            f"peak torque |T|: {r.peak_torque:.6g}    mean theta'^2: {r.mean_square_speed:.6g}",
            f"convention: {CONVENTION}"]
     if a.save:
         out.append(f"motion written to {a.save}")
     if a.plot:
         out.append(f"figure written to {a.plot}")
+    return "\n".join(out)
+
+
+def _gain(p, pu) -> str:
+    return f"{100 * (p / pu - 1):+.2f} %" if pu > 0 else "-"
+
+
+def _optimize_all(a, kw) -> dict | str:
+    """Uniform, Fourier, BVP (gamma > 0 only) and limit for one case."""
+    from .api import optimize
+
+    if a.save or a.plot:
+        raise ParameterError("--method all: --save and --plot need a single method "
+                             "(fourier or bvp)")
+    f = optimize(method="fourier", **kw)
+    b = optimize(method="bvp", **kw) if a.gamma > 0 else None
+    if a.json:
+        return {"uniform_power": f.uniform_power, "limit_power": f.limit_power,
+                "damping": f.damping, "omega": f.omega, "excitation": f.excitation,
+                "fourier": f.to_dict(), "bvp": None if b is None else b.to_dict()}
+    rows = [["best uniform rotation (Eq. 17)", _fmt(f.uniform_power, 10), "", "closed form"],
+            [f"Fourier, N = {f.harmonics} (Eq. 10)", _fmt(f.power, 10),
+             _gain(f.power, f.uniform_power), f.status],
+            [f"BVP, epsilon = {2 * f.damping:g} (Eq. 22)",
+             "-" if b is None else _fmt(b.power, 10),
+             "-" if b is None else _gain(b.power, f.uniform_power),
+             "needs gamma > 0" if b is None else
+             f"{b.status}, {b.mesh_nodes} nodes, residual {b.max_residual:.1e}"],
+            ["limit gamma -> 0 (Eqs. 19/24/32)", _fmt(f.limit_power, 10),
+             _gain(f.limit_power, f.uniform_power), "closed form, no damping"]]
+    out = [f"excitation: {_describe(f.excitation)}; damping gamma = {f.damping:g}", "",
+           _table(rows, ["method", "power P", "vs uniform", "status"])]
+    if b is not None:
+        out += ["", f"Fourier - BVP: {f.power - b.power:+.3e}  (agree when N resolves the "
+                    "boundary layers)"]
     return "\n".join(out)
 
 
@@ -309,6 +373,18 @@ def _cmd_harmonics(a) -> dict | str:
     return "\n".join(out)
 
 
+def _cmd_figure(a) -> dict | str:
+    from .plotting import save_figure
+    from .report import paper_figure
+
+    _check_output(a.plot, "--plot", (".png", ".svg"))
+    fig, numbers = paper_figure(f"fig{a.number}")
+    save_figure(fig, a.plot)
+    if a.json:
+        return {"figure": int(a.number), "file": a.plot, "numbers": numbers}
+    return f"figure {a.number} written to {a.plot}"
+
+
 def _cmd_reproduce(a) -> dict | str:
     from .report import reproduce
 
@@ -334,7 +410,7 @@ def _cmd_reproduce(a) -> dict | str:
 
 COMMANDS = {"optimize": _cmd_optimize, "threshold": _cmd_threshold,
             "damping-sweep": _cmd_damping_sweep, "harmonics": _cmd_harmonics,
-            "reproduce": _cmd_reproduce}
+            "figure": _cmd_figure, "reproduce": _cmd_reproduce}
 
 
 def main(argv=None) -> int:

@@ -25,7 +25,7 @@ from .plotting import (
 )
 from .results import CONVENTION, to_jsonable
 
-__all__ = ["reproduce"]
+__all__ = ["FIGURES", "paper_figure", "reproduce"]
 
 
 def _atomic_write(path: Path, data: bytes) -> None:
@@ -109,6 +109,17 @@ def _fig7():
     left, right = paper.fig7_left(), paper.fig7_right()
     fig = plot_theta_panels([left["panel"], right["panel"]])
     return fig, {"left": left["numbers"], "right": right["numbers"]}
+
+
+FIGURES = ("fig4", "fig5", "fig6", "fig7", "fig8", "fig9", "fig10")
+
+
+def paper_figure(key: str):
+    """Recompute one of the paper's figures: returns ``(matplotlib Figure, numbers dict)``."""
+    for k, _, _, _, build in _figures():
+        if k == key:
+            return build()
+    raise ValueError(f"figure: expected one of {', '.join(FIGURES)}, got {key!r}")
 
 
 # ---------------------------------------------------------------------------------------

@@ -61,6 +61,10 @@ class OptimizeResult(_Result):
         ``{"a0": float, "a": [N], "b": [N]}`` of Eq. 10.
     peak_torque : float
         ``max |T(t)|`` over the period (Eq. 14).
+    method : str
+        "fourier" (Eq. 10, N harmonics) or "bvp" (Euler-Lagrange BVP, Eqs. 13/22/27); for
+        "bvp", ``coefficients`` is the N-harmonic Fourier projection of the BVP motion, and
+        ``mesh_nodes``, ``max_residual``, ``continuation_steps`` describe the solve.
     """
 
     power: float
@@ -83,6 +87,9 @@ class OptimizeResult(_Result):
     strict_maximum: bool = False
     quadrature_points: int = 0
     mean_square_speed: float = float("nan")
+    mesh_nodes: int | None = None
+    max_residual: float | None = None
+    continuation_steps: int | None = None
     excitation: dict = field(default_factory=dict)
     convention: str = CONVENTION
     _motion: object = field(default=None, repr=False)
