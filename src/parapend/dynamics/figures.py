@@ -1,0 +1,267 @@
+"""Figures of the uncontrolled dynamics (paper Figs. 1 right and 2), matplotlib Agg.
+
+Every function builds a :class:`matplotlib.figure.Figure` on an explicit Agg canvas
+(no pyplot, the global backend is not switched), returns it, and saves it only when
+``path`` is given (format from the extension: PNG, SVG, PDF). Angles follow paper Eq. 1
+(``phi`` from the hanging position).
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from pathlib import Path
+
+import numpy as np
+import xarray as xr
+from matplotlib.backends.backend_agg import FigureCanvasAgg
+from matplotlib.colors import ListedColormap
+from matplotlib.figure import Figure
+from matplotlib.lines import Line2D
+from matplotlib.patches import Patch
+
+from .attractors import find_attractors
+from .continuation import periodic_orbit
+from .simulate import trajectory
+
+__all__ = ["COEXISTENCE_CASE", "plot_basins", "plot_coexistence", "plot_rotation_boundaries"]
+
+#: Paper Section 1: a period-2 oscillation coexists with the period-1 rotation for
+#: gamma = 0.1, p = 0.8, omega = 2.1. Initial conditions (phi, phi') at t = 0 reaching each
+#: (checked, with every point of a 7 x 7 neighbourhood of half-width 0.03, in
+#: tests/test_dynamics.py).
+COEXISTENCE_CASE = {
+    "gamma": 0.1, "p": 0.8, "omega": 2.1,
+    "initial_conditions": {
+        "P2 oscillation": (0.5, 0.0),
+        "P1 rotation (+)": (0.0, 2.5),
+        "P1 rotation (-)": (0.0, -2.5),
+    },
+}
+
+_OTHER_COLOR = "#3a3a3a"
+# rest, oscillations (blues/greens), rotations + (reds), rotations - (oranges/yellows)
+_PALETTE = {
+    "rest": ["#7f7f7f"],
+    "oscillation": ["#1f77b4", "#9ecae1", "#2ca02c", "#98df8a", "#17becf", "#6baed6"],
+    "rotation+": ["#d62728", "#e377c2", "#8c564b", "#ff9896"],
+    "rotation-": ["#ff7f0e", "#ffdd57", "#bcbd22", "#ffbb78"],
+}
+
+
+def _save(fig: Figure, path: str | Path | None) -> None:
+    if path is not None:
+        path = Path(path)
+        fig.savefig(path, format=path.suffix.lstrip(".").lower() or "png", dpi=130,
+                    bbox_inches="tight")
+
+
+def _new_figure(size) -> Figure:
+    fig = Figure(figsize=size, layout="constrained")
+    FigureCanvasAgg(fig)
+    return fig
+
+
+def _wrap_for_plot(phi: np.ndarray, *others: np.ndarray) -> list[np.ndarray]:
+    """``phi`` wrapped to ``[-pi, pi)``, NaN inserted at the jumps (also into ``others``)."""
+    w = phi - 2 * math.pi * np.floor((phi + math.pi) / (2 * math.pi))
+    at = np.flatnonzero(np.abs(np.diff(w)) > math.pi) + 1
+    return [np.insert(np.asarray(x, dtype=float), at, np.nan) for x in (w, *others)]
+
+
+def _motions(gamma: float, p: float, omega: float) -> list[tuple[float, float, str]]:
+    """Starting points on the attractors to draw: the paper's P2 oscillation and P1
+    rotation (+) by shooting; if either is missing or unstable at these parameters, every
+    attractor (anticlockwise or oscillating) reached from :data:`COEXISTENCE_CASE`'s
+    initial conditions, polished by shooting where that converges."""
+    osc = periodic_orbit(gamma, p, omega, phi0=1.28, dphi0=-0.21, period=2, winding=0)
+    rot = periodic_orbit(gamma, p, omega, winding=1)
+    if osc.success and osc.stable and rot.success and rot.stable:
+        return [(osc.phi0, osc.dphi0, "period-2 oscillation"),
+                (rot.phi0, rot.dphi0, "period-1 rotation (+)")]
+    ics = np.array(list(COEXISTENCE_CASE["initial_conditions"].values()))
+    found = find_attractors(ics[:, 0], ics[:, 1], gamma, p, omega)
+    out = []
+    for a in found.attractors:
+        if a.winding < 0:
+            continue
+        orb = periodic_orbit(gamma, p, omega, phi0=a.phi[0], dphi0=a.dphi[0],
+                             period=a.period, winding=a.winding)
+        x = (orb.phi0, orb.dphi0) if orb.success else (a.phi[0], a.dphi[0])
+        out.append((*x, a.name))
+    return out
+
+
+def plot_coexistence(gamma: float = 0.1, p: float = 0.8, omega: float = 2.1, *,
+                     periods: int = 6, path: str | Path | None = None) -> Figure:
+    """Paper Fig. 1 right: a period-2 oscillation and a period-1 rotation of Eq. 1.
+
+    Both motions are started on the attractors themselves (found by shooting,
+    :func:`parapend.dynamics.continuation.periodic_orbit`) and integrated with DOP853. At
+    other parameters, the attractors reached from the initial conditions of
+    :data:`COEXISTENCE_CASE` are drawn instead (the clockwise mirror images omitted).
+
+    Parameters
+    ----------
+    gamma, p, omega : float
+        Parameters of Eq. 1 (default: the paper's coexistence case).
+    periods : int
+        Forcing periods shown.
+    path : str or Path, optional
+        Save the figure there.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        Left: ``phi(t)`` wrapped to ``[-pi, pi)`` against ``t/T``. Right: phase portrait
+        ``(phi mod 2 pi, phi')`` with the Poincare points at ``t = m*T`` marked.
+    """
+    period = 2 * math.pi / omega
+    fig = _new_figure((10, 4))
+    ax1, ax2 = fig.subplots(1, 2, width_ratios=(1.6, 1))
+    colors = ["#1f77b4", "#d62728", "#2ca02c", "#9467bd", "#ff7f0e"]
+    motions = _motions(gamma, p, omega)
+    for (phi0, dphi0, label), color in zip(motions, colors):
+        tr = trajectory(phi0, dphi0, gamma, p, omega, periods * period, points_per_period=200)
+        wrapped, tau_p, dphi_p = _wrap_for_plot(tr.phi, tr.t / period, tr.dphi)
+        ax1.plot(tau_p, wrapped, color=color, lw=1.5, label=label)
+        ax2.plot(wrapped, dphi_p, color=color, lw=1.2, label=label)
+        strobe = tr.t.size // periods * np.arange(periods + 1)
+        strobe = strobe[strobe < tr.t.size]
+        ps = tr.phi[strobe] - 2 * math.pi * np.floor((tr.phi[strobe] + math.pi) / (2 * math.pi))
+        ax2.plot(ps, tr.dphi[strobe], "o", color=color, mec="k", ms=7, zorder=3)
+    ax1.set_xlabel(r"$t/T$,  $T = 2\pi/\omega$")
+    ax1.set_ylabel(r"$\varphi$ (rad, wrapped to $[-\pi, \pi)$)")
+    ax1.set_ylim(-math.pi, math.pi)
+    ax1.set_yticks([-math.pi, -math.pi / 2, 0, math.pi / 2, math.pi],
+                   [r"$-\pi$", r"$-\pi/2$", "0", r"$\pi/2$", r"$\pi$"])
+    ax1.grid(alpha=0.3)
+    if motions:
+        ax1.legend(loc="lower right", fontsize=9)
+    else:
+        ax1.text(0.5, 0.5, "no periodic attractor found", transform=ax1.transAxes,
+                 ha="center")
+    ax1.set_title(rf"Eq. 1: $\gamma={gamma:g}$, $p={p:g}$, $\omega={omega:g}$")
+    ax2.set_xlabel(r"$\varphi$ mod $2\pi$")
+    ax2.set_ylabel(r"$\dot\varphi$")
+    ax2.set_xlim(-math.pi, math.pi)
+    ax2.set_xticks([-math.pi, 0, math.pi], [r"$-\pi$", "0", r"$\pi$"])
+    ax2.grid(alpha=0.3)
+    ax2.set_title("phase portrait (dots: $t = mT$)")
+    _save(fig, path)
+    return fig
+
+
+def _colors(ds) -> list[str]:
+    used = {k: 0 for k in _PALETTE}
+    colors = [_OTHER_COLOR]
+    for c in ds["code"].values[1:]:
+        kind = str(ds["kind"].values[c])
+        if kind == "rotation":
+            kind = "rotation+" if int(ds["winding"].values[c]) > 0 else "rotation-"
+        pal = _PALETTE.get(kind, _PALETTE["oscillation"])
+        colors.append(pal[used[kind] % len(pal)])
+        used[kind] += 1
+    return colors
+
+
+def plot_basins(ds: xr.Dataset, *, path: str | Path | None = None,
+                show_attractors: bool = True, title: str | None = None) -> Figure:
+    """Basin-of-attraction picture (paper Fig. 2 right) from :func:`~.basins.basin_map`.
+
+    Parameters
+    ----------
+    ds : xarray.Dataset
+        Output of :func:`parapend.dynamics.basins.basin_map`.
+    path : str or Path, optional
+        Save the figure there.
+    show_attractors : bool
+        Mark each attractor's Poincare points (white-edged markers in its colour).
+    title : str, optional
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        Colours by attractor code; the legend lists each attractor with its share of the
+        grid.
+    """
+    colors = _colors(ds)
+    ncode = len(colors)
+    phi = ds["phi"].values
+    dphi = ds["dphi"].values
+    dx = (phi[1] - phi[0]) if phi.size > 1 else 1.0
+    dy = (dphi[1] - dphi[0]) if dphi.size > 1 else 1.0
+    fig = _new_figure((7.8, 5.2))
+    ax = fig.add_subplot()
+    ax.imshow(ds["attractor"].values, origin="lower", interpolation="nearest",
+              cmap=ListedColormap(colors), vmin=-0.5, vmax=ncode - 0.5, aspect="auto",
+              extent=(phi[0] - dx / 2, phi[-1] + dx / 2, dphi[0] - dy / 2, dphi[-1] + dy / 2))
+    handles = []
+    frac = ds["basin_fraction"].values
+    for c in range(ncode):
+        if c == 0 and frac[0] == 0:
+            continue
+        handles.append(Patch(facecolor=colors[c], edgecolor="k", lw=0.5,
+                             label=f"{ds['name'].values[c]}  ({100 * frac[c]:.1f}%)"))
+    if show_attractors:
+        for c in range(1, ncode):
+            pp = ds["poincare_phi"].values[c]
+            pd = ds["poincare_dphi"].values[c]
+            ok = np.isfinite(pp)
+            ax.plot(pp[ok], pd[ok], marker="o", ls="none", ms=12, mfc="white", mec="white",
+                    zorder=3)
+            ax.plot(pp[ok], pd[ok], marker="o", ls="none", ms=7, mfc=colors[c], mec="k",
+                    mew=1.2, zorder=4)
+        handles.append(Line2D([], [], marker="o", ls="none", ms=7, mfc="white", mec="k",
+                              label="attractor on the section"))
+    ax.legend(handles=handles, loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=9,
+              frameon=False)
+    ax.set_xlabel(r"$\varphi(t_0)$ (rad, from hanging)")
+    ax.set_ylabel(r"$\dot\varphi(t_0)$")
+    ax.set_xticks([-math.pi, -math.pi / 2, 0, math.pi / 2, math.pi],
+                  [r"$-\pi$", r"$-\pi/2$", "0", r"$\pi/2$", r"$\pi$"])
+    ax.set_xlim(phi[0] - dx / 2, phi[-1] + dx / 2)
+    ax.set_ylim(dphi[0] - dy / 2, dphi[-1] + dy / 2)
+    if title is None:
+        a = ds.attrs
+        title = (rf"Basins, Eq. 1: $\gamma={a['gamma']:g}$, $p={a['p']:g}$, "
+                 rf"$\omega={a['omega']:g}$ ({phi.size}$\times${dphi.size}, "
+                 f"{a['periods']} periods max)")
+    ax.set_title(title, fontsize=10)
+    _save(fig, path)
+    return fig
+
+
+def plot_rotation_boundaries(ds: xr.Dataset, *, path: str | Path | None = None) -> Figure:
+    """Curves J, G, E of the period-1 rotation in the ``(omega, p)`` plane (Fig. 2 left).
+
+    Parameters
+    ----------
+    ds : xarray.Dataset
+        Output of :func:`parapend.dynamics.continuation.rotation_boundaries`.
+    path : str or Path, optional
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
+    fig = _new_figure((6.4, 4.6))
+    ax = fig.add_subplot()
+    om = ds["omega"].values
+    styles = {"p_J": ("k", "-", "J: birth (fold)"), "p_G": ("0.45", "--", "G: loss of "
+                                                             "stability (period doubling)"),
+              "p_E": ("0.45", ":", "E: stability regained (period doubling)")}
+    for key, (c, ls, lab) in styles.items():
+        ax.plot(om, ds[key].values, color=c, ls=ls, marker=".", label=lab)
+    ax.set_xlabel(r"$\omega$")
+    ax.set_ylabel(r"$p$")
+    ax.set_title(rf"Period-1 rotation of Eq. 1, $\gamma = {ds.attrs['gamma']:g}$", fontsize=10)
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=8)
+    _save(fig, path)
+    return fig
+
+
+def legend_of(ds: xr.Dataset) -> dict[int, str]:
+    """``{code: name}`` of a basin dataset (from its JSON ``legend`` attribute)."""
+    return {int(k): v for k, v in json.loads(ds.attrs["legend"]).items()}
