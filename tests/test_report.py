@@ -20,12 +20,13 @@ def report_dir(tmp_path_factory):
 
 def test_files_written(report_dir):
     figs = {p.name for p in (report_dir / "figures").iterdir()}
-    for key in ("fig4", "fig5", "fig6", "fig7", "fig8", "fig9", "fig10"):
+    for key in ("fig1", "fig2a", "fig2b", "fig4", "fig5", "fig6", "fig7", "fig8", "fig9",
+                "fig10"):
         assert f"{key}.png" in figs and f"{key}.svg" in figs
         assert (report_dir / "figures" / f"{key}.png").stat().st_size > 10_000
     assert {p.name for p in (report_dir / "tables").iterdir()} >= {
         "table1.csv", "table2.csv", "table3.csv", "scalars.csv"}
-    assert (report_dir / "report.html").read_text().count("data:image/png;base64,") == 7
+    assert (report_dir / "report.html").read_text().count("data:image/png;base64,") == 10
 
 
 def test_key_numbers(report_dir):
@@ -51,6 +52,17 @@ def test_key_numbers(report_dir):
     f9 = r["figures"]["fig9"]
     assert len(f9["power"]) >= 3 and max(f9["power"]) - min(f9["power"]) < 1e-6
     assert all(abs(v - 2 * 3.141592653589793) < 1e-3 for v in f9["theta_at_half_period"])
+    # Fig. 1: the recorded initial conditions reach the attractors they are named after, and
+    # the rotation's Floquet multipliers obey Liouville's formula
+    f1 = r["figures"]["fig1"]
+    assert all(k == v for k, v in f1["reached"].items())
+    assert f1["rotation_floquet_product"] == pytest.approx(f1["liouville_exp_minus_gamma_T"],
+                                                           rel=1e-8)
+    # Fig. 2: both paper cases lie between J and G (stable rotation); basins sum to one
+    f2 = r["figures"]["fig2a"]
+    i = f2["omega"].index(1.8)
+    assert f2["p_J"][i] < 0.5 < f2["p_G"][i]
+    assert sum(r["figures"]["fig2b"]["basin_fraction"]) == pytest.approx(1.0)
     dev = [row["max_deviation_from_uniform"] for row in r["figures"]["fig10"]]
     assert all(b < a for a, b in zip(dev, dev[1:])) and dev[-1] < 1e-3
 
@@ -102,7 +114,7 @@ def test_report_renders_in_headless_chromium(report_dir, tmp_path):
              f"--user-data-dir={tmp_path / 'profile'}"]
     dom = subprocess.run([exe, *flags, "--virtual-time-budget=5000", "--dump-dom",
                           probe.as_uri()], capture_output=True, text=True, timeout=120)
-    assert "<title>IMAGES:7:7</title>" in dom.stdout
+    assert "<title>IMAGES:10:10</title>" in dom.stdout
     shot = tmp_path / "shot.png"
     subprocess.run([exe, *flags, f"--screenshot={shot}", "--window-size=1100,3000",
                     (report_dir / "report.html").as_uri()], capture_output=True, timeout=120)

@@ -131,10 +131,12 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--plot", metavar="PNG", help="draw power against N (PNG or SVG)")
     p.add_argument("--json", action="store_true", help="print one JSON object")
 
-    p = sub.add_parser("figure", help="recompute one of the paper's figures 4-10",
-                       description="Recompute one of the paper's figures (4-10; 5, 7 and 10 "
-                                   "are the Euler-Lagrange BVP solutions) and save it.")
-    p.add_argument("number", choices=["4", "5", "6", "7", "8", "9", "10"],
+    p = sub.add_parser("figure", help="recompute one of the paper's figures",
+                       description="Recompute one of the paper's figures and save it: 1 "
+                                   "(uncontrolled motions), 2a/2b (rotation boundaries, "
+                                   "basins), 4-10 (optima; 5, 7 and 10 are Euler-Lagrange BVP "
+                                   "solutions).")
+    p.add_argument("number", choices=["1", "2a", "2b", "4", "5", "6", "7", "8", "9", "10"],
                    help="figure number in the paper")
     p.add_argument("--plot", metavar="PNG", required=True, help="output file (PNG or SVG)")
     p.add_argument("--json", action="store_true", help="print the figure's numbers as JSON")
@@ -381,7 +383,7 @@ def _cmd_figure(a) -> dict | str:
     fig, numbers = paper_figure(f"fig{a.number}")
     save_figure(fig, a.plot)
     if a.json:
-        return {"figure": int(a.number), "file": a.plot, "numbers": numbers}
+        return {"figure": a.number, "file": a.plot, "numbers": numbers}
     return f"figure {a.number} written to {a.plot}"
 
 

@@ -251,3 +251,63 @@ def fig10(epsilon: float = 1e-3, alphas=(0.1, 0.03, 0.01, 0.001)) -> dict:
     curves.append(("uniform rotation omega t + pi", tau, 2 * math.pi * tau + math.pi))
     return {"panel": {"title": f"square wave, Eq. 27, epsilon = {epsilon:g}", "curves": curves,
                       "limit": None}, "numbers": numbers, "omega": omega}
+
+
+# ---------------------------------------------------------------------------------------
+# Uncontrolled dynamics (Eq. 1, angle phi from the hanging position; theta = phi + pi)
+FIG2_BASINS = {"gamma": 0.1, "p": 0.5, "omega": 1.8}  # damping not given in the paper
+FIG2_OMEGAS = tuple(round(0.9 + 0.15 * i, 2) for i in range(15))
+
+
+def fig1() -> dict:
+    """Fig. 1 right: a period-2 oscillation and a period-1 rotation of Eq. 1 coexisting."""
+    from .dynamics.attractors import find_attractors
+    from .dynamics.continuation import periodic_orbit
+    from .dynamics.figures import COEXISTENCE_CASE, plot_coexistence
+
+    g, p, w = (COEXISTENCE_CASE[k] for k in ("gamma", "p", "omega"))
+    ics = COEXISTENCE_CASE["initial_conditions"]
+    phi0 = np.array([v[0] for v in ics.values()])
+    dphi0 = np.array([v[1] for v in ics.values()])
+    search = find_attractors(phi0, dphi0, g, p, w)
+    reached = {name: search.legend[int(c)] for name, c in zip(ics, search.labels)}
+    rot = [a for a in search.attractors if a.kind == "rotation" and a.winding > 0][0]
+    orbit = periodic_orbit(g, p, w, phi0=float(rot.phi[0]), dphi0=float(rot.dphi[0]))
+    numbers = {"gamma": g, "p": p, "omega": w, "convention": "paper Eq. 1 (phi from hanging)",
+               "initial_conditions": {k: list(v) for k, v in ics.items()},
+               "reached": reached,
+               "attractors": [{"name": a.name, "period": a.period, "winding": a.winding,
+                               "poincare_phi": a.phi.tolist(), "poincare_dphi": a.dphi.tolist()}
+                              for a in search.attractors],
+               "rotation_floquet_abs": np.abs(orbit.multipliers).tolist(),
+               "rotation_floquet_product": float(np.prod(orbit.multipliers).real),
+               "liouville_exp_minus_gamma_T": math.exp(-g * 2 * math.pi / w),
+               "rotation_stable": bool(orbit.stable)}
+    return {"figure": plot_coexistence(g, p, w), "numbers": numbers}
+
+
+def fig2_left(omegas=FIG2_OMEGAS, gamma: float = 0.1) -> dict:
+    """Fig. 2 left: period-1 rotation birth (J) and stability boundaries (G, E) in (omega, p)."""
+    from .dynamics.continuation import rotation_boundaries
+    from .dynamics.figures import plot_rotation_boundaries
+
+    ds = rotation_boundaries(gamma, np.asarray(omegas))
+    numbers = {"gamma": gamma, "omega": ds["omega"].values.tolist(),
+               **{k: ds[k].values.tolist() for k in ("p_J", "p_G", "p_E")},
+               "convention": "paper Eq. 1 (p, omega)"}
+    return {"figure": plot_rotation_boundaries(ds), "numbers": numbers}
+
+
+def fig2_right(case=None) -> dict:
+    """Fig. 2 right: basins of attraction of Eq. 1 (p = 0.5, omega = 1.8)."""
+    from .dynamics.basins import basin_map
+    from .dynamics.figures import plot_basins
+
+    case = dict(FIG2_BASINS if case is None else case)
+    ds = basin_map(case["gamma"], case["p"], case["omega"], split_phases=True)
+    names = [str(v) for v in ds["name"].values]
+    numbers = {**case, "grid": [int(ds.sizes[d]) for d in ds["attractor"].dims],
+               "attractors": names,
+               "basin_fraction": [float(v) for v in ds["basin_fraction"].values],
+               "convention": "paper Eq. 1 (phi from hanging)"}
+    return {"figure": plot_basins(ds), "numbers": numbers}
