@@ -426,10 +426,14 @@ def main(argv=None) -> int:
     except SolverError as exc:
         print(f"parapend {a.command}: solver error: {exc}", file=sys.stderr)
         return 1
-    if isinstance(out, dict):
-        print(json.dumps(to_jsonable(out), indent=2))
-    else:
-        print(out)
+    try:
+        if isinstance(out, dict):
+            print(json.dumps(to_jsonable(out), indent=2))
+        else:
+            print(out)
+        sys.stdout.flush()
+    except BrokenPipeError:  # e.g. `parapend optimize | head`: the reader left, not an error
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
     return 0
 
 
