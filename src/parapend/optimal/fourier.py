@@ -28,8 +28,11 @@ direction (escaping saddles), with a backtracking line search that never decreas
 It is started from several seeds and the best local maximum wins:
 
 - ``limit``: the gamma -> 0 piecewise-constant motion (closed form, :mod:`.limit`),
-  projected onto N harmonics with Lanczos smoothing;
-- ``uniform``: the best uniform rotation (Eq. 17), nudged along the best ascent direction;
+  projected onto N harmonics with Lanczos smoothing; with several maxima of q per period,
+  up to 8 of its equally good half-turn direction patterns (``limit-1``, ...), which lead
+  to different optima once gamma > 0;
+- ``uniform``: the best uniform rotation (Eq. 17), optimized first with 8 harmonics and
+  then padded (continuation in N; see ``_uniform_start``);
 - ``warm``: a previous solution (continuation in N or in gamma), padded with zeros, whose
   objective is already the previous optimum, so optima never decrease along a continuation.
 
@@ -48,7 +51,7 @@ from scipy.linalg import eigh
 from scipy.linalg.lapack import dpotrf, dpotrs
 
 from ..power import uniform_power
-from .limit import limit, limit_seed
+from .limit import direction_patterns, limit, limit_seed
 
 __all__ = ["FourierProblem", "LocalSolution", "solve_fourier"]
 
@@ -206,9 +209,11 @@ def _ascent_direction(g: np.ndarray, h: np.ndarray) -> np.ndarray:
         return p
     scale = max(float(np.max(np.abs(np.diag(a)))), 1e-12)
     if float(np.max(np.abs(g))) <= 1e-8 * scale:
+        # at (or very near) a saddle: a unit step along the most positive curvature of P;
+        # the caller caps its length and backtracks, and P rises quadratically along it
         lam, vec = eigh(a, check_finite=False)
         d = vec[:, 0]
-        return d * (1.0 if g @ d >= 0 else -1.0) * math.sqrt(max(-lam[0], 0.0) / scale)
+        return d * (1.0 if g @ d >= 0 else -1.0) * (0.5 if lam[0] < 0 else 0.0)
     mu = 1e-3 * scale
     eye = np.eye(a.shape[0])
     while True:
@@ -283,6 +288,24 @@ def _uniform_seed(excitation, harmonics: int, damping: float) -> np.ndarray:
     return x
 
 
+_UNIFORM_HARMONICS = 8
+
+
+def _uniform_start(excitation, harmonics: int, damping: float, gtol: float) -> np.ndarray:
+    """The best uniform rotation, first optimized with at most 8 harmonics, then padded.
+
+    Continuation in N: from the uniform rotation a Newton run with many harmonics creeps
+    along a long, nearly flat valley (hundreds of iterations at N = 256, and at N = 40 it can
+    stop on a lower local maximum); with 8 harmonics it converges in a few steps, and the
+    padded result starts the N-harmonic run with that power already reached.
+    """
+    x = _uniform_seed(excitation, min(harmonics, _UNIFORM_HARMONICS), damping)
+    if harmonics <= _UNIFORM_HARMONICS:
+        return x
+    small = FourierProblem(excitation, _UNIFORM_HARMONICS, damping)
+    return _pad(newton_maximize(small, x, "uniform", gtol=gtol).x, harmonics)
+
+
 def _pad(x: np.ndarray, harmonics: int) -> np.ndarray:
     """Embed a packed vector with fewer (or more) harmonics into ``harmonics`` terms."""
     n0 = (x.size - 1) // 2
@@ -324,9 +347,12 @@ def solve_fourier(excitation, harmonics: int, damping: float, *, warm: np.ndarra
         starts.append(("warm", _pad(np.asarray(warm, dtype=float), harmonics)))
     for name in seeds:
         if name == "limit":
-            starts.append(("limit", limit_seed(limit(excitation), harmonics).vector))
+            lim = limit(excitation)
+            for i, d in enumerate(direction_patterns(lim)):
+                starts.append(("limit" if i == 0 else f"limit-{i}",
+                               limit_seed(lim, harmonics, d).vector))
         elif name == "uniform":
-            starts.append(("uniform", _uniform_seed(excitation, harmonics, damping)))
+            starts.append(("uniform", _uniform_start(excitation, harmonics, damping, gtol)))
         else:
             raise ValueError(f"seeds: unknown seed {name!r}")
     runs = [newton_maximize(problem, x0, name, gtol=gtol, maxiter=maxiter)

@@ -34,7 +34,7 @@ import numpy as np
 
 from ..trajectory import FourierMotion, PiecewiseConstantMotion
 
-__all__ = ["LimitResult", "limit", "limit_seed"]
+__all__ = ["LimitResult", "direction_patterns", "limit", "limit_seed"]
 
 
 @dataclass(frozen=True, eq=False)
@@ -92,19 +92,58 @@ def limit(excitation) -> LimitResult:
     return LimitResult(power, tv, motion)
 
 
-def limit_seed(lim: LimitResult, harmonics: int) -> FourierMotion:
+def direction_patterns(lim: LimitResult, count: int = 8, seed: int = 0) -> list[np.ndarray]:
+    """Up to ``count`` distinct half-turn direction patterns of the limit motion.
+
+    All patterns (``m + 1`` forward and ``m - 1`` backward half-turns) give the same limit
+    power, but at gamma > 0 they lead to different local optima. The canonical pattern
+    comes first; when there are more than ``count`` patterns the rest are drawn with a seeded
+    generator (reproducible).
+    """
+    from itertools import combinations
+
+    d0 = np.asarray(lim.directions)
+    m = d0.size
+    if m <= 2:
+        return [d0]
+    n_back = (m - 2) // 2
+    total = math.comb(m, n_back)
+    out = [d0]
+    seen = {tuple(d0)}
+    if total <= count:
+        cands = combinations(range(m), n_back)
+    else:
+        rng = np.random.default_rng(seed)
+        cands = (tuple(sorted(rng.choice(m, n_back, replace=False))) for _ in range(50 * count))
+    for back in cands:
+        d = np.ones(m, dtype=int)
+        d[list(back)] = -1
+        if tuple(d) not in seen:
+            seen.add(tuple(d))
+            out.append(d)
+        if len(out) >= count:
+            break
+    return out
+
+
+def limit_seed(lim: LimitResult, harmonics: int, directions=None) -> FourierMotion:
     """Project the limit motion onto ``harmonics`` Fourier terms (Eq. 10), Lanczos-smoothed.
 
-    A starting point for the Fourier optimizer near the basin of the global optimum.
+    A starting point for the Fourier optimizer near the basin of the global optimum;
+    ``directions`` replaces the canonical half-turn directions (see
+    :func:`direction_patterns`).
     """
-    omega = lim.motion.omega
+    motion = lim.motion
+    if directions is not None:
+        motion = PiecewiseConstantMotion(motion.omega, motion.switch_times,
+                                         np.asarray(directions), motion.theta_start)
+    omega = motion.omega
     m = max(1024, 32 * harmonics)
     t = (2 * math.pi / omega) * (np.arange(m) + 0.5) / m
     s = omega * t
-    x = np.fft.rfft(lim.motion.theta(t) - s) / m
+    x = np.fft.rfft(motion.theta(t) - s) / m
     n = np.arange(1, harmonics + 1)
     # the samples sit at half-steps: undo that phase
     c = 2 * x[1:harmonics + 1] * np.exp(1j * n * math.pi / m)
     sigma = np.sinc(n / (harmonics + 1))
-    a0 = float((x[0] * 1).real)
-    return FourierMotion(omega, a0, -c.imag * sigma, c.real * sigma)
+    return FourierMotion(omega, float(x[0].real), -c.imag * sigma, c.real * sigma)
