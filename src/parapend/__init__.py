@@ -11,6 +11,7 @@ The public API mirrors the ``parapend`` command line::
 from .api import EXCITATIONS, build_excitation, damping_sweep, harmonic_table, optimize, threshold
 from .errors import ParameterError, SolverError
 from .excitation import fourier, from_csv, harmonic, square, two_harmonic
+from .optimal.bvp import BVPSolution, solve_bvp_optimum
 from .optimal.limit import limit
 from .power import mean_power, uniform_power
 from .results import OptimizeResult, ThresholdResult
@@ -18,6 +19,7 @@ from .results import OptimizeResult, ThresholdResult
 __version__ = "0.1.0"
 
 __all__ = [
+    "BVPSolution",
     "EXCITATIONS",
     "OptimizeResult",
     "ParameterError",
@@ -33,6 +35,7 @@ __all__ = [
     "limit",
     "mean_power",
     "optimize",
+    "solve_bvp_optimum",
     "square",
     "threshold",
     "two_harmonic",
