@@ -39,7 +39,8 @@ FIG4_HARMONICS = (1, 2, 4, 8, 16, 32)
 
 
 def _row(quantity, paper, value, params, note=""):
-    diff = None if paper is None else value - paper
+    numbers = all(isinstance(v, (int, float)) for v in (paper, value))
+    diff = value - paper if numbers else None
     return {"quantity": quantity, "paper": paper, "parapend": value, "difference": diff,
             "note": note, "parameters": params}
 
