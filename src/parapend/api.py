@@ -75,6 +75,14 @@ def build_excitation(excitation: str = "harmonic", *, omega: float = 1.8, delta:
                          f"got {excitation!r}")
 
 
+def _attrs(exc) -> dict:
+    """Excitation parameters as Dataset attributes (NetCDF-safe: numbers and strings)."""
+    import json
+
+    return {k: v if isinstance(v, (int, float, str)) else json.dumps(v)
+            for k, v in exc.describe().items()}
+
+
 def _message(status: str) -> str:
     return {
         "converged": "converged: gradient below tolerance at a local maximum",
@@ -209,7 +217,7 @@ def harmonic_table(harmonics=range(2, 65), *, gamma: float = 0.0, progress=None,
          "found_by": ("harmonics", found)},
         coords={"harmonics": np.array(ns)},
         attrs={"uniform_power": pu, "limit_power": limit(exc).power, "damping": gamma,
-               **{k: str(v) for k, v in exc.describe().items()}},
+               **_attrs(exc)},
     )
 
 
@@ -317,7 +325,7 @@ def damping_sweep(*, omega: float = 1.8, delta: float = -0.3, harmonics: int = 3
         coords={"damping": gammas},
         attrs={"damping_threshold": thr.damping_threshold,
                "uniform_threshold": thr.uniform_threshold, "limit_power": limit(exc).power,
-               "harmonics": n, **{k: str(v) for k, v in exc.describe().items()}},
+               "harmonics": n, **_attrs(exc)},
     )
 
 

@@ -323,6 +323,13 @@ def _cmd_threshold(a) -> dict | str:
     ])
 
 
+def _dataset_json(ds) -> dict:
+    """A one-dimensional Dataset as JSON: its coordinate, every variable, every attribute."""
+    out = {name: ds[name].values for name in ds.coords}
+    out.update({name: ds[name].values for name in ds.data_vars})
+    return {**out, **ds.attrs}
+
+
 def _cmd_damping_sweep(a) -> dict | str:
     from .api import damping_sweep
 
@@ -334,10 +341,7 @@ def _cmd_damping_sweep(a) -> dict | str:
 
         plot_damping_sweep(ds, a.plot)
     if a.json:
-        return {"damping": ds["damping"].values, "power": ds["power"].values,
-                "uniform_power": ds["uniform_power"].values,
-                "peak_torque": ds["peak_torque"].values,
-                "status": [str(s) for s in ds["status"].values], **ds.attrs}
+        return _dataset_json(ds)
     rows = [[f"{g:.6f}", _fmt(p), _fmt(u), f"{t:.4g}", str(s)] for g, p, u, t, s in zip(
         ds["damping"].values, ds["power"].values, ds["uniform_power"].values,
         ds["peak_torque"].values, ds["status"].values)]
@@ -363,8 +367,7 @@ def _cmd_harmonics(a) -> dict | str:
 
         plot_harmonic_table(ds, a.plot)
     if a.json:
-        return {"harmonics": ds["harmonics"].values, "power": ds["power"].values,
-                "status": [str(s) for s in ds["status"].values], **ds.attrs}
+        return _dataset_json(ds)
     rows = [[str(n), _fmt(p, 8), str(s)] for n, p, s in zip(
         ds["harmonics"].values, ds["power"].values, ds["status"].values)]
     out = [_table(rows, ["N", "optimal P", "status"]), "",

@@ -35,6 +35,14 @@ def save_figure(fig, path) -> Path:
     return path
 
 
+def _finish(fig, path):
+    """Lay out, save if ``path`` is given, and return the figure."""
+    fig.tight_layout()
+    if path is not None:
+        save_figure(fig, path)
+    return fig
+
+
 def _pi_label(v: float) -> str:
     k = int(round(v / np.pi))
     return {0: "0", 1: "π", -1: "-π"}.get(k, f"{k}π")
@@ -79,10 +87,7 @@ def plot_optimum(result, path=None, points: int = 2000):
     ax2.set_xlabel("tau = omega t / 2 pi")
     ax2.grid(alpha=0.3)
     ax2.set_xlim(0, 1)
-    fig.tight_layout()
-    if path is not None:
-        save_figure(fig, path)
-    return fig
+    return _finish(fig, path)
 
 
 def plot_damping_sweep(ds, path=None):
@@ -102,10 +107,7 @@ def plot_damping_sweep(ds, path=None):
     ax.set_ylabel("mean extracted power P")
     ax.grid(alpha=0.3)
     ax.legend()
-    fig.tight_layout()
-    if path is not None:
-        save_figure(fig, path)
-    return fig
+    return _finish(fig, path)
 
 
 def plot_harmonic_table(ds, path=None):
@@ -118,10 +120,7 @@ def plot_harmonic_table(ds, path=None):
     ax.set_ylabel("mean extracted power P")
     ax.grid(alpha=0.3)
     ax.legend()
-    fig.tight_layout()
-    if path is not None:
-        save_figure(fig, path)
-    return fig
+    return _finish(fig, path)
 
 
 def plot_theta_panels(panels, path=None, ncols: int | None = None):
@@ -154,10 +153,7 @@ def plot_theta_panels(panels, path=None, ncols: int | None = None):
         ax.legend(fontsize=7, loc="upper left")
     for ax in list(axes.flat)[n:]:
         ax.set_visible(False)
-    fig.tight_layout()
-    if path is not None:
-        save_figure(fig, path)
-    return fig
+    return _finish(fig, path)
 
 
 def plot_square_approximations(omega: float, alphas, path=None):
@@ -177,7 +173,4 @@ def plot_square_approximations(omega: float, alphas, path=None):
                  fontsize=9)
     ax.grid(alpha=0.3)
     ax.legend(fontsize=8)
-    fig.tight_layout()
-    if path is not None:
-        save_figure(fig, path)
-    return fig
+    return _finish(fig, path)
