@@ -69,3 +69,15 @@ def test_limit_motion_power_equals_total_variation_formula():
                 parapend.fourier([(1, 0.2, 0), (2, 0.15, 1.0), (4, 0.08, 0.3)], omega=2.0)]:
         lim = parapend.limit(exc)
         assert limit_motion_power(lim.motion, exc) == pytest.approx(lim.power, abs=1e-14)
+
+
+def test_peak_torque_against_dense_sampling_and_the_bvp(paper):
+    """Peak |T| (printed by the CLI): equals a 200k-point pointwise maximum, and the Fourier
+    and BVP optima (two methods, same problem) need the same peak torque."""
+    r = parapend.optimize(gamma=5e-4, harmonics=64)
+    t = np.linspace(0, paper.period, 200_001)
+    dense = np.max(np.abs(torque(r.motion, paper, 5e-4, t)))
+    assert r.peak_torque == pytest.approx(dense, rel=1e-8)
+    b = parapend.optimize(gamma=5e-4, harmonics=64, method="bvp")
+    assert b.peak_torque == pytest.approx(r.peak_torque, rel=1e-6)
+    assert b.mean_square_speed == pytest.approx(r.mean_square_speed, rel=1e-8)

@@ -198,8 +198,11 @@ class _Progress:
 
 
 def _fmt(x, digits=6):
+    """Fixed decimals for ordinary magnitudes, significant digits for tiny or huge ones."""
     if x is None:
         return "-"
+    if x != 0 and not 1e-3 <= abs(x) < 1e6:
+        return f"{x:.{digits}g}"
     return f"{x:.{digits}f}"
 
 

@@ -292,6 +292,9 @@ def parse_fourier_terms(text: str) -> tuple:
 
 
 # ---------------------------------------------------------------------------------------
+SQUARE_MAX_HARMONICS = 1 << 20
+
+
 @dataclass(frozen=True, eq=False)
 class SquareExcitation(Excitation):
     """tanh-smoothed square wave ``q = delta*H(t)`` of paper Eq. 26 (Eq. 30 scales it by delta).
@@ -323,8 +326,11 @@ class SquareExcitation(Excitation):
 
     @cached_property
     def spectrum(self) -> np.ndarray:
-        # |Q_k| ~ 4|delta|/(pi k) * exp(-pi k omega alpha/2): keep k while above 1e-17 of Q_1
-        kmax = int(math.ceil(2 * 40.0 / (math.pi * self.omega * self.alpha))) | 1
+        # |Q_k| ~ 4|delta|/(pi k) * exp(-pi k omega alpha/2): keep k while above 1e-17 of Q_1,
+        # but at most SQUARE_MAX_HARMONICS (the optimizers' grids never resolve more; only
+        # alpha * omega < ~2.4e-5 is affected, and q, dq/dt, extrema use the formula anyway)
+        kmax = min(int(math.ceil(2 * 40.0 / (math.pi * self.omega * self.alpha))),
+                   SQUARE_MAX_HARMONICS) | 1
         k = np.arange(kmax + 1, dtype=float)
         x = math.pi * k * self.omega * self.alpha
         with np.errstate(divide="ignore", invalid="ignore"):
