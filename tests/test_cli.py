@@ -132,3 +132,18 @@ def test_figure_command(tmp_path, capsys):
     png = tmp_path / "f8.png"
     code, out, _ = run(capsys, "figure", "8", "--plot", str(png))
     assert code == 0 and png.read_bytes()[:4] == b"\x89PNG"
+
+
+def test_sweeps_save_netcdf(tmp_path, capsys):
+    import xarray as xr
+
+    nc = tmp_path / "h.nc"
+    code, out, _ = run(capsys, "harmonics", "--to", "5", "--save", str(nc), "--json")
+    with xr.open_dataset(nc) as ds:
+        np.testing.assert_array_equal(ds["power"].values, json.loads(out)["power"])
+        assert ds.attrs["omega"] == 1.8
+    nc2 = tmp_path / "s.nc"
+    code, _, _ = run(capsys, "damping-sweep", "--points", "4", "--harmonics", "8",
+                     "--save", str(nc2))
+    with xr.open_dataset(nc2) as ds:
+        assert code == 0 and ds.sizes["damping"] == 4 and "damping_threshold" in ds.attrs

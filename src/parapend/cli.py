@@ -118,6 +118,7 @@ def build_parser() -> argparse.ArgumentParser:
                    help="largest damping (default 1.25 gamma*)")
     p.add_argument("--points", type=_int, default=41, help="number of dampings (default 41)")
     p.add_argument("--plot", metavar="PNG", help="draw power against damping (PNG or SVG)")
+    p.add_argument("--save", metavar="NC", help="write the sweep as a NetCDF file (.nc)")
     p.add_argument("--json", action="store_true", help="print one JSON object")
 
     p = sub.add_parser("harmonics", help="optimal power against the number of harmonics",
@@ -129,6 +130,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--from", dest="n_from", type=_int, default=2, help="smallest N (default 2)")
     p.add_argument("--to", dest="n_to", type=_int, default=64, help="largest N (default 64)")
     p.add_argument("--plot", metavar="PNG", help="draw power against N (PNG or SVG)")
+    p.add_argument("--save", metavar="NC", help="write the table as a NetCDF file (.nc)")
     p.add_argument("--json", action="store_true", help="print one JSON object")
 
     p = sub.add_parser("figure", help="recompute one of the paper's figures",
@@ -326,6 +328,20 @@ def _cmd_threshold(a) -> dict | str:
     ])
 
 
+def _write_dataset(ds, path: str) -> None:
+    """Write a Dataset to NetCDF through a temporary file (an old file is never half-written)."""
+    p = Path(path)
+    fd, tmp = tempfile.mkstemp(dir=p.parent if str(p.parent) else ".", prefix=".tmp-",
+                               suffix=".nc")
+    os.close(fd)
+    try:
+        ds.to_netcdf(tmp)
+        os.replace(tmp, p)
+    finally:
+        if os.path.exists(tmp):
+            os.unlink(tmp)
+
+
 def _dataset_json(ds) -> dict:
     """A one-dimensional Dataset as JSON: its coordinate, every variable, every attribute."""
     out = {name: ds[name].values for name in ds.coords}
@@ -337,12 +353,15 @@ def _cmd_damping_sweep(a) -> dict | str:
     from .api import damping_sweep
 
     _check_output(a.plot, "--plot", (".png", ".svg"))
+    _check_output(a.save, "--save", (".nc",))
     ds = damping_sweep(harmonics=a.harmonics, gamma_max=a.gamma_max, points=a.points,
                        progress=_Progress("damping sweep"), **_excitation_kwargs(a))
     if a.plot:
         from .plotting import plot_damping_sweep
 
         plot_damping_sweep(ds, a.plot)
+    if a.save:
+        _write_dataset(ds, a.save)
     if a.json:
         return _dataset_json(ds)
     rows = [[f"{g:.6f}", _fmt(p), _fmt(u), f"{t:.4g}", str(s)] for g, p, u, t, s in zip(
@@ -361,6 +380,7 @@ def _cmd_harmonics(a) -> dict | str:
     from .api import harmonic_table
 
     _check_output(a.plot, "--plot", (".png", ".svg"))
+    _check_output(a.save, "--save", (".nc",))
     if a.n_from < 1 or a.n_to < a.n_from:
         raise ParameterError(f"--from/--to: expected 1 <= from <= to, got {a.n_from}..{a.n_to}")
     ds = harmonic_table(range(a.n_from, a.n_to + 1), gamma=a.gamma,
@@ -369,6 +389,8 @@ def _cmd_harmonics(a) -> dict | str:
         from .plotting import plot_harmonic_table
 
         plot_harmonic_table(ds, a.plot)
+    if a.save:
+        _write_dataset(ds, a.save)
     if a.json:
         return _dataset_json(ds)
     rows = [[str(n), _fmt(p, 8), str(s)] for n, p, s in zip(
