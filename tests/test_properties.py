@@ -2,7 +2,6 @@
 
 import math
 
-import numpy as np
 from hypothesis import given
 from hypothesis import strategies as st
 
@@ -31,8 +30,7 @@ def test_bounds_and_monotonicity(exc, gamma):
     assert pu - 1e-12 <= b1.power <= b2.power + 1e-12
     assert b2.power <= lim - gamma * exc.omega**2 + 1e-12  # damping costs at least gamma omega^2
     m = FourierMotion.from_vector(exc.omega, b2.x)
-    assert mean_power(m, exc, gamma, points=8192) == np.float64(b2.power) or \
-        abs(mean_power(m, exc, gamma, points=8192) - b2.power) < 1e-11
+    assert abs(mean_power(m, exc, gamma, points=8192) - b2.power) < 1e-11
 
 
 @given(excitations)

@@ -84,10 +84,11 @@ def build_parser() -> argparse.ArgumentParser:
     sub = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)
     sub.required = True
 
-    p = sub.add_parser("optimize", help="optimal period-1 rotation (Fourier series, Eq. 10)",
+    p = sub.add_parser("optimize", help="optimal period-1 rotation (Fourier Eq. 10, BVP Eq. 22)",
                        description="Optimal period-1 rotation by truncated Fourier series "
-                                   "(Eqs. 10-11), beside the best uniform rotation (Eq. 17) "
-                                   "and the gamma -> 0 limit (Eqs. 19, 24, 32 generalized).")
+                                   "(Eqs. 10-11) or the penalized Euler-Lagrange BVP (Eqs. 13, "
+                                   "22, 27), beside the best uniform rotation (Eq. 17) and the "
+                                   "gamma -> 0 limit (Eqs. 19, 24, 32 generalized).")
     _add_excitation(p)
     p.add_argument("--gamma", type=_finite_float("gamma"), default=0.0,
                    help="viscous damping gamma >= 0 (default 0)")
