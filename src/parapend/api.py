@@ -6,7 +6,6 @@ import logging
 import math
 
 import numpy as np
-import xarray as xr
 
 from . import excitation as exc_mod
 from .errors import (
@@ -192,12 +191,15 @@ def _optimize_bvp(exc, gamma: float, n: int, common: dict) -> OptimizeResult:
 
 
 def harmonic_table(harmonics=range(2, 65), *, gamma: float = 0.0, progress=None,
-                   **excitation_args) -> xr.Dataset:
+                   **excitation_args):
     """Optimal power against N, by continuation in N (each solve warm-started from the last).
 
     Because the warm start embeds the (N-1)-harmonic optimum, whose power is already reached,
     and the Newton iteration never lowers the power, the table is nondecreasing in N.
+    Returns an ``xarray.Dataset`` over ``harmonics``.
     """
+    import xarray as xr
+
     exc = build_excitation(**excitation_args)
     gamma = check_nonnegative("gamma", gamma)
     ns = [check_int("harmonics", n, 1, MAX_HARMONICS) for n in harmonics]
@@ -287,12 +289,15 @@ def threshold(*, omega: float = 1.8, delta: float = -0.3, harmonics=None, excita
 
 def damping_sweep(*, omega: float = 1.8, delta: float = -0.3, harmonics: int = 32,
                   excitation="harmonic", square_alpha: float = 0.001, fourier=None, file=None,
-                  gamma_max=None, points: int = 41, progress=None) -> xr.Dataset:
+                  gamma_max=None, points: int = 41, progress=None):
     """Optimal and uniform power against damping (paper Fig. 6), with the threshold gamma*.
 
     ``gamma_max=None`` sweeps to 1.25 gamma*. Solves run from the largest damping down,
-    each warm-started from the previous optimum.
+    each warm-started from the previous optimum. Returns an ``xarray.Dataset`` over
+    ``damping``.
     """
+    import xarray as xr
+
     exc = build_excitation(excitation, omega=omega, delta=delta, square_alpha=square_alpha,
                            fourier=fourier, file=file)
     n = check_int("harmonics", harmonics, 1, MAX_HARMONICS)
