@@ -56,6 +56,7 @@ from .simulate import (
     _check_params,
     _check_steps,
     _RK4Map,
+    initial_conditions,
     phi_to_theta,
 )
 
@@ -660,10 +661,7 @@ def find_attractors(phi0: ArrayLike, dphi0: ArrayLike, gamma: float, p: float, o
     tol, kmax, periods, rcap, steps = _check_search(tol, max_period, periods, capture_radius,
                                                     steps_per_period)
     t0 = check_finite("t0", t0)
-    phi0, dphi0 = np.broadcast_arrays(np.asarray(phi0, dtype=float),
-                                      np.asarray(dphi0, dtype=float))
-    if not (np.all(np.isfinite(phi0)) and np.all(np.isfinite(dphi0))):
-        raise ParameterError("phi0, dphi0: expected finite initial conditions")
+    phi0, dphi0 = initial_conditions(phi0, dphi0)
     shape = phi0.shape
     entries, raw, used, end_th, end_v, stats = _run_search(
         phi_to_theta(phi0).ravel(), dphi0.ravel().copy(), gamma, p, omega, periods=periods,

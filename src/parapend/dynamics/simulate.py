@@ -353,6 +353,15 @@ class Stroboscopic:
         return np.rint((self.phi - self.phi[0]) / (2 * math.pi))
 
 
+def initial_conditions(phi0, dphi0) -> tuple[np.ndarray, np.ndarray]:
+    """Broadcast initial ``(phi, phi')`` to float arrays of one shape; reject non-finite ones."""
+    phi0, dphi0 = np.broadcast_arrays(np.asarray(phi0, dtype=float),
+                                      np.asarray(dphi0, dtype=float))
+    if not (np.all(np.isfinite(phi0)) and np.all(np.isfinite(dphi0))):
+        raise ParameterError("phi0, dphi0: expected finite initial conditions")
+    return phi0, dphi0
+
+
 def stroboscopic(phi0: ArrayLike, dphi0: ArrayLike, gamma: float, p: float, omega: float,
                  periods: int, *, steps_per_period: int = 256, t0: float = 0.0) -> Stroboscopic:
     """Stroboscopic map of paper Eq. 1 for many initial conditions at once (fixed-step RK4).
@@ -383,10 +392,7 @@ def stroboscopic(phi0: ArrayLike, dphi0: ArrayLike, gamma: float, p: float, omeg
     periods = check_int("periods", periods, 0)
     steps = _check_steps(steps_per_period)
     t0 = check_finite("t0", t0)
-    phi0, dphi0 = np.broadcast_arrays(np.asarray(phi0, dtype=float),
-                                      np.asarray(dphi0, dtype=float))
-    if not (np.all(np.isfinite(phi0)) and np.all(np.isfinite(dphi0))):
-        raise ParameterError("phi0, dphi0: expected finite initial conditions")
+    phi0, dphi0 = initial_conditions(phi0, dphi0)
     shape = phi0.shape
     # unwrapped phi = (theta + 2 pi turns) - pi; theta is kept within [-pi, pi) each period
     th = phi_to_theta(phi0).ravel().copy()
