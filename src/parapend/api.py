@@ -17,14 +17,14 @@ from .errors import (
     check_positive,
 )
 from .model import peak_torque as _peak_torque
-from .optimal.fourier import solve_fourier
+from .optimal.fourier import search_fourier, solve_fourier
 from .optimal.limit import limit
 from .power import uniform_power
 from .results import OptimizeResult, ThresholdResult
 from .trajectory import FourierMotion
 
 __all__ = ["EXCITATIONS", "METHODS", "build_excitation", "damping_sweep", "harmonic_table",
-           "motion_samples", "optimize", "threshold"]
+           "motion_samples", "optimize", "spectrum_harmonics", "threshold"]
 
 log = logging.getLogger(__name__)
 
@@ -122,7 +122,8 @@ def optimize(*, omega: float = 1.8, delta: float = -0.3, gamma: float = 0.0, har
     if method == "bvp":
         res = _optimize_bvp(exc, gamma, n, common)
     else:
-        best, runs = solve_fourier(exc, n, gamma, warm=warm)
+        found = search_fourier(exc, n, gamma, warm=warm)
+        best, runs, ev = found.best, found.runs, found.evidence
         motion = FourierMotion.from_vector(exc.omega, best.x)
         maxima = sorted({round(r.power, 12) for r in runs if r.status == "converged"},
                         reverse=True)
@@ -141,12 +142,27 @@ def optimize(*, omega: float = 1.8, delta: float = -0.3, gamma: float = 0.0, har
             strict_maximum=best.strict_maximum,
             quadrature_points=best.points,
             mean_square_speed=motion.mean_square_speed(),
+            search=ev.strategy,
+            candidate_patterns=ev.candidate_patterns,
+            patterns_tried=ev.patterns_tried,
+            polished=ev.polished,
+            abandoned=ev.abandoned,
+            second_power=ev.second_power,
+            upper_bound=ev.upper_bound,
+            bound_gap=ev.upper_bound - best.power,
             _motion=motion,
             **common,
         )
     if throw and not res.success:
         raise SolverError(f"optimize: {res.message}")
     return res
+
+
+def _second(best: float, values) -> float | None:
+    """Best value distinct from ``best`` by more than 1e-9 (relative), or None."""
+    others = [v for v in values if v is not None and math.isfinite(v)
+              and v < best - 1e-9 * max(1.0, abs(best))]
+    return max(others) if others else None
 
 
 def _coefficients(motion: FourierMotion) -> dict:
@@ -184,6 +200,12 @@ def _optimize_bvp(exc, gamma: float, n: int, common: dict) -> OptimizeResult:
         mean_square_speed=sol.mean_square_speed,
         mesh_nodes=sol.mesh_nodes,
         max_residual=sol.max_residual,
+        search="bvp-starts",
+        patterns_tried=len(sol.candidates),
+        polished=sum(v is not None and math.isfinite(v) for v in sol.candidates.values()),
+        second_power=_second(sol.power, sol.candidates.values()),
+        upper_bound=common["limit_power"] - gamma * exc.omega**2,
+        bound_gap=common["limit_power"] - gamma * exc.omega**2 - sol.power,
         continuation_steps=sol.continuation_steps,
         _motion=motion,
         **common,
@@ -196,7 +218,9 @@ def harmonic_table(harmonics=range(2, 65), *, gamma: float = 0.0, progress=None,
 
     Because the warm start embeds the (N-1)-harmonic optimum, whose power is already reached,
     and the Newton iteration never lowers the power, the table is nondecreasing in N.
-    Returns an ``xarray.Dataset`` over ``harmonics``.
+    Returns an ``xarray.Dataset`` over ``harmonics``; its attributes carry the excitation's
+    band (``spectrum_harmonics``: a table that stops below it misses part of q) and the
+    change of the last optimum when N is doubled once (``refinement_change``).
     """
     import xarray as xr
 
@@ -214,13 +238,39 @@ def harmonic_table(harmonics=range(2, 65), *, gamma: float = 0.0, progress=None,
         if progress is not None:
             progress(i + 1, len(ns))
     pu, _ = uniform_power(exc, gamma)
+    change = _refinement_change(exc, ns[-1], [(gamma, powers[-1])]) if ns else math.nan
     return xr.Dataset(
         {"power": ("harmonics", np.array(powers)), "status": ("harmonics", status),
          "found_by": ("harmonics", found)},
         coords={"harmonics": np.array(ns)},
         attrs={"uniform_power": pu, "limit_power": limit(exc).power, "damping": gamma,
+               "spectrum_harmonics": spectrum_harmonics(exc), "refinement_change": change,
                **_attrs(exc)},
     )
+
+
+def spectrum_harmonics(exc, rel: float = 1e-6) -> int:
+    """Highest harmonic ``k`` of ``q`` with ``|Q_k| >= rel * max |Q|`` (the band a
+    resolution N must cover; the square wave's is large, its tail falls like 1/k)."""
+    mag = np.abs(np.asarray(exc.spectrum)[1:])
+    if mag.size == 0 or mag.max() == 0:
+        return 0
+    return int(np.nonzero(mag >= rel * mag.max())[0][-1]) + 1
+
+
+def _resolution(exc, lowest: int = 8, highest: int = 256) -> int:
+    """Smallest power of two >= the excitation's band, within [lowest, highest]."""
+    k = max(spectrum_harmonics(exc), 1)
+    return int(min(highest, max(lowest, 1 << math.ceil(math.log2(k)))))
+
+
+def _refinement_change(exc, n: int, points) -> float:
+    """Largest ``|P*(2N) - P*(N)|`` over ``(gamma, P*(N))`` pairs: the check by refinement."""
+    out = 0.0
+    for g, p in points:
+        fine, _ = solve_fourier(exc, 2 * n, g)
+        out = max(out, abs(fine.power - p))
+    return out
 
 
 def _threshold_at(exc, n: int, gamma0: float, warm, tol: float, maxiter: int):
@@ -228,23 +278,35 @@ def _threshold_at(exc, n: int, gamma0: float, warm, tol: float, maxiter: int):
 
     P* is a maximum of functions affine in gamma, hence convex and nonincreasing; started
     where P* >= 0, each Newton step stays left of the root and the iteration is monotone.
+    The steps follow the current local maximum (warm starts); where they have converged the
+    global search runs at that gamma, and if it finds a higher maximum (another branch) the
+    iteration goes on from there, so the root is that of the global optimum.
     """
     g = gamma0
     p = kin = math.nan
     x = warm
     status = "max_iterations"
-    for it in range(1, maxiter + 1):
-        best, _ = solve_fourier(exc, n, g, warm=x)
+    it = 0
+    full = warm is None
+    while it < maxiter:
+        it += 1
+        best, _ = solve_fourier(exc, n, g, warm=x, seeds=("limit", "uniform") if full else ())
+        full = False
         x = best.x
         p = best.power
         kin = FourierMotion.from_vector(exc.omega, x).mean_square_speed()
         if best.status != "converged":
             return g, p, kin, x, it, best.status
         step = p / kin
-        g += step
         if abs(step) <= tol * max(g, 1e-300):
-            status = "converged"
-            break
+            glob, _ = solve_fourier(exc, n, g, warm=x)
+            if glob.power <= p + 1e-13 * max(1.0, abs(p)):
+                status = "converged"
+                g += step
+                break
+            x = glob.x  # a better branch: continue the Newton iteration from it
+            continue
+        g += step
     return g, p, kin, x, it, status
 
 
@@ -253,7 +315,9 @@ def threshold(*, omega: float = 1.8, delta: float = -0.3, harmonics=None, excita
               throw: bool = False) -> ThresholdResult:
     """Damping threshold gamma* beyond which no power can be extracted (paper Fig. 6, 0.0856).
 
-    ``harmonics=None`` doubles N from 8 until gamma* changes by less than 1e-10 (relative).
+    ``harmonics=None`` starts from N covering the excitation's spectrum (a power of two,
+    at least 8; :func:`spectrum_harmonics`) and doubles N until gamma* changes by less than
+    1e-8 (relative), so every answer is checked by at least one refinement.
     """
     exc = build_excitation(excitation, omega=omega, delta=delta, square_alpha=square_alpha,
                            fourier=fourier, file=file)
@@ -263,44 +327,60 @@ def threshold(*, omega: float = 1.8, delta: float = -0.3, harmonics=None, excita
         return ThresholdResult(0.0, 0.0, 0.0, 0, exc.omega, True, "converged",
                                "constant excitation: no power can be extracted", 0,
                                excitation=exc.describe())
-    ns = [check_int("harmonics", harmonics, 1, MAX_HARMONICS)] if harmonics is not None \
-        else [8, 16, 32, 64, 128, 256]
+    if harmonics is not None:
+        ns = [check_int("harmonics", harmonics, 1, MAX_HARMONICS)]
+    else:
+        n0 = _resolution(exc)
+        ns = [n0 * 2**j for j in range(6) if n0 * 2**j <= max(256, 2 * n0)]
     g_prev = None
     x = None
     total = 0
     g, p, kin, status, n = gamma_u, math.nan, math.nan, "max_iterations", ns[0]
+    change = math.nan
     for n in ns:
         g, p, kin, x, it, status = _threshold_at(exc, n, g if g_prev else gamma_u, x, tol, 60)
         total += it
         if status != "converged":
             break
-        if g_prev is not None and abs(g - g_prev) <= 1e-10 * g:
-            break
+        if g_prev is not None:
+            change = abs(g - g_prev)
+            if change <= 1e-8 * g:
+                break
         g_prev = g
     success = status == "converged"
-    msg = ("converged: optimal power vanishes at this damping" if success
-           else f"threshold iteration did not converge ({status})")
+    if success and len(ns) > 1 and not change <= 1e-8 * g:
+        status, success = "unresolved", False
+        msg = (f"gamma* still changes by {change:.2e} between N = {n // 2} and N = {n}; "
+               "the excitation's spectrum needs more harmonics (pass harmonics=)")
+    else:
+        msg = ("converged: optimal power vanishes at this damping" if success
+               else f"threshold iteration did not converge ({status})")
     res = ThresholdResult(g, gamma_u, p, n, exc.omega, success, status, msg, total,
-                          mean_square_speed=kin, excitation=exc.describe())
+                          mean_square_speed=kin, refinement_change=change,
+                          excitation=exc.describe())
     if throw and not success:
         raise SolverError(f"threshold: {msg}")
     return res
 
 
-def damping_sweep(*, omega: float = 1.8, delta: float = -0.3, harmonics: int = 32,
+def damping_sweep(*, omega: float = 1.8, delta: float = -0.3, harmonics: int | None = None,
                   excitation="harmonic", square_alpha: float = 0.001, fourier=None, file=None,
                   gamma_max=None, points: int = 41, progress=None):
     """Optimal and uniform power against damping (paper Fig. 6), with the threshold gamma*.
 
-    ``gamma_max=None`` sweeps to 1.25 gamma*. Solves run from the largest damping down,
-    each warm-started from the previous optimum. Returns an ``xarray.Dataset`` over
-    ``damping``.
+    ``gamma_max=None`` sweeps to 1.25 gamma*. ``harmonics=None`` takes N = 32 or, when the
+    excitation's spectrum reaches higher, the power of two covering it. Solves run from the
+    largest damping down, each warm-started from the previous optimum. The resolution is
+    checked by one refinement: the sweep's end points are solved again with 2N, and the
+    largest change is the attribute ``refinement_change``. Returns an ``xarray.Dataset``
+    over ``damping``.
     """
     import xarray as xr
 
     exc = build_excitation(excitation, omega=omega, delta=delta, square_alpha=square_alpha,
                            fourier=fourier, file=file)
-    n = check_int("harmonics", harmonics, 1, MAX_HARMONICS)
+    n = (max(32, _resolution(exc, highest=512)) if harmonics is None
+         else check_int("harmonics", harmonics, 1, MAX_HARMONICS))
     npts = check_int("points", points, 2, 100000)
     thr = threshold(excitation=exc)
     gmax = 1.25 * thr.damping_threshold if gamma_max is None else check_positive("gamma-max",
@@ -322,6 +402,8 @@ def damping_sweep(*, omega: float = 1.8, delta: float = -0.3, harmonics: int = 3
         if progress is not None:
             progress(npts - i, npts)
     status.reverse()
+    change = _refinement_change(exc, n, [(float(gammas[0]), power[0]),
+                                         (float(gammas[-1]), power[-1])])
     pu = np.array([uniform_power(exc, float(g))[0] for g in gammas])
     return xr.Dataset(
         {"power": ("damping", power), "uniform_power": ("damping", pu),
@@ -330,7 +412,7 @@ def damping_sweep(*, omega: float = 1.8, delta: float = -0.3, harmonics: int = 3
         coords={"damping": gammas},
         attrs={"damping_threshold": thr.damping_threshold,
                "uniform_threshold": thr.uniform_threshold, "limit_power": limit(exc).power,
-               "harmonics": n, **_attrs(exc)},
+               "harmonics": n, "refinement_change": change, **_attrs(exc)},
     )
 
 

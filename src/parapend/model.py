@@ -32,26 +32,43 @@ def torque(motion, excitation, damping: float, t):
             - (1.0 + excitation.q(t)) * np.sin(th))
 
 
-def peak_torque(motion, excitation, damping: float, points: int = 4096) -> float:
-    """``max |T(t)|`` over one period: the largest of ``points`` uniform samples, refined by a
-    bounded scalar search around it.
+def _sample_points(motion, excitation) -> int:
+    """Uniform samples per period that resolve a Fourier motion's torque: a power of two
+    with at least 16 points per top harmonic of the motion and 8 per harmonic of ``q``."""
+    k = max(int(getattr(motion, "harmonics", 0)), int(np.size(excitation.spectrum)) - 1, 256)
+    return 1 << int(np.ceil(np.log2(16 * k)))
 
-    Fourier motions are sampled by inverse FFTs (``FourierMotion.on_grid``), others pointwise.
+
+def peak_torque(motion, excitation, damping: float, points: int | None = None) -> float:
+    """``max |T(t)|`` over one period, taken from the motion's own resolution.
+
+    The samples come from the motion itself: a motion with ``sample_times()`` (the BVP's
+    spectral elements: points inside every element, so a boundary layer a thousandth of the
+    period wide is sampled as finely as the rest) gives its own; a Fourier motion is
+    sampled by inverse FFTs on a grid with 16 points per top harmonic
+    (``FourierMotion.on_grid``; ``points`` overrides). The largest sample is then refined
+    by a bounded scalar search between its neighbours.
     """
     from scipy.optimize import minimize_scalar
 
     period = 2 * np.pi / motion.omega
-    t = period * np.arange(points) / points
-    if hasattr(motion, "on_grid") and points > 2 * motion.harmonics:
-        th, thd, thdd = motion.on_grid(points)
-        tq = np.abs(thdd + damping * thd - (1.0 + excitation.q(t)) * np.sin(th))
-    else:
+    if points is None and hasattr(motion, "sample_times"):
+        t = np.asarray(motion.sample_times(), dtype=float)
         tq = np.abs(torque(motion, excitation, damping, t))
+    else:
+        points = points or _sample_points(motion, excitation)
+        t = period * np.arange(points) / points
+        if hasattr(motion, "on_grid") and points > 2 * motion.harmonics:
+            th, thd, thdd = motion.on_grid(points)
+            tq = np.abs(thdd + damping * thd - (1.0 + excitation.q(t)) * np.sin(th))
+        else:
+            tq = np.abs(torque(motion, excitation, damping, t))
     i = int(np.argmax(tq))
-    h = period / points
+    lo = t[i - 1] if i > 0 else t[-1] - period
+    hi = t[i + 1] if i + 1 < t.size else t[0] + period
     r = minimize_scalar(lambda x: -abs(float(torque(motion, excitation, damping, x))),
-                        bounds=(t[i] - h, t[i] + h), method="bounded",
-                        options={"xatol": 1e-10 * period})
+                        bounds=(lo, hi), method="bounded",
+                        options={"xatol": 1e-12 * period})
     return float(max(tq[i], -r.fun))
 
 

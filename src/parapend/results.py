@@ -65,6 +65,15 @@ class OptimizeResult(_Result):
         "fourier" (Eq. 10, N harmonics) or "bvp" (Euler-Lagrange BVP, Eqs. 13/22/27); for
         "bvp", ``coefficients`` is the N-harmonic Fourier projection of the BVP motion, and
         ``mesh_nodes``, ``max_residual``, ``continuation_steps`` describe the solve.
+    search, candidate_patterns, patterns_tried, polished, abandoned : the evidence of the
+        global search (docs/global.md): ``search`` is "exhaustive" (every half-turn
+        direction pattern of the limit motion, ``candidate_patterns`` of them, was a seed),
+        "dynamic-programme" (too many to list: seeds from the (t, theta) dynamic programme),
+        or "bvp-starts"; runs carried to convergence and runs abandoned as unable to win.
+    second_power : float or None
+        Best other local maximum found (None: every run reached the optimum).
+    upper_bound, bound_gap : ``limit_power - gamma omega^2`` (no rotation does better, as
+        ``<theta'^2> >= omega^2``) and its distance to ``power``.
     """
 
     power: float
@@ -87,6 +96,14 @@ class OptimizeResult(_Result):
     strict_maximum: bool = False
     quadrature_points: int = 0
     mean_square_speed: float = float("nan")
+    search: str = ""
+    candidate_patterns: int = 1
+    patterns_tried: int = 0
+    polished: int = 0
+    abandoned: int = 0
+    second_power: float | None = None
+    upper_bound: float = float("nan")
+    bound_gap: float = float("nan")
     mesh_nodes: int | None = None
     max_residual: float | None = None
     continuation_steps: int | None = None
@@ -107,7 +124,8 @@ class ThresholdResult(_Result):
 
     ``power_at_threshold`` is the optimal power at ``damping_threshold`` (zero to the
     solver's tolerance); ``uniform_threshold`` is ``|Q1|/(2 omega)``, where the best uniform
-    rotation stops extracting.
+    rotation stops extracting. ``harmonics`` is the final N; ``refinement_change`` is
+    ``|gamma*(N) - gamma*(N/2)|``, the check by one refinement (NaN when N was given).
     """
 
     damping_threshold: float
@@ -120,5 +138,6 @@ class ThresholdResult(_Result):
     message: str
     iterations: int
     mean_square_speed: float = float("nan")
+    refinement_change: float = float("nan")
     excitation: dict = field(default_factory=dict)
     convention: str = CONVENTION

@@ -51,9 +51,10 @@ from scipy.linalg import eigh
 from scipy.linalg.lapack import dpotrf, dpotrs
 
 from ..power import uniform_power
-from .limit import direction_patterns, limit, limit_seed
+from .limit import all_patterns, direction_patterns, limit, limit_seed, pattern_count
 
-__all__ = ["FourierProblem", "LocalSolution", "solve_fourier"]
+__all__ = ["FourierProblem", "FourierSearch", "LocalSolution", "SearchEvidence",
+           "search_fourier", "solve_fourier"]
 
 
 def _grid_size(harmonics: int, excitation) -> int:
@@ -195,8 +196,10 @@ def _cholesky_solve(a: np.ndarray, g: np.ndarray) -> np.ndarray | None:
     return p if info == 0 else None
 
 
-def _ascent_direction(g: np.ndarray, h: np.ndarray) -> np.ndarray:
-    """Ascent step: Newton where ``-H`` is positive definite, else a shifted Newton step.
+def _ascent_step(g: np.ndarray, h: np.ndarray) -> tuple[np.ndarray, bool]:
+    """Ascent step, and whether it is a Newton step (``-H`` positive definite).
+
+    Newton where ``-H`` is positive definite, else a shifted Newton step:
 
     ``-H + mu I`` is factorized with ``mu`` raised until Cholesky succeeds (Nocedal & Wright,
     Alg. 3.3). Where the gradient is negligible but ``-H`` is indefinite (a saddle such as
@@ -206,20 +209,20 @@ def _ascent_direction(g: np.ndarray, h: np.ndarray) -> np.ndarray:
     a = -h
     p = _cholesky_solve(a, g)
     if p is not None:
-        return p
+        return p, True
     scale = max(float(np.max(np.abs(np.diag(a)))), 1e-12)
     if float(np.max(np.abs(g))) <= 1e-8 * scale:
         # at (or very near) a saddle: a unit step along the most positive curvature of P;
         # the caller caps its length and backtracks, and P rises quadratically along it
         lam, vec = eigh(a, check_finite=False)
         d = vec[:, 0]
-        return d * (1.0 if g @ d >= 0 else -1.0) * (0.5 if lam[0] < 0 else 0.0)
+        return d * (1.0 if g @ d >= 0 else -1.0) * (0.5 if lam[0] < 0 else 0.0), False
     mu = 1e-3 * scale
     eye = np.eye(a.shape[0])
     while True:
         p = _cholesky_solve(a + mu * eye, g)
         if p is not None:
-            return p
+            return p, False
         mu *= 4.0
 
 
@@ -229,12 +232,20 @@ def _is_maximum(h: np.ndarray) -> bool:
 
 
 def newton_maximize(problem: FourierProblem, x0: np.ndarray, seed: str, *,
-                    gtol: float = 1e-11, maxiter: int = 200, max_step: float = 1.0
-                    ) -> LocalSolution:
+                    gtol: float = 1e-11, maxiter: int = 200, max_step: float = 1.0,
+                    abandon_below: float = -math.inf) -> LocalSolution:
     """Safeguarded Newton ascent with backtracking; never lowers ``P``.
 
     Stops when the gradient's max-norm is below ``gtol`` times the excitation scale, when
     no step increases ``P`` above rounding (stalled), or after ``maxiter`` iterations.
+
+    ``abandon_below`` prunes a run that cannot win (status ``"abandoned"``): once the
+    iterate is in the concave region (``-H`` positive definite, uncapped Newton step), the
+    quadratic model predicts the remaining increase ``g^T (-H)^{-1} g / 2``; when even
+    ``_ABANDON_SAFETY`` times that cannot lift ``P`` above ``abandon_below`` (the best power
+    found so far) by more than 1e-10 of the excitation scale, the run stops: it leads to a
+    lower maximum or to the same one again. Near a maximum Newton converges quadratically,
+    so the model's prediction is accurate to its own square there.
     """
     x = np.array(x0, dtype=float)
     scale = max(float(np.max(np.abs(problem.w))), 1e-300)
@@ -250,8 +261,13 @@ def newton_maximize(problem: FourierProblem, x0: np.ndarray, seed: str, *,
             status = "converged"
             it -= 1
             break
-        d = _ascent_direction(g, h)
+        d, newton = _ascent_step(g, h)
         norm = float(np.max(np.abs(d)))
+        if abandon_below > -math.inf and it > 1 and norm <= max_step and newton:
+            gain = 0.5 * float(g @ d)
+            if p + _ABANDON_SAFETY * gain < abandon_below + 1e-10 * scale:
+                status = "abandoned"
+                break
         if norm > max_step:
             d *= max_step / norm
         slope = float(g @ d)
@@ -279,6 +295,9 @@ def newton_maximize(problem: FourierProblem, x0: np.ndarray, seed: str, *,
         p, g, h = problem.evaluate(x)
     gn = float(np.max(np.abs(g)))
     return LocalSolution(x, float(p), gn, it, status, seed, problem.points, _is_maximum(h))
+
+
+_ABANDON_SAFETY = 4.0
 
 
 def _uniform_seed(excitation, harmonics: int, damping: float) -> np.ndarray:
@@ -319,7 +338,7 @@ def _pad(x: np.ndarray, harmonics: int) -> np.ndarray:
 
 def _best(runs):
     """Highest power; a converged run wins over an unconverged one within rounding."""
-    finite = [r for r in runs if math.isfinite(r.power)] or runs
+    finite = [r for r in runs if math.isfinite(r.power) and r.status != "abandoned"] or runs
     top = max(finite, key=lambda r: r.power)
     conv = [r for r in finite if r.status == "converged"]
     if conv:
@@ -329,34 +348,171 @@ def _best(runs):
     return top
 
 
-def solve_fourier(excitation, harmonics: int, damping: float, *, warm: np.ndarray | None = None,
-                  seeds: tuple[str, ...] = ("limit", "uniform"), gtol: float = 1e-11,
-                  maxiter: int = 200, points: int | None = None):
-    """Best local maximum of the N-harmonic problem over the given seeds.
+#: Direction patterns are enumerated exhaustively up to this count (12 extrema per period
+#: give C(12, 5) = 792); beyond it the dynamic programme of :mod:`.dynprog` proposes them.
+ENUMERATE_MAX = 1024
+#: Patterns proposed by the dynamic programme (and by seeded sampling) beyond ENUMERATE_MAX.
+PROPOSE_COUNT = 16
 
-    Returns
-    -------
-    best : LocalSolution
-        The best local maximum (ties: first seed), on a grid whose power is converged.
-    runs : list of LocalSolution
-        Every local run, for the record.
+
+@dataclass(frozen=True)
+class SearchEvidence:
+    """How the optimum was found, and how far it can be from the best possible.
+
+    Attributes
+    ----------
+    strategy : str
+        ``"exhaustive"`` (every half-turn direction pattern of the limit motion was a seed),
+        ``"dynamic-programme"`` (too many patterns: candidates from the (t, theta) dynamic
+        programme plus a seeded sample), or ``"local"`` (only the given seeds).
+    candidate_patterns : int
+        Number of half-turn direction patterns, ``C(2m, m - 1)`` for ``2m`` extrema.
+    patterns_tried : int
+        Seeds started from a pattern (or a dynamic-programme path).
+    polished : int
+        Runs carried to convergence.
+    abandoned : int
+        Runs stopped early because their quadratic model could not reach the best power.
+    second_power : float or None
+        Best converged local maximum distinct from the optimum (by more than 1e-9).
+    upper_bound : float
+        ``limit - gamma omega^2``: every rotation has ``<theta'^2> >= omega^2``.
     """
-    problem = FourierProblem(excitation, harmonics, damping, points)
-    starts = []
+
+    strategy: str
+    candidate_patterns: int
+    patterns_tried: int
+    polished: int
+    abandoned: int
+    second_power: float | None
+    upper_bound: float
+
+
+@dataclass(frozen=True)
+class FourierSearch:
+    """Outcome of :func:`search_fourier`: the best local maximum, every run, the evidence."""
+
+    best: LocalSolution
+    runs: list
+    evidence: SearchEvidence
+
+
+def _seeds(excitation, harmonics: int, damping: float, warm, seeds, gtol: float):
+    """Primary seeds (polished to convergence): warm start, canonical limit, uniform."""
+    out = []
     if warm is not None:
-        starts.append(("warm", _pad(np.asarray(warm, dtype=float), harmonics)))
+        out.append(("warm", _pad(np.asarray(warm, dtype=float), harmonics)))
     for name in seeds:
         if name == "limit":
             lim = limit(excitation)
-            for i, d in enumerate(direction_patterns(lim)):
-                starts.append(("limit" if i == 0 else f"limit-{i}",
-                               limit_seed(lim, harmonics, d).vector))
+            out.append(("limit", limit_seed(lim, harmonics).vector))
         elif name == "uniform":
-            starts.append(("uniform", _uniform_start(excitation, harmonics, damping, gtol)))
+            out.append(("uniform", _uniform_start(excitation, harmonics, damping, gtol)))
         else:
             raise ValueError(f"seeds: unknown seed {name!r}")
+    return out
+
+
+def _pattern_seeds(excitation, harmonics: int, damping: float, problem):
+    """Further seeds from the half-turn direction patterns: all, or proposed ones.
+
+    Returns the strategy, the number of patterns and ``(name, x, pattern)`` triples
+    (``pattern`` None for a dynamic-programme path).
+    """
+    lim = limit(excitation)
+    count = pattern_count(lim)
+    if count <= 1:
+        return "exhaustive", count, []
+    if count <= ENUMERATE_MAX:
+        pats = list(all_patterns(lim))[1:]
+        return "exhaustive", count, [(f"limit-{i + 1}", limit_seed(lim, harmonics, d).vector, d)
+                                     for i, d in enumerate(pats)]
+    from .dynprog import propose_seeds
+
+    out = [(name, x, None) for name, x in
+           propose_seeds(excitation, harmonics, damping, problem, PROPOSE_COUNT)]
+    pats = direction_patterns(lim, PROPOSE_COUNT + 1, seed=0)[1:]
+    out += [(f"limit-{i + 1}", limit_seed(lim, harmonics, d).vector, d)
+            for i, d in enumerate(pats)]
+    return "dynamic-programme", count, out
+
+
+#: Swaps of a forward and a backward half-turn at most this many extrema apart are tried by
+#: the pattern local search; and at most SWAP_BUDGET of them in all.
+SWAP_WINDOW = 4
+SWAP_BUDGET = 64
+
+
+def _swap_search(lim, harmonics: int, pattern, run):
+    """Local search over patterns: swap a forward and a nearby backward half-turn.
+
+    ``run(name, x)`` polishes a seed against the best so far and returns the run. Accepts
+    the first improving swap and starts over, until none improves or the budget is spent.
+    Each pass costs ``O(m * SWAP_WINDOW)`` polishes (``2m`` extrema), not ``C(2m, m - 1)``.
+    """
+    d = np.array(pattern)
+    e = d.size
+    tried, best = 0, None
+    improved = True
+    seen = {tuple(d)}
+    while improved and tried < SWAP_BUDGET:
+        improved = False
+        for i in range(e):
+            for k in range(1, SWAP_WINDOW + 1):
+                j = (i + k) % e
+                if d[i] == d[j]:
+                    continue
+                c = d.copy()
+                c[i], c[j] = d[j], d[i]
+                if tuple(c) in seen:
+                    continue
+                seen.add(tuple(c))
+                tried += 1
+                r, better = run(f"swap-{tried}", limit_seed(lim, harmonics, c).vector)
+                if better:
+                    d, best, improved = c, r, True
+                    break
+                if tried >= SWAP_BUDGET:
+                    break
+            if improved or tried >= SWAP_BUDGET:
+                break
+    return tried, best
+
+
+def search_fourier(excitation, harmonics: int, damping: float, *, warm: np.ndarray | None = None,
+                   seeds: tuple[str, ...] = ("limit", "uniform"), gtol: float = 1e-11,
+                   maxiter: int = 200, points: int | None = None) -> FourierSearch:
+    """Global search for the N-harmonic optimum (see the module docstring and docs/global.md).
+
+    The primary seeds (``warm``, ``limit``, ``uniform``) are polished to convergence; then,
+    when ``"limit"`` is among ``seeds``, every other half-turn direction pattern of the limit
+    motion (or, when there are more than :data:`ENUMERATE_MAX`, those the dynamic programme
+    proposes) is started with ``abandon_below`` set to the best power so far.
+    """
+    problem = FourierProblem(excitation, harmonics, damping, points)
     runs = [newton_maximize(problem, x0, name, gtol=gtol, maxiter=maxiter)
-            for name, x0 in starts]
+            for name, x0 in _seeds(excitation, harmonics, damping, warm, seeds, gtol)]
+    strategy, count, extra = "local", pattern_count(limit(excitation)), []
+    if "limit" in seeds:
+        strategy, count, extra = _pattern_seeds(excitation, harmonics, damping, problem)
+    lim = limit(excitation)
+    best_pattern = np.asarray(lim.directions)
+
+    def run(name, x0):
+        bar = _best(runs).power if runs else -math.inf
+        r = newton_maximize(problem, x0, name, gtol=gtol, maxiter=maxiter, abandon_below=bar)
+        runs.append(r)
+        return r, r.status == "converged" and r.power > bar + 1e-13 * max(1.0, abs(bar))
+
+    for name, x0, pattern in extra:
+        _, better = run(name, x0)
+        if better and pattern is not None:
+            best_pattern = pattern
+    swaps = 0
+    if strategy == "dynamic-programme" and damping == 0:
+        # at gamma = 0 the programme ranks patterns poorly (docs/global.md): search near the
+        # best one by swaps
+        swaps, _ = _swap_search(lim, harmonics, best_pattern, run)
     best = _best(runs)
     # grid refinement: double M until the power of the optimum no longer moves
     for _ in range(8):
@@ -366,4 +522,32 @@ def solve_fourier(excitation, harmonics: int, damping: float, *, warm: np.ndarra
         problem = fine
         best = newton_maximize(problem, best.x, best.seed, gtol=gtol, maxiter=maxiter)
         runs.append(best)
-    return best, runs
+    conv = [r.power for r in runs if r.status == "converged"]
+    others = [v for v in conv if v < best.power - 1e-9 * max(1.0, abs(best.power))]
+    evidence = SearchEvidence(
+        strategy=strategy,
+        candidate_patterns=count,
+        patterns_tried=len(extra) + swaps + ("limit" in seeds),
+        polished=sum(r.status == "converged" for r in runs),
+        abandoned=sum(r.status == "abandoned" for r in runs),
+        second_power=max(others) if others else None,
+        upper_bound=limit(excitation).power - damping * excitation.omega**2,
+    )
+    return FourierSearch(best, runs, evidence)
+
+
+def solve_fourier(excitation, harmonics: int, damping: float, *, warm: np.ndarray | None = None,
+                  seeds: tuple[str, ...] = ("limit", "uniform"), gtol: float = 1e-11,
+                  maxiter: int = 200, points: int | None = None):
+    """Best local maximum of the N-harmonic problem (:func:`search_fourier` without evidence).
+
+    Returns
+    -------
+    best : LocalSolution
+        The best local maximum (ties: first seed), on a grid whose power is converged.
+    runs : list of LocalSolution
+        Every local run, for the record.
+    """
+    r = search_fourier(excitation, harmonics, damping, warm=warm, seeds=seeds, gtol=gtol,
+                       maxiter=maxiter, points=points)
+    return r.best, r.runs

@@ -34,7 +34,8 @@ import numpy as np
 
 from ..trajectory import FourierMotion, PiecewiseConstantMotion
 
-__all__ = ["LimitResult", "direction_patterns", "limit", "limit_seed"]
+__all__ = ["LimitResult", "all_patterns", "direction_patterns", "limit", "limit_seed",
+           "pattern_count"]
 
 
 @dataclass(frozen=True, eq=False)
@@ -92,6 +93,32 @@ def limit(excitation) -> LimitResult:
     return LimitResult(power, tv, motion)
 
 
+def pattern_count(lim: LimitResult) -> int:
+    """Number of half-turn direction patterns of the limit motion: ``C(2m, m - 1)``.
+
+    With ``2m`` extrema per period, ``m + 1`` half-turns go forward and ``m - 1`` backward
+    (one net turn, Eq. 3); every choice of the backward ones gives the same limit power.
+    """
+    e = int(np.size(lim.directions))
+    return 1 if e <= 2 else math.comb(e, (e - 2) // 2)
+
+
+def all_patterns(lim: LimitResult):
+    """Every half-turn direction pattern, canonical first (a generator; see pattern_count)."""
+    from itertools import combinations
+
+    d0 = np.asarray(lim.directions)
+    e = d0.size
+    yield d0
+    if e <= 2:
+        return
+    for back in combinations(range(e), (e - 2) // 2):
+        d = np.ones(e, dtype=int)
+        d[list(back)] = -1
+        if not np.array_equal(d, d0):
+            yield d
+
+
 def direction_patterns(lim: LimitResult, count: int = 8, seed: int = 0) -> list[np.ndarray]:
     """Up to ``count`` distinct half-turn direction patterns of the limit motion.
 
@@ -100,24 +127,17 @@ def direction_patterns(lim: LimitResult, count: int = 8, seed: int = 0) -> list[
     comes first; when there are more than ``count`` patterns the rest are drawn with a seeded
     generator (reproducible).
     """
-    from itertools import combinations
-
     d0 = np.asarray(lim.directions)
     m = d0.size
-    if m <= 2:
-        return [d0]
+    if pattern_count(lim) <= count:
+        return list(all_patterns(lim))
     n_back = (m - 2) // 2
-    total = math.comb(m, n_back)
+    rng = np.random.default_rng(seed)
     out = [d0]
     seen = {tuple(d0)}
-    if total <= count:
-        cands = combinations(range(m), n_back)
-    else:
-        rng = np.random.default_rng(seed)
-        cands = (tuple(sorted(rng.choice(m, n_back, replace=False))) for _ in range(50 * count))
-    for back in cands:
+    for _ in range(50 * count):
         d = np.ones(m, dtype=int)
-        d[list(back)] = -1
+        d[rng.choice(m, n_back, replace=False)] = -1
         if tuple(d) not in seen:
             seen.add(tuple(d))
             out.append(d)
