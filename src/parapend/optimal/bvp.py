@@ -797,13 +797,34 @@ def _uniform_branch(exc, damping: float, tol: float, max_nodes: int, p: int) -> 
     return _Candidate(mesh, n, z, p_h, eta, status, maximum, steps, its, "uniform")
 
 
-def _limit_seed(exc, epsilon: float, p: int):
-    """Mesh and start from the gamma -> 0 motion, half-turns smoothed to the layer widths."""
+def _pattern_of(exc, motion):
+    """Turns of ``motion`` at the extrema of q, in half-turns: ``(theta_start, d_k)``.
+
+    The level (a multiple of pi, rounded) in the middle of each dwell between extrema,
+    differenced: ``d_k`` is +-1 for a half-turn, 0 where the motion does not turn, +-2 for a
+    full turn between two dwells. The ``d_k`` sum to 2 (one turn per period).
+    """
+    tk = np.asarray(exc.extrema.t, dtype=float)
+    tp = exc.period
+    mids = 0.5 * (tk + np.append(tk[1:], tk[0] + tp))
+    levels = np.rint(np.asarray(motion.theta(np.append(mids[-1] - tp, mids))) / math.pi)
+    return math.pi * levels[0], np.diff(levels)
+
+
+def _limit_seed(exc, epsilon: float, p: int, pattern=None):
+    """Mesh and start from the gamma -> 0 motion, half-turns smoothed to the layer widths.
+
+    ``pattern = (theta_start, d_k)`` replaces the limit motion's canonical turns (see
+    :func:`_pattern_of`).
+    """
     lim = limit(exc)
     mot = lim.motion
     tp = exc.period
     tk = np.asarray(mot.switch_times, dtype=float)
     dk = np.asarray(mot.directions, dtype=float)
+    theta_start = float(mot.theta_start)
+    if pattern is not None:
+        theta_start, dk = float(pattern[0]), np.asarray(pattern[1], dtype=float)
     hq = 1e-5 * tp
     qpp = np.abs((np.asarray(exc.dq(tk + hq)) - np.asarray(exc.dq(tk - hq))) / (2 * hq))
     wk = np.minimum((epsilon / np.maximum(qpp, 1e-300)) ** (1.0 / 3.0), tp / 16)
@@ -828,7 +849,7 @@ def _limit_seed(exc, epsilon: float, p: int):
     edges[0], edges[-1] = 0.0, tp
     mesh = _Mesh(edges, p)
     t = mesh.t
-    theta = np.full(t.size, float(mot.theta_start))
+    theta = np.full(t.size, theta_start)
     for t0, w, d in zip(tk, wk, dk, strict=True):
         s = -1.0
         for shift in (-tp, 0.0, tp):
@@ -839,11 +860,27 @@ def _limit_seed(exc, epsilon: float, p: int):
     return mesh, n, z
 
 
-def _limit_branch(exc, damping: float, tol: float, max_nodes: int, p: int) -> _Candidate:
-    mesh, n, z = _limit_seed(exc, 2.0 * damping, p)
+def _limit_branch(exc, damping: float, tol: float, max_nodes: int, p: int,
+                  pattern=None, name: str = "limit") -> _Candidate:
+    mesh, n, z = _limit_seed(exc, 2.0 * damping, p, pattern)
     mesh, n, z, p_h, eta, status, maximum, its = _adapt_solve(exc, damping, mesh, n, z, tol,
                                                              max_nodes)
-    return _Candidate(mesh, n, z, p_h, eta, status, maximum, 1, its, "limit")
+    return _Candidate(mesh, n, z, p_h, eta, status, maximum, 1, its, name)
+
+
+#: Harmonics of the Fourier search whose optimum's turn pattern seeds the BVP.
+_FOURIER_SEED_HARMONICS = 24
+
+
+def _fourier_branch(exc, damping: float, tol: float, max_nodes: int, p: int) -> _Candidate:
+    """Start from the turn pattern of the global Fourier optimum (docs/global.md): with
+    several extrema per period the canonical limit pattern is often not the best one."""
+    from ..trajectory import FourierMotion
+    from .fourier import search_fourier
+
+    found = search_fourier(exc, _FOURIER_SEED_HARMONICS, damping)
+    motion = FourierMotion.from_vector(exc.omega, found.best.x)
+    return _limit_branch(exc, damping, tol, max_nodes, p, _pattern_of(exc, motion), "fourier")
 
 
 _MESSAGES = {
@@ -857,7 +894,7 @@ _MESSAGES = {
 
 def solve_bvp_optimum(excitation, damping: float, *, tol: float = 1e-8,
                       max_nodes: int = 200_000, degree: int = 10,
-                      seeds: tuple[str, ...] = ("uniform", "limit"),
+                      seeds: tuple[str, ...] = ("uniform", "limit", "fourier"),
                       throw: bool = False) -> BVPSolution:
     """Optimal period-1 rotation from the penalized Euler-Lagrange BVP (Eqs. 13, 22, 27).
 
@@ -875,8 +912,10 @@ def solve_bvp_optimum(excitation, damping: float, *, tol: float = 1e-8,
         Largest number of unknowns (GLL nodes per period) allowed.
     degree : int
         Polynomial degree ``p`` of the spectral elements (4..16).
-    seeds : tuple of {"uniform", "limit"}
-        Starting points tried; the best converged local maximum wins.
+    seeds : tuple of {"uniform", "limit", "fourier"}
+        Starting points tried; the best converged local maximum wins. ``"fourier"`` (used
+        only when q has several maxima per period) starts from the turn pattern of the
+        global N = 24 Fourier optimum.
     throw : bool
         Raise :class:`~parapend.errors.SolverError` instead of returning an unsuccessful
         result.
@@ -894,10 +933,10 @@ def solve_bvp_optimum(excitation, damping: float, *, tol: float = 1e-8,
         raise ParameterError(f"tol: expected a number in [1e-14, 0.1], got {tol!r}")
     degree = check_int("degree", degree, 4, 16)
     max_nodes = check_int("max_nodes", max_nodes, 16 * _MIN_ELEMENTS)
-    if isinstance(seeds, str) or not seeds or any(s not in ("uniform", "limit")
+    if isinstance(seeds, str) or not seeds or any(s not in ("uniform", "limit", "fourier")
                                                    for s in seeds):
         raise ParameterError(f"seeds: expected a non-empty tuple of 'uniform', 'limit', "
-                             f"got {seeds!r}")
+                             f"'fourier', got {seeds!r}")
     p = int(degree)
     lim = limit(excitation)
     cands = []
@@ -912,8 +951,10 @@ def solve_bvp_optimum(excitation, damping: float, *, tol: float = 1e-8,
     for name in seeds:
         if name == "uniform":
             cands.append(_uniform_branch(excitation, gamma, tol, int(max_nodes), p))
-        elif lim.power > 0:
+        elif name == "limit" and lim.power > 0:
             cands.append(_limit_branch(excitation, gamma, tol, int(max_nodes), p))
+        elif name == "fourier" and np.size(lim.directions) > 2:
+            cands.append(_fourier_branch(excitation, gamma, tol, int(max_nodes), p))
     iterations = sum(c.iterations for c in cands)
     good = [c for c in cands if c.status == "converged" and c.maximum]
     pool = good or [c for c in cands if math.isfinite(c.power)] or cands

@@ -377,6 +377,9 @@ class SearchEvidence:
         Best converged local maximum distinct from the optimum (by more than 1e-9).
     upper_bound : float
         ``limit - gamma omega^2``: every rotation has ``<theta'^2> >= omega^2``.
+    screen_harmonics : int or None
+        N at which the patterns were compared before the best few were polished at the
+        full N (None: compared at the full N).
     """
 
     strategy: str
@@ -386,6 +389,7 @@ class SearchEvidence:
     abandoned: int
     second_power: float | None
     upper_bound: float
+    screen_harmonics: int | None = None
 
 
 @dataclass(frozen=True)
@@ -397,14 +401,13 @@ class FourierSearch:
     evidence: SearchEvidence
 
 
-def _seeds(excitation, harmonics: int, damping: float, warm, seeds, gtol: float):
+def _seeds(excitation, lim, harmonics: int, damping: float, warm, seeds, gtol: float):
     """Primary seeds (polished to convergence): warm start, canonical limit, uniform."""
     out = []
     if warm is not None:
         out.append(("warm", _pad(np.asarray(warm, dtype=float), harmonics)))
     for name in seeds:
         if name == "limit":
-            lim = limit(excitation)
             out.append(("limit", limit_seed(lim, harmonics).vector))
         elif name == "uniform":
             out.append(("uniform", _uniform_start(excitation, harmonics, damping, gtol)))
@@ -413,13 +416,12 @@ def _seeds(excitation, harmonics: int, damping: float, warm, seeds, gtol: float)
     return out
 
 
-def _pattern_seeds(excitation, harmonics: int, damping: float, problem):
+def _pattern_seeds(excitation, lim, harmonics: int, damping: float, problem):
     """Further seeds from the half-turn direction patterns: all, or proposed ones.
 
     Returns the strategy, the number of patterns and ``(name, x, pattern)`` triples
     (``pattern`` None for a dynamic-programme path).
     """
-    lim = limit(excitation)
     count = pattern_count(lim)
     if count <= 1:
         return "exhaustive", count, []
@@ -437,6 +439,11 @@ def _pattern_seeds(excitation, harmonics: int, damping: float, problem):
     return "dynamic-programme", count, out
 
 
+#: Above this many harmonics, and for gamma > 0, the patterns are compared at this N (cost
+#: grows like N^3 per Newton step) and the SCREEN_KEEP best distinct maxima are polished at
+#: the full N.
+SCREEN_HARMONICS = 32
+SCREEN_KEEP = 8
 #: Swaps of a forward and a backward half-turn at most this many extrema apart are tried by
 #: the pattern local search; and at most SWAP_BUDGET of them in all.
 SWAP_WINDOW = 4
@@ -490,12 +497,29 @@ def search_fourier(excitation, harmonics: int, damping: float, *, warm: np.ndarr
     proposes) is started with ``abandon_below`` set to the best power so far.
     """
     problem = FourierProblem(excitation, harmonics, damping, points)
-    runs = [newton_maximize(problem, x0, name, gtol=gtol, maxiter=maxiter)
-            for name, x0 in _seeds(excitation, harmonics, damping, warm, seeds, gtol)]
-    strategy, count, extra = "local", pattern_count(limit(excitation)), []
-    if "limit" in seeds:
-        strategy, count, extra = _pattern_seeds(excitation, harmonics, damping, problem)
     lim = limit(excitation)
+    runs = [newton_maximize(problem, x0, name, gtol=gtol, maxiter=maxiter)
+            for name, x0 in _seeds(excitation, lim, harmonics, damping, warm, seeds, gtol)]
+    strategy, count, extra = "local", pattern_count(lim), []
+    screen = None
+    if "limit" in seeds and count > 1 and harmonics > SCREEN_HARMONICS and damping > 0:
+        # compare the patterns at N = SCREEN_HARMONICS, polish the best few at N (at
+        # gamma = 0 the ranking depends on N itself, docs/global.md: no screening)
+        screen = SCREEN_HARMONICS
+        coarse = search_fourier(excitation, screen, damping, seeds=seeds, gtol=gtol,
+                                maxiter=maxiter)
+        strategy = coarse.evidence.strategy
+        ranked = sorted((r for r in coarse.runs if r.status == "converged"),
+                        key=lambda r: -r.power)
+        kept: list = []
+        for r in ranked:
+            if all(abs(r.power - k.power) > 1e-12 for k in kept):
+                kept.append(r)
+            if len(kept) >= SCREEN_KEEP:
+                break
+        extra = [(f"{r.seed}@N={screen}", _pad(r.x, harmonics), None) for r in kept]
+    elif "limit" in seeds:
+        strategy, count, extra = _pattern_seeds(excitation, lim, harmonics, damping, problem)
     best_pattern = np.asarray(lim.directions)
 
     def run(name, x0):
@@ -509,7 +533,7 @@ def search_fourier(excitation, harmonics: int, damping: float, *, warm: np.ndarr
         if better and pattern is not None:
             best_pattern = pattern
     swaps = 0
-    if strategy == "dynamic-programme" and damping == 0:
+    if strategy == "dynamic-programme" and damping == 0 and screen is None:
         # at gamma = 0 the programme ranks patterns poorly (docs/global.md): search near the
         # best one by swaps
         swaps, _ = _swap_search(lim, harmonics, best_pattern, run)
@@ -527,11 +551,13 @@ def search_fourier(excitation, harmonics: int, damping: float, *, warm: np.ndarr
     evidence = SearchEvidence(
         strategy=strategy,
         candidate_patterns=count,
-        patterns_tried=len(extra) + swaps + ("limit" in seeds),
+        patterns_tried=(coarse.evidence.patterns_tried if screen else
+                        len(extra) + swaps + ("limit" in seeds)),
         polished=sum(r.status == "converged" for r in runs),
         abandoned=sum(r.status == "abandoned" for r in runs),
         second_power=max(others) if others else None,
-        upper_bound=limit(excitation).power - damping * excitation.omega**2,
+        upper_bound=lim.power - damping * excitation.omega**2,
+        screen_harmonics=screen,
     )
     return FourierSearch(best, runs, evidence)
 
