@@ -117,7 +117,7 @@ def optimize(*, omega: float = 1.8, delta: float = -0.3, gamma: float = 0.0, har
         raise ParameterError(f"method: expected one of {', '.join(METHODS)}, got {method!r}")
     pu, _ = uniform_power(exc, gamma)
     lim = limit(exc)
-    common = {"uniform_power": pu, "limit_power": lim.power, "harmonics": n, "damping": gamma,
+    common = {"uniform_power": pu, "limit_power": lim.power, "harmonics": n, "gamma": gamma,
               "omega": exc.omega, "excitation": exc.describe(), "_excitation": exc}
     if method == "bvp":
         res = _optimize_bvp(exc, gamma, n, common)
@@ -218,7 +218,7 @@ def harmonic_table(harmonics=range(2, 65), *, gamma: float = 0.0, progress=None,
         {"power": ("harmonics", np.array(powers)), "status": ("harmonics", status),
          "found_by": ("harmonics", found)},
         coords={"harmonics": np.array(ns)},
-        attrs={"uniform_power": pu, "limit_power": limit(exc).power, "damping": gamma,
+        attrs={"uniform_power": pu, "limit_power": limit(exc).power, "gamma": gamma,
                **_attrs(exc)},
     )
 
@@ -294,7 +294,7 @@ def damping_sweep(*, omega: float = 1.8, delta: float = -0.3, harmonics: int = 3
 
     ``gamma_max=None`` sweeps to 1.25 gamma*. Solves run from the largest damping down,
     each warm-started from the previous optimum. Returns an ``xarray.Dataset`` over
-    ``damping``.
+    ``gamma`` (the damping).
     """
     import xarray as xr
 
@@ -324,10 +324,10 @@ def damping_sweep(*, omega: float = 1.8, delta: float = -0.3, harmonics: int = 3
     status.reverse()
     pu = np.array([uniform_power(exc, float(g))[0] for g in gammas])
     return xr.Dataset(
-        {"power": ("damping", power), "uniform_power": ("damping", pu),
-         "mean_square_speed": ("damping", kin), "peak_torque": ("damping", torque),
-         "status": ("damping", status)},
-        coords={"damping": gammas},
+        {"power": ("gamma", power), "uniform_power": ("gamma", pu),
+         "mean_square_speed": ("gamma", kin), "peak_torque": ("gamma", torque),
+         "status": ("gamma", status)},
+        coords={"gamma": gammas},
         attrs={"damping_threshold": thr.damping_threshold,
                "uniform_threshold": thr.uniform_threshold, "limit_power": limit(exc).power,
                "harmonics": n, **_attrs(exc)},
@@ -346,4 +346,4 @@ def motion_samples(result, points: int = 1000) -> dict:
     motion = result.motion
     t = exc.period * np.arange(npts) / npts
     return {"t": t, "tau": t / exc.period, "theta": motion.theta(t),
-            "theta_dot": motion.theta_dot(t), "torque": torque(motion, exc, result.damping, t)}
+            "theta_dot": motion.theta_dot(t), "torque": torque(motion, exc, result.gamma, t)}

@@ -54,7 +54,7 @@ class OptimizeResult(_Result):
         gamma -> 0 supremum ``omega*TV(q)/(2 pi)`` (Eqs. 19/24/32 generalized).
     gain_over_uniform : float or None
         ``power/uniform_power - 1``; None when the uniform rotation extracts nothing.
-    harmonics, damping, omega : the problem.
+    harmonics, gamma, omega : the problem (gamma: viscous damping, the CLI flag --gamma).
     success, status, message, iterations : convergence (status "converged", "stalled",
         "max_iterations" or "nonfinite"); iterations of the winning Newton run.
     coefficients : dict
@@ -72,7 +72,7 @@ class OptimizeResult(_Result):
     limit_power: float
     gain_over_uniform: float | None
     harmonics: int
-    damping: float
+    gamma: float
     omega: float
     success: bool
     status: str

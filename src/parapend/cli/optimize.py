@@ -99,7 +99,7 @@ def _cmd_optimize(a) -> dict | str:
     if a.json:
         return r.to_dict()
     name = (f"Fourier optimum, N = {r.harmonics} (Eq. 10)" if r.method == "fourier"
-            else f"BVP optimum, epsilon = {2 * r.damping:g} (Eq. 22)")
+            else f"BVP optimum, epsilon = {2 * r.gamma:g} (Eq. 22)")
     rows = [
         ["best uniform rotation (Eq. 17)", _fmt(r.uniform_power), ""],
         [name, _fmt(r.power), _gain(r.power, r.uniform_power)],
@@ -110,7 +110,7 @@ def _cmd_optimize(a) -> dict | str:
            f"{len(r.local_maxima)} distinct local maxima" if r.method == "fourier" else
            f"{r.mesh_nodes} mesh nodes, max residual {r.max_residual:.2g}, "
            f"{r.continuation_steps} continuation steps, found from the {r.found_by} start")
-    out = [f"excitation: {_describe(r.excitation)}; damping gamma = {r.damping:g}", "",
+    out = [f"excitation: {_describe(r.excitation)}; damping gamma = {r.gamma:g}", "",
            _table(rows, ["motion", "power P", "vs uniform"]), "",
            f"status: {r.status} ({how})",
            f"peak torque |T|: {r.peak_torque:.6g}    mean theta'^2: {r.mean_square_speed:.6g}",
@@ -137,19 +137,19 @@ def _optimize_all(a, kw) -> dict | str:
     b = optimize(method="bvp", **kw) if a.gamma > 0 else None
     if a.json:
         return {"uniform_power": f.uniform_power, "limit_power": f.limit_power,
-                "damping": f.damping, "omega": f.omega, "excitation": f.excitation,
+                "gamma": f.gamma, "omega": f.omega, "excitation": f.excitation,
                 "fourier": f.to_dict(), "bvp": None if b is None else b.to_dict()}
     rows = [["best uniform rotation (Eq. 17)", _fmt(f.uniform_power, 10), "", "closed form"],
             [f"Fourier, N = {f.harmonics} (Eq. 10)", _fmt(f.power, 10),
              _gain(f.power, f.uniform_power), f.status],
-            [f"BVP, epsilon = {2 * f.damping:g} (Eq. 22)",
+            [f"BVP, epsilon = {2 * f.gamma:g} (Eq. 22)",
              "-" if b is None else _fmt(b.power, 10),
              "-" if b is None else _gain(b.power, f.uniform_power),
              "needs gamma > 0" if b is None else
              f"{b.status}, {b.mesh_nodes} nodes, residual {b.max_residual:.1e}"],
             ["limit gamma -> 0 (Eqs. 19/24/32)", _fmt(f.limit_power, 10),
              _gain(f.limit_power, f.uniform_power), "closed form, no damping"]]
-    out = [f"excitation: {_describe(f.excitation)}; damping gamma = {f.damping:g}", "",
+    out = [f"excitation: {_describe(f.excitation)}; damping gamma = {f.gamma:g}", "",
            _table(rows, ["method", "power P", "vs uniform", "status"])]
     if b is not None:
         out += ["", f"Fourier - BVP: {f.power - b.power:+.3e}  (agree when N resolves the "
@@ -165,7 +165,7 @@ def _cmd_threshold(a) -> dict | str:
         return r.to_dict()
     return "\n".join([
         f"excitation: {_describe(r.excitation)}",
-        f"damping threshold gamma*: {r.damping_threshold:.10f}  (optimal power vanishes)",
+        f"damping threshold gamma*: {r.gamma_threshold:.10f}  (optimal power vanishes)",
         f"uniform-rotation threshold: {r.uniform_threshold:.10f}  (|Q1| / 2 omega)",
         f"status: {r.status} (N = {r.harmonics}, {r.iterations} Newton steps in gamma)",
     ])
@@ -187,7 +187,7 @@ def _cmd_damping_sweep(a) -> dict | str:
     if a.json:
         return _dataset_json(ds)
     rows = [[f"{g:.6f}", _fmt(p), _fmt(u), f"{t:.4g}", str(s)] for g, p, u, t, s in zip(
-        ds["damping"].values, ds["power"].values, ds["uniform_power"].values,
+        ds["gamma"].values, ds["power"].values, ds["uniform_power"].values,
         ds["peak_torque"].values, ds["status"].values)]
     out = [f"excitation: {ds.attrs['excitation']}, omega={ds.attrs['omega']}; "
            f"N = {ds.attrs['harmonics']}", "",
