@@ -165,7 +165,7 @@ def _cmd_threshold(a) -> dict | str:
         return r.to_dict()
     return "\n".join([
         f"excitation: {_describe(r.excitation)}",
-        f"damping threshold gamma*: {r.gamma_threshold:.10f}  (optimal power vanishes)",
+        f"damping threshold gamma*: {r.damping_threshold:.10f}  (optimal power vanishes)",
         f"uniform-rotation threshold: {r.uniform_threshold:.10f}  (|Q1| / 2 omega)",
         f"status: {r.status} (N = {r.harmonics}, {r.iterations} Newton steps in gamma)",
     ])
