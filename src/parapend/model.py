@@ -36,7 +36,9 @@ def peak_torque(motion, excitation, damping: float, points: int = 4096) -> float
     """``max |T(t)|`` over one period: the largest of ``points`` uniform samples, refined by a
     bounded scalar search around it.
 
-    Fourier motions are sampled by inverse FFTs (``FourierMotion.on_grid``), others pointwise.
+    Fourier motions are sampled by inverse FFTs (``FourierMotion.on_grid``) and ``q`` by a
+    folded inverse FFT (``Excitation.q_uniform``): O(M log M) time and O(M + K) memory for a
+    spectrum of K harmonics (no dense K x M matrix). Other motions are sampled pointwise.
     """
     from scipy.optimize import minimize_scalar
 
@@ -44,7 +46,7 @@ def peak_torque(motion, excitation, damping: float, points: int = 4096) -> float
     t = period * np.arange(points) / points
     if hasattr(motion, "on_grid") and points > 2 * motion.harmonics:
         th, thd, thdd = motion.on_grid(points)
-        tq = np.abs(thdd + damping * thd - (1.0 + excitation.q(t)) * np.sin(th))
+        tq = np.abs(thdd + damping * thd - (1.0 + excitation.q_uniform(points)) * np.sin(th))
     else:
         tq = np.abs(torque(motion, excitation, damping, t))
     i = int(np.argmax(tq))

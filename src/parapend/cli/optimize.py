@@ -5,10 +5,12 @@ from __future__ import annotations
 import csv
 import io
 
+from .. import limits
 from ..errors import ParameterError
 from ..results import CONVENTION
 from . import _output
 from ._common import (
+    FIGURE_SUFFIXES,
     _add_excitation,
     _check_output,
     _dataset_json,
@@ -31,13 +33,15 @@ def add_parsers(sub) -> None:
                                    "gamma -> 0 limit (Eqs. 19, 24, 32 generalized).")
     _add_excitation(p)
     p.add_argument("--gamma", type=_finite_float("gamma"), default=0.0,
-                   help="viscous damping gamma >= 0 (default 0)")
-    p.add_argument("--harmonics", type=_int, default=24, help="number N of harmonics (default 24)")
+                   help="viscous damping gamma in [0, 1e3] (default 0)")
+    p.add_argument("--harmonics", type=_int, default=24,
+                   help=f"number N of harmonics, at most {limits.MAX_HARMONICS} (default 24)")
     p.add_argument("--method", choices=["fourier", "bvp", "all"], default="fourier",
                    help="fourier: Eq. 10 with N harmonics; bvp: Euler-Lagrange BVP (Eqs. 13, "
-                        "22, 27; needs gamma > 0); all: uniform, Fourier, BVP and limit side "
-                        "by side (default fourier)")
-    p.add_argument("--plot", metavar="PNG", help="draw theta(tau) and torque (PNG or SVG)")
+                        "22, 27; needs gamma >= 1e-7); all: uniform, Fourier, BVP and limit "
+                        "side by side (default fourier)")
+    p.add_argument("--plot", metavar="PNG",
+                   help="draw theta(tau) and torque (PNG, SVG or PDF)")
     p.add_argument("--save", metavar="CSV",
                    help="write one period of the motion: t,tau,theta,theta_dot,torque")
     p.add_argument("--json", action="store_true", help="print one JSON object")
@@ -47,18 +51,23 @@ def add_parsers(sub) -> None:
                                    "vanishes (paper Fig. 6: 0.0856 at delta=-0.3, omega=1.8).")
     _add_excitation(p)
     p.add_argument("--harmonics", type=_int, default=None,
-                   help="fixed N (default: doubled from 8 until gamma* converges)")
+                   help=f"fixed N, at most {limits.MAX_THRESHOLD_HARMONICS} (default: doubled "
+                        "from 8 until gamma* converges)")
     p.add_argument("--json", action="store_true", help="print one JSON object")
 
     p = sub.add_parser("damping-sweep", help="optimal power against damping (paper Fig. 6)",
                        description="Optimal and uniform power against damping gamma, from 0 "
                                    "to 1.25 gamma* by default (paper Fig. 6).")
     _add_excitation(p)
-    p.add_argument("--harmonics", type=_int, default=32, help="N (default 32)")
+    p.add_argument("--harmonics", type=_int, default=32,
+                   help=f"N, at most {limits.MAX_SWEEP_HARMONICS} (default 32)")
     p.add_argument("--gamma-max", type=_finite_float("gamma-max"), default=None,
                    help="largest damping (default 1.25 gamma*)")
-    p.add_argument("--points", type=_int, default=41, help="number of dampings (default 41)")
-    p.add_argument("--plot", metavar="PNG", help="draw power against damping (PNG or SVG)")
+    p.add_argument("--points", type=_int, default=41,
+                   help=f"number of dampings, 2 to {limits.MAX_POINTS}, with points x N^2 <= "
+                        f"{limits.MAX_SWEEP_WORK} (default 41)")
+    p.add_argument("--plot", metavar="PNG",
+                   help="draw power against damping (PNG, SVG or PDF)")
     p.add_argument("--save", metavar="NC", help="write the sweep as a NetCDF file (.nc)")
     p.add_argument("--json", action="store_true", help="print one JSON object")
 
@@ -67,10 +76,11 @@ def add_parsers(sub) -> None:
                                    "(nondecreasing in N), beside the uniform and limit powers.")
     _add_excitation(p)
     p.add_argument("--gamma", type=_finite_float("gamma"), default=0.0,
-                   help="viscous damping gamma >= 0 (default 0)")
+                   help="viscous damping gamma in [0, 1e3] (default 0)")
     p.add_argument("--from", dest="n_from", type=_int, default=2, help="smallest N (default 2)")
-    p.add_argument("--to", dest="n_to", type=_int, default=64, help="largest N (default 64)")
-    p.add_argument("--plot", metavar="PNG", help="draw power against N (PNG or SVG)")
+    p.add_argument("--to", dest="n_to", type=_int, default=64,
+                   help=f"largest N, at most {limits.MAX_TABLE_HARMONICS} (default 64)")
+    p.add_argument("--plot", metavar="PNG", help="draw power against N (PNG, SVG or PDF)")
     p.add_argument("--save", metavar="NC", help="write the table as a NetCDF file (.nc)")
     p.add_argument("--json", action="store_true", help="print one JSON object")
 
@@ -78,7 +88,7 @@ def add_parsers(sub) -> None:
 def _cmd_optimize(a) -> dict | str:
     from ..api import motion_samples, optimize
 
-    _check_output(a.plot, "--plot", (".png", ".svg"))
+    _check_output(a.plot, "--plot", FIGURE_SUFFIXES)
     _check_output(a.save, "--save", (".csv",))
     kw = {"gamma": a.gamma, "harmonics": a.harmonics, **_excitation_kwargs(a)}
     if a.method == "all":
@@ -95,7 +105,7 @@ def _cmd_optimize(a) -> dict | str:
     if a.plot:
         from ..plotting import plot_optimum
 
-        plot_optimum(r, a.plot)
+        _output.plot(plot_optimum, r, a.plot)
     if a.json:
         return r.to_dict()
     name = (f"Fourier optimum, N = {r.harmonics} (Eq. 10)" if r.method == "fourier"
@@ -106,15 +116,21 @@ def _cmd_optimize(a) -> dict | str:
         ["limit gamma -> 0 (Eqs. 19/24/32)", _fmt(r.limit_power),
          _gain(r.limit_power, r.uniform_power)],
     ]
-    how = (f"{r.iterations} Newton iterations, found from the {r.found_by} seed, "
-           f"{len(r.local_maxima)} distinct local maxima" if r.method == "fourier" else
-           f"{r.mesh_nodes} mesh nodes, max residual {r.max_residual:.2g}, "
-           f"{r.continuation_steps} continuation steps, found from the {r.found_by} start")
+    if r.found_by == "constant excitation":
+        how = "q is constant: the motion is the uniform rotation theta = omega t"
+    elif r.method == "fourier":
+        how = (f"{r.iterations} Newton iterations, found from the {r.found_by} seed, "
+               f"{len(r.local_maxima)} distinct local maxima")
+    else:
+        how = (f"{r.mesh_nodes} mesh nodes, max residual {r.max_residual:.2g}, "
+               f"{r.continuation_steps} continuation steps, found from the {r.found_by} start")
     out = [f"excitation: {_describe(r.excitation)}; damping gamma = {r.gamma:g}", "",
            _table(rows, ["motion", "power P", "vs uniform"]), "",
            f"status: {r.status} ({how})",
            f"peak torque |T|: {r.peak_torque:.6g}    mean theta'^2: {r.mean_square_speed:.6g}",
            f"convention: {CONVENTION}"]
+    if r.status == "no_power":
+        out.insert(5, f"note: {r.message}")
     if a.save:
         out.append(f"motion written to {a.save}")
     if a.plot:
@@ -134,23 +150,28 @@ def _optimize_all(a, kw) -> dict | str:
         raise ParameterError("--method all: --save and --plot need a single method "
                              "(fourier or bvp)")
     f = optimize(method="fourier", **kw)
-    b = optimize(method="bvp", **kw) if a.gamma > 0 else None
+    b = optimize(method="bvp", **kw) if a.gamma >= limits.MIN_BVP_GAMMA else None
     if a.json:
         return {"uniform_power": f.uniform_power, "limit_power": f.limit_power,
                 "gamma": f.gamma, "omega": f.omega, "excitation": f.excitation,
                 "fourier": f.to_dict(), "bvp": None if b is None else b.to_dict()}
-    rows = [["best uniform rotation (Eq. 17)", _fmt(f.uniform_power, 10), "", "closed form"],
+    rows = [[f"best uniform rotation at gamma = {f.gamma:g} (Eq. 17)",
+             _fmt(f.uniform_power, 10), "", "closed form"],
             [f"Fourier, N = {f.harmonics} (Eq. 10)", _fmt(f.power, 10),
              _gain(f.power, f.uniform_power), f.status],
             [f"BVP, epsilon = {2 * f.gamma:g} (Eq. 22)",
              "-" if b is None else _fmt(b.power, 10),
              "-" if b is None else _gain(b.power, f.uniform_power),
-             "needs gamma > 0" if b is None else
-             f"{b.status}, {b.mesh_nodes} nodes, residual {b.max_residual:.1e}"],
-            ["limit gamma -> 0 (Eqs. 19/24/32)", _fmt(f.limit_power, 10),
-             _gain(f.limit_power, f.uniform_power), "closed form, no damping"]]
+             f"needs gamma >= {limits.MIN_BVP_GAMMA:g}" if b is None else
+             f"{b.status}, {b.mesh_nodes} nodes, residual {b.max_residual:.1e}"
+             if b.mesh_nodes is not None else b.status],
+            ["limit gamma -> 0, undamped (Eqs. 19/24/32)", _fmt(f.limit_power, 10),
+             _gain(f.limit_power, f.uniform_power), "closed form, gamma = 0"]]
     out = [f"excitation: {_describe(f.excitation)}; damping gamma = {f.gamma:g}", "",
            _table(rows, ["method", "power P", "vs uniform", "status"])]
+    if f.gamma > 0:
+        out += ["", f"note: the limit row is the undamped (gamma = 0) supremum, an upper bound; "
+                    f"the other rows are at gamma = {f.gamma:g}"]
     if b is not None:
         out += ["", f"Fourier - BVP: {f.power - b.power:+.3e}  (agree when N resolves the "
                     "boundary layers)"]
@@ -165,8 +186,8 @@ def _cmd_threshold(a) -> dict | str:
         return r.to_dict()
     return "\n".join([
         f"excitation: {_describe(r.excitation)}",
-        f"damping threshold gamma*: {r.damping_threshold:.10f}  (optimal power vanishes)",
-        f"uniform-rotation threshold: {r.uniform_threshold:.10f}  (|Q1| / 2 omega)",
+        f"damping threshold gamma*: {_fmt(r.damping_threshold, 10)}  (optimal power vanishes)",
+        f"uniform-rotation threshold: {_fmt(r.uniform_threshold, 10)}  (|Q1| / 2 omega)",
         f"status: {r.status} (N = {r.harmonics}, {r.iterations} Newton steps in gamma)",
     ])
 
@@ -174,25 +195,25 @@ def _cmd_threshold(a) -> dict | str:
 def _cmd_damping_sweep(a) -> dict | str:
     from ..api import damping_sweep
 
-    _check_output(a.plot, "--plot", (".png", ".svg"))
+    _check_output(a.plot, "--plot", FIGURE_SUFFIXES)
     _check_output(a.save, "--save", (".nc",))
     ds = damping_sweep(harmonics=a.harmonics, gamma_max=a.gamma_max, points=a.points,
                        progress=_Progress("damping sweep"), **_excitation_kwargs(a))
     if a.plot:
         from ..plotting import plot_damping_sweep
 
-        plot_damping_sweep(ds, a.plot)
+        _output.plot(plot_damping_sweep, ds, a.plot)
     if a.save:
         _output.write_dataset(ds, a.save)
     if a.json:
         return _dataset_json(ds)
-    rows = [[f"{g:.6f}", _fmt(p), _fmt(u), f"{t:.4g}", str(s)] for g, p, u, t, s in zip(
+    rows = [[_fmt(g), _fmt(p), _fmt(u), f"{t:.4g}", str(s)] for g, p, u, t, s in zip(
         ds["gamma"].values, ds["power"].values, ds["uniform_power"].values,
         ds["peak_torque"].values, ds["status"].values)]
     out = [f"excitation: {ds.attrs['excitation']}, omega={ds.attrs['omega']}; "
            f"N = {ds.attrs['harmonics']}", "",
            _table(rows, ["gamma", "optimal P", "uniform P", "peak |T|", "status"]), "",
-           f"damping threshold gamma*: {ds.attrs['damping_threshold']:.10f}"]
+           f"damping threshold gamma*: {_fmt(ds.attrs['damping_threshold'], 10)}"]
     if a.plot:
         out.append(f"figure written to {a.plot}")
     return "\n".join(out)
@@ -201,16 +222,21 @@ def _cmd_damping_sweep(a) -> dict | str:
 def _cmd_harmonics(a) -> dict | str:
     from ..api import harmonic_table
 
-    _check_output(a.plot, "--plot", (".png", ".svg"))
+    _check_output(a.plot, "--plot", FIGURE_SUFFIXES)
     _check_output(a.save, "--save", (".nc",))
-    if a.n_from < 1 or a.n_to < a.n_from:
-        raise ParameterError(f"--from/--to: expected 1 <= from <= to, got {a.n_from}..{a.n_to}")
+    top = limits.MAX_TABLE_HARMONICS
+    if not 1 <= a.n_to <= top:
+        raise ParameterError(f"--to: expected an integer in [1, {top}] (the continuation to "
+                             f"{top} takes about 10 s, to 512 over 10 minutes), got {a.n_to}")
+    if not 1 <= a.n_from <= a.n_to:
+        raise ParameterError(f"--from: expected an integer in [1, --to = {a.n_to}], "
+                             f"got {a.n_from}")
     ds = harmonic_table(range(a.n_from, a.n_to + 1), gamma=a.gamma,
                         progress=_Progress("harmonics"), **_excitation_kwargs(a))
     if a.plot:
         from ..plotting import plot_harmonic_table
 
-        plot_harmonic_table(ds, a.plot)
+        _output.plot(plot_harmonic_table, ds, a.plot)
     if a.save:
         _output.write_dataset(ds, a.save)
     if a.json:
@@ -218,8 +244,8 @@ def _cmd_harmonics(a) -> dict | str:
     rows = [[str(n), _fmt(p, 8), str(s)] for n, p, s in zip(
         ds["harmonics"].values, ds["power"].values, ds["status"].values)]
     out = [_table(rows, ["N", "optimal P", "status"]), "",
-           f"best uniform: {ds.attrs['uniform_power']:.8f}    "
-           f"limit gamma -> 0: {ds.attrs['limit_power']:.8f}"]
+           f"best uniform: {_fmt(ds.attrs['uniform_power'], 8)}    "
+           f"limit gamma -> 0 (undamped): {_fmt(ds.attrs['limit_power'], 8)}"]
     if a.plot:
         out.append(f"figure written to {a.plot}")
     return "\n".join(out)

@@ -6,7 +6,15 @@ from pathlib import Path
 
 from ..errors import ParameterError
 from . import _output
-from ._common import _check_output, _fmt, _Progress, _table
+from ._common import (
+    FIGURE_SUFFIXES,
+    _blocking_file,
+    _check_output,
+    _fmt,
+    _Progress,
+    _table,
+    _Ticker,
+)
 
 
 def add_parsers(sub) -> None:
@@ -18,7 +26,9 @@ def add_parsers(sub) -> None:
                                    "solutions).")
     p.add_argument("number", choices=["1", "2a", "2b", "4", "5", "6", "7", "8", "9", "10"],
                    help="figure number in the paper")
-    p.add_argument("--plot", metavar="PNG", required=True, help="output file (PNG or SVG)")
+    p.add_argument("--plot", metavar="PNG", default=None,
+                   help="output file, PNG, SVG or PDF (default: figN.png in the current "
+                        "directory, e.g. fig5.png)")
     p.add_argument("--json", action="store_true", help="print the figure's numbers as JSON")
 
     p = sub.add_parser("reproduce", help="regenerate the paper's tables and figures, with a report",
@@ -33,24 +43,37 @@ def add_parsers(sub) -> None:
 def _cmd_figure(a) -> dict | str:
     from ..report import paper_figure
 
-    _check_output(a.plot, "--plot", (".png", ".svg"))
-    fig, numbers = paper_figure(f"fig{a.number}")
-    _output.save_figure(fig, a.plot)
+    default = a.plot is None
+    path = f"fig{a.number}.png" if default else a.plot
+    _check_output(path, "--plot", FIGURE_SUFFIXES)
+    with _Ticker(f"figure {a.number}"):
+        fig, numbers = paper_figure(f"fig{a.number}")
+    _output.save_figure(fig, path)
     if a.json:
-        return {"figure": a.number, "file": a.plot, "numbers": numbers}
-    return f"figure {a.number} written to {a.plot}"
+        return {"figure": a.number, "file": path, "numbers": numbers}
+    how = " (default name; choose another with --plot)" if default else ""
+    return f"figure {a.number} written to {path}{how}"
 
 
 def _cmd_reproduce(a) -> dict | str:
     from ..report import reproduce
 
+    if not a.out.strip():
+        raise ParameterError("--out: expected a directory name, got an empty string")
     out = Path(a.out)
     if out.exists() and not out.is_dir():
         raise ParameterError(f"--out: expected a directory, got the file {a.out!r}")
+    blocker = _blocking_file(out)
+    if blocker is not None:
+        raise ParameterError(f"--out: {str(blocker)!r} is a file, not a directory")
     if not out.parent.is_dir():
         raise ParameterError(f"--out: parent directory {str(out.parent)!r} does not exist")
-    bar = _Progress("reproduce")
-    res = reproduce(out, progress=lambda done, total, label: bar(done, total))
+    try:
+        _output.probe_dir(out if out.is_dir() else out.parent)
+    except _output.OutputError as exc:
+        raise ParameterError(f"--out: {exc}") from None
+    bar = _Progress("reproduce", delay=0.0)
+    res = reproduce(out, progress=lambda done, total, label: bar(done, total, label))
     if a.json:
         return res
     rows = []
