@@ -257,9 +257,16 @@ def _optimize_bvp(exc, gamma: float, n: int, common: dict) -> OptimizeResult:
                              f"'bvp' (epsilon = 2 gamma; gamma = 0 has no smooth optimum and "
                              f"smaller gamma needs boundary layers finer than the mesh cap), "
                              f"got {gamma!r}")
-    # bounded work: each residual evaluation costs (mesh nodes) x (harmonics of q)
-    k = exc.spectrum.size
-    max_nodes = int(min(200_000, max(20_000, 4e8 // max(k, 1))))
+    extrema = exc.extrema.t.size
+    if extrema > limits.MAX_BVP_EXTREMA:
+        raise ParameterError(
+            f"method: 'bvp' resolves a boundary layer at every extremum of q, and this q has "
+            f"{extrema} extrema per period (at most {limits.MAX_BVP_EXTREMA}); smooth the "
+            "excitation or use method 'fourier'")
+    # bounded work: each residual evaluation costs (mesh nodes) x (harmonics of q); past the
+    # node cap the solver returns status "max_nodes" instead of refining further
+    k = 1 if isinstance(exc, exc_mod.SquareExcitation) else exc.spectrum.size
+    max_nodes = int(min(200_000, max(2_000, limits.MAX_BVP_WORK // k)))
     sol = solve_bvp_optimum(exc, gamma, max_nodes=max_nodes)
     motion = sol.motion()
     m = max(4096, 8 * n)

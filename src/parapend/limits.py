@@ -8,10 +8,10 @@ is in the document above. Only this module holds the numbers.
 from __future__ import annotations
 
 __all__ = [
-    "MAX_AMPLITUDE", "MAX_BYTES_FILE", "MAX_FILE_ROWS", "MAX_FOURIER_K", "MAX_GAMMA",
-    "MAX_HARMONICS", "MAX_PHASE", "MAX_POINTS", "MAX_SWEEP_HARMONICS", "MAX_SWEEP_WORK",
-    "MAX_TABLE_HARMONICS", "MAX_THRESHOLD_HARMONICS", "MIN_BVP_GAMMA", "OMEGA_RANGE",
-    "SQUARE_ALPHA_MIN",
+    "MAX_AMPLITUDE", "MAX_BVP_EXTREMA", "MAX_BVP_WORK", "MAX_BYTES_FILE", "MAX_FILE_ROWS",
+    "MAX_FOURIER_K", "MAX_GAMMA", "MAX_HARMONICS", "MAX_PHASE", "MAX_POINTS",
+    "MAX_SWEEP_HARMONICS", "MAX_SWEEP_WORK", "MAX_TABLE_HARMONICS", "MAX_THRESHOLD_HARMONICS",
+    "MIN_BVP_GAMMA", "OMEGA_RANGE", "SQUARE_ALPHA_MIN",
 ]
 
 #: forcing frequency omega, units sqrt(g/l)
@@ -40,6 +40,10 @@ MAX_SWEEP_HARMONICS = 256
 MAX_POINTS = 1001
 #: points * harmonics**2 of a damping sweep (about a minute of work)
 MAX_SWEEP_WORK = 1 << 20
+#: extrema of q per period for the Euler-Lagrange BVP (each needs a boundary layer)
+MAX_BVP_EXTREMA = 64
+#: mesh nodes x harmonics of q for one BVP (each residual evaluates q at every node)
+MAX_BVP_WORK = 4e7
 #: rows of a sampled-excitation CSV file, and its size in bytes
 MAX_FILE_ROWS = 16384
 MAX_BYTES_FILE = 4 << 20
