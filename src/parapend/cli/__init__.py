@@ -82,7 +82,10 @@ def main(argv=None) -> int:
     if closed:  # keep fd 1 from being reused by an output file opened later
         _silence_stdout()
     parser = build_parser()
-    a = parser.parse_args(argv)
+    try:
+        a = parser.parse_args(argv)
+    except SystemExit as exc:  # --help, --version (0) or a usage error (2, one line printed)
+        return exc.code if isinstance(exc.code, int) else EXIT_USAGE
     if a.command is None:
         parser.print_help(sys.stderr)
         return EXIT_USAGE
