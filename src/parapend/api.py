@@ -447,14 +447,21 @@ def damping_sweep(*, omega: float = 1.8, delta=None, harmonics: int = 32,
     torque = np.empty(npts)
     status = []
     warm = None
+    constant = thr.damping_threshold <= 0  # q constant: only the uniform rotation's loss
     for i in range(npts - 1, -1, -1):
-        best, _ = solve_fourier(exc, n, float(gammas[i]), warm=warm)
-        warm = best.x
-        motion = FourierMotion.from_vector(exc.omega, best.x)
-        power[i] = best.power
+        if constant:
+            motion = FourierMotion(exc.omega, 0.0, np.zeros(n), np.zeros(n))
+            power[i] = 0.0 - float(gammas[i]) * exc.omega**2
+            st = "no_power"
+        else:
+            best, _ = solve_fourier(exc, n, float(gammas[i]), warm=warm)
+            warm = best.x
+            motion = FourierMotion.from_vector(exc.omega, best.x)
+            power[i] = best.power
+            st = best.status
         kin[i] = motion.mean_square_speed()
         torque[i] = _peak_torque(motion, exc, float(gammas[i]))
-        status.append(best.status)
+        status.append(st)
         if progress is not None:
             progress(npts - i, npts)
     status.reverse()
