@@ -57,7 +57,7 @@ def _files(d: Path) -> dict:
     w("header_only.csv", "tau,q\n")
     w("rows15.csv", rows(15))
     w("huge_q.csv", rows(32, q=np.full(32, 1e308)))
-    w("nan_q.csv", rows(32).replace("0.0,0.0", "0.0,nan"))
+    w("nan_q.csv", "tau,q\n0.0,nan\n" + rows(32).split("\n", 2)[2])
     w("tiny_gap.csv", "tau,q\n0.0,0.0\n1e-300,0.0\n" + "\n".join(
         f"{i / 32!r},{math.sin(2 * math.pi * i / 32)!r}" for i in range(2, 32)))
     w("unsorted.csv", "tau,q\n" + "\n".join(f"{(i * 7 % 32) / 32},{i}" for i in range(32)))
@@ -107,7 +107,7 @@ def cli_cases(f: dict, out: str) -> list[tuple[str, list[str], dict]]:
         add("optimize", "--harmonics", v)
     add("optimize", "--harmonics", "1024", heavy=True)
     # excitations
-    for v in ("1e-308", "0", "-1", "1e9", "nan", "1e-9", "3.49e-9"):
+    for v in ("1e-308", "0", "-1", "1e9", "nan", "1e-9", "3.49e-9", "3.5e-9", "0.4363"):
         add("optimize", "--excitation", "square", "--square-alpha", v)
     for v in ("", ",", "1", "1:2:3:4", "0:1", "-1:0.3", "1:nan", "1:inf", "a:b", "2.9:0.3",
               "1000000:0.3", "999999999999:0.3", "1:0.3:1e300", "1:1e300", "1" * 400 + ":1",
@@ -152,7 +152,7 @@ def cli_cases(f: dict, out: str) -> list[tuple[str, list[str], dict]]:
                        ("--save", f"{out}/nodir/x.csv"), ("--save", f"{out}/x.txt"),
                        ("--plot", f"{out}/x"), ("--plot", f"{out}/x.pdf"),
                        ("--plot", f"{out}/x.svg"), ("--save", ""), ("--save", f["dir"]),
-                       ("--save", "/dev/full.csv"), ("--plot", f"{out}/x.PNG")):
+                       ("--plot", f"{out}/x.PNG")):
         add("optimize", "--harmonics", "8", flag, path)
     add("optimize", stdout="full")
     add("optimize", stdout="closed")
@@ -211,10 +211,12 @@ API_CASES = [
     "p.optimize(excitation='square', square_alpha=-1)",
     "p.optimize(excitation='harmonic', file='x.csv')", "p.optimize(warm='x')",
     "p.optimize(warm=[1, 2])", "p.optimize(warm=[float('nan')] * 3)",
-    "p.optimize(bogus=1)", "p.optimize(delta=0)", "p.optimize(gamma=0.09)",
+    "p.optimize(bogus=1)", "p.optimize(delta=0, gamma=0.1, method='bvp')",
+    "p.optimize(delta=0)", "p.optimize(gamma=0.09)",
     "p.threshold(harmonics=0)", "p.threshold(harmonics=10**6)", "p.threshold(tol=-1)",
     "p.threshold(omega=1e-320)", "p.damping_sweep(points=0)", "p.damping_sweep(points=10**9)",
     "p.damping_sweep(points=3, gamma_max=-1)", "p.damping_sweep(delta=0, points=3)",
+    "p.damping_sweep(delta=0, points=3, gamma_max=0.1)",
     "p.harmonic_table(5)", "p.harmonic_table([])", "p.harmonic_table([2, 4096])",
     "p.harmonic_table(['a'])", "p.harmonic_table([2], gamma=-1)", "p.harmonic_table([2], x=1)",
     "p.mean_power(p.optimize(harmonics=2).motion, p.harmonic(), points=0)",

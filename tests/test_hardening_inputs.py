@@ -262,6 +262,11 @@ def test_constant_excitation_is_explicit(capsys):
     assert "peak torque |T|: 1 " in out
     err = one_line_error(capsys, ["damping-sweep", "--delta", "0"])
     assert "constant" in err
+    ds = parapend.damping_sweep(delta=0.0, gamma_max=0.1, points=3, harmonics=4)
+    assert set(ds["status"].values) == {"no_power"}
+    np.testing.assert_allclose(ds["power"].values, -np.array([0, 0.05, 0.1]) * 1.8**2)
+    with pytest.raises(ParameterError, match="excitation: expected an Excitation"):
+        parapend.limit("harmonic")
 
 
 def test_above_threshold_says_no_power(capsys):
