@@ -55,8 +55,11 @@ class OptimizeResult(_Result):
     gain_over_uniform : float or None
         ``power/uniform_power - 1``; None when the uniform rotation extracts nothing.
     harmonics, gamma, omega : the problem (gamma: viscous damping, the CLI flag --gamma).
-    success, status, message, iterations : convergence (status "converged", "stalled",
-        "max_iterations" or "nonfinite"); iterations of the winning Newton run.
+    success, status, message, iterations : convergence. ``success`` means the solver
+        converged; status "converged", "no_power" (converged, but the optimum is P <= 0:
+        gamma at or above gamma*, or a constant q; ``success`` is True), "stalled",
+        "max_iterations", "nonfinite" (Fourier) or the BVP's statuses; iterations of the
+        winning Newton run.
     coefficients : dict
         ``{"a0": float, "a": [N], "b": [N]}`` of Eq. 10.
     peak_torque : float
