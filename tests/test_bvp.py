@@ -87,7 +87,7 @@ def test_paper_case_matches_fourier_reference(gamma):
     assert sol.max_residual <= 1e-8
     assert sol.power == pytest.approx(PAPER_FOURIER[gamma], abs=1e-9)
     assert sol.power_by_parts == pytest.approx(sol.power, abs=1e-12)
-    assert sol.epsilon == 2 * gamma and sol.damping == gamma
+    assert sol.epsilon == 2 * gamma and sol.gamma == gamma
 
 
 def test_paper_case_matches_live_fourier_converged_in_n():

@@ -10,7 +10,7 @@ import pytest
 
 from parapend.cli import main
 
-KEYS = {"power", "uniform_power", "limit_power", "gain_over_uniform", "harmonics", "damping",
+KEYS = {"power", "uniform_power", "limit_power", "gain_over_uniform", "harmonics", "gamma",
         "omega", "success", "status", "message", "iterations", "coefficients", "peak_torque"}
 
 
@@ -120,7 +120,7 @@ def test_method_bvp_json_and_all(capsys):
     d = json.loads(out)
     assert code == 0 and abs(d["fourier"]["power"] - d["bvp"]["power"]) < 1e-9
     code, out, _ = run(capsys, "optimize", "--method", "all")
-    assert code == 0 and "needs gamma > 0" in out
+    assert code == 0 and "needs gamma >= 1e-07" in out
 
 
 def test_method_bvp_needs_damping(capsys):
@@ -146,4 +146,4 @@ def test_sweeps_save_netcdf(tmp_path, capsys):
     code, _, _ = run(capsys, "damping-sweep", "--points", "4", "--harmonics", "8",
                      "--save", str(nc2))
     with xr.open_dataset(nc2) as ds:
-        assert code == 0 and ds.sizes["damping"] == 4 and "damping_threshold" in ds.attrs
+        assert code == 0 and ds.sizes["gamma"] == 4 and "damping_threshold" in ds.attrs

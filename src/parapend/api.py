@@ -8,13 +8,12 @@ import math
 import numpy as np
 
 from . import excitation as exc_mod
+from . import limits
 from .errors import (
     ParameterError,
     SolverError,
-    check_finite,
     check_int,
-    check_nonnegative,
-    check_positive,
+    check_range,
 )
 from .model import peak_torque as _peak_torque
 from .optimal.fourier import search_fourier, solve_fourier
@@ -29,49 +28,94 @@ __all__ = ["EXCITATIONS", "METHODS", "build_excitation", "damping_sweep", "harmo
 log = logging.getLogger(__name__)
 
 EXCITATIONS = ("harmonic", "two-harmonic", "square", "fourier", "file")
-MAX_HARMONICS = 4096
+MAX_HARMONICS = limits.MAX_HARMONICS
+DEFAULT_DELTA = -0.3
+DEFAULT_SQUARE_ALPHA = 0.001
+_USES_DELTA = ("harmonic", "two-harmonic", "square")
 
 
-def build_excitation(excitation: str = "harmonic", *, omega: float = 1.8, delta: float = -0.3,
-                     square_alpha: float = 0.001, fourier=None, file=None):
+def infer_excitation(excitation=None, *, delta=None, square_alpha=None, fourier=None,
+                     file=None) -> str:
+    """The excitation kind a set of parameters asks for; refuses contradictions.
+
+    ``excitation=None`` means: ``"file"`` if ``file`` is given, ``"fourier"`` if ``fourier``
+    is given, else ``"harmonic"``. A parameter the chosen excitation would ignore is refused
+    (one line naming it), never silently dropped: ``file`` only with "file", ``fourier``
+    only with "fourier", ``delta`` only with harmonic, two-harmonic and square,
+    ``square_alpha`` only with "square".
+    """
+    if excitation is None:
+        if file is not None and fourier is not None:
+            raise ParameterError("file, fourier: expected one excitation, got both a file and "
+                                 "Fourier terms")
+        excitation = "file" if file is not None else "fourier" if fourier is not None \
+            else "harmonic"
+    if not isinstance(excitation, str) or excitation not in EXCITATIONS:
+        raise ParameterError(f"excitation: expected one of {', '.join(EXCITATIONS)}, "
+                             f"got {excitation!r:.60}")
+    ignored = []
+    if file is not None and excitation != "file":
+        ignored.append("file")
+    if fourier is not None and excitation != "fourier":
+        ignored.append("fourier")
+    if delta is not None and excitation not in _USES_DELTA:
+        ignored.append("delta")
+    if square_alpha is not None and excitation != "square":
+        ignored.append("square-alpha")
+    if ignored:
+        raise ParameterError(f"{', '.join(ignored)}: not used by excitation {excitation!r}; "
+                             "drop it or choose the excitation that uses it")
+    return excitation
+
+
+def build_excitation(excitation: str | None = None, *, omega: float = 1.8, delta=None,
+                     square_alpha=None, fourier=None, file=None):
     """Build an :class:`~parapend.excitation.Excitation` from command-line style parameters.
 
     Parameters
     ----------
-    excitation : {"harmonic", "two-harmonic", "square", "fourier", "file"}
+    excitation : {"harmonic", "two-harmonic", "square", "fourier", "file"} or None
+        None infers it (see :func:`infer_excitation`): ``file`` alone means "file",
+        ``fourier`` alone means "fourier", otherwise "harmonic".
     omega : float
-        Forcing frequency (> 0).
-    delta : float
-        Amplitude for harmonic, two-harmonic (Eq. 23) and square (Eq. 26) excitations.
-    square_alpha : float
-        Smoothing width alpha of Eq. 26.
-    fourier : str or sequence of (k, amp, phase)
-        Terms for ``excitation="fourier"``, e.g. ``"1:-0.3:0,3:0.1:0.5"``.
+        Forcing frequency in [1e-3, 1e3] (units ``sqrt(g/l)``, docs/limits-of-input.md).
+    delta : float or None
+        Amplitude for harmonic, two-harmonic (Eq. 23) and square (Eq. 26) excitations,
+        ``|delta| <= 1e3`` (default -0.3); refused with the other excitations.
+    square_alpha : float or None
+        Smoothing width alpha of Eq. 26 (default 0.001); only with "square".
+    fourier : str or sequence of (k, amp[, phase])
+        Terms for ``excitation="fourier"``, e.g. ``"1:-0.3:0,3:0.1:0.5"``; integer
+        ``1 <= k <= 1024``.
     file : path
-        CSV with header ``tau,q`` for ``excitation="file"``.
+        CSV with header ``tau,q`` for ``excitation="file"`` (UTF-8, at most 16384 rows).
     """
     if isinstance(excitation, exc_mod.Excitation):
         return excitation
-    omega = check_positive("omega", omega)
-    delta = check_finite("delta", delta)
-    if excitation == "harmonic":
+    kind = infer_excitation(excitation, delta=delta, square_alpha=square_alpha,
+                            fourier=fourier, file=file)
+    delta = DEFAULT_DELTA if delta is None else delta
+    if kind == "harmonic":
         return exc_mod.harmonic(delta, omega)
-    if excitation == "two-harmonic":
+    if kind == "two-harmonic":
         return exc_mod.two_harmonic(delta, omega)
-    if excitation == "square":
-        return exc_mod.square(delta, omega, check_positive("square-alpha", square_alpha))
-    if excitation == "fourier":
+    if kind == "square":
+        return exc_mod.square(delta, omega,
+                              DEFAULT_SQUARE_ALPHA if square_alpha is None else square_alpha)
+    if kind == "fourier":
         if fourier is None:
             raise ParameterError("fourier: expected terms 'k:amp[:phase],...' with "
                                  "excitation 'fourier'")
         terms = exc_mod.parse_fourier_terms(fourier) if isinstance(fourier, str) else fourier
         return exc_mod.fourier(terms, omega)
-    if excitation == "file":
-        if file is None:
-            raise ParameterError("file: expected a CSV path with excitation 'file'")
-        return exc_mod.from_csv(file, omega)
-    raise ParameterError(f"excitation: expected one of {', '.join(EXCITATIONS)}, "
-                         f"got {excitation!r}")
+    if file is None:
+        raise ParameterError("file: expected a CSV path with excitation 'file'")
+    return exc_mod.from_csv(file, omega)
+
+
+def _check_gamma(gamma) -> float:
+    return check_range("gamma", gamma, 0.0, limits.MAX_GAMMA,
+                       why="viscous damping, units sqrt(g/l); see docs/limits-of-input.md")
 
 
 def _attrs(exc) -> dict:
@@ -89,14 +133,22 @@ def _message(status: str) -> str:
                    "try more harmonics or a different damping",
         "max_iterations": "maximum number of Newton iterations reached",
         "nonfinite": "non-finite power encountered",
+        "no_power": "converged, but no positive power exists: the damping is at or above the "
+                    "threshold gamma* (every period-1 rotation costs energy; the power shown "
+                    "is the smallest loss)",
     }[status]
+
+
+def _no_power_message(exc) -> str:
+    return ("no power can be extracted: the excitation is constant (q has no variation), "
+            "so only the uniform rotation's damping loss remains")
 
 
 METHODS = ("fourier", "bvp")
 
 
-def optimize(*, omega: float = 1.8, delta: float = -0.3, gamma: float = 0.0, harmonics: int = 24,
-             excitation="harmonic", square_alpha: float = 0.001, fourier=None, file=None,
+def optimize(*, omega: float = 1.8, delta=None, gamma: float = 0.0, harmonics: int = 24,
+             excitation=None, square_alpha=None, fourier=None, file=None,
              method: str = "fourier", warm=None, throw: bool = False) -> OptimizeResult:
     """Optimal period-1 rotation for any excitation.
 
@@ -108,18 +160,36 @@ def optimize(*, omega: float = 1.8, delta: float = -0.3, gamma: float = 0.0, har
     vector ``[a0, a_1..a_K, b_1..b_K]`` to start the Fourier method from (continuation). With
     ``throw=True`` a non-converged solve raises :class:`~parapend.errors.SolverError`;
     otherwise it is reported in ``success``/``status``.
+
+    ``success`` means the solver converged. Status ``"no_power"`` (with ``success=True``)
+    says that it converged but the optimum is ``P <= 0``: the damping is at or above the
+    threshold gamma* (the power is then the smallest loss), or the excitation is constant
+    (``delta = 0``: nothing to extract; the motion is the uniform rotation). Parameter ranges:
+    docs/limits-of-input.md; ``harmonics <= 1024``.
     """
     exc = build_excitation(excitation, omega=omega, delta=delta, square_alpha=square_alpha,
                            fourier=fourier, file=file)
-    gamma = check_nonnegative("gamma", gamma)
+    gamma = _check_gamma(gamma)
     n = check_int("harmonics", harmonics, 1, MAX_HARMONICS)
-    if method not in METHODS:
-        raise ParameterError(f"method: expected one of {', '.join(METHODS)}, got {method!r}")
+    if not isinstance(method, str) or method not in METHODS:
+        raise ParameterError(f"method: expected one of {', '.join(METHODS)}, "
+                             f"got {method!r:.60}")
+    if warm is not None:
+        try:
+            warm = np.asarray(warm, dtype=float)
+        except (TypeError, ValueError):
+            raise ParameterError("warm: expected a vector [a0, a_1..a_K, b_1..b_K] of "
+                                 "numbers") from None
+        if warm.ndim != 1 or warm.size % 2 != 1 or not np.all(np.isfinite(warm)):
+            raise ParameterError(f"warm: expected a finite vector [a0, a_1..a_K, b_1..b_K] "
+                                 f"of odd length, got shape {warm.shape}")
     pu, _ = uniform_power(exc, gamma)
     lim = limit(exc)
-    common = {"uniform_power": pu, "limit_power": lim.power, "harmonics": n, "damping": gamma,
+    common = {"uniform_power": pu, "limit_power": lim.power, "harmonics": n, "gamma": gamma,
               "omega": exc.omega, "excitation": exc.describe(), "_excitation": exc}
-    if method == "bvp":
+    if lim.power <= 0:
+        res = _constant_excitation(exc, gamma, n, method, common)
+    elif method == "bvp":
         res = _optimize_bvp(exc, gamma, n, common)
     else:
         found = search_fourier(exc, n, gamma, warm=warm)
@@ -127,12 +197,13 @@ def optimize(*, omega: float = 1.8, delta: float = -0.3, gamma: float = 0.0, har
         motion = FourierMotion.from_vector(exc.omega, best.x)
         maxima = sorted({round(r.power, 12) for r in runs if r.status == "converged"},
                         reverse=True)
+        status = "no_power" if best.status == "converged" and best.power <= 0 else best.status
         res = OptimizeResult(
             power=best.power,
             gain_over_uniform=(best.power / pu - 1.0) if pu > 0 else None,
             success=best.status == "converged",
-            status=best.status,
-            message=_message(best.status),
+            status=status,
+            message=_message(status),
             iterations=best.iterations,
             coefficients=_coefficients(motion),
             peak_torque=_peak_torque(motion, exc, gamma),
@@ -165,6 +236,30 @@ def _second(best: float, values) -> float | None:
     return max(others) if others else None
 
 
+def _constant_excitation(exc, gamma: float, n: int, method: str, common: dict):
+    """No variation of q: nothing to extract. The cheapest period-1 rotation is uniform,
+    ``theta = omega t`` (``P = -gamma omega^2``), and its torque is what it costs to hold it."""
+    motion = FourierMotion(exc.omega, 0.0, np.zeros(n), np.zeros(n))
+    return OptimizeResult(
+        power=-gamma * exc.omega**2,
+        gain_over_uniform=None,
+        success=True,
+        status="no_power",
+        message=_no_power_message(exc),
+        iterations=0,
+        coefficients=_coefficients(motion),
+        peak_torque=_peak_torque(motion, exc, gamma),
+        method=method,
+        found_by="constant excitation",
+        local_maxima=[],
+        gradient_norm=0.0,
+        strict_maximum=False,
+        mean_square_speed=motion.mean_square_speed(),
+        _motion=motion,
+        **common,
+    )
+
+
 def _coefficients(motion: FourierMotion) -> dict:
     return {"a0": motion.a0, "a": motion.a.tolist(), "b": motion.b.tolist()}
 
@@ -173,10 +268,22 @@ def _optimize_bvp(exc, gamma: float, n: int, common: dict) -> OptimizeResult:
     from .optimal.bvp import solve_bvp_optimum
     from .trajectory import SampledMotion
 
-    if gamma <= 0:
-        raise ParameterError("gamma: expected a number > 0 with method 'bvp' (epsilon = 2 "
-                             "gamma; gamma = 0 has no smooth optimum), got 0")
-    sol = solve_bvp_optimum(exc, gamma)
+    if gamma < limits.MIN_BVP_GAMMA:
+        raise ParameterError(f"gamma: expected a number >= {limits.MIN_BVP_GAMMA:g} with method "
+                             f"'bvp' (epsilon = 2 gamma; gamma = 0 has no smooth optimum and "
+                             f"smaller gamma needs boundary layers finer than the mesh cap), "
+                             f"got {gamma!r}")
+    extrema = exc.extrema.t.size
+    if extrema > limits.MAX_BVP_EXTREMA:
+        raise ParameterError(
+            f"method: 'bvp' resolves a boundary layer at every extremum of q, and this q has "
+            f"{extrema} extrema per period (at most {limits.MAX_BVP_EXTREMA}); smooth the "
+            "excitation or use method 'fourier'")
+    # bounded work: each residual evaluation costs (mesh nodes) x (harmonics of q); past the
+    # node cap the solver returns status "max_nodes" instead of refining further
+    k = 1 if isinstance(exc, exc_mod.SquareExcitation) else exc.spectrum.size
+    max_nodes = int(min(200_000, max(2_000, limits.MAX_BVP_WORK // k)))
+    sol = solve_bvp_optimum(exc, gamma, max_nodes=max_nodes)
     motion = sol.motion()
     m = max(4096, 8 * n)
     t = exc.period * np.arange(m) / m
@@ -187,8 +294,8 @@ def _optimize_bvp(exc, gamma: float, n: int, common: dict) -> OptimizeResult:
         power=sol.power,
         gain_over_uniform=(sol.power / pu - 1.0) if pu > 0 else None,
         success=sol.success,
-        status=sol.status,
-        message=sol.message,
+        status="no_power" if sol.success and sol.power <= 0 else sol.status,
+        message=_message("no_power") if sol.success and sol.power <= 0 else sol.message,
         iterations=sol.iterations,
         coefficients=_coefficients(proj),
         peak_torque=_peak_torque(motion, exc, gamma),
@@ -218,15 +325,26 @@ def harmonic_table(harmonics=range(2, 65), *, gamma: float = 0.0, progress=None,
 
     Because the warm start embeds the (N-1)-harmonic optimum, whose power is already reached,
     and the Newton iteration never lowers the power, the table is nondecreasing in N.
+    ``harmonics``: integers in [1, 128] (:data:`parapend.limits.MAX_TABLE_HARMONICS`; the
+    continuation to 128 takes about 10 s, to 512 it took 11 minutes).
     Returns an ``xarray.Dataset`` over ``harmonics``; its attributes carry the excitation's
     band (``spectrum_harmonics``: a table that stops below it misses part of q) and the
     change of the last optimum when N is doubled once (``refinement_change``).
     """
     import xarray as xr
 
+    unknown = set(excitation_args) - {"excitation", "omega", "delta", "square_alpha",
+                                      "fourier", "file"}
+    if unknown:
+        raise ParameterError(f"{', '.join(sorted(unknown))}: not a parameter of "
+                             "harmonic_table")
     exc = build_excitation(**excitation_args)
-    gamma = check_nonnegative("gamma", gamma)
-    ns = [check_int("harmonics", n, 1, MAX_HARMONICS) for n in harmonics]
+    gamma = _check_gamma(gamma)
+    if isinstance(harmonics, (str, bytes)) or not hasattr(harmonics, "__iter__"):
+        raise ParameterError(f"harmonics: expected a sequence of integers, got {harmonics!r:.60}")
+    ns = [check_int("harmonics", n, 1, limits.MAX_TABLE_HARMONICS) for n in harmonics]
+    if not ns:
+        raise ParameterError("harmonics: expected at least one number of harmonics, got none")
     powers, status, found = [], [], []
     warm = None
     for i, n in enumerate(ns):
@@ -243,7 +361,7 @@ def harmonic_table(harmonics=range(2, 65), *, gamma: float = 0.0, progress=None,
         {"power": ("harmonics", np.array(powers)), "status": ("harmonics", status),
          "found_by": ("harmonics", found)},
         coords={"harmonics": np.array(ns)},
-        attrs={"uniform_power": pu, "limit_power": limit(exc).power, "damping": gamma,
+        attrs={"uniform_power": pu, "limit_power": limit(exc).power, "gamma": gamma,
                "spectrum_harmonics": spectrum_harmonics(exc), "refinement_change": change,
                **_attrs(exc)},
     )
@@ -310,14 +428,15 @@ def _threshold_at(exc, n: int, gamma0: float, warm, tol: float, maxiter: int):
     return g, p, kin, x, it, status
 
 
-def threshold(*, omega: float = 1.8, delta: float = -0.3, harmonics=None, excitation="harmonic",
-              square_alpha: float = 0.001, fourier=None, file=None, tol: float = 1e-12,
+def threshold(*, omega: float = 1.8, delta=None, harmonics=None, excitation=None,
+              square_alpha=None, fourier=None, file=None, tol: float = 1e-12,
               throw: bool = False) -> ThresholdResult:
     """Damping threshold gamma* beyond which no power can be extracted (paper Fig. 6, 0.0856).
 
     ``harmonics=None`` starts from N covering the excitation's spectrum (a power of two,
     at least 8; :func:`spectrum_harmonics`) and doubles N until gamma* changes by less than
     1e-8 (relative), so every answer is checked by at least one refinement.
+    A fixed ``harmonics`` is at most 512 (:data:`parapend.limits.MAX_THRESHOLD_HARMONICS`).
     """
     exc = build_excitation(excitation, omega=omega, delta=delta, square_alpha=square_alpha,
                            fourier=fourier, file=file)
@@ -327,8 +446,9 @@ def threshold(*, omega: float = 1.8, delta: float = -0.3, harmonics=None, excita
         return ThresholdResult(0.0, 0.0, 0.0, 0, exc.omega, True, "converged",
                                "constant excitation: no power can be extracted", 0,
                                excitation=exc.describe())
+    tol = check_range("tol", tol, 1e-15, 1e-3)
     if harmonics is not None:
-        ns = [check_int("harmonics", harmonics, 1, MAX_HARMONICS)]
+        ns = [check_int("harmonics", harmonics, 1, limits.MAX_THRESHOLD_HARMONICS)]
     else:
         n0 = _resolution(exc)
         ns = [n0 * 2**j for j in range(6) if n0 * 2**j <= max(256, 2 * n0)]
@@ -363,42 +483,64 @@ def threshold(*, omega: float = 1.8, delta: float = -0.3, harmonics=None, excita
     return res
 
 
-def damping_sweep(*, omega: float = 1.8, delta: float = -0.3, harmonics: int | None = None,
-                  excitation="harmonic", square_alpha: float = 0.001, fourier=None, file=None,
+def damping_sweep(*, omega: float = 1.8, delta=None, harmonics: int | None = None,
+                  excitation=None, square_alpha=None, fourier=None, file=None,
                   gamma_max=None, points: int = 41, progress=None):
     """Optimal and uniform power against damping (paper Fig. 6), with the threshold gamma*.
 
     ``gamma_max=None`` sweeps to 1.25 gamma*. ``harmonics=None`` takes N = 32 or, when the
-    excitation's spectrum reaches higher, the power of two covering it. Solves run from the
-    largest damping down, each warm-started from the previous optimum. The resolution is
-    checked by one refinement: the sweep's end points are solved again with 2N, and the
-    largest change is the attribute ``refinement_change``. Returns an ``xarray.Dataset``
-    over ``damping``.
+    excitation's spectrum reaches higher, the power of two covering it (at most 256).
+    Solves run from the largest damping down, each warm-started from the previous
+    optimum. The resolution is checked by one refinement: the sweep's end points are
+    solved again with 2N, and the largest change is the attribute
+    ``refinement_change``. Returns an ``xarray.Dataset`` over ``gamma`` (the damping).
+    Bounded work: ``harmonics <= 256``, ``2 <= points <= 1001`` and
+    ``points * harmonics**2 <= 2**20`` (about a minute; docs/limits-of-input.md).
     """
     import xarray as xr
 
     exc = build_excitation(excitation, omega=omega, delta=delta, square_alpha=square_alpha,
                            fourier=fourier, file=file)
-    n = (max(32, _resolution(exc, highest=512)) if harmonics is None
-         else check_int("harmonics", harmonics, 1, MAX_HARMONICS))
-    npts = check_int("points", points, 2, 100000)
+    n = (max(32, _resolution(exc, highest=limits.MAX_SWEEP_HARMONICS)) if harmonics is None
+         else check_int("harmonics", harmonics, 1, limits.MAX_SWEEP_HARMONICS))
+    npts = check_int("points", points, 2, limits.MAX_POINTS)
+    if npts * n * n > limits.MAX_SWEEP_WORK:
+        raise ParameterError(
+            f"points: expected points * harmonics^2 <= {limits.MAX_SWEEP_WORK} (about a "
+            f"minute of work), got {npts} * {n}^2 = {npts * n * n}; lower --points or "
+            f"--harmonics (at N = {n}, at most {max(limits.MAX_SWEEP_WORK // (n * n), 0)} "
+            "points)")
+    if gamma_max is not None:
+        gamma_max = check_range("gamma-max", gamma_max, 0.0, limits.MAX_GAMMA)
+        if gamma_max <= 0:
+            raise ParameterError(f"gamma-max: expected a number > 0, got {gamma_max!r}")
     thr = threshold(excitation=exc)
-    gmax = 1.25 * thr.damping_threshold if gamma_max is None else check_positive("gamma-max",
-                                                                                 gamma_max)
+    if gamma_max is None and thr.damping_threshold <= 0:
+        raise ParameterError("gamma-max: the excitation is constant (no variation of q), so "
+                             "nothing can be extracted at any damping and gamma* = 0; give "
+                             "--gamma-max to sweep the losses anyway")
+    gmax = 1.25 * thr.damping_threshold if gamma_max is None else gamma_max
     gammas = np.linspace(0.0, gmax, npts)
     power = np.empty(npts)
     kin = np.empty(npts)
     torque = np.empty(npts)
     status = []
     warm = None
+    constant = thr.damping_threshold <= 0  # q constant: only the uniform rotation's loss
     for i in range(npts - 1, -1, -1):
-        best, _ = solve_fourier(exc, n, float(gammas[i]), warm=warm)
-        warm = best.x
-        motion = FourierMotion.from_vector(exc.omega, best.x)
-        power[i] = best.power
+        if constant:
+            motion = FourierMotion(exc.omega, 0.0, np.zeros(n), np.zeros(n))
+            power[i] = 0.0 - float(gammas[i]) * exc.omega**2
+            st = "no_power"
+        else:
+            best, _ = solve_fourier(exc, n, float(gammas[i]), warm=warm)
+            warm = best.x
+            motion = FourierMotion.from_vector(exc.omega, best.x)
+            power[i] = best.power
+            st = best.status
         kin[i] = motion.mean_square_speed()
         torque[i] = _peak_torque(motion, exc, float(gammas[i]))
-        status.append(best.status)
+        status.append(st)
         if progress is not None:
             progress(npts - i, npts)
     status.reverse()
@@ -406,10 +548,10 @@ def damping_sweep(*, omega: float = 1.8, delta: float = -0.3, harmonics: int | N
                                          (float(gammas[-1]), power[-1])])
     pu = np.array([uniform_power(exc, float(g))[0] for g in gammas])
     return xr.Dataset(
-        {"power": ("damping", power), "uniform_power": ("damping", pu),
-         "mean_square_speed": ("damping", kin), "peak_torque": ("damping", torque),
-         "status": ("damping", status)},
-        coords={"damping": gammas},
+        {"power": ("gamma", power), "uniform_power": ("gamma", pu),
+         "mean_square_speed": ("gamma", kin), "peak_torque": ("gamma", torque),
+         "status": ("gamma", status)},
+        coords={"gamma": gammas},
         attrs={"damping_threshold": thr.damping_threshold,
                "uniform_threshold": thr.uniform_threshold, "limit_power": limit(exc).power,
                "harmonics": n, "refinement_change": change, **_attrs(exc)},
@@ -423,9 +565,9 @@ def motion_samples(result, points: int = 1000) -> dict:
     """
     from .model import torque
 
-    npts = check_int("points", points, 2)
+    npts = check_int("points", points, 2, 10**6)
     exc = result._excitation
     motion = result.motion
     t = exc.period * np.arange(npts) / npts
     return {"t": t, "tau": t / exc.period, "theta": motion.theta(t),
-            "theta_dot": motion.theta_dot(t), "torque": torque(motion, exc, result.damping, t)}
+            "theta_dot": motion.theta_dot(t), "torque": torque(motion, exc, result.gamma, t)}

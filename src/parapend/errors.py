@@ -5,7 +5,7 @@ from __future__ import annotations
 import math
 
 __all__ = ["ParameterError", "SolverError", "check_finite", "check_int", "check_nonnegative",
-           "check_positive"]
+           "check_positive", "check_range"]
 
 
 class ParameterError(ValueError):
@@ -16,13 +16,21 @@ class SolverError(RuntimeError):
     """Raised only when the caller asks for it (``throw=True``) and a solver did not converge."""
 
 
+def _short(value) -> str:
+    """``repr`` of a value, cut to one short line for a message."""
+    text = repr(value)
+    return text if len(text) <= 60 else text[:57] + "..."
+
+
 def _as_float(name: str, value) -> float:
+    if isinstance(value, (bool, str, bytes)) or value is None:
+        raise ParameterError(f"{name}: expected a number, got {_short(value)}")
     try:
         x = float(value)
-    except (TypeError, ValueError):
-        raise ParameterError(f"{name}: expected a number, got {value!r}") from None
+    except (TypeError, ValueError, OverflowError):
+        raise ParameterError(f"{name}: expected a number, got {_short(value)}") from None
     if not math.isfinite(x):
-        raise ParameterError(f"{name}: expected a finite number, got {value!r}")
+        raise ParameterError(f"{name}: expected a finite number, got {_short(value)}")
     return x
 
 
@@ -35,7 +43,7 @@ def check_positive(name: str, value) -> float:
     """Return ``value`` as a float, or raise unless it is finite and > 0."""
     x = _as_float(name, value)
     if x <= 0:
-        raise ParameterError(f"{name}: expected a number > 0, got {value!r}")
+        raise ParameterError(f"{name}: expected a number > 0, got {_short(value)}")
     return x
 
 
@@ -43,7 +51,23 @@ def check_nonnegative(name: str, value) -> float:
     """Return ``value`` as a float, or raise unless it is finite and >= 0."""
     x = _as_float(name, value)
     if x < 0:
-        raise ParameterError(f"{name}: expected a number >= 0, got {value!r}")
+        raise ParameterError(f"{name}: expected a number >= 0, got {_short(value)}")
+    return x
+
+
+def check_range(name: str, value, lo: float, hi: float, *, absolute: bool = False,
+                why: str = "") -> float:
+    """Return ``value`` as a float, or raise unless it is finite and in ``[lo, hi]``.
+
+    With ``absolute=True`` the bound applies to ``|value|`` (``lo`` is then ignored and 0 is
+    admissible). ``why`` is appended to the message (the reason for the bound).
+    """
+    x = _as_float(name, value)
+    bad = abs(x) > hi if absolute else not lo <= x <= hi
+    if bad:
+        rng = f"|{name}| <= {hi:g}" if absolute else f"a number in [{lo:g}, {hi:g}]"
+        tail = f" ({why})" if why else ""
+        raise ParameterError(f"{name}: expected {rng}, got {_short(value)}{tail}")
     return x
 
 
@@ -53,10 +77,10 @@ def check_int(name: str, value, minimum: int = 1, maximum: int | None = None) ->
         ok = int(value) == value
     except (TypeError, ValueError, OverflowError):
         ok = False
-    if not ok or isinstance(value, bool):
-        raise ParameterError(f"{name}: expected an integer >= {minimum}, got {value!r}")
+    if not ok or isinstance(value, (bool, str, bytes)):
+        raise ParameterError(f"{name}: expected an integer >= {minimum}, got {_short(value)}")
     n = int(value)
     if n < minimum or (maximum is not None and n > maximum):
         rng = f">= {minimum}" if maximum is None else f"in [{minimum}, {maximum}]"
-        raise ParameterError(f"{name}: expected an integer {rng}, got {value!r}")
+        raise ParameterError(f"{name}: expected an integer {rng}, got {_short(value)}")
     return n

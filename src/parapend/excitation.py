@@ -26,7 +26,8 @@ from pathlib import Path
 import numpy as np
 from scipy.optimize import brentq
 
-from .errors import ParameterError, check_finite, check_positive
+from . import limits
+from .errors import ParameterError, check_finite, check_int, check_range
 
 __all__ = [
     "Excitation",
@@ -97,6 +98,10 @@ class Excitation:
         """``q`` at ``s_j = 2*pi*j/m``, band-limited to harmonics < m/2."""
         return _synthesize(self.spectrum, m)
 
+    def q_uniform(self, m: int) -> np.ndarray:
+        """``q`` exactly (not band-limited) at ``t_j = j T/m``, j = 0..m-1 (by spectrum folding)."""
+        return _evaluate_uniform(self.spectrum, m)
+
     # -- pointwise -------------------------------------------------------------------------
     def q(self, t):
         """Base acceleration over g at time(s) ``t``."""
@@ -141,9 +146,29 @@ def _synthesize(spec: np.ndarray, m: int) -> np.ndarray:
 
 
 def _evaluate(spec: np.ndarray, s: np.ndarray) -> np.ndarray:
+    """``Re sum_k Q[k] exp(iks)`` at phases ``s`` (any shape), in chunks of bounded memory.
+
+    The dense ``exp(i s k)`` matrix is built for at most ``2**20`` entries at a time (16 MB),
+    so a long spectrum (a sampled excitation with many rows) never needs gigabytes.
+    """
+    s = np.asarray(s, dtype=float)
+    flat = s.ravel()
     k = np.arange(spec.size)
-    out = np.exp(1j * np.multiply.outer(s, k)) @ spec
-    return out.real
+    out = np.empty(flat.size)
+    step = max(1, (1 << 20) // max(spec.size, 1))
+    for i in range(0, flat.size, step):
+        out[i:i + step] = (np.exp(1j * np.multiply.outer(flat[i:i + step], k)) @ spec).real
+    return out.reshape(s.shape) if s.ndim else out[0]
+
+
+def _evaluate_uniform(spec: np.ndarray, m: int) -> np.ndarray:
+    """Exact ``Re sum_k Q[k] exp(iks)`` at ``s_j = 2 pi j/m``, j = 0..m-1, in O(K + m log m).
+
+    On the grid ``exp(iks_j)`` depends on ``k mod m`` only: fold the spectrum, one inverse FFT.
+    """
+    folded = np.zeros(m, dtype=complex)
+    np.add.at(folded, np.arange(spec.size) % m, spec)
+    return (np.fft.ifft(folded) * m).real
 
 
 def _extrema_from_roots(exc: Excitation) -> Extrema:
@@ -213,17 +238,10 @@ class FourierExcitation(Excitation):
     _spec: np.ndarray = field(init=False, repr=False, compare=False)
 
     def __post_init__(self):
-        check_positive("omega", self.omega)
-        check_finite("mean", self.mean)
-        if not self.terms:
-            raise ParameterError("fourier: expected at least one term k:amp:phase, got none")
-        kmax = 0
-        for k, amp, ph in self.terms:
-            if int(k) != k or k < 1:
-                raise ParameterError(f"fourier: harmonic number must be an integer >= 1, got {k}")
-            check_finite("fourier amplitude", amp)
-            check_finite("fourier phase", ph)
-            kmax = max(kmax, int(k))
+        _check_omega(self.omega)
+        check_range("mean", self.mean, 0, limits.MAX_AMPLITUDE, absolute=True)
+        object.__setattr__(self, "terms", _check_terms(self.terms))
+        kmax = max(k for k, _, _ in self.terms)
         spec = np.zeros(kmax + 1, dtype=complex)
         spec[0] = self.mean
         for k, amp, ph in self.terms:
@@ -247,24 +265,61 @@ class FourierExcitation(Excitation):
         return d
 
 
+def _check_omega(omega) -> float:
+    return check_range("omega", omega, *limits.OMEGA_RANGE,
+                       why="forcing frequency in units sqrt(g/l); see docs/limits-of-input.md")
+
+
+def _check_delta(delta) -> float:
+    return check_range("delta", delta, 0, limits.MAX_AMPLITUDE, absolute=True,
+                       why="base acceleration amplitude over g")
+
+
+def _check_terms(terms) -> tuple:
+    """Validate Fourier terms ``(k, amp[, phase])``: integer 1 <= k <= MAX_FOURIER_K, finite
+    bounded amplitude and phase. Returns a tuple of ``(int, float, float)``."""
+    if isinstance(terms, (str, bytes)) or not hasattr(terms, "__iter__"):
+        raise ParameterError(f"fourier: expected a sequence of (k, amp, phase) terms, "
+                             f"got {terms!r:.60}")
+    out = []
+    for term in terms:
+        if isinstance(term, (str, bytes)) or not hasattr(term, "__len__") \
+                or len(term) not in (2, 3):
+            raise ParameterError(f"fourier: expected each term as (k, amp) or (k, amp, phase), "
+                                 f"got {term!r:.60}")
+        k = check_int("fourier k", term[0], 1, limits.MAX_FOURIER_K)
+        amp = check_range("fourier amplitude", term[1], 0, limits.MAX_AMPLITUDE, absolute=True)
+        ph = check_range("fourier phase", term[2] if len(term) == 3 else 0.0, 0,
+                         limits.MAX_PHASE, absolute=True)
+        out.append((k, amp, ph))
+    if not out:
+        raise ParameterError("fourier: expected at least one term k:amp:phase, got none")
+    return tuple(out)
+
+
 def harmonic(delta: float = -0.3, omega: float = 1.8) -> FourierExcitation:
     """Harmonic excitation ``q = delta*sin(omega*t)`` (paper Eq. 2)."""
-    check_finite("delta", delta)
+    delta = _check_delta(delta)
     return FourierExcitation(omega, ((1, float(delta), 0.0),), name="harmonic")
 
 
 def two_harmonic(delta: float = -0.3, omega: float = 1.8) -> FourierExcitation:
     """Two-harmonic excitation ``q = delta*(sin(omega t) + sin(2 omega t)/4)`` (paper Eq. 23)."""
-    check_finite("delta", delta)
+    delta = _check_delta(delta)
     return FourierExcitation(
         omega, ((1, float(delta), 0.0), (2, float(delta) / 4.0, 0.0)), name="two-harmonic"
     )
 
 
 def fourier(terms, omega: float = 1.8, mean: float = 0.0) -> FourierExcitation:
-    """General Fourier-series excitation ``q = mean + sum amp_k sin(k omega t + phase_k)``."""
-    return FourierExcitation(omega, tuple((int(k), float(a), float(p)) for k, a, p in terms),
-                             mean=float(mean), name="fourier")
+    """General Fourier-series excitation ``q = mean + sum amp_k sin(k omega t + phase_k)``.
+
+    ``terms``: ``(k, amp)`` or ``(k, amp, phase)`` with integer ``1 <= k <= 1024``
+    (:data:`parapend.limits.MAX_FOURIER_K`); a non-integer k is refused, not truncated.
+    """
+    return FourierExcitation(_check_omega(omega), _check_terms(terms),
+                             mean=check_range("mean", mean, 0, limits.MAX_AMPLITUDE,
+                                              absolute=True), name="fourier")
 
 
 def parse_fourier_terms(text: str) -> tuple:
@@ -278,13 +333,17 @@ def parse_fourier_terms(text: str) -> tuple:
         if len(parts) not in (2, 3):
             raise ParameterError(f"--fourier: expected terms 'k:amp[:phase]', got {item!r}")
         try:
-            k = int(parts[0])
+            k = int(parts[0]) if len(parts[0].strip()) <= 30 else None
             amp = float(parts[1])
             ph = float(parts[2]) if len(parts) == 3 else 0.0
         except ValueError:
+            k = None
+        if k is None:
             raise ParameterError(
-                f"--fourier: expected integer k and numbers amp, phase, got {item!r}"
-            ) from None
+                f"--fourier: expected integer k and numbers amp, phase, got {item!r:.60}")
+        if not 1 <= k <= limits.MAX_FOURIER_K:
+            raise ParameterError(f"--fourier: harmonic number k must be an integer in "
+                                 f"[1, {limits.MAX_FOURIER_K}], got {k}")
         terms.append((k, amp, ph))
     if not terms:
         raise ParameterError("--fourier: expected at least one term 'k:amp[:phase]', got none")
@@ -315,14 +374,14 @@ class SquareExcitation(Excitation):
     name: str = "square"
 
     def __post_init__(self):
-        check_positive("omega", self.omega)
-        check_finite("delta", self.delta)
-        check_positive("square-alpha", self.alpha)
-        if self.alpha > self.period / 8:
+        _check_omega(self.omega)
+        _check_delta(self.delta)
+        alpha = check_finite("square-alpha", self.alpha)
+        lo, hi = limits.SQUARE_ALPHA_MIN * self.period, self.period / 8
+        if not lo <= alpha <= hi:
             raise ParameterError(
-                f"square-alpha: expected a smoothing width below T/8 = {self.period / 8:.4g}, "
-                f"got {self.alpha}"
-            )
+                f"square-alpha: expected a smoothing width in [{limits.SQUARE_ALPHA_MIN:g} T, "
+                f"T/8] = [{lo:.4g}, {hi:.4g}] (T = 2 pi/omega), got {self.alpha!r}")
 
     @cached_property
     def spectrum(self) -> np.ndarray:
@@ -337,6 +396,9 @@ class SquareExcitation(Excitation):
             f = np.where(k > 0, x / np.sinh(x / 2), 2.0)
             spec = np.where(k % 2 == 1, -4j * self.delta * f / (2 * np.pi * np.maximum(k, 1)), 0)
         return spec.astype(complex)
+
+    def q_uniform(self, m: int) -> np.ndarray:
+        return self.q(self.period * np.arange(m) / m)
 
     def q(self, t):
         T, a = self.period, self.alpha
@@ -368,7 +430,8 @@ class SquareExcitation(Excitation):
 
 def square(delta: float = -0.3, omega: float = 1.8, alpha: float = 0.001) -> SquareExcitation:
     """tanh-smoothed square-wave excitation of paper Eq. 26, amplitude ``delta``."""
-    return SquareExcitation(float(omega), float(delta), float(alpha))
+    return SquareExcitation(_check_omega(omega), _check_delta(delta),
+                            check_finite("square-alpha", alpha))
 
 
 # ---------------------------------------------------------------------------------------
@@ -388,23 +451,36 @@ class SampledExcitation(Excitation):
     name: str = "file"
 
     def __post_init__(self):
-        check_positive("omega", self.omega)
-        tau = np.asarray(self.tau, dtype=float)
-        q = np.asarray(self.values, dtype=float)
+        _check_omega(self.omega)
         where = f" in {self.source}" if self.source else ""
-        if tau.ndim != 1 or tau.size != q.size:
+        try:
+            tau = np.asarray(self.tau, dtype=float)
+            q = np.asarray(self.values, dtype=float)
+        except (TypeError, ValueError):
+            raise ParameterError(f"file: expected numbers in tau and q{where}") from None
+        if tau.ndim != 1 or tau.shape != q.shape:
             raise ParameterError(f"file: expected equal-length tau and q columns{where}")
         if tau.size < 16:
             raise ParameterError(f"file: expected at least 16 samples of one period{where}, "
                                  f"got {tau.size}")
+        if tau.size > limits.MAX_FILE_ROWS:
+            raise ParameterError(f"file: expected at most {limits.MAX_FILE_ROWS} samples of one "
+                                 f"period{where}, got {tau.size} (resample the record)")
         if not (np.all(np.isfinite(tau)) and np.all(np.isfinite(q))):
             raise ParameterError(f"file: expected finite numbers in tau and q{where}")
+        if np.max(np.abs(q)) > limits.MAX_AMPLITUDE:
+            raise ParameterError(f"file: expected |q| <= {limits.MAX_AMPLITUDE:g} (base "
+                                 f"acceleration over g){where}, got {np.max(np.abs(q)):.4g}")
         if tau[0] < 0 or tau[-1] >= 1:
             raise ParameterError(
                 f"file: expected tau in [0, 1) (one period, endpoint not repeated){where}, "
                 f"got tau from {tau[0]:g} to {tau[-1]:g}")
         if np.any(np.diff(tau) <= 0):
             raise ParameterError(f"file: expected strictly increasing tau{where}")
+        gap = float(np.min(np.diff(tau)))
+        if gap < 1e-6 / tau.size:
+            raise ParameterError(f"file: expected tau spacings of at least 1e-6 of the mean "
+                                 f"spacing{where}, got a gap of {gap:.3g}")
 
     @cached_property
     def spectrum(self) -> np.ndarray:
@@ -436,17 +512,51 @@ class SampledExcitation(Excitation):
                 "samples": len(self.tau)}
 
 
-def from_csv(path, omega: float = 1.8) -> SampledExcitation:
-    """Read one period of ``q`` from a CSV file with header ``tau,q`` (DESIGN.md section 4)."""
-    path = Path(path)
+def _read_bounded(path: Path) -> str:
+    """The text of ``path``: at most ``MAX_BYTES_FILE`` bytes, UTF-8 (a BOM is accepted)."""
+    if path.is_dir():
+        raise ParameterError(f"file: expected a CSV file, got the directory {str(path)!r}")
     try:
-        text = path.read_text()
-    except (OSError, UnicodeDecodeError) as exc:
+        with open(path, "rb") as fh:
+            data = fh.read(limits.MAX_BYTES_FILE + 1)
+    except OSError as exc:
         raise ParameterError(f"file: cannot read {path}: {exc.strerror or exc}") from None
-    rows = list(csv.reader(text.splitlines()))
+    if len(data) > limits.MAX_BYTES_FILE:
+        raise ParameterError(f"file: {path} is larger than {limits.MAX_BYTES_FILE >> 20} MiB; "
+                             f"expected one period of at most {limits.MAX_FILE_ROWS} rows "
+                             "'tau,q'")
+    if b"\0" in data:
+        raise ParameterError(f"file: {path} is not a text CSV (it contains NUL bytes: binary, "
+                             "or UTF-16); save it as UTF-8")
+    try:
+        return data.decode("utf-8-sig")
+    except UnicodeDecodeError as exc:
+        raise ParameterError(f"file: {path} is not UTF-8 text (byte {exc.start}); save it as "
+                             "UTF-8") from None
+
+
+def from_csv(path, omega: float = 1.8) -> SampledExcitation:
+    """Read one period of ``q`` from a CSV file with header ``tau,q`` (DESIGN.md section 4).
+
+    The file must be UTF-8 (a byte-order mark is accepted), at most
+    :data:`parapend.limits.MAX_BYTES_FILE` bytes and :data:`parapend.limits.MAX_FILE_ROWS`
+    rows; it is never read beyond that size.
+    """
+    if not isinstance(path, (str, Path)) or not str(path):
+        raise ParameterError(f"file: expected a CSV path, got {path!r:.60}")
+    _check_omega(omega)
+    path = Path(path)
+    text = _read_bounded(path)
+    try:
+        rows = list(csv.reader(text.splitlines()))
+    except csv.Error as exc:
+        raise ParameterError(f"file: not a CSV file {path}: {exc}") from None
     rows = [r for r in rows if r and any(c.strip() for c in r)]
     if not rows or [c.strip().lower() for c in rows[0]] != ["tau", "q"]:
         raise ParameterError(f"file: expected a CSV header 'tau,q' in {path}")
+    if len(rows) - 1 > limits.MAX_FILE_ROWS:
+        raise ParameterError(f"file: expected at most {limits.MAX_FILE_ROWS} rows in {path}, "
+                             f"got {len(rows) - 1} (resample the record)")
     tau, q = [], []
     for i, r in enumerate(rows[1:], start=2):
         try:
@@ -456,5 +566,5 @@ def from_csv(path, omega: float = 1.8) -> SampledExcitation:
             q.append(float(r[1]))
         except ValueError:
             raise ParameterError(f"file: expected two numbers on line {i} of {path}, "
-                                 f"got {','.join(r)!r}") from None
+                                 f"got {','.join(r)!r:.60}") from None
     return SampledExcitation(float(omega), tuple(tau), tuple(q), source=str(path))

@@ -46,8 +46,9 @@ def peak_torque(motion, excitation, damping: float, points: int | None = None) -
     spectral elements: points inside every element, so a boundary layer a thousandth of the
     period wide is sampled as finely as the rest) gives its own; a Fourier motion is
     sampled by inverse FFTs on a grid with 16 points per top harmonic
-    (``FourierMotion.on_grid``; ``points`` overrides). The largest sample is then refined
-    by a bounded scalar search between its neighbours.
+    (``FourierMotion.on_grid``; ``points`` overrides) and ``q`` by a folded inverse FFT
+    (``Excitation.q_uniform``: O(M log M) time, O(M + K) memory for K harmonics). The
+    largest sample is then refined by a bounded scalar search between its neighbours.
     """
     from scipy.optimize import minimize_scalar
 
@@ -60,7 +61,8 @@ def peak_torque(motion, excitation, damping: float, points: int | None = None) -
         t = period * np.arange(points) / points
         if hasattr(motion, "on_grid") and points > 2 * motion.harmonics:
             th, thd, thdd = motion.on_grid(points)
-            tq = np.abs(thdd + damping * thd - (1.0 + excitation.q(t)) * np.sin(th))
+            tq = np.abs(thdd + damping * thd
+                        - (1.0 + excitation.q_uniform(points)) * np.sin(th))
         else:
             tq = np.abs(torque(motion, excitation, damping, t))
     i = int(np.argmax(tq))

@@ -163,7 +163,7 @@ def fig6() -> dict:
     """Fig. 6: optimal power against damping, with gamma*."""
     ds = api.damping_sweep(**PAPER_CASE, harmonics=32, points=31)
     return {"dataset": ds, "numbers": {
-        "damping": ds["damping"].values.tolist(), "power": ds["power"].values.tolist(),
+        "gamma": ds["gamma"].values.tolist(), "power": ds["power"].values.tolist(),
         "uniform_power": ds["uniform_power"].values.tolist(),
         "damping_threshold": ds.attrs["damping_threshold"], "harmonics": 32, **PAPER_CASE}}
 
@@ -213,7 +213,7 @@ def fig5(epsilons=(1e-1, 1e-2, 1e-4, 1e-6)) -> dict:
     for eps in epsilons:
         sol = _bvp(exc, eps)
         curves.append((f"epsilon = {eps:g}: P = {sol.power:.6f}", *_bvp_curve(sol, exc.omega)))
-        numbers.append({"epsilon": eps, "damping": eps / 2, "power": sol.power,
+        numbers.append({"epsilon": eps, "gamma": eps / 2, "power": sol.power,
                         "mesh_nodes": sol.mesh_nodes, "max_residual": sol.max_residual,
                         "success": sol.success})
     lim = limit(exc)

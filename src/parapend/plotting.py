@@ -71,7 +71,7 @@ def plot_optimum(result, path=None, points: int = 2000):
     ax1.plot(tau, lim.motion.theta(t), "k--", lw=1, label=f"limit gamma -> 0: P = {lim.power:.5f}")
     from .power import uniform_power
 
-    _, phi = uniform_power(exc, result.damping)
+    _, phi = uniform_power(exc, result.gamma)
     ax1.plot(tau, om * t + phi, ":", color="gray", lw=1,
              label=f"best uniform: P = {result.uniform_power:.5f}")
     ax1.set_ylabel("theta (rad, from upright)")
@@ -80,8 +80,8 @@ def plot_optimum(result, path=None, points: int = 2000):
     ax1.grid(alpha=0.3)
     ax1.legend(loc="upper left", fontsize=8)
     desc = ", ".join(f"{k}={v}" for k, v in result.excitation.items() if k != "terms")
-    ax1.set_title(f"Optimal period-1 rotation ({desc}, gamma={result.damping:g})", fontsize=9)
-    tq = torque(motion, exc, result.damping, t)
+    ax1.set_title(f"Optimal period-1 rotation ({desc}, gamma={result.gamma:g})", fontsize=9)
+    tq = torque(motion, exc, result.gamma, t)
     ax2.plot(tau, tq, color="C3", lw=1.2)
     ax2.set_ylabel("torque T (non-dim.)")
     ax2.set_xlabel("tau = omega t / 2 pi")
@@ -93,7 +93,7 @@ def plot_optimum(result, path=None, points: int = 2000):
 def plot_damping_sweep(ds, path=None):
     """Optimal and uniform power against damping with the threshold (cf. paper Fig. 6)."""
     fig, ax = plt.subplots(figsize=(7, 4.2))
-    g = ds["damping"].values
+    g = ds["gamma"].values
     ax.plot(g, ds["power"].values, "o-", ms=3,
             label=f"optimal (Fourier, N = {ds.attrs['harmonics']})")
     ax.plot(g, ds["uniform_power"].values, "--", label="best uniform rotation")

@@ -22,11 +22,38 @@ import math
 
 import numpy as np
 
+from . import limits
+from .errors import ParameterError, check_int, check_range
+
 __all__ = ["limit_motion_power", "mean_power", "power_by_parts", "uniform_power"]
 
 
 def _grid(omega: float, points: int) -> np.ndarray:
     return (2 * math.pi / omega) * np.arange(points) / points
+
+
+def _check_excitation(excitation):
+    from .excitation import Excitation
+
+    if not isinstance(excitation, Excitation):
+        raise ParameterError(f"excitation: expected an Excitation (parapend.harmonic(...), "
+                             f"parapend.build_excitation(...)), got {type(excitation).__name__}")
+    return excitation
+
+
+def _check_motion(motion):
+    if not all(hasattr(motion, a) for a in ("omega", "theta", "theta_dot")):
+        raise ParameterError(f"motion: expected a motion with omega, theta and theta_dot "
+                             f"(e.g. OptimizeResult.motion), got {type(motion).__name__}")
+    return motion
+
+
+def _check_common(motion, excitation, damping, points):
+    _check_motion(motion)
+    _check_excitation(excitation)
+    gamma = check_range("gamma", damping, 0.0, limits.MAX_GAMMA)
+    npts = check_int("points", points, 2, 1 << 24)
+    return gamma, npts
 
 
 def mean_power(motion, excitation, damping: float = 0.0, points: int = 4096) -> float:
@@ -41,6 +68,7 @@ def mean_power(motion, excitation, damping: float = 0.0, points: int = 4096) -> 
     points : int
         Quadrature points per period.
     """
+    damping, points = _check_common(motion, excitation, damping, points)
     t = _grid(motion.omega, points)
     th, thd = motion.theta(t), motion.theta_dot(t)
     q = excitation.q(t)
@@ -49,6 +77,7 @@ def mean_power(motion, excitation, damping: float = 0.0, points: int = 4096) -> 
 
 def power_by_parts(motion, excitation, damping: float = 0.0, points: int = 4096) -> float:
     """Same power in the integrated-by-parts form ``<q' cos(theta)> - gamma <theta'^2>``."""
+    damping, points = _check_common(motion, excitation, damping, points)
     t = _grid(motion.omega, points)
     th, thd = motion.theta(t), motion.theta_dot(t)
     return float(np.mean(excitation.dq(t) * np.cos(th)) - damping * np.mean(thd * thd))
@@ -62,6 +91,8 @@ def uniform_power(excitation, damping: float = 0.0) -> tuple[float, float]:
     ``phi = arg(1j*Q1)`` and ``P = omega |Q1| / 2 - gamma omega^2``. For ``q = delta sin(omega
     t)``: ``P = omega |delta| / 2`` (Eq. 17), reached at ``phi = pi`` when ``delta < 0``.
     """
+    _check_excitation(excitation)
+    damping = check_range("gamma", damping, 0.0, limits.MAX_GAMMA)
     q1 = excitation.first_harmonic
     om = excitation.omega
     phi = float(np.angle(1j * q1)) if q1 != 0 else 0.0

@@ -54,9 +54,12 @@ class OptimizeResult(_Result):
         gamma -> 0 supremum ``omega*TV(q)/(2 pi)`` (Eqs. 19/24/32 generalized).
     gain_over_uniform : float or None
         ``power/uniform_power - 1``; None when the uniform rotation extracts nothing.
-    harmonics, damping, omega : the problem.
-    success, status, message, iterations : convergence (status "converged", "stalled",
-        "max_iterations" or "nonfinite"); iterations of the winning Newton run.
+    harmonics, gamma, omega : the problem (gamma: viscous damping, the CLI flag --gamma).
+    success, status, message, iterations : convergence. ``success`` means the solver
+        converged; status "converged", "no_power" (converged, but the optimum is P <= 0:
+        gamma at or above gamma*, or a constant q; ``success`` is True), "stalled",
+        "max_iterations", "nonfinite" (Fourier) or the BVP's statuses; iterations of the
+        winning Newton run.
     coefficients : dict
         ``{"a0": float, "a": [N], "b": [N]}`` of Eq. 10.
     peak_torque : float
@@ -81,7 +84,7 @@ class OptimizeResult(_Result):
     limit_power: float
     gain_over_uniform: float | None
     harmonics: int
-    damping: float
+    gamma: float
     omega: float
     success: bool
     status: str

@@ -620,9 +620,9 @@ class BVPSolution:
     power_by_parts : float
         The same power as ``<q' cos(theta)> - gamma <theta'^2>`` (an accuracy check).
     epsilon : float
-        Penalty parameter of Eqs. 12-13, ``2 * damping``.
-    damping : float
-        Viscous damping ``gamma`` (Eq. 14).
+        Penalty parameter of Eqs. 12-13, ``2 * gamma``.
+    gamma : float
+        Viscous damping (Eq. 14).
     omega : float
         Forcing frequency.
     t : ndarray, shape (mesh_nodes + 1,)
@@ -666,7 +666,7 @@ class BVPSolution:
     power: float
     power_by_parts: float
     epsilon: float
-    damping: float
+    gamma: float
     omega: float
     t: np.ndarray
     theta: np.ndarray
@@ -973,7 +973,7 @@ def solve_bvp_optimum(excitation, damping: float, *, tol: float = 1e-8,
         power=p15,
         power_by_parts=pbp,
         epsilon=2.0 * gamma,
-        damping=gamma,
+        gamma=gamma,
         omega=om,
         t=t,
         theta=np.append(th_nodes, th_nodes[0] + 2 * math.pi),

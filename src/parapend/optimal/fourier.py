@@ -444,6 +444,27 @@ def _pattern_seeds(excitation, lim, harmonics: int, damping: float, problem):
 #: the full N.
 SCREEN_HARMONICS = 32
 SCREEN_KEEP = 8
+#: Work allowed for comparing the patterns at the full N, in seeds x N^3 (792 patterns at
+#: N = 96: a few seconds); beyond it, at gamma = 0, they are compared at the largest N
+#: within it.
+ENUMERATE_WORK = 792 * 96**3
+
+
+def _screen_harmonics(count: int, harmonics: int, damping: float) -> int | None:
+    """N at which to compare the patterns, or None for the full N (docs/global.md).
+
+    gamma > 0: N = SCREEN_HARMONICS (the ranking is that of the full N: checked). gamma = 0:
+    the ranking depends on N itself, so the full N unless that exceeds ENUMERATE_WORK, and
+    then the largest N within it (the evidence says so: ``screen_harmonics``).
+    """
+    if damping > 0:
+        return SCREEN_HARMONICS if harmonics > SCREEN_HARMONICS else None
+    seeds = count if count <= ENUMERATE_MAX else 2 * PROPOSE_COUNT + SWAP_BUDGET
+    if seeds * harmonics**3 <= ENUMERATE_WORK:
+        return None
+    return max(SCREEN_HARMONICS, int((ENUMERATE_WORK / seeds) ** (1.0 / 3.0)))
+
+
 #: Swaps of a forward and a backward half-turn at most this many extrema apart are tried by
 #: the pattern local search; and at most SWAP_BUDGET of them in all.
 SWAP_WINDOW = 4
@@ -502,10 +523,10 @@ def search_fourier(excitation, harmonics: int, damping: float, *, warm: np.ndarr
             for name, x0 in _seeds(excitation, lim, harmonics, damping, warm, seeds, gtol)]
     strategy, count, extra = "local", pattern_count(lim), []
     screen = None
-    if "limit" in seeds and count > 1 and harmonics > SCREEN_HARMONICS and damping > 0:
-        # compare the patterns at N = SCREEN_HARMONICS, polish the best few at N (at
-        # gamma = 0 the ranking depends on N itself, docs/global.md: no screening)
-        screen = SCREEN_HARMONICS
+    if "limit" in seeds and count > 1:
+        screen = _screen_harmonics(count, harmonics, damping)
+    if screen is not None:
+        # compare the patterns at N = screen, polish the best few at N
         coarse = search_fourier(excitation, screen, damping, seeds=seeds, gtol=gtol,
                                 maxiter=maxiter)
         strategy = coarse.evidence.strategy

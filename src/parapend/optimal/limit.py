@@ -67,6 +67,13 @@ class LimitResult:
 
 def limit(excitation) -> LimitResult:
     """Closed-form gamma -> 0 limit of paper Eqs. 19/24/32 for any periodic excitation."""
+    from ..excitation import Excitation
+
+    if not isinstance(excitation, Excitation):
+        from ..errors import ParameterError
+
+        raise ParameterError(f"excitation: expected an Excitation (parapend.harmonic(...), "
+                             f"parapend.build_excitation(...)), got {type(excitation).__name__}")
     ext = excitation.extrema
     tv = excitation.total_variation
     power = excitation.omega * tv / (2 * math.pi)

@@ -1,0 +1,7 @@
+"""``python -m parapend``: the ``parapend`` command line."""
+
+import sys
+
+from .cli import main
+
+sys.exit(main())

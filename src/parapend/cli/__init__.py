@@ -1,0 +1,130 @@
+"""The ``parapend`` command line: a thin layer over :mod:`parapend.api`.
+
+Every command has ``--help``, defaults to the paper's case (harmonic excitation,
+delta = -0.3, omega = 1.8), prints a plain-text table or, with ``--json``, one JSON object.
+User errors print one line and exit with code 2; only this package prints.
+
+Exit codes: 0 success; 1 a file or standard output could not be written, or a solver
+error; 2 a usage error (bad value, unknown option, unreadable input file, and a bare
+``parapend`` with no command, which prints the list of commands to stderr); 130 when
+interrupted (Ctrl-C).
+
+Modules: :mod:`._common` (parser helpers, number parsing, tables, progress),
+:mod:`._output` (every file written), :mod:`.optimize` (optimize, threshold, damping-sweep,
+harmonics), :mod:`.paper` (figure, reproduce).
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import sys
+
+from .. import __version__
+from ..errors import ParameterError, SolverError
+from ..results import to_jsonable
+from . import optimize as _optimize_cmds
+from . import paper as _paper_cmds
+from ._common import EXIT_USAGE, _Parser
+from ._output import OutputError
+
+EXIT_FAILURE = 1
+
+__all__ = ["build_parser", "main"]
+
+COMMANDS = {**_optimize_cmds.COMMANDS, **_paper_cmds.COMMANDS}
+
+
+def build_parser():
+    """The ``parapend`` argument parser with every subcommand."""
+    parser = _Parser(prog="parapend", description=(
+        "Optimal energy extraction from period-1 rotations of a parametrically excited "
+        "pendulum: theta'' + gamma theta' - (1 + q(t)) sin(theta) = T(t). Power P = -<T "
+        "theta'> is positive when harvested."))
+    parser.add_argument("--version", action="version", version=f"parapend {__version__}")
+    sub = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser,
+                                title="commands")
+    _optimize_cmds.add_parsers(sub)
+    _paper_cmds.add_parsers(sub)
+    return parser
+
+
+def _stdout_closed() -> bool:
+    """True when file descriptor 1 is closed (``parapend ... >&-``)."""
+    try:
+        os.fstat(1)
+        return False
+    except OSError:
+        return True
+
+
+def _err(line: str) -> None:
+    """One line on stderr; silent if stderr itself is gone."""
+    try:
+        print(line, file=sys.stderr or sys.__stderr__)
+    except (OSError, ValueError, AttributeError):
+        pass
+
+
+def _silence_stdout() -> None:
+    """Point fd 1 at /dev/null so the interpreter's final flush cannot fail again."""
+    try:
+        fd = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(fd, 1)
+        os.close(fd)
+    except OSError:
+        pass
+
+
+def main(argv=None) -> int:
+    """Run ``parapend`` with ``argv`` (default ``sys.argv[1:]``); return the exit code."""
+    closed = argv is None and _stdout_closed()
+    if closed:  # keep fd 1 from being reused by an output file opened later
+        _silence_stdout()
+    parser = build_parser()
+    try:
+        a = parser.parse_args(argv)
+    except SystemExit as exc:  # --help, --version (0) or a usage error (2, one line printed)
+        return exc.code if isinstance(exc.code, int) else EXIT_USAGE
+    if a.command is None:
+        parser.print_help(sys.stderr)
+        return EXIT_USAGE
+    name = f"parapend {a.command}"
+    try:
+        out = COMMANDS[a.command](a)
+    except ParameterError as exc:
+        _err(f"{name}: error: {exc}")
+        return EXIT_USAGE
+    except SolverError as exc:
+        _err(f"{name}: solver error: {exc}")
+        return EXIT_FAILURE
+    except OutputError as exc:
+        _err(f"{name}: error: {exc}")
+        return EXIT_FAILURE
+    except OSError as exc:  # any other file-system failure: one line, not a traceback
+        where = f" {exc.filename!r}" if getattr(exc, "filename", None) else ""
+        _err(f"{name}: error: cannot write{where}: {exc.strerror or exc}")
+        return EXIT_FAILURE
+    except MemoryError:
+        _err(f"{name}: error: out of memory; use smaller --harmonics, --points or input files")
+        return EXIT_FAILURE
+    except KeyboardInterrupt:
+        _err(f"{name}: interrupted")
+        return 130
+    if closed:
+        _err(f"{name}: error: standard output is closed; the result was not printed")
+        return EXIT_FAILURE
+    try:
+        if isinstance(out, dict):
+            print(json.dumps(to_jsonable(out), indent=2))
+        else:
+            print(out)
+        sys.stdout.flush()
+    except BrokenPipeError:  # e.g. `parapend optimize | head`: the reader left, not an error
+        _silence_stdout()
+    except (OSError, ValueError) as exc:  # /dev/full, a closed or broken stream
+        _silence_stdout()
+        _err(f"{name}: error: cannot write to standard output: "
+             f"{getattr(exc, 'strerror', None) or exc}")
+        return EXIT_FAILURE
+    return 0

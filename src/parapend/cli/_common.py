@@ -1,0 +1,259 @@
+"""Shared pieces of the command line: parser, number parsing, tables, errors, progress."""
+
+from __future__ import annotations
+
+import argparse
+import math
+import os
+import re
+import sys
+import time
+from pathlib import Path
+
+from ..errors import ParameterError
+
+EXIT_USAGE = 2
+
+
+# a leading '-' followed by a number in any notation (-1, -.5, -1e-3, -1E+2, -inf) is a
+# value, not an option: argparse's own matcher knows only -1 and -1.5
+_NEGATIVE_NUMBER = re.compile(r"^-(\d+\.?\d*|\.\d+)([eE][-+]?\d+)?$|^-(inf|infinity|nan)$",
+                              re.IGNORECASE)
+
+
+class _Parser(argparse.ArgumentParser):
+    """ArgumentParser whose errors are one line (no usage dump) with exit code 2, and which
+    reads ``-1e-3`` as a negative number (``--delta -1e-3``)."""
+
+    def __init__(self, *args, **kwargs):
+        super().__init__(*args, **kwargs)
+        self._negative_number_matcher = _NEGATIVE_NUMBER
+
+    def error(self, message):
+        self.exit(EXIT_USAGE, f"{self.prog}: error: {message}\n")
+
+
+def _finite_float(name):
+    def conv(text):
+        try:
+            x = float(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"expected a number, got {text!r:.40}") from None
+        if not math.isfinite(x):
+            raise argparse.ArgumentTypeError(f"expected a finite number, got {text!r:.40}")
+        return x
+
+    conv.__name__ = name
+    return conv
+
+
+def _int(text):
+    t = text.strip()
+    if len(t) > 30:  # int() of a thousand-digit string is slow and never a valid count
+        raise argparse.ArgumentTypeError(f"expected an integer, got {text[:20]!r}... "
+                                         f"({len(t)} characters)")
+    try:
+        return int(t)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected an integer, got {text!r:.40}") from None
+
+
+def _add_excitation(p):
+    g = p.add_argument_group("excitation q(t) (base acceleration over g)")
+    g.add_argument("--excitation", default=None,
+                   choices=["harmonic", "two-harmonic", "square", "fourier", "file"],
+                   help="harmonic: delta sin(omega t); two-harmonic: Eq. 23; square: Eq. 26; "
+                        "fourier: --fourier terms; file: --file CSV (default: file if --file "
+                        "is given, fourier if --fourier is given, else harmonic)")
+    g.add_argument("--omega", type=_finite_float("omega"), default=1.8,
+                   help="forcing frequency in [1e-3, 1e3], units sqrt(g/l) (default 1.8)")
+    g.add_argument("--delta", type=_finite_float("delta"), default=None,
+                   help="amplitude of harmonic, two-harmonic, square, |delta| <= 1e3 "
+                        "(default -0.3)")
+    g.add_argument("--square-alpha", type=_finite_float("square-alpha"), default=None,
+                   help="tanh smoothing width alpha of Eq. 26, square only (default 0.001)")
+    g.add_argument("--fourier", metavar="TERMS",
+                   help="'k:amp:phase,...' for q = sum amp sin(k omega t + phase), integer "
+                        "1 <= k <= 1024")
+    g.add_argument("--file", metavar="CSV",
+                   help="one period of q: UTF-8 CSV header 'tau,q', tau = omega t/2pi in "
+                        "[0, 1), 16 to 16384 rows")
+
+
+def _excitation_kwargs(a) -> dict:
+    return {"excitation": a.excitation, "omega": a.omega, "delta": a.delta,
+            "square_alpha": a.square_alpha, "fourier": a.fourier, "file": a.file}
+
+
+FIGURE_SUFFIXES = (".png", ".svg", ".pdf")
+
+
+def _blocking_file(p: Path) -> Path | None:
+    """The first ancestor of ``p`` (nearest the root) that exists but is not a directory."""
+    for anc in reversed(p.parents):
+        if anc.exists() and not anc.is_dir():
+            return anc
+    return None
+
+
+def _check_output(path: str | None, what: str, suffixes) -> None:
+    """Fail early (before any work) if an output path cannot be written."""
+    if path is None:
+        return
+    if not path.strip():
+        raise ParameterError(f"{what}: expected a file name, got an empty string")
+    p = Path(path)
+    if p.suffix.lower() not in suffixes:
+        raise ParameterError(f"{what}: expected a file name ending in {' or '.join(suffixes)}, "
+                             f"got {path!r:.80}")
+    try:
+        max_name = os.pathconf(p.parent if str(p.parent) else ".", "PC_NAME_MAX")
+    except (OSError, ValueError):
+        max_name = 255
+    if len(os.fsencode(p.name)) + 16 > max_name:  # + room for the temporary file's prefix
+        raise ParameterError(f"{what}: file name too long ({len(p.name)} characters; the file "
+                             f"system allows {max_name})")
+    blocker = _blocking_file(p)
+    if blocker is not None:
+        raise ParameterError(f"{what}: {str(blocker)!r} is a file, not a directory")
+    parent = p.parent if str(p.parent) else Path(".")
+    if not parent.is_dir():
+        raise ParameterError(f"{what}: directory {str(parent)!r} does not exist")
+    if p.is_dir():
+        raise ParameterError(f"{what}: {path!r} is a directory, expected a file name")
+    from ._output import OutputError, probe_dir
+
+    try:
+        probe_dir(parent)
+    except OutputError as exc:
+        raise ParameterError(f"{what}: {exc}") from None
+
+
+class _Ticker:
+    """Context manager: on a terminal, an elapsed-time line on stderr for work without
+    natural steps (one figure); silent for the first ``delay`` seconds and when piped."""
+
+    def __init__(self, label: str, delay: float = 2.0):
+        self.label = label
+        self.delay = delay
+        self.thread = None
+
+    def __enter__(self):
+        import threading
+
+        try:
+            on = sys.stderr is not None and sys.stderr.isatty()
+        except (ValueError, OSError):
+            on = False
+        if on:
+            self.stop = threading.Event()
+            self.thread = threading.Thread(target=self._run, daemon=True)
+            self.thread.start()
+        return self
+
+    def _run(self):
+        start = time.monotonic()
+        drawn = False
+        while not self.stop.wait(0.5):
+            el = time.monotonic() - start
+            if el >= self.delay:
+                try:
+                    sys.stderr.write(f"\r{self.label}: working, {el:4.0f} s")
+                    sys.stderr.flush()
+                    drawn = True
+                except (OSError, ValueError):
+                    return
+        if drawn:
+            try:
+                sys.stderr.write("\r" + " " * (len(self.label) + 20) + "\r")
+                sys.stderr.flush()
+            except (OSError, ValueError):
+                pass
+
+    def __exit__(self, *exc):
+        if self.thread is not None:
+            self.stop.set()
+            self.thread.join()
+        return False
+
+
+class _Progress:
+    """A one-line progress bar on stderr, only when stderr is a terminal.
+
+    Call it as ``bar(done, total)`` (or ``bar(done, total, label)``); it draws nothing for
+    the first ``delay`` seconds, so quick runs stay silent, and erases itself at the end.
+    """
+
+    def __init__(self, label: str, delay: float = 1.0):
+        self.label = label
+        self.delay = delay
+        self.start = time.monotonic()
+        self.drawn = False
+        try:
+            self.on = sys.stderr is not None and sys.stderr.isatty()
+        except (ValueError, OSError):
+            self.on = False
+
+    def __call__(self, done: int, total: int, label: str | None = None) -> None:
+        if not self.on or (not self.drawn and time.monotonic() - self.start < self.delay
+                           and done < total):
+            return
+        width = 30
+        k = int(width * done / max(total, 1))
+        what = self.label if label is None else f"{self.label}: {label}"
+        line = f"{what[:40]} [{'#' * k}{'.' * (width - k)}] {done}/{total}"
+        try:
+            if done >= total:
+                if self.drawn:
+                    sys.stderr.write("\r" + " " * len(line) + "\r")
+            else:
+                sys.stderr.write("\r" + line)
+                self.drawn = True
+            sys.stderr.flush()
+        except (OSError, ValueError):
+            self.on = False
+
+
+def _fmt(x, digits=6):
+    """A number for a table: exact zero as ``0``, fixed decimals for ordinary magnitudes,
+    significant digits for tiny or huge ones (never ``0.000000`` for a nonzero value)."""
+    if x is None:
+        return "-"
+    x = float(x)
+    if not math.isfinite(x):
+        return str(x)
+    if x == 0:
+        return "0"
+    if not 1e-3 <= abs(x) < 1e6:
+        return f"{x:.{digits}g}"
+    return f"{x:.{digits}f}"
+
+
+def _is_number(text: str) -> bool:
+    try:
+        float(text.replace("%", "").replace("+", ""))
+        return True
+    except ValueError:
+        return text in ("", "-")
+
+
+def _table(rows, header) -> str:
+    """Plain-text table: numeric columns right-aligned, text columns left-aligned."""
+    cols = [header] + rows
+    widths = [max(len(str(r[i])) for r in cols) for i in range(len(header))]
+    numeric = [all(_is_number(str(r[i])) for r in rows) for i in range(len(header))]
+    lines = ["  ".join(str(v).rjust(w) if num else str(v).ljust(w)
+                       for v, w, num in zip(r, widths, numeric)).rstrip() for r in cols]
+    lines.insert(1, "  ".join("-" * w for w in widths))
+    return "\n".join(lines)
+
+
+def _describe(exc: dict) -> str:
+    return ", ".join(f"{k}={v}" for k, v in exc.items())
+
+
+def _dataset_json(ds) -> dict:
+    """A one-dimensional Dataset as JSON: its coordinate, every variable, every attribute."""
+    out = {name: ds[name].values for name in ds.coords}
+    out.update({name: ds[name].values for name in ds.data_vars})
+    return {**out, **ds.attrs}

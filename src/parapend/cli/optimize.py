@@ -1,0 +1,270 @@
+"""``parapend optimize | threshold | damping-sweep | harmonics``."""
+
+from __future__ import annotations
+
+import csv
+import io
+
+from .. import limits
+from ..errors import ParameterError
+from ..results import CONVENTION
+from . import _output
+from ._common import (
+    FIGURE_SUFFIXES,
+    _add_excitation,
+    _check_output,
+    _dataset_json,
+    _describe,
+    _excitation_kwargs,
+    _finite_float,
+    _fmt,
+    _int,
+    _Progress,
+    _table,
+)
+
+
+def add_parsers(sub) -> None:
+    """Add optimize, threshold, damping-sweep and harmonics to the subcommand parser."""
+    p = sub.add_parser("optimize", help="optimal period-1 rotation (Fourier Eq. 10, BVP Eq. 22)",
+                       description="Optimal period-1 rotation by truncated Fourier series "
+                                   "(Eqs. 10-11) or the penalized Euler-Lagrange BVP (Eqs. 13, "
+                                   "22, 27), beside the best uniform rotation (Eq. 17) and the "
+                                   "gamma -> 0 limit (Eqs. 19, 24, 32 generalized).")
+    _add_excitation(p)
+    p.add_argument("--gamma", type=_finite_float("gamma"), default=0.0,
+                   help="viscous damping gamma in [0, 1e3] (default 0)")
+    p.add_argument("--harmonics", type=_int, default=24,
+                   help=f"number N of harmonics, at most {limits.MAX_HARMONICS} (default 24)")
+    p.add_argument("--method", choices=["fourier", "bvp", "all"], default="fourier",
+                   help="fourier: Eq. 10 with N harmonics; bvp: Euler-Lagrange BVP (Eqs. 13, "
+                        "22, 27; needs gamma >= 1e-7); all: uniform, Fourier, BVP and limit "
+                        "side by side (default fourier)")
+    p.add_argument("--plot", metavar="PNG",
+                   help="draw theta(tau) and torque (PNG, SVG or PDF)")
+    p.add_argument("--save", metavar="CSV",
+                   help="write one period of the motion: t,tau,theta,theta_dot,torque")
+    p.add_argument("--json", action="store_true", help="print one JSON object")
+
+    p = sub.add_parser("threshold", help="damping gamma* beyond which no power is extracted",
+                       description="Damping threshold gamma* where the optimal power "
+                                   "vanishes (paper Fig. 6: 0.0856 at delta=-0.3, omega=1.8).")
+    _add_excitation(p)
+    p.add_argument("--harmonics", type=_int, default=None,
+                   help=f"fixed N, at most {limits.MAX_THRESHOLD_HARMONICS} (default: doubled "
+                        "from 8 until gamma* converges)")
+    p.add_argument("--json", action="store_true", help="print one JSON object")
+
+    p = sub.add_parser("damping-sweep", help="optimal power against damping (paper Fig. 6)",
+                       description="Optimal and uniform power against damping gamma, from 0 "
+                                   "to 1.25 gamma* by default (paper Fig. 6).")
+    _add_excitation(p)
+    p.add_argument("--harmonics", type=_int, default=None,
+                   help=f"N, at most {limits.MAX_SWEEP_HARMONICS} (default 32, or the "
+                        "excitation's band when higher)")
+    p.add_argument("--gamma-max", type=_finite_float("gamma-max"), default=None,
+                   help="largest damping (default 1.25 gamma*)")
+    p.add_argument("--points", type=_int, default=41,
+                   help=f"number of dampings, 2 to {limits.MAX_POINTS}, with points x N^2 <= "
+                        f"{limits.MAX_SWEEP_WORK} (default 41)")
+    p.add_argument("--plot", metavar="PNG",
+                   help="draw power against damping (PNG, SVG or PDF)")
+    p.add_argument("--save", metavar="NC", help="write the sweep as a NetCDF file (.nc)")
+    p.add_argument("--json", action="store_true", help="print one JSON object")
+
+    p = sub.add_parser("harmonics", help="optimal power against the number of harmonics",
+                       description="Fourier optimum for N = FROM..TO by continuation in N "
+                                   "(nondecreasing in N), beside the uniform and limit powers.")
+    _add_excitation(p)
+    p.add_argument("--gamma", type=_finite_float("gamma"), default=0.0,
+                   help="viscous damping gamma in [0, 1e3] (default 0)")
+    p.add_argument("--from", dest="n_from", type=_int, default=2, help="smallest N (default 2)")
+    p.add_argument("--to", dest="n_to", type=_int, default=64,
+                   help=f"largest N, at most {limits.MAX_TABLE_HARMONICS} (default 64)")
+    p.add_argument("--plot", metavar="PNG", help="draw power against N (PNG, SVG or PDF)")
+    p.add_argument("--save", metavar="NC", help="write the table as a NetCDF file (.nc)")
+    p.add_argument("--json", action="store_true", help="print one JSON object")
+
+
+def _cmd_optimize(a) -> dict | str:
+    from ..api import motion_samples, optimize
+
+    _check_output(a.plot, "--plot", FIGURE_SUFFIXES)
+    _check_output(a.save, "--save", (".csv",))
+    kw = {"gamma": a.gamma, "harmonics": a.harmonics, **_excitation_kwargs(a)}
+    if a.method == "all":
+        return _optimize_all(a, kw)
+    r = optimize(method=a.method, **kw)
+    if a.save:
+        s = motion_samples(r)
+        buf = io.StringIO()
+        w = csv.writer(buf, lineterminator="\n")
+        w.writerow(["t", "tau", "theta", "theta_dot", "torque"])
+        for row in zip(s["t"], s["tau"], s["theta"], s["theta_dot"], s["torque"]):
+            w.writerow([repr(float(v)) for v in row])
+        _output.write_text(a.save, buf.getvalue())
+    if a.plot:
+        from ..plotting import plot_optimum
+
+        _output.plot(plot_optimum, r, a.plot)
+    if a.json:
+        return r.to_dict()
+    name = (f"Fourier optimum, N = {r.harmonics} (Eq. 10)" if r.method == "fourier"
+            else f"BVP optimum, epsilon = {2 * r.gamma:g} (Eq. 22)")
+    rows = [
+        ["best uniform rotation (Eq. 17)", _fmt(r.uniform_power), ""],
+        [name, _fmt(r.power), _gain(r.power, r.uniform_power)],
+        ["limit gamma -> 0 (Eqs. 19/24/32)", _fmt(r.limit_power),
+         _gain(r.limit_power, r.uniform_power)],
+    ]
+    if r.found_by == "constant excitation":
+        how = "q is constant: the motion is the uniform rotation theta = omega t"
+    elif r.method == "fourier":
+        how = (f"{r.iterations} Newton iterations, found from the {r.found_by} seed, "
+               f"{len(r.local_maxima)} distinct local maxima")
+        search = (f"search: {r.search}, {r.patterns_tried} of {r.candidate_patterns} "
+                  f"half-turn direction patterns tried, {r.polished} runs polished, "
+                  f"{r.abandoned} abandoned as unable to win")
+        if r.second_power is not None:
+            search += f"; second-best maximum {_fmt(r.second_power)}"
+    else:
+        how = (f"{r.mesh_nodes} mesh nodes, max residual {r.max_residual:.2g}, "
+               f"{r.continuation_steps} continuation steps, found from the {r.found_by} start")
+    out = [f"excitation: {_describe(r.excitation)}; damping gamma = {r.gamma:g}", "",
+           _table(rows, ["motion", "power P", "vs uniform"]), "",
+           f"status: {r.status} ({how})",
+           f"upper bound limit - gamma omega^2: {_fmt(r.upper_bound)} "
+           f"(gap {_fmt(r.bound_gap)})",
+           f"peak torque |T|: {r.peak_torque:.6g}    mean theta'^2: {r.mean_square_speed:.6g}",
+           f"convention: {CONVENTION}"]
+    if r.method == "fourier" and r.found_by != "constant excitation":
+        out.insert(5, search)
+    if r.status == "no_power":
+        out.insert(5, f"note: {r.message}")
+    if a.save:
+        out.append(f"motion written to {a.save}")
+    if a.plot:
+        out.append(f"figure written to {a.plot}")
+    return "\n".join(out)
+
+
+def _gain(p, pu) -> str:
+    return f"{100 * (p / pu - 1):+.2f} %" if pu > 0 else "-"
+
+
+def _optimize_all(a, kw) -> dict | str:
+    """Uniform, Fourier, BVP (gamma > 0 only) and limit for one case."""
+    from ..api import optimize
+
+    if a.save or a.plot:
+        raise ParameterError("--method all: --save and --plot need a single method "
+                             "(fourier or bvp)")
+    f = optimize(method="fourier", **kw)
+    b = optimize(method="bvp", **kw) if a.gamma >= limits.MIN_BVP_GAMMA else None
+    if a.json:
+        return {"uniform_power": f.uniform_power, "limit_power": f.limit_power,
+                "gamma": f.gamma, "omega": f.omega, "excitation": f.excitation,
+                "fourier": f.to_dict(), "bvp": None if b is None else b.to_dict()}
+    rows = [[f"best uniform rotation at gamma = {f.gamma:g} (Eq. 17)",
+             _fmt(f.uniform_power, 10), "", "closed form"],
+            [f"Fourier, N = {f.harmonics} (Eq. 10)", _fmt(f.power, 10),
+             _gain(f.power, f.uniform_power), f.status],
+            [f"BVP, epsilon = {2 * f.gamma:g} (Eq. 22)",
+             "-" if b is None else _fmt(b.power, 10),
+             "-" if b is None else _gain(b.power, f.uniform_power),
+             f"needs gamma >= {limits.MIN_BVP_GAMMA:g}" if b is None else
+             f"{b.status}, {b.mesh_nodes} nodes, residual {b.max_residual:.1e}"
+             if b.mesh_nodes is not None else b.status],
+            ["limit gamma -> 0, undamped (Eqs. 19/24/32)", _fmt(f.limit_power, 10),
+             _gain(f.limit_power, f.uniform_power), "closed form, gamma = 0"]]
+    out = [f"excitation: {_describe(f.excitation)}; damping gamma = {f.gamma:g}", "",
+           _table(rows, ["method", "power P", "vs uniform", "status"])]
+    if f.gamma > 0:
+        out += ["", f"note: the limit row is the undamped (gamma = 0) supremum, an upper bound; "
+                    f"the other rows are at gamma = {f.gamma:g}"]
+    if b is not None:
+        out += ["", f"Fourier - BVP: {f.power - b.power:+.3e}  (agree when N resolves the "
+                    "boundary layers)"]
+    return "\n".join(out)
+
+
+def _cmd_threshold(a) -> dict | str:
+    from ..api import threshold
+
+    r = threshold(harmonics=a.harmonics, **_excitation_kwargs(a))
+    if a.json:
+        return r.to_dict()
+    return "\n".join([
+        f"excitation: {_describe(r.excitation)}",
+        f"damping threshold gamma*: {_fmt(r.damping_threshold, 10)}  (optimal power vanishes)",
+        f"uniform-rotation threshold: {_fmt(r.uniform_threshold, 10)}  (|Q1| / 2 omega)",
+        f"status: {r.status} (N = {r.harmonics}, {r.iterations} Newton steps in gamma; "
+        f"change from N/2: {_fmt(r.refinement_change, 3)})",
+    ])
+
+
+def _cmd_damping_sweep(a) -> dict | str:
+    from ..api import damping_sweep
+
+    _check_output(a.plot, "--plot", FIGURE_SUFFIXES)
+    _check_output(a.save, "--save", (".nc",))
+    ds = damping_sweep(harmonics=a.harmonics, gamma_max=a.gamma_max, points=a.points,
+                       progress=_Progress("damping sweep"), **_excitation_kwargs(a))
+    if a.plot:
+        from ..plotting import plot_damping_sweep
+
+        _output.plot(plot_damping_sweep, ds, a.plot)
+    if a.save:
+        _output.write_dataset(ds, a.save)
+    if a.json:
+        return _dataset_json(ds)
+    rows = [[_fmt(g), _fmt(p), _fmt(u), f"{t:.4g}", str(s)] for g, p, u, t, s in zip(
+        ds["gamma"].values, ds["power"].values, ds["uniform_power"].values,
+        ds["peak_torque"].values, ds["status"].values)]
+    out = [f"excitation: {ds.attrs['excitation']}, omega={ds.attrs['omega']}; "
+           f"N = {ds.attrs['harmonics']}", "",
+           _table(rows, ["gamma", "optimal P", "uniform P", "peak |T|", "status"]), "",
+           f"damping threshold gamma*: {_fmt(ds.attrs['damping_threshold'], 10)}",
+           f"resolution check: end points with 2N change by at most "
+           f"{_fmt(ds.attrs['refinement_change'], 3)}"]
+    if a.plot:
+        out.append(f"figure written to {a.plot}")
+    return "\n".join(out)
+
+
+def _cmd_harmonics(a) -> dict | str:
+    from ..api import harmonic_table
+
+    _check_output(a.plot, "--plot", FIGURE_SUFFIXES)
+    _check_output(a.save, "--save", (".nc",))
+    top = limits.MAX_TABLE_HARMONICS
+    if not 1 <= a.n_to <= top:
+        raise ParameterError(f"--to: expected an integer in [1, {top}] (the continuation to "
+                             f"{top} takes about 10 s, to 512 over 10 minutes), got {a.n_to}")
+    if not 1 <= a.n_from <= a.n_to:
+        raise ParameterError(f"--from: expected an integer in [1, --to = {a.n_to}], "
+                             f"got {a.n_from}")
+    ds = harmonic_table(range(a.n_from, a.n_to + 1), gamma=a.gamma,
+                        progress=_Progress("harmonics"), **_excitation_kwargs(a))
+    if a.plot:
+        from ..plotting import plot_harmonic_table
+
+        _output.plot(plot_harmonic_table, ds, a.plot)
+    if a.save:
+        _output.write_dataset(ds, a.save)
+    if a.json:
+        return _dataset_json(ds)
+    rows = [[str(n), _fmt(p, 8), str(s)] for n, p, s in zip(
+        ds["harmonics"].values, ds["power"].values, ds["status"].values)]
+    out = [_table(rows, ["N", "optimal P", "status"]), "",
+           f"best uniform: {_fmt(ds.attrs['uniform_power'], 8)}    "
+           f"limit gamma -> 0 (undamped): {_fmt(ds.attrs['limit_power'], 8)}",
+           f"band of q: {ds.attrs['spectrum_harmonics']} harmonics; last row with 2N changes "
+           f"by {_fmt(ds.attrs['refinement_change'], 3)}"]
+    if a.plot:
+        out.append(f"figure written to {a.plot}")
+    return "\n".join(out)
+
+
+COMMANDS = {"optimize": _cmd_optimize, "threshold": _cmd_threshold,
+            "damping-sweep": _cmd_damping_sweep, "harmonics": _cmd_harmonics}

@@ -1,0 +1,49 @@
+"""Admissible ranges of the inputs, checked at the API edge (see ``docs/limits-of-input.md``).
+
+Each bound keeps the model meaningful and the numerics inside double precision and inside
+a bounded time and memory (well under 2 minutes and 2 GB on one core); the reason for each
+is in the document above. Only this module holds the numbers.
+"""
+
+from __future__ import annotations
+
+__all__ = [
+    "MAX_AMPLITUDE", "MAX_BVP_EXTREMA", "MAX_BVP_WORK", "MAX_BYTES_FILE", "MAX_FILE_ROWS",
+    "MAX_FOURIER_K", "MAX_GAMMA", "MAX_HARMONICS", "MAX_PHASE", "MAX_POINTS",
+    "MAX_SWEEP_HARMONICS", "MAX_SWEEP_WORK", "MAX_TABLE_HARMONICS", "MAX_THRESHOLD_HARMONICS",
+    "MIN_BVP_GAMMA", "OMEGA_RANGE", "SQUARE_ALPHA_MIN",
+]
+
+#: forcing frequency omega, units sqrt(g/l)
+OMEGA_RANGE = (1e-3, 1e3)
+#: |delta| and |amplitude| of a Fourier term or a sample of q (base acceleration over g)
+MAX_AMPLITUDE = 1e3
+#: |phase| of a Fourier term, radians
+MAX_PHASE = 1e6
+#: viscous damping gamma (non-dimensional, unit sqrt(g/l))
+MAX_GAMMA = 1e3
+#: smallest gamma for the Euler-Lagrange BVP (epsilon = 2 gamma)
+MIN_BVP_GAMMA = 1e-7
+#: smallest tanh width of Eq. 26, as a fraction of the period 2 pi/omega
+SQUARE_ALPHA_MIN = 1e-9
+#: largest harmonic number k of a Fourier-series excitation
+MAX_FOURIER_K = 1024
+#: harmonics N of one Fourier solve (optimize)
+MAX_HARMONICS = 1024
+#: harmonics N of each solve inside threshold (several solves)
+MAX_THRESHOLD_HARMONICS = 512
+#: largest N of a harmonic table (continuation over N = from..to)
+MAX_TABLE_HARMONICS = 128
+#: harmonics N inside a damping sweep
+MAX_SWEEP_HARMONICS = 256
+#: dampings in a damping sweep
+MAX_POINTS = 1001
+#: points * harmonics**2 of a damping sweep (about a minute of work)
+MAX_SWEEP_WORK = 1 << 20
+#: extrema of q per period for the Euler-Lagrange BVP (each needs a boundary layer)
+MAX_BVP_EXTREMA = 64
+#: mesh nodes x harmonics of q for one BVP (each residual evaluates q at every node)
+MAX_BVP_WORK = 4e7
+#: rows of a sampled-excitation CSV file, and its size in bytes
+MAX_FILE_ROWS = 16384
+MAX_BYTES_FILE = 4 << 20

@@ -1,0 +1,336 @@
+"""Issue 8 (first half): every bad input becomes one line and a non-zero exit, work is
+bounded, nothing is silently ignored or misleading. Fast: no solve here takes over ~1 s."""
+
+import json
+import math
+import os
+import resource
+import signal
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import parapend
+from parapend import limits
+from parapend.cli import main
+from parapend.errors import ParameterError
+
+SRC = str(Path(__file__).resolve().parents[1] / "src")
+
+
+def run(capsys, *args):
+    code = main(list(args))
+    out, err = capsys.readouterr()
+    return code, out, err
+
+
+def one_line_error(capsys, args, code=2):
+    c, out, err = run(capsys, *args)
+    assert c == code, (args, c, err)
+    assert err.count("\n") == 1 and "Traceback" not in err, err
+    return err
+
+
+def cli(*args, stdout=subprocess.PIPE, limit_fsize=None, timeout=60):
+    """Run ``python -m parapend`` in a subprocess (for closed or failing stdout)."""
+    def pre():
+        if limit_fsize is not None:
+            signal.signal(signal.SIGXFSZ, signal.SIG_IGN)
+            resource.setrlimit(resource.RLIMIT_FSIZE, (limit_fsize, limit_fsize))
+    env = {**os.environ, "PYTHONPATH": SRC}
+    return subprocess.run([sys.executable, "-m", "parapend", *args], stdout=stdout,
+                          stderr=subprocess.PIPE, text=True, timeout=timeout, env=env,
+                          preexec_fn=pre)
+
+
+def write_csv(path, n=32, q=None, header="tau,q"):
+    tau = np.arange(n) / n
+    q = -0.3 * np.sin(2 * np.pi * tau) if q is None else q
+    path.write_text(header + "\n" + "\n".join(f"{a!r},{b!r}" for a, b in
+                                             zip(tau.tolist(), np.asarray(q).tolist())))
+    return path
+
+
+# -- 2. tracebacks -> one line naming the parameter ----------------------------------------
+@pytest.mark.parametrize("args, word", [
+    (["optimize", "--omega", "1e155"], "omega"),
+    (["optimize", "--omega", "1e-308"], "omega"),
+    (["optimize", "--delta=1e308"], "delta"),
+    (["threshold", "--omega", "1e-320"], "omega"),
+    (["optimize", "--excitation", "square", "--square-alpha", "1e-308"], "square-alpha"),
+    (["optimize", "--method", "bvp", "--gamma", "1e-320"], "gamma"),
+    (["optimize", "--gamma", "1e300"], "gamma"),
+    (["optimize", "--fourier", "1:0.3:1e300"], "phase"),
+    (["optimize", "--fourier", "1:1e300"], "amplitude"),
+    (["optimize", "--omega", "1e"], "omega"),
+    (["optimize", "--omega", ""], "omega"),
+    (["optimize", "--harmonics", "9" * 5000], "harmonics"),
+    (["optimize", "--harmonics", "-3"], "harmonics"),
+    (["optimize", "--bogus"], "unrecognized"),
+])
+def test_extreme_values_one_line(capsys, args, word):
+    assert word in one_line_error(capsys, args)
+
+
+def test_api_ranges_named():
+    with pytest.raises(ParameterError, match=r"omega: expected a number in \[0.001, 1000\]"):
+        parapend.optimize(omega=1e155)
+    with pytest.raises(ParameterError, match=r"delta: expected \|delta\| <= 1000"):
+        parapend.harmonic(1e308)
+    with pytest.raises(ParameterError, match="square-alpha"):
+        parapend.square(alpha=1e-308)
+    with pytest.raises(ParameterError, match=r"gamma: expected a number >= 1e-07"):
+        parapend.optimize(method="bvp", gamma=1e-320)
+    with pytest.raises(ParameterError, match=r"gamma: expected a number in \[0, 1000\]"):
+        parapend.harmonic_table([2], gamma=-1.0)
+    with pytest.raises(ParameterError, match=r"gamma-max"):
+        parapend.damping_sweep(gamma_max=1e300, points=3, harmonics=4)
+
+
+@pytest.mark.parametrize("content, word", [
+    ("tau,q\n0,1\n".encode("latin-1") + "0.5,\xe9\n".encode("latin-1"), "UTF-8"),
+    ("tau,q\n0,0\n".encode("utf-16"), "NUL"),
+    (bytes(range(256)) * 4, "NUL"),
+    (b"", "header"),
+])
+def test_csv_encodings_one_line(tmp_path, capsys, content, word):
+    p = tmp_path / "q.csv"
+    p.write_bytes(content)
+    assert word in one_line_error(capsys, ["optimize", "--file", str(p)])
+
+
+def test_csv_utf8_bom_accepted(tmp_path, capsys):
+    p = write_csv(tmp_path / "q.csv")
+    p.write_bytes(b"\xef\xbb\xbf" + p.read_bytes())
+    code, out, _ = run(capsys, "optimize", "--file", str(p), "--harmonics", "4", "--json")
+    assert code == 0 and json.loads(out)["excitation"]["excitation"] == "file"
+
+
+def test_csv_huge_values_tiny_gaps_and_directories(tmp_path, capsys):
+    p = write_csv(tmp_path / "big.csv", q=np.full(32, 1e308))
+    assert "|q| <= 1000" in one_line_error(capsys, ["optimize", "--file", str(p)])
+    tau = np.concatenate(([0.0, 1e-300], np.arange(2, 32) / 32)).tolist()
+    p = tmp_path / "gap.csv"
+    p.write_text("tau,q\n" + "\n".join(f"{t!r},{math.sin(2 * math.pi * t)!r}" for t in tau))
+    assert "spacing" in one_line_error(capsys, ["optimize", "--file", str(p)])
+    assert "directory" in one_line_error(capsys, ["optimize", "--file", str(tmp_path)])
+
+
+def test_csv_reading_is_bounded(tmp_path, capsys):
+    err = one_line_error(capsys, ["optimize", "--file", "/dev/zero"])
+    assert "larger than" in err
+    p = write_csv(tmp_path / "long.csv", n=limits.MAX_FILE_ROWS + 1)
+    assert str(limits.MAX_FILE_ROWS) in one_line_error(capsys, ["optimize", "--file", str(p)])
+
+
+@pytest.mark.parametrize("args", [
+    ["optimize", "--save", "/proc/x.csv"],
+    ["optimize", "--plot", "/sys/x.png"],
+    ["optimize", "--save", "x" * 300 + ".csv"],
+    ["reproduce", "--out", "/proc/x"],
+    ["reproduce", "--out", ""],
+    ["optimize", "--save", ""],
+])
+def test_unwritable_outputs_one_line(capsys, args):
+    one_line_error(capsys, args)
+
+
+def test_reproduce_out_below_a_file(tmp_path, capsys):
+    f = tmp_path / "afile"
+    f.write_text("x")
+    err = one_line_error(capsys, ["reproduce", "--out", str(f / "sub")])
+    assert "is a file" in err and "afile" in err
+
+
+def test_full_disk_one_line(tmp_path):
+    r = cli("optimize", "--harmonics", "4", "--save", str(tmp_path / "m.csv"),
+            limit_fsize=1000)
+    assert r.returncode == 1 and "Traceback" not in r.stderr
+    assert r.stderr.count("\n") == 1 and "m.csv" in r.stderr
+    assert [p.name for p in tmp_path.iterdir()] == []  # no temporary left behind
+
+
+def test_stdout_full_or_closed():
+    with open("/dev/full", "w") as full:
+        r = cli("optimize", "--harmonics", "4", stdout=full)
+    assert r.returncode == 1 and "Traceback" not in r.stderr and r.stderr.count("\n") == 1
+    r = subprocess.run(f"{sys.executable} -m parapend optimize --harmonics 4 >&-", shell=True,
+                       capture_output=True, text=True, env={**os.environ, "PYTHONPATH": SRC},
+                       timeout=60)
+    assert r.returncode == 1 and "Traceback" not in r.stderr and "closed" in r.stderr
+
+
+# -- 3. bounded time and memory ------------------------------------------------------------
+@pytest.mark.parametrize("args, words", [
+    (["optimize", "--harmonics", "4096"], ["harmonics", "1024"]),
+    (["optimize", "--harmonics", "2048"], ["harmonics", "1024"]),
+    (["optimize", "--fourier", "1000000:0.3"], ["k", "1024"]),
+    (["optimize", "--fourier", "999999999999:0.3"], ["k", "1024"]),
+    (["damping-sweep", "--points", "100000"], ["points", "1001"]),
+    (["damping-sweep", "--points", "1000", "--harmonics", "64"], ["points", "harmonics"]),
+    (["harmonics", "--to", "4096"], ["--to", "128", "4096"]),
+    (["harmonics", "--to", "512"], ["--to", "128"]),
+    (["harmonics", "--to", "1000000000"], ["--to", "1000000000"]),
+    (["threshold", "--harmonics", "1024"], ["harmonics", "512"]),
+])
+def test_caps_name_parameter_and_cap(capsys, args, words):
+    err = one_line_error(capsys, args)
+    assert all(w in err for w in words), err
+
+
+def test_bvp_refuses_rough_excitation():
+    rng = np.random.default_rng(0)
+    tau = np.arange(512) / 512
+    exc = parapend.excitation.SampledExcitation(
+        1.8, tuple(tau), tuple(-0.3 * np.sin(2 * np.pi * tau) + 0.01 * rng.standard_normal(512)))
+    with pytest.raises(ParameterError, match="extrema per period"):
+        parapend.optimize(excitation=exc, method="bvp", gamma=1e-4)
+
+
+def test_peak_torque_long_spectrum_bounded_memory():
+    """q on the torque grid by folding: exact, and no dense (points x K) matrix."""
+    from parapend.excitation import _evaluate, _evaluate_uniform
+
+    rng = np.random.default_rng(1)
+    spec = rng.standard_normal(3000) + 1j * rng.standard_normal(3000)
+    s = 2 * np.pi * np.arange(512) / 512
+    np.testing.assert_allclose(_evaluate_uniform(spec, 512), _evaluate(spec, s), atol=1e-9)
+    n = limits.MAX_FILE_ROWS
+    tau = np.arange(n) / n
+    exc = parapend.excitation.SampledExcitation(1.8, tuple(tau),
+                                                tuple(-0.3 * np.sin(2 * np.pi * tau)))
+    before = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
+    q = exc.q_uniform(4096)
+    assert resource.getrusage(resource.RUSAGE_SELF).ru_maxrss - before < 200_000  # KB
+    np.testing.assert_allclose(q, -0.3 * np.sin(2 * np.pi * np.arange(4096) / 4096),
+                               atol=1e-12)
+
+
+# -- 4. nothing silently ignored or misleading ---------------------------------------------
+def test_excitation_inferred_from_file_and_fourier(tmp_path, capsys):
+    p = write_csv(tmp_path / "q.csv")
+    code, out, _ = run(capsys, "optimize", "--file", str(p), "--harmonics", "4", "--json")
+    assert code == 0 and json.loads(out)["excitation"]["excitation"] == "file"
+    code, out, _ = run(capsys, "optimize", "--fourier", "1:-0.3,2:0.1", "--harmonics", "4",
+                       "--json")
+    assert code == 0 and json.loads(out)["excitation"]["excitation"] == "fourier"
+
+
+@pytest.mark.parametrize("args, word", [
+    (["optimize", "--excitation", "harmonic", "--file", "x.csv"], "file"),
+    (["optimize", "--excitation", "square", "--fourier", "1:0.3"], "fourier"),
+    (["optimize", "--fourier", "1:0.3", "--delta", "0.2"], "delta"),
+    (["optimize", "--fourier", "1:0.3", "--file", "x.csv"], "file"),
+    (["optimize", "--square-alpha", "0.01"], "square-alpha"),
+    (["threshold", "--excitation", "file", "--file", "x.csv", "--delta", "1"], "delta"),
+])
+def test_ignored_options_refused(capsys, args, word):
+    err = one_line_error(capsys, args)
+    assert word in err and ("not used" in err or "both" in err)
+
+
+def test_api_refuses_bad_types_and_values():
+    with pytest.raises(ParameterError, match=r"fourier k: expected an integer"):
+        parapend.optimize(fourier=[(2.9, 0.3, 0)])
+    with pytest.raises(ParameterError, match="points"):
+        parapend.mean_power(parapend.optimize(harmonics=2).motion, parapend.harmonic(),
+                            points=0)
+    with pytest.raises(ParameterError, match="gamma"):
+        parapend.uniform_power(parapend.harmonic(), -1)
+    for kwargs, name in [({"omega": "1.8"}, "omega"), ({"harmonics": [3]}, "harmonics"),
+                         ({"fourier": 5}, "fourier"), ({"fourier": [(1,)]}, "fourier"),
+                         ({"file": 5}, "file"), ({"excitation": 3}, "excitation"),
+                         ({"method": None}, "method"), ({"gamma": None}, "gamma"),
+                         ({"warm": "x"}, "warm"), ({"delta": [1, 2]}, "delta")]:
+        with pytest.raises(ParameterError, match=f"^{name}"):
+            parapend.optimize(**kwargs)
+    with pytest.raises(ParameterError, match="excitation: expected an Excitation"):
+        parapend.uniform_power("harmonic")
+    with pytest.raises(ParameterError, match="harmonics"):
+        parapend.harmonic_table(5)
+
+
+def test_constant_excitation_is_explicit(capsys):
+    r = parapend.optimize(delta=0.0, gamma=0.01)
+    assert r.status == "no_power" and r.success and r.power == -0.01 * 1.8**2
+    assert r.peak_torque == pytest.approx(1 + 0.01 * 1.8, rel=1e-9)  # hold the uniform turn
+    code, out, _ = run(capsys, "optimize", "--delta", "0")
+    assert code == 0 and "status: no_power" in out and "constant" in out
+    assert "peak torque |T|: 1 " in out
+    err = one_line_error(capsys, ["damping-sweep", "--delta", "0"])
+    assert "constant" in err
+    ds = parapend.damping_sweep(delta=0.0, gamma_max=0.1, points=3, harmonics=4)
+    assert set(ds["status"].values) == {"no_power"}
+    np.testing.assert_allclose(ds["power"].values, -np.array([0, 0.05, 0.1]) * 1.8**2)
+    with pytest.raises(ParameterError, match="excitation: expected an Excitation"):
+        parapend.limit("harmonic")
+
+
+def test_above_threshold_says_no_power(capsys):
+    r = parapend.optimize(gamma=0.09, harmonics=16)
+    assert r.success and r.status == "no_power" and r.power < 0
+    assert "gamma*" in r.message
+    code, out, _ = run(capsys, "optimize", "--gamma", "0.09", "--harmonics", "16")
+    assert code == 0 and "status: no_power" in out and "gamma*" in out
+
+
+def test_negative_scientific_numbers_parse(capsys):
+    code, out, _ = run(capsys, "optimize", "--delta", "-1e-3", "--harmonics", "4", "--json")
+    assert code == 0 and json.loads(out)["excitation"]["delta"] == -1e-3
+    code, out, _ = run(capsys, "optimize", "--delta", "-1E+0", "--harmonics", "4", "--json")
+    assert code == 0 and json.loads(out)["excitation"]["delta"] == -1.0
+
+
+def test_method_all_labels_undamped_limit(capsys):
+    code, out, _ = run(capsys, "optimize", "--method", "all", "--gamma", "0.01",
+                       "--harmonics", "8")
+    assert code == 0 and "undamped" in out and "gamma = 0.01" in out
+
+
+def test_number_format():
+    from parapend.cli._common import _fmt
+
+    assert _fmt(0.0) == "0" and _fmt(-0.0) == "0"
+    assert _fmt(-5.551115123125783e-17) == "-5.55112e-17"
+    assert _fmt(2.9e-9, 10) != "0.0000000029" and "e-09" in _fmt(2.9e-9, 10)
+    assert _fmt(0.27) == "0.270000"
+
+
+# -- 5. user experience -------------------------------------------------------------------
+def test_bare_parapend_lists_commands(capsys):
+    code, out, err = run(capsys)
+    assert code == 2 and out == ""
+    assert all(c in err for c in ("optimize", "threshold", "damping-sweep", "harmonics",
+                                  "figure", "reproduce"))
+
+
+def test_figure_default_name_and_pdf(tmp_path, capsys, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    code, out, _ = run(capsys, "figure", "8")
+    assert code == 0 and (tmp_path / "fig8.png").read_bytes()[:4] == b"\x89PNG"
+    assert "fig8.png" in out and "default" in out
+    code, _, _ = run(capsys, "optimize", "--harmonics", "4", "--plot", str(tmp_path / "o.pdf"))
+    assert code == 0 and (tmp_path / "o.pdf").read_bytes()[:4] == b"%PDF"
+
+
+def test_progress_bar_only_on_a_terminal(capsys, monkeypatch):
+    from parapend.cli._common import _Progress
+
+    bar = _Progress("sweep", delay=0.0)
+    assert bar.on is False  # captured stderr is not a terminal
+    monkeypatch.setattr(sys.stderr, "isatty", lambda: True, raising=False)
+    bar = _Progress("sweep", delay=0.0)
+    bar(1, 3)
+    bar(3, 3)
+    err = capsys.readouterr().err
+    assert "sweep [" in err and "1/3" in err and err.endswith("\r")
+
+
+def test_gamma_is_the_one_name(capsys):
+    r = parapend.optimize(harmonics=4, gamma=0.01)
+    assert r.gamma == 0.01 and "gamma" in r.to_dict() and "damping" not in r.to_dict()
+    ds = parapend.damping_sweep(harmonics=4, points=3)
+    assert "gamma" in ds.coords and "damping" not in ds.coords
