@@ -168,3 +168,19 @@ def test_motion_of_the_optimum_is_that_of_the_seed_named():
     assert any(r.seed == found.best.seed and r.power == found.best.power for r in found.runs)
     m = FourierMotion.from_vector(exc.omega, found.best.x)
     assert m.harmonics == 24
+
+
+def test_bvp_approaches_the_limit_like_epsilon_to_two_thirds():
+    """Boundary layers of width (epsilon/|q''|)^(1/3) cost epsilon^(2/3): the BVP's gap to the
+    limit shrinks by 100^(2/3) = 21.5 per factor 100 in gamma, down to gamma = 1e-18."""
+    from parapend.optimal.bvp import solve_bvp_optimum
+
+    exc = parapend.harmonic()
+    lim = limit(exc).power
+    gaps = []
+    for g in (1e-10, 1e-12, 1e-14, 1e-16, 1e-18):
+        s = solve_bvp_optimum(exc, g)
+        assert s.success
+        gaps.append(lim - s.power)
+    ratios = np.array(gaps[:-1]) / np.array(gaps[1:])
+    assert np.all(np.abs(ratios / 100 ** (2 / 3) - 1) < 0.02), ratios

@@ -544,8 +544,8 @@ def damping_sweep(*, omega: float = 1.8, delta=None, harmonics: int | None = Non
         if progress is not None:
             progress(npts - i, npts)
     status.reverse()
-    change = _refinement_change(exc, n, [(float(gammas[0]), power[0]),
-                                         (float(gammas[-1]), power[-1])])
+    change = 0.0 if constant else _refinement_change(exc, n, [(float(gammas[0]), power[0]),
+                                                              (float(gammas[-1]), power[-1])])
     pu = np.array([uniform_power(exc, float(g))[0] for g in gammas])
     return xr.Dataset(
         {"power": ("gamma", power), "uniform_power": ("gamma", pu),

@@ -23,7 +23,7 @@ MAX_PHASE = 1e6
 #: viscous damping gamma (non-dimensional, unit sqrt(g/l))
 MAX_GAMMA = 1e3
 #: smallest gamma for the Euler-Lagrange BVP (epsilon = 2 gamma)
-MIN_BVP_GAMMA = 1e-7
+MIN_BVP_GAMMA = 1e-18
 #: smallest tanh width of Eq. 26, as a fraction of the period 2 pi/omega
 SQUARE_ALPHA_MIN = 1e-9
 #: largest harmonic number k of a Fourier-series excitation
