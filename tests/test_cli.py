@@ -120,7 +120,7 @@ def test_method_bvp_json_and_all(capsys):
     d = json.loads(out)
     assert code == 0 and abs(d["fourier"]["power"] - d["bvp"]["power"]) < 1e-9
     code, out, _ = run(capsys, "optimize", "--method", "all")
-    assert code == 0 and "needs gamma >= 1e-07" in out
+    assert code == 0 and "needs gamma >= 1e-18" in out
 
 
 def test_method_bvp_needs_damping(capsys):

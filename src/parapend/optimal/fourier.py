@@ -441,7 +441,7 @@ def _pattern_seeds(excitation, lim, harmonics: int, damping: float, problem):
 
 #: Above this many harmonics, and for gamma > 0, the patterns are compared at this N (cost
 #: grows like N^3 per Newton step) and the SCREEN_KEEP best distinct maxima are polished at
-#: the full N.
+#: the full N (4 above N = 128 and 2 above N = 512, where one Newton step costs 0.1 to 1 s).
 SCREEN_HARMONICS = 32
 SCREEN_KEEP = 8
 #: Work allowed for comparing the patterns at the full N, in seeds x N^3 (792 patterns at
@@ -536,7 +536,7 @@ def search_fourier(excitation, harmonics: int, damping: float, *, warm: np.ndarr
         for r in ranked:
             if all(abs(r.power - k.power) > 1e-12 for k in kept):
                 kept.append(r)
-            if len(kept) >= SCREEN_KEEP:
+            if len(kept) >= (SCREEN_KEEP if harmonics <= 128 else 4 if harmonics <= 512 else 2):
                 break
         extra = [(f"{r.seed}@N={screen}", _pad(r.x, harmonics), None) for r in kept]
     elif "limit" in seeds:
