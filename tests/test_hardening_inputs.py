@@ -169,6 +169,7 @@ def test_stdout_full_or_closed():
     (["optimize", "--harmonics", "2048"], ["harmonics", "1024"]),
     (["optimize", "--fourier", "1000000:0.3"], ["k", "1024"]),
     (["optimize", "--fourier", "999999999999:0.3"], ["k", "1024"]),
+    (["optimize", "--fourier", "-1:0.3"], ["k", "1024", "-1"]),
     (["damping-sweep", "--points", "100000"], ["points", "1001"]),
     (["damping-sweep", "--points", "1000", "--harmonics", "64"], ["points", "harmonics"]),
     (["harmonics", "--to", "4096"], ["--to", "128", "4096"]),

@@ -17,8 +17,9 @@ EXIT_USAGE = 2
 
 # a leading '-' followed by a number in any notation (-1, -.5, -1e-3, -1E+2, -inf) is a
 # value, not an option: argparse's own matcher knows only -1 and -1.5
-_NEGATIVE_NUMBER = re.compile(r"^-(\d+\.?\d*|\.\d+)([eE][-+]?\d+)?$|^-(inf|infinity|nan)$",
-                              re.IGNORECASE)
+# (and so is a Fourier term list starting with a negative number, '-1:0.3', refused later)
+_NEGATIVE_NUMBER = re.compile(r"^-(\d+\.?\d*|\.\d+)([eE][-+]?\d+)?$|^-(inf|infinity|nan)$"
+                              r"|^-[\d.][^\s]*:", re.IGNORECASE)
 
 
 class _Parser(argparse.ArgumentParser):
