@@ -289,7 +289,12 @@ def fig10(epsilon: float = 1e-3, alphas=(0.1, 0.03, 0.01, 0.001)) -> dict:
 # ---------------------------------------------------------------------------------------
 # Uncontrolled dynamics (Eq. 1, angle phi from the hanging position; theta = phi + pi)
 FIG2_BASINS = {"gamma": 0.1, "p": 0.5, "omega": 1.8}  # damping not given in the paper
-FIG2_OMEGAS = tuple(round(0.9 + 0.15 * i, 2) for i in range(15))
+# Fig. 2 left: omega in [1.1, 3] (below, continuation in p needs far smaller steps: minutes),
+# p up to 6 so that curve E is found over the whole range.
+FIG2_OMEGAS = tuple(round(1.1 + 0.1 * i, 2) for i in range(20))
+FIG2_P_MAX = 6.0
+FIG2_POINTS = {"Fig. 1: $p = 0.8$, $\\omega = 2.1$": (2.1, 0.8),
+               "Fig. 2 basins: $p = 0.5$, $\\omega = 1.8$": (1.8, 0.5)}
 
 
 def fig1() -> dict:
@@ -324,11 +329,11 @@ def fig2_left(omegas=FIG2_OMEGAS, gamma: float = 0.1) -> dict:
     from .dynamics.continuation import rotation_boundaries
     from .dynamics.figures import plot_rotation_boundaries
 
-    ds = rotation_boundaries(gamma, np.asarray(omegas))
+    ds = rotation_boundaries(gamma, np.asarray(omegas), p_max=FIG2_P_MAX, ds=0.1)
     numbers = {"gamma": gamma, "omega": ds["omega"].values.tolist(),
                **{k: ds[k].values.tolist() for k in ("p_J", "p_G", "p_E")},
-               "convention": "paper Eq. 1 (p, omega)"}
-    return {"figure": plot_rotation_boundaries(ds), "numbers": numbers}
+               "p_max": FIG2_P_MAX, "convention": "paper Eq. 1 (p, omega)"}
+    return {"figure": plot_rotation_boundaries(ds, points=FIG2_POINTS), "numbers": numbers}
 
 
 def fig2_right(case=None) -> dict:

@@ -69,7 +69,8 @@ def _figures():
          "Curves J (birth), G (loss of stability) and E (stability regained) of period-1 "
          "rotations in the (omega, p) plane, adopted from Horton et al. (2011).",
          "Recomputed at gamma = 0.1 by shooting with Floquet multipliers and continuation in p "
-         "through folds, on a grid of omega spaced 0.05, up to p = 6: J is a fold (multiplier "
+         "through folds (steps of 0.1 in arclength, bifurcations located exactly), for omega "
+         "from 1.1 to 3 in steps of 0.1, up to p = 6: J is a fold (multiplier "
          "+1), G and E period doublings (-1). The rotation exists above J and is unstable in "
          "the shaded band between G and E. The paper's operating points are marked: Fig. 1's "
          "(omega, p) = (2.1, 0.8) and Fig. 2's basins at (1.8, 0.5), both where the rotation "
