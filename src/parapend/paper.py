@@ -269,7 +269,7 @@ def fig10(epsilon: float = 1e-3, alphas=(0.1, 0.03, 0.01, 0.001)) -> dict:
         tau = sol.t * exc.omega / (2 * math.pi)
         dev = sol.theta - (exc.omega * sol.t + math.pi)
         curves.append((rf"$\alpha = {a:g}$: $P = {sol.power:.6f}$", tau, sol.theta))
-        devs.append((rf"$\alpha = {a:g}$: max $= {np.max(np.abs(dev)):.1e}$", tau, dev))
+        devs.append((rf"$\alpha = {a:g}$: max {np.max(np.abs(dev)):.1e}", tau, dev))
         mid = float(np.interp(0.5, tau, sol.theta))
         numbers.append({"square_alpha": a, "epsilon": epsilon, "power": sol.power,
                         "theta_at_half_period": mid,
@@ -282,7 +282,7 @@ def fig10(epsilon: float = 1e-3, alphas=(0.1, 0.03, 0.01, 0.001)) -> dict:
          "limit": None},
         {"title": "distance to the uniform rotation", "curves": devs, "limit": None,
          "ylabel": r"$\theta - (\omega t + \pi)$ (rad)", "pi_ticks": False,
-         "legend": "lower left"}],
+         "legend": "below"}],
         "numbers": numbers, "omega": omega}
 
 

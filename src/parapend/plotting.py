@@ -113,16 +113,17 @@ def plot_damping_sweep(ds, path=None, extra=None):
     ax.axhline(0, color="k", lw=0.7)
     gs = ds.attrs["damping_threshold"]
     ax.axvline(gs, color="C3", lw=0.8, ls=":")
-    ax.annotate(rf"$\gamma^* = {gs:.6f}$", (gs, 0), xytext=(-8, 14), textcoords="offset points",
-                color="C3", ha="right")
+    ax.annotate(rf"$\gamma^* = {gs:.6f}$", (gs, 0), xytext=(6, 40), textcoords="offset points",
+                color="C3", ha="left", arrowprops={"arrowstyle": "-", "color": "C3", "lw": 0.6})
     ax.plot([0], [plim], "k*", ms=9, label=LIMIT_LABEL, zorder=3)
     ax.set_xlabel(r"damping $\gamma$")
     ax.set_ylabel("mean extracted power $P$")
     ax.set_title("power against damping (linear axes)")
     ax.legend()
-    pos = g > 0
-    axr.loglog(g[pos], np.maximum(plim - p[pos], 1e-16), "o-", ms=3,
-               label=f"Fourier, $N = {n}$")
+    if not extra:
+        pos = g > 0
+        axr.loglog(g[pos], np.maximum(plim - p[pos], 1e-16), "o-", ms=3,
+                   label=f"Fourier, $N = {n}$")
     for i, (label, gx, px) in enumerate(extra or []):
         gx, px = np.asarray(gx), np.asarray(px)
         axr.loglog(gx, np.maximum(plim - px, 1e-16), "s-" if i == 0 else "^-", ms=3,
@@ -158,7 +159,8 @@ def plot_theta_panels(panels, path=None, ncols: int | None = None):
         ``{"title": str, "curves": [(label, tau, theta), ...], "limit": (tau, theta) or None}``
         with ``tau = omega t / 2 pi`` over one period and theta in radians. Optional keys:
         ``"ylabel"`` (default theta in rad) and ``"pi_ticks"`` (default True: ticks at the
-        multiples of pi), ``"legend"`` (legend location, default upper left).
+        multiples of pi), ``"legend"`` (legend location, default upper left; ``"below"``
+        puts it under the axes).
     """
     n = len(panels)
     ncols = ncols or min(n, 2)
@@ -175,7 +177,10 @@ def plot_theta_panels(panels, path=None, ncols: int | None = None):
         ax.set_xlim(0, 1)
         if panel.get("pi_ticks", True):
             _pi_ticks(ax)
-        ax.legend(loc=panel.get("legend", "upper left"))
+        if panel.get("legend") == "below":
+            ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.16), ncol=2)
+        else:
+            ax.legend(loc=panel.get("legend", "upper left"))
     for ax in list(axes.flat)[n:]:
         ax.set_visible(False)
     return _finish(fig, path)
