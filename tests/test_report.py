@@ -175,6 +175,9 @@ def test_report_header_contents_and_columns(report_dir):
     results = (report_dir / "results.json").read_text()
     assert numpy.__version__ not in results and "run time" not in results
     assert "identical" in text and "omega |delta|" in text  # Fig. 4's caption explains it
+    # 200-dpi figures shown at half their pixel width: equal text size for every figure
+    widths = [int(w) for w in re.findall(r"<img [^>]*width='(\d+)'", text)]
+    assert len(widths) == 10 and all(300 < w < 1200 for w in widths)
 
 
 def test_figure_pngs_are_200_dpi(report_dir):

@@ -275,7 +275,7 @@ h1{font-size:1.6em}h2{font-size:1.2em;margin-top:2em;border-bottom:1px solid #dd
 table{border-collapse:collapse;margin:1em 0;font-size:.9em}
 td,th{border:1px solid #ccc;padding:.3em .6em;vertical-align:top}
 th{background:#f4f4f4;text-align:left}
-td.paper,td.parapend,td.difference{font-family:monospace;text-align:right;white-space:nowrap}
+td.paper,td.parapend,td.difference{font-variant-numeric:tabular-nums;text-align:right;white-space:nowrap}
 img{max-width:100%;height:auto;border:1px solid #eee}
 .note{color:#555;font-size:.92em}
 header.run{background:#f7f7f7;border:1px solid #e2e2e2;padding:.6em 1em;font-size:.9em}
@@ -301,6 +301,12 @@ def environment() -> dict:
             "NumPy": numpy.__version__, "SciPy": scipy.__version__,
             "matplotlib": matplotlib.__version__, "xarray": xarray.__version__,
             "platform": f"{platform.system()} {platform.machine()}, {os.cpu_count()} CPU(s)"}
+
+
+def _css_width(png: bytes) -> int:
+    """Display width in CSS pixels of a 200-dpi PNG: as at 100 dpi, so that every figure's
+    text has the same size on the page (a single panel is not stretched to the full width)."""
+    return int.from_bytes(png[16:20], "big") // 2
 
 
 def _header(run: dict) -> str:
@@ -342,7 +348,8 @@ def _html(results: dict, figures: list[dict], run: dict) -> str:
         parts += [f"<h2 id='{f['key']}'>{html.escape(f['title'])}</h2>",
                   f"<p><b>Paper:</b> {html.escape(f['paper'])}<br><b>Here:</b> "
                   f"{html.escape(f['here'])}</p>",
-                  f"<img alt='{html.escape(f['title'])}' src='data:image/png;base64,{uri}'>"]
+                  f"<img alt='{html.escape(f['title'])}' width='{_css_width(f['png'])}' "
+                  f"src='data:image/png;base64,{uri}'>"]
         if f["rows"]:
             parts.append(_html_table(f["rows"]))
     parts.append("</body></html>")
