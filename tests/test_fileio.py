@@ -265,3 +265,11 @@ def test_style_is_not_global(tmp_path):
     parapend.plotting.plot_square_approximations(1.8, (0.1,))
     after = {k: v for k, v in matplotlib.rcParams.items() if k != "backend"}
     assert after == before
+
+
+def test_cli_reports_unwritable_figure_in_one_line(capsys):
+    from parapend.cli import main
+
+    assert main(["figure", "8", "--plot", "/proc/x.png"]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "cannot write '/proc/x.png'" in err
