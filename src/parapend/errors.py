@@ -4,12 +4,17 @@ from __future__ import annotations
 
 import math
 
-__all__ = ["ParameterError", "SolverError", "check_finite", "check_int", "check_nonnegative",
-           "check_positive", "check_range"]
+__all__ = ["OutputError", "ParameterError", "SolverError", "check_finite", "check_int",
+           "check_nonnegative", "check_positive", "check_range"]
 
 
 class ParameterError(ValueError):
     """A user-supplied parameter is invalid; the message names it and what was expected."""
+
+
+class OutputError(ParameterError):
+    """An output file or directory cannot be written; the message is one line naming the path
+    and the operating system's reason (see :mod:`parapend.fileio`)."""
 
 
 class SolverError(RuntimeError):

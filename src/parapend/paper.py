@@ -149,8 +149,8 @@ def fig4() -> dict:
         fam = fourier_family(exc)
         lim = limit(exc)
         panels.append({
-            "title": f"delta = {delta:g}, omega = {omega:g}",
-            "curves": [(f"N = {n}: P = {p:.5f}", *_curve(m, omega)) for n, p, m in fam],
+            "title": rf"$\delta = {delta:g}$, $\omega = {omega:g}$",
+            "curves": [(f"$N = {n}$: $P = {p:.5f}$", *_curve(m, omega)) for n, p, m in fam],
             "limit": _curve(lim.motion, omega, 4001),
         })
         numbers.append({"delta": delta, "omega": omega, "gamma": 0.0,
@@ -159,13 +159,36 @@ def fig4() -> dict:
     return {"panels": panels, "numbers": numbers}
 
 
+FIG6_LOG_DAMPING = tuple(float(g) for g in np.geomspace(1e-7, 0.05, 12))
+
+
 def fig6() -> dict:
-    """Fig. 6: optimal power against damping, with gamma*."""
+    """Fig. 6: optimal power against damping, with gamma*; and, to resolve gamma -> 0, the
+    BVP optimum (Eq. 13, epsilon = 2 gamma) and the N = 32 Fourier optimum at log-spaced
+    damping (``extra``: ``[(label, damping, power), ...]``)."""
+    from .optimal.bvp import solve_bvp_optimum
+
     ds = api.damping_sweep(**PAPER_CASE, harmonics=32, points=31)
-    return {"dataset": ds, "numbers": {
+    exc = api.build_excitation("harmonic", **PAPER_CASE)
+    gl = np.array(FIG6_LOG_DAMPING)
+    bvp = [solve_bvp_optimum(exc, g) for g in gl]
+    four = []
+    warm = None
+    for g in gl[::-1]:
+        best, _ = solve_fourier(exc, 32, float(g), warm=warm)
+        warm = best.x
+        four.append(best.power)
+    four = four[::-1]
+    bvp_power = [s.power for s in bvp]
+    extra = [(r"Euler-Lagrange BVP, $\epsilon = 2\gamma$", gl, bvp_power),
+             ("Fourier, $N = 32$", gl, four)]
+    return {"dataset": ds, "extra": extra, "numbers": {
         "gamma": ds["gamma"].values.tolist(), "power": ds["power"].values.tolist(),
         "uniform_power": ds["uniform_power"].values.tolist(),
-        "damping_threshold": ds.attrs["damping_threshold"], "harmonics": 32, **PAPER_CASE}}
+        "damping_threshold": ds.attrs["damping_threshold"], "harmonics": 32,
+        "limit_power": ds.attrs["limit_power"], "bvp_gamma": gl.tolist(),
+        "bvp_power": bvp_power, "bvp_success": [bool(s.success) for s in bvp],
+        "log_damping_fourier_power": four, **PAPER_CASE}}
 
 
 def fig7_left() -> dict:
@@ -174,7 +197,7 @@ def fig7_left() -> dict:
     fam = fourier_family(exc, (1, 2, 4, 8, 16, 30))
     lim = limit(exc)
     panel = {"title": "two-harmonic excitation (Eq. 23): Fourier optima",
-             "curves": [(f"N = {n}: P = {p:.5f}", *_curve(m, exc.omega)) for n, p, m in fam],
+             "curves": [(f"$N = {n}$: $P = {p:.5f}$", *_curve(m, exc.omega)) for n, p, m in fam],
              "limit": _curve(lim.motion, exc.omega, 4001)}
     return {"panel": panel, "numbers": {
         "harmonics": [n for n, _, _ in fam], "power": [p for _, p, _ in fam],
@@ -186,8 +209,8 @@ def fig9() -> dict:
     """Fig. 9: non-unique optima for the square wave (N = 40, alpha = 0.001)."""
     exc, sols = square_nonunique()
     half = exc.period / 2
-    panel = {"title": "square wave (Eq. 26, alpha = 0.001), N = 40: distinct optima",
-             "curves": [(f"optimum {i + 1}: P = {p:.7f}", *_curve(m, exc.omega))
+    panel = {"title": r"square wave (Eq. 26, $\alpha = 0.001$), $N = 40$: distinct optima",
+             "curves": [(f"optimum {i + 1}: $P = {p:.7f}$", *_curve(m, exc.omega))
                         for i, (p, m) in enumerate(sols[:4])],
              "limit": None}
     return {"panel": panel, "numbers": {
@@ -212,12 +235,13 @@ def fig5(epsilons=(1e-1, 1e-2, 1e-4, 1e-6)) -> dict:
     curves, numbers = [], []
     for eps in epsilons:
         sol = _bvp(exc, eps)
-        curves.append((f"epsilon = {eps:g}: P = {sol.power:.6f}", *_bvp_curve(sol, exc.omega)))
+        curves.append((rf"$\epsilon = {eps:g}$: $P = {sol.power:.6f}$",
+                       *_bvp_curve(sol, exc.omega)))
         numbers.append({"epsilon": eps, "gamma": eps / 2, "power": sol.power,
                         "mesh_nodes": sol.mesh_nodes, "max_residual": sol.max_residual,
                         "success": sol.success})
     lim = limit(exc)
-    return {"panel": {"title": "Eq. 13 (harmonic), decreasing epsilon", "curves": curves,
+    return {"panel": {"title": r"Eq. 13 (harmonic), decreasing $\epsilon$", "curves": curves,
                       "limit": _curve(lim.motion, exc.omega, 4001)},
             "numbers": numbers}
 
@@ -227,8 +251,8 @@ def fig7_right(epsilon: float = 1e-4) -> dict:
     exc = two_harmonic(**PAPER_CASE)
     sol = _bvp(exc, epsilon)
     lim = limit(exc)
-    return {"panel": {"title": f"two-harmonic, Eq. 22, epsilon = {epsilon:g}",
-                      "curves": [(f"BVP: P = {sol.power:.6f}", *_bvp_curve(sol, exc.omega))],
+    return {"panel": {"title": rf"two-harmonic, Eq. 22, $\epsilon = {epsilon:g}$",
+                      "curves": [(f"BVP: $P = {sol.power:.6f}$", *_bvp_curve(sol, exc.omega))],
                       "limit": _curve(lim.motion, exc.omega, 4001)},
             "numbers": {"epsilon": epsilon, "power": sol.power, "mesh_nodes": sol.mesh_nodes,
                         "max_residual": sol.max_residual, "success": sol.success}}
@@ -236,28 +260,41 @@ def fig7_right(epsilon: float = 1e-4) -> dict:
 
 def fig10(epsilon: float = 1e-3, alphas=(0.1, 0.03, 0.01, 0.001)) -> dict:
     """Fig. 10: Eq. 27 for the tanh-smoothed square wave, decreasing alpha: the penalty selects
-    the uniform rotation through (0.5, 2 pi)."""
-    curves, numbers = [], []
-    for a in alphas:
-        exc = square_exc(PAPER_CASE["delta"], PAPER_CASE["omega"], a)
-        sol = _bvp(exc, epsilon)
-        curves.append((f"alpha = {a:g}: P = {sol.power:.6f}", *_bvp_curve(sol, exc.omega)))
-        mid = float(np.interp(0.5, sol.t * exc.omega / (2 * math.pi), sol.theta))
-        uni = float(np.max(np.abs(sol.theta - (exc.omega * sol.t + math.pi))))
-        numbers.append({"square_alpha": a, "epsilon": epsilon, "power": sol.power,
-                        "theta_at_half_period": mid, "max_deviation_from_uniform": uni,
-                        "success": sol.success})
+    the uniform rotation through (0.5, 2 pi). Two panels: theta, and theta - (omega t + pi)."""
+    curves, devs, numbers = [], [], []
     omega = PAPER_CASE["omega"]
+    for a in alphas:
+        exc = square_exc(PAPER_CASE["delta"], omega, a)
+        sol = _bvp(exc, epsilon)
+        tau = sol.t * exc.omega / (2 * math.pi)
+        dev = sol.theta - (exc.omega * sol.t + math.pi)
+        curves.append((rf"$\alpha = {a:g}$: $P = {sol.power:.6f}$", tau, sol.theta))
+        devs.append((rf"$\alpha = {a:g}$: max {np.max(np.abs(dev)):.1e}", tau, dev))
+        mid = float(np.interp(0.5, tau, sol.theta))
+        numbers.append({"square_alpha": a, "epsilon": epsilon, "power": sol.power,
+                        "theta_at_half_period": mid,
+                        "max_deviation_from_uniform": float(np.max(np.abs(dev))),
+                        "success": sol.success})
     tau = np.linspace(0, 1, 201)
-    curves.append(("uniform rotation omega t + pi", tau, 2 * math.pi * tau + math.pi))
-    return {"panel": {"title": f"square wave, Eq. 27, epsilon = {epsilon:g}", "curves": curves,
-                      "limit": None}, "numbers": numbers, "omega": omega}
+    curves.append((r"uniform rotation $\omega t + \pi$", tau, 2 * math.pi * tau + math.pi))
+    return {"panels": [
+        {"title": rf"square wave, Eq. 27, $\epsilon = {epsilon:g}$", "curves": curves,
+         "limit": None},
+        {"title": "distance to the uniform rotation", "curves": devs, "limit": None,
+         "ylabel": r"$\theta - (\omega t + \pi)$ (rad)", "pi_ticks": False,
+         "legend": "below"}],
+        "numbers": numbers, "omega": omega}
 
 
 # ---------------------------------------------------------------------------------------
 # Uncontrolled dynamics (Eq. 1, angle phi from the hanging position; theta = phi + pi)
 FIG2_BASINS = {"gamma": 0.1, "p": 0.5, "omega": 1.8}  # damping not given in the paper
-FIG2_OMEGAS = tuple(round(0.9 + 0.15 * i, 2) for i in range(15))
+# Fig. 2 left: omega in [1.1, 3] (below, continuation in p needs far smaller steps: minutes),
+# p up to 6 so that curve E is found over the whole range.
+FIG2_OMEGAS = tuple(round(1.1 + 0.1 * i, 2) for i in range(20))
+FIG2_P_MAX = 6.0
+FIG2_POINTS = {"Fig. 1: $p = 0.8$, $\\omega = 2.1$": (2.1, 0.8),
+               "Fig. 2 basins: $p = 0.5$, $\\omega = 1.8$": (1.8, 0.5)}
 
 
 def fig1() -> dict:
@@ -292,11 +329,11 @@ def fig2_left(omegas=FIG2_OMEGAS, gamma: float = 0.1) -> dict:
     from .dynamics.continuation import rotation_boundaries
     from .dynamics.figures import plot_rotation_boundaries
 
-    ds = rotation_boundaries(gamma, np.asarray(omegas))
+    ds = rotation_boundaries(gamma, np.asarray(omegas), p_max=FIG2_P_MAX, ds=0.1)
     numbers = {"gamma": gamma, "omega": ds["omega"].values.tolist(),
                **{k: ds[k].values.tolist() for k in ("p_J", "p_G", "p_E")},
-               "convention": "paper Eq. 1 (p, omega)"}
-    return {"figure": plot_rotation_boundaries(ds), "numbers": numbers}
+               "p_max": FIG2_P_MAX, "convention": "paper Eq. 1 (p, omega)"}
+    return {"figure": plot_rotation_boundaries(ds, points=FIG2_POINTS), "numbers": numbers}
 
 
 def fig2_right(case=None) -> dict:

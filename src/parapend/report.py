@@ -1,55 +1,54 @@
 """``parapend reproduce``: regenerate the paper's tables and figures, compare, write a report.
 
 Writes into ``out``: ``figures/*.png|svg``, ``tables/*.csv``, ``results.json`` (every number
-with the parameters that produced it; no timings, so two runs give identical files) and
-``report.html`` (one self-contained page, figures embedded as PNG data URIs).
+with the parameters that produced it; no timings or versions of other packages, so two runs
+give identical files) and ``report.html`` (one self-contained page, figures embedded as PNG
+data URIs, with the versions, the environment and the run time in its header).
+
+The report is written whole or not at all: everything goes into a hidden staging directory
+``.OUT.parapend-staging-*`` beside ``out``, which then takes the place of ``out`` by renaming
+(an older report is renamed aside first and removed after the swap). A run that is killed
+leaves the older report as it was, and at worst hidden directories that the next run removes.
 """
 
 from __future__ import annotations
 
 import base64
+import contextlib
 import csv
 import html
 import io
 import json
 import os
+import platform
+import re
+import shutil
 import tempfile
+import time
+from datetime import datetime, timezone
 from pathlib import Path
 
 from . import __version__, paper
+from .errors import OutputError
+from .fileio import output_error, save_figure, umask, write_text
 from .plotting import (
     plot_damping_sweep,
     plot_square_approximations,
     plot_theta_panels,
-    save_figure,
 )
 from .results import CONVENTION, to_jsonable
 
-__all__ = ["FIGURES", "paper_figure", "reproduce"]
+__all__ = ["FIGURES", "REPORT_ENTRIES", "paper_figure", "reproduce"]
 
-
-def _atomic_write(path: Path, data: bytes) -> None:
-    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=".tmp-")
-    try:
-        with os.fdopen(fd, "wb") as fh:
-            fh.write(data)
-        os.replace(tmp, path)
-    finally:
-        if os.path.exists(tmp):
-            os.unlink(tmp)
+#: What a report directory holds; ``reproduce`` replaces only a directory holding nothing else.
+REPORT_ENTRIES = frozenset({"figures", "tables", "results.json", "report.html"})
 
 
 def _save(fig, figdir: Path, name: str) -> dict:
-    """Save PNG and SVG; return the PNG bytes for embedding."""
-    import matplotlib
-
-    matplotlib.rcParams["svg.hashsalt"] = "parapend"  # deterministic SVG ids
-    buf = io.BytesIO()
-    fig.savefig(buf, format="png", dpi=110, bbox_inches="tight", metadata={"Software": None})
-    png = buf.getvalue()
-    _atomic_write(figdir / f"{name}.png", png)
+    """Save PNG and SVG (reproducible bytes, 200 dpi); return the PNG bytes for embedding."""
+    png = save_figure(fig, figdir / f"{name}.png", close=False)
     save_figure(fig, figdir / f"{name}.svg")
-    return {"name": name, "png": png}
+    return {"name": name, "png": png.read_bytes()}
 
 
 # Each figure: (key, title, paper caption summary, how this run differs, builder)
@@ -70,7 +69,12 @@ def _figures():
          "Curves J (birth), G (loss of stability) and E (stability regained) of period-1 "
          "rotations in the (omega, p) plane, adopted from Horton et al. (2011).",
          "Recomputed at gamma = 0.1 by shooting with Floquet multipliers and continuation in p "
-         "through folds; J is a fold (multiplier +1), G and E period doublings (-1).",
+         "through folds (steps of 0.1 in arclength, bifurcations located exactly), for omega "
+         "from 1.1 to 3 in steps of 0.1, up to p = 6: J is a fold (multiplier "
+         "+1), G and E period doublings (-1). The rotation exists above J and is unstable in "
+         "the shaded band between G and E. The paper's operating points are marked: Fig. 1's "
+         "(omega, p) = (2.1, 0.8) and Fig. 2's basins at (1.8, 0.5), both where the rotation "
+         "is stable.",
          lambda: _dyn(paper.fig2_left())),
         ("fig2b", "Figure 2 (right): basins of attraction at p = 0.5, omega = 1.8",
          "Four coexisting attractors at p = 0.5, omega = 1.8 (damping not stated); the "
@@ -82,7 +86,11 @@ def _figures():
          "Optima for increasing N at four (delta, omega) near the 1:2 resonance "
          "(values not listed).",
          "We use (delta, omega) = " + ", ".join(f"({d:g}, {w:g})" for d, w in paper.FIG4_CASES)
-         + "; each N is solved to a gradient below 1e-11 by Newton's method, continuing in N.",
+         + "; each N is solved to a gradient below 1e-11 by Newton's method, continuing in N. "
+         "The four panels look identical, and they are: at gamma = 0 the power of a motion "
+         "is P = <q' cos(theta)> = delta omega <cos(2 pi tau) cos(theta)>, so as a function "
+         "of tau = omega t / 2 pi the optimal motion does not depend on (delta, omega) (for "
+         "delta < 0), and every power scales with omega |delta|: the table divides it out.",
          lambda: _panels_fig(paper.fig4(), "panels")),
         ("fig5", "Figure 5: penalized Euler-Lagrange solutions (Eq. 13)",
          "bvp4c solutions for progressively smaller epsilon, down to 1e-4.",
@@ -91,8 +99,11 @@ def _figures():
          lambda: _panels_fig(paper.fig5(), "panel")),
         ("fig6", "Figure 6: power against damping",
          "Net power output against gamma; none beyond gamma = 0.0856.",
-         "Same curve (sign: positive = harvested); gamma* from Newton's method on the convex "
-         "optimal-power curve.",
+         "Left: the same curve (sign: positive = harvested; Fourier optimum, N = 32); gamma* "
+         "from Newton's method on the convex optimal-power curve. Right: the deficit below "
+         "the gamma -> 0 limit on logarithmic axes, which resolves small gamma: the "
+         "penalized Euler-Lagrange BVP (epsilon = 2 gamma) approaches the limit like a power "
+         "of gamma, while any fixed N levels off at its own gamma = 0 value.",
          _fig6),
         ("fig7", "Figure 7: two-harmonic excitation (Eq. 23)",
          "Left, Fourier optima for increasing N; right, Eq. 22 at epsilon = 1e-4; "
@@ -113,8 +124,9 @@ def _figures():
          lambda: _panels_fig(paper.fig9(), "panel")),
         ("fig10", "Figure 10: the penalty selects the uniform rotation (square wave)",
          "Eq. 27 at epsilon = 0.001 for decreasing alpha approaches omega t + pi.",
-         "Same; the table below gives the distance to the uniform rotation.",
-         lambda: _panels_fig(paper.fig10(), "panel")),
+         "Left: theta as in the paper. Right: theta - (omega t + pi), the distance to the "
+         "uniform rotation, which shrinks with alpha (the table gives its maximum).",
+         lambda: _panels_fig(paper.fig10(), "panels")),
     ]
 
 
@@ -125,7 +137,7 @@ def _panels_fig(data, key):
 
 def _fig6():
     d = paper.fig6()
-    return plot_damping_sweep(d["dataset"]), d["numbers"]
+    return plot_damping_sweep(d["dataset"], extra=d["extra"]), d["numbers"]
 
 
 def _fig7():
@@ -153,7 +165,7 @@ def _write_table(path: Path, rows: list[dict]) -> None:
     for r in rows:
         w.writerow([r["quantity"], r["paper"], repr(r["parapend"]),
                     "" if r["difference"] is None else repr(r["difference"]), r["note"]])
-    _atomic_write(path, buf.getvalue().encode())
+    write_text(path, buf.getvalue())
 
 
 def _fmt(x, nd=6):
@@ -194,8 +206,9 @@ def _figure_rows(key: str, n) -> list[dict]:
             zip(n["attractors"], n["basin_fraction"]) if a != "other"]
     if key == "fig4":
         return [row(f"delta = {c['delta']:g}, omega = {c['omega']:g}: N = "
-                    f"{c['harmonics'][-1]} / limit", None, c["power"][-1], {},
-                    f"limit {c['limit_power']:.6f}; uniform {c['uniform_power']:.6f}")
+                    f"{c['harmonics'][-1]}", None, c["power"][-1], {},
+                    f"limit {c['limit_power']:.6f}, uniform {c['uniform_power']:.6f}; divided "
+                    f"by omega |delta|: {c['power'][-1] / (c['omega'] * abs(c['delta'])):.10f}")
                 for c in n]
     if key == "fig5":
         return [row(f"power at epsilon = {c['epsilon']:g}", None, c["power"], {},
@@ -205,7 +218,10 @@ def _figure_rows(key: str, n) -> list[dict]:
         return [row("damping threshold gamma*", pc["fig6"]["damping_threshold"],
                     n["damping_threshold"], {}, "Read off the figure in the paper."),
                 row("power at gamma = 0 (N = 32)", pc["table1"]["limit"], n["power"][0], {},
-                    "The paper's curve approaches the limit 0.3438; N = 32 is just below.")]
+                    "The paper's curve approaches the limit 0.3438; N = 32 is just below."),
+                row(f"BVP power at gamma = {n['bvp_gamma'][0]:.0e}", None, n["bvp_power"][0],
+                    {}, f"{n['limit_power'] - n['bvp_power'][0]:.1e} below the limit (right "
+                        "panel).")]
     if key == "fig7":
         taus = n["left"]["switch_tau"]
         return [row("first transition (tau)", pc["section71"]["tau1"], taus[0], {},
@@ -231,72 +247,196 @@ def _figure_rows(key: str, n) -> list[dict]:
     return []
 
 
+_COLUMNS = (("quantity", "quantity"), ("paper", "paper"), ("parapend", "parapend"),
+            ("difference", "difference"), ("note", "why"))
+
+
+def _cells(r: dict) -> dict:
+    return {"quantity": html.escape(r["quantity"]), "paper": _fmt(r["paper"], 4),
+            "parapend": _fmt(r["parapend"]), "difference": _fmt(_diff(r)),
+            "note": html.escape(r["note"])}
+
+
 def _html_table(rows: list[dict]) -> str:
-    out = ["<table><tr><th>quantity</th><th>paper</th><th>parapend</th><th>difference</th>"
-           "<th>why</th></tr>"]
-    for r in rows:
-        out.append(
-            f"<tr><td>{html.escape(r['quantity'])}</td><td>{_fmt(r['paper'], 4)}</td>"
-            f"<td>{_fmt(r['parapend'])}</td><td>{_fmt(_diff(r))}</td>"
-            f"<td>{html.escape(r['note'])}</td></tr>")
+    """Rows as an HTML table; a column that is empty in every row is left out."""
+    cells = [_cells(r) for r in rows]
+    cols = [(k, h) for k, h in _COLUMNS if any(c[k] for c in cells)]
+    out = ["<table><tr>" + "".join(f"<th class='{k}'>{h}</th>" for k, h in cols) + "</tr>"]
+    for c in cells:
+        out.append("<tr>" + "".join(f"<td class='{k}'>{c[k]}</td>" for k, _ in cols) + "</tr>")
     out.append("</table>")
     return "\n".join(out)
 
 
 _CSS = """
-body{font-family:system-ui,sans-serif;max-width:1050px;margin:2em auto;padding:0 1em;
+body{font-family:system-ui,sans-serif;max-width:1100px;margin:2em auto;padding:0 1em;
 line-height:1.45;color:#222}
 h1{font-size:1.6em}h2{font-size:1.2em;margin-top:2em;border-bottom:1px solid #ddd}
 table{border-collapse:collapse;margin:1em 0;font-size:.9em}
 td,th{border:1px solid #ccc;padding:.3em .6em;vertical-align:top}
-td:nth-child(2),td:nth-child(3),td:nth-child(4){font-family:monospace;text-align:right}
+th{background:#f4f4f4;text-align:left}
+td.paper,td.parapend,td.difference{font-variant-numeric:tabular-nums;text-align:right;white-space:nowrap}
 img{max-width:100%;height:auto;border:1px solid #eee}
 .note{color:#555;font-size:.92em}
+header.run{background:#f7f7f7;border:1px solid #e2e2e2;padding:.6em 1em;font-size:.9em}
+header.run dl{display:grid;grid-template-columns:max-content auto;gap:.1em 1em;margin:0}
+header.run dt{color:#555}header.run dd{margin:0;font-family:monospace}
+nav.toc ol{columns:2;font-size:.95em}
 """
 
+_TABLES = (("table1", "Table 1: harmonic excitation"),
+           ("table2", "Table 2: two-harmonic excitation (Eq. 23)"),
+           ("table3", "Table 3: square-wave excitation (Eq. 26, alpha = 0.001)"),
+           ("scalars", "Other numbers in the text"))
 
-def _html(results: dict, figures: list[dict]) -> str:
+
+def environment() -> dict:
+    """Versions of parapend, Python and the numerical libraries, and the platform."""
+    import matplotlib
+    import numpy
+    import scipy
+    import xarray
+
+    return {"parapend": __version__, "Python": platform.python_version(),
+            "NumPy": numpy.__version__, "SciPy": scipy.__version__,
+            "matplotlib": matplotlib.__version__, "xarray": xarray.__version__,
+            "platform": f"{platform.system()} {platform.machine()}, {os.cpu_count()} CPU(s)"}
+
+
+def _css_width(png: bytes) -> int:
+    """Display width in CSS pixels of a 200-dpi PNG: as at 100 dpi, so that every figure's
+    text has the same size on the page (a single panel is not stretched to the full width)."""
+    return int.from_bytes(png[16:20], "big") // 2
+
+
+def _header(run: dict) -> str:
+    env = run["environment"]
+    items = [("parapend", env["parapend"]),
+             ("environment", ", ".join(f"{k} {env[k]}" for k in (
+                 "Python", "NumPy", "SciPy", "matplotlib", "xarray"))),
+             ("machine", env["platform"]),
+             ("generated", run["finished"]),
+             ("run time", f"{run['seconds']:.1f} s")]
+    dl = "".join(f"<dt>{html.escape(k)}</dt><dd>{html.escape(v)}</dd>" for k, v in items)
+    return f"<header class='run'><dl>{dl}</dl></header>"
+
+
+def _html(results: dict, figures: list[dict], run: dict) -> str:
     t = results["tables"]
+    toc = [f"<li><a href='#{k}'>{html.escape(title)}</a></li>" for k, title in _TABLES]
+    toc += [f"<li><a href='#{f['key']}'>{html.escape(f['title'])}</a></li>" for f in figures]
     parts = [
         "<!DOCTYPE html><html lang='en'><head><meta charset='utf-8'>",
         "<title>parapend: reproduction of Nandakumar, Wiercigroch &amp; Chatterjee (2012)"
         "</title>", f"<style>{_CSS}</style></head><body>",
         "<h1>Optimum energy extraction from a parametrically excited pendulum: the paper's "
-        "results, recomputed</h1>",
+        "results, recomputed</h1>", _header(run),
         "<p>Nandakumar, Wiercigroch &amp; Chatterjee, <i>Mech. Res. Commun.</i> 2012, "
         f"recomputed by parapend {html.escape(__version__)}. Every value in the "
         "<b>parapend</b> column is computed by this run; the <b>paper</b> column holds the "
-        "paper's printed values. Differences are parapend minus paper.</p>",
+        "paper's printed values. Differences are parapend minus paper. The numbers are also "
+        "in <code>results.json</code> and <code>tables/*.csv</code>, the figures in "
+        "<code>figures/</code> (PNG and SVG).</p>",
         f"<p class='note'>Convention: {html.escape(CONVENTION)}. Model: theta'' + gamma "
         "theta' - (1 + q(t)) sin(theta) = T(t); paper case delta = -0.3, omega = 1.8.</p>",
-        "<h2>Table 1: harmonic excitation</h2>", _html_table(t["table1"]),
-        "<h2>Table 2: two-harmonic excitation (Eq. 23)</h2>", _html_table(t["table2"]),
-        "<h2>Table 3: square-wave excitation (Eq. 26, alpha = 0.001)</h2>",
-        _html_table(t["table3"]),
-        "<h2>Other numbers in the text</h2>", _html_table(t["scalars"]),
+        "<nav class='toc'><h2>Contents</h2><ol>" + "".join(toc) + "</ol></nav>",
     ]
+    for key, title in _TABLES:
+        parts += [f"<h2 id='{key}'>{html.escape(title)}</h2>", _html_table(t[key])]
     for f in figures:
         uri = base64.b64encode(f["png"]).decode()
         parts += [f"<h2 id='{f['key']}'>{html.escape(f['title'])}</h2>",
                   f"<p><b>Paper:</b> {html.escape(f['paper'])}<br><b>Here:</b> "
                   f"{html.escape(f['here'])}</p>",
-                  f"<img alt='{html.escape(f['title'])}' src='data:image/png;base64,{uri}'>"]
+                  f"<img alt='{html.escape(f['title'])}' width='{_css_width(f['png'])}' "
+                  f"src='data:image/png;base64,{uri}'>"]
         if f["rows"]:
             parts.append(_html_table(f["rows"]))
     parts.append("</body></html>")
     return "\n".join(parts)
 
 
-def reproduce(out, progress=None) -> dict:
-    """Regenerate every table and figure into directory ``out``; return the results dict.
+# ---------------------------------------------------------------------------------------
+# Writing the report whole: a staging directory beside ``out``, swapped into place.
+def _pid_alive(pid: int) -> bool:
+    if pid == os.getpid():
+        return False  # ours, left by an earlier call that failed: no longer in use
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except OSError:  # e.g. another user's process: alive
+        return True
+    return True
 
-    ``progress(done, total, label)`` is called after each step if given.
-    """
+
+def _clean_stale(parent: Path, name: str) -> None:
+    """Remove staging and set-aside directories of ``name`` left by runs that were killed."""
+    pat = re.compile(re.escape(f".{name}.parapend-") + r"(staging|old)-(\d+)-")
+    with contextlib.suppress(OSError):
+        for entry in parent.iterdir():
+            m = pat.match(entry.name)
+            if m and entry.is_dir() and not entry.is_symlink() and not _pid_alive(
+                    int(m.group(2))):
+                shutil.rmtree(entry, ignore_errors=True)
+
+
+def _check_out(out) -> Path:
+    """The report directory to (re)place, or an OutputError saying why it may not be."""
+    if str(out) == "":
+        raise OutputError("cannot write report: expected a directory name, got an empty string")
     out = Path(out)
-    figdir, tabdir = out / "figures", out / "tables"
-    figdir.mkdir(parents=True, exist_ok=True)
-    tabdir.mkdir(parents=True, exist_ok=True)
-    figs = _figures()
+    try:
+        if out.is_symlink():
+            out = out.resolve()
+        out = Path(os.path.abspath(out))
+        if out.exists() and not out.is_dir():
+            raise OutputError(f"cannot write report {str(out)!r}: it exists and is not a "
+                              "directory")
+        cwd = Path.cwd()
+        if out == cwd or out in cwd.parents or out.parent == out:
+            raise OutputError(f"cannot write report {str(out)!r}: it is the current "
+                              "directory or contains it; give a new or report directory")
+        for parent in out.parents:
+            if parent.exists():
+                if not parent.is_dir():
+                    raise OutputError(f"cannot write report {str(out)!r}: {str(parent)!r} "
+                                      "is a file, not a directory")
+                break
+        if out.is_dir():
+            foreign = sorted(p.name for p in out.iterdir() if p.name not in REPORT_ENTRIES)
+            if foreign:
+                raise OutputError(
+                    f"cannot write report {str(out)!r}: it holds {len(foreign)} entr"
+                    f"{'y' if len(foreign) == 1 else 'ies'} that are not part of a parapend "
+                    f"report (e.g. {foreign[0]!r}), which replacing it would delete; give a "
+                    "new, empty or report directory")
+    except OSError as exc:
+        raise output_error(out, exc) from None
+    return out
+
+
+def _swap(staging: Path, out: Path) -> None:
+    """Move ``staging`` to ``out``; an existing ``out`` is renamed aside, then removed."""
+    if not out.exists():
+        os.rename(staging, out)
+        return
+    aside = Path(tempfile.mkdtemp(dir=out.parent, prefix=f".{out.name}.parapend-old-"
+                                                         f"{os.getpid()}-"))
+    os.rename(out, aside / "report")
+    try:
+        os.rename(staging, out)
+    except BaseException:
+        os.rename(aside / "report", out)
+        raise
+    finally:
+        shutil.rmtree(aside, ignore_errors=True)
+
+
+def _write_all(root: Path, figs: list, progress) -> tuple[dict, list[dict]]:
+    figdir, tabdir = root / "figures", root / "tables"
+    figdir.mkdir()
+    tabdir.mkdir()
     total = len(figs) + 2
     tables = paper.tables()
     for name, rows in tables.items():
@@ -315,8 +455,57 @@ def reproduce(out, progress=None) -> dict:
         if progress:
             progress(i, total, key)
     text = json.dumps(to_jsonable(results), indent=1, sort_keys=True)
-    _atomic_write(out / "results.json", text.encode())
-    _atomic_write(out / "report.html", _html(results, rendered).encode())
+    write_text(root / "results.json", text)
+    return results, rendered
+
+
+def reproduce(out, progress=None) -> dict:
+    """Regenerate every table and figure into directory ``out``; return the results dict.
+
+    The report is built in a hidden staging directory beside ``out`` and moved into place
+    when complete, so ``out`` always holds one whole report, old or new (see the module
+    docstring). ``out`` may not exist yet (its parents are created), may be empty, or may
+    hold an earlier report; a directory holding anything else is refused.
+
+    Parameters
+    ----------
+    out : str or os.PathLike
+        The report directory.
+    progress : callable, optional
+        ``progress(done, total, label)``, called after each step.
+
+    Returns
+    -------
+    dict
+        What ``results.json`` holds.
+
+    Raises
+    ------
+    OutputError
+        ``out`` cannot be written, or is a directory that is not a report.
+    """
+    start = time.perf_counter()
+    out = _check_out(out)
+    try:
+        out.parent.mkdir(parents=True, exist_ok=True)
+        _clean_stale(out.parent, out.name)
+        staging = Path(tempfile.mkdtemp(dir=out.parent, prefix=f".{out.name}.parapend-staging-"
+                                                               f"{os.getpid()}-"))
+    except OSError as exc:
+        raise output_error(out, exc) from None
+    try:
+        os.chmod(staging, 0o777 & ~umask())
+        figs = _figures()
+        results, rendered = _write_all(staging, figs, progress)
+        run = {"environment": environment(), "seconds": time.perf_counter() - start,
+               "finished": datetime.now(timezone.utc).strftime("%Y-%m-%d %H:%M UTC")}
+        write_text(staging / "report.html", _html(results, rendered, run))
+        _swap(staging, out)
+    except OSError as exc:
+        raise output_error(out, exc) from None
+    finally:  # any failure, KeyboardInterrupt included: no staging directory is left
+        if staging.exists():
+            shutil.rmtree(staging, ignore_errors=True)
     if progress:
-        progress(total, total, "report")
+        progress(len(figs) + 2, len(figs) + 2, "report")
     return results

@@ -92,14 +92,14 @@ def main(argv=None) -> int:
     name = f"parapend {a.command}"
     try:
         out = COMMANDS[a.command](a)
+    except OutputError as exc:  # before ParameterError, of which it is a subclass
+        _err(f"{name}: error: {exc}")
+        return EXIT_FAILURE
     except ParameterError as exc:
         _err(f"{name}: error: {exc}")
         return EXIT_USAGE
     except SolverError as exc:
         _err(f"{name}: solver error: {exc}")
-        return EXIT_FAILURE
-    except OutputError as exc:
-        _err(f"{name}: error: {exc}")
         return EXIT_FAILURE
     except OSError as exc:  # any other file-system failure: one line, not a traceback
         where = f" {exc.filename!r}" if getattr(exc, "filename", None) else ""

@@ -1,29 +1,23 @@
-"""Every file the command line writes goes through this module.
+"""Every file the command line writes goes through this module, and from here through
+:mod:`parapend.fileio`: atomic replacement, the user's umask, no temporaries left behind.
 
-Kept thin on purpose: the functions here are the one place to rewire when file writing
-changes (e.g. umask-respecting atomic writes in ``parapend.fileio``). A failure to write
-(read-only or pseudo file system, full disk, permission) becomes an :class:`OutputError`
-with one line naming the file; the command line prints it and exits with code 1.
+A failure to write (read-only or pseudo file system, full disk, permission, a name too long)
+is an :class:`~parapend.errors.OutputError` with one line naming the file; the command line
+prints it and exits with code 1 (a path refused before any work, by
+:func:`~parapend.cli._common._check_output`, exits with code 2).
 """
 
 from __future__ import annotations
 
+import contextlib
 import os
 import tempfile
 from pathlib import Path
 
-__all__ = ["OutputError", "probe_dir", "save_figure", "write_dataset", "write_text"]
+from .. import fileio
+from ..errors import OutputError
 
-
-class OutputError(OSError):
-    """An output file or directory could not be written; the message is one line."""
-
-
-def _fail(path, exc: BaseException) -> OutputError:
-    text = str(exc).strip()
-    why = getattr(exc, "strerror", None) or (text.splitlines()[0] if text else
-                                              type(exc).__name__)
-    return OutputError(f"cannot write {str(path)!r}: {why}")
+__all__ = ["OutputError", "plot", "probe_dir", "save_figure", "write_dataset", "write_text"]
 
 
 def probe_dir(directory) -> None:
@@ -31,60 +25,35 @@ def probe_dir(directory) -> None:
     cannot be written (``/proc``, ``/sys``, a read-only mount, no permission)."""
     d = Path(directory) if str(directory) else Path(".")
     try:
-        fd, tmp = tempfile.mkstemp(dir=d, prefix=".parapend-probe-")
+        fd, tmp = tempfile.mkstemp(dir=d, prefix=fileio.TEMP_PREFIX + "probe-")
         os.close(fd)
-        os.unlink(tmp)
+        with contextlib.suppress(OSError):
+            os.unlink(tmp)
     except OSError as exc:
         raise OutputError(f"cannot create files in directory {str(d)!r}: "
                           f"{exc.strerror or exc}") from None
 
 
 def write_text(path, text: str) -> None:
-    """Write ``text`` to ``path`` through a temporary file (an old file is never half-written)."""
-    p = Path(path)
-    tmp = None
-    try:
-        fd, tmp = tempfile.mkstemp(dir=p.parent if str(p.parent) else ".", prefix=".tmp-")
-        with os.fdopen(fd, "w", newline="") as fh:
-            fh.write(text)
-        os.replace(tmp, p)
-    except OSError as exc:
-        raise _fail(p, exc) from None
-    finally:
-        if tmp is not None and os.path.exists(tmp):
-            os.unlink(tmp)
+    """Write ``text`` to ``path`` atomically (:func:`parapend.fileio.write_text`)."""
+    fileio.write_text(path, text)
 
 
 def write_dataset(ds, path) -> None:
-    """Write a Dataset to NetCDF through a temporary file (an old file is never half-written)."""
-    p = Path(path)
-    tmp = None
-    try:
-        fd, tmp = tempfile.mkstemp(dir=p.parent if str(p.parent) else ".", prefix=".tmp-",
-                                   suffix=".nc")
-        os.close(fd)
-        ds.to_netcdf(tmp)
-        os.replace(tmp, p)
-    except (OSError, RuntimeError) as exc:  # netCDF4/h5py report a full disk as RuntimeError
-        raise _fail(p, exc) from None
-    finally:
-        if tmp is not None and os.path.exists(tmp):
-            os.unlink(tmp)
+    """Write a Dataset to NetCDF atomically (:func:`parapend.fileio.write_dataset`)."""
+    fileio.write_dataset(ds, path)
 
 
 def save_figure(fig, path) -> None:
-    """Save a matplotlib figure by extension (PNG, SVG, PDF) via :mod:`parapend.plotting`."""
-    from ..plotting import save_figure as _save
-
-    try:
-        _save(fig, path)
-    except OSError as exc:
-        raise _fail(path, exc) from None
+    """Save a matplotlib figure by extension (PNG, SVG, PDF; :func:`parapend.fileio.save_figure`)."""
+    fileio.save_figure(fig, path)
 
 
 def plot(func, data, path) -> None:
     """Draw ``func(data, path)`` (a :mod:`parapend.plotting` function that saves to ``path``)."""
     try:
         func(data, path)
+    except OutputError:
+        raise
     except OSError as exc:
-        raise _fail(path, exc) from None
+        raise fileio.output_error(path, exc) from None

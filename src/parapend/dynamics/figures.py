@@ -1,9 +1,10 @@
 """Figures of the uncontrolled dynamics (paper Figs. 1 right and 2), matplotlib Agg.
 
 Every function builds a :class:`matplotlib.figure.Figure` on an explicit Agg canvas
-(no pyplot, the global backend is not switched), returns it, and saves it only when
-``path`` is given (format from the extension: PNG, SVG, PDF). Angles follow paper Eq. 1
-(``phi`` from the hanging position).
+(no pyplot, the global backend is not switched) in parapend's style
+(:func:`parapend.style.figure_style`), returns it, and saves it only when ``path`` is given
+(format from the extension: PNG, SVG, PDF; through :func:`parapend.fileio.save_figure`).
+Angles follow paper Eq. 1 (``phi`` from the hanging position).
 """
 
 from __future__ import annotations
@@ -20,6 +21,8 @@ from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 from matplotlib.patches import Patch
 
+from ..fileio import save_figure
+from ..style import figure_style
 from .attractors import find_attractors
 from .continuation import periodic_orbit
 from .simulate import trajectory
@@ -51,9 +54,7 @@ _PALETTE = {
 
 def _save(fig: Figure, path: str | Path | None) -> None:
     if path is not None:
-        path = Path(path)
-        fig.savefig(path, format=path.suffix.lstrip(".").lower() or "png", dpi=130,
-                    bbox_inches="tight")
+        save_figure(fig, path, close=False)
 
 
 def _new_figure(size) -> Figure:
@@ -92,6 +93,7 @@ def _motions(gamma: float, p: float, omega: float) -> list[tuple[float, float, s
     return out
 
 
+@figure_style()
 def plot_coexistence(gamma: float = 0.1, p: float = 0.8, omega: float = 2.1, *,
                      periods: int = 6, path: str | Path | None = None) -> Figure:
     """Paper Fig. 1 right: a period-2 oscillation and a period-1 rotation of Eq. 1.
@@ -165,6 +167,7 @@ def _colors(ds) -> list[str]:
     return colors
 
 
+@figure_style()
 def plot_basins(ds: xr.Dataset, *, path: str | Path | None = None,
                 show_attractors: bool = True, title: str | None = None) -> Figure:
     """Basin-of-attraction picture (paper Fig. 2 right) from :func:`~.basins.basin_map`.
@@ -232,32 +235,53 @@ def plot_basins(ds: xr.Dataset, *, path: str | Path | None = None,
     return fig
 
 
-def plot_rotation_boundaries(ds: xr.Dataset, *, path: str | Path | None = None) -> Figure:
+@figure_style()
+def plot_rotation_boundaries(ds: xr.Dataset, *, path: str | Path | None = None,
+                             points: dict[str, tuple[float, float]] | None = None) -> Figure:
     """Curves J, G, E of the period-1 rotation in the ``(omega, p)`` plane (Fig. 2 left).
+
+    The band between G and E, where the rotation exists but is unstable, is shaded (up to
+    the top of the plot where E was not found below the continuation's ``p_max``).
 
     Parameters
     ----------
     ds : xarray.Dataset
         Output of :func:`parapend.dynamics.continuation.rotation_boundaries`.
     path : str or Path, optional
+    points : dict, optional
+        ``{label: (omega, p)}``: operating points to mark (e.g. the paper's cases).
 
     Returns
     -------
     matplotlib.figure.Figure
     """
-    fig = _new_figure((6.4, 4.6))
+    fig = _new_figure((7.2, 5.0))
     ax = fig.add_subplot()
     om = ds["omega"].values
-    styles = {"p_J": ("k", "-", "J: birth (fold)"), "p_G": ("0.45", "--", "G: loss of "
-                                                             "stability (period doubling)"),
-              "p_E": ("0.45", ":", "E: stability regained (period doubling)")}
+    pj, pg, pe = (ds[k].values for k in ("p_J", "p_G", "p_E"))
+    top = 1.05 * float(np.nanmax(np.concatenate([pj, pg, pe, [1.0]])))
+    band = np.isfinite(pg)
+    ax.fill_between(om, np.where(band, pg, np.nan), np.where(np.isfinite(pe), pe, top),
+                    where=band, color="C3", alpha=0.13, lw=0,
+                    label="rotation unstable (between G and E)")
+    ax.fill_between(om, 0, pj, where=np.isfinite(pj), color="0.5", alpha=0.12, lw=0,
+                    label="no period-1 rotation (below J)")
+    styles = {"p_J": ("k", "-", "J: birth (fold)"),
+              "p_G": ("C3", "--", "G: loss of stability (period doubling)"),
+              "p_E": ("C0", "-.", "E: stability regained (period doubling)")}
     for key, (c, ls, lab) in styles.items():
-        ax.plot(om, ds[key].values, color=c, ls=ls, marker=".", label=lab)
+        ax.plot(om, ds[key].values, color=c, ls=ls, lw=1.5, label=lab)
+    for i, (label, (w, p)) in enumerate((points or {}).items()):
+        ax.plot([w], [p], marker="*o^s"[i % 4], ms=11, color="gold", mec="k", ls="none",
+                zorder=4)
+        ax.annotate(label, (w, p), xytext=(8, -3 if i % 2 else 6), textcoords="offset points",
+                    fontsize=8, bbox={"boxstyle": "round,pad=0.2", "fc": "white", "ec": "0.7"})
+    ax.set_xlim(om[0], om[-1])
+    ax.set_ylim(0, top)
     ax.set_xlabel(r"$\omega$")
     ax.set_ylabel(r"$p$")
-    ax.set_title(rf"Period-1 rotation of Eq. 1, $\gamma = {ds.attrs['gamma']:g}$", fontsize=10)
-    ax.grid(alpha=0.3)
-    ax.legend(fontsize=8)
+    ax.set_title(rf"Period-1 rotation of Eq. 1, $\gamma = {ds.attrs['gamma']:g}$")
+    ax.legend(loc="upper left")
     _save(fig, path)
     return fig
 
