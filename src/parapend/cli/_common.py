@@ -125,7 +125,7 @@ def _check_output(path: str | None, what: str, suffixes) -> None:
     from ._output import OutputError, probe_dir
 
     try:
-        probe_dir(parent)
+        probe_dir(parent, path)
     except OutputError as exc:
         raise ParameterError(f"{what}: {exc}") from None
 

@@ -20,9 +20,10 @@ from ..errors import OutputError
 __all__ = ["OutputError", "plot", "probe_dir", "save_figure", "write_dataset", "write_text"]
 
 
-def probe_dir(directory) -> None:
+def probe_dir(directory, target=None) -> None:
     """Create and remove a temporary file in ``directory``: fail before any long work if it
-    cannot be written (``/proc``, ``/sys``, a read-only mount, no permission)."""
+    cannot be written (``/proc``, ``/sys``, a read-only mount, no permission). ``target``,
+    the file to be written there, is named in the message."""
     d = Path(directory) if str(directory) else Path(".")
     try:
         fd, tmp = tempfile.mkstemp(dir=d, prefix=fileio.TEMP_PREFIX + "probe-")
@@ -30,8 +31,9 @@ def probe_dir(directory) -> None:
         with contextlib.suppress(OSError):
             os.unlink(tmp)
     except OSError as exc:
-        raise OutputError(f"cannot create files in directory {str(d)!r}: "
-                          f"{exc.strerror or exc}") from None
+        what = (f"cannot write {str(target)!r}" if target is not None
+                else f"cannot create files in directory {str(d)!r}")
+        raise OutputError(f"{what}: {exc.strerror or exc}") from None
 
 
 def write_text(path, text: str) -> None:
@@ -45,7 +47,7 @@ def write_dataset(ds, path) -> None:
 
 
 def save_figure(fig, path) -> None:
-    """Save a matplotlib figure by extension (PNG, SVG, PDF; :func:`parapend.fileio.save_figure`)."""
+    """Save a figure by extension, PNG, SVG or PDF (:func:`parapend.fileio.save_figure`)."""
     fileio.save_figure(fig, path)
 
 
