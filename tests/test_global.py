@@ -184,3 +184,19 @@ def test_bvp_approaches_the_limit_like_epsilon_to_two_thirds():
         gaps.append(lim - s.power)
     ratios = np.array(gaps[:-1]) / np.array(gaps[1:])
     assert np.all(np.abs(ratios / 100 ** (2 / 3) - 1) < 0.02), ratios
+
+
+def test_many_extrema_use_the_dynamic_programme_and_report_the_count(capsys):
+    """80 extrema per period: C(80, 39) ~ 1e23 patterns, beyond 2^53 (a float in JSON)."""
+    import json
+
+    from parapend.cli import main
+
+    code = main(["optimize", "--fourier", "1:0.3,40:0.05", "--gamma", "0.01", "--json"])
+    d = json.loads(capsys.readouterr().out)
+    assert code == 0 and d["success"] and d["search"] == "dynamic-programme"
+    assert d["extrema_per_period"] == 80
+    assert d["candidate_patterns"] == float(math.comb(80, 39))
+    assert d["patterns_tried"] < 100 and d["power"] >= d["uniform_power"]
+    code = main(["optimize", "--fourier", "1:0.3,40:0.05", "--gamma", "0.01"])
+    assert "of about 10^23.0 half-turn direction patterns" in capsys.readouterr().out

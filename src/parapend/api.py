@@ -214,7 +214,8 @@ def optimize(*, omega: float = 1.8, delta=None, gamma: float = 0.0, harmonics: i
             quadrature_points=best.points,
             mean_square_speed=motion.mean_square_speed(),
             search=ev.strategy,
-            candidate_patterns=ev.candidate_patterns,
+            candidate_patterns=_json_count(ev.candidate_patterns),
+            extrema_per_period=int(exc.extrema.t.size),
             patterns_tried=ev.patterns_tried,
             polished=ev.polished,
             abandoned=ev.abandoned,
@@ -227,6 +228,17 @@ def optimize(*, omega: float = 1.8, delta=None, gamma: float = 0.0, harmonics: i
     if throw and not res.success:
         raise SolverError(f"optimize: {res.message}")
     return res
+
+
+def _json_count(n: int) -> int | float:
+    """An exact count while JSON readers keep it exact (< 2^53), else a float (inf, shown as
+    null, past 1e308: a noisy record's C(2m, m - 1) can have a thousand digits)."""
+    if n < 2**53:
+        return int(n)
+    try:
+        return float(n)
+    except OverflowError:
+        return math.inf
 
 
 def _second(best: float, values) -> float | None:

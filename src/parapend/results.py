@@ -70,7 +70,8 @@ class OptimizeResult(_Result):
         ``mesh_nodes``, ``max_residual``, ``continuation_steps`` describe the solve.
     search, candidate_patterns, patterns_tried, polished, abandoned : the evidence of the
         global search (docs/global.md): ``search`` is "exhaustive" (every half-turn
-        direction pattern of the limit motion, ``candidate_patterns`` of them, was a seed),
+        direction pattern of the limit motion, ``candidate_patterns`` of them, was a seed;
+        ``C(2m, m - 1)`` for ``extrema_per_period = 2m``, a float past 2^53, inf past 1e308),
         "dynamic-programme" (too many to list: seeds from the (t, theta) dynamic programme),
         or "bvp-starts"; runs carried to convergence and runs abandoned as unable to win.
     second_power : float or None
@@ -100,7 +101,8 @@ class OptimizeResult(_Result):
     quadrature_points: int = 0
     mean_square_speed: float = float("nan")
     search: str = ""
-    candidate_patterns: int = 1
+    candidate_patterns: int | float = 1
+    extrema_per_period: int = 2
     patterns_tried: int = 0
     polished: int = 0
     abandoned: int = 0

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import csv
 import io
+import math
 
 from .. import limits
 from ..errors import ParameterError
@@ -122,7 +123,7 @@ def _cmd_optimize(a) -> dict | str:
     elif r.method == "fourier":
         how = (f"{r.iterations} Newton iterations, found from the {r.found_by} seed, "
                f"{len(r.local_maxima)} distinct local maxima")
-        search = (f"search: {r.search}, {r.patterns_tried} of {r.candidate_patterns} "
+        search = (f"search: {r.search}, {r.patterns_tried} of {_count(r)} "
                   f"half-turn direction patterns tried, {r.polished} runs polished, "
                   f"{r.abandoned} abandoned as unable to win")
         if r.second_power is not None:
@@ -186,6 +187,15 @@ def _optimize_all(a, kw) -> dict | str:
         out += ["", f"Fourier - BVP: {f.power - b.power:+.3e}  (agree when N resolves the "
                     "boundary layers)"]
     return "\n".join(out)
+
+
+def _count(r) -> str:
+    """``C(2m, m - 1)`` exactly when short, else as a power of ten (from log-gamma)."""
+    if isinstance(r.candidate_patterns, int) and r.candidate_patterns < 10**9:
+        return str(r.candidate_patterns)
+    m = r.extrema_per_period // 2
+    lg = (math.lgamma(2 * m + 1) - math.lgamma(m) - math.lgamma(m + 2)) / math.log(10)
+    return f"about 10^{lg:.1f}"
 
 
 def _cmd_threshold(a) -> dict | str:
