@@ -138,6 +138,16 @@ def test_sweeps_report_their_refinement():
     assert ds.attrs["refinement_change"] == pytest.approx(fine - ds.power.values[0], abs=1e-12)
     tab = parapend.harmonic_table(range(2, 5))
     assert tab.attrs["spectrum_harmonics"] == 1 and tab.attrs["refinement_change"] > 0
+    assert tab.global_search.values.tolist() == [True, False, True]
+
+
+def test_harmonic_table_global_rows_are_the_optimum():
+    exc = parapend.fourier(FAST_CASES[0][0], omega=FAST_CASES[0][1])
+    tab = parapend.harmonic_table(range(6, 10), excitation=exc)
+    assert tab.global_search.values.tolist() == [True, False, True, True]
+    for n, p, g in zip(tab.harmonics.values, tab.power.values, tab.global_search.values):
+        best = parapend.optimize(excitation=exc, harmonics=int(n)).power
+        assert p <= best + 1e-12 and (not g or p == pytest.approx(best, abs=1e-10))
 
 
 def test_bvp_peak_torque_from_its_own_mesh():

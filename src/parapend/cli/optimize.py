@@ -264,9 +264,10 @@ def _cmd_harmonics(a) -> dict | str:
         _output.write_dataset(ds, a.save)
     if a.json:
         return _dataset_json(ds)
-    rows = [[str(n), _fmt(p, 8), str(s)] for n, p, s in zip(
-        ds["harmonics"].values, ds["power"].values, ds["status"].values)]
-    out = [_table(rows, ["N", "optimal P", "status"]), "",
+    rows = [[str(n), _fmt(p, 8), str(s), "global" if g else "continued"]
+            for n, p, s, g in zip(ds["harmonics"].values, ds["power"].values,
+                                  ds["status"].values, ds["global_search"].values)]
+    out = [_table(rows, ["N", "optimal P", "status", "search"]), "",
            f"best uniform: {_fmt(ds.attrs['uniform_power'], 8)}    "
            f"limit gamma -> 0 (undamped): {_fmt(ds.attrs['limit_power'], 8)}",
            f"band of q: {ds.attrs['spectrum_harmonics']} harmonics; last row with 2N changes "
