@@ -513,7 +513,8 @@ def damping_sweep(*, omega: float = 1.8, delta=None, harmonics: int | None = Non
     Solves run from the largest damping down, each warm-started from the previous
     optimum, and each is a global search (docs/global.md). The resolution is checked by
     one refinement: the sweep's end points are solved again with 2N, and the largest
-    change is the attribute ``refinement_change``. Returns an ``xarray.Dataset`` over ``gamma`` (the damping).
+    change is the attribute ``refinement_change``. Returns an ``xarray.Dataset`` over
+    ``gamma`` (the damping).
     Bounded work: ``harmonics <= 256``, ``2 <= points <= 1001`` and
     ``points * harmonics**2 <= 2**20`` (about a minute; docs/limits-of-input.md).
     """
