@@ -210,3 +210,16 @@ def test_many_extrema_use_the_dynamic_programme_and_report_the_count(capsys):
     assert d["patterns_tried"] < 100 and d["power"] >= d["uniform_power"]
     code = main(["optimize", "--fourier", "1:0.3,40:0.05", "--gamma", "0.01"])
     assert "of about 10^23.0 half-turn direction patterns" in capsys.readouterr().out
+
+
+def test_screening_resolution_policy():
+    """gamma > 0: patterns ranked at N = 32 above it; gamma = 0: at the full N while
+    count x N^3 stays within the work budget, else at the largest N within it."""
+    from parapend.optimal.fourier import ENUMERATE_WORK, _screen_harmonics
+
+    assert _screen_harmonics(792, 24, 0.01) is None
+    assert _screen_harmonics(792, 64, 0.01) == 32
+    assert _screen_harmonics(792, 96, 0.0) is None
+    assert _screen_harmonics(792, 1024, 0.0) == 96
+    n = _screen_harmonics(15, 1024, 0.0)
+    assert 15 * n**3 <= ENUMERATE_WORK < 15 * (n + 1) ** 3

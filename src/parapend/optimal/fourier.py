@@ -462,7 +462,12 @@ def _screen_harmonics(count: int, harmonics: int, damping: float) -> int | None:
     seeds = count if count <= ENUMERATE_MAX else 2 * PROPOSE_COUNT + SWAP_BUDGET
     if seeds * harmonics**3 <= ENUMERATE_WORK:
         return None
-    return max(SCREEN_HARMONICS, int((ENUMERATE_WORK / seeds) ** (1.0 / 3.0)))
+    n = round((ENUMERATE_WORK / seeds) ** (1.0 / 3.0))  # the integer cube root, exactly:
+    while seeds * n**3 > ENUMERATE_WORK:
+        n -= 1
+    while seeds * (n + 1) ** 3 <= ENUMERATE_WORK:
+        n += 1
+    return max(SCREEN_HARMONICS, n)
 
 
 #: Swaps of a forward and a backward half-turn at most this many extrema apart are tried by
