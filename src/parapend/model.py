@@ -34,9 +34,14 @@ def torque(motion, excitation, damping: float, t):
 
 def _sample_points(motion, excitation) -> int:
     """Uniform samples per period that resolve a Fourier motion's torque: a power of two
-    with at least 16 points per top harmonic of the motion and 8 per harmonic of ``q``."""
+    with at least 16 points per top harmonic of the motion and of ``q``, at most 2^20.
+
+    The cap bounds memory (a square wave's spectrum reaches 2^20 harmonics: 16 points each
+    took 2.4 GB); ``q`` enters the torque only through its value, which is bounded, so
+    missing its sharpest jumps can only miss the instant, not a larger peak of ``q``.
+    """
     k = max(int(getattr(motion, "harmonics", 0)), int(np.size(excitation.spectrum)) - 1, 256)
-    return 1 << int(np.ceil(np.log2(16 * k)))
+    return min(1 << int(np.ceil(np.log2(16 * k))), 1 << 20)
 
 
 def peak_torque(motion, excitation, damping: float, points: int | None = None) -> float:
