@@ -53,7 +53,7 @@ import numpy as np
 
 from ..model import peak_torque
 from ..trajectory import FourierMotion
-from .fourier import FourierProblem, newton_maximize
+from .fourier import FourierProblem, _pad, newton_maximize
 
 __all__ = ["PTOProblem", "PTOSolution", "pto_profile", "solve_pto"]
 
@@ -274,6 +274,9 @@ class PTOSolution:
     stages: list = field(default_factory=list)
 
 
+_CONTINUATION_HARMONICS = 24
+
+
 def _inner(problem, x, gtol, maxiter):
     return newton_maximize(problem, x, "warm", gtol=gtol, maxiter=maxiter)
 
@@ -308,9 +311,18 @@ def solve_pto(excitation, harmonics: int, damping: float, x0: np.ndarray, *,
     -------
     PTOSolution
     """
+    x = np.array(x0, dtype=float)
+    if harmonics > _CONTINUATION_HARMONICS:
+        # continuation in N: from the unconstrained optimum with many harmonics (large,
+        # oscillating instantaneous power) Newton creeps; the 24-harmonic PTO optimum,
+        # padded, starts it within a few iterations of the answer
+        small = solve_pto(excitation, _CONTINUATION_HARMONICS, damping,
+                          _pad(x, _CONTINUATION_HARMONICS), torque_limit=torque_limit,
+                          efficiency=efficiency, copper_loss=copper_loss, tol=tol, gtol=gtol,
+                          maxiter=maxiter, max_outer=max_outer)
+        x = _pad(small.x, harmonics)
     prob = PTOProblem(excitation, harmonics, damping, torque_limit=torque_limit,
                       efficiency=efficiency, copper_loss=copper_loss, points=points)
-    x = np.array(x0, dtype=float)
     iters = 0
     outer = 0
     stages = []
@@ -352,6 +364,8 @@ def solve_pto(excitation, harmonics: int, damping: float, x0: np.ndarray, *,
     viol = 0.0 if torque_limit is None else max(peak / torque_limit - 1.0, 0.0)
     if torque_limit is not None and viol > tol and status == "converged":
         status = "infeasible"
+    elif status == "infeasible" and viol <= tol:
+        status = "stalled"  # feasible on the dense evaluation, multipliers not converged
     mech = prob.base.power(x)
     _, g, _ = prob.evaluate(x)
     return PTOSolution(x=x, power=float(mech), electrical_power=prob.electrical(x),
