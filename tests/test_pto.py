@@ -133,7 +133,8 @@ def test_efficiency_avoids_motoring():
 def test_pto_bad_input():
     with pytest.raises(ParameterError, match="^torque-limit: expected a number > 0"):
         pto.optimize_pto(torque_limit=0.0)
-    with pytest.raises(ParameterError, match="^efficiency-motoring: expected a number in"):
+    with pytest.raises(ParameterError,
+                       match=r"^efficiency-motoring: expected a number in \(0, 1\]"):
         pto.optimize_pto(efficiency_motoring=1.5)
     with pytest.raises(ParameterError, match="^harmonics"):
         pto.optimize_pto(efficiency=0.9, harmonics=500)
@@ -173,3 +174,64 @@ def test_casadi_cross_check(gamma, kw):
 @pytest.mark.parametrize("gamma,kw", SLOW_CASES)
 def test_casadi_cross_check_all(gamma, kw):
     _cross_check(gamma, kw)
+
+
+# -- command line ------------------------------------------------------------------------------
+
+
+def _run(capsys, *args):
+    from parapend.cli import main
+
+    code = main(list(args))
+    out = capsys.readouterr()
+    return code, out.out, out.err
+
+
+def test_cli_units_json(capsys):
+    code, out, _ = _run(capsys, "optimize", "--length", "1", "--mass", "10", "--frequency",
+                        "0.9", "--amplitude", "0.09", "--json")
+    import json
+
+    d = json.loads(out)
+    assert code == 0
+    assert d["omega"] == pytest.approx(1.80546, abs=1e-5)
+    assert d["power_w"] == pytest.approx(103.51, abs=0.01)
+    for k in ("uniform_power_w", "limit_power_w", "peak_torque_nm"):
+        assert d[k] > 0
+
+
+def test_cli_pto_save(capsys, tmp_path):
+    f = tmp_path / "m.csv"
+    code, out, _ = _run(capsys, "optimize", "--gamma", "0.05", "--torque-limit", "2.5",
+                        "--efficiency", "0.9", "--save", str(f))
+    assert code == 0 and "electrical power" in out
+    head = f.read_text().splitlines()[0]
+    assert head == "t,tau,theta,theta_dot,torque,power,electrical_power"
+
+
+@pytest.mark.parametrize("args,name", [
+    (("--torque-limit", "-1"), "torque-limit"),
+    (("--efficiency", "0"), "efficiency"),
+    (("--efficiency-generating", "1.2"), "efficiency-generating"),
+    (("--torque-limit-nm", "5"), "torque-limit-nm"),
+    (("--frequency", "1"), "length, mass"),
+    (("--length", "1", "--mass", "1", "--frequency", "1", "--omega", "2"), "frequency"),
+    (("--length", "-1", "--mass", "1"), "length"),
+])
+def test_cli_bad_input(capsys, args, name):
+    code, out, err = _run(capsys, "optimize", *args)
+    assert code == 2 and out == ""
+    assert err.count("\n") == 1 and f"error: {name}:" in err
+
+
+def test_cli_pto_curve_efficiency(capsys):
+    import json
+
+    code, out, _ = _run(capsys, "pto-curve", "--vary", "efficiency", "--points", "2",
+                        "--gamma", "0.05", "--json")
+    d = json.loads(out)
+    assert code == 0
+    p = d["electrical_power"]
+    assert d["value"] == [1.0, 0.5]
+    assert p[0] == pytest.approx(d["unconstrained_power"], abs=1e-6)
+    assert p[1] < p[0]

@@ -21,7 +21,7 @@ import numpy as np
 
 from . import limits
 from .api import _coefficients, optimize
-from .errors import ParameterError, SolverError, check_int, check_range
+from .errors import ParameterError, SolverError, check_finite, check_int, check_range
 from .optimal.constrained import pto_profile, solve_pto
 from .trajectory import FourierMotion
 
@@ -43,9 +43,10 @@ def efficiencies(efficiency=None, efficiency_generating=None, efficiency_motorin
 
 
 def _eta(name, value) -> float:
-    x = check_range(name, value, 0.0, 1.0, why="a fraction of the power converted")
-    if x <= 0.0:
-        raise ParameterError(f"{name}: expected a number in (0, 1], got {value!r}")
+    x = check_finite(name, value)
+    if not 0.0 < x <= 1.0:
+        raise ParameterError(f"{name}: expected a number in (0, 1] (a fraction of the power "
+                             f"converted), got {value!r}")
     return x
 
 
@@ -237,3 +238,60 @@ def pto_curve(vary: str = "torque-limit", *, values=None, points: int = 12,
         ds["electrical_power_w"] = ds["electrical_power"] * units.power
         ds["peak_torque_nm"] = ds["peak_torque"] * units.torque
     return ds
+
+
+def plot_pto_profile(result, path=None, points: int = 2000):
+    """Torque ``T(t)`` and instantaneous power ``p = -T theta'`` of an optimum over one period.
+
+    The torque limit (if any) is drawn as dashed lines; motoring (``p < 0``) is shaded.
+    Returns the figure (saved through :func:`parapend.plotting.save_figure` if ``path``).
+    """
+    from .plotting import _finish, plt
+
+    exc = result._excitation
+    eff = None if result.efficiency_generating is None else (result.efficiency_generating,
+                                                              result.efficiency_motoring)
+    prof = pto_profile(result.motion, exc, result.gamma, points=points, efficiency=eff)
+    tau = prof["tau"]
+    fig, (ax1, ax2) = plt.subplots(2, 1, figsize=(7, 5.5), sharex=True)
+    ax1.plot(tau, prof["torque"], color="C3", lw=1.2, label="torque T (Eq. 14)")
+    if result.torque_limit is not None:
+        for s in (1, -1):
+            ax1.axhline(s * result.torque_limit, color="k", ls="--", lw=0.8)
+    ax1.set_ylabel("torque (m g l)")
+    ax1.set_title(f"Power take-off: P = {result.power:.5f}, peak |T| = "
+                  f"{result.peak_torque:.4g}, gamma = {result.gamma:g}", fontsize=9)
+    ax1.grid(alpha=0.3)
+    p = prof["power"]
+    ax2.plot(tau, p, color="C0", lw=1.2, label="mechanical p = -T theta'")
+    ax2.fill_between(tau, p, 0, where=p < 0, color="C1", alpha=0.4, label="motoring")
+    if "electrical_power" in prof:
+        ax2.plot(tau, prof["electrical_power"], color="C2", lw=1, label="electrical")
+    ax2.set_ylabel("power (m g l / t0)")
+    ax2.set_xlabel("tau = omega t / 2 pi")
+    ax2.grid(alpha=0.3)
+    ax2.legend(fontsize=8)
+    ax2.set_xlim(0, 1)
+    return _finish(fig, path)
+
+
+def plot_pto_curve(ds, path=None):
+    """Optimal (mechanical and electrical) power against the varied PTO parameter."""
+    from .plotting import _finish, plt
+
+    fig, ax = plt.subplots(figsize=(7, 4.2))
+    v = ds["value"].values
+    ax.plot(v, ds["power"].values, "o-", label="mechanical P")
+    ax.plot(v, ds["electrical_power"].values, "s--", label="electrical")
+    ax.axhline(ds.attrs["unconstrained_power"], color="k", ls=":", lw=1,
+               label="ideal optimum")
+    ax.axhline(ds.attrs["uniform_power"], color="gray", ls=":", lw=1, label="best uniform")
+    if ds.attrs["vary"] == "torque-limit":
+        ax.set_xscale("log")
+        ax.set_xlabel("torque limit T_max (m g l)")
+    else:
+        ax.set_xlabel("efficiency eta (generating = motoring)")
+    ax.set_ylabel("mean power (m g l / t0)")
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=8)
+    return _finish(fig, path)

@@ -344,7 +344,8 @@ def solve_pto(excitation, harmonics: int, damping: float, x0: np.ndarray, *,
             stages.append(("width", float(w), prob.electrical(x)))
         # at the final widths Newton meets the kink (curvature ~ 1/w at p = 0) and may stop on
         # its iteration cap; the stage is converged when the exact electrical power no longer
-        # moves between widths (by less than 10 |kappa| w: the smoothing error itself is below |kappa| w log 2)
+        # moves between widths (by less than 10 |kappa| w; the smoothing error itself is below
+        # |kappa| w log 2)
         kappa = abs(efficiency[0] - 1.0 / efficiency[1])
         if status in ("max_iterations", "stalled") and len(stages) > 1 and abs(
                 stages[-1][2] - stages[-2][2]) <= max(1e-9, 10 * kappa * prob.width):
@@ -394,7 +395,8 @@ def _augmented(prob: PTOProblem, x, gtol, maxiter, max_outer):
     f_prev = math.inf
     status = "max_iterations"
     k = 0
-    for k in range(1, max_outer + 1):
+    for _ in range(max_outer):
+        k += 1
         r = _inner(prob, x, gtol, maxiter)
         x = r.x
         iters += r.iterations
