@@ -38,7 +38,8 @@ def collocate(excitation, damping: float, *, intervals: int = 200, torque_limit=
     -------
     dict with ``power`` (mechanical, Simpson mean of ``-T v``), ``electrical_power``,
     ``peak_torque`` (over nodes), ``status`` (IPOPT's return status), ``t``, ``theta``,
-    ``v``, ``torque`` (nodes and midpoints, ``2 K + 1`` points).
+    ``v``, ``torque`` (nodes and midpoints, ``2 K + 1`` points), ``solve_time`` (s, IPOPT
+    only, the graph built before it).
     """
     import casadi as ca
 
@@ -106,6 +107,9 @@ def collocate(excitation, damping: float, *, intervals: int = 200, torque_limit=
         opti.set_initial(pm, np.maximum(-g_p, 0))
     opti.solver("ipopt", {"print_time": False},
                 {"print_level": 0, "sb": "yes", "tol": tol, "max_iter": 3000})
+    import time
+
+    start = time.perf_counter()
     try:
         sol = opti.solve()
         stats = sol.stats()
@@ -113,6 +117,7 @@ def collocate(excitation, damping: float, *, intervals: int = 200, torque_limit=
     except RuntimeError:
         stats = opti.stats()
         get = opti.debug.value
+    solve_time = time.perf_counter() - start
     uu, vv, tt = np.asarray(get(u)).ravel(), np.asarray(get(v)).ravel(), np.asarray(get(th))
     pv = -uu * vv
     ele = pv if efficiency is None else np.where(pv > 0, efficiency[0] * pv,
@@ -120,4 +125,4 @@ def collocate(excitation, damping: float, *, intervals: int = 200, torque_limit=
     return {"power": float(w @ pv), "electrical_power": float(w @ ele),
             "peak_torque": float(np.max(np.abs(uu))), "status": stats["return_status"],
             "iterations": stats.get("iter_count"), "t": t, "theta": tt.ravel(), "v": vv,
-            "torque": uu}
+            "torque": uu, "solve_time": solve_time}
