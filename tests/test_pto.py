@@ -202,8 +202,8 @@ def test_cli_units_json(capsys):
 
 def test_cli_pto_save(capsys, tmp_path):
     f = tmp_path / "m.csv"
-    code, out, _ = _run(capsys, "optimize", "--gamma", "0.05", "--torque-limit", "2.5",
-                        "--efficiency", "0.9", "--save", str(f))
+    code, out, _ = _run(capsys, "optimize", "--gamma", "0.05", "--efficiency", "0.9",
+                        "--save", str(f))
     assert code == 0 and "electrical power" in out
     head = f.read_text().splitlines()[0]
     assert head == "t,tau,theta,theta_dot,torque,power,electrical_power"

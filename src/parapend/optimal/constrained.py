@@ -388,13 +388,15 @@ def _augmented(prob: PTOProblem, x, gtol, maxiter, max_outer):
 
     Stops when the grid violation is below 1e-10 and the objective moved by less than
     1e-12 between two outer iterations; ``rho`` is raised tenfold (to at most 1e8) when
-    the violation did not fall by 4.
+    the violation did not fall by 4. Multipliers and ``rho`` change only after an inner
+    solve that converged (or stalled at its best point).
     """
     iters = 0
     viol_prev = math.inf
     f_prev = math.inf
     status = "max_iterations"
     k = 0
+    unfinished = 0
     for _ in range(max_outer):
         k += 1
         r = _inner(prob, x, gtol, maxiter)
@@ -402,6 +404,14 @@ def _augmented(prob: PTOProblem, x, gtol, maxiter, max_outer):
         iters += r.iterations
         viol = prob.violation(x)
         f = prob.base.power(x) if prob.efficiency is None else prob.electrical(x, False)
+        if r.status not in ("converged", "stalled") and unfinished < 1:
+            # inner solve unfinished (iteration cap): continue it once before touching lam or
+            # rho, else rho runs away on a violation that only reflects the unfinished solve
+            # (at the smallest efficiency widths the kink keeps Newton below its tolerance,
+            # so a second unfinished solve proceeds)
+            unfinished += 1
+            continue
+        unfinished = 0
         prob.update_multipliers(x)
         if viol <= 1e-10 and abs(f - f_prev) <= 1e-12 * max(1.0, abs(f)):
             status = "converged"
