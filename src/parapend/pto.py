@@ -133,17 +133,23 @@ def optimize_pto(*, torque_limit=None, efficiency=None, efficiency_generating=No
     motion = FourierMotion.from_vector(exc.omega, sol.x)
     prof = pto_profile(motion, exc, gamma, efficiency=eff)
     pu = ideal.uniform_power
-    msg = {"converged": "converged: optimum of the power take-off problem",
+    status = sol.status
+    if status == "converged" and sol.electrical_power <= 0:
+        status = "no_power"  # converged, but every rotation costs energy through this PTO
+    msg = {"no_power": "converged, but no positive power is delivered: every period-1 "
+                       "rotation costs energy through this power take-off (the power shown "
+                       "is the smallest loss)",
+           "converged": "converged: optimum of the power take-off problem",
            "infeasible": f"infeasible: no {n}-harmonic rotation found with |T| <= "
                          f"{tmax}; raise the torque limit",
            "stalled": "stalled: the augmented Lagrangian did not settle its multipliers; "
                       "the motion is feasible but may not be optimal",
            "max_iterations": "maximum number of Newton iterations reached",
-           "nonfinite": "non-finite power encountered"}.get(sol.status, sol.status)
+           "nonfinite": "non-finite power encountered"}.get(status, status)
     res = dataclasses.replace(
         ideal, power=sol.power,
         gain_over_uniform=(sol.power / pu - 1.0) if pu > 0 else None,
-        success=sol.status == "converged", status=sol.status, message=msg,
+        success=status in ("converged", "no_power"), status=status, message=msg,
         iterations=sol.iterations, coefficients=_coefficients(motion),
         peak_torque=sol.peak_torque, found_by="warm" if warm is not None else "ideal optimum",
         local_maxima=[], gradient_norm=sol.gradient_norm, strict_maximum=False,
