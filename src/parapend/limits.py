@@ -11,7 +11,8 @@ __all__ = [
     "MAX_AMPLITUDE", "MAX_BVP_EXTREMA", "MAX_BVP_WORK", "MAX_BYTES_FILE", "MAX_FILE_ROWS",
     "MAX_FOURIER_K", "MAX_GAMMA", "MAX_HARMONICS", "MAX_PHASE", "MAX_POINTS",
     "MAX_SWEEP_HARMONICS", "MAX_SWEEP_WORK", "MAX_TABLE_HARMONICS", "MAX_THRESHOLD_HARMONICS",
-    "MIN_BVP_GAMMA", "OMEGA_RANGE", "SQUARE_ALPHA_MIN",
+    "MAX_PTO_HARMONICS", "MAX_PTO_POINTS", "MAX_TORQUE_LIMIT", "MIN_BVP_GAMMA", "OMEGA_RANGE",
+    "SQUARE_ALPHA_MIN",
 ]
 
 #: forcing frequency omega, units sqrt(g/l)
@@ -47,3 +48,10 @@ MAX_BVP_WORK = 4e7
 #: rows of a sampled-excitation CSV file, and its size in bytes
 MAX_FILE_ROWS = 16384
 MAX_BYTES_FILE = 4 << 20
+#: harmonics N of a power take-off solve (torque limit, efficiency): dense grid matrices of
+#: M x (2N+1) with M >= 32 N, about 100 MB at N = 128
+MAX_PTO_HARMONICS = 128
+#: torque limit, units m g l (the paper-case ideal optimum needs 587 at N = 24)
+MAX_TORQUE_LIMIT = 1e6
+#: points of a pto-curve
+MAX_PTO_POINTS = 101

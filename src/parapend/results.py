@@ -78,6 +78,23 @@ class OptimizeResult(_Result):
         Best other local maximum found (None: every run reached the optimum).
     upper_bound, bound_gap : ``limit_power - gamma omega^2`` (no rotation does better, as
         ``<theta'^2> >= omega^2``) and its distance to ``power``.
+    torque_limit, efficiency_generating, efficiency_motoring : float or None
+        The power take-off (:func:`parapend.pto.optimize_pto`): ``|T| <= torque_limit``
+        (m g l), electrical power ``eta_g p`` generating, ``p / eta_m`` motoring; None when
+        not set. ``power`` stays the mechanical ``P = -<T theta'>`` of the PTO optimum.
+    electrical_power : float or None
+        Mean electrical power of the motion, unsmoothed efficiency model.
+    unconstrained_power : float or None
+        The ideal (lossless, unlimited) optimum the PTO solve started from.
+    peak_power, motoring_energy, harvested_energy : float or None
+        ``max p`` of ``p = -T theta'``, and ``int max(-p, 0) dt``, ``int max(p, 0) dt`` over
+        one forcing period (m g l): the energy the machine puts back into, and takes from,
+        the pendulum each cycle.
+    max_violation : float or None
+        ``max(peak_torque / torque_limit - 1, 0)`` on the dense evaluation.
+    units, power_w, uniform_power_w, limit_power_w, peak_torque_nm, electrical_power_w,
+    energy_per_cycle_j, motoring_energy_j : physical values (W, N m, J) when a pendulum's
+        length and mass were given (:mod:`parapend.units`); None otherwise.
     """
 
     power: float
@@ -113,6 +130,23 @@ class OptimizeResult(_Result):
     max_residual: float | None = None
     continuation_steps: int | None = None
     excitation: dict = field(default_factory=dict)
+    torque_limit: float | None = None
+    efficiency_generating: float | None = None
+    efficiency_motoring: float | None = None
+    electrical_power: float | None = None
+    unconstrained_power: float | None = None
+    peak_power: float | None = None
+    motoring_energy: float | None = None
+    harvested_energy: float | None = None
+    max_violation: float | None = None
+    units: dict | None = None
+    power_w: float | None = None
+    uniform_power_w: float | None = None
+    limit_power_w: float | None = None
+    peak_torque_nm: float | None = None
+    electrical_power_w: float | None = None
+    energy_per_cycle_j: float | None = None
+    motoring_energy_j: float | None = None
     convention: str = CONVENTION
     _motion: object = field(default=None, repr=False)
     _excitation: object = field(default=None, repr=False)

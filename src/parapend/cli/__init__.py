@@ -11,7 +11,8 @@ interrupted (Ctrl-C).
 
 Modules: :mod:`._common` (parser helpers, number parsing, tables, progress),
 :mod:`._output` (every file written), :mod:`.optimize` (optimize, threshold, damping-sweep,
-harmonics), :mod:`.paper` (figure, reproduce).
+harmonics), :mod:`.paper` (figure, reproduce), :mod:`.pto` (pto-curve; the power take-off and unit
+options of optimize).
 """
 
 from __future__ import annotations
@@ -25,6 +26,7 @@ from ..errors import ParameterError, SolverError
 from ..results import to_jsonable
 from . import optimize as _optimize_cmds
 from . import paper as _paper_cmds
+from . import pto as _pto_cmds
 from ._common import EXIT_USAGE, _Parser
 from ._output import OutputError
 
@@ -32,7 +34,7 @@ EXIT_FAILURE = 1
 
 __all__ = ["build_parser", "main"]
 
-COMMANDS = {**_optimize_cmds.COMMANDS, **_paper_cmds.COMMANDS}
+COMMANDS = {**_optimize_cmds.COMMANDS, **_paper_cmds.COMMANDS, **_pto_cmds.COMMANDS}
 
 
 def build_parser():
@@ -46,6 +48,7 @@ def build_parser():
                                 title="commands")
     _optimize_cmds.add_parsers(sub)
     _paper_cmds.add_parsers(sub)
+    _pto_cmds.add_parsers(sub)
     return parser
 
 

@@ -10,6 +10,7 @@ from .. import limits
 from ..errors import ParameterError
 from ..results import CONVENTION
 from . import _output
+from . import pto as _pto
 from ._common import (
     FIGURE_SUFFIXES,
     _add_excitation,
@@ -44,8 +45,11 @@ def add_parsers(sub) -> None:
     p.add_argument("--plot", metavar="PNG",
                    help="draw theta(tau) and torque (PNG, SVG or PDF)")
     p.add_argument("--save", metavar="CSV",
-                   help="write one period of the motion: t,tau,theta,theta_dot,torque")
+                   help="write one period of the motion: t,tau,theta,theta_dot,torque,power "
+                        "(p = -T theta'; and electrical_power with an efficiency)")
     p.add_argument("--json", action="store_true", help="print one JSON object")
+    _pto.add_pto_options(p)
+    _pto.add_unit_options(p)
 
     p = sub.add_parser("threshold", help="damping gamma* beyond which no power is extracted",
                        description="Damping threshold gamma* where the optimal power "
@@ -93,25 +97,54 @@ def _cmd_optimize(a) -> dict | str:
     _check_output(a.plot, "--plot", FIGURE_SUFFIXES)
     _check_output(a.save, "--save", (".csv",))
     kw = {"gamma": a.gamma, "harmonics": a.harmonics, **_excitation_kwargs(a)}
+    units, kw = _pto.apply_units(a, kw)
+    pto = _pto.wants_pto(a)
     if a.method == "all":
+        if pto or units is not None:
+            raise ParameterError("method: 'all' compares the ideal methods; the power "
+                                 "take-off and unit options need fourier (or bvp for units)")
         return _optimize_all(a, kw)
-    r = optimize(method=a.method, **kw)
+    if pto:
+        from ..pto import optimize_pto
+
+        r = optimize_pto(units=units, method=a.method, **_pto.pto_kwargs(a), **kw)
+    else:
+        r = optimize(method=a.method, **kw)
+        if units is not None:
+            import dataclasses
+
+            from ..pto import physical_fields
+
+            r = dataclasses.replace(r, **physical_fields(r, units))
     if a.save:
         s = motion_samples(r)
+        cols = ["t", "tau", "theta", "theta_dot", "torque"]
+        s["power"] = -s["torque"] * s["theta_dot"]
+        cols.append("power")
+        if r.efficiency_generating is not None:
+            p = s["power"]
+            s["electrical_power"] = [x * r.efficiency_generating if x > 0
+                                     else x / r.efficiency_motoring for x in p]
+            cols.append("electrical_power")
         buf = io.StringIO()
         w = csv.writer(buf, lineterminator="\n")
-        w.writerow(["t", "tau", "theta", "theta_dot", "torque"])
-        for row in zip(s["t"], s["tau"], s["theta"], s["theta_dot"], s["torque"]):
+        w.writerow(cols)
+        for row in zip(*(s[c] for c in cols)):
             w.writerow([repr(float(v)) for v in row])
         _output.write_text(a.save, buf.getvalue())
     if a.plot:
-        from ..plotting import plot_optimum
+        if pto:
+            from ..pto import plot_pto_profile as plot_fn
+        else:
+            from ..plotting import plot_optimum as plot_fn
 
-        _output.plot(plot_optimum, r, a.plot)
+        _output.plot(plot_fn, r, a.plot)
     if a.json:
         return r.to_dict()
     name = (f"Fourier optimum, N = {r.harmonics} (Eq. 10)" if r.method == "fourier"
             else f"BVP optimum, epsilon = {2 * r.gamma:g} (Eq. 22)")
+    if pto:
+        name = f"power take-off optimum, N = {r.harmonics}"
     rows = [
         ["best uniform rotation (Eq. 17)", _fmt(r.uniform_power), ""],
         [name, _fmt(r.power), _gain(r.power, r.uniform_power)],
@@ -142,6 +175,8 @@ def _cmd_optimize(a) -> dict | str:
         out.insert(5, search)
     if r.status == "no_power":
         out.insert(5, f"note: {r.message}")
+    out += _pto.pto_lines(r) if pto else []
+    out += _pto.physical_lines(r, units)
     if a.save:
         out.append(f"motion written to {a.save}")
     if a.plot:

@@ -1,0 +1,303 @@
+"""A realistic power take-off from Python: torque limit, efficiency, physical units.
+
+Mirrors ``parapend optimize --torque-limit/--efficiency...`` and ``parapend pto-curve``::
+
+    import parapend.pto as pto
+    r = pto.optimize_pto(gamma=0.03, torque_limit=2.5, efficiency=0.9)
+    r.power, r.electrical_power, r.peak_torque
+    ds = pto.pto_curve(vary="torque-limit", gamma=0.03)
+
+The method is :mod:`parapend.optimal.constrained` (augmented Lagrangian and smoothed
+efficiency on the exact-Hessian Fourier Newton kernel), warm-started from the ideal optimum
+of :func:`parapend.optimize`.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+
+import numpy as np
+
+from . import limits
+from .api import _coefficients, optimize
+from .errors import ParameterError, SolverError, check_finite, check_int, check_range
+from .optimal.constrained import pto_profile, solve_pto
+from .trajectory import FourierMotion
+
+__all__ = ["VARY", "efficiencies", "optimize_pto", "physical_fields", "pto_curve"]
+
+VARY = ("torque-limit", "efficiency")
+
+
+def efficiencies(efficiency=None, efficiency_generating=None, efficiency_motoring=None):
+    """``(eta_g, eta_m)`` from the options, or None when none is given; each in (0, 1]."""
+    if efficiency is None and efficiency_generating is None and efficiency_motoring is None:
+        return None
+    base = 1.0 if efficiency is None else _eta("efficiency", efficiency)
+    eg = base if efficiency_generating is None else _eta("efficiency-generating",
+                                                         efficiency_generating)
+    em = base if efficiency_motoring is None else _eta("efficiency-motoring",
+                                                       efficiency_motoring)
+    return eg, em
+
+
+def _eta(name, value) -> float:
+    x = check_finite(name, value)
+    if not 0.0 < x <= 1.0:
+        raise ParameterError(f"{name}: expected a number in (0, 1] (a fraction of the power "
+                             f"converted), got {value!r}")
+    return x
+
+
+def _torque_limit(value):
+    if value is None:
+        return None
+    x = check_range("torque-limit", value, 0.0, limits.MAX_TORQUE_LIMIT,
+                    why="units m g l; see docs/limits-of-input.md")
+    if x <= 0.0:
+        raise ParameterError(f"torque-limit: expected a number > 0, got {value!r}")
+    return x
+
+
+def physical_fields(result, units) -> dict:
+    """The unit-suffixed fields (W, N m, J) of a result, for :func:`dataclasses.replace`."""
+    if units is None:
+        return {}
+    period = 2 * math.pi / result.omega
+    out = {"units": units.describe(), "power_w": units.to_watts(result.power),
+           "uniform_power_w": units.to_watts(result.uniform_power),
+           "limit_power_w": units.to_watts(result.limit_power),
+           "peak_torque_nm": units.to_newton_metres(result.peak_torque),
+           "energy_per_cycle_j": units.to_joules(result.power * period)}
+    if result.electrical_power is not None:
+        out["electrical_power_w"] = units.to_watts(result.electrical_power)
+    if result.motoring_energy is not None:
+        out["motoring_energy_j"] = units.to_joules(result.motoring_energy)
+    return out
+
+
+def optimize_pto(*, torque_limit=None, efficiency=None, efficiency_generating=None,
+                 efficiency_motoring=None, copper_loss: float = 0.0, units=None,
+                 warm=None, throw: bool = False, ideal=None, **optimize_args):
+    """Optimal period-1 rotation through a real power take-off.
+
+    Parameters
+    ----------
+    torque_limit : float or None
+        ``T_max`` (units m g l): ``|T(t)| <= T_max`` on the motion's dense evaluation.
+    efficiency, efficiency_generating, efficiency_motoring : float or None
+        In (0, 1]: electrical power ``eta_g p`` when ``p = -T theta' > 0`` (generating) and
+        ``p / eta_m`` when motoring; ``efficiency`` sets both.
+    copper_loss : float
+        ``r >= 0`` of a winding loss ``r T^2`` (non-dimensional ``R / k_t^2`` times
+        ``(m g l)^2`` over the power unit), subtracted from the electrical power.
+    units : parapend.units.Units or None
+        Adds the W / N m / J fields to the result.
+    warm : ndarray or None
+        Start (packed Eq. 10 coefficients) instead of the ideal optimum (continuation).
+    ideal : OptimizeResult or None
+        The ideal optimum, when already computed.
+    **optimize_args
+        As :func:`parapend.optimize` (``harmonics`` at most 128 here, method "fourier").
+
+    Returns
+    -------
+    OptimizeResult
+        ``power`` is the mechanical power of the PTO optimum, ``electrical_power`` the
+        electrical, ``unconstrained_power`` the ideal optimum; ``status`` "converged",
+        "infeasible" (no rotation found within the torque limit), "stalled" or
+        "max_iterations".
+    """
+    tmax = _torque_limit(torque_limit)
+    eff = efficiencies(efficiency, efficiency_generating, efficiency_motoring)
+    r_cu = check_range("copper-loss", copper_loss, 0.0, 1e6)
+    if optimize_args.get("method", "fourier") != "fourier":
+        raise ParameterError("method: a power take-off is optimized with method 'fourier'")
+    n = check_int("harmonics", optimize_args.get("harmonics", 24), 1,
+                  limits.MAX_PTO_HARMONICS)
+    ideal = ideal if ideal is not None else optimize(**optimize_args)
+    exc = ideal._excitation
+    gamma = ideal.gamma
+    if tmax is None and eff is None and r_cu == 0.0:
+        res = ideal
+        prof = pto_profile(ideal.motion, exc, gamma)
+        res = dataclasses.replace(res, electrical_power=ideal.power,
+                                  unconstrained_power=ideal.power,
+                                  peak_power=prof["peak_power"],
+                                  motoring_energy=prof["motoring_energy"],
+                                  harvested_energy=prof["harvested_energy"])
+        return dataclasses.replace(res, **physical_fields(res, units))
+    x0 = ideal.motion.vector if warm is None else np.asarray(warm, dtype=float)
+    sol = solve_pto(exc, n, gamma, x0, torque_limit=tmax, efficiency=eff, copper_loss=r_cu)
+    motion = FourierMotion.from_vector(exc.omega, sol.x)
+    prof = pto_profile(motion, exc, gamma, efficiency=eff)
+    pu = ideal.uniform_power
+    status = sol.status
+    if status == "converged" and sol.electrical_power <= 0:
+        status = "no_power"  # converged, but every rotation costs energy through this PTO
+    msg = {"no_power": "converged, but no positive power is delivered: every period-1 "
+                       "rotation costs energy through this power take-off (the power shown "
+                       "is the smallest loss)",
+           "converged": "converged: optimum of the power take-off problem",
+           "infeasible": f"infeasible: no {n}-harmonic rotation found with |T| <= "
+                         f"{tmax}; raise the torque limit",
+           "stalled": "stalled: the augmented Lagrangian did not settle its multipliers; "
+                      "the motion is feasible but may not be optimal",
+           "max_iterations": "maximum number of Newton iterations reached",
+           "nonfinite": "non-finite power encountered"}.get(status, status)
+    res = dataclasses.replace(
+        ideal, power=sol.power,
+        gain_over_uniform=(sol.power / pu - 1.0) if pu > 0 else None,
+        success=status in ("converged", "no_power"), status=status, message=msg,
+        iterations=sol.iterations, coefficients=_coefficients(motion),
+        peak_torque=sol.peak_torque, found_by="warm" if warm is not None else "ideal optimum",
+        local_maxima=[], gradient_norm=sol.gradient_norm, strict_maximum=False,
+        quadrature_points=sol.points, mean_square_speed=motion.mean_square_speed(),
+        torque_limit=tmax, efficiency_generating=None if eff is None else eff[0],
+        efficiency_motoring=None if eff is None else eff[1],
+        electrical_power=sol.electrical_power, unconstrained_power=ideal.power,
+        peak_power=prof["peak_power"], motoring_energy=prof["motoring_energy"],
+        harvested_energy=prof["harvested_energy"], max_violation=sol.max_violation,
+        _motion=motion)
+    res = dataclasses.replace(res, **physical_fields(res, units))
+    if throw and not res.success:
+        raise SolverError(f"optimize: {res.message}")
+    return res
+
+
+def pto_curve(vary: str = "torque-limit", *, values=None, points: int = 12,
+              efficiency=None, efficiency_generating=None, efficiency_motoring=None,
+              torque_limit=None, units=None, progress=None, **optimize_args):
+    """Optimal power against the torque limit or the efficiency.
+
+    Parameters
+    ----------
+    vary : {"torque-limit", "efficiency"}
+        ``torque-limit``: from the ideal optimum's peak torque down (geometrically) to the
+        smallest limit at which a rotation is still found (the last feasible value), each
+        solve warm-started from the previous (continuation from large to small ``T_max``);
+        ``efficiency``: ``eta = eta_g = eta_m`` from 1 down to 0.5 (or ``values``).
+    values : sequence of float or None
+        The limits (m g l) or efficiencies to use instead of the defaults.
+    points : int
+        Number of values (2 to 101).
+
+    Returns
+    -------
+    xarray.Dataset
+        Over ``value``: ``power`` (mechanical), ``electrical_power``, ``peak_torque``,
+        ``motoring_energy``, ``status``; attrs ``vary``, ``unconstrained_power``, and, for
+        the torque limit, ``smallest_feasible_limit`` (the smallest value solved feasibly).
+    """
+    import xarray as xr
+
+    if not isinstance(vary, str) or vary not in VARY:
+        raise ParameterError(f"vary: expected one of {', '.join(VARY)}, got {vary!r:.40}")
+    npts = check_int("points", points, 2, limits.MAX_PTO_POINTS)
+    ideal = optimize(**optimize_args)
+    if vary == "torque-limit":
+        if torque_limit is not None:
+            raise ParameterError("torque-limit: it is the varied quantity; drop it")
+        eff = efficiencies(efficiency, efficiency_generating, efficiency_motoring)
+        if values is None:
+            top = ideal.peak_torque
+            vals = list(top * np.geomspace(1.0, 0.02, npts))
+        else:
+            vals = sorted((_torque_limit(v) for v in values), reverse=True)
+    else:
+        eff = None
+        if any(v is not None for v in (efficiency, efficiency_generating,
+                                       efficiency_motoring)):
+            raise ParameterError("efficiency: it is the varied quantity; drop it")
+        vals = list(np.linspace(1.0, 0.5, npts)) if values is None else \
+            [_eta("efficiency", v) for v in values]
+    rows = []
+    warm = None
+    for i, v in enumerate(vals):
+        kw = {"torque_limit": v, "efficiency": None if eff is None else eff[0],
+              "efficiency_motoring": None if eff is None else eff[1]} \
+            if vary == "torque-limit" else {"efficiency": v, "torque_limit": torque_limit}
+        r = optimize_pto(units=units, warm=warm, ideal=ideal, **kw, **optimize_args)
+        rows.append(r)
+        if progress is not None:
+            progress(i + 1, len(vals))
+        if vary == "torque-limit" and r.status == "infeasible":
+            break  # below the smallest feasible limit: smaller ones are infeasible too
+        warm = r.motion.vector
+    feas = [r.torque_limit for r in rows if r.status != "infeasible"]
+    ds = xr.Dataset(
+        {"power": ("value", [r.power for r in rows]),
+         "electrical_power": ("value", [r.electrical_power for r in rows]),
+         "peak_torque": ("value", [r.peak_torque for r in rows]),
+         "motoring_energy": ("value", [r.motoring_energy for r in rows]),
+         "status": ("value", [r.status for r in rows])},
+        coords={"value": [float(v) for v in vals[:len(rows)]]},
+        attrs={"vary": vary, "unconstrained_power": ideal.power,
+               "uniform_power": ideal.uniform_power, "harmonics": ideal.harmonics,
+               "gamma": ideal.gamma, "omega": ideal.omega,
+               "convention": "power: mechanical P = -<T theta'>; torque units m g l"})
+    if vary == "torque-limit":
+        ds.attrs["smallest_feasible_limit"] = min(feas) if feas else float("nan")
+    if units is not None:
+        ds["power_w"] = ds["power"] * units.power
+        ds["electrical_power_w"] = ds["electrical_power"] * units.power
+        ds["peak_torque_nm"] = ds["peak_torque"] * units.torque
+    return ds
+
+
+def plot_pto_profile(result, path=None, points: int = 2000):
+    """Torque ``T(t)`` and instantaneous power ``p = -T theta'`` of an optimum over one period.
+
+    The torque limit (if any) is drawn as dashed lines; motoring (``p < 0``) is shaded.
+    Returns the figure (saved through :func:`parapend.plotting.save_figure` if ``path``).
+    """
+    from .plotting import _finish, plt
+
+    exc = result._excitation
+    eff = None if result.efficiency_generating is None else (result.efficiency_generating,
+                                                              result.efficiency_motoring)
+    prof = pto_profile(result.motion, exc, result.gamma, points=points, efficiency=eff)
+    tau = prof["tau"]
+    fig, (ax1, ax2) = plt.subplots(2, 1, figsize=(7, 5.5), sharex=True)
+    ax1.plot(tau, prof["torque"], color="C3", lw=1.2, label="torque T (Eq. 14)")
+    if result.torque_limit is not None:
+        for s in (1, -1):
+            ax1.axhline(s * result.torque_limit, color="k", ls="--", lw=0.8)
+    ax1.set_ylabel("torque (m g l)")
+    ax1.set_title(f"Power take-off: P = {result.power:.5f}, peak |T| = "
+                  f"{result.peak_torque:.4g}, gamma = {result.gamma:g}", fontsize=9)
+    ax1.grid(alpha=0.3)
+    p = prof["power"]
+    ax2.plot(tau, p, color="C0", lw=1.2, label="mechanical p = -T theta'")
+    ax2.fill_between(tau, p, 0, where=p < 0, color="C1", alpha=0.4, label="motoring")
+    if "electrical_power" in prof:
+        ax2.plot(tau, prof["electrical_power"], color="C2", lw=1, label="electrical")
+    ax2.set_ylabel("power (m g l / t0)")
+    ax2.set_xlabel("tau = omega t / 2 pi")
+    ax2.grid(alpha=0.3)
+    ax2.legend(fontsize=8)
+    ax2.set_xlim(0, 1)
+    return _finish(fig, path)
+
+
+def plot_pto_curve(ds, path=None):
+    """Optimal (mechanical and electrical) power against the varied PTO parameter."""
+    from .plotting import _finish, plt
+
+    fig, ax = plt.subplots(figsize=(7, 4.2))
+    v = ds["value"].values
+    ax.plot(v, ds["power"].values, "o-", label="mechanical P")
+    ax.plot(v, ds["electrical_power"].values, "s--", label="electrical")
+    ax.axhline(ds.attrs["unconstrained_power"], color="k", ls=":", lw=1,
+               label="ideal optimum")
+    ax.axhline(ds.attrs["uniform_power"], color="gray", ls=":", lw=1, label="best uniform")
+    if ds.attrs["vary"] == "torque-limit":
+        ax.set_xscale("log")
+        ax.set_xlabel("torque limit T_max (m g l)")
+    else:
+        ax.set_xlabel("efficiency eta (generating = motoring)")
+    ax.set_ylabel("mean power (m g l / t0)")
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=8)
+    return _finish(fig, path)

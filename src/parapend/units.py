@@ -1,0 +1,179 @@
+r"""Physical <-> non-dimensional units, converted once at the edge (DESIGN.md section 1).
+
+The physical pendulum (angle ``theta`` from the upright, point mass ``m`` at distance ``l``
+from the pivot, or a rigid body of moment of inertia ``I`` about the pivot and centre of mass
+at ``l``), on a base that heaves vertically as ``z(t) = A sin(2 pi f t)``::
+
+    I theta_tt + c theta_t - m g l (1 + z_tt/g) sin(theta) = T_phys          (Eq. 14, SI)
+
+becomes paper Eq. 14, ``theta'' + gamma theta' - (1 + q) sin theta = T``, with
+
+=================  =======================================  ==========================
+quantity           unit                                     point mass (``I = m l^2``)
+=================  =======================================  ==========================
+time               ``t0 = sqrt(I / (m g l))``               ``sqrt(l/g)``
+torque             ``m g l``                                ``m g l``
+power              ``m g l / t0``                           ``m g^1.5 l^0.5``
+energy             ``m g l``                                ``m g l``
+=================  =======================================  ==========================
+
+and ``omega = 2 pi f t0``, ``q(t) = z_tt/g = -A (2 pi f)^2 / g sin(omega t)``, so
+``delta = -A (2 pi f)^2 / g`` (the paper's ``delta < 0`` is a positive displacement
+amplitude), ``gamma = c t0 / I`` (``c / (m g^0.5 l^1.5)`` for a point mass).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+from .errors import ParameterError, check_nonnegative, check_positive
+
+__all__ = ["STANDARD_GRAVITY", "Units"]
+
+#: default g, m/s^2
+STANDARD_GRAVITY = 9.81
+
+
+@dataclass(frozen=True)
+class Units:
+    """Scales of one physical pendulum.
+
+    Parameters
+    ----------
+    length : float
+        Distance ``l`` from the pivot to the centre of mass, m (> 0).
+    mass : float
+        Pendulum mass ``m``, kg (> 0).
+    gravity : float
+        ``g``, m/s^2 (> 0, default 9.81).
+    inertia : float or None
+        Moment of inertia about the pivot, kg m^2; None means a point mass, ``m l^2``.
+    """
+
+    length: float
+    mass: float
+    gravity: float = STANDARD_GRAVITY
+    inertia: float | None = None
+
+    def __post_init__(self):
+        object.__setattr__(self, "length", check_positive("length", self.length))
+        object.__setattr__(self, "mass", check_positive("mass", self.mass))
+        object.__setattr__(self, "gravity", check_positive("gravity", self.gravity))
+        if self.inertia is not None:
+            object.__setattr__(self, "inertia", check_positive("inertia", self.inertia))
+
+    # -- scales -----------------------------------------------------------------------------
+    @property
+    def moment_of_inertia(self) -> float:
+        """``I`` about the pivot, kg m^2."""
+        return self.mass * self.length**2 if self.inertia is None else self.inertia
+
+    @property
+    def time(self) -> float:
+        """Time unit ``t0 = sqrt(I / (m g l))``, s (``sqrt(l/g)`` for a point mass)."""
+        return math.sqrt(self.moment_of_inertia / (self.mass * self.gravity * self.length))
+
+    @property
+    def torque(self) -> float:
+        """Torque unit ``m g l``, N m."""
+        return self.mass * self.gravity * self.length
+
+    @property
+    def energy(self) -> float:
+        """Energy unit ``m g l``, J."""
+        return self.torque
+
+    @property
+    def power(self) -> float:
+        """Power unit ``m g l / t0``, W (``m g^1.5 l^0.5`` for a point mass)."""
+        return self.torque / self.time
+
+    @property
+    def damping(self) -> float:
+        """Unit of the viscous damping coefficient: ``I / t0``, N m s/rad."""
+        return self.moment_of_inertia / self.time
+
+    # -- conversions ------------------------------------------------------------------------
+    def omega(self, frequency: float) -> float:
+        """Non-dimensional forcing frequency ``omega = 2 pi f t0`` of a base frequency in Hz."""
+        f = check_positive("frequency", frequency)
+        return 2 * math.pi * f * self.time
+
+    def frequency(self, omega: float) -> float:
+        """Base frequency in Hz of a non-dimensional ``omega``."""
+        return omega / (2 * math.pi * self.time)
+
+    def delta(self, amplitude: float, frequency: float) -> float:
+        """``delta = -A (2 pi f)^2 / g`` of a base displacement ``A sin(2 pi f t)`` (A in m)."""
+        a = check_nonnegative("amplitude", amplitude)
+        f = check_positive("frequency", frequency)
+        return -a * (2 * math.pi * f) ** 2 / self.gravity
+
+    def amplitude(self, delta: float, frequency: float) -> float:
+        """Base displacement amplitude (m) of ``delta`` at ``frequency`` Hz (inverse of delta)."""
+        return -delta * self.gravity / (2 * math.pi * frequency) ** 2
+
+    def gamma(self, damping_coefficient: float) -> float:
+        """Non-dimensional ``gamma = c t0 / I`` of a viscous coefficient ``c`` in N m s/rad."""
+        return check_nonnegative("damping-coefficient", damping_coefficient) / self.damping
+
+    def damping_coefficient(self, gamma: float) -> float:
+        """Viscous coefficient (N m s/rad) of a non-dimensional ``gamma``."""
+        return gamma * self.damping
+
+    def to_watts(self, power: float) -> float:
+        return power * self.power
+
+    def from_watts(self, watts: float) -> float:
+        return watts / self.power
+
+    def to_newton_metres(self, torque: float) -> float:
+        return torque * self.torque
+
+    def from_newton_metres(self, torque_nm: float) -> float:
+        return torque_nm / self.torque
+
+    def to_joules(self, energy: float) -> float:
+        return energy * self.energy
+
+    def to_seconds(self, t: float) -> float:
+        return t * self.time
+
+    def describe(self) -> dict:
+        """The scales, for JSON output (SI units in the key names)."""
+        return {"length_m": self.length, "mass_kg": self.mass, "gravity_m_s2": self.gravity,
+                "inertia_kg_m2": self.moment_of_inertia, "time_unit_s": self.time,
+                "torque_unit_nm": self.torque, "power_unit_w": self.power}
+
+
+def from_options(*, length=None, mass=None, gravity=None, inertia=None, frequency=None,
+                 amplitude=None, damping_coefficient=None) -> tuple[Units | None, dict]:
+    """Units and the non-dimensional parameters they imply, from command-line options.
+
+    Returns ``(units, params)``: ``units`` is None when no physical option is given;
+    ``params`` holds ``omega`` (from ``frequency``), ``delta`` (from ``amplitude`` and
+    ``frequency``) and ``gamma`` (from ``damping_coefficient``) where those are given.
+    ``length`` and ``mass`` are required as soon as any physical option is.
+    """
+    given = {k: v for k, v in {"gravity": gravity, "inertia": inertia, "frequency": frequency,
+                               "amplitude": amplitude,
+                               "damping-coefficient": damping_coefficient}.items()
+             if v is not None}
+    if length is None and mass is None and not given:
+        return None, {}
+    missing = [n for n, v in (("length", length), ("mass", mass)) if v is None]
+    if missing:
+        raise ParameterError(f"{', '.join(missing)}: required with physical units (options "
+                             f"--length and --mass, given: {', '.join(given) or 'one of them'})")
+    u = Units(length, mass, STANDARD_GRAVITY if gravity is None else gravity, inertia)
+    params = {}
+    if amplitude is not None and frequency is None:
+        raise ParameterError("amplitude: needs --frequency (delta = -A (2 pi f)^2 / g)")
+    if frequency is not None:
+        params["omega"] = u.omega(frequency)
+    if amplitude is not None:
+        params["delta"] = u.delta(amplitude, frequency)
+    if damping_coefficient is not None:
+        params["gamma"] = u.gamma(damping_coefficient)
+    return u, params

@@ -1,0 +1,237 @@
+"""Physical units and the power take-off (issue 9): torque limit, efficiency, profiles."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+import parapend
+from parapend import pto
+from parapend.errors import ParameterError
+from parapend.optimal.constrained import PTOProblem, pto_profile
+from parapend.units import Units, from_options
+
+# -- units -------------------------------------------------------------------------------
+
+
+@pytest.mark.parametrize("length,mass,g,inertia", [(1.0, 10.0, 9.81, None),
+                                                   (0.37, 2.5, 9.80665, None),
+                                                   (2.0, 40.0, 9.81, 200.0)])
+def test_units_round_trip(length, mass, g, inertia):
+    u = Units(length, mass, g, inertia)
+    for f, a, c in [(0.9, 0.09, 3.0), (0.13, 1.7, 0.0)]:
+        assert u.frequency(u.omega(f)) == pytest.approx(f, rel=1e-15)
+        assert u.amplitude(u.delta(a, f), f) == pytest.approx(a, rel=1e-15)
+        assert u.damping_coefficient(u.gamma(c)) == pytest.approx(c, rel=1e-15, abs=1e-300)
+    assert u.from_watts(u.to_watts(0.3)) == pytest.approx(0.3, rel=1e-15)
+    assert u.from_newton_metres(u.to_newton_metres(5.0)) == pytest.approx(5.0, rel=1e-15)
+    # power unit = torque unit / time unit; point mass: m g^1.5 l^0.5
+    assert u.power == pytest.approx(u.torque / u.time, rel=1e-15)
+    if inertia is None:
+        assert u.power == pytest.approx(mass * g**1.5 * length**0.5, rel=1e-14)
+        assert u.time == pytest.approx(math.sqrt(length / g), rel=1e-15)
+
+
+def test_worked_example_hand_calculation():
+    """docs/units.md: 1 m, 10 kg, base heave 0.09 m at 0.9 Hz."""
+    u = Units(1.0, 10.0)
+    assert u.power == pytest.approx(10 * 9.81**1.5, rel=1e-15)  # 307.258 W
+    assert u.power == pytest.approx(307.2582, abs=1e-4)
+    assert u.omega(0.9) == pytest.approx(2 * math.pi * 0.9 / math.sqrt(9.81), rel=1e-15)
+    assert u.omega(0.9) == pytest.approx(1.80546, abs=1e-5)
+    assert u.delta(0.09, 0.9) == pytest.approx(-0.293372, abs=1e-6)
+    # the paper's case exactly (delta = -0.3, omega = 1.8) on this pendulum: 105.5 W
+    r = parapend.optimize(harmonics=24)
+    assert u.to_watts(r.power) == pytest.approx(105.53, abs=0.01)
+    _, p = from_options(length=1.0, mass=10.0, frequency=0.9, amplitude=0.09)
+    r2 = parapend.optimize(harmonics=24, **p)
+    assert u.to_watts(r2.power) == pytest.approx(103.51, abs=0.01)
+
+
+def test_units_bad_input():
+    with pytest.raises(ParameterError, match="^length: expected a number > 0"):
+        Units(0.0, 1.0)
+    with pytest.raises(ParameterError, match="^mass"):
+        from_options(length=1.0, frequency=1.0)
+    with pytest.raises(ParameterError, match="^amplitude: needs --frequency"):
+        from_options(length=1.0, mass=1.0, amplitude=0.1)
+
+
+# -- derivatives, reductions ----------------------------------------------------------------
+
+
+@pytest.mark.parametrize("kw", [{"efficiency": (0.8, 0.7)}, {"copper_loss": 0.01},
+                                {"torque_limit": 1.0}])
+def test_exact_derivatives(kw):
+    exc = parapend.harmonic(-0.3, 1.8)
+    rng = np.random.default_rng(1)
+    x = 0.1 * rng.normal(size=13)
+    pr = PTOProblem(exc, 6, 0.02, **kw)
+    pr.width = 0.3
+    if "torque_limit" in kw:
+        pr.lam_plus, pr.lam_minus = rng.random(pr.points), rng.random(pr.points)
+    f, g, h = pr.evaluate(x)
+    e = 1e-6
+    eye = np.eye(x.size)
+    gn = np.array([(pr.power(x + e * v) - pr.power(x - e * v)) / (2 * e) for v in eye])
+    hn = np.array([(pr.evaluate(x + e * v)[1] - pr.evaluate(x - e * v)[1]) / (2 * e)
+                   for v in eye])
+    assert np.max(np.abs(g - gn)) <= 1e-7 * np.max(np.abs(g))
+    assert np.max(np.abs(h - hn)) <= 1e-5 * np.max(np.abs(h))
+
+
+def test_reduces_to_core():
+    """eta = 1 and a torque limit above the ideal peak give the ideal optimum to 1e-6."""
+    ideal = parapend.optimize(gamma=0.03, harmonics=24)
+    r = pto.optimize_pto(gamma=0.03, harmonics=24, efficiency=1.0)
+    assert r.electrical_power == pytest.approx(ideal.power, abs=1e-6)
+    assert r.power == pytest.approx(ideal.power, abs=1e-6)
+    r = pto.optimize_pto(gamma=0.03, harmonics=24, torque_limit=1.5 * ideal.peak_torque)
+    assert r.power == pytest.approx(ideal.power, abs=1e-6)
+    assert r.status == "converged"
+
+
+def test_torque_limit_feasible_and_monotone():
+    ideal = parapend.optimize(gamma=0.03, harmonics=24)
+    powers = []
+    for tmax in (3.0, 2.0):
+        r = pto.optimize_pto(gamma=0.03, harmonics=24, torque_limit=tmax)
+        assert r.status == "converged"
+        # the motion's own dense evaluation satisfies the limit
+        s = parapend.api.motion_samples(r, points=20000)
+        assert np.max(np.abs(s["torque"])) <= tmax * (1 + 1e-9)
+        assert r.peak_torque <= tmax * (1 + 1e-9)
+        powers.append(r.power)
+    assert ideal.power >= powers[0] >= powers[1] > ideal.uniform_power * 0.9
+
+
+def test_profile_energy_balance():
+    """harvested - motoring energy per cycle = P * period; peak torque matches the result."""
+    r = parapend.optimize(gamma=0.03, harmonics=24)
+    exc = r._excitation
+    prof = pto_profile(r.motion, exc, r.gamma, points=4096)
+    period = exc.period
+    assert prof["harvested_energy"] - prof["motoring_energy"] == pytest.approx(
+        r.power * period, abs=1e-9)
+    assert prof["peak_torque"] == pytest.approx(r.peak_torque, rel=1e-9)
+    assert prof["motoring_energy"] > 0  # the ideal optimum motors part of each cycle
+    assert np.mean(prof["power"]) == pytest.approx(r.power, abs=1e-10)
+
+
+def test_efficiency_avoids_motoring():
+    ideal = pto.optimize_pto(gamma=0.03, harmonics=24)
+    r = pto.optimize_pto(gamma=0.03, harmonics=24, efficiency=0.7)
+    assert r.status == "converged"
+    assert r.motoring_energy < 1e-3 * ideal.motoring_energy
+    # the electrical optimum beats the ideal motion run through the lossy machine
+    p = pto_profile(ideal.motion, ideal._excitation, 0.03)["power"]
+    assert r.electrical_power > np.mean(np.where(p > 0, 0.7 * p, p / 0.7))
+
+
+def test_pto_bad_input():
+    with pytest.raises(ParameterError, match="^torque-limit: expected a number > 0"):
+        pto.optimize_pto(torque_limit=0.0)
+    with pytest.raises(ParameterError,
+                       match=r"^efficiency-motoring: expected a number in \(0, 1\]"):
+        pto.optimize_pto(efficiency_motoring=1.5)
+    with pytest.raises(ParameterError, match="^harmonics"):
+        pto.optimize_pto(efficiency=0.9, harmonics=500)
+    with pytest.raises(ParameterError, match="^vary"):
+        pto.pto_curve("mass")
+
+
+# -- independent formulation: CasADi/IPOPT direct collocation ----------------------------------
+
+CASES = [(0.03, {"torque_limit": 2.5}), (0.05, {"efficiency": (0.7, 0.7)})]
+SLOW_CASES = [(g, {"torque_limit": t}) for g in (0.03, 0.05) for t in (3.0, 2.5, 2.0)] + [
+    (g, {"efficiency": (e, e)}) for g in (0.03, 0.05) for e in (0.9, 0.7)]
+
+
+def _cross_check(gamma, kw):
+    pytest.importorskip("casadi")
+    from casadi_pto import collocate
+
+    exc = parapend.harmonic(-0.3, 1.8)
+    eff = kw.get("efficiency")
+    r = pto.optimize_pto(gamma=gamma, harmonics=24, torque_limit=kw.get("torque_limit"),
+                         efficiency=None if eff is None else eff[0],
+                         efficiency_motoring=None if eff is None else eff[1])
+    c = collocate(exc, gamma, intervals=150, **kw)
+    assert c["status"] == "Solve_Succeeded"
+    assert r.success
+    # Fourier N = 24 and collocation K = 150 both within ~1e-5 of their limits here
+    assert r.electrical_power == pytest.approx(c["electrical_power"], abs=1e-4)
+
+
+@pytest.mark.parametrize("gamma,kw", CASES)
+def test_casadi_cross_check(gamma, kw):
+    _cross_check(gamma, kw)
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("gamma,kw", SLOW_CASES)
+def test_casadi_cross_check_all(gamma, kw):
+    _cross_check(gamma, kw)
+
+
+# -- command line ------------------------------------------------------------------------------
+
+
+def _run(capsys, *args):
+    from parapend.cli import main
+
+    code = main(list(args))
+    out = capsys.readouterr()
+    return code, out.out, out.err
+
+
+def test_cli_units_json(capsys):
+    code, out, _ = _run(capsys, "optimize", "--length", "1", "--mass", "10", "--frequency",
+                        "0.9", "--amplitude", "0.09", "--json")
+    import json
+
+    d = json.loads(out)
+    assert code == 0
+    assert d["omega"] == pytest.approx(1.80546, abs=1e-5)
+    assert d["power_w"] == pytest.approx(103.51, abs=0.01)
+    for k in ("uniform_power_w", "limit_power_w", "peak_torque_nm"):
+        assert d[k] > 0
+
+
+def test_cli_pto_save(capsys, tmp_path):
+    f = tmp_path / "m.csv"
+    code, out, _ = _run(capsys, "optimize", "--gamma", "0.05", "--efficiency", "0.9",
+                        "--save", str(f))
+    assert code == 0 and "electrical power" in out
+    head = f.read_text().splitlines()[0]
+    assert head == "t,tau,theta,theta_dot,torque,power,electrical_power"
+
+
+@pytest.mark.parametrize("args,name", [
+    (("--torque-limit", "-1"), "torque-limit"),
+    (("--efficiency", "0"), "efficiency"),
+    (("--efficiency-generating", "1.2"), "efficiency-generating"),
+    (("--torque-limit-nm", "5"), "torque-limit-nm"),
+    (("--frequency", "1"), "length, mass"),
+    (("--length", "1", "--mass", "1", "--frequency", "1", "--omega", "2"), "frequency"),
+    (("--length", "-1", "--mass", "1"), "length"),
+])
+def test_cli_bad_input(capsys, args, name):
+    code, out, err = _run(capsys, "optimize", *args)
+    assert code == 2 and out == ""
+    assert err.count("\n") == 1 and f"error: {name}:" in err
+
+
+def test_cli_pto_curve_efficiency(capsys):
+    import json
+
+    code, out, _ = _run(capsys, "pto-curve", "--vary", "efficiency", "--points", "2",
+                        "--gamma", "0.05", "--json")
+    d = json.loads(out)
+    assert code == 0
+    p = d["electrical_power"]
+    assert d["value"] == [1.0, 0.5]
+    assert p[0] == pytest.approx(d["unconstrained_power"], abs=1e-6)
+    assert p[1] < p[0]
