@@ -576,7 +576,23 @@ def _finalize(entries: list[_Entry], raw_labels, used, end_th, end_v):
     return labels, phase, tuple(attractors), legend
 
 
-def _resolve_workers(workers) -> int:
+ENGINES = ("numba", "numpy")
+
+
+def _check_engine(engine) -> str:
+    if engine not in ENGINES:
+        raise ParameterError(f"engine: expected one of {', '.join(ENGINES)}, got {engine!r:.40}")
+    return engine
+
+
+def _resolve_workers(workers, engine: str = "numpy") -> int:
+    """Threads: ``None`` means 1 for the NumPy engine and every core numba sees for numba."""
+    if workers is None:
+        if engine == "numba":
+            import numba
+
+            return int(numba.config.NUMBA_NUM_THREADS)
+        return 1
     return check_int("workers", workers, 1, 64)
 
 
@@ -597,9 +613,10 @@ _PILOT_SIZE = 256
 
 
 def _run_search(th0, v0, gamma, p, omega, *, periods, steps, t0, tol, kmax, rcap, workers,
-                pilot: bool):
+                pilot: bool, engine: str = "numpy", progress=None):
     """Pilot (coarse subsample, quarter steps, no capture) then the full search."""
-    s = _Search(gamma, p, omega, steps, t0, tol, kmax, periods, rcap, workers)
+    s = _Search(gamma, p, omega, steps, t0, tol, kmax, periods, rcap,
+                workers if engine == "numpy" else 1)
     n = th0.size
     pilot_periods = pilot_size = 0
     if pilot and rcap > 0 and n > 4 * _PILOT_SIZE:
@@ -609,9 +626,85 @@ def _run_search(th0, v0, gamma, p, omega, *, periods, steps, t0, tol, kmax, rcap
         pilot_periods, pilot_size = ps.stats["periods"], sel.size
         for ent in ps.entries:
             s.add_entry(_Entry(ent.period, ent.winding, ent.theta, ent.v, ent.kind))
-    raw, used, end_th, end_v = s.run(th0, v0)
-    stats = dict(s.stats, pilot_periods=pilot_periods, pilot_size=pilot_size)
+    if engine == "numba":
+        raw, used, end_th, end_v, kstats = _run_compiled(s, th0, v0, workers, progress)
+        stats = dict(s.stats, **kstats)
+    else:
+        raw, used, end_th, end_v = s.run(th0, v0)
+        stats = dict(s.stats)
+    stats.update(pilot_periods=pilot_periods, pilot_size=pilot_size, engine=engine)
     return s.entries, raw, used, end_th, end_v, stats
+
+
+def _run_compiled(s: _Search, th0, v0, workers: int, progress=None):
+    """The grid by the compiled kernel (:mod:`._kernel`), with the catalogue fixed first.
+
+    The pilot's attractors are verified and refined by the NumPy engine (probes and
+    anchors only, no grid point), then every grid point runs independently in the kernel
+    with capture by the verified attractors. Points that converged to an attractor outside
+    the catalogue come back with their cycle and are catalogued here, in index order, with
+    the NumPy engine's matching rule.
+    """
+    import numba
+
+    from . import _kernel
+
+    s.run(np.empty(0), np.empty(0))       # probes and anchors of the pilot's entries
+    ents = s.entries
+    ne, kmax = len(ents), s.kmax
+    ent_th = np.zeros((max(ne, 1), kmax))
+    ent_v = np.zeros((max(ne, 1), kmax))
+    for e, ent in enumerate(ents):
+        ent_th[e, :ent.period] = ent.theta
+        ent_v[e, :ent.period] = ent.v
+    ent_k = np.array([ent.period for ent in ents], dtype=np.int64)
+    ent_r = np.array([ent.winding for ent in ents], dtype=np.int64)
+    ent_cap = np.array([bool(ent.capture) for ent in ents], dtype=np.bool_)
+    m0 = s.maps[0]
+    th0 = np.ascontiguousarray(th0, dtype=float)
+    v0 = np.ascontiguousarray(v0, dtype=float)
+    n = th0.size
+    edges = np.linspace(0, n, max(1, min(20, n // 20000)) + 1).astype(np.int64)
+    parts = []
+    before = numba.get_num_threads()
+    numba.set_num_threads(min(workers, numba.config.NUMBA_NUM_THREADS))
+    try:
+        for c in range(edges.size - 1):
+            sl = slice(edges[c], edges[c + 1])
+            parts.append(_kernel.basin_kernel(
+                th0[sl], v0[sl], m0.a, m0.gamma, m0.h, m0.steps, s.tol, kmax, s.max_periods,
+                s.rcap, s.match_tol, ent_th, ent_v, ent_k, ent_r, ent_cap))
+            if progress is not None:
+                progress(int(edges[c + 1]), n)
+    finally:
+        numba.set_num_threads(before)
+    raw, used, end_th, end_v, new_k, new_r, cyc_th, cyc_v = (
+        np.concatenate(x) for x in zip(*parts))
+    captured_or_matched = int(np.count_nonzero(raw >= 0))
+    new = np.flatnonzero(raw == _kernel.NEW)
+    while new.size:
+        i = new[0]
+        k, r = int(new_k[i]), int(new_r[i])
+        cth, cv = cyc_th[i, :k].copy(), cyc_v[i, :k].copy()
+        e = -1
+        for f, ent in enumerate(ents):
+            if (ent.period == k and ent.winding == r
+                    and _dist_set(cth[0], cv[0], ent) < s.match_tol):
+                e = f
+                break
+        if e < 0:
+            kind = _kind(k, r, _wrap(cth - math.pi), cv, s.tol)
+            ents.append(_Entry(k, r, cth, cv, kind, refined=True))
+            e = len(ents) - 1
+        ent = ents[e]
+        same = new[(new_k[new] == k) & (new_r[new] == r)]
+        same = same[_dist_set(cyc_th[same, 0], cyc_v[same, 0], ent) < s.match_tol]
+        raw[same] = e
+        raw[i] = e
+        new = new[raw[new] == _kernel.NEW]
+    stats = {"periods": int(np.sum(used)), "decided_by_catalogue": captured_or_matched,
+             "catalogued_after": int(np.count_nonzero(raw >= 0)) - captured_or_matched}
+    return raw, used, end_th, end_v, stats
 
 
 def find_attractors(phi0: ArrayLike, dphi0: ArrayLike, gamma: float, p: float, omega: float, *,

@@ -31,6 +31,7 @@ from .attractors import (
     _check_search,
     _Entry,
     _finalize,
+    _check_engine,
     _resolve_workers,
     _run_search,
     _wrap,
@@ -121,8 +122,8 @@ def basin_map(gamma: float, p: float, omega: float, *, n_phi: int = 200, n_dphi:
               dphi_range: tuple[float, float] = (-3.0, 3.0), periods: int = 300,
               steps_per_period: int = 128, t0: float = 0.0, tol: float = 1e-6,
               max_period: int = 8, capture_radius: float = 0.05, symmetric: bool = True,
-              split_phases: bool = False, pilot: bool = True, workers: int = 1
-              ) -> xr.Dataset:
+              split_phases: bool = False, pilot: bool = True, workers: int | None = None,
+              engine: str = "numba", progress=None) -> xr.Dataset:
     """Basins of attraction of paper Eq. 1 on an ``(phi, phi')`` grid at ``t = t0``.
 
     Parameters
@@ -135,8 +136,22 @@ def basin_map(gamma: float, p: float, omega: float, *, n_phi: int = 200, n_dphi:
         Range of initial ``phi'`` (ends included).
     periods : int
         Budget of forcing periods per trajectory.
-    steps_per_period, t0, tol, max_period, capture_radius, pilot, workers
+    steps_per_period, t0, tol, max_period, capture_radius, pilot
         As :func:`parapend.dynamics.attractors.find_attractors`.
+    workers : int, optional
+        Threads: default every core for ``engine="numba"``, 1 for ``"numpy"``. Labels do
+        not depend on it.
+    engine : {"numba", "numpy"}
+        ``"numba"`` (default): the compiled kernel of :mod:`parapend.dynamics._kernel`,
+        parallel over the points, the same RK4 arithmetic and the same decision rules
+        (capture, lag-k convergence, budget) as the NumPy engine; the attractor catalogue
+        (pilot and capture verification) is built first by the NumPy engine. ``"numpy"``:
+        the vectorized engine of :func:`~parapend.dynamics.attractors.find_attractors`.
+        The two give identical labels except, rarely, on fractal basin boundaries where
+        the order in which capture becomes available differs (tested on small grids).
+    progress : callable, optional
+        ``progress(done, total)`` called as parts of the grid are finished (numba engine:
+        up to 20 parts), for a progress display; the library itself never prints.
     symmetric : bool
         Use the ``(phi, phi') -> (-phi, -phi')`` symmetry when the grid allows it (halves
         the work; identical labels, see module docstring).
@@ -169,7 +184,8 @@ def basin_map(gamma: float, p: float, omega: float, *, n_phi: int = 200, n_dphi:
     tol, kmax, periods, rcap, steps = _check_search(tol, max_period, periods, capture_radius,
                                                     steps_per_period)
     t0 = check_finite("t0", t0)
-    workers = _resolve_workers(workers)
+    engine = _check_engine(engine)
+    workers = _resolve_workers(workers, engine)
     phi, dphi = grid(n_phi, n_dphi, dphi_range)
     n_phi, n_dphi = phi.size, dphi.size
     theta = _theta_grid(n_phi)
@@ -179,7 +195,8 @@ def basin_map(gamma: float, p: float, omega: float, *, n_phi: int = 200, n_dphi:
     v0 = np.broadcast_to(dphi[:, None], (n_dphi, ncol)).ravel().copy()
     entries, raw, used, end_th, end_v, stats = _run_search(
         th0, v0, gamma, p, omega, periods=periods, steps=steps, t0=t0, tol=tol, kmax=kmax,
-        rcap=rcap, workers=workers, pilot=bool(pilot))
+        rcap=rcap, workers=workers, pilot=bool(pilot), engine=engine,
+        progress=progress)
     raw, used, end_th, end_v = (a.reshape(n_dphi, ncol) for a in (raw, used, end_th, end_v))
     if use_sym:
         mirror = np.array(_mirror_entries(entries, max(1e3 * tol, 1e-2)) + [-1])
@@ -236,9 +253,11 @@ def basin_map(gamma: float, p: float, omega: float, *, n_phi: int = 200, n_dphi:
             "periods": periods, "steps_per_period": steps, "tol": tol,
             "max_period": kmax, "capture_radius": rcap, "pilot": int(bool(pilot)),
             "symmetric_used": int(use_sym), "split_phases": int(bool(split_phases)),
-            "workers": workers,
+            "workers": workers, "engine": engine,
             "convention": CONVENTION,
-            "method": "fixed-step RK4 stroboscopic map (parapend.dynamics.attractors)",
+            "method": ("fixed-step RK4 stroboscopic map (parapend.dynamics.attractors"
+                       + (", compiled kernel parapend.dynamics._kernel)" if engine == "numba"
+                          else ")")),
             "elapsed_s": elapsed,
             "stats": json.dumps(stats),
         },
