@@ -47,3 +47,21 @@ MAX_BVP_WORK = 4e7
 #: rows of a sampled-excitation CSV file, and its size in bytes
 MAX_FILE_ROWS = 16384
 MAX_BYTES_FILE = 4 << 20
+
+# --- uncontrolled pendulum, paper Eq. 1 (simulate, basins, rotations) ---------------------
+#: forcing frequency omega of Eq. 1 (steps are tied to the forcing period)
+DYN_OMEGA_RANGE = (0.05, 50.0)
+#: |p|, excitation strength of Eq. 1, and the damping gamma of Eq. 1
+DYN_MAX_P = 100.0
+DYN_MAX_GAMMA = 10.0
+#: simulate: forcing periods, and the simulated time periods * 2 pi/omega
+SIM_MAX_PERIODS = 20000
+SIM_MAX_TIME = 5e4
+#: basins: grid points per axis, period budget, and points x periods (the 1000 x 1000,
+#: 300-period map of issue 10; worst case every point runs the whole budget)
+BASIN_MAX_RESOLUTION = 2000
+BASIN_MAX_PERIODS = 5000
+BASIN_MAX_WORK = 3e8
+#: rotations: values of omega in one map, and the largest p followed
+ROT_MAX_OMEGAS = 60
+ROT_MAX_P = 5.0

@@ -11,7 +11,8 @@ interrupted (Ctrl-C).
 
 Modules: :mod:`._common` (parser helpers, number parsing, tables, progress),
 :mod:`._output` (every file written), :mod:`.optimize` (optimize, threshold, damping-sweep,
-harmonics), :mod:`.paper` (figure, reproduce).
+harmonics), :mod:`.paper` (figure, reproduce), :mod:`.dynamics` (simulate, basins,
+rotations: the uncontrolled pendulum of paper Eq. 1).
 """
 
 from __future__ import annotations
@@ -23,6 +24,7 @@ import sys
 from .. import __version__
 from ..errors import ParameterError, SolverError
 from ..results import to_jsonable
+from . import dynamics as _dynamics_cmds
 from . import optimize as _optimize_cmds
 from . import paper as _paper_cmds
 from ._common import EXIT_USAGE, _Parser
@@ -32,7 +34,7 @@ EXIT_FAILURE = 1
 
 __all__ = ["build_parser", "main"]
 
-COMMANDS = {**_optimize_cmds.COMMANDS, **_paper_cmds.COMMANDS}
+COMMANDS = {**_optimize_cmds.COMMANDS, **_paper_cmds.COMMANDS, **_dynamics_cmds.COMMANDS}
 
 
 def build_parser():
@@ -46,6 +48,7 @@ def build_parser():
                                 title="commands")
     _optimize_cmds.add_parsers(sub)
     _paper_cmds.add_parsers(sub)
+    _dynamics_cmds.add_parsers(sub)
     return parser
 
 

@@ -28,10 +28,10 @@ import xarray as xr
 from ..errors import ParameterError, check_finite, check_int
 from .attractors import (
     Attractor,
+    _check_engine,
     _check_search,
     _Entry,
     _finalize,
-    _check_engine,
     _resolve_workers,
     _run_search,
     _wrap,
@@ -41,27 +41,38 @@ from .simulate import CONVENTION, _check_params
 __all__ = ["basin_map", "grid"]
 
 
+def _range(name, rng):
+    try:
+        lo, hi = (check_finite(name, x) for x in rng)
+    except TypeError:
+        raise ParameterError(f"{name}: expected (low, high), got {rng!r}") from None
+    if hi <= lo:
+        raise ParameterError(f"{name}: expected low < high, got {rng!r}")
+    return lo, hi
+
+
 def grid(n_phi: int = 200, n_dphi: int = 200,
-         dphi_range: tuple[float, float] = (-3.0, 3.0)) -> tuple[np.ndarray, np.ndarray]:
+         dphi_range: tuple[float, float] = (-3.0, 3.0),
+         phi_range: tuple[float, float] | None = None) -> tuple[np.ndarray, np.ndarray]:
     """Grid axes of :func:`basin_map`.
 
     Returns
     -------
     phi : ndarray, shape (n_phi,)
-        ``-pi + 2*pi*i/n_phi`` (angle from hanging, Eq. 1 convention), covering ``[-pi, pi)``.
+        ``-pi + 2*pi*i/n_phi`` (angle from hanging, Eq. 1 convention), covering ``[-pi, pi)``;
+        with ``phi_range = (a, b)``, ``n_phi`` points from ``a`` to ``b``, ends included.
     dphi : ndarray, shape (n_dphi,)
         ``n_dphi`` points from ``dphi_range[0]`` to ``dphi_range[1]``, exactly antisymmetric
         when the range is symmetric about 0.
     """
     n_phi = check_int("n_phi", n_phi, 2)
     n_dphi = check_int("n_dphi", n_dphi, 2)
-    try:
-        lo, hi = (check_finite("dphi_range", x) for x in dphi_range)
-    except TypeError:
-        raise ParameterError(f"dphi_range: expected (low, high), got {dphi_range!r}") from None
-    if hi <= lo:
-        raise ParameterError(f"dphi_range: expected low < high, got {dphi_range!r}")
-    phi = math.pi * (2.0 * np.arange(n_phi) - n_phi) / n_phi
+    lo, hi = _range("dphi_range", dphi_range)
+    if phi_range is None:
+        phi = math.pi * (2.0 * np.arange(n_phi) - n_phi) / n_phi
+    else:
+        a, b = _range("phi_range", phi_range)
+        phi = a + (b - a) * np.arange(n_phi, dtype=float) / (n_phi - 1)
     j = np.arange(n_dphi, dtype=float)
     if lo == -hi:
         dphi = hi * (2.0 * j - (n_dphi - 1)) / (n_dphi - 1)
@@ -119,7 +130,8 @@ def _split(labels, phase, attractors):
 
 
 def basin_map(gamma: float, p: float, omega: float, *, n_phi: int = 200, n_dphi: int = 200,
-              dphi_range: tuple[float, float] = (-3.0, 3.0), periods: int = 300,
+              dphi_range: tuple[float, float] = (-3.0, 3.0),
+              phi_range: tuple[float, float] | None = None, periods: int = 300,
               steps_per_period: int = 128, t0: float = 0.0, tol: float = 1e-6,
               max_period: int = 8, capture_radius: float = 0.05, symmetric: bool = True,
               split_phases: bool = False, pilot: bool = True, workers: int | None = None,
@@ -134,6 +146,9 @@ def basin_map(gamma: float, p: float, omega: float, *, n_phi: int = 200, n_dphi:
         Grid size (see :func:`grid`).
     dphi_range : (float, float)
         Range of initial ``phi'`` (ends included).
+    phi_range : (float, float), optional
+        Range of initial ``phi`` (ends included); default the whole circle ``[-pi, pi)``
+        (see :func:`grid`). A custom range is integrated without the symmetry.
     periods : int
         Budget of forcing periods per trajectory.
     steps_per_period, t0, tol, max_period, capture_radius, pilot
@@ -186,10 +201,10 @@ def basin_map(gamma: float, p: float, omega: float, *, n_phi: int = 200, n_dphi:
     t0 = check_finite("t0", t0)
     engine = _check_engine(engine)
     workers = _resolve_workers(workers, engine)
-    phi, dphi = grid(n_phi, n_dphi, dphi_range)
+    phi, dphi = grid(n_phi, n_dphi, dphi_range, phi_range)
     n_phi, n_dphi = phi.size, dphi.size
-    theta = _theta_grid(n_phi)
-    use_sym = bool(symmetric) and dphi[0] == -dphi[-1]
+    theta = _theta_grid(n_phi) if phi_range is None else phi + math.pi
+    use_sym = bool(symmetric) and dphi[0] == -dphi[-1] and phi_range is None
     ncol = n_phi // 2 + 1 if use_sym else n_phi
     th0 = np.broadcast_to(theta[None, :ncol], (n_dphi, ncol)).ravel().copy()
     v0 = np.broadcast_to(dphi[:, None], (n_dphi, ncol)).ravel().copy()

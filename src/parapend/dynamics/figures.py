@@ -24,7 +24,8 @@ from .attractors import find_attractors
 from .continuation import periodic_orbit
 from .simulate import trajectory
 
-__all__ = ["COEXISTENCE_CASE", "plot_basins", "plot_coexistence", "plot_rotation_boundaries"]
+__all__ = ["COEXISTENCE_CASE", "plot_basins", "plot_coexistence", "plot_motion",
+           "plot_rotation_boundaries"]
 
 #: Paper Section 1: a period-2 oscillation coexists with the period-1 rotation for
 #: gamma = 0.1, p = 0.8, omega = 2.1. Initial conditions (phi, phi') at t = 0 reaching each
@@ -248,6 +249,17 @@ def plot_rotation_boundaries(ds: xr.Dataset, *, path: str | Path | None = None) 
     fig = _new_figure((6.4, 4.6))
     ax = fig.add_subplot()
     om = ds["omega"].values
+    pj, pg, pe = (ds[k].values for k in ("p_J", "p_G", "p_E"))
+    top = float(ds.attrs.get("p_max", np.nanmax(np.r_[pj, pg, pe, 1.0])))
+    if om.size > 1:   # shaded: where a stable period-1 rotation exists (J < p < G, p > E)
+        ax.fill_between(om, pj, np.where(np.isnan(pg), top, pg), where=np.isfinite(pj),
+                        color="#d62728", alpha=0.15, lw=0,
+                        label="stable period-1 rotation")
+        ax.fill_between(om, np.where(np.isnan(pe), top, pe), top, where=np.isfinite(pe),
+                        color="#d62728", alpha=0.15, lw=0)
+        ax.fill_between(om, np.where(np.isnan(pg), top, pg), np.where(np.isnan(pe), top, pe),
+                        where=np.isfinite(pg), color="0.6", alpha=0.2, lw=0,
+                        label="unstable (period doubled)")
     styles = {"p_J": ("k", "-", "J: birth (fold)"), "p_G": ("0.45", "--", "G: loss of "
                                                              "stability (period doubling)"),
               "p_E": ("0.45", ":", "E: stability regained (period doubling)")}
@@ -255,9 +267,53 @@ def plot_rotation_boundaries(ds: xr.Dataset, *, path: str | Path | None = None) 
         ax.plot(om, ds[key].values, color=c, ls=ls, marker=".", label=lab)
     ax.set_xlabel(r"$\omega$")
     ax.set_ylabel(r"$p$")
+    ax.set_ylim(0, top)
     ax.set_title(rf"Period-1 rotation of Eq. 1, $\gamma = {ds.attrs['gamma']:g}$", fontsize=10)
     ax.grid(alpha=0.3)
     ax.legend(fontsize=8)
+    _save(fig, path)
+    return fig
+
+
+def plot_motion(motion, *, path: str | Path | None = None) -> Figure:
+    """Time history and phase portrait of one motion of Eq. 1 (paper Fig. 1 right).
+
+    Parameters
+    ----------
+    motion : parapend.dynamics.motion.Motion
+        From :func:`parapend.dynamics.motion.simulate`.
+    path : str or Path, optional
+        Save the figure there.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        Left: ``phi(t)`` (unwrapped) and ``phi'(t)``; right: the phase portrait, ``phi``
+        wrapped to ``[-pi, pi)``, the last half of the run darker, Poincare points marked.
+    """
+    m = motion
+    fig = _new_figure((10.0, 4.2))
+    ax1, ax2 = fig.subplots(1, 2)
+    ax1.plot(m.t, m.phi, lw=0.8, label=r"$\varphi$ (unwrapped)")
+    ax1.plot(m.t, m.dphi, lw=0.8, label=r"$\dot\varphi$")
+    ax1.set_xlabel("t")
+    ax1.legend(fontsize=8)
+    ax1.grid(alpha=0.3)
+    half = m.t.size // 2
+    w, dp = _wrap_for_plot(m.phi[:half + 1], m.dphi[:half + 1])
+    ax2.plot(w, dp, lw=0.5, color="0.75")
+    w, dp = _wrap_for_plot(m.phi[half:], m.dphi[half:])
+    ax2.plot(w, dp, lw=0.8, color="k")
+    c = m.classification
+    if c.phi.size:
+        ax2.plot(c.phi, c.dphi, "o", ms=7, mfc="#d62728", mec="k", label="Poincare points")
+        ax2.legend(fontsize=8)
+    ax2.set_xlim(-math.pi, math.pi)
+    ax2.set_xlabel(r"$\varphi$ (rad, from hanging)")
+    ax2.set_ylabel(r"$\dot\varphi$")
+    fig.suptitle(rf"Eq. 1: $\gamma={m.gamma:g}$, $p={m.p:g}$, $\omega={m.omega:g}$, "
+                 rf"$(\varphi_0, \dot\varphi_0) = ({m.phi0:g}, {m.dphi0:g})$: {c.name}",
+                 fontsize=10)
     _save(fig, path)
     return fig
 
