@@ -26,7 +26,7 @@ import numba as nb
 import numpy as np
 
 LANES = 16
-GROUPS = 256          # static work units, points interleaved (balances the two cores)
+MAX_GROUPS = 256      # static work units, points interleaved (balances the cores)
 NEW = -3              # converged to an attractor outside the catalogue
 OTHER = -1
 
@@ -135,8 +135,10 @@ def _dist_entry(th, v, eth, ev, k):
 
 @nb.njit(parallel=True, cache=True)
 def basin_kernel(th0, v0, a, g, h, steps, tol, kmax, max_periods, rcap, match_tol,
-                 ent_th, ent_v, ent_k, ent_r, ent_cap):
+                 ent_th, ent_v, ent_k, ent_r, ent_cap, groups):
     """Label every initial condition ``(th0[i], v0[i])`` (project convention, theta wrapped).
+
+    Group ``grp`` of ``groups`` takes points ``grp, grp + groups, ...``, ``LANES`` at a time.
 
     Returns ``labels`` (entry index, ``OTHER`` or ``NEW``), ``used`` (periods), the state at
     retirement ``end_th, end_v``, and for ``NEW`` points the period ``k``, winding ``r`` and
@@ -153,7 +155,7 @@ def basin_kernel(th0, v0, a, g, h, steps, tol, kmax, max_periods, rcap, match_to
     new_r = np.zeros(n, dtype=np.int64)
     cyc_th = np.zeros((n, kmax))
     cyc_v = np.zeros((n, kmax))
-    for grp in nb.prange(GROUPS):
+    for grp in nb.prange(groups):
         th = np.zeros(LANES)
         v = np.zeros(LANES)
         turns = np.zeros(LANES)
@@ -175,7 +177,7 @@ def basin_kernel(th0, v0, a, g, h, steps, tol, kmax, max_periods, rcap, match_to
                 th[lane] = th0[nxt] - _TWO_PI * w
                 v[lane] = v0[nxt]
                 turns[lane] = w
-                nxt += GROUPS
+                nxt += groups
                 active += 1
         while active > 0:
             _period(th, v, a, g, h, steps)
@@ -257,7 +259,7 @@ def basin_kernel(th0, v0, a, g, h, steps, tol, kmax, max_periods, rcap, match_to
                     th[lane] = th0[nxt] - _TWO_PI * w
                     v[lane] = v0[nxt]
                     turns[lane] = w
-                    nxt += GROUPS
+                    nxt += groups
                 else:
                     idx[lane] = -1
                     th[lane] = 0.0
@@ -272,6 +274,11 @@ def basin_kernel(th0, v0, a, g, h, steps, tol, kmax, max_periods, rcap, match_to
                     cnt[lane, q] = 0
                     wprev[lane, q] = 0.0
     return labels, used, end_th, end_v, new_k, new_r, cyc_th, cyc_v
+
+
+def n_groups(n: int) -> int:
+    """Groups for ``n`` points: enough to balance the threads, each filling its lanes."""
+    return max(1, min(MAX_GROUPS, n // (2 * LANES)))
 
 
 @nb.njit(parallel=True, cache=True)
