@@ -74,12 +74,15 @@ def main() -> None:
     print(f"warm-up 40 x 40 (loads or compiles the kernel): {time.perf_counter() - t:.1f} s")
 
     t = time.perf_counter()
+    cpu = time.process_time()
     ds = basin_map(*CASE, n_phi=n, n_dphi=n, periods=periods)
     t_ours = time.perf_counter() - t
+    cpu_ours = time.process_time() - cpu
     frac = ds["basin_fraction"].values
     names = list(ds["name"].values)
     mean_periods = float(ds["periods_used"].values.mean())
-    print(f"ours (compiled, early termination): {t_ours:.2f} s, load {_load()}; mean periods "
+    print(f"ours (compiled, early termination): {t_ours:.2f} s wall, {cpu_ours:.1f} s CPU "
+          f"(all threads), load {_load()}; mean periods "
           f"per point {mean_periods:.1f}; "
           + ", ".join(f"{nm} {100 * f:.2f}%" for nm, f in zip(names, frac)))
 
@@ -92,11 +95,13 @@ def main() -> None:
     _kernel.full_time_kernel(th[sel[:64]].copy(), v[sel[:64]].copy(), m.a, m.gamma, m.h,
                              m.steps, 1)
     t = time.perf_counter()
+    cpu = time.process_time()
     _kernel.full_time_kernel(th[sel].copy(), v[sel].copy(), m.a, m.gamma, m.h, m.steps,
                              periods)
     t_plain = (time.perf_counter() - t) * (n * n) / sel.size
+    cpu_plain = (time.process_time() - cpu) * (n * n) / sel.size
     print(f"plain compiled kernel, full {periods} periods, whole grid: {t_plain:.1f} s "
-          f"(extrapolated from {sel.size} points), load {_load()}")
+          f"wall, {cpu_plain:.0f} s CPU (extrapolated from {sel.size} points), load {_load()}")
 
     # NumPy engine against ours on a smaller grid
     k = a.numpy_resolution
@@ -129,9 +134,10 @@ def main() -> None:
     print()
     print(f"| {n} x {n}, {periods} periods | time | ratio to ours |")
     print("|---|---|---|")
-    print(f"| ours: compiled kernel, early termination | {t_ours:.1f} s | 1 |")
-    print(f"| plain compiled kernel, full time (extrapolated) | {t_plain:.0f} s | "
-          f"{t_plain / t_ours:.1f}x |")
+    print(f"| ours: compiled kernel, early termination | {t_ours:.1f} s ({cpu_ours:.0f} s CPU)"
+          " | 1 |")
+    print(f"| plain compiled kernel, full time (extrapolated) | {t_plain:.0f} s "
+          f"({cpu_plain:.0f} s CPU) | {t_plain / t_ours:.1f}x (CPU {cpu_plain / cpu_ours:.1f}x) |")
     print(f"| NumPy engine (measured at {k} x {k}, ratio) | | {t_np / t_nb:.1f}x |")
     print(f"| SciPy solve_ivp loop (extrapolated) | {t_ivp / 3600:.1f} h | "
           f"{t_ivp / t_ours:.0f}x |")
