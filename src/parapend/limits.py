@@ -57,11 +57,13 @@ DYN_MAX_GAMMA = 10.0
 #: simulate: forcing periods, and the simulated time periods * 2 pi/omega
 SIM_MAX_PERIODS = 20000
 SIM_MAX_TIME = 5e4
-#: basins: grid points per axis, period budget, and points x periods (the 1000 x 1000,
-#: 300-period map of issue 10; worst case every point runs the whole budget)
+#: basins: grid points per axis, period budget, and integrated points x periods (the
+#: default grid is symmetric and integrates half its points: the 1000 x 1000, 300-period
+#: map of issue 10 is 1.5e8; worst case, every point running the whole budget, about 240 s
+#: of CPU, two minutes on two idle cores)
 BASIN_MAX_RESOLUTION = 2000
 BASIN_MAX_PERIODS = 5000
-BASIN_MAX_WORK = 3e8
+BASIN_MAX_WORK = 1.6e8
 #: rotations: values of omega in one map, and the largest p followed
 ROT_MAX_OMEGAS = 60
 ROT_MAX_P = 5.0

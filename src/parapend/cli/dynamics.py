@@ -130,8 +130,9 @@ def add_parsers(sub) -> None:
     p.add_argument("--dphi-range", type=_numbers("dphi-range", 2), default=(-3.0, 3.0),
                    metavar="LOW:HIGH", help="initial dphi range, ends included (default -3:3)")
     p.add_argument("--periods", type=_int, default=300,
-                   help=f"period budget per point, 1 to {limits.BASIN_MAX_PERIODS}, with N^2 x "
-                        f"periods <= {limits.BASIN_MAX_WORK:g} (default 300)")
+                   help=f"period budget per point, 1 to {limits.BASIN_MAX_PERIODS}, with "
+                        f"integrated points x periods <= {limits.BASIN_MAX_WORK:g} (half "
+                        "the grid on the default symmetric grid; default 300)")
     p.add_argument("--split-phases", action="store_true",
                    help="one basin per phase of a period-k attractor (the paper's four "
                         "attractors of Fig. 2 right)")
@@ -247,9 +248,15 @@ def _cmd_basins(a) -> dict | str:
     _check_output(a.save, "--save", (".nc",))
     n = check_int("resolution", a.resolution, 2, limits.BASIN_MAX_RESOLUTION)
     periods = check_int("periods", a.periods, 1, limits.BASIN_MAX_PERIODS)
-    if n * n * periods > limits.BASIN_MAX_WORK:
-        raise ParameterError(f"periods: expected resolution^2 x periods <= "
-                             f"{limits.BASIN_MAX_WORK:g}, got {n}^2 x {periods}")
+    # the default grid (whole circle, dphi range symmetric about 0) integrates half its
+    # columns (symmetry of Eq. 1); the bound is on the trajectories actually integrated
+    sym = a.phi_range is None and a.dphi_range[0] == -a.dphi_range[1]
+    work = (n * (n // 2 + 1) if sym else n * n) * periods
+    if work > limits.BASIN_MAX_WORK:
+        raise ParameterError(f"periods: expected integrated points x periods <= "
+                             f"{limits.BASIN_MAX_WORK:g} (1000 x 1000 at 300 periods), got "
+                             f"{work:.3g} ({n} x {n}{', half by symmetry' if sym else ''}, "
+                             f"{periods} periods)")
     for name, rng, cap in (("phi-range", a.phi_range, 1e3), ("dphi-range", a.dphi_range, 1e3)):
         if rng is not None:
             if rng[1] <= rng[0]:
