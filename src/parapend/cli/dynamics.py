@@ -107,7 +107,7 @@ def add_parsers(sub) -> None:
                    help="initial angular rate (default 0)")
     p.add_argument("--periods", type=_int, default=200,
                    help=f"forcing periods, 1 to {limits.SIM_MAX_PERIODS}, with periods x 2 pi/"
-                        f"omega <= {limits.SIM_MAX_TIME:g} (default 200)")
+                        f"omega x sqrt(1 + |p|) <= {limits.SIM_MAX_WORK:g} (default 200)")
     p.add_argument("--points-per-period", type=_int, default=64,
                    help="output samples per forcing period, 2 to 1024 (default 64)")
     p.add_argument("--plot", metavar="PNG",
@@ -171,10 +171,10 @@ def _cmd_simulate(a) -> dict | str:
     _check_output(a.plot, "--plot", FIGURE_SUFFIXES)
     _check_output(a.save, "--save", (".csv",))
     periods = check_int("periods", a.periods, 1, limits.SIM_MAX_PERIODS)
-    if periods * 2 * math.pi / a.omega > limits.SIM_MAX_TIME:
-        raise ParameterError(f"periods: expected periods x 2 pi/omega <= "
-                             f"{limits.SIM_MAX_TIME:g}, got {periods} x "
-                             f"{2 * math.pi / a.omega:.4g}")
+    work = periods * 2 * math.pi / a.omega * math.sqrt(1 + abs(a.p))
+    if work > limits.SIM_MAX_WORK:
+        raise ParameterError(f"periods: expected periods x 2 pi/omega x sqrt(1 + |p|) <= "
+                             f"{limits.SIM_MAX_WORK:g}, got {work:.4g}")
     check_int("points-per-period", a.points_per_period, 2, 1024)
     from ._common import _Ticker
 
