@@ -168,6 +168,7 @@ def test_floquet_stability_agrees_with_simulation_across_G_and_E():
     (["rotations", "--omega", "1:2:1000"], "omega"),
     (["rotations", "--omega", "1:2"], "omega"),
     (["rotations", "--p-max", "50"], "p-max"),
+    (["rotations", "--omega", "0.5"], "omega"),
 ])
 def test_cli_errors_one_line_exit_2(capsys, args, word):
     code, out, err = _run(capsys, *args)

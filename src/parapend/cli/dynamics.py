@@ -151,7 +151,7 @@ def add_parsers(sub) -> None:
     p._negative_number_matcher = _RANGE_OR_NUMBER
     p.add_argument("--gamma", type=_finite_float("gamma"), default=0.1,
                    help=f"damping gamma in [0, {limits.DYN_MAX_GAMMA:g}] (default 0.1)")
-    lo, hi = limits.DYN_OMEGA_RANGE
+    lo, hi = limits.ROT_OMEGA_RANGE
     p.add_argument("--omega", type=_omega_arg, default=2.1, metavar="W|FROM:TO:N",
                    help=f"one frequency, or N (1 to {limits.ROT_MAX_OMEGAS}) from FROM to TO, "
                         f"each in [{lo:g}, {hi:g}] (default 2.1)")
@@ -292,7 +292,7 @@ def _cmd_basins(a) -> dict | str:
 
 # --- rotations -----------------------------------------------------------------------------
 def _omegas(a) -> np.ndarray:
-    lo, hi = limits.DYN_OMEGA_RANGE
+    lo, hi = limits.ROT_OMEGA_RANGE
     if isinstance(a.omega, tuple):
         w0, w1, n = a.omega
         if n != int(n):
