@@ -61,8 +61,8 @@ SIM_MAX_PERIODS = 20000
 SIM_MAX_WORK = 1e5
 #: basins: grid points per axis, period budget, and integrated points x periods (the
 #: default grid is symmetric and integrates half its points: the 1000 x 1000, 300-period
-#: map of issue 10 is 1.5e8; worst case, every point running the whole budget, about 240 s
-#: of CPU, two minutes on two idle cores)
+#: map of issue 10 is 1.5e8; worst case, every point running the whole budget, about 180 s
+#: of CPU, 1.5 minutes on two idle cores)
 BASIN_MAX_RESOLUTION = 2000
 BASIN_MAX_PERIODS = 5000
 BASIN_MAX_WORK = 1.6e8
