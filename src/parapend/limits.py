@@ -55,3 +55,28 @@ MAX_PTO_HARMONICS = 128
 MAX_TORQUE_LIMIT = 1e6
 #: points of a pto-curve
 MAX_PTO_POINTS = 101
+
+# --- uncontrolled pendulum, paper Eq. 1 (simulate, basins, rotations) ---------------------
+#: forcing frequency omega of Eq. 1 (steps are tied to the forcing period)
+DYN_OMEGA_RANGE = (0.05, 50.0)
+#: |p|, excitation strength of Eq. 1, and the damping gamma of Eq. 1
+DYN_MAX_P = 100.0
+DYN_MAX_GAMMA = 10.0
+#: simulate: forcing periods, and the simulated time periods * 2 pi/omega times the fastest
+#: natural frequency sqrt(1 + |p|) (DOP853 steps scale with it: omega = 0.05, p = 100 over
+#: t = 5e4 took 150 s under load; 1e5 is about 30 s under load, 10 s idle)
+SIM_MAX_PERIODS = 20000
+SIM_MAX_WORK = 1e5
+#: basins: grid points per axis, period budget, and integrated points x periods (the
+#: default grid is symmetric and integrates half its points: the 1000 x 1000, 300-period
+#: map of issue 10 is 1.5e8; worst case, every point running the whole budget, about 180 s
+#: of CPU, 1.5 minutes on two idle cores)
+BASIN_MAX_RESOLUTION = 2000
+BASIN_MAX_PERIODS = 5000
+BASIN_MAX_WORK = 1.6e8
+#: rotations: omega range, values of omega in one map, and the largest p followed
+#: (continuation to p = 5 at omega = 0.9 took 133 s under load, omega = 0.6 over 200 s;
+#: omega = 0.8 to p = 3 took 21 s, omega = 10 to p = 5 took 15 s)
+ROT_OMEGA_RANGE = (0.8, 10.0)
+ROT_MAX_OMEGAS = 40
+ROT_MAX_P = 3.0

@@ -11,8 +11,9 @@ interrupted (Ctrl-C).
 
 Modules: :mod:`._common` (parser helpers, number parsing, tables, progress),
 :mod:`._output` (every file written), :mod:`.optimize` (optimize, threshold, damping-sweep,
-harmonics), :mod:`.paper` (figure, reproduce), :mod:`.pto` (pto-curve; the power take-off and unit
-options of optimize).
+ harmonics), :mod:`.paper` (figure, reproduce), :mod:`.pto` (pto-curve; the power
+ take-off and unit options of optimize), :mod:`.dynamics` (simulate, basins,
+ rotations: the uncontrolled pendulum of paper Eq. 1).
 """
 
 from __future__ import annotations
@@ -24,6 +25,7 @@ import sys
 from .. import __version__
 from ..errors import ParameterError, SolverError
 from ..results import to_jsonable
+from . import dynamics as _dynamics_cmds
 from . import optimize as _optimize_cmds
 from . import paper as _paper_cmds
 from . import pto as _pto_cmds
@@ -34,7 +36,8 @@ EXIT_FAILURE = 1
 
 __all__ = ["build_parser", "main"]
 
-COMMANDS = {**_optimize_cmds.COMMANDS, **_paper_cmds.COMMANDS, **_pto_cmds.COMMANDS}
+COMMANDS = {**_optimize_cmds.COMMANDS, **_paper_cmds.COMMANDS, **_pto_cmds.COMMANDS,
+            **_dynamics_cmds.COMMANDS}
 
 
 def build_parser():
@@ -49,6 +52,7 @@ def build_parser():
     _optimize_cmds.add_parsers(sub)
     _paper_cmds.add_parsers(sub)
     _pto_cmds.add_parsers(sub)
+    _dynamics_cmds.add_parsers(sub)
     return parser
 
 

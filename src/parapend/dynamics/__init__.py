@@ -14,6 +14,8 @@ integrated; conversion happens at the edges.
 - :mod:`.basins`: basins of attraction on an initial-condition grid (xarray).
 - :mod:`.continuation`: periodic orbits by shooting, Floquet multipliers, continuation of
   the period-1 rotation and its bifurcation curves J, G, E.
+- :mod:`.motion`: one simulated motion, its time history and final classification.
+- :mod:`._kernel`: compiled (numba) basin kernel, imported only when a basin map runs.
 - :mod:`.figures`: paper Fig. 1 right, basin pictures, bifurcation curves.
 """
 
@@ -23,11 +25,14 @@ from .continuation import (
     Bifurcation,
     Branch,
     PeriodicOrbit,
+    RotationBoundaries,
     continue_rotation,
     floquet,
     periodic_orbit,
     rotation_boundaries,
+    rotation_boundaries_at,
 )
+from .motion import Motion, simulate
 from .simulate import (
     CONVENTION,
     Stroboscopic,
@@ -48,7 +53,9 @@ __all__ = [
     "Bifurcation",
     "Branch",
     "Classification",
+    "Motion",
     "PeriodicOrbit",
+    "RotationBoundaries",
     "Stroboscopic",
     "Trajectory",
     "basin_map",
@@ -63,6 +70,8 @@ __all__ = [
     "phi_to_theta",
     "rhs",
     "rotation_boundaries",
+    "rotation_boundaries_at",
+    "simulate",
     "trajectory",
     "stroboscopic",
     "theta_to_phi",

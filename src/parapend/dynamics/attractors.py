@@ -576,7 +576,23 @@ def _finalize(entries: list[_Entry], raw_labels, used, end_th, end_v):
     return labels, phase, tuple(attractors), legend
 
 
-def _resolve_workers(workers) -> int:
+ENGINES = ("numba", "numpy")
+
+
+def _check_engine(engine) -> str:
+    if engine not in ENGINES:
+        raise ParameterError(f"engine: expected one of {', '.join(ENGINES)}, got {engine!r:.40}")
+    return engine
+
+
+def _resolve_workers(workers, engine: str = "numpy") -> int:
+    """Threads: ``None`` means 1 for the NumPy engine and every core numba sees for numba."""
+    if workers is None:
+        if engine == "numba":
+            import numba
+
+            return int(numba.config.NUMBA_NUM_THREADS)
+        return 1
     return check_int("workers", workers, 1, 64)
 
 
@@ -597,8 +613,12 @@ _PILOT_SIZE = 256
 
 
 def _run_search(th0, v0, gamma, p, omega, *, periods, steps, t0, tol, kmax, rcap, workers,
-                pilot: bool):
+                pilot: bool, engine: str = "numpy", progress=None):
     """Pilot (coarse subsample, quarter steps, no capture) then the full search."""
+    if engine == "numba":
+        return _run_compiled(th0, v0, gamma, p, omega, periods=periods, steps=steps, t0=t0,
+                             tol=tol, kmax=kmax, rcap=rcap, workers=workers,
+                             pilot=pilot, progress=progress)
     s = _Search(gamma, p, omega, steps, t0, tol, kmax, periods, rcap, workers)
     n = th0.size
     pilot_periods = pilot_size = 0
@@ -610,8 +630,143 @@ def _run_search(th0, v0, gamma, p, omega, *, periods, steps, t0, tol, kmax, rcap
         for ent in ps.entries:
             s.add_entry(_Entry(ent.period, ent.winding, ent.theta, ent.v, ent.kind))
     raw, used, end_th, end_v = s.run(th0, v0)
-    stats = dict(s.stats, pilot_periods=pilot_periods, pilot_size=pilot_size)
+    stats = dict(s.stats, pilot_periods=pilot_periods, pilot_size=pilot_size, engine=engine)
     return s.entries, raw, used, end_th, end_v, stats
+
+
+class _Compiled:
+    """Calls of the compiled kernel (:mod:`._kernel`) for one parameter set."""
+
+    def __init__(self, gamma, p, omega, steps, t0, tol, kmax, max_periods, workers):
+        from . import _kernel
+
+        self.k = _kernel
+        self.gamma, self.p, self.omega, self.t0 = gamma, p, omega, t0
+        self.tol, self.kmax, self.max_periods = tol, kmax, max_periods
+        self.match_tol = max(1e3 * tol, 1e-2)
+        self.workers = workers
+        self.steps = steps
+
+    def run(self, th0, v0, entries, rcap, *, steps=None, capture=None, progress=None):
+        """Kernel over ``(th0, v0)`` with catalogue ``entries``; capture radius ``rcap`` for
+        the entries flagged in ``capture`` (default: their ``capture`` attribute)."""
+        import numba
+
+        m = _RK4Map(self.gamma, self.p, self.omega, steps or self.steps, self.t0)
+        kmax = self.kmax
+        ne = len(entries)
+        ent_th = np.zeros((max(ne, 1), kmax))
+        ent_v = np.zeros((max(ne, 1), kmax))
+        for e, ent in enumerate(entries):
+            ent_th[e, :ent.period] = ent.theta
+            ent_v[e, :ent.period] = ent.v
+        ent_k = np.array([ent.period for ent in entries], dtype=np.int64)
+        ent_r = np.array([ent.winding for ent in entries], dtype=np.int64)
+        if capture is None:
+            capture = [bool(ent.capture) for ent in entries]
+        ent_cap = np.array(capture, dtype=np.bool_).reshape(-1)[:ne]
+        th0 = np.ascontiguousarray(th0, dtype=float)
+        v0 = np.ascontiguousarray(v0, dtype=float)
+        n = th0.size
+        edges = np.linspace(0, n, max(1, min(20, n // 20000)) + 1).astype(np.int64)
+        parts = []
+        before = numba.get_num_threads()
+        numba.set_num_threads(min(self.workers, numba.config.NUMBA_NUM_THREADS))
+        try:
+            for c in range(edges.size - 1):
+                sl = slice(edges[c], edges[c + 1])
+                parts.append(self.k.basin_kernel(
+                    th0[sl], v0[sl], m.a, m.gamma, m.h, m.steps, self.tol, kmax,
+                    self.max_periods, rcap, self.match_tol, ent_th, ent_v, ent_k, ent_r,
+                    ent_cap, self.k.n_groups(edges[c + 1] - edges[c])))
+                if progress is not None:
+                    progress(int(edges[c + 1]), n)
+        finally:
+            numba.set_num_threads(before)
+        return tuple(np.concatenate(x) for x in zip(*parts))
+
+    def catalogue(self, entries, raw, new_k, new_r, cyc_th, cyc_v):
+        """Give every ``NEW`` point an entry (matching rule of ``_Search._match``; new
+        entries appended in index order, refined). Modifies ``raw`` and ``entries``."""
+        new = np.flatnonzero(raw == self.k.NEW)
+        while new.size:
+            i = new[0]
+            k, r = int(new_k[i]), int(new_r[i])
+            cth, cv = cyc_th[i, :k].copy(), cyc_v[i, :k].copy()
+            e = -1
+            for f, ent in enumerate(entries):
+                if (ent.period == k and ent.winding == r
+                        and _dist_set(cth[0], cv[0], ent) < self.match_tol):
+                    e = f
+                    break
+            if e < 0:
+                kind = _kind(k, r, _wrap(cth - math.pi), cv, self.tol)
+                entries.append(_Entry(k, r, cth, cv, kind, refined=True))
+                e = len(entries) - 1
+            ent = entries[e]
+            same = new[(new_k[new] == k) & (new_r[new] == r)]
+            same = same[_dist_set(cyc_th[same, 0], cyc_v[same, 0], ent) < self.match_tol]
+            raw[same] = e
+            raw[i] = e
+            new = new[raw[new] == self.k.NEW]
+
+
+def _run_compiled(th0, v0, gamma, p, omega, *, periods, steps, t0, tol, kmax, rcap, workers,
+                  pilot, progress=None):
+    """The search with the compiled kernel: catalogue first, then every point on its own.
+
+    1. Pilot (as the NumPy engine: 256 evenly spaced points, a quarter of the steps, no
+       capture): the attractors found become entries.
+    2. Anchors: one trajectory from each pilot entry at full steps, run to ``tol``
+       convergence, replaces the entry's points (``refined``).
+    3. Verification: eight probes on a circle of radius ``rcap`` around each Poincare point;
+       an entry gets capture when all its probes come back to within ``rcap/10`` of it
+       before reaching (within ``rcap/10``) or converging to any other entry.
+    4. The grid, with capture by the verified entries; points that converged to an attractor
+       outside the catalogue are catalogued afterwards in index order.
+    """
+    c = _Compiled(gamma, p, omega, steps, t0, tol, kmax, periods, workers)
+    entries: list[_Entry] = []
+    n = th0.size
+    stats = {"pilot_periods": 0, "pilot_size": 0, "anchor_periods": 0, "probe_periods": 0}
+    if pilot and rcap > 0 and n > 4 * _PILOT_SIZE:
+        sel = np.unique(np.linspace(0, n - 1, _PILOT_SIZE).round().astype(np.int64))
+        out = c.run(th0[sel], v0[sel], [], 0.0, steps=max(16, steps // 4))
+        c.catalogue(entries, out[0], *out[4:])
+        stats.update(pilot_periods=int(out[1].sum()), pilot_size=int(sel.size))
+        if entries:
+            # anchors: refine each entry's points at full steps (empty catalogue: each
+            # converged anchor comes back NEW with its cycle)
+            out = c.run(np.array([e.theta[0] for e in entries]),
+                        np.array([e.v[0] for e in entries]), [], 0.0)
+            stats["anchor_periods"] = int(out[1].sum())
+            for e, ent in enumerate(entries):
+                k = int(out[4][e])
+                if (out[0][e] == c.k.NEW and k == ent.period and out[5][e] == ent.winding):
+                    ent.theta, ent.v = out[6][e, :k].copy(), out[7][e, :k].copy()
+                    ent.refined = True
+            # verification probes
+            a = _TWO_PI * np.arange(_PROBES) / _PROBES
+            pth = np.concatenate([(ent.theta[:, None] + rcap * np.cos(a)).ravel()
+                                  for ent in entries])
+            pv = np.concatenate([(ent.v[:, None] + rcap * np.sin(a)).ravel()
+                                 for ent in entries])
+            owner = np.concatenate([np.full(ent.period * _PROBES, e)
+                                    for e, ent in enumerate(entries)])
+            out = c.run(pth, pv, entries, 0.1 * rcap, capture=[True] * len(entries))
+            stats["probe_periods"] = int(out[1].sum())
+            for e, ent in enumerate(entries):
+                ent.capture = bool(np.all(out[0][owner == e] == e))
+    n_cat = len(entries)
+    raw, used, end_th, end_v, new_k, new_r, cyc_th, cyc_v = c.run(th0, v0, entries, rcap,
+                                                                   progress=progress)
+    decided = int(np.count_nonzero(raw >= 0))
+    c.catalogue(entries, raw, new_k, new_r, cyc_th, cyc_v)
+    stats.update(periods=int(np.sum(used)), decided_by_catalogue=decided,
+                 catalogued_after=int(np.count_nonzero(raw >= 0)) - decided,
+                 entries_before_grid=n_cat,
+                 verified=int(sum(e.capture for e in entries)), engine="numba")
+    return entries, raw, used, end_th, end_v, stats
 
 
 def find_attractors(phi0: ArrayLike, dphi0: ArrayLike, gamma: float, p: float, omega: float, *,

@@ -28,6 +28,7 @@ import xarray as xr
 from ..errors import ParameterError, check_finite, check_int
 from .attractors import (
     Attractor,
+    _check_engine,
     _check_search,
     _Entry,
     _finalize,
@@ -40,27 +41,38 @@ from .simulate import CONVENTION, _check_params
 __all__ = ["basin_map", "grid"]
 
 
+def _range(name, rng):
+    try:
+        lo, hi = (check_finite(name, x) for x in rng)
+    except TypeError:
+        raise ParameterError(f"{name}: expected (low, high), got {rng!r}") from None
+    if hi <= lo:
+        raise ParameterError(f"{name}: expected low < high, got {rng!r}")
+    return lo, hi
+
+
 def grid(n_phi: int = 200, n_dphi: int = 200,
-         dphi_range: tuple[float, float] = (-3.0, 3.0)) -> tuple[np.ndarray, np.ndarray]:
+         dphi_range: tuple[float, float] = (-3.0, 3.0),
+         phi_range: tuple[float, float] | None = None) -> tuple[np.ndarray, np.ndarray]:
     """Grid axes of :func:`basin_map`.
 
     Returns
     -------
     phi : ndarray, shape (n_phi,)
-        ``-pi + 2*pi*i/n_phi`` (angle from hanging, Eq. 1 convention), covering ``[-pi, pi)``.
+        ``-pi + 2*pi*i/n_phi`` (angle from hanging, Eq. 1 convention), covering ``[-pi, pi)``;
+        with ``phi_range = (a, b)``, ``n_phi`` points from ``a`` to ``b``, ends included.
     dphi : ndarray, shape (n_dphi,)
         ``n_dphi`` points from ``dphi_range[0]`` to ``dphi_range[1]``, exactly antisymmetric
         when the range is symmetric about 0.
     """
     n_phi = check_int("n_phi", n_phi, 2)
     n_dphi = check_int("n_dphi", n_dphi, 2)
-    try:
-        lo, hi = (check_finite("dphi_range", x) for x in dphi_range)
-    except TypeError:
-        raise ParameterError(f"dphi_range: expected (low, high), got {dphi_range!r}") from None
-    if hi <= lo:
-        raise ParameterError(f"dphi_range: expected low < high, got {dphi_range!r}")
-    phi = math.pi * (2.0 * np.arange(n_phi) - n_phi) / n_phi
+    lo, hi = _range("dphi_range", dphi_range)
+    if phi_range is None:
+        phi = math.pi * (2.0 * np.arange(n_phi) - n_phi) / n_phi
+    else:
+        a, b = _range("phi_range", phi_range)
+        phi = a + (b - a) * np.arange(n_phi, dtype=float) / (n_phi - 1)
     j = np.arange(n_dphi, dtype=float)
     if lo == -hi:
         dphi = hi * (2.0 * j - (n_dphi - 1)) / (n_dphi - 1)
@@ -118,11 +130,12 @@ def _split(labels, phase, attractors):
 
 
 def basin_map(gamma: float, p: float, omega: float, *, n_phi: int = 200, n_dphi: int = 200,
-              dphi_range: tuple[float, float] = (-3.0, 3.0), periods: int = 300,
+              dphi_range: tuple[float, float] = (-3.0, 3.0),
+              phi_range: tuple[float, float] | None = None, periods: int = 300,
               steps_per_period: int = 128, t0: float = 0.0, tol: float = 1e-6,
               max_period: int = 8, capture_radius: float = 0.05, symmetric: bool = True,
-              split_phases: bool = False, pilot: bool = True, workers: int = 1
-              ) -> xr.Dataset:
+              split_phases: bool = False, pilot: bool = True, workers: int | None = None,
+              engine: str = "numba", progress=None) -> xr.Dataset:
     """Basins of attraction of paper Eq. 1 on an ``(phi, phi')`` grid at ``t = t0``.
 
     Parameters
@@ -133,10 +146,27 @@ def basin_map(gamma: float, p: float, omega: float, *, n_phi: int = 200, n_dphi:
         Grid size (see :func:`grid`).
     dphi_range : (float, float)
         Range of initial ``phi'`` (ends included).
+    phi_range : (float, float), optional
+        Range of initial ``phi`` (ends included); default the whole circle ``[-pi, pi)``
+        (see :func:`grid`). A custom range is integrated without the symmetry.
     periods : int
         Budget of forcing periods per trajectory.
-    steps_per_period, t0, tol, max_period, capture_radius, pilot, workers
+    steps_per_period, t0, tol, max_period, capture_radius, pilot
         As :func:`parapend.dynamics.attractors.find_attractors`.
+    workers : int, optional
+        Threads: default every core for ``engine="numba"``, 1 for ``"numpy"``. Labels do
+        not depend on it.
+    engine : {"numba", "numpy"}
+        ``"numba"`` (default): the compiled kernel of :mod:`parapend.dynamics._kernel`,
+        parallel over the points, the same RK4 arithmetic and the same decision rules
+        (capture, lag-k convergence, budget) as the NumPy engine; the attractor catalogue
+        (pilot and capture verification) is built first by the NumPy engine. ``"numpy"``:
+        the vectorized engine of :func:`~parapend.dynamics.attractors.find_attractors`.
+        The two give identical labels except, rarely, on fractal basin boundaries where
+        the order in which capture becomes available differs (tested on small grids).
+    progress : callable, optional
+        ``progress(done, total)`` called as parts of the grid are finished (numba engine:
+        up to 20 parts), for a progress display; the library itself never prints.
     symmetric : bool
         Use the ``(phi, phi') -> (-phi, -phi')`` symmetry when the grid allows it (halves
         the work; identical labels, see module docstring).
@@ -169,17 +199,19 @@ def basin_map(gamma: float, p: float, omega: float, *, n_phi: int = 200, n_dphi:
     tol, kmax, periods, rcap, steps = _check_search(tol, max_period, periods, capture_radius,
                                                     steps_per_period)
     t0 = check_finite("t0", t0)
-    workers = _resolve_workers(workers)
-    phi, dphi = grid(n_phi, n_dphi, dphi_range)
+    engine = _check_engine(engine)
+    workers = _resolve_workers(workers, engine)
+    phi, dphi = grid(n_phi, n_dphi, dphi_range, phi_range)
     n_phi, n_dphi = phi.size, dphi.size
-    theta = _theta_grid(n_phi)
-    use_sym = bool(symmetric) and dphi[0] == -dphi[-1]
+    theta = _theta_grid(n_phi) if phi_range is None else phi + math.pi
+    use_sym = bool(symmetric) and dphi[0] == -dphi[-1] and phi_range is None
     ncol = n_phi // 2 + 1 if use_sym else n_phi
     th0 = np.broadcast_to(theta[None, :ncol], (n_dphi, ncol)).ravel().copy()
     v0 = np.broadcast_to(dphi[:, None], (n_dphi, ncol)).ravel().copy()
     entries, raw, used, end_th, end_v, stats = _run_search(
         th0, v0, gamma, p, omega, periods=periods, steps=steps, t0=t0, tol=tol, kmax=kmax,
-        rcap=rcap, workers=workers, pilot=bool(pilot))
+        rcap=rcap, workers=workers, pilot=bool(pilot), engine=engine,
+        progress=progress)
     raw, used, end_th, end_v = (a.reshape(n_dphi, ncol) for a in (raw, used, end_th, end_v))
     if use_sym:
         mirror = np.array(_mirror_entries(entries, max(1e3 * tol, 1e-2)) + [-1])
@@ -236,9 +268,11 @@ def basin_map(gamma: float, p: float, omega: float, *, n_phi: int = 200, n_dphi:
             "periods": periods, "steps_per_period": steps, "tol": tol,
             "max_period": kmax, "capture_radius": rcap, "pilot": int(bool(pilot)),
             "symmetric_used": int(use_sym), "split_phases": int(bool(split_phases)),
-            "workers": workers,
+            "workers": workers, "engine": engine,
             "convention": CONVENTION,
-            "method": "fixed-step RK4 stroboscopic map (parapend.dynamics.attractors)",
+            "method": ("fixed-step RK4 stroboscopic map (parapend.dynamics.attractors"
+                       + (", compiled kernel parapend.dynamics._kernel)" if engine == "numba"
+                          else ")")),
             "elapsed_s": elapsed,
             "stats": json.dumps(stats),
         },

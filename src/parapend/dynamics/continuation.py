@@ -47,7 +47,9 @@ __all__ = [
     "continue_rotation",
     "floquet",
     "periodic_orbit",
+    "RotationBoundaries",
     "rotation_boundaries",
+    "rotation_boundaries_at",
 ]
 
 _TWO_PI = 2 * math.pi
@@ -528,7 +530,7 @@ def _refine(Xa, Xb, gamma, omega, t0, r, which, tol, iters=30):
 
 
 def rotation_boundaries(gamma: float, omegas: ArrayLike, *, p_start: float | None = None,
-                        p_max: float = 3.0, ds: float = 0.02) -> xr.Dataset:
+                        p_max: float = 3.0, ds: float = 0.02, progress=None) -> xr.Dataset:
     """Curves J (birth, fold), G (loss of stability) and E (regain) of paper Fig. 2 left.
 
     For each ``omega``, a period-1 rotation is found by shooting at ``p_start`` (default:
@@ -545,6 +547,8 @@ def rotation_boundaries(gamma: float, omegas: ArrayLike, *, p_start: float | Non
     p_start : float, optional
     p_max : float
     ds : float
+    progress : callable, optional
+        ``progress(done, total)`` after each ``omega`` (for a progress display).
 
     Returns
     -------
@@ -554,32 +558,138 @@ def rotation_boundaries(gamma: float, omegas: ArrayLike, *, p_start: float | Non
     """
     omegas = np.atleast_1d(np.asarray(omegas, dtype=float))
     out = {"p_J": [], "p_G": [], "p_E": [], "p_start": []}
-    for om in omegas:
-        starts = [p_start] if p_start is not None else list(np.arange(1, 11) * 0.3)
-        pj = pg = pe = p0 = math.nan
-        for ps in starts:
-            orb = periodic_orbit(gamma, ps, om)
-            if not orb.success:
-                continue
-            p0 = ps
-            # down through the fold and back up the other branch (the start may be on the
-            # saddle branch), then up from the start
-            down = continue_rotation(gamma, om, ps, direction=-1, p_max=p_max, ds=ds,
-                                     stop_at_fold=False)
-            up = continue_rotation(gamma, om, ps, direction=1, p_max=p_max, ds=ds,
-                                   stop_at_fold=False)
-            bifs = down.bifurcations + up.bifurcations
-            folds = [b.p for b in bifs if b.kind == "fold"]
-            pj = min(folds) if folds else math.nan
-            gs = [b.p for b in bifs if b.label == "G"]
-            pg = min(gs) if gs else math.nan
-            es = [b.p for b in bifs if b.label == "E" and not b.p < pg]
-            pe = min(es) if es else math.nan
-            break
+    for i, om in enumerate(omegas):
+        bifs, p0 = _bifurcations_at(gamma, om, p_start, p_max, ds)
+        pj, pg, pe = _lowest_jge(bifs)
         out["p_J"].append(pj)
         out["p_G"].append(pg)
         out["p_E"].append(pe)
         out["p_start"].append(p0)
+        if progress is not None:
+            progress(i + 1, omegas.size)
     return xr.Dataset({k: ("omega", np.array(v)) for k, v in out.items()},
                       coords={"omega": omegas},
-                      attrs={"gamma": gamma, "convention": "paper Eq. 1 (p, omega)"})
+                      attrs={"gamma": gamma, "p_max": float(p_max),
+                             "convention": "paper Eq. 1 (p, omega)"})
+
+
+def _bifurcations_at(gamma, om, p_start, p_max, ds):
+    """Bifurcations along the period-1 rotation at one ``omega`` and the start used."""
+    starts = [p_start] if p_start is not None else list(np.arange(1, 11) * 0.3)
+    for ps in starts:
+        orb = periodic_orbit(gamma, ps, om)
+        if not orb.success:
+            continue
+        # down through the fold and back up the other branch (the start may be on the
+        # saddle branch), then up from the start
+        down = continue_rotation(gamma, om, ps, direction=-1, p_max=p_max, ds=ds,
+                                 stop_at_fold=False)
+        up = continue_rotation(gamma, om, ps, direction=1, p_max=p_max, ds=ds,
+                               stop_at_fold=False)
+        return down.bifurcations + up.bifurcations, float(ps)
+    return (), math.nan
+
+
+def _lowest_jge(bifs):
+    """J: lowest fold; G: lowest loss of stability; E: lowest regain not below G."""
+    folds = [b.p for b in bifs if b.kind == "fold"]
+    pj = min(folds) if folds else math.nan
+    gs = [b.p for b in bifs if b.label == "G"]
+    pg = min(gs) if gs else math.nan
+    es = [b.p for b in bifs if b.label == "E" and not b.p < pg]
+    pe = min(es) if es else math.nan
+    return pj, pg, pe
+
+
+def _distinct(values, tol=1e-6):
+    out = []
+    for v in sorted(values):
+        if not out or v - out[-1] > tol:
+            out.append(float(v))
+    return tuple(out)
+
+
+@dataclass(frozen=True, eq=False)
+class RotationBoundaries:
+    """Bifurcations of the period-1 rotation of paper Eq. 1 at one ``omega`` (Fig. 2 left).
+
+    Attributes
+    ----------
+    gamma, omega, p_max : float
+    p_J, p_G, p_E : tuple of float
+        Every fold (J, birth), loss of stability (G) and regain (E) found on ``[0, p_max]``,
+        increasing; usually one value each or none.
+    lowest_J, lowest_G, lowest_E : float
+        The values :func:`rotation_boundaries` reports (NaN when absent): the lowest fold,
+        the lowest G and the lowest E not below it.
+    p_start : float
+        Where shooting started the branch (NaN: no period-1 rotation found by shooting).
+    bifurcations : tuple of Bifurcation
+    success : bool
+        A branch was found.
+    status, message : str
+        ``"ok"`` or ``"no_rotation_found"``.
+    """
+
+    gamma: float
+    omega: float
+    p_max: float
+    p_J: tuple
+    p_G: tuple
+    p_E: tuple
+    lowest_J: float
+    lowest_G: float
+    lowest_E: float
+    p_start: float
+    bifurcations: tuple
+    success: bool
+    status: str
+    message: str
+
+    def to_dict(self) -> dict:
+        return {"gamma": self.gamma, "omega": self.omega, "p_max": self.p_max,
+                "p_J": list(self.p_J), "p_G": list(self.p_G), "p_E": list(self.p_E),
+                "lowest_J": self.lowest_J, "lowest_G": self.lowest_G,
+                "lowest_E": self.lowest_E, "p_start": self.p_start,
+                "bifurcations": [{"label": b.label, "kind": b.kind, "p": b.p,
+                                  "phi0": b.phi0, "dphi0": b.dphi0} for b in self.bifurcations],
+                "success": self.success, "status": self.status, "message": self.message}
+
+
+def rotation_boundaries_at(gamma: float, omega: float, *, p_start: float | None = None,
+                           p_max: float = 3.0, ds: float = 0.02) -> RotationBoundaries:
+    """Curves J, G, E of paper Fig. 2 left at one ``omega``, every occurrence listed.
+
+    The same computation as one column of :func:`rotation_boundaries` (whose values are
+    ``lowest_J``, ``lowest_G``, ``lowest_E``), keeping every bifurcation found.
+
+    Parameters
+    ----------
+    gamma, omega : float
+        Damping and excitation frequency of Eq. 1.
+    p_start : float, optional
+        Where to start the branch (default: the first of 0.3, 0.6, ..., 3.0 where shooting
+        converges).
+    p_max : float
+        Largest excitation strength ``p`` followed.
+    ds : float
+        Continuation step.
+
+    Returns
+    -------
+    RotationBoundaries
+    """
+    gamma, _, omega = _check_params(gamma, 0.0, omega)
+    p_max = check_positive("p_max", p_max)
+    bifs, p0 = _bifurcations_at(gamma, omega, p_start, p_max, ds)
+    pj, pg, pe = _lowest_jge(bifs)
+    ok = not math.isnan(p0)
+    bifs = tuple(sorted(bifs, key=lambda b: b.p))
+    return RotationBoundaries(
+        gamma, omega, p_max,
+        _distinct([b.p for b in bifs if b.kind == "fold"]),
+        _distinct([b.p for b in bifs if b.label == "G"]),
+        _distinct([b.p for b in bifs if b.label == "E"]),
+        pj, pg, pe, p0, bifs, ok, "ok" if ok else "no_rotation_found",
+        "" if ok else f"no period-1 rotation found by shooting at p = 0.3, 0.6, ..., 3 "
+                      f"(omega = {omega:g}); give p_start where one exists")

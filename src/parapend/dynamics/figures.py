@@ -27,7 +27,8 @@ from .attractors import find_attractors
 from .continuation import periodic_orbit
 from .simulate import trajectory
 
-__all__ = ["COEXISTENCE_CASE", "plot_basins", "plot_coexistence", "plot_rotation_boundaries"]
+__all__ = ["COEXISTENCE_CASE", "plot_basins", "plot_coexistence", "plot_motion",
+           "plot_rotation_boundaries"]
 
 #: Paper Section 1: a period-2 oscillation coexists with the period-1 rotation for
 #: gamma = 0.1, p = 0.8, omega = 2.1. Initial conditions (phi, phi') at t = 0 reaching each
@@ -276,12 +277,56 @@ def plot_rotation_boundaries(ds: xr.Dataset, *, path: str | Path | None = None,
                 zorder=4)
         ax.annotate(label, (w, p), xytext=(8, -3 if i % 2 else 6), textcoords="offset points",
                     fontsize=8, bbox={"boxstyle": "round,pad=0.2", "fc": "white", "ec": "0.7"})
-    ax.set_xlim(om[0], om[-1])
+    if om.size > 1:
+        ax.set_xlim(om[0], om[-1])
     ax.set_ylim(0, top)
     ax.set_xlabel(r"$\omega$")
     ax.set_ylabel(r"$p$")
     ax.set_title(rf"Period-1 rotation of Eq. 1, $\gamma = {ds.attrs['gamma']:g}$")
     ax.legend(loc="upper left")
+    _save(fig, path)
+    return fig
+
+
+def plot_motion(motion, *, path: str | Path | None = None) -> Figure:
+    """Time history and phase portrait of one motion of Eq. 1 (paper Fig. 1 right).
+
+    Parameters
+    ----------
+    motion : parapend.dynamics.motion.Motion
+        From :func:`parapend.dynamics.motion.simulate`.
+    path : str or Path, optional
+        Save the figure there.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        Left: ``phi(t)`` (unwrapped) and ``phi'(t)``; right: the phase portrait, ``phi``
+        wrapped to ``[-pi, pi)``, the last half of the run darker, Poincare points marked.
+    """
+    m = motion
+    fig = _new_figure((10.0, 4.2))
+    ax1, ax2 = fig.subplots(1, 2)
+    ax1.plot(m.t, m.phi, lw=0.8, label=r"$\varphi$ (unwrapped)")
+    ax1.plot(m.t, m.dphi, lw=0.8, label=r"$\dot\varphi$")
+    ax1.set_xlabel("t")
+    ax1.legend(fontsize=8)
+    ax1.grid(alpha=0.3)
+    half = m.t.size // 2
+    w, dp = _wrap_for_plot(m.phi[:half + 1], m.dphi[:half + 1])
+    ax2.plot(w, dp, lw=0.5, color="0.75")
+    w, dp = _wrap_for_plot(m.phi[half:], m.dphi[half:])
+    ax2.plot(w, dp, lw=0.8, color="k")
+    c = m.classification
+    if c.phi.size:
+        ax2.plot(c.phi, c.dphi, "o", ms=7, mfc="#d62728", mec="k", label="Poincare points")
+        ax2.legend(fontsize=8)
+    ax2.set_xlim(-math.pi, math.pi)
+    ax2.set_xlabel(r"$\varphi$ (rad, from hanging)")
+    ax2.set_ylabel(r"$\dot\varphi$")
+    fig.suptitle(rf"Eq. 1: $\gamma={m.gamma:g}$, $p={m.p:g}$, $\omega={m.omega:g}$, "
+                 rf"$(\varphi_0, \dot\varphi_0) = ({m.phi0:g}, {m.dphi0:g})$: {c.name}",
+                 fontsize=10)
     _save(fig, path)
     return fig
 
