@@ -248,6 +248,16 @@ def _cmd_threshold(a) -> dict | str:
     ])
 
 
+def _plot_and_save(ds, a, plotter: str) -> None:
+    """``--plot`` with ``parapend.plotting.<plotter>`` and ``--save`` of a Dataset."""
+    if a.plot:
+        from .. import plotting
+
+        _output.plot(getattr(plotting, plotter), ds, a.plot)
+    if a.save:
+        _output.write_dataset(ds, a.save)
+
+
 def _cmd_damping_sweep(a) -> dict | str:
     from ..api import damping_sweep
 
@@ -255,12 +265,7 @@ def _cmd_damping_sweep(a) -> dict | str:
     _check_output(a.save, "--save", (".nc",))
     ds = damping_sweep(harmonics=a.harmonics, gamma_max=a.gamma_max, points=a.points,
                        progress=_Progress("damping sweep"), **_excitation_kwargs(a))
-    if a.plot:
-        from ..plotting import plot_damping_sweep
-
-        _output.plot(plot_damping_sweep, ds, a.plot)
-    if a.save:
-        _output.write_dataset(ds, a.save)
+    _plot_and_save(ds, a, "plot_damping_sweep")
     if a.json:
         return _dataset_json(ds)
     rows = [[_fmt(g), _fmt(p), _fmt(u), f"{t:.4g}", str(s)] for g, p, u, t, s in zip(
@@ -291,12 +296,7 @@ def _cmd_harmonics(a) -> dict | str:
                              f"got {a.n_from}")
     ds = harmonic_table(range(a.n_from, a.n_to + 1), gamma=a.gamma,
                         progress=_Progress("harmonics"), **_excitation_kwargs(a))
-    if a.plot:
-        from ..plotting import plot_harmonic_table
-
-        _output.plot(plot_harmonic_table, ds, a.plot)
-    if a.save:
-        _output.write_dataset(ds, a.save)
+    _plot_and_save(ds, a, "plot_harmonic_table")
     if a.json:
         return _dataset_json(ds)
     rows = [[str(n), _fmt(p, 8), str(s), "global" if g else "continued"]
