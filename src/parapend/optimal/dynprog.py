@@ -118,24 +118,21 @@ def _project(path: np.ndarray, omega: float, harmonics: int) -> np.ndarray:
     return np.concatenate(([x[0].real], -c.imag, c.real))
 
 
-def propose_seeds(excitation, harmonics: int, damping: float, problem, count: int,
-                  scales=(1.0,)):
+def propose_seeds(excitation, harmonics: int, damping: float, count: int):
     """Up to ``count`` distinct seeds from the best paths, best first, as ``(name, x)``."""
     steps = int(min(4096, max(128, 4 * harmonics, 8 * excitation.extrema.t.size)))
-    g0 = _effective_damping(excitation, harmonics, damping)
+    values, paths = best_paths(excitation, _effective_damping(excitation, harmonics, damping),
+                               steps)
     out, seen = [], []
-    for f in scales:
-        values, paths = best_paths(excitation, g0 * f, steps)
-        order = np.argsort(-values, kind="stable")
-        for s in order:
-            if not math.isfinite(values[s]):
-                continue
-            x = _project(paths[s], excitation.omega, harmonics)
-            # same path up to the start angle: same seed
-            if any(np.max(np.abs(x - y)) < 0.3 for y in seen):
-                continue
-            seen.append(x)
-            out.append((f"dp-{len(out) + 1}", x))
-            if len(out) >= count:
-                return out
+    for s in np.argsort(-values, kind="stable"):
+        if not math.isfinite(values[s]):
+            continue
+        x = _project(paths[s], excitation.omega, harmonics)
+        # same path up to the start angle: same seed
+        if any(np.max(np.abs(x - y)) < 0.3 for y in seen):
+            continue
+        seen.append(x)
+        out.append((f"dp-{len(out) + 1}", x))
+        if len(out) >= count:
+            break
     return out

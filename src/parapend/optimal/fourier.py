@@ -20,24 +20,27 @@ and products of trigonometric functions become sums of ``V`` at ``n +- k`` (inde
 built once per N). One Newton iteration for N = 40 costs two FFTs of a few hundred points
 and an 81 x 81 Cholesky factorization.
 
-Globalization (DESIGN.md section 5). ``P`` is not concave, and the uniform rotation is a
-stationary point for N = 1, so a local solver started there can stop at a saddle. The
-solver here is a safeguarded Newton method that takes the Newton step when ``-H`` is
-positive definite and otherwise a step along ``|H|^{-1} g`` plus the most positive curvature
-direction (escaping saddles), with a backtracking line search that never decreases ``P``.
-It is started from several seeds and the best local maximum wins:
+Globalization (DESIGN.md section 5; docs/global.md). ``P`` is not concave, and the
+uniform rotation is a stationary point for N = 1, so a local solver started there can stop
+at a saddle. The solver here is a safeguarded Newton method that takes the Newton step when
+``-H`` is positive definite and otherwise a shifted Newton step or the most positive
+curvature direction (escaping saddles), with a backtracking line search that never
+decreases ``P``. :func:`search_fourier` starts it from several seeds and keeps the best
+local maximum:
 
-- ``limit``: the gamma -> 0 piecewise-constant motion (closed form, :mod:`.limit`),
-  projected onto N harmonics with Lanczos smoothing; with several maxima of q per period,
-  up to 8 of its equally good half-turn direction patterns (``limit-1``, ...), which lead
-  to different optima once gamma > 0;
+- ``warm``: a previous solution (continuation in N or in gamma), padded with zeros;
+- ``limit``: the gamma -> 0 piecewise-constant motion (:mod:`.limit`), projected onto N
+  harmonics with Lanczos smoothing;
 - ``uniform``: the best uniform rotation (Eq. 17), optimized first with 8 harmonics and
   then padded (continuation in N; see ``_uniform_start``);
-- ``warm``: a previous solution (continuation in N or in gamma), padded with zeros, whose
-  objective is already the previous optimum, so optima never decrease along a continuation.
+- every other half-turn direction pattern of the limit motion (``limit-1``, ...) when there
+  are at most ENUMERATE_MAX, else seeds from the dynamic programme of :mod:`.dynprog`
+  (``dp-1``, ...), a seeded sample and, at gamma = 0, swaps (``swap-1``, ...). These runs
+  are abandoned once their quadratic model cannot beat the best power so far.
 
-The result records which seed gave the optimum (``found_by``) and every local maximum found.
-The grid size ``M`` is doubled until the power changes by less than 1e-14 between grids.
+The result records which seed gave the optimum (``found_by``), every run, and the evidence
+(:class:`SearchEvidence`). The grid size ``M`` is doubled until the power changes by less
+than 1e-14 between grids.
 """
 
 from __future__ import annotations
@@ -416,7 +419,7 @@ def _seeds(excitation, lim, harmonics: int, damping: float, warm, seeds, gtol: f
     return out
 
 
-def _pattern_seeds(excitation, lim, harmonics: int, damping: float, problem):
+def _pattern_seeds(excitation, lim, harmonics: int, damping: float):
     """Further seeds from the half-turn direction patterns: all, or proposed ones.
 
     Returns the strategy, the number of patterns and ``(name, x, pattern)`` triples
@@ -432,7 +435,7 @@ def _pattern_seeds(excitation, lim, harmonics: int, damping: float, problem):
     from .dynprog import propose_seeds
 
     out = [(name, x, None) for name, x in
-           propose_seeds(excitation, harmonics, damping, problem, PROPOSE_COUNT)]
+           propose_seeds(excitation, harmonics, damping, PROPOSE_COUNT)]
     pats = direction_patterns(lim, PROPOSE_COUNT + 1, seed=0)[1:]
     out += [(f"limit-{i + 1}", limit_seed(lim, harmonics, d).vector, d)
             for i, d in enumerate(pats)]
@@ -545,14 +548,20 @@ def search_fourier(excitation, harmonics: int, damping: float, *, warm: np.ndarr
                 break
         extra = [(f"{r.seed}@N={screen}", _pad(r.x, harmonics), None) for r in kept]
     elif "limit" in seeds:
-        strategy, count, extra = _pattern_seeds(excitation, lim, harmonics, damping, problem)
+        strategy, count, extra = _pattern_seeds(excitation, lim, harmonics, damping)
     best_pattern = np.asarray(lim.directions)
+    # the best power so far (the bar a new run must beat), kept as runs finish rather than
+    # recomputed over all runs for each of up to 1024 seeds
+    bar = max((r.power for r in runs if math.isfinite(r.power)), default=-math.inf)
 
     def run(name, x0):
-        bar = _best(runs).power if runs else -math.inf
+        nonlocal bar
         r = newton_maximize(problem, x0, name, gtol=gtol, maxiter=maxiter, abandon_below=bar)
         runs.append(r)
-        return r, r.status == "converged" and r.power > bar + 1e-13 * max(1.0, abs(bar))
+        better = r.status == "converged" and r.power > bar + 1e-13 * max(1.0, abs(bar))
+        if r.status != "abandoned" and math.isfinite(r.power):
+            bar = max(bar, r.power)
+        return r, better
 
     for name, x0, pattern in extra:
         _, better = run(name, x0)
