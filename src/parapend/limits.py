@@ -80,3 +80,19 @@ BASIN_MAX_WORK = 1.6e8
 ROT_OMEGA_RANGE = (0.8, 10.0)
 ROT_MAX_OMEGAS = 40
 ROT_MAX_P = 3.0
+
+# --- irregular seas (sea command, docs/seas.md) ------------------------------------------
+#: significant wave height and |z| of a measured record, m
+SEA_MAX_HS = 30.0
+#: peak period, s
+SEA_TP_RANGE = (1.0, 30.0)
+#: repeat period in peak periods (about the number of waves in the record)
+SEA_WAVES_RANGE = (2.0, 400.0)
+#: components of q (harmonics of the repeat period) of one record
+SEA_MAX_COMPONENTS = 8192
+#: rows of a measured record CSV 't,z'
+SEA_MAX_RECORD_ROWS = 1 << 17
+#: harmonics N of the motion over one record (operator Newton: memory O(N), time O(N log N))
+SEA_MAX_HARMONICS = 16384
+#: windings tried by --winding auto
+SEA_MAX_WINDINGS = 64
