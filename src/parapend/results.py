@@ -95,6 +95,10 @@ class OptimizeResult(_Result):
     units, power_w, uniform_power_w, limit_power_w, peak_torque_nm, electrical_power_w,
     energy_per_cycle_j, motoring_energy_j : physical values (W, N m, J) when a pendulum's
         length and mass were given (:mod:`parapend.units`); None otherwise.
+    winding : int
+        K, turns per forcing period, ``theta(t + 2 pi/omega) = theta(t) + 2 pi K`` (1: the
+        paper's period-1 rotation); ``uniform_power`` is then the uniform rotation with K
+        turns and ``upper_bound`` is ``limit - gamma K^2 omega^2``.
     """
 
     power: float
@@ -147,6 +151,7 @@ class OptimizeResult(_Result):
     electrical_power_w: float | None = None
     energy_per_cycle_j: float | None = None
     motoring_energy_j: float | None = None
+    winding: int = 1
     convention: str = CONVENTION
     _motion: object = field(default=None, repr=False)
     _excitation: object = field(default=None, repr=False)

@@ -47,6 +47,10 @@ def add_parsers(sub) -> None:
     p.add_argument("--save", metavar="CSV",
                    help="write one period of the motion: t,tau,theta,theta_dot,torque,power "
                         "(p = -T theta'; and electrical_power with an efficiency)")
+    p.add_argument("--winding", type=_int, default=1,
+                   help="K turns per forcing period, theta(t + 2 pi/omega) = theta(t) + 2 pi "
+                        "K (default 1, the paper's period-1 rotation; K > 1: method fourier, "
+                        "N >= 2K; docs/seas.md)")
     p.add_argument("--json", action="store_true", help="print one JSON object")
     _pto.add_pto_options(p)
     _pto.add_unit_options(p)
@@ -99,6 +103,11 @@ def _cmd_optimize(a) -> dict | str:
     kw = {"gamma": a.gamma, "harmonics": a.harmonics, **_excitation_kwargs(a)}
     units, kw = _pto.apply_units(a, kw)
     pto = _pto.wants_pto(a)
+    if a.winding != 1:
+        if pto or a.method == "all":
+            raise ParameterError("winding: K > 1 works with method fourier or bvp without a "
+                                 "power take-off; drop --winding or those options")
+        kw["winding"] = a.winding
     if a.method == "all":
         if pto or units is not None:
             raise ParameterError("method: 'all' compares the ideal methods; the power "
@@ -143,6 +152,8 @@ def _cmd_optimize(a) -> dict | str:
         return r.to_dict()
     name = (f"Fourier optimum, N = {r.harmonics} (Eq. 10)" if r.method == "fourier"
             else f"BVP optimum, epsilon = {2 * r.gamma:g} (Eq. 22)")
+    if r.winding != 1:
+        name += f", winding K = {r.winding}"
     if pto:
         name = f"power take-off optimum, N = {r.harmonics}"
     rows = [
@@ -167,7 +178,8 @@ def _cmd_optimize(a) -> dict | str:
     out = [f"excitation: {_describe(r.excitation)}; damping gamma = {r.gamma:g}", "",
            _table(rows, ["motion", "power P", "vs uniform"]), "",
            f"status: {r.status} ({how})",
-           f"upper bound limit - gamma omega^2: {_fmt(r.upper_bound)} "
+           f"upper bound limit - gamma {'' if r.winding == 1 else 'K^2 '}omega^2: "
+           f"{_fmt(r.upper_bound)} "
            f"(gap {_fmt(r.bound_gap)})",
            f"peak torque |T|: {r.peak_torque:.6g}    mean theta'^2: {r.mean_square_speed:.6g}",
            f"convention: {CONVENTION}"]
