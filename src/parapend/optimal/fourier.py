@@ -568,6 +568,8 @@ def _pattern_seeds(excitation, lim, harmonics: int, damping: float,
     (``pattern`` None for a dynamic-programme path).
     """
     count = pattern_count(lim)
+    if lim.winding != 1:
+        return _winding_seeds(excitation, lim, harmonics, damping, count, propose)
     if count <= 1:
         return "exhaustive", count, []
     if count <= ENUMERATE_MAX:
@@ -587,6 +589,32 @@ def _pattern_seeds(excitation, lim, harmonics: int, damping: float,
     out += [(f"limit-{i + 1}", limit_seed(lim, harmonics, d).vector, d)
             for i, d in enumerate(pats)]
     return "dynamic-programme", count, out
+
+
+def _winding_seeds(excitation, lim, harmonics: int, damping: float, count: int, propose):
+    """Winding K != 1: the dynamic programme's seeds, always, then every pattern (at most
+    ENUMERATE_MAX) or a seeded sample of them.
+
+    The half-turn patterns of K != 1 do not cover the damped optima: with about as many
+    extrema as turns (``m = K``) there is a single pattern, while a damped optimum may skip
+    a small swing and turn twice elsewhere (measured: harmonics 8 to 12 of omega = 0.2,
+    K = 10, gamma = 0.05: the one pattern gave -0.06559, the programme -0.05928, which an
+    independent multi-start BFGS confirms). The programme models such motions.
+    """
+    from .dynprog import propose_seeds
+
+    propose = PROPOSE_COUNT if propose is None else propose
+    out = [(name, x, None) for name, x in
+           propose_seeds(excitation, harmonics, damping, propose, winding=lim.winding)]
+    if count <= ENUMERATE_MAX:
+        pats = list(all_patterns(lim))[1:]
+        strategy = "patterns+dynamic-programme"
+    else:
+        pats = direction_patterns(lim, propose + 1, seed=0)[1:]
+        strategy = "dynamic-programme"
+    out += [(f"limit-{i + 1}", limit_seed(lim, harmonics, d).vector, d)
+            for i, d in enumerate(pats)]
+    return strategy, count, out
 
 
 #: Above this many harmonics, and for gamma > 0, the patterns are compared at this N (cost
