@@ -148,7 +148,11 @@ def _csv_rows(path, header: list, name: str, max_rows: int = None) -> list:
     if not isinstance(path, (str, Path)) or not str(path):
         raise ParameterError(f"{name}: expected a CSV path, got {path!r:.60}")
     path = Path(path)
-    text = _read_bounded(path)
+    try:
+        text = _read_bounded(path)
+    except ParameterError as exc:  # name the parameter the user gave, not "file"
+        msg = str(exc)
+        raise ParameterError(f"{name}:{msg[5:]}" if msg.startswith("file:") else msg) from None
     rows = [r for r in csv.reader(text.splitlines()) if r and any(c.strip() for c in r)]
     if not rows or [c.strip().lower() for c in rows[0]] != header:
         raise ParameterError(f"{name}: expected a CSV header '{','.join(header)}' in {path}")
