@@ -20,7 +20,7 @@ from parapend.cli import main
 from parapend.errors import ParameterError
 from parapend.excitation import fourier
 from parapend.optimal.dynprog import best_paths_winding
-from parapend.optimal.fourier import FourierProblem, search_fourier
+from parapend.optimal.fourier import FourierProblem, newton_maximize, search_fourier
 from parapend.optimal.limit import limit, pattern_count
 from parapend.power import limit_motion_power, uniform_power
 from parapend.sea_api import sea, sea_samples
@@ -196,6 +196,18 @@ def test_operator_hessian_is_the_dense_hessian_and_the_gradient_is_exact(winding
     mot = parapend.trajectory.FourierMotion.from_vector(1.8, x, winding)
     t = exc.period * np.arange(4096) / 4096
     assert dense.kinetic(x) == pytest.approx(np.mean(mot.theta_dot(t) ** 2), rel=1e-12)
+
+
+def test_operator_kernel_escapes_a_saddle_like_the_dense_one():
+    # q = 0.3 sin 3s, N = 1: theta = s is stationary with an indefinite Hessian (no
+    # harmonic of q works on it); a 1e-9 nudge leaves a gradient too small to step along
+    exc = fourier([(3, 0.3, 0.0)], omega=1.0)
+    x = np.array([0.0, 1e-9, 0.0])
+    runs = [newton_maximize(FourierProblem(exc, 1, 0.0, hessian=h), x, "saddle")
+            for h in ("dense", "operator")]
+    assert runs[0].power > 0.29 and runs[0].status == runs[1].status == "converged"
+    assert runs[1].power == pytest.approx(runs[0].power, abs=1e-13)
+    assert runs[1].strict_maximum
 
 
 def test_limit_with_winding_directions_and_power():

@@ -138,6 +138,9 @@ def _cmd_sea(a) -> dict | str:
     out += [f"status: {r.status}; found from the {r.found_by} seed ({r.search}: "
             f"{r.polished} runs polished, {r.abandoned} abandoned); refinement N -> 2N "
             f"changed P by {r.refinement_change:.2g}"]
+    if r.refinement_change > 1e-6 * abs(r.power):
+        out.append(f"note: the power changed by {r.refinement_change / abs(r.power):.1e} "
+                   "(relative) when N was doubled; give more --harmonics for more digits")
     if a.save:
         out.append(f"record and motion written to {a.save}")
     if a.plot:
