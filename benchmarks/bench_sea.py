@@ -15,6 +15,9 @@ WAVES peak periods; pendulum l = 1 m, m = 10 kg, gamma = 0.01, winding K = 1.
 The powers are printed beside each other: the collocation's ``-<T theta'>`` on its Simpson
 rule and parapend's optimum. Timings depend on the machine and its load; read the ratios.
 
+``--kernels [N ...]`` times one Newton run with the dense Hessian (Cholesky, O(N^3)) against
+the operator Hessian (Newton-CG, FFTs) from the same seed instead.
+
 Run: ``OPENBLAS_NUM_THREADS=1 python benchmarks/bench_sea.py [--waves 4 10 25]``. With 40
 intervals per peak period IPOPT exploited the coarse rule (P = 9.6 against a limit of 0.02 on
 10 waves): the turns of the optimum are about one time unit wide, so 150 are used.
@@ -36,13 +39,41 @@ from parapend.sea_api import sea  # noqa: E402
 INTERVALS = 150
 
 
+def kernels(sizes):
+    """One Newton run, dense Hessian (Cholesky) against the operator (Newton-CG), same seed."""
+    from parapend.optimal.fourier import FourierProblem, newton_maximize
+    from parapend.optimal.limit import limit, limit_seed
+
+    r = sea(hs=2.0, tp=8.0, repeat_period=8.0 * 20, seed=0, harmonics=64)
+    exc = r.excitation
+    lim = limit(exc)
+    print("| N | dense P | dense s | operator P | operator s | ratio |")
+    print("|---|---|---|---|---|---|")
+    for n in sizes:
+        x0 = limit_seed(lim, n).vector
+        out = []
+        for h in ("dense", "operator"):
+            pb = FourierProblem(exc, n, r.gamma, hessian=h)
+            t = time.perf_counter()
+            sol = newton_maximize(pb, x0, "limit")
+            out.append((sol.power, time.perf_counter() - t))
+        print(f"| {n} | {out[0][0]:.12f} | {out[0][1]:.2f} | {out[1][0]:.12f} | "
+              f"{out[1][1]:.2f} | {out[0][1] / out[1][1]:.1f}x |", flush=True)
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--waves", type=int, nargs="+", default=[4, 10, 25])
+    ap.add_argument("--kernels", type=int, nargs="*", default=None,
+                    help="only time one Newton run, dense against operator Hessian, at these N "
+                         "(20-wave record from its limit seed)")
     ap.add_argument("--intervals", type=int, default=INTERVALS,
                     help="collocation intervals per peak period")
     ap.add_argument("--max-iter", type=int, default=3000)
     a = ap.parse_args()
+    if a.kernels is not None:
+        kernels(a.kernels or [128, 256, 512, 1024])
+        return
     from casadi_pto import collocate
 
     rows = []

@@ -198,6 +198,26 @@ def test_operator_hessian_is_the_dense_hessian_and_the_gradient_is_exact(winding
     assert dense.kinetic(x) == pytest.approx(np.mean(mot.theta_dot(t) ** 2), rel=1e-12)
 
 
+def test_banded_preconditioner_reaches_the_same_maximum(monkeypatch):
+    import parapend.optimal.fourier as fmod
+
+    exc = sea_record(UNITS, repeat_period=48.0, seed=1)
+    x0 = fmod.limit_seed(limit(exc), 96).vector
+    out = []
+    for pc in ("diagonal", "banded"):
+        monkeypatch.setattr(fmod, "PRECONDITIONER", pc)
+        pb = FourierProblem(exc, 96, 0.01, hessian="operator")
+        out.append(newton_maximize(pb, x0, "limit"))
+    assert out[0].status == out[1].status == "converged"
+    assert out[1].power == pytest.approx(out[0].power, abs=1e-14)
+    # the preconditioner is symmetric positive definite
+    _, _, op = FourierProblem(exc, 24, 0.01, hessian="operator").evaluate(
+        fmod._pad(out[0].x, 24))
+    pm = np.column_stack([op.precondition(e) for e in np.eye(49)])
+    np.testing.assert_allclose(pm, pm.T, atol=1e-12 * np.max(np.abs(pm)))
+    assert np.min(np.linalg.eigvalsh(0.5 * (pm + pm.T))) > 0
+
+
 def test_operator_kernel_escapes_a_saddle_like_the_dense_one():
     # q = 0.3 sin 3s, N = 1: theta = s is stationary with an indefinite Hessian (no
     # harmonic of q works on it); a 1e-9 nudge leaves a gradient too small to step along
