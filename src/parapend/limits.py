@@ -11,7 +11,8 @@ __all__ = [
     "MAX_AMPLITUDE", "MAX_BVP_EXTREMA", "MAX_BVP_WORK", "MAX_BYTES_FILE", "MAX_FILE_ROWS",
     "MAX_FOURIER_K", "MAX_GAMMA", "MAX_HARMONICS", "MAX_PHASE", "MAX_POINTS",
     "MAX_SWEEP_HARMONICS", "MAX_SWEEP_WORK", "MAX_TABLE_HARMONICS", "MAX_THRESHOLD_HARMONICS",
-    "MAX_PTO_HARMONICS", "MAX_PTO_POINTS", "MAX_TORQUE_LIMIT", "MIN_BVP_GAMMA", "OMEGA_RANGE",
+    "MAX_PTO_HARMONICS", "MAX_PTO_INTERVALS", "MAX_PTO_POINTS", "MAX_TORQUE_LIMIT",
+    "MIN_BVP_GAMMA", "OMEGA_RANGE",
     "SQUARE_ALPHA_MIN",
 ]
 
@@ -55,6 +56,9 @@ MAX_PTO_HARMONICS = 128
 MAX_TORQUE_LIMIT = 1e6
 #: points of a pto-curve
 MAX_PTO_POINTS = 101
+#: Hermite intervals of the torque-limited optimum (the doubling stops here: 2048 intervals
+#: take about a second per solve)
+MAX_PTO_INTERVALS = 2048
 
 # --- uncontrolled pendulum, paper Eq. 1 (simulate, basins, rotations) ---------------------
 #: forcing frequency omega of Eq. 1 (steps are tied to the forcing period)

@@ -7,9 +7,15 @@ Mirrors ``parapend optimize --torque-limit/--efficiency...`` and ``parapend pto-
     r.power, r.electrical_power, r.peak_torque
     ds = pto.pto_curve(vary="torque-limit", gamma=0.03)
 
-The method is :mod:`parapend.optimal.constrained` (augmented Lagrangian and smoothed
-efficiency on the exact-Hessian Fourier Newton kernel), warm-started from the ideal optimum
-of :func:`parapend.optimize`.
+Two methods, both warm-started from the ideal optimum of :func:`parapend.optimize`:
+
+- a torque limit (alone or with a copper loss): :mod:`parapend.optimal.hermite`, the motion
+  as K cubic Hermite intervals and a primal-dual interior point on the banded Newton
+  system (the optimal torque is bang-bang: a local basis resolves its jumps, a Fourier
+  series does not); K from the excitation, checked by one doubling;
+- an efficiency (with or without a limit): :mod:`parapend.optimal.constrained`, the
+  smoothed efficiency (and an augmented Lagrangian for the limit) on the exact-Hessian
+  Fourier Newton kernel.
 """
 
 from __future__ import annotations
@@ -23,6 +29,7 @@ from . import limits
 from .api import _coefficients, optimize
 from .errors import ParameterError, SolverError, check_finite, check_int, check_range
 from .optimal.constrained import pto_profile, solve_pto
+from .optimal.hermite import HermiteMotion
 from .trajectory import FourierMotion
 
 __all__ = ["VARY", "efficiencies", "optimize_pto", "physical_fields", "pto_curve"]
@@ -128,9 +135,17 @@ def optimize_pto(*, torque_limit=None, efficiency=None, efficiency_generating=No
                                   motoring_energy=prof["motoring_energy"],
                                   harvested_energy=prof["harvested_energy"])
         return dataclasses.replace(res, **physical_fields(res, units))
-    x0 = ideal.motion.vector if warm is None else np.asarray(warm, dtype=float)
-    sol = solve_pto(exc, n, gamma, x0, torque_limit=tmax, efficiency=eff, copper_loss=r_cu)
-    motion = FourierMotion.from_vector(exc.omega, sol.x)
+    extra = {}
+    if eff is None:
+        sol, motion, extra = _time_domain(exc, gamma, ideal, tmax, r_cu, warm)
+        coefficients = _coefficients(_projection(motion, exc, n))
+    else:
+        x0 = ideal.motion.vector if warm is None or not isinstance(warm, np.ndarray) else \
+            np.asarray(warm, dtype=float)
+        sol = solve_pto(exc, n, gamma, x0, torque_limit=tmax, efficiency=eff,
+                        copper_loss=r_cu)
+        motion = FourierMotion.from_vector(exc.omega, sol.x)
+        coefficients = _coefficients(motion)
     prof = pto_profile(motion, exc, gamma, efficiency=eff)
     pu = ideal.uniform_power
     status = sol.status
@@ -140,8 +155,11 @@ def optimize_pto(*, torque_limit=None, efficiency=None, efficiency_generating=No
                        "rotation costs energy through this power take-off (the power shown "
                        "is the smallest loss)",
            "converged": "converged: optimum of the power take-off problem",
-           "infeasible": f"infeasible: no {n}-harmonic rotation found with |T| <= "
-                         f"{tmax}; raise the torque limit",
+           "infeasible": f"infeasible: no rotation found with |T| <= {tmax}; raise the "
+                         "torque limit",
+           "unresolved": "converged, but the power still moved by more than 1e-6 "
+                         f"at the last doubling of the intervals (cap "
+                         f"{limits.MAX_PTO_INTERVALS})",
            "stalled": "stalled: the augmented Lagrangian did not settle its multipliers; "
                       "the motion is feasible but may not be optimal",
            "max_iterations": "maximum number of Newton iterations reached",
@@ -149,21 +167,85 @@ def optimize_pto(*, torque_limit=None, efficiency=None, efficiency_generating=No
     res = dataclasses.replace(
         ideal, power=sol.power,
         gain_over_uniform=(sol.power / pu - 1.0) if pu > 0 else None,
-        success=status in ("converged", "no_power"), status=status, message=msg,
-        iterations=sol.iterations, coefficients=_coefficients(motion),
+        success=status in ("converged", "no_power", "unresolved"), status=status,
+        message=msg,
+        iterations=sol.iterations, coefficients=coefficients,
         peak_torque=sol.peak_torque, found_by="warm" if warm is not None else "ideal optimum",
         local_maxima=[], gradient_norm=sol.gradient_norm, strict_maximum=False,
-        quadrature_points=sol.points, mean_square_speed=motion.mean_square_speed(),
+        quadrature_points=getattr(sol, "points", 0),
+        mean_square_speed=motion.mean_square_speed(),
         torque_limit=tmax, efficiency_generating=None if eff is None else eff[0],
         efficiency_motoring=None if eff is None else eff[1],
         electrical_power=sol.electrical_power, unconstrained_power=ideal.power,
         peak_power=prof["peak_power"], motoring_energy=prof["motoring_energy"],
         harvested_energy=prof["harvested_energy"], max_violation=sol.max_violation,
-        _motion=motion)
+        _motion=motion, **extra)
     res = dataclasses.replace(res, **physical_fields(res, units))
     if throw and not res.success:
         raise SolverError(f"optimize: {res.message}")
     return res
+
+
+def _projection(motion, exc, n: int) -> FourierMotion:
+    """The N-harmonic Fourier projection of a motion (for ``coefficients``)."""
+    from .trajectory import SampledMotion
+
+    m = max(4096, 8 * n)
+    t = exc.period * np.arange(m) / m
+    proj = SampledMotion(exc.omega, motion.theta(t)).to_fourier()
+    return FourierMotion(exc.omega, proj.a0, proj.a[:n], proj.b[:n])
+
+
+def intervals_for(exc) -> int:
+    """Starting number of Hermite intervals: 64, or 8 per harmonic of ``q``, a power of
+    two (then doubled until the power moves by less than 1e-6)."""
+    k = 8 * max(1, int(np.size(exc.spectrum)) - 1)
+    return int(min(limits.MAX_PTO_INTERVALS, max(64, 1 << int(math.ceil(math.log2(k))))))
+
+
+@dataclasses.dataclass
+class _TimeDomain:
+    power: float
+    electrical_power: float
+    peak_torque: float
+    max_violation: float
+    status: str
+    iterations: int
+    gradient_norm: float = float("nan")
+
+
+def _time_domain(exc, gamma, ideal, tmax, copper_loss, warm, rtol: float = 1e-6):
+    """Torque-limited optimum on Hermite intervals, doubled until the power settles."""
+    from .optimal.hermite import solve_hermite
+
+    start = ideal.motion if warm is None or isinstance(warm, np.ndarray) else warm
+    k = intervals_for(exc)
+    prev = None
+    iters = 0
+    change = float("nan")
+    while True:
+        sol = solve_hermite(exc, gamma, k, start, torque_limit=tmax, copper_loss=copper_loss)
+        iters += sol.iterations
+        if sol.status != "converged":
+            break
+        motion = HermiteMotion(exc.omega, sol.x[0::2].copy(), sol.x[1::2].copy())
+        if prev is not None:
+            change = abs(sol.electrical_power - prev)
+            if change <= rtol * max(1.0, abs(sol.electrical_power)) or \
+                    2 * k > limits.MAX_PTO_INTERVALS:
+                break
+        prev = sol.electrical_power
+        start = motion
+        k *= 2
+    motion = HermiteMotion(exc.omega, sol.x[0::2].copy(), sol.x[1::2].copy())
+    status = sol.status
+    if status == "converged" and not change <= rtol * max(1.0, abs(sol.electrical_power)):
+        status = "unresolved"
+    viol = max(sol.peak_torque / tmax - 1.0, 0.0)
+    out = _TimeDomain(power=sol.power, electrical_power=sol.electrical_power,
+                      peak_torque=sol.peak_torque, max_violation=viol, status=status,
+                      iterations=iters)
+    return out, motion, {"method": "hermite", "intervals": k, "refinement_change": change}
 
 
 def pto_curve(vary: str = "torque-limit", *, values=None, points: int = 12,
@@ -224,7 +306,7 @@ def pto_curve(vary: str = "torque-limit", *, values=None, points: int = 12,
             progress(i + 1, len(vals))
         if vary == "torque-limit" and r.status == "infeasible":
             break  # below the smallest feasible limit: smaller ones are infeasible too
-        warm = r.motion.vector
+        warm = r.motion if r.method == "hermite" else r.motion.vector
     feas = [r.torque_limit for r in rows if r.status != "infeasible"]
     ds = xr.Dataset(
         {"power": ("value", [r.power for r in rows]),
