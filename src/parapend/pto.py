@@ -29,7 +29,6 @@ from . import limits
 from .api import _coefficients, optimize
 from .errors import ParameterError, SolverError, check_finite, check_int, check_range
 from .optimal.constrained import pto_profile, solve_pto
-from .optimal.hermite import HermiteMotion
 from .trajectory import FourierMotion
 
 __all__ = ["VARY", "efficiencies", "optimize_pto", "physical_fields", "pto_curve"]
@@ -228,7 +227,7 @@ def _time_domain(exc, gamma, ideal, tmax, copper_loss, warm, rtol: float = 1e-6)
         iters += sol.iterations
         if sol.status != "converged":
             break
-        motion = HermiteMotion(exc.omega, sol.x[0::2].copy(), sol.x[1::2].copy())
+        motion = sol.motion
         if prev is not None:
             change = abs(sol.electrical_power - prev)
             if change <= rtol * max(1.0, abs(sol.electrical_power)) or \
@@ -237,7 +236,7 @@ def _time_domain(exc, gamma, ideal, tmax, copper_loss, warm, rtol: float = 1e-6)
         prev = sol.electrical_power
         start = motion
         k *= 2
-    motion = HermiteMotion(exc.omega, sol.x[0::2].copy(), sol.x[1::2].copy())
+    motion = sol.motion
     status = sol.status
     if status == "converged" and not change <= rtol * max(1.0, abs(sol.electrical_power)):
         status = "unresolved"

@@ -80,26 +80,18 @@ def _fold(k: int) -> np.ndarray:
     return np.where(i <= (k - 1) // 2, 2 * i, 2 * (k - i) - 1)
 
 
-@dataclass(frozen=True, eq=False)
-class HermiteMotion:
-    """Piecewise cubic Hermite rotation: nodes ``t_k = k T_p / K``, ``theta_k``, ``v_k``.
+class _PiecewiseCubic:
+    """A rotation that is a cubic on each of ``K`` uniform intervals of the period,
+    ``theta(t + T_p) = theta(t) + 2 pi winding``; subclasses give ``rows`` and ``local``."""
 
-    ``theta(t + T_p) = theta(t) + 2 pi winding``. ``theta_ddot`` jumps at the nodes; at a
-    node it gives the right-hand limit (:meth:`peak_torque` takes both).
-    """
-
-    omega: float
-    theta_nodes: np.ndarray
-    v_nodes: np.ndarray
-    winding: int = 1
-
-    @property
-    def intervals(self) -> int:
-        return int(self.theta_nodes.size)
+    rows = staticmethod(_hermite_rows)
 
     @property
     def period(self) -> float:
         return 2 * math.pi / self.omega
+
+    def local(self) -> np.ndarray:  # pragma: no cover - abstract
+        raise NotImplementedError
 
     def _locate(self, t):
         t = np.asarray(t, dtype=float)
@@ -108,37 +100,25 @@ class HermiteMotion:
         turns = np.floor(t / self.period)
         tt = t - turns * self.period
         j = np.minimum(np.floor(tt / h), k - 1).astype(int)
-        tau = tt / h - j
-        nxt = (j + 1) % k
-        wrap = np.where(j == k - 1, 2 * math.pi * self.winding, 0.0)
-        y = np.stack([self.theta_nodes[j], self.v_nodes[j], self.theta_nodes[nxt] + wrap,
-                      self.v_nodes[nxt]], axis=-1)
-        return tau, h, y, 2 * math.pi * self.winding * turns
+        return tt / h - j, h, self.local()[j], 2 * math.pi * self.winding * turns
 
     def theta(self, t):
         tau, h, y, off = self._locate(t)
-        return np.sum(_hermite_rows(tau, h)[0] * y, axis=-1) + off
+        return np.sum(self.rows(tau, h)[0] * y, axis=-1) + off
 
     def theta_dot(self, t):
         tau, h, y, _ = self._locate(t)
-        return np.sum(_hermite_rows(tau, h)[1] * y, axis=-1)
+        return np.sum(self.rows(tau, h)[1] * y, axis=-1)
 
     def theta_ddot(self, t):
         tau, h, y, _ = self._locate(t)
-        return np.sum(_hermite_rows(tau, h)[2] * y, axis=-1)
-
-    def local(self):
-        """``y`` of every interval, shape (K, 4): ``theta_j, v_j, theta_{j+1}, v_{j+1}``."""
-        nxt = np.roll(np.arange(self.intervals), -1)
-        th_b = self.theta_nodes[nxt].copy()
-        th_b[-1] += 2 * math.pi * self.winding
-        return np.stack([self.theta_nodes, self.v_nodes, th_b, self.v_nodes[nxt]], axis=1)
+        return np.sum(self.rows(tau, h)[2] * y, axis=-1)
 
     def profile_on(self, tau: np.ndarray):
         """``t, theta, theta', theta''`` at local ``tau`` of every interval, shape (K, len)."""
         k = self.intervals
         h = self.period / k
-        b0, b1, b2 = _hermite_rows(np.asarray(tau, dtype=float), h)
+        b0, b1, b2 = self.rows(np.asarray(tau, dtype=float), h)
         y = self.local()
         t = h * (np.arange(k)[:, None] + np.asarray(tau)[None, :])
         return t, y @ b0.T, y @ b1.T, y @ b2.T
@@ -171,7 +151,7 @@ class HermiteMotion:
         base = h * sel
 
         def f(s):
-            b0, b1, b2 = _hermite_rows(s, h)
+            b0, b1, b2 = self.rows(s, h)
             a = np.sum(b0 * y, 1)
             return np.abs(np.sum(b2 * y, 1) + damping * np.sum(b1 * y, 1)
                           - (1.0 + excitation.q(base + h * s)) * np.sin(a))
@@ -207,13 +187,29 @@ class HermiteMotion:
         _, _, thd, _ = self.profile_on((x + 1) / 2)
         return float(np.sum(thd * thd * w) / (2 * self.intervals))
 
-    @classmethod
-    def from_motion(cls, motion, intervals: int, winding: int = 1) -> HermiteMotion:
-        """Interpolate any motion (``theta``, ``theta_dot``) at ``intervals`` nodes."""
-        t = motion.period * np.arange(intervals) / intervals if hasattr(motion, "period") \
-            else 2 * math.pi / motion.omega * np.arange(intervals) / intervals
-        return cls(motion.omega, np.asarray(motion.theta(t), dtype=float),
-                   np.asarray(motion.theta_dot(t), dtype=float), winding)
+
+
+@dataclass(frozen=True, eq=False)
+class HermiteMotion(_PiecewiseCubic):
+    """Piecewise cubic Hermite rotation: nodes ``t_k = k T_p / K``, ``theta_k``, ``v_k``
+    (``C^1``: ``theta''`` and the torque jump at the nodes; at a node ``theta_ddot`` gives
+    the right-hand limit, :meth:`peak_torque` takes both)."""
+
+    omega: float
+    theta_nodes: np.ndarray
+    v_nodes: np.ndarray
+    winding: int = 1
+
+    @property
+    def intervals(self) -> int:
+        return int(self.theta_nodes.size)
+
+    def local(self):
+        """``y`` of every interval, shape (K, 4): ``theta_j, v_j, theta_{j+1}, v_{j+1}``."""
+        nxt = np.roll(np.arange(self.intervals), -1)
+        th_b = self.theta_nodes[nxt].copy()
+        th_b[-1] += 2 * math.pi * self.winding
+        return np.stack([self.theta_nodes, self.v_nodes, th_b, self.v_nodes[nxt]], axis=1)
 
 
 class HermiteProblem:
@@ -253,8 +249,8 @@ class HermiteProblem:
         xg, wg = np.polynomial.legendre.leggauss(GAUSS_POINTS)
         self.tau_g = (xg + 1) / 2
         self.weight = np.tile(wg / 2 * h / period, (k, 1))  # mean = sum weight * f
-        self.rows_g = _hermite_rows(self.tau_g, h)
-        self.rows_c = _hermite_rows(TORQUE_TAU, h)
+        self.rows_g = self.rows(self.tau_g, h)
+        self.rows_c = self.rows(TORQUE_TAU, h)
         b0g, b1g, _ = self.rows_g
         b0c = self.rows_c[0]
 
@@ -270,24 +266,36 @@ class HermiteProblem:
         self.lin_g = self.rows_g[2] + damping * self.rows_g[1]
         self.lin_c = self.rows_c[2] + damping * self.rows_c[1]
         # banded assembly of the 4x4 interval blocks (lower band, folded node order)
+        self._layout(k)
+
+    rows = staticmethod(_hermite_rows)
+    band = _BAND
+
+    def _layout(self, k):
         pos = _fold(k)
         nodes = np.stack([np.arange(k), np.roll(np.arange(k), -1)], axis=1)  # (K, 2)
         gvar = np.stack([2 * pos[nodes[:, 0]], 2 * pos[nodes[:, 0]] + 1,
                          2 * pos[nodes[:, 1]], 2 * pos[nodes[:, 1]] + 1], axis=1)  # (K, 4)
+        n = 2 * k
+        perm = np.empty(n, dtype=int)  # folded position of variable (node, component)
+        perm[0::2] = 2 * pos
+        perm[1::2] = 2 * pos + 1
+        wrap = np.zeros((k, 4))
+        wrap[-1, 2] = 2 * math.pi * self.winding
+        self._next = np.roll(np.arange(k), -1)
+        self._assembly(gvar, n, perm, wrap)
+
+    def _assembly(self, gvar, n, perm, wrap):
         gi = np.repeat(gvar, 4, axis=1)  # row index of entry a*4+b
         gj = np.tile(gvar, (1, 4))
         keep = gi >= gj
-        n = 2 * k
+        assert int(np.max(gi - gj)) <= self.band
         self.n = n
-        self.perm = np.empty(n, dtype=int)  # folded position of variable (node, component)
-        self.perm[0::2] = 2 * pos
-        self.perm[1::2] = 2 * pos + 1
+        self.perm = perm
         self._flat = ((gi - gj) * n + gj)[keep]
         self._sel = keep
         self._gvar = gvar
-        self._next = np.roll(np.arange(k), -1)
-        self.wrap = np.zeros((k, 4))
-        self.wrap[-1, 2] = 2 * math.pi * self.winding
+        self.wrap = wrap
 
     # -- motion <-> variables ------------------------------------------------------------------
     def local(self, x: np.ndarray) -> np.ndarray:
@@ -431,8 +439,9 @@ class HermiteProblem:
                 d_tt = float(np.sum(lp / sp + lm / sm))
                 rhs_t = -(1.0 - float(np.sum(mu / sp + mu / sm)))
         n = self.n
+        nb = self.band + 1
         ab = np.bincount(self._flat, weights=blocks.reshape(k, 16)[self._sel],
-                         minlength=(_BAND + 1) * n)[:(_BAND + 1) * n].reshape(_BAND + 1, n)
+                         minlength=nb * n)[:nb * n].reshape(nb, n)
         g = np.bincount(self._gvar.ravel(), weights=grad.ravel(), minlength=n)
         if border is not None:
             border = np.bincount(self._gvar.ravel(), weights=border.ravel(), minlength=n)
@@ -453,6 +462,7 @@ class HermiteSolution:
     peak_torque: float = math.nan
     intervals: int = 0
     stages: list = field(default_factory=list)
+    motion: object = None
 
 
 def _solve(ab, rhs, border, rhs_t, d_tt, delta):
@@ -632,7 +642,7 @@ def solve_hermite(excitation, damping: float, intervals: int, start, *, torque_l
                 return HermiteSolution(ph1.x, ph1.t, "infeasible", iters, ph1.mu,
                                        power=pr.power(ph1.x), electrical_power=pr.electrical(
                                            ph1.x), peak_torque=ph1.peak_torque,
-                                       intervals=k, stages=stages)
+                                       intervals=k, stages=stages, motion=pr.motion(ph1.x))
             xa = ph1.x
         x = _blend_feasible(pr, x, xa)
     sol = interior_point(pr, x)
@@ -670,4 +680,5 @@ def solve_hermite(excitation, damping: float, intervals: int, start, *, torque_l
     sol.peak_torque = peak
     sol.intervals = k
     sol.stages = stages
+    sol.motion = motion
     return sol
