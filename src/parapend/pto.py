@@ -29,6 +29,7 @@ from . import limits
 from .api import _coefficients, optimize
 from .errors import ParameterError, SolverError, check_finite, check_int, check_range
 from .optimal.constrained import pto_profile, solve_pto
+from .power import uniform_power
 from .trajectory import FourierMotion
 
 __all__ = ["VARY", "efficiencies", "optimize_pto", "physical_fields", "pto_curve"]
@@ -225,6 +226,9 @@ def _time_domain(exc, gamma, ideal, tmax, copper_loss, warm, rtol: float = 1e-6)
     while True:
         sol = solve_hermite(exc, gamma, k, start, torque_limit=tmax, copper_loss=copper_loss)
         iters += sol.iterations
+        if sol.status == "infeasible" and prev is None and 2 * k <= limits.MAX_PTO_INTERVALS:
+            k *= 2  # the smallest peak torque falls with the resolution: try a finer one
+            continue
         if sol.status != "converged":
             break
         motion = sol.motion
@@ -247,6 +251,20 @@ def _time_domain(exc, gamma, ideal, tmax, copper_loss, warm, rtol: float = 1e-6)
     return out, motion, {"method": "hermite", "intervals": k, "refinement_change": change}
 
 
+def _smallest_limit(ideal):
+    """The smallest peak torque of a rotation (phase 1 of :mod:`parapend.optimal.hermite`
+    from the best uniform rotation, on twice :func:`intervals_for` intervals): ``(dense
+    peak of that motion, status)``. Any smaller limit is infeasible near it; this limit is
+    met (by that motion). A free rotating attractor of the pendulum makes it about 0."""
+    from .optimal.hermite import minimum_peak_torque
+
+    exc = ideal._excitation
+    _, phi = uniform_power(exc, ideal.gamma)
+    uniform = FourierMotion(exc.omega, phi, np.zeros(1), np.zeros(1))
+    sol, _ = minimum_peak_torque(exc, ideal.gamma, 2 * intervals_for(exc), uniform)
+    return float(sol.peak_torque), sol.status
+
+
 def pto_curve(vary: str = "torque-limit", *, values=None, points: int = 12,
               efficiency=None, efficiency_generating=None, efficiency_motoring=None,
               torque_limit=None, units=None, progress=None, **optimize_args):
@@ -256,8 +274,10 @@ def pto_curve(vary: str = "torque-limit", *, values=None, points: int = 12,
     ----------
     vary : {"torque-limit", "efficiency"}
         ``torque-limit``: from the ideal optimum's peak torque down (geometrically) to the
-        smallest limit at which a rotation is still found (the last feasible value), each
-        solve warm-started from the previous (continuation from large to small ``T_max``);
+        smallest feasible limit (the smallest peak torque of any rotation found, phase 1 of
+        :mod:`parapend.optimal.hermite`; 2 % of the top when a free rotation makes that
+        about 0), each solve warm-started from the previous; with an efficiency, down to 2 %
+        of the top (the Fourier method), stopping at the first infeasible value;
         ``efficiency``: ``eta = eta_g = eta_m`` from 1 down to 0.5 (or ``values``).
     values : sequence of float or None
         The limits (m g l) or efficiencies to use instead of the defaults.
@@ -269,7 +289,9 @@ def pto_curve(vary: str = "torque-limit", *, values=None, points: int = 12,
     xarray.Dataset
         Over ``value``: ``power`` (mechanical), ``electrical_power``, ``peak_torque``,
         ``motoring_energy``, ``status``; attrs ``vary``, ``unconstrained_power``, and, for
-        the torque limit, ``smallest_feasible_limit`` (the smallest value solved feasibly).
+        the torque limit, ``smallest_solved_limit`` (the smallest value solved feasibly),
+        ``smallest_feasible_limit`` and ``smallest_feasible_status`` (phase 1, no
+        efficiency).
     """
     import xarray as xr
 
@@ -281,9 +303,12 @@ def pto_curve(vary: str = "torque-limit", *, values=None, points: int = 12,
         if torque_limit is not None:
             raise ParameterError("torque-limit: it is the varied quantity; drop it")
         eff = efficiencies(efficiency, efficiency_generating, efficiency_motoring)
+        tmin = _smallest_limit(ideal) if eff is None else None
         if values is None:
             top = ideal.peak_torque
-            vals = list(top * np.geomspace(1.0, 0.02, npts))
+            low = 0.02 * top if tmin is None else \
+                min(top, max(tmin[0] * (1 + 2e-3), 0.02 * top))
+            vals = list(top * np.geomspace(1.0, low / top, npts))
         else:
             vals = sorted((_torque_limit(v) for v in values), reverse=True)
     else:
@@ -319,7 +344,10 @@ def pto_curve(vary: str = "torque-limit", *, values=None, points: int = 12,
                "gamma": ideal.gamma, "omega": ideal.omega,
                "convention": "power: mechanical P = -<T theta'>; torque units m g l"})
     if vary == "torque-limit":
-        ds.attrs["smallest_feasible_limit"] = min(feas) if feas else float("nan")
+        ds.attrs["smallest_solved_limit"] = min(feas) if feas else float("nan")
+        if tmin is not None:
+            ds.attrs["smallest_feasible_limit"] = tmin[0]
+            ds.attrs["smallest_feasible_status"] = tmin[1]
     if units is not None:
         ds["power_w"] = ds["power"] * units.power
         ds["electrical_power_w"] = ds["electrical_power"] * units.power
@@ -367,9 +395,13 @@ def plot_pto_curve(ds, path=None):
     from .plotting import _finish, plt
 
     fig, ax = plt.subplots(figsize=(7, 4.2))
+    ok = np.isin(ds["status"].values, ["converged", "no_power"])
     v = ds["value"].values
-    ax.plot(v, ds["power"].values, "o-", label="mechanical P")
-    ax.plot(v, ds["electrical_power"].values, "s--", label="electrical")
+    ax.plot(v[ok], ds["power"].values[ok], "o-", label="mechanical P")
+    ax.plot(v[ok], ds["electrical_power"].values[ok], "s--", label="electrical")
+    if not ok.all():
+        ax.plot(v[~ok], ds["power"].values[~ok], "x", color="C3", ms=8,
+                label="not converged (status)")
     ax.axhline(ds.attrs["unconstrained_power"], color="k", ls=":", lw=1,
                label="ideal optimum")
     ax.axhline(ds.attrs["uniform_power"], color="gray", ls=":", lw=1, label="best uniform")

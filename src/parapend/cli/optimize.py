@@ -144,7 +144,8 @@ def _cmd_optimize(a) -> dict | str:
     name = (f"Fourier optimum, N = {r.harmonics} (Eq. 10)" if r.method == "fourier"
             else f"BVP optimum, epsilon = {2 * r.gamma:g} (Eq. 22)")
     if pto:
-        name = f"power take-off optimum, N = {r.harmonics}"
+        name = (f"power take-off optimum, K = {r.intervals}" if r.method == "hermite" else
+                f"power take-off optimum, N = {r.harmonics}")
     rows = [
         ["best uniform rotation (Eq. 17)", _fmt(r.uniform_power), ""],
         [name, _fmt(r.power), _gain(r.power, r.uniform_power)],
@@ -161,6 +162,9 @@ def _cmd_optimize(a) -> dict | str:
                   f"{r.abandoned} abandoned as unable to win")
         if r.second_power is not None:
             search += f"; second-best maximum {_fmt(r.second_power)}"
+    elif r.method == "hermite":
+        how = (f"{r.iterations} interior-point iterations, {r.intervals} cubic Hermite "
+               f"intervals, started from the {r.found_by}")
     else:
         how = (f"{r.mesh_nodes} mesh nodes, max residual {r.max_residual:.2g}, "
                f"{r.continuation_steps} continuation steps, found from the {r.found_by} start")

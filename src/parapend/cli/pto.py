@@ -121,6 +121,9 @@ def pto_lines(r) -> list[str]:
     if r.torque_limit is not None:
         out.append(f"torque limit {r.torque_limit:.6g} (peak |T| {r.peak_torque:.6g}, "
                    f"violation {r.max_violation:.1e})")
+    if r.method == "hermite":
+        out.append(f"time domain: {r.intervals} cubic Hermite intervals, interior point; "
+                   f"power change at the last doubling {r.refinement_change:.1e}")
     if r.efficiency_generating is not None:
         out.append(f"efficiency: generating {r.efficiency_generating:g}, motoring "
                    f"{r.efficiency_motoring:g}; electrical power {_fmt(r.electrical_power, 8)}"
@@ -191,7 +194,13 @@ def _cmd_pto_curve(a) -> dict | str:
            f"{_fmt(ds.attrs['uniform_power'], 8)} (gamma = {ds.attrs['gamma']:g}, N = "
            f"{ds.attrs['harmonics']}); units m g l, m g l / t0"]
     if a.vary == "torque-limit":
-        out.append(f"smallest feasible limit found: {ds.attrs['smallest_feasible_limit']:.6g}")
+        if "smallest_feasible_limit" in ds.attrs:
+            out.append(f"smallest peak torque of a rotation: "
+                       f"{ds.attrs['smallest_feasible_limit']:.6g} (phase 1, "
+                       f"{ds.attrs['smallest_feasible_status']}); smallest limit solved: "
+                       f"{ds.attrs['smallest_solved_limit']:.6g}")
+        else:
+            out.append(f"smallest limit solved: {ds.attrs['smallest_solved_limit']:.6g}")
     if a.plot:
         out.append(f"figure written to {a.plot}")
     return "\n".join(out)

@@ -50,7 +50,8 @@ import math
 from dataclasses import dataclass, field
 
 import numpy as np
-from scipy.linalg import LinAlgError, cho_solve_banded, cholesky_banded
+from scipy.linalg import LinAlgError
+from scipy.linalg.lapack import dpbtrf, dpbtrs
 
 __all__ = ["HermiteMotion", "HermiteProblem", "HermiteSolution", "interior_point",
            "minimum_peak_torque", "solve_hermite"]
@@ -146,33 +147,25 @@ class _PiecewiseCubic:
         if sel.size == 0:
             return best
         y = self.local()[sel]
-        lo = tau[np.maximum(i[sel] - 1, 0)]
-        hi = tau[np.minimum(i[sel] + 1, samples)]
         base = h * sel
-
-        def f(s):
+        # zoom: 9 points across the bracket around the best sample, the bracket shrunk to
+        # the two neighbouring points, six times (spacing 1/16 -> 1/16 / 4^6 of the interval)
+        centre = tau[i[sel]]
+        half = np.full(sel.size, 1.0 / samples)
+        grid = np.linspace(-1.0, 1.0, 9)
+        top_v = best[sel]
+        for _ in range(6):
+            s = np.clip(centre[:, None] + half[:, None] * grid[None, :], 0.0, 1.0)
             b0, b1, b2 = self.rows(s, h)
-            a = np.sum(b0 * y, 1)
-            return np.abs(np.sum(b2 * y, 1) + damping * np.sum(b1 * y, 1)
-                          - (1.0 + excitation.q(base + h * s)) * np.sin(a))
-
-        g = (math.sqrt(5) - 1) / 2
-        c, d = hi - g * (hi - lo), lo + g * (hi - lo)
-        fc, fd = f(c), f(d)
-        for _ in range(24):  # the bracket shrinks to 0.618^24 = 1e-5 of 2/samples
-            left = fc > fd  # the maximum lies in [lo, d]
-            hi = np.where(left, d, hi)
-            lo = np.where(left, lo, c)
-            c_new = np.where(left, hi - g * (hi - lo), d)
-            d_new = np.where(left, c, lo + g * (hi - lo))
-            fc_new = np.where(left, 0.0, fd)
-            fd_new = np.where(left, fc, 0.0)
-            c, d = c_new, d_new
-            ev_c, ev_d = f(c), f(d)
-            fc = np.where(left, ev_c, fc_new)
-            fd = np.where(left, fd_new, ev_d)
+            val = np.abs(np.einsum("ksi,ki->ks", b2 + damping * b1, y)
+                         - (1.0 + excitation.q(base[:, None] + h * s))
+                         * np.sin(np.einsum("ksi,ki->ks", b0, y)))
+            j = np.argmax(val, axis=1)
+            top_v = np.maximum(top_v, val[np.arange(sel.size), j])
+            centre = s[np.arange(sel.size), j]
+            half = half / 4
         out = best.copy()
-        out[sel] = np.maximum(best[sel], np.maximum(fc, fd))
+        out[sel] = top_v
         return out
 
     def interval_peaks(self, excitation, damping: float, floor: float,
@@ -431,7 +424,7 @@ class HermiteProblem:
             # c+- = +-scale T - (t or 1): grad c+- = +-scale jt, hess c+- = +-scale hess T
             grad += np.einsum("kc,kci->ki", scale * (mu / sp - mu / sm), jtc)
             sig = (lp / sp + lm / sm) * scale * scale
-            blocks += np.einsum("kc,kci,kcj->kij", sig, jtc, jtc)
+            blocks += (jtc * sig[..., None]).transpose(0, 2, 1) @ jtc
             blocks += ((scale * (lp - lm) * htc) @ self._c00).reshape(k, 4, 4)
             if self.phase1:
                 # grad_t c+- = -1
@@ -466,12 +459,16 @@ class HermiteSolution:
 
 
 def _solve(ab, rhs, border, rhs_t, d_tt, delta):
+    """Solve the (bordered) banded system by LAPACK's banded Cholesky (dpbtrf/dpbtrs);
+    LinAlgError when ``ab + delta I`` is not positive definite."""
     a = ab.copy()
     a[0] += delta
-    c = cholesky_banded(a, lower=True, check_finite=False)
+    c, info = dpbtrf(a, lower=1)
+    if info != 0:
+        raise LinAlgError("not positive definite")
     if border is None:
-        return cho_solve_banded((c, True), rhs, check_finite=False), 0.0
-    both = cho_solve_banded((c, True), np.stack([rhs, border], axis=1), check_finite=False)
+        return dpbtrs(c, rhs, lower=1)[0], 0.0
+    both = dpbtrs(c, np.stack([rhs, border], axis=1), lower=1)[0]
     # the border's Schur complement is positive in exact arithmetic (the phase-1 matrix is
     # J^T Sigma J + ... with J = [J_x, -1]); cancellation may leave it at roundoff
     schur = max(d_tt + delta - border @ both[:, 1], 1e-12 * (d_tt + delta))
@@ -638,7 +635,7 @@ def solve_hermite(excitation, damping: float, intervals: int, start, *, torque_l
                                          stop_below=torque_limit * (1 - 1e-3), winding=winding)
             iters += ph1.iterations
             stages.append(("phase1", ph1.t, ph1.status))
-            if ph1.status != "feasible":
+            if not ph1.t < torque_limit:  # stopped below the limit, or converged below it
                 return HermiteSolution(ph1.x, ph1.t, "infeasible", iters, ph1.mu,
                                        power=pr.power(ph1.x), electrical_power=pr.electrical(
                                            ph1.x), peak_torque=ph1.peak_torque,
@@ -664,7 +661,16 @@ def solve_hermite(excitation, damping: float, intervals: int, start, *, torque_l
         lim[over, 0] *= (torque_limit / peaks[over]) ** 2 * (1 - 0.1 * tol)
         pr.grid_limit = lim
         x = _blend_feasible(pr, sol.x, xa)
-        sol = interior_point(pr, x, mu0=1e-6 * abs(pr.objective(x)) / pr.barrier_count())
+        if x is None:  # the anchor is not inside the tightened limits: a new one, or stop
+            ph1, _ = minimum_peak_torque(excitation, damping, k, pr.motion(xa),
+                                         stop_below=float(np.min(lim)) * (1 - 1e-3),
+                                         winding=winding)
+            iters += ph1.iterations
+            x = _blend_feasible(pr, sol.x, ph1.x) if ph1.t < np.min(lim) else None
+            if x is None:
+                break
+            xa = ph1.x
+        sol = interior_point(pr, x, mu0=1e-4 * abs(pr.objective(x)) / pr.barrier_count())
         iters += sol.iterations
         stages.append(("tighten", float(np.min(lim)), sol.status))
         motion = pr.motion(sol.x)
