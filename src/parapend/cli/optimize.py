@@ -13,6 +13,7 @@ from . import _output
 from . import pto as _pto
 from ._common import (
     FIGURE_SUFFIXES,
+    Default,
     _add_excitation,
     _check_output,
     _dataset_json,
@@ -34,7 +35,7 @@ def add_parsers(sub) -> None:
                                    "22, 27), beside the best uniform rotation (Eq. 17) and the "
                                    "gamma -> 0 limit (Eqs. 19, 24, 32 generalized).")
     _add_excitation(p)
-    p.add_argument("--gamma", type=_finite_float("gamma"), default=0.0,
+    p.add_argument("--gamma", type=_finite_float("gamma"), default=Default(0.0),
                    help="viscous damping gamma in [0, 1e3] (default 0)")
     p.add_argument("--harmonics", type=_int, default=24,
                    help=f"number N of harmonics, at most {limits.MAX_HARMONICS} (default 24)")
@@ -81,7 +82,7 @@ def add_parsers(sub) -> None:
                        description="Fourier optimum for N = FROM..TO by continuation in N "
                                    "(nondecreasing in N), beside the uniform and limit powers.")
     _add_excitation(p)
-    p.add_argument("--gamma", type=_finite_float("gamma"), default=0.0,
+    p.add_argument("--gamma", type=_finite_float("gamma"), default=Default(0.0),
                    help="viscous damping gamma in [0, 1e3] (default 0)")
     p.add_argument("--from", dest="n_from", type=_int, default=2, help="smallest N (default 2)")
     p.add_argument("--to", dest="n_to", type=_int, default=64,
