@@ -9,7 +9,9 @@ design's under model error or irregular excitation). The controller samples the 
 ``M`` times per forcing period (``h = 2 pi / (omega M)``), optionally with Gaussian
 measurement noise, and holds its torque over the interval (zero-order hold):
 
-- pump (:mod:`.swingup`) until the pendulum rotates forward with energy above the top's;
+- pump (:mod:`.swingup`) until the pendulum rotates forward with energy above the top's,
+  and again whenever tracking has been a quarter turn or more off the orbit for a whole
+  period (lost: a limited torque could not pull it in);
 - then track: ``T_k = sat(T_ff,k - K_k e_k)``, ``e_k = (wrap(theta_k - theta*_k),
   theta'_k - theta*'_k)``, the feedforward of Eq. 14 on the optimal motion plus the
   periodic LQR gain (:mod:`.riccati`), saturated at ``|T| <= T_max``. Wrapping the angle
@@ -28,7 +30,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .swingup import energy, pump_torque, ready_to_catch
+from .swingup import pump_torque, ready_to_catch
 
 __all__ = ["ClosedLoopRun", "run_closed_loop"]
 
@@ -106,20 +108,24 @@ def run_closed_loop(target, gains, *, periods: int, torque_limit: float | None,
     out_om = [0.0] * (nk + 1)
     out_t = [0.0] * (nk + 1)
     out_mode = [0] * (nk + 1)
-    mode = PUMP
+    mode, braking, astray = PUMP, False, 0
     sin = math.sin
     for k in range(nk + 1):
         out_th[k], out_om[k] = th, om
         y0, y1 = th + nz_th[k], om + nz_om[k]
         j = k % m
         if mode == PUMP and ready_to_catch(y0, y1, catch_margin):
-            mode = TRACK
-        if mode == PUMP:
-            u = pump_torque(y1, level)
-        else:
+            mode, astray = TRACK, 0
+        if mode == TRACK:
             n = k // m
             e0 = wrap(y0 - ref_th[j] - two_pi * n)
             e1 = y1 - ref_om[j]
+            astray = astray + 1 if abs(e0) > 0.5 * math.pi else 0
+            if astray > m:  # a quarter turn or more off for a whole period: pump again
+                mode, braking = PUMP, False
+        if mode == PUMP:
+            u, braking = pump_torque(y0, y1, level, catch_margin, braking)
+        else:
             u = ff[j] - k1s[j] * e0 - k2s[j] * e1
             if u > tmax:
                 u = tmax
@@ -160,5 +166,3 @@ def mechanical_energy(run) -> np.ndarray:
     """``E_k`` of :func:`.swingup.energy` along the run."""
     return 0.5 * run.theta_dot**2 + np.cos(run.theta)
 
-
-_ = energy  # re-exported helper used by callers through this module
