@@ -62,7 +62,8 @@ def wrap(x: float) -> float:
 def run_closed_loop(target, gains, *, periods: int, torque_limit: float | None,
                     plant_q, plant_gamma: float, state0=(math.pi, 0.0),
                     noise=(0.0, 0.0), rng=None, pump_level: float = 1.0,
-                    catch_margin: float = 0.05, substeps: int = 4) -> ClosedLoopRun:
+                    catch_margin: float = 0.05, substeps: int = 4,
+                    start_tracking: bool = False) -> ClosedLoopRun:
     """Simulate the sampled closed loop from ``state0`` (default hanging at rest).
 
     Parameters
@@ -84,6 +85,8 @@ def run_closed_loop(target, gains, *, periods: int, torque_limit: float | None,
         Source of the noise (needed when ``noise`` is not zero).
     pump_level : float
         Pump torque ``T_p`` (capped at ``T_max``).
+    start_tracking : bool
+        Start in the tracking mode (no swing-up): for a state near the orbit.
     """
     m, h = target.samples, target.step
     nk = periods * m
@@ -108,7 +111,7 @@ def run_closed_loop(target, gains, *, periods: int, torque_limit: float | None,
     out_om = [0.0] * (nk + 1)
     out_t = [0.0] * (nk + 1)
     out_mode = [0] * (nk + 1)
-    mode, braking, astray = PUMP, False, 0
+    mode, braking, astray = (TRACK if start_tracking else PUMP), False, 0
     sin = math.sin
     for k in range(nk + 1):
         out_th[k], out_om[k] = th, om

@@ -18,7 +18,7 @@ import numpy as np
 from .. import limits
 from ..errors import ParameterError, check_int, check_range
 from ..results import _Result
-from .track import AVERAGE_PERIODS, prepare, simulate_design
+from .track import AVERAGE_PERIODS, simulate_design
 
 __all__ = ["RobustnessResult", "track_runs"]
 
@@ -72,11 +72,12 @@ def track_runs(*, runs: int = 20, seed: int = 0, periods: int = 100, torque_limi
                torque_margin: float = 0.1, gamma_error: float = 0.0,
                delta_error: float = 0.0, noise_theta: float = 0.0, noise_speed: float = 0.0,
                irregular: bool = False, lock_tolerance: float = 0.1, r_weight: float = 0.1,
-               progress=None, **optimize_args) -> RobustnessResult:
+               progress=None, design=None, **optimize_args) -> RobustnessResult:
     """``runs`` seeded closed-loop runs from hanging rest (module docstring); the other
     parameters as :func:`parapend.control.track` (the errors are the bounds of the draws).
-    At most ``runs * periods <= 40000`` (:data:`parapend.limits.MAX_TRACK_WORK`)."""
-    from .track import _multipliers
+    At most ``runs * periods <= 40000`` (:data:`parapend.limits.MAX_TRACK_WORK`);
+    ``design``: a :func:`~parapend.control.track.prepare` result to reuse."""
+    from .track import _design, _multipliers
 
     runs = check_int("runs", runs, 1, 1000)
     periods = check_int("periods", periods, 2 * AVERAGE_PERIODS, limits.MAX_TRACK_PERIODS)
@@ -89,8 +90,7 @@ def track_runs(*, runs: int = 20, seed: int = 0, periods: int = 100, torque_limi
     nt = check_range("noise-theta", noise_theta, 0.0, 1.0)
     ns = check_range("noise-speed", noise_speed, 0.0, 10.0)
     tol = check_range("lock-tolerance", lock_tolerance, 1e-6, math.pi)
-    d = prepare(torque_limit=torque_limit, torque_margin=torque_margin, r_weight=r_weight,
-                **optimize_args)
+    d = _design(design, torque_limit, torque_margin, r_weight, optimize_args)
     if d.status == "infeasible":
         raise ParameterError(f"torque-limit: no rotation within the design limit "
                              f"{d.design_limit:g} ({d.message})")

@@ -9,14 +9,14 @@ Below the top's energy (``E < 1 + catch_margin``) the pump applies
 ``T = T_p sign(theta')`` (``T_p = min(T_max, pump_level)``, forward when at rest): the
 torque term is then ``T_p |theta'| >= 0``, the largest rate of energy input a torque
 bounded by ``T_p`` can give, and the parametric term ``q sin(theta) theta'`` only adds to
-or subtracts from it as the phase falls. Above it the pendulum rotates: backwards
+or subtracts from it as the phase falls. Above it the pendulum rotates. Backwards
 (``theta' < 0``) the pump brakes, pushing forward (``T = +T_p``) until the pendulum has
-turned (``theta' >= 0``; the braking is held across the energy threshold, else the pump
-would hover at ``E = 1 + catch_margin`` alternately braking and pumping backwards); forwards (``theta' > 0``) the tracking
-controller takes over (:mod:`.closedloop`), and the rotation's phase is pulled onto the
-forcing by the tracking feedback on the wrapped angle error. (A pump that only followed
-``sign(theta')`` would spin a pendulum that a noisy measurement started backwards ever
-faster backwards, never reaching the forward catch.)
+turned (``theta' >= 0``); the braking is held across the energy threshold, else the pump
+would hover at ``E = 1 + catch_margin``, alternately braking and pumping backwards.
+Forwards (``theta' > 0``) the tracking controller takes over (:mod:`.closedloop`), and
+the rotation's phase is pulled onto the forcing by the tracking feedback on the wrapped
+angle error. (A pump that only followed ``sign(theta')`` would spin a pendulum that a
+noisy measurement started backwards ever faster backwards, never reaching the catch.)
 """
 
 from __future__ import annotations

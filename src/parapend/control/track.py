@@ -234,7 +234,8 @@ def track(*, torque_limit=None, torque_margin: float = 0.1, periods: int = 100,
           seed: int = 0, gamma_error: float = 0.0, delta_error: float = 0.0,
           noise_theta: float = 0.0, noise_speed: float = 0.0, irregular: bool = False,
           lock_tolerance: float = 0.1, r_weight: float = 0.1, theta0: float = math.pi,
-          theta_dot0: float = 0.0, throw: bool = False, **optimize_args) -> TrackResult:
+          theta_dot0: float = 0.0, throw: bool = False, design=None,
+          **optimize_args) -> TrackResult:
     """Swing up from ``(theta0, theta_dot0)`` (default hanging at rest), catch and hold the
     optimal rotation of a case under ``|T| <= torque_limit``; simulate ``periods`` forcing
     periods of the full nonlinear Eq. 14.
@@ -262,6 +263,9 @@ def track(*, torque_limit=None, torque_margin: float = 0.1, periods: int = 100,
         Largest wrapped angle error (rad) of a locked period.
     r_weight : float
         Torque weight ``R`` of the LQR (``Q = I``).
+    design : Design or None
+        A design from :func:`prepare` to reuse (then the case, ``torque_limit``,
+        ``torque_margin`` and ``r_weight`` come from it and are not given).
     **optimize_args
         The case, as :func:`parapend.optimize` (``gamma``, ``omega``, ``delta``,
         ``harmonics``, ``excitation``, ...).
@@ -275,12 +279,25 @@ def track(*, torque_limit=None, torque_margin: float = 0.1, periods: int = 100,
     lock_tolerance = check_range("lock-tolerance", lock_tolerance, 1e-6, math.pi)
     state0 = _check_state((theta0, theta_dot0))
     check_finite("r-weight", r_weight)
-    d = prepare(torque_limit=torque_limit, torque_margin=torque_margin, r_weight=r_weight,
-                **optimize_args)
+    d = _design(design, torque_limit, torque_margin, r_weight, optimize_args)
     return _result(d, periods=periods, seed=seed, gamma_error=gamma_error,
                    delta_error=delta_error, noise_theta=noise_theta, noise_speed=noise_speed,
                    irregular=bool(irregular), lock_tolerance=lock_tolerance, state0=state0,
                    throw=throw)
+
+
+def _design(design, torque_limit, torque_margin, r_weight, optimize_args) -> Design:
+    if design is None:
+        return prepare(torque_limit=torque_limit, torque_margin=torque_margin,
+                       r_weight=r_weight, **optimize_args)
+    if not isinstance(design, Design):
+        raise ParameterError(f"design: expected a Design from prepare(), got "
+                             f"{type(design).__name__}")
+    if optimize_args or torque_limit is not None:
+        raise ParameterError("design: a prepared design fixes the case and the torque "
+                             "limit; drop " + ", ".join(sorted(optimize_args) or
+                                                       ["torque_limit"]))
+    return design
 
 
 def _result(d: Design, *, periods, seed, gamma_error, delta_error, noise_theta, noise_speed,
