@@ -75,7 +75,7 @@ def track_runs(*, runs: int = 20, seed: int = 0, periods: int = 100, torque_limi
                progress=None, design=None, **optimize_args) -> RobustnessResult:
     """``runs`` seeded closed-loop runs from hanging rest (module docstring); the other
     parameters as :func:`parapend.control.track` (the errors are the bounds of the draws).
-    At most ``runs * periods <= 40000`` (:data:`parapend.limits.MAX_TRACK_WORK`);
+    At most ``runs * periods <= 10000`` (:data:`parapend.limits.MAX_TRACK_WORK`);
     ``design``: a :func:`~parapend.control.track.prepare` result to reuse."""
     from .track import _design, _multipliers
 
@@ -83,7 +83,7 @@ def track_runs(*, runs: int = 20, seed: int = 0, periods: int = 100, torque_limi
     periods = check_int("periods", periods, 2 * AVERAGE_PERIODS, limits.MAX_TRACK_PERIODS)
     if runs * periods > limits.MAX_TRACK_WORK:
         raise ParameterError(f"runs: expected runs * periods <= {limits.MAX_TRACK_WORK} "
-                             f"(about a minute), got {runs} * {periods}")
+                             f"(about 50 s), got {runs} * {periods}")
     seed = check_int("seed", seed, 0, 2**63 - 1)
     ge = abs(check_range("gamma-error", gamma_error, -0.9, 0.9))
     de = abs(check_range("delta-error", delta_error, -0.9, 0.9))
