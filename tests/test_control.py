@@ -144,6 +144,14 @@ def test_open_loop_unstable_optimum_is_locked_and_held():
     assert abs(r.mean_power / opt.power - 1) < 1e-3
 
 
+def test_above_the_damping_threshold_the_rotation_is_held_at_a_cost():
+    # gamma = 0.2 > gamma* = 0.0856: the optimum is the smallest loss (status no_power)
+    r = track(gamma=0.2, periods=30)
+    assert r.optimum_status == "no_power" and r.predicted_power < 0
+    assert r.locked and r.mean_power == pytest.approx(r.predicted_power, rel=1e-4)
+    assert r.energy_before_lock < 0 and r.payback_periods is None
+
+
 # --- Floquet multipliers and the periodic Riccati equation -------------------------------
 @pytest.mark.parametrize("case", [{}, UNSTABLE])
 def test_open_loop_multipliers_against_nonlinear_flow(case):

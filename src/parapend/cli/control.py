@@ -142,8 +142,12 @@ def _cmd_track(a) -> dict | str:
            + (f"; optimum at T_max {_fmt(r.optimum_at_torque_limit, 8)}"
               if r.optimum_at_torque_limit is not None else ""),
            f"swing-up handed over after {_fmt(r.catch_period, 4)} periods; energy before "
-           f"the lock {_fmt(r.energy_before_lock, 6)} (m g l), paid back in "
-           f"{_fmt(r.payback_periods, 4)} periods",
+           f"the lock {_fmt(r.energy_before_lock, 6)} (m g l), " + (
+               f"paid back in {_fmt(r.payback_periods, 4)} periods"
+               if r.payback_periods is not None else
+               "never paid back (the locked power is not positive)" if r.locked else
+               "no payback (not locked)"),
+           f"tracked optimum: status {r.optimum_status}",
            f"peak torque applied {_fmt(r.peak_torque, 5)} (the optimum's "
            f"{_fmt(r.tracked_peak_torque, 5)}); tracking error {r.tracking_error:.3g} rad",
            f"Floquet multipliers, open loop: {_mult(r.open_loop_multipliers)}",

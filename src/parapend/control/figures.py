@@ -39,7 +39,10 @@ def plot_track(result, path=None):
                      f"T_max = {_num(result.torque_limit)}; "
                      + (f"locked after {result.lock_period} periods" if result.locked
                         else "not locked"), fontsize=9)
-        a0.semilogy(per, np.maximum(err, 1e-12), lw=0.5, color="C1")
+        floor = max(1e-12, 0.3 * float(np.percentile(err[err > 0], 1))) if np.any(err > 0) \
+            else 1e-12
+        a0.semilogy(per, np.maximum(err, floor), lw=0.5, color="C1")
+        a0.set_ylim(bottom=floor)
         a0.axhline(result.lock_tolerance, color="k", ls="--", lw=0.7)
         a0.set_ylabel("|angle error| (rad)")
         a2.plot(per, run.torque, lw=0.5, color="C2")

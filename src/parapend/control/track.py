@@ -64,7 +64,11 @@ class TrackResult(_Result):
         Extracted energy up to the lock (negative: the energy spent on swing-up and catch).
     payback_periods : float or None
         Periods after the lock until the locked power has returned that energy
-        (``-energy_before_lock / (mean_power * period)``; 0 if nothing was spent).
+        (``-energy_before_lock / (mean_power * period)``; 0 if nothing was spent; None if
+        not locked, or if energy was spent and the locked power is not positive).
+    optimum_status : str
+        Status of the tracked optimum's solve (``optimize`` or ``optimize_pto``):
+        "converged", "no_power" (its power is not positive), "stalled", ...
     tracking_error : float
         Largest wrapped angle error over the last 10 periods (rad).
     open_loop_multipliers, closed_loop_multipliers : list of [re, im]
@@ -85,6 +89,7 @@ class TrackResult(_Result):
     tracking_error: float
     open_loop_multipliers: list
     closed_loop_multipliers: list
+    optimum_status: str
     success: bool
     status: str
     message: str
@@ -220,8 +225,9 @@ def simulate_design(d: Design, *, periods: int, seed: int = 0, gamma_error: floa
     e_lock = None if lock is None else float(w[lock * m])
     payback = None
     if e_lock is not None:
+        # None: energy was spent and the locked power never returns it
         payback = 0.0 if e_lock >= 0 else (-e_lock / (mean_power * tg.period)
-                                           if mean_power > 0 else math.inf)
+                                           if mean_power > 0 else None)
     fields = {"locked": lock is not None, "lock_period": lock,
               "catch_period": float(catch[0] / m) if catch.size else None,
               "mean_power": mean_power, "peak_torque": float(np.max(np.abs(run.torque))),
@@ -330,8 +336,9 @@ def _result(d: Design, *, periods, seed, gamma_error, delta_error, noise_theta, 
         tracked_peak_torque=tg.peak_torque,
         open_loop_multipliers=_multipliers(d.lqr.open_loop_multipliers),
         closed_loop_multipliers=_multipliers(d.lqr.closed_loop_multipliers),
-        success=status == "locked", status=status, message=msg, gamma=tg.gamma,
-        omega=tg.omega, torque_limit=d.torque_limit, design_torque_limit=d.design_limit,
+        optimum_status=d.status, success=status == "locked", status=status, message=msg,
+        gamma=tg.gamma, omega=tg.omega, torque_limit=d.torque_limit,
+        design_torque_limit=d.design_limit,
         periods=periods, samples_per_period=tg.samples, lock_tolerance=lock_tolerance,
         seed=seed, delta_error=delta_error, noise_theta=noise_theta,
         noise_speed=noise_speed, irregular=irregular, riccati_sweeps=d.lqr.sweeps,
