@@ -152,6 +152,33 @@ def test_above_the_damping_threshold_the_rotation_is_held_at_a_cost():
     assert r.energy_before_lock < 0 and r.payback_periods is None
 
 
+def _random_cases(n, seed=11):
+    """Seeded two-term Fourier excitations around the paper's: q = a1 sin(omega t) +
+    a2 sin(k omega t + phi), omega in [1, 3], a1 in [-0.5, -0.1], |a2| <= 0.2, k in {2, 3}."""
+    rng = np.random.default_rng(seed)
+    out = []
+    for _ in range(n):
+        omega = float(rng.uniform(1.0, 3.0))
+        k2 = int(rng.integers(2, 4))
+        a1, a2 = float(rng.uniform(-0.5, -0.1)), float(rng.uniform(-0.2, 0.2))
+        out.append((omega, f"1:{a1}:0.0,{k2}:{a2}:{float(rng.uniform(0, 6.28))}"))
+    return out
+
+
+@pytest.mark.parametrize("count", [10, pytest.param(30, marks=pytest.mark.slow)])
+def test_random_optima_stable_or_not_are_locked_and_held(count):
+    unstable = 0
+    for omega, terms in _random_cases(count):
+        opt = optimize(gamma=GAMMA, omega=omega, fourier=terms)
+        r = track(gamma=GAMMA, omega=omega, fourier=terms,
+                  torque_limit=3 * opt.peak_torque, periods=30)
+        unstable += max(abs(complex(*z)) for z in r.open_loop_multipliers) > 1
+        assert max(abs(complex(*z)) for z in r.closed_loop_multipliers) < 0.5
+        assert r.locked and r.lock_period <= 50, (omega, terms)
+        assert abs(r.mean_power / opt.power - 1) < 1e-3
+    assert unstable >= count // 5  # the batch does contain open-loop unstable optima
+
+
 # --- Floquet multipliers and the periodic Riccati equation -------------------------------
 @pytest.mark.parametrize("case", [{}, UNSTABLE])
 def test_open_loop_multipliers_against_nonlinear_flow(case):
