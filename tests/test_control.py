@@ -133,6 +133,19 @@ def test_torque_limit_one_reaches_the_torque_limited_optimum(limited):
     assert abs(first - (r.lock_period + r.payback_periods)) <= 1.0
 
 
+def test_tracking_the_optimum_at_the_limit_itself_without_margin():
+    """The literal reading: track the torque-limited optimum at T_max = 1 with T_max = 1
+    (no margin). The feedforward rides the limit on arcs; on the orbit the feedback is
+    zero, so the exact feedforward holds it, and the power is that optimum's."""
+    d = prepare(gamma=GAMMA, torque_limit=1.0, torque_margin=0.0)
+    r = track(design=d, periods=30)
+    assert r.design_torque_limit == 1.0 and r.optimum_at_torque_limit is None
+    assert r.locked and r.peak_torque <= 1.0
+    assert abs(r.mean_power / r.predicted_power - 1) < 1e-2
+    assert r.predicted_power == pytest.approx(optimize_pto(torque_limit=1.0, gamma=GAMMA).power,
+                                              rel=1e-9)
+
+
 def test_open_loop_unstable_optimum_is_locked_and_held():
     opt = optimize(gamma=GAMMA, **UNSTABLE)
     r = track(gamma=GAMMA, torque_limit=3 * opt.peak_torque, periods=40, **UNSTABLE)

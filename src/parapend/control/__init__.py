@@ -10,6 +10,7 @@
 - :mod:`.robustness`: seeded batches of runs with model error, noise and irregular seas.
 """
 
-from .track import TrackResult, track
+from .robustness import RobustnessResult, track_runs
+from .track import TrackResult, prepare, track
 
-__all__ = ["TrackResult", "track"]
+__all__ = ["RobustnessResult", "TrackResult", "prepare", "track", "track_runs"]

@@ -75,16 +75,21 @@ class Target:
         return self.period / self.samples
 
 
-def build_target(result, samples: int = 256) -> Target:
-    """The target of an optimize / optimize_pto result (``power``, ``peak_torque``,
-    ``gamma``, ``torque_limit``, ``motion``, ``_excitation``)."""
-    exc = result._excitation
+def build_target(result, samples: int = 256, *, excitation=None, gamma=None) -> Target:
+    """The target of an optimize / optimize_pto result.
+
+    Only ``power``, ``peak_torque``, ``torque_limit`` (if any) and ``motion`` of the result
+    are read, with ``excitation`` and ``gamma`` (default: the result's ``_excitation`` and
+    ``gamma``, as :func:`parapend.optimize` gives them).
+    """
+    exc = result._excitation if excitation is None else excitation
+    gamma = float(result.gamma if gamma is None else gamma)
     motion = result.motion
     period = 2 * math.pi / exc.omega
     h = period / samples
     t = h * np.arange(samples)
-    ff = _torque(motion, exc, result.gamma, t + 0.5 * h)
-    return Target(excitation=exc, gamma=float(result.gamma), motion=motion,
+    ff = _torque(motion, exc, gamma, t + 0.5 * h)
+    return Target(excitation=exc, gamma=gamma, motion=motion,
                   power=float(result.power), peak_torque=float(result.peak_torque),
                   design_limit=getattr(result, "torque_limit", None), samples=int(samples),
                   t=t, theta=np.asarray(motion.theta(t), dtype=float),

@@ -153,17 +153,17 @@ def prepare(*, torque_limit=None, torque_margin: float = 0.1, r_weight: float = 
     chosen, design, at_limit = ideal, None, None
     status, message = ideal.status, ideal.message
     if torque_limit is not None and ideal.peak_torque > (1 - margin) * torque_limit:
+        # only optimize_pto(torque_limit=..., **optimize_args) and its result's power,
+        # peak_torque, status, torque_limit and motion are relied on
         from ..pto import optimize_pto
 
         design = (1 - margin) * torque_limit
-        chosen = optimize_pto(torque_limit=design, ideal=ideal, **optimize_args)
-        status, message = chosen.status, chosen.message
+        chosen = optimize_pto(torque_limit=design, **optimize_args)
+        status = chosen.status
+        message = getattr(chosen, "message", status)
         if margin > 0:
-            at_limit = optimize_pto(torque_limit=torque_limit, ideal=ideal,
-                                    warm=chosen.motion.vector
-                                    if hasattr(chosen.motion, "vector") else None,
-                                    **optimize_args).power
-    target = build_target(chosen, SAMPLES)
+            at_limit = optimize_pto(torque_limit=torque_limit, **optimize_args).power
+    target = build_target(chosen, SAMPLES, excitation=ideal._excitation, gamma=ideal.gamma)
     lqr = periodic_lqr(target, r_weight=r_weight)
     return Design(target, lqr, torque_limit, design, at_limit, status, message)
 
