@@ -13,7 +13,8 @@ Modules: :mod:`._common` (parser helpers, number parsing, tables, progress),
 :mod:`._output` (every file written), :mod:`.optimize` (optimize, threshold, damping-sweep,
  harmonics), :mod:`.paper` (figure, reproduce), :mod:`.pto` (pto-curve; the power
  take-off and unit options of optimize), :mod:`.dynamics` (simulate, basins,
- rotations: the uncontrolled pendulum of paper Eq. 1).
+ rotations: the uncontrolled pendulum of paper Eq. 1), :mod:`.control` (track: the
+ closed loop of issue 11).
 """
 
 from __future__ import annotations
@@ -25,6 +26,7 @@ import sys
 from .. import __version__
 from ..errors import ParameterError, SolverError
 from ..results import to_jsonable
+from . import control as _control_cmds
 from . import dynamics as _dynamics_cmds
 from . import optimize as _optimize_cmds
 from . import paper as _paper_cmds
@@ -37,7 +39,7 @@ EXIT_FAILURE = 1
 __all__ = ["build_parser", "main"]
 
 COMMANDS = {**_optimize_cmds.COMMANDS, **_paper_cmds.COMMANDS, **_pto_cmds.COMMANDS,
-            **_dynamics_cmds.COMMANDS}
+            **_dynamics_cmds.COMMANDS, **_control_cmds.COMMANDS}
 
 
 def build_parser():
@@ -53,6 +55,7 @@ def build_parser():
     _paper_cmds.add_parsers(sub)
     _pto_cmds.add_parsers(sub)
     _dynamics_cmds.add_parsers(sub)
+    _control_cmds.add_parsers(sub)
     return parser
 
 
