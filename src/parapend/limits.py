@@ -11,7 +11,8 @@ __all__ = [
     "MAX_AMPLITUDE", "MAX_BVP_EXTREMA", "MAX_BVP_WORK", "MAX_BYTES_FILE", "MAX_FILE_ROWS",
     "MAX_FOURIER_K", "MAX_GAMMA", "MAX_HARMONICS", "MAX_PHASE", "MAX_POINTS",
     "MAX_SWEEP_HARMONICS", "MAX_SWEEP_WORK", "MAX_TABLE_HARMONICS", "MAX_THRESHOLD_HARMONICS",
-    "MAX_PTO_HARMONICS", "MAX_PTO_POINTS", "MAX_TORQUE_LIMIT", "MIN_BVP_GAMMA", "OMEGA_RANGE",
+    "MAX_PTO_HARMONICS", "MAX_PTO_INTERVALS", "MAX_PTO_POINTS", "MAX_TORQUE_LIMIT",
+    "MIN_BVP_GAMMA", "OMEGA_RANGE",
     "SQUARE_ALPHA_MIN",
 ]
 
@@ -55,6 +56,9 @@ MAX_PTO_HARMONICS = 128
 MAX_TORQUE_LIMIT = 1e6
 #: points of a pto-curve
 MAX_PTO_POINTS = 101
+#: Hermite intervals of the torque-limited optimum (the doubling stops here: 2048 intervals
+#: take about a second per solve)
+MAX_PTO_INTERVALS = 2048
 
 # --- uncontrolled pendulum, paper Eq. 1 (simulate, basins, rotations) ---------------------
 #: forcing frequency omega of Eq. 1 (steps are tied to the forcing period)
@@ -81,6 +85,13 @@ ROT_OMEGA_RANGE = (0.8, 10.0)
 ROT_MAX_OMEGAS = 40
 ROT_MAX_P = 3.0
 
+# --- closed-loop control (track) ------------------------------------------------------
+#: forcing periods of one closed-loop run (about 1.5 ms each at 256 samples per period)
+MAX_TRACK_PERIODS = 2000
+#: runs x periods of a seeded robustness batch (track --runs): 20 irregular runs of 2000
+#: periods (40000) took 213 s and 430 MB under load 4; 5 such runs (10000) took 64 s
+MAX_TRACK_WORK = 10000
+
 # --- irregular seas (sea command, docs/seas.md) ------------------------------------------
 #: significant wave height and |z| of a measured record, m
 SEA_MAX_HS = 30.0
@@ -94,5 +105,3 @@ SEA_MAX_COMPONENTS = 8192
 SEA_MAX_RECORD_ROWS = 1 << 17
 #: harmonics N of the motion over one record (operator Newton: memory O(N), time O(N log N))
 SEA_MAX_HARMONICS = 16384
-#: windings tried by --winding auto
-SEA_MAX_WINDINGS = 64

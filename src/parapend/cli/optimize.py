@@ -13,6 +13,7 @@ from . import _output
 from . import pto as _pto
 from ._common import (
     FIGURE_SUFFIXES,
+    Default,
     _add_excitation,
     _check_output,
     _dataset_json,
@@ -34,7 +35,7 @@ def add_parsers(sub) -> None:
                                    "22, 27), beside the best uniform rotation (Eq. 17) and the "
                                    "gamma -> 0 limit (Eqs. 19, 24, 32 generalized).")
     _add_excitation(p)
-    p.add_argument("--gamma", type=_finite_float("gamma"), default=0.0,
+    p.add_argument("--gamma", type=_finite_float("gamma"), default=Default(0.0),
                    help="viscous damping gamma in [0, 1e3] (default 0)")
     p.add_argument("--harmonics", type=_int, default=24,
                    help=f"number N of harmonics, at most {limits.MAX_HARMONICS} (default 24)")
@@ -85,7 +86,7 @@ def add_parsers(sub) -> None:
                        description="Fourier optimum for N = FROM..TO by continuation in N "
                                    "(nondecreasing in N), beside the uniform and limit powers.")
     _add_excitation(p)
-    p.add_argument("--gamma", type=_finite_float("gamma"), default=0.0,
+    p.add_argument("--gamma", type=_finite_float("gamma"), default=Default(0.0),
                    help="viscous damping gamma in [0, 1e3] (default 0)")
     p.add_argument("--from", dest="n_from", type=_int, default=2, help="smallest N (default 2)")
     p.add_argument("--to", dest="n_to", type=_int, default=64,
@@ -155,7 +156,8 @@ def _cmd_optimize(a) -> dict | str:
     if r.winding != 1:
         name += f", winding K = {r.winding}"
     if pto:
-        name = f"power take-off optimum, N = {r.harmonics}"
+        name = (f"power take-off optimum, K = {r.intervals}" if r.method == "hermite" else
+                f"power take-off optimum, N = {r.harmonics}")
     rows = [
         ["best uniform rotation (Eq. 17)", _fmt(r.uniform_power), ""],
         [name, _fmt(r.power), _gain(r.power, r.uniform_power)],
@@ -172,6 +174,9 @@ def _cmd_optimize(a) -> dict | str:
                   f"{r.abandoned} abandoned as unable to win")
         if r.second_power is not None:
             search += f"; second-best maximum {_fmt(r.second_power)}"
+    elif r.method == "hermite":
+        how = (f"{r.iterations} interior-point iterations, {r.intervals} cubic Hermite "
+               f"intervals, started from the {r.found_by}")
     else:
         how = (f"{r.mesh_nodes} mesh nodes, max residual {r.max_residual:.2g}, "
                f"{r.continuation_steps} continuation steps, found from the {r.found_by} start")
