@@ -9,8 +9,13 @@ import pytest
 
 import parapend
 from parapend.excitation import harmonic
-from parapend.optimal.hermite import (HermiteMotion, HermiteProblem, _fold, minimum_peak_torque,
-                                      solve_hermite)
+from parapend.optimal.hermite import (
+    HermiteMotion,
+    HermiteProblem,
+    _fold,
+    minimum_peak_torque,
+    solve_hermite,
+)
 from parapend.power import uniform_power
 from parapend.trajectory import FourierMotion
 
