@@ -106,8 +106,8 @@ def _cmd_optimize(a) -> dict | str:
     pto = _pto.wants_pto(a)
     if a.winding != 1:
         if pto or a.method == "all":
-            raise ParameterError("winding: K > 1 works with method fourier or bvp without a "
-                                 "power take-off; drop --winding or those options")
+            raise ParameterError("winding: K > 1 works with method fourier and no power "
+                                 "take-off options; drop --winding or those options")
         kw["winding"] = a.winding
     if a.method == "all":
         if pto or units is not None:
