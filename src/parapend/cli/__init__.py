@@ -13,7 +13,7 @@ Modules: :mod:`._common` (parser helpers, number parsing, tables, progress),
 :mod:`._output` (every file written), :mod:`.optimize` (optimize, threshold, damping-sweep,
  harmonics), :mod:`.paper` (figure, reproduce), :mod:`.pto` (pto-curve; the power
  take-off and unit options of optimize), :mod:`.dynamics` (simulate, basins,
- rotations: the uncontrolled pendulum of paper Eq. 1).
+ rotations: the uncontrolled pendulum of paper Eq. 1), :mod:`.sweep` (sweep, map: design maps).
 """
 
 from __future__ import annotations
@@ -29,6 +29,7 @@ from . import dynamics as _dynamics_cmds
 from . import optimize as _optimize_cmds
 from . import paper as _paper_cmds
 from . import pto as _pto_cmds
+from . import sweep as _sweep_cmds
 from ._common import EXIT_USAGE, _Parser
 from ._output import OutputError
 
@@ -37,7 +38,7 @@ EXIT_FAILURE = 1
 __all__ = ["build_parser", "main"]
 
 COMMANDS = {**_optimize_cmds.COMMANDS, **_paper_cmds.COMMANDS, **_pto_cmds.COMMANDS,
-            **_dynamics_cmds.COMMANDS}
+            **_dynamics_cmds.COMMANDS, **_sweep_cmds.COMMANDS}
 
 
 def build_parser():
@@ -53,6 +54,7 @@ def build_parser():
     _paper_cmds.add_parsers(sub)
     _pto_cmds.add_parsers(sub)
     _dynamics_cmds.add_parsers(sub)
+    _sweep_cmds.add_parsers(sub)
     return parser
 
 
