@@ -97,8 +97,8 @@ VARIABLES = {
     "threshold_status": ("solver status of the damping threshold", None),
 }
 _BRANCH_TOL = 1e-9
-#: points per block (one chunk, one task): about half a second of work
-_BLOCK_POINTS = 256
+#: points per block (one chunk, one task): about a quarter of a second of work
+_BLOCK_POINTS = 128
 _BLOCK_POINTS_PTO = 8
 
 
@@ -689,7 +689,7 @@ def sweep(store=None, *, omega=1.8, delta=None, gamma=0.0, torque_limit=None, ef
     progress : callable or None
         ``progress(done_points, total_points)`` after each block.
     block_points : int or None
-        Points per block (one chunk, one task), about: default 256 (8 with a power
+        Points per block (one chunk, one task), about: default 128 (8 with a power
         take-off). Part of the sweep's identity, as it sets where continuation runs start.
     """
     spec = sweep_spec(omega=omega, delta=delta, gamma=gamma, torque_limit=torque_limit,
@@ -768,6 +768,11 @@ def _execute(spec, todo, workers, scheduler, write) -> str:
 MAP_QUANTITIES = ("power", "gain", "damping_threshold", "uniform_power", "limit_power",
                   "electrical_power", "branch_gap")
 _PAPER = {"omega": 1.8, "delta": -0.3, "gamma": 0.0}
+_SHORT = {"power": "optimal power P", "gain": "gain over the best uniform rotation",
+          "damping_threshold": "damping threshold gamma*",
+          "uniform_power": "power of the best uniform rotation",
+          "limit_power": "limit power (gamma -> 0)", "electrical_power": "electrical power",
+          "branch_gap": "continued branch above the global search"}
 _LABELS = {"omega": r"$\omega$", "delta": r"$\delta$", "gamma": r"$\gamma$",
            "torque_limit": r"$T_{max}$", "efficiency": r"$\eta$"}
 
@@ -812,15 +817,15 @@ def map_data(ds, quantity: str = "power", x: str | None = None, y: str | None = 
     status = sub["status"]
     ok = sub["done"].values & np.isin(status.values, [_CODE[s] for s in _SUCCESS])
     failed = sub["done"].values & ~ok
-    if quantity == "gain":
+    if quantity == "gain":  # as optimize's gain_over_uniform: none where uniform <= 0
+        pu = sub["uniform_power"].values
         with np.errstate(divide="ignore", invalid="ignore"):
-            z = 100.0 * (sub["power"].values / sub["uniform_power"].values - 1.0)
-        label = "gain over the best uniform rotation (%)"
+            z = np.where(pu > 0, 100.0 * (sub["power"].values / pu - 1.0), np.nan)
     else:
         z = np.array(sub[quantity].values, dtype=float)
-        long = VARIABLES[quantity][0].split(",")[0].split(" (")[0]
-        units = VARIABLES[quantity][1]
-        label = f"{long} ({units})" if units else long
+    label = _SHORT[quantity]
+    units = "%" if quantity == "gain" else VARIABLES[quantity][1]
+    label = f"{label} ({units})" if units else label
     if quantity == "damping_threshold":
         ok = sub["done"].values & np.isin(sub["threshold_status"].values,
                                           [_CODE[s] for s in _SUCCESS])
@@ -828,6 +833,8 @@ def map_data(ds, quantity: str = "power", x: str | None = None, y: str | None = 
     z = np.where(ok, z, np.nan)
     fixed = {**{a: float(ds[a]) for a in AXES if a in ds.coords and ds[a].ndim == 0},
              **{k: float(sub[k]) for k in sel}}
+    if quantity == "damping_threshold":  # gamma* depends on the excitation only
+        fixed = {k: v for k, v in fixed.items() if k in ("omega", "delta")}
     title = ", ".join(f"{k} = {v:.4g}" for k, v in fixed.items())
     return z, failed, sub[x].values, sub[y].values, x, y, label, title
 
@@ -848,13 +855,19 @@ def plot_map(ds, quantity: str = "power", x=None, y=None, at=None, path=None):
     with figure_style():
         fig, ax = plt.subplots(figsize=(6.4, 4.8))
         cmap = plt.get_cmap("viridis").with_extremes(bad="0.85")
-        mesh = ax.pcolormesh(xs, ys, np.ma.masked_invalid(z), shading="nearest", cmap=cmap)
-        cb = fig.colorbar(mesh, ax=ax)
-        cb.set_label(label)
         finite = np.isfinite(z)
-        if min(z.shape) >= 3 and finite.sum() >= 9 and np.nanmax(z) > np.nanmin(z):
-            cs = ax.contour(xs, ys, np.ma.masked_invalid(z), levels=8, colors="white",
-                            linewidths=0.7)
+        lo, hi = (np.percentile(z[finite], [1, 99]) if finite.sum() >= 100 else
+                  (np.nanmin(z), np.nanmax(z)) if finite.any() else (0.0, 1.0))
+        # a few extreme points (the gain where the uniform rotation's power tends to 0)
+        # would flatten the rest: the colours span the 1st to 99th percentile
+        clipped = finite.any() and (np.nanmin(z) < lo or np.nanmax(z) > hi)
+        mesh = ax.pcolormesh(xs, ys, np.ma.masked_invalid(z), shading="nearest", cmap=cmap,
+                             vmin=lo, vmax=hi)
+        cb = fig.colorbar(mesh, ax=ax, extend="both" if clipped else "neither")
+        cb.set_label(label)
+        if min(z.shape) >= 3 and finite.sum() >= 9 and hi > lo:
+            cs = ax.contour(xs, ys, np.ma.masked_invalid(z), levels=np.linspace(lo, hi, 9)[1:-1],
+                            colors="white", linewidths=0.7)
             ax.clabel(cs, fontsize=7, fmt="%.3g")
             if quantity in ("power", "electrical_power") and np.nanmin(z) < 0 < np.nanmax(z):
                 ax.contour(xs, ys, np.ma.masked_invalid(z), levels=[0.0], colors="black",
@@ -868,7 +881,7 @@ def plot_map(ds, quantity: str = "power", x=None, y=None, at=None, path=None):
             ax.plot([px], [py], marker="*", color="red", ms=12, mec="white", ls="none",
                     label=r"paper's case ($\omega$ = 1.8, $\delta$ = -0.3)")
         if ax.get_legend_handles_labels()[0]:
-            ax.legend(loc="upper right")
+            ax.legend(loc="best")
         ax.set_xlabel(f"{_LABELS[xn]} ({_AXIS_ATTRS[xn][1]})")
         ax.set_ylabel(f"{_LABELS[yn]} ({_AXIS_ATTRS[yn][1]})")
         ax.grid(False)
