@@ -239,6 +239,14 @@ def test_dask_cluster_writes_the_same_store(reference, cluster, tmp_path):
                    scheduler=cluster.scheduler_address)
     assert run.executor.startswith("Dask cluster at tcp://127.0.0.1")
     assert _files(store) == _files(ref_store)
+    # the command line, on the same cluster: the same arrays (the command attribute differs)
+    cli = tmp_path / "cli.zarr"
+    assert main(["sweep", "--omega", "1.6:2.0:4", "--delta", "-0.3,-0.2,-0.1", "--gamma",
+                 "0.01", "--block-points", "3", "--store", str(cli), "--scheduler",
+                 cluster.scheduler_address, "--json"]) == 0
+    a, b = sw.open_sweep(cli), sw.open_sweep(ref_store)
+    for v in b.data_vars:
+        assert np.array_equal(a[v].values, b[v].values, equal_nan=v != "done")
 
 
 # -- input ----------------------------------------------------------------------------------

@@ -145,7 +145,8 @@ def parse_axis(name: str, value) -> tuple[float, ...]:
         if vals.ndim != 1 or vals.size == 0 or vals.size > limits.MAP_MAX_POINTS:
             raise ParameterError(f"{flag}: expected a number or a sequence of 1 to "
                                  f"{limits.MAP_MAX_POINTS} numbers")
-    out = tuple(_check_value(name, v) for v in vals)
+    out = tuple(_check_value(name, v.item() if isinstance(v, np.generic) else v)
+                for v in vals)
     if len(set(out)) != len(out):
         raise ParameterError(f"{flag}: expected distinct values, got a repeated one")
     return out
@@ -627,33 +628,31 @@ def _run_local(spec, todo, workers, done_cb):
     return f"{workers} local processes"
 
 
-def _run_dask(spec, todo, scheduler, done_cb):
+def _connect(scheduler):
+    """A distributed Client for ``scheduler`` (an address or a Client), and whether we own it:
+    connected before the store is touched, so a wrong address leaves nothing behind."""
     try:
-        from distributed import Client, as_completed
+        from distributed import Client
     except ImportError:
         raise ParameterError("scheduler: needs the 'distributed' package (python -m pip "
                              "install distributed)") from None
     if hasattr(scheduler, "submit"):
-        client, own = scheduler, False
-    else:
-        try:
-            client = Client(str(scheduler), timeout="10s", set_as_default=False)
-        except (OSError, TimeoutError, ValueError) as err:
-            raise ParameterError(f"scheduler: cannot connect to {str(scheduler)!r}: "
-                                 f"{' '.join(str(err).split())[:160]}") from None
-        own = True
+        return scheduler, False
     try:
-        futs = {}
-        for b in todo:
-            f = client.submit(compute_block, spec, b, pure=False)
-            futs[f] = b
-        for f in as_completed(list(futs), loop=client.loop):
-            done_cb(futs[f], f.result())
-            f.release()
-        return f"Dask cluster at {client.scheduler.address}"
-    finally:
-        if own:
-            client.close()
+        return Client(str(scheduler), timeout="10s", set_as_default=False), True
+    except (OSError, TimeoutError, ValueError) as err:
+        raise ParameterError(f"scheduler: cannot connect to {str(scheduler)!r}: "
+                             f"{' '.join(str(err).split())[:160]}") from None
+
+
+def _run_dask(spec, todo, client, done_cb):
+    from distributed import as_completed
+
+    futs = {client.submit(compute_block, spec, b, pure=False): b for b in todo}
+    for f in as_completed(list(futs), loop=client.loop):
+        done_cb(futs[f], f.result())
+        f.release()
+    return f"Dask cluster at {client.scheduler.address}"
 
 
 def sweep(store=None, *, omega=1.8, delta=None, gamma=0.0, torque_limit=None, efficiency=None,
@@ -701,6 +700,15 @@ def sweep(store=None, *, omega=1.8, delta=None, gamma=0.0, torque_limit=None, ef
     else:
         workers = max(1, min(os.cpu_count() or 1, spec.blocks))
     t0 = time.monotonic()
+    client, own = _connect(scheduler) if scheduler is not None else (None, False)
+    try:
+        return _sweep(spec, store, workers, client, overwrite, command, progress, t0)
+    finally:
+        if own:
+            client.close()
+
+
+def _sweep(spec, store, workers, client, overwrite, command, progress, t0) -> SweepRun:
     total = spec.points
     sizes = [int(np.prod([s.stop - s.start for s in spec.block_slices(b)]))
              for b in range(spec.blocks)]
@@ -719,7 +727,7 @@ def sweep(store=None, *, omega=1.8, delta=None, gamma=0.0, torque_limit=None, ef
             if progress is not None:
                 progress(counted[0], total)
 
-        how = _execute(spec, list(range(spec.blocks)), workers, scheduler, write)
+        how = _execute(spec, list(range(spec.blocks)), workers, client, write)
         for k, v in arrays.items():
             ds[k] = (spec.dims, v, ds[k].attrs)
         return SweepRun(ds, None, total, spec.blocks, total, 0, time.monotonic() - t0, how)
@@ -750,15 +758,15 @@ def sweep(store=None, *, omega=1.8, delta=None, gamma=0.0, torque_limit=None, ef
             if progress is not None:
                 progress(counted[0], total)
 
-        how = _execute(spec, todo, workers, scheduler, write) if todo else "nothing to do"
+        how = _execute(spec, todo, workers, client, write) if todo else "nothing to do"
     ds = open_sweep(path)
     return SweepRun(ds, str(path), total, spec.blocks, total - resumed, resumed,
                     time.monotonic() - t0, how)
 
 
-def _execute(spec, todo, workers, scheduler, write) -> str:
-    if scheduler is not None:
-        return _run_dask(spec, todo, scheduler, write)
+def _execute(spec, todo, workers, client, write) -> str:
+    if client is not None:
+        return _run_dask(spec, todo, client, write)
     return _run_local(spec, todo, min(workers, max(len(todo), 1)), write)
 
 
