@@ -617,7 +617,7 @@ def _run_local(spec, todo, workers, done_cb):
             done_cb(b, compute_block(spec, b))
         return "serial"
     ctx = mp.get_context("forkserver")
-    ctx.set_forkserver_preload(["parapend.sweep"])
+    ctx.set_forkserver_preload(["parapend.sweep", "parapend.api", "parapend.optimal.fourier"])
     ex = cf.ProcessPoolExecutor(max_workers=workers, mp_context=ctx, initializer=_worker_init)
     try:
         futs = {ex.submit(compute_block, spec, b): b for b in todo}
