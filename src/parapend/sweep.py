@@ -52,7 +52,7 @@ from pathlib import Path
 import numpy as np
 
 from . import limits
-from .errors import ParameterError, check_int, check_range
+from .errors import ParameterError, SolverError, check_int, check_range
 
 __all__ = ["AXES", "STATUSES", "VARIABLES", "SweepRun", "SweepSpec", "compute_block",
            "open_sweep", "parse_axis", "plot_map", "sweep", "sweep_spec"]
@@ -622,7 +622,13 @@ def _run_local(spec, todo, workers, done_cb):
     try:
         futs = {ex.submit(compute_block, spec, b): b for b in todo}
         for f in cf.as_completed(futs):
-            done_cb(futs[f], f.result())
+            try:
+                vals = f.result()
+            except cf.process.BrokenProcessPool:
+                raise SolverError("a worker process died (killed, or out of memory); the "
+                                  "finished blocks are in the store: run the same command "
+                                  "again to resume") from None
+            done_cb(futs[f], vals)
     finally:
         ex.shutdown(wait=True, cancel_futures=True)
     return f"{workers} local processes"
@@ -650,7 +656,15 @@ def _run_dask(spec, todo, client, done_cb):
 
     futs = {client.submit(compute_block, spec, b, pure=False): b for b in todo}
     for f in as_completed(list(futs), loop=client.loop):
-        done_cb(futs[f], f.result())
+        try:
+            vals = f.result()
+        except (KeyboardInterrupt, ParameterError):
+            raise
+        except Exception as err:  # a lost worker, a worker without parapend, ...
+            raise SolverError(f"a block failed on the Dask cluster ({type(err).__name__}: "
+                              f"{' '.join(str(err).split())[:160]}); the finished blocks are "
+                              "in the store: run the same command again to resume") from None
+        done_cb(futs[f], vals)
         f.release()
     return f"Dask cluster at {client.scheduler.address}"
 
