@@ -602,10 +602,25 @@ class SweepRun:
     executor: str
 
 
-def _worker_init() -> None:
+def _worker_init(parent: int) -> None:
+    """A pool worker ignores Ctrl-C (the parent handles it) and exits when the parent is
+    gone (``kill -9``: the pool's queues would keep it waiting for ever)."""
     import signal
+    import threading
 
-    signal.signal(signal.SIGINT, signal.SIG_IGN)  # the parent handles Ctrl-C
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+
+    def watch():
+        while True:
+            time.sleep(0.5)
+            try:
+                os.kill(parent, 0)
+            except ProcessLookupError:
+                os._exit(1)
+            except OSError:
+                pass
+
+    threading.Thread(target=watch, daemon=True).start()
 
 
 def _run_local(spec, todo, workers, done_cb):
@@ -618,7 +633,8 @@ def _run_local(spec, todo, workers, done_cb):
         return "serial"
     ctx = mp.get_context("forkserver")
     ctx.set_forkserver_preload(["parapend.sweep", "parapend.api", "parapend.optimal.fourier"])
-    ex = cf.ProcessPoolExecutor(max_workers=workers, mp_context=ctx, initializer=_worker_init)
+    ex = cf.ProcessPoolExecutor(max_workers=workers, mp_context=ctx, initializer=_worker_init,
+                                initargs=(os.getpid(),))
     try:
         futs = {ex.submit(compute_block, spec, b): b for b in todo}
         for f in cf.as_completed(futs):
