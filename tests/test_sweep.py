@@ -8,6 +8,7 @@ import os
 import signal
 import subprocess
 import sys
+import time
 from pathlib import Path
 
 import numpy as np
@@ -330,3 +331,38 @@ def test_map_of_a_partial_store_marks_missing_points(reference, tmp_path):
     assert not failed.any() and title == "gamma = 0.01"
     with pytest.raises(ParameterError, match="not complete"):
         sw.open_sweep(store, complete=True)
+
+
+@pytest.mark.slow
+def test_cli_kill_9_with_two_processes_then_resume(tmp_path):
+    """The command line with its pool of two processes: kill -9 in the middle, run the same
+    command again, and every file of the store equals an uninterrupted run's."""
+    import zarr
+
+    # --threshold makes each point slower (several solves), so the kill lands mid-run
+    argv = [sys.executable, "-m", "parapend", "sweep", "--omega", "1.4:2.2:16", "--delta",
+            "-0.4:-0.1:24", "--gamma", "0.02", "--block-points", "24", "--workers", "2",
+            "--threshold"]
+    env = {**os.environ, "PYTHONPATH": SRC}
+    ref, cut = tmp_path / "ref", tmp_path / "cut"
+    ref.mkdir()
+    cut.mkdir()
+    subprocess.run(argv, cwd=ref, env=env, check=True, capture_output=True)
+    proc = subprocess.Popen(argv, cwd=cut, env=env, stdout=subprocess.DEVNULL,
+                            stderr=subprocess.DEVNULL)
+    deadline = time.monotonic() + 120
+    done = 0
+    while time.monotonic() < deadline and proc.poll() is None:
+        time.sleep(0.05)
+        try:
+            done = int(np.asarray(zarr.open_group(cut / "map.zarr", mode="r")["done"][...]).sum())
+        except Exception:  # not created yet
+            continue
+        if done >= 24:
+            break
+    os.kill(proc.pid, signal.SIGKILL)
+    proc.wait()
+    mask = np.asarray(zarr.open_group(cut / "map.zarr", mode="r")["done"][...])
+    assert 0 < mask.sum() < mask.size
+    subprocess.run(argv, cwd=cut, env=env, check=True, capture_output=True)
+    assert _files(cut / "map.zarr") == _files(ref / "map.zarr")
