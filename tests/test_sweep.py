@@ -366,3 +366,22 @@ def test_cli_kill_9_with_two_processes_then_resume(tmp_path):
     assert 0 < mask.sum() < mask.size
     subprocess.run(argv, cwd=cut, env=env, check=True, capture_output=True)
     assert _files(cut / "map.zarr") == _files(ref / "map.zarr")
+
+
+@pytest.mark.parametrize("excitation", ["two-harmonic", "square"])
+def test_every_point_equals_optimize_more_excitations(excitation):
+    """Several extrema per period (the pattern seeds of the global search), gamma = 0 and
+    gamma > 0, continuation along gamma: every point is optimize's."""
+    kw = {"square_alpha": 0.05} if excitation == "square" else {}
+    run = sw.sweep(None, omega="1.5,2.1", delta="-0.35,-0.2", gamma="0:0.04:5",
+                   excitation=excitation, harmonics=16, workers=1, **kw)
+    ds = run.dataset
+    for o in ds["omega"].values:
+        for d in ds["delta"].values:
+            for g in ds["gamma"].values:
+                r = parapend.optimize(omega=float(o), delta=float(d), gamma=float(g),
+                                      excitation=excitation, harmonics=16, **kw)
+                v = ds.sel(omega=o, delta=d, gamma=g)
+                assert abs(float(v["power"]) - r.power) <= 1e-9
+                assert sw.STATUSES[int(v["status"])] == r.status
+    assert float(ds["branch_gap"].min()) >= 0.0
