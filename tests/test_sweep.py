@@ -385,3 +385,28 @@ def test_every_point_equals_optimize_more_excitations(excitation):
                 assert abs(float(v["power"]) - r.power) <= 1e-9
                 assert sw.STATUSES[int(v["status"])] == r.status
     assert float(ds["branch_gap"].min()) >= 0.0
+
+
+def test_branch_gap_records_a_better_continued_branch(monkeypatch):
+    """When the global search misses the best maximum (here: crippled to one Newton step
+    from the uniform rotation), the continuation from the neighbour finds it: branch_gap is
+    the difference to optimize's true optimum, and power stays the search's own value."""
+    import parapend.optimal.fourier as fourier
+
+    def crippled(exc, n, gamma, **kw):
+        problem = fourier.FourierProblem(exc, n, gamma)
+        r = fourier.newton_maximize(problem, fourier._uniform_seed(exc, n, gamma), "uniform",
+                                    maxiter=1)
+        return fourier.FourierSearch(r, [r], None)
+
+    true = {d: parapend.optimize(omega=1.8, delta=d, gamma=0.01, harmonics=12).power
+            for d in (-0.3, -0.25, -0.2)}
+    monkeypatch.setattr(fourier, "search_fourier", crippled)
+    ds = sw.sweep(None, omega=1.8, delta="-0.3,-0.25,-0.2", gamma=0.01, harmonics=12,
+                  workers=1).dataset
+    gap, power = ds["branch_gap"].values, ds["power"].values
+    assert gap[0] == 0.0  # the first point of a run has no neighbour to continue
+    assert list(ds["status"].values) == [sw.STATUSES.index("max_iterations")] * 3
+    for j, d in enumerate((-0.25, -0.2), start=1):
+        assert power[j] < true[d] - 1e-6
+        assert gap[j] == pytest.approx(true[d] - power[j], abs=1e-9)
