@@ -410,3 +410,21 @@ def test_branch_gap_records_a_better_continued_branch(monkeypatch):
     for j, d in enumerate((-0.25, -0.2), start=1):
         assert power[j] < true[d] - 1e-6
         assert gap[j] == pytest.approx(true[d] - power[j], abs=1e-9)
+
+
+def test_map_of_three_axes_selects_the_third(tmp_path):
+    ds = sw.sweep(None, omega="1.8,2.0", delta="-0.3,-0.2", gamma="0,0.01", harmonics=8,
+                  workers=1).dataset
+    z, failed, xs, ys, xn, yn, label, title = sw.map_data(ds, "power", at={"gamma": 0.011})
+    assert (xn, yn) == ("omega", "delta") and title == "gamma = 0.01"
+    assert np.array_equal(z, ds["power"].sel(gamma=0.01).values.T)
+    z0, *_ = sw.map_data(ds, "power", x="delta", y="gamma", at={"omega": 2.0})
+    assert np.array_equal(z0, ds["power"].sel(omega=2.0).values.T)
+    with pytest.raises(ParameterError, match="^at: 'delta' is not another axis"):
+        sw.map_data(ds, "power", at={"delta": -0.3})
+    with pytest.raises(ParameterError, match="^variable: 'damping_threshold' is not in"):
+        sw.map_data(ds, "damping_threshold")
+    fig = sw.plot_map(ds, "gain", at={"gamma": 0.0}, path=tmp_path / "g.svg")
+    assert (tmp_path / "g.svg").read_text().startswith("<?xml")
+    # the paper's case is inside the map: the star is drawn
+    assert any("paper" in t.get_text() for t in fig.axes[0].get_legend().get_texts())

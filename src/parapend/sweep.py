@@ -940,8 +940,9 @@ def plot_map(ds, quantity: str = "power", x=None, y=None, at=None, path=None):
                     label=r"paper's case ($\omega$ = 1.8, $\delta$ = -0.3)")
         if ax.get_legend_handles_labels()[0]:
             ax.legend(loc="best")
-        ax.set_xlabel(f"{_LABELS[xn]} ({_AXIS_ATTRS[xn][1]})")
-        ax.set_ylabel(f"{_LABELS[yn]} ({_AXIS_ATTRS[yn][1]})")
+        for name, setter in ((xn, ax.set_xlabel), (yn, ax.set_ylabel)):
+            unit = _AXIS_ATTRS[name][1]
+            setter(_LABELS[name] + ("" if unit == "1" else f" ({unit})"))
         ax.grid(False)
         if title:
             ax.set_title(title)

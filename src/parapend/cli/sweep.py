@@ -67,8 +67,7 @@ def add_parsers(sub) -> None:
                    help="tanh width of Eq. 26, square only")
     e.add_argument("--fourier", metavar="TERMS", help="'k:amp:phase,...' (omega axis only)")
     p.add_argument("--harmonics", type=_int, default=24,
-                   help=f"N of every solve, at most {limits.MAP_MAX_HARMONICS} "
-                        f"({limits.MAX_PTO_HARMONICS} with a power take-off; default 24)")
+                   help=f"N of every solve, at most {limits.MAP_MAX_HARMONICS} (default 24)")
     p.add_argument("--threshold", action="store_true",
                    help="also compute gamma* at every (omega, delta): several solves each")
     p.add_argument("--store", default="map.zarr",
