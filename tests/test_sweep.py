@@ -432,3 +432,15 @@ def test_map_of_three_axes_selects_the_third(tmp_path):
     assert (tmp_path / "g.svg").read_text().startswith("<?xml")
     # the paper's case is inside the map: the star is drawn
     assert any("paper" in t.get_text() for t in fig.axes[0].get_legend().get_texts())
+
+
+def test_delta_through_zero_symmetric_and_constant_case():
+    """q -> -q is a half-period shift: the map is even in delta; delta = 0 is a constant q,
+    no_power with the uniform rotation's loss -gamma omega^2 (as optimize)."""
+    ds = sw.sweep(None, omega=1.8, delta="-0.2,-0.1,0,0.1,0.2", gamma=0.01, harmonics=12,
+                  workers=1).dataset
+    p = ds["power"].values
+    assert np.allclose(p, p[::-1], rtol=0, atol=1e-12)
+    assert p[2] == pytest.approx(-0.01 * 1.8**2, abs=1e-15)
+    assert sw.STATUSES[int(ds["status"][2])] == "no_power"
+    assert [sw.STATUSES[int(c)] for c in ds["status"].values[[0, 1, 3, 4]]] == ["converged"] * 4
