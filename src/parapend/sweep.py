@@ -490,13 +490,13 @@ def _locked(path: Path):
         os.close(fd)  # releases the lock
 
 
+@contextlib.contextmanager
 def _quiet_zarr():
     """Zarr warns about foreign files (a ``.partial`` left by a killed write): they are
     removed on resume, and a reader need not see the warning."""
-    ctx = warnings.catch_warnings()
-    ctx.__enter__()
-    warnings.filterwarnings("ignore", message="Object at .* is not recognized")
-    return ctx
+    with warnings.catch_warnings():
+        warnings.filterwarnings("ignore", message="Object at .* is not recognized")
+        yield
 
 
 def _store_spec(path: Path) -> str | None:
@@ -526,7 +526,7 @@ def _create(path: Path, spec: SweepSpec, command: str | None) -> None:
 
 def _prepare(path: Path, spec: SweepSpec, command: str | None, overwrite: bool) -> None:
     """Under the lock: create the store, or check that it holds this sweep (resume)."""
-    expected = {*spec.variables, "done", *AXES, "zarr.json"}
+    expected = {*VARIABLES, "done", *AXES, "zarr.json"}  # what a sweep store can hold
     entries = {e.name for e in path.iterdir()}
     recorded = _store_spec(path)
     if recorded is not None and recorded == spec.to_json() and not overwrite:
@@ -541,9 +541,6 @@ def _prepare(path: Path, spec: SweepSpec, command: str | None, overwrite: bool) 
     if recorded is None and entries and not entries <= expected:
         raise ParameterError(f"store: {str(path)!r} exists and is not a parapend sweep store; "
                              "choose another --store")
-    if recorded is None and entries - expected and overwrite:
-        raise ParameterError(f"store: {str(path)!r} is not a parapend sweep store; not "
-                             "overwriting it")
     # an interrupted creation (no root zarr.json), or --overwrite of a sweep store
     if (path / "zarr.json").exists():
         os.unlink(path / "zarr.json")
@@ -580,11 +577,8 @@ def open_sweep(store, *, complete: bool = False):
         raise ParameterError(f"store: {str(store)!r} does not exist")
     try:
         if path.is_dir():
-            ctx = _quiet_zarr()
-            try:
+            with _quiet_zarr():
                 ds = xr.open_zarr(path, consolidated=False, zarr_format=3).load()
-            finally:
-                ctx.__exit__(None, None, None)
         else:
             with xr.open_dataset(path) as f:
                 ds = f.load()
@@ -787,12 +781,9 @@ def _sweep(spec, store, workers, client, overwrite, command, progress, t0) -> Sw
     path.mkdir(exist_ok=True)
     with _locked(path):
         _prepare(path, spec, command, overwrite)
-        ctx = _quiet_zarr()
-        try:
+        with _quiet_zarr():
             group = zarr.open_group(path, mode="r+", zarr_format=3)
             done = np.asarray(group["done"][...], dtype=bool)
-        finally:
-            ctx.__exit__(None, None, None)
         todo = [b for b in range(spec.blocks) if not done[spec.block_slices(b)].all()]
         resumed = total - sum(sizes[b] for b in todo)
         counted = [resumed]
