@@ -218,6 +218,12 @@ def test_store_of_another_sweep_is_refused(reference, tmp_path):
     with pytest.raises(ParameterError, match="not a parapend sweep store"):
         sw.sweep(foreign, omega="1.8,1.9")
     assert (foreign / "notes.txt").read_text() == "mine"
+    # a creation cut short (arrays, no root zarr.json) is ours: made again, then computed
+    cut = tmp_path / "cut.zarr"
+    (cut / "power").mkdir(parents=True)
+    (cut / "power" / "zarr.json").write_text("{")
+    assert sw.sweep(cut, omega="1.8,1.9", workers=1).computed_points == 2
+    assert bool(sw.open_sweep(cut, complete=True)["done"].all())
 
 
 # -- Dask distributed -----------------------------------------------------------------------
