@@ -26,13 +26,16 @@ import numpy as np
 
 
 def collocate(excitation, damping: float, *, intervals: int = 200, torque_limit=None,
-              efficiency=None, guess=None, tol: float = 1e-10):
+              efficiency=None, guess=None, tol: float = 1e-10, winding: int = 1,
+              max_iter: int = 3000):
     """Maximize the mean (electrical) power by direct collocation.
 
     Parameters
     ----------
     guess : callable ``t -> (theta, v, T)`` or None
         Initial guess; None starts from the best uniform rotation (Eq. 17).
+    winding : int
+        K turns per period: ``theta(T_p) = theta(0) + 2 pi K`` (records of irregular seas).
 
     Returns
     -------
@@ -67,7 +70,7 @@ def collocate(excitation, damping: float, *, intervals: int = 200, torque_limit=
         opti.subject_to(th[b] == th[a] + h / 6 * (fa[0] + 4 * fm[0] + fb[0]))
         opti.subject_to(v[b] == v[a] + h / 6 * (fa[1] + 4 * fm[1] + fb[1]))
         opti.subject_to(u[m] == 0.5 * (u[a] + u[b]))  # piecewise-linear torque
-    opti.subject_to(th[2 * k] == th[0] + 2 * math.pi)
+    opti.subject_to(th[2 * k] == th[0] + 2 * math.pi * winding)
     opti.subject_to(v[2 * k] == v[0])
     w = np.ones(2 * k + 1)
     w[1::2] = 4.0
@@ -90,9 +93,10 @@ def collocate(excitation, damping: float, *, intervals: int = 200, torque_limit=
         opti.subject_to(opti.bounded(-torque_limit, u, torque_limit))
     opti.minimize(-obj)
     if guess is None:
-        _, phi = uniform_power(excitation, damping)
-        g_th = om * t + phi
-        g_v = om * np.ones_like(t)
+        _, phi = (uniform_power(excitation, damping) if winding == 1
+                  else uniform_power(excitation, damping, winding))
+        g_th = winding * om * t + phi
+        g_v = winding * om * np.ones_like(t)
         g_u = damping * om - q1 * np.sin(g_th)
         if torque_limit is not None:
             g_u = np.clip(g_u, -torque_limit, torque_limit)
@@ -106,7 +110,7 @@ def collocate(excitation, damping: float, *, intervals: int = 200, torque_limit=
         opti.set_initial(pp, np.maximum(g_p, 0))
         opti.set_initial(pm, np.maximum(-g_p, 0))
     opti.solver("ipopt", {"print_time": False},
-                {"print_level": 0, "sb": "yes", "tol": tol, "max_iter": 3000})
+                {"print_level": 0, "sb": "yes", "tol": tol, "max_iter": max_iter})
     import time
 
     start = time.perf_counter()

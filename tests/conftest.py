@@ -4,9 +4,16 @@ import os
 
 # One BLAS thread. The solvers work on small matrices (a Newton step at N = 24 is 49 x 49),
 # where OpenBLAS threads only spin: on a loaded 2-core machine one property test took 300+ s
-# with the default threads and 19 s with one. Set before NumPy is first imported.
+# with the default threads and 19 s with one. NumPy is already imported when pytest loads
+# this file (a plugin imports it), so the environment variables alone come too late for the
+# running process: threadpoolctl sets the loaded library's thread count; the variables are
+# for subprocesses (CLI runs, Dask workers).
 for _var in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
     os.environ.setdefault(_var, "1")
+
+from threadpoolctl import threadpool_limits  # noqa: E402
+
+threadpool_limits(1)
 
 import matplotlib  # noqa: E402
 import pytest  # noqa: E402

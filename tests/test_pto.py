@@ -235,3 +235,15 @@ def test_cli_pto_curve_efficiency(capsys):
     assert d["value"] == [1.0, 0.5]
     assert p[0] == pytest.approx(d["unconstrained_power"], abs=1e-6)
     assert p[1] < p[0]
+
+
+def test_cli_explicit_default_beside_physical_option(capsys):
+    """--omega 1.8 (the default's value, typed) contradicts --frequency; omitted it does not."""
+    args = ["optimize", "--length", "1", "--mass", "10", "--frequency", "0.9", "--amplitude",
+            "0.09"]
+    code, _, err = _run(capsys, *args, "--omega", "1.8")
+    assert code == 2 and "frequency: give either --frequency or --omega" in err
+    code, _, err = _run(capsys, *args, "--gamma", "0", "--damping-coefficient", "1")
+    assert code == 2 and "damping-coefficient: give either" in err
+    code, out, _ = _run(capsys, *args, "--damping-coefficient", "1")
+    assert code == 0 and "power" in out

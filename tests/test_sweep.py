@@ -88,8 +88,8 @@ def test_torque_limit_axis_equals_optimize_pto():
 
 @pytest.mark.slow
 def test_infeasible_torque_limit_is_recorded():
-    """A torque limit too small at a damping above gamma*: status infeasible (about 10 s
-    per such point), kept in the map with its power, never dropped."""
+    """A torque limit too small at a damping above gamma*: status infeasible (a few
+    seconds per such point), kept in the map with its power, never dropped."""
     run = sw.sweep(None, omega=1.8, gamma="0.05,0.12", torque_limit="0.05,3", harmonics=4,
                    workers=1)
     ds = run.dataset

@@ -15,6 +15,7 @@ from .optimal.bvp import BVPSolution, solve_bvp_optimum
 from .optimal.limit import limit
 from .power import mean_power, uniform_power
 from .results import OptimizeResult, ThresholdResult
+from .sea_api import SeaResult, sea
 
 __version__ = "0.1.0"
 
@@ -23,6 +24,7 @@ __all__ = [
     "EXCITATIONS",
     "OptimizeResult",
     "ParameterError",
+    "SeaResult",
     "SolverError",
     "ThresholdResult",
     "__version__",
@@ -35,6 +37,7 @@ __all__ = [
     "limit",
     "mean_power",
     "optimize",
+    "sea",
     "solve_bvp_optimum",
     "square",
     "threshold",

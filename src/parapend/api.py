@@ -149,7 +149,8 @@ METHODS = ("fourier", "bvp")
 
 def optimize(*, omega: float = 1.8, delta=None, gamma: float = 0.0, harmonics: int = 24,
              excitation=None, square_alpha=None, fourier=None, file=None,
-             method: str = "fourier", warm=None, throw: bool = False) -> OptimizeResult:
+             method: str = "fourier", warm=None, winding: int = 1,
+             throw: bool = False) -> OptimizeResult:
     """Optimal period-1 rotation for any excitation.
 
     Parameters mirror ``parapend optimize``. ``gamma`` is the viscous damping (>= 0).
@@ -166,11 +167,18 @@ def optimize(*, omega: float = 1.8, delta=None, gamma: float = 0.0, harmonics: i
     threshold gamma* (the power is then the smallest loss), or the excitation is constant
     (``delta = 0``: nothing to extract; the motion is the uniform rotation). Parameter ranges:
     docs/limits-of-input.md; ``harmonics <= 1024``.
+
+    ``winding`` K >= 1: ``theta(t + 2 pi/omega) = theta(t) + 2 pi K`` (docs/seas.md); K = 1
+    is the paper's period-1 rotation and computes exactly as without it. K > 1 needs method
+    "fourier" and ``harmonics >= 2 K``.
     """
     exc = build_excitation(excitation, omega=omega, delta=delta, square_alpha=square_alpha,
                            fourier=fourier, file=file)
     gamma = _check_gamma(gamma)
     n = check_int("harmonics", harmonics, 1, MAX_HARMONICS)
+    winding = check_int("winding", winding, 1, MAX_HARMONICS // 2)
+    if winding != 1:
+        return _optimize_winding(exc, gamma, n, method, warm, winding, throw)
     if not isinstance(method, str) or method not in METHODS:
         raise ParameterError(f"method: expected one of {', '.join(METHODS)}, "
                              f"got {method!r:.60}")
@@ -225,6 +233,45 @@ def optimize(*, omega: float = 1.8, delta=None, gamma: float = 0.0, harmonics: i
             _motion=motion,
             **common,
         )
+    if throw and not res.success:
+        raise SolverError(f"optimize: {res.message}")
+    return res
+
+
+def _optimize_winding(exc, gamma: float, n: int, method: str, warm, winding: int,
+                      throw: bool) -> OptimizeResult:
+    """``optimize`` with K turns per period (Fourier method only)."""
+    if method != "fourier":
+        raise ParameterError(f"method: winding {winding} needs method 'fourier' (the BVP "
+                             "solves period-1 rotations only)")
+    if n < 2 * winding:
+        raise ParameterError(f"harmonics: expected at least 2 K = {2 * winding} harmonics "
+                             f"for winding {winding}, got {n}")
+    lim = limit(exc, winding)
+    pu, _ = uniform_power(exc, gamma, winding)
+    if lim.power <= 0:
+        raise ParameterError("winding: the excitation is constant; nothing to extract")
+    found = search_fourier(exc, n, gamma, warm=warm, winding=winding,
+                           hessian="dense" if n <= 256 else "operator")
+    best, runs, ev = found.best, found.runs, found.evidence
+    motion = FourierMotion.from_vector(exc.omega, best.x, winding)
+    maxima = sorted({round(r.power, 12) for r in runs if r.status == "converged"},
+                    reverse=True)
+    status = "no_power" if best.status == "converged" and best.power <= 0 else best.status
+    res = OptimizeResult(
+        power=best.power, uniform_power=pu, limit_power=lim.power,
+        gain_over_uniform=(best.power / pu - 1.0) if pu > 0 else None,
+        harmonics=n, gamma=gamma, omega=exc.omega, success=best.status == "converged",
+        status=status, message=_message(status), iterations=best.iterations,
+        coefficients=_coefficients(motion), peak_torque=_peak_torque(motion, exc, gamma),
+        found_by=best.seed, local_maxima=maxima, gradient_norm=best.gradient_norm,
+        strict_maximum=best.strict_maximum, quadrature_points=best.points,
+        mean_square_speed=motion.mean_square_speed(), search=ev.strategy,
+        candidate_patterns=_json_count(ev.candidate_patterns),
+        extrema_per_period=int(exc.extrema.t.size), patterns_tried=ev.patterns_tried,
+        polished=ev.polished, abandoned=ev.abandoned, second_power=ev.second_power,
+        upper_bound=ev.upper_bound, bound_gap=ev.upper_bound - best.power,
+        excitation=exc.describe(), winding=winding, _motion=motion, _excitation=exc)
     if throw and not res.success:
         raise SolverError(f"optimize: {res.message}")
     return res

@@ -11,7 +11,8 @@ __all__ = [
     "MAX_AMPLITUDE", "MAX_BVP_EXTREMA", "MAX_BVP_WORK", "MAX_BYTES_FILE", "MAX_FILE_ROWS",
     "MAX_FOURIER_K", "MAX_GAMMA", "MAX_HARMONICS", "MAX_PHASE", "MAX_POINTS",
     "MAX_SWEEP_HARMONICS", "MAX_SWEEP_WORK", "MAX_TABLE_HARMONICS", "MAX_THRESHOLD_HARMONICS",
-    "MAX_PTO_HARMONICS", "MAX_PTO_POINTS", "MAX_TORQUE_LIMIT", "MIN_BVP_GAMMA", "OMEGA_RANGE",
+    "MAX_PTO_HARMONICS", "MAX_PTO_INTERVALS", "MAX_PTO_POINTS", "MAX_TORQUE_LIMIT",
+    "MIN_BVP_GAMMA", "OMEGA_RANGE",
     "SQUARE_ALPHA_MIN", "MAP_MAX_POINTS", "MAP_MAX_PTO_POINTS", "MAP_MAX_HARMONICS",
     "MAP_MAX_WORK",
 ]
@@ -56,12 +57,16 @@ MAX_PTO_HARMONICS = 128
 MAX_TORQUE_LIMIT = 1e6
 #: points of a pto-curve
 MAX_PTO_POINTS = 101
+#: Hermite intervals of the torque-limited optimum (the doubling stops here: 2048 intervals
+#: take about a second per solve)
+MAX_PTO_INTERVALS = 2048
 
 # --- design maps (parapend sweep, issue 13) ------------------------------------------------
 #: points of one map (the issue asks for 10^4 to 10^6; at N = 24 about 2 ms of CPU each,
 #: so 2^20 points are about 35 CPU-minutes, resumable)
 MAP_MAX_POINTS = 1 << 20
-#: points of a map with a power take-off (0.2 to 2 s each: 4096 points are hours of CPU)
+#: points of a map with a power take-off (0.2 to 0.5 s each at N = 24, 2 s infeasible:
+#: 4096 points are up to 2 hours of CPU)
 MAP_MAX_PTO_POINTS = 4096
 #: harmonics N of each solve of a map
 MAP_MAX_HARMONICS = 128
@@ -92,3 +97,24 @@ BASIN_MAX_WORK = 1.6e8
 ROT_OMEGA_RANGE = (0.8, 10.0)
 ROT_MAX_OMEGAS = 40
 ROT_MAX_P = 3.0
+
+# --- closed-loop control (track) ------------------------------------------------------
+#: forcing periods of one closed-loop run (about 1.5 ms each at 256 samples per period)
+MAX_TRACK_PERIODS = 2000
+#: runs x periods of a seeded robustness batch (track --runs): 20 irregular runs of 2000
+#: periods (40000) took 213 s and 430 MB under load 4; 5 such runs (10000) took 64 s
+MAX_TRACK_WORK = 10000
+
+# --- irregular seas (sea command, docs/seas.md) ------------------------------------------
+#: significant wave height and |z| of a measured record, m
+SEA_MAX_HS = 30.0
+#: peak period, s
+SEA_TP_RANGE = (1.0, 30.0)
+#: repeat period in peak periods (about the number of waves in the record)
+SEA_WAVES_RANGE = (2.0, 400.0)
+#: components of q (harmonics of the repeat period) of one record
+SEA_MAX_COMPONENTS = 8192
+#: rows of a measured record CSV 't,z'
+SEA_MAX_RECORD_ROWS = 1 << 17
+#: harmonics N of the motion over one record (operator Newton: memory O(N), time O(N log N))
+SEA_MAX_HARMONICS = 16384

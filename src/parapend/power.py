@@ -83,16 +83,25 @@ def power_by_parts(motion, excitation, damping: float = 0.0, points: int = 4096)
     return float(np.mean(excitation.dq(t) * np.cos(th)) - damping * np.mean(thd * thd))
 
 
-def uniform_power(excitation, damping: float = 0.0) -> tuple[float, float]:
+def uniform_power(excitation, damping: float = 0.0, winding: int = 1) -> tuple[float, float]:
     """Best uniform rotation ``theta = omega t + phi`` (Eq. 17 generalized): (power, phi).
 
     Only the first harmonic ``Q1`` of ``q`` does work on a uniform rotation:
     ``<q' cos(s + phi)> = omega |Q1| cos(phi - arg(1j Q1)) / 2``, so the best phase is
     ``phi = arg(1j*Q1)`` and ``P = omega |Q1| / 2 - gamma omega^2``. For ``q = delta sin(omega
     t)``: ``P = omega |delta| / 2`` (Eq. 17), reached at ``phi = pi`` when ``delta < 0``.
+
+    Winding K, ``theta = K omega t + phi``: only the K-th harmonic works,
+    ``P = K omega |Q_K| / 2 - gamma K^2 omega^2`` at ``phi = arg(1j Q_K)``.
     """
     _check_excitation(excitation)
     damping = check_range("gamma", damping, 0.0, limits.MAX_GAMMA)
+    if winding != 1:
+        spec = excitation.spectrum
+        qk = complex(spec[winding]) if 0 < winding < spec.size else 0j
+        om = excitation.omega * winding
+        phi = float(np.angle(1j * qk)) if qk != 0 else 0.0
+        return float(om * abs(qk) / 2 - damping * om * om), phi
     q1 = excitation.first_harmonic
     om = excitation.omega
     phi = float(np.angle(1j * q1)) if q1 != 0 else 0.0

@@ -7,9 +7,15 @@ Mirrors ``parapend optimize --torque-limit/--efficiency...`` and ``parapend pto-
     r.power, r.electrical_power, r.peak_torque
     ds = pto.pto_curve(vary="torque-limit", gamma=0.03)
 
-The method is :mod:`parapend.optimal.constrained` (augmented Lagrangian and smoothed
-efficiency on the exact-Hessian Fourier Newton kernel), warm-started from the ideal optimum
-of :func:`parapend.optimize`.
+Two methods, both warm-started from the ideal optimum of :func:`parapend.optimize`:
+
+- a torque limit (alone or with a copper loss): :mod:`parapend.optimal.hermite`, the motion
+  as K cubic Hermite intervals and a primal-dual interior point on the banded Newton
+  system (the optimal torque is bang-bang: a local basis resolves its jumps, a Fourier
+  series does not); K from the excitation, checked by one doubling;
+- an efficiency (with or without a limit): :mod:`parapend.optimal.constrained`, the
+  smoothed efficiency (and an augmented Lagrangian for the limit) on the exact-Hessian
+  Fourier Newton kernel.
 """
 
 from __future__ import annotations
@@ -23,6 +29,7 @@ from . import limits
 from .api import _coefficients, optimize
 from .errors import ParameterError, SolverError, check_finite, check_int, check_range
 from .optimal.constrained import pto_profile, solve_pto
+from .power import uniform_power
 from .trajectory import FourierMotion
 
 __all__ = ["VARY", "efficiencies", "optimize_pto", "physical_fields", "pto_curve"]
@@ -128,9 +135,17 @@ def optimize_pto(*, torque_limit=None, efficiency=None, efficiency_generating=No
                                   motoring_energy=prof["motoring_energy"],
                                   harvested_energy=prof["harvested_energy"])
         return dataclasses.replace(res, **physical_fields(res, units))
-    x0 = ideal.motion.vector if warm is None else np.asarray(warm, dtype=float)
-    sol = solve_pto(exc, n, gamma, x0, torque_limit=tmax, efficiency=eff, copper_loss=r_cu)
-    motion = FourierMotion.from_vector(exc.omega, sol.x)
+    extra = {}
+    if eff is None:
+        sol, motion, extra = _time_domain(exc, gamma, ideal, tmax, r_cu, warm)
+        coefficients = _coefficients(_projection(motion, exc, n))
+    else:
+        x0 = ideal.motion.vector if warm is None or not isinstance(warm, np.ndarray) else \
+            np.asarray(warm, dtype=float)
+        sol = solve_pto(exc, n, gamma, x0, torque_limit=tmax, efficiency=eff,
+                        copper_loss=r_cu)
+        motion = FourierMotion.from_vector(exc.omega, sol.x)
+        coefficients = _coefficients(motion)
     prof = pto_profile(motion, exc, gamma, efficiency=eff)
     pu = ideal.uniform_power
     status = sol.status
@@ -140,8 +155,11 @@ def optimize_pto(*, torque_limit=None, efficiency=None, efficiency_generating=No
                        "rotation costs energy through this power take-off (the power shown "
                        "is the smallest loss)",
            "converged": "converged: optimum of the power take-off problem",
-           "infeasible": f"infeasible: no {n}-harmonic rotation found with |T| <= "
-                         f"{tmax}; raise the torque limit",
+           "infeasible": f"infeasible: no rotation found with |T| <= {tmax}; raise the "
+                         "torque limit",
+           "unresolved": "converged, but the power still moved by more than 1e-6 "
+                         f"at the last doubling of the intervals (cap "
+                         f"{limits.MAX_PTO_INTERVALS})",
            "stalled": "stalled: the augmented Lagrangian did not settle its multipliers; "
                       "the motion is feasible but may not be optimal",
            "max_iterations": "maximum number of Newton iterations reached",
@@ -149,21 +167,102 @@ def optimize_pto(*, torque_limit=None, efficiency=None, efficiency_generating=No
     res = dataclasses.replace(
         ideal, power=sol.power,
         gain_over_uniform=(sol.power / pu - 1.0) if pu > 0 else None,
-        success=status in ("converged", "no_power"), status=status, message=msg,
-        iterations=sol.iterations, coefficients=_coefficients(motion),
+        success=status in ("converged", "no_power", "unresolved"), status=status,
+        message=msg,
+        iterations=sol.iterations, coefficients=coefficients,
         peak_torque=sol.peak_torque, found_by="warm" if warm is not None else "ideal optimum",
         local_maxima=[], gradient_norm=sol.gradient_norm, strict_maximum=False,
-        quadrature_points=sol.points, mean_square_speed=motion.mean_square_speed(),
+        quadrature_points=getattr(sol, "points", 0),
+        mean_square_speed=motion.mean_square_speed(),
         torque_limit=tmax, efficiency_generating=None if eff is None else eff[0],
         efficiency_motoring=None if eff is None else eff[1],
         electrical_power=sol.electrical_power, unconstrained_power=ideal.power,
         peak_power=prof["peak_power"], motoring_energy=prof["motoring_energy"],
         harvested_energy=prof["harvested_energy"], max_violation=sol.max_violation,
-        _motion=motion)
+        _motion=motion, **extra)
     res = dataclasses.replace(res, **physical_fields(res, units))
     if throw and not res.success:
         raise SolverError(f"optimize: {res.message}")
     return res
+
+
+def _projection(motion, exc, n: int) -> FourierMotion:
+    """The N-harmonic Fourier projection of a motion (for ``coefficients``)."""
+    from .trajectory import SampledMotion
+
+    m = max(4096, 8 * n)
+    t = exc.period * np.arange(m) / m
+    proj = SampledMotion(exc.omega, motion.theta(t)).to_fourier()
+    return FourierMotion(exc.omega, proj.a0, proj.a[:n], proj.b[:n])
+
+
+def intervals_for(exc) -> int:
+    """Starting number of Hermite intervals: 64, or 8 per harmonic of ``q``, a power of
+    two (then doubled until the power moves by less than 1e-6)."""
+    k = 8 * max(1, int(np.size(exc.spectrum)) - 1)
+    return int(min(limits.MAX_PTO_INTERVALS, max(64, 1 << int(math.ceil(math.log2(k))))))
+
+
+@dataclasses.dataclass
+class _TimeDomain:
+    power: float
+    electrical_power: float
+    peak_torque: float
+    max_violation: float
+    status: str
+    iterations: int
+    gradient_norm: float = float("nan")
+
+
+def _time_domain(exc, gamma, ideal, tmax, copper_loss, warm, rtol: float = 1e-6):
+    """Torque-limited optimum on Hermite intervals, doubled until the power settles."""
+    from .optimal.hermite import solve_hermite
+
+    start = ideal.motion if warm is None or isinstance(warm, np.ndarray) else warm
+    k = intervals_for(exc)
+    prev = None
+    iters = 0
+    change = float("nan")
+    while True:
+        sol = solve_hermite(exc, gamma, k, start, torque_limit=tmax, copper_loss=copper_loss)
+        iters += sol.iterations
+        if sol.status == "infeasible" and prev is None and 2 * k <= limits.MAX_PTO_INTERVALS:
+            k *= 2  # the smallest peak torque falls with the resolution: try a finer one
+            continue
+        if sol.status != "converged":
+            break
+        motion = sol.motion
+        if prev is not None:
+            change = abs(sol.electrical_power - prev)
+            if change <= rtol * max(1.0, abs(sol.electrical_power)) or \
+                    2 * k > limits.MAX_PTO_INTERVALS:
+                break
+        prev = sol.electrical_power
+        start = motion
+        k *= 2
+    motion = sol.motion
+    status = sol.status
+    if status == "converged" and not change <= rtol * max(1.0, abs(sol.electrical_power)):
+        status = "unresolved"
+    viol = max(sol.peak_torque / tmax - 1.0, 0.0)
+    out = _TimeDomain(power=sol.power, electrical_power=sol.electrical_power,
+                      peak_torque=sol.peak_torque, max_violation=viol, status=status,
+                      iterations=iters)
+    return out, motion, {"method": "hermite", "intervals": k, "refinement_change": change}
+
+
+def _smallest_limit(ideal):
+    """The smallest peak torque of a rotation (phase 1 of :mod:`parapend.optimal.hermite`
+    from the best uniform rotation, on twice :func:`intervals_for` intervals): ``(dense
+    peak of that motion, status)``. Any smaller limit is infeasible near it; this limit is
+    met (by that motion). A free rotating attractor of the pendulum makes it about 0."""
+    from .optimal.hermite import minimum_peak_torque
+
+    exc = ideal._excitation
+    _, phi = uniform_power(exc, ideal.gamma)
+    uniform = FourierMotion(exc.omega, phi, np.zeros(1), np.zeros(1))
+    sol, _ = minimum_peak_torque(exc, ideal.gamma, 2 * intervals_for(exc), uniform)
+    return float(sol.peak_torque), sol.status
 
 
 def pto_curve(vary: str = "torque-limit", *, values=None, points: int = 12,
@@ -175,8 +274,10 @@ def pto_curve(vary: str = "torque-limit", *, values=None, points: int = 12,
     ----------
     vary : {"torque-limit", "efficiency"}
         ``torque-limit``: from the ideal optimum's peak torque down (geometrically) to the
-        smallest limit at which a rotation is still found (the last feasible value), each
-        solve warm-started from the previous (continuation from large to small ``T_max``);
+        smallest feasible limit (the smallest peak torque of any rotation found, phase 1 of
+        :mod:`parapend.optimal.hermite`; 2 % of the top when a free rotation makes that
+        about 0), each solve warm-started from the previous; with an efficiency, down to 2 %
+        of the top (the Fourier method), stopping at the first infeasible value;
         ``efficiency``: ``eta = eta_g = eta_m`` from 1 down to 0.5 (or ``values``).
     values : sequence of float or None
         The limits (m g l) or efficiencies to use instead of the defaults.
@@ -188,7 +289,9 @@ def pto_curve(vary: str = "torque-limit", *, values=None, points: int = 12,
     xarray.Dataset
         Over ``value``: ``power`` (mechanical), ``electrical_power``, ``peak_torque``,
         ``motoring_energy``, ``status``; attrs ``vary``, ``unconstrained_power``, and, for
-        the torque limit, ``smallest_feasible_limit`` (the smallest value solved feasibly).
+        the torque limit, ``smallest_solved_limit`` (the smallest value solved feasibly),
+        ``smallest_feasible_limit`` and ``smallest_feasible_status`` (phase 1, no
+        efficiency).
     """
     import xarray as xr
 
@@ -200,9 +303,12 @@ def pto_curve(vary: str = "torque-limit", *, values=None, points: int = 12,
         if torque_limit is not None:
             raise ParameterError("torque-limit: it is the varied quantity; drop it")
         eff = efficiencies(efficiency, efficiency_generating, efficiency_motoring)
+        tmin = _smallest_limit(ideal) if eff is None else None
         if values is None:
             top = ideal.peak_torque
-            vals = list(top * np.geomspace(1.0, 0.02, npts))
+            low = 0.02 * top if tmin is None else \
+                min(top, max(tmin[0] * (1 + 2e-3), 0.02 * top))
+            vals = list(top * np.geomspace(1.0, low / top, npts))
         else:
             vals = sorted((_torque_limit(v) for v in values), reverse=True)
     else:
@@ -224,7 +330,7 @@ def pto_curve(vary: str = "torque-limit", *, values=None, points: int = 12,
             progress(i + 1, len(vals))
         if vary == "torque-limit" and r.status == "infeasible":
             break  # below the smallest feasible limit: smaller ones are infeasible too
-        warm = r.motion.vector
+        warm = r.motion if r.method == "hermite" else r.motion.vector
     feas = [r.torque_limit for r in rows if r.status != "infeasible"]
     ds = xr.Dataset(
         {"power": ("value", [r.power for r in rows]),
@@ -238,7 +344,10 @@ def pto_curve(vary: str = "torque-limit", *, values=None, points: int = 12,
                "gamma": ideal.gamma, "omega": ideal.omega,
                "convention": "power: mechanical P = -<T theta'>; torque units m g l"})
     if vary == "torque-limit":
-        ds.attrs["smallest_feasible_limit"] = min(feas) if feas else float("nan")
+        ds.attrs["smallest_solved_limit"] = min(feas) if feas else float("nan")
+        if tmin is not None:
+            ds.attrs["smallest_feasible_limit"] = tmin[0]
+            ds.attrs["smallest_feasible_status"] = tmin[1]
     if units is not None:
         ds["power_w"] = ds["power"] * units.power
         ds["electrical_power_w"] = ds["electrical_power"] * units.power
@@ -286,9 +395,13 @@ def plot_pto_curve(ds, path=None):
     from .plotting import _finish, plt
 
     fig, ax = plt.subplots(figsize=(7, 4.2))
+    ok = np.isin(ds["status"].values, ["converged", "no_power"])
     v = ds["value"].values
-    ax.plot(v, ds["power"].values, "o-", label="mechanical P")
-    ax.plot(v, ds["electrical_power"].values, "s--", label="electrical")
+    ax.plot(v[ok], ds["power"].values[ok], "o-", label="mechanical P")
+    ax.plot(v[ok], ds["electrical_power"].values[ok], "s--", label="electrical")
+    if not ok.all():
+        ax.plot(v[~ok], ds["power"].values[~ok], "x", color="C3", ms=8,
+                label="not converged (status)")
     ax.axhline(ds.attrs["unconstrained_power"], color="k", ls=":", lw=1,
                label="ideal optimum")
     ax.axhline(ds.attrs["uniform_power"], color="gray", ls=":", lw=1, label="best uniform")

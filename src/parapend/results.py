@@ -92,9 +92,17 @@ class OptimizeResult(_Result):
         the pendulum each cycle.
     max_violation : float or None
         ``max(peak_torque / torque_limit - 1, 0)`` on the dense evaluation.
+    intervals, refinement_change : int or None, float or None
+        The torque-limited optimum is solved in the time domain (``method`` "hermite",
+        :mod:`parapend.optimal.hermite`) on ``intervals`` cubic Hermite intervals, checked by
+        one doubling: ``refinement_change`` is the change of the power between the last two.
     units, power_w, uniform_power_w, limit_power_w, peak_torque_nm, electrical_power_w,
     energy_per_cycle_j, motoring_energy_j : physical values (W, N m, J) when a pendulum's
         length and mass were given (:mod:`parapend.units`); None otherwise.
+    winding : int
+        K, turns per forcing period, ``theta(t + 2 pi/omega) = theta(t) + 2 pi K`` (1: the
+        paper's period-1 rotation); ``uniform_power`` is then the uniform rotation with K
+        turns and ``upper_bound`` is ``limit - gamma K^2 omega^2``.
     """
 
     power: float
@@ -139,6 +147,8 @@ class OptimizeResult(_Result):
     motoring_energy: float | None = None
     harvested_energy: float | None = None
     max_violation: float | None = None
+    intervals: int | None = None
+    refinement_change: float | None = None
     units: dict | None = None
     power_w: float | None = None
     uniform_power_w: float | None = None
@@ -147,13 +157,15 @@ class OptimizeResult(_Result):
     electrical_power_w: float | None = None
     energy_per_cycle_j: float | None = None
     motoring_energy_j: float | None = None
+    winding: int = 1
     convention: str = CONVENTION
     _motion: object = field(default=None, repr=False)
     _excitation: object = field(default=None, repr=False)
 
     @property
     def motion(self):
-        """The optimal motion (a :class:`~parapend.trajectory.FourierMotion`)."""
+        """The optimal motion: a :class:`~parapend.trajectory.FourierMotion`, or a
+        :class:`~parapend.optimal.hermite.HermiteMotion` for ``method`` "hermite"."""
         return self._motion
 
 

@@ -1,7 +1,8 @@
 """Period-1 rotations ``theta(t)`` (Eqs. 3-4): Fourier series, sampled, piecewise-constant.
 
 Every motion gives ``theta``, ``theta_dot`` and ``theta_ddot`` at arbitrary times and
-satisfies ``theta(t + 2*pi/omega) = theta(t) + 2*pi`` (one turn per forcing period).
+satisfies ``theta(t + 2*pi/omega) = theta(t) + 2*pi*K`` (``K = winding`` turns per period,
+1 unless given: the paper's period-1 rotation; records of irregular seas use more).
 """
 
 from __future__ import annotations
@@ -34,12 +35,13 @@ class FourierMotion:
     a0: float
     a: np.ndarray
     b: np.ndarray
+    winding: int = 1
 
     @classmethod
-    def from_vector(cls, omega: float, x: np.ndarray) -> FourierMotion:
+    def from_vector(cls, omega: float, x: np.ndarray, winding: int = 1) -> FourierMotion:
         """Build from the packed vector ``x = [a0, a_1..a_N, b_1..b_N]``."""
         n = (x.size - 1) // 2
-        return cls(omega, float(x[0]), np.array(x[1:n + 1]), np.array(x[n + 1:]))
+        return cls(omega, float(x[0]), np.array(x[1:n + 1]), np.array(x[n + 1:]), winding)
 
     @property
     def harmonics(self) -> int:
@@ -58,12 +60,12 @@ class FourierMotion:
 
     def theta(self, t):
         s, _, sn, cn = self._trig(t)
-        return s + self.a0 + sn @ self.a + cn @ self.b
+        return self.winding * s + self.a0 + sn @ self.a + cn @ self.b
 
     def theta_dot(self, t):
-        """Eq. 11."""
+        """Eq. 11 (with ``K`` in place of the leading 1 for winding ``K``)."""
         _, n, sn, cn = self._trig(t)
-        return self.omega * (1.0 + cn @ (n * self.a) - sn @ (n * self.b))
+        return self.omega * (self.winding + cn @ (n * self.a) - sn @ (n * self.b))
 
     def theta_ddot(self, t):
         _, n, sn, cn = self._trig(t)
@@ -81,18 +83,19 @@ class FourierMotion:
         c = np.zeros(m // 2 + 1, dtype=complex)
         c[1:n + 1] = (0.5 * m) * (self.b - 1j * self.a)  # Re((b - ia) e^{iks})
         s = 2 * np.pi * np.arange(m) / m
-        theta = s + self.a0 + np.fft.irfft(c, m)
+        theta = self.winding * s + self.a0 + np.fft.irfft(c, m)
         d = np.zeros_like(c)
         d[1:n + 1] = c[1:n + 1] * (1j * k)
-        theta_dot = self.omega * (1.0 + np.fft.irfft(d, m))
+        theta_dot = self.omega * (self.winding + np.fft.irfft(d, m))
         d[1:n + 1] *= 1j * k
         theta_ddot = self.omega**2 * np.fft.irfft(d, m)
         return theta, theta_dot, theta_ddot
 
     def mean_square_speed(self) -> float:
-        """``<theta'^2> = omega^2 (1 + sum n^2 (a_n^2 + b_n^2)/2)`` (Parseval, exact)."""
+        """``<theta'^2> = omega^2 (K^2 + sum n^2 (a_n^2 + b_n^2)/2)`` (Parseval, exact)."""
         n = np.arange(1, self.harmonics + 1)
-        return float(self.omega**2 * (1.0 + 0.5 * np.sum(n * n * (self.a**2 + self.b**2))))
+        ab2 = self.a**2 + self.b**2
+        return float(self.omega**2 * (self.winding**2 + 0.5 * np.sum(n * n * ab2)))
 
 
 @dataclass(frozen=True, eq=False)
@@ -136,6 +139,7 @@ class PiecewiseConstantMotion:
     switch_times: np.ndarray
     directions: np.ndarray
     theta_start: float
+    winding: int = 1
 
     def theta(self, t):
         t = np.asarray(t, dtype=float)
@@ -144,4 +148,4 @@ class PiecewiseConstantMotion:
         tm = t - turns * period
         steps = np.searchsorted(self.switch_times, tm, side="right")
         cum = np.concatenate(([0.0], np.cumsum(self.directions)))
-        return self.theta_start + math.pi * cum[steps] + 2 * math.pi * turns
+        return self.theta_start + math.pi * cum[steps] + 2 * math.pi * self.winding * turns

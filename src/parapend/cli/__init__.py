@@ -13,7 +13,9 @@ Modules: :mod:`._common` (parser helpers, number parsing, tables, progress),
 :mod:`._output` (every file written), :mod:`.optimize` (optimize, threshold, damping-sweep,
  harmonics), :mod:`.paper` (figure, reproduce), :mod:`.pto` (pto-curve; the power
  take-off and unit options of optimize), :mod:`.dynamics` (simulate, basins,
- rotations: the uncontrolled pendulum of paper Eq. 1), :mod:`.sweep` (sweep, map: design maps).
+ rotations: the uncontrolled pendulum of paper Eq. 1), :mod:`.control` (track: the
+ closed loop of issue 11), :mod:`.sea` (sea: irregular seas), :mod:`.sweep` (sweep, map:
+ design maps).
 """
 
 from __future__ import annotations
@@ -25,10 +27,12 @@ import sys
 from .. import __version__
 from ..errors import ParameterError, SolverError
 from ..results import to_jsonable
+from . import control as _control_cmds
 from . import dynamics as _dynamics_cmds
 from . import optimize as _optimize_cmds
 from . import paper as _paper_cmds
 from . import pto as _pto_cmds
+from . import sea as _sea_cmds
 from . import sweep as _sweep_cmds
 from ._common import EXIT_USAGE, _Parser
 from ._output import OutputError
@@ -38,7 +42,8 @@ EXIT_FAILURE = 1
 __all__ = ["build_parser", "main"]
 
 COMMANDS = {**_optimize_cmds.COMMANDS, **_paper_cmds.COMMANDS, **_pto_cmds.COMMANDS,
-            **_dynamics_cmds.COMMANDS, **_sweep_cmds.COMMANDS}
+            **_dynamics_cmds.COMMANDS, **_control_cmds.COMMANDS, **_sea_cmds.COMMANDS,
+            **_sweep_cmds.COMMANDS}
 
 
 def build_parser():
@@ -54,6 +59,8 @@ def build_parser():
     _paper_cmds.add_parsers(sub)
     _pto_cmds.add_parsers(sub)
     _dynamics_cmds.add_parsers(sub)
+    _control_cmds.add_parsers(sub)
+    _sea_cmds.add_parsers(sub)
     _sweep_cmds.add_parsers(sub)
     return parser
 
@@ -85,11 +92,24 @@ def _silence_stdout() -> None:
         pass
 
 
+def _one_blas_thread() -> None:
+    """One BLAS thread unless the user chose (``OPENBLAS_NUM_THREADS`` and the like): every
+    solve here is on small or banded matrices, where BLAS threads only spin (3 to 12 times
+    slower on a loaded 2-core machine)."""
+    if any(v in os.environ for v in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS",
+                                     "MKL_NUM_THREADS")):
+        return
+    from threadpoolctl import threadpool_limits
+
+    threadpool_limits(1, user_api="blas")
+
+
 def main(argv=None) -> int:
     """Run ``parapend`` with ``argv`` (default ``sys.argv[1:]``); return the exit code."""
     closed = argv is None and _stdout_closed()
     if closed:  # keep fd 1 from being reused by an output file opened later
         _silence_stdout()
+    _one_blas_thread()
     parser = build_parser()
     try:
         a = parser.parse_args(argv)

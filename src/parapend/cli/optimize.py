@@ -13,6 +13,7 @@ from . import _output
 from . import pto as _pto
 from ._common import (
     FIGURE_SUFFIXES,
+    Default,
     _add_excitation,
     _check_output,
     _dataset_json,
@@ -34,7 +35,7 @@ def add_parsers(sub) -> None:
                                    "22, 27), beside the best uniform rotation (Eq. 17) and the "
                                    "gamma -> 0 limit (Eqs. 19, 24, 32 generalized).")
     _add_excitation(p)
-    p.add_argument("--gamma", type=_finite_float("gamma"), default=0.0,
+    p.add_argument("--gamma", type=_finite_float("gamma"), default=Default(0.0),
                    help="viscous damping gamma in [0, 1e3] (default 0)")
     p.add_argument("--harmonics", type=_int, default=24,
                    help=f"number N of harmonics, at most {limits.MAX_HARMONICS} (default 24)")
@@ -47,6 +48,10 @@ def add_parsers(sub) -> None:
     p.add_argument("--save", metavar="CSV",
                    help="write one period of the motion: t,tau,theta,theta_dot,torque,power "
                         "(p = -T theta'; and electrical_power with an efficiency)")
+    p.add_argument("--winding", type=_int, default=1,
+                   help="K turns per forcing period, theta(t + 2 pi/omega) = theta(t) + 2 pi "
+                        "K (default 1, the paper's period-1 rotation; K > 1: method fourier, "
+                        "N >= 2K; docs/seas.md)")
     p.add_argument("--json", action="store_true", help="print one JSON object")
     _pto.add_pto_options(p)
     _pto.add_unit_options(p)
@@ -81,7 +86,7 @@ def add_parsers(sub) -> None:
                        description="Fourier optimum for N = FROM..TO by continuation in N "
                                    "(nondecreasing in N), beside the uniform and limit powers.")
     _add_excitation(p)
-    p.add_argument("--gamma", type=_finite_float("gamma"), default=0.0,
+    p.add_argument("--gamma", type=_finite_float("gamma"), default=Default(0.0),
                    help="viscous damping gamma in [0, 1e3] (default 0)")
     p.add_argument("--from", dest="n_from", type=_int, default=2, help="smallest N (default 2)")
     p.add_argument("--to", dest="n_to", type=_int, default=64,
@@ -99,6 +104,11 @@ def _cmd_optimize(a) -> dict | str:
     kw = {"gamma": a.gamma, "harmonics": a.harmonics, **_excitation_kwargs(a)}
     units, kw = _pto.apply_units(a, kw)
     pto = _pto.wants_pto(a)
+    if a.winding != 1:
+        if pto or a.method == "all":
+            raise ParameterError("winding: K > 1 works with method fourier or bvp without a "
+                                 "power take-off; drop --winding or those options")
+        kw["winding"] = a.winding
     if a.method == "all":
         if pto or units is not None:
             raise ParameterError("method: 'all' compares the ideal methods; the power "
@@ -143,8 +153,11 @@ def _cmd_optimize(a) -> dict | str:
         return r.to_dict()
     name = (f"Fourier optimum, N = {r.harmonics} (Eq. 10)" if r.method == "fourier"
             else f"BVP optimum, epsilon = {2 * r.gamma:g} (Eq. 22)")
+    if r.winding != 1:
+        name += f", winding K = {r.winding}"
     if pto:
-        name = f"power take-off optimum, N = {r.harmonics}"
+        name = (f"power take-off optimum, K = {r.intervals}" if r.method == "hermite" else
+                f"power take-off optimum, N = {r.harmonics}")
     rows = [
         ["best uniform rotation (Eq. 17)", _fmt(r.uniform_power), ""],
         [name, _fmt(r.power), _gain(r.power, r.uniform_power)],
@@ -161,13 +174,17 @@ def _cmd_optimize(a) -> dict | str:
                   f"{r.abandoned} abandoned as unable to win")
         if r.second_power is not None:
             search += f"; second-best maximum {_fmt(r.second_power)}"
+    elif r.method == "hermite":
+        how = (f"{r.iterations} interior-point iterations, {r.intervals} cubic Hermite "
+               f"intervals, started from the {r.found_by}")
     else:
         how = (f"{r.mesh_nodes} mesh nodes, max residual {r.max_residual:.2g}, "
                f"{r.continuation_steps} continuation steps, found from the {r.found_by} start")
     out = [f"excitation: {_describe(r.excitation)}; damping gamma = {r.gamma:g}", "",
            _table(rows, ["motion", "power P", "vs uniform"]), "",
            f"status: {r.status} ({how})",
-           f"upper bound limit - gamma omega^2: {_fmt(r.upper_bound)} "
+           f"upper bound limit - gamma {'' if r.winding == 1 else 'K^2 '}omega^2: "
+           f"{_fmt(r.upper_bound)} "
            f"(gap {_fmt(r.bound_gap)})",
            f"peak torque |T|: {r.peak_torque:.6g}    mean theta'^2: {r.mean_square_speed:.6g}",
            f"convention: {CONVENTION}"]

@@ -7,6 +7,7 @@ from ..errors import ParameterError
 from . import _output
 from ._common import (
     FIGURE_SUFFIXES,
+    Default,
     _add_excitation,
     _check_output,
     _dataset_json,
@@ -16,10 +17,8 @@ from ._common import (
     _int,
     _Progress,
     _table,
+    given,
 )
-
-_DEFAULT_OMEGA = 1.8
-_DEFAULT_GAMMA = 0.0
 
 
 def add_pto_options(p, torque_limit: bool = True) -> None:
@@ -74,11 +73,11 @@ def apply_units(a, kw: dict):
                                  amplitude=a.amplitude,
                                  damping_coefficient=a.damping_coefficient)
     kw = dict(kw)
-    if "omega" in params and kw.get("omega") != _DEFAULT_OMEGA:
+    if "omega" in params and given(kw.get("omega")):
         raise ParameterError("frequency: give either --frequency or --omega, not both")
     if "delta" in params and kw.get("delta") is not None:
         raise ParameterError("amplitude: give either --amplitude or --delta, not both")
-    if "gamma" in params and kw.get("gamma", _DEFAULT_GAMMA) != _DEFAULT_GAMMA:
+    if "gamma" in params and given(kw.get("gamma")):
         raise ParameterError("damping-coefficient: give either --damping-coefficient or "
                              "--gamma, not both")
     kw.update(params)
@@ -121,6 +120,9 @@ def pto_lines(r) -> list[str]:
     if r.torque_limit is not None:
         out.append(f"torque limit {r.torque_limit:.6g} (peak |T| {r.peak_torque:.6g}, "
                    f"violation {r.max_violation:.1e})")
+    if r.method == "hermite":
+        out.append(f"time domain: {r.intervals} cubic Hermite intervals, interior point; "
+                   f"power change at the last doubling {r.refinement_change:.1e}")
     if r.efficiency_generating is not None:
         out.append(f"efficiency: generating {r.efficiency_generating:g}, motoring "
                    f"{r.efficiency_motoring:g}; electrical power {_fmt(r.electrical_power, 8)}"
@@ -142,7 +144,7 @@ def add_parsers(sub) -> None:
     _add_excitation(p)
     p.add_argument("--vary", choices=["torque-limit", "efficiency"], default="torque-limit",
                    help="the varied parameter (default torque-limit)")
-    p.add_argument("--gamma", type=_finite_float("gamma"), default=0.03,
+    p.add_argument("--gamma", type=_finite_float("gamma"), default=Default(0.03),
                    help="viscous damping gamma in [0, 1e3] (default 0.03)")
     p.add_argument("--harmonics", type=_int, default=24,
                    help=f"N, at most {limits.MAX_PTO_HARMONICS} (default 24)")
@@ -191,7 +193,13 @@ def _cmd_pto_curve(a) -> dict | str:
            f"{_fmt(ds.attrs['uniform_power'], 8)} (gamma = {ds.attrs['gamma']:g}, N = "
            f"{ds.attrs['harmonics']}); units m g l, m g l / t0"]
     if a.vary == "torque-limit":
-        out.append(f"smallest feasible limit found: {ds.attrs['smallest_feasible_limit']:.6g}")
+        if "smallest_feasible_limit" in ds.attrs:
+            out.append(f"smallest peak torque of a rotation: "
+                       f"{ds.attrs['smallest_feasible_limit']:.6g} (phase 1, "
+                       f"{ds.attrs['smallest_feasible_status']}); smallest limit solved: "
+                       f"{ds.attrs['smallest_solved_limit']:.6g}")
+        else:
+            out.append(f"smallest limit solved: {ds.attrs['smallest_solved_limit']:.6g}")
     if a.plot:
         out.append(f"figure written to {a.plot}")
     return "\n".join(out)

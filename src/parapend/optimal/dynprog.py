@@ -24,6 +24,11 @@ about ``T / (2N)``; ``gamma_N`` is the damping whose boundary layer (width
 width, so that at gamma = 0 the programme still prefers the patterns a truncated series
 realizes best. The best path of every start angle, deduplicated, projected onto N
 harmonics, is a seed for the Newton polish in :mod:`.fourier`, which decides.
+
+Winding K (records of irregular seas, ``theta_M = theta_0 + 2 pi K``): the lifted angle of
+a path with K turns would need ``K`` turns of states; :func:`best_paths_winding` keeps only
+a window of ``WINDOW`` turns either side of the uniform rotation ``2 pi K t / T``, moving
+with it, so the cost is ``O(M starts (2 WINDOW K + 1) D)`` whatever K.
 """
 
 from __future__ import annotations
@@ -32,7 +37,7 @@ import math
 
 import numpy as np
 
-__all__ = ["best_paths", "propose_seeds"]
+__all__ = ["best_paths", "best_paths_winding", "propose_seeds"]
 
 #: Angle points per turn.
 ANGLES = 32
@@ -105,11 +110,70 @@ def best_paths(excitation, damping: float, steps: int, angles: int = ANGLES,
     return values, paths
 
 
-def _project(path: np.ndarray, omega: float, harmonics: int) -> np.ndarray:
+#: Turns either side of the uniform rotation ``K s`` that a winding-K path may lag or lead.
+WINDOW = 3
+
+
+def best_paths_winding(excitation, damping: float, steps: int, winding: int,
+                       angles: int = ANGLES, max_jump: int = MAX_JUMP, starts: int = 8,
+                       window: int = WINDOW):
+    """Best closed paths with ``theta_steps = theta_0 + 2 pi K`` (see the module docstring).
+
+    The state is the lifted angle index relative to the uniform rotation's,
+    ``c_i = round(K angles i / steps)``, within ``+-window`` turns; ``starts`` start angles
+    evenly spread over one turn. Returns ``(values, paths)`` as :func:`best_paths`.
+    """
+    period = excitation.period
+    h = period / steps
+    t = h * np.arange(steps)
+    dq = excitation.dq(t)
+    if winding * angles > max_jump * steps // 2:
+        raise ValueError("steps: too few for the winding (K angles must be <= steps D / 2)")
+    half = window * angles
+    rel = np.arange(-half, half + 1)
+    nstate = rel.size
+    first = (np.arange(starts) * angles) // starts  # start offsets in angle points
+    dth = 2 * math.pi / angles
+    centre = np.rint(winding * angles * np.arange(steps + 1) / steps).astype(int)
+    jumps = np.arange(-max_jump, max_jump + 1)
+    jump_cost = damping * (jumps * dth) ** 2 / h**2 / steps
+    v = np.full((starts, nstate), -np.inf)
+    v[:, half] = 0.0
+    arg = np.empty((steps, starts, nstate), dtype=np.int8)
+    base = first[:, None] + rel[None, :]
+    for i in range(steps):
+        v = v + (dq[i] / steps) * np.cos(dth * (base + centre[i]))
+        shift = centre[i + 1] - centre[i]
+        best = np.full_like(v, -np.inf)
+        barg = np.zeros(v.shape, dtype=np.int8)
+        for d, c in zip(jumps, jump_cost):
+            e = int(d) - shift  # r' = r + d - shift
+            cand = np.full_like(v, -np.inf)
+            if e >= 0:
+                cand[:, e:] = v[:, :nstate - e] - c
+            else:
+                cand[:, :e] = v[:, -e:] - c
+            better = cand > best
+            best = np.where(better, cand, best)
+            barg = np.where(better, np.int8(d), barg)
+        v = best
+        arg[i] = barg
+    values = v[:, half]
+    paths = np.empty((starts, steps + 1))
+    r = np.full(starts, half)
+    rows = np.arange(starts)
+    for i in range(steps, -1, -1):
+        paths[:, i] = dth * (first + rel[r] + centre[i])
+        if i > 0:
+            r = r - arg[i - 1, rows, r] + (centre[i] - centre[i - 1])
+    return values, paths
+
+
+def _project(path: np.ndarray, omega: float, harmonics: int, winding: int = 1) -> np.ndarray:
     """Packed N-harmonic coefficients of a lifted path sampled at ``t_i = i T / M``."""
     m = path.size - 1
     s = 2 * math.pi * np.arange(m) / m
-    x = np.fft.rfft(path[:-1] - s) / m
+    x = np.fft.rfft(path[:-1] - (s if winding == 1 else winding * s)) / m
     n = np.arange(1, harmonics + 1)
     c = np.zeros(harmonics, dtype=complex)
     k = min(harmonics, m // 2 - 1)
@@ -118,16 +182,26 @@ def _project(path: np.ndarray, omega: float, harmonics: int) -> np.ndarray:
     return np.concatenate(([x[0].real], -c.imag, c.real))
 
 
-def propose_seeds(excitation, harmonics: int, damping: float, count: int):
+#: Time steps of the winding programme: at most this many (8 per extremum of q below it).
+MAX_STEPS_WINDING = 16384
+
+
+def propose_seeds(excitation, harmonics: int, damping: float, count: int, winding: int = 1):
     """Up to ``count`` distinct seeds from the best paths, best first, as ``(name, x)``."""
-    steps = int(min(4096, max(128, 4 * harmonics, 8 * excitation.extrema.t.size)))
-    values, paths = best_paths(excitation, _effective_damping(excitation, harmonics, damping),
-                               steps)
+    if winding == 1:
+        steps = int(min(4096, max(128, 4 * harmonics, 8 * excitation.extrema.t.size)))
+        values, paths = best_paths(excitation,
+                                   _effective_damping(excitation, harmonics, damping), steps)
+    else:
+        steps = int(min(MAX_STEPS_WINDING, max(128, 2 * harmonics,
+                                               8 * excitation.extrema.t.size, 8 * winding)))
+        values, paths = best_paths_winding(
+            excitation, _effective_damping(excitation, harmonics, damping), steps, winding)
     out, seen = [], []
     for s in np.argsort(-values, kind="stable"):
         if not math.isfinite(values[s]):
             continue
-        x = _project(paths[s], excitation.omega, harmonics)
+        x = _project(paths[s], excitation.omega, harmonics, winding)
         # same path up to the start angle: same seed
         if any(np.max(np.abs(x - y)) < 0.3 for y in seen):
             continue

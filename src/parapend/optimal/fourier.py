@@ -106,6 +106,11 @@ def _hessian_tables(n: int):
     return idx, coef
 
 
+#: Kinds of Hessian: the dense (2N+1)^2 matrix read off the FFT tables (Cholesky), or the
+#: matrix-free operator (two FFTs per product, truncated conjugate gradients).
+HESSIANS = ("dense", "operator")
+
+
 class FourierProblem:
     """Objective, exact gradient and Hessian of the N-harmonic problem on an M-point grid.
 
@@ -118,22 +123,38 @@ class FourierProblem:
         gamma >= 0.
     points : int, optional
         Quadrature points M (power of two, > 4N); chosen from N and the excitation if None.
+    winding : int, optional
+        K, turns per period of ``q``: ``theta = K s + a0 + sum ...`` (Eq. 10 with K in place
+        of 1; K = 1 is the paper's period-1 rotation and computes exactly as before).
+    hessian : {"dense", "operator"}
+        ``"dense"``: :meth:`evaluate` returns the (2N+1) x (2N+1) Hessian (O(N^2) memory,
+        O(N^3) per Newton step). ``"operator"``: it returns a :class:`HessianOperator` whose
+        product costs two FFTs of M points (records of irregular seas: N in the thousands).
     """
 
-    def __init__(self, excitation, harmonics: int, damping: float, points: int | None = None):
+    def __init__(self, excitation, harmonics: int, damping: float, points: int | None = None,
+                 winding: int = 1, hessian: str = "dense"):
+        if hessian not in HESSIANS:
+            raise ValueError(f"hessian: expected one of {HESSIANS}, got {hessian!r}")
         self.excitation = excitation
         self.omega = excitation.omega
         self.harmonics = n = harmonics
         self.damping = damping
+        self.winding = int(winding)
+        self.hessian = hessian
         m = points or _grid_size(n, excitation)
-        while m < 8 * n + 8:
+        while m < 8 * n + 8 * self.winding:
             m *= 2
         self.points = m
         self.s = 2 * np.pi * np.arange(m) / m
+        # K s of theta = K s + periodic part (the same array, not a product, when K = 1)
+        self._ks = self.s if self.winding == 1 else self.winding * self.s
+        self._k0 = 1.0 if self.winding == 1 else float(self.winding) ** 2
         self.w = excitation.dq_grid(m)
         k = np.arange(1, n + 1)
         self._k2 = np.concatenate(([0.0], k * k, k * k)).astype(float)
-        self._idx, self._coef = _hessian_tables(n)
+        if hessian == "dense":
+            self._idx, self._coef = _hessian_tables(n)
 
     # ------------------------------------------------------------------------------------
     def theta(self, x: np.ndarray) -> np.ndarray:
@@ -141,18 +162,21 @@ class FourierProblem:
         n, m = self.harmonics, self.points
         c = np.zeros(m // 2 + 1, dtype=complex)
         c[1:n + 1] = (0.5 * m) * (x[n + 1:] - 1j * x[1:n + 1])  # Re((b - ia) e^{ins})
-        return self.s + x[0] + np.fft.irfft(c, m)
+        return self._ks + x[0] + np.fft.irfft(c, m)
 
     def kinetic(self, x: np.ndarray) -> float:
-        """``<theta'^2>`` (exact, Parseval)."""
-        return self.omega**2 * (1.0 + 0.5 * float(np.dot(self._k2, x * x)))
+        """``<theta'^2> = omega^2 (K^2 + sum n^2 (a_n^2 + b_n^2) / 2)`` (exact, Parseval)."""
+        return self.omega**2 * (self._k0 + 0.5 * float(np.dot(self._k2, x * x)))
 
     def power(self, x: np.ndarray) -> float:
         """Objective ``P(x)`` only."""
         return float(np.mean(self.w * np.cos(self.theta(x)))) - self.damping * self.kinetic(x)
 
     def evaluate(self, x: np.ndarray):
-        """Return ``(P, gradient, Hessian)`` at ``x`` (exact to quadrature accuracy)."""
+        """Return ``(P, gradient, Hessian)`` at ``x`` (exact to quadrature accuracy).
+
+        The Hessian is an ndarray (``hessian="dense"``) or a :class:`HessianOperator`.
+        """
         n, m = self.harmonics, self.points
         th = self.theta(x)
         sn, cs = np.sin(th), np.cos(th)
@@ -161,16 +185,182 @@ class FourierProblem:
         U = np.fft.rfft(u)[: n + 1] / m
         V = np.fft.rfft(v)[: 2 * n + 1] / m
         gw = self.damping * self.omega**2
-        p = V[0].real - gw * (1.0 + 0.5 * float(np.dot(self._k2, x * x)))
+        p = V[0].real - gw * (self._k0 + 0.5 * float(np.dot(self._k2, x * x)))
         g = np.empty(2 * n + 1)
         g[0] = -U[0].real
         g[1:n + 1] = U[1:].imag
         g[n + 1:] = -U[1:].real
         g -= gw * self._k2 * x
+        if self.hessian == "operator":
+            return float(p), g, HessianOperator(self, v, V, gw)
         X = np.concatenate((V.real, -V.imag))
         h = -(self._coef[0] * X[self._idx[0]] + self._coef[1] * X[self._idx[1]])
         h.flat[:: h.shape[0] + 1] -= gw * self._k2
         return float(p), g, h
+
+
+class HessianOperator:
+    """The Hessian of ``P`` as an operator: ``H d = -P_N(v * Phi d) - gamma omega^2 k^2 d``.
+
+    ``v = q' cos(theta)`` on the grid, ``Phi d`` the trigonometric polynomial with
+    coefficients ``d`` (one inverse FFT) and ``P_N`` the projection on the N harmonics (one
+    FFT): the same matrix as the dense Hessian, ``-<v phi_i phi_k>`` plus the diagonal
+    damping term, applied in O(M log M) without forming it.
+    """
+
+    def __init__(self, problem: FourierProblem, v: np.ndarray, V: np.ndarray, gw: float):
+        self.problem = problem
+        self.v = v
+        self.gw = gw
+        n = problem.harmonics
+        k2 = problem._k2
+        # diagonal of -H: <v> for a0, <v sin^2 ns> = (V0 - Re V_2n)/2, <v cos^2 ns> = (V0 +
+        # Re V_2n)/2
+        d = np.empty(2 * n + 1)
+        d[0] = V[0].real
+        v2 = V[2:2 * n + 1:2].real
+        d[1:n + 1] = 0.5 * (V[0].real - v2)
+        d[n + 1:] = 0.5 * (V[0].real + v2)
+        self.diagonal = d + gw * k2  # of -H
+        self._lu = None
+        av = np.abs(v)
+        # the banded preconditioner replaces v by |v|: good where v is mostly positive (near
+        # a maximum, v = q' cos(theta) ~ |q'|), poor far from one
+        self.mostly_positive = float(np.sum(av[v < 0])) <= BANDED_NEGATIVE * float(np.sum(av))
+
+    def matvec(self, d: np.ndarray) -> np.ndarray:
+        """``H d`` (Hessian of P times d): two real FFTs."""
+        pr = self.problem
+        n, m = pr.harmonics, pr.points
+        c = np.zeros(m // 2 + 1, dtype=complex)
+        c[0] = m * d[0]
+        c[1:n + 1] = (0.5 * m) * (d[n + 1:] - 1j * d[1:n + 1])
+        f = self.v * np.fft.irfft(c, m)
+        G = np.fft.rfft(f)[: n + 1] / m
+        out = np.empty(2 * n + 1)
+        out[0] = G[0].real
+        out[1:n + 1] = -G[1:].imag
+        out[n + 1:] = G[1:].real
+        return -out - self.gw * pr._k2 * d
+
+    def precondition(self, r: np.ndarray) -> np.ndarray:
+        """Approximate ``(-H)^{-1} r`` by a banded solve in time.
+
+        In function space ``-H`` is ``L = v + 2 gamma omega^2 (-d^2/ds^2)`` between the
+        synthesis ``Phi`` and the projection ``Phi^T <.>`` (Gram matrix
+        ``G = diag(1, 1/2, ..)``). The preconditioner replaces ``v`` by ``|v| + mu`` and the
+        second derivative by its three-point difference on the M-point grid (within 5 % of
+        ``n^2`` up to ``n = N``, as ``M >= 8N``), and solves that cyclic tridiagonal system
+        exactly: ``G^{-1} Phi^T <L~^{-1} Phi G^{-1} r>``, symmetric positive definite.
+        """
+        pr = self.problem
+        n, m = pr.harmonics, pr.points
+        if self._lu is None:
+            from scipy.sparse import diags
+            from scipy.sparse.linalg import splu
+
+            ds = 2 * math.pi / m
+            c = 2.0 * self.gw / ds**2
+            av = np.abs(self.v)
+            mu = 1e-2 * float(np.mean(av)) + 1e-300
+            a = diags([np.full(m - 1, -c), av + mu + 2 * c, np.full(m - 1, -c),
+                       [-c], [-c]], [-1, 0, 1, m - 1, -(m - 1)], shape=(m, m), format="csc")
+            self._lu = splu(a)
+        c = np.zeros(m // 2 + 1, dtype=complex)
+        c[0] = m * r[0]
+        c[1:n + 1] = m * (r[n + 1:] - 1j * r[1:n + 1])  # G^{-1}: twice the coefficients
+        f = self._lu.solve(np.fft.irfft(c, m))
+        F = np.fft.rfft(f)[: n + 1] / m
+        out = np.empty(2 * n + 1)
+        out[0] = F[0].real
+        out[1:n + 1] = -2.0 * F[1:].imag
+        out[n + 1:] = 2.0 * F[1:].real
+        return out
+
+    def dense(self) -> np.ndarray:
+        """The full matrix (tests only: O(N^2) memory)."""
+        e = np.eye(self.diagonal.size)
+        return np.column_stack([self.matvec(c) for c in e])
+
+
+#: The banded preconditioner is used when at most this fraction of ``int |v|`` has ``v < 0``.
+BANDED_NEGATIVE = 0.05
+#: Truncated conjugate gradients of the operator Newton step: at most this many iterations.
+CG_MAXITER = 400
+
+
+def _cg_ascent_step(g: np.ndarray, op: HessianOperator, scale: float):
+    """Newton-CG step for ``-H d = g``, preconditioned (:data:`PRECONDITIONER`).
+
+    Truncated CG (Steihaug's rule without a radius; the caller caps the step and
+    backtracks): the relative residual is brought below ``min(0.5, sqrt(|g|/scale))``
+    (superlinear convergence), but never below 1e-4; if a direction of non-positive
+    curvature of ``-H`` appears, CG stops with the iterate so far (or, at the first
+    iteration, that direction, which is an ascent direction). Returns ``(d, newton)``:
+    ``newton`` is True when CG converged with positive curvature throughout (``-H``
+    positive definite on the Krylov space).
+    At a saddle (no Newton step and a negligible gradient), the step follows the most
+    positive curvature of P, found by Lanczos (:func:`scipy.sparse.linalg.eigsh`).
+    """
+    pre = np.abs(op.diagonal)
+    pre = np.maximum(pre, 1e-3 * float(np.max(pre)) + 1e-300)
+    gn = float(np.linalg.norm(g))
+    d, newton = _cg_solve(g, op, pre, gn, scale)
+    # a saddle: no Newton step and a negligible gradient (Lanczos only then: it costs
+    # hundreds of products, and near a maximum CG needs a few tens)
+    if not newton and float(np.max(np.abs(g))) <= 1e-8 * max(float(np.max(pre)), 1e-12):
+        from scipy.sparse.linalg import LinearOperator, eigsh
+
+        size = g.size
+        a = LinearOperator((size, size), matvec=lambda z: -op.matvec(np.ravel(z)),
+                           dtype=float)
+        lam, vec = eigsh(a, k=1, which="SA", tol=1e-6, maxiter=20 * size,
+                         v0=np.ones(size))
+        if lam[0] < 0:
+            e = vec[:, 0]
+            return e * (1.0 if g @ e >= 0 else -1.0) * 0.5, False
+    return d, newton
+
+
+#: Preconditioner of the operator Newton-CG: "diagonal" (the exact diagonal of -H) or
+#: "banded" (time-domain tridiagonal solve, :meth:`HessianOperator.precondition`). Measured
+#: on a 20-wave record from the limit seed (bench_sea.py --kernels): banded needs 22 Hessian
+#: products at every N from 256 to 4096, diagonal 67 to 90, but diagonal is faster up to
+#: N = 4096 (0.31 s against 1.02 s; the sparse LU of each Newton step dominates).
+PRECONDITIONER = "diagonal"
+
+
+def _cg_solve(g, op, pre, gn, scale):
+    # forcing term: superlinear while |g| is large, never below 1e-4 (below it CG only
+    # stagnates at rounding, hundreds of products per step for nothing; the outer Newton
+    # iteration still gains four digits per step)
+    target = max(1e-4, min(0.5, math.sqrt(gn / scale))) * gn
+    x = np.zeros_like(g)
+    r = g.copy()
+    if PRECONDITIONER == "banded" and op.mostly_positive:
+        def apply(v):
+            return op.precondition(v)
+    else:
+        def apply(v):
+            return v / pre
+    z = apply(r)
+    p = z.copy()
+    rz = float(r @ z)
+    for it in range(CG_MAXITER):
+        ap = -op.matvec(p)
+        curv = float(p @ ap)
+        if curv <= 1e-14 * float(p @ p) * float(np.max(pre)):
+            return (p if it == 0 else x), False
+        alpha = rz / curv
+        x += alpha * p
+        r -= alpha * ap
+        if float(np.linalg.norm(r)) <= target:
+            return x, True
+        z = apply(r)
+        rz_new = float(r @ z)
+        p = z + (rz_new / rz) * p
+        rz = rz_new
+    return x, False
 
 
 @dataclass(frozen=True)
@@ -254,6 +444,8 @@ def newton_maximize(problem: FourierProblem, x0: np.ndarray, seed: str, *,
     scale = max(float(np.max(np.abs(problem.w))), 1e-300)
     p, g, h = problem.evaluate(x)
     status = "max_iterations"
+    operator = isinstance(h, HessianOperator)
+    newton = False
     it = 0
     for it in range(1, maxiter + 1):
         if not math.isfinite(p):
@@ -264,7 +456,7 @@ def newton_maximize(problem: FourierProblem, x0: np.ndarray, seed: str, *,
             status = "converged"
             it -= 1
             break
-        d, newton = _ascent_step(g, h)
+        d, newton = _cg_ascent_step(g, h, scale) if operator else _ascent_step(g, h)
         norm = float(np.max(np.abs(d)))
         if abandon_below > -math.inf and it > 1 and norm <= max_step and newton:
             gain = 0.5 * float(g @ d)
@@ -297,14 +489,18 @@ def newton_maximize(problem: FourierProblem, x0: np.ndarray, seed: str, *,
         x = xn
         p, g, h = problem.evaluate(x)
     gn = float(np.max(np.abs(g)))
-    return LocalSolution(x, float(p), gn, it, status, seed, problem.points, _is_maximum(h))
+    # operator Hessian: -H was positive definite on the last step's Krylov space (no O(N^3)
+    # factorization to certify it on the whole space)
+    strict = newton if operator else _is_maximum(h)
+    return LocalSolution(x, float(p), gn, it, status, seed, problem.points, strict)
 
 
 _ABANDON_SAFETY = 4.0
 
 
-def _uniform_seed(excitation, harmonics: int, damping: float) -> np.ndarray:
-    _, phi = uniform_power(excitation, damping)
+def _uniform_seed(excitation, harmonics: int, damping: float, winding: int = 1) -> np.ndarray:
+    _, phi = (uniform_power(excitation, damping) if winding == 1
+              else uniform_power(excitation, damping, winding))
     x = np.zeros(2 * harmonics + 1)
     x[0] = phi
     return x
@@ -405,13 +601,19 @@ class FourierSearch:
 
 
 def _seeds(excitation, lim, harmonics: int, damping: float, warm, seeds, gtol: float):
-    """Primary seeds (polished to convergence): warm start, canonical limit, uniform."""
+    """Primary seeds (polished to convergence): warm start, canonical limit, uniform.
+
+    Winding K != 1: the uniform rotation ``K s + phi`` is padded without the 8-harmonic
+    continuation (8 harmonics cannot describe a motion with K > 8 turns per period).
+    """
     out = []
     if warm is not None:
         out.append(("warm", _pad(np.asarray(warm, dtype=float), harmonics)))
     for name in seeds:
         if name == "limit":
             out.append(("limit", limit_seed(lim, harmonics).vector))
+        elif name == "uniform" and lim.winding != 1:
+            out.append(("uniform", _uniform_seed(excitation, harmonics, damping, lim.winding)))
         elif name == "uniform":
             out.append(("uniform", _uniform_start(excitation, harmonics, damping, gtol)))
         else:
@@ -419,13 +621,16 @@ def _seeds(excitation, lim, harmonics: int, damping: float, warm, seeds, gtol: f
     return out
 
 
-def _pattern_seeds(excitation, lim, harmonics: int, damping: float):
+def _pattern_seeds(excitation, lim, harmonics: int, damping: float,
+                   propose: int = None):
     """Further seeds from the half-turn direction patterns: all, or proposed ones.
 
     Returns the strategy, the number of patterns and ``(name, x, pattern)`` triples
     (``pattern`` None for a dynamic-programme path).
     """
     count = pattern_count(lim)
+    if lim.winding != 1:
+        return _winding_seeds(excitation, lim, harmonics, damping, count, propose)
     if count <= 1:
         return "exhaustive", count, []
     if count <= ENUMERATE_MAX:
@@ -434,12 +639,43 @@ def _pattern_seeds(excitation, lim, harmonics: int, damping: float):
                                      for i, d in enumerate(pats)]
     from .dynprog import propose_seeds
 
-    out = [(name, x, None) for name, x in
-           propose_seeds(excitation, harmonics, damping, PROPOSE_COUNT)]
-    pats = direction_patterns(lim, PROPOSE_COUNT + 1, seed=0)[1:]
+    propose = PROPOSE_COUNT if propose is None else propose
+    if lim.winding == 1:
+        out = [(name, x, None) for name, x in
+               propose_seeds(excitation, harmonics, damping, propose)]
+    else:
+        out = [(name, x, None) for name, x in
+               propose_seeds(excitation, harmonics, damping, propose, winding=lim.winding)]
+    pats = direction_patterns(lim, propose + 1, seed=0)[1:]
     out += [(f"limit-{i + 1}", limit_seed(lim, harmonics, d).vector, d)
             for i, d in enumerate(pats)]
     return "dynamic-programme", count, out
+
+
+def _winding_seeds(excitation, lim, harmonics: int, damping: float, count: int, propose):
+    """Winding K != 1: the dynamic programme's seeds, always, then every pattern (at most
+    ENUMERATE_MAX) or a seeded sample of them.
+
+    The half-turn patterns of K != 1 do not cover the damped optima: with about as many
+    extrema as turns (``m = K``) there is a single pattern, while a damped optimum may skip
+    a small swing and turn twice elsewhere (measured: harmonics 8 to 12 of omega = 0.2,
+    K = 10, gamma = 0.05: the one pattern gave -0.06559, the programme -0.05928, which an
+    independent multi-start BFGS confirms). The programme models such motions.
+    """
+    from .dynprog import propose_seeds
+
+    propose = PROPOSE_COUNT if propose is None else propose
+    out = [(name, x, None) for name, x in
+           propose_seeds(excitation, harmonics, damping, propose, winding=lim.winding)]
+    if count <= ENUMERATE_MAX:
+        pats = list(all_patterns(lim))[1:]
+        strategy = "patterns+dynamic-programme"
+    else:
+        pats = direction_patterns(lim, propose + 1, seed=0)[1:]
+        strategy = "dynamic-programme"
+    out += [(f"limit-{i + 1}", limit_seed(lim, harmonics, d).vector, d)
+            for i, d in enumerate(pats)]
+    return strategy, count, out
 
 
 #: Above this many harmonics, and for gamma > 0, the patterns are compared at this N (cost
@@ -517,21 +753,30 @@ def _swap_search(lim, harmonics: int, pattern, run):
 
 def search_fourier(excitation, harmonics: int, damping: float, *, warm: np.ndarray | None = None,
                    seeds: tuple[str, ...] = ("limit", "uniform"), gtol: float = 1e-11,
-                   maxiter: int = 200, points: int | None = None) -> FourierSearch:
+                   maxiter: int = 200, points: int | None = None, winding: int = 1,
+                   hessian: str = "dense", propose: int | None = None) -> FourierSearch:
     """Global search for the N-harmonic optimum (see the module docstring and docs/global.md).
 
     The primary seeds (``warm``, ``limit``, ``uniform``) are polished to convergence; then,
     when ``"limit"`` is among ``seeds``, every other half-turn direction pattern of the limit
     motion (or, when there are more than :data:`ENUMERATE_MAX`, those the dynamic programme
     proposes) is started with ``abandon_below`` set to the best power so far.
+
+    ``winding`` K: turns per period (``theta = K s + ...``; docs/seas.md). With K != 1 the
+    patterns are always compared at the full N (no screening at N = 32, which could not
+    draw K turns), the dynamic programme follows the uniform rotation ``K s`` (its window of
+    lifted angles moves with it) and the uniform seed is ``K s + phi``.
+    ``hessian="operator"``: matrix-free Newton-CG (:class:`HessianOperator`), for N in the
+    thousands. ``propose``: dynamic-programme and sampled seeds (default PROPOSE_COUNT).
     """
-    problem = FourierProblem(excitation, harmonics, damping, points)
-    lim = limit(excitation)
+    problem = FourierProblem(excitation, harmonics, damping, points, winding=winding,
+                             hessian=hessian)
+    lim = limit(excitation) if winding == 1 else limit(excitation, winding)
     runs = [newton_maximize(problem, x0, name, gtol=gtol, maxiter=maxiter)
             for name, x0 in _seeds(excitation, lim, harmonics, damping, warm, seeds, gtol)]
     strategy, count, extra = "local", pattern_count(lim), []
     screen = None
-    if "limit" in seeds and count > 1:
+    if "limit" in seeds and count > 1 and winding == 1:
         screen = _screen_harmonics(count, harmonics, damping)
     if screen is not None:
         # compare the patterns at N = screen, polish the best few at N
@@ -548,7 +793,7 @@ def search_fourier(excitation, harmonics: int, damping: float, *, warm: np.ndarr
                 break
         extra = [(f"{r.seed}@N={screen}", _pad(r.x, harmonics), None) for r in kept]
     elif "limit" in seeds:
-        strategy, count, extra = _pattern_seeds(excitation, lim, harmonics, damping)
+        strategy, count, extra = _pattern_seeds(excitation, lim, harmonics, damping, propose)
     best_pattern = np.asarray(lim.directions)
     # the best power so far (the bar a new run must beat), kept as runs finish rather than
     # recomputed over all runs for each of up to 1024 seeds
@@ -575,7 +820,8 @@ def search_fourier(excitation, harmonics: int, damping: float, *, warm: np.ndarr
     best = _best(runs)
     # grid refinement: double M until the power of the optimum no longer moves
     for _ in range(8):
-        fine = FourierProblem(excitation, harmonics, damping, 2 * problem.points)
+        fine = FourierProblem(excitation, harmonics, damping, 2 * problem.points,
+                              winding=winding, hessian=hessian)
         if abs(fine.power(best.x) - best.power) <= 1e-14 * max(1.0, abs(best.power)):
             break
         problem = fine
@@ -591,7 +837,8 @@ def search_fourier(excitation, harmonics: int, damping: float, *, warm: np.ndarr
         polished=sum(r.status == "converged" for r in runs),
         abandoned=sum(r.status == "abandoned" for r in runs),
         second_power=max(others) if others else None,
-        upper_bound=lim.power - damping * excitation.omega**2,
+        upper_bound=(lim.power - damping * excitation.omega**2 if winding == 1
+                     else lim.power - damping * (winding * excitation.omega) ** 2),
         screen_harmonics=screen,
     )
     return FourierSearch(best, runs, evidence)

@@ -23,6 +23,13 @@ are reversed (the limit motion is non-unique); this module's canonical choice tu
 at the global minimum and the global maximum, and alternates backward/forward at the others,
 so that the pendulum rocks between the same upright and hanging positions during the smaller
 swings of ``q``.
+
+Winding K (``theta(t + T) = theta(t) + 2 pi K``, records of irregular seas): the bound and
+the supremum are the same, ``omega TV(q) / 2 pi`` for every integer K (docs/limit.md): the
+half-turns now sum to ``2 pi K``, ``m + K`` forward and ``m - K`` backward when ``m >= K``;
+with fewer extrema the missing ``K - m`` full turns are added at extrema, since an
+instantaneous full turn does no work at gamma = 0. The canonical pattern for K != 1 keeps
+the net angle close to the uniform rotation ``K omega t`` (see :func:`_winding_directions`).
 """
 
 from __future__ import annotations
@@ -55,6 +62,7 @@ class LimitResult:
     power: float
     total_variation: float
     motion: PiecewiseConstantMotion
+    winding: int = 1
 
     @property
     def switch_times(self) -> np.ndarray:
@@ -65,8 +73,45 @@ class LimitResult:
         return self.motion.directions
 
 
-def limit(excitation) -> LimitResult:
-    """Closed-form gamma -> 0 limit of paper Eqs. 19/24/32 for any periodic excitation."""
+def _winding_directions(t: np.ndarray, period: float, winding: int) -> np.ndarray:
+    """Half-turn directions (odd integers, in units of pi) summing to ``2 K``, close to K s.
+
+    Greedy in time: at each extremum turn forward when the net angle is behind the uniform
+    rotation ``2 pi K t / T``, else backward, while the remaining extrema can still reach
+    the total. With fewer than ``2K`` extrema every half-turn is forward and the missing
+    full turns (``+2`` each) are spread evenly over the extrema.
+    """
+    e = t.size
+    if e < 2 * winding:
+        d = np.ones(e, dtype=int)
+        extra = winding - e // 2
+        for i in range(extra):
+            d[int((i + 0.5) * e / extra) % e] += 2
+        return d
+    n_back = (e - 2 * winding) // 2
+    d = np.empty(e, dtype=int)
+    cum = 0
+    back = 0
+    for j in range(e):
+        left = e - j
+        ideal = 2.0 * winding * t[j] / period
+        if n_back - back >= left:
+            d[j] = -1
+        elif n_back - back <= 0:
+            d[j] = 1
+        else:
+            d[j] = 1 if cum <= ideal else -1
+        back += d[j] < 0
+        cum += d[j]
+    return d
+
+
+def limit(excitation, winding: int = 1) -> LimitResult:
+    """Closed-form gamma -> 0 limit of paper Eqs. 19/24/32 for any periodic excitation.
+
+    ``winding``: K turns per period of ``q`` (the supremum does not depend on it; the
+    canonical limit motion does).
+    """
     from ..excitation import Excitation
 
     if not isinstance(excitation, Excitation):
@@ -80,8 +125,14 @@ def limit(excitation) -> LimitResult:
     m = ext.t.size
     if m == 0:  # constant q: no power can be extracted; the limit motion is uniform-like
         motion = PiecewiseConstantMotion(excitation.omega, np.array([0.0, excitation.period / 2]),
-                                         np.array([1, 1]), 0.0)
-        return LimitResult(0.0, 0.0, motion)
+                                         np.array([winding, winding]), 0.0, winding)
+        return LimitResult(0.0, 0.0, motion, winding)
+    theta_start = 0.0 if ext.is_max[0] else math.pi
+    if winding != 1:
+        directions = _winding_directions(ext.t, excitation.period, winding)
+        motion = PiecewiseConstantMotion(excitation.omega, ext.t.copy(), directions,
+                                         theta_start, winding)
+        return LimitResult(power, tv, motion, winding)
     directions = np.empty(m, dtype=int)
     i_min = int(np.argmin(ext.q))
     i_max = int(np.argmax(ext.q))
@@ -95,7 +146,6 @@ def limit(excitation) -> LimitResult:
             j = (j + 1) % m
     # dwell before the first extremum: q rises into a maximum (upright, 0) or falls into a
     # minimum (hanging, pi)
-    theta_start = 0.0 if ext.is_max[0] else math.pi
     motion = PiecewiseConstantMotion(excitation.omega, ext.t.copy(), directions, theta_start)
     return LimitResult(power, tv, motion)
 
@@ -105,9 +155,11 @@ def pattern_count(lim: LimitResult) -> int:
 
     With ``2m`` extrema per period, ``m + 1`` half-turns go forward and ``m - 1`` backward
     (one net turn, Eq. 3); every choice of the backward ones gives the same limit power.
+    Winding K: ``C(2m, m - K)`` (1 when ``m <= K``: only the canonical pattern is used).
     """
     e = int(np.size(lim.directions))
-    return 1 if e <= 2 else math.comb(e, (e - 2) // 2)
+    k = lim.winding
+    return 1 if e <= 2 * k else math.comb(e, (e - 2 * k) // 2)
 
 
 def all_patterns(lim: LimitResult):
@@ -117,9 +169,9 @@ def all_patterns(lim: LimitResult):
     d0 = np.asarray(lim.directions)
     e = d0.size
     yield d0
-    if e <= 2:
+    if e <= 2 * lim.winding:
         return
-    for back in combinations(range(e), (e - 2) // 2):
+    for back in combinations(range(e), (e - 2 * lim.winding) // 2):
         d = np.ones(e, dtype=int)
         d[list(back)] = -1
         if not np.array_equal(d, d0):
@@ -138,7 +190,7 @@ def direction_patterns(lim: LimitResult, count: int = 8, seed: int = 0) -> list[
     m = d0.size
     if pattern_count(lim) <= count:
         return list(all_patterns(lim))
-    n_back = (m - 2) // 2
+    n_back = (m - 2 * lim.winding) // 2
     rng = np.random.default_rng(seed)
     out = [d0]
     seen = {tuple(d0)}
@@ -163,14 +215,15 @@ def limit_seed(lim: LimitResult, harmonics: int, directions=None) -> FourierMoti
     motion = lim.motion
     if directions is not None:
         motion = PiecewiseConstantMotion(motion.omega, motion.switch_times,
-                                         np.asarray(directions), motion.theta_start)
+                                         np.asarray(directions), motion.theta_start,
+                                         lim.winding)
     omega = motion.omega
     m = max(1024, 32 * harmonics)
     t = (2 * math.pi / omega) * (np.arange(m) + 0.5) / m
     s = omega * t
-    x = np.fft.rfft(motion.theta(t) - s) / m
+    x = np.fft.rfft(motion.theta(t) - (s if lim.winding == 1 else lim.winding * s)) / m
     n = np.arange(1, harmonics + 1)
     # the samples sit at half-steps: undo that phase
     c = 2 * x[1:harmonics + 1] * np.exp(1j * n * math.pi / m)
     sigma = np.sinc(n / (harmonics + 1))
-    return FourierMotion(omega, float(x[0].real), -c.imag * sigma, c.real * sigma)
+    return FourierMotion(omega, float(x[0].real), -c.imag * sigma, c.real * sigma, lim.winding)

@@ -1,0 +1,162 @@
+"""``parapend track``: swing up from rest, catch and hold the optimal rotation (issue 11)."""
+
+from __future__ import annotations
+
+import csv
+import io
+import math
+
+from .. import limits
+from ..errors import ParameterError
+from . import _output
+from ._common import (
+    FIGURE_SUFFIXES,
+    _add_excitation,
+    _check_output,
+    _excitation_kwargs,
+    _finite_float,
+    _fmt,
+    _int,
+    _Progress,
+)
+
+
+def add_parsers(sub) -> None:
+    p = sub.add_parser(
+        "track", help="closed loop: swing up from rest, catch and hold the optimal rotation",
+        description="Simulate the full nonlinear model (Eq. 14) under a sampled controller "
+                    "(256 samples per forcing period): energy pumping from the hanging rest, "
+                    "then the optimal torque as feedforward plus a periodic LQR on the "
+                    "wrapped error, saturated at |T| <= --torque-limit. Under a torque limit "
+                    "the torque-limited optimum at (1 - --torque-margin) T_max is tracked. "
+                    "theta is measured from the upright (hanging at rest is pi).")
+    _add_excitation(p)
+    p.add_argument("--gamma", type=_finite_float("gamma"), default=0.0,
+                   help="viscous damping gamma in [0, 1e3] (default 0)")
+    p.add_argument("--harmonics", type=_int, default=24,
+                   help=f"N of the optimum, at most {limits.MAX_PTO_HARMONICS} with a torque "
+                        "limit (default 24)")
+    g = p.add_argument_group("power take-off and controller")
+    g.add_argument("--torque-limit", type=_finite_float("torque-limit"), default=None,
+                   help="|T(t)| <= this, units m g l (> 0; default: no limit)")
+    g.add_argument("--torque-margin", type=_finite_float("torque-margin"), default=0.1,
+                   help="fraction of the torque limit kept for feedback, in [0, 0.9] "
+                        "(default 0.1)")
+    g.add_argument("--r-weight", type=_finite_float("r-weight"), default=0.1,
+                   help="LQR torque weight R (Q = identity), in [1e-6, 1e6] (default 0.1)")
+    g.add_argument("--lock-tolerance", type=_finite_float("lock-tolerance"), default=0.1,
+                   help="largest angle error (rad) of a locked period (default 0.1)")
+    g.add_argument("--theta0", type=_finite_float("theta0"), default=math.pi,
+                   help="initial angle from the upright (default pi: hanging)")
+    g.add_argument("--theta-dot0", type=_finite_float("theta-dot0"), default=0.0,
+                   help="initial angular speed (default 0)")
+    g = p.add_argument_group("run and robustness (seeded)")
+    g.add_argument("--periods", type=_int, default=100,
+                   help=f"forcing periods simulated, 20 to {limits.MAX_TRACK_PERIODS} "
+                        "(default 100)")
+    g.add_argument("--seed", type=_int, default=0, help="seed of noise and irregular q")
+    g.add_argument("--runs", type=_int, default=1,
+                   help="seeded runs; with more than one, each run draws its model errors "
+                        f"uniformly within +-the given ones (runs x periods <= "
+                        f"{limits.MAX_TRACK_WORK}; default 1)")
+    g.add_argument("--gamma-error", type=_finite_float("gamma-error"), default=0.0,
+                   help="relative error of the plant's damping, in [-0.9, 0.9]")
+    g.add_argument("--delta-error", type=_finite_float("delta-error"), default=0.0,
+                   help="relative error of the plant's excitation amplitude, in [-0.9, 0.9]")
+    g.add_argument("--noise-theta", type=_finite_float("noise-theta"), default=0.0,
+                   help="std of the measurement noise on theta, rad, in [0, 1]")
+    g.add_argument("--noise-speed", type=_finite_float("noise-speed"), default=0.0,
+                   help="std of the measurement noise on theta', in [0, 10]")
+    g.add_argument("--irregular", action="store_true",
+                   help="drive the plant with a seeded random-phase JONSWAP-shaped record "
+                        "around omega (same rms as q) instead of q")
+    p.add_argument("--save", metavar="CSV",
+                   help="write the run: t,theta,theta_dot,torque,q, 256 samples per period "
+                        "(torque held on [t, t + h)); one run only")
+    p.add_argument("--plot", metavar="PNG",
+                   help="draw theta, torque and cumulative energy (PNG, SVG or PDF); one run")
+    p.add_argument("--json", action="store_true", help="print one JSON object")
+
+
+def _mult(ms) -> str:
+    return ", ".join(f"{complex(re, im):.4g} (|.| {abs(complex(re, im)):.4g})"
+                     for re, im in ms)
+
+
+def _cmd_track(a) -> dict | str:
+    from ..control.robustness import track_runs
+    from ..control.track import track
+
+    _check_output(a.plot, "--plot", FIGURE_SUFFIXES)
+    _check_output(a.save, "--save", (".csv",))
+    kw = {"gamma": a.gamma, "harmonics": a.harmonics, **_excitation_kwargs(a)}
+    common = dict(torque_limit=a.torque_limit, torque_margin=a.torque_margin,
+                  periods=a.periods, seed=a.seed, gamma_error=a.gamma_error,
+                  delta_error=a.delta_error, noise_theta=a.noise_theta,
+                  noise_speed=a.noise_speed, irregular=a.irregular,
+                  lock_tolerance=a.lock_tolerance, r_weight=a.r_weight, **kw)
+    if a.runs != 1:
+        if a.save or a.plot:
+            raise ParameterError("runs: --save and --plot write one run; drop them or use "
+                                 "--runs 1")
+        if a.theta0 != math.pi or a.theta_dot0 != 0.0:
+            raise ParameterError("runs: a batch starts from the hanging rest; drop --theta0 "
+                                 "and --theta-dot0 or use --runs 1")
+        r = track_runs(runs=a.runs, progress=_Progress("track"), **common)
+        if a.json:
+            return r.to_dict()
+        return "\n".join([
+            f"{r.runs} seeded runs (seed {r.seed}), {r.periods} periods each, from the "
+            f"hanging rest; gamma = {r.gamma:g}, omega = {r.omega:g}, T_max = "
+            f"{_fmt(r.torque_limit)}",
+            f"plant: gamma error within +-{r.gamma_error:g}, delta error within "
+            f"+-{r.delta_error:g}, noise (theta, theta') = ({r.noise_theta:g}, "
+            f"{r.noise_speed:g}), irregular q: {'yes' if r.irregular else 'no'}",
+            f"locked: {r.fraction_locked:.3g} of the runs (latest lock after "
+            f"{r.lock_period_max} periods)",
+            f"mean power over the last 10 periods: mean {_fmt(r.mean_power, 6)} (min "
+            f"{_fmt(r.power_min, 6)}, max {_fmt(r.power_max, 6)}); locked runs "
+            f"{_fmt(r.locked_mean_power, 6)}; predicted {_fmt(r.predicted_power, 6)}",
+            f"peak torque {_fmt(r.peak_torque, 5)}"])
+    r = track(theta0=a.theta0, theta_dot0=a.theta_dot0, **common)
+    if r._run is not None and a.save:
+        run = r._run
+        buf = io.StringIO()
+        w = csv.writer(buf, lineterminator="\n")
+        w.writerow(["t", "theta", "theta_dot", "torque", "q"])
+        for row in zip(run.t, run.theta, run.theta_dot, run.torque, run.q):
+            w.writerow([repr(float(v)) for v in row])
+        _output.write_text(a.save, buf.getvalue())
+    if r._run is not None and a.plot:
+        from ..control.figures import plot_track
+
+        _output.plot(plot_track, r, a.plot)
+    if a.json:
+        return r.to_dict()
+    out = [f"{r.status}: {r.message}",
+           f"gamma = {r.gamma:g}, omega = {r.omega:g}, T_max = {_fmt(r.torque_limit)}"
+           + (f" (tracking the optimum at {r.design_torque_limit:.6g})"
+              if r.design_torque_limit is not None else ""),
+           f"mean power (last 10 periods) {_fmt(r.mean_power, 8)}; predicted "
+           f"{_fmt(r.predicted_power, 8)}"
+           + (f"; optimum at T_max {_fmt(r.optimum_at_torque_limit, 8)}"
+              if r.optimum_at_torque_limit is not None else ""),
+           f"swing-up handed over after {_fmt(r.catch_period, 4)} periods; energy before "
+           f"the lock {_fmt(r.energy_before_lock, 6)} (m g l), " + (
+               f"paid back in {_fmt(r.payback_periods, 4)} periods"
+               if r.payback_periods is not None else
+               "never paid back (the locked power is not positive)" if r.locked else
+               "no payback (not locked)"),
+           f"tracked optimum: status {r.optimum_status}",
+           f"peak torque applied {_fmt(r.peak_torque, 5)} (the optimum's "
+           f"{_fmt(r.tracked_peak_torque, 5)}); tracking error {r.tracking_error:.3g} rad",
+           f"Floquet multipliers, open loop: {_mult(r.open_loop_multipliers)}",
+           f"closed loop: {_mult(r.closed_loop_multipliers)}"]
+    if a.save:
+        out.append(f"run written to {a.save}")
+    if a.plot:
+        out.append(f"figure written to {a.plot}")
+    return "\n".join(out)
+
+
+COMMANDS = {"track": _cmd_track}

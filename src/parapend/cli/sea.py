@@ -1,0 +1,151 @@
+"""``parapend sea``: the best rotation over a record of irregular sea (docs/seas.md)."""
+
+from __future__ import annotations
+
+import csv
+import io
+
+from .. import limits
+from ..errors import ParameterError
+from . import _output
+from ._common import FIGURE_SUFFIXES, _check_output, _finite_float, _fmt, _int, _table
+
+
+def _winding(text):
+    t = text.strip()
+    return t if t == "auto" else _int(t)
+
+
+def add_parsers(sub) -> None:
+    p = sub.add_parser("sea", help="best rotation over an irregular sea record (JONSWAP, PM, "
+                                   "or a measured heave record)",
+                       description="Optimal rotation of a pendulum over a periodic record of "
+                                   "irregular sea, in watts, beside the uniform rotation at "
+                                   "the mean wave frequency and the gamma -> 0 limit "
+                                   "(docs/seas.md).")
+    g = p.add_argument_group("sea state (IEC TS 62600-2 spectra) or a measured record")
+    g.add_argument("--hs", type=_finite_float("hs"), default=None,
+                   help="significant wave height, m (default 2)")
+    g.add_argument("--tp", type=_finite_float("tp"), default=None,
+                   help="peak period, s (default 8)")
+    g.add_argument("--spectrum", choices=["jonswap", "pierson-moskowitz"], default="jonswap",
+                   help="spectrum shape (default jonswap)")
+    g.add_argument("--gamma-peak", type=_finite_float("gamma-peak"), default=3.3,
+                   help="JONSWAP peak enhancement in [1, 20] (default 3.3)")
+    g.add_argument("--repeat-period", type=_finite_float("repeat-period"), default=None,
+                   help=f"T_r, s: the record repeats with it; {limits.SEA_WAVES_RANGE[0]:g} "
+                        f"to {limits.SEA_WAVES_RANGE[1]:g} peak periods (default 100 Tp)")
+    g.add_argument("--seed", type=_int, default=None,
+                   help="seed of the random phases (default 0)")
+    g.add_argument("--cutoff", type=_finite_float("cutoff"), default=3.0,
+                   help="highest frequency, in units of the peak frequency, 1.5 to 10 "
+                        "(default 3)")
+    g.add_argument("--response", metavar="CSV", default=None,
+                   help="heave response of the buoy, CSV 'f,gain,phase' (Hz, m/m, rad); "
+                        "default: the base follows the surface (a small buoy)")
+    g.add_argument("--record", metavar="CSV", default=None,
+                   help="measured heave record, CSV 't,z' (s, m), instead of a sea state")
+    g.add_argument("--taper", type=_finite_float("taper"), default=0.1,
+                   help="with --record: fraction of the record under the Tukey taper that "
+                        "makes it periodic (default 0.1)")
+    g = p.add_argument_group("pendulum (SI units)")
+    g.add_argument("--length", type=_finite_float("length"), default=1.0,
+                   help="pivot to centre of mass, m (default 1)")
+    g.add_argument("--mass", type=_finite_float("mass"), default=10.0, help="kg (default 10)")
+    g.add_argument("--inertia", type=_finite_float("inertia"), default=None,
+                   help="about the pivot, kg m^2 (default m l^2)")
+    g.add_argument("--gravity", type=_finite_float("gravity"), default=9.81,
+                   help="m/s^2 (default 9.81)")
+    g.add_argument("--gamma", type=_finite_float("gamma"), default=None,
+                   help="viscous damping, non-dimensional (default 0.01)")
+    g.add_argument("--damping-coefficient", type=_finite_float("damping-coefficient"),
+                   default=None, help="viscous damping c, N m s/rad (instead of --gamma)")
+    g = p.add_argument_group("motion")
+    g.add_argument("--winding", type=_winding, default=1,
+                   help="K turns over the record, theta(t + T_r) = theta(t) + 2 pi K, or "
+                        "'auto': K = 1 and fractions of the mean-wave-frequency K (default 1)")
+    g.add_argument("--harmonics", type=_int, default=None,
+                   help="N (default 16 per mean wave, then checked at 2N)")
+    p.add_argument("--plot", metavar="PNG", help="draw the record, the motion and the energy")
+    p.add_argument("--save", metavar="CSV",
+                   help="write t,z,q,theta,theta_dot,power,energy over the record")
+    p.add_argument("--json", action="store_true", help="print one JSON object")
+
+
+def _cmd_sea(a) -> dict | str:
+    from ..sea_api import plot_sea, sea, sea_samples
+
+    _check_output(a.plot, "--plot", FIGURE_SUFFIXES)
+    _check_output(a.save, "--save", (".csv",))
+    if a.record is not None:
+        bad = [n for n, v in (("hs", a.hs), ("tp", a.tp), ("seed", a.seed),
+                              ("repeat-period", a.repeat_period), ("response", a.response))
+               if v is not None]
+        if bad:
+            raise ParameterError(f"{', '.join(bad)}: not used with --record; drop it")
+        kw = {"record": a.record, "taper": a.taper}
+    else:
+        kw = {"hs": 2.0 if a.hs is None else a.hs, "tp": 8.0 if a.tp is None else a.tp,
+              "spectrum": a.spectrum, "gamma_peak": a.gamma_peak,
+              "repeat_period": a.repeat_period, "seed": 0 if a.seed is None else a.seed,
+              "response": a.response}
+    r = sea(cutoff=a.cutoff, length=a.length, mass=a.mass, inertia=a.inertia,
+            gravity=a.gravity, gamma=a.gamma, damping_coefficient=a.damping_coefficient,
+            winding=a.winding, harmonics=a.harmonics, **kw)
+    if a.save:
+        s = sea_samples(r)
+        cols = ["t", "z", "q", "theta", "theta_dot", "power", "energy"]
+        buf = io.StringIO()
+        w = csv.writer(buf, lineterminator="\n")
+        w.writerow(cols)
+        for row in zip(*(s[c] for c in cols)):
+            w.writerow([repr(float(v)) for v in row])
+        _output.write_text(a.save, buf.getvalue())
+    if a.plot:
+        _output.plot(plot_sea, r, a.plot)
+    if a.json:
+        return r.to_dict()
+    rec, u = r.record, r.units
+    if "hs" in rec:
+        head = (f"sea: {rec['spectrum']}, Hs = {rec['hs']:g} m, Tp = {rec['tp']:g} s"
+                + (f", gamma_peak = {rec['gamma_peak']:g}" if "gamma_peak" in rec else "")
+                + f", seed {rec['seed']}, {rec['components']} components up to "
+                  f"{rec['cutoff']:g} fp; base heave: {rec['response']}")
+    else:
+        head = (f"record: {rec['record']} ({rec['rows']} rows, taper {rec['taper']:g}), "
+                f"{rec['components']} components up to {rec['cutoff']:g} x its peak")
+    rows = [[f"uniform rotation at the mean wave frequency (K = {r.uniform_winding})",
+             _fmt(r.uniform_power), f"{r.uniform_power_w:.6g}"],
+            [f"optimum, winding K = {r.winding}, N = {r.harmonics}", _fmt(r.power),
+             f"{r.power_w:.6g}"],
+            ["upper bound limit - gamma K^2 omega_r^2", _fmt(r.upper_bound),
+             f"{r.upper_bound_w:.6g}"],
+            ["limit gamma -> 0, omega_r TV(q) / 2 pi", _fmt(r.limit_power),
+             f"{r.limit_power_w:.6g}"]]
+    out = [head,
+           f"record: T_r = {rec['repeat_period']:.6g} s, Hs (4 std z) = "
+           f"{rec['hs_record']:.4g} m, mean period {rec['mean_period']:.4g} s, "
+           f"{rec['extrema']} extrema of q, max |q| = {rec['max_abs_q']:.4g}",
+           f"pendulum: l = {u['length_m']:g} m, m = {u['mass_kg']:g} kg, I = "
+           f"{u['inertia_kg_m2']:g} kg m^2, gamma = {r.gamma:g} (c = "
+           f"{r.gamma * u['inertia_kg_m2'] / u['time_unit_s']:.4g} N m s/rad); power unit "
+           f"{u['power_unit_w']:.6g} W", "",
+           _table(rows, ["motion", "power P", "watts"]), ""]
+    if len(r.windings) > 1:
+        out += [_table([[str(w["winding"]), _fmt(w["power"]), f"{w['power_w']:.6g}",
+                         w["status"]] for w in r.windings],
+                       ["winding K", "power P", "watts", "status"]), ""]
+    out += [f"status: {r.status}; found from the {r.found_by} seed ({r.search}: "
+            f"{r.polished} runs polished, {r.abandoned} abandoned); refinement N -> 2N "
+            f"changed P by {r.refinement_change:.2g}"]
+    if r.refinement_change > 1e-6 * abs(r.power):
+        out.append(f"note: the power changed by {r.refinement_change / abs(r.power):.1e} "
+                   "(relative) when N was doubled; give more --harmonics for more digits")
+    if a.save:
+        out.append(f"record and motion written to {a.save}")
+    if a.plot:
+        out.append(f"figure written to {a.plot}")
+    return "\n".join(out)
+
+
+COMMANDS = {"sea": _cmd_sea}
