@@ -13,7 +13,8 @@ __all__ = [
     "MAX_SWEEP_HARMONICS", "MAX_SWEEP_WORK", "MAX_TABLE_HARMONICS", "MAX_THRESHOLD_HARMONICS",
     "MAX_PTO_HARMONICS", "MAX_PTO_INTERVALS", "MAX_PTO_POINTS", "MAX_TORQUE_LIMIT",
     "MIN_BVP_GAMMA", "OMEGA_RANGE",
-    "SQUARE_ALPHA_MIN",
+    "SQUARE_ALPHA_MIN", "MAP_MAX_POINTS", "MAP_MAX_PTO_POINTS", "MAP_MAX_HARMONICS",
+    "MAP_MAX_WORK",
 ]
 
 #: forcing frequency omega, units sqrt(g/l)
@@ -59,6 +60,18 @@ MAX_PTO_POINTS = 101
 #: Hermite intervals of the torque-limited optimum (the doubling stops here: 2048 intervals
 #: take about a second per solve)
 MAX_PTO_INTERVALS = 2048
+
+# --- design maps (parapend sweep, issue 13) ------------------------------------------------
+#: points of one map (the issue asks for 10^4 to 10^6; at N = 24 about 2 ms of CPU each,
+#: so 2^20 points are about 35 CPU-minutes, resumable)
+MAP_MAX_POINTS = 1 << 20
+#: points of a map with a power take-off (0.2 to 0.5 s each at N = 24, 2 s infeasible:
+#: 4096 points are up to 2 hours of CPU)
+MAP_MAX_PTO_POINTS = 4096
+#: harmonics N of each solve of a map
+MAP_MAX_HARMONICS = 128
+#: points * max(N, 24)^2 of a map (N = 24 at the point cap; N = 128 at 36 864 points)
+MAP_MAX_WORK = MAP_MAX_POINTS * 24**2
 
 # --- uncontrolled pendulum, paper Eq. 1 (simulate, basins, rotations) ---------------------
 #: forcing frequency omega of Eq. 1 (steps are tied to the forcing period)

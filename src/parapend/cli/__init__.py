@@ -14,7 +14,8 @@ Modules: :mod:`._common` (parser helpers, number parsing, tables, progress),
  harmonics), :mod:`.paper` (figure, reproduce), :mod:`.pto` (pto-curve; the power
  take-off and unit options of optimize), :mod:`.dynamics` (simulate, basins,
  rotations: the uncontrolled pendulum of paper Eq. 1), :mod:`.control` (track: the
- closed loop of issue 11), :mod:`.sea` (sea: irregular seas).
+ closed loop of issue 11), :mod:`.sea` (sea: irregular seas), :mod:`.sweep` (sweep, map:
+ design maps).
 """
 
 from __future__ import annotations
@@ -32,6 +33,7 @@ from . import optimize as _optimize_cmds
 from . import paper as _paper_cmds
 from . import pto as _pto_cmds
 from . import sea as _sea_cmds
+from . import sweep as _sweep_cmds
 from ._common import EXIT_USAGE, _Parser
 from ._output import OutputError
 
@@ -40,7 +42,8 @@ EXIT_FAILURE = 1
 __all__ = ["build_parser", "main"]
 
 COMMANDS = {**_optimize_cmds.COMMANDS, **_paper_cmds.COMMANDS, **_pto_cmds.COMMANDS,
-            **_dynamics_cmds.COMMANDS, **_control_cmds.COMMANDS, **_sea_cmds.COMMANDS}
+            **_dynamics_cmds.COMMANDS, **_control_cmds.COMMANDS, **_sea_cmds.COMMANDS,
+            **_sweep_cmds.COMMANDS}
 
 
 def build_parser():
@@ -58,6 +61,7 @@ def build_parser():
     _dynamics_cmds.add_parsers(sub)
     _control_cmds.add_parsers(sub)
     _sea_cmds.add_parsers(sub)
+    _sweep_cmds.add_parsers(sub)
     return parser
 
 

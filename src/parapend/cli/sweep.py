@@ -1,0 +1,225 @@
+"""``parapend sweep`` and ``parapend map``: resumable design maps and their heat maps.
+
+A thin shell over :mod:`parapend.sweep` (docs/sweep.md).
+"""
+
+from __future__ import annotations
+
+import re
+import shlex
+import sys
+import time
+
+import numpy as np
+
+from .. import limits
+from ..errors import ParameterError
+from ._common import FIGURE_SUFFIXES, _check_output, _finite_float, _fmt, _int, _Progress
+
+# '-0.5:-0.05:128' and '-0.3,-0.2' are values, not options
+_NEGATIVE_VALUE = re.compile(r"^-(\d+\.?\d*|\.\d+)([eE][-+]?\d+)?$|^-(inf|infinity|nan)$"
+                             r"|^-[\d.][^\s]*[:,]", re.IGNORECASE)
+
+_AXIS_HELP = "one value, START:STOP:COUNT (COUNT values, ends included) or a comma list"
+
+
+class _EtaProgress(_Progress):
+    """The progress bar with the points per second of this run and the time left."""
+
+    def __init__(self, label: str):
+        super().__init__(label)
+        self.first = None
+
+    def __call__(self, done: int, total: int, label: str | None = None) -> None:
+        now = time.monotonic()
+        if self.first is None:
+            self.first = (now, done)  # points found finished in the store are not counted
+            return super().__call__(done, total, label)
+        t0, d0 = self.first
+        rate = (done - d0) / max(now - t0, 1e-9)
+        eta = (total - done) / rate if rate > 0 else float("inf")
+        text = f"ETA {eta:.0f} s" if eta < 1e7 else "ETA -"
+        return super().__call__(done, total, text if label is None else f"{label}, {text}")
+
+
+def add_parsers(sub) -> None:
+    p = sub.add_parser(
+        "sweep", help="design map: the optimum over a grid of parameters (resumable)",
+        description="Optimal, uniform and limit power (and on request the damping threshold "
+                    "gamma*) at every point of a grid over omega, delta, gamma, the torque "
+                    "limit and the efficiency, written block by block to a Zarr store. Run "
+                    "the same command again after an interruption to resume it.")
+    p._negative_number_matcher = _NEGATIVE_VALUE
+    g = p.add_argument_group("axes (" + _AXIS_HELP + ")")
+    g.add_argument("--omega", default="1.8", help="forcing frequency (default 1.8)")
+    g.add_argument("--delta", default=None, help="excitation amplitude (default -0.3)")
+    g.add_argument("--gamma", default="0", help="viscous damping (default 0)")
+    g.add_argument("--torque-limit", default=None,
+                   help="T_max of the power take-off, units m g l (each point then solves "
+                        "the power take-off problem: 0.2 to 2 s a point)")
+    g.add_argument("--efficiency", default=None,
+                   help="efficiency of the power take-off in (0, 1] (as --torque-limit)")
+    e = p.add_argument_group("excitation q(t)")
+    e.add_argument("--excitation", default=None,
+                   choices=["harmonic", "two-harmonic", "square", "fourier"],
+                   help="default harmonic (fourier with --fourier)")
+    e.add_argument("--square-alpha", type=_finite_float("square-alpha"), default=None,
+                   help="tanh width of Eq. 26, square only")
+    e.add_argument("--fourier", metavar="TERMS", help="'k:amp:phase,...' (omega axis only)")
+    p.add_argument("--harmonics", type=_int, default=24,
+                   help=f"N of every solve, at most {limits.MAP_MAX_HARMONICS} (default 24)")
+    p.add_argument("--threshold", action="store_true",
+                   help="also compute gamma* at every (omega, delta): several solves each")
+    p.add_argument("--store", default="map.zarr",
+                   help="Zarr store (a directory; default map.zarr), resumed if it holds "
+                        "this sweep")
+    p.add_argument("--overwrite", action="store_true",
+                   help="replace a store that holds a different sweep")
+    p.add_argument("--netcdf", metavar="FILE.nc", help="also export the finished map to NetCDF")
+    p.add_argument("--workers", type=_int, default=None,
+                   help="local processes (default: all CPUs)")
+    p.add_argument("--scheduler", metavar="ADDRESS",
+                   help="run on an existing Dask distributed cluster (tcp://host:8786); "
+                        "needs the 'distributed' package")
+    p.add_argument("--block-points", type=_int, default=None,
+                   help="points per block, one chunk of the store (default 128, 8 with a "
+                        "power take-off)")
+    p.add_argument("--json", action="store_true", help="print one JSON object")
+
+    m = sub.add_parser("map", help="heat map of a sweep store over two of its axes",
+                       description="Heat map of one quantity of a sweep store (power, gain "
+                                   "over the uniform rotation, gamma*, ...) over two axes, "
+                                   "with contour lines, failed points crossed and the "
+                                   "paper's case marked.")
+    m._negative_number_matcher = _NEGATIVE_VALUE
+    m.add_argument("--store", default="map.zarr",
+                   help="a sweep store (Zarr directory) or its NetCDF export")
+    from ..sweep import MAP_QUANTITIES
+
+    m.add_argument("--variable", default="power", choices=MAP_QUANTITIES,
+                   help="gain = power / uniform_power - 1 in percent (default power)")
+    axes = ["omega", "delta", "gamma", "torque-limit", "efficiency"]
+    m.add_argument("--x", default=None, choices=axes, help="horizontal axis (default: the "
+                                                           "first swept)")
+    m.add_argument("--y", default=None, choices=axes, help="vertical axis (default: the "
+                                                           "second swept)")
+    m.add_argument("--at", action="append", default=[], metavar="AXIS=VALUE",
+                   help="value of a further axis (nearest; default its first value); "
+                        "repeatable")
+    m.add_argument("--plot", metavar="PNG", default="map.png",
+                   help="figure file, PNG, SVG or PDF (default map.png)")
+    m.add_argument("--json", action="store_true", help="print one JSON object")
+
+
+def _command_line() -> str:
+    argv = sys.argv[1:] if sys.argv and sys.argv[0] else []
+    return "parapend " + " ".join(shlex.quote(a) for a in argv)
+
+
+def _cmd_sweep(a) -> dict | str:
+    from .. import sweep as sw
+
+    _check_output(a.netcdf, "--netcdf", (".nc",))
+    if a.scheduler is not None and a.workers is not None:
+        raise ParameterError("workers: the processes are the cluster's with --scheduler; "
+                             "drop --workers")
+    if a.scheduler is not None:
+        try:
+            import distributed  # noqa: F401
+        except ImportError:
+            raise ParameterError("scheduler: needs the 'distributed' package (python -m pip "
+                                 "install distributed)") from None
+    run = sw.sweep(a.store, omega=a.omega, delta=a.delta, gamma=a.gamma,
+                   torque_limit=a.torque_limit, efficiency=a.efficiency,
+                   harmonics=a.harmonics, excitation=a.excitation,
+                   square_alpha=a.square_alpha, fourier=a.fourier, threshold=a.threshold,
+                   workers=a.workers, scheduler=a.scheduler, overwrite=a.overwrite,
+                   command=_command_line(), progress=_EtaProgress("sweep"),
+                   block_points=a.block_points)
+    ds = run.dataset
+    if a.netcdf:
+        from . import _output
+
+        _output.write_dataset(ds, a.netcdf)
+    codes = ds["status"].values[ds["done"].values]
+    counts = {s: int(np.sum(codes == i)) for i, s in enumerate(sw.STATUSES)
+              if np.any(codes == i)}
+    p = ds["power"].values
+    ok = ds["done"].values & np.isin(ds["status"].values, [0, 1])
+    best = None
+    if ok.any():
+        k = np.unravel_index(np.nanargmax(np.where(ok, p, -np.inf)), p.shape)
+        best = {"power": float(p[k]), **{d: float(ds[d].values[i])
+                                          for d, i in zip(ds["power"].dims, k)}}
+    out = {"store": run.store, "dims": {d: int(ds.sizes[d]) for d in ds["power"].dims},
+           "points": run.points, "blocks": run.blocks,
+           "computed_points": run.computed_points, "resumed_points": run.resumed_points,
+           "seconds": run.seconds, "executor": run.executor, "status_counts": counts,
+           "largest_power": best, "largest_branch_gap": (
+               float(np.nanmax(ds["branch_gap"].values)) if "branch_gap" in ds
+               and ok.any() else None),
+           "netcdf": a.netcdf}
+    if a.json:
+        return out
+    lines = [f"map over {' x '.join(f'{d} ({n})' for d, n in out['dims'].items())}: "
+             f"{run.points} points in {run.blocks} blocks, store {run.store}",
+             f"computed now {run.computed_points}, found finished {run.resumed_points}; "
+             f"{run.seconds:.1f} s ({run.executor})",
+             "status: " + ", ".join(f"{s} {n}" for s, n in counts.items())]
+    if best is not None:
+        where = ", ".join(f"{k} = {v:.6g}" for k, v in best.items() if k != "power")
+        lines.append(f"largest power {_fmt(best['power'], 8)} at {where}")
+    if out["largest_branch_gap"]:
+        lines.append(f"continuation found a higher branch than the global search, by up to "
+                     f"{out['largest_branch_gap']:.3g} (variable branch_gap)")
+    if a.netcdf:
+        lines.append(f"NetCDF written to {a.netcdf}")
+    lines.append("heat map: parapend map --store " + shlex.quote(str(run.store)))
+    return "\n".join(lines)
+
+
+def _cmd_map(a) -> dict | str:
+    from .. import sweep as sw
+    from . import _output
+
+    _check_output(a.plot, "--plot", FIGURE_SUFFIXES)
+    at = {}
+    for item in a.at:
+        name, sep, value = item.partition("=")
+        name = name.strip().replace("-", "_")
+        if not sep or name not in sw.AXES:
+            raise ParameterError(f"at: expected AXIS=VALUE with AXIS one of "
+                                 f"{', '.join(sw.AXES)}, got {item!r:.40}")
+        try:
+            at[name] = float(value)
+        except ValueError:
+            raise ParameterError(f"at: expected a number after '=', got {item!r:.40}") \
+                from None
+    ds = sw.open_sweep(a.store)
+    x = a.x.replace("-", "_") if a.x else None
+    y = a.y.replace("-", "_") if a.y else None
+    z, failed, xs, ys, xn, yn, label, title = sw.map_data(ds, a.variable, x, y, at)
+    _output.plot(lambda d, path: sw.plot_map(d, a.variable, xn, yn, at, path), ds, a.plot)
+    finite = np.isfinite(z)
+    out = {"plot": a.plot, "variable": a.variable, "x": xn, "y": yn, "fixed": title,
+           "points": int(z.size), "failed": int(failed.sum()),
+           "not_computed": int(z.size - finite.sum() - failed.sum()),
+           "min": float(np.nanmin(z)) if finite.any() else None,
+           "max": float(np.nanmax(z)) if finite.any() else None}
+    if finite.any():
+        i, j = np.unravel_index(np.nanargmax(z), z.shape)
+        out["max_at"] = {xn: float(xs[j]), yn: float(ys[i])}
+    if a.json:
+        return out
+    lines = [f"heat map of {a.variable} over ({xn}, {yn}) written to {a.plot}"
+             + (f" ({title})" if title else "")]
+    if finite.any():
+        lines.append(f"range {_fmt(out['min'], 6)} to {_fmt(out['max'], 6)} ({label}); "
+                     f"largest at {xn} = {out['max_at'][xn]:.6g}, {yn} = "
+                     f"{out['max_at'][yn]:.6g}")
+    lines.append(f"{out['points']} points: {out['failed']} failed, {out['not_computed']} not "
+                 "computed (grey)")
+    return "\n".join(lines)
+
+
+COMMANDS = {"sweep": _cmd_sweep, "map": _cmd_map}

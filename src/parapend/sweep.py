@@ -1,0 +1,943 @@
+r"""Design maps: resumable parameter sweeps over omega, delta, gamma, T_max and efficiency.
+
+One sweep computes, at every point of a grid, what :func:`parapend.optimize` computes (the
+optimum of the truncated Fourier problem, Eqs. 10-11, by the global search of
+docs/global.md), the best uniform rotation (Eq. 17) and the gamma -> 0 limit (Eqs. 19, 24,
+32), and on request the damping threshold gamma* (Eq. 15, Fig. 6). With a torque limit or an
+efficiency (fixed or swept) each point is :func:`parapend.pto.optimize_pto` instead.
+
+The grid
+    Axes in the order ``omega, delta, gamma, torque_limit, efficiency``; an axis with two or
+    more values is a dimension, one with one value a scalar coordinate. The last dimension
+    is the fastest: the grid is cut into *blocks* of whole runs along it (one chunk of the
+    store each), and inside a run every point starts a continuation from its neighbour's
+    optimum (the warm start, below). Each run starts afresh, so a block's values do not
+    depend on which process computes it or in which order: a resumed sweep recomputes a
+    block exactly as an uninterrupted one did.
+
+The warm start and the global search
+    A point's ``power`` is the global search started cold, exactly as in
+    :func:`parapend.optimize`; so it equals optimize's power (bit for bit on one machine).
+    The neighbour's optimum is then continued to this point (one Newton run, abandoned as
+    soon as its quadratic model cannot beat the global search); when it converges to a
+    higher maximum (by more than 1e-9), the excess is ``branch_gap`` and the continuation
+    goes on along that branch. So the warm start cannot change ``power``; it checks the
+    global search along every run of the map (0 everywhere on the maps measured so far).
+
+The store (Zarr 3)
+    Made whole (every array, its chunks, coordinates and attributes) before the first
+    block, then written block by block: the variables of a block, then its ``done`` mask.
+    Zarr skips chunks that equal the fill value, so the data alone cannot say what
+    finished; the mask can, and a block is only counted when its mask is written. Running
+    the same sweep on the same store resumes it: the blocks whose mask is set are not
+    recomputed, and the store ends byte for byte as an uninterrupted run's. The store is
+    locked (``flock`` on its directory) while a sweep writes it: a second sweep on it is
+    refused with one line; the lock dies with its process (``kill -9`` included).
+"""
+
+from __future__ import annotations
+
+import contextlib
+import dataclasses
+import json
+import logging
+import math
+import os
+import shutil
+import tempfile
+import time
+import warnings
+from pathlib import Path
+
+import numpy as np
+
+from . import limits
+from .errors import ParameterError, SolverError, check_int, check_range
+
+__all__ = ["AXES", "STATUSES", "VARIABLES", "SweepRun", "SweepSpec", "compute_block",
+           "open_sweep", "parse_axis", "plot_map", "sweep", "sweep_spec"]
+
+log = logging.getLogger(__name__)
+
+#: Sweepable parameters, in the order of the dimensions of a map.
+AXES = ("omega", "delta", "gamma", "torque_limit", "efficiency")
+_FLAGS = {"omega": "omega", "delta": "delta", "gamma": "gamma",
+          "torque_limit": "torque-limit", "efficiency": "efficiency"}
+_AXIS_ATTRS = {
+    "omega": ("forcing frequency omega", "sqrt(g/l)"),
+    "delta": ("excitation amplitude delta (base acceleration over g)", "1"),
+    "gamma": ("viscous damping gamma", "sqrt(g/l)"),
+    "torque_limit": ("torque limit T_max of the power take-off", "m g l"),
+    "efficiency": ("efficiency of the power take-off (generating and motoring)", "1"),
+}
+_POWER_UNITS = "m g l sqrt(g/l)"
+
+#: Status codes of the ``status`` variable (CF ``flag_values``/``flag_meanings``); -1 is the
+#: fill value, "not computed". "error": the point raised (logged), "other": a status this
+#: version does not know.
+STATUSES = ("converged", "no_power", "stalled", "max_iterations", "nonfinite", "infeasible",
+            "unresolved", "error", "other")
+_CODE = {s: i for i, s in enumerate(STATUSES)}
+NOT_COMPUTED = -1
+_SUCCESS = ("converged", "no_power")
+
+#: Variables of a map: name -> (long name, units); which are present depends on the sweep.
+VARIABLES = {
+    "power": ("optimal mean power extracted, P = -<T theta'> (positive = harvested)",
+              _POWER_UNITS),
+    "uniform_power": ("power of the best uniform rotation (Eq. 17)", _POWER_UNITS),
+    "limit_power": ("gamma -> 0 limit of the power, omega TV(q) / 2 pi (Eqs. 19, 24, 32)",
+                    _POWER_UNITS),
+    "electrical_power": ("electrical power of the power take-off optimum", _POWER_UNITS),
+    "branch_gap": ("power of the branch continued from the neighbouring point above the "
+                   "global search's (0: the global search found the best)", _POWER_UNITS),
+    "status": ("solver status of the optimum", None),
+    "damping_threshold": ("damping threshold gamma* beyond which no power can be extracted "
+                          "(Fig. 6; ideal power take-off)", "sqrt(g/l)"),
+    "threshold_status": ("solver status of the damping threshold", None),
+}
+_BRANCH_TOL = 1e-9
+#: a continuation whose first Newton step lands this close to the global search's maximum
+#: (max-norm of the coefficients, relative to max(1, |x|)) is on that maximum's branch
+_SAME_BRANCH = 1e-4
+#: points per block (one chunk, one task): about a quarter of a second of work
+_BLOCK_POINTS = 128
+_BLOCK_POINTS_PTO = 8
+
+
+# -- the grid ------------------------------------------------------------------------------
+
+def parse_axis(name: str, value) -> tuple[float, ...]:
+    """Values of one axis: a number, a sequence of numbers, or text ``START:STOP:COUNT``
+    (``COUNT`` values from START to STOP inclusive, like :func:`numpy.linspace`) or
+    ``A,B,C``. Each value is checked against the parameter's admissible range."""
+    flag = _FLAGS[name]
+    if isinstance(value, str):
+        text = value.strip()
+        if text.count(":") == 2:
+            a, b, c = text.split(":")
+            try:
+                start, stop = float(a), float(b)
+            except ValueError:
+                raise ParameterError(f"{flag}: expected START:STOP:COUNT with numbers, got "
+                                     f"{value!r:.60}") from None
+            try:
+                count = int(c.strip())
+            except ValueError:
+                raise ParameterError(f"{flag}: expected an integer COUNT in START:STOP:COUNT, "
+                                     f"got {value!r:.60}") from None
+            count = check_int(flag, count, 1, limits.MAP_MAX_POINTS)
+            for x in (start, stop):
+                _check_value(name, x)
+            vals = np.linspace(start, stop, count)
+        elif ":" in text:
+            raise ParameterError(f"{flag}: expected START:STOP:COUNT (three fields) or a "
+                                 f"comma list, got {value!r:.60}")
+        else:
+            parts = [p for p in text.split(",")]
+            if len(parts) > limits.MAP_MAX_POINTS or not all(p.strip() for p in parts):
+                raise ParameterError(f"{flag}: expected numbers separated by commas, got "
+                                     f"{value!r:.60}")
+            try:
+                vals = np.array([float(p) for p in parts])
+            except ValueError:
+                raise ParameterError(f"{flag}: expected numbers separated by commas, got "
+                                     f"{value!r:.60}") from None
+    else:
+        vals = np.atleast_1d(np.asarray(value, dtype=object))
+        if vals.ndim != 1 or vals.size == 0 or vals.size > limits.MAP_MAX_POINTS:
+            raise ParameterError(f"{flag}: expected a number or a sequence of 1 to "
+                                 f"{limits.MAP_MAX_POINTS} numbers")
+    out = tuple(_check_value(name, v.item() if isinstance(v, np.generic) else v)
+                for v in vals)
+    if len(set(out)) != len(out):
+        raise ParameterError(f"{flag}: expected distinct values, got a repeated one")
+    return out
+
+
+def _check_value(name: str, v) -> float:
+    flag = _FLAGS[name]
+    if name == "omega":
+        return check_range(flag, v, *limits.OMEGA_RANGE,
+                           why="units sqrt(g/l); see docs/limits-of-input.md")
+    if name == "delta":
+        return check_range(flag, v, 0.0, limits.MAX_AMPLITUDE, absolute=True)
+    if name == "gamma":
+        return check_range(flag, v, 0.0, limits.MAX_GAMMA)
+    if name == "torque_limit":
+        x = check_range(flag, v, 0.0, limits.MAX_TORQUE_LIMIT, why="units m g l")
+        if x <= 0:
+            raise ParameterError(f"{flag}: expected a number > 0, got {v!r}")
+        return x
+    x = check_range(flag, v, 0.0, 1.0)
+    if x <= 0:
+        raise ParameterError(f"{flag}: expected a number in (0, 1], got {v!r}")
+    return x
+
+
+@dataclasses.dataclass(frozen=True)
+class SweepSpec:
+    """What a sweep computes: the axes, the excitation, N, and whether gamma* is wanted.
+
+    ``values`` maps every name of :data:`AXES` to a tuple of floats (one value: a scalar
+    coordinate; none: not used, e.g. no torque limit).
+    """
+
+    values: dict
+    excitation: str = "harmonic"
+    square_alpha: float | None = None
+    fourier: str | None = None
+    harmonics: int = 24
+    threshold: bool = False
+    block_points: int | None = None
+
+    @property
+    def dims(self) -> tuple[str, ...]:
+        return tuple(a for a in AXES if len(self.values[a]) >= 2)
+
+    @property
+    def shape(self) -> tuple[int, ...]:
+        return tuple(len(self.values[a]) for a in self.dims)
+
+    @property
+    def points(self) -> int:
+        return int(np.prod(self.shape))
+
+    @property
+    def pto(self) -> bool:
+        return bool(self.values["torque_limit"] or self.values["efficiency"])
+
+    @property
+    def variables(self) -> tuple[str, ...]:
+        out = ["power", "uniform_power", "limit_power"]
+        out += ["electrical_power"] if self.pto else ["branch_gap"]
+        out += ["status"]
+        if self.threshold:
+            out += ["damping_threshold", "threshold_status"]
+        return tuple(out)
+
+    @property
+    def chunks(self) -> tuple[int, ...]:
+        """One block: runs along the fastest dimension, several of them side by side."""
+        target = self.block_points or (_BLOCK_POINTS_PTO if self.pto else _BLOCK_POINTS)
+        shape = self.shape
+        c = [1] * len(shape)
+        c[-1] = min(shape[-1], target)
+        if len(shape) >= 2:
+            c[-2] = min(shape[-2], max(1, target // c[-1]))
+        return tuple(c)
+
+    @property
+    def block_grid(self) -> tuple[int, ...]:
+        return tuple(-(-n // c) for n, c in zip(self.shape, self.chunks))
+
+    @property
+    def blocks(self) -> int:
+        return int(np.prod(self.block_grid))
+
+    def block_slices(self, block: int) -> tuple[slice, ...]:
+        idx = np.unravel_index(block, self.block_grid)
+        return tuple(slice(i * c, min((i + 1) * c, n))
+                     for i, c, n in zip(idx, self.chunks, self.shape))
+
+    def to_json(self) -> str:
+        """The sweep's identity (stored in the attributes; a resume must match it)."""
+        return json.dumps({"axes": {a: list(self.values[a]) for a in AXES},
+                           "excitation": self.excitation, "square_alpha": self.square_alpha,
+                           "fourier": self.fourier, "harmonics": self.harmonics,
+                           "threshold": self.threshold, "chunks": list(self.chunks)},
+                          sort_keys=True)
+
+    def excitation_args(self, omega: float, delta: float | None) -> dict:
+        kw = {"excitation": self.excitation, "omega": omega}
+        if self.excitation in ("harmonic", "two-harmonic", "square"):
+            kw["delta"] = delta
+        if self.excitation == "square":
+            kw["square_alpha"] = self.square_alpha
+        if self.excitation == "fourier":
+            kw["fourier"] = self.fourier
+        return kw
+
+
+def sweep_spec(*, omega=1.8, delta=None, gamma=0.0, torque_limit=None, efficiency=None,
+               harmonics: int = 24, excitation=None, square_alpha=None, fourier=None,
+               threshold: bool = False, block_points: int | None = None) -> SweepSpec:
+    """Check the parameters of a sweep (one line naming the offending one) and build its
+    :class:`SweepSpec`; the bounds are in :mod:`parapend.limits` (``MAP_*``)."""
+    from .api import build_excitation, infer_excitation
+
+    kind = infer_excitation(excitation, delta=delta, square_alpha=square_alpha,
+                            fourier=fourier)
+    if kind == "file":
+        raise ParameterError("excitation: a sweep takes harmonic, two-harmonic, square or "
+                             "fourier (a sampled file has no delta to vary)")
+    uses_delta = kind in ("harmonic", "two-harmonic", "square")
+    values = {"omega": parse_axis("omega", omega),
+              "delta": parse_axis("delta", -0.3 if delta is None else delta) if uses_delta
+              else (),
+              "gamma": parse_axis("gamma", gamma),
+              "torque_limit": () if torque_limit is None else parse_axis("torque_limit",
+                                                                         torque_limit),
+              "efficiency": () if efficiency is None else parse_axis("efficiency",
+                                                                     efficiency)}
+    pto = bool(values["torque_limit"] or values["efficiency"])
+    n = check_int("harmonics", harmonics, 1,
+                  limits.MAX_PTO_HARMONICS if pto else limits.MAP_MAX_HARMONICS)
+    if block_points is not None:
+        block_points = check_int("block-points", block_points, 1, 1 << 16)
+    spec = SweepSpec(values, kind, square_alpha, fourier, n, bool(threshold), block_points)
+    if not spec.dims:
+        raise ParameterError("omega, delta, gamma, torque-limit, efficiency: expected at least "
+                             "one axis with two or more values (e.g. --omega 1.2:2.4:128)")
+    pts = spec.points
+    cap = limits.MAP_MAX_PTO_POINTS if pto else limits.MAP_MAX_POINTS
+    if pts > cap:
+        raise ParameterError(f"{', '.join(_FLAGS[d] for d in spec.dims)}: expected at most "
+                             f"{cap} points{' with a power take-off' if pto else ''}, got "
+                             f"{' x '.join(map(str, spec.shape))} = {pts}")
+    if pts * max(n, 24) ** 2 > limits.MAP_MAX_WORK:
+        raise ParameterError(f"harmonics: expected points * max(harmonics, 24)^2 <= "
+                             f"{limits.MAP_MAX_WORK}, got {pts} * {max(n, 24)}^2; lower "
+                             "--harmonics or the number of points")
+    # the excitation parameters that do not vary: checked once here (an unknown Fourier term
+    # list, a square_alpha out of range), with the first values of the axes
+    build_excitation(**spec.excitation_args(values["omega"][0],
+                                            values["delta"][0] if uses_delta else None))
+    return spec
+
+
+# -- one block -----------------------------------------------------------------------------
+
+def _ideal_point(exc, n: int, gamma: float, warm):
+    """What optimize computes (power, status), plus the continuation check; see the module
+    docstring. Returns (power, status, branch_gap, x for the next point)."""
+    from .optimal.fourier import (
+        FourierProblem,
+        _ascent_step,
+        _pad,
+        newton_maximize,
+        search_fourier,
+    )
+
+    found = search_fourier(exc, n, gamma)
+    best = found.best
+    status = "no_power" if best.status == "converged" and best.power <= 0 else best.status
+    gap, x = 0.0, best.x
+    if warm is not None and math.isfinite(best.power):
+        problem = FourierProblem(exc, n, gamma, best.points)
+        x0 = _pad(warm, n)
+        # one Newton step decides most points: when it lands on the global search's maximum
+        # (within 1e-4 of the coefficients, from the concave region), the continuation
+        # converges there (Newton converges quadratically near a strict maximum: the next
+        # step would be within ~1e-8) and there is no other branch; a step of 1/47 of the
+        # delta range of the benchmark's map lands within 5e-5 (median 5e-6)
+        p, g, h = problem.evaluate(x0)
+        d, is_newton = _ascent_step(g, h)
+        near = float(np.max(np.abs(x0 + d - best.x))) <= _SAME_BRANCH * max(
+            1.0, float(np.max(np.abs(best.x))))
+        if not (is_newton and math.isfinite(p) and near):
+            r = newton_maximize(problem, x0, "warm", abandon_below=best.power)
+            if r.status == "converged" and r.power > best.power + _BRANCH_TOL * max(
+                    1.0, abs(best.power)):
+                gap, x = r.power - best.power, r.x
+    return best.power, status, gap, x
+
+
+def _point(spec: SweepSpec, p: dict, warm, thresholds: dict):
+    """Every variable at one point ``p`` (axis name -> value); returns (values, warm)."""
+    from .api import build_excitation, threshold
+    from .optimal.limit import limit
+    from .power import uniform_power
+
+    kw = spec.excitation_args(p["omega"], p.get("delta"))
+    out = {}
+    try:
+        exc = build_excitation(**kw)
+        gamma = p["gamma"]
+        lim = limit(exc).power
+        out["uniform_power"] = uniform_power(exc, gamma)[0]
+        out["limit_power"] = lim
+        if spec.pto:
+            from .pto import optimize_pto
+
+            r = optimize_pto(torque_limit=p.get("torque_limit"), efficiency=p.get("efficiency"),
+                             gamma=gamma, harmonics=spec.harmonics, **kw)
+            out.update(power=r.power, electrical_power=r.electrical_power, status=r.status)
+        elif lim <= 0:  # constant q: as optimize, the uniform rotation's loss
+            out.update(power=-gamma * exc.omega**2, status="no_power", branch_gap=0.0)
+            warm = None
+        else:
+            pw, st, gap, warm = _ideal_point(exc, spec.harmonics, gamma, warm)
+            out.update(power=pw, status=st, branch_gap=gap)
+    except Exception as err:  # recorded as status "error", never dropped
+        log.warning("sweep point %s failed: %s: %s", p, type(err).__name__, err)
+        out = {"status": "error"}
+        warm = None
+    if spec.threshold:
+        key = (p["omega"], p.get("delta"))
+        if key not in thresholds:
+            try:
+                t = threshold(**kw)
+                thresholds[key] = (t.damping_threshold, t.status)
+            except Exception as err:
+                log.warning("sweep threshold at %s failed: %s: %s", p, type(err).__name__, err)
+                thresholds[key] = (math.nan, "error")
+        out["damping_threshold"], out["threshold_status"] = thresholds[key]
+    return out, warm
+
+
+def compute_block(spec: SweepSpec, block: int) -> dict:
+    """The variables of one block, as arrays of the block's shape (runs along the fastest
+    dimension continue from point to point; each run starts afresh)."""
+    sl = spec.block_slices(block)
+    shape = tuple(s.stop - s.start for s in sl)
+    out = {v: (np.full(shape, NOT_COMPUTED, dtype=np.int8) if v.endswith("status")
+               else np.full(shape, np.nan)) for v in spec.variables}
+    fixed = {a: (spec.values[a][0] if len(spec.values[a]) == 1 else None) for a in AXES
+             if len(spec.values[a]) <= 1}
+    thresholds: dict = {}
+    for lead in np.ndindex(*shape[:-1]):
+        warm = None
+        for j in range(shape[-1]):
+            idx = (*lead, j)
+            p = dict(fixed)
+            for d, s, i in zip(spec.dims, sl, idx):
+                p[d] = spec.values[d][s.start + i]
+            vals, warm = _point(spec, p, warm, thresholds)
+            for k, v in vals.items():
+                if k.endswith("status"):
+                    out[k][idx] = _CODE.get(v, _CODE["other"])
+                elif v is not None:
+                    out[k][idx] = v
+    return out
+
+
+# -- the store -----------------------------------------------------------------------------
+
+def _attrs(spec: SweepSpec, command: str | None) -> dict:
+    from . import __version__
+
+    a = {"title": "parapend design map", "parapend_version": __version__,
+         "command": command or "parapend.sweep()", "sweep": spec.to_json(),
+         "excitation": spec.excitation, "harmonics": spec.harmonics,
+         "conventions": "theta'' + gamma theta' - (1 + q(t)) sin(theta) = T(t), theta from "
+                        "the upright; P = -<T theta'> > 0 is harvested (docs/design.md)"}
+    if spec.excitation == "square":
+        a["square_alpha"] = "default" if spec.square_alpha is None else spec.square_alpha
+    if spec.excitation == "fourier":
+        a["fourier"] = str(spec.fourier)
+    return a
+
+
+def _var_attrs(name: str) -> dict:
+    long, units = VARIABLES[name]
+    a = {"long_name": long}
+    if units:
+        a["units"] = units
+    if name.endswith("status"):
+        a.update(flag_values=list(range(len(STATUSES))), flag_meanings=" ".join(STATUSES),
+                 comment="-1: not computed; success: converged or no_power")
+    return a
+
+
+def _template(spec: SweepSpec, command: str | None):
+    """The whole store as a lazy Dataset (dask arrays of fill values) and its encoding."""
+    import dask.array as da
+    import xarray as xr
+
+    dims, shape, chunks = spec.dims, spec.shape, spec.chunks
+    data, enc = {}, {}
+    for v in (*spec.variables, "done"):
+        if v == "done":
+            arr = da.zeros(shape, dtype=bool, chunks=chunks)
+            fill = False
+            attrs = {"long_name": "block finished (written after the block's data)"}
+        elif v.endswith("status"):
+            arr = da.full(shape, NOT_COMPUTED, dtype=np.int8, chunks=chunks)
+            fill, attrs = NOT_COMPUTED, _var_attrs(v)
+        else:
+            arr = da.full(shape, np.nan, dtype=float, chunks=chunks)
+            fill, attrs = np.nan, _var_attrs(v)
+        data[v] = (dims, arr, attrs)
+        enc[v] = {"chunks": chunks, "fill_value": fill}
+    coords = {}
+    for a in AXES:
+        vals = spec.values[a]
+        long, units = _AXIS_ATTRS[a]
+        if len(vals) >= 2:
+            coords[a] = (a, np.array(vals), {"long_name": long, "units": units})
+        elif len(vals) == 1:
+            coords[a] = ((), vals[0], {"long_name": long, "units": units})
+    ds = xr.Dataset(data, coords=coords, attrs=_attrs(spec, command))
+    return ds, enc
+
+
+@contextlib.contextmanager
+def _locked(path: Path):
+    """An exclusive, non-blocking ``flock`` on the store's directory for the sweep's time."""
+    import fcntl
+
+    fd = os.open(path, os.O_RDONLY | os.O_DIRECTORY)
+    try:
+        try:
+            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except BlockingIOError:
+            raise ParameterError(f"store: {str(path)!r} is being written by another parapend "
+                                 "sweep; wait for it to finish or choose another --store") \
+                from None
+        yield
+    finally:
+        os.close(fd)  # releases the lock
+
+
+@contextlib.contextmanager
+def _quiet_zarr():
+    """Zarr warns about foreign files (a ``.partial`` left by a killed write): they are
+    removed on resume, and a reader need not see the warning."""
+    with warnings.catch_warnings():
+        warnings.filterwarnings("ignore", message="Object at .* is not recognized")
+        yield
+
+
+def _store_spec(path: Path) -> str | None:
+    """The sweep identity recorded in a store's root metadata, or None."""
+    try:
+        meta = json.loads((path / "zarr.json").read_text(encoding="utf-8"))
+        return meta["attributes"]["sweep"]
+    except (OSError, ValueError, KeyError, TypeError):
+        return None
+
+
+def _create(path: Path, spec: SweepSpec, command: str | None) -> None:
+    """Write the whole layout into a temporary directory beside the store, then move its
+    entries in, the root ``zarr.json`` last: a store with a root ``zarr.json`` is complete."""
+    ds, enc = _template(spec, command)
+    tmp = Path(tempfile.mkdtemp(prefix=".tmp-parapend-", dir=path.parent))
+    try:
+        ds.to_zarr(tmp, mode="w-", compute=False, encoding=enc, consolidated=False,
+                   zarr_format=3)
+        names = sorted(e.name for e in tmp.iterdir() if e.name != "zarr.json")
+        for name in names:
+            os.replace(tmp / name, path / name)
+        os.replace(tmp / "zarr.json", path / "zarr.json")
+    finally:
+        shutil.rmtree(tmp, ignore_errors=True)
+
+
+def _prepare(path: Path, spec: SweepSpec, command: str | None, overwrite: bool) -> None:
+    """Under the lock: create the store, or check that it holds this sweep (resume)."""
+    expected = {*VARIABLES, "done", *AXES, "zarr.json"}  # what a sweep store can hold
+    entries = {e.name for e in path.iterdir()}
+    recorded = _store_spec(path)
+    if recorded is not None and recorded == spec.to_json() and not overwrite:
+        for p in path.rglob("*.partial"):  # a chunk write cut short by kill -9
+            with contextlib.suppress(OSError):
+                p.unlink()
+        return
+    if recorded is not None and not overwrite:
+        raise ParameterError(f"store: {str(path)!r} holds a different sweep (other axes, "
+                             "excitation, harmonics or threshold); choose another --store, "
+                             "or --overwrite to replace it")
+    if recorded is None and entries and not entries <= expected:
+        raise ParameterError(f"store: {str(path)!r} exists and is not a parapend sweep store; "
+                             "choose another --store")
+    # an interrupted creation (no root zarr.json), or --overwrite of a sweep store
+    if (path / "zarr.json").exists():
+        os.unlink(path / "zarr.json")
+    for e in path.iterdir():
+        if e.is_dir():
+            shutil.rmtree(e)
+        else:
+            e.unlink()
+    _create(path, spec, command)
+
+
+def _check_store_path(store) -> Path:
+    if store is None or not str(store).strip():
+        raise ParameterError("store: expected a directory name, e.g. map.zarr")
+    path = Path(store)
+    parent = path.parent if str(path.parent) else Path(".")
+    if not parent.is_dir():
+        raise ParameterError(f"store: directory {str(parent)!r} does not exist")
+    if path.exists() and not path.is_dir():
+        raise ParameterError(f"store: {str(path)!r} is a file, expected a Zarr store "
+                             "(a directory)")
+    return path
+
+
+def open_sweep(store, *, complete: bool = False):
+    """Open a sweep store (Zarr directory, or a NetCDF export) as an ``xarray.Dataset``.
+
+    ``complete=True`` refuses a store whose ``done`` mask is not all set.
+    """
+    import xarray as xr
+
+    path = Path(store)
+    if not path.exists():
+        raise ParameterError(f"store: {str(store)!r} does not exist")
+    try:
+        if path.is_dir():
+            with _quiet_zarr():
+                ds = xr.open_zarr(path, consolidated=False, zarr_format=3).load()
+        else:
+            with xr.open_dataset(path) as f:
+                ds = f.load()
+    except (OSError, ValueError, KeyError, TypeError) as err:
+        raise ParameterError(f"store: cannot read {str(store)!r} as a sweep store: "
+                             f"{' '.join(str(err).split())[:160]}") from None
+    if "sweep" not in ds.attrs or "done" not in ds:
+        raise ParameterError(f"store: {str(store)!r} is not a parapend sweep store")
+    ds["done"] = ds["done"].astype(bool)
+    if complete and not bool(ds["done"].all()):
+        raise ParameterError(f"store: {str(store)!r} is not complete ({int(ds['done'].sum())} "
+                             f"of {ds['done'].size} points); run the same sweep again to "
+                             "finish it")
+    return ds
+
+
+# -- running -------------------------------------------------------------------------------
+
+@dataclasses.dataclass(frozen=True)
+class SweepRun:
+    """Outcome of :func:`sweep`: the map and what this run did.
+
+    ``dataset`` has one variable per quantity (see :data:`VARIABLES`) over the swept
+    dimensions, plus ``done``; ``computed_points`` were computed by this run,
+    ``resumed_points`` found finished in the store.
+    """
+
+    dataset: object
+    store: str | None
+    points: int
+    blocks: int
+    computed_points: int
+    resumed_points: int
+    seconds: float
+    executor: str
+
+
+def _worker_init(parent: int) -> None:
+    """A pool worker ignores Ctrl-C (the parent handles it) and exits when the parent is
+    gone (``kill -9``: the pool's queues would keep it waiting for ever)."""
+    import signal
+    import threading
+
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+
+    def watch():
+        while True:
+            time.sleep(0.5)
+            try:
+                os.kill(parent, 0)
+            except ProcessLookupError:
+                os._exit(1)
+            except OSError:
+                pass
+
+    threading.Thread(target=watch, daemon=True).start()
+
+
+def _run_local(spec, todo, workers, done_cb):
+    import concurrent.futures as cf
+    import multiprocessing as mp
+
+    if workers == 1 or len(todo) <= 1:
+        for b in todo:
+            done_cb(b, compute_block(spec, b))
+        return "serial"
+    ctx = mp.get_context("forkserver")
+    ctx.set_forkserver_preload(["parapend.sweep", "parapend.api", "parapend.optimal.fourier"])
+    ex = cf.ProcessPoolExecutor(max_workers=workers, mp_context=ctx, initializer=_worker_init,
+                                initargs=(os.getpid(),))
+    try:
+        futs = {ex.submit(compute_block, spec, b): b for b in todo}
+        for f in cf.as_completed(futs):
+            try:
+                vals = f.result()
+            except cf.process.BrokenProcessPool:
+                raise SolverError("a worker process died (killed, or out of memory); the "
+                                  "finished blocks are in the store: run the same command "
+                                  "again to resume") from None
+            done_cb(futs[f], vals)
+    finally:
+        ex.shutdown(wait=True, cancel_futures=True)
+    return f"{workers} local processes"
+
+
+def _connect(scheduler):
+    """A distributed Client for ``scheduler`` (an address or a Client), and whether we own it:
+    connected before the store is touched, so a wrong address leaves nothing behind."""
+    try:
+        from distributed import Client
+    except ImportError:
+        raise ParameterError("scheduler: needs the 'distributed' package (python -m pip "
+                             "install distributed)") from None
+    if hasattr(scheduler, "submit"):
+        return scheduler, False
+    try:
+        return Client(str(scheduler), timeout="10s", set_as_default=False), True
+    except (OSError, TimeoutError, ValueError) as err:
+        raise ParameterError(f"scheduler: cannot connect to {str(scheduler)!r}: "
+                             f"{' '.join(str(err).split())[:160]}") from None
+
+
+def _run_dask(spec, todo, client, done_cb):
+    from distributed import as_completed
+
+    futs = {client.submit(compute_block, spec, b, pure=False): b for b in todo}
+    for f in as_completed(list(futs), loop=client.loop):
+        try:
+            vals = f.result()
+        except (KeyboardInterrupt, ParameterError):
+            raise
+        except Exception as err:  # a lost worker, a worker without parapend, ...
+            raise SolverError(f"a block failed on the Dask cluster ({type(err).__name__}: "
+                              f"{' '.join(str(err).split())[:160]}); the finished blocks are "
+                              "in the store: run the same command again to resume") from None
+        done_cb(futs[f], vals)
+        f.release()
+    return f"Dask cluster at {client.scheduler.address}"
+
+
+def sweep(store=None, *, omega=1.8, delta=None, gamma=0.0, torque_limit=None, efficiency=None,
+          harmonics: int = 24, excitation=None, square_alpha=None, fourier=None,
+          threshold: bool = False, workers: int | None = None, scheduler=None,
+          overwrite: bool = False, command: str | None = None, progress=None,
+          block_points: int | None = None) -> SweepRun:
+    """A design map: the optimum (and more) at every point of a grid; see the module text.
+
+    Parameters
+    ----------
+    store : path or None
+        Zarr store (a directory, e.g. ``map.zarr``) written block by block and resumed when
+        it already holds this sweep; None computes in memory.
+    omega, delta, gamma, torque_limit, efficiency : number, sequence, or str
+        One value, a sequence, ``"START:STOP:COUNT"`` or ``"A,B,C"`` (:func:`parse_axis`).
+        ``torque_limit`` or ``efficiency`` makes each point :func:`parapend.pto.optimize_pto`.
+    harmonics : int
+        N of every solve (at most 128).
+    excitation, square_alpha, fourier
+        As :func:`parapend.optimize` (not "file").
+    threshold : bool
+        Also compute gamma* (:func:`parapend.threshold`) for every (omega, delta).
+    workers : int or None
+        Local processes (default: the number of CPUs, at most the number of blocks).
+    scheduler : str or distributed.Client or None
+        Address of a Dask distributed scheduler (``tcp://host:8786``), or a Client: the
+        blocks run there, and are written here as they finish.
+    overwrite : bool
+        Replace a store that holds a different sweep.
+    command : str or None
+        The command line, recorded in the attributes (the first run's stays).
+    progress : callable or None
+        ``progress(done_points, total_points)`` after each block.
+    block_points : int or None
+        Points per block (one chunk, one task), about: default 128 (8 with a power
+        take-off). Part of the sweep's identity, as it sets where continuation runs start.
+    """
+    spec = sweep_spec(omega=omega, delta=delta, gamma=gamma, torque_limit=torque_limit,
+                      efficiency=efficiency, harmonics=harmonics, excitation=excitation,
+                      square_alpha=square_alpha, fourier=fourier, threshold=threshold,
+                      block_points=block_points)
+    if workers is not None:
+        workers = check_int("workers", workers, 1, 256)
+    else:
+        workers = max(1, min(os.cpu_count() or 1, spec.blocks))
+    t0 = time.monotonic()
+    client, own = _connect(scheduler) if scheduler is not None else (None, False)
+    try:
+        return _sweep(spec, store, workers, client, overwrite, command, progress, t0)
+    finally:
+        if own:
+            client.close()
+
+
+def _sweep(spec, store, workers, client, overwrite, command, progress, t0) -> SweepRun:
+    total = spec.points
+    sizes = [int(np.prod([s.stop - s.start for s in spec.block_slices(b)]))
+             for b in range(spec.blocks)]
+    if store is None:
+        ds, _ = _template(spec, command)
+        ds = ds.compute()
+        arrays = {v: ds[v].values.copy() for v in (*spec.variables, "done")}
+        counted = [0]
+
+        def write(b, vals):
+            sl = spec.block_slices(b)
+            for k, v in vals.items():
+                arrays[k][sl] = v
+            arrays["done"][sl] = True
+            counted[0] += sizes[b]
+            if progress is not None:
+                progress(counted[0], total)
+
+        how = _execute(spec, list(range(spec.blocks)), workers, client, write)
+        for k, v in arrays.items():
+            ds[k] = (spec.dims, v, ds[k].attrs)
+        return SweepRun(ds, None, total, spec.blocks, total, 0, time.monotonic() - t0, how)
+    path = _check_store_path(store)
+    import zarr
+
+    path.mkdir(exist_ok=True)
+    with _locked(path):
+        _prepare(path, spec, command, overwrite)
+        with _quiet_zarr():
+            group = zarr.open_group(path, mode="r+", zarr_format=3)
+            done = np.asarray(group["done"][...], dtype=bool)
+        todo = [b for b in range(spec.blocks) if not done[spec.block_slices(b)].all()]
+        resumed = total - sum(sizes[b] for b in todo)
+        counted = [resumed]
+        if progress is not None:
+            progress(resumed, total)
+
+        def write(b, vals):
+            sl = spec.block_slices(b)
+            for k in spec.variables:  # the data first, then the mask
+                group[k][sl] = vals[k]
+            group["done"][sl] = np.ones(vals["status"].shape, dtype=bool)
+            counted[0] += sizes[b]
+            if progress is not None:
+                progress(counted[0], total)
+
+        how = _execute(spec, todo, workers, client, write) if todo else "nothing to do"
+    ds = open_sweep(path)
+    return SweepRun(ds, str(path), total, spec.blocks, total - resumed, resumed,
+                    time.monotonic() - t0, how)
+
+
+def _execute(spec, todo, workers, client, write) -> str:
+    if client is not None:
+        return _run_dask(spec, todo, client, write)
+    return _run_local(spec, todo, min(workers, max(len(todo), 1)), write)
+
+
+# -- heat maps -----------------------------------------------------------------------------
+
+#: What ``parapend map`` can draw: a variable of the store, or ``gain`` (over uniform).
+MAP_QUANTITIES = ("power", "gain", "damping_threshold", "uniform_power", "limit_power",
+                  "electrical_power", "branch_gap")
+_PAPER = {"omega": 1.8, "delta": -0.3, "gamma": 0.0}
+_SHORT = {"power": "optimal power P", "gain": "gain over the best uniform rotation",
+          "damping_threshold": "damping threshold gamma*",
+          "uniform_power": "power of the best uniform rotation",
+          "limit_power": "limit power (gamma -> 0)", "electrical_power": "electrical power",
+          "branch_gap": "continued branch above the global search"}
+_LABELS = {"omega": r"$\omega$", "delta": r"$\delta$", "gamma": r"$\gamma$",
+           "torque_limit": r"$T_{max}$", "efficiency": r"$\eta$"}
+
+
+def map_data(ds, quantity: str = "power", x: str | None = None, y: str | None = None,
+             at: dict | None = None):
+    """The 2-D slice a heat map shows: ``(values over (y, x), failed mask, title, label)``.
+
+    ``gain`` is ``power / uniform_power - 1`` in percent. Points not computed are NaN;
+    failed points (status other than converged and no_power) are NaN and flagged.
+    Dimensions other than ``x`` and ``y`` are selected by ``at`` (nearest value; default
+    their first value).
+    """
+    if quantity not in MAP_QUANTITIES:
+        raise ParameterError(f"variable: expected one of {', '.join(MAP_QUANTITIES)}, got "
+                             f"{quantity!r:.40}")
+    need = "power" if quantity == "gain" else quantity
+    if need not in ds:
+        raise ParameterError(f"variable: {quantity!r} is not in this store (threshold maps "
+                             "need a sweep with --threshold)")
+    dims = [d for d in AXES if d in ds.dims]
+    if len(dims) < 2:
+        raise ParameterError(f"store: a heat map needs two swept axes, this store has "
+                             f"{', '.join(dims) or 'none'}")
+    x = x or dims[0]
+    y = y or next(d for d in dims if d != x)
+    for name, v in (("x", x), ("y", y)):
+        if v not in dims:
+            raise ParameterError(f"{name}: expected one of the store's axes "
+                                 f"{', '.join(dims)}, got {v!r:.40}")
+    if x == y:
+        raise ParameterError("x, y: expected two different axes")
+    at = dict(at or {})
+    for k in at:
+        if k not in dims or k in (x, y):
+            raise ParameterError(f"at: {k!r:.40} is not another axis of the store "
+                                 f"({', '.join(d for d in dims if d not in (x, y)) or 'none'})")
+    sel = {d: ds[d].values[0] for d in dims if d not in (x, y)}
+    sel.update(at)
+    sub = ds.sel(sel, method="nearest") if sel else ds
+    sub = sub.transpose(y, x)
+    status = sub["status"]
+    ok = sub["done"].values & np.isin(status.values, [_CODE[s] for s in _SUCCESS])
+    failed = sub["done"].values & ~ok
+    if quantity == "gain":  # as optimize's gain_over_uniform: none where uniform <= 0
+        pu = sub["uniform_power"].values
+        with np.errstate(divide="ignore", invalid="ignore"):
+            z = np.where(pu > 0, 100.0 * (sub["power"].values / pu - 1.0), np.nan)
+    else:
+        z = np.array(sub[quantity].values, dtype=float)
+    label = _SHORT[quantity]
+    units = "%" if quantity == "gain" else VARIABLES[quantity][1]
+    label = f"{label} ({units})" if units else label
+    if quantity == "damping_threshold":
+        ok = sub["done"].values & np.isin(sub["threshold_status"].values,
+                                          [_CODE[s] for s in _SUCCESS])
+        failed = sub["done"].values & ~ok
+    z = np.where(ok, z, np.nan)
+    fixed = {**{a: float(ds[a]) for a in AXES if a in ds.coords and ds[a].ndim == 0},
+             **{k: float(sub[k]) for k in sel}}
+    if quantity == "damping_threshold":  # gamma* depends on the excitation only
+        fixed = {k: v for k, v in fixed.items() if k in ("omega", "delta")}
+    title = ", ".join(f"{k} = {v:.4g}" for k, v in fixed.items())
+    return z, failed, sub[x].values, sub[y].values, x, y, label, title
+
+
+def plot_map(ds, quantity: str = "power", x=None, y=None, at=None, path=None):
+    """Heat map of ``quantity`` over two axes, with labelled contour lines, the zero
+    contour of the power (where it crosses gamma*) in black, failed points crossed, and the
+    paper's case (omega = 1.8, delta = -0.3, gamma = 0) marked when inside the map."""
+    import matplotlib
+
+    matplotlib.use("Agg", force=False)
+    import matplotlib.pyplot as plt
+
+    from .fileio import save_figure
+    from .style import figure_style
+
+    z, failed, xs, ys, xn, yn, label, title = map_data(ds, quantity, x, y, at)
+    with figure_style():
+        fig, ax = plt.subplots(figsize=(6.4, 4.8))
+        cmap = plt.get_cmap("viridis").with_extremes(bad="0.85")
+        finite = np.isfinite(z)
+        lo, hi = (np.percentile(z[finite], [1, 99]) if finite.sum() >= 100 else
+                  (np.nanmin(z), np.nanmax(z)) if finite.any() else (0.0, 1.0))
+        # a few extreme points (the gain where the uniform rotation's power tends to 0)
+        # would flatten the rest: the colours span the 1st to 99th percentile
+        clipped = finite.any() and (np.nanmin(z) < lo or np.nanmax(z) > hi)
+        mesh = ax.pcolormesh(xs, ys, np.ma.masked_invalid(z), shading="nearest", cmap=cmap,
+                             vmin=lo, vmax=hi)
+        cb = fig.colorbar(mesh, ax=ax, extend="both" if clipped else "neither")
+        cb.set_label(label)
+        if min(z.shape) >= 3 and finite.sum() >= 9 and hi > lo:
+            cs = ax.contour(xs, ys, np.ma.masked_invalid(z), levels=np.linspace(lo, hi, 9)[1:-1],
+                            colors="white", linewidths=0.7)
+            ax.clabel(cs, fontsize=7, fmt="%.3g")
+            if quantity in ("power", "electrical_power") and np.nanmin(z) < 0 < np.nanmax(z):
+                ax.contour(xs, ys, np.ma.masked_invalid(z), levels=[0.0], colors="black",
+                           linewidths=1.2)
+        if failed.any():
+            yy, xx = np.nonzero(failed)
+            ax.plot(xs[xx], ys[yy], "x", color="red", ms=4, label="failed (see status)")
+        px, py = _PAPER.get(xn), _PAPER.get(yn)
+        if (px is not None and py is not None and xs.min() <= px <= xs.max()
+                and ys.min() <= py <= ys.max()):
+            ax.plot([px], [py], marker="*", color="red", ms=12, mec="white", ls="none",
+                    label=r"paper's case ($\omega$ = 1.8, $\delta$ = -0.3)")
+        if ax.get_legend_handles_labels()[0]:
+            ax.legend(loc="best")
+        for name, setter in ((xn, ax.set_xlabel), (yn, ax.set_ylabel)):
+            unit = _AXIS_ATTRS[name][1]
+            setter(_LABELS[name] + ("" if unit == "1" else f" ({unit})"))
+        ax.grid(False)
+        if title:
+            ax.set_title(title)
+        fig.tight_layout()
+    if path is not None:
+        save_figure(fig, path)
+    return fig
