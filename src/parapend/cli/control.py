@@ -68,8 +68,8 @@ def add_parsers(sub) -> None:
     g.add_argument("--noise-speed", type=_finite_float("noise-speed"), default=0.0,
                    help="std of the measurement noise on theta', in [0, 10]")
     g.add_argument("--irregular", action="store_true",
-                   help="drive the plant with a seeded random-phase JONSWAP-shaped record "
-                        "around omega (same rms as q) instead of q")
+                   help="drive the plant with a seeded JONSWAP sea record (parapend.seas) "
+                        "peaked at omega, with the rms of q, instead of q")
     p.add_argument("--save", metavar="CSV",
                    help="write the run: t,theta,theta_dot,torque,q, 256 samples per period "
                         "(torque held on [t, t + h)); one run only")
