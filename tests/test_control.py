@@ -402,3 +402,17 @@ def test_cli_text_json_and_plot(capsys, tmp_path):
     d = json.loads(out)
     assert d["runs"] == 2 and d["fraction_locked"] == 1.0
     assert d["run_power"][0] != d["run_power"][1]  # each run its own noise
+
+
+def test_cli_states_the_irregular_sea(capsys):
+    code, out, _ = _cli(capsys, "track", "--gamma", "0.01", "--torque-limit", "25",
+                        "--periods", "20", "--irregular", "--seed", "2")
+    assert code == 0
+    line = next(x for x in out.splitlines() if x.startswith("irregular sea:"))
+    code, js, _ = _cli(capsys, "track", "--gamma", "0.01", "--torque-limit", "25",
+                       "--periods", "20", "--irregular", "--seed", "2", "--json")
+    sea = json.loads(js)["sea"]
+    # the stated Hs is the one that gives the design rms (0.3 / sqrt 2) at omega = 1.8
+    _, info = design_sea(1.8, 0.3 / math.sqrt(2), sea["seed"])
+    assert sea["hs"] == pytest.approx(info["hs"], rel=1e-12)
+    assert f"Hs {sea['hs']:.4g}" in line and f"seed {sea['seed']}" in line
