@@ -16,12 +16,11 @@ from parapend.api import optimize
 from parapend.cli import main
 from parapend.control import track
 from parapend.control.closedloop import energy_series, run_closed_loop
-from parapend.control.irregular import irregular, jonswap
 from parapend.control.riccati import periodic_lqr
 from parapend.control.robustness import track_runs
 from parapend.control.swingup import energy, pump_torque
 from parapend.control.target import build_target
-from parapend.control.track import prepare
+from parapend.control.track import SEA_WAVES, _on_grid, design_sea, prepare
 from parapend.model import torque as eq14_torque
 from parapend.pto import optimize_pto
 
@@ -311,17 +310,59 @@ def test_robustness_batch_is_seeded_and_reports_its_runs(limited):
     assert r.locked
 
 
-def test_irregular_generator_spectrum_and_rms():
-    rng = np.random.default_rng(3)
-    sea = irregular(1.8, 0.3 / math.sqrt(2), rng)
-    assert sea.mean_square == pytest.approx(0.045, rel=1e-12)
-    t = np.linspace(0, 4000, 400_001)
-    assert np.mean(sea.q(t) ** 2) == pytest.approx(0.045, rel=0.05)
-    assert np.all((sea.frequencies >= 0.9) & (sea.frequencies <= 4.5))
-    # the acceleration spectrum w^4 S(w) of JONSWAP peaks near the design frequency times
-    # (5/4)^(1/4) / ... : its largest amplitude sits within the peak region
-    w = np.linspace(0.9, 4.5, 20001)
-    assert 1.8 <= w[np.argmax(w**4 * jonswap(w, 1.8))] <= 2.2
+def test_irregular_sea_is_a_seas_record_at_the_design_frequency_and_rms():
+    from parapend.seas import sea_record
+    from parapend.units import Units
+
+    rms = 0.3 / math.sqrt(2)
+    sea, info = design_sea(1.8, rms, 3)
+    # the mean square: Parseval's sum |Q_k|^2 / 2 against the direct sum on one repeat
+    # (2048 > 2 x 300 points: exact for the trigonometric polynomial)
+    period = 2 * math.pi / sea.omega
+    t = period * np.arange(2048) / 2048
+    assert np.mean(sea.q(t) ** 2) == pytest.approx(rms**2, rel=1e-12)
+    # peaked at the design frequency: the heave spectrum's largest component is harmonic
+    # SEA_WAVES of the repeat period, i.e. omega = 1.8
+    assert sea.omega == pytest.approx(1.8 / SEA_WAVES, rel=1e-14)
+    assert int(np.argmax(np.abs(sea.heave))) == SEA_WAVES
+    assert info["components"] == 3 * SEA_WAVES and info["seed"] == 3
+    # the same sea state in other units (a 2 m pendulum, Tp at its omega = 1.8, Hs scaled
+    # with the length) is the same non-dimensional record: the time unit is immaterial
+    u = Units(2.0, 5.0)
+    tp = 2 * math.pi * u.time / 1.8
+    other = sea_record(u, hs=info["hs"] * u.length, tp=tp, repeat_period=SEA_WAVES * tp,
+                       seed=3)
+    assert np.allclose(other.spec, sea.spec, rtol=0, atol=1e-12 * np.abs(sea.spec).max())
+    # seeded: the same seed gives the same record, another seed another one
+    assert np.array_equal(design_sea(1.8, rms, 3)[0].spec, sea.spec)
+    assert not np.allclose(design_sea(1.8, rms, 4)[0].spec, sea.spec)
+
+
+def test_irregular_q_on_the_loop_grid_equals_the_direct_sum():
+    sea, _ = design_sea(1.0, 0.2, 11)
+    points = SEA_WAVES * 8 * 256
+    q = _on_grid(sea, points)
+    step = 2 * math.pi / sea.omega / points
+    t = step * np.arange(3 * points + 1)  # three repeats: the table wraps
+    pick = np.random.default_rng(0).integers(0, t.size, 500)
+    fast = q(t)[pick]
+    assert np.max(np.abs(fast - sea.q(t[pick]))) < 1e-12
+    off = t[pick] + 0.3 * step  # off the grid: the direct sum
+    assert np.array_equal(q(off), sea.q(off))
+
+
+def test_irregular_runs_are_seeded_and_report_their_sea(limited):
+    a = track(design=limited, periods=20, irregular=True, seed=5)
+    b = track(design=limited, periods=20, irregular=True, seed=5)
+    c = track(design=limited, periods=20, irregular=True, seed=6)
+    assert a.mean_power == b.mean_power and a.sea == b.sea
+    assert a.sea["seed"] != c.sea["seed"] and a.mean_power != c.mean_power
+    rms = math.sqrt(np.mean(limited.target.excitation.q_uniform(1024) ** 2))
+    assert a.sea["rms_q"] == pytest.approx(rms, rel=1e-12)
+    # the plant saw that sea: the saved q is the record's
+    sea, _ = design_sea(limited.target.omega, rms, a.sea["seed"])
+    assert np.max(np.abs(a._run.q - sea.q(a._run.t))) < 1e-12
+    assert track(design=limited, periods=20).sea is None
 
 
 # --- command line ------------------------------------------------------------------------
@@ -361,3 +402,17 @@ def test_cli_text_json_and_plot(capsys, tmp_path):
     d = json.loads(out)
     assert d["runs"] == 2 and d["fraction_locked"] == 1.0
     assert d["run_power"][0] != d["run_power"][1]  # each run its own noise
+
+
+def test_cli_states_the_irregular_sea(capsys):
+    code, out, _ = _cli(capsys, "track", "--gamma", "0.01", "--torque-limit", "25",
+                        "--periods", "20", "--irregular", "--seed", "2")
+    assert code == 0
+    line = next(x for x in out.splitlines() if x.startswith("irregular sea:"))
+    code, js, _ = _cli(capsys, "track", "--gamma", "0.01", "--torque-limit", "25",
+                       "--periods", "20", "--irregular", "--seed", "2", "--json")
+    sea = json.loads(js)["sea"]
+    # the stated Hs is the one that gives the design rms (0.3 / sqrt 2) at omega = 1.8
+    _, info = design_sea(1.8, 0.3 / math.sqrt(2), sea["seed"])
+    assert sea["hs"] == pytest.approx(info["hs"], rel=1e-12)
+    assert f"Hs {sea['hs']:.4g}" in line and f"seed {sea['seed']}" in line

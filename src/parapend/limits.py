@@ -99,10 +99,10 @@ ROT_MAX_OMEGAS = 40
 ROT_MAX_P = 3.0
 
 # --- closed-loop control (track) ------------------------------------------------------
-#: forcing periods of one closed-loop run (about 1.5 ms each at 256 samples per period)
+#: forcing periods of one closed-loop run (about 1.7 ms each at 256 samples per period)
 MAX_TRACK_PERIODS = 2000
-#: runs x periods of a seeded robustness batch (track --runs): 20 irregular runs of 2000
-#: periods (40000) took 213 s and 430 MB under load 4; 5 such runs (10000) took 64 s
+#: runs x periods of a seeded robustness batch (track --runs): 5 irregular runs of 2000
+#: periods (10000) took 17.6 s and 443 MB under load about 2 (docs/control.md)
 MAX_TRACK_WORK = 10000
 
 # --- irregular seas (sea command, docs/seas.md) ------------------------------------------

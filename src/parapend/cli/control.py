@@ -68,8 +68,8 @@ def add_parsers(sub) -> None:
     g.add_argument("--noise-speed", type=_finite_float("noise-speed"), default=0.0,
                    help="std of the measurement noise on theta', in [0, 10]")
     g.add_argument("--irregular", action="store_true",
-                   help="drive the plant with a seeded random-phase JONSWAP-shaped record "
-                        "around omega (same rms as q) instead of q")
+                   help="drive the plant with a seeded JONSWAP sea record (parapend.seas) "
+                        "peaked at omega, with the rms of q, instead of q")
     p.add_argument("--save", metavar="CSV",
                    help="write the run: t,theta,theta_dot,torque,q, 256 samples per period "
                         "(torque held on [t, t + h)); one run only")
@@ -152,6 +152,12 @@ def _cmd_track(a) -> dict | str:
            f"{_fmt(r.tracked_peak_torque, 5)}); tracking error {r.tracking_error:.3g} rad",
            f"Floquet multipliers, open loop: {_mult(r.open_loop_multipliers)}",
            f"closed loop: {_mult(r.closed_loop_multipliers)}"]
+    if r.sea is not None:
+        sea = r.sea
+        out.append(f"irregular sea: JONSWAP peaked at omega {sea['peak_omega']:g}, Hs "
+                   f"{sea['hs']:.4g} (units g t0^2), rms of q {sea['rms_q']:.4g}, "
+                   f"{sea['components']} components, repeating every "
+                   f"{sea['repeat_periods']} peak periods, seed {sea['seed']}")
     if a.save:
         out.append(f"run written to {a.save}")
     if a.plot:

@@ -5,8 +5,8 @@
   (periodic LQR gains, open- and closed-loop Floquet multipliers).
 - :mod:`.swingup`: energy pumping from rest and the hand-over to tracking.
 - :mod:`.closedloop`: the sampled closed loop on the full nonlinear Eq. 14.
-- :mod:`.irregular`: a seeded random-phase (JONSWAP-shaped) excitation for robustness runs.
-- :mod:`.track`: the entry point :func:`track` and its result.
+- :mod:`.track`: the entry point :func:`track` and its result; the irregular sea of a
+  robustness run (:func:`.track.design_sea`, a record of :mod:`parapend.seas`).
 - :mod:`.robustness`: seeded batches of runs with model error, noise and irregular seas.
 """
 

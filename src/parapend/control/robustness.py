@@ -83,7 +83,7 @@ def track_runs(*, runs: int = 20, seed: int = 0, periods: int = 100, torque_limi
     periods = check_int("periods", periods, 2 * AVERAGE_PERIODS, limits.MAX_TRACK_PERIODS)
     if runs * periods > limits.MAX_TRACK_WORK:
         raise ParameterError(f"runs: expected runs * periods <= {limits.MAX_TRACK_WORK} "
-                             f"(about 50 s), got {runs} * {periods}")
+                             f"(about 20 s), got {runs} * {periods}")
     seed = check_int("seed", seed, 0, 2**63 - 1)
     ge = abs(check_range("gamma-error", gamma_error, -0.9, 0.9))
     de = abs(check_range("delta-error", delta_error, -0.9, 0.9))

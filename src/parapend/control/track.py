@@ -27,7 +27,7 @@ from .closedloop import energy_series, run_closed_loop
 from .riccati import periodic_lqr
 from .target import build_target
 
-__all__ = ["TrackResult", "lock_analysis", "prepare", "track"]
+__all__ = ["TrackResult", "design_sea", "lock_analysis", "prepare", "track"]
 
 #: controller (and saved series) samples per forcing period
 SAMPLES = 256
@@ -58,6 +58,8 @@ class TrackResult(_Result):
         reserved; None otherwise).
     peak_torque : float
         Largest ``|T|`` applied during the run.
+    sea : dict or None
+        With ``irregular``: the sea record that drove the plant (:func:`design_sea`).
     tracked_peak_torque : float
         Peak torque of the tracked optimum.
     energy_before_lock : float or None
@@ -109,6 +111,7 @@ class TrackResult(_Result):
     riccati_sweeps: int
     riccati_residual: float
     excitation: dict = field(default_factory=dict)
+    sea: dict | None = None
     convention: str = ("theta from the upright (hanging at rest is theta = pi); power "
                        "positive when harvested, P = -<T theta'>; torque units m g l")
     _run: object = field(default=None, repr=False)
@@ -192,20 +195,82 @@ def _check_state(state0):
             check_range("theta-dot0", om, 0.0, 1e3, absolute=True))
 
 
+#: peak periods in one repeat of the irregular record (``T_r = SEA_WAVES T_p``)
+SEA_WAVES = 100
+#: peak period (s) of the sea state behind an irregular run; only a choice of time unit
+#: (the record in the pendulum's units depends on ``omega`` and ``rms`` alone)
+SEA_TP = 1.0
+
+
+def design_sea(omega: float, rms: float, seed: int):
+    """The irregular sea of a robustness run, in the pendulum's units: a JONSWAP record of
+    :func:`parapend.seas.sea_record` (peak enhancement 3.3, cutoff 3 peak frequencies,
+    ``SEA_WAVES`` peak periods per repeat, phases seeded ``seed``) whose peak frequency is
+    the design frequency ``omega`` and whose ``q`` has the root mean square ``rms`` (that of
+    the design excitation).
+
+    ``sea_record`` takes a sea state in SI units and a pendulum; the record in non-dimensional
+    time depends only on ``Tp / t0`` and ``Hs / (g t0^2)``. So the pendulum is the one whose
+    time unit puts ``Tp = SEA_TP`` at ``omega``, ``t0 = Tp omega / 2 pi`` (a point mass of
+    length ``g t0^2``), and ``Hs`` is set from the record's mean square, which is linear in
+    ``Hs^2``: ``<q^2> = sum |Q_k|^2 / 2``. Returns the excitation and its description
+    (``hs`` in units of ``g t0^2``, the pendulum length for a point mass).
+    """
+    from ..seas import sea_record
+    from ..units import STANDARD_GRAVITY, Units
+
+    t0 = SEA_TP * omega / (2 * math.pi)
+    units = Units(STANDARD_GRAVITY * t0**2, 1.0)
+
+    def record(hs):
+        return sea_record(units, hs=hs, tp=SEA_TP, spectrum="jonswap",
+                          repeat_period=SEA_WAVES * SEA_TP, seed=seed)
+
+    unit = record(1.0)
+    hs = rms / math.sqrt(0.5 * float(np.sum(np.abs(unit.spec) ** 2)))
+    if hs > limits.SEA_MAX_HS:
+        raise ParameterError(f"irregular: the design excitation's rms {rms:.3g} needs a sea "
+                             f"state above Hs = {limits.SEA_MAX_HS:g} m at Tp = {SEA_TP:g} s")
+    sea = record(hs)
+    info = {"spectrum": "jonswap", "gamma_peak": 3.3, "peak_omega": omega,
+            "hs": hs / units.length, "repeat_periods": SEA_WAVES,
+            "components": sea.info["components"], "cutoff": sea.info["cutoff"],
+            "seed": seed, "rms_q": rms}
+    return sea, info
+
+
+def _on_grid(sea, points: int):
+    """``q`` of a periodic record as a vectorized function of time, exact on the grid of
+    ``points`` uniform times per repeat (by one FFT, :meth:`Excitation.q_uniform`) and by the
+    direct sum elsewhere. The closed loop asks for ``q`` at its RK4 half steps, which are
+    this grid for ``points = 8 x samples`` per design period (4 RK4 steps per sample)."""
+    table = sea.q_uniform(points)
+    scale = points * sea.omega / (2 * math.pi)
+
+    def q(t):
+        t = np.asarray(t, dtype=float)
+        x = t * scale
+        j = np.rint(x)
+        if np.all(np.abs(x - j) < 1e-6):
+            return table[j.astype(np.int64) % points]
+        return sea.q(t)
+
+    return q
+
+
 def simulate_design(d: Design, *, periods: int, seed: int = 0, gamma_error: float = 0.0,
                     delta_error: float = 0.0, noise_theta: float = 0.0,
                     noise_speed: float = 0.0, irregular: bool = False,
                     lock_tolerance: float = 0.1, state0=(math.pi, 0.0), rng=None):
     """One closed-loop run of a prepared design; returns ``(run, fields)``."""
-    from .irregular import irregular as make_irregular
-
     tg = d.target
     rng = np.random.default_rng(seed) if rng is None else rng
     plant_gamma = tg.gamma * (1.0 + gamma_error)
+    sea_info = None
     if irregular:
         rms = math.sqrt(float(np.mean(tg.excitation.q_uniform(1024) ** 2)))
-        sea = make_irregular(tg.omega, rms, rng)
-        base_q = sea.q
+        sea, sea_info = design_sea(tg.omega, rms, int(rng.integers(0, 2**63 - 1)))
+        base_q = _on_grid(sea, SEA_WAVES * 8 * tg.samples)
     else:
         base_q = tg.excitation.q
     scale = 1.0 + delta_error
@@ -232,7 +297,7 @@ def simulate_design(d: Design, *, periods: int, seed: int = 0, gamma_error: floa
               "catch_period": float(catch[0] / m) if catch.size else None,
               "mean_power": mean_power, "peak_torque": float(np.max(np.abs(run.torque))),
               "energy_before_lock": e_lock, "payback_periods": payback,
-              "tracking_error": err, "plant_gamma": plant_gamma}
+              "tracking_error": err, "plant_gamma": plant_gamma, "sea": sea_info}
     return run, fields
 
 
@@ -263,8 +328,9 @@ def track(*, torque_limit=None, torque_margin: float = 0.1, periods: int = 100,
     noise_theta, noise_speed : float
         Standard deviations of the Gaussian measurement noise on theta (rad) and theta'.
     irregular : bool
-        The plant is driven by a seeded irregular record around the design frequency
-        (:mod:`.irregular`) instead of the design excitation.
+        The plant is driven by a seeded irregular sea (:func:`design_sea`: a JONSWAP record
+        of :mod:`parapend.seas` peaked at the design frequency, with the design
+        excitation's rms) instead of the design excitation.
     lock_tolerance : float
         Largest wrapped angle error (rad) of a locked period.
     r_weight : float
