@@ -47,7 +47,7 @@ def test_fold_makes_the_cycle_banded():
 
 
 @pytest.mark.parametrize("kw", [{"torque_limit": 1.6}, {"torque_limit": 1.6, "copper_loss": 0.02},
-                                {"phase1": True}])
+                                {"phase1": True}, {"torque_limit": 1.2, "elastic": 7.0}])
 def test_newton_system_is_the_barrier_hessian(kw):
     """With lambda = mu / s the primal-dual matrix is the barrier function's Hessian and the
     right-hand side minus its gradient: both checked by central differences, which also
@@ -56,7 +56,7 @@ def test_newton_system_is_the_barrier_hessian(kw):
     pr = HermiteProblem(EXC, 7, gamma, **kw)
     rng = np.random.default_rng(3)
     x = pr.start(_uniform(gamma)) + 0.01 * rng.normal(size=14)
-    t = 1.7 if kw.get("phase1") else None
+    t = 1.7 if kw.get("phase1") else (0.5 if "elastic" in kw else None)
 
     def barrier(x):
         c = pr.constraints(x, t)
@@ -78,6 +78,23 @@ def test_newton_system_is_the_barrier_hessian(kw):
 
     hn = np.array([(g(x + e * v) - g(x - e * v)) / (2 * e) for v in eye])
     assert np.max(np.abs(hess - 0.5 * (hn + hn.T))) <= 1e-6 * np.max(np.abs(hn))
+    if t is not None:  # the border variable: its gradient, diagonal and coupling column
+        _, _, border, rhs_t, d_tt = pr.newton(x, t, lam, mu)
+
+        def bt(tt):
+            c = pr.constraints(x, tt)
+            return pr.objective(x, mu, tt) - mu * np.sum(np.log(-c))
+
+        assert -rhs_t == pytest.approx((bt(t + e) - bt(t - e)) / (2 * e), rel=1e-6)
+
+        def gt(tt):  # the barrier gradient in x at fixed lambda = mu / s(x, t)
+            lam_t = mu / -pr.constraints(x, tt)
+            return -pr.newton(x, tt, lam_t, mu)[1][pr.perm]
+
+        np.testing.assert_allclose(border[pr.perm], (gt(t + e) - gt(t - e)) / (2 * e),
+                                   rtol=1e-5, atol=1e-7 * np.max(np.abs(border)))
+        d2 = (bt(t + e) - 2 * bt(t) + bt(t - e)) / e**2
+        assert d_tt == pytest.approx(d2, rel=1e-4)
 
 
 def test_hermite_motion_is_a_c1_rotation():
@@ -142,3 +159,18 @@ def test_infeasible_limit_is_a_status():
     s = solve_hermite(EXC, 0.3, 64, ideal.motion, torque_limit=1e-3)
     assert s.status == "infeasible"
     assert s.t > 1e-3
+
+
+def test_small_limit_reaches_the_constant_brake():
+    """Below a free rotation's reach (gamma = 0.01, T_max = 0.1) the best motion brakes with
+    -T_max all the way round: P <= T_max <|theta'|> = T_max omega for a monotone rotation,
+    and the solver comes within 1e-3 of that bound from a start far away (the ideal optimum,
+    peak torque 8.3), through elastic mode."""
+    ideal = parapend.optimize(gamma=0.01)
+    s = solve_hermite(EXC, 0.01, 128, ideal.motion, torque_limit=0.1)
+    assert s.status == "converged"
+    assert "elastic" in [st[0] for st in s.stages]
+    assert s.peak_torque <= 0.1 * (1 + 1e-9)
+    _, _, thd, _ = s.motion.profile_on(np.linspace(0, 1, 9))
+    assert np.all(thd > 0)  # monotone: the bound applies
+    assert 0.18 * (1 - 1e-3) < s.power <= 0.18

@@ -223,14 +223,19 @@ def _time_domain(exc, gamma, ideal, tmax, copper_loss, warm, rtol: float = 1e-6)
     prev = None
     iters = 0
     change = float("nan")
+    anchor = None
     while True:
-        sol = solve_hermite(exc, gamma, k, start, torque_limit=tmax, copper_loss=copper_loss)
+        sol = solve_hermite(exc, gamma, k, start, torque_limit=tmax, copper_loss=copper_loss,
+                            anchor=anchor)
         iters += sol.iterations
-        if sol.status == "infeasible" and prev is None and 2 * k <= limits.MAX_PTO_INTERVALS:
-            k *= 2  # the smallest peak torque falls with the resolution: try a finer one
+        if sol.status != "converged" and prev is None and 2 * k <= limits.MAX_PTO_INTERVALS:
+            # the smallest peak torque falls with the resolution, and near a free rotation
+            # (tiny limits) a coarse mesh may stall: try a finer one
+            k *= 2
             continue
         if sol.status != "converged":
             break
+        anchor = sol.anchor  # strictly inside the limit: the finer solve starts towards it
         motion = sol.motion
         if prev is not None:
             change = abs(sol.electrical_power - prev)

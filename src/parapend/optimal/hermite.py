@@ -220,14 +220,18 @@ class HermiteProblem:
     copper_loss : float
         ``r >= 0`` of the loss ``r <T^2>``.
     phase1 : bool
-        Minimize the peak torque ``t`` instead (no power objective).
+        Minimize the peak torque ``t`` instead (no power objective): ``|T| <= t``.
+    elastic : float or None
+        Elastic mode (a start from anywhere): ``|T| <= torque_limit + t``, ``t >= 0``, and
+        ``elastic * t`` added to the minimized ``-P`` (an exact penalty once ``elastic``
+        exceeds the limit's multipliers).
     winding : int
         Turns per forcing period.
     """
 
     def __init__(self, excitation, intervals: int, damping: float, *, torque_limit=None,
                  copper_loss: float = 0.0, phase1: bool = False,
-                 winding: int = 1):
+                 elastic: float | None = None, winding: int = 1):
         self.excitation = excitation
         self.omega = om = excitation.omega
         self.k = k = int(intervals)
@@ -236,6 +240,8 @@ class HermiteProblem:
         self.h = h = period / k
         self.winding = int(winding)
         self.phase1 = phase1
+        self.elastic = elastic
+        self.border = "phase1" if phase1 else ("elastic" if elastic is not None else None)
         self.torque_limit = torque_limit
         self.grid_limit = torque_limit
         self.copper_loss = float(copper_loss)
@@ -334,32 +340,37 @@ class HermiteProblem:
     # -- the pieces of the interior point --------------------------------------------------------
     def constraints(self, x, t=None):
         """The torque constraints ``c <= 0`` at the constraint points, flat."""
-        if not self.phase1 and self.grid_limit is None:
+        if self.border is None and self.grid_limit is None:
             return np.zeros(0)
         tq = self._at(self.local(x), self.rows_c, self.q1_c, self.lin_c)[4]
         if self.phase1:
             return np.concatenate([(tq - t).ravel(), (-tq - t).ravel()])
+        if self.elastic is not None:
+            b = self.torque_limit + t
+            return np.concatenate([(tq - b).ravel(), (-tq - b).ravel(), [-t]])
         lim = self.grid_limit
         return np.concatenate([(tq / lim - 1.0).ravel(), (-tq / lim - 1.0).ravel()])
 
     def constraint_step(self, dx, dt=None) -> np.ndarray:
         """``J d``: the linearized change of :meth:`constraints` along a step, at the point
         of the last :meth:`newton` call."""
-        if not self.phase1 and self.grid_limit is None:
+        if self.border is None and self.grid_limit is None:
             return np.zeros(0)
         dy = self.local(dx) - self.wrap
         dtq = np.einsum("kci,ki->kc", self._jtc, dy)
         if self.phase1:
             return np.concatenate([(dtq - dt).ravel(), (-dtq - dt).ravel()])
+        if self.elastic is not None:
+            return np.concatenate([(dtq - dt).ravel(), (-dtq - dt).ravel(), [-dt]])
         lim = self.grid_limit
         return np.concatenate([(dtq / lim).ravel(), (-dtq / lim).ravel()])
 
     def barrier_count(self) -> int:
         """Number of barrier terms (the barrier's duality gap is this times ``mu``)."""
         n = 0
-        if self.phase1 or self.grid_limit is not None:
+        if self.border is not None or self.grid_limit is not None:
             n += 2 * self.rows_c[0].shape[0] * self.k
-        return n
+        return n + (self.elastic is not None)
 
     def objective(self, x, mu: float = 0.0, t=None) -> float:
         """``phi`` to minimize: ``-(power)`` or, in phase 1, ``t`` (``mu`` unused: the
@@ -371,7 +382,7 @@ class HermiteProblem:
         f = np.sum(self.weight * (self.q1_g * sn * thd - self.damping * thd * thd))
         if self.copper_loss:
             f -= self.copper_loss * np.sum(self.weight * tq * tq)
-        return -float(f)
+        return -float(f) + (self.elastic * float(t) if self.elastic is not None else 0.0)
 
     def newton(self, x, t, lam, mu):
         """Banded Newton matrix and right-hand side of the barrier problem.
@@ -406,31 +417,36 @@ class HermiteProblem:
                                    + ((w * tqg * self.q1_g * sng) @ self._g00).reshape(k, 4, 4))
         border = None
         rhs_t = d_tt = 0.0
-        if self.phase1 or self.grid_limit is not None:
+        if self.border is not None or self.grid_limit is not None:
             b0c = self.rows_c[0]
             _, _, snc, csc, tqc = self._at(y, self.rows_c, self.q1_c, self.lin_c)
             jtc = self.lin_c[None] - (self.q1_c * csc)[..., None] * b0c[None]  # dT/dy
             self._jtc = jtc
             htc = self.q1_c * snc  # d2T/dy2 = htc b0 b0^T
             n_c = tqc.size
-            if self.phase1:
+            if self.border is not None:
                 scale = 1.0
-                sp, sm = t - tqc, t + tqc
+                b = t if self.phase1 else self.torque_limit + t
+                sp, sm = b - tqc, b + tqc
             else:
                 scale = 1.0 / self.grid_limit
                 sp, sm = 1.0 - tqc * scale, 1.0 + tqc * scale
             lp = lam[:n_c].reshape(tqc.shape)
-            lm = lam[n_c:].reshape(tqc.shape)
+            lm = lam[n_c:2 * n_c].reshape(tqc.shape)
             # c+- = +-scale T - (t or 1): grad c+- = +-scale jt, hess c+- = +-scale hess T
             grad += np.einsum("kc,kci->ki", scale * (mu / sp - mu / sm), jtc)
             sig = (lp / sp + lm / sm) * scale * scale
             blocks += (jtc * sig[..., None]).transpose(0, 2, 1) @ jtc
             blocks += ((scale * (lp - lm) * htc) @ self._c00).reshape(k, 4, 4)
-            if self.phase1:
-                # grad_t c+- = -1
+            if self.border is not None:
+                # grad_t c+- = -1 (and, elastic, c_t = -t)
                 border = -np.einsum("kc,kci->ki", lp / sp - lm / sm, jtc)
                 d_tt = float(np.sum(lp / sp + lm / sm))
-                rhs_t = -(1.0 - float(np.sum(mu / sp + mu / sm)))
+                g_t = 1.0 - float(np.sum(mu / sp + mu / sm))
+                if self.elastic is not None:
+                    d_tt += float(lam[-1]) / t
+                    g_t += self.elastic - 1.0 - mu / t
+                rhs_t = -g_t
         n = self.n
         nb = self.band + 1
         ab = np.bincount(self._flat, weights=blocks.reshape(k, 16)[self._sel],
@@ -456,6 +472,7 @@ class HermiteSolution:
     intervals: int = 0
     stages: list = field(default_factory=list)
     motion: object = None
+    anchor: object = None  # the strictly feasible motion the solve started towards
 
 
 def _solve(ab, rhs, border, rhs_t, d_tt, delta):
@@ -491,6 +508,9 @@ def interior_point(problem: HermiteProblem, x, *, t=None, mu0: float | None = No
     x = np.array(x, dtype=float)
     if pr.phase1 and t is None:
         t = float(np.max(np.abs(pr.torque_points(x)))) * 1.05 + 0.05
+    if pr.elastic is not None and t is None:
+        lim = pr.torque_limit
+        t = max(float(np.max(np.abs(pr.torque_points(x)))) - lim, 0.0) + 0.05 * lim + 1e-3
     c = pr.constraints(x, t)
     if c.size and np.max(c) >= 0:
         return HermiteSolution(x, t, "infeasible_start", 0, math.nan)
@@ -504,7 +524,9 @@ def interior_point(problem: HermiteProblem, x, *, t=None, mu0: float | None = No
     lam = mu / s
     status = "max_iterations"
     delta_last = 0.0
-    stagnant = 0  # steps at mu_min that changed the barrier function by < 1e-14 relative
+    # consecutive steps that changed the barrier function by < 1e-14 relative: the barrier
+    # problem is solved as far as the arithmetic (or a jam at the boundary) allows
+    stagnant = 0
     it = 0
     for it in range(1, maxiter + 1):  # noqa: B007 (returned: the iteration count)
         ab, rhs, border, rhs_t, d_tt = pr.newton(x, t, lam, mu)
@@ -564,7 +586,7 @@ def interior_point(problem: HermiteProblem, x, *, t=None, mu0: float | None = No
             if np.any(neg):
                 amax = min(1.0, float(np.min(-_FRACTION * lam[neg] / dlam[neg])))
             lam = np.clip(lam + amax * dlam, 1e-30, None)
-        stagnant = stagnant + 1 if mu <= mu_min * (1 + 1e-12) and abs(bn - b0) <= 1e-14 * (
+        stagnant = stagnant + 1 if abs(bn - b0) <= 1e-14 * (
             1 + abs(b0)) else 0
         x, t, s, phi = xn, tn, sn, phin
         if stop_below is not None and t is not None and t < stop_below:
@@ -582,6 +604,25 @@ def _blend_feasible(problem: HermiteProblem, x, anchor, t=None):
         if not c.size or np.max(c) < 0:
             return xb
     return None
+
+
+def _elastic(excitation, damping, k, x, torque_limit, copper_loss, winding, stages):
+    """Elastic mode from ``x``: ``|T| <= L + t``, ``t >= 0``, penalty ``M t``, ``M`` raised
+    tenfold until ``t`` vanishes (at most ``1e5``); ``L`` a little below the limit so that
+    the optimum is strictly inside. Returns ``(x, t, iterations)``."""
+    weight = 10.0 * max(1.0, excitation.omega)
+    t, iters = None, 0
+    while True:
+        el = HermiteProblem(excitation, k, damping, torque_limit=torque_limit * (1 - 1e-4),
+                            copper_loss=copper_loss, elastic=weight, winding=winding)
+        sol = interior_point(el, x, t=t)
+        iters += sol.iterations
+        stages.append(("elastic", weight, sol.t, sol.status))
+        x, t = sol.x, sol.t
+        if t < 1e-5 * torque_limit or weight >= 1e5 or sol.status == "infeasible_start":
+            return x, t, iters
+        weight *= 10.0
+        t = t * 1.5 + 1e-3 * torque_limit  # strictly inside again
 
 
 def _dense_peaks(motion, excitation, damping, torque_limit):
@@ -611,10 +652,12 @@ def solve_hermite(excitation, damping: float, intervals: int, start, *, torque_l
     """Optimal PTO motion on ``intervals`` Hermite intervals, from the motion ``start``.
 
     ``anchor``: a motion strictly inside the torque limit (default: the best uniform
-    rotation, else the phase-1 motion); the start is blended towards it until strictly
-    feasible. The result satisfies ``|T| <= torque_limit (1 + tol)`` on the motion's dense
-    evaluation (:meth:`HermiteMotion.peak_torque`), or has status "infeasible" (no rotation
-    near the start has a peak torque below the limit: ``t`` is the smallest peak found).
+    rotation); the start is blended towards it until strictly feasible. Without such an
+    anchor, elastic mode (``|T| <= T_max + t``, penalty on ``t``) from the start itself finds
+    a strictly feasible point near the optimum. The result satisfies
+    ``|T| <= torque_limit (1 + tol)`` on the motion's dense evaluation
+    (:meth:`HermiteMotion.peak_torque`), or has status "infeasible" (no rotation near the
+    start has a peak torque below the limit: ``t`` is the smallest peak found by phase 1).
     """
     from ..power import uniform_power
     from ..trajectory import FourierMotion
@@ -625,29 +668,47 @@ def solve_hermite(excitation, damping: float, intervals: int, start, *, torque_l
     x = pr.start(start)
     stages = []
     iters = 0
+    x_start = x
     if torque_limit is not None:
         if anchor is None:
             _, phi = uniform_power(excitation, damping)
             anchor = FourierMotion(excitation.omega, phi, np.zeros(1), np.zeros(1))
         xa = pr.start(anchor)
-        if np.max(np.abs(pr.torque_points(xa))) >= torque_limit * (1 - 1e-3):
-            ph1, _ = minimum_peak_torque(excitation, damping, k, anchor,
-                                         stop_below=torque_limit * (1 - 1e-3), winding=winding)
+        # blend towards the anchor when it is strictly inside; otherwise elastic mode below
+        # (a phase-1 motion as the anchor was tried: near a free rotation it leads into the
+        # basin of a poor local optimum)
+        inside = np.max(np.abs(pr.torque_points(xa))) < torque_limit * (1 - 1e-3)
+        x = _blend_feasible(pr, x, xa) if inside else None
+    if x is not None:
+        sol = interior_point(pr, x)
+        iters += sol.iterations
+        stages.append(("solve", torque_limit, sol.status))
+    if torque_limit is not None and (x is None or sol.status != "converged"):
+        # no strictly feasible start, or the solve from it stalled: elastic mode from the
+        # start itself (it keeps the start's basin)
+        xe, te, it_e = _elastic(excitation, damping, k, x_start, torque_limit, copper_loss,
+                                winding, stages)
+        iters += it_e
+        if not te < 1e-5 * torque_limit:
+            # the limit is not met near the start: the smallest peak near it (phase 1)
+            ph1, _ = minimum_peak_torque(excitation, damping, k, pr.motion(xe),
+                                         winding=winding)
             iters += ph1.iterations
             stages.append(("phase1", ph1.t, ph1.status))
-            if not ph1.t < torque_limit:  # stopped below the limit, or converged below it
-                return HermiteSolution(ph1.x, ph1.t, "infeasible", iters, ph1.mu,
-                                       power=pr.power(ph1.x), electrical_power=pr.electrical(
-                                           ph1.x), peak_torque=ph1.peak_torque,
-                                       intervals=k, stages=stages, motion=pr.motion(ph1.x))
-            xa = ph1.x
-        x = _blend_feasible(pr, x, xa)
-    sol = interior_point(pr, x)
-    iters += sol.iterations
-    stages.append(("solve", torque_limit, sol.status))
+            return HermiteSolution(ph1.x, ph1.t, "infeasible", iters, ph1.mu,
+                                   power=pr.power(ph1.x), electrical_power=pr.electrical(ph1.x),
+                                   peak_torque=ph1.peak_torque, intervals=k, stages=stages,
+                                   motion=pr.motion(ph1.x))
+        xa = x = xe  # strictly inside the limit, and near its optimum already
+        sol = interior_point(pr, x, mu0=1e-4 * abs(pr.objective(x)) / pr.barrier_count())
+        iters += sol.iterations
+        stages.append(("solve", torque_limit, sol.status))
+
     motion = pr.motion(sol.x)
     peaks = _dense_peaks(motion, excitation, damping, torque_limit)
     peak = float(np.max(peaks))
+    # the optimum on the untightened grid bounds every motion within the limit everywhere
+    bound = pr.power(sol.x) if sol.status == "converged" else math.inf
     for _ in range(6):
         if torque_limit is None or peak <= torque_limit * (1 + tol) or \
                 sol.status != "converged":
@@ -679,6 +740,14 @@ def solve_hermite(excitation, damping: float, intervals: int, start, *, torque_l
     status = sol.status
     if torque_limit is not None and peak > torque_limit * (1 + tol) and status == "converged":
         status = "stalled"
+    if torque_limit is not None and status == "max_iterations" and \
+            peak <= torque_limit * (1 + tol) and \
+            pr.power(sol.x) >= bound - 1e-8 * max(1.0, abs(bound)):
+        # a tightened solve slowed down (near a free rotation every constraint is active),
+        # but its motion meets the limit everywhere and is within 1e-8 of the untightened
+        # optimum, an upper bound: optimal to that
+        status = "converged"
+        stages.append(("bound", bound, "certified"))
     sol.status = status
     sol.iterations = iters
     sol.power = pr.power(sol.x)
@@ -687,4 +756,5 @@ def solve_hermite(excitation, damping: float, intervals: int, start, *, torque_l
     sol.intervals = k
     sol.stages = stages
     sol.motion = motion
+    sol.anchor = None if torque_limit is None else pr.motion(xa)
     return sol
