@@ -167,7 +167,7 @@ def test_small_limit_reaches_the_constant_brake():
     and the solver comes within 1e-3 of that bound from a start far away (the ideal optimum,
     peak torque 8.3), through elastic mode."""
     ideal = parapend.optimize(gamma=0.01)
-    s = solve_hermite(EXC, 0.01, 128, ideal.motion, torque_limit=0.1)
+    s = solve_hermite(EXC, 0.01, 256, ideal.motion, torque_limit=0.1)
     assert s.status == "converged"
     assert "elastic" in [st[0] for st in s.stages]
     assert s.peak_torque <= 0.1 * (1 + 1e-9)
