@@ -10,16 +10,17 @@ Problems (paper case ``q = -0.3 sin(1.8 t)``), issue 9: the torque-limited optim
      check included);
    - efficiency: :func:`parapend.optimal.constrained.solve_pto` with N harmonics (smoothed
      efficiency on the Fourier Newton kernel).
-   Wall time of everything, ideal optimum included, median of ``--repeat`` runs after one
+   Wall time of everything, ideal optimum included, the best of ``--repeat`` runs after one
    untimed warm-up.
 2. **CasADi + IPOPT**: ``tests/casadi_pto.py``, Hermite-Simpson collocation on K intervals,
    piecewise-linear torque as the control, exact efficiency through slacks. IPOPT's solve
-   time only (the graph built before it is not counted), median of ``--repeat``.
+   time only (the graph built before it is not counted), the best of ``--repeat``.
 
 The error is against a reference: the collocation with K = 600. For each accuracy level
 the fastest configuration of each tool that reaches it is compared: the ratio is CasADi's
 time over ours (above 1: parapend faster). Timings depend on the machine and its load;
-read the ratios (both tools run in this one process, alternately).
+read the ratios (both tools run in this one process, alternately; the best of the repeats
+is the least disturbed by other load).
 
 Run: ``OPENBLAS_NUM_THREADS=1 python benchmarks/bench_pto.py``.
 """
@@ -27,7 +28,6 @@ Run: ``OPENBLAS_NUM_THREADS=1 python benchmarks/bench_pto.py``.
 from __future__ import annotations
 
 import argparse
-import statistics
 import sys
 import time
 from pathlib import Path
@@ -52,14 +52,14 @@ def ours(gamma, kw, size):
                      parapend.optimize(gamma=gamma, harmonics=size).motion.vector, **kw)
 
 
-def median_time(fn, repeat):
+def best_time(fn, repeat):
     fn()
     ts, out = [], None
     for _ in range(repeat):
         t = time.perf_counter()
         out = fn()
         ts.append(time.perf_counter() - t)
-    return statistics.median(ts), out
+    return min(ts), out
 
 
 def main():
@@ -78,14 +78,14 @@ def main():
         sizes = (64, 128, 256, 512) if "torque_limit" in kw else (16, 24, 32)
         label = "K" if "torque_limit" in kw else "N"
         for n in sizes:
-            t, s = median_time(lambda n=n, g=gamma, k=kw: ours(g, k, n), a.repeat)
+            t, s = best_time(lambda n=n, g=gamma, k=kw: ours(g, k, n), a.repeat)
             rows.append(("parapend", f"{label}={n}", t, s.electrical_power))
         for k in (25, 50, 100, 150, 200):
             ts = []
             for _ in range(a.repeat):
                 c = collocate(exc, gamma, intervals=k, **kw)
                 ts.append(c["solve_time"])
-            rows.append(("casadi", f"K={k}", statistics.median(ts), c["electrical_power"]))
+            rows.append(("casadi", f"K={k}", min(ts), c["electrical_power"]))
         for tool, m, t, v in rows:
             print(f"{name:30s} {tool + ' ' + m:18s} {t:8.3f} {v:12.8f} {abs(v - ref):9.1e}",
                   flush=True)
