@@ -731,7 +731,7 @@ def solve_hermite(excitation, damping: float, intervals: int, start, *, torque_l
             if x is None:
                 break
             xa = ph1.x
-        sol = interior_point(pr, x, mu0=1e-5 * abs(pr.objective(x)) / pr.barrier_count())
+        sol = interior_point(pr, x, mu0=1e-4 * abs(pr.objective(x)) / pr.barrier_count())
         iters += sol.iterations
         stages.append(("tighten", float(np.min(lim)), sol.status))
         motion = pr.motion(sol.x)
