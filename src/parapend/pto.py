@@ -160,8 +160,11 @@ def optimize_pto(*, torque_limit=None, efficiency=None, efficiency_generating=No
            "unresolved": "converged, but the power still moved by more than 1e-6 "
                          f"at the last doubling of the intervals (cap "
                          f"{limits.MAX_PTO_INTERVALS})",
-           "stalled": "stalled: the augmented Lagrangian did not settle its multipliers; "
-                      "the motion is feasible but may not be optimal",
+           "stalled": ("stalled: the interior point could not meet the limit between its "
+                       "points, or its last steps made no progress; the motion is reported as "
+                       "it is (see max_violation)" if eff is None else
+                       "stalled: the augmented Lagrangian did not settle its multipliers; "
+                       "the motion is feasible but may not be optimal"),
            "max_iterations": "maximum number of Newton iterations reached",
            "nonfinite": "non-finite power encountered"}.get(status, status)
     res = dataclasses.replace(
