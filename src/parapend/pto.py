@@ -226,7 +226,7 @@ def _time_domain(exc, gamma, ideal, tmax, copper_loss, warm, rtol: float = 1e-6)
     prev = None
     iters = 0
     change = float("nan")
-    anchor = None
+    anchor = last = None
     while True:
         sol = solve_hermite(exc, gamma, k, start, torque_limit=tmax, copper_loss=copper_loss,
                             anchor=anchor)
@@ -237,7 +237,10 @@ def _time_domain(exc, gamma, ideal, tmax, copper_loss, warm, rtol: float = 1e-6)
             k *= 2
             continue
         if sol.status != "converged":
+            if last is not None:  # keep the converged coarser optimum, as unresolved
+                sol, k = last
             break
+        last = sol, k
         anchor = sol.anchor  # strictly inside the limit: the finer solve starts towards it
         motion = sol.motion
         if prev is not None:
