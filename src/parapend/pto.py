@@ -237,8 +237,8 @@ def _time_domain(exc, gamma, ideal, tmax, copper_loss, warm, rtol: float = 1e-6)
             k *= 2
             continue
         if sol.status != "converged":
-            if last is not None:  # keep the converged coarser optimum, as unresolved
-                sol, k = last
+            if last is not None and not sol.power > last[0].power:
+                sol, k = last  # the converged coarser optimum is better: keep it, unresolved
             break
         last = sol, k
         anchor = sol.anchor  # strictly inside the limit: the finer solve starts towards it
