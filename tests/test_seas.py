@@ -336,11 +336,101 @@ def test_undamped_winding_optimum_rises_towards_the_limit_from_below():
     assert lim - prev < 0.003 * lim
 
 
-def test_optimize_refuses_winding_with_bvp_or_too_few_harmonics():
-    with pytest.raises(ParameterError, match="method: winding 3 needs method 'fourier'"):
-        parapend.optimize(winding=3, method="bvp", gamma=0.1)
+def test_optimize_refuses_winding_bvp_without_damping_or_too_few_harmonics():
+    with pytest.raises(ParameterError, match="gamma: expected a number >= 1e-18 with method "
+                                             "'bvp'"):
+        parapend.optimize(winding=3, method="bvp", gamma=0.0)
+    with pytest.raises(ParameterError, match="method: expected one of fourier, bvp"):
+        parapend.optimize(winding=3, method="shooting", gamma=0.1)
     with pytest.raises(ParameterError, match="harmonics: expected at least 2 K = 20"):
         parapend.optimize(winding=10, harmonics=12)
+
+
+@pytest.mark.parametrize("winding, gamma", [(9, 0.01), (10, 0.05)])
+def test_winding_bvp_agrees_with_the_fourier_optimum_converged_in_n(winding, gamma):
+    """The Euler-Lagrange BVP with theta(t + Tp) = theta(t) + 2 pi K (spectral elements,
+    docs/bvp.md) against the Fourier optimum of the same winding, converged in N (N = 160
+    and 200 agree to 1e-12): measured 5e-13 (K = 9) and 2e-12 (K = 10) relative."""
+    from parapend.optimal.bvp import solve_bvp_optimum
+
+    exc = fourier([(8, 0.1, 0.0), (9, 0.12, 1.0), (10, 0.08, 2.0), (11, 0.1, 3.0),
+                   (12, 0.06, 4.0)], omega=0.2)
+    f = [search_fourier(exc, n, gamma, winding=winding).best.power for n in (160, 200)]
+    assert abs(f[1] - f[0]) < 1e-11 * abs(f[0])
+    sol = solve_bvp_optimum(exc, gamma, winding=winding)
+    assert sol.success and sol.strict_maximum and sol.winding == winding
+    assert abs(sol.power - f[1]) < 1e-9 * abs(f[1])
+    assert sol.power_by_parts == pytest.approx(sol.power, rel=1e-10, abs=1e-12)
+    # the boundary condition: K turns per period, at the nodes and for the motion anywhere
+    tp = exc.period
+    assert sol.theta[-1] - sol.theta[0] == pytest.approx(2 * math.pi * winding, abs=1e-12)
+    m = sol.motion()
+    t = np.linspace(-tp, 2 * tp, 61)
+    assert np.allclose(m.theta(t + tp) - m.theta(t), 2 * math.pi * winding, atol=1e-9)
+    assert np.allclose(m.theta_dot(t + tp), m.theta_dot(t), atol=1e-6)
+    assert m.mean_square_speed() == pytest.approx(sol.mean_square_speed, rel=1e-14)
+    # the state form of Eq. 15, -<T theta'> with T from Eq. 14, by Gauss-Legendre on the
+    # motion's own elements
+    xg, wg = np.polynomial.legendre.leggauss(24)
+    h = np.diff(m.edges)[:, None]
+    ts = (m.edges[:-1, None] + 0.5 * h * (xg + 1)).ravel()
+    w = (0.5 * h * wg).ravel()
+    tq = parapend.model.torque(m, exc, gamma, ts)
+    assert -np.sum(w * tq * m.theta_dot(ts)) / tp == pytest.approx(sol.power, abs=1e-9)
+    # through the API: the same optimum, the K-turn bound and uniform rotation, and the
+    # N-harmonic projection of theta - K omega t close to the Fourier coefficients
+    r = parapend.optimize(fourier=exc.terms, omega=0.2, gamma=gamma, harmonics=160,
+                          winding=winding, method="bvp")
+    assert r.method == "bvp" and r.winding == winding and r.power == sol.power
+    assert r.upper_bound == pytest.approx(limit(exc).power - gamma * (winding * 0.2) ** 2)
+    assert r.uniform_power == uniform_power(exc, gamma, winding)[0]
+    rf = parapend.optimize(fourier=exc.terms, omega=0.2, gamma=gamma, harmonics=160,
+                           winding=winding)
+    assert rf.power == pytest.approx(f[0], rel=1e-12)
+    # (measured: coefficients within 4e-7, motions within 2e-6 rad; the powers agree to
+    # the square of that)
+    assert np.allclose(r.coefficients["a"], rf.coefficients["a"], atol=1e-5)
+    assert np.allclose(r.coefficients["b"], rf.coefficients["b"], atol=1e-5)
+    assert np.max(np.abs(rf.motion.theta(t) - r.motion.theta(t))) < 1e-4
+    x = r.motion.theta(t)
+    proj = parapend.trajectory.FourierMotion(0.2, r.coefficients["a0"],
+                                             np.array(r.coefficients["a"]),
+                                             np.array(r.coefficients["b"]), winding)
+    assert np.max(np.abs(proj.theta(t) - x)) < 1e-5
+
+
+# solve_bvp_optimum on the main branch before the BVP took a winding (float.hex): winding 1
+# (the default) must give them bit for bit
+_BVP_MAIN = [("harmonic", 5e-4, "0x1.55d009c76c7eep-2", "uniform", 380),
+             ("three", 1e-3, "0x1.a28f66e411ab4p-2", "limit", 1240)]
+
+
+@pytest.mark.parametrize("case", _BVP_MAIN)
+def test_bvp_winding_one_reproduces_main_bit_for_bit(case):
+    from parapend.optimal.bvp import solve_bvp_optimum
+
+    name, gamma, power, found_by, nodes = case
+    exc = parapend.harmonic() if name == "harmonic" else fourier(
+        [(1, 0.3, 0.0), (2, 0.2, 1.0), (3, 0.1, 2.0)], omega=1.5)
+    for sol in (solve_bvp_optimum(exc, gamma), solve_bvp_optimum(exc, gamma, winding=1)):
+        assert sol.power.hex() == power and sol.found_by == found_by
+        assert sol.mesh_nodes == nodes and sol.winding == 1
+
+
+def test_winding_bvp_cli(capsys):
+    args = ["optimize", "--fourier", "8:0.1:0,9:0.12:1,10:0.08:2,11:0.1:3,12:0.06:4",
+            "--omega", "0.2", "--gamma", "0.01", "--winding", "9", "--method", "bvp"]
+    assert main([*args, "--json"]) == 0
+    d = json.loads(capsys.readouterr().out)
+    assert d["winding"] == 9 and d["method"] == "bvp" and d["success"]
+    assert main(args) == 0
+    out = capsys.readouterr().out
+    assert "BVP optimum, epsilon = 0.02 (Eq. 22), winding K = 9" in out
+    assert f"{d['power']:.6f}" in out and "gamma K^2 omega^2" in out
+    assert main([*args[:-1], "all"]) == 2
+    err = capsys.readouterr().err
+    assert "winding: K > 1 works with method fourier or bvp" in err
+    assert len(err.strip().splitlines()) == 1
 
 
 # --- sea ----------------------------------------------------------------------------------

@@ -169,19 +169,21 @@ def optimize(*, omega: float = 1.8, delta=None, gamma: float = 0.0, harmonics: i
     docs/limits-of-input.md; ``harmonics <= 1024``.
 
     ``winding`` K >= 1: ``theta(t + 2 pi/omega) = theta(t) + 2 pi K`` (docs/seas.md); K = 1
-    is the paper's period-1 rotation and computes exactly as without it. K > 1 needs method
-    "fourier" and ``harmonics >= 2 K``.
+    is the paper's period-1 rotation and computes exactly as without it. K > 1 with method
+    "fourier" needs ``harmonics >= 2 K``; with method "bvp" the Euler-Lagrange BVP is solved
+    with ``theta(t + Tp) = theta(t) + 2 pi K`` (docs/bvp.md) and ``coefficients`` are the
+    N-harmonic projection of ``theta - K omega t``.
     """
     exc = build_excitation(excitation, omega=omega, delta=delta, square_alpha=square_alpha,
                            fourier=fourier, file=file)
     gamma = _check_gamma(gamma)
     n = check_int("harmonics", harmonics, 1, MAX_HARMONICS)
     winding = check_int("winding", winding, 1, MAX_HARMONICS // 2)
-    if winding != 1:
-        return _optimize_winding(exc, gamma, n, method, warm, winding, throw)
     if not isinstance(method, str) or method not in METHODS:
         raise ParameterError(f"method: expected one of {', '.join(METHODS)}, "
                              f"got {method!r:.60}")
+    if winding != 1:
+        return _optimize_winding(exc, gamma, n, method, warm, winding, throw)
     if warm is not None:
         try:
             warm = np.asarray(warm, dtype=float)
@@ -240,17 +242,22 @@ def optimize(*, omega: float = 1.8, delta=None, gamma: float = 0.0, harmonics: i
 
 def _optimize_winding(exc, gamma: float, n: int, method: str, warm, winding: int,
                       throw: bool) -> OptimizeResult:
-    """``optimize`` with K turns per period (Fourier method only)."""
-    if method != "fourier":
-        raise ParameterError(f"method: winding {winding} needs method 'fourier' (the BVP "
-                             "solves period-1 rotations only)")
-    if n < 2 * winding:
+    """``optimize`` with K turns per period (Fourier method, or the BVP)."""
+    if method == "fourier" and n < 2 * winding:
         raise ParameterError(f"harmonics: expected at least 2 K = {2 * winding} harmonics "
                              f"for winding {winding}, got {n}")
     lim = limit(exc, winding)
     pu, _ = uniform_power(exc, gamma, winding)
     if lim.power <= 0:
         raise ParameterError("winding: the excitation is constant; nothing to extract")
+    if method == "bvp":
+        common = {"uniform_power": pu, "limit_power": lim.power, "harmonics": n,
+                  "gamma": gamma, "omega": exc.omega, "excitation": exc.describe(),
+                  "winding": winding, "_excitation": exc}
+        res = _optimize_bvp(exc, gamma, n, common, winding)
+        if throw and not res.success:
+            raise SolverError(f"optimize: {res.message}")
+        return res
     found = search_fourier(exc, n, gamma, warm=warm, winding=winding,
                            hessian="dense" if n <= 256 else "operator")
     best, runs, ev = found.best, found.runs, found.evidence
@@ -323,7 +330,7 @@ def _coefficients(motion: FourierMotion) -> dict:
     return {"a0": motion.a0, "a": motion.a.tolist(), "b": motion.b.tolist()}
 
 
-def _optimize_bvp(exc, gamma: float, n: int, common: dict) -> OptimizeResult:
+def _optimize_bvp(exc, gamma: float, n: int, common: dict, winding: int = 1) -> OptimizeResult:
     from .optimal.bvp import solve_bvp_optimum
     from .trajectory import SampledMotion
 
@@ -342,12 +349,18 @@ def _optimize_bvp(exc, gamma: float, n: int, common: dict) -> OptimizeResult:
     # node cap the solver returns status "max_nodes" instead of refining further
     k = 1 if isinstance(exc, exc_mod.SquareExcitation) else exc.spectrum.size
     max_nodes = int(min(200_000, max(2_000, limits.MAX_BVP_WORK // k)))
-    sol = solve_bvp_optimum(exc, gamma, max_nodes=max_nodes)
+    if winding == 1:
+        sol = solve_bvp_optimum(exc, gamma, max_nodes=max_nodes)
+    else:
+        sol = solve_bvp_optimum(exc, gamma, max_nodes=max_nodes, winding=winding)
     motion = sol.motion()
     m = max(4096, 8 * n)
     t = exc.period * np.arange(m) / m
-    proj = SampledMotion(exc.omega, motion.theta(t)).to_fourier()
-    proj = FourierMotion(exc.omega, proj.a0, proj.a[:n], proj.b[:n])
+    theta = motion.theta(t)
+    if winding != 1:  # SampledMotion removes one turn; K - 1 more leave theta - K omega t
+        theta = theta - (winding - 1) * 2 * np.pi * np.arange(m) / m
+    proj = SampledMotion(exc.omega, theta).to_fourier()
+    proj = FourierMotion(exc.omega, proj.a0, proj.a[:n], proj.b[:n], winding)
     pu = common["uniform_power"]
     return OptimizeResult(
         power=sol.power,
@@ -370,8 +383,8 @@ def _optimize_bvp(exc, gamma: float, n: int, common: dict) -> OptimizeResult:
         patterns_tried=len(sol.candidates),
         polished=sum(v is not None and math.isfinite(v) for v in sol.candidates.values()),
         second_power=_second(sol.power, sol.candidates.values()),
-        upper_bound=common["limit_power"] - gamma * exc.omega**2,
-        bound_gap=common["limit_power"] - gamma * exc.omega**2 - sol.power,
+        upper_bound=common["limit_power"] - gamma * (winding * exc.omega) ** 2,
+        bound_gap=common["limit_power"] - gamma * (winding * exc.omega) ** 2 - sol.power,
         continuation_steps=sol.continuation_steps,
         _motion=motion,
         **common,

@@ -60,7 +60,8 @@ def plot_optimum(result, path=None, points: int = 2000):
     om = exc.omega
     t = exc.period * np.arange(points + 1) / points
     tau = _tau(om, t)
-    lim = limit(exc)
+    k = int(getattr(result, "winding", 1) or 1)
+    lim = limit(exc, k)
     fig, (ax1, ax2) = plt.subplots(2, 1, figsize=(7, 6), sharex=True,
                                    gridspec_kw={"height_ratios": [3, 2]})
     label = f"{result.method}, $N = {result.harmonics}$" if result.method == "fourier" \
@@ -70,15 +71,17 @@ def plot_optimum(result, path=None, points: int = 2000):
              label=f"{LIMIT_LABEL}: $P = {lim.power:.5f}$")
     from .power import uniform_power
 
-    _, phi = uniform_power(exc, result.gamma)
-    ax1.plot(tau, om * t + phi, ":", color="gray", lw=1,
+    _, phi = uniform_power(exc, result.gamma, k)
+    ax1.plot(tau, k * om * t + phi, ":", color="gray", lw=1,
              label=f"best uniform rotation: $P = {result.uniform_power:.5f}$")
     ax1.set_ylabel(r"$\theta$ (rad, from upright)")
-    ax1.set_yticks(np.pi * np.arange(0, 5))
-    ax1.set_yticklabels([_pi_label(np.pi * k) for k in range(5)])
+    if k == 1:
+        ax1.set_yticks(np.pi * np.arange(0, 5))
+        ax1.set_yticklabels([_pi_label(np.pi * j) for j in range(5)])
     ax1.legend(loc="upper left")
     desc = ", ".join(f"{k}={v}" for k, v in result.excitation.items() if k != "terms")
-    ax1.set_title(f"Optimal period-1 rotation ({desc}, $\\gamma = {result.gamma:g}$)")
+    what = "period-1 rotation" if k == 1 else f"rotation, winding K = {k}"
+    ax1.set_title(f"Optimal {what} ({desc}, $\\gamma = {result.gamma:g}$)")
     tq = torque(motion, exc, result.gamma, t)
     ax2.plot(tau, tq, color="C3", lw=1.2)
     ax2.set_ylabel("torque $T$ (non-dim.)")

@@ -50,8 +50,8 @@ def add_parsers(sub) -> None:
                         "(p = -T theta'; and electrical_power with an efficiency)")
     p.add_argument("--winding", type=_int, default=1,
                    help="K turns per forcing period, theta(t + 2 pi/omega) = theta(t) + 2 pi "
-                        "K (default 1, the paper's period-1 rotation; K > 1: method fourier, "
-                        "N >= 2K; docs/seas.md)")
+                        "K (default 1, the paper's period-1 rotation; K > 1: method fourier "
+                        "with N >= 2K, or bvp; docs/seas.md)")
     p.add_argument("--json", action="store_true", help="print one JSON object")
     _pto.add_pto_options(p)
     _pto.add_unit_options(p)
@@ -106,8 +106,8 @@ def _cmd_optimize(a) -> dict | str:
     pto = _pto.wants_pto(a)
     if a.winding != 1:
         if pto or a.method == "all":
-            raise ParameterError("winding: K > 1 works with method fourier and no power "
-                                 "take-off options; drop --winding or those options")
+            raise ParameterError("winding: K > 1 works with method fourier or bvp and no "
+                                 "power take-off options; drop --winding or those options")
         kw["winding"] = a.winding
     if a.method == "all":
         if pto or units is not None:

@@ -87,6 +87,7 @@ from numpy.polynomial import legendre as npleg
 from scipy.linalg import LinAlgError, cho_solve_banded, cholesky_banded
 
 from ..errors import ParameterError, SolverError, check_finite, check_int
+from ..limits import MAX_HARMONICS
 from ..power import uniform_power
 from .limit import limit
 
@@ -153,12 +154,14 @@ class _Mesh:
     The unknowns are the angles at the ``n = E p`` distinct GLL nodes
     ``t[0] = 0 < t[1] < ... < t[n-1] < Tp``; element ``e`` uses nodes ``e p .. e p + p``
     (modulo ``n``), and its last node in the last element is the first node plus one turn
-    (Eq. 3), recorded in ``wrap`` (in units of pi).
+    (Eq. 3), or ``winding`` turns (``theta(t + Tp) = theta(t) + 2 pi K``), recorded in
+    ``wrap`` (in units of pi).
     """
 
-    def __init__(self, edges: np.ndarray, p: int):
+    def __init__(self, edges: np.ndarray, p: int, winding: int = 1):
         self.edges = np.asarray(edges, dtype=float)
         self.p = p
+        self.winding = winding
         self.E = e = self.edges.size - 1
         self.n = n = e * p
         x, w, dmat, _ = _gll(p)
@@ -167,7 +170,7 @@ class _Mesh:
         self.t = self.t_el[:, :p].ravel()
         self.idx = (np.arange(e)[:, None] * p + np.arange(p + 1)[None, :]) % n
         self.wrap = np.zeros((e, p + 1), dtype=np.int64)
-        self.wrap[-1, -1] = 2
+        self.wrap[-1, -1] = 2 * winding
         self.W = np.bincount(self.idx.ravel(), weights=(0.5 * h[:, None] * w).ravel(),
                              minlength=n)
         self.kref = dmat.T @ (w[:, None] * dmat)
@@ -533,7 +536,8 @@ class SpectralElementMotion:
     ``theta`` is continuous; ``theta'`` and ``theta''`` are the exact derivatives of the
     element polynomials (at an element end the element to the right is used; ``theta'``
     jumps there by at most :attr:`BVPSolution.slope_jump` relative to ``max|theta'|``).
-    The period-1 extension ``theta(t + Tp) = theta(t) + 2 pi`` (Eq. 3) holds for any ``t``.
+    The period-1 extension ``theta(t + Tp) = theta(t) + 2 pi`` (Eq. 3) holds for any ``t``
+    (``+ 2 pi K`` with ``winding`` K).
     Inside the period the interpolation error is that of the solution itself: the ODE
     residual is at most ``max_residual`` relative to ``1 + |theta''|``.
 
@@ -547,6 +551,8 @@ class SpectralElementMotion:
         Polynomial degree ``p``.
     values : ndarray, shape (E, p+1)
         ``theta`` at the GLL points of each element (radians).
+    winding : int
+        Turns K per period: ``theta(t + Tp) = theta(t) + 2 pi K``.
     """
 
     omega: float
@@ -556,13 +562,15 @@ class SpectralElementMotion:
     _mesh: _Mesh = field(repr=False, compare=False, default=None)
     _n: np.ndarray = field(repr=False, compare=False, default=None)
     _z: np.ndarray = field(repr=False, compare=False, default=None)
+    winding: int = 1
 
     @classmethod
     def _from_state(cls, omega: float, mesh: _Mesh, n: np.ndarray,
-                    z: np.ndarray) -> SpectralElementMotion:
+                    z: np.ndarray, winding: int = 1) -> SpectralElementMotion:
         base, loc = mesh.local(n, z)
         values = math.pi * base[:, None] + loc
-        return cls(omega, mesh.edges.copy(), mesh.p, values, mesh, n.copy(), z.copy())
+        return cls(omega, mesh.edges.copy(), mesh.p, values, mesh, n.copy(), z.copy(),
+                   winding)
 
     @property
     def period(self) -> float:
@@ -578,7 +586,7 @@ class SpectralElementMotion:
     def theta(self, t):
         """``theta(t)`` (radians), any ``t`` (array_like)."""
         (base, loc), turns, shape = self._eval(t, 0)
-        val = (math.pi * base + loc).reshape(shape) + 2 * math.pi * turns
+        val = (math.pi * base + loc).reshape(shape) + 2 * math.pi * self.winding * turns
         return val if val.ndim else float(val)
 
     def theta_dot(self, t):
@@ -629,7 +637,7 @@ class BVPSolution:
         Mesh nodes over one period, ``t[0] = 0``, ``t[-1] = Tp`` (the GLL points of all
         elements, shared element ends once).
     theta, theta_dot : ndarray, shape (mesh_nodes + 1,)
-        ``theta`` and ``theta'`` at ``t`` (``theta[-1] = theta[0] + 2 pi``; ``theta'`` from
+        ``theta`` and ``theta'`` at ``t`` (``theta[-1] = theta[0] + 2 pi K``; ``theta'`` from
         the element to the right of a node).
     mesh_nodes : int
         Distinct nodes (unknowns) per period, ``elements * degree``.
@@ -661,6 +669,8 @@ class BVPSolution:
         Best uniform rotation (Eq. 17) at this damping and the gamma -> 0 supremum.
     mean_square_speed : float
         ``<theta'^2>``.
+    winding : int
+        Turns K per period, ``theta(t + Tp) = theta(t) + 2 pi K`` (1: Eq. 3).
     """
 
     power: float
@@ -687,6 +697,7 @@ class BVPSolution:
     uniform_power: float
     limit_power: float
     mean_square_speed: float
+    winding: int = 1
     _motion: SpectralElementMotion = field(repr=False, default=None)
 
     def motion(self) -> SpectralElementMotion:
@@ -751,22 +762,28 @@ def _adapt_solve(exc, damping: float, mesh: _Mesh, n: np.ndarray, z: np.ndarray,
         if (edges.size - 1) * p > max_nodes:
             status = "max_nodes"
             break
-        new = _Mesh(edges, p)
+        new = _Mesh(edges, p, mesh.winding)
         n, z = _interpolate(mesh, n, z, new)
         mesh = new
     return mesh, n, z, p_h, emax, status, info.maximum, its
 
 
-def _uniform_branch(exc, damping: float, tol: float, max_nodes: int, p: int) -> _Candidate:
-    """Continuation in epsilon from the best uniform rotation (large epsilon) down."""
+def _uniform_branch(exc, damping: float, tol: float, max_nodes: int, p: int,
+                    winding: int = 1) -> _Candidate:
+    """Continuation in epsilon from the best uniform rotation (large epsilon) down.
+
+    With winding K the start is ``theta = K omega t + phi`` (the best uniform rotation of
+    winding K, :func:`parapend.power.uniform_power`), from ``epsilon_0 = 2 max|q'| /
+    (K omega)^2``, on ``16 K`` elements (16 per turn).
+    """
     eps_target = 2.0 * damping
-    _, phi = uniform_power(exc, damping)
+    _, phi = uniform_power(exc, damping, winding)
     tp = exc.period
     tgrid = tp * np.arange(1024) / 1024
     dqmax = float(np.max(np.abs(exc.dq(tgrid))))
-    eps = max(eps_target, 2.0 * dqmax / exc.omega**2)
-    mesh = _Mesh(np.linspace(0.0, tp, 17), p)
-    n, z = _split_angle(exc.omega * mesh.t + phi)
+    eps = max(eps_target, 2.0 * dqmax / (winding * exc.omega) ** 2)
+    mesh = _Mesh(np.linspace(0.0, tp, 16 * winding + 1), p, winding)
+    n, z = _split_angle(winding * exc.omega * mesh.t + phi)
     factor = 0.1
     its = steps = 0
     tol_mid = max(tol, 1e-5)
@@ -802,7 +819,7 @@ def _pattern_of(exc, motion):
 
     The level (a multiple of pi, rounded) in the middle of each dwell between extrema,
     differenced: ``d_k`` is +-1 for a half-turn, 0 where the motion does not turn, +-2 for a
-    full turn between two dwells. The ``d_k`` sum to 2 (one turn per period).
+    full turn between two dwells. The ``d_k`` sum to ``2 K`` (K turns per period).
     """
     tk = np.asarray(exc.extrema.t, dtype=float)
     tp = exc.period
@@ -811,13 +828,14 @@ def _pattern_of(exc, motion):
     return math.pi * levels[0], np.diff(levels)
 
 
-def _limit_seed(exc, epsilon: float, p: int, pattern=None):
+def _limit_seed(exc, epsilon: float, p: int, pattern=None, winding: int = 1):
     """Mesh and start from the gamma -> 0 motion, half-turns smoothed to the layer widths.
 
     ``pattern = (theta_start, d_k)`` replaces the limit motion's canonical turns (see
-    :func:`_pattern_of`).
+    :func:`_pattern_of`). Winding K: the limit motion of ``limit(exc, K)``, whose turns sum
+    to K per period (a ``d_k`` of 3 or more where q has fewer than 2 K extrema).
     """
-    lim = limit(exc)
+    lim = limit(exc, winding)
     mot = lim.motion
     tp = exc.period
     tk = np.asarray(mot.switch_times, dtype=float)
@@ -847,7 +865,7 @@ def _limit_seed(exc, epsilon: float, p: int, pattern=None):
     m = max(_MIN_ELEMENTS, int(math.ceil(cum[-1])))
     edges = np.interp(cum[-1] * np.arange(m + 1) / m, cum, grid)
     edges[0], edges[-1] = 0.0, tp
-    mesh = _Mesh(edges, p)
+    mesh = _Mesh(edges, p, winding)
     t = mesh.t
     theta = np.full(t.size, theta_start)
     for t0, w, d in zip(tk, wk, dk, strict=True):
@@ -861,8 +879,8 @@ def _limit_seed(exc, epsilon: float, p: int, pattern=None):
 
 
 def _limit_branch(exc, damping: float, tol: float, max_nodes: int, p: int,
-                  pattern=None, name: str = "limit") -> _Candidate:
-    mesh, n, z = _limit_seed(exc, 2.0 * damping, p, pattern)
+                  pattern=None, name: str = "limit", winding: int = 1) -> _Candidate:
+    mesh, n, z = _limit_seed(exc, 2.0 * damping, p, pattern, winding)
     mesh, n, z, p_h, eta, status, maximum, its = _adapt_solve(exc, damping, mesh, n, z, tol,
                                                              max_nodes)
     return _Candidate(mesh, n, z, p_h, eta, status, maximum, 1, its, name)
@@ -872,15 +890,23 @@ def _limit_branch(exc, damping: float, tol: float, max_nodes: int, p: int,
 _FOURIER_SEED_HARMONICS = 24
 
 
-def _fourier_branch(exc, damping: float, tol: float, max_nodes: int, p: int) -> _Candidate:
+def _fourier_branch(exc, damping: float, tol: float, max_nodes: int, p: int,
+                    winding: int = 1) -> _Candidate:
     """Start from the turn pattern of the global Fourier optimum (docs/global.md): with
-    several extrema per period the canonical limit pattern is often not the best one."""
+    several extrema per period the canonical limit pattern is often not the best one.
+    Winding K: the Fourier optimum of winding K with ``max(24, 4 K)`` harmonics."""
     from ..trajectory import FourierMotion
     from .fourier import search_fourier
 
-    found = search_fourier(exc, _FOURIER_SEED_HARMONICS, damping)
-    motion = FourierMotion.from_vector(exc.omega, found.best.x)
-    return _limit_branch(exc, damping, tol, max_nodes, p, _pattern_of(exc, motion), "fourier")
+    if winding == 1:
+        found = search_fourier(exc, _FOURIER_SEED_HARMONICS, damping)
+    else:
+        nh = max(_FOURIER_SEED_HARMONICS, 4 * winding)
+        found = search_fourier(exc, nh, damping, winding=winding,
+                               hessian="dense" if nh <= 256 else "operator")
+    motion = FourierMotion.from_vector(exc.omega, found.best.x, winding)
+    return _limit_branch(exc, damping, tol, max_nodes, p, _pattern_of(exc, motion), "fourier",
+                         winding)
 
 
 _MESSAGES = {
@@ -895,7 +921,7 @@ _MESSAGES = {
 def solve_bvp_optimum(excitation, damping: float, *, tol: float = 1e-8,
                       max_nodes: int = 200_000, degree: int = 10,
                       seeds: tuple[str, ...] = ("uniform", "limit", "fourier"),
-                      throw: bool = False) -> BVPSolution:
+                      winding: int = 1, throw: bool = False) -> BVPSolution:
     """Optimal period-1 rotation from the penalized Euler-Lagrange BVP (Eqs. 13, 22, 27).
 
     Parameters
@@ -915,7 +941,11 @@ def solve_bvp_optimum(excitation, damping: float, *, tol: float = 1e-8,
     seeds : tuple of {"uniform", "limit", "fourier"}
         Starting points tried; the best converged local maximum wins. ``"fourier"`` (used
         only when q has several maxima per period) starts from the turn pattern of the
-        global N = 24 Fourier optimum.
+        global N = 24 Fourier optimum (``max(24, 4 K)`` for winding K).
+    winding : int
+        K >= 1 turns per period of q: ``theta(t + Tp) = theta(t) + 2 pi K`` replaces Eq. 3
+        (docs/seas.md, docs/bvp.md); the Euler-Lagrange equation is the same, only the
+        boundary condition and the starts change. K = 1 is the paper's period-1 rotation.
     throw : bool
         Raise :class:`~parapend.errors.SolverError` instead of returning an unsuccessful
         result.
@@ -937,24 +967,27 @@ def solve_bvp_optimum(excitation, damping: float, *, tol: float = 1e-8,
                                                    for s in seeds):
         raise ParameterError(f"seeds: expected a non-empty tuple of 'uniform', 'limit', "
                              f"'fourier', got {seeds!r}")
+    winding = check_int("winding", winding, 1, MAX_HARMONICS // 2)
     p = int(degree)
-    lim = limit(excitation)
+    k = int(winding)
+    lim = limit(excitation, k)
     cands = []
     tgrid = excitation.period * np.arange(1024) / 1024
     if not np.any(np.asarray(excitation.dq(tgrid), dtype=float)):
         # constant q: every uniform rotation is optimal (P = -gamma omega^2), none strictly
-        mesh = _Mesh(np.linspace(0.0, excitation.period, _MIN_ELEMENTS + 1), p)
-        n, z = _split_angle(excitation.omega * mesh.t)
-        cands.append(_Candidate(mesh, n, z, -gamma * excitation.omega**2, 0.0, "converged",
-                                True, 0, 0, "uniform"))
+        mesh = _Mesh(np.linspace(0.0, excitation.period, _MIN_ELEMENTS * k + 1), p, k)
+        n, z = _split_angle(k * excitation.omega * mesh.t)
+        cands.append(_Candidate(mesh, n, z, -gamma * (k * excitation.omega) ** 2, 0.0,
+                                "converged", True, 0, 0, "uniform"))
         seeds = ()
     for name in seeds:
         if name == "uniform":
-            cands.append(_uniform_branch(excitation, gamma, tol, int(max_nodes), p))
+            cands.append(_uniform_branch(excitation, gamma, tol, int(max_nodes), p, k))
         elif name == "limit" and lim.power > 0:
-            cands.append(_limit_branch(excitation, gamma, tol, int(max_nodes), p))
+            cands.append(_limit_branch(excitation, gamma, tol, int(max_nodes), p,
+                                       winding=k))
         elif name == "fourier" and np.size(lim.directions) > 2:
-            cands.append(_fourier_branch(excitation, gamma, tol, int(max_nodes), p))
+            cands.append(_fourier_branch(excitation, gamma, tol, int(max_nodes), p, k))
     iterations = sum(c.iterations for c in cands)
     good = [c for c in cands if c.status == "converged" and c.maximum]
     pool = good or [c for c in cands if math.isfinite(c.power)] or cands
@@ -968,7 +1001,7 @@ def solve_bvp_optimum(excitation, damping: float, *, tol: float = 1e-8,
     t = np.append(mesh.t, excitation.period)
     th_nodes = math.pi * n + z
     _, _, dth = _eval_elements(mesh, n, z, mesh.t, derivs=1)
-    motion = SpectralElementMotion._from_state(om, mesh, n, z)
+    motion = SpectralElementMotion._from_state(om, mesh, n, z, k)
     sol = BVPSolution(
         power=p15,
         power_by_parts=pbp,
@@ -976,7 +1009,7 @@ def solve_bvp_optimum(excitation, damping: float, *, tol: float = 1e-8,
         gamma=gamma,
         omega=om,
         t=t,
-        theta=np.append(th_nodes, th_nodes[0] + 2 * math.pi),
+        theta=np.append(th_nodes, th_nodes[0] + 2 * math.pi * k),
         theta_dot=np.append(dth, dth[0]),
         mesh_nodes=mesh.n,
         elements=mesh.E,
@@ -991,9 +1024,10 @@ def solve_bvp_optimum(excitation, damping: float, *, tol: float = 1e-8,
         strict_maximum=best.maximum,
         found_by=best.seed,
         candidates={c.seed: c.power for c in cands},
-        uniform_power=uniform_power(excitation, gamma)[0],
+        uniform_power=uniform_power(excitation, gamma, k)[0],
         limit_power=lim.power,
         mean_square_speed=kin,
+        winding=k,
         _motion=motion,
     )
     if throw and not sol.success:
