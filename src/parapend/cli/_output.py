@@ -41,6 +41,20 @@ def write_text(path, text: str) -> None:
     fileio.write_text(path, text)
 
 
+def write_columns(path, columns: dict) -> None:
+    """Write equal-length columns as CSV (header = the keys, values as ``repr(float)``: they
+    read back exactly) atomically."""
+    import csv
+    import io
+
+    buf = io.StringIO()
+    w = csv.writer(buf, lineterminator="\n")
+    w.writerow(list(columns))
+    for row in zip(*columns.values()):
+        w.writerow([repr(float(v)) for v in row])
+    write_text(path, buf.getvalue())
+
+
 def write_dataset(ds, path) -> None:
     """Write a Dataset to NetCDF atomically (:func:`parapend.fileio.write_dataset`)."""
     fileio.write_dataset(ds, path)

@@ -2,8 +2,6 @@
 
 from __future__ import annotations
 
-import csv
-import io
 import math
 
 from .. import limits
@@ -121,12 +119,9 @@ def _cmd_track(a) -> dict | str:
     r = track(theta0=a.theta0, theta_dot0=a.theta_dot0, **common)
     if r._run is not None and a.save:
         run = r._run
-        buf = io.StringIO()
-        w = csv.writer(buf, lineterminator="\n")
-        w.writerow(["t", "theta", "theta_dot", "torque", "q"])
-        for row in zip(run.t, run.theta, run.theta_dot, run.torque, run.q):
-            w.writerow([repr(float(v)) for v in row])
-        _output.write_text(a.save, buf.getvalue())
+        _output.write_columns(a.save, {"t": run.t, "theta": run.theta,
+                                       "theta_dot": run.theta_dot, "torque": run.torque,
+                                       "q": run.q})
     if r._run is not None and a.plot:
         from ..control.figures import plot_track
 

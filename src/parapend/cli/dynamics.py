@@ -7,8 +7,6 @@ defaults are the paper's coexistence case gamma = 0.1, p = 0.8, omega = 2.1 (Sec
 
 from __future__ import annotations
 
-import csv
-import io
 import math
 import re
 
@@ -182,12 +180,8 @@ def _cmd_simulate(a) -> dict | str:
         m = simulate(a.gamma, a.p, a.omega, a.phi0, a.dphi0, periods,
                      points_per_period=a.points_per_period)
     if a.save:
-        buf = io.StringIO()
-        w = csv.writer(buf, lineterminator="\n")
-        w.writerow(["t", "phi", "dphi", "energy"])
-        for row in zip(m.t, m.phi, m.dphi, m.energy):
-            w.writerow([repr(float(v)) for v in row])
-        _output.write_text(a.save, buf.getvalue())
+        _output.write_columns(a.save, {"t": m.t, "phi": m.phi, "dphi": m.dphi,
+                                       "energy": m.energy})
     if a.plot:
         from ..dynamics.figures import plot_motion
 

@@ -2,8 +2,6 @@
 
 from __future__ import annotations
 
-import csv
-import io
 import math
 
 from .. import limits
@@ -136,12 +134,7 @@ def _cmd_optimize(a) -> dict | str:
             s["electrical_power"] = [x * r.efficiency_generating if x > 0
                                      else x / r.efficiency_motoring for x in p]
             cols.append("electrical_power")
-        buf = io.StringIO()
-        w = csv.writer(buf, lineterminator="\n")
-        w.writerow(cols)
-        for row in zip(*(s[c] for c in cols)):
-            w.writerow([repr(float(v)) for v in row])
-        _output.write_text(a.save, buf.getvalue())
+        _output.write_columns(a.save, {c: s[c] for c in cols})
     if a.plot:
         if pto:
             from ..pto import plot_pto_profile as plot_fn

@@ -2,9 +2,6 @@
 
 from __future__ import annotations
 
-import csv
-import io
-
 from .. import limits
 from ..errors import ParameterError
 from . import _output
@@ -95,12 +92,7 @@ def _cmd_sea(a) -> dict | str:
     if a.save:
         s = sea_samples(r)
         cols = ["t", "z", "q", "theta", "theta_dot", "power", "energy"]
-        buf = io.StringIO()
-        w = csv.writer(buf, lineterminator="\n")
-        w.writerow(cols)
-        for row in zip(*(s[c] for c in cols)):
-            w.writerow([repr(float(v)) for v in row])
-        _output.write_text(a.save, buf.getvalue())
+        _output.write_columns(a.save, {c: s[c] for c in cols})
     if a.plot:
         _output.plot(plot_sea, r, a.plot)
     if a.json:
