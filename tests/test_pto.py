@@ -247,3 +247,15 @@ def test_cli_explicit_default_beside_physical_option(capsys):
     assert code == 2 and "damping-coefficient: give either" in err
     code, out, _ = _run(capsys, *args, "--damping-coefficient", "1")
     assert code == 0 and "power" in out
+
+
+def test_copper_loss_alone_and_with_a_slack_limit_agree():
+    """A copper loss alone goes to the Fourier method, with a limit above its peak to the
+    time domain: two methods, one optimum (the loss keeps the peak torque below 2)."""
+    r = pto.optimize_pto(gamma=0.03, copper_loss=0.01)
+    h = pto.optimize_pto(gamma=0.03, copper_loss=0.01, torque_limit=2.0)
+    assert (r.method, h.method) == ("fourier", "hermite")
+    assert r.status == h.status == "converged"
+    assert r.peak_torque < 2.0
+    assert h.electrical_power == pytest.approx(r.electrical_power, rel=1e-7)
+    assert h.electrical_power < h.power  # the loss is subtracted

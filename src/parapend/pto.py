@@ -13,9 +13,9 @@ Two methods, both warm-started from the ideal optimum of :func:`parapend.optimiz
   as K cubic Hermite intervals and a primal-dual interior point on the banded Newton
   system (the optimal torque is bang-bang: a local basis resolves its jumps, a Fourier
   series does not); K from the excitation, checked by one doubling;
-- an efficiency (with or without a limit): :mod:`parapend.optimal.constrained`, the
-  smoothed efficiency (and an augmented Lagrangian for the limit) on the exact-Hessian
-  Fourier Newton kernel.
+- an efficiency (with or without a limit), or a copper loss without a limit:
+  :mod:`parapend.optimal.constrained`, the smoothed efficiency (and an augmented Lagrangian
+  for the limit) on the exact-Hessian Fourier Newton kernel.
 """
 
 from __future__ import annotations
@@ -28,7 +28,7 @@ import numpy as np
 from . import limits
 from .api import _coefficients, optimize
 from .errors import ParameterError, SolverError, check_finite, check_int, check_range
-from .optimal.constrained import pto_profile, solve_pto
+from .optimal.constrained import PTOSolution, pto_profile, solve_pto
 from .power import uniform_power
 from .trajectory import FourierMotion
 
@@ -136,7 +136,7 @@ def optimize_pto(*, torque_limit=None, efficiency=None, efficiency_generating=No
                                   harvested_energy=prof["harvested_energy"])
         return dataclasses.replace(res, **physical_fields(res, units))
     extra = {}
-    if eff is None:
+    if eff is None and tmax is not None:
         sol, motion, extra = _time_domain(exc, gamma, ideal, tmax, r_cu, warm)
         coefficients = _coefficients(_projection(motion, exc, n))
     else:
@@ -175,7 +175,7 @@ def optimize_pto(*, torque_limit=None, efficiency=None, efficiency_generating=No
         iterations=sol.iterations, coefficients=coefficients,
         peak_torque=sol.peak_torque, found_by="warm" if warm is not None else "ideal optimum",
         local_maxima=[], gradient_norm=sol.gradient_norm, strict_maximum=False,
-        quadrature_points=getattr(sol, "points", 0),
+        quadrature_points=sol.points,
         mean_square_speed=motion.mean_square_speed(),
         torque_limit=tmax, efficiency_generating=None if eff is None else eff[0],
         efficiency_motoring=None if eff is None else eff[1],
@@ -204,17 +204,6 @@ def intervals_for(exc) -> int:
     two (then doubled until the power moves by less than 1e-6)."""
     k = 8 * max(1, int(np.size(exc.spectrum)) - 1)
     return int(min(limits.MAX_PTO_INTERVALS, max(64, 1 << int(math.ceil(math.log2(k))))))
-
-
-@dataclasses.dataclass
-class _TimeDomain:
-    power: float
-    electrical_power: float
-    peak_torque: float
-    max_violation: float
-    status: str
-    iterations: int
-    gradient_norm: float = float("nan")
 
 
 def _time_domain(exc, gamma, ideal, tmax, copper_loss, warm, rtol: float = 1e-6):
@@ -256,9 +245,10 @@ def _time_domain(exc, gamma, ideal, tmax, copper_loss, warm, rtol: float = 1e-6)
     if status == "converged" and not change <= rtol * max(1.0, abs(sol.electrical_power)):
         status = "unresolved"
     viol = max(sol.peak_torque / tmax - 1.0, 0.0)
-    out = _TimeDomain(power=sol.power, electrical_power=sol.electrical_power,
+    out = PTOSolution(x=sol.x, power=sol.power, electrical_power=sol.electrical_power,
                       peak_torque=sol.peak_torque, max_violation=viol, status=status,
-                      iterations=iters)
+                      iterations=iters, outer_iterations=len(sol.stages),
+                      gradient_norm=float("nan"), stages=sol.stages)
     return out, motion, {"method": "hermite", "intervals": k, "refinement_change": change}
 
 
