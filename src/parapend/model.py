@@ -47,7 +47,9 @@ def _sample_points(motion, excitation) -> int:
 def peak_torque(motion, excitation, damping: float, points: int | None = None) -> float:
     """``max |T(t)|`` over one period, taken from the motion's own resolution.
 
-    The samples come from the motion itself: a motion with ``sample_times()`` (the BVP's
+    The samples come from the motion itself: a motion with its own ``peak_torque`` (the
+    time-domain PTO's Hermite motion, whose torque jumps at the nodes) gives it; a motion
+    with ``sample_times()`` (the BVP's
     spectral elements: points inside every element, so a boundary layer a thousandth of the
     period wide is sampled as finely as the rest) gives its own; a Fourier motion is
     sampled by inverse FFTs on a grid with 16 points per top harmonic
@@ -57,6 +59,8 @@ def peak_torque(motion, excitation, damping: float, points: int | None = None) -
     """
     from scipy.optimize import minimize_scalar
 
+    if hasattr(motion, "peak_torque"):
+        return motion.peak_torque(excitation, damping)
     period = 2 * np.pi / motion.omega
     if points is None and hasattr(motion, "sample_times"):
         t = np.asarray(motion.sample_times(), dtype=float)

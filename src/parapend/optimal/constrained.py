@@ -462,9 +462,7 @@ def pto_profile(motion, excitation, damping: float, points: int = 4096,
     dt = period / points
     out = {"t": t, "tau": t / period, "theta": th, "theta_dot": thd, "torque": tq,
            "power": p,
-           "peak_torque": motion.peak_torque(excitation, damping)
-           if hasattr(motion, "peak_torque") else
-           peak_torque(motion, excitation, damping, points=points),
+           "peak_torque": peak_torque(motion, excitation, damping, points=points),
            "peak_power": float(np.max(p)), "peak_motoring_power": float(max(-np.min(p), 0.0)),
            "harvested_energy": float(np.sum(np.maximum(p, 0.0)) * dt),
            "motoring_energy": float(np.sum(np.maximum(-p, 0.0)) * dt)}

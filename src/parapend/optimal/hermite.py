@@ -81,18 +81,31 @@ def _fold(k: int) -> np.ndarray:
     return np.where(i <= (k - 1) // 2, 2 * i, 2 * (k - i) - 1)
 
 
-class _PiecewiseCubic:
-    """A rotation that is a cubic on each of ``K`` uniform intervals of the period,
-    ``theta(t + T_p) = theta(t) + 2 pi winding``; subclasses give ``rows`` and ``local``."""
+@dataclass(frozen=True, eq=False)
+class HermiteMotion:
+    """Piecewise cubic Hermite rotation: nodes ``t_k = k T_p / K``, ``theta_k``, ``v_k``
+    (``C^1``: ``theta''`` and the torque jump at the nodes; at a node ``theta_ddot`` gives
+    the right-hand limit, :meth:`peak_torque` takes both)."""
 
-    rows = staticmethod(_hermite_rows)
+    omega: float
+    theta_nodes: np.ndarray
+    v_nodes: np.ndarray
+    winding: int = 1
+
+    @property
+    def intervals(self) -> int:
+        return int(self.theta_nodes.size)
+
+    def local(self):
+        """``y`` of every interval, shape (K, 4): ``theta_j, v_j, theta_{j+1}, v_{j+1}``."""
+        nxt = np.roll(np.arange(self.intervals), -1)
+        th_b = self.theta_nodes[nxt].copy()
+        th_b[-1] += 2 * math.pi * self.winding
+        return np.stack([self.theta_nodes, self.v_nodes, th_b, self.v_nodes[nxt]], axis=1)
 
     @property
     def period(self) -> float:
         return 2 * math.pi / self.omega
-
-    def local(self) -> np.ndarray:  # pragma: no cover - abstract
-        raise NotImplementedError
 
     def _locate(self, t):
         t = np.asarray(t, dtype=float)
@@ -105,36 +118,36 @@ class _PiecewiseCubic:
 
     def theta(self, t):
         tau, h, y, off = self._locate(t)
-        return np.sum(self.rows(tau, h)[0] * y, axis=-1) + off
+        return np.sum(_hermite_rows(tau, h)[0] * y, axis=-1) + off
 
     def theta_dot(self, t):
         tau, h, y, _ = self._locate(t)
-        return np.sum(self.rows(tau, h)[1] * y, axis=-1)
+        return np.sum(_hermite_rows(tau, h)[1] * y, axis=-1)
 
     def theta_ddot(self, t):
         tau, h, y, _ = self._locate(t)
-        return np.sum(self.rows(tau, h)[2] * y, axis=-1)
+        return np.sum(_hermite_rows(tau, h)[2] * y, axis=-1)
 
     def profile_on(self, tau: np.ndarray):
         """``t, theta, theta', theta''`` at local ``tau`` of every interval, shape (K, len)."""
         k = self.intervals
         h = self.period / k
-        b0, b1, b2 = self.rows(np.asarray(tau, dtype=float), h)
+        b0, b1, b2 = _hermite_rows(np.asarray(tau, dtype=float), h)
         y = self.local()
         t = h * (np.arange(k)[:, None] + np.asarray(tau)[None, :])
         return t, y @ b0.T, y @ b1.T, y @ b2.T
 
     def peak_torque(self, excitation, damping: float, samples: int = 16) -> float:
-        """``max |T|`` of the motion: every interval sampled (both ends included: ``T``
-        jumps at nodes) and its largest sample refined by a golden-section search between
-        its neighbours, vectorized over intervals."""
-        return float(np.max(self._peaks(excitation, damping, samples)))
+        """``max |T|`` of the motion (:meth:`interval_peaks`)."""
+        return float(np.max(self.interval_peaks(excitation, damping, samples=samples)))
 
-    def _peaks(self, excitation, damping: float, samples: int,
-               floor: float | None = None) -> np.ndarray:
-        """Per-interval ``max |T|``; only intervals whose sampled maximum reaches 95 % of
-        ``floor`` (default: the largest sample) are refined, the others keep their samples
-        (their true maximum lies below: the samples miss at most ``(h/16)^2 |T''| / 8``)."""
+    def interval_peaks(self, excitation, damping: float, floor: float | None = None,
+                       samples: int = 16) -> np.ndarray:
+        """``max |T|`` over each interval, shape (K,): every interval sampled at
+        ``samples + 1`` points (both ends: ``T`` jumps at nodes), and those whose sampled
+        maximum reaches 95 % of ``floor`` (a torque limit; default the largest sample)
+        refined by zooming on it, vectorized; the others keep their samples (their true
+        maximum lies below: the samples miss at most ``(h/16)^2 |T''| / 8``)."""
         k = self.intervals
         h = self.period / k
         tau = np.linspace(0.0, 1.0, samples + 1)
@@ -156,7 +169,7 @@ class _PiecewiseCubic:
         top_v = best[sel]
         for _ in range(6):
             s = np.clip(centre[:, None] + half[:, None] * grid[None, :], 0.0, 1.0)
-            b0, b1, b2 = self.rows(s, h)
+            b0, b1, b2 = _hermite_rows(s, h)
             val = np.abs(np.einsum("ksi,ki->ks", b2 + damping * b1, y)
                          - (1.0 + excitation.q(base[:, None] + h * s))
                          * np.sin(np.einsum("ksi,ki->ks", b0, y)))
@@ -168,41 +181,11 @@ class _PiecewiseCubic:
         out[sel] = top_v
         return out
 
-    def interval_peaks(self, excitation, damping: float, floor: float,
-                       samples: int = 16) -> np.ndarray:
-        """``max |T|`` over each interval (shape (K,)), exact where it reaches 95 % of
-        ``floor`` (a torque limit), else a lower bound."""
-        return self._peaks(excitation, damping, samples, floor)
-
     def mean_square_speed(self) -> float:
         """``<theta'^2>`` by Gauss-Legendre quadrature (exact: a polynomial of degree 4)."""
         x, w = np.polynomial.legendre.leggauss(3)
         _, _, thd, _ = self.profile_on((x + 1) / 2)
         return float(np.sum(thd * thd * w) / (2 * self.intervals))
-
-
-
-@dataclass(frozen=True, eq=False)
-class HermiteMotion(_PiecewiseCubic):
-    """Piecewise cubic Hermite rotation: nodes ``t_k = k T_p / K``, ``theta_k``, ``v_k``
-    (``C^1``: ``theta''`` and the torque jump at the nodes; at a node ``theta_ddot`` gives
-    the right-hand limit, :meth:`peak_torque` takes both)."""
-
-    omega: float
-    theta_nodes: np.ndarray
-    v_nodes: np.ndarray
-    winding: int = 1
-
-    @property
-    def intervals(self) -> int:
-        return int(self.theta_nodes.size)
-
-    def local(self):
-        """``y`` of every interval, shape (K, 4): ``theta_j, v_j, theta_{j+1}, v_{j+1}``."""
-        nxt = np.roll(np.arange(self.intervals), -1)
-        th_b = self.theta_nodes[nxt].copy()
-        th_b[-1] += 2 * math.pi * self.winding
-        return np.stack([self.theta_nodes, self.v_nodes, th_b, self.v_nodes[nxt]], axis=1)
 
 
 class HermiteProblem:
@@ -248,8 +231,8 @@ class HermiteProblem:
         xg, wg = np.polynomial.legendre.leggauss(GAUSS_POINTS)
         self.tau_g = (xg + 1) / 2
         self.weight = np.tile(wg / 2 * h / period, (k, 1))  # mean = sum weight * f
-        self.rows_g = self.rows(self.tau_g, h)
-        self.rows_c = self.rows(TORQUE_TAU, h)
+        self.rows_g = _hermite_rows(self.tau_g, h)
+        self.rows_c = _hermite_rows(TORQUE_TAU, h)
         b0g, b1g, _ = self.rows_g
         b0c = self.rows_c[0]
 
@@ -265,36 +248,22 @@ class HermiteProblem:
         self.lin_g = self.rows_g[2] + damping * self.rows_g[1]
         self.lin_c = self.rows_c[2] + damping * self.rows_c[1]
         # banded assembly of the 4x4 interval blocks (lower band, folded node order)
-        self._layout(k)
-
-    rows = staticmethod(_hermite_rows)
-    band = _BAND
-
-    def _layout(self, k):
         pos = _fold(k)
-        nodes = np.stack([np.arange(k), np.roll(np.arange(k), -1)], axis=1)  # (K, 2)
-        gvar = np.stack([2 * pos[nodes[:, 0]], 2 * pos[nodes[:, 0]] + 1,
-                         2 * pos[nodes[:, 1]], 2 * pos[nodes[:, 1]] + 1], axis=1)  # (K, 4)
-        n = 2 * k
-        perm = np.empty(n, dtype=int)  # folded position of variable (node, component)
-        perm[0::2] = 2 * pos
-        perm[1::2] = 2 * pos + 1
-        wrap = np.zeros((k, 4))
-        wrap[-1, 2] = 2 * math.pi * self.winding
-        self._next = np.roll(np.arange(k), -1)
-        self._assembly(gvar, n, perm, wrap)
-
-    def _assembly(self, gvar, n, perm, wrap):
+        nxt = np.roll(np.arange(k), -1)
+        gvar = np.stack([2 * pos, 2 * pos + 1, 2 * pos[nxt], 2 * pos[nxt] + 1], axis=1)
+        self.n = n = 2 * k
+        self.perm = np.empty(n, dtype=int)  # folded position of variable (node, component)
+        self.perm[0::2] = 2 * pos
+        self.perm[1::2] = 2 * pos + 1
+        self.wrap = np.zeros((k, 4))
+        self.wrap[-1, 2] = 2 * math.pi * self.winding
+        self._next = nxt
         gi = np.repeat(gvar, 4, axis=1)  # row index of entry a*4+b
         gj = np.tile(gvar, (1, 4))
         keep = gi >= gj
-        assert int(np.max(gi - gj)) <= self.band
-        self.n = n
-        self.perm = perm
         self._flat = ((gi - gj) * n + gj)[keep]
         self._sel = keep
         self._gvar = gvar
-        self.wrap = wrap
 
     # -- motion <-> variables ------------------------------------------------------------------
     def local(self, x: np.ndarray) -> np.ndarray:
@@ -448,7 +417,7 @@ class HermiteProblem:
                     g_t += self.elastic - 1.0 - mu / t
                 rhs_t = -g_t
         n = self.n
-        nb = self.band + 1
+        nb = _BAND + 1
         ab = np.bincount(self._flat, weights=blocks.reshape(k, 16)[self._sel],
                          minlength=nb * n)[:nb * n].reshape(nb, n)
         g = np.bincount(self._gvar.ravel(), weights=grad.ravel(), minlength=n)
@@ -625,12 +594,6 @@ def _elastic(excitation, damping, k, x, torque_limit, copper_loss, winding, stag
         t = t * 1.5 + 1e-3 * torque_limit  # strictly inside again
 
 
-def _dense_peaks(motion, excitation, damping, torque_limit):
-    if torque_limit is None:
-        return motion._peaks(excitation, damping, 16)
-    return motion.interval_peaks(excitation, damping, torque_limit)
-
-
 def minimum_peak_torque(excitation, damping: float, intervals: int, start, *,
                         stop_below: float | None = None, winding: int = 1):
     """Phase 1: the rotation of smallest peak torque near ``start`` (a motion).
@@ -705,7 +668,7 @@ def solve_hermite(excitation, damping: float, intervals: int, start, *, torque_l
         stages.append(("solve", torque_limit, sol.status))
 
     motion = pr.motion(sol.x)
-    peaks = _dense_peaks(motion, excitation, damping, torque_limit)
+    peaks = motion.interval_peaks(excitation, damping, torque_limit)
     peak = float(np.max(peaks))
     # the optimum on the untightened grid bounds every motion within the limit everywhere
     bound = pr.power(sol.x) if sol.status == "converged" else math.inf
@@ -735,7 +698,7 @@ def solve_hermite(excitation, damping: float, intervals: int, start, *, torque_l
         iters += sol.iterations
         stages.append(("tighten", float(np.min(lim)), sol.status))
         motion = pr.motion(sol.x)
-        peaks = _dense_peaks(motion, excitation, damping, torque_limit)
+        peaks = motion.interval_peaks(excitation, damping, torque_limit)
         peak = float(np.max(peaks))
     status = sol.status
     if torque_limit is not None and peak > torque_limit * (1 + tol) and status == "converged":
