@@ -27,13 +27,18 @@ this interior point without a reliable convergence, see docs/units.md.)
 **Torque limit** ``|T| <= T_max`` at ``tau = 0, 1/2, 1`` of every interval (both sides of
 every node), then checked on the motion's own dense evaluation
 (:meth:`HermiteMotion.peak_torque`): the grid limit is tightened by any excess between
-the points and the solve repeated.
+the points (by twice the excess, with a margin of ``5e-8`` relative on every interval at
+the limit) and the solve repeated.
 
 **Solver.** A feasible primal-dual interior point (Nocedal & Wright, Alg. 19.1 with the
 slacks eliminated: every iterate is strictly feasible), barrier parameter ``mu`` reduced by
-the Fiacco-McCormick rule of IPOPT (``mu <- max(mu_min, min(mu / 5, mu^1.5))`` once the
-barrier problem is solved to ``10 mu``), Armijo backtracking on the barrier function,
-fraction to the boundary 0.995 for the duals. The Newton matrix
+the Fiacco-McCormick rule of IPOPT (``mu <- max(mu_min, min(mu / 5, mu^1.3))`` once the
+barrier problem is solved to ``10 mu``; IPOPT's power is 1.5), the first step at the new
+``mu`` a Mehrotra predictor-corrector step (the affine step's products ``ds dlambda``
+corrected, same factorization), Armijo backtracking on the barrier function, fraction to
+the boundary 0.995 for primal and dual steps. Objective, constraints, line-search trials
+and the Newton matrix are compiled loops over the intervals
+(:mod:`parapend.optimal._hermite_kernel`). The Newton matrix
 ``H_L + J^T diag(lambda / s) J`` couples only neighbouring nodes; ordered
 ``0, K-1, 1, K-2, ...`` the cyclic block-tridiagonal matrix becomes banded (lower
 bandwidth 5) and is factored by LAPACK's banded Cholesky, with a multiple of the identity
@@ -53,12 +58,19 @@ import numpy as np
 from scipy.linalg import LinAlgError
 from scipy.linalg.lapack import dpbtrf, dpbtrs
 
+from . import _hermite_kernel as _k
+
 __all__ = ["HermiteMotion", "HermiteProblem", "HermiteSolution", "interior_point",
            "minimum_peak_torque", "solve_hermite"]
 
 GAUSS_POINTS = 4
 TORQUE_TAU = np.array([0.0, 0.5, 1.0])
 _FRACTION = 0.995
+# barrier parameter update (IPOPT's rule with a milder superlinear power: fewer damped
+# steps after each decrease; measured over 42 limit/damping/K cases)
+_MU_FACTOR, _MU_POWER = 0.2, 1.3
+# tightening: a margin of _MARGIN tol on every interval within _NEAR of the limit
+_NEAR, _MARGIN = 1e-3, 50
 _BAND = 5  # lower bandwidth of the folded Newton matrix
 
 
@@ -146,40 +158,17 @@ class HermiteMotion:
         """``max |T|`` over each interval, shape (K,): every interval sampled at
         ``samples + 1`` points (both ends: ``T`` jumps at nodes), and those whose sampled
         maximum reaches 95 % of ``floor`` (a torque limit; default the largest sample)
-        refined by zooming on it, vectorized; the others keep their samples (their true
-        maximum lies below: the samples miss at most ``(h/16)^2 |T''| / 8``)."""
-        k = self.intervals
-        h = self.period / k
-        tau = np.linspace(0.0, 1.0, samples + 1)
-        t, th, thd, thdd = self.profile_on(tau)
-        tq = np.abs(thdd + damping * thd - (1.0 + excitation.q(t)) * np.sin(th))
-        i = np.argmax(tq, axis=1)
-        best = tq[np.arange(k), i]
-        top = float(np.max(best)) if floor is None else floor
-        sel = np.nonzero(best >= 0.95 * top)[0]
-        if sel.size == 0:
-            return best
-        y = self.local()[sel]
-        base = h * sel
-        # zoom: 9 points across the bracket around the best sample, the bracket shrunk to
-        # the two neighbouring points, six times (spacing 1/16 -> 1/16 / 4^6 of the interval)
-        centre = tau[i[sel]]
-        half = np.full(sel.size, 1.0 / samples)
-        grid = np.linspace(-1.0, 1.0, 9)
-        top_v = best[sel]
-        for _ in range(6):
-            s = np.clip(centre[:, None] + half[:, None] * grid[None, :], 0.0, 1.0)
-            b0, b1, b2 = _hermite_rows(s, h)
-            val = np.abs(np.einsum("ksi,ki->ks", b2 + damping * b1, y)
-                         - (1.0 + excitation.q(base[:, None] + h * s))
-                         * np.sin(np.einsum("ksi,ki->ks", b0, y)))
-            j = np.argmax(val, axis=1)
-            top_v = np.maximum(top_v, val[np.arange(sel.size), j])
-            centre = s[np.arange(sel.size), j]
-            half = half / 4
-        out = best.copy()
-        out[sel] = top_v
-        return out
+        refined by zooming on it (:func:`parapend.optimal._hermite_kernel.interval_peaks`);
+        the others keep their samples (their true maximum lies below: the samples miss at
+        most ``(h/16)^2 |T''| / 8``)."""
+        x = np.empty(2 * self.intervals)
+        x[0::2] = self.theta_nodes
+        x[1::2] = self.v_nodes
+        return _k.interval_peaks(x, self.intervals, 2 * math.pi * self.winding,
+                                 self.period / self.intervals, float(damping),
+                                 np.asarray(excitation.spectrum, dtype=complex),
+                                 float(self.omega), int(samples),
+                                 -1.0 if floor is None else float(floor))
 
     def mean_square_speed(self) -> float:
         """``<theta'^2>`` by Gauss-Legendre quadrature (exact: a polynomial of degree 4)."""
@@ -226,44 +215,45 @@ class HermiteProblem:
         self.elastic = elastic
         self.border = "phase1" if phase1 else ("elastic" if elastic is not None else None)
         self.torque_limit = torque_limit
-        self.grid_limit = torque_limit
         self.copper_loss = float(copper_loss)
+        self.mode = (_k.PHASE1 if phase1 else _k.ELASTIC if elastic is not None else
+                     _k.LIMIT if torque_limit is not None else _k.NONE)
+        self.grid_limit = torque_limit
         xg, wg = np.polynomial.legendre.leggauss(GAUSS_POINTS)
         self.tau_g = (xg + 1) / 2
-        self.weight = np.tile(wg / 2 * h / period, (k, 1))  # mean = sum weight * f
+        self.wg = wg / 2 * h / period  # mean = sum over intervals of wg . f
         self.rows_g = _hermite_rows(self.tau_g, h)
         self.rows_c = _hermite_rows(TORQUE_TAU, h)
-        b0g, b1g, _ = self.rows_g
-        b0c = self.rows_c[0]
-
-        def outer(a, b):
-            return (a[:, :, None] * b[:, None, :]).reshape(a.shape[0], 16)
-
-        self._g00, self._g01, self._g11 = outer(b0g, b0g), outer(b0g, b1g), outer(b1g, b1g)
-        self._c00 = outer(b0c, b0c)
         base = h * np.arange(k)[:, None]
         self.q1_g = 1.0 + excitation.q(base + h * self.tau_g[None, :])
         self.q1_c = 1.0 + excitation.q(base + h * TORQUE_TAU[None, :])
         # torque rows, linear part: theta'' + gamma theta'
         self.lin_g = self.rows_g[2] + damping * self.rows_g[1]
         self.lin_c = self.rows_c[2] + damping * self.rows_c[1]
-        # banded assembly of the 4x4 interval blocks (lower band, folded node order)
+        self.wrap_turns = 2 * math.pi * self.winding
+        # folded positions of every interval's variables (the banded assembly)
         pos = _fold(k)
         nxt = np.roll(np.arange(k), -1)
-        gvar = np.stack([2 * pos, 2 * pos + 1, 2 * pos[nxt], 2 * pos[nxt] + 1], axis=1)
+        self._gvar = np.stack([2 * pos, 2 * pos + 1, 2 * pos[nxt], 2 * pos[nxt] + 1], axis=1)
         self.n = n = 2 * k
         self.perm = np.empty(n, dtype=int)  # folded position of variable (node, component)
         self.perm[0::2] = 2 * pos
         self.perm[1::2] = 2 * pos + 1
         self.wrap = np.zeros((k, 4))
-        self.wrap[-1, 2] = 2 * math.pi * self.winding
+        self.wrap[-1, 2] = self.wrap_turns
         self._next = nxt
-        gi = np.repeat(gvar, 4, axis=1)  # row index of entry a*4+b
-        gj = np.tile(gvar, (1, 4))
-        keep = gi >= gj
-        self._flat = ((gi - gj) * n + gj)[keep]
-        self._sel = keep
-        self._gvar = gvar
+        self._jtc = np.zeros((k, TORQUE_TAU.size, 4))
+
+    @property
+    def grid_limit(self):
+        """The limit at the constraint points: ``T_max`` or, tightened, one per interval."""
+        return self._grid_limit
+
+    @grid_limit.setter
+    def grid_limit(self, value):
+        self._grid_limit = value
+        lim = 1.0 if value is None else np.asarray(value, dtype=float).ravel()
+        self._scale = np.ascontiguousarray(np.broadcast_to(1.0 / lim, (self.k,)))
 
     # -- motion <-> variables ------------------------------------------------------------------
     def local(self, x: np.ndarray) -> np.ndarray:
@@ -282,148 +272,83 @@ class HermiteProblem:
         x[1::2] = motion.theta_dot(t)
         return x
 
-    # -- pointwise quantities --------------------------------------------------------------------
-    def _at(self, y, rows, q1, lin):
-        b0, b1, _ = rows
-        th = y @ b0.T
-        thd = y @ b1.T
-        sn, cs = np.sin(th), np.cos(th)
-        tq = y @ lin.T - q1 * sn
-        return th, thd, sn, cs, tq
-
+    # -- pointwise quantities (compiled kernels: parapend.optimal._hermite_kernel) -------------
     def torque_points(self, x) -> np.ndarray:
         """``T`` at the constraint points, shape (K, 3)."""
-        return self._at(self.local(x), self.rows_c, self.q1_c, self.lin_c)[4]
+        return _k.torques(np.asarray(x, dtype=float), self.k, self.wrap_turns,
+                          self.rows_c[0], self.lin_c, self.q1_c)
+
+    def _power_terms(self, x):
+        return _k.power_terms(np.asarray(x, dtype=float), self.k, self.wrap_turns,
+                              self.rows_g[0], self.rows_g[1], self.lin_g, self.q1_g,
+                              self.wg, self.damping)
 
     def power(self, x) -> float:
         """Mean mechanical power ``P`` (Eq. 15, state form)."""
-        _, thd, sn, _, _ = self._at(self.local(x), self.rows_g, self.q1_g, self.lin_g)
-        return float(np.sum(self.weight * (self.q1_g * sn * thd - self.damping * thd * thd)))
+        return float(self._power_terms(x)[0])
 
     def electrical(self, x) -> float:
         """Mean power delivered after the copper loss, ``P - r <T^2>``."""
-        _, thd, sn, _, tq = self._at(self.local(x), self.rows_g, self.q1_g, self.lin_g)
-        e = self.q1_g * sn * thd - self.damping * thd * thd
-        return float(np.sum(self.weight * (e - self.copper_loss * tq * tq)))
+        p, t2 = self._power_terms(x)
+        return float(p - self.copper_loss * t2)
 
     # -- the pieces of the interior point --------------------------------------------------------
     def constraints(self, x, t=None):
         """The torque constraints ``c <= 0`` at the constraint points, flat."""
-        if self.border is None and self.grid_limit is None:
-            return np.zeros(0)
-        tq = self._at(self.local(x), self.rows_c, self.q1_c, self.lin_c)[4]
-        if self.phase1:
-            return np.concatenate([(tq - t).ravel(), (-tq - t).ravel()])
-        if self.elastic is not None:
-            b = self.torque_limit + t
-            return np.concatenate([(tq - b).ravel(), (-tq - b).ravel(), [-t]])
-        lim = self.grid_limit
-        return np.concatenate([(tq / lim - 1.0).ravel(), (-tq / lim - 1.0).ravel()])
+        return _k.constraints(np.asarray(x, dtype=float), 0.0 if t is None else float(t),
+                              self.k, self.wrap_turns, self.rows_c[0], self.lin_c,
+                              self.q1_c, self.mode, self._scale,
+                              float(self.torque_limit or 0.0))
 
     def constraint_step(self, dx, dt=None) -> np.ndarray:
         """``J d``: the linearized change of :meth:`constraints` along a step, at the point
         of the last :meth:`newton` call."""
-        if self.border is None and self.grid_limit is None:
-            return np.zeros(0)
-        dy = self.local(dx) - self.wrap
-        dtq = np.einsum("kci,ki->kc", self._jtc, dy)
-        if self.phase1:
-            return np.concatenate([(dtq - dt).ravel(), (-dtq - dt).ravel()])
-        if self.elastic is not None:
-            return np.concatenate([(dtq - dt).ravel(), (-dtq - dt).ravel(), [-dt]])
-        lim = self.grid_limit
-        return np.concatenate([(dtq / lim).ravel(), (-dtq / lim).ravel()])
+        return _k.constraint_step(np.asarray(dx, dtype=float), 0.0 if dt is None else
+                                  float(dt), self.k, self._jtc, self.mode, self._scale)
 
     def barrier_count(self) -> int:
         """Number of barrier terms (the barrier's duality gap is this times ``mu``)."""
-        n = 0
-        if self.border is not None or self.grid_limit is not None:
-            n += 2 * self.rows_c[0].shape[0] * self.k
-        return n + (self.elastic is not None)
+        if self.mode == _k.NONE:
+            return 0
+        return 2 * TORQUE_TAU.size * self.k + (self.mode == _k.ELASTIC)
 
     def objective(self, x, mu: float = 0.0, t=None) -> float:
         """``phi`` to minimize: ``-(power)`` or, in phase 1, ``t`` (``mu`` unused: the
         barrier terms are added by :func:`interior_point`)."""
         if self.phase1:
             return float(t)
-        y = self.local(x)
-        _, thd, sn, _, tq = self._at(y, self.rows_g, self.q1_g, self.lin_g)
-        f = np.sum(self.weight * (self.q1_g * sn * thd - self.damping * thd * thd))
-        if self.copper_loss:
-            f -= self.copper_loss * np.sum(self.weight * tq * tq)
-        return -float(f) + (self.elastic * float(t) if self.elastic is not None else 0.0)
+        p, t2 = self._power_terms(x)
+        f = -float(p) + self.copper_loss * float(t2)
+        return f + (self.elastic * float(t) if self.elastic is not None else 0.0)
+
+    def trial(self, x, dx, alpha, t, dt, s, mu, floor):
+        """Line-search trial ``x + alpha dx``: ``(ok, barrier, xn, tn, sn, phi)``
+        (:func:`parapend.optimal._hermite_kernel.trial`)."""
+        return _k.trial(x, dx, float(alpha), 0.0 if t is None else float(t),
+                        0.0 if dt is None else float(dt), s, float(mu), float(floor), self.k,
+                        self.wrap_turns, self.rows_g[0], self.rows_g[1], self.lin_g,
+                        self.q1_g, self.wg, self.damping, self.copper_loss, self.rows_c[0],
+                        self.lin_c, self.q1_c, self.mode, self._scale,
+                        float(self.torque_limit or 0.0), float(self.elastic or 0.0))
 
     def newton(self, x, t, lam, mu):
         """Banded Newton matrix and right-hand side of the barrier problem.
 
         Returns ``(ab, rhs, border, rhs_t, d_tt)``: ``ab`` the lower band of the Newton
         matrix in the folded order, ``rhs`` minus the barrier gradient, ``border`` the
-        column ``M_xt`` and ``rhs_t``, ``d_tt`` its entries for ``t`` (phase 1).
+        column ``M_xt`` and ``rhs_t``, ``d_tt`` its entries for ``t`` (phase 1, elastic
+        mode; else None, 0, 0).
         """
-        k = self.k
-        y = self.local(x)
-        blocks = np.zeros((k, 4, 4))
-        grad = np.zeros((k, 4))  # gradient of the barrier function in y
-        b0g, b1g, _ = self.rows_g
-        thg, thdg, sng, csg, tqg = self._at(y, self.rows_g, self.q1_g, self.lin_g)
-        w = self.weight
-        if not self.phase1:
-            # f = q1 sin(th) th' - gamma th'^2, minimize -sum w f
-            a = w * self.q1_g
-            gf = (a * csg * thdg)[..., None] * b0g + ((a * sng) - 2 * self.damping * w *
-                                                     thdg)[..., None] * b1g
-            grad -= gf.sum(1)
-            hb = -((a * sng * thdg) @ self._g00).reshape(k, 4, 4)
-            cross = ((a * csg) @ self._g01).reshape(k, 4, 4)
-            hb += cross + cross.transpose(0, 2, 1)
-            hb -= 2 * self.damping * (w @ self._g11).reshape(k, 4, 4)
-            blocks -= hb
-            if self.copper_loss:
-                r = self.copper_loss
-                jtg = self.lin_g[None] - (self.q1_g * csg)[..., None] * b0g[None]
-                grad += 2 * r * np.einsum("kg,kgi->ki", w * tqg, jtg)
-                blocks += 2 * r * (np.einsum("kg,kgi,kgj->kij", w, jtg, jtg)
-                                   + ((w * tqg * self.q1_g * sng) @ self._g00).reshape(k, 4, 4))
-        border = None
-        rhs_t = d_tt = 0.0
-        if self.border is not None or self.grid_limit is not None:
-            b0c = self.rows_c[0]
-            _, _, snc, csc, tqc = self._at(y, self.rows_c, self.q1_c, self.lin_c)
-            jtc = self.lin_c[None] - (self.q1_c * csc)[..., None] * b0c[None]  # dT/dy
-            self._jtc = jtc
-            htc = self.q1_c * snc  # d2T/dy2 = htc b0 b0^T
-            n_c = tqc.size
-            if self.border is not None:
-                scale = 1.0
-                b = t if self.phase1 else self.torque_limit + t
-                sp, sm = b - tqc, b + tqc
-            else:
-                scale = 1.0 / self.grid_limit
-                sp, sm = 1.0 - tqc * scale, 1.0 + tqc * scale
-            lp = lam[:n_c].reshape(tqc.shape)
-            lm = lam[n_c:2 * n_c].reshape(tqc.shape)
-            # c+- = +-scale T - (t or 1): grad c+- = +-scale jt, hess c+- = +-scale hess T
-            grad += np.einsum("kc,kci->ki", scale * (mu / sp - mu / sm), jtc)
-            sig = (lp / sp + lm / sm) * scale * scale
-            blocks += (jtc * sig[..., None]).transpose(0, 2, 1) @ jtc
-            blocks += ((scale * (lp - lm) * htc) @ self._c00).reshape(k, 4, 4)
-            if self.border is not None:
-                # grad_t c+- = -1 (and, elastic, c_t = -t)
-                border = -np.einsum("kc,kci->ki", lp / sp - lm / sm, jtc)
-                d_tt = float(np.sum(lp / sp + lm / sm))
-                g_t = 1.0 - float(np.sum(mu / sp + mu / sm))
-                if self.elastic is not None:
-                    d_tt += float(lam[-1]) / t
-                    g_t += self.elastic - 1.0 - mu / t
-                rhs_t = -g_t
-        n = self.n
-        nb = _BAND + 1
-        ab = np.bincount(self._flat, weights=blocks.reshape(k, 16)[self._sel],
-                         minlength=nb * n)[:nb * n].reshape(nb, n)
-        g = np.bincount(self._gvar.ravel(), weights=grad.ravel(), minlength=n)
-        if border is not None:
-            border = np.bincount(self._gvar.ravel(), weights=border.ravel(), minlength=n)
-        return ab, -g, border, rhs_t, d_tt
+        ab, rhs, border, rhs_t, d_tt = _k.newton(
+            np.asarray(x, dtype=float), 0.0 if t is None else float(t),
+            np.asarray(lam, dtype=float), float(mu), self.k, self.wrap_turns,
+            self.rows_g[0], self.rows_g[1], self.lin_g, self.q1_g, self.wg, self.damping,
+            self.copper_loss, self.rows_c[0], self.lin_c, self.q1_c, self.mode, self._scale,
+            float(self.torque_limit or 0.0), float(self.elastic or 0.0), self._gvar,
+            self._jtc)
+        if self.mode in (_k.PHASE1, _k.ELASTIC):
+            return ab, rhs, border, float(rhs_t), float(d_tt)
+        return ab, rhs, None, 0.0, 0.0
 
 
 @dataclass
@@ -444,14 +369,19 @@ class HermiteSolution:
     anchor: object = None  # the strictly feasible motion the solve started towards
 
 
-def _solve(ab, rhs, border, rhs_t, d_tt, delta):
-    """Solve the (bordered) banded system by LAPACK's banded Cholesky (dpbtrf/dpbtrs);
-    LinAlgError when ``ab + delta I`` is not positive definite."""
+def _factor(ab, delta):
+    """LAPACK's banded Cholesky (dpbtrf) of ``ab + delta I``; LinAlgError when it is not
+    positive definite."""
     a = ab.copy()
     a[0] += delta
     c, info = dpbtrf(a, lower=1)
     if info != 0:
         raise LinAlgError("not positive definite")
+    return c
+
+
+def _solve(c, rhs, border, rhs_t, d_tt, delta):
+    """Solve the (bordered) banded system from its factor ``c`` (:func:`_factor`)."""
     if border is None:
         return dpbtrs(c, rhs, lower=1)[0], 0.0
     both = dpbtrs(c, np.stack([rhs, border], axis=1), lower=1)[0]
@@ -460,6 +390,33 @@ def _solve(ab, rhs, border, rhs_t, d_tt, delta):
     schur = max(d_tt + delta - border @ both[:, 1], 1e-12 * (d_tt + delta))
     dt = (rhs_t - border @ both[:, 0]) / schur
     return both[:, 0] - both[:, 1] * dt, dt
+
+
+def _predictor_corrector(pr, fac, rhs, border, rhs_t, d_tt, delta, s, lam, mu, mu_new):
+    """Mehrotra's predictor-corrector step into the barrier problem at ``mu_new``, from the
+    factor of the Newton matrix at ``mu`` (it does not depend on ``mu``).
+
+    The affine step (``mu = 0``) predicts the products ``ds_i dlambda_i`` that a linear step
+    misses; the corrector aims at ``s_i lambda_i = mu_new - ds_i dlambda_i`` (Nocedal &
+    Wright, Eq. 19.12 adapted to eliminated slacks). Returns ``(dx (folded), dt, slope,
+    target)``, ``slope`` the derivative of the barrier function at ``mu_new`` along the step
+    and ``target`` the dual estimate it aims at; None when the step is not a descent step.
+    """
+    if not lam.size:
+        return None
+    ones = _k.jt_apply(1.0 / s, pr.k, pr._jtc, pr.mode, pr._scale, pr._gvar)
+    rhs0, rhs_t0 = rhs + mu * ones[0], rhs_t + mu * ones[1]  # the right-hand side at mu = 0
+    dx_a, dt_a = _solve(fac, rhs0, border, rhs_t0, d_tt, delta)
+    ds_a = -pr.constraint_step(dx_a[pr.perm], dt_a)
+    dlam_a = -lam - lam / s * ds_a
+    target = (mu_new - ds_a * dlam_a) / s
+    jw = _k.jt_apply(target, pr.k, pr._jtc, pr.mode, pr._scale, pr._gvar)
+    dx_f, dt = _solve(fac, rhs0 - jw[0], border, rhs_t0 - jw[1], d_tt, delta)
+    rhs_new, rhs_t_new = rhs0 - mu_new * ones[0], rhs_t0 - mu_new * ones[1]
+    slope = -float(rhs_new @ dx_f) - (rhs_t_new * dt if border is not None else 0.0)
+    if not slope < 0:
+        return None
+    return dx_f, dt, slope, target
 
 
 def interior_point(problem: HermiteProblem, x, *, t=None, mu0: float | None = None,
@@ -502,7 +459,7 @@ def interior_point(problem: HermiteProblem, x, *, t=None, mu0: float | None = No
         delta = 0.0  # inertia correction: the smallest delta I that makes it definite
         for _ in range(30):
             try:
-                dx_f, dt = _solve(ab, rhs, border, rhs_t, d_tt, delta)
+                fac = _factor(ab, delta)
                 break
             except LinAlgError:
                 # first try: a third of the last shift, or 1e-8 of the median diagonal (the
@@ -513,48 +470,46 @@ def interior_point(problem: HermiteProblem, x, *, t=None, mu0: float | None = No
             status = "singular"
             break
         delta_last = delta
+        dx_f, dt = _solve(fac, rhs, border, rhs_t, d_tt, delta)
         dx = dx_f[pr.perm]
         slope = -float(rhs @ dx_f) - (rhs_t * dt if border is not None else 0.0)
         # -slope is the Newton decrement squared: about twice the distance of the barrier
         # function to its minimum at this mu
         # (floored at the precision to which the barrier function can be compared)
+        target = mu / s  # the dual estimate the step aims at (lambda_i s_i = mu)
         if -slope <= max(2e-2 * m * mu, 1e-12 * (1.0 + abs(phi))) or stagnant >= 5:
             if mu <= mu_min * (1 + 1e-12):
                 status = "converged"
                 break
-            if mu > mu_min * (1 + 1e-12):
-                mu = max(mu_min, min(0.2 * mu, mu**1.5))
-            phi = pr.objective(x, mu, t)
+            mu_new = max(mu_min, min(_MU_FACTOR * mu, mu**_MU_POWER))
             stagnant = 0
-            continue
+            pc = _predictor_corrector(pr, fac, rhs, border, rhs_t, d_tt, delta, s, lam, mu,
+                                      mu_new)
+            mu = mu_new
+            phi = pr.objective(x, mu, t)
+            if pc is None:
+                continue
+            dx_f, dt, slope, target = pc
+            dx = dx_f[pr.perm]
         b0 = phi - mu * float(np.sum(np.log(s)))
         # fraction to the boundary on the linearized slacks (s + alpha ds >= (1 - tau) s)
         ds = -pr.constraint_step(dx, dt)
-        neg = ds < 0
-        alpha = min(1.0, float(np.min(_FRACTION * s[neg] / -ds[neg]))) if np.any(neg) else 1.0
+        alpha = _k.max_step(s, ds, _FRACTION)
         for _ in range(50):
-            xn = x + alpha * dx
-            tn = None if t is None else t + alpha * dt
-            cn = pr.constraints(xn, tn)
-            if not cn.size or np.max(cn) < 0:
-                sn = -cn
-                if np.all(sn > 0.1 * (1 - _FRACTION) * s):
-                    phin = pr.objective(xn, mu, tn)
-                    bn = phin - mu * float(np.sum(np.log(sn)))
-                    if bn <= b0 + 1e-4 * alpha * min(slope, 0.0) or abs(bn - b0) <= 1e-15 * (
-                            1 + abs(b0)):
-                        break
+            ok, bn, xn, tn, sn, phin = pr.trial(x, dx, alpha, t, dt, s, mu,
+                                                0.1 * (1 - _FRACTION))
+            if ok and (bn <= b0 + 1e-4 * alpha * min(slope, 0.0)
+                       or abs(bn - b0) <= 1e-15 * (1 + abs(b0))):
+                break
             alpha *= 0.5
         else:
             status = "stalled"
             break
+        if t is None:
+            tn = None
         if lam.size:  # dual step, fraction to the boundary
-            dlam = mu / s - lam - lam / s * ds  # mu/s - lam + Sigma J dx
-            neg = dlam < 0
-            amax = 1.0
-            if np.any(neg):
-                amax = min(1.0, float(np.min(-_FRACTION * lam[neg] / dlam[neg])))
-            lam = np.clip(lam + amax * dlam, 1e-30, None)
+            dlam = target - lam - lam / s * ds  # mu/s - lam + Sigma J dx
+            lam = np.maximum(lam + _k.max_step(lam, dlam, _FRACTION) * dlam, 1e-30)
         stagnant = stagnant + 1 if abs(bn - b0) <= 1e-14 * (
             1 + abs(b0)) else 0
         x, t, s, phi = xn, tn, sn, phin
@@ -682,7 +637,10 @@ def solve_hermite(excitation, damping: float, intervals: int, start, *, torque_l
         over = peaks > torque_limit
         # (twice the excess: the optimum presses against the new limit and the peak between
         # the points moves with it)
-        lim[over, 0] *= (torque_limit / peaks[over]) ** 2 * (1 - 0.1 * tol)
+        lim[over, 0] *= (torque_limit / peaks[over]) ** 2
+        # and a margin of 20 tol on every interval at the limit: the peaks move with the
+        # new optimum, and an excess of a few tol elsewhere would cost another round
+        lim[peaks > torque_limit * (1 - _NEAR), 0] *= 1 - _MARGIN * tol
         pr.grid_limit = lim
         x = _blend_feasible(pr, sol.x, xa)
         if x is None:  # the anchor is not inside the tightened limits: a new one, or stop
