@@ -216,10 +216,19 @@ def _time_domain(exc, gamma, ideal, tmax, copper_loss, warm, rtol: float = 1e-6)
     iters = 0
     change = float("nan")
     anchor = last = None
+    bound = tmax * exc.omega  # every monotone rotation: P <= T_max <theta'> = T_max omega
+    brake_tried = copper_loss != 0.0
     while True:
         sol = solve_hermite(exc, gamma, k, start, torque_limit=tmax, copper_loss=copper_loss,
                             anchor=anchor)
         iters += sol.iterations
+        if not brake_tried and (sol.status != "converged" or sol.power >= 0.9 * bound):
+            # near the bound: the constant brake attains it, if it exists; then no monotone
+            # rotation (the Hermite optimum, refined or not) can do better
+            brake_tried = True
+            brake = _constant_brake(exc, gamma, tmax, sol.motion, iters)
+            if brake is not None and brake[0].power >= sol.power:
+                return brake
         if sol.status != "converged" and prev is None and 2 * k <= limits.MAX_PTO_INTERVALS:
             # the smallest peak torque falls with the resolution, and near a free rotation
             # (tiny limits) a coarse mesh may stall: try a finer one
@@ -252,16 +261,46 @@ def _time_domain(exc, gamma, ideal, tmax, copper_loss, warm, rtol: float = 1e-6)
     return out, motion, {"method": "hermite", "intervals": k, "refinement_change": change}
 
 
+def _constant_brake(exc, gamma, tmax, start, iters):
+    """The rotation under the constant torque ``-T_max`` (:mod:`parapend.optimal.brake`),
+    as ``(PTOSolution, motion, extra)``, or None when there is none near ``start``."""
+    from .model import peak_torque
+    from .optimal.brake import constant_brake
+    from .power import mean_power
+
+    found = constant_brake(exc, gamma, tmax, start)
+    if found is None:
+        return None
+    motion, n, _ = found
+    power = mean_power(motion, exc, gamma, points=max(4096, 16 * n))
+    # the resolution check: the power on half the harmonics (the coefficients above N/2
+    # are what the doubling added)
+    half = FourierMotion(exc.omega, motion.a0, motion.a[:n // 2], motion.b[:n // 2])
+    change = abs(power - mean_power(half, exc, gamma, points=max(4096, 16 * n)))
+    peak = peak_torque(motion, exc, gamma)
+    out = PTOSolution(x=motion.vector, power=power, electrical_power=power, peak_torque=peak,
+                      max_violation=max(peak / tmax - 1.0, 0.0), status="converged",
+                      iterations=iters, outer_iterations=0, gradient_norm=float("nan"),
+                      stages=[("constant-brake", n, "converged")])
+    return out, motion, {"method": "constant-brake", "harmonics": n,
+                         "refinement_change": change}
+
+
 def _smallest_limit(ideal):
     """The smallest peak torque of a rotation (phase 1 of :mod:`parapend.optimal.hermite`
     from the best uniform rotation, on twice :func:`intervals_for` intervals): ``(dense
     peak of that motion, status)``. Any smaller limit is infeasible near it; this limit is
-    met (by that motion). A free rotating attractor of the pendulum makes it about 0."""
+    met (by that motion). When the pendulum has a free period-1 rotation (Eq. 14 with
+    ``T = 0``, :func:`parapend.optimal.brake.constant_brake` at zero torque, from the best
+    uniform rotation), it is 0 exactly, status "free rotation"."""
+    from .optimal.brake import constant_brake
     from .optimal.hermite import minimum_peak_torque
 
     exc = ideal._excitation
     _, phi = uniform_power(exc, ideal.gamma)
     uniform = FourierMotion(exc.omega, phi, np.zeros(1), np.zeros(1))
+    if constant_brake(exc, ideal.gamma, 0.0, uniform) is not None:
+        return 0.0, "free rotation"
     sol, _ = minimum_peak_torque(exc, ideal.gamma, 2 * intervals_for(exc), uniform)
     return float(sol.peak_torque), sol.status
 
@@ -276,8 +315,9 @@ def pto_curve(vary: str = "torque-limit", *, values=None, points: int = 12,
     vary : {"torque-limit", "efficiency"}
         ``torque-limit``: from the ideal optimum's peak torque down (geometrically) to the
         smallest feasible limit (the smallest peak torque of any rotation found, phase 1 of
-        :mod:`parapend.optimal.hermite`; 2 % of the top when a free rotation makes that
-        about 0), each solve warm-started from the previous; with an efficiency, down to 2 %
+        :mod:`parapend.optimal.hermite`, but at least 2 % of the top; 0.2 % of the top when
+        the pendulum has a free rotation, which makes it 0), each solve warm-started from
+        the previous; with an efficiency, down to 2 %
         of the top (the Fourier method), stopping at the first infeasible value;
         ``efficiency``: ``eta = eta_g = eta_m`` from 1 down to 0.5 (or ``values``).
     values : sequence of float or None
@@ -307,7 +347,9 @@ def pto_curve(vary: str = "torque-limit", *, values=None, points: int = 12,
         tmin = _smallest_limit(ideal) if eff is None else None
         if values is None:
             top = ideal.peak_torque
-            low = 0.02 * top if tmin is None else \
+            # down to the smallest feasible limit; with a free rotation (smallest limit 0)
+            # to 0.2 % of the top, through the constant brake's P = T_max omega
+            low = 0.02 * top if tmin is None else 0.002 * top if tmin[0] == 0.0 else \
                 min(top, max(tmin[0] * (1 + 2e-3), 0.02 * top))
             vals = list(top * np.geomspace(1.0, low / top, npts))
         else:
@@ -331,7 +373,7 @@ def pto_curve(vary: str = "torque-limit", *, values=None, points: int = 12,
             progress(i + 1, len(vals))
         if vary == "torque-limit" and r.status == "infeasible":
             break  # below the smallest feasible limit: smaller ones are infeasible too
-        warm = r.motion if r.method == "hermite" else r.motion.vector
+        warm = r.motion if r.method in ("hermite", "constant-brake") else r.motion.vector
     feas = [r.torque_limit for r in rows if r.status != "infeasible"]
     ds = xr.Dataset(
         {"power": ("value", [r.power for r in rows]),
@@ -407,6 +449,11 @@ def plot_pto_curve(ds, path=None):
                label="ideal optimum")
     ax.axhline(ds.attrs["uniform_power"], color="gray", ls=":", lw=1, label="best uniform")
     if ds.attrs["vary"] == "torque-limit":
+        # the bound of every rotation that never turns back, reached by the constant brake
+        tb = np.geomspace(v.min(), v.max(), 200)
+        keep = tb * ds.attrs["omega"] <= ds.attrs["unconstrained_power"]
+        ax.plot(tb[keep], tb[keep] * ds.attrs["omega"], color="C2", ls="-.", lw=1,
+                label="T_max omega (constant brake)")
         ax.set_xscale("log")
         ax.set_xlabel("torque limit T_max (m g l)")
     else:

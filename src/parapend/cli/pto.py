@@ -194,10 +194,12 @@ def _cmd_pto_curve(a) -> dict | str:
            f"{ds.attrs['harmonics']}); units m g l, m g l / t0"]
     if a.vary == "torque-limit":
         if "smallest_feasible_limit" in ds.attrs:
+            how = ("a free rotation needs no torque"
+                   if ds.attrs["smallest_feasible_status"] == "free rotation" else
+                   f"phase 1, {ds.attrs['smallest_feasible_status']}")
             out.append(f"smallest peak torque of a rotation: "
-                       f"{ds.attrs['smallest_feasible_limit']:.6g} (phase 1, "
-                       f"{ds.attrs['smallest_feasible_status']}); smallest limit solved: "
-                       f"{ds.attrs['smallest_solved_limit']:.6g}")
+                       f"{ds.attrs['smallest_feasible_limit']:.6g} ({how}); smallest limit "
+                       f"solved: {ds.attrs['smallest_solved_limit']:.6g}")
         else:
             out.append(f"smallest limit solved: {ds.attrs['smallest_solved_limit']:.6g}")
     if a.plot:
