@@ -72,3 +72,4 @@ def test_no_brake_above_what_the_excitation_sustains():
     r = optimize_pto(gamma=0.01, torque_limit=0.3, ideal=ideal)
     assert r.method == "hermite" and r.status == "converged"
     assert r.power < 0.3 * r.omega
+

@@ -259,3 +259,10 @@ def test_copper_loss_alone_and_with_a_slack_limit_agree():
     assert r.peak_torque < 2.0
     assert h.electrical_power == pytest.approx(r.electrical_power, rel=1e-7)
     assert h.electrical_power < h.power  # the loss is subtracted
+
+
+def test_a_power_take_off_is_for_one_turn_per_period():
+    """The time-domain solvers are built for K = 1: another winding is refused, not solved
+    silently with one turn."""
+    with pytest.raises(ParameterError, match="winding"):
+        pto.optimize_pto(gamma=0.01, torque_limit=1.0, winding=2)

@@ -121,6 +121,9 @@ def optimize_pto(*, torque_limit=None, efficiency=None, efficiency_generating=No
     r_cu = check_range("copper-loss", copper_loss, 0.0, 1e6)
     if optimize_args.get("method", "fourier") != "fourier":
         raise ParameterError("method: a power take-off is optimized with method 'fourier'")
+    if optimize_args.get("winding", 1) != 1:
+        raise ParameterError("winding: a power take-off is optimized for one turn per "
+                             "forcing period (K = 1); drop winding")
     n = check_int("harmonics", optimize_args.get("harmonics", 24), 1,
                   limits.MAX_PTO_HARMONICS)
     ideal = ideal if ideal is not None else optimize(**optimize_args)
