@@ -404,6 +404,23 @@ def test_cli_text_json_and_plot(capsys, tmp_path):
     assert d["run_power"][0] != d["run_power"][1]  # each run its own noise
 
 
+def test_cli_batch_states_the_count_and_the_fraction_locked(capsys):
+    # three irregular runs of the paper case: two lock, one does not (seed 0), so the
+    # line must give the count, the batch size and the fraction, not "1 of the runs"
+    args = ("track", "--gamma", "0.01", "--torque-limit", "25", "--periods", "20", "--runs",
+            "3", "--irregular")
+    code, out, _ = _cli(capsys, *args)
+    assert code == 0
+    line = next(x for x in out.splitlines() if x.startswith("locked:"))
+    code, js, _ = _cli(capsys, *args, "--json")
+    d = json.loads(js)
+    k = sum(d["run_locked"])
+    assert 0 < k < d["runs"] == 3  # a mixed batch, or the check below says little
+    latest = max(p for p in d["run_lock_period"] if p is not None)
+    assert line == (f"locked: {k} of 3 runs ({100 * k / 3:.3g} %), the latest after "
+                    f"{latest} periods")
+
+
 def test_cli_states_the_irregular_sea(capsys):
     code, out, _ = _cli(capsys, "track", "--gamma", "0.01", "--torque-limit", "25",
                         "--periods", "20", "--irregular", "--seed", "2")
