@@ -158,6 +158,40 @@ def test_open_loop_unstable_optimum_is_locked_and_held():
     assert abs(r.mean_power / opt.power - 1) < 1e-3
 
 
+def test_small_limit_tracks_the_constant_brake_and_locks_at_its_bound():
+    """At T_max = 0.1 the target (the optimum at 0.09) is the constant brake: its power is
+    the bound of every monotone rotation, T_design omega (Eq. 15), reached with status
+    converged; it is unstable open loop, and the loop holds it at that power."""
+    tmax = 0.1
+    r = track(gamma=GAMMA, torque_limit=tmax, periods=200)
+    tg = r._target
+    design = 0.9 * tmax
+    assert r.optimum_status == "converged"
+    assert r.predicted_power == pytest.approx(design * tg.omega, rel=1e-9)
+    assert r.optimum_at_torque_limit == pytest.approx(tmax * tg.omega, rel=1e-9)
+    assert r.tracked_peak_torque == pytest.approx(design, rel=1e-9)
+    assert r.locked and r.peak_torque <= tmax
+    assert r.mean_power == pytest.approx(r.predicted_power, rel=1e-6)
+    # open-loop multipliers: a finite-difference monodromy of Eq. 14 under the constant
+    # torque -T_design (DOP853), independent of the target's Fourier motion but for its
+    # state at t = 0
+
+    def f(t, y):
+        return [y[1], (1 + tg.excitation.q(t)) * math.sin(y[0]) - GAMMA * y[1] - design]
+
+    x0 = np.array([tg.motion.theta(0.0), tg.motion.theta_dot(0.0)], dtype=float)
+    eps = 1e-6
+    cols = [(solve_ivp(f, (0, tg.period), x0 + eps * e, method="DOP853", rtol=1e-12,
+                       atol=1e-12).y[:, -1]
+             - solve_ivp(f, (0, tg.period), x0 - eps * e, method="DOP853", rtol=1e-12,
+                         atol=1e-12).y[:, -1]) / (2 * eps) for e in np.eye(2)]
+    ev = np.sort_complex(np.linalg.eigvals(np.array(cols).T))
+    ref = np.sort_complex([complex(*z) for z in r.open_loop_multipliers])
+    assert np.max(np.abs(ev - ref)) < 1e-4 * np.max(np.abs(ref))
+    assert np.max(np.abs(ref)) > 2  # unstable without feedback
+    assert max(abs(complex(*z)) for z in r.closed_loop_multipliers) < 0.1
+
+
 def test_above_the_damping_threshold_the_rotation_is_held_at_a_cost():
     # gamma = 0.2 > gamma* = 0.0856: the optimum is the smallest loss (status no_power)
     r = track(gamma=0.2, periods=30)
