@@ -158,6 +158,40 @@ def test_open_loop_unstable_optimum_is_locked_and_held():
     assert abs(r.mean_power / opt.power - 1) < 1e-3
 
 
+def test_small_limit_tracks_the_constant_brake_and_locks_at_its_bound():
+    """At T_max = 0.1 the target (the optimum at 0.09) is the constant brake: its power is
+    the bound of every monotone rotation, T_design omega (Eq. 15), reached with status
+    converged; it is unstable open loop, and the loop holds it at that power."""
+    tmax = 0.1
+    r = track(gamma=GAMMA, torque_limit=tmax, periods=200)
+    tg = r._target
+    design = 0.9 * tmax
+    assert r.optimum_status == "converged"
+    assert r.predicted_power == pytest.approx(design * tg.omega, rel=1e-9)
+    assert r.optimum_at_torque_limit == pytest.approx(tmax * tg.omega, rel=1e-9)
+    assert r.tracked_peak_torque == pytest.approx(design, rel=1e-9)
+    assert r.locked and r.peak_torque <= tmax
+    assert r.mean_power == pytest.approx(r.predicted_power, rel=1e-6)
+    # open-loop multipliers: a finite-difference monodromy of Eq. 14 under the constant
+    # torque -T_design (DOP853), independent of the target's Fourier motion but for its
+    # state at t = 0
+
+    def f(t, y):
+        return [y[1], (1 + tg.excitation.q(t)) * math.sin(y[0]) - GAMMA * y[1] - design]
+
+    x0 = np.array([tg.motion.theta(0.0), tg.motion.theta_dot(0.0)], dtype=float)
+    eps = 1e-6
+    cols = [(solve_ivp(f, (0, tg.period), x0 + eps * e, method="DOP853", rtol=1e-12,
+                       atol=1e-12).y[:, -1]
+             - solve_ivp(f, (0, tg.period), x0 - eps * e, method="DOP853", rtol=1e-12,
+                         atol=1e-12).y[:, -1]) / (2 * eps) for e in np.eye(2)]
+    ev = np.sort_complex(np.linalg.eigvals(np.array(cols).T))
+    ref = np.sort_complex([complex(*z) for z in r.open_loop_multipliers])
+    assert np.max(np.abs(ev - ref)) < 1e-4 * np.max(np.abs(ref))
+    assert np.max(np.abs(ref)) > 2  # unstable without feedback
+    assert max(abs(complex(*z)) for z in r.closed_loop_multipliers) < 0.1
+
+
 def test_above_the_damping_threshold_the_rotation_is_held_at_a_cost():
     # gamma = 0.2 > gamma* = 0.0856: the optimum is the smallest loss (status no_power)
     r = track(gamma=0.2, periods=30)
@@ -402,6 +436,23 @@ def test_cli_text_json_and_plot(capsys, tmp_path):
     d = json.loads(out)
     assert d["runs"] == 2 and d["fraction_locked"] == 1.0
     assert d["run_power"][0] != d["run_power"][1]  # each run its own noise
+
+
+def test_cli_batch_states_the_count_and_the_fraction_locked(capsys):
+    # three irregular runs of the paper case: two lock, one does not (seed 0), so the
+    # line must give the count, the batch size and the fraction, not "1 of the runs"
+    args = ("track", "--gamma", "0.01", "--torque-limit", "25", "--periods", "20", "--runs",
+            "3", "--irregular")
+    code, out, _ = _cli(capsys, *args)
+    assert code == 0
+    line = next(x for x in out.splitlines() if x.startswith("locked:"))
+    code, js, _ = _cli(capsys, *args, "--json")
+    d = json.loads(js)
+    k = sum(d["run_locked"])
+    assert 0 < k < d["runs"] == 3  # a mixed batch, or the check below says little
+    latest = max(p for p in d["run_lock_period"] if p is not None)
+    assert line == (f"locked: {k} of 3 runs ({100 * k / 3:.3g} %), the latest after "
+                    f"{latest} periods")
 
 
 def test_cli_states_the_irregular_sea(capsys):

@@ -110,8 +110,9 @@ def _cmd_track(a) -> dict | str:
             f"plant: gamma error within +-{r.gamma_error:g}, delta error within "
             f"+-{r.delta_error:g}, noise (theta, theta') = ({r.noise_theta:g}, "
             f"{r.noise_speed:g}), irregular q: {'yes' if r.irregular else 'no'}",
-            f"locked: {r.fraction_locked:.3g} of the runs (latest lock after "
-            f"{r.lock_period_max} periods)",
+            f"locked: {sum(r.run_locked)} of {r.runs} runs ({100 * r.fraction_locked:.3g} %)"
+            + (f", the latest after {r.lock_period_max} periods"
+               if r.lock_period_max is not None else ""),
             f"mean power over the last 10 periods: mean {_fmt(r.mean_power, 6)} (min "
             f"{_fmt(r.power_min, 6)}, max {_fmt(r.power_max, 6)}); locked runs "
             f"{_fmt(r.locked_mean_power, 6)}; predicted {_fmt(r.predicted_power, 6)}",
