@@ -161,7 +161,8 @@ def test_open_loop_unstable_optimum_is_locked_and_held():
 def test_small_limit_tracks_the_constant_brake_and_locks_at_its_bound():
     """At T_max = 0.1 the target (the optimum at 0.09) is the constant brake: its power is
     the bound of every monotone rotation, T_design omega (Eq. 15), reached with status
-    converged; it is unstable open loop, and the loop holds it at that power."""
+    converged; of the brake rotations it is the stable one, and the loop holds it at that
+    power."""
     tmax = 0.1
     r = track(gamma=GAMMA, torque_limit=tmax, periods=200)
     tg = r._target
@@ -188,7 +189,11 @@ def test_small_limit_tracks_the_constant_brake_and_locks_at_its_bound():
     ev = np.sort_complex(np.linalg.eigvals(np.array(cols).T))
     ref = np.sort_complex([complex(*z) for z in r.open_loop_multipliers])
     assert np.max(np.abs(ev - ref)) < 1e-4 * np.max(np.abs(ref))
-    assert np.max(np.abs(ref)) > 2  # unstable without feedback
+    # of the brake rotations (all of power T_design omega) the target is the node, not the
+    # saddle (3.16 and 0.31): a complex pair of modulus exp(-gamma T / 2) (Liouville: the
+    # product of the multipliers is exp(-gamma T))
+    assert np.abs(ref) == pytest.approx(np.full(2, math.exp(-GAMMA * tg.period / 2)),
+                                        rel=1e-6)
     assert max(abs(complex(*z)) for z in r.closed_loop_multipliers) < 0.1
 
 

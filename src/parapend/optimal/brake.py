@@ -79,16 +79,62 @@ def _newton(x, n, omega, gamma, q1, s, torque_limit, winding, maxiter=50):
     return x, bool(np.max(np.abs(r)) <= 1e-10 * scale)
 
 
+def multipliers(motion, excitation, damping: float) -> np.ndarray:
+    """Floquet multipliers of a rotation under a constant torque: the eigenvalues of the
+    monodromy matrix of Eq. 14 linearized about it, ``d(dtheta)/dt = dv``,
+    ``d(dv)/dt = (1 + q) cos(theta) dtheta - gamma dv`` (SciPy DOP853 over one period)."""
+    from scipy.integrate import solve_ivp
+
+    def rhs(t, y):
+        c = (1.0 + excitation.q(t)) * math.cos(float(motion.theta(t)))
+        return [y[2], y[3], c * y[0] - damping * y[2], c * y[1] - damping * y[3]]
+
+    y = solve_ivp(rhs, (0.0, 2 * math.pi / excitation.omega), [1.0, 0.0, 0.0, 1.0],
+                  method="DOP853", rtol=1e-10, atol=1e-12).y[:, -1]
+    return np.linalg.eigvals(y.reshape(2, 2))
+
+
 def constant_brake(excitation, damping: float, torque_limit: float, start, *,
-                   winding: int = 1, max_harmonics: int = 1024):
-    """The rotation under the constant torque ``-torque_limit``, from ``start`` (a motion
-    near it, e.g. the torque-limited optimum).
+                   winding: int = 1, max_harmonics: int = 1024, phases: int = 8):
+    """The rotation under the constant torque ``-torque_limit``: Newton's method from
+    ``start`` (a motion near it, e.g. the torque-limited optimum) and from the uniform
+    rotations ``theta = K omega t + phi`` at ``phases`` phases.
+
+    Every such rotation has the power ``K omega T_max``; there may be several (a saddle
+    and a node of the forced pendulum: two at ``gamma = 0.01``, ``T_max = 0.063``, Floquet
+    multipliers 3.59 and 0.27 against a complex pair of modulus ``exp(-gamma T_p / 2)``).
+    The one returned has the smallest largest multiplier: the one a controller holds most
+    easily (docs/control.md).
 
     Returns ``(motion, harmonics, change)``: a :class:`FourierMotion` with ``theta' > 0``
     everywhere, its number of harmonics and the largest coefficient change at the last
-    doubling; or None when Newton's method does not converge (no such rotation near the
-    start, e.g. a limit too large to be sustained) or the rotation turns back.
+    doubling; or None when no start converges (no such rotation, e.g. a limit too large to
+    be sustained) or every rotation found turns back.
     """
+    omega = excitation.omega
+    starts = [start] + [FourierMotion(omega, 2 * math.pi * j / phases, np.zeros(1),
+                                      np.zeros(1), winding) for j in range(phases)]
+    found = []
+    for st in starts:
+        f = _one_brake(excitation, damping, torque_limit, st, winding, max_harmonics)
+        if f is None:
+            continue
+        t0 = np.array([0.0])
+        key = (float(np.mod(f[0].theta(t0)[0], 2 * math.pi)), float(f[0].theta_dot(t0)[0]))
+        if any(abs(key[0] - k[0]) < 1e-6 and abs(key[1] - k[1]) < 1e-6 for k, _ in found):
+            continue
+        found.append((key, f))
+    if not found:
+        return None
+    if len(found) == 1:
+        return found[0][1]
+    worst = [float(np.max(np.abs(multipliers(f[0], excitation, damping)))) for _, f in found]
+    return found[int(np.argmin(worst))][1]
+
+
+def _one_brake(excitation, damping, torque_limit, start, winding, max_harmonics):
+    """Newton's method from one start (:func:`constant_brake`), ``N`` doubled until the
+    coefficients settle."""
     omega = excitation.omega
     period = 2 * math.pi / omega
     m = 4096
