@@ -14,8 +14,9 @@ Two methods, both warm-started from the ideal optimum of :func:`parapend.optimiz
   system (the optimal torque is bang-bang: a local basis resolves its jumps, a Fourier
   series does not); K from the excitation, checked by one doubling;
 - an efficiency (with or without a limit), or a copper loss without a limit:
-  :mod:`parapend.optimal.constrained`, the smoothed efficiency (and an augmented Lagrangian
-  for the limit) on the exact-Hessian Fourier Newton kernel.
+  :mod:`parapend.optimal.collocation`, Hermite-Simpson collocation with the torque as an
+  unknown (the efficiency exact through two slacks per point) and a full-space primal-dual
+  interior point on the banded KKT system; K from the excitation, checked by one doubling.
 """
 
 from __future__ import annotations
@@ -28,7 +29,7 @@ import numpy as np
 from . import limits
 from .api import _coefficients, optimize
 from .errors import ParameterError, SolverError, check_finite, check_int, check_range
-from .optimal.constrained import PTOSolution, pto_profile, solve_pto
+from .optimal.constrained import PTOSolution, pto_profile
 from .power import uniform_power
 from .trajectory import FourierMotion
 
@@ -135,17 +136,11 @@ def optimize_pto(*, torque_limit=None, efficiency=None, efficiency_generating=No
                                   motoring_energy=prof["motoring_energy"],
                                   harvested_energy=prof["harvested_energy"])
         return dataclasses.replace(res, **physical_fields(res, units))
-    extra = {}
     if eff is None and tmax is not None:
         sol, motion, extra = _time_domain(exc, gamma, ideal, tmax, r_cu, warm)
-        coefficients = _coefficients(_projection(motion, exc, n))
     else:
-        x0 = ideal.motion.vector if warm is None or not isinstance(warm, np.ndarray) else \
-            np.asarray(warm, dtype=float)
-        sol = solve_pto(exc, n, gamma, x0, torque_limit=tmax, efficiency=eff,
-                        copper_loss=r_cu)
-        motion = FourierMotion.from_vector(exc.omega, sol.x)
-        coefficients = _coefficients(motion)
+        sol, motion, extra = _collocation(exc, gamma, ideal, tmax, r_cu, eff, warm)
+    coefficients = _coefficients(_projection(motion, exc, n))
     prof = pto_profile(motion, exc, gamma, efficiency=eff)
     pu = ideal.uniform_power
     status = sol.status
@@ -162,9 +157,11 @@ def optimize_pto(*, torque_limit=None, efficiency=None, efficiency_generating=No
                          f"{limits.MAX_PTO_INTERVALS})",
            "stalled": ("stalled: the interior point could not meet the limit between its "
                        "points, or its last steps made no progress; the motion is reported as "
-                       "it is (see max_violation)" if eff is None else
-                       "stalled: the augmented Lagrangian did not settle its multipliers; "
-                       "the motion is feasible but may not be optimal"),
+                       "it is (see max_violation)" if extra["method"] == "hermite" else
+                       "stalled: the interior point's line search found no acceptable "
+                       "point; the motion is reported as it is"),
+           "singular": "singular: no regularization of the KKT matrix gave a descent "
+                       "step; the motion is reported as it is",
            "max_iterations": "maximum number of Newton iterations reached",
            "nonfinite": "non-finite power encountered"}.get(status, status)
     res = dataclasses.replace(
@@ -252,6 +249,57 @@ def _time_domain(exc, gamma, ideal, tmax, copper_loss, warm, rtol: float = 1e-6)
     return out, motion, {"method": "hermite", "intervals": k, "refinement_change": change}
 
 
+def _collocation(exc, gamma, ideal, tmax, copper_loss, eff, warm, rtol: float = 1e-6):
+    """Efficiency / copper-loss optimum by Hermite-Simpson collocation
+    (:mod:`parapend.optimal.collocation`), the intervals doubled until the electrical power
+    moves by less than ``rtol``."""
+    from .optimal.collocation import solve_collocation
+
+    if warm is None:
+        start = ideal.motion
+    elif isinstance(warm, np.ndarray):
+        start = FourierMotion.from_vector(exc.omega, np.asarray(warm, dtype=float))
+    else:
+        start = warm
+    k = intervals_for(exc)
+    prev = last = None
+    iters = 0
+    change = float("nan")
+    while True:
+        sol = solve_collocation(exc, gamma, k, start, efficiency=eff, torque_limit=tmax,
+                                copper_loss=copper_loss)
+        iters += sol.iterations
+        if sol.status != "converged" and last is None and start is not ideal.motion:
+            # a warm start (continuation) that failed: from the ideal optimum instead
+            start = ideal.motion
+            continue
+        if sol.status != "converged":
+            if last is not None:
+                sol, k = last  # the converged coarser optimum: kept, "unresolved"
+            break
+        last = sol, k
+        if prev is not None:
+            change = abs(sol.electrical_power - prev)
+            if change <= rtol * max(1.0, abs(sol.electrical_power)) or \
+                    2 * k > limits.MAX_PTO_INTERVALS:
+                break
+        prev = sol.electrical_power
+        start = sol.motion
+        k *= 2
+    status = sol.status
+    if status == "converged" and not change <= rtol * max(1.0, abs(sol.electrical_power)):
+        status = "unresolved"
+    viol = 0.0 if tmax is None else max(sol.peak_torque / tmax - 1.0, 0.0)
+    out = PTOSolution(x=np.concatenate([sol.motion.theta_nodes, sol.motion.v_nodes,
+                                        sol.motion.u_nodes]),
+                      power=sol.power, electrical_power=sol.electrical_power,
+                      peak_torque=sol.peak_torque, max_violation=viol, status=status,
+                      iterations=iters, outer_iterations=1, gradient_norm=sol.kkt_error,
+                      points=2 * k)
+    return out, sol.motion, {"method": "collocation", "intervals": k,
+                             "refinement_change": change}
+
+
 def _smallest_limit(ideal):
     """The smallest peak torque of a rotation (phase 1 of :mod:`parapend.optimal.hermite`
     from the best uniform rotation, on twice :func:`intervals_for` intervals): ``(dense
@@ -278,7 +326,8 @@ def pto_curve(vary: str = "torque-limit", *, values=None, points: int = 12,
         smallest feasible limit (the smallest peak torque of any rotation found, phase 1 of
         :mod:`parapend.optimal.hermite`; 2 % of the top when a free rotation makes that
         about 0), each solve warm-started from the previous; with an efficiency, down to 2 %
-        of the top (the Fourier method), stopping at the first infeasible value;
+        of the top (:mod:`parapend.optimal.collocation`), stopping at the first infeasible
+        value;
         ``efficiency``: ``eta = eta_g = eta_m`` from 1 down to 0.5 (or ``values``).
     values : sequence of float or None
         The limits (m g l) or efficiencies to use instead of the defaults.
@@ -331,7 +380,7 @@ def pto_curve(vary: str = "torque-limit", *, values=None, points: int = 12,
             progress(i + 1, len(vals))
         if vary == "torque-limit" and r.status == "infeasible":
             break  # below the smallest feasible limit: smaller ones are infeasible too
-        warm = r.motion if r.method == "hermite" else r.motion.vector
+        warm = r.motion
     feas = [r.torque_limit for r in rows if r.status != "infeasible"]
     ds = xr.Dataset(
         {"power": ("value", [r.power for r in rows]),

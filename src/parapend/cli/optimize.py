@@ -149,7 +149,8 @@ def _cmd_optimize(a) -> dict | str:
     if r.winding != 1:
         name += f", winding K = {r.winding}"
     if pto:
-        name = (f"power take-off optimum, K = {r.intervals}" if r.method == "hermite" else
+        name = (f"power take-off optimum, K = {r.intervals}"
+                if r.method in ("hermite", "collocation") else
                 f"power take-off optimum, N = {r.harmonics}")
     rows = [
         ["best uniform rotation (Eq. 17)", _fmt(r.uniform_power), ""],
@@ -169,6 +170,9 @@ def _cmd_optimize(a) -> dict | str:
             search += f"; second-best maximum {_fmt(r.second_power)}"
     elif r.method == "hermite":
         how = (f"{r.iterations} interior-point iterations, {r.intervals} cubic Hermite "
+               f"intervals, started from the {r.found_by}")
+    elif r.method == "collocation":
+        how = (f"{r.iterations} interior-point iterations, {r.intervals} Hermite-Simpson "
                f"intervals, started from the {r.found_by}")
     else:
         how = (f"{r.mesh_nodes} mesh nodes, max residual {r.max_residual:.2g}, "

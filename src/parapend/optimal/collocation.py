@@ -54,8 +54,6 @@ __all__ = ["CollocationMotion", "CollocationSolution", "solve_collocation"]
 _KL = 14  # half bandwidth of the folded KKT matrix
 _NB = 5  # unknowns per node block: theta, v, u, and the two multipliers of its interval
 _FRACTION = 0.995
-_DEBUG = False
-_THETA_MAX = 1e4
 
 
 def _fold(k: int) -> np.ndarray:
@@ -537,6 +535,7 @@ def solve_collocation(excitation, damping: float, intervals: int, start, *,
     filt = []  # (theta, phi) pairs of the filter, reset when mu changes
     delta_last = 0.0
     delta_c = 1e-12
+    resets = 0
     ls_multipliers = True
     status = "max_iterations"
     history = []
@@ -550,7 +549,6 @@ def solve_collocation(excitation, damping: float, intervals: int, start, *,
         err_mu = max(dual_inf, prim_inf, comp)
         # the error of the unperturbed KKT conditions: complementarity without mu
         err0 = max(dual_inf, prim_inf, comp + mu)
-        history.append((mu, err_mu))
         if not math.isfinite(err_mu):
             status = "nonfinite"
             break
@@ -646,7 +644,7 @@ def solve_collocation(excitation, damping: float, intervals: int, start, *,
         phi0, th0 = _merit(th, v, u, a, b, q1n, q1m, h, damping, wrap, mu, eg, em, r, tmax,
                            slack, 0.0)
         if theta_max is None:
-            theta_max = _THETA_MAX * max(1.0, th0)
+            theta_max = 1e4 * max(1.0, th0)
             theta_min = 1e-4 * max(1.0, th0)
         slope = _slope(th, v, u, a, b, dz, da if slack else None, db if slack else None,
                        q1n, q1m, h, damping, wrap, mu, eg, em, r, tmax, w, slack, gp, jb)
@@ -674,6 +672,12 @@ def solve_collocation(excitation, damping: float, intervals: int, start, *,
             alpha *= 0.5
             if alpha < 1e-12:
                 break
+        if not accepted and filt and resets < 5:
+            # the filter blocks every point along the step (no restoration phase here):
+            # forget it (IPOPT's filter reset heuristic) and try again
+            filt = []
+            resets += 1
+            continue
         if not accepted:
             # no acceptable point along the step: at the final barrier parameter with the
             # KKT error within 1000 tol this is the floor of the arithmetic (IPOPT's
@@ -683,8 +687,7 @@ def solve_collocation(excitation, damping: float, intervals: int, start, *,
             break
         if not ftype:
             filt.append(((1 - 1e-5) * th0, phi0 - 1e-5 * th0))
-        if _DEBUG:
-            print(it, f"mu={mu:.1e} err={err_mu:.2e} d={dual_inf:.1e} p={prim_inf:.1e} c={comp:.1e} amax={amax:.2e} alpha={alpha:.2e} dmax={dmax:.2e} delta={delta:.1e} slope={slope:.2e} th0={th0:.1e} ftype={ftype}")
+        history.append((mu, err_mu, delta, alpha))
         th, v, u, a, b = thn, vn, un, an, bn
         y = y + alpha * dy
         if slack:
