@@ -276,15 +276,15 @@ def _kkt(th, v, u, a, b, xi, za, zb, y, al, be, q1n, q1m, h, gamma, wrap, pos, m
 
 
 @nb.njit(cache=True)
-def _inertia(band, kl):
-    """Number of negative pivots of the banded ``L D L^T`` (no pivoting) of the symmetric
-    matrix with lower band ``band[d, j] = A[j + d, j]``, and whether a pivot was tiny
-    (zero: the count is then unreliable). By Sylvester's law it is the number of negative
-    eigenvalues."""
+def _ldl(band, kl):
+    """Banded ``L D L^T`` without pivoting of the symmetric matrix with lower band
+    ``band[d, j] = A[j + d, j]``, in place (``band[0]`` becomes ``D``, ``band[d, j]`` the
+    multiplier ``L[j + d, j]``). Returns the number of negative pivots, which by Sylvester's
+    law is the number of negative eigenvalues, and whether a pivot was zero (the count and
+    the factors are then unusable)."""
     n = band.shape[1]
-    a = band.copy()
+    a = band
     neg = 0
-    tiny = False
     for j in range(n):
         d = a[0, j]
         if abs(d) <= 1e-200 or not math.isfinite(d):
@@ -298,7 +298,75 @@ def _inertia(band, kl):
                 for c in range(i, top + 1):
                     # A[j + c, j + i] -= A[j + c, j] A[j + i, j] / d
                     a[c - i, j + i] -= a[c, j] * lij
-    return neg, tiny
+        for i in range(1, top + 1):
+            a[i, j] /= d
+    return neg, False
+
+
+def _inertia(band, kl):
+    """Number of negative eigenvalues of a symmetric banded matrix (:func:`_ldl` on a
+    copy), and whether the factorization broke down."""
+    return _ldl(band.copy(), kl)
+
+
+@nb.njit(cache=True)
+def _ldl_solve(fac, kl, ab, rhs):
+    """Solve with the factors of :func:`_ldl`, then one step of iterative refinement on the
+    matrix ``ab`` (general band storage, half bandwidth ``kl``). Returns the solution and
+    the relative residual after refinement (max norm)."""
+    n = rhs.size
+    x = _ldl_subst(fac, kl, rhs)
+    for _ in range(2):
+        r = rhs - _band_mult(ab, kl, x)
+        dx = _ldl_subst(fac, kl, r)
+        x += dx
+    r = rhs - _band_mult(ab, kl, x)
+    big = 0.0
+    res = 0.0
+    for i in range(n):
+        big = max(big, abs(rhs[i]))
+        res = max(res, abs(r[i]))
+    return x, res / max(big, 1e-300)
+
+
+@nb.njit(cache=True)
+def _ldl_subst(fac, kl, b):
+    n = b.size
+    x = b.copy()
+    for j in range(n):  # L y = b
+        xj = x[j]
+        for i in range(1, min(kl, n - 1 - j) + 1):
+            x[j + i] -= fac[i, j] * xj
+    for j in range(n):
+        x[j] /= fac[0, j]
+    for j in range(n - 1, -1, -1):  # L^T x = y
+        acc = x[j]
+        for i in range(1, min(kl, n - 1 - j) + 1):
+            acc -= fac[i, j] * x[j + i]
+        x[j] = acc
+    return x
+
+
+@nb.njit(cache=True)
+def _band_mult(ab, kl, x):
+    """``A x`` for ``A`` in LAPACK's general band storage (``A[i, j]`` at
+    ``ab[2 kl + i - j, j]``)."""
+    n = x.size
+    y = np.zeros(n)
+    for j in range(n):
+        xj = x[j]
+        for i in range(max(0, j - kl), min(n, j + kl + 1)):
+            y[i] += ab[2 * kl + i - j, j] * xj
+    return y
+
+
+@nb.njit(cache=True)
+def _to_boundary(x, dx, cur, frac):
+    """Largest step ``<= cur`` with ``x + alpha dx >= (1 - frac) x``."""
+    for i in range(x.size):
+        if dx[i] < 0:
+            cur = min(cur, -frac * x[i] / dx[i])
+    return cur
 
 
 @nb.njit(cache=True)
@@ -582,10 +650,17 @@ def solve_collocation(excitation, damping: float, intervals: int, start, *,
             m = ab.copy()
             m[2 * _KL, zdiag] += delta
             m[2 * _KL, ydiag] -= delta_c
-            neg, tiny = _inertia(m[2 * _KL:], _KL)
+            fac = m[2 * _KL:].copy()
+            neg, tiny = _ldl(fac, _KL)
             if neg == n2 and not tiny:
-                x, info = dgbsv(_KL, _KL, m, rhs)[2:]
-                if info == 0 and np.all(np.isfinite(x)):
+                x, res = _ldl_solve(fac, _KL, m, rhs)
+                if not res <= 1e-10:
+                    # the factorization without pivoting lost accuracy: banded LU with
+                    # partial pivoting (the inertia count stands)
+                    x, info = dgbsv(_KL, _KL, m, rhs)[2:]
+                    if info != 0:
+                        x = x + math.nan
+                if np.all(np.isfinite(x)):
                     sol = x
                     break
             if tiny:
@@ -625,18 +700,12 @@ def solve_collocation(excitation, damping: float, intervals: int, start, *,
         # fraction to the boundary
         amax = 1.0
         dmax = 1.0
-
-        def ftb(x, dx, cur):
-            neg = dx < 0
-            return min(cur, float(np.min(-_FRACTION * x[neg] / dx[neg]))) if np.any(neg) \
-                else cur
-
         if slack:
-            amax = ftb(b, db, ftb(a, da, amax))
-            dmax = ftb(zb, dzb, ftb(za, dza, dmax))
+            amax = _to_boundary(b, db, _to_boundary(a, da, amax, _FRACTION), _FRACTION)
+            dmax = _to_boundary(zb, dzb, _to_boundary(za, dza, dmax, _FRACTION), _FRACTION)
         if tmax > 0:
-            amax = ftb(gdn, du, ftb(gup, -du, amax))
-            dmax = ftb(be, dbe, ftb(al, dal, dmax))
+            amax = _to_boundary(gdn, du, _to_boundary(gup, -du, amax, _FRACTION), _FRACTION)
+            dmax = _to_boundary(be, dbe, _to_boundary(al, dal, dmax, _FRACTION), _FRACTION)
         # filter line search (Waechter & Biegler 2006, without restoration): a trial point
         # is accepted if it reduces the infeasibility theta or the barrier objective phi
         # enough and is not dominated by the filter; an objective step (theta small, phi
