@@ -311,15 +311,13 @@ def _inertia(band, kl):
 
 @nb.njit(cache=True)
 def _ldl_solve(fac, kl, ab, rhs):
-    """Solve with the factors of :func:`_ldl`, then one step of iterative refinement on the
+    """Solve with the factors of :func:`_ldl` and one step of iterative refinement on the
     matrix ``ab`` (general band storage, half bandwidth ``kl``). Returns the solution and
     the relative residual after refinement (max norm)."""
     n = rhs.size
     x = _ldl_subst(fac, kl, rhs)
-    for _ in range(2):
-        r = rhs - _band_mult(ab, kl, x)
-        dx = _ldl_subst(fac, kl, r)
-        x += dx
+    r = rhs - _band_mult(ab, kl, x)
+    x += _ldl_subst(fac, kl, r)
     r = rhs - _band_mult(ab, kl, x)
     big = 0.0
     res = 0.0
@@ -358,6 +356,40 @@ def _band_mult(ab, kl, x):
         for i in range(max(0, j - kl), min(n, j + kl + 1)):
             y[i] += ab[2 * kl + i - j, j] * xj
     return y
+
+
+@nb.njit(cache=True)
+def _recover(dz, gp, dpc, a, b, xi, za, zb, mu, eg, em):
+    """The eliminated per-point unknowns along the step ``dz`` (K, 3): ``dxi`` (multiplier
+    of ``p+ - p- = p``), ``dp+``, ``dp-`` and their bound multipliers' steps."""
+    k = dz.shape[0]
+    n2 = 2 * k
+    dxi = np.empty(n2)
+    da = np.empty(n2)
+    db = np.empty(n2)
+    dza = np.empty(n2)
+    dzb = np.empty(n2)
+    for i in range(n2):
+        j = i // 2
+        if i % 2 == 0:  # node: grad p = (0, -u, -v)
+            gdz = gp[i, 1] * dz[j, 1] + gp[i, 2] * dz[j, 2]
+            w = 1.0
+        else:  # midpoint: the interval's two nodes
+            jb = j + 1 if j + 1 < k else 0
+            gdz = 0.0
+            for c in range(3):
+                gdz += gp[i, c] * dz[j, c] + gp[i, 3 + c] * dz[jb, c]
+            w = 2.0
+        sa = za[i] / a[i]
+        sb = zb[i] / b[i]
+        dxi[i] = dpc[i] - gdz / (1.0 / sa + 1.0 / sb)
+        ra = -w * eg + xi[i] - mu / a[i]
+        rb = w / em - xi[i] - mu / b[i]
+        da[i] = (-ra - dxi[i]) / sa
+        db[i] = (-rb + dxi[i]) / sb
+        dza[i] = mu / a[i] - za[i] - sa * da[i]
+        dzb[i] = mu / b[i] - zb[i] - sb * db[i]
+    return dxi, da, db, dza, dzb
 
 
 @nb.njit(cache=True)
@@ -680,19 +712,7 @@ def solve_collocation(excitation, damping: float, intervals: int, start, *,
         dth, dv, du = dz[:, 0], dz[:, 1], dz[:, 2]
         # eliminated unknowns
         if slack:
-            # grad p^T dz per point: nodes (0, -u, -v); midpoints local 6-vectors
-            gdz = np.empty(n2)
-            gdz[0::2] = gp[0::2, 1] * dv + gp[0::2, 2] * du
-            loc = np.concatenate([dz, dz[jb]], axis=1)
-            gdz[1::2] = np.sum(gp[1::2] * loc, axis=1)
-            sa_, sb_ = za / a, zb / b
-            dxi = dpc - gdz * (1.0 / (1.0 / sa_ + 1.0 / sb_))
-            ra = -w * eg + xi - mu / a
-            rb = w / em - xi - mu / b
-            da = (-ra - dxi) / sa_
-            db = (-rb + dxi) / sb_
-            dza = mu / a - za - sa_ * da
-            dzb = mu / b - zb - sb_ * db
+            dxi, da, db, dza, dzb = _recover(dz, gp, dpc, a, b, xi, za, zb, mu, eg, em)
         if tmax > 0:
             gup, gdn = tmax - u, tmax + u
             dal = mu / gup - al + al / gup * du
