@@ -267,7 +267,7 @@ def _collocation(exc, gamma, ideal, tmax, copper_loss, eff, warm, rtol: float = 
     change = float("nan")
     while True:
         sol = solve_collocation(exc, gamma, k, start, efficiency=eff, torque_limit=tmax,
-                                copper_loss=copper_loss)
+                                copper_loss=copper_loss, winding=ideal.winding)
         iters += sol.iterations
         if sol.status != "converged" and last is None and start is not ideal.motion:
             # a warm start (continuation) that failed: from the ideal optimum instead

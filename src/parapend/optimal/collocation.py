@@ -602,7 +602,9 @@ def solve_collocation(excitation, damping: float, intervals: int, start, *,
     if tmax > 0:
         u = np.clip(u, -0.99 * tmax, 0.99 * tmax)
     if mu0 is None:
-        mu0 = 1e-2
+        # on the objective scaled by 3K (Simpson weights 1 and 2, slack multipliers of
+        # order 1): 1 took the fewest steps of 0.01 to 3 over 120 cases (docs/units.md)
+        mu0 = 1.0
     mu = mu0
     mu_min = tol / 10
     n2 = 2 * k
@@ -794,8 +796,9 @@ def solve_collocation(excitation, damping: float, intervals: int, start, *,
     ws = w / (3 * k)
     mech = float(ws @ p)
     ele = float(ws @ np.where(p > 0, eg * p, p / em)) - r * float(ws @ (uu * uu))
-    return CollocationSolution(motion, mech, ele, float(np.max(np.abs(u))), status, it, k,
-                               err0, mu, history)
+    # iterations: the Newton steps (KKT solves), not the barrier updates
+    return CollocationSolution(motion, mech, ele, float(np.max(np.abs(u))), status,
+                               len(history), k, err0, mu, history)
 
 
 def _slope(th, v, u, a, b, dz, da, db, q1n, q1m, h, gamma, wrap, mu, eg, em, r, tmax, w,
