@@ -15,9 +15,9 @@ separated form, the midpoint states given by the nodes of the interval::
     v_b - v_a - h/6 (f_a + 4 f_m + f_b) = 0
 
 (2 equations per interval). The mechanical power at the ``2K`` points (nodes and
-midpoints) is ``p = -u v``; its mean is Simpson's rule (weights 1/3K at nodes, 2/3K at
-midpoints), as is the copper loss ``r <u^2>`` (exact for a piecewise-linear ``u``). The
-efficiency is exact, through two slacks per point: ``p+ - p- = p``, ``p+, p- >= 0``,
+midpoints) is ``p = -u v``; its mean (``P``, Eq. 15) is Simpson's rule (weights 1/3K at
+nodes, 2/3K at midpoints), as is the copper loss ``r <u^2>`` (exact for a piecewise-linear
+``u``). The efficiency is exact, through two slacks per point: ``p+ - p- = p``, ``p+, p- >= 0``,
 objective ``eta_g p+ - p- / eta_m`` (maximized; ``eta_g <= 1/eta_m``, so at the optimum one
 of the two vanishes). Optional bounds ``|u_j| <= T_max`` (at the nodes: the torque is
 linear between them, so this is ``|u(t)| <= T_max`` everywhere).
@@ -25,17 +25,20 @@ linear between them, so this is ``|u(t)| <= T_max`` everywhere).
 **Solver.** A primal-dual interior point in the manner of IPOPT (Waechter & Biegler 2006):
 log barrier on the bounds, the Fiacco-McCormick rule ``mu <- max(mu_min, min(mu/5,
 mu^1.5))`` once the barrier problem is solved to ``10 mu``, fraction to the boundary 0.995,
-backtracking on the l1 merit function. Per point, the slacks, their bound multipliers and
-the multiplier of ``p+ - p- = p`` are eliminated in closed form (a rank-one term
-``Sigma+ Sigma- / (Sigma+ + Sigma-) grad p grad p^T``), the torque-bound multipliers
+a filter line search (without restoration phase: a filter that blocks the whole step is
+reset), least-squares multipliers at the start. Per point, the slacks, their bound
+multipliers and the multiplier of ``p+ - p- = p`` are eliminated in closed form (a rank-one
+term ``Sigma+ Sigma- / (Sigma+ + Sigma-) grad p grad p^T``), the torque-bound multipliers
 likewise (diagonal). What remains is the symmetric indefinite KKT system in
 ``(theta_j, v_j, u_j)`` and the two collocation multipliers per interval; ordered by node
 as ``0, K-1, 1, K-2, ...`` (the periodic wrap becomes local) it is banded with half
-bandwidth 14, solved by LAPACK's banded LU (``dgbsv``) in ``O(K)``. The primal
-regularization ``delta`` is chosen without an inertia count, by the curvature test of
-Chiang & Zavala (2016): the step is accepted when ``dz^T (W + delta I) dz >= kappa
-dz^T dz``, else ``delta`` is raised and the system solved again; a small dual
-regularization keeps it regular.
+bandwidth 14. It is factored as a banded ``L D L^T`` without pivoting: by Sylvester's law
+the signs of ``D`` give its inertia, which must show exactly ``2K`` negative eigenvalues
+(the reduced Hessian positive definite; else ``delta I`` is added to the primal block,
+IPOPT's inertia correction, and the factorization repeated). The step comes from the same
+factors with one step of iterative refinement (LAPACK's banded LU with partial pivoting,
+``dgbsv``, when the residual stays above 1e-10). The inertia-free curvature test of Chiang
+& Zavala (2016) was tried first: it let the iterates converge to saddle points.
 
 Assembly, step recovery and merit are compiled with numba.
 """
@@ -402,7 +405,7 @@ def _to_boundary(x, dx, cur, frac):
 
 
 @nb.njit(cache=True)
-def _merit(th, v, u, a, b, q1n, q1m, h, gamma, wrap, mu, eg, em, r, tmax, slack, nu):  # noqa: ARG001
+def _merit(th, v, u, a, b, q1n, q1m, h, gamma, wrap, mu, eg, em, r, tmax, slack):
     """``(barrier objective, infeasibility sum |c| + |e|)`` (scaled objective ``3K`` times
     the negated mean electrical power); ``inf`` barrier outside the bounds."""
     k = th.size
@@ -677,7 +680,7 @@ def solve_collocation(excitation, damping: float, intervals: int, start, *,
         # of the last, growing 8-fold) for which the matrix has exactly 2K negative
         # eigenvalues, i.e. W + delta I is positive definite on the null space of the
         # defects' Jacobian (else the step may lead to a saddle point); the inertia from
-        # the signs of a banded LDL^T, the step from LAPACK's banded LU
+        # the signs of a banded LDL^T, the step from the same factors
         delta = 0.0
         sol = None
         for _ in range(60):
@@ -733,7 +736,7 @@ def solve_collocation(excitation, damping: float, intervals: int, start, *,
         # enough and is not dominated by the filter; an objective step (theta small, phi
         # decreasing along the step) must satisfy Armijo on phi
         phi0, th0 = _merit(th, v, u, a, b, q1n, q1m, h, damping, wrap, mu, eg, em, r, tmax,
-                           slack, 0.0)
+                           slack)
         if theta_max is None:
             theta_max = 1e4 * max(1.0, th0)
             theta_min = 1e-4 * max(1.0, th0)
@@ -747,7 +750,7 @@ def solve_collocation(excitation, damping: float, intervals: int, start, *,
             an = a + alpha * da if slack else a
             bn = b + alpha * db if slack else b
             phi1, th1 = _merit(thn, vn, un, an, bn, q1n, q1m, h, damping, wrap, mu, eg, em,
-                               r, tmax, slack, 0.0)
+                               r, tmax, slack)
             if math.isfinite(phi1) and th1 <= theta_max and not any(
                     th1 >= tf and phi1 >= pf for tf, pf in filt):
                 switching = slope < 0 and alpha * (-slope) ** 2.3 > th0 ** 1.1 and \
