@@ -173,3 +173,16 @@ def test_optimize_pto_routes_and_reports_the_collocation():
     assert r.motoring_energy == prof["motoring_energy"]
     # with efficiency 0.7 the optimum (almost) never motors
     assert r.motoring_energy < 1e-3
+
+
+def test_limit_below_the_smallest_peak_is_infeasible_not_an_exception():
+    """At gamma = 0.3 no rotation has a peak torque below 0.4165 (phase 1 of the Hermite
+    method, docs/units.md): with an efficiency and T_max = 0.3 the status says so."""
+    r = pto.optimize_pto(gamma=0.3, efficiency=0.7, torque_limit=0.3)
+    assert (r.method, r.status, r.success) == ("collocation", "infeasible", False)
+    assert "raise the torque limit" in r.message
+    with pytest.raises(parapend.errors.SolverError, match="infeasible"):
+        pto.optimize_pto(gamma=0.3, efficiency=0.7, torque_limit=0.3, throw=True)
+    ok = pto.optimize_pto(gamma=0.3, efficiency=0.7, torque_limit=0.5)
+    assert ok.status == "no_power" and ok.success  # feasible, and every rotation costs
+    assert ok.peak_torque <= 0.5 * (1 + 1e-12)

@@ -289,6 +289,11 @@ def _collocation(exc, gamma, ideal, tmax, copper_loss, eff, warm, rtol: float = 
     status = sol.status
     if status == "converged" and not change <= rtol * max(1.0, abs(sol.electrical_power)):
         status = "unresolved"
+    if status != "converged" and tmax is not None and last is None and \
+            not sol.infeasibility <= 1e-6:
+        # no motion meeting the dynamics was found within the limit (below the smallest
+        # peak torque of a rotation, the interior point stalls far from the dynamics)
+        status = "infeasible"
     viol = 0.0 if tmax is None else max(sol.peak_torque / tmax - 1.0, 0.0)
     out = PTOSolution(x=np.concatenate([sol.motion.theta_nodes, sol.motion.v_nodes,
                                         sol.motion.u_nodes]),

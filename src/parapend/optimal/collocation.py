@@ -549,8 +549,9 @@ class CollocationSolution:
     ``power``: Simpson mean of ``p = -u v`` (mechanical); ``electrical_power``: the mean of
     ``eta_g p`` / ``p / eta_m`` at the points, exact (not the slacks), minus the copper
     loss; ``peak_torque``: ``max |u_j|``; ``status`` "converged", "max_iterations",
-    "stalled" (the line search failed) or "nonfinite"; ``kkt_error``: the final
-    unscaled KKT error (max norm).
+    "stalled" (the line search failed), "singular" or "nonfinite"; ``kkt_error``: the
+    final KKT error (max norm, scaled objective); ``infeasibility``: the largest defect of
+    the collocation equations at the returned motion (0 up to roundoff when converged).
     """
 
     motion: CollocationMotion
@@ -563,6 +564,7 @@ class CollocationSolution:
     kkt_error: float
     mu: float
     history: list = field(default_factory=list)
+    infeasibility: float = math.nan
 
 
 def solve_collocation(excitation, damping: float, intervals: int, start, *,
@@ -799,9 +801,13 @@ def solve_collocation(excitation, damping: float, intervals: int, start, *,
     ws = w / (3 * k)
     mech = float(ws @ p)
     ele = float(ws @ np.where(p > 0, eg * p, p / em)) - r * float(ws @ (uu * uu))
+    g = np.zeros((9, 6))
+    defect = max((max(abs(c[0]), abs(c[1])) for c in (
+        _interval(j, k, th, v, u, q1n, q1m, h, damping, wrap, g) for j in range(k))),
+        default=0.0)
     # iterations: the Newton steps (KKT solves), not the barrier updates
     return CollocationSolution(motion, mech, ele, float(np.max(np.abs(u))), status,
-                               len(history), k, err0, mu, history)
+                               len(history), k, err0, mu, history, float(defect))
 
 
 def _slope(th, v, u, a, b, dz, da, db, q1n, q1m, h, gamma, wrap, mu, eg, em, r, tmax, w,
