@@ -421,6 +421,9 @@ def plot_pto_profile(result, path=None, points: int = 2000):
     exc = result._excitation
     eff = None if result.efficiency_generating is None else (result.efficiency_generating,
                                                               result.efficiency_motoring)
+    k = getattr(result.motion, "intervals", None)
+    if k:  # a grid through every node: the vertices of a piecewise-linear torque drawn
+        points = k * -(-points // k)
     prof = pto_profile(result.motion, exc, result.gamma, points=points, efficiency=eff)
     tau = prof["tau"]
     fig, (ax1, ax2) = plt.subplots(2, 1, figsize=(7, 5.5), sharex=True)
