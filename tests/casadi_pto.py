@@ -3,8 +3,10 @@
 Hermite-Simpson collocation (separated form) of the controlled pendulum, Eq. 14,
 ``theta' = v, v' = -gamma v + (1 + q(t)) sin(theta) + T``, with the torque ``T`` as the
 control at every node and midpoint, over one forcing period, periodic up to one turn
-(``theta(T_p) = theta(0) + 2 pi``, ``v(T_p) = v(0)``). It shares nothing with
-:mod:`parapend.optimal.constrained` but the excitation's ``q(t)``:
+(``theta(T_p) = theta(0) + 2 pi``, ``v(T_p) = v(0)``). It shares nothing with parapend's
+solvers but the excitation's ``q(t)``; :mod:`parapend.optimal.collocation` solves this
+same discrete problem with its own interior point (tests/test_collocation.py compares
+them at equal K):
 
 - torque limit: the bounds ``-T_max <= T <= T_max`` on the control;
 - efficiency: exact (not smoothed), with slacks ``p = p+ - p-``, ``p+, p- >= 0`` and the
