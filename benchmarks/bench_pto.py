@@ -8,8 +8,9 @@ Problems (paper case ``q = -0.3 sin(1.8 t)``), issue 9: the torque-limited optim
    - torque limit: :func:`parapend.optimal.hermite.solve_hermite` on K cubic Hermite
      intervals (primal-dual interior point on the banded Newton system, dense feasibility
      check included);
-   - efficiency: :func:`parapend.optimal.constrained.solve_pto` with N harmonics (smoothed
-     efficiency on the Fourier Newton kernel).
+   - efficiency: :func:`parapend.optimal.collocation.solve_collocation` on K intervals:
+     the same Hermite-Simpson collocation as IPOPT's below (so equal K, equal discrete
+     problem and error), by a full-space primal-dual interior point on the banded KKT system.
    Wall time of everything, ideal optimum included, the best of ``--repeat`` runs after one
    untimed warm-up.
 2. **CasADi + IPOPT**: ``tests/casadi_pto.py``, Hermite-Simpson collocation on K intervals,
@@ -35,7 +36,7 @@ from pathlib import Path
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
 
 import parapend  # noqa: E402
-from parapend.optimal.constrained import solve_pto  # noqa: E402
+from parapend.optimal.collocation import solve_collocation  # noqa: E402
 from parapend.optimal.hermite import solve_hermite  # noqa: E402
 
 CASES = [(0.03, {"torque_limit": 2.5}), (0.05, {"torque_limit": 2.0}),
@@ -48,8 +49,7 @@ def ours(gamma, kw, size):
     r = parapend.optimize(gamma=gamma, harmonics=24)
     if "torque_limit" in kw:
         return solve_hermite(r._excitation, gamma, size, r.motion, **kw)
-    return solve_pto(r._excitation, size, gamma, r.motion.vector if size == 24 else
-                     parapend.optimize(gamma=gamma, harmonics=size).motion.vector, **kw)
+    return solve_collocation(r._excitation, gamma, size, r.motion, **kw)
 
 
 def best_time(fn, repeat):
@@ -65,6 +65,8 @@ def best_time(fn, repeat):
 def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--repeat", type=int, default=3)
+    ap.add_argument("--problems", choices=["all", "torque-limit", "efficiency"], default="all",
+                    help="which rows to run")
     a = ap.parse_args()
     from casadi_pto import collocate
 
@@ -72,11 +74,13 @@ def main():
     print(f"{'case':30s} {'method':18s} {'time s':>8s} {'value':>12s} {'|error|':>9s}")
     summary = []
     for gamma, kw in CASES:
+        if a.problems != "all" and ("torque_limit" in kw) != (a.problems == "torque-limit"):
+            continue
         ref = collocate(exc, gamma, intervals=600, **kw)["electrical_power"]
         name = f"gamma={gamma} " + ", ".join(f"{k}={v}" for k, v in kw.items())
         rows = []
-        sizes = (64, 128, 256, 512) if "torque_limit" in kw else (16, 24, 32)
-        label = "K" if "torque_limit" in kw else "N"
+        sizes = (64, 128, 256, 512) if "torque_limit" in kw else (25, 50, 100, 150, 200)
+        label = "K"
         for n in sizes:
             t, s = best_time(lambda n=n, g=gamma, k=kw: ours(g, k, n), a.repeat)
             rows.append(("parapend", f"{label}={n}", t, s.electrical_power))

@@ -3,8 +3,10 @@
 Hermite-Simpson collocation (separated form) of the controlled pendulum, Eq. 14,
 ``theta' = v, v' = -gamma v + (1 + q(t)) sin(theta) + T``, with the torque ``T`` as the
 control at every node and midpoint, over one forcing period, periodic up to one turn
-(``theta(T_p) = theta(0) + 2 pi``, ``v(T_p) = v(0)``). It shares nothing with
-:mod:`parapend.optimal.constrained` but the excitation's ``q(t)``:
+(``theta(T_p) = theta(0) + 2 pi``, ``v(T_p) = v(0)``). It shares nothing with parapend's
+solvers but the excitation's ``q(t)``; :mod:`parapend.optimal.collocation` solves this
+same discrete problem with its own interior point (tests/test_collocation.py compares
+them at equal K):
 
 - torque limit: the bounds ``-T_max <= T <= T_max`` on the control;
 - efficiency: exact (not smoothed), with slacks ``p = p+ - p-``, ``p+, p- >= 0`` and the
@@ -27,7 +29,7 @@ import numpy as np
 
 def collocate(excitation, damping: float, *, intervals: int = 200, torque_limit=None,
               efficiency=None, guess=None, tol: float = 1e-10, winding: int = 1,
-              max_iter: int = 3000):
+              max_iter: int = 3000, copper_loss: float = 0.0):
     """Maximize the mean (electrical) power by direct collocation.
 
     Parameters
@@ -36,10 +38,15 @@ def collocate(excitation, damping: float, *, intervals: int = 200, torque_limit=
         Initial guess; None starts from the best uniform rotation (Eq. 17).
     winding : int
         K turns per period: ``theta(T_p) = theta(0) + 2 pi K`` (records of irregular seas).
+    copper_loss : float
+        ``r`` of a winding loss ``r <T^2>`` subtracted from the electrical power (Simpson's
+        rule: exact for the piecewise-linear torque); with it and no efficiency the power
+        is the mean of ``-T v``, not the state form.
 
     Returns
     -------
-    dict with ``power`` (mechanical, Simpson mean of ``-T v``), ``electrical_power``,
+    dict with ``power`` (mechanical, Simpson mean of ``-T v``), ``electrical_power``
+    (after the efficiency and the copper loss),
     ``peak_torque`` (over nodes), ``status`` (IPOPT's return status), ``t``, ``theta``,
     ``v``, ``torque`` (nodes and midpoints, ``2 K + 1`` points), ``solve_time`` (s, IPOPT
     only, the graph built before it).
@@ -77,7 +84,9 @@ def collocate(excitation, damping: float, *, intervals: int = 200, torque_limit=
     w[2:-1:2] = 2.0
     w *= h / 6 / period  # Simpson weights of the mean
     p = -u * v
-    if efficiency is None:
+    if efficiency is None and copper_loss:
+        obj = ca.dot(ca.DM(w), p)
+    elif efficiency is None:
         # P = <(1 + q) sin(theta) theta'> - gamma <theta'^2> (Eq. 15; = -<T theta'> by the
         # energy balance): the torque does not enter, so it cannot chatter to exploit the rule
         obj = ca.dot(ca.DM(w), q1 * ca.sin(th) * v - damping * v * v)
@@ -89,6 +98,8 @@ def collocate(excitation, damping: float, *, intervals: int = 200, torque_limit=
         opti.subject_to(pm >= 0)
         opti.subject_to(pp - pm == p)
         obj = ca.dot(ca.DM(w), eg * pp - pm / em)
+    if copper_loss:
+        obj = obj - copper_loss * ca.dot(ca.DM(w), u * u)
     if torque_limit is not None:
         opti.subject_to(opti.bounded(-torque_limit, u, torque_limit))
     opti.minimize(-obj)
@@ -126,6 +137,7 @@ def collocate(excitation, damping: float, *, intervals: int = 200, torque_limit=
     pv = -uu * vv
     ele = pv if efficiency is None else np.where(pv > 0, efficiency[0] * pv,
                                                   pv / efficiency[1])
+    ele = ele - copper_loss * uu * uu
     return {"power": float(w @ pv), "electrical_power": float(w @ ele),
             "peak_torque": float(np.max(np.abs(uu))), "status": stats["return_status"],
             "iterations": stats.get("iter_count"), "t": t, "theta": tt.ravel(), "v": vv,

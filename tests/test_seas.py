@@ -429,7 +429,7 @@ def test_winding_bvp_cli(capsys):
     assert f"{d['power']:.6f}" in out and "gamma K^2 omega^2" in out
     assert main([*args[:-1], "all"]) == 2
     err = capsys.readouterr().err
-    assert "winding: K > 1 works with method fourier or bvp" in err
+    assert "winding: K > 1 works with method fourier or bvp (and the power" in err
     assert len(err.strip().splitlines()) == 1
 
 

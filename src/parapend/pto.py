@@ -14,8 +14,9 @@ Two methods, both warm-started from the ideal optimum of :func:`parapend.optimiz
   system (the optimal torque is bang-bang: a local basis resolves its jumps, a Fourier
   series does not); K from the excitation, checked by one doubling;
 - an efficiency (with or without a limit), or a copper loss without a limit:
-  :mod:`parapend.optimal.constrained`, the smoothed efficiency (and an augmented Lagrangian
-  for the limit) on the exact-Hessian Fourier Newton kernel.
+  :mod:`parapend.optimal.collocation`, Hermite-Simpson collocation with the torque as an
+  unknown (the efficiency exact through two slacks per point) and a full-space primal-dual
+  interior point on the banded KKT system; K from the excitation, checked by one doubling.
 """
 
 from __future__ import annotations
@@ -28,7 +29,7 @@ import numpy as np
 from . import limits
 from .api import _coefficients, optimize
 from .errors import ParameterError, SolverError, check_finite, check_int, check_range
-from .optimal.constrained import PTOSolution, pto_profile, solve_pto
+from .optimal.constrained import PTOSolution, pto_profile
 from .power import uniform_power
 from .trajectory import FourierMotion
 
@@ -121,9 +122,6 @@ def optimize_pto(*, torque_limit=None, efficiency=None, efficiency_generating=No
     r_cu = check_range("copper-loss", copper_loss, 0.0, 1e6)
     if optimize_args.get("method", "fourier") != "fourier":
         raise ParameterError("method: a power take-off is optimized with method 'fourier'")
-    if optimize_args.get("winding", 1) != 1:
-        raise ParameterError("winding: a power take-off is optimized for one turn per "
-                             "forcing period (K = 1); drop winding")
     n = check_int("harmonics", optimize_args.get("harmonics", 24), 1,
                   limits.MAX_PTO_HARMONICS)
     ideal = ideal if ideal is not None else optimize(**optimize_args)
@@ -138,17 +136,11 @@ def optimize_pto(*, torque_limit=None, efficiency=None, efficiency_generating=No
                                   motoring_energy=prof["motoring_energy"],
                                   harvested_energy=prof["harvested_energy"])
         return dataclasses.replace(res, **physical_fields(res, units))
-    extra = {}
     if eff is None and tmax is not None:
         sol, motion, extra = _time_domain(exc, gamma, ideal, tmax, r_cu, warm)
-        coefficients = _coefficients(_projection(motion, exc, n))
     else:
-        x0 = ideal.motion.vector if warm is None or not isinstance(warm, np.ndarray) else \
-            np.asarray(warm, dtype=float)
-        sol = solve_pto(exc, n, gamma, x0, torque_limit=tmax, efficiency=eff,
-                        copper_loss=r_cu)
-        motion = FourierMotion.from_vector(exc.omega, sol.x)
-        coefficients = _coefficients(motion)
+        sol, motion, extra = _collocation(exc, gamma, ideal, tmax, r_cu, eff, warm)
+    coefficients = _coefficients(_projection(motion, exc, n))
     prof = pto_profile(motion, exc, gamma, efficiency=eff)
     pu = ideal.uniform_power
     status = sol.status
@@ -165,9 +157,11 @@ def optimize_pto(*, torque_limit=None, efficiency=None, efficiency_generating=No
                          f"{limits.MAX_PTO_INTERVALS})",
            "stalled": ("stalled: the interior point could not meet the limit between its "
                        "points, or its last steps made no progress; the motion is reported as "
-                       "it is (see max_violation)" if eff is None else
-                       "stalled: the augmented Lagrangian did not settle its multipliers; "
-                       "the motion is feasible but may not be optimal"),
+                       "it is (see max_violation)" if extra["method"] == "hermite" else
+                       "stalled: the interior point's line search found no acceptable "
+                       "point; the motion is reported as it is"),
+           "singular": "singular: no regularization of the KKT matrix gave a descent "
+                       "step; the motion is reported as it is",
            "max_iterations": "maximum number of Newton iterations reached",
            "nonfinite": "non-finite power encountered"}.get(status, status)
     res = dataclasses.replace(
@@ -219,17 +213,19 @@ def _time_domain(exc, gamma, ideal, tmax, copper_loss, warm, rtol: float = 1e-6)
     iters = 0
     change = float("nan")
     anchor = last = None
-    bound = tmax * exc.omega  # every monotone rotation: P <= T_max <theta'> = T_max omega
+    wind = ideal.winding
+    # every monotone rotation: P <= T_max <theta'> = T_max K omega
+    bound = tmax * wind * exc.omega
     brake_tried = copper_loss != 0.0
     while True:
         sol = solve_hermite(exc, gamma, k, start, torque_limit=tmax, copper_loss=copper_loss,
-                            anchor=anchor)
+                            anchor=anchor, winding=wind)
         iters += sol.iterations
         if not brake_tried and (sol.status != "converged" or sol.power >= 0.9 * bound):
             # near the bound: the constant brake attains it, if it exists; then no monotone
             # rotation (the Hermite optimum, refined or not) can do better
             brake_tried = True
-            brake = _constant_brake(exc, gamma, tmax, sol.motion, iters)
+            brake = _constant_brake(exc, gamma, tmax, sol.motion, iters, wind)
             if brake is not None and brake[0].power >= sol.power:
                 return brake
         if sol.status != "converged" and prev is None and 2 * k <= limits.MAX_PTO_INTERVALS:
@@ -264,21 +260,22 @@ def _time_domain(exc, gamma, ideal, tmax, copper_loss, warm, rtol: float = 1e-6)
     return out, motion, {"method": "hermite", "intervals": k, "refinement_change": change}
 
 
-def _constant_brake(exc, gamma, tmax, start, iters):
+def _constant_brake(exc, gamma, tmax, start, iters, winding: int = 1):
     """The rotation under the constant torque ``-T_max`` (:mod:`parapend.optimal.brake`),
     as ``(PTOSolution, motion, extra)``, or None when there is none near ``start``."""
     from .model import peak_torque
     from .optimal.brake import constant_brake
     from .power import mean_power
 
-    found = constant_brake(exc, gamma, tmax, start)
+    found = constant_brake(exc, gamma, tmax, start, winding=winding)
     if found is None:
         return None
     motion, n, _ = found
     power = mean_power(motion, exc, gamma, points=max(4096, 16 * n))
     # the resolution check: the power on half the harmonics (the coefficients above N/2
     # are what the doubling added)
-    half = FourierMotion(exc.omega, motion.a0, motion.a[:n // 2], motion.b[:n // 2])
+    half = FourierMotion(exc.omega, motion.a0, motion.a[:n // 2], motion.b[:n // 2],
+                         winding)
     change = abs(power - mean_power(half, exc, gamma, points=max(4096, 16 * n)))
     peak = peak_torque(motion, exc, gamma)
     out = PTOSolution(x=motion.vector, power=power, electrical_power=power, peak_torque=peak,
@@ -287,6 +284,62 @@ def _constant_brake(exc, gamma, tmax, start, iters):
                       stages=[("constant-brake", n, "converged")])
     return out, motion, {"method": "constant-brake", "harmonics": n,
                          "refinement_change": change}
+
+
+def _collocation(exc, gamma, ideal, tmax, copper_loss, eff, warm, rtol: float = 1e-6):
+    """Efficiency / copper-loss optimum by Hermite-Simpson collocation
+    (:mod:`parapend.optimal.collocation`), the intervals doubled until the electrical power
+    moves by less than ``rtol``."""
+    from .optimal.collocation import solve_collocation
+
+    if warm is None:
+        start = ideal.motion
+    elif isinstance(warm, np.ndarray):
+        start = FourierMotion.from_vector(exc.omega, np.asarray(warm, dtype=float))
+    else:
+        start = warm
+    k = intervals_for(exc)
+    prev = last = None
+    iters = 0
+    change = float("nan")
+    while True:
+        sol = solve_collocation(exc, gamma, k, start, efficiency=eff, torque_limit=tmax,
+                                copper_loss=copper_loss, winding=ideal.winding)
+        iters += sol.iterations
+        if sol.status != "converged" and last is None and start is not ideal.motion:
+            # a warm start (continuation) that failed: from the ideal optimum instead
+            start = ideal.motion
+            continue
+        if sol.status != "converged":
+            if last is not None:
+                sol, k = last  # the converged coarser optimum: kept, "unresolved"
+            break
+        last = sol, k
+        if prev is not None:
+            change = abs(sol.electrical_power - prev)
+            if change <= rtol * max(1.0, abs(sol.electrical_power)) or \
+                    2 * k > limits.MAX_PTO_INTERVALS:
+                break
+        prev = sol.electrical_power
+        start = sol.motion
+        k *= 2
+    status = sol.status
+    if status == "converged" and not change <= rtol * max(1.0, abs(sol.electrical_power)):
+        status = "unresolved"
+    if status != "converged" and tmax is not None and last is None and \
+            not sol.infeasibility <= 1e-6:
+        # no motion meeting the dynamics was found within the limit (below the smallest
+        # peak torque of a rotation, the interior point stalls far from the dynamics)
+        status = "infeasible"
+    viol = 0.0 if tmax is None else max(sol.peak_torque / tmax - 1.0, 0.0)
+    out = PTOSolution(x=np.concatenate([sol.motion.theta_nodes, sol.motion.v_nodes,
+                                        sol.motion.u_nodes]),
+                      power=sol.power, electrical_power=sol.electrical_power,
+                      peak_torque=sol.peak_torque, max_violation=viol, status=status,
+                      iterations=iters, outer_iterations=1, gradient_norm=sol.kkt_error,
+                      points=2 * k)
+    return out, sol.motion, {"method": "collocation", "intervals": k,
+                             "refinement_change": change}
 
 
 def _smallest_limit(ideal):
@@ -300,11 +353,13 @@ def _smallest_limit(ideal):
     from .optimal.hermite import minimum_peak_torque
 
     exc = ideal._excitation
-    _, phi = uniform_power(exc, ideal.gamma)
-    uniform = FourierMotion(exc.omega, phi, np.zeros(1), np.zeros(1))
-    if constant_brake(exc, ideal.gamma, 0.0, uniform) is not None:
+    wind = ideal.winding
+    _, phi = uniform_power(exc, ideal.gamma, wind)
+    uniform = FourierMotion(exc.omega, phi, np.zeros(1), np.zeros(1), wind)
+    if constant_brake(exc, ideal.gamma, 0.0, uniform, winding=wind) is not None:
         return 0.0, "free rotation"
-    sol, _ = minimum_peak_torque(exc, ideal.gamma, 2 * intervals_for(exc), uniform)
+    sol, _ = minimum_peak_torque(exc, ideal.gamma, 2 * intervals_for(exc), uniform,
+                                 winding=wind)
     return float(sol.peak_torque), sol.status
 
 
@@ -320,8 +375,8 @@ def pto_curve(vary: str = "torque-limit", *, values=None, points: int = 12,
         smallest feasible limit (the smallest peak torque of any rotation found, phase 1 of
         :mod:`parapend.optimal.hermite`, but at least 2 % of the top; 0.2 % of the top when
         the pendulum has a free rotation, which makes it 0), each solve warm-started from
-        the previous; with an efficiency, down to 2 %
-        of the top (the Fourier method), stopping at the first infeasible value;
+        the previous; with an efficiency, down to 2 % of the top
+        (:mod:`parapend.optimal.collocation`), stopping at the first infeasible value;
         ``efficiency``: ``eta = eta_g = eta_m`` from 1 down to 0.5 (or ``values``).
     values : sequence of float or None
         The limits (m g l) or efficiencies to use instead of the defaults.
@@ -376,7 +431,7 @@ def pto_curve(vary: str = "torque-limit", *, values=None, points: int = 12,
             progress(i + 1, len(vals))
         if vary == "torque-limit" and r.status == "infeasible":
             break  # below the smallest feasible limit: smaller ones are infeasible too
-        warm = r.motion if r.method in ("hermite", "constant-brake") else r.motion.vector
+        warm = r.motion
     feas = [r.torque_limit for r in rows if r.status != "infeasible"]
     ds = xr.Dataset(
         {"power": ("value", [r.power for r in rows]),
@@ -412,6 +467,9 @@ def plot_pto_profile(result, path=None, points: int = 2000):
     exc = result._excitation
     eff = None if result.efficiency_generating is None else (result.efficiency_generating,
                                                               result.efficiency_motoring)
+    k = getattr(result.motion, "intervals", None)
+    if k:  # a grid through every node: the vertices of a piecewise-linear torque drawn
+        points = k * -(-points // k)
     prof = pto_profile(result.motion, exc, result.gamma, points=points, efficiency=eff)
     tau = prof["tau"]
     fig, (ax1, ax2) = plt.subplots(2, 1, figsize=(7, 5.5), sharex=True)

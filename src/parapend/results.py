@@ -94,8 +94,11 @@ class OptimizeResult(_Result):
         ``max(peak_torque / torque_limit - 1, 0)`` on the dense evaluation.
     intervals, refinement_change : int or None, float or None
         The torque-limited optimum is solved in the time domain (``method`` "hermite",
-        :mod:`parapend.optimal.hermite`) on ``intervals`` cubic Hermite intervals, checked by
-        one doubling: ``refinement_change`` is the change of the power between the last two.
+        :mod:`parapend.optimal.hermite`) on ``intervals`` cubic Hermite intervals, the
+        efficiency and copper-loss optima (``method`` "collocation",
+        :mod:`parapend.optimal.collocation`) on ``intervals`` Hermite-Simpson intervals; both
+        checked by one doubling: ``refinement_change`` is the change of the (electrical)
+        power between the last two.
     units, power_w, uniform_power_w, limit_power_w, peak_torque_nm, electrical_power_w,
     energy_per_cycle_j, motoring_energy_j : physical values (W, N m, J) when a pendulum's
         length and mass were given (:mod:`parapend.units`); None otherwise.
@@ -165,7 +168,8 @@ class OptimizeResult(_Result):
     @property
     def motion(self):
         """The optimal motion: a :class:`~parapend.trajectory.FourierMotion`, or a
-        :class:`~parapend.optimal.hermite.HermiteMotion` for ``method`` "hermite"."""
+        :class:`~parapend.optimal.hermite.HermiteMotion` for ``method`` "hermite", a
+        :class:`~parapend.optimal.collocation.CollocationMotion` for "collocation"."""
         return self._motion
 
 

@@ -103,9 +103,9 @@ def _cmd_optimize(a) -> dict | str:
     units, kw = _pto.apply_units(a, kw)
     pto = _pto.wants_pto(a)
     if a.winding != 1:
-        if pto or a.method == "all":
-            raise ParameterError("winding: K > 1 works with method fourier or bvp and no "
-                                 "power take-off options; drop --winding or those options")
+        if a.method == "all":
+            raise ParameterError("winding: K > 1 works with method fourier or bvp (and the "
+                                 "power take-off options); drop --winding or use one method")
         kw["winding"] = a.winding
     if a.method == "all":
         if pto or units is not None:
@@ -149,8 +149,12 @@ def _cmd_optimize(a) -> dict | str:
     if r.winding != 1:
         name += f", winding K = {r.winding}"
     if pto:
-        name = (f"power take-off optimum, K = {r.intervals}" if r.method == "hermite" else
+        name = (f"power take-off optimum, {r.intervals} intervals"
+                if r.method in ("hermite", "collocation") else
+                "power take-off optimum, constant brake" if r.method == "constant-brake" else
                 f"power take-off optimum, N = {r.harmonics}")
+        if r.winding != 1:
+            name += f", winding K = {r.winding}"
     rows = [
         ["best uniform rotation (Eq. 17)", _fmt(r.uniform_power), ""],
         [name, _fmt(r.power), _gain(r.power, r.uniform_power)],
@@ -169,6 +173,13 @@ def _cmd_optimize(a) -> dict | str:
             search += f"; second-best maximum {_fmt(r.second_power)}"
     elif r.method == "hermite":
         how = (f"{r.iterations} interior-point iterations, {r.intervals} cubic Hermite "
+               f"intervals, started from the {r.found_by}")
+    elif r.method == "constant-brake":
+        how = (f"the rotation under the constant torque -T_max, {r.harmonics} harmonics "
+               f"collocated, Newton; its power T_max K omega bounds every rotation that "
+               f"never turns back")
+    elif r.method == "collocation":
+        how = (f"{r.iterations} interior-point iterations, {r.intervals} Hermite-Simpson "
                f"intervals, started from the {r.found_by}")
     else:
         how = (f"{r.mesh_nodes} mesh nodes, max residual {r.max_residual:.2g}, "

@@ -123,10 +123,17 @@ def pto_lines(r) -> list[str]:
     if r.method == "hermite":
         out.append(f"time domain: {r.intervals} cubic Hermite intervals, interior point; "
                    f"power change at the last doubling {r.refinement_change:.1e}")
+    if r.method == "constant-brake":
+        out.append(f"constant brake: T = -T_max throughout, {r.harmonics} harmonics; power "
+                   f"change from half of them {r.refinement_change:.1e}")
+    if r.method == "collocation":
+        out.append(f"time domain: {r.intervals} Hermite-Simpson intervals (torque piecewise "
+                   f"linear), interior point; electrical power change at the last doubling "
+                   f"{r.refinement_change:.1e}")
     if r.efficiency_generating is not None:
         out.append(f"efficiency: generating {r.efficiency_generating:g}, motoring "
                    f"{r.efficiency_motoring:g}; electrical power {_fmt(r.electrical_power, 8)}"
-                   " (kink at p = 0 smoothed by softplus, width continued to 1e-7)")
+                   " (exact kink at p = 0, slacks p+ - p- = p)")
     if r.unconstrained_power is not None and r.unconstrained_power != r.power:
         out.append(f"ideal (unlimited, lossless) optimum: {_fmt(r.unconstrained_power, 8)}")
     if r.peak_power is not None:

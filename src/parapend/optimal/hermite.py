@@ -589,8 +589,8 @@ def solve_hermite(excitation, damping: float, intervals: int, start, *, torque_l
     x_start = x
     if torque_limit is not None:
         if anchor is None:
-            _, phi = uniform_power(excitation, damping)
-            anchor = FourierMotion(excitation.omega, phi, np.zeros(1), np.zeros(1))
+            _, phi = uniform_power(excitation, damping, winding)
+            anchor = FourierMotion(excitation.omega, phi, np.zeros(1), np.zeros(1), winding)
         xa = pr.start(anchor)
         # blend towards the anchor when it is strictly inside; otherwise elastic mode below
         # (a phase-1 motion as the anchor was tried: near a free rotation it leads into the
