@@ -13,7 +13,7 @@ import parapend
 from parapend import pto
 from parapend.model import torque
 from parapend.optimal import collocation as C
-from parapend.optimal.constrained import pto_profile
+from parapend.optimal.profile import pto_profile
 
 EXC = parapend.harmonic(-0.3, 1.8)
 

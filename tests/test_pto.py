@@ -10,7 +10,7 @@ import pytest
 import parapend
 from parapend import pto
 from parapend.errors import ParameterError
-from parapend.optimal.constrained import pto_profile
+from parapend.optimal.profile import pto_profile
 from parapend.units import Units, from_options
 
 # -- units -------------------------------------------------------------------------------

@@ -29,7 +29,7 @@ import numpy as np
 from . import limits
 from .api import _coefficients, optimize
 from .errors import ParameterError, SolverError, check_finite, check_int, check_range
-from .optimal.constrained import PTOSolution, pto_profile
+from .optimal.profile import PTOSolution, pto_profile
 from .power import uniform_power
 from .trajectory import FourierMotion
 

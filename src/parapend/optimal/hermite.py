@@ -21,8 +21,9 @@ mechanical power, the state form of Eq. 15,
 ``P = <(1 + q) sin(theta) theta'> - gamma <theta'^2>`` (``= -<T theta'>``: ``<theta''
 theta'> = 0`` for a ``C^1`` periodic motion, exactly under the quadrature), minus a copper
 loss ``r <T^2>`` (winding loss ``R (T / k_t)^2``) when one is given. (An efficiency is
-solved on the Fourier series, :mod:`parapend.optimal.constrained`: its kink at ``p = 0`` left
-this interior point without a reliable convergence, see docs/units.md.)
+solved by :mod:`parapend.optimal.collocation`, with the torque as a variable: here, with
+the torque eliminated, its kink at ``p = 0`` left this interior point without a reliable
+convergence, see docs/units.md.)
 
 **Torque limit** ``|T| <= T_max`` at ``tau = 0, 1/2, 1`` of every interval (both sides of
 every node), then checked on the motion's own dense evaluation
