@@ -101,8 +101,9 @@ def constant_brake(excitation, damping: float, torque_limit: float, start, *,
     rotations ``theta = K omega t + phi`` at ``phases`` phases.
 
     Every such rotation has the power ``K omega T_max``; there may be several (a saddle
-    and a stable focus of the forced pendulum: two at ``gamma = 0.01``, ``T_max = 0.063``, Floquet
-    multipliers 3.59 and 0.27 against a complex pair of modulus ``exp(-gamma T_p / 2)``).
+    and a stable focus of the forced pendulum: two at ``gamma = 0.01``,
+    ``T_max = 0.063``, Floquet multipliers 3.59 and 0.27 against a complex pair of modulus
+    ``exp(-gamma T_p / 2)``).
     The one returned has the smallest largest multiplier: the one a controller holds most
     easily (docs/control.md).
 
