@@ -78,7 +78,7 @@ class ProblemBatch:
         self.omega2 = [p.omega**2 for p in problems]
         self.damping = [p.damping for p in problems]
         self.gw = [p.damping * p.omega**2 for p in problems]
-        self.scale = [max(float(np.max(np.abs(p.w))), 1e-300) for p in problems]
+        self.scale = [max(float(np.abs(p.w).max()), 1e-300) for p in problems]
 
     def _theta(self, x: np.ndarray) -> np.ndarray:
         n, m = self.harmonics, self.points
@@ -117,7 +117,15 @@ class ProblemBatch:
         g[:, n + 1:] = -U[:, 1:].real
         g -= gwa * self._k2 * x
         X = np.concatenate((V.real, -V.imag), axis=-1)
-        h = -(self._coef[0] * X[:, self._idx[0]] + self._coef[1] * X[:, self._idx[1]])
+        # -(coef0 X[idx0] + coef1 X[idx1]) of FourierProblem.evaluate, in place: the
+        # products are exact (coefficients 0, 1/2, 1), so the one rounding of the sum is the
+        # same in any order
+        h = np.take(X, self._idx[0], axis=1)
+        h *= self._coef[0]
+        t = np.take(X, self._idx[1], axis=1)
+        t *= self._coef[1]
+        h += t
+        np.negative(h, out=h)
         h[:, self._diag, self._diag] -= gwa * self._k2
         return p, g, h
 
@@ -142,7 +150,7 @@ def newton_maximize_batch(batch: ProblemBatch, x0: np.ndarray, seeds, *, gtol: f
     out: list = [None] * size
 
     def finish(i, status, it):
-        gn = float(np.max(np.abs(gs[i])))
+        gn = float(np.abs(gs[i]).max())
         out[i] = LocalSolution(xs[i], float(ps[i]), gn, it, status, seeds[i],
                                batch.points, _is_maximum(hs[i]))
 
@@ -156,12 +164,12 @@ def newton_maximize_batch(batch: ProblemBatch, x0: np.ndarray, seeds, *, gtol: f
             if not math.isfinite(pi):
                 finish(i, "nonfinite", it)
                 continue
-            gn = float(np.max(np.abs(gi)))
+            gn = float(np.abs(gi).max())
             if gn <= gtol * scale:
                 finish(i, "converged", it - 1)
                 continue
             d, newton = _ascent_step(gi, hs[i])
-            norm = float(np.max(np.abs(d)))
+            norm = float(np.abs(d).max())
             if below[i] > -math.inf and it > 1 and norm <= max_step and newton:
                 gain = 0.5 * float(gi @ d)
                 if pi + _ABANDON_SAFETY * gain < below[i] + 1e-10 * scale:
