@@ -738,18 +738,50 @@ def _worker_init(parent: int) -> None:
     threading.Thread(target=watch, daemon=True).start()
 
 
-def _run_local(spec, todo, workers, done_cb):
-    import concurrent.futures as cf
-    import multiprocessing as mp
+class _LocalPool:
+    """The local worker processes (a ``forkserver`` pool), started in the background as soon
+    as the sweep's parameters are checked: the server's imports and the workers' start (about
+    a second) then overlap the preparation of the store instead of preceding the first block.
+    """
 
-    if workers == 1 or len(todo) <= 1:
+    def __init__(self, workers: int):
+        import concurrent.futures as cf
+        import multiprocessing as mp
+        import threading
+
+        ctx = mp.get_context("forkserver")
+        ctx.set_forkserver_preload(["parapend.sweep", "parapend.api", "parapend.optimal.fourier",
+                                    "parapend.optimal.batch"])
+        self.workers = workers
+        self.executor = cf.ProcessPoolExecutor(max_workers=workers, mp_context=ctx,
+                                               initializer=_worker_init,
+                                               initargs=(os.getpid(),))
+        self._boot = threading.Thread(target=self._start, daemon=True)
+        self._boot.start()
+
+    def _start(self):
+        # the first submit starts every worker (in this thread, not the caller's)
+        with contextlib.suppress(Exception):
+            self.executor.submit(_ready)
+
+    def shutdown(self):
+        self._boot.join()
+        self.executor.shutdown(wait=True, cancel_futures=True)
+
+
+def _ready() -> None:
+    """A first task: it makes the pool start its processes."""
+
+
+def _run_local(spec, todo, pool, done_cb):
+    import concurrent.futures as cf
+
+    if pool is None or len(todo) <= 1:
         for b in todo:
             done_cb(b, compute_block(spec, b))
         return "serial"
-    ctx = mp.get_context("forkserver")
-    ctx.set_forkserver_preload(["parapend.sweep", "parapend.api", "parapend.optimal.fourier"])
-    ex = cf.ProcessPoolExecutor(max_workers=workers, mp_context=ctx, initializer=_worker_init,
-                                initargs=(os.getpid(),))
+    ex = pool.executor
+    pool._boot.join()
     try:
         futs = {ex.submit(compute_block, spec, b): b for b in todo}
         for f in cf.as_completed(futs):
@@ -762,7 +794,7 @@ def _run_local(spec, todo, workers, done_cb):
             done_cb(futs[f], vals)
     finally:
         ex.shutdown(wait=True, cancel_futures=True)
-    return f"{workers} local processes"
+    return f"{pool.workers} local processes"
 
 
 def _connect(scheduler):
@@ -846,14 +878,20 @@ def sweep(store=None, *, omega=1.8, delta=None, gamma=0.0, torque_limit=None, ef
         workers = max(1, min(os.cpu_count() or 1, spec.blocks))
     t0 = time.monotonic()
     client, own = _connect(scheduler) if scheduler is not None else (None, False)
+    if store is not None:
+        _check_store_path(store)
+    pool = (_LocalPool(workers) if client is None and workers > 1 and spec.blocks > 1
+            else None)
     try:
-        return _sweep(spec, store, workers, client, overwrite, command, progress, t0)
+        return _sweep(spec, store, pool, client, overwrite, command, progress, t0)
     finally:
+        if pool is not None:
+            pool.shutdown()
         if own:
             client.close()
 
 
-def _sweep(spec, store, workers, client, overwrite, command, progress, t0) -> SweepRun:
+def _sweep(spec, store, pool, client, overwrite, command, progress, t0) -> SweepRun:
     total = spec.points
     sizes = [int(np.prod([s.stop - s.start for s in spec.block_slices(b)]))
              for b in range(spec.blocks)]
@@ -872,7 +910,7 @@ def _sweep(spec, store, workers, client, overwrite, command, progress, t0) -> Sw
             if progress is not None:
                 progress(counted[0], total)
 
-        how = _execute(spec, list(range(spec.blocks)), workers, client, write)
+        how = _execute(spec, list(range(spec.blocks)), pool, client, write)
         for k, v in arrays.items():
             ds[k] = (spec.dims, v, ds[k].attrs)
         return SweepRun(ds, None, total, spec.blocks, total, 0, time.monotonic() - t0, how)
@@ -900,16 +938,16 @@ def _sweep(spec, store, workers, client, overwrite, command, progress, t0) -> Sw
             if progress is not None:
                 progress(counted[0], total)
 
-        how = _execute(spec, todo, workers, client, write) if todo else "nothing to do"
+        how = _execute(spec, todo, pool, client, write) if todo else "nothing to do"
     ds = open_sweep(path)
     return SweepRun(ds, str(path), total, spec.blocks, total - resumed, resumed,
                     time.monotonic() - t0, how)
 
 
-def _execute(spec, todo, workers, client, write) -> str:
+def _execute(spec, todo, pool, client, write) -> str:
     if client is not None:
         return _run_dask(spec, todo, client, write)
-    return _run_local(spec, todo, min(workers, max(len(todo), 1)), write)
+    return _run_local(spec, todo, pool, write)
 
 
 # -- heat maps -----------------------------------------------------------------------------

@@ -132,14 +132,15 @@ class ProblemBatch:
 
 def newton_maximize_batch(batch: ProblemBatch, x0: np.ndarray, seeds, *, gtol: float = 1e-11,
                           maxiter: int = 200, max_step: float = 1.0,
-                          abandon_below=None) -> list:
+                          abandon_below=None, certify: bool = True) -> list:
     """:func:`.fourier.newton_maximize` for every member of ``batch`` from ``x0[i]``.
 
     Returns one :class:`.fourier.LocalSolution` per member, equal to what
     ``newton_maximize(batch.problems[i], x0[i], seeds[i], ...)`` returns. The iterations
     run in lockstep: each round decides every active member's step (per member), then
     evaluates the line search's trial points of all members together, then the accepted
-    points' gradients and Hessians together.
+    points' gradients and Hessians together. ``certify=False`` leaves ``strict_maximum``
+    False without factorizing the last Hessian (for runs whose ``x`` only is used).
     """
     size = len(batch.problems)
     x0 = np.array(x0, dtype=float)
@@ -152,7 +153,7 @@ def newton_maximize_batch(batch: ProblemBatch, x0: np.ndarray, seeds, *, gtol: f
     def finish(i, status, it):
         gn = float(np.abs(gs[i]).max())
         out[i] = LocalSolution(xs[i], float(ps[i]), gn, it, status, seeds[i],
-                               batch.points, _is_maximum(hs[i]))
+                               batch.points, certify and _is_maximum(hs[i]))
 
     active = list(range(size))
     for it in range(1, maxiter + 1):
@@ -255,7 +256,7 @@ def search_fourier_batch(points, harmonics: int, *, gtol: float = 1e-11,
             ids = [batched[j] for j in grp]
             runs = newton_maximize_batch(ProblemBatch([small[i] for i in ids]),
                                          np.array([useed[i] for i in ids]),
-                                         ["uniform"] * len(ids), gtol=gtol)
+                                         ["uniform"] * len(ids), gtol=gtol, certify=False)
             for i, r in zip(ids, runs):
                 useed[i] = _pad(r.x, harmonics)
     # the primary runs, limit then uniform, polished to convergence
