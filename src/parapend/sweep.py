@@ -24,6 +24,11 @@ The warm start and the global search
     goes on along that branch. So the warm start cannot change ``power``; it checks the
     global search along every run of the map (0 everywhere on the maps measured so far).
 
+The searches of a block together
+    The global searches of a block's points run in lockstep (:mod:`.optimal.batch`): the
+    array work of each Newton iteration is done for up to 128 points at once, with the same
+    arithmetic per point as ``search_fourier``, so ``power`` is still optimize's bit for bit.
+
 The store (Zarr 3)
     Made whole (every array, its chunks, coordinates and attributes) before the first
     block, then written block by block: the variables of a block, then its ``done`` mask.
@@ -865,7 +870,7 @@ def sweep(store=None, *, omega=1.8, delta=None, gamma=0.0, torque_limit=None, ef
     progress : callable or None
         ``progress(done_points, total_points)`` after each block.
     block_points : int or None
-        Points per block (one chunk, one task), about: default 128 (8 with a power
+        Points per block (one chunk, one task), about: default 512 (8 with a power
         take-off). Part of the sweep's identity, as it sets where continuation runs start.
     """
     spec = sweep_spec(omega=omega, delta=delta, gamma=gamma, torque_limit=torque_limit,
