@@ -103,6 +103,27 @@ def test_batched_search_is_search_fourier_bit_for_bit():
         assert "converged" in statuses and min(f.best.power for f, _ in got) < 0
 
 
+def test_batched_problems_and_limit_seeds_are_the_scalar_ones():
+    """dq/dt on the grids and the limit seeds, built for many points at once, equal those
+    of FourierProblem and limit_seed (any grid, N, excitation, sign of delta)."""
+    from parapend.optimal.batch import _limit_seeds, _problems
+    from parapend.optimal.fourier import FourierProblem
+    from parapend.optimal.limit import limit, limit_seed
+
+    ex = [parapend.harmonic(d, om) for om in (0.3, 1.7, 3.0) for d in (-0.5, -0.02, 0.4)]
+    ex += [parapend.two_harmonic(-0.3, 1.8), parapend.square(-0.3, 1.8, 0.05),
+           parapend.fourier([(1, 0.2, 0.0), (7, 0.1, 1.0)], omega=1.5)]
+    pts = [(e, 0.01) for e in ex]
+    for n in (5, 8, 24):
+        for grids in (None, [1024] * len(pts)):
+            for (e, g), p in zip(pts, _problems(pts, n, grids)):
+                q = FourierProblem(e, n, g, None if grids is None else 1024)
+                assert q.points == p.points and np.array_equal(q.w, p.w)
+        lims = [limit(e) for e in ex[:-1]]
+        for lim, x in zip(lims, _limit_seeds(lims, n)):
+            assert np.array_equal(x, limit_seed(lim, n).vector)
+
+
 def _check_pto(ds, n):
     from parapend.pto import optimize_pto
 

@@ -45,11 +45,12 @@ from .fourier import (
     _best,
     _is_maximum,
     _pad,
+    _problem_points,
     _uniform_seed,
     newton_maximize,
     search_fourier,
 )
-from .limit import limit, limit_seed, pattern_count
+from .limit import limit, pattern_count
 
 __all__ = ["ProblemBatch", "newton_maximize_batch", "search_fourier_batch"]
 
@@ -215,6 +216,59 @@ def newton_maximize_batch(batch: ProblemBatch, x0: np.ndarray, seeds, *, gtol: f
     return out
 
 
+def _problems(points, harmonics: int, grids=None) -> list:
+    """``FourierProblem(excitation, harmonics, damping, grid)`` for every point, with
+    ``dq/dt`` on the grids of all points with the same M and spectrum length synthesized by
+    one inverse FFT (row by row the numbers of ``Excitation.dq_grid``)."""
+    from ..excitation import _synthesize
+
+    ms = [_problem_points(harmonics, e, None if grids is None else grids[i], 1)
+          for i, (e, _) in enumerate(points)]
+    specs = [e.dq_spectrum() for e, _ in points]
+    dq: list = [None] * len(points)
+    for grp in _groups([(m, sp.size) for m, sp in zip(ms, specs)]):
+        m, size = ms[grp[0]], specs[grp[0]].size
+        kmax = min(size, (m + 1) // 2)
+        x = np.zeros((len(grp), m // 2 + 1), dtype=complex)
+        sp = np.array([specs[i] for i in grp])
+        x[:, 0] = sp[:, 0].real * m
+        x[:, 1:kmax] = sp[:, 1:kmax] * (m / 2.0)
+        for i, w in zip(grp, np.fft.irfft(x, m, axis=-1)):
+            dq[i] = w
+    return [FourierProblem(e, harmonics, g, m, dq=w)
+            for (e, g), m, w in zip(points, ms, dq)]
+
+
+def _limit_seeds(lims, harmonics: int) -> np.ndarray:
+    """``limit_seed(lim, harmonics).vector`` for every limit motion (winding 1, canonical
+    directions): the samples of each motion, then one FFT of them all (row by row the
+    numbers of :func:`.limit.limit_seed`)."""
+    m = max(1024, 32 * harmonics)
+    j = np.arange(m) + 0.5
+    om = np.array([[lim.motion.omega] for lim in lims])
+    period = np.array([[2 * math.pi / lim.motion.omega] for lim in lims])
+    t = period * j / m
+    s = om * t
+    turns = np.floor(t / period)
+    tm = t - turns * period
+    cum = np.empty_like(t)
+    for r, lim in enumerate(lims):
+        mo = lim.motion
+        steps = np.searchsorted(mo.switch_times, tm[r], side="right")
+        cum[r] = np.concatenate(([0.0], np.cumsum(mo.directions)))[steps]
+    start = np.array([[lim.motion.theta_start] for lim in lims])
+    theta = start + math.pi * cum + 2 * math.pi * 1 * turns
+    x = np.fft.rfft(theta - s, axis=-1) / m
+    n = np.arange(1, harmonics + 1)
+    c = 2 * x[:, 1:harmonics + 1] * np.exp(1j * n * math.pi / m)
+    sigma = np.sinc(n / (harmonics + 1))
+    out = np.empty((len(lims), 2 * harmonics + 1))
+    out[:, 0] = x[:, 0].real
+    out[:, 1:harmonics + 1] = -c.imag * sigma
+    out[:, harmonics + 1:] = c.real * sigma
+    return out
+
+
 def _groups(keys):
     """Indices grouped by key, in order of first appearance."""
     out: dict = {}
@@ -244,14 +298,14 @@ def search_fourier_batch(points, harmonics: int, *, gtol: float = 1e-11,
             batched.append(i)
     if not batched:
         return out
-    problems = {i: FourierProblem(points[i][0], harmonics, points[i][1]) for i in batched}
+    sub = [points[i] for i in batched]
+    problems = dict(zip(batched, _problems(sub, harmonics)))
     # uniform seed: the best uniform rotation, optimized first with 8 harmonics, then padded
     # (fourier._uniform_start)
     small_n = min(harmonics, _UNIFORM_HARMONICS)
     useed = {i: _uniform_seed(points[i][0], small_n, points[i][1]) for i in batched}
     if harmonics > _UNIFORM_HARMONICS:
-        small = {i: FourierProblem(points[i][0], _UNIFORM_HARMONICS, points[i][1])
-                 for i in batched}
+        small = dict(zip(batched, _problems(sub, _UNIFORM_HARMONICS)))
         for grp in _groups([small[i].points for i in batched]):
             ids = [batched[j] for j in grp]
             runs = newton_maximize_batch(ProblemBatch([small[i] for i in ids]),
@@ -264,7 +318,7 @@ def search_fourier_batch(points, harmonics: int, *, gtol: float = 1e-11,
     for grp in _groups([problems[i].points for i in batched]):
         ids = [batched[j] for j in grp]
         probs = [problems[i] for i in ids]
-        x0 = [limit_seed(lims[i], harmonics).vector for i in ids] + [useed[i] for i in ids]
+        x0 = [*_limit_seeds([lims[i] for i in ids], harmonics), *(useed[i] for i in ids)]
         runs = newton_maximize_batch(ProblemBatch(probs + probs), np.array(x0),
                                      ["limit"] * len(ids) + ["uniform"] * len(ids),
                                      gtol=gtol, maxiter=maxiter)
@@ -272,8 +326,8 @@ def search_fourier_batch(points, harmonics: int, *, gtol: float = 1e-11,
             primary[i] = [runs[k], runs[len(ids) + k]]
     best = {i: _best(primary[i]) for i in batched}
     # grid refinement: the first check for all points together, the rare refinements alone
-    fine = {i: FourierProblem(points[i][0], harmonics, points[i][1], 2 * problems[i].points)
-            for i in batched}
+    fine = dict(zip(batched, _problems(sub, harmonics,
+                                       [2 * problems[i].points for i in batched])))
     for grp in _groups([fine[i].points for i in batched]):
         ids = [batched[j] for j in grp]
         pf = ProblemBatch([fine[i] for i in ids]).power(list(range(len(ids))),
