@@ -749,29 +749,39 @@ class _LocalPool:
     a second) then overlap the preparation of the store instead of preceding the first block.
     """
 
-    def __init__(self, workers: int):
+    def __init__(self, workers: int, start: bool = True):
+        self.workers = workers
+        self.executor = None
+        self._boot = None
+        if start:
+            self.start()
+
+    def start(self):
+        """Start the processes in the background (once)."""
         import concurrent.futures as cf
         import multiprocessing as mp
         import threading
 
+        if self.executor is not None:
+            return
         ctx = mp.get_context("forkserver")
         ctx.set_forkserver_preload(["parapend.sweep", "parapend.api", "parapend.optimal.fourier",
                                     "parapend.optimal.batch"])
-        self.workers = workers
-        self.executor = cf.ProcessPoolExecutor(max_workers=workers, mp_context=ctx,
+        self.executor = cf.ProcessPoolExecutor(max_workers=self.workers, mp_context=ctx,
                                                initializer=_worker_init,
                                                initargs=(os.getpid(),))
-        self._boot = threading.Thread(target=self._start, daemon=True)
+        self._boot = threading.Thread(target=self._submit_first, daemon=True)
         self._boot.start()
 
-    def _start(self):
+    def _submit_first(self):
         # the first submit starts every worker (in this thread, not the caller's)
         with contextlib.suppress(Exception):
             self.executor.submit(_ready)
 
     def shutdown(self):
-        self._boot.join()
-        self.executor.shutdown(wait=True, cancel_futures=True)
+        if self.executor is not None:
+            self._boot.join()
+            self.executor.shutdown(wait=True, cancel_futures=True)
 
 
 def _ready() -> None:
@@ -785,8 +795,9 @@ def _run_local(spec, todo, pool, done_cb):
         for b in todo:
             done_cb(b, compute_block(spec, b))
         return "serial"
-    ex = pool.executor
+    pool.start()
     pool._boot.join()
+    ex = pool.executor
     try:
         futs = {ex.submit(compute_block, spec, b): b for b in todo}
         for f in cf.as_completed(futs):
@@ -883,10 +894,12 @@ def sweep(store=None, *, omega=1.8, delta=None, gamma=0.0, torque_limit=None, ef
         workers = max(1, min(os.cpu_count() or 1, spec.blocks))
     t0 = time.monotonic()
     client, own = _connect(scheduler) if scheduler is not None else (None, False)
-    if store is not None:
-        _check_store_path(store)
-    pool = (_LocalPool(workers) if client is None and workers > 1 and spec.blocks > 1
-            else None)
+    # the pool starts at once unless the store holds this sweep already (a resume, where
+    # there may be nothing left to do): then only when blocks are left
+    resume = (store is not None and not overwrite
+              and _store_spec(_check_store_path(store)) == spec.to_json())
+    pool = (_LocalPool(workers, start=not resume)
+            if client is None and workers > 1 and spec.blocks > 1 else None)
     try:
         return _sweep(spec, store, pool, client, overwrite, command, progress, t0)
     finally:
