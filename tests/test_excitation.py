@@ -44,7 +44,7 @@ def test_extrema_found_once_per_shape_in_the_phase():
         assert ex.t.size in (2, 4, 6, 8, 10)
         for t, q in zip(ex.t, ex.q):
             h = 1e-3 * e.period
-            r = brentq(lambda x: float(e.dq(x)), t - h, t + h, xtol=1e-15)
+            r = brentq(lambda x, e=e: float(e.dq(x)), t - h, t + h, xtol=1e-15)
             assert t == pytest.approx(r, abs=4e-15 * e.period)
             assert q == float(e.q(t))
     E._phase_extrema.cache_clear()

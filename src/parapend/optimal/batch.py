@@ -220,8 +220,6 @@ def _problems(points, harmonics: int, grids=None) -> list:
     """``FourierProblem(excitation, harmonics, damping, grid)`` for every point, with
     ``dq/dt`` on the grids of all points with the same M and spectrum length synthesized by
     one inverse FFT (row by row the numbers of ``Excitation.dq_grid``)."""
-    from ..excitation import _synthesize
-
     ms = [_problem_points(harmonics, e, None if grids is None else grids[i], 1)
           for i, (e, _) in enumerate(points)]
     specs = [e.dq_spectrum() for e, _ in points]
