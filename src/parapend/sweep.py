@@ -112,6 +112,8 @@ _BLOCK_POINTS = 512
 #: global searches run together at most this many at a time: 64 to 128 points cost 0.74 to
 #: 0.77 ms each, 512 points 0.91 ms (the Hessians of a batch leave the cache)
 _BATCH_POINTS = 128
+#: and at most this many Hessian entries per batch (4 MiB of doubles; N = 24 allows 218)
+_BATCH_ENTRIES = 1 << 19
 _BLOCK_POINTS_PTO = 8
 
 
@@ -362,8 +364,11 @@ def _searches(spec: SweepSpec, ideal: list) -> list:
         return []
     try:
         out = []
-        for i in range(0, len(ideal), _BATCH_POINTS):
-            part = ideal[i:i + _BATCH_POINTS]
+        # at most _BATCH_POINTS points, fewer at large N: the Hessians of a batch take
+        # points * (2N + 1)^2 doubles (twice that in the primary runs, limit and uniform)
+        step = max(1, min(_BATCH_POINTS, _BATCH_ENTRIES // (2 * spec.harmonics + 1) ** 2))
+        for i in range(0, len(ideal), step):
+            part = ideal[i:i + step]
             out += batch.search_fourier_batch([(e, g) for e, g, _ in part], spec.harmonics,
                                               limits=[lim for _, _, lim in part])
         return out
