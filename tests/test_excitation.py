@@ -30,6 +30,33 @@ def test_two_harmonic_switching_instants_of_paper():
     np.testing.assert_allclose(e.dq(e.extrema.t), 0, atol=1e-13)
 
 
+def test_extrema_found_once_per_shape_in_the_phase():
+    """The extrema are found in s = omega t for the shape of q (spectrum over its largest
+    harmonic amplitude), once per shape: they equal Brent's method on dq/dt in t itself, and
+    a map over omega and delta of one excitation computes them twice (one per sign)."""
+    from scipy.optimize import brentq
+
+    E._phase_extrema.cache_clear()
+    terms = [(1, -0.3, 0.2), (3, 0.15, 1.0), (5, 0.05, -0.4)]
+    for e in (parapend.fourier(terms, omega=2.1), parapend.two_harmonic(0.2, 1.3),
+              parapend.harmonic(-0.45, 0.7)):
+        ex = e.extrema
+        assert ex.t.size in (2, 4, 6, 8, 10)
+        for t, q in zip(ex.t, ex.q):
+            h = 1e-3 * e.period
+            r = brentq(lambda x, e=e: float(e.dq(x)), t - h, t + h, xtol=1e-15)
+            assert t == pytest.approx(r, abs=4e-15 * e.period)
+            assert q == float(e.q(t))
+    E._phase_extrema.cache_clear()
+    for om in (1.2, 1.7, 2.4):
+        for d in (-0.5, -0.17, 0.05, 0.3):
+            ex = parapend.harmonic(d, om).extrema
+            s = ex.t * om
+            np.testing.assert_allclose(s, [np.pi / 2, 3 * np.pi / 2], rtol=1e-15)
+            assert list(ex.is_max) == [d > 0, d < 0]
+    assert E._phase_extrema.cache_info().misses == 2
+
+
 def test_fourier_series_matches_definition():
     terms = [(1, -0.3, 0.2), (3, 0.15, 1.0), (5, 0.05, -0.4)]
     e = parapend.fourier(terms, omega=2.1)

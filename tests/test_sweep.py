@@ -66,6 +66,64 @@ def test_every_point_equals_optimize(reference):
     assert ds.attrs["command"] == "test" and ds.attrs["parapend_version"] == parapend.__version__
 
 
+def _same_search(a, b):
+    """Two FourierSearch results equal bit for bit: every run and the evidence."""
+    assert len(a.runs) == len(b.runs)
+    for r, s in zip(a.runs, b.runs):
+        assert np.array_equal(r.x, s.x)
+        assert (r.power, r.status, r.iterations, r.seed, r.points, r.strict_maximum,
+                r.gradient_norm) == (s.power, s.status, s.iterations, s.seed, s.points,
+                                     s.strict_maximum, s.gradient_norm)
+    assert a.best.power == b.best.power and np.array_equal(a.best.x, b.best.x)
+    assert a.evidence == b.evidence
+
+
+def test_batched_search_is_search_fourier_bit_for_bit():
+    """The sweep's batched global search (optimal/batch.py) gives every point exactly what
+    search_fourier gives it alone: each run's coefficients, power, status, iterations and
+    strictness, and the evidence. Gamma 0, gamma > 0, above gamma* (no power), both signs
+    of delta, N below and above the 8-harmonic uniform start, two excitations of one
+    shape in one batch with others, and a point with several patterns (handed to
+    search_fourier)."""
+    from parapend.optimal.batch import search_fourier_batch
+    from parapend.optimal.fourier import search_fourier
+
+    for n in (6, 12):
+        pts = [(parapend.harmonic(d, om), g) for om in (1.3, 2.2) for d in (-0.4, -0.1, 0.25)
+               for g in (0.0, 0.01, 0.4)]
+        pts += [(parapend.two_harmonic(-0.3, 1.8), 0.01),
+                (parapend.fourier([(1, 0.2, 0.0), (3, 0.15, 0.4)], omega=1.8), 0.01)]
+        got = search_fourier_batch(pts, n)
+        for (exc, g), (found, problem) in zip(pts, got):
+            _same_search(found, search_fourier(exc, n, g))
+            if problem is not None:
+                assert problem.points == found.runs[0].points
+        assert got[-1][1] is None and got[-1][0].evidence.candidate_patterns > 1
+        statuses = {f.best.status for f, _ in got}
+        assert "converged" in statuses and min(f.best.power for f, _ in got) < 0
+
+
+def test_batched_problems_and_limit_seeds_are_the_scalar_ones():
+    """dq/dt on the grids and the limit seeds, built for many points at once, equal those
+    of FourierProblem and limit_seed (any grid, N, excitation, sign of delta)."""
+    from parapend.optimal.batch import _limit_seeds, _problems
+    from parapend.optimal.fourier import FourierProblem
+    from parapend.optimal.limit import limit, limit_seed
+
+    ex = [parapend.harmonic(d, om) for om in (0.3, 1.7, 3.0) for d in (-0.5, -0.02, 0.4)]
+    ex += [parapend.two_harmonic(-0.3, 1.8), parapend.square(-0.3, 1.8, 0.05),
+           parapend.fourier([(1, 0.2, 0.0), (7, 0.1, 1.0)], omega=1.5)]
+    pts = [(e, 0.01) for e in ex]
+    for n in (5, 8, 24):
+        for grids in (None, [1024] * len(pts)):
+            for (e, g), p in zip(pts, _problems(pts, n, grids)):
+                q = FourierProblem(e, n, g, None if grids is None else 1024)
+                assert q.points == p.points and np.array_equal(q.w, p.w)
+        lims = [limit(e) for e in ex[:-1]]
+        for lim, x in zip(lims, _limit_seeds(lims, n)):
+            assert np.array_equal(x, limit_seed(lim, n).vector)
+
+
 def _check_pto(ds, n):
     from parapend.pto import optimize_pto
 
@@ -401,17 +459,21 @@ def test_branch_gap_records_a_better_continued_branch(monkeypatch):
     """When the global search misses the best maximum (here: crippled to one Newton step
     from the uniform rotation), the continuation from the neighbour finds it: branch_gap is
     the difference to optimize's true optimum, and power stays the search's own value."""
+    import parapend.optimal.batch as batch
     import parapend.optimal.fourier as fourier
 
-    def crippled(exc, n, gamma, **kw):
-        problem = fourier.FourierProblem(exc, n, gamma)
-        r = fourier.newton_maximize(problem, fourier._uniform_seed(exc, n, gamma), "uniform",
-                                    maxiter=1)
-        return fourier.FourierSearch(r, [r], None)
+    def crippled(points, n, **kw):
+        out = []
+        for exc, gamma in points:
+            problem = fourier.FourierProblem(exc, n, gamma)
+            r = fourier.newton_maximize(problem, fourier._uniform_seed(exc, n, gamma),
+                                        "uniform", maxiter=1)
+            out.append((fourier.FourierSearch(r, [r], None), problem))
+        return out
 
     true = {d: parapend.optimize(omega=1.8, delta=d, gamma=0.01, harmonics=12).power
             for d in (-0.3, -0.25, -0.2)}
-    monkeypatch.setattr(fourier, "search_fourier", crippled)
+    monkeypatch.setattr(batch, "search_fourier_batch", crippled)
     ds = sw.sweep(None, omega=1.8, delta="-0.3,-0.25,-0.2", gamma=0.01, harmonics=12,
                   workers=1).dataset
     gap, power = ds["branch_gap"].values, ds["power"].values

@@ -20,7 +20,7 @@ from __future__ import annotations
 import csv
 import math
 from dataclasses import dataclass, field
-from functools import cached_property
+from functools import cached_property, lru_cache
 from pathlib import Path
 
 import numpy as np
@@ -172,14 +172,41 @@ def _evaluate_uniform(spec: np.ndarray, m: int) -> np.ndarray:
 
 
 def _extrema_from_roots(exc: Excitation) -> Extrema:
-    """Locate sign changes of ``dq`` on a fine grid, then refine each by Brent's method."""
+    """Extrema from the roots of ``dq``, found in the phase ``s = omega t`` for the shape of q.
+
+    Where ``dq/dt`` vanishes depends only on the *shape* of the spectrum: the roots of
+    ``dq/dt = omega Re sum_k i k Q[k] e^{iks}`` in ``s`` are those of the same sum with
+    ``Q`` divided by its largest harmonic amplitude, whatever ``omega`` and the amplitude
+    (``delta``). They are found once per shape (:func:`_phase_extrema`, cached: a design map
+    over omega and delta has one or two shapes) and scaled, ``t = s / omega``; ``q`` is
+    evaluated at each.
+    """
     spec = exc.spectrum
     kmax = spec.size - 1
     if kmax == 0 or np.max(np.abs(spec[1:])) == 0.0:
         return Extrema(np.empty(0), np.empty(0), np.empty(0, dtype=bool))
+    shape = np.ascontiguousarray(spec[1:] / float(np.max(np.abs(spec[1:]))), dtype=complex)
+    s, ismax = _phase_extrema(shape.tobytes())
+    ts = s / exc.omega
+    qs = np.array([float(exc.q(t)) for t in ts])
+    return Extrema(ts, qs, ismax.copy())
+
+
+@lru_cache(maxsize=256)
+def _phase_extrema(shape_bytes: bytes):
+    """Phases ``s`` in ``[0, 2 pi)`` where ``Re sum_k i k S[k] e^{iks}`` changes sign (``S``:
+    the harmonics k >= 1 of a spectrum, as bytes), and whether each is a maximum of q.
+
+    Sign changes on a fine grid (at least 64 points per top harmonic), each refined by
+    Brent's method.
+    """
+    shape = np.frombuffer(shape_bytes, dtype=complex)
+    kmax = shape.size
+    dspec = np.zeros(kmax + 1, dtype=complex)
+    dspec[1:] = 1j * np.arange(1, kmax + 1) * shape
     m = int(max(4096, 64 * kmax))
     s = 2 * np.pi * np.arange(m) / m
-    d = exc.dq_grid(m)
+    d = _synthesize(dspec, m)
     scale = np.max(np.abs(d))
     d = np.where(np.abs(d) < 1e-13 * scale, 0.0, d)
     sign = np.sign(d)
@@ -188,30 +215,31 @@ def _extrema_from_roots(exc: Excitation) -> Extrema:
     sign = sign[nz]
     idx = nz
     change = np.flatnonzero(sign != np.roll(sign, -1))
-    ts, qs, ismax = [], [], []
-    period = exc.period
+    ss, ismax = [], []
 
-    def f(t):
-        return float(exc.dq(t))
+    def f(x):
+        return float(_evaluate(dspec, x))
 
     for c in change:
         i0, i1 = idx[c], idx[(c + 1) % idx.size]
-        t0 = s[i0] / exc.omega
-        t1 = s[i1] / exc.omega if i1 > i0 else (s[i1] + 2 * np.pi) / exc.omega
-        f0, f1 = f(t0), f(t1)
+        s0 = s[i0]
+        s1 = s[i1] if i1 > i0 else s[i1] + 2 * np.pi
+        f0, f1 = f(s0), f(s1)
         if f0 == 0.0:
-            r = t0
+            r = s0
         elif f1 == 0.0:
-            r = t1
+            r = s1
         elif f0 * f1 > 0:  # grid sign flip not confirmed by the exact derivative
             continue
         else:
-            r = brentq(f, t0, t1, xtol=1e-15)
-        ts.append(r % period)
-        qs.append(float(exc.q(r)))
+            r = brentq(f, s0, s1, xtol=1e-15)
+        ss.append(r % (2 * np.pi))
         ismax.append(sign[c] > 0)
-    order = np.argsort(ts)
-    return Extrema(np.asarray(ts)[order], np.asarray(qs)[order], np.asarray(ismax)[order])
+    order = np.argsort(ss)
+    out = np.asarray(ss, dtype=float)[order], np.asarray(ismax, dtype=bool)[order]
+    for a in out:
+        a.flags.writeable = False
+    return out
 
 
 # ---------------------------------------------------------------------------------------

@@ -62,8 +62,8 @@ MAX_PTO_POINTS = 101
 MAX_PTO_INTERVALS = 2048
 
 # --- design maps (parapend sweep, issue 13) ------------------------------------------------
-#: points of one map (the issue asks for 10^4 to 10^6; at N = 24 about 2 ms of CPU each,
-#: so 2^20 points are about 35 CPU-minutes, resumable)
+#: points of one map (the issue asks for 10^4 to 10^6; at N = 24 about 1 ms of CPU each
+#: for a harmonic excitation, so 2^20 points are about 15 to 20 CPU-minutes, resumable)
 MAP_MAX_POINTS = 1 << 20
 #: points of a map with a power take-off (0.2 to 0.5 s each at N = 24, 2 s infeasible:
 #: 4096 points are up to 2 hours of CPU)

@@ -24,6 +24,11 @@ The warm start and the global search
     goes on along that branch. So the warm start cannot change ``power``; it checks the
     global search along every run of the map (0 everywhere on the maps measured so far).
 
+The searches of a block together
+    The global searches of a block's points run in lockstep (:mod:`.optimal.batch`): the
+    array work of each Newton iteration is done for up to 128 points at once, with the same
+    arithmetic per point as ``search_fourier``, so ``power`` is still optimize's bit for bit.
+
 The store (Zarr 3)
     Made whole (every array, its chunks, coordinates and attributes) before the first
     block, then written block by block: the variables of a block, then its ``done`` mask.
@@ -100,8 +105,15 @@ _BRANCH_TOL = 1e-9
 #: a continuation whose first Newton step lands this close to the global search's maximum
 #: (max-norm of the coefficients, relative to max(1, |x|)) is on that maximum's branch
 _SAME_BRANCH = 1e-4
-#: points per block (one chunk, one task): about a quarter of a second of work
-_BLOCK_POINTS = 128
+#: points per block (one chunk, one task): about half a second of work at N = 24; smaller
+#: blocks cost the writing process more than the computing ones (measured on the benchmark's
+#: map: 3.7 s of its CPU with 128-point blocks, 1.0 s with 512)
+_BLOCK_POINTS = 512
+#: global searches run together at most this many at a time: 64 to 128 points cost 0.74 to
+#: 0.77 ms each, 512 points 0.91 ms (the Hessians of a batch leave the cache)
+_BATCH_POINTS = 128
+#: and at most this many Hessian entries per batch (4 MiB of doubles; N = 24 allows 218)
+_BATCH_ENTRIES = 1 << 19
 _BLOCK_POINTS_PTO = 8
 
 
@@ -308,30 +320,27 @@ def sweep_spec(*, omega=1.8, delta=None, gamma=0.0, torque_limit=None, efficienc
 
 # -- one block -----------------------------------------------------------------------------
 
-def _ideal_point(exc, n: int, gamma: float, warm):
-    """What optimize computes (power, status), plus the continuation check; see the module
-    docstring. Returns (power, status, branch_gap, x for the next point)."""
-    from .optimal.fourier import (
-        FourierProblem,
-        _ascent_step,
-        _pad,
-        newton_maximize,
-        search_fourier,
-    )
+def _continue(exc, n: int, gamma: float, found, problem, warm, first=None):
+    """What optimize computes (power, status) from the point's global search ``found``, plus
+    the continuation check from the neighbour's optimum ``warm``; see the module docstring.
+    ``problem``: the search's N-harmonic problem (reused when ``best`` is on its grid);
+    ``first``: ``problem.evaluate`` at the padded ``warm`` when computed already (with the
+    other points of the block). Returns (power, status, branch_gap, x for the next point)."""
+    from .optimal.fourier import FourierProblem, _ascent_step, _pad, newton_maximize
 
-    found = search_fourier(exc, n, gamma)
     best = found.best
     status = "no_power" if best.status == "converged" and best.power <= 0 else best.status
     gap, x = 0.0, best.x
     if warm is not None and math.isfinite(best.power):
-        problem = FourierProblem(exc, n, gamma, best.points)
+        if problem is None or problem.points != best.points:
+            problem, first = FourierProblem(exc, n, gamma, best.points), None
         x0 = _pad(warm, n)
         # one Newton step decides most points: when it lands on the global search's maximum
         # (within 1e-4 of the coefficients, from the concave region), the continuation
         # converges there (Newton converges quadratically near a strict maximum: the next
         # step would be within ~1e-8) and there is no other branch; a step of 1/47 of the
         # delta range of the benchmark's map lands within 5e-5 (median 5e-6)
-        p, g, h = problem.evaluate(x0)
+        p, g, h = first if first is not None else problem.evaluate(x0)
         d, is_newton = _ascent_step(g, h)
         near = float(np.max(np.abs(x0 + d - best.x))) <= _SAME_BRANCH * max(
             1.0, float(np.max(np.abs(best.x))))
@@ -343,67 +352,169 @@ def _ideal_point(exc, n: int, gamma: float, warm):
     return best.power, status, gap, x
 
 
-def _point(spec: SweepSpec, p: dict, warm, thresholds: dict):
-    """Every variable at one point ``p`` (axis name -> value); returns (values, warm)."""
-    from .api import build_excitation, threshold
+def _searches(spec: SweepSpec, ideal: list) -> list:
+    """The global search of every ideal point of a block, ``(found, problem)`` each, or the
+    exception it raised: all together (:func:`.optimal.batch.search_fourier_batch`, the
+    same numbers as ``search_fourier`` point by point); if that raises, point by point, so
+    that only the failing points are errors."""
+    from .optimal import batch
+    from .optimal.fourier import search_fourier
+
+    if not ideal:
+        return []
+    try:
+        out = []
+        # at most _BATCH_POINTS points, fewer at large N: the Hessians of a batch take
+        # points * (2N + 1)^2 doubles (twice that in the primary runs, limit and uniform)
+        step = max(1, min(_BATCH_POINTS, _BATCH_ENTRIES // (2 * spec.harmonics + 1) ** 2))
+        for i in range(0, len(ideal), step):
+            part = ideal[i:i + step]
+            out += batch.search_fourier_batch([(e, g) for e, g, _ in part], spec.harmonics,
+                                              limits=[lim for _, _, lim in part])
+        return out
+    except Exception:  # noqa: BLE001 - recomputed point by point below
+        out = []
+        for exc, gamma, _ in ideal:
+            try:
+                out.append((search_fourier(exc, spec.harmonics, gamma), None))
+            except Exception as err:  # noqa: BLE001 - recorded as status "error"
+                out.append(err)
+        return out
+
+
+def _first_steps(spec: SweepSpec, runs: list, found: list) -> dict:
+    """``problem.evaluate`` at the padded optimum of the previous point, for every ideal
+    point whose neighbour is ideal too: the first step of the continuation, all together.
+    Keyed by the point's index in ``found``; a point whose neighbour's continuation ends on
+    another branch (``branch_gap``) is evaluated again, alone, by :func:`_continue`."""
+    from .optimal.batch import ProblemBatch
+    from .optimal.fourier import _pad
+
+    pairs = []  # (k of the point, k of its neighbour)
+    for kinds in runs:
+        for prev, kind in zip(kinds, kinds[1:]):
+            if isinstance(prev, tuple) and isinstance(kind, tuple):
+                a, b = found[prev[1]], found[kind[1]]
+                if (not isinstance(a, Exception) and not isinstance(b, Exception)
+                        and b[1] is not None and b[1].points == b[0].best.points
+                        and math.isfinite(b[0].best.power)):
+                    pairs.append((kind[1], prev[1]))
+    out: dict = {}
+    groups: dict = {}
+    for k, j in pairs:
+        groups.setdefault(found[k][1].points, []).append((k, j))
+    for grp in groups.values():
+        try:
+            p, g, h = ProblemBatch([found[k][1] for k, _ in grp]).evaluate(
+                list(range(len(grp))),
+                np.array([_pad(found[j][0].best.x, spec.harmonics) for _, j in grp]))
+        except Exception:  # noqa: BLE001 - evaluated point by point in _continue
+            continue
+        for i, (k, _) in enumerate(grp):
+            out[k] = (p[i], g[i].copy(), h[i])
+    return out
+
+
+def _point_input(spec: SweepSpec, p: dict):
+    """The parts of a point that need no global search: (values, kind) with kind "pto",
+    "constant", "error" or ``(excitation, gamma, limit)`` for an ideal point."""
+    from .api import build_excitation
     from .optimal.limit import limit
     from .power import uniform_power
 
     kw = spec.excitation_args(p["omega"], p.get("delta"))
-    out = {}
+    out: dict = {}
     try:
         exc = build_excitation(**kw)
         gamma = p["gamma"]
-        lim = limit(exc).power
+        lim = limit(exc)
         out["uniform_power"] = uniform_power(exc, gamma)[0]
-        out["limit_power"] = lim
+        out["limit_power"] = lim.power
         if spec.pto:
             from .pto import optimize_pto
 
             r = optimize_pto(torque_limit=p.get("torque_limit"), efficiency=p.get("efficiency"),
                              gamma=gamma, harmonics=spec.harmonics, **kw)
             out.update(power=r.power, electrical_power=r.electrical_power, status=r.status)
-        elif lim <= 0:  # constant q: as optimize, the uniform rotation's loss
+            return out, "pto"
+        if lim.power <= 0:  # constant q: as optimize, the uniform rotation's loss
             out.update(power=-gamma * exc.omega**2, status="no_power", branch_gap=0.0)
-            warm = None
-        else:
-            pw, st, gap, warm = _ideal_point(exc, spec.harmonics, gamma, warm)
-            out.update(power=pw, status=st, branch_gap=gap)
+            return out, "constant"
+        return out, (exc, gamma, lim)
     except Exception as err:  # recorded as status "error", never dropped
         log.warning("sweep point %s failed: %s: %s", p, type(err).__name__, err)
-        out = {"status": "error"}
-        warm = None
-    if spec.threshold:
-        key = (p["omega"], p.get("delta"))
-        if key not in thresholds:
-            try:
-                t = threshold(**kw)
-                thresholds[key] = (t.damping_threshold, t.status)
-            except Exception as err:
-                log.warning("sweep threshold at %s failed: %s: %s", p, type(err).__name__, err)
-                thresholds[key] = (math.nan, "error")
-        out["damping_threshold"], out["threshold_status"] = thresholds[key]
-    return out, warm
+        return {"status": "error"}, "error"
+
+
+def _threshold(spec: SweepSpec, p: dict, thresholds: dict):
+    """gamma* at the point's (omega, delta), once per block for each."""
+    from .api import threshold
+
+    key = (p["omega"], p.get("delta"))
+    if key not in thresholds:
+        try:
+            t = threshold(**spec.excitation_args(p["omega"], p.get("delta")))
+            thresholds[key] = (t.damping_threshold, t.status)
+        except Exception as err:
+            log.warning("sweep threshold at %s failed: %s: %s", p, type(err).__name__, err)
+            thresholds[key] = (math.nan, "error")
+    return thresholds[key]
 
 
 def compute_block(spec: SweepSpec, block: int) -> dict:
-    """The variables of one block, as arrays of the block's shape (runs along the fastest
-    dimension continue from point to point; each run starts afresh)."""
+    """The variables of one block, as arrays of the block's shape.
+
+    The global searches of all the block's ideal points run together
+    (:mod:`.optimal.batch`); then each run along the fastest dimension continues from point
+    to point (each run starts afresh)."""
     sl = spec.block_slices(block)
     shape = tuple(s.stop - s.start for s in sl)
     out = {v: (np.full(shape, NOT_COMPUTED, dtype=np.int8) if v.endswith("status")
                else np.full(shape, np.nan)) for v in spec.variables}
     fixed = {a: (spec.values[a][0] if len(spec.values[a]) == 1 else None) for a in AXES
              if len(spec.values[a]) <= 1}
-    thresholds: dict = {}
+    runs, ideal = [], []  # runs: [(index, point, values, kind)]; ideal: search inputs
     for lead in np.ndindex(*shape[:-1]):
-        warm = None
+        run = []
         for j in range(shape[-1]):
             idx = (*lead, j)
             p = dict(fixed)
             for d, s, i in zip(spec.dims, sl, idx):
                 p[d] = spec.values[d][s.start + i]
-            vals, warm = _point(spec, p, warm, thresholds)
+            vals, kind = _point_input(spec, p)
+            if isinstance(kind, tuple):  # ("ideal", k into ideal, excitation, gamma)
+                ideal.append(kind)
+                kind = ("ideal", len(ideal) - 1, kind[0], kind[1])
+            run.append((idx, p, vals, kind))
+        runs.append(run)
+    found = _searches(spec, ideal)
+    first = _first_steps(spec, [[kind for *_, kind in run] for run in runs], found)
+    thresholds: dict = {}
+    for run in runs:
+        warm, prev = None, None
+        for idx, p, vals, kind in run:
+            if kind in ("error", "constant"):
+                warm = None
+            elif kind != "pto":
+                _, k, exc, gamma = kind
+                try:
+                    if isinstance(found[k], Exception):
+                        raise found[k]
+                    # the first step was evaluated from the neighbour's global optimum: valid
+                    # when the warm start is that optimum (no branch above it)
+                    pre = first.get(k) if prev is not None and warm is prev else None
+                    pw, st, gap, warm = _continue(exc, spec.harmonics, gamma, *found[k], warm,
+                                                  pre)
+                    prev = found[k][0].best.x
+                    vals.update(power=pw, status=st, branch_gap=gap)
+                except Exception as err:  # recorded as status "error", never dropped
+                    log.warning("sweep point %s failed: %s: %s", p, type(err).__name__, err)
+                    vals.clear()
+                    vals["status"] = "error"
+                    warm = None
+            if spec.threshold:
+                vals["damping_threshold"], vals["threshold_status"] = _threshold(
+                    spec, p, thresholds)
             for k, v in vals.items():
                 if k.endswith("status"):
                     out[k][idx] = _CODE.get(v, _CODE["other"])
@@ -637,18 +748,61 @@ def _worker_init(parent: int) -> None:
     threading.Thread(target=watch, daemon=True).start()
 
 
-def _run_local(spec, todo, workers, done_cb):
-    import concurrent.futures as cf
-    import multiprocessing as mp
+class _LocalPool:
+    """The local worker processes (a ``forkserver`` pool), started in the background as soon
+    as the sweep's parameters are checked: the server's imports and the workers' start (about
+    a second) then overlap the preparation of the store instead of preceding the first block.
+    """
 
-    if workers == 1 or len(todo) <= 1:
+    def __init__(self, workers: int, start: bool = True):
+        self.workers = workers
+        self.executor = None
+        self._boot = None
+        if start:
+            self.start()
+
+    def start(self):
+        """Start the processes in the background (once)."""
+        import concurrent.futures as cf
+        import multiprocessing as mp
+        import threading
+
+        if self.executor is not None:
+            return
+        ctx = mp.get_context("forkserver")
+        ctx.set_forkserver_preload(["parapend.sweep", "parapend.api", "parapend.optimal.fourier",
+                                    "parapend.optimal.batch"])
+        self.executor = cf.ProcessPoolExecutor(max_workers=self.workers, mp_context=ctx,
+                                               initializer=_worker_init,
+                                               initargs=(os.getpid(),))
+        self._boot = threading.Thread(target=self._submit_first, daemon=True)
+        self._boot.start()
+
+    def _submit_first(self):
+        # the first submit starts every worker (in this thread, not the caller's)
+        with contextlib.suppress(Exception):
+            self.executor.submit(_ready)
+
+    def shutdown(self):
+        if self.executor is not None:
+            self._boot.join()
+            self.executor.shutdown(wait=True, cancel_futures=True)
+
+
+def _ready() -> None:
+    """A first task: it makes the pool start its processes."""
+
+
+def _run_local(spec, todo, pool, done_cb):
+    import concurrent.futures as cf
+
+    if pool is None or len(todo) <= 1:
         for b in todo:
             done_cb(b, compute_block(spec, b))
         return "serial"
-    ctx = mp.get_context("forkserver")
-    ctx.set_forkserver_preload(["parapend.sweep", "parapend.api", "parapend.optimal.fourier"])
-    ex = cf.ProcessPoolExecutor(max_workers=workers, mp_context=ctx, initializer=_worker_init,
-                                initargs=(os.getpid(),))
+    pool.start()
+    pool._boot.join()
+    ex = pool.executor
     try:
         futs = {ex.submit(compute_block, spec, b): b for b in todo}
         for f in cf.as_completed(futs):
@@ -661,7 +815,7 @@ def _run_local(spec, todo, workers, done_cb):
             done_cb(futs[f], vals)
     finally:
         ex.shutdown(wait=True, cancel_futures=True)
-    return f"{workers} local processes"
+    return f"{pool.workers} local processes"
 
 
 def _connect(scheduler):
@@ -732,7 +886,7 @@ def sweep(store=None, *, omega=1.8, delta=None, gamma=0.0, torque_limit=None, ef
     progress : callable or None
         ``progress(done_points, total_points)`` after each block.
     block_points : int or None
-        Points per block (one chunk, one task), about: default 128 (8 with a power
+        Points per block (one chunk, one task), about: default 512 (8 with a power
         take-off). Part of the sweep's identity, as it sets where continuation runs start.
     """
     spec = sweep_spec(omega=omega, delta=delta, gamma=gamma, torque_limit=torque_limit,
@@ -745,14 +899,22 @@ def sweep(store=None, *, omega=1.8, delta=None, gamma=0.0, torque_limit=None, ef
         workers = max(1, min(os.cpu_count() or 1, spec.blocks))
     t0 = time.monotonic()
     client, own = _connect(scheduler) if scheduler is not None else (None, False)
+    # the pool starts at once unless the store holds this sweep already (a resume, where
+    # there may be nothing left to do): then only when blocks are left
+    resume = (store is not None and not overwrite
+              and _store_spec(_check_store_path(store)) == spec.to_json())
+    pool = (_LocalPool(workers, start=not resume)
+            if client is None and workers > 1 and spec.blocks > 1 else None)
     try:
-        return _sweep(spec, store, workers, client, overwrite, command, progress, t0)
+        return _sweep(spec, store, pool, client, overwrite, command, progress, t0)
     finally:
+        if pool is not None:
+            pool.shutdown()
         if own:
             client.close()
 
 
-def _sweep(spec, store, workers, client, overwrite, command, progress, t0) -> SweepRun:
+def _sweep(spec, store, pool, client, overwrite, command, progress, t0) -> SweepRun:
     total = spec.points
     sizes = [int(np.prod([s.stop - s.start for s in spec.block_slices(b)]))
              for b in range(spec.blocks)]
@@ -771,7 +933,7 @@ def _sweep(spec, store, workers, client, overwrite, command, progress, t0) -> Sw
             if progress is not None:
                 progress(counted[0], total)
 
-        how = _execute(spec, list(range(spec.blocks)), workers, client, write)
+        how = _execute(spec, list(range(spec.blocks)), pool, client, write)
         for k, v in arrays.items():
             ds[k] = (spec.dims, v, ds[k].attrs)
         return SweepRun(ds, None, total, spec.blocks, total, 0, time.monotonic() - t0, how)
@@ -799,16 +961,16 @@ def _sweep(spec, store, workers, client, overwrite, command, progress, t0) -> Sw
             if progress is not None:
                 progress(counted[0], total)
 
-        how = _execute(spec, todo, workers, client, write) if todo else "nothing to do"
+        how = _execute(spec, todo, pool, client, write) if todo else "nothing to do"
     ds = open_sweep(path)
     return SweepRun(ds, str(path), total, spec.blocks, total - resumed, resumed,
                     time.monotonic() - t0, how)
 
 
-def _execute(spec, todo, workers, client, write) -> str:
+def _execute(spec, todo, pool, client, write) -> str:
     if client is not None:
         return _run_dask(spec, todo, client, write)
-    return _run_local(spec, todo, min(workers, max(len(todo), 1)), write)
+    return _run_local(spec, todo, pool, write)
 
 
 # -- heat maps -----------------------------------------------------------------------------

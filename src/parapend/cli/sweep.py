@@ -82,7 +82,7 @@ def add_parsers(sub) -> None:
                    help="run on an existing Dask distributed cluster (tcp://host:8786); "
                         "needs the 'distributed' package")
     p.add_argument("--block-points", type=_int, default=None,
-                   help="points per block, one chunk of the store (default 128, 8 with a "
+                   help="points per block, one chunk of the store (default 512, 8 with a "
                         "power take-off)")
     p.add_argument("--json", action="store_true", help="print one JSON object")
 

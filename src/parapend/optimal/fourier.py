@@ -66,6 +66,15 @@ def _grid_size(harmonics: int, excitation) -> int:
     return max(64, 1 << int(math.ceil(math.log2(8 * (k + 1)))))
 
 
+def _problem_points(harmonics: int, excitation, points: int | None, winding: int) -> int:
+    """The grid M of :class:`FourierProblem`: ``points`` (or the initial grid), doubled until
+    it holds 8 points per harmonic and turn."""
+    m = points or _grid_size(harmonics, excitation)
+    while m < 8 * harmonics + 8 * winding:
+        m *= 2
+    return m
+
+
 @lru_cache(maxsize=64)
 def _hessian_tables(n: int):
     """Index tables so that <v phi_i phi_k> = sum_j coef_j * X[idx_j] with X = [C | S]."""
@@ -130,10 +139,12 @@ class FourierProblem:
         ``"dense"``: :meth:`evaluate` returns the (2N+1) x (2N+1) Hessian (O(N^2) memory,
         O(N^3) per Newton step). ``"operator"``: it returns a :class:`HessianOperator` whose
         product costs two FFTs of M points (records of irregular seas: N in the thousands).
+    dq : ndarray, optional
+        ``excitation.dq_grid(M)``, when the caller has it (the same numbers).
     """
 
     def __init__(self, excitation, harmonics: int, damping: float, points: int | None = None,
-                 winding: int = 1, hessian: str = "dense"):
+                 winding: int = 1, hessian: str = "dense", dq: np.ndarray | None = None):
         if hessian not in HESSIANS:
             raise ValueError(f"hessian: expected one of {HESSIANS}, got {hessian!r}")
         self.excitation = excitation
@@ -142,15 +153,14 @@ class FourierProblem:
         self.damping = damping
         self.winding = int(winding)
         self.hessian = hessian
-        m = points or _grid_size(n, excitation)
-        while m < 8 * n + 8 * self.winding:
-            m *= 2
-        self.points = m
+        self.points = m = _problem_points(n, excitation, points, self.winding)
         self.s = 2 * np.pi * np.arange(m) / m
         # K s of theta = K s + periodic part (the same array, not a product, when K = 1)
         self._ks = self.s if self.winding == 1 else self.winding * self.s
         self._k0 = 1.0 if self.winding == 1 else float(self.winding) ** 2
-        self.w = excitation.dq_grid(m)
+        # dq: excitation.dq_grid(m) computed by the caller (optimal/batch.py: one inverse FFT
+        # for many excitations, the same numbers)
+        self.w = excitation.dq_grid(m) if dq is None else dq
         k = np.arange(1, n + 1)
         self._k2 = np.concatenate(([0.0], k * k, k * k)).astype(float)
         if hessian == "dense":
