@@ -653,7 +653,10 @@ def solve_hermite(excitation, damping: float, intervals: int, start, *, torque_l
             if x is None:
                 break
             xa = ph1.x
-        sol = interior_point(pr, x, mu0=1e-4 * abs(pr.objective(x)) / pr.barrier_count())
+        # the barrier restarts at the scale of the change: 1e-4 of the objective, less when
+        # the excess was small (a last interval 3e-7 over needs no wide restart)
+        scale = min(1e-4, 100.0 * (peak / torque_limit - 1.0))
+        sol = interior_point(pr, x, mu0=scale * abs(pr.objective(x)) / pr.barrier_count())
         iters += sol.iterations
         stages.append(("tighten", float(np.min(lim)), sol.status))
         motion = pr.motion(sol.x)
