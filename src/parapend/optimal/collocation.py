@@ -52,17 +52,13 @@ import numba as nb
 import numpy as np
 from scipy.linalg.lapack import dgbsv
 
+from .hermite import _fold  # node order 0, K-1, 1, K-2, ...: the cyclic wrap made banded
+
 __all__ = ["CollocationMotion", "CollocationSolution", "solve_collocation"]
 
 _KL = 14  # half bandwidth of the folded KKT matrix
 _NB = 5  # unknowns per node block: theta, v, u, and the two multipliers of its interval
 _FRACTION = 0.995
-
-
-def _fold(k: int) -> np.ndarray:
-    """Position of node ``i`` in the order ``0, K-1, 1, K-2, ...`` (cyclic -> banded)."""
-    i = np.arange(k)
-    return np.where(i <= (k - 1) // 2, 2 * i, 2 * (k - i) - 1)
 
 
 # -- compiled kernels ---------------------------------------------------------------------------
