@@ -52,7 +52,7 @@ import numba as nb
 import numpy as np
 from scipy.linalg.lapack import dgbsv
 
-from .hermite import _fold  # node order 0, K-1, 1, K-2, ...: the cyclic wrap made banded
+from .hermite import _fold, locate  # node order 0, K-1, 1, K-2, ...: the cyclic wrap made banded
 
 __all__ = ["CollocationMotion", "CollocationSolution", "solve_collocation"]
 
@@ -484,14 +484,8 @@ class CollocationMotion:
         return 2 * math.pi / self.omega
 
     def _locate(self, t):
-        t = np.asarray(t, dtype=float)
-        k = self.intervals
-        h = self.period / k
-        turns = np.floor(t / self.period)
-        tt = t - turns * self.period
-        j = np.minimum(np.floor(tt / h), k - 1).astype(int)
-        jb = (j + 1) % k
-        return tt / h - j, h, j, jb, 2 * math.pi * self.winding * turns
+        tau, h, j, off = locate(t, self.period, self.intervals, self.winding)
+        return tau, h, j, (j + 1) % self.intervals, off
 
     def _f_nodes(self):
         tn = self.period / self.intervals * np.arange(self.intervals)

@@ -88,6 +88,18 @@ def _hermite_rows(tau: np.ndarray, h: float):
     return b0, b1, b2
 
 
+def locate(t, period: float, k: int, winding: int):
+    """Interval of times ``t`` on ``K`` uniform intervals of a period: ``(tau, h, j, off)``,
+    the local coordinate in [0, 1], the step, the interval index and the angle ``2 pi W``
+    per whole period before ``t``."""
+    t = np.asarray(t, dtype=float)
+    h = period / k
+    turns = np.floor(t / period)
+    tt = t - turns * period
+    j = np.minimum(np.floor(tt / h), k - 1).astype(int)
+    return tt / h - j, h, j, 2 * math.pi * winding * turns
+
+
 def _fold(k: int) -> np.ndarray:
     """Position of node ``i`` in the order ``0, K-1, 1, K-2, ...`` (cyclic -> banded)."""
     i = np.arange(k)
@@ -121,13 +133,8 @@ class HermiteMotion:
         return 2 * math.pi / self.omega
 
     def _locate(self, t):
-        t = np.asarray(t, dtype=float)
-        k = self.intervals
-        h = self.period / k
-        turns = np.floor(t / self.period)
-        tt = t - turns * self.period
-        j = np.minimum(np.floor(tt / h), k - 1).astype(int)
-        return tt / h - j, h, self.local()[j], 2 * math.pi * self.winding * turns
+        tau, h, j, off = locate(t, self.period, self.intervals, self.winding)
+        return tau, h, self.local()[j], off
 
     def theta(self, t):
         tau, h, y, off = self._locate(t)
