@@ -12,15 +12,20 @@ __all__ = [
     "MAX_FOURIER_K", "MAX_GAMMA", "MAX_HARMONICS", "MAX_PHASE", "MAX_POINTS",
     "MAX_SWEEP_HARMONICS", "MAX_SWEEP_WORK", "MAX_TABLE_HARMONICS", "MAX_THRESHOLD_HARMONICS",
     "MAX_PTO_HARMONICS", "MAX_PTO_INTERVALS", "MAX_PTO_POINTS", "MAX_TORQUE_LIMIT",
-    "MIN_BVP_GAMMA", "OMEGA_RANGE",
+    "MIN_AMPLITUDE", "MIN_BVP_GAMMA", "OMEGA_RANGE",
     "SQUARE_ALPHA_MIN", "MAP_MAX_POINTS", "MAP_MAX_PTO_POINTS", "MAP_MAX_HARMONICS",
-    "MAP_MAX_WORK",
+    "MAP_MAX_WORK", "UNIT_GRAVITY_RANGE", "UNIT_INERTIA_RATIO", "UNIT_LENGTH_RANGE",
+    "UNIT_MASS_RANGE", "SEA_MAX_RESAMPLED",
 ]
 
 #: forcing frequency omega, units sqrt(g/l)
 OMEGA_RANGE = (1e-3, 1e3)
 #: |delta| and |amplitude| of a Fourier term or a sample of q (base acceleration over g)
 MAX_AMPLITUDE = 1e3
+#: smallest nonzero amplitude: |delta|, a Fourier amplitude, and the largest harmonic of q
+#: (a file's or a sea record's); below it the products of the solvers reach the subnormal
+#: range (5e-324 raised a ValueError in the root finder, 1e-308 already lost 8 digits)
+MIN_AMPLITUDE = 1e-100
 #: |phase| of a Fourier term, radians
 MAX_PHASE = 1e6
 #: viscous damping gamma (non-dimensional, unit sqrt(g/l))
@@ -60,6 +65,16 @@ MAX_PTO_POINTS = 101
 #: Hermite intervals of the torque-limited optimum (the doubling stops here: 2048 intervals
 #: take about a second per solve)
 MAX_PTO_INTERVALS = 2048
+
+# --- physical units (units.py) ------------------------------------------------------------
+#: pendulum length l (m), mass m (kg), gravity g (m/s^2): the scales m g l, sqrt(l/g) and
+#: m g^1.5 l^0.5 then stay between 1e-30 and 1e30 (1e308 overflowed l^2, 1e-320 made the
+#: time unit 0)
+UNIT_LENGTH_RANGE = (1e-6, 1e6)
+UNIT_MASS_RANGE = (1e-12, 1e12)
+UNIT_GRAVITY_RANGE = (1e-3, 1e3)
+#: moment of inertia about the pivot, as a multiple of m l^2 (I = I_cm + m l^2 >= m l^2)
+UNIT_INERTIA_RATIO = (1.0, 1e6)
 
 # --- design maps (parapend sweep, issue 13) ------------------------------------------------
 #: points of one map (the issue asks for 10^4 to 10^6; at N = 24 about 1 ms of CPU each
@@ -116,5 +131,8 @@ SEA_WAVES_RANGE = (2.0, 400.0)
 SEA_MAX_COMPONENTS = 8192
 #: rows of a measured record CSV 't,z'
 SEA_MAX_RECORD_ROWS = 1 << 17
+#: points of a measured record resampled at its median spacing (8 MB per array; one late
+#: sample, 40 rows 0.01 s apart and one at t = 3e5 s, reached 2.85 GB)
+SEA_MAX_RESAMPLED = 1 << 20
 #: harmonics N of the motion over one record (operator Newton: memory O(N), time O(N log N))
 SEA_MAX_HARMONICS = 16384
