@@ -121,7 +121,11 @@ def test_csv_huge_values_tiny_gaps_and_directories(tmp_path, capsys):
 
 def test_csv_reading_is_bounded(tmp_path, capsys):
     err = one_line_error(capsys, ["optimize", "--file", "/dev/zero"])
-    assert "larger than" in err
+    assert "regular" in err and "character device" in err
+    big = tmp_path / "sparse.csv"  # refused by its size before a byte is read
+    with open(big, "wb") as fh:
+        fh.truncate(limits.MAX_BYTES_FILE + 1)
+    assert "larger than" in one_line_error(capsys, ["optimize", "--file", str(big)])
     p = write_csv(tmp_path / "long.csv", n=limits.MAX_FILE_ROWS + 1)
     assert str(limits.MAX_FILE_ROWS) in one_line_error(capsys, ["optimize", "--file", str(p)])
 

@@ -9,13 +9,13 @@ from __future__ import annotations
 
 __all__ = [
     "MAX_AMPLITUDE", "MAX_BVP_EXTREMA", "MAX_BVP_WORK", "MAX_BYTES_FILE", "MAX_FILE_ROWS",
-    "MAX_FOURIER_K", "MAX_GAMMA", "MAX_HARMONICS", "MAX_PHASE", "MAX_POINTS",
+    "MAX_FILE_GAP", "MAX_FOURIER_K", "MAX_GAMMA", "MAX_HARMONICS", "MAX_PHASE", "MAX_POINTS",
     "MAX_SWEEP_HARMONICS", "MAX_SWEEP_WORK", "MAX_TABLE_HARMONICS", "MAX_THRESHOLD_HARMONICS",
     "MAX_PTO_HARMONICS", "MAX_PTO_INTERVALS", "MAX_PTO_POINTS", "MAX_TORQUE_LIMIT",
     "MIN_AMPLITUDE", "MIN_BVP_GAMMA", "OMEGA_RANGE",
     "SQUARE_ALPHA_MIN", "MAP_MAX_POINTS", "MAP_MAX_PTO_POINTS", "MAP_MAX_HARMONICS",
     "MAP_MAX_WORK", "UNIT_GRAVITY_RANGE", "UNIT_INERTIA_RATIO", "UNIT_LENGTH_RANGE",
-    "UNIT_MASS_RANGE", "SEA_MAX_RESAMPLED",
+    "UNIT_MASS_RANGE", "SEA_MAX_RESAMPLED", "SEA_MIN_HS",
 ]
 
 #: forcing frequency omega, units sqrt(g/l)
@@ -55,6 +55,8 @@ MAX_BVP_WORK = 4e7
 #: rows of a sampled-excitation CSV file, and its size in bytes
 MAX_FILE_ROWS = 16384
 MAX_BYTES_FILE = 4 << 20
+#: widest gap between successive samples of a file (cyclically), as a fraction of the period
+MAX_FILE_GAP = 0.125
 #: harmonics N of a power take-off solve (torque limit, efficiency): dense grid matrices of
 #: M x (2N+1) with M >= 32 N, about 100 MB at N = 128
 MAX_PTO_HARMONICS = 128
@@ -121,8 +123,10 @@ MAX_TRACK_PERIODS = 2000
 MAX_TRACK_WORK = 10000
 
 # --- irregular seas (sea command, docs/seas.md) ------------------------------------------
-#: significant wave height and |z| of a measured record, m
+#: significant wave height and |z| of a measured record, m; the smallest Hs (below it q
+#: drops towards the subnormal range: hs = 1e-320 gave q = 0)
 SEA_MAX_HS = 30.0
+SEA_MIN_HS = 1e-6
 #: peak period, s
 SEA_TP_RANGE = (1.0, 30.0)
 #: repeat period in peak periods (about the number of waves in the record)

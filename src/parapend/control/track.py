@@ -228,9 +228,10 @@ def design_sea(omega: float, rms: float, seed: int):
 
     unit = record(1.0)
     hs = rms / math.sqrt(0.5 * float(np.sum(np.abs(unit.spec) ** 2)))
-    if hs > limits.SEA_MAX_HS:
+    if not limits.SEA_MIN_HS <= hs <= limits.SEA_MAX_HS:
         raise ParameterError(f"irregular: the design excitation's rms {rms:.3g} needs a sea "
-                             f"state above Hs = {limits.SEA_MAX_HS:g} m at Tp = {SEA_TP:g} s")
+                             f"state of Hs = {hs:.3g} m at Tp = {SEA_TP:g} s, outside "
+                             f"[{limits.SEA_MIN_HS:g}, {limits.SEA_MAX_HS:g}] m")
     sea = record(hs)
     info = {"spectrum": "jonswap", "gamma_peak": 3.3, "peak_omega": omega,
             "hs": hs / units.length, "repeat_periods": SEA_WAVES,
