@@ -15,7 +15,7 @@ __all__ = [
     "MIN_AMPLITUDE", "MIN_BVP_GAMMA", "OMEGA_RANGE",
     "SQUARE_ALPHA_MIN", "MAP_MAX_POINTS", "MAP_MAX_PTO_POINTS", "MAP_MAX_HARMONICS",
     "MAP_MAX_WORK", "UNIT_GRAVITY_RANGE", "UNIT_INERTIA_RATIO", "UNIT_LENGTH_RANGE",
-    "UNIT_MASS_RANGE", "SEA_MAX_RESAMPLED", "SEA_MIN_HS",
+    "UNIT_MASS_RANGE", "SEA_MAX_RESAMPLED", "SEA_MIN_HS", "TRACK_MAX_STEP_RATE",
 ]
 
 #: forcing frequency omega, units sqrt(g/l)
@@ -121,6 +121,11 @@ MAX_TRACK_PERIODS = 2000
 #: runs x periods of a seeded robustness batch (track --runs): 5 irregular runs of 2000
 #: periods (10000) took 17.6 s and 443 MB under load about 2 (docs/control.md)
 MAX_TRACK_WORK = 10000
+#: largest sample interval of the closed loop, 2 pi/(256 omega), times the plant's fastest
+#: rate max(gamma, sqrt(1 + max|q|)) (each with the largest model error, x 1.9): at least
+#: 2 pi samples per fastest swing (omega = 1e-3 gave NaN LQR gains, gamma = 1e3 an unstable
+#: RK4; at omega = 0.02 the paper's case still runs, not locked, at 0.05 it locks)
+TRACK_MAX_STEP_RATE = 1.0
 
 # --- irregular seas (sea command, docs/seas.md) ------------------------------------------
 #: significant wave height and |z| of a measured record, m; the smallest Hs (below it q
