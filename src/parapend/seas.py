@@ -208,9 +208,9 @@ def _check_sea(hs, tp, spectrum, gamma_peak, repeat_period, cutoff):
         raise ParameterError("gamma-peak: only used by spectrum 'jonswap'")
     cutoff = check_range("cutoff", cutoff, 1.5, 10.0,
                          why="highest component frequency, in units of the peak frequency")
-    waves = repeat_period / tp if repeat_period is not None else None
     if repeat_period is not None:
         repeat_period = check_positive("repeat-period", repeat_period)
+        waves = repeat_period / tp
         if not limits.SEA_WAVES_RANGE[0] <= waves <= limits.SEA_WAVES_RANGE[1]:
             raise ParameterError(
                 f"repeat-period: expected {limits.SEA_WAVES_RANGE[0]:g} to "
