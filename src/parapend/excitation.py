@@ -193,7 +193,7 @@ def check_excitation(exc: Excitation, name: str, hint: str = "") -> Excitation:
     if top > limits.MAX_AMPLITUDE:
         raise ParameterError(
             f"{name}: expected |q(t)| <= {limits.MAX_AMPLITUDE:g} (base acceleration over g) "
-            f"everywhere in the period, got a maximum of {top:.7g} where q is evaluated"
+            f"everywhere in the period, got q reaching |q| = {top:.7g}"
             + (hint or _SERIES_HINT.get(type(exc).__name__, "")))
     return exc
 
@@ -347,7 +347,7 @@ class FourierExcitation(Excitation):
         object.__setattr__(self, "_spec", spec)
         if self.name == "fourier":
             # harmonic and two-harmonic are parameterized by |delta| <= 1e3 (max |q| is
-            # |delta| and 1.17 |delta|); a general series is checked as summed
+            # |delta| and 1.101 |delta|); a general series is checked as summed
             check_excitation(self, "fourier")
 
     @property
