@@ -423,6 +423,7 @@ def test_subnormal_amplitudes_one_line(tmp_path, capsys):
                  ["track", "--delta", "5e-324", "--periods", "20"],
                  ["track", "--fourier", "1:1e-320", "--periods", "20"],
                  ["sea", "--record", rec], ["sea", "--hs", "1e-320"],
+                 ["sweep", "--delta=-0.3,5e-324", "--store", str(tmp_path / "st")],
                  ["optimize", "--length", "1", "--mass", "1", "--frequency", "1",
                   "--amplitude", "1e-320"]):
         err = one_line_error(capsys, args)
