@@ -157,7 +157,7 @@ def max_abs_q(exc: Excitation, cap: float | None = None) -> float:
     return _max_abs_spectrum(spec.tobytes(), cap)
 
 
-@lru_cache(maxsize=256)
+@lru_cache(maxsize=64)
 def _max_abs_spectrum(spec_bytes: bytes, cap: float | None) -> float:
     """:func:`max_abs_q` of a spectrum (as bytes): it does not depend on omega, so a map over
     omega computes it once."""
