@@ -398,7 +398,10 @@ def _check_terms(terms) -> tuple:
             raise ParameterError(f"fourier: expected each term as (k, amp) or (k, amp, phase), "
                                  f"got {term!r:.60}")
         k = check_int("fourier k", term[0], 1, limits.MAX_FOURIER_K)
-        amp = _check_amplitude("fourier amplitude", term[1])
+        # each term at most 1e3; the smallest amplitude applies to the series (its largest
+        # harmonic, check_excitation): a tiny term beside others is harmless
+        amp = check_range("fourier amplitude", term[1], 0, limits.MAX_AMPLITUDE,
+                          absolute=True)
         ph = check_range("fourier phase", term[2] if len(term) == 3 else 0.0, 0,
                          limits.MAX_PHASE, absolute=True)
         out.append((k, amp, ph))
