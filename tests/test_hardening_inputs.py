@@ -439,6 +439,9 @@ def test_smallest_amplitude_still_solved_exactly():
     assert small.power / 0.3e-99 == pytest.approx(big.power / 0.3, rel=1e-9)
     with pytest.raises(ParameterError, match=r"delta: expected 0 or 1e-100 <= \|delta\|"):
         parapend.optimize(delta=1e-101)
+    # the rule is on the series' largest harmonic: a subnormal term beside others is harmless
+    tiny = parapend.optimize(fourier=[(1, -0.3), (2, 1e-320)], harmonics=8)
+    assert tiny.power == pytest.approx(big.power, rel=1e-12)
 
 
 @pytest.mark.parametrize("args, word", [
