@@ -121,7 +121,11 @@ def test_csv_huge_values_tiny_gaps_and_directories(tmp_path, capsys):
 
 def test_csv_reading_is_bounded(tmp_path, capsys):
     err = one_line_error(capsys, ["optimize", "--file", "/dev/zero"])
-    assert "larger than" in err
+    assert "regular" in err and "character device" in err
+    big = tmp_path / "sparse.csv"  # refused by its size before a byte is read
+    with open(big, "wb") as fh:
+        fh.truncate(limits.MAX_BYTES_FILE + 1)
+    assert "larger than" in one_line_error(capsys, ["optimize", "--file", str(big)])
     p = write_csv(tmp_path / "long.csv", n=limits.MAX_FILE_ROWS + 1)
     assert str(limits.MAX_FILE_ROWS) in one_line_error(capsys, ["optimize", "--file", str(p)])
 
@@ -335,3 +339,229 @@ def test_gamma_is_the_one_name(capsys):
     assert r.gamma == 0.01 and "gamma" in r.to_dict() and "damping" not in r.to_dict()
     ds = parapend.damping_sweep(harmonics=4, points=3)
     assert "gamma" in ds.coords and "damping" not in ds.coords
+
+
+# -- 6. inputs checked where they are used (second audit) ----------------------------------
+def _rows(path, header, a, b):
+    path.write_text(header + "\n" + "\n".join(f"{float(x)!r},{float(y)!r}"
+                                              for x, y in zip(a, b)))
+    return str(path)
+
+
+def test_file_samples_must_cover_the_period(tmp_path, capsys):
+    """Samples within tau in [0.5, 0.500063]: the periodic spline across the rest of the
+    period is not data (it reached |q| = 2842 and a 'converged' P = 3232 before)."""
+    tau = 0.5 + np.linspace(0.0, 0.000063, 32)
+    p = _rows(tmp_path / "narrow.csv", "tau,q", tau, 900 * np.sin(np.linspace(0, 6, 32)))
+    err = one_line_error(capsys, ["optimize", "--file", p])
+    assert "gap" in err and "0.125" in err
+
+
+def test_file_interpolant_is_capped_not_only_its_samples(tmp_path, capsys):
+    """Samples within |q| <= 1e3, spread over the period, whose interpolant overshoots."""
+    from scipy.interpolate import CubicSpline
+
+    tau = np.sort(np.append(np.arange(16) / 16, 0.5 + 1e-4))
+    q = np.zeros(tau.size)
+    q[tau == 0.5], q[tau == 0.5 + 1e-4] = 1000.0, -1000.0
+    p = _rows(tmp_path / "spike.csv", "tau,q", tau, q)
+    err = one_line_error(capsys, ["optimize", "--file", p])
+    assert "|q(t)| <= 1000" in err and "interpolant" in err
+    # independent: the periodic cubic spline through the samples itself exceeds the cap
+    spline = CubicSpline(np.append(tau, 1.0), np.append(q, q[0]), bc_type="periodic")
+    assert np.max(np.abs(spline(np.linspace(0, 1, 200001)))) > 1000
+    # a file whose interpolant peaks exactly at the cap is accepted (exact extrema)
+    tau = np.arange(32) / 32
+    p = _rows(tmp_path / "cap.csv", "tau,q", tau, 1000 * np.sin(2 * np.pi * tau))
+    exc = parapend.from_csv(p)
+    assert parapend.excitation.max_abs_q(exc) == pytest.approx(1000, rel=1e-12)
+
+
+def test_max_abs_q_against_dense_evaluation():
+    from parapend.excitation import max_abs_q
+
+    rng = np.random.default_rng(7)
+    for _ in range(6):
+        k = int(rng.integers(1, 60))
+        terms = [(j, float(rng.normal()), float(rng.uniform(0, 2 * np.pi)))
+                 for j in range(1, k + 1)]
+        exc = parapend.fourier(terms, omega=float(rng.uniform(0.5, 3)), mean=0.2)
+        dense = np.max(np.abs(exc.q(np.linspace(0, exc.period, 400001))))
+        # the dense grid is below the maximum by at most (K pi/400000)^2 / 2 relative
+        assert dense <= max_abs_q(exc) <= dense * (1 + 1e-7)
+    assert max_abs_q(parapend.square(-0.3)) == 0.3
+    assert max_abs_q(parapend.harmonic(0.0)) == 0.0
+
+
+@pytest.mark.parametrize("terms, ok", [
+    ("1:1000,1:1000,1:1000", False),   # duplicate orders add up: max |q| = 3000
+    ("1:1000,2:1", False),             # just above the cap (a grid point sits at 1000)
+    ("1:999,2:1", True),
+    ("1:600,3:600", True),             # 4 x(1 - x^2) at x = 1/sqrt 3: 923.8
+])
+def test_fourier_series_capped_as_summed(capsys, terms, ok):
+    if ok:
+        exc = parapend.build_excitation(fourier=terms)
+        dense = np.max(np.abs(exc.q(np.linspace(0, exc.period, 200001))))
+        assert dense <= 1000
+    else:
+        err = one_line_error(capsys, ["optimize", "--fourier", terms])
+        assert "fourier: expected |q(t)| <= 1000" in err and "summed" in err
+        # independent: the series summed on a dense grid exceeds the cap
+        terms_ = parapend.excitation.parse_fourier_terms(terms)
+        s = np.linspace(0, 2 * np.pi, 200001)
+        assert np.max(np.abs(sum(a * np.sin(k * s + ph) for k, a, ph in terms_))) > 1000
+
+
+def test_subnormal_amplitudes_one_line(tmp_path, capsys):
+    tau = np.arange(32) / 32
+    f = _rows(tmp_path / "sub.csv", "tau,q", tau, 1e-320 * np.sin(2 * np.pi * tau))
+    t = np.arange(400) * 0.1
+    rec = _rows(tmp_path / "subrec.csv", "t,z", t, 1e-320 * np.sin(t))
+    for args in (["optimize", "--delta", "5e-324"], ["optimize", "--fourier", "1:1e-320"],
+                 ["optimize", "--file", f], ["threshold", "--delta", "5e-324"],
+                 ["track", "--delta", "5e-324", "--periods", "20"],
+                 ["track", "--fourier", "1:1e-320", "--periods", "20"],
+                 ["sea", "--record", rec], ["sea", "--hs", "1e-320"],
+                 ["sweep", "--delta=-0.3,5e-324", "--store", str(tmp_path / "st")],
+                 ["optimize", "--length", "1", "--mass", "1", "--frequency", "1",
+                  "--amplitude", "1e-320"]):
+        err = one_line_error(capsys, args)
+        assert "1e-100" in err or "1e-06" in err, err
+
+
+def test_smallest_amplitude_still_solved_exactly():
+    """At gamma = 0 the optimum scales with delta (the set of motions does not depend on
+    it and P = <q sin(theta) theta'>): the smallest admissible delta gives the same gain."""
+    big = parapend.optimize(delta=-0.3, harmonics=8)
+    small = parapend.optimize(delta=-0.3e-99, harmonics=8)
+    assert small.status == "converged"
+    assert small.power / 0.3e-99 == pytest.approx(big.power / 0.3, rel=1e-9)
+    with pytest.raises(ParameterError, match=r"delta: expected 0 or 1e-100 <= \|delta\|"):
+        parapend.optimize(delta=1e-101)
+    # the rule is on the series' largest harmonic: a subnormal term beside others is harmless
+    tiny = parapend.optimize(fourier=[(1, -0.3), (2, 1e-320)], harmonics=8)
+    assert tiny.power == pytest.approx(big.power, rel=1e-12)
+
+
+@pytest.mark.parametrize("args, word", [
+    (["optimize", "--length", "1e308", "--mass", "1", "--frequency", "1"], "length"),
+    (["optimize", "--length", "1e-320", "--mass", "1"], "length"),
+    (["optimize", "--length", "1", "--mass", "1e308"], "mass"),
+    (["optimize", "--length", "1", "--mass", "1", "--gravity", "1e-320"], "gravity"),
+    (["optimize", "--length", "1", "--mass", "1", "--inertia", "0.5"], "inertia"),
+    (["optimize", "--length", "1", "--mass", "1", "--frequency", "1e6"], "frequency"),
+    (["optimize", "--length", "1", "--mass", "1", "--frequency", "1", "--amplitude", "1e6"],
+     "amplitude"),
+    (["optimize", "--length", "1", "--mass", "1", "--damping-coefficient", "1e308"],
+     "damping-coefficient"),
+    (["sea", "--length", "1e308"], "length"),
+    (["sea", "--mass", "1e308"], "mass"),
+])
+def test_physical_units_have_ranges(capsys, args, word):
+    err = one_line_error(capsys, args)
+    assert err.split("error: ")[1].startswith(word + ":"), err
+
+
+def test_units_scales_finite_over_the_ranges():
+    from parapend.units import Units
+
+    for l_ in limits.UNIT_LENGTH_RANGE:
+        for m in limits.UNIT_MASS_RANGE:
+            for g in limits.UNIT_GRAVITY_RANGE:
+                for ratio in limits.UNIT_INERTIA_RATIO:
+                    u = Units(l_, m, g, ratio * m * l_**2)
+                    scales = (u.time, u.torque, u.power, u.damping, u.moment_of_inertia)
+                    assert all(1e-35 < x < 1e35 for x in scales), (l_, m, g, ratio)
+                    # power unit = torque unit / time unit, independently
+                    assert u.power == pytest.approx(m * g * l_ / math.sqrt(ratio * l_ / g),
+                                                    rel=1e-13)
+
+
+def test_track_refuses_plants_it_cannot_sample(capsys):
+    err = one_line_error(capsys, ["track", "--gamma", "1e3", "--periods", "20"])
+    assert err.split("error: ")[1].startswith("gamma: expected gamma <= 38.6")
+    err = one_line_error(capsys, ["track", "--omega", "1e-3", "--periods", "20"])
+    # 2 pi sqrt(1 + 1.9 * 0.3) / 256
+    assert err.split("error: ")[1].startswith(
+        f"omega: expected omega >= {2 * math.pi * math.sqrt(1 + 1.9 * 0.3) / 256:.4g}")
+
+
+def test_track_divergence_is_a_status(monkeypatch):
+    """The safety net behind the sampling rule: a run that blows up ends with a status."""
+    from parapend.control.closedloop import Diverged, run_closed_loop
+    from parapend.control.track import prepare, track
+
+    monkeypatch.setattr(limits, "TRACK_MAX_STEP_RATE", 1e9)
+    r = track(gamma=1e3, periods=20)  # h gamma = 13.6: RK4 over h/4 is unstable
+    assert r.status == "diverged" and not r.success and math.isnan(r.mean_power)
+    with pytest.raises(parapend.errors.SolverError, match="diverged"):
+        track(gamma=1e3, periods=20, throw=True)
+    d = prepare(harmonics=8)
+    with pytest.raises(Diverged):
+        run_closed_loop(d.target, d.lqr.gains, periods=20, torque_limit=None,
+                        plant_q=lambda t: 0 * t, plant_gamma=-200.0)
+
+
+def test_threshold_out_of_range_names_the_excitation(capsys):
+    err = one_line_error(capsys, ["threshold", "--omega", "1e-3", "--delta", "1e3"])
+    assert err.split("error: ")[1].startswith("excitation:")
+    assert "omega = 0.001" in err and "delta = 1000" in err and "500000.0" not in err
+    # the uniform rotation's threshold, |Q1|/(2 omega) = 1e3/(2e-3), is the number named
+    assert "5e+05" in err
+
+
+def test_sea_q_cap_applies_to_the_record(capsys):
+    err = one_line_error(capsys, ["sea", "--gravity", "1e-3"])
+    assert err.split("error: ")[1].startswith("sea: expected |q(t)| <= 1000")
+    assert "gravity" in err
+
+
+@pytest.mark.parametrize("option", ["--file", "--record", "--response"])
+def test_fifo_refused_without_blocking(tmp_path, option):
+    fifo = tmp_path / "pipe.csv"
+    os.mkfifo(fifo)
+    cmd = ["sea", option, str(fifo)] if option != "--file" else ["optimize", option, str(fifo)]
+    r = cli(*cmd, timeout=60)  # a blocking open would hang until the timeout
+    assert r.returncode == 2 and "FIFO" in r.stderr and r.stderr.count("\n") == 1, r.stderr
+
+
+def test_sea_record_resampled_length_capped(tmp_path):
+    t = np.append(np.arange(40) * 0.01, 3e5)
+    rec = _rows(tmp_path / "late.csv", "t,z", t, 0.1 * np.sin(t))
+    before = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
+    with pytest.raises(ParameterError, match=rf"record: resampling .* more than "
+                                             rf"{limits.SEA_MAX_RESAMPLED}"):
+        parapend.sea(record=rec)
+    assert resource.getrusage(resource.RUSAGE_SELF).ru_maxrss - before < 100_000  # KB
+
+
+def test_sea_response_arrays_checked():
+    f = [0.0, 0.1, 0.2]
+    with pytest.raises(ParameterError, match=r"response: expected gains in \[0, 1e3\]"):
+        parapend.sea(response=(f, [1.0, -1.0, 1.0], [0.0, 0.0, 0.0]))
+    with pytest.raises(ParameterError, match="response: expected three 1-D arrays"):
+        parapend.sea(response=(f, [1.0, 1.0], [0.0, 0.0, 0.0]))
+    with pytest.raises(ParameterError, match="response: expected a CSV path or three"):
+        parapend.sea(response=42)
+    with pytest.raises(ParameterError, match="response: expected finite"):
+        parapend.sea(response=(f, [1.0, np.nan, 1.0], [0.0, 0.0, 0.0]))
+
+
+def test_any_real_number_accepted_anything_else_refused():
+    from decimal import Decimal
+    from fractions import Fraction
+
+    ref = parapend.optimize(omega=1.8, delta=-0.3, gamma=0.01, harmonics=4)
+    for conv in (Decimal, lambda x: Fraction(str(x)), np.float32, np.array):
+        r = parapend.optimize(omega=conv("1.8") if conv is Decimal else conv(1.8),
+                              delta=conv("-0.3") if conv is Decimal else conv(-0.3),
+                              gamma=conv("0.01") if conv is Decimal else conv(0.01),
+                              harmonics=4)
+        if conv is np.float32:  # float32(1.8) is another number than 1.8
+            assert r.power == pytest.approx(ref.power, rel=1e-6)
+        else:
+            assert r.power == ref.power and r.omega == 1.8
+    for bad in ("1.8", 1.8 + 0j, [1.8], np.array([1.8]), None, True, Decimal("NaN")):
+        with pytest.raises(ParameterError, match=r"^omega: expected a (real|finite) number"):
+            parapend.optimize(omega=bad, harmonics=4)

@@ -505,7 +505,23 @@ def _threshold_at(exc, n: int, gamma0: float, warm, tol: float, maxiter: int):
             x = glob.x  # a better branch: continue the Newton iteration from it
             continue
         g += step
+        _check_threshold_in_range(exc, g)  # the iterates stay below gamma*
     return g, p, kin, x, it, status
+
+
+def _check_threshold_in_range(exc, gamma: float) -> None:
+    """Refuse an excitation whose threshold lies above the admissible damping (``gamma`` is
+    a lower bound of gamma*: the uniform rotation's threshold, or a Newton iterate), naming
+    the excitation the user gave, not the damping of an internal solve."""
+    if gamma <= limits.MAX_GAMMA:
+        return
+    desc = ", ".join(f"{k} = {v:g}" if isinstance(v, float) else f"{k} = {v}"
+                     for k, v in exc.describe().items() if k != "excitation")
+    raise ParameterError(
+        f"excitation: expected a damping threshold within the damping range [0, "
+        f"{limits.MAX_GAMMA:g}], got an excitation ({exc.describe()['excitation']}, {desc}) "
+        f"that still extracts power at gamma = {gamma:.4g}; use a smaller amplitude or "
+        "a larger omega")
 
 
 def threshold(*, omega: float = 1.8, delta=None, harmonics=None, excitation=None,
@@ -527,6 +543,7 @@ def threshold(*, omega: float = 1.8, delta=None, harmonics=None, excitation=None
                                "constant excitation: no power can be extracted", 0,
                                excitation=exc.describe())
     tol = check_range("tol", tol, 1e-15, 1e-3)
+    _check_threshold_in_range(exc, gamma_u)
     if harmonics is not None:
         ns = [check_int("harmonics", harmonics, 1, limits.MAX_THRESHOLD_HARMONICS)]
     else:

@@ -3,6 +3,8 @@
 from __future__ import annotations
 
 import math
+import numbers
+from decimal import Decimal
 
 __all__ = ["OutputError", "ParameterError", "SolverError", "check_finite", "check_int",
            "check_nonnegative", "check_positive", "check_range"]
@@ -28,8 +30,13 @@ def _short(value) -> str:
 
 
 def _as_float(name: str, value) -> float:
-    if isinstance(value, (bool, str, bytes)) or value is None:
-        raise ParameterError(f"{name}: expected a number, got {_short(value)}")
+    """``value`` as a finite float: any real number is accepted (``numbers.Real``: int,
+    float, Fraction, NumPy scalars and 0-d arrays; and ``decimal.Decimal``), converted with
+    ``float``; anything else (bool, str, complex, sequences, None) is refused."""
+    if getattr(value, "ndim", None) == 0 and hasattr(value, "item"):
+        value = value.item()  # a 0-d NumPy array
+    if isinstance(value, bool) or not isinstance(value, (numbers.Real, Decimal)):
+        raise ParameterError(f"{name}: expected a real number, got {_short(value)}")
     try:
         x = float(value)
     except (TypeError, ValueError, OverflowError):

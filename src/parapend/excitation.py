@@ -19,6 +19,8 @@ from __future__ import annotations
 
 import csv
 import math
+import os
+import stat
 from dataclasses import dataclass, field
 from functools import cached_property, lru_cache
 from pathlib import Path
@@ -35,9 +37,11 @@ __all__ = [
     "FourierExcitation",
     "SampledExcitation",
     "SquareExcitation",
+    "check_excitation",
     "fourier",
     "from_csv",
     "harmonic",
+    "max_abs_q",
     "parse_fourier_terms",
     "square",
     "two_harmonic",
@@ -134,6 +138,70 @@ class Excitation:
     def describe(self) -> dict:
         """Parameters that define this excitation (JSON-ready)."""
         raise NotImplementedError
+
+
+def max_abs_q(exc: Excitation, cap: float | None = None) -> float:
+    """``max |q(t)|`` over one period, of the excitation as it is evaluated (its spectrum).
+
+    ``q`` is a trigonometric polynomial of degree ``K`` in the phase ``s``; on ``m = 16 K``
+    uniform points (by one FFT) the largest ``|q|`` is within a factor ``1 - pi K / m``
+    (Bernstein's inequality ``|q'| <= K max|q|`` over half a grid step) of the true maximum.
+    When that bracket straddles ``cap`` (or no ``cap`` is given) the maximum is taken
+    exactly at the extrema of ``q`` (the roots of ``dq/dt``, :attr:`Excitation.extrema`),
+    where ``|q|`` attains it. With a ``cap``, any value above it is returned as soon as it is
+    certain to exceed it.
+    """
+    if isinstance(exc, SquareExcitation):
+        return abs(exc.delta)  # |H| < 1 in Eq. 26: tanh plateaus of height 1
+    spec = np.ascontiguousarray(exc.spectrum, dtype=complex)
+    return _max_abs_spectrum(spec.tobytes(), cap)
+
+
+@lru_cache(maxsize=64)
+def _max_abs_spectrum(spec_bytes: bytes, cap: float | None) -> float:
+    """:func:`max_abs_q` of a spectrum (as bytes): it does not depend on omega, so a map over
+    omega computes it once."""
+    spec = np.frombuffer(spec_bytes, dtype=complex)
+    k = spec.size - 1
+    if k == 0 or not np.any(spec[1:] != 0):
+        return abs(float(spec[0].real))
+    m = 16 * k
+    on_grid = float(np.max(np.abs(_evaluate_uniform(spec, m))))
+    upper = on_grid / (1.0 - math.pi * k / m)
+    if cap is not None and (upper <= cap or on_grid > cap):
+        return on_grid
+    shape = np.ascontiguousarray(spec[1:] / float(np.max(np.abs(spec[1:]))), dtype=complex)
+    s, _ = _phase_extrema(shape.tobytes())
+    return max(on_grid, float(np.max(np.abs(_evaluate(spec, s))))) if s.size else on_grid
+
+
+def check_excitation(exc: Excitation, name: str, hint: str = "") -> Excitation:
+    """The checks every excitation built from data shares (a Fourier series, a file, a sea
+    record): its largest harmonic is 0 or at least :data:`parapend.limits.MIN_AMPLITUDE`
+    (smaller amplitudes reach the subnormal range inside the solvers), and ``max |q(t)|``
+    of the series as it is evaluated, not only at its samples or term by term, is at most
+    :data:`parapend.limits.MAX_AMPLITUDE`. ``name`` is the parameter the error names,
+    ``hint`` (a parenthesis) what sets the size of q."""
+    spec = exc.spectrum
+    amp = float(np.max(np.abs(spec[1:]))) if spec.size > 1 else 0.0
+    if 0.0 < amp < limits.MIN_AMPLITUDE:
+        raise ParameterError(
+            f"{name}: expected q to vary by 0 (constant) or with harmonics of at least "
+            f"{limits.MIN_AMPLITUDE:g} (base acceleration over g), got a largest harmonic of "
+            f"{amp:.3g}; give 0 for no excitation or scale q up")
+    top = max_abs_q(exc, limits.MAX_AMPLITUDE)
+    if top > limits.MAX_AMPLITUDE:
+        raise ParameterError(
+            f"{name}: expected |q(t)| <= {limits.MAX_AMPLITUDE:g} (base acceleration over g) "
+            f"everywhere in the period, got q reaching |q| = {top:.7g}"
+            + (hint or _SERIES_HINT.get(type(exc).__name__, "")))
+    return exc
+
+
+_SERIES_HINT = {
+    "FourierExcitation": " (the terms are summed)",
+    "SampledExcitation": " (the interpolant between the samples)",
+}
 
 
 def _synthesize(spec: np.ndarray, m: int) -> np.ndarray:
@@ -266,8 +334,9 @@ class FourierExcitation(Excitation):
     _spec: np.ndarray = field(init=False, repr=False, compare=False)
 
     def __post_init__(self):
-        _check_omega(self.omega)
-        check_range("mean", self.mean, 0, limits.MAX_AMPLITUDE, absolute=True)
+        object.__setattr__(self, "omega", _check_omega(self.omega))
+        object.__setattr__(self, "mean", check_range("mean", self.mean, 0,
+                                                     limits.MAX_AMPLITUDE, absolute=True))
         object.__setattr__(self, "terms", _check_terms(self.terms))
         kmax = max(k for k, _, _ in self.terms)
         spec = np.zeros(kmax + 1, dtype=complex)
@@ -276,6 +345,10 @@ class FourierExcitation(Excitation):
             # amp*sin(k s + ph) = Re(-1j*amp*exp(1j*ph) * exp(1j*k*s))
             spec[int(k)] += -1j * amp * np.exp(1j * ph)
         object.__setattr__(self, "_spec", spec)
+        if self.name == "fourier":
+            # harmonic and two-harmonic are parameterized by |delta| <= 1e3 (max |q| is
+            # |delta| and 1.101 |delta|); a general series is checked as summed
+            check_excitation(self, "fourier")
 
     @property
     def spectrum(self) -> np.ndarray:
@@ -298,9 +371,18 @@ def _check_omega(omega) -> float:
                        why="forcing frequency in units sqrt(g/l); see docs/limits-of-input.md")
 
 
+def _check_amplitude(name: str, value, why: str = "base acceleration amplitude over g"):
+    """An amplitude: ``|value| <= MAX_AMPLITUDE``, and 0 or ``|value| >= MIN_AMPLITUDE``
+    (subnormal amplitudes broke the root finder of the extrema; docs/limits-of-input.md)."""
+    x = check_range(name, value, 0, limits.MAX_AMPLITUDE, absolute=True, why=why)
+    if 0.0 < abs(x) < limits.MIN_AMPLITUDE:
+        raise ParameterError(f"{name}: expected 0 or {limits.MIN_AMPLITUDE:g} <= |{name}| <= "
+                             f"{limits.MAX_AMPLITUDE:g}, got {value!r} ({why})")
+    return x
+
+
 def _check_delta(delta) -> float:
-    return check_range("delta", delta, 0, limits.MAX_AMPLITUDE, absolute=True,
-                       why="base acceleration amplitude over g")
+    return _check_amplitude("delta", delta)
 
 
 def _check_terms(terms) -> tuple:
@@ -316,7 +398,10 @@ def _check_terms(terms) -> tuple:
             raise ParameterError(f"fourier: expected each term as (k, amp) or (k, amp, phase), "
                                  f"got {term!r:.60}")
         k = check_int("fourier k", term[0], 1, limits.MAX_FOURIER_K)
-        amp = check_range("fourier amplitude", term[1], 0, limits.MAX_AMPLITUDE, absolute=True)
+        # each term at most 1e3; the smallest amplitude applies to the series (its largest
+        # harmonic, check_excitation): a tiny term beside others is harmless
+        amp = check_range("fourier amplitude", term[1], 0, limits.MAX_AMPLITUDE,
+                          absolute=True)
         ph = check_range("fourier phase", term[2] if len(term) == 3 else 0.0, 0,
                          limits.MAX_PHASE, absolute=True)
         out.append((k, amp, ph))
@@ -402,9 +487,10 @@ class SquareExcitation(Excitation):
     name: str = "square"
 
     def __post_init__(self):
-        _check_omega(self.omega)
-        _check_delta(self.delta)
+        object.__setattr__(self, "omega", _check_omega(self.omega))
+        object.__setattr__(self, "delta", _check_delta(self.delta))
         alpha = check_finite("square-alpha", self.alpha)
+        object.__setattr__(self, "alpha", alpha)
         lo, hi = limits.SQUARE_ALPHA_MIN * self.period, self.period / 8
         if not lo <= alpha <= hi:
             raise ParameterError(
@@ -479,7 +565,7 @@ class SampledExcitation(Excitation):
     name: str = "file"
 
     def __post_init__(self):
-        _check_omega(self.omega)
+        object.__setattr__(self, "omega", _check_omega(self.omega))
         where = f" in {self.source}" if self.source else ""
         try:
             tau = np.asarray(self.tau, dtype=float)
@@ -509,6 +595,17 @@ class SampledExcitation(Excitation):
         if gap < 1e-6 / tau.size:
             raise ParameterError(f"file: expected tau spacings of at least 1e-6 of the mean "
                                  f"spacing{where}, got a gap of {gap:.3g}")
+        # the samples must cover the period: across a wider gap the interpolant is not
+        # drawn by data (the periodic spline over a gap of 0.99994 reached |q| = 2842 from
+        # samples within |q| <= 1e3)
+        gaps = np.diff(np.append(tau, tau[0] + 1.0))
+        widest = int(np.argmax(gaps))
+        if gaps[widest] > limits.MAX_FILE_GAP:
+            raise ParameterError(
+                f"file: expected samples spread over the whole period (no gap in tau wider "
+                f"than {limits.MAX_FILE_GAP:g}){where}, got a gap of {gaps[widest]:.4g} after "
+                f"tau = {tau[widest]:.6g}")
+        check_excitation(self, "file")
 
     @cached_property
     def spectrum(self) -> np.ndarray:
@@ -541,14 +638,42 @@ class SampledExcitation(Excitation):
 
 
 def _read_bounded(path: Path) -> str:
-    """The text of ``path``: at most ``MAX_BYTES_FILE`` bytes, UTF-8 (a BOM is accepted)."""
+    """The text of ``path``: at most ``MAX_BYTES_FILE`` bytes, UTF-8 (a BOM is accepted).
+
+    Only a regular file is read: the file is opened without blocking (a FIFO would wait for
+    a writer forever), then refused unless ``fstat`` says it is a regular file, and refused
+    before reading if its size is over the cap; the read itself is bounded as well (a
+    file that grows meanwhile)."""
     if path.is_dir():
         raise ParameterError(f"file: expected a CSV file, got the directory {str(path)!r}")
     try:
-        with open(path, "rb") as fh:
+        fd = os.open(path, os.O_RDONLY | getattr(os, "O_NONBLOCK", 0)
+                     | getattr(os, "O_NOCTTY", 0))
+    except OSError as exc:
+        raise ParameterError(f"file: cannot read {path}: {exc.strerror or exc}") from None
+    try:
+        st = os.fstat(fd)
+        if not stat.S_ISREG(st.st_mode):
+            kind = ("a FIFO (named pipe)" if stat.S_ISFIFO(st.st_mode) else
+                    "a character device" if stat.S_ISCHR(st.st_mode) else
+                    "a block device" if stat.S_ISBLK(st.st_mode) else
+                    "a socket" if stat.S_ISSOCK(st.st_mode) else "not a regular file")
+            raise ParameterError(f"file: expected a regular CSV file, got {kind}: {path} "
+                                 "(save the data to a file first)")
+        if st.st_size > limits.MAX_BYTES_FILE:
+            raise ParameterError(f"file: {path} is larger than {limits.MAX_BYTES_FILE >> 20} "
+                                 f"MiB; expected one period of at most {limits.MAX_FILE_ROWS} "
+                                 "rows 'tau,q'")
+        if hasattr(os, "set_blocking"):
+            os.set_blocking(fd, True)
+        with os.fdopen(fd, "rb") as fh:
+            fd = None
             data = fh.read(limits.MAX_BYTES_FILE + 1)
     except OSError as exc:
         raise ParameterError(f"file: cannot read {path}: {exc.strerror or exc}") from None
+    finally:
+        if fd is not None:
+            os.close(fd)
     if len(data) > limits.MAX_BYTES_FILE:
         raise ParameterError(f"file: {path} is larger than {limits.MAX_BYTES_FILE >> 20} MiB; "
                              f"expected one period of at most {limits.MAX_FILE_ROWS} rows "

@@ -9,18 +9,23 @@ from __future__ import annotations
 
 __all__ = [
     "MAX_AMPLITUDE", "MAX_BVP_EXTREMA", "MAX_BVP_WORK", "MAX_BYTES_FILE", "MAX_FILE_ROWS",
-    "MAX_FOURIER_K", "MAX_GAMMA", "MAX_HARMONICS", "MAX_PHASE", "MAX_POINTS",
+    "MAX_FILE_GAP", "MAX_FOURIER_K", "MAX_GAMMA", "MAX_HARMONICS", "MAX_PHASE", "MAX_POINTS",
     "MAX_SWEEP_HARMONICS", "MAX_SWEEP_WORK", "MAX_TABLE_HARMONICS", "MAX_THRESHOLD_HARMONICS",
     "MAX_PTO_HARMONICS", "MAX_PTO_INTERVALS", "MAX_PTO_POINTS", "MAX_TORQUE_LIMIT",
-    "MIN_BVP_GAMMA", "OMEGA_RANGE",
+    "MIN_AMPLITUDE", "MIN_BVP_GAMMA", "OMEGA_RANGE",
     "SQUARE_ALPHA_MIN", "MAP_MAX_POINTS", "MAP_MAX_PTO_POINTS", "MAP_MAX_HARMONICS",
-    "MAP_MAX_WORK",
+    "MAP_MAX_WORK", "UNIT_GRAVITY_RANGE", "UNIT_INERTIA_RATIO", "UNIT_LENGTH_RANGE",
+    "UNIT_MASS_RANGE", "SEA_MAX_RESAMPLED", "SEA_MIN_HS", "TRACK_MAX_STEP_RATE",
 ]
 
 #: forcing frequency omega, units sqrt(g/l)
 OMEGA_RANGE = (1e-3, 1e3)
 #: |delta| and |amplitude| of a Fourier term or a sample of q (base acceleration over g)
 MAX_AMPLITUDE = 1e3
+#: smallest nonzero amplitude: |delta|, a Fourier amplitude, and the largest harmonic of q
+#: (a file's or a sea record's); below it the products of the solvers reach the subnormal
+#: range (5e-324 raised a ValueError in the root finder, 1e-308 already lost 8 digits)
+MIN_AMPLITUDE = 1e-100
 #: |phase| of a Fourier term, radians
 MAX_PHASE = 1e6
 #: viscous damping gamma (non-dimensional, unit sqrt(g/l))
@@ -50,6 +55,8 @@ MAX_BVP_WORK = 4e7
 #: rows of a sampled-excitation CSV file, and its size in bytes
 MAX_FILE_ROWS = 16384
 MAX_BYTES_FILE = 4 << 20
+#: widest gap between successive samples of a file (cyclically), as a fraction of the period
+MAX_FILE_GAP = 0.125
 #: harmonics N of a power take-off solve (torque limit, efficiency): dense grid matrices of
 #: M x (2N+1) with M >= 32 N, about 100 MB at N = 128
 MAX_PTO_HARMONICS = 128
@@ -60,6 +67,16 @@ MAX_PTO_POINTS = 101
 #: Hermite intervals of the torque-limited optimum (the doubling stops here: 2048 intervals
 #: take about a second per solve)
 MAX_PTO_INTERVALS = 2048
+
+# --- physical units (units.py) ------------------------------------------------------------
+#: pendulum length l (m), mass m (kg), gravity g (m/s^2): the scales m g l, sqrt(l/g) and
+#: m g^1.5 l^0.5 then stay between 1e-30 and 1e30 (1e308 overflowed l^2, 1e-320 made the
+#: time unit 0)
+UNIT_LENGTH_RANGE = (1e-6, 1e6)
+UNIT_MASS_RANGE = (1e-12, 1e12)
+UNIT_GRAVITY_RANGE = (1e-3, 1e3)
+#: moment of inertia about the pivot, as a multiple of m l^2 (I = I_cm + m l^2 >= m l^2)
+UNIT_INERTIA_RATIO = (1.0, 1e6)
 
 # --- design maps (parapend sweep, issue 13) ------------------------------------------------
 #: points of one map (the issue asks for 10^4 to 10^6; at N = 24 about 1 ms of CPU each
@@ -104,10 +121,17 @@ MAX_TRACK_PERIODS = 2000
 #: runs x periods of a seeded robustness batch (track --runs): 5 irregular runs of 2000
 #: periods (10000) took 17.6 s and 443 MB under load about 2 (docs/control.md)
 MAX_TRACK_WORK = 10000
+#: largest sample interval of the closed loop, 2 pi/(256 omega), times the plant's fastest
+#: rate max(gamma, sqrt(1 + max|q|)) (each with the largest model error, x 1.9): at least
+#: 2 pi samples per fastest swing (omega = 1e-3 gave NaN LQR gains, gamma = 1e3 an unstable
+#: RK4; at omega = 0.02 the paper's case still runs, not locked, at 0.05 it locks)
+TRACK_MAX_STEP_RATE = 1.0
 
 # --- irregular seas (sea command, docs/seas.md) ------------------------------------------
-#: significant wave height and |z| of a measured record, m
+#: significant wave height and |z| of a measured record, m; the smallest Hs (below it q
+#: drops towards the subnormal range: hs = 1e-320 gave q = 0)
 SEA_MAX_HS = 30.0
+SEA_MIN_HS = 1e-6
 #: peak period, s
 SEA_TP_RANGE = (1.0, 30.0)
 #: repeat period in peak periods (about the number of waves in the record)
@@ -116,5 +140,8 @@ SEA_WAVES_RANGE = (2.0, 400.0)
 SEA_MAX_COMPONENTS = 8192
 #: rows of a measured record CSV 't,z'
 SEA_MAX_RECORD_ROWS = 1 << 17
+#: points of a measured record resampled at its median spacing (8 MB per array; one late
+#: sample, 40 rows 0.01 s apart and one at t = 3e5 s, reached 2.85 GB)
+SEA_MAX_RESAMPLED = 1 << 20
 #: harmonics N of the motion over one record (operator Newton: memory O(N), time O(N log N))
 SEA_MAX_HARMONICS = 16384

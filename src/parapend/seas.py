@@ -47,7 +47,7 @@ import numpy as np
 
 from . import limits
 from .errors import ParameterError, check_int, check_positive, check_range
-from .excitation import Excitation, _read_bounded
+from .excitation import Excitation, _read_bounded, check_excitation
 
 __all__ = ["SPECTRA", "SeaExcitation", "jonswap", "measured_record", "pierson_moskowitz",
            "read_response", "sea_record", "spectral_moments"]
@@ -135,12 +135,32 @@ def read_response(path) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Heave response table, CSV ``f,gain,phase`` (Hz, m of heave per m of wave, radians)."""
     rows = _csv_rows(path, ["f", "gain", "phase"], "response")
     a = np.array(rows)
-    f, gain, phase = a[:, 0], a[:, 1], a[:, 2]
+    return check_response(a[:, 0], a[:, 1], a[:, 2], f" in {path}")
+
+
+def check_response(f, gain, phase, where: str = "") -> tuple:
+    """A heave response table (from a file or given as arrays): three equal-length 1-D
+    arrays of finite numbers, at least 2 rows, ``f >= 0`` strictly increasing (Hz), gains in
+    ``[0, 1e3]`` (m/m), phases finite (rad)."""
+    try:
+        f, gain, phase = (np.array(v, dtype=float) for v in (f, gain, phase))
+    except (TypeError, ValueError):
+        raise ParameterError(f"response: expected three arrays of numbers (f, gain, "
+                             f"phase){where}") from None
+    if not (f.ndim == gain.ndim == phase.ndim == 1 and f.shape == gain.shape == phase.shape):
+        raise ParameterError(f"response: expected three 1-D arrays of equal length (f, gain, "
+                             f"phase){where}")
+    if f.size > limits.MAX_FILE_ROWS:
+        raise ParameterError(f"response: expected at most {limits.MAX_FILE_ROWS} rows{where}, "
+                             f"got {f.size}")
+    if not all(np.all(np.isfinite(v)) for v in (f, gain, phase)):
+        raise ParameterError(f"response: expected finite numbers{where}")
     if f.size < 2 or np.any(np.diff(f) <= 0) or f[0] < 0:
         raise ParameterError(f"response: expected at least 2 rows with f >= 0 strictly "
-                             f"increasing in {path}")
+                             f"increasing{where}")
     if np.any(gain < 0) or np.max(gain) > 1e3:
-        raise ParameterError(f"response: expected gains in [0, 1e3] in {path}")
+        raise ParameterError(f"response: expected gains in [0, 1e3]{where}, got "
+                             f"{float(np.min(gain)):.4g} to {float(np.max(gain)):.4g}")
     return f, gain, phase
 
 
@@ -176,9 +196,8 @@ def _csv_rows(path, header: list, name: str, max_rows: int = None) -> list:
 
 
 def _check_sea(hs, tp, spectrum, gamma_peak, repeat_period, cutoff):
-    hs = check_range("hs", hs, 0.0, limits.SEA_MAX_HS, why="significant wave height, m")
-    if hs <= 0:
-        raise ParameterError(f"hs: expected a significant wave height > 0 m, got {hs!r}")
+    hs = check_range("hs", hs, limits.SEA_MIN_HS, limits.SEA_MAX_HS,
+                     why="significant wave height, m")
     tp = check_range("tp", tp, *limits.SEA_TP_RANGE, why="peak period, s")
     if not isinstance(spectrum, str) or spectrum not in SPECTRA:
         raise ParameterError(f"spectrum: expected one of {', '.join(SPECTRA)}, "
@@ -189,9 +208,9 @@ def _check_sea(hs, tp, spectrum, gamma_peak, repeat_period, cutoff):
         raise ParameterError("gamma-peak: only used by spectrum 'jonswap'")
     cutoff = check_range("cutoff", cutoff, 1.5, 10.0,
                          why="highest component frequency, in units of the peak frequency")
-    waves = repeat_period / tp if repeat_period is not None else None
     if repeat_period is not None:
         repeat_period = check_positive("repeat-period", repeat_period)
+        waves = repeat_period / tp
         if not limits.SEA_WAVES_RANGE[0] <= waves <= limits.SEA_WAVES_RANGE[1]:
             raise ParameterError(
                 f"repeat-period: expected {limits.SEA_WAVES_RANGE[0]:g} to "
@@ -244,7 +263,15 @@ def sea_record(units, *, hs: float = 2.0, tp: float = 8.0, spectrum: str = "jons
         info["gamma_peak"] = gamma_peak
     heave = eta
     if response is not None:
-        rf, rg, rp = read_response(response) if isinstance(response, (str, Path)) else response
+        if isinstance(response, (str, Path)):
+            rf, rg, rp = read_response(response)
+        else:
+            try:
+                rf, rg, rp = response
+            except (TypeError, ValueError):
+                raise ParameterError("response: expected a CSV path or three arrays (f, gain, "
+                                     "phase)") from None
+            rf, rg, rp = check_response(rf, rg, rp)
         gain = np.interp(f, rf, rg, left=0.0, right=0.0)
         ph = np.interp(f, rf, rp)
         heave = eta * gain * np.exp(1j * ph)
@@ -264,10 +291,20 @@ def _excitation(units, heave: np.ndarray, tr: float, info: dict) -> SeaExcitatio
     if q.size - 1 > limits.SEA_MAX_COMPONENTS:
         raise ParameterError(f"repeat-period: {q.size - 1} components (at most "
                              f"{limits.SEA_MAX_COMPONENTS}); shorten the record or the cutoff")
+    measured = "record" in info
     if not np.any(q[1:] != 0):
+        if measured:
+            raise ParameterError(f"record: the heave in {info['record']} has no variation "
+                                 "below the cutoff; no motion of the base")
         raise ParameterError("response: the heave response is zero over the sea's "
                              "frequencies; no motion of the base")
-    return SeaExcitation(omega, q, heave, info)
+    # the cap on q applies to q = z''/g as evaluated, whatever sets it (hs, the cutoff, the
+    # response, g: sea --gravity 1e-3 gave max |q| = 2146)
+    return check_excitation(
+        SeaExcitation(omega, q, heave, info), "record" if measured else "sea",
+        f" (q = z''/g of the {'record' if measured else 'sea record'} with g = "
+        f"{units.gravity:g} m/s^2: {'a smaller cutoff' if measured else 'a smaller hs or cutoff'}"
+        f", or a larger gravity)")
 
 
 def measured_record(units, path, *, taper: float = 0.1, cutoff: float = 3.0) -> SeaExcitation:
@@ -284,7 +321,13 @@ def measured_record(units, path, *, taper: float = 0.1, cutoff: float = 3.0) -> 
     if np.max(np.abs(z)) > limits.SEA_MAX_HS:
         raise ParameterError(f"record: expected |z| <= {limits.SEA_MAX_HS:g} m in {path}")
     dt = float(np.median(np.diff(t)))
-    n = int(round((t[-1] - t[0]) / dt)) + 1
+    span = (t[-1] - t[0]) / dt
+    if not span < limits.SEA_MAX_RESAMPLED:  # before any allocation
+        raise ParameterError(
+            f"record: resampling {t[-1] - t[0]:.6g} s at the median spacing {dt:.4g} s needs "
+            f"{span:.4g} points, more than {limits.SEA_MAX_RESAMPLED} (SEA_MAX_RESAMPLED) in "
+            f"{path}; the record has gaps or uneven sampling: resample it uniformly")
+    n = int(round(span)) + 1
     tu = t[0] + dt * np.arange(n)
     zu = np.interp(tu, t, z)
     zu = zu - zu.mean()

@@ -172,8 +172,10 @@ def _check_value(name: str, v) -> float:
     if name == "omega":
         return check_range(flag, v, *limits.OMEGA_RANGE,
                            why="units sqrt(g/l); see docs/limits-of-input.md")
-    if name == "delta":
-        return check_range(flag, v, 0.0, limits.MAX_AMPLITUDE, absolute=True)
+    if name == "delta":  # the excitation's own rule: 0 or 1e-100 <= |delta| <= 1e3
+        from .excitation import _check_amplitude
+
+        return _check_amplitude(flag, v)
     if name == "gamma":
         return check_range(flag, v, 0.0, limits.MAX_GAMMA)
     if name == "torque_limit":

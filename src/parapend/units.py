@@ -27,6 +27,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
+from . import limits
 from .errors import ParameterError, check_nonnegative, check_positive
 
 __all__ = ["STANDARD_GRAVITY", "Units"]
@@ -57,11 +58,35 @@ class Units:
     inertia: float | None = None
 
     def __post_init__(self):
-        object.__setattr__(self, "length", check_positive("length", self.length))
-        object.__setattr__(self, "mass", check_positive("mass", self.mass))
-        object.__setattr__(self, "gravity", check_positive("gravity", self.gravity))
+        for name, rng, unit in (("length", limits.UNIT_LENGTH_RANGE, "m"),
+                                ("mass", limits.UNIT_MASS_RANGE, "kg"),
+                                ("gravity", limits.UNIT_GRAVITY_RANGE, "m/s^2")):
+            object.__setattr__(self, name, _in_range(name, getattr(self, name), rng, unit))
         if self.inertia is not None:
-            object.__setattr__(self, "inertia", check_positive("inertia", self.inertia))
+            inertia = check_positive("inertia", self.inertia)
+            ml2 = self.mass * self.length**2
+            lo, hi = (r * ml2 for r in limits.UNIT_INERTIA_RATIO)
+            if not lo * (1 - 1e-12) <= inertia <= hi:
+                raise ParameterError(
+                    f"inertia: expected a moment of inertia about the pivot in [m l^2, "
+                    f"{limits.UNIT_INERTIA_RATIO[1]:g} m l^2] = [{lo:.6g}, {hi:.6g}] kg m^2 "
+                    f"(I = I_cm + m l^2), got {self.inertia!r}")
+            object.__setattr__(self, "inertia", inertia)
+
+    def _derived(self, name: str, value: float, what: str, lo: float, hi: float,
+                 given: float, unit: str, absolute: bool = False) -> float:
+        """``value`` (the non-dimensional ``what`` that option ``name`` gives) checked
+        against ``[lo, hi]`` (``|value|`` with ``absolute``); the error names the option."""
+        x = abs(value) if absolute else value
+        if math.isfinite(value) and lo <= x <= hi and not (
+                what == "delta" and 0 < x < limits.MIN_AMPLITUDE):
+            return value
+        rng = (f"0 or in [{limits.MIN_AMPLITUDE:g}, {hi:g}]" if what == "delta"
+               else f"in [{lo:g}, {hi:g}]")
+        raise ParameterError(
+            f"{name}: expected a value giving {'|' + what + '|' if absolute else what} "
+            f"{rng} for this pendulum (time unit {self.time:.4g} s), got {given!r} {unit} "
+            f"({what} = {value:.4g})")
 
     # -- scales -----------------------------------------------------------------------------
     @property
@@ -98,7 +123,8 @@ class Units:
     def omega(self, frequency: float) -> float:
         """Non-dimensional forcing frequency ``omega = 2 pi f t0`` of a base frequency in Hz."""
         f = check_positive("frequency", frequency)
-        return 2 * math.pi * f * self.time
+        return self._derived("frequency", 2 * math.pi * f * self.time, "omega",
+                             *limits.OMEGA_RANGE, frequency, "Hz")
 
     def frequency(self, omega: float) -> float:
         """Base frequency in Hz of a non-dimensional ``omega``."""
@@ -108,7 +134,9 @@ class Units:
         """``delta = -A (2 pi f)^2 / g`` of a base displacement ``A sin(2 pi f t)`` (A in m)."""
         a = check_nonnegative("amplitude", amplitude)
         f = check_positive("frequency", frequency)
-        return -a * (2 * math.pi * f) ** 2 / self.gravity
+        d = -a * (2 * math.pi * f) ** 2 / self.gravity
+        return self._derived("amplitude", d, "delta", 0.0, limits.MAX_AMPLITUDE, amplitude,
+                             "m", absolute=True)
 
     def amplitude(self, delta: float, frequency: float) -> float:
         """Base displacement amplitude (m) of ``delta`` at ``frequency`` Hz (inverse of delta)."""
@@ -116,7 +144,9 @@ class Units:
 
     def gamma(self, damping_coefficient: float) -> float:
         """Non-dimensional ``gamma = c t0 / I`` of a viscous coefficient ``c`` in N m s/rad."""
-        return check_nonnegative("damping-coefficient", damping_coefficient) / self.damping
+        c = check_nonnegative("damping-coefficient", damping_coefficient)
+        return self._derived("damping-coefficient", c / self.damping, "gamma", 0.0,
+                             limits.MAX_GAMMA, damping_coefficient, "N m s/rad")
 
     def damping_coefficient(self, gamma: float) -> float:
         """Viscous coefficient (N m s/rad) of a non-dimensional ``gamma``."""
@@ -145,6 +175,15 @@ class Units:
         return {"length_m": self.length, "mass_kg": self.mass, "gravity_m_s2": self.gravity,
                 "inertia_kg_m2": self.moment_of_inertia, "time_unit_s": self.time,
                 "torque_unit_nm": self.torque, "power_unit_w": self.power}
+
+
+def _in_range(name: str, value, rng: tuple, unit: str) -> float:
+    """A positive scale within ``rng`` (> 0 first, so that 0 and negatives say so)."""
+    x = check_positive(name, value)
+    if not rng[0] <= x <= rng[1]:
+        raise ParameterError(f"{name}: expected a number in [{rng[0]:g}, {rng[1]:g}] {unit} "
+                             f"(see docs/limits-of-input.md), got {value!r}")
+    return x
 
 
 def from_options(*, length=None, mass=None, gravity=None, inertia=None, frequency=None,

@@ -32,9 +32,21 @@ import numpy as np
 
 from .swingup import pump_torque, ready_to_catch
 
-__all__ = ["ClosedLoopRun", "run_closed_loop"]
+__all__ = ["ClosedLoopRun", "Diverged", "run_closed_loop"]
 
 PUMP, TRACK = 0, 1
+#: |theta'| beyond which a run is abandoned as diverged (the sampled loop or the RK4 steps
+#: are unstable for this plant; ``track`` refuses such plants, this is the safety net)
+DIVERGED_SPEED = 1e12
+
+
+class Diverged(ArithmeticError):
+    """The closed loop left every bounded state (``|theta'| > DIVERGED_SPEED`` or NaN) at
+    sample ``k`` (attribute ``sample``)."""
+
+    def __init__(self, sample: int):
+        super().__init__(f"the closed loop diverged at sample {sample}")
+        self.sample = sample
 
 
 @dataclass(frozen=True, eq=False)
@@ -152,6 +164,8 @@ def run_closed_loop(target, gains, *, periods: int, torque_limit: float | None,
             b4 = (1.0 + qc) * sin(th + dt * a3) - g * a4 + u
             th += dt / 6.0 * (a1 + 2 * a2 + 2 * a3 + a4)
             om += dt / 6.0 * (b1 + 2 * b2 + 2 * b3 + b4)
+            if not -DIVERGED_SPEED < om < DIVERGED_SPEED:  # also NaN
+                raise Diverged(k)
     t = h * np.arange(nk + 1)
     return ClosedLoopRun(t=t, theta=np.array(out_th), theta_dot=np.array(out_om),
                          torque=np.array(out_t), q=np.asarray(qg[::2 * substeps]),

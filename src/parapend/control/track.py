@@ -23,7 +23,7 @@ import numpy as np
 from .. import limits
 from ..errors import ParameterError, SolverError, check_finite, check_int, check_range
 from ..results import _Result
-from .closedloop import energy_series, run_closed_loop
+from .closedloop import Diverged, energy_series, run_closed_loop
 from .riccati import periodic_lqr
 from .target import build_target
 
@@ -153,6 +153,7 @@ def prepare(*, torque_limit=None, torque_margin: float = 0.1, r_weight: float = 
         if torque_limit <= 0:
             raise ParameterError(f"torque-limit: expected a number > 0, got {torque_limit!r}")
     ideal = optimize(**optimize_args)
+    check_sampling(ideal._excitation, ideal.gamma)
     chosen, design, at_limit = ideal, None, None
     status, message = ideal.status, ideal.message
     if torque_limit is not None and ideal.peak_torque > (1 - margin) * torque_limit:
@@ -169,6 +170,43 @@ def prepare(*, torque_limit=None, torque_margin: float = 0.1, r_weight: float = 
     target = build_target(chosen, SAMPLES, excitation=ideal._excitation, gamma=ideal.gamma)
     lqr = periodic_lqr(target, r_weight=r_weight)
     return Design(target, lqr, torque_limit, design, at_limit, status, message)
+
+
+#: largest relative model error of a plant (``gamma_error``, ``delta_error``)
+MAX_MODEL_ERROR = 0.9
+
+
+def check_sampling(exc, gamma: float) -> None:
+    """Refuse a case whose plant the sampled loop cannot resolve.
+
+    The controller samples ``SAMPLES`` times per forcing period, ``h = 2 pi/(omega SAMPLES)``,
+    and the plant is integrated by RK4 over ``h/4``. Its fastest rates are the damping
+    ``gamma`` and the frequency ``sqrt(1 + max|q|)`` of small swings about the top, each up
+    to ``1 + MAX_MODEL_ERROR`` times larger in a plant with model error. Required:
+    ``h * max(rates) <= limits.TRACK_MAX_STEP_RATE`` (at least 2 pi samples per fastest
+    swing; ``omega = 1e-3`` with ``h = 24.5`` gave NaN gains, ``gamma = 1e3`` with
+    ``h gamma = 13.6`` an unstable RK4 and a math domain error).
+    """
+    from ..excitation import max_abs_q
+
+    f = 1.0 + MAX_MODEL_ERROR
+    h = exc.period / SAMPLES
+    qmax = max_abs_q(exc)
+    swing = math.sqrt(1.0 + f * qmax)
+    c = limits.TRACK_MAX_STEP_RATE
+    if h * f * gamma > c and f * gamma >= swing:
+        raise ParameterError(
+            f"gamma: expected gamma <= {c / (f * h):.4g} for track at omega = {exc.omega:g} "
+            f"(the sample interval 2 pi/({SAMPLES} omega) = {h:.3g} times the plant's "
+            f"damping rate, up to {f:g} gamma with model error, must be at most {c:g}), got "
+            f"{gamma:g}")
+    if h * swing > c:
+        omin = 2 * math.pi * swing / (SAMPLES * c)
+        raise ParameterError(
+            f"omega: expected omega >= {omin:.4g} for track with this excitation (max |q| = "
+            f"{qmax:.4g}: the sample interval 2 pi/({SAMPLES} omega) = {h:.3g} times the "
+            f"swing rate sqrt(1 + {f:g} max|q|) = {swing:.4g} must be at most {c:g}), got "
+            f"{exc.omega:g}")
 
 
 def lock_analysis(run, target, tol: float):
@@ -228,9 +266,10 @@ def design_sea(omega: float, rms: float, seed: int):
 
     unit = record(1.0)
     hs = rms / math.sqrt(0.5 * float(np.sum(np.abs(unit.spec) ** 2)))
-    if hs > limits.SEA_MAX_HS:
+    if not limits.SEA_MIN_HS <= hs <= limits.SEA_MAX_HS:
         raise ParameterError(f"irregular: the design excitation's rms {rms:.3g} needs a sea "
-                             f"state above Hs = {limits.SEA_MAX_HS:g} m at Tp = {SEA_TP:g} s")
+                             f"state of Hs = {hs:.3g} m at Tp = {SEA_TP:g} s, outside "
+                             f"[{limits.SEA_MIN_HS:g}, {limits.SEA_MAX_HS:g}] m")
     sea = record(hs)
     info = {"spectrum": "jonswap", "gamma_peak": 3.3, "peak_omega": omega,
             "hs": hs / units.length, "repeat_periods": SEA_WAVES,
@@ -375,27 +414,33 @@ def _design(design, torque_limit, torque_margin, r_weight, optimize_args) -> Des
 def _result(d: Design, *, periods, seed, gamma_error, delta_error, noise_theta, noise_speed,
             irregular, lock_tolerance, state0, throw, rng=None) -> TrackResult:
     tg = d.target
+    failed = {"locked": False, "lock_period": None, "catch_period": None,
+              "mean_power": math.nan, "peak_torque": math.nan, "energy_before_lock": None,
+              "payback_periods": None, "tracking_error": math.nan, "plant_gamma": math.nan}
     if d.status == "infeasible":
         msg = f"no rotation within the design torque limit: {d.message}"
         if throw:
             raise SolverError(f"track: {msg}")
-        run, fields = None, {"locked": False, "lock_period": None, "catch_period": None,
-                             "mean_power": math.nan, "peak_torque": math.nan,
-                             "energy_before_lock": None, "payback_periods": None,
-                             "tracking_error": math.nan, "plant_gamma": math.nan}
-        status = "infeasible"
+        run, fields, status = None, failed, "infeasible"
     else:
-        run, fields = simulate_design(d, periods=periods, seed=seed, gamma_error=gamma_error,
-                                      delta_error=delta_error, noise_theta=noise_theta,
-                                      noise_speed=noise_speed, irregular=irregular,
-                                      lock_tolerance=lock_tolerance, state0=state0, rng=rng)
-        status = "locked" if fields["locked"] else "not_locked"
-        msg = (f"locked after {fields['lock_period']} periods and held to the end"
-               if fields["locked"] else
-               f"not locked: the last {AVERAGE_PERIODS} periods are not all within "
-               f"{lock_tolerance:g} rad of the orbit; more --periods, a larger --torque-limit "
-               "or --lock-tolerance")
-        if throw and not fields["locked"]:
+        try:
+            run, fields = simulate_design(d, periods=periods, seed=seed,
+                                          gamma_error=gamma_error, delta_error=delta_error,
+                                          noise_theta=noise_theta, noise_speed=noise_speed,
+                                          irregular=irregular, lock_tolerance=lock_tolerance,
+                                          state0=state0, rng=rng)
+        except Diverged as exc:
+            run, fields, status = None, failed, "diverged"
+            msg = (f"the closed loop diverged after {exc.sample / tg.samples:.4g} periods "
+                   "(|theta'| unbounded): the sampled controller does not hold this plant")
+        else:
+            status = "locked" if fields["locked"] else "not_locked"
+            msg = (f"locked after {fields['lock_period']} periods and held to the end"
+                   if fields["locked"] else
+                   f"not locked: the last {AVERAGE_PERIODS} periods are not all within "
+                   f"{lock_tolerance:g} rad of the orbit; more --periods, a larger "
+                   "--torque-limit or --lock-tolerance")
+        if throw and status != "locked":
             raise SolverError(f"track: {msg}")
     return TrackResult(
         **fields, predicted_power=tg.power, optimum_at_torque_limit=d.optimum_at_torque_limit,
