@@ -299,7 +299,7 @@ def cluster():
     # a real scheduler and two workers talking TCP on loopback (threads of this process:
     # quick to start, and the blocks they compute are the same)
     with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=False,
-                                  protocol="tcp", host="127.0.0.1", dashboard_address=None,
+                                  protocol="tcp", host="127.0.0.1", dashboard_address=":0",
                                   silence_logs=50) as c:
         yield c
 
@@ -836,3 +836,105 @@ def test_netcdf_on_a_full_disk_says_so(reference, tmp_path, monkeypatch, capsys)
     assert main(["sweep", "--omega", "1.6:2.0:4", "--delta", "-0.3,-0.2,-0.1", "--gamma",
                  "0.01", "--block-points", "3", "--workers", "1", "--netcdf", "m.nc"]) == 1
     _one_line(capsys, "cannot write 'm.nc': No space left on device")
+
+
+def _interrupt(proc, ready, timeout=120):
+    """Wait until ``ready()`` (the sweep is under way), send SIGINT, return (rc, stderr)."""
+    deadline = time.monotonic() + timeout
+    while time.monotonic() < deadline and proc.poll() is None and not ready():
+        time.sleep(0.05)
+    assert proc.poll() is None, proc.communicate()
+    proc.send_signal(signal.SIGINT)
+    _, err = proc.communicate(timeout=timeout)
+    return proc.returncode, err
+
+
+def _blocks_done(store):
+    import zarr
+
+    try:
+        return int(np.asarray(zarr.open_group(store, mode="r")["done"][...]).sum())
+    except Exception:  # noqa: BLE001 - not created yet
+        return 0
+
+
+@pytest.mark.skipif(sys.platform == "win32", reason="SIGINT")
+def test_ctrl_c_with_local_processes_is_one_line(tmp_path):
+    """Ctrl-C while two local processes compute blocks with a power take-off (up to half a
+    minute each): one line and exit code 130 at once, the running blocks are not waited
+    for; the blocks written are sound."""
+    argv = [sys.executable, "-m", "parapend", "sweep", "--omega", "1.6:2.0:8", "--gamma",
+            "0.01,0.05", "--torque-limit", "0.3,1,2", "--workers", "2", "--store", "m.zarr"]
+    env = {**os.environ, "PYTHONPATH": SRC}
+    proc = subprocess.Popen(argv, cwd=tmp_path, env=env, stdout=subprocess.PIPE,
+                            stderr=subprocess.PIPE, text=True)
+    rc, err = _interrupt(proc, lambda: "sweep" in (sw._root_attrs(tmp_path / "m.zarr") or {}))
+    assert rc == 130 and err == "parapend sweep: interrupted\n"
+    sw.open_sweep(tmp_path / "m.zarr")  # verified: no damage
+
+
+def test_bad_scheduler_address_is_one_line(tmp_path):
+    """`--scheduler garbage` printed its line, then a TimeoutError traceback 20 s later
+    (the half-made Client's destructor): now one line, exit 2, nothing created."""
+    pytest.importorskip("distributed")
+    env = {**os.environ, "PYTHONPATH": SRC}
+    for address, match in (("garbage", "scheduler: expected an address such as "
+                                        "tcp://host:8786, got 'garbage'"),
+                           ("tcp://host-without-port", "scheduler: expected an address")):
+        p = subprocess.run([sys.executable, "-m", "parapend", "sweep", "--omega", "1,2",
+                            "--scheduler", address], cwd=tmp_path, env=env,
+                           capture_output=True, text=True, timeout=120)
+        assert p.returncode == 2 and p.stderr.count("\n") == 1 and match in p.stderr, p.stderr
+    assert list(tmp_path.iterdir()) == []
+
+
+@pytest.mark.skipif(sys.platform == "win32", reason="SIGINT")
+def test_silent_scheduler_is_one_line_and_ctrl_c_during_connect(tmp_path):
+    """A server that accepts the connection but never answers (distributed would wait for
+    ever): one line after the deadline (here lowered to 1 s), exit 2; Ctrl-C while
+    connecting: one line, exit 130."""
+    import socket
+
+    pytest.importorskip("distributed")
+    env = {**os.environ, "PYTHONPATH": SRC}
+    def listener():
+        srv = socket.socket()
+        srv.bind(("127.0.0.1", 0))
+        srv.listen(8)
+        srv.settimeout(60)
+        return srv, f"tcp://127.0.0.1:{srv.getsockname()[1]}"
+
+    srv, address = listener()
+    with srv:
+        code = ("import sys; from parapend import sweep as sw; sw._CONNECT_SECONDS = 1\n"
+                "from parapend.cli import main\n"
+                f"sys.exit(main(['sweep', '--omega', '1,2', '--scheduler', {address!r}]))\n")
+        p = subprocess.run([sys.executable, "-c", code], cwd=tmp_path, env=env,
+                           capture_output=True, text=True, timeout=120)
+    assert p.returncode == 2 and p.stderr.count("\n") == 1, p.stderr
+    assert f"cannot connect to {address!r}: no answer within 2 s" in p.stderr
+    srv, address = listener()
+    with srv:
+        proc = subprocess.Popen([sys.executable, "-m", "parapend", "sweep", "--omega", "1,2",
+                                 "--scheduler", address], cwd=tmp_path, env=env,
+                                stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+        conn, _ = srv.accept()  # connected: it waits for the handshake
+        with conn:
+            rc, err = _interrupt(proc, lambda: True)
+    assert rc == 130 and err == "parapend sweep: interrupted\n"
+    assert list(tmp_path.iterdir()) == []
+
+
+@pytest.mark.skipif(sys.platform == "win32", reason="SIGINT")
+def test_ctrl_c_during_a_scheduler_sweep_is_one_line(cluster, tmp_path):
+    """Ctrl-C while the blocks run on a Dask cluster: one line, exit 130, no traceback; the
+    blocks written are sound."""
+    argv = [sys.executable, "-m", "parapend", "sweep", "--omega", "1.4:2.2:32", "--delta",
+            "-0.4:-0.1:24", "--gamma", "0.02", "--threshold", "--block-points", "24",
+            "--store", "m.zarr", "--scheduler", cluster.scheduler_address]
+    env = {**os.environ, "PYTHONPATH": SRC}
+    proc = subprocess.Popen(argv, cwd=tmp_path, env=env, stdout=subprocess.PIPE,
+                            stderr=subprocess.PIPE, text=True)
+    rc, err = _interrupt(proc, lambda: _blocks_done(tmp_path / "m.zarr") >= 24)
+    assert rc == 130 and err == "parapend sweep: interrupted\n"
+    sw.open_sweep(tmp_path / "m.zarr")

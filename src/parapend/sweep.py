@@ -31,13 +31,16 @@ The searches of a block together
 
 The store (Zarr 3)
     Made whole (every array, its chunks, coordinates and attributes) before the first
-    block, then written block by block: the variables of a block, then its ``done`` mask.
-    Zarr skips chunks that equal the fill value, so the data alone cannot say what
-    finished; the mask can, and a block is only counted when its mask is written. Running
-    the same sweep on the same store resumes it: the blocks whose mask is set are not
-    recomputed, and the store ends byte for byte as an uninterrupted run's. The store is
-    locked (``flock`` on its directory) while a sweep writes it: a second sweep on it is
-    refused with one line; the lock dies with its process (``kill -9`` included).
+    block, behind a root ``zarr.json`` that says "being created" (written first: a
+    directory is only ever emptied when parapend recognises it as its own), then written
+    block by block: the variables of a block, then its ``done`` mask. Zarr skips chunks
+    that equal the fill value, so the data alone cannot say what finished; the mask can, and
+    a block is only counted when its mask is written. Running the same sweep on the same
+    store resumes it: the blocks whose mask is set are verified (every chunk present and
+    decodable, a status at every point) and not recomputed unless damaged, and the store
+    ends byte for byte as an uninterrupted run's. The store is locked (``flock`` on its
+    directory) while a sweep writes it: a second sweep on it is refused with one line; the
+    lock dies with its process (``kill -9`` included).
 """
 
 from __future__ import annotations
@@ -1272,7 +1275,9 @@ def sweep(store=None, *, omega=1.8, delta=None, gamma=0.0, torque_limit=None, ef
         Address of a Dask distributed scheduler (``tcp://host:8786``), or a Client: the
         blocks run there, and are written here as they finish.
     overwrite : bool
-        Replace a store that holds a different sweep.
+        Replace a store that holds a different sweep. A directory that is not a parapend
+        sweep store (or a store holding files a sweep does not write) is refused either
+        way, never deleted.
     command : str or None
         The command line, recorded in the attributes (the first run's stays).
     progress : callable or None
