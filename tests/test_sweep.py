@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import hashlib
 import json
+import math
 import os
 import signal
 import subprocess
@@ -938,3 +939,21 @@ def test_ctrl_c_during_a_scheduler_sweep_is_one_line(cluster, tmp_path):
     rc, err = _interrupt(proc, lambda: _blocks_done(tmp_path / "m.zarr") >= 24)
     assert rc == 130 and err == "parapend sweep: interrupted\n"
     sw.open_sweep(tmp_path / "m.zarr")
+
+
+def test_a_success_without_a_finite_power_is_recorded_as_nonfinite(tmp_path, monkeypatch):
+    """What a store's check relies on holds by construction: a point whose solver says
+    converged but whose power is NaN is stored as "nonfinite" (and is then a legitimate NaN,
+    not damage)."""
+    real = sw._continue
+
+    def nan_power(*a, **k):
+        power, status, gap, x = real(*a, **k)
+        return math.nan, status, gap, x
+
+    monkeypatch.setattr(sw, "_continue", nan_power)
+    store = tmp_path / "m.zarr"
+    run = sw.sweep(store, omega="1.8,1.9", workers=1)
+    assert (run.dataset["status"].values == sw.STATUSES.index("nonfinite")).all()
+    again = sw.sweep(store, omega="1.8,1.9", workers=1)
+    assert (again.computed_points, again.repaired_points) == (0, 0)

@@ -466,6 +466,13 @@ def _threshold(spec: SweepSpec, p: dict, thresholds: dict):
     return thresholds[key]
 
 
+def _finite(x) -> bool:
+    try:
+        return math.isfinite(x)
+    except TypeError:
+        return False
+
+
 def compute_block(spec: SweepSpec, block: int) -> dict:
     """The variables of one block, as arrays of the block's shape.
 
@@ -520,6 +527,11 @@ def compute_block(spec: SweepSpec, block: int) -> dict:
             if spec.threshold:
                 vals["damping_threshold"], vals["threshold_status"] = _threshold(
                     spec, p, thresholds)
+            # a success always has a finite number (what _verify relies on to tell a
+            # legitimate NaN from a lost chunk)
+            for st, num in (("status", "power"), ("threshold_status", "damping_threshold")):
+                if vals.get(st) in _SUCCESS and not _finite(vals.get(num)):
+                    vals[st] = "nonfinite"
             for k, v in vals.items():
                 if k.endswith("status"):
                     out[k][idx] = _CODE.get(v, _CODE["other"])
