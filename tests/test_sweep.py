@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import hashlib
 import json
+import math
 import os
 import signal
 import subprocess
@@ -276,12 +277,19 @@ def test_store_of_another_sweep_is_refused(reference, tmp_path):
     with pytest.raises(ParameterError, match="not a parapend sweep store"):
         sw.sweep(foreign, omega="1.8,1.9")
     assert (foreign / "notes.txt").read_text() == "mine"
-    # a creation cut short (arrays, no root zarr.json) is ours: made again, then computed
+    # a creation cut short (its root says so: parapend writes that first) is ours: made
+    # again, then computed
     cut = tmp_path / "cut.zarr"
     (cut / "power").mkdir(parents=True)
     (cut / "power" / "zarr.json").write_text("{")
+    sw._write_marker(cut)
     assert sw.sweep(cut, omega="1.8,1.9", workers=1).computed_points == 2
     assert bool(sw.open_sweep(cut, complete=True)["done"].all())
+    # arrays without that root are not recognised as parapend's: refused, kept
+    (cut / "zarr.json").unlink()
+    with pytest.raises(ParameterError, match="not a parapend sweep store"):
+        sw.sweep(cut, omega="1.8,1.9", workers=1, overwrite=True)
+    assert (cut / "power" / "zarr.json").is_file()
 
 
 # -- Dask distributed -----------------------------------------------------------------------
@@ -292,7 +300,7 @@ def cluster():
     # a real scheduler and two workers talking TCP on loopback (threads of this process:
     # quick to start, and the blocks they compute are the same)
     with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=False,
-                                  protocol="tcp", host="127.0.0.1", dashboard_address=None,
+                                  protocol="tcp", host="127.0.0.1", dashboard_address=":0",
                                   silence_logs=50) as c:
         yield c
 
@@ -512,3 +520,440 @@ def test_delta_through_zero_symmetric_and_constant_case():
     assert p[2] == pytest.approx(-0.01 * 1.8**2, abs=1e-15)
     assert sw.STATUSES[int(ds["status"][2])] == "no_power"
     assert [sw.STATUSES[int(c)] for c in ds["status"].values[[0, 1, 3, 4]]] == ["converged"] * 4
+
+
+# -- foreign directories, damaged stores, interruptions --------------------------------------
+
+def _copy(store: Path, to: Path) -> Path:
+    import shutil
+
+    shutil.copytree(store, to)
+    return to
+
+
+def _one_line(capsys, match):
+    err = capsys.readouterr().err
+    assert match in err, err
+    assert err.count("\n") == 1 and "Traceback" not in err, err
+
+
+def test_a_foreign_directory_is_never_deleted(reference, tmp_path, capsys, monkeypatch):
+    """A directory that parapend did not create is refused with one line, --overwrite or
+    not, even when its names look like a store's (the audit's case: power/measurements.csv
+    and a file omega); and so is a store that also holds a file parapend did not write."""
+    monkeypatch.chdir(tmp_path)
+    d = tmp_path / "data"
+    (d / "power").mkdir(parents=True)
+    (d / "power" / "measurements.csv").write_text("t,p\n0,1\n")
+    (d / "omega").write_text("mine")
+    before = _files(d)
+    for extra in ([], ["--overwrite"]):
+        assert main(["sweep", "--store", "data", "--omega", "1:2:3", "--workers", "1",
+                     *extra]) == 2
+        _one_line(capsys, "store: 'data' exists and is not a parapend sweep store")
+        assert _files(d) == before
+    # another Zarr group (not a sweep's), and arrays without a root: refused too
+    other = tmp_path / "other.zarr"
+    other.mkdir()
+    (other / "zarr.json").write_text('{"zarr_format": 3, "node_type": "group", '
+                                     '"attributes": {"title": "mine"}}')
+    with pytest.raises(ParameterError, match="not a parapend sweep store"):
+        sw.sweep(other, omega="1.8,1.9", workers=1, overwrite=True)
+    assert (other / "zarr.json").is_file()
+    # a sweep store holding a file of the user's: resumed, but never emptied
+    store = _copy(reference[0], tmp_path / "map.zarr")
+    (store / "notes.txt").write_text("mine")
+    assert sw.sweep(store, **GRID, workers=1, block_points=3).computed_points == 0
+    with pytest.raises(ParameterError, match="also holds 'notes.txt', which parapend did not"):
+        sw.sweep(store, omega="1.8,1.9", workers=1, overwrite=True)
+    assert (store / "notes.txt").read_text() == "mine"
+    # without it, --overwrite replaces the store (another sweep) and an empty directory is
+    # used as it is
+    (store / "notes.txt").unlink()
+    assert sw.sweep(store, omega="1.8,1.9", workers=1, overwrite=True).computed_points == 2
+    (tmp_path / "empty").mkdir()
+    assert sw.sweep(tmp_path / "empty", omega="1.8,1.9", workers=1).computed_points == 2
+
+
+@pytest.mark.skipif(sys.platform == "win32", reason="kill -9")
+def test_kill_9_during_creation_leaves_nothing_behind(reference, tmp_path, capsys):
+    """kill -9 while the store is created (after its first two arrays are moved in): the
+    store's root says "being created", so the next run recognises it as parapend's, makes it
+    again and computes it; the temporary directory was inside the store and is gone, and
+    nothing is left beside the store."""
+    ref_store, _ = reference
+    work = tmp_path / "work"
+    work.mkdir()
+    store = work / "map.zarr"
+    code = ("import os, signal, sys\n"
+            "from parapend import sweep as sw\n"
+            "from pathlib import Path\n"
+            "real, calls = os.replace, [0]\n"
+            "def replace(a, b):\n"
+            "    a, b = Path(a), Path(b)\n"
+            "    if a.parent.name.startswith('.tmp-parapend-') and b.parent == store:\n"
+            "        calls[0] += 1  # an entry moved from the temporary into the store\n"
+            "        if calls[0] == 3:  # two arrays are in: kill -9\n"
+            "            os.kill(os.getpid(), signal.SIGKILL)\n"
+            "    real(a, b)\n"
+            "store = Path(sys.argv[1])\n"
+            "os.replace = replace\n"
+            f"sw.sweep(sys.argv[1], **{GRID!r}, workers=1, block_points=3, command='test')\n")
+    env = {**os.environ, "PYTHONPATH": SRC}
+    proc = subprocess.run([sys.executable, "-c", code, str(store)], env=env,
+                          capture_output=True, timeout=300)
+    assert proc.returncode == -signal.SIGKILL
+    inside = sorted(e.name for e in store.iterdir())
+    assert any(n.startswith(".tmp-parapend-") for n in inside) and len(inside) == 4
+    assert json.loads((store / "zarr.json").read_text())["attributes"]["parapend_store"] \
+        == "creating"
+    assert sorted(e.name for e in work.iterdir()) == ["map.zarr"]
+    with pytest.raises(ParameterError, match="was not created completely"):
+        sw.open_sweep(store)
+    assert main(["map", "--store", str(store), "--plot", str(tmp_path / "m.png")]) == 2
+    _one_line(capsys, "was not created completely")
+    run = sw.sweep(store, **GRID, workers=1, block_points=3, command="test")
+    assert run.computed_points == 12
+    assert _files(store) == _files(ref_store)
+    assert sorted(e.name for e in work.iterdir()) == ["map.zarr"]
+    assert not any(e.name.startswith(".tmp-parapend-") for e in store.iterdir())
+
+
+def test_stale_temporaries_of_an_earlier_version_are_removed(tmp_path):
+    """Earlier versions created a store in a .tmp-parapend-* directory beside it, left there
+    by kill -9: such a directory (holding only a store's entries) is removed once ten
+    minutes old; a recent one, one with other files, and parapend's temporary files are
+    kept."""
+    old = time.time() - 3600
+
+    def temp(name, entries, when):
+        d = tmp_path / name
+        d.mkdir()
+        for e in entries:
+            (d / e).mkdir()
+        if "zarr.json" not in entries:
+            (d / "zarr.json").write_text('{"zarr_format": 3, "node_type": "group", '
+                                         '"attributes": {"title": "parapend design map"}}')
+        os.utime(d, (when, when))
+        return d
+
+    stale = temp(".tmp-parapend-abc", ["power", "done"], old)
+    fresh = temp(".tmp-parapend-new", ["power"], time.time())
+    mixed = temp(".tmp-parapend-mix", ["power", "photos"], old)
+    f = tmp_path / ".tmp-parapend-x.nc"
+    f.write_text("")
+    os.utime(f, (old, old))
+    sw.sweep(tmp_path / "map.zarr", omega="1.8,1.9", workers=1)
+    assert not stale.exists() and fresh.exists() and mixed.exists() and f.exists()
+
+
+def _reference_blocks(tmp_path, **kw):
+    """A store and its copy to damage."""
+    store = tmp_path / "ref.zarr"
+    sw.sweep(store, **kw, workers=1, command="test")
+    return store
+
+
+@pytest.mark.parametrize("damage", ["delete power", "garbage status", "flip limit_power",
+                                    "garbage done", "delete done", "truncate branch_gap"])
+def test_damaged_chunks_are_found_and_recomputed(reference, tmp_path, capsys, damage):
+    """A chunk of a finished block deleted by hand, replaced by garbage, with one bit
+    flipped (zstd's checksum), or truncated: `map` says the store is damaged (one line,
+    exit 2) instead of drawing NaNs, and the same sweep recomputes that block, never
+    passing it off as done; the store then equals an uninterrupted one, byte for byte."""
+    ref_store, _ = reference
+    store = _copy(ref_store, tmp_path / "d.zarr")
+    action, var = damage.split()
+    chunk = store / var / "c" / "2" / "0"  # block 2 of 4 (omega = 1.867, 3 points)
+    data = chunk.read_bytes()
+    if action == "delete":
+        chunk.unlink()
+    elif action == "garbage":
+        chunk.write_bytes(bytes(range(7, 47)))
+    elif action == "flip":
+        b = bytearray(data)
+        b[len(b) // 2] ^= 1
+        chunk.write_bytes(bytes(b))
+    else:
+        chunk.write_bytes(data[: len(data) // 2])
+    if damage == "delete done":  # the block is not marked finished: as if never computed
+        assert not sw.open_sweep(store)["done"].values[2].any()
+        assert main(["map", "--store", str(store), "--plot", str(tmp_path / "m.png"),
+                     "--json"]) == 0
+        assert json.loads(capsys.readouterr().out)["not_computed"] == 3
+    else:
+        with pytest.raises(ParameterError, match=r"is damaged: 1 of 4 blocks \(3 points\)"):
+            sw.open_sweep(store)
+        assert main(["map", "--store", str(store), "--plot", str(tmp_path / "m.png")]) == 2
+        _one_line(capsys, "is damaged: 1 of 4 blocks (3 points) marked finished have missing")
+    run = sw.sweep(store, **GRID, workers=1, block_points=3, command="test")
+    assert run.computed_points == 3
+    assert run.repaired_points == (0 if damage == "delete done" else 3)
+    assert _files(store) == _files(ref_store)
+
+
+def test_damage_in_a_partial_edge_chunk_and_all_nan_blocks(tmp_path):
+    """A block whose points all failed (status error, every value NaN) is written whole, so
+    it is not mistaken for damage and a missing chunk of it is found; a garbage chunk at the
+    edge of the grid (a block smaller than the chunk) is recomputed without being read."""
+    kw = {"omega": "1.8,2.4", "delta": "-0.3,-0.2,-0.1", "excitation": "square",
+          "square_alpha": 0.4, "harmonics": 8, "block_points": 2}
+    ref = _reference_blocks(tmp_path, **kw)
+    ds = sw.open_sweep(ref)
+    assert (ds["status"].values[1] == sw.STATUSES.index("error")).all()
+    assert np.isnan(ds["power"].values[1]).all()
+    run = sw.sweep(ref, **kw, workers=1, command="test")
+    assert (run.computed_points, run.repaired_points) == (0, 0)
+    store = _copy(ref, tmp_path / "d.zarr")
+    (store / "power" / "c" / "1" / "1").unlink()  # all NaN, but written: its loss is seen
+    (store / "uniform_power" / "c" / "0" / "1").write_bytes(b"garbage")  # edge: 1 of 2
+    with pytest.raises(ParameterError, match=r"is damaged: 2 of 4 blocks \(2 points\)"):
+        sw.open_sweep(store)
+    run = sw.sweep(store, **kw, workers=1, command="test")
+    assert (run.computed_points, run.repaired_points) == (2, 2)
+    assert _files(store) == _files(ref)
+
+
+def test_damaged_structure_is_one_line_then_overwrite(reference, tmp_path, capsys):
+    """An array deleted (KeyError before), `done` of another dtype (ValueError before),
+    garbage array metadata, a coordinate changed: `sweep` and `map` stop with one line
+    (exit 2) naming what is damaged; --overwrite computes the store again."""
+    import zarr
+
+    ref_store, _ = reference
+    argv = ["sweep", "--omega", "1.6:2.0:4", "--delta", "-0.3,-0.2,-0.1", "--gamma", "0.01",
+            "--block-points", "3", "--workers", "1", "--store"]
+
+    def power_deleted(s):
+        import shutil
+
+        shutil.rmtree(s / "power")
+
+    def done_int64(s):
+        g = zarr.open_group(s, mode="r+")
+        d = np.asarray(g["done"][...])
+        del g["done"]
+        g.create_array("done", shape=d.shape, dtype="int64", chunks=(1, 3), fill_value=0,
+                       dimension_names=("omega", "delta"))[...] = d
+
+    def garbage_meta(s):
+        (s / "status" / "zarr.json").write_text("{not json")
+
+    def coordinate(s):
+        zarr.open_group(s, mode="r+")["omega"][0] = 1.5
+
+    for damage, match in ((power_deleted, "array 'power' is missing"),
+                          (done_int64, "array 'done' is int64"),
+                          (garbage_meta, "array 'status' is unreadable"),
+                          (coordinate, "coordinate 'omega' differs")):
+        store = _copy(ref_store, tmp_path / damage.__name__)
+        damage(store)
+        for cmd in (argv + [str(store)], ["map", "--store", str(store), "--plot",
+                                          str(tmp_path / "m.png")]):
+            assert main(cmd) == 2
+            _one_line(capsys, f"store: {str(store)!r} is damaged ({match}")
+        assert main(argv + [str(store), "--overwrite", "--json"]) == 0
+        assert json.loads(capsys.readouterr().out)["computed_points"] == 12
+        a, b = sw.open_sweep(store), sw.open_sweep(ref_store)
+        for v in b.data_vars:
+            assert np.array_equal(a[v].values, b[v].values, equal_nan=v != "done")
+
+
+def test_full_disk_while_writing_the_store_then_resume(reference, tmp_path, monkeypatch):
+    """No space left after two blocks: one line naming the store and the reason, the
+    finished blocks kept; the same sweep then resumes to the uninterrupted store."""
+    import errno
+
+    import zarr
+
+    ref_store, _ = reference
+    store = tmp_path / "full.zarr"
+    real, masks = zarr.Array.__setitem__, [0]
+
+    def setitem(self, key, value):  # the disk is full once two blocks are written
+        if masks[0] == 2:
+            raise OSError(errno.ENOSPC, "No space left on device")
+        real(self, key, value)
+        masks[0] += self.path.endswith("done")
+
+    monkeypatch.setattr(zarr.Array, "__setitem__", setitem)
+    with pytest.raises(parapend.errors.OutputError,
+                       match=r"^cannot write .*full.zarr': No space left on device; the "
+                             "finished blocks are in the store"):
+        sw.sweep(store, **GRID, workers=1, block_points=3, command="test")
+    monkeypatch.setattr(zarr.Array, "__setitem__", real)
+    run = sw.sweep(store, **GRID, workers=1, block_points=3, command="test")
+    assert run.resumed_points == 6 and run.computed_points == 6
+    assert _files(store) == _files(ref_store)
+
+
+def test_netcdf_on_a_full_disk_says_so(reference, tmp_path, monkeypatch, capsys):
+    """HDF5 reports a full disk as "Permission denied" (on creating the file) or "NetCDF:
+    HDF error" (RuntimeError, a traceback before): with (almost) no space left the message
+    says "No space left on device"; with space left the writer's own reason stays."""
+    import errno
+
+    import xarray as xr
+
+    from parapend import fileio
+    from parapend.errors import OutputError
+
+    ds = sw.open_sweep(reference[0])
+    free = [0]
+
+    class Stat:
+        f_frsize = 4096
+
+        @property
+        def f_bavail(self):
+            return free[0] // 4096
+
+        f_bfree = f_bavail
+
+    monkeypatch.setattr(fileio.os, "statvfs", lambda d: Stat())
+    for exc in (PermissionError(errno.EACCES, "Permission denied"),
+                RuntimeError("NetCDF: HDF error"),
+                OSError(errno.ENOSPC, "No space left on device")):
+        def fail(self, name, exc=exc):
+            Path(name).write_bytes(b"CDF")
+            raise exc
+
+        monkeypatch.setattr(xr.Dataset, "to_netcdf", fail)
+        free[0] = 0
+        with pytest.raises(OutputError, match=r"^cannot write '.*m.nc': No space left on "
+                                              "device"):
+            fileio.write_dataset(ds, tmp_path / "m.nc")
+        free[0] = 1 << 30
+        reason = {PermissionError: "Permission denied", RuntimeError: "NetCDF: HDF error",
+                  OSError: "No space left on device"}[type(exc)]
+        with pytest.raises(OutputError, match=f"^cannot write '.*m.nc': .*{reason}"):
+            fileio.write_dataset(ds, tmp_path / "m.nc")
+        assert sorted(p.name for p in tmp_path.iterdir()) == []
+    free[0] = 0
+    monkeypatch.setattr(xr.Dataset, "to_netcdf", lambda self, name: (_ for _ in ()).throw(
+        PermissionError(errno.EACCES, "Permission denied")))
+    monkeypatch.chdir(tmp_path)
+    _copy(reference[0], tmp_path / "map.zarr")
+    assert main(["sweep", "--omega", "1.6:2.0:4", "--delta", "-0.3,-0.2,-0.1", "--gamma",
+                 "0.01", "--block-points", "3", "--workers", "1", "--netcdf", "m.nc"]) == 1
+    _one_line(capsys, "cannot write 'm.nc': No space left on device")
+
+
+def _interrupt(proc, ready, timeout=120):
+    """Wait until ``ready()`` (the sweep is under way), send SIGINT, return (rc, stderr)."""
+    deadline = time.monotonic() + timeout
+    while time.monotonic() < deadline and proc.poll() is None and not ready():
+        time.sleep(0.05)
+    assert proc.poll() is None, proc.communicate()
+    proc.send_signal(signal.SIGINT)
+    _, err = proc.communicate(timeout=timeout)
+    return proc.returncode, err
+
+
+def _blocks_done(store):
+    import zarr
+
+    try:
+        return int(np.asarray(zarr.open_group(store, mode="r")["done"][...]).sum())
+    except Exception:  # noqa: BLE001 - not created yet
+        return 0
+
+
+@pytest.mark.skipif(sys.platform == "win32", reason="SIGINT")
+def test_ctrl_c_with_local_processes_is_one_line(tmp_path):
+    """Ctrl-C while two local processes compute blocks with a power take-off (up to half a
+    minute each): one line and exit code 130 at once, the running blocks are not waited
+    for; the blocks written are sound."""
+    argv = [sys.executable, "-m", "parapend", "sweep", "--omega", "1.6:2.0:8", "--gamma",
+            "0.01,0.05", "--torque-limit", "0.3,1,2", "--workers", "2", "--store", "m.zarr"]
+    env = {**os.environ, "PYTHONPATH": SRC}
+    proc = subprocess.Popen(argv, cwd=tmp_path, env=env, stdout=subprocess.PIPE,
+                            stderr=subprocess.PIPE, text=True)
+    rc, err = _interrupt(proc, lambda: "sweep" in (sw._root_attrs(tmp_path / "m.zarr") or {}))
+    assert rc == 130 and err == "parapend sweep: interrupted\n"
+    sw.open_sweep(tmp_path / "m.zarr")  # verified: no damage
+
+
+def test_bad_scheduler_address_is_one_line(tmp_path):
+    """`--scheduler garbage` printed its line, then a TimeoutError traceback 20 s later
+    (the half-made Client's destructor): now one line, exit 2, nothing created."""
+    pytest.importorskip("distributed")
+    env = {**os.environ, "PYTHONPATH": SRC}
+    for address, match in (("garbage", "scheduler: expected an address such as "
+                                        "tcp://host:8786, got 'garbage'"),
+                           ("tcp://host-without-port", "scheduler: expected an address")):
+        p = subprocess.run([sys.executable, "-m", "parapend", "sweep", "--omega", "1,2",
+                            "--scheduler", address], cwd=tmp_path, env=env,
+                           capture_output=True, text=True, timeout=120)
+        assert p.returncode == 2 and p.stderr.count("\n") == 1 and match in p.stderr, p.stderr
+    assert list(tmp_path.iterdir()) == []
+
+
+@pytest.mark.skipif(sys.platform == "win32", reason="SIGINT")
+def test_silent_scheduler_is_one_line_and_ctrl_c_during_connect(tmp_path):
+    """A server that accepts the connection but never answers (distributed would wait for
+    ever): one line after the deadline (here lowered to 1 s), exit 2; Ctrl-C while
+    connecting: one line, exit 130."""
+    import socket
+
+    pytest.importorskip("distributed")
+    env = {**os.environ, "PYTHONPATH": SRC}
+    def listener():
+        srv = socket.socket()
+        srv.bind(("127.0.0.1", 0))
+        srv.listen(8)
+        srv.settimeout(60)
+        return srv, f"tcp://127.0.0.1:{srv.getsockname()[1]}"
+
+    srv, address = listener()
+    with srv:
+        code = ("import sys; from parapend import sweep as sw; sw._CONNECT_SECONDS = 1\n"
+                "from parapend.cli import main\n"
+                f"sys.exit(main(['sweep', '--omega', '1,2', '--scheduler', {address!r}]))\n")
+        p = subprocess.run([sys.executable, "-c", code], cwd=tmp_path, env=env,
+                           capture_output=True, text=True, timeout=120)
+    assert p.returncode == 2 and p.stderr.count("\n") == 1, p.stderr
+    assert f"cannot connect to {address!r}: no answer within 2 s" in p.stderr
+    srv, address = listener()
+    with srv:
+        proc = subprocess.Popen([sys.executable, "-m", "parapend", "sweep", "--omega", "1,2",
+                                 "--scheduler", address], cwd=tmp_path, env=env,
+                                stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+        conn, _ = srv.accept()  # connected: it waits for the handshake
+        with conn:
+            rc, err = _interrupt(proc, lambda: True)
+    assert rc == 130 and err == "parapend sweep: interrupted\n"
+    assert list(tmp_path.iterdir()) == []
+
+
+@pytest.mark.skipif(sys.platform == "win32", reason="SIGINT")
+def test_ctrl_c_during_a_scheduler_sweep_is_one_line(cluster, tmp_path):
+    """Ctrl-C while the blocks run on a Dask cluster: one line, exit 130, no traceback; the
+    blocks written are sound."""
+    argv = [sys.executable, "-m", "parapend", "sweep", "--omega", "1.4:2.2:32", "--delta",
+            "-0.4:-0.1:24", "--gamma", "0.02", "--threshold", "--block-points", "24",
+            "--store", "m.zarr", "--scheduler", cluster.scheduler_address]
+    env = {**os.environ, "PYTHONPATH": SRC}
+    proc = subprocess.Popen(argv, cwd=tmp_path, env=env, stdout=subprocess.PIPE,
+                            stderr=subprocess.PIPE, text=True)
+    rc, err = _interrupt(proc, lambda: _blocks_done(tmp_path / "m.zarr") >= 24)
+    assert rc == 130 and err == "parapend sweep: interrupted\n"
+    sw.open_sweep(tmp_path / "m.zarr")
+
+
+def test_a_success_without_a_finite_power_is_recorded_as_nonfinite(tmp_path, monkeypatch):
+    """What a store's check relies on holds by construction: a point whose solver says
+    converged but whose power is NaN is stored as "nonfinite" (and is then a legitimate NaN,
+    not damage)."""
+    real = sw._continue
+
+    def nan_power(*a, **k):
+        power, status, gap, x = real(*a, **k)
+        return math.nan, status, gap, x
+
+    monkeypatch.setattr(sw, "_continue", nan_power)
+    store = tmp_path / "m.zarr"
+    run = sw.sweep(store, omega="1.8,1.9", workers=1)
+    assert (run.dataset["status"].values == sw.STATUSES.index("nonfinite")).all()
+    again = sw.sweep(store, omega="1.8,1.9", workers=1)
+    assert (again.computed_points, again.repaired_points) == (0, 0)

@@ -18,6 +18,7 @@ operating system's reason.
 from __future__ import annotations
 
 import contextlib
+import errno
 import io
 import os
 import stat
@@ -95,6 +96,28 @@ def _write_in_place(path: Path, write: Callable[[str], None], shown) -> None:
         raise output_error(shown, exc) from None
 
 
+#: Free space (bytes) below which a failed write is put down to a full disk.
+_LOW_SPACE = 1 << 20
+
+
+def _full_disk(directory, exc: OSError) -> OSError:
+    """``exc``, or an ``ENOSPC`` error when the disk is full: HDF5 (NetCDF) reports a full
+    disk as "Permission denied" or "HDF error", and the file it failed on is one that was
+    just created here, so a full disk is the likely reason when almost no space is left."""
+    if exc.errno in (errno.ENOSPC, getattr(errno, "EDQUOT", errno.ENOSPC)):
+        return exc
+    try:
+        st = os.statvfs(directory)
+    except (OSError, AttributeError):  # no statvfs (Windows)
+        return exc
+    root = hasattr(os, "geteuid") and os.geteuid() == 0
+    free = (st.f_bfree if root else st.f_bavail) * st.f_frsize
+    if free >= _LOW_SPACE:
+        return exc
+    return OSError(errno.ENOSPC, f"{os.strerror(errno.ENOSPC)} ({free} bytes free; the "
+                                 f"writer reported: {_reason(exc)})")
+
+
 def _atomic(path, write: Callable[[str], None]) -> Path:
     """Call ``write(tmp)`` to fill a temporary beside ``path``, then move it onto ``path``."""
     target = _target(path)
@@ -110,7 +133,10 @@ def _atomic(path, write: Callable[[str], None]) -> Path:
     try:
         fd, tmp = tempfile.mkstemp(dir=directory, prefix=TEMP_PREFIX, suffix=target.suffix)
         os.close(fd)
-        write(tmp)
+        try:
+            write(tmp)
+        except OSError as exc:
+            raise _full_disk(directory, exc) from None
         os.chmod(tmp, 0o666 & ~umask())
         os.replace(tmp, target)
         tmp = None
@@ -207,5 +233,14 @@ def save_figure(fig, path, dpi: int = 200, close: bool = True) -> Path:
 
 
 def write_dataset(ds, path) -> Path:
-    """Write an ``xarray.Dataset`` to NetCDF at ``path`` atomically; see :func:`write_bytes`."""
-    return _atomic(path, lambda name: ds.to_netcdf(name))
+    """Write an ``xarray.Dataset`` to NetCDF at ``path`` atomically; see :func:`write_bytes`.
+
+    The NetCDF library's failures (``RuntimeError: NetCDF: HDF error``) are
+    :class:`OutputError` too, with "No space left on device" when the disk is full."""
+    def write(name: str) -> None:
+        try:
+            ds.to_netcdf(name)
+        except RuntimeError as exc:
+            raise OSError(errno.EIO, f"NetCDF library: {_reason(exc)}") from None
+
+    return _atomic(path, write)

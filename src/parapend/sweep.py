@@ -31,13 +31,16 @@ The searches of a block together
 
 The store (Zarr 3)
     Made whole (every array, its chunks, coordinates and attributes) before the first
-    block, then written block by block: the variables of a block, then its ``done`` mask.
-    Zarr skips chunks that equal the fill value, so the data alone cannot say what
-    finished; the mask can, and a block is only counted when its mask is written. Running
-    the same sweep on the same store resumes it: the blocks whose mask is set are not
-    recomputed, and the store ends byte for byte as an uninterrupted run's. The store is
-    locked (``flock`` on its directory) while a sweep writes it: a second sweep on it is
-    refused with one line; the lock dies with its process (``kill -9`` included).
+    block, behind a root ``zarr.json`` that says "being created" (written first: a
+    directory is only ever emptied when parapend recognises it as its own), then written
+    block by block: the variables of a block, then its ``done`` mask. Zarr skips chunks
+    that equal the fill value, so the data alone cannot say what finished; the mask can, and
+    a block is only counted when its mask is written. Running the same sweep on the same
+    store resumes it: the blocks whose mask is set are verified (every chunk present and
+    decodable, a status at every point) and not recomputed unless damaged, and the store
+    ends byte for byte as an uninterrupted run's. The store is locked (``flock`` on its
+    directory) while a sweep writes it: a second sweep on it is refused with one line; the
+    lock dies with its process (``kill -9`` included).
 """
 
 from __future__ import annotations
@@ -50,6 +53,7 @@ import math
 import os
 import shutil
 import tempfile
+import threading
 import time
 import warnings
 from pathlib import Path
@@ -57,7 +61,8 @@ from pathlib import Path
 import numpy as np
 
 from . import limits
-from .errors import ParameterError, SolverError, check_int, check_range
+from .errors import OutputError, ParameterError, SolverError, check_int, check_range
+from .fileio import TEMP_PREFIX
 
 __all__ = ["AXES", "STATUSES", "VARIABLES", "SweepRun", "SweepSpec", "compute_block",
            "open_sweep", "parse_axis", "plot_map", "sweep", "sweep_spec"]
@@ -463,6 +468,13 @@ def _threshold(spec: SweepSpec, p: dict, thresholds: dict):
     return thresholds[key]
 
 
+def _finite(x) -> bool:
+    try:
+        return math.isfinite(x)
+    except TypeError:
+        return False
+
+
 def compute_block(spec: SweepSpec, block: int) -> dict:
     """The variables of one block, as arrays of the block's shape.
 
@@ -517,6 +529,11 @@ def compute_block(spec: SweepSpec, block: int) -> dict:
             if spec.threshold:
                 vals["damping_threshold"], vals["threshold_status"] = _threshold(
                     spec, p, thresholds)
+            # a success always has a finite number (what _verify relies on to tell a
+            # legitimate NaN from a lost chunk)
+            for st, num in (("status", "power"), ("threshold_status", "damping_threshold")):
+                if vals.get(st) in _SUCCESS and not _finite(vals.get(num)):
+                    vals[st] = "nonfinite"
             for k, v in vals.items():
                 if k.endswith("status"):
                     out[k][idx] = _CODE.get(v, _CODE["other"])
@@ -557,6 +574,7 @@ def _template(spec: SweepSpec, command: str | None):
     """The whole store as a lazy Dataset (dask arrays of fill values) and its encoding."""
     import dask.array as da
     import xarray as xr
+    from zarr.codecs import ZstdCodec
 
     dims, shape, chunks = spec.dims, spec.shape, spec.chunks
     data, enc = {}, {}
@@ -572,7 +590,9 @@ def _template(spec: SweepSpec, command: str | None):
             arr = da.full(shape, np.nan, dtype=float, chunks=chunks)
             fill, attrs = np.nan, _var_attrs(v)
         data[v] = (dims, arr, attrs)
-        enc[v] = {"chunks": chunks, "fill_value": fill}
+        # zstd with its checksum: a chunk altered on disk fails to decode (found by _verify)
+        enc[v] = {"chunks": chunks, "fill_value": fill,
+                  "compressors": (ZstdCodec(level=0, checksum=True),)}
     coords = {}
     for a in AXES:
         vals = spec.values[a]
@@ -612,20 +632,86 @@ def _quiet_zarr():
         yield
 
 
+#: The title every sweep store carries in its root attributes.
+_TITLE = "parapend design map"
+#: ``parapend_store`` of the root ``zarr.json`` a sweep writes first into a store it creates
+#: (see :func:`_prepare`): the directory is parapend's, and its creation has not finished.
+_CREATING = "creating"
+#: A temporary directory that an earlier version's store creation left beside the store
+#: (``kill -9``) is removed once it is this old (seconds): a creation takes well under one.
+_STALE_SECONDS = 600
+
+
+def _own_names() -> set:
+    """The names a sweep writes at the top of its store (its temporaries aside)."""
+    return {*VARIABLES, "done", *AXES, "zarr.json"}
+
+
+def _short(err: BaseException) -> str:
+    return " ".join(str(err).split())[:160] or type(err).__name__
+
+
+def _root_attrs(path: Path) -> dict | None:
+    """The attributes of the Zarr 3 group whose ``zarr.json`` is in ``path``, or None."""
+    try:
+        meta = json.loads((path / "zarr.json").read_text(encoding="utf-8"))
+    except (OSError, ValueError):
+        return None
+    if not isinstance(meta, dict) or meta.get("node_type") != "group":
+        return None
+    attrs = meta.get("attributes")
+    return attrs if isinstance(attrs, dict) else None
+
+
+def _identify(path: Path) -> tuple[str, str | None]:
+    """What the directory ``path`` holds, by what parapend itself writes there: ``("store",
+    identity)`` for a sweep store (root attributes with the title and the sweep's identity),
+    ``("creating", None)`` for a creation that did not finish (the root ``zarr.json`` that
+    :func:`_prepare` writes first), ``("empty", None)`` when it holds nothing but parapend's
+    temporaries, else ``("foreign", None)``."""
+    attrs = _root_attrs(path)
+    if attrs is not None and attrs.get("parapend_store") == _CREATING:
+        return "creating", None
+    if attrs is not None and attrs.get("title") == _TITLE and isinstance(attrs.get("sweep"),
+                                                                         str):
+        return "store", attrs["sweep"]
+    if all(e.name.startswith(TEMP_PREFIX) for e in path.iterdir()):
+        return "empty", None
+    return "foreign", None
+
+
 def _store_spec(path: Path) -> str | None:
     """The sweep identity recorded in a store's root metadata, or None."""
     try:
-        meta = json.loads((path / "zarr.json").read_text(encoding="utf-8"))
-        return meta["attributes"]["sweep"]
-    except (OSError, ValueError, KeyError, TypeError):
+        return _identify(path)[1]
+    except OSError:
         return None
 
 
+def _write_marker(path: Path) -> None:
+    """Make the root ``zarr.json`` of ``path`` say "a parapend store being created", atomically
+    (a temporary beside it, then a rename): from then on the directory is recognised as
+    parapend's, whatever interrupts the creation."""
+    meta = {"zarr_format": 3, "node_type": "group",
+            "attributes": {"title": _TITLE, "parapend_store": _CREATING}}
+    fd, tmp = tempfile.mkstemp(prefix=TEMP_PREFIX, dir=path)
+    try:
+        with os.fdopen(fd, "w", encoding="utf-8") as fh:
+            fh.write(json.dumps(meta))
+        os.replace(tmp, path / "zarr.json")
+    except BaseException:
+        with contextlib.suppress(OSError):
+            os.unlink(tmp)
+        raise
+
+
 def _create(path: Path, spec: SweepSpec, command: str | None) -> None:
-    """Write the whole layout into a temporary directory beside the store, then move its
-    entries in, the root ``zarr.json`` last: a store with a root ``zarr.json`` is complete."""
+    """Write the whole layout into a temporary directory inside the store (so that a
+    ``kill -9`` leaves it where the next run on the store removes it), then move its entries
+    in, the root ``zarr.json`` last: a store whose root attributes hold the sweep is
+    complete."""
     ds, enc = _template(spec, command)
-    tmp = Path(tempfile.mkdtemp(prefix=".tmp-parapend-", dir=path.parent))
+    tmp = Path(tempfile.mkdtemp(prefix=TEMP_PREFIX, dir=path))
     try:
         ds.to_zarr(tmp, mode="w-", compute=False, encoding=enc, consolidated=False,
                    zarr_format=3)
@@ -637,31 +723,72 @@ def _create(path: Path, spec: SweepSpec, command: str | None) -> None:
         shutil.rmtree(tmp, ignore_errors=True)
 
 
+def _remove(entry: Path) -> None:
+    if entry.is_dir() and not entry.is_symlink():
+        shutil.rmtree(entry)
+    else:
+        entry.unlink()
+
+
+def _remove_stale_temps(parent: Path) -> None:
+    """Remove the temporary directories that an earlier version's store creation, killed,
+    left beside a store: named ``.tmp-parapend-*``, directories (parapend's other
+    temporaries are files), holding nothing but a store's entries (and a root ``zarr.json``
+    with a sweep store's title, if any) and untouched for ten minutes."""
+    own, now = _own_names(), time.time()
+    try:
+        entries = [e for e in parent.iterdir() if e.name.startswith(TEMP_PREFIX)]
+    except OSError:
+        return
+    for e in entries:
+        try:
+            if e.is_symlink() or not e.is_dir() or now - e.stat().st_mtime < _STALE_SECONDS:
+                continue
+            names = {c.name for c in e.iterdir()}
+            if not names or not names <= own:
+                continue
+            if "zarr.json" in names and (_root_attrs(e) or {}).get("title") != _TITLE:
+                continue
+            shutil.rmtree(e)
+        except OSError:
+            continue
+
+
 def _prepare(path: Path, spec: SweepSpec, command: str | None, overwrite: bool) -> None:
-    """Under the lock: create the store, or check that it holds this sweep (resume)."""
-    expected = {*VARIABLES, "done", *AXES, "zarr.json"}  # what a sweep store can hold
-    entries = {e.name for e in path.iterdir()}
-    recorded = _store_spec(path)
-    if recorded is not None and recorded == spec.to_json() and not overwrite:
+    """Under the lock: create the store, or check that it holds this sweep (resume).
+
+    Only a directory that parapend recognises as its own (a sweep store, a creation cut short,
+    or an empty directory) is ever emptied: anything else is refused, ``--overwrite`` or
+    not, and so is a store that also holds files parapend did not write."""
+    _remove_stale_temps(path.parent if str(path.parent) else Path("."))
+    kind, recorded = _identify(path)
+    if kind == "foreign":
+        raise ParameterError(f"store: {str(path)!r} exists and is not a parapend sweep store "
+                             "(parapend never deletes such a directory, --overwrite or not); "
+                             "choose another --store")
+    if kind == "store" and not overwrite:
+        if recorded != spec.to_json():
+            raise ParameterError(f"store: {str(path)!r} holds a different sweep (other axes, "
+                                 "excitation, harmonics or threshold); choose another "
+                                 "--store, or --overwrite to replace it")
         for p in path.rglob("*.partial"):  # a chunk write cut short by kill -9
             with contextlib.suppress(OSError):
                 p.unlink()
         return
-    if recorded is not None and not overwrite:
-        raise ParameterError(f"store: {str(path)!r} holds a different sweep (other axes, "
-                             "excitation, harmonics or threshold); choose another --store, "
-                             "or --overwrite to replace it")
-    if recorded is None and entries and not entries <= expected:
-        raise ParameterError(f"store: {str(path)!r} exists and is not a parapend sweep store; "
-                             "choose another --store")
-    # an interrupted creation (no root zarr.json), or --overwrite of a sweep store
-    if (path / "zarr.json").exists():
-        os.unlink(path / "zarr.json")
-    for e in path.iterdir():
-        if e.is_dir():
-            shutil.rmtree(e)
-        else:
-            e.unlink()
+    # an empty directory, a creation cut short, or --overwrite of a sweep store: emptied,
+    # after its root says "being created", and only of the names a sweep writes
+    own = _own_names()
+    entries = list(path.iterdir())
+    extra = sorted(e.name for e in entries
+                   if e.name not in own and not e.name.startswith(TEMP_PREFIX))
+    if extra:
+        raise ParameterError(f"store: {str(path)!r} also holds {extra[0]!r}, which parapend "
+                             "did not write; move it away or choose another --store")
+    _write_marker(path)
+    for e in entries:
+        if e.name != "zarr.json":
+            with contextlib.suppress(FileNotFoundError):
+                _remove(e)
     _create(path, spec, command)
 
 
@@ -678,16 +805,220 @@ def _check_store_path(store) -> Path:
     return path
 
 
+# -- verifying a store -----------------------------------------------------------------------
+
+@dataclasses.dataclass(frozen=True)
+class _StoredSpec(SweepSpec):
+    """A sweep read back from a store's identity: its chunks are the recorded ones."""
+
+    stored_chunks: tuple = ()
+
+    @property
+    def chunks(self) -> tuple[int, ...]:
+        return self.stored_chunks
+
+
+def _spec_of(identity) -> SweepSpec | None:
+    """The :class:`SweepSpec` (its layout) of a store's recorded identity, or None."""
+    try:
+        d = json.loads(identity)
+        values = {a: tuple(float(v) for v in d["axes"][a]) for a in AXES}
+        spec = _StoredSpec(values, str(d["excitation"]), d["square_alpha"], d["fourier"],
+                           int(d["harmonics"]), bool(d["threshold"]), None,
+                           tuple(int(c) for c in d["chunks"]))
+        ok = (len(spec.chunks) == len(spec.dims) >= 1
+              and all(1 <= c <= n for c, n in zip(spec.chunks, spec.shape)))
+    except (TypeError, ValueError, KeyError, AttributeError):
+        return None
+    return spec if ok else None
+
+
+def _damaged(path: Path, what: str) -> ParameterError:
+    return ParameterError(f"store: {str(path)!r} is damaged ({what}); compute it again with "
+                          "parapend sweep --overwrite, or choose another --store")
+
+
+def _expected(name: str):
+    """dtype and fill value of a store's array."""
+    if name == "done":
+        return np.dtype(bool), False
+    if name.endswith("status"):
+        return np.dtype(np.int8), NOT_COMPUTED
+    return np.dtype(float), math.nan
+
+
+def _array(group, path: Path, spec: SweepSpec, name: str):
+    """The store's array ``name``, checked against the sweep's layout."""
+    import zarr
+
+    try:
+        a = group[name]
+    except KeyError:
+        raise _damaged(path, f"array {name!r} is missing") from None
+    except Exception as err:  # noqa: BLE001 - metadata that cannot be read
+        raise _damaged(path, f"array {name!r} is unreadable: {_short(err)}") from None
+    dtype, fill = _expected(name)
+    if not isinstance(a, zarr.Array):
+        raise _damaged(path, f"{name!r} is not an array")
+    try:
+        same_fill = (math.isnan(a.fill_value) if isinstance(fill, float)
+                     else a.fill_value == fill)
+    except TypeError:
+        same_fill = False
+    if (np.dtype(a.dtype) != dtype or tuple(a.shape) != spec.shape
+            or tuple(a.chunks) != spec.chunks or not same_fill):
+        raise _damaged(path, f"array {name!r} is {np.dtype(a.dtype)} {list(a.shape)} in "
+                             f"chunks {list(a.chunks)}, fill {a.fill_value}; expected {dtype} "
+                             f"{list(spec.shape)} in chunks {list(spec.chunks)}, fill {fill}")
+    return a
+
+
+def _check_coords(group, path: Path, spec: SweepSpec) -> None:
+    for a in AXES:
+        vals = spec.values[a]
+        if not vals:
+            continue
+        try:
+            got = np.asarray(group[a][...], dtype=float)
+        except Exception as err:  # noqa: BLE001 - missing or unreadable
+            raise _damaged(path, f"coordinate {a!r} is missing or unreadable: "
+                                 f"{_short(err)}") from None
+        want = np.array(vals) if len(vals) >= 2 else np.array(vals[0])
+        if got.shape != want.shape or not np.array_equal(got, want):
+            raise _damaged(path, f"coordinate {a!r} differs from the sweep's values")
+
+
+def _read(a, name: str, spec: SweepSpec, blocks) -> tuple[np.ndarray, set]:
+    """All of array ``a`` and the blocks (of ``blocks``) whose chunk cannot be read: at
+    once, or block by block when that fails (the others then hold the fill value)."""
+    try:
+        return np.asarray(a[...]), set()
+    except Exception:  # noqa: BLE001 - a chunk that cannot be decoded: found below
+        dtype, fill = _expected(name)
+        out, bad = np.full(spec.shape, fill, dtype=dtype), set()
+        for b in blocks:
+            sl = spec.block_slices(b)
+            try:
+                out[sl] = a[sl]
+            except Exception:  # noqa: BLE001 - recorded
+                bad.add(b)
+        return out, bad
+
+
+def _chunk_files(path: Path, name: str) -> set:
+    """The chunk keys present in array ``name``'s directory (``c/0/3``, ...)."""
+    root = path / name
+    out = set()
+    for d, _, files in os.walk(root):
+        rel = os.path.relpath(d, root)
+        for f in files:
+            if f != "zarr.json" and not f.endswith(".partial"):
+                out.add(f if rel == "." else f"{rel}/{f}".replace(os.sep, "/"))
+    return out
+
+
+def _chunk_key(array, spec: SweepSpec, block: int) -> str:
+    """The key (relative file name, ``c/0/3``) of a block's chunk in ``array``."""
+    return array.metadata.encode_chunk_key(
+        tuple(int(i) for i in np.unravel_index(block, spec.block_grid)))
+
+
+def _verify(path: Path, spec: SweepSpec) -> tuple[np.ndarray, dict]:
+    """Check a store against its sweep, cheaply: what a resume or a reader relies on.
+
+    The arrays and coordinates must have the sweep's layout (else :class:`ParameterError`,
+    one line). Then every block whose ``done`` mask is set must have every variable's chunk
+    present (the data are written with ``write_empty_chunks``: a finished block has them
+    all, NaN or not), decodable (zstd with a checksum), a status code at every point and a
+    finite power where the status is a success. Returns ``done`` (per block: finished and
+    sound) and ``damaged`` (block -> what is wrong), which includes blocks whose mask cannot
+    be read.
+    """
+    import zarr
+
+    nb = spec.blocks
+    with _quiet_zarr():
+        try:
+            group = zarr.open_group(path, mode="r", zarr_format=3)
+        except Exception as err:  # noqa: BLE001 - damaged root metadata
+            raise _damaged(path, f"its root cannot be read: {_short(err)}") from None
+        arrays = {v: _array(group, path, spec, v) for v in ("done", *spec.variables)}
+        _check_coords(group, path, spec)
+        mask, unreadable = _read(arrays["done"], "done", spec, range(nb))
+        damaged = {b: "done: unreadable chunk" for b in unreadable}
+        slices = [spec.block_slices(b) for b in range(nb)]
+        done = np.array([b not in damaged and bool(mask[slices[b]].all()) for b in range(nb)],
+                        dtype=bool)
+        finished = np.flatnonzero(done).tolist()
+        if not finished:
+            return done, damaged
+        keys = [_chunk_key(arrays["done"], spec, b) for b in range(nb)]
+        values = {}
+        for v in spec.variables:
+            present = _chunk_files(path, v)
+            for b in finished:
+                if b not in damaged and keys[b] not in present:
+                    damaged[b] = f"{v}: chunk missing"
+            values[v], bad = _read(arrays[v], v, spec, [b for b in finished if b not in damaged])
+            for b in sorted(bad):
+                damaged.setdefault(b, f"{v}: chunk unreadable")
+    success = [_CODE[s] for s in _SUCCESS]
+    for b in finished:
+        if b in damaged:
+            continue
+        sl = slices[b]
+        for st_name, val_name in (("status", "power"),
+                                  ("threshold_status", "damping_threshold")):
+            if st_name not in values:
+                continue
+            st = values[st_name][sl]
+            if not ((st >= 0) & (st < len(STATUSES))).all():
+                damaged[b] = f"{st_name}: a point without a status"
+            elif not np.isfinite(values[val_name][sl][np.isin(st, success)]).all():
+                damaged[b] = f"{val_name}: NaN where the status is a success"
+    for b in damaged:
+        done[b] = False
+    return done, damaged
+
+
+def _damage_line(spec: SweepSpec, damaged: dict) -> str:
+    points = sum(int(np.prod([s.stop - s.start for s in spec.block_slices(b)]))
+                 for b in damaged)
+    first = damaged[min(damaged)]
+    return (f"{len(damaged)} of {spec.blocks} blocks ({points} points) marked finished have "
+            f"missing or unreadable data ({first}{', ...' if len(damaged) > 1 else ''})")
+
+
 def open_sweep(store, *, complete: bool = False):
     """Open a sweep store (Zarr directory, or a NetCDF export) as an ``xarray.Dataset``.
 
-    ``complete=True`` refuses a store whose ``done`` mask is not all set.
+    A Zarr store is verified first (:func:`_verify`): a store whose creation did not finish,
+    or one with missing or unreadable data in a finished block, is refused with one line
+    (running the sweep again recomputes those blocks). ``complete=True`` also refuses a
+    store whose ``done`` mask is not all set.
     """
     import xarray as xr
 
     path = Path(store)
     if not path.exists():
         raise ParameterError(f"store: {str(store)!r} does not exist")
+    if path.is_dir():
+        attrs = _root_attrs(path)
+        if attrs is None or attrs.get("title") != _TITLE:
+            raise ParameterError(f"store: {str(store)!r} is not a parapend sweep store (no "
+                                 "readable zarr.json with a sweep's attributes)")
+        if attrs.get("parapend_store") == _CREATING:
+            raise ParameterError(f"store: {str(store)!r} was not created completely (the "
+                                 "sweep was interrupted while creating it); run the sweep "
+                                 "again")
+        spec = _spec_of(attrs.get("sweep"))
+        if spec is None:
+            raise _damaged(path, "its sweep identity cannot be read")
+        _, damaged = _verify(path, spec)
+        if damaged:
+            raise ParameterError(f"store: {str(store)!r} is damaged: "
+                                 f"{_damage_line(spec, damaged)}; run the same sweep again "
+                                 "(its 'command' attribute) to recompute them")
     try:
         if path.is_dir():
             with _quiet_zarr():
@@ -695,9 +1026,9 @@ def open_sweep(store, *, complete: bool = False):
         else:
             with xr.open_dataset(path) as f:
                 ds = f.load()
-    except (OSError, ValueError, KeyError, TypeError) as err:
+    except Exception as err:  # noqa: BLE001 - any file that is not a readable sweep store
         raise ParameterError(f"store: cannot read {str(store)!r} as a sweep store: "
-                             f"{' '.join(str(err).split())[:160]}") from None
+                             f"{_short(err)}") from None
     if "sweep" not in ds.attrs or "done" not in ds:
         raise ParameterError(f"store: {str(store)!r} is not a parapend sweep store")
     ds["done"] = ds["done"].astype(bool)
@@ -716,7 +1047,8 @@ class SweepRun:
 
     ``dataset`` has one variable per quantity (see :data:`VARIABLES`) over the swept
     dimensions, plus ``done``; ``computed_points`` were computed by this run,
-    ``resumed_points`` found finished in the store.
+    ``resumed_points`` found finished in the store; ``repaired_points`` (of the computed)
+    were marked finished in the store but had missing or unreadable data.
     """
 
     dataset: object
@@ -727,6 +1059,7 @@ class SweepRun:
     resumed_points: int
     seconds: float
     executor: str
+    repaired_points: int = 0
 
 
 def _worker_init(parent: int) -> None:
@@ -815,9 +1148,26 @@ def _run_local(spec, todo, pool, done_cb):
                                   "finished blocks are in the store: run the same command "
                                   "again to resume") from None
             done_cb(futs[f], vals)
+    except BaseException:
+        # Ctrl-C or an error: the running blocks would not be written, so they are not
+        # waited for (a block with a power take-off can take half a minute)
+        _stop_workers(ex)
+        raise
     finally:
         ex.shutdown(wait=True, cancel_futures=True)
     return f"{pool.workers} local processes"
+
+
+def _stop_workers(ex) -> None:
+    """End the worker processes of the executor ``ex`` now (SIGTERM)."""
+    terminate = getattr(ex, "terminate_workers", None)  # Python 3.14
+    if terminate is not None:
+        with contextlib.suppress(Exception):
+            terminate()
+        return
+    for proc in list((getattr(ex, "_processes", None) or {}).values()):
+        with contextlib.suppress(Exception):
+            proc.terminate()
 
 
 def _connect(scheduler):
@@ -830,11 +1180,68 @@ def _connect(scheduler):
                              "install distributed)") from None
     if hasattr(scheduler, "submit"):
         return scheduler, False
+    address = str(scheduler).strip()
     try:
-        return Client(str(scheduler), timeout="10s", set_as_default=False), True
-    except (OSError, TimeoutError, ValueError) as err:
-        raise ParameterError(f"scheduler: cannot connect to {str(scheduler)!r}: "
-                             f"{' '.join(str(err).split())[:160]}") from None
+        from distributed.comm.addressing import parse_address, parse_host_port
+
+        scheme, location = parse_address(address)
+        if scheme in ("tcp", "tls"):
+            parse_host_port(location)
+    except (ValueError, TypeError) as err:
+        raise ParameterError(f"scheduler: expected an address such as tcp://host:8786, got "
+                             f"{address!r:.80} ({_short(err)})") from None
+    # made in two steps so that a client whose start fails can be discarded here (left to
+    # the garbage collector it would wait 20 s to close, then print a traceback), and in a
+    # thread: distributed waits for ever on a server that accepts the connection but never
+    # answers its handshake, and Ctrl-C must not wait for it either
+    client = Client.__new__(Client)
+    failed: list = []
+
+    def start():
+        try:
+            client.__init__(address, timeout=f"{_CONNECT_SECONDS}s", set_as_default=False)
+        except BaseException as err:  # noqa: BLE001 - handed to the caller's thread
+            failed.append(err)
+
+    thread = threading.Thread(target=start, name="parapend-connect", daemon=True)
+    thread.start()
+    try:
+        thread.join(2 * _CONNECT_SECONDS)
+    except BaseException:  # Ctrl-C
+        _discard(client)
+        raise
+    if thread.is_alive():
+        _discard(client)
+        raise ParameterError(f"scheduler: cannot connect to {address!r:.80}: no answer within "
+                             f"{2 * _CONNECT_SECONDS} s (is it a Dask scheduler?)")
+    if failed:
+        err = failed[0]
+        _discard(client)
+        why = (_short(err) if isinstance(err, (OSError, TimeoutError, ValueError))
+               else "what answers there is not a Dask scheduler")
+        raise ParameterError(f"scheduler: cannot connect to {address!r:.80}: {why}") \
+            from None
+    return client, True
+
+
+#: seconds to connect to a Dask scheduler (twice that for its first answer)
+_CONNECT_SECONDS = 10
+
+
+def _discard(client) -> None:
+    """Forget a Client that did not start or did not close: no 20 s close at collection."""
+    with contextlib.suppress(Exception):
+        client.status = "closed"
+    with contextlib.suppress(Exception):
+        client._loop_runner.stop()
+
+
+def _close(client) -> None:
+    """Close a Client we opened, within 2 s (a Ctrl-C must not wait for a slow scheduler)."""
+    try:
+        client.close(timeout=2)
+    except Exception:  # noqa: BLE001 - a scheduler that does not answer: let it be
+        _discard(client)
 
 
 def _run_dask(spec, todo, client, done_cb):
@@ -882,7 +1289,9 @@ def sweep(store=None, *, omega=1.8, delta=None, gamma=0.0, torque_limit=None, ef
         Address of a Dask distributed scheduler (``tcp://host:8786``), or a Client: the
         blocks run there, and are written here as they finish.
     overwrite : bool
-        Replace a store that holds a different sweep.
+        Replace a store that holds a different sweep. A directory that is not a parapend
+        sweep store (or a store holding files a sweep does not write) is refused either
+        way, never deleted.
     command : str or None
         The command line, recorded in the attributes (the first run's stays).
     progress : callable or None
@@ -913,7 +1322,7 @@ def sweep(store=None, *, omega=1.8, delta=None, gamma=0.0, torque_limit=None, ef
         if pool is not None:
             pool.shutdown()
         if own:
-            client.close()
+            _close(client)
 
 
 def _sweep(spec, store, pool, client, overwrite, command, progress, t0) -> SweepRun:
@@ -940,15 +1349,43 @@ def _sweep(spec, store, pool, client, overwrite, command, progress, t0) -> Sweep
             ds[k] = (spec.dims, v, ds[k].attrs)
         return SweepRun(ds, None, total, spec.blocks, total, 0, time.monotonic() - t0, how)
     path = _check_store_path(store)
+    path.mkdir(exist_ok=True)
+    try:
+        return _sweep_store(spec, path, pool, client, overwrite, command, progress, t0,
+                            sizes)
+    except OSError as exc:  # a full disk, a store made read-only, ...
+        raise OutputError(f"cannot write {str(path)!r}: {_short_os(exc)}; the finished blocks "
+                          "are in the store: run the same command again to resume") from None
+
+
+def _short_os(exc: OSError) -> str:
+    return " ".join(str(exc.strerror or exc).split())[:160]
+
+
+def _sweep_store(spec, path, pool, client, overwrite, command, progress, t0, sizes):
     import zarr
 
-    path.mkdir(exist_ok=True)
+    total = spec.points
     with _locked(path):
         _prepare(path, spec, command, overwrite)
+        done, damaged = _verify(path, spec)
         with _quiet_zarr():
             group = zarr.open_group(path, mode="r+", zarr_format=3)
-            done = np.asarray(group["done"][...], dtype=bool)
-        todo = [b for b in range(spec.blocks) if not done[spec.block_slices(b)].all()]
+            # every chunk of a finished block is written, also one that equals the fill
+            # value (all NaN): so a missing chunk is always damage (_verify)
+            arrays = {k: group[k].with_config({"write_empty_chunks": True})
+                      for k in spec.variables}
+            mask = group["done"]
+        if damaged:
+            log.warning("store %s: %s; recomputed", path, _damage_line(spec, damaged))
+            # not finished until recomputed: the mask's chunk goes first, then the data's
+            # (a chunk that cannot be decoded is never read back to be updated)
+            for b in sorted(damaged):
+                for k in ("done", *spec.variables):
+                    with contextlib.suppress(FileNotFoundError):
+                        os.unlink(path / k / _chunk_key(mask, spec, b))
+        todo = [b for b in range(spec.blocks) if not done[b]]
+        repaired = sum(sizes[b] for b in damaged)
         resumed = total - sum(sizes[b] for b in todo)
         counted = [resumed]
         if progress is not None:
@@ -957,8 +1394,8 @@ def _sweep(spec, store, pool, client, overwrite, command, progress, t0) -> Sweep
         def write(b, vals):
             sl = spec.block_slices(b)
             for k in spec.variables:  # the data first, then the mask
-                group[k][sl] = vals[k]
-            group["done"][sl] = np.ones(vals["status"].shape, dtype=bool)
+                arrays[k][sl] = vals[k]
+            mask[sl] = np.ones(vals["status"].shape, dtype=bool)
             counted[0] += sizes[b]
             if progress is not None:
                 progress(counted[0], total)
@@ -966,7 +1403,7 @@ def _sweep(spec, store, pool, client, overwrite, command, progress, t0) -> Sweep
         how = _execute(spec, todo, pool, client, write) if todo else "nothing to do"
     ds = open_sweep(path)
     return SweepRun(ds, str(path), total, spec.blocks, total - resumed, resumed,
-                    time.monotonic() - t0, how)
+                    time.monotonic() - t0, how, repaired)
 
 
 def _execute(spec, todo, pool, client, write) -> str:

@@ -74,7 +74,8 @@ def add_parsers(sub) -> None:
                    help="Zarr store (a directory; default map.zarr), resumed if it holds "
                         "this sweep")
     p.add_argument("--overwrite", action="store_true",
-                   help="replace a store that holds a different sweep")
+                   help="replace a store that holds a different sweep (a parapend store "
+                        "only: no other directory is ever deleted)")
     p.add_argument("--netcdf", metavar="FILE.nc", help="also export the finished map to NetCDF")
     p.add_argument("--workers", type=_int, default=None,
                    help="local processes (default: all CPUs)")
@@ -154,6 +155,7 @@ def _cmd_sweep(a) -> dict | str:
     out = {"store": run.store, "dims": {d: int(ds.sizes[d]) for d in ds["power"].dims},
            "points": run.points, "blocks": run.blocks,
            "computed_points": run.computed_points, "resumed_points": run.resumed_points,
+           "repaired_points": run.repaired_points,
            "seconds": run.seconds, "executor": run.executor, "status_counts": counts,
            "largest_power": best, "largest_branch_gap": (
                float(np.nanmax(ds["branch_gap"].values)) if "branch_gap" in ds
@@ -164,7 +166,10 @@ def _cmd_sweep(a) -> dict | str:
     lines = [f"map over {' x '.join(f'{d} ({n})' for d, n in out['dims'].items())}: "
              f"{run.points} points in {run.blocks} blocks, store {run.store}",
              f"computed now {run.computed_points}, found finished {run.resumed_points}; "
-             f"{run.seconds:.1f} s ({run.executor})",
+             f"{run.seconds:.1f} s ({run.executor})"
+             + (f"\n{run.repaired_points} of the points computed now were marked finished in "
+                "the store but their data were missing or unreadable"
+                if run.repaired_points else ""),
              "status: " + ", ".join(f"{s} {n}" for s, n in counts.items())]
     if best is not None:
         where = ", ".join(f"{k} = {v:.6g}" for k, v in best.items() if k != "power")
