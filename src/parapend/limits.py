@@ -12,6 +12,7 @@ __all__ = [
     "MAX_FOURIER_K", "MAX_GAMMA", "MAX_HARMONICS", "MAX_PHASE", "MAX_POINTS",
     "MAX_SWEEP_HARMONICS", "MAX_SWEEP_WORK", "MAX_TABLE_HARMONICS", "MAX_THRESHOLD_HARMONICS",
     "MAX_PTO_HARMONICS", "MAX_PTO_INTERVALS", "MAX_PTO_POINTS", "MAX_TORQUE_LIMIT",
+    "MIN_TORQUE_LIMIT", "MAX_PTO_Q_HARMONICS", "MAX_PTO_CURVE_WORK",
     "MIN_BVP_GAMMA", "OMEGA_RANGE",
     "SQUARE_ALPHA_MIN", "MAP_MAX_POINTS", "MAP_MAX_PTO_POINTS", "MAP_MAX_HARMONICS",
     "MAP_MAX_WORK",
@@ -55,6 +56,17 @@ MAX_BYTES_FILE = 4 << 20
 MAX_PTO_HARMONICS = 128
 #: torque limit, units m g l (the paper-case ideal optimum needs 587 at N = 24)
 MAX_TORQUE_LIMIT = 1e6
+#: smallest torque limit, units m g l: the torque of a motion is evaluated to about 1e-14
+#: absolute (inverse dynamics of terms of order 1 + |q|); at 1e-320 the limit was "met"
+#: with a relative violation of 1e306
+MIN_TORQUE_LIMIT = 1e-6
+#: harmonics of q a power take-off solve accepts: its mesh (at most MAX_PTO_INTERVALS
+#: intervals) cannot follow more, and each dense torque check costs O(harmonics) per point
+#: (a 16384-row file, 8192 harmonics, ran past 5 minutes)
+MAX_PTO_Q_HARMONICS = 1024
+#: points x starting intervals of a pto-curve (each point solves on K and 2K intervals;
+#: 2 to 10 s at K = 1024): 8 points at K = 1024, 101 points at K <= 64
+MAX_PTO_CURVE_WORK = 8192
 #: points of a pto-curve
 MAX_PTO_POINTS = 101
 #: Hermite intervals of the torque-limited optimum (the doubling stops here: 2048 intervals

@@ -99,6 +99,19 @@ class OptimizeResult(_Result):
         :mod:`parapend.optimal.collocation`) on ``intervals`` Hermite-Simpson intervals; both
         checked by one doubling: ``refinement_change`` is the change of the (electrical)
         power between the last two.
+    peak_torque_converged : bool or None
+        Whether ``peak_torque`` moved by less than 1 % between the last two meshes of a
+        time-domain PTO solve (None: no refinement, e.g. the Fourier optimum at fixed N).
+        False where the optimal torque is impulsive (its peak grows with the mesh, as the
+        efficiency optimum at gamma = 0: 16, 32, 65, 129 on 128 to 1024 intervals) or
+        singular (many torques give the same power): ``peak_torque``, ``peak_torque_nm``
+        and ``peak_power`` are then properties of the mesh, not of the motion.
+    peak_torque_coarse : float or None
+        The peak torque on half the intervals (the last refinement).
+    torque_impulse, torque_impulse_change : float or None
+        Collocation: ``int |T| dt`` over the arc around the peak where ``T`` keeps its sign
+        (the braking impulse, m g l times the time unit), and its change from half the
+        intervals; it converges where the peak does not.
     units, power_w, uniform_power_w, limit_power_w, peak_torque_nm, electrical_power_w,
     energy_per_cycle_j, motoring_energy_j : physical values (W, N m, J) when a pendulum's
         length and mass were given (:mod:`parapend.units`); None otherwise.
@@ -152,6 +165,10 @@ class OptimizeResult(_Result):
     max_violation: float | None = None
     intervals: int | None = None
     refinement_change: float | None = None
+    peak_torque_converged: bool | None = None
+    peak_torque_coarse: float | None = None
+    torque_impulse: float | None = None
+    torque_impulse_change: float | None = None
     units: dict | None = None
     power_w: float | None = None
     uniform_power_w: float | None = None

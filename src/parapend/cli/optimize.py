@@ -190,11 +190,11 @@ def _cmd_optimize(a) -> dict | str:
            f"upper bound limit - gamma {'' if r.winding == 1 else 'K^2 '}omega^2: "
            f"{_fmt(r.upper_bound)} "
            f"(gap {_fmt(r.bound_gap)})",
-           f"peak torque |T|: {r.peak_torque:.6g}    mean theta'^2: {r.mean_square_speed:.6g}",
+           f"peak torque |T|: {_peak(r)}    mean theta'^2: {r.mean_square_speed:.6g}",
            f"convention: {CONVENTION}"]
     if r.method == "fourier" and r.found_by != "constant excitation":
         out.insert(5, search)
-    if r.status == "no_power":
+    if r.status == "no_power" or (pto and (not r.success or "; " in r.message)):
         out.insert(5, f"note: {r.message}")
     out += _pto.pto_lines(r) if pto else []
     out += _pto.physical_lines(r, units)
@@ -203,6 +203,15 @@ def _cmd_optimize(a) -> dict | str:
     if a.plot:
         out.append(f"figure written to {a.plot}")
     return "\n".join(out)
+
+
+def _peak(r) -> str:
+    """The peak torque, marked where it is not converged under mesh refinement."""
+    if r.peak_torque_converged is False:
+        grows = r.peak_torque_coarse is not None and r.peak_torque > 1.5 * r.peak_torque_coarse
+        return (f"{'>= ' if grows else ''}{r.peak_torque:.6g} (not converged under mesh "
+                "refinement, see below)")
+    return f"{r.peak_torque:.6g}"
 
 
 def _gain(p, pu) -> str:

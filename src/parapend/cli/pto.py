@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import math
+
 from .. import limits
 from ..errors import ParameterError
 from . import _output
@@ -122,15 +124,33 @@ def pto_lines(r) -> list[str]:
                    f"violation {r.max_violation:.1e})")
     if r.method == "hermite":
         out.append(f"time domain: {r.intervals} cubic Hermite intervals, interior point; "
-                   f"power change at the last doubling {r.refinement_change:.1e}")
+                   f"power change at the last doubling {_change(r.refinement_change)}")
     if r.method == "constant-brake":
         out.append(f"constant brake: T = -T_max throughout, {r.harmonics} harmonics; power "
-                   f"change from half of them {r.refinement_change:.1e}")
+                   f"change from half of them {_change(r.refinement_change)}")
     if r.method == "collocation":
         out.append(f"time domain: {r.intervals} Hermite-Simpson intervals (torque piecewise "
                    f"linear), interior point; electrical power change at the last doubling "
-                   f"{r.refinement_change:.1e}")
-    if r.efficiency_generating is not None:
+                   f"{_change(r.refinement_change)}")
+    if r.peak_torque_converged is False:
+        grows = r.peak_torque_coarse is not None and \
+            r.peak_torque > 1.5 * r.peak_torque_coarse
+        out.append(f"peak torque NOT converged under mesh refinement: {r.peak_torque:.6g} on "
+                   f"{r.intervals} intervals, {r.peak_torque_coarse:.6g} on "
+                   f"{r.intervals // 2}; "
+                   + ("it grows with the mesh (impulsive braking): read it as a lower bound"
+                      if grows else "the optimal torque is singular there (many torques give "
+                      "the same power): the peak is a property of the mesh")
+                   + "; so are peak power and the peak in N m")
+        if r.torque_impulse is not None:
+            out.append(f"torque impulse over the peak's arc (int |T| dt): "
+                       f"{r.torque_impulse:.6g}, change from {r.intervals // 2} intervals "
+                       f"{_change(r.torque_impulse_change)}")
+    if r.efficiency_generating == 1.0 and r.efficiency_motoring == 1.0 and \
+            r.method == "fourier":
+        out.append("efficiency 1 both ways, no limit: lossless, the ideal problem (its "
+                   "Fourier optimum)")
+    elif r.efficiency_generating is not None:
         out.append(f"efficiency: generating {r.efficiency_generating:g}, motoring "
                    f"{r.efficiency_motoring:g}; electrical power {_fmt(r.electrical_power, 8)}"
                    " (exact kink at p = 0, slacks p+ - p- = p)")
@@ -140,6 +160,13 @@ def pto_lines(r) -> list[str]:
         out.append(f"peak power {r.peak_power:.6g}; per cycle: harvested "
                    f"{r.harvested_energy:.6g}, motoring {r.motoring_energy:.6g} (m g l)")
     return out
+
+
+def _change(x) -> str:
+    """A refinement change, or what stands in for it when no finer mesh was solved."""
+    if x is None or not math.isfinite(x):
+        return "not available (no finer mesh solved)"
+    return f"{x:.1e}"
 
 
 def add_parsers(sub) -> None:
