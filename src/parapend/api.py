@@ -230,6 +230,7 @@ def optimize(*, omega: float = 1.8, delta=None, gamma: float = 0.0, harmonics: i
             polished=ev.polished,
             abandoned=ev.abandoned,
             second_power=ev.second_power,
+            second_distance=ev.second_distance,
             upper_bound=ev.upper_bound,
             bound_gap=ev.upper_bound - best.power,
             _motion=motion,
@@ -277,7 +278,7 @@ def _optimize_winding(exc, gamma: float, n: int, method: str, warm, winding: int
         candidate_patterns=_json_count(ev.candidate_patterns),
         extrema_per_period=int(exc.extrema.t.size), patterns_tried=ev.patterns_tried,
         polished=ev.polished, abandoned=ev.abandoned, second_power=ev.second_power,
-        upper_bound=ev.upper_bound, bound_gap=ev.upper_bound - best.power,
+        second_distance=ev.second_distance, upper_bound=ev.upper_bound, bound_gap=ev.upper_bound - best.power,
         excitation=exc.describe(), winding=winding, _motion=motion, _excitation=exc)
     if throw and not res.success:
         raise SolverError(f"optimize: {res.message}")

@@ -74,8 +74,13 @@ class OptimizeResult(_Result):
         ``C(2m, m - 1)`` for ``extrema_per_period = 2m``, a float past 2^53, inf past 1e308),
         "dynamic-programme" (too many to list: seeds from the (t, theta) dynamic programme),
         or "bvp-starts"; runs carried to convergence and runs abandoned as unable to win.
-    second_power : float or None
-        Best other local maximum found (None: every run reached the optimum).
+    second_power, second_distance : float or None
+        The best other distinct local maximum among the runs polished to convergence, and
+        the RMS distance of its motion from the optimum's over one period (rad; distinct:
+        above 1e-6). Runs abandoned as unable to win are never polished, so a better other
+        maximum may exist: ``second_power`` is a lower bound of the second-best maximum.
+        None: every polished run reached the optimum. (BVP: the best other start's power,
+        distinct by more than 1e-9 relative; no distance.)
     upper_bound, bound_gap : ``limit_power - gamma omega^2`` (no rotation does better, as
         ``<theta'^2> >= omega^2``) and its distance to ``power``.
     torque_limit, efficiency_generating, efficiency_motoring : float or None
@@ -148,6 +153,7 @@ class OptimizeResult(_Result):
     polished: int = 0
     abandoned: int = 0
     second_power: float | None = None
+    second_distance: float | None = None
     upper_bound: float = float("nan")
     bound_gap: float = float("nan")
     mesh_nodes: int | None = None

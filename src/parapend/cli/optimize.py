@@ -170,7 +170,11 @@ def _cmd_optimize(a) -> dict | str:
                   f"half-turn direction patterns tried, {r.polished} runs polished, "
                   f"{r.abandoned} abandoned as unable to win")
         if r.second_power is not None:
-            search += f"; second-best maximum {_fmt(r.second_power)}"
+            search += (f"; best other polished maximum {_fmt(r.second_power)}"
+                       + (f" ({r.second_distance:.2g} rad RMS away)"
+                          if r.second_distance is not None else "")
+                       + (" (abandoned runs are not polished: better ones may exist)"
+                          if r.abandoned else ""))
     elif r.method == "hermite":
         how = (f"{r.iterations} interior-point iterations, {r.intervals} cubic Hermite "
                f"intervals, started from the {r.found_by}")
