@@ -278,7 +278,8 @@ def _optimize_winding(exc, gamma: float, n: int, method: str, warm, winding: int
         candidate_patterns=_json_count(ev.candidate_patterns),
         extrema_per_period=int(exc.extrema.t.size), patterns_tried=ev.patterns_tried,
         polished=ev.polished, abandoned=ev.abandoned, second_power=ev.second_power,
-        second_distance=ev.second_distance, upper_bound=ev.upper_bound, bound_gap=ev.upper_bound - best.power,
+        second_distance=ev.second_distance, upper_bound=ev.upper_bound,
+        bound_gap=ev.upper_bound - best.power,
         excitation=exc.describe(), winding=winding, _motion=motion, _excitation=exc)
     if throw and not res.success:
         raise SolverError(f"optimize: {res.message}")

@@ -65,8 +65,9 @@ MIN_TORQUE_LIMIT = 1e-6
 #: (a 16384-row file, 8192 harmonics, ran past 5 minutes)
 MAX_PTO_Q_HARMONICS = 1024
 #: points x starting intervals of a pto-curve (each point solves on K and 2K intervals;
-#: 2 to 10 s at K = 1024): 8 points at K = 1024, 101 points at K <= 64
-MAX_PTO_CURVE_WORK = 8192
+#: 2 to 10 s at K = 1024: 8 points of a 2048-row noisy record took 30 CPU-s, 105 s under
+#: load): 4 points at K = 1024, 16 at K = 256, 64 at K = 64
+MAX_PTO_CURVE_WORK = 4096
 #: points of a pto-curve
 MAX_PTO_POINTS = 101
 #: Hermite intervals of the torque-limited optimum (the doubling stops here: 2048 intervals
