@@ -66,8 +66,8 @@ MIN_TORQUE_LIMIT = 1e-6
 MAX_PTO_Q_HARMONICS = 1024
 #: points x starting intervals of a pto-curve (each point solves on K and 2K intervals;
 #: 2 to 10 s at K = 1024: 8 points of a 2048-row noisy record took 30 CPU-s, 105 s under
-#: load): 4 points at K = 1024, 16 at K = 256, 64 at K = 64
-MAX_PTO_CURVE_WORK = 4096
+#: load): 6 points at K = 1024, 25 at K = 256, all 101 at K = 64
+MAX_PTO_CURVE_WORK = 101 * 64
 #: points of a pto-curve
 MAX_PTO_POINTS = 101
 #: Hermite intervals of the torque-limited optimum (the doubling stops here: 2048 intervals
