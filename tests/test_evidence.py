@@ -65,6 +65,23 @@ def test_smooth_or_limited_optimum_is_not_flagged(kw):
     assert r.peak_torque == pytest.approx(r.peak_torque_coarse, rel=pto.PEAK_RTOL)
 
 
+def test_undamped_fourier_peak_grows_with_n_and_says_so(capsys):
+    peaks = [parapend.optimize(harmonics=n).peak_torque for n in (12, 24, 48)]
+    assert peaks[1] > 3 * peaks[0] and peaks[2] > 3 * peaks[1]  # like N^2
+    r = parapend.optimize()
+    assert r.peak_torque_converged is False
+    assert parapend.optimize(gamma=0.03).peak_torque_converged is None
+    assert main(["optimize"]) == 0
+    assert "(of the N = 24 motion: at gamma = 0 it grows" in capsys.readouterr().out
+
+
+def test_pto_curve_flags_the_peak():
+    ds = pto.pto_curve("efficiency", values=[1.0, 0.8], gamma=0.0)
+    assert list(ds["peak_torque_converged"].values) == [0, 0]  # the ideal at gamma = 0 too
+    ds = pto.pto_curve("efficiency", values=[1.0, 0.8], gamma=0.03)
+    assert list(ds["peak_torque_converged"].values) == [-1, 0]
+
+
 def test_torque_impulse_of_a_triangle_is_its_area():
     # one period of 8 intervals (h = 0.5): a triangle 0, 1, 2, 1, 0 then a negative arc
     u = np.array([0.0, 1.0, 2.0, 1.0, 0.0, -1.0, -3.0, -1.0])

@@ -232,6 +232,7 @@ def optimize(*, omega: float = 1.8, delta=None, gamma: float = 0.0, harmonics: i
             second_power=ev.second_power,
             second_distance=ev.second_distance,
             upper_bound=ev.upper_bound,
+            peak_torque_converged=_fourier_peak_converged(gamma),
             bound_gap=ev.upper_bound - best.power,
             _motion=motion,
             **common,
@@ -280,10 +281,19 @@ def _optimize_winding(exc, gamma: float, n: int, method: str, warm, winding: int
         polished=ev.polished, abandoned=ev.abandoned, second_power=ev.second_power,
         second_distance=ev.second_distance, upper_bound=ev.upper_bound,
         bound_gap=ev.upper_bound - best.power,
+        peak_torque_converged=_fourier_peak_converged(gamma),
         excitation=exc.describe(), winding=winding, _motion=motion, _excitation=exc)
     if throw and not res.success:
         raise SolverError(f"optimize: {res.message}")
     return res
+
+
+def _fourier_peak_converged(gamma: float) -> bool | None:
+    """False at gamma = 0: the N-harmonic optimum approaches the limit motion, whose flips
+    are instantaneous (Eqs. 19-21), and its peak torque grows like N^2 (164, 587, 2215 at
+    N = 12, 24, 48 on the paper's case); None otherwise (not checked: at gamma > 0 the
+    motion is smooth, 4.158945 at N = 24 and 48 at gamma = 0.03)."""
+    return False if gamma == 0 else None
 
 
 def _json_count(n: int) -> int | float:

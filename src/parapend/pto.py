@@ -544,7 +544,9 @@ def pto_curve(vary: str = "torque-limit", *, values=None, points: int = 12,
     -------
     xarray.Dataset
         Over ``value``: ``power`` (mechanical), ``electrical_power``, ``peak_torque``,
-        ``motoring_energy``, ``status``; attrs ``vary``, ``unconstrained_power``, and, for
+        ``motoring_energy``, ``peak_torque_converged`` (1, 0: not converged under mesh
+        refinement, the peak is a property of the mesh; -1: not checked, the ideal
+        optimum), ``status``; attrs ``vary``, ``unconstrained_power``, and, for
         the torque limit, ``smallest_solved_limit`` (the smallest value solved feasibly),
         ``smallest_feasible_limit`` and ``smallest_feasible_status`` (phase 1, no
         efficiency).
@@ -604,6 +606,9 @@ def pto_curve(vary: str = "torque-limit", *, values=None, points: int = 12,
          "electrical_power": ("value", [r.electrical_power for r in rows]),
          "peak_torque": ("value", [r.peak_torque for r in rows]),
          "motoring_energy": ("value", [r.motoring_energy for r in rows]),
+         "peak_torque_converged": ("value", np.array(
+             [-1 if r.peak_torque_converged is None else int(r.peak_torque_converged)
+              for r in rows], dtype=np.int8)),
          "status": ("value", [r.status for r in rows])},
         coords={"value": [float(v) for v in vals[:len(rows)]]},
         attrs={"vary": vary, "unconstrained_power": ideal.power,

@@ -106,7 +106,9 @@ class OptimizeResult(_Result):
         power between the last two.
     peak_torque_converged : bool or None
         Whether ``peak_torque`` moved by less than 1 % between the last two meshes of a
-        time-domain PTO solve (None: no refinement, e.g. the Fourier optimum at fixed N).
+        time-domain PTO solve. The Fourier optimum at gamma = 0: False (its peak grows like
+        N^2 towards the limit's instant flips: 164, 587, 2215 at N = 12, 24, 48); at
+        gamma > 0 and for the BVP: None (not checked).
         False where the optimal torque is impulsive (its peak grows with the mesh, as the
         efficiency optimum at gamma = 0: 16, 32, 65, 129 on 128 to 1024 intervals) or
         singular (many torques give the same power): ``peak_torque``, ``peak_torque_nm``

@@ -211,6 +211,9 @@ def _cmd_optimize(a) -> dict | str:
 
 def _peak(r) -> str:
     """The peak torque, marked where it is not converged under mesh refinement."""
+    if r.peak_torque_converged is False and r.method == "fourier":
+        return (f"{r.peak_torque:.6g} (of the N = {r.harmonics} motion: at gamma = 0 it grows "
+                "like N^2 as the optimum approaches the limit's instant flips)")
     if r.peak_torque_converged is False:
         grows = r.peak_torque_coarse is not None and r.peak_torque > 1.5 * r.peak_torque_coarse
         return (f"{'>= ' if grows else ''}{r.peak_torque:.6g} (not converged under mesh "

@@ -132,7 +132,7 @@ def pto_lines(r) -> list[str]:
         out.append(f"time domain: {r.intervals} Hermite-Simpson intervals (torque piecewise "
                    f"linear), interior point; electrical power change at the last doubling "
                    f"{_change(r.refinement_change)}")
-    if r.peak_torque_converged is False:
+    if r.peak_torque_converged is False and r.peak_torque_coarse is not None:
         grows = r.peak_torque_coarse is not None and \
             r.peak_torque > 1.5 * r.peak_torque_coarse
         out.append(f"peak torque NOT converged under mesh refinement: {r.peak_torque:.6g} on "
@@ -212,11 +212,13 @@ def _cmd_pto_curve(a) -> dict | str:
     if a.json:
         return _dataset_json(ds)
     name = "T_max" if a.vary == "torque-limit" else "eta"
-    rows = [[f"{v:.6g}", _fmt(p, 8), _fmt(e, 8), f"{t:.5g}", _fmt(m), str(s)]
-            for v, p, e, t, m, s in zip(ds["value"].values, ds["power"].values,
-                                        ds["electrical_power"].values,
-                                        ds["peak_torque"].values,
-                                        ds["motoring_energy"].values, ds["status"].values)]
+    rows = [[f"{v:.6g}", _fmt(p, 8), _fmt(e, 8), f"{t:.5g}" + ("*" if c == 0 else ""),
+             _fmt(m), str(s)]
+            for v, p, e, t, m, s, c in zip(ds["value"].values, ds["power"].values,
+                                           ds["electrical_power"].values,
+                                           ds["peak_torque"].values,
+                                           ds["motoring_energy"].values, ds["status"].values,
+                                           ds["peak_torque_converged"].values)]
     head = [name, "mech. P", "electrical", "peak |T|", "motoring E", "status"]
     if units is not None:
         for r, w in zip(rows, ds["power_w"].values):
@@ -226,6 +228,10 @@ def _cmd_pto_curve(a) -> dict | str:
            f"ideal optimum {_fmt(ds.attrs['unconstrained_power'], 8)}, best uniform "
            f"{_fmt(ds.attrs['uniform_power'], 8)} (gamma = {ds.attrs['gamma']:g}, N = "
            f"{ds.attrs['harmonics']}); units m g l, m g l / t0"]
+    if (ds["peak_torque_converged"].values == 0).any():
+        out.append("* peak torque not converged under mesh refinement (impulsive or singular "
+                   "braking): a property of the mesh, not of the motion (optimize --json: "
+                   "torque_impulse)")
     if a.vary == "torque-limit":
         if "smallest_feasible_limit" in ds.attrs:
             how = ("a free rotation needs no torque"
