@@ -250,3 +250,5 @@ def test_motion_distance_is_the_rms_over_a_period():
     t = np.linspace(0, 2 * np.pi / 1.8, 4096, endpoint=False)
     d = (FourierMotion.from_vector(1.8, x).theta(t) - FourierMotion.from_vector(1.8, y).theta(t))
     assert motion_distance(x, y) == pytest.approx(float(np.sqrt(np.mean(d**2))), rel=1e-12)
+    # a turn further is the same motion
+    assert motion_distance(x + np.eye(5)[0] * 2 * np.pi, x) == pytest.approx(0.0, abs=1e-15)

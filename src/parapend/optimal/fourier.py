@@ -614,9 +614,11 @@ DISTINCT_RMS = 1e-6
 
 def motion_distance(x: np.ndarray, y: np.ndarray) -> float:
     """RMS over one period of the difference of two motions given by packed coefficients
-    ``[a0, a_1..a_N, b_1..b_N]`` (Parseval: ``sqrt(da0^2 + sum(da_k^2 + db_k^2) / 2)``)."""
+    ``[a0, a_1..a_N, b_1..b_N]`` (Parseval: ``sqrt(da0^2 + sum(da_k^2 + db_k^2) / 2)``),
+    ``da0`` taken modulo 2 pi (a motion and its copy a turn further are the same)."""
     d = np.asarray(x, dtype=float) - np.asarray(y, dtype=float)
-    return float(math.sqrt(d[0] ** 2 + 0.5 * float(np.sum(d[1:] ** 2))))
+    d0 = math.remainder(float(d[0]), 2 * math.pi)
+    return float(math.sqrt(d0**2 + 0.5 * float(np.sum(d[1:] ** 2))))
 
 
 def second_maximum(runs, best) -> tuple[float | None, float | None]:
