@@ -75,6 +75,12 @@ def test_undamped_fourier_peak_grows_with_n_and_says_so(capsys):
     assert "(of the N = 24 motion: at gamma = 0 it grows" in capsys.readouterr().out
 
 
+def test_damping_sweep_marks_the_undamped_peak(capsys):
+    assert main(["damping-sweep", "--points", "2", "--harmonics", "8"]) == 0
+    out = capsys.readouterr().out
+    assert "* at gamma = 0 the peak torque is that of the N-harmonic motion" in out
+
+
 def test_pto_curve_flags_the_peak():
     ds = pto.pto_curve("efficiency", values=[1.0, 0.8], gamma=0.0)
     assert list(ds["peak_torque_converged"].values) == [0, 0]  # the ideal at gamma = 0 too

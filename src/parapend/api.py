@@ -649,7 +649,11 @@ def damping_sweep(*, omega: float = 1.8, delta=None, harmonics: int | None = Non
         coords={"gamma": gammas},
         attrs={"damping_threshold": thr.damping_threshold,
                "uniform_threshold": thr.uniform_threshold, "limit_power": limit(exc).power,
-               "harmonics": n, "refinement_change": change, **_attrs(exc)},
+               "harmonics": n, "refinement_change": change,
+               "peak_torque_note": "at gamma = 0 the peak torque is that of the N-harmonic "
+                                   "motion and grows like N^2 (the limit motion flips "
+                                   "instantly); at gamma > 0 it converges in N",
+               **_attrs(exc)},
     )
 
 

@@ -305,7 +305,8 @@ def _cmd_damping_sweep(a) -> dict | str:
     _plot_and_save(ds, a, "plot_damping_sweep")
     if a.json:
         return _dataset_json(ds)
-    rows = [[_fmt(g), _fmt(p), _fmt(u), f"{t:.4g}", str(s)] for g, p, u, t, s in zip(
+    rows = [[_fmt(g), _fmt(p), _fmt(u), f"{t:.4g}" + ("*" if g == 0 else ""), str(s)]
+            for g, p, u, t, s in zip(
         ds["gamma"].values, ds["power"].values, ds["uniform_power"].values,
         ds["peak_torque"].values, ds["status"].values)]
     out = [f"excitation: {ds.attrs['excitation']}, omega={ds.attrs['omega']}; "
@@ -314,6 +315,8 @@ def _cmd_damping_sweep(a) -> dict | str:
            f"damping threshold gamma*: {_fmt(ds.attrs['damping_threshold'], 10)}",
            f"resolution check: end points with 2N change by at most "
            f"{_fmt(ds.attrs['refinement_change'], 3)}"]
+    if (ds["gamma"].values == 0).any():
+        out.append(f"* {ds.attrs['peak_torque_note']}")
     if a.plot:
         out.append(f"figure written to {a.plot}")
     return "\n".join(out)
