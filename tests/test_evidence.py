@@ -4,6 +4,7 @@ the global search (docs/units.md, docs/global.md)."""
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import math
 import os
@@ -146,6 +147,24 @@ def test_no_pto_success_above_the_physical_bound(seed):
     assert r.upper_bound == pytest.approx(bound, rel=1e-9)
     if r.success:
         assert r.power <= bound + 1e-9
+
+
+def test_a_power_above_the_bound_is_a_failure(monkeypatch, capsys):
+    """Whatever a time-domain solver returns, a power above ``limit - gamma omega^2`` is
+    status ``above_bound``, not a success (the solver is replaced by one that overstates)."""
+    real = pto._collocation
+
+    def overstating(*args, **kw):
+        sol, motion, extra = real(*args, **kw)
+        return dataclasses.replace(sol, power=10.0, electrical_power=9.0), motion, extra
+
+    monkeypatch.setattr(pto, "_collocation", overstating)
+    r = pto.optimize_pto(gamma=0.03, efficiency=0.9)
+    assert (r.status, r.success) == ("above_bound", False)
+    assert "exceeds the bound" in r.message
+    assert main(["optimize", "--gamma", "0.03", "--efficiency", "0.9"]) == 0
+    out = capsys.readouterr().out
+    assert "status: above_bound" in out and "note: failed" in out
 
 
 def test_absurdly_small_torque_limit_is_refused(capsys):
