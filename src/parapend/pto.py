@@ -142,8 +142,9 @@ def optimize_pto(*, torque_limit=None, efficiency=None, efficiency_generating=No
     ideal : OptimizeResult or None
         The ideal optimum, when already computed.
     max_intervals : int or None
-        Cap of the time-domain mesh (default :data:`parapend.limits.MAX_PTO_INTERVALS`;
-        :func:`pto_curve` lowers it to bound its work).
+        Cap of the time-domain mesh, 2 to :data:`parapend.limits.MAX_PTO_INTERVALS` (the
+        default): a smaller cap bounds the work; a result not settled within it is
+        "unresolved".
     **optimize_args
         As :func:`parapend.optimize` (``harmonics`` at most 128 here, method "fourier").
 
@@ -195,7 +196,8 @@ def optimize_pto(*, torque_limit=None, efficiency=None, efficiency_generating=No
                                   harvested_energy=prof["harvested_energy"])
         return dataclasses.replace(res, **physical_fields(res, units))
     check_pto_excitation(exc)
-    cap = limits.MAX_PTO_INTERVALS if max_intervals is None else int(max_intervals)
+    cap = limits.MAX_PTO_INTERVALS if max_intervals is None else \
+        check_int("max-intervals", max_intervals, 2, limits.MAX_PTO_INTERVALS)
     if eff is None and tmax is not None:
         sol, motion, extra = _time_domain(exc, gamma, ideal, tmax, r_cu, warm, cap=cap)
     else:
