@@ -12,7 +12,8 @@ __all__ = [
     "MAX_FILE_GAP", "MAX_FOURIER_K", "MAX_GAMMA", "MAX_HARMONICS", "MAX_PHASE", "MAX_POINTS",
     "MAX_SWEEP_HARMONICS", "MAX_SWEEP_WORK", "MAX_TABLE_HARMONICS", "MAX_THRESHOLD_HARMONICS",
     "MAX_PTO_HARMONICS", "MAX_PTO_INTERVALS", "MAX_PTO_POINTS", "MAX_TORQUE_LIMIT",
-    "MIN_AMPLITUDE", "MIN_BVP_GAMMA", "OMEGA_RANGE",
+    "MIN_AMPLITUDE", "MIN_TORQUE_LIMIT", "MAX_PTO_Q_HARMONICS", "MAX_PTO_CURVE_WORK",
+    "MIN_BVP_GAMMA", "OMEGA_RANGE",
     "SQUARE_ALPHA_MIN", "MAP_MAX_POINTS", "MAP_MAX_PTO_POINTS", "MAP_MAX_HARMONICS",
     "MAP_MAX_WORK", "UNIT_GRAVITY_RANGE", "UNIT_INERTIA_RATIO", "UNIT_LENGTH_RANGE",
     "UNIT_MASS_RANGE", "SEA_MAX_RESAMPLED", "SEA_MIN_HS", "TRACK_MAX_STEP_RATE",
@@ -62,6 +63,18 @@ MAX_FILE_GAP = 0.125
 MAX_PTO_HARMONICS = 128
 #: torque limit, units m g l (the paper-case ideal optimum needs 587 at N = 24)
 MAX_TORQUE_LIMIT = 1e6
+#: smallest torque limit, units m g l: the torque of a motion is evaluated to about 1e-14
+#: absolute (inverse dynamics of terms of order 1 + |q|); at 1e-320 the limit was "met"
+#: with a relative violation of 1e306
+MIN_TORQUE_LIMIT = 1e-6
+#: harmonics of q a power take-off solve accepts: its mesh (at most MAX_PTO_INTERVALS
+#: intervals) cannot follow more, and each dense torque check costs O(harmonics) per point
+#: (a 16384-row file, 8192 harmonics, ran past 5 minutes)
+MAX_PTO_Q_HARMONICS = 1024
+#: points x starting intervals of a pto-curve (each point solves on K and 2K intervals;
+#: 2 to 10 s at K = 1024: 8 points of a 2048-row noisy record took 30 CPU-s, 105 s under
+#: load): 6 points at K = 1024, 25 at K = 256, all 101 at K = 64
+MAX_PTO_CURVE_WORK = 101 * 64
 #: points of a pto-curve
 MAX_PTO_POINTS = 101
 #: Hermite intervals of the torque-limited optimum (the doubling stops here: 2048 intervals

@@ -27,7 +27,7 @@ import math
 import numpy as np
 
 from . import limits
-from .api import _coefficients, optimize
+from .api import _coefficients, build_excitation, optimize
 from .errors import ParameterError, SolverError, check_finite, check_int, check_range
 from .optimal.profile import PTOSolution, pto_profile
 from .power import uniform_power
@@ -61,11 +61,45 @@ def _eta(name, value) -> float:
 def _torque_limit(value):
     if value is None:
         return None
-    x = check_range("torque-limit", value, 0.0, limits.MAX_TORQUE_LIMIT,
-                    why="units m g l; see docs/limits-of-input.md")
-    if x <= 0.0:
-        raise ParameterError(f"torque-limit: expected a number > 0, got {value!r}")
+    return check_range("torque-limit", value, limits.MIN_TORQUE_LIMIT, limits.MAX_TORQUE_LIMIT,
+                       why="units m g l; below, the limit is under the rounding of the "
+                           "torque's evaluation; see docs/limits-of-input.md")
+
+
+def _check_warm(warm):
+    """``warm`` as given (None, or a motion with ``theta`` and ``theta_dot``), or as a float
+    vector ``[a0, a_1..a_N, b_1..b_N]``; anything else is a :class:`ParameterError`."""
+    if warm is None or (hasattr(warm, "theta") and hasattr(warm, "theta_dot")):
+        return warm
+    try:
+        x = np.asarray(warm, dtype=float)
+    except (TypeError, ValueError):
+        x = None
+    if x is None or x.ndim != 1 or x.size < 3 or x.size % 2 != 1 or \
+            not np.all(np.isfinite(x)):
+        shape = "?" if x is None else x.shape
+        raise ParameterError(f"warm: expected a motion or a finite vector [a0, a_1..a_N, "
+                             f"b_1..b_N] of odd length >= 3, got {type(warm).__name__} of "
+                             f"shape {shape}")
     return x
+
+
+def check_pto_excitation(exc) -> None:
+    """Refuse an excitation whose ``q`` has more harmonics than the time-domain PTO mesh can
+    follow (:data:`parapend.limits.MAX_PTO_Q_HARMONICS`): the solve would not resolve it and
+    its dense torque checks cost O(harmonics) per point."""
+    n = int(np.size(exc.spectrum)) - 1
+    if n <= limits.MAX_PTO_Q_HARMONICS:
+        return
+    a_min = 80.0 / (math.pi * exc.omega * (limits.MAX_PTO_Q_HARMONICS - 1))
+    hint = {"square": f"raise --square-alpha to at least {a_min:.3g} (the tanh width of "
+                      "Eq. 26 sets the harmonics)",
+            "file": "resample the record uniformly to at most "
+                    f"{2 * limits.MAX_PTO_Q_HARMONICS} rows (non-uniform records are "
+                    "resampled to 4096 points) or smooth it"}.get(exc.name, "use fewer terms")
+    raise ParameterError(f"excitation: a power take-off is solved on at most "
+                         f"{limits.MAX_PTO_INTERVALS} intervals, which follow q up to "
+                         f"{limits.MAX_PTO_Q_HARMONICS} harmonics; this q has {n}: {hint}")
 
 
 def physical_fields(result, units) -> dict:
@@ -87,7 +121,8 @@ def physical_fields(result, units) -> dict:
 
 def optimize_pto(*, torque_limit=None, efficiency=None, efficiency_generating=None,
                  efficiency_motoring=None, copper_loss: float = 0.0, units=None,
-                 warm=None, throw: bool = False, ideal=None, **optimize_args):
+                 warm=None, throw: bool = False, ideal=None, max_intervals=None,
+                 **optimize_args):
     """Optimal period-1 rotation through a real power take-off.
 
     Parameters
@@ -106,6 +141,10 @@ def optimize_pto(*, torque_limit=None, efficiency=None, efficiency_generating=No
         Start (packed Eq. 10 coefficients) instead of the ideal optimum (continuation).
     ideal : OptimizeResult or None
         The ideal optimum, when already computed.
+    max_intervals : int or None
+        Cap of the time-domain mesh, 2 to :data:`parapend.limits.MAX_PTO_INTERVALS` (the
+        default): a smaller cap bounds the work; a result not settled within it is
+        "unresolved".
     **optimize_args
         As :func:`parapend.optimize` (``harmonics`` at most 128 here, method "fourier").
 
@@ -114,47 +153,84 @@ def optimize_pto(*, torque_limit=None, efficiency=None, efficiency_generating=No
     OptimizeResult
         ``power`` is the mechanical power of the PTO optimum, ``electrical_power`` the
         electrical, ``unconstrained_power`` the ideal optimum; ``status`` "converged",
-        "infeasible" (no rotation found within the torque limit), "stalled" or
-        "max_iterations".
+        "no_power", "infeasible" (no rotation found within the torque limit),
+        "unresolved" (the last doubling of the mesh moved the power by more than 1e-6, or
+        failed), "above_bound" (a power above ``limit - gamma K^2 omega^2``, which no
+        rotation can beat), "violated", "stalled" or "max_iterations"; ``success`` only for
+        "converged" and "no_power". ``peak_torque_converged`` says whether the peak torque
+        moved by less than 1 % at the last doubling (False: an impulsive or singular
+        braking, whose peak is a property of the mesh; ``torque_impulse`` is then the
+        converging quantity). Lossless and unlimited (``efficiency`` 1 or None, no limit, no
+        copper loss) is the ideal problem: the ideal optimum is returned.
     """
     tmax = _torque_limit(torque_limit)
     eff = efficiencies(efficiency, efficiency_generating, efficiency_motoring)
     r_cu = check_range("copper-loss", copper_loss, 0.0, 1e6)
+    warm = _check_warm(warm)
     if optimize_args.get("method", "fourier") != "fourier":
         raise ParameterError("method: a power take-off is optimized with method 'fourier'")
     n = check_int("harmonics", optimize_args.get("harmonics", 24), 1,
                   limits.MAX_PTO_HARMONICS)
+    lossless = tmax is None and r_cu == 0.0 and (eff is None or eff == (1.0, 1.0))
+    if ideal is None and not lossless:  # refuse before the ideal optimum's work
+        check_pto_excitation(build_excitation(**{
+            k: optimize_args[k] for k in ("excitation", "omega", "delta", "square_alpha",
+                                          "fourier", "file") if k in optimize_args}))
     ideal = ideal if ideal is not None else optimize(**optimize_args)
     exc = ideal._excitation
     gamma = ideal.gamma
-    if tmax is None and eff is None and r_cu == 0.0:
+    if lossless:
+        # lossless and unlimited: the ideal problem itself. (At gamma = 0 its supremum, the
+        # limit power, is approached only by ever faster flips; the time-domain mesh then
+        # turns several radians per interval, Simpson's rule aliases, and the discrete
+        # problem's optimum was 114 against a bound of 0.41. The N-harmonic optimum is the
+        # answer to the question asked, the same as without the options.)
         res = ideal
         prof = pto_profile(ideal.motion, exc, gamma)
         res = dataclasses.replace(res, electrical_power=ideal.power,
                                   unconstrained_power=ideal.power,
+                                  efficiency_generating=None if eff is None else eff[0],
+                                  efficiency_motoring=None if eff is None else eff[1],
                                   peak_power=prof["peak_power"],
                                   motoring_energy=prof["motoring_energy"],
                                   harvested_energy=prof["harvested_energy"])
         return dataclasses.replace(res, **physical_fields(res, units))
+    check_pto_excitation(exc)
+    cap = limits.MAX_PTO_INTERVALS if max_intervals is None else \
+        check_int("max-intervals", max_intervals, 2, limits.MAX_PTO_INTERVALS)
     if eff is None and tmax is not None:
-        sol, motion, extra = _time_domain(exc, gamma, ideal, tmax, r_cu, warm)
+        sol, motion, extra = _time_domain(exc, gamma, ideal, tmax, r_cu, warm, cap=cap)
     else:
-        sol, motion, extra = _collocation(exc, gamma, ideal, tmax, r_cu, eff, warm)
+        sol, motion, extra = _collocation(exc, gamma, ideal, tmax, r_cu, eff, warm, cap=cap)
     coefficients = _coefficients(_projection(motion, exc, n))
     prof = pto_profile(motion, exc, gamma, efficiency=eff)
     pu = ideal.uniform_power
     status = sol.status
+    bound = ideal.upper_bound
     if status == "converged" and sol.electrical_power <= 0:
         status = "no_power"  # converged, but every rotation costs energy through this PTO
+    if status in ("converged", "no_power", "unresolved") and \
+            not sol.power <= bound + 1e-6 * max(1.0, abs(bound)):
+        # no rotation does better than limit - gamma K^2 omega^2 (<theta'^2> >= K^2 omega^2)
+        status = "above_bound"
+    elif status in ("converged", "no_power") and tmax is not None and \
+            not sol.peak_torque - tmax <= 1e-6 * tmax + 1e-12 * _torque_scale(exc):
+        status = "violated"  # beyond the rounding of the torque's evaluation
+    peak_conv = extra.pop("peak_torque_converged")
     msg = {"no_power": "converged, but no positive power is delivered: every period-1 "
                        "rotation costs energy through this power take-off (the power shown "
                        "is the smallest loss)",
            "converged": "converged: optimum of the power take-off problem",
            "infeasible": f"infeasible: no rotation found with |T| <= {tmax}; raise the "
                          "torque limit",
-           "unresolved": "converged, but the power still moved by more than 1e-6 "
-                         f"at the last doubling of the intervals (cap "
-                         f"{limits.MAX_PTO_INTERVALS})",
+           "unresolved": "not resolved: the power still moved by more than 1e-6 "
+                         f"at the last doubling of the intervals (cap {cap}), or the "
+                         "finer mesh failed; the coarser optimum is shown",
+           "above_bound": f"failed: the power {sol.power:.6g} exceeds the bound "
+                          f"{bound:.6g} that no rotation can beat (limit - gamma K^2 omega^2): "
+                          "the time-domain mesh does not resolve this motion",
+           "violated": f"failed: the motion exceeds the torque limit by "
+                       f"{sol.max_violation:.2g} (relative)",
            "stalled": ("stalled: the interior point could not meet the limit between its "
                        "points, or its last steps made no progress; the motion is reported as "
                        "it is (see max_violation)" if extra["method"] == "hermite" else
@@ -164,26 +240,83 @@ def optimize_pto(*, torque_limit=None, efficiency=None, efficiency_generating=No
                        "step; the motion is reported as it is",
            "max_iterations": "maximum number of Newton iterations reached",
            "nonfinite": "non-finite power encountered"}.get(status, status)
+    if peak_conv is False:
+        msg += ("; the peak torque is not converged under mesh refinement (see "
+                "peak_torque_coarse, torque_impulse)")
+    if tmax is not None and tmax >= ideal.peak_torque and \
+            sol.power > ideal.power + 1e-6 * max(1.0, abs(ideal.power)):
+        msg += (f"; the limit does not bind at the {ideal.harmonics}-harmonic ideal optimum "
+                f"(peak {ideal.peak_torque:.6g}), and this optimum exceeds it by "
+                f"{sol.power - ideal.power:.3g}: the Fourier series does not resolve the "
+                "motion, the ideal optimum is a lower bound (raise --harmonics)")
     res = dataclasses.replace(
         ideal, power=sol.power,
         gain_over_uniform=(sol.power / pu - 1.0) if pu > 0 else None,
-        success=status in ("converged", "no_power", "unresolved"), status=status,
+        success=status in ("converged", "no_power"), status=status,
         message=msg,
         iterations=sol.iterations, coefficients=coefficients,
         peak_torque=sol.peak_torque, found_by="warm" if warm is not None else "ideal optimum",
         local_maxima=[], gradient_norm=sol.gradient_norm, strict_maximum=False,
         quadrature_points=sol.points,
         mean_square_speed=motion.mean_square_speed(),
+        bound_gap=bound - sol.power, second_power=None,
         torque_limit=tmax, efficiency_generating=None if eff is None else eff[0],
         efficiency_motoring=None if eff is None else eff[1],
         electrical_power=sol.electrical_power, unconstrained_power=ideal.power,
         peak_power=prof["peak_power"], motoring_energy=prof["motoring_energy"],
         harvested_energy=prof["harvested_energy"], max_violation=sol.max_violation,
-        _motion=motion, **extra)
+        peak_torque_converged=peak_conv, _motion=motion, **extra)
     res = dataclasses.replace(res, **physical_fields(res, units))
     if throw and not res.success:
         raise SolverError(f"optimize: {res.message}")
     return res
+
+
+def _torque_scale(exc) -> float:
+    """``1 + max |q|``: the size of the terms of Eq. 14 whose rounding the torque carries."""
+    q = exc.extrema.q
+    return 1.0 + (float(np.max(np.abs(q))) if q.size else abs(float(np.real(
+        exc.spectrum[0]))))
+
+
+#: relative change of the peak torque between the last two meshes below which it counts as
+#: converged (smooth optima: 0.1 to 0.3 % from 64 to 128 intervals; singular or impulsive
+#: braking: 2.6 % to 100 %)
+PEAK_RTOL = 1e-2
+
+
+def _peak_converged(fine: float, coarse) -> bool | None:
+    if coarse is None or not math.isfinite(coarse):
+        return None
+    return bool(abs(fine - coarse) <= PEAK_RTOL * max(abs(fine), abs(coarse)))
+
+
+def torque_impulse(u: np.ndarray, h: float) -> float:
+    """``int |T| dt`` over the arc around the peak of a piecewise-linear torque (node values
+    ``u`` on a periodic mesh of step ``h``) on which ``T`` keeps the sign of its peak: the
+    impulse of the braking (or driving) arc. Exact for the piecewise-linear torque; where
+    the peak grows with the mesh (an impulsive optimum) this converges."""
+    u = np.asarray(u, dtype=float)
+    k = u.size
+    j0 = int(np.argmax(np.abs(u)))
+    sgn = 1.0 if u[j0] >= 0 else -1.0
+    w = sgn * np.roll(u, -j0)  # the peak at 0, positive
+    total = 0.0
+    for direction in (1, -1):
+        i = 0
+        while True:
+            a = w[i % k]
+            nxt = i + direction
+            b = w[nxt % k]
+            if b > 0:
+                total += 0.5 * h * (a + b)
+            else:
+                total += 0.5 * h * a * a / (a - b) if a > 0 else 0.0
+                break
+            i = nxt
+            if abs(i) >= k:
+                return float(np.sum(np.abs(u)) * h)  # one sign throughout: the whole period
+    return float(total)
 
 
 def _projection(motion, exc, n: int) -> FourierMotion:
@@ -198,21 +331,25 @@ def _projection(motion, exc, n: int) -> FourierMotion:
 
 def intervals_for(exc) -> int:
     """Starting number of Hermite intervals: 64, or 8 per harmonic of ``q``, a power of
-    two (then doubled until the power moves by less than 1e-6)."""
+    two, at most half :data:`parapend.limits.MAX_PTO_INTERVALS` (then doubled until the
+    power moves by less than 1e-6: there is always one doubling to check the result)."""
     k = 8 * max(1, int(np.size(exc.spectrum)) - 1)
-    return int(min(limits.MAX_PTO_INTERVALS, max(64, 1 << int(math.ceil(math.log2(k))))))
+    return int(min(limits.MAX_PTO_INTERVALS // 2,
+                   max(64, 1 << int(math.ceil(math.log2(k))))))
 
 
-def _time_domain(exc, gamma, ideal, tmax, copper_loss, warm, rtol: float = 1e-6):
+def _time_domain(exc, gamma, ideal, tmax, copper_loss, warm, rtol: float = 1e-6,
+                 cap: int = limits.MAX_PTO_INTERVALS):
     """Torque-limited optimum on Hermite intervals, doubled until the power settles."""
     from .optimal.hermite import solve_hermite
 
     start = ideal.motion if warm is None or isinstance(warm, np.ndarray) else warm
-    k = intervals_for(exc)
+    k = min(intervals_for(exc), max(cap // 2, 1))
     prev = None
     iters = 0
     change = float("nan")
     anchor = last = None
+    coarse_peak = None
     wind = ideal.winding
     # every monotone rotation: P <= T_max <theta'> = T_max K omega
     bound = tmax * wind * exc.omega
@@ -228,7 +365,7 @@ def _time_domain(exc, gamma, ideal, tmax, copper_loss, warm, rtol: float = 1e-6)
             brake = _constant_brake(exc, gamma, tmax, sol.motion, iters, wind)
             if brake is not None and brake[0].power >= sol.power:
                 return brake
-        if sol.status != "converged" and prev is None and 2 * k <= limits.MAX_PTO_INTERVALS:
+        if sol.status != "converged" and prev is None and 2 * k <= cap:
             # the smallest peak torque falls with the resolution, and near a free rotation
             # (tiny limits) a coarse mesh may stall: try a finer one
             k *= 2
@@ -236,15 +373,19 @@ def _time_domain(exc, gamma, ideal, tmax, copper_loss, warm, rtol: float = 1e-6)
         if sol.status != "converged":
             if last is not None and not sol.power > last[0].power:
                 sol, k = last  # the converged coarser optimum is better: keep it, unresolved
+                coarse_peak = None
             break
+        if last is not None:
+            coarse_peak = last[0].peak_torque
         last = sol, k
         anchor = sol.anchor  # strictly inside the limit: the finer solve starts towards it
         motion = sol.motion
         if prev is not None:
             change = abs(sol.electrical_power - prev)
-            if change <= rtol * max(1.0, abs(sol.electrical_power)) or \
-                    2 * k > limits.MAX_PTO_INTERVALS:
+            if change <= rtol * max(1.0, abs(sol.electrical_power)) or 2 * k > cap:
                 break
+        elif 2 * k > cap:
+            break
         prev = sol.electrical_power
         start = motion
         k *= 2
@@ -257,7 +398,10 @@ def _time_domain(exc, gamma, ideal, tmax, copper_loss, warm, rtol: float = 1e-6)
                       peak_torque=sol.peak_torque, max_violation=viol, status=status,
                       iterations=iters, outer_iterations=len(sol.stages),
                       gradient_norm=float("nan"), stages=sol.stages)
-    return out, motion, {"method": "hermite", "intervals": k, "refinement_change": change}
+    return out, motion, {"method": "hermite", "intervals": k, "refinement_change": change,
+                         "peak_torque_coarse": coarse_peak,
+                         "peak_torque_converged": _peak_converged(sol.peak_torque,
+                                                                  coarse_peak)}
 
 
 def _constant_brake(exc, gamma, tmax, start, iters, winding: int = 1):
@@ -282,11 +426,13 @@ def _constant_brake(exc, gamma, tmax, start, iters, winding: int = 1):
                       max_violation=max(peak / tmax - 1.0, 0.0), status="converged",
                       iterations=iters, outer_iterations=0, gradient_norm=float("nan"),
                       stages=[("constant-brake", n, "converged")])
+    # the torque is -T_max by construction; the dense peak of the motion checks the solve
     return out, motion, {"method": "constant-brake", "harmonics": n,
-                         "refinement_change": change}
+                         "refinement_change": change, "peak_torque_converged": True}
 
 
-def _collocation(exc, gamma, ideal, tmax, copper_loss, eff, warm, rtol: float = 1e-6):
+def _collocation(exc, gamma, ideal, tmax, copper_loss, eff, warm, rtol: float = 1e-6,
+                 cap: int = limits.MAX_PTO_INTERVALS):
     """Efficiency / copper-loss optimum by Hermite-Simpson collocation
     (:mod:`parapend.optimal.collocation`), the intervals doubled until the electrical power
     moves by less than ``rtol``."""
@@ -298,8 +444,8 @@ def _collocation(exc, gamma, ideal, tmax, copper_loss, eff, warm, rtol: float = 
         start = FourierMotion.from_vector(exc.omega, np.asarray(warm, dtype=float))
     else:
         start = warm
-    k = intervals_for(exc)
-    prev = last = None
+    k = min(intervals_for(exc), max(cap // 2, 1))
+    prev = last = coarse = None
     iters = 0
     change = float("nan")
     while True:
@@ -313,13 +459,17 @@ def _collocation(exc, gamma, ideal, tmax, copper_loss, eff, warm, rtol: float = 
         if sol.status != "converged":
             if last is not None:
                 sol, k = last  # the converged coarser optimum: kept, "unresolved"
+                coarse = None
             break
+        if last is not None:
+            coarse = last[0]
         last = sol, k
         if prev is not None:
             change = abs(sol.electrical_power - prev)
-            if change <= rtol * max(1.0, abs(sol.electrical_power)) or \
-                    2 * k > limits.MAX_PTO_INTERVALS:
+            if change <= rtol * max(1.0, abs(sol.electrical_power)) or 2 * k > cap:
                 break
+        elif 2 * k > cap:
+            break
         prev = sol.electrical_power
         start = sol.motion
         k *= 2
@@ -338,8 +488,17 @@ def _collocation(exc, gamma, ideal, tmax, copper_loss, eff, warm, rtol: float = 
                       peak_torque=sol.peak_torque, max_violation=viol, status=status,
                       iterations=iters, outer_iterations=1, gradient_norm=sol.kkt_error,
                       points=2 * k)
-    return out, sol.motion, {"method": "collocation", "intervals": k,
-                             "refinement_change": change}
+    period = 2 * math.pi / exc.omega
+    imp = torque_impulse(sol.motion.u_nodes, period / k)
+    imp_c = None if coarse is None else torque_impulse(coarse.motion.u_nodes,
+                                                       period / coarse.intervals)
+    return out, sol.motion, {
+        "method": "collocation", "intervals": k, "refinement_change": change,
+        "peak_torque_coarse": None if coarse is None else coarse.peak_torque,
+        "peak_torque_converged": _peak_converged(
+            sol.peak_torque, None if coarse is None else coarse.peak_torque),
+        "torque_impulse": imp,
+        "torque_impulse_change": None if imp_c is None else abs(imp - imp_c)}
 
 
 def _smallest_limit(ideal):
@@ -387,7 +546,9 @@ def pto_curve(vary: str = "torque-limit", *, values=None, points: int = 12,
     -------
     xarray.Dataset
         Over ``value``: ``power`` (mechanical), ``electrical_power``, ``peak_torque``,
-        ``motoring_energy``, ``status``; attrs ``vary``, ``unconstrained_power``, and, for
+        ``motoring_energy``, ``peak_torque_converged`` (1, 0: not converged under mesh
+        refinement, the peak is a property of the mesh; -1: not checked, the ideal
+        optimum), ``status``; attrs ``vary``, ``unconstrained_power``, and, for
         the torque limit, ``smallest_solved_limit`` (the smallest value solved feasibly),
         ``smallest_feasible_limit`` and ``smallest_feasible_status`` (phase 1, no
         efficiency).
@@ -397,6 +558,9 @@ def pto_curve(vary: str = "torque-limit", *, values=None, points: int = 12,
     if not isinstance(vary, str) or vary not in VARY:
         raise ParameterError(f"vary: expected one of {', '.join(VARY)}, got {vary!r:.40}")
     npts = check_int("points", points, 2, limits.MAX_PTO_POINTS)
+    check_pto_excitation(build_excitation(**{
+        k: optimize_args[k] for k in ("excitation", "omega", "delta", "square_alpha",
+                                      "fourier", "file") if k in optimize_args}))
     ideal = optimize(**optimize_args)
     if vary == "torque-limit":
         if torque_limit is not None:
@@ -419,6 +583,12 @@ def pto_curve(vary: str = "torque-limit", *, values=None, points: int = 12,
             raise ParameterError("efficiency: it is the varied quantity; drop it")
         vals = list(np.linspace(1.0, 0.5, npts)) if values is None else \
             [_eta("efficiency", v) for v in values]
+    k0 = intervals_for(ideal._excitation)
+    if len(vals) * k0 > limits.MAX_PTO_CURVE_WORK:
+        raise ParameterError(
+            f"points: expected at most {max(limits.MAX_PTO_CURVE_WORK // k0, 1)} values for "
+            f"this excitation (values x intervals <= {limits.MAX_PTO_CURVE_WORK}; each "
+            f"solve starts on {k0} intervals, 8 per harmonic of q), got {len(vals)}")
     rows = []
     warm = None
     for i, v in enumerate(vals):
@@ -438,6 +608,9 @@ def pto_curve(vary: str = "torque-limit", *, values=None, points: int = 12,
          "electrical_power": ("value", [r.electrical_power for r in rows]),
          "peak_torque": ("value", [r.peak_torque for r in rows]),
          "motoring_energy": ("value", [r.motoring_energy for r in rows]),
+         "peak_torque_converged": ("value", np.array(
+             [-1 if r.peak_torque_converged is None else int(r.peak_torque_converged)
+              for r in rows], dtype=np.int8)),
          "status": ("value", [r.status for r in rows])},
         coords={"value": [float(v) for v in vals[:len(rows)]]},
         attrs={"vary": vary, "unconstrained_power": ideal.power,

@@ -74,8 +74,13 @@ class OptimizeResult(_Result):
         ``C(2m, m - 1)`` for ``extrema_per_period = 2m``, a float past 2^53, inf past 1e308),
         "dynamic-programme" (too many to list: seeds from the (t, theta) dynamic programme),
         or "bvp-starts"; runs carried to convergence and runs abandoned as unable to win.
-    second_power : float or None
-        Best other local maximum found (None: every run reached the optimum).
+    second_power, second_distance : float or None
+        The best other distinct local maximum among the runs polished to convergence, and
+        the RMS distance of its motion from the optimum's over one period (rad; distinct:
+        above 1e-6). Runs abandoned as unable to win are never polished, so a better other
+        maximum may exist: ``second_power`` is a lower bound of the second-best maximum.
+        None: every polished run reached the optimum. (BVP: the best other start's power,
+        distinct by more than 1e-9 relative; no distance.)
     upper_bound, bound_gap : ``limit_power - gamma omega^2`` (no rotation does better, as
         ``<theta'^2> >= omega^2``) and its distance to ``power``.
     torque_limit, efficiency_generating, efficiency_motoring : float or None
@@ -99,6 +104,21 @@ class OptimizeResult(_Result):
         :mod:`parapend.optimal.collocation`) on ``intervals`` Hermite-Simpson intervals; both
         checked by one doubling: ``refinement_change`` is the change of the (electrical)
         power between the last two.
+    peak_torque_converged : bool or None
+        Whether ``peak_torque`` moved by less than 1 % between the last two meshes of a
+        time-domain PTO solve. The Fourier optimum at gamma = 0: False (its peak grows like
+        N^2 towards the limit's instant flips: 164, 587, 2215 at N = 12, 24, 48); at
+        gamma > 0 and for the BVP: None (not checked).
+        False where the optimal torque is impulsive (its peak grows with the mesh, as the
+        efficiency optimum at gamma = 0: 16, 32, 65, 129 on 128 to 1024 intervals) or
+        singular (many torques give the same power): ``peak_torque``, ``peak_torque_nm``
+        and ``peak_power`` are then properties of the mesh, not of the motion.
+    peak_torque_coarse : float or None
+        The peak torque on half the intervals (the last refinement).
+    torque_impulse, torque_impulse_change : float or None
+        Collocation: ``int |T| dt`` over the arc around the peak where ``T`` keeps its sign
+        (the braking impulse, m g l times the time unit), and its change from half the
+        intervals; it converges where the peak does not.
     units, power_w, uniform_power_w, limit_power_w, peak_torque_nm, electrical_power_w,
     energy_per_cycle_j, motoring_energy_j : physical values (W, N m, J) when a pendulum's
         length and mass were given (:mod:`parapend.units`); None otherwise.
@@ -135,6 +155,7 @@ class OptimizeResult(_Result):
     polished: int = 0
     abandoned: int = 0
     second_power: float | None = None
+    second_distance: float | None = None
     upper_bound: float = float("nan")
     bound_gap: float = float("nan")
     mesh_nodes: int | None = None
@@ -152,6 +173,10 @@ class OptimizeResult(_Result):
     max_violation: float | None = None
     intervals: int | None = None
     refinement_change: float | None = None
+    peak_torque_converged: bool | None = None
+    peak_torque_coarse: float | None = None
+    torque_impulse: float | None = None
+    torque_impulse_change: float | None = None
     units: dict | None = None
     power_w: float | None = None
     uniform_power_w: float | None = None

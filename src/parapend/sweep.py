@@ -184,10 +184,8 @@ def _check_value(name: str, v) -> float:
     if name == "gamma":
         return check_range(flag, v, 0.0, limits.MAX_GAMMA)
     if name == "torque_limit":
-        x = check_range(flag, v, 0.0, limits.MAX_TORQUE_LIMIT, why="units m g l")
-        if x <= 0:
-            raise ParameterError(f"{flag}: expected a number > 0, got {v!r}")
-        return x
+        return check_range(flag, v, limits.MIN_TORQUE_LIMIT, limits.MAX_TORQUE_LIMIT,
+                           why="units m g l")
     x = check_range(flag, v, 0.0, 1.0)
     if x <= 0:
         raise ParameterError(f"{flag}: expected a number in (0, 1], got {v!r}")

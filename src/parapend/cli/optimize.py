@@ -170,7 +170,11 @@ def _cmd_optimize(a) -> dict | str:
                   f"half-turn direction patterns tried, {r.polished} runs polished, "
                   f"{r.abandoned} abandoned as unable to win")
         if r.second_power is not None:
-            search += f"; second-best maximum {_fmt(r.second_power)}"
+            search += (f"; best other polished maximum {_fmt(r.second_power)}"
+                       + (f" ({r.second_distance:.2g} rad RMS away)"
+                          if r.second_distance is not None else "")
+                       + (" (abandoned runs are not polished: better ones may exist)"
+                          if r.abandoned else ""))
     elif r.method == "hermite":
         how = (f"{r.iterations} interior-point iterations, {r.intervals} cubic Hermite "
                f"intervals, started from the {r.found_by}")
@@ -190,11 +194,11 @@ def _cmd_optimize(a) -> dict | str:
            f"upper bound limit - gamma {'' if r.winding == 1 else 'K^2 '}omega^2: "
            f"{_fmt(r.upper_bound)} "
            f"(gap {_fmt(r.bound_gap)})",
-           f"peak torque |T|: {r.peak_torque:.6g}    mean theta'^2: {r.mean_square_speed:.6g}",
+           f"peak torque |T|: {_peak(r)}    mean theta'^2: {r.mean_square_speed:.6g}",
            f"convention: {CONVENTION}"]
     if r.method == "fourier" and r.found_by != "constant excitation":
         out.insert(5, search)
-    if r.status == "no_power":
+    if r.status == "no_power" or (pto and (not r.success or "; " in r.message)):
         out.insert(5, f"note: {r.message}")
     out += _pto.pto_lines(r) if pto else []
     out += _pto.physical_lines(r, units)
@@ -203,6 +207,18 @@ def _cmd_optimize(a) -> dict | str:
     if a.plot:
         out.append(f"figure written to {a.plot}")
     return "\n".join(out)
+
+
+def _peak(r) -> str:
+    """The peak torque, marked where it is not converged under mesh refinement."""
+    if r.peak_torque_converged is False and r.method == "fourier":
+        return (f"{r.peak_torque:.6g} (of the N = {r.harmonics} motion: at gamma = 0 it grows "
+                "like N^2 as the optimum approaches the limit's instant flips)")
+    if r.peak_torque_converged is False:
+        grows = r.peak_torque_coarse is not None and r.peak_torque > 1.5 * r.peak_torque_coarse
+        return (f"{'>= ' if grows else ''}{r.peak_torque:.6g} (not converged under mesh "
+                "refinement, see below)")
+    return f"{r.peak_torque:.6g}"
 
 
 def _gain(p, pu) -> str:
@@ -289,7 +305,8 @@ def _cmd_damping_sweep(a) -> dict | str:
     _plot_and_save(ds, a, "plot_damping_sweep")
     if a.json:
         return _dataset_json(ds)
-    rows = [[_fmt(g), _fmt(p), _fmt(u), f"{t:.4g}", str(s)] for g, p, u, t, s in zip(
+    rows = [[_fmt(g), _fmt(p), _fmt(u), f"{t:.4g}" + ("*" if g == 0 else ""), str(s)]
+            for g, p, u, t, s in zip(
         ds["gamma"].values, ds["power"].values, ds["uniform_power"].values,
         ds["peak_torque"].values, ds["status"].values)]
     out = [f"excitation: {ds.attrs['excitation']}, omega={ds.attrs['omega']}; "
@@ -298,6 +315,8 @@ def _cmd_damping_sweep(a) -> dict | str:
            f"damping threshold gamma*: {_fmt(ds.attrs['damping_threshold'], 10)}",
            f"resolution check: end points with 2N change by at most "
            f"{_fmt(ds.attrs['refinement_change'], 3)}"]
+    if (ds["gamma"].values == 0).any():
+        out.append(f"* {ds.attrs['peak_torque_note']}")
     if a.plot:
         out.append(f"figure written to {a.plot}")
     return "\n".join(out)

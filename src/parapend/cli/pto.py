@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import math
+
 from .. import limits
 from ..errors import ParameterError
 from . import _output
@@ -122,15 +124,33 @@ def pto_lines(r) -> list[str]:
                    f"violation {r.max_violation:.1e})")
     if r.method == "hermite":
         out.append(f"time domain: {r.intervals} cubic Hermite intervals, interior point; "
-                   f"power change at the last doubling {r.refinement_change:.1e}")
+                   f"power change at the last doubling {_change(r.refinement_change)}")
     if r.method == "constant-brake":
         out.append(f"constant brake: T = -T_max throughout, {r.harmonics} harmonics; power "
-                   f"change from half of them {r.refinement_change:.1e}")
+                   f"change from half of them {_change(r.refinement_change)}")
     if r.method == "collocation":
         out.append(f"time domain: {r.intervals} Hermite-Simpson intervals (torque piecewise "
                    f"linear), interior point; electrical power change at the last doubling "
-                   f"{r.refinement_change:.1e}")
-    if r.efficiency_generating is not None:
+                   f"{_change(r.refinement_change)}")
+    if r.peak_torque_converged is False and r.peak_torque_coarse is not None:
+        grows = r.peak_torque_coarse is not None and \
+            r.peak_torque > 1.5 * r.peak_torque_coarse
+        out.append(f"peak torque NOT converged under mesh refinement: {r.peak_torque:.6g} on "
+                   f"{r.intervals} intervals, {r.peak_torque_coarse:.6g} on "
+                   f"{r.intervals // 2}; "
+                   + ("it grows with the mesh (impulsive braking): read it as a lower bound"
+                      if grows else "the optimal torque is singular there (many torques give "
+                      "the same power): the peak is a property of the mesh")
+                   + "; so are peak power and the peak in N m")
+        if r.torque_impulse is not None:
+            out.append(f"torque impulse over the peak's arc (int |T| dt): "
+                       f"{r.torque_impulse:.6g}, change from {r.intervals // 2} intervals "
+                       f"{_change(r.torque_impulse_change)}")
+    if r.efficiency_generating == 1.0 and r.efficiency_motoring == 1.0 and \
+            r.method == "fourier":
+        out.append("efficiency 1 both ways, no limit: lossless, the ideal problem (its "
+                   "Fourier optimum)")
+    elif r.efficiency_generating is not None:
         out.append(f"efficiency: generating {r.efficiency_generating:g}, motoring "
                    f"{r.efficiency_motoring:g}; electrical power {_fmt(r.electrical_power, 8)}"
                    " (exact kink at p = 0, slacks p+ - p- = p)")
@@ -140,6 +160,13 @@ def pto_lines(r) -> list[str]:
         out.append(f"peak power {r.peak_power:.6g}; per cycle: harvested "
                    f"{r.harvested_energy:.6g}, motoring {r.motoring_energy:.6g} (m g l)")
     return out
+
+
+def _change(x) -> str:
+    """A refinement change, or what stands in for it when no finer mesh was solved."""
+    if x is None or not math.isfinite(x):
+        return "not available (no finer mesh solved)"
+    return f"{x:.1e}"
 
 
 def add_parsers(sub) -> None:
@@ -185,11 +212,13 @@ def _cmd_pto_curve(a) -> dict | str:
     if a.json:
         return _dataset_json(ds)
     name = "T_max" if a.vary == "torque-limit" else "eta"
-    rows = [[f"{v:.6g}", _fmt(p, 8), _fmt(e, 8), f"{t:.5g}", _fmt(m), str(s)]
-            for v, p, e, t, m, s in zip(ds["value"].values, ds["power"].values,
-                                        ds["electrical_power"].values,
-                                        ds["peak_torque"].values,
-                                        ds["motoring_energy"].values, ds["status"].values)]
+    rows = [[f"{v:.6g}", _fmt(p, 8), _fmt(e, 8), f"{t:.5g}" + ("*" if c == 0 else ""),
+             _fmt(m), str(s)]
+            for v, p, e, t, m, s, c in zip(ds["value"].values, ds["power"].values,
+                                           ds["electrical_power"].values,
+                                           ds["peak_torque"].values,
+                                           ds["motoring_energy"].values, ds["status"].values,
+                                           ds["peak_torque_converged"].values)]
     head = [name, "mech. P", "electrical", "peak |T|", "motoring E", "status"]
     if units is not None:
         for r, w in zip(rows, ds["power_w"].values):
@@ -199,6 +228,10 @@ def _cmd_pto_curve(a) -> dict | str:
            f"ideal optimum {_fmt(ds.attrs['unconstrained_power'], 8)}, best uniform "
            f"{_fmt(ds.attrs['uniform_power'], 8)} (gamma = {ds.attrs['gamma']:g}, N = "
            f"{ds.attrs['harmonics']}); units m g l, m g l / t0"]
+    if (ds["peak_torque_converged"].values == 0).any():
+        out.append("* peak torque not converged under mesh refinement (impulsive or singular "
+                   "braking): a property of the mesh, not of the motion (optimize --json: "
+                   "torque_impulse)")
     if a.vary == "torque-limit":
         if "smallest_feasible_limit" in ds.attrs:
             how = ("a free rotation needs no torque"

@@ -49,6 +49,7 @@ from .fourier import (
     _uniform_seed,
     newton_maximize,
     search_fourier,
+    second_maximum,
 )
 from .limit import limit, pattern_count
 
@@ -347,13 +348,12 @@ def search_fourier_batch(points, harmonics: int, *, gtol: float = 1e-11,
                     runs.append(b)
             exc, gamma = points[i]
             lim = lims[i]
-            conv = [r.power for r in runs if r.status == "converged"]
-            others = [c for c in conv if c < b.power - 1e-9 * max(1.0, abs(b.power))]
+            second, dist = second_maximum(runs, b)
             evidence = SearchEvidence(
                 strategy="exhaustive", candidate_patterns=pattern_count(lim),
                 patterns_tried=1, polished=sum(r.status == "converged" for r in runs),
                 abandoned=sum(r.status == "abandoned" for r in runs),
-                second_power=max(others) if others else None,
+                second_power=second, second_distance=dist,
                 upper_bound=lim.power - gamma * exc.omega**2, screen_harmonics=None)
             out[i] = (FourierSearch(b, runs, evidence), problems[i])
     return out

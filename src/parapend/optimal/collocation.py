@@ -52,7 +52,7 @@ import numba as nb
 import numpy as np
 from scipy.linalg.lapack import dgbsv
 
-from .hermite import _fold, locate  # node order 0, K-1, 1, K-2, ...: the cyclic wrap made banded
+from .hermite import _fold, locate, q_on_intervals  # _fold: node order 0, K-1, 1, K-2, ...
 
 __all__ = ["CollocationMotion", "CollocationSolution", "solve_collocation"]
 
@@ -577,8 +577,9 @@ def solve_collocation(excitation, damping: float, intervals: int, start, *,
     period = 2 * math.pi / om
     h = period / k
     tn = h * np.arange(k)
-    q1n = 1.0 + np.asarray(excitation.q(tn), dtype=float)
-    q1m = 1.0 + np.asarray(excitation.q(tn + h / 2), dtype=float)
+    qnm = q_on_intervals(excitation, k, (0.0, 0.5))
+    q1n = 1.0 + np.ascontiguousarray(qnm[:, 0])
+    q1m = 1.0 + np.ascontiguousarray(qnm[:, 1])
     wrap = 2 * math.pi * winding
     eg, em = (1.0, 1.0) if efficiency is None else (float(efficiency[0]),
                                                      float(efficiency[1]))

@@ -583,7 +583,11 @@ class SearchEvidence:
     abandoned : int
         Runs stopped early because their quadratic model could not reach the best power.
     second_power : float or None
-        Best converged local maximum distinct from the optimum (by more than 1e-9).
+        Best other distinct local maximum among the runs polished to convergence
+        (:func:`second_maximum`); runs abandoned as unable to win are not polished, so a
+        better other maximum may exist (it is a lower bound of the second-best maximum).
+    second_distance : float or None
+        RMS distance over one period between that maximum's motion and the optimum's, rad.
     upper_bound : float
         ``limit - gamma omega^2``: every rotation has ``<theta'^2> >= omega^2``.
     screen_harmonics : int or None
@@ -599,6 +603,36 @@ class SearchEvidence:
     second_power: float | None
     upper_bound: float
     screen_harmonics: int | None = None
+    second_distance: float | None = None
+
+
+#: two converged runs whose motions differ by at most this RMS angle (rad) are the same
+#: local maximum (Newton converges to gtol 1e-11; the optimum before and after a grid
+#: refinement differs by about 1e-10)
+DISTINCT_RMS = 1e-6
+
+
+def motion_distance(x: np.ndarray, y: np.ndarray) -> float:
+    """RMS over one period of the difference of two motions given by packed coefficients
+    ``[a0, a_1..a_N, b_1..b_N]`` (Parseval: ``sqrt(da0^2 + sum(da_k^2 + db_k^2) / 2)``),
+    ``da0`` taken modulo 2 pi (a motion and its copy a turn further are the same)."""
+    d = np.asarray(x, dtype=float) - np.asarray(y, dtype=float)
+    d0 = math.remainder(float(d[0]), 2 * math.pi)
+    return float(math.sqrt(d0**2 + 0.5 * float(np.sum(d[1:] ** 2))))
+
+
+def second_maximum(runs, best) -> tuple[float | None, float | None]:
+    """``(power, distance)`` of the best converged run whose motion is distinct from
+    ``best`` (RMS distance above :data:`DISTINCT_RMS`), or ``(None, None)``. Only runs
+    polished to convergence count: abandoned runs never reached their maximum."""
+    out = (None, None)
+    for r in runs:
+        if r.status != "converged" or not math.isfinite(r.power) or r.x.size != best.x.size:
+            continue
+        dist = motion_distance(r.x, best.x)
+        if dist > DISTINCT_RMS and (out[0] is None or r.power > out[0]):
+            out = (float(r.power), dist)
+    return out
 
 
 @dataclass(frozen=True)
@@ -837,8 +871,7 @@ def search_fourier(excitation, harmonics: int, damping: float, *, warm: np.ndarr
         problem = fine
         best = newton_maximize(problem, best.x, best.seed, gtol=gtol, maxiter=maxiter)
         runs.append(best)
-    conv = [r.power for r in runs if r.status == "converged"]
-    others = [v for v in conv if v < best.power - 1e-9 * max(1.0, abs(best.power))]
+    second, dist = second_maximum(runs, best)
     evidence = SearchEvidence(
         strategy=strategy,
         candidate_patterns=count,
@@ -846,10 +879,11 @@ def search_fourier(excitation, harmonics: int, damping: float, *, warm: np.ndarr
                         len(extra) + swaps + ("limit" in seeds)),
         polished=sum(r.status == "converged" for r in runs),
         abandoned=sum(r.status == "abandoned" for r in runs),
-        second_power=max(others) if others else None,
+        second_power=second,
         upper_bound=(lim.power - damping * excitation.omega**2 if winding == 1
                      else lim.power - damping * (winding * excitation.omega) ** 2),
         screen_harmonics=screen,
+        second_distance=dist,
     )
     return FourierSearch(best, runs, evidence)
 
