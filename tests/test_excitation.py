@@ -148,3 +148,27 @@ def test_fourier_terms_parse_and_errors():
     for bad in ["", "1", "a:1", "0:1:0", "1.5:1"]:
         with pytest.raises(ParameterError):
             parapend.fourier(E.parse_fourier_terms(bad))
+
+
+def test_nonuniform_record_resampled_from_its_own_density(tmp_path):
+    """A non-uniform record is resampled at eight points per sample (at least 256): the
+    spline's spectrum is the signal's to the spline's accuracy, and a record of up to 256
+    rows stays within the harmonics a power take-off solve follows (it was refused)."""
+    from parapend.excitation import _resample_points
+
+    assert [_resample_points(n) for n in (16, 100, 256, 257, 16384)] == [256, 1024, 2048,
+                                                                          4096, 4096]
+    rng = np.random.default_rng(5)
+    tau = np.sort(rng.uniform(0, 1, 200))
+    q = -0.3 * np.sin(2 * np.pi * tau)
+    e = parapend.from_csv(_write(tmp_path, _csv(tau, q)), omega=1.8)
+    spec = e.spectrum
+    assert spec.size == 1025
+    # the fundamental of -0.3 sin s is 0.3i in this project's exp(+i s) convention; the
+    # spline through 200 random samples carries the rest at its O(h^4) accuracy
+    assert abs(spec[1] - 0.3j) < 1e-5 and np.max(np.abs(spec[2:])) < 1e-5
+    from parapend.pto import optimize_pto
+
+    pto = optimize_pto(file=str(tmp_path / "q.csv"), omega=1.8, gamma=0.03, torque_limit=2.0)
+    ref = optimize_pto(omega=1.8, delta=-0.3, gamma=0.03, torque_limit=2.0)
+    assert pto.success and abs(pto.power - ref.power) < 1e-4 * ref.power

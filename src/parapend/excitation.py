@@ -555,7 +555,10 @@ class SampledExcitation(Excitation):
 
     Uniform samples define the trigonometric interpolant (band-limited to half the sample
     count); non-uniform samples are first interpolated by a periodic cubic spline and
-    resampled on 4096 uniform points.
+    resampled on ``8 * 2**ceil(log2(rows))`` uniform points, at least 256 and at most 4096
+    (:func:`_resample_points`): eight points per sample spacing, where the spline's spectrum
+    has decayed like ``k**-4``, and no more harmonics than the data can define (a record of
+    up to 256 rows stays within the 1024 harmonics a power take-off solve follows).
     """
 
     omega: float
@@ -619,7 +622,7 @@ class SampledExcitation(Excitation):
 
             spline = CubicSpline(np.append(tau, tau[0] + 1.0), np.append(q, q[0]),
                                  bc_type="periodic")
-            n = 4096
+            n = _resample_points(n)
             grid = tau[0] + np.arange(n) / n
             q = spline(grid)
         x = np.fft.rfft(q) / n
@@ -635,6 +638,12 @@ class SampledExcitation(Excitation):
     def describe(self) -> dict:
         return {"excitation": "file", "omega": self.omega, "file": self.source,
                 "samples": len(self.tau)}
+
+
+def _resample_points(rows: int) -> int:
+    """Uniform points on which a non-uniform record's periodic spline is resampled: eight per
+    sample (rounded up to a power of two), from 256 to 4096."""
+    return int(min(4096, max(256, 8 * (1 << max(0, int(rows) - 1).bit_length()))))
 
 
 def _read_bounded(path: Path) -> str:

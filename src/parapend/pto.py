@@ -95,8 +95,8 @@ def check_pto_excitation(exc) -> None:
     hint = {"square": f"raise --square-alpha to at least {a_min:.3g} (the tanh width of "
                       "Eq. 26 sets the harmonics)",
             "file": "resample the record uniformly to at most "
-                    f"{2 * limits.MAX_PTO_Q_HARMONICS} rows (non-uniform records are "
-                    "resampled to 4096 points) or smooth it"}.get(exc.name, "use fewer terms")
+                    f"{2 * limits.MAX_PTO_Q_HARMONICS} rows (a non-uniform record to at most "
+                    "256 rows) or smooth it"}.get(exc.name, "use fewer terms")
     raise ParameterError(f"excitation: a power take-off is solved on at most "
                          f"{limits.MAX_PTO_INTERVALS} intervals, which follow q up to "
                          f"{limits.MAX_PTO_Q_HARMONICS} harmonics; this q has {n}: {hint}")
