@@ -218,19 +218,28 @@ def _accuracy(check, entries, code_of, mirror, split_code, ncode, parent, steps,
                                                           both))
     lo = wilson_interval(k2, n)[0]
     hi = wilson_interval(kab, n)[1]
-    # per attractor: sampled points whose label changes and involves it (before or after);
-    # on a symmetric grid each sampled point also stands for its mirror image
+    # per attractor: the shift of its share when the sample is relabelled by (a) or (b),
+    # d_i = [new label is c] - [old label is c]; bound |mean d| + z sqrt(p_hi/n), p_hi the
+    # Wilson upper bound of the share of points whose change involves c (var d <= p); on a
+    # symmetric grid each sampled point also stands for its mirror image
     unsplit = ncode if parent is None else int(parent.max()) + 1
-    k_code = np.zeros(unsplit)
     views = [lambda r: r]
     if use_sym and mirror is not None:
         views.append(lambda r: np.where(r >= 0, mirror[np.clip(r, 0, mirror.size - 1)], -1))
-    for view in views:
-        codes = [code_of[view(keys[name][0])] for name in ("orig", "a", "b")]
+    err = np.zeros(unsplit)
+    for name in ("a", "b"):
         for c in range(unsplit):
-            inv = either & ((codes[0] == c) | (codes[1] == c) | (codes[2] == c))
-            k_code[c] += np.count_nonzero(inv) / len(views)
-    err = np.array([min(wilson_interval(k, n)[1], hi) for k in k_code])
+            d = np.zeros(n)
+            inv = np.zeros(n)
+            for view in views:
+                old = code_of[view(keys["orig"][0])] == c
+                new = code_of[view(keys[name][0])] == c
+                if split_code is not None:     # a change of phase moves a point between codes
+                    new &= keys[name][1] == keys["orig"][1]
+                d += (new.astype(float) - old) / len(views)
+                inv += (changed[name] & (old | new)) / len(views)
+            p_hi = wilson_interval(float(inv.sum()), n)[1]
+            err[c] = max(err[c], abs(d.mean()) + _Z95 * math.sqrt(p_hi / n))
     frac_err = err if parent is None else err[parent]
     record = {
         "method": ("a seeded random sample of the integrated initial conditions is re-run "
@@ -413,8 +422,8 @@ def basin_map(gamma: float, p: float, omega: float, *, n_phi: int = 200, n_dphi:
                                          dtype=np.int32)),
             "basin_fraction": ("code", frac),
             "basin_fraction_error": ("code", frac_err, {
-                "long_name": "95 % upper bound on the error of basin_fraction from uncertain "
-                             "labels (see attrs accuracy)"}),
+                "long_name": "95 % bound on the shift of basin_fraction when its uncertain "
+                             "labels are recomputed (see attrs accuracy)"}),
             "poincare_phi": (("code", "point"), pphi),
             "poincare_dphi": (("code", "point"), pdphi),
         },
