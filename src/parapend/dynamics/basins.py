@@ -148,7 +148,9 @@ def wilson_interval(k: float, n: int, z: float = _Z95) -> tuple[float, float]:
     den = 1.0 + z * z / n
     centre = (ph + z * z / (2 * n)) / den
     half = z * math.sqrt(max(ph * (1 - ph), 0.0) / n + z * z / (4.0 * n * n)) / den
-    return max(0.0, centre - half), min(1.0, centre + half)
+    lo = 0.0 if k <= 0 else max(0.0, centre - half)
+    hi = 1.0 if k >= n else min(1.0, centre + half)
+    return lo, hi
 
 
 def _phases(entries, raw, used, end_th, end_v):
