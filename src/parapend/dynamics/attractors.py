@@ -657,13 +657,18 @@ class _DeferredSigint:
     ``KeyboardInterrupt``. Here Python's handler is replaced, while the block runs, by one
     that only records the signal; ``check()`` (called between kernel calls) and the exit of
     the block run the original handler, which raises ``KeyboardInterrupt``. Outside the main
-    thread, or when SIGINT is not handled by a Python function, nothing is changed.
+    thread, when SIGINT is not handled by a Python function, or with ``NUMBA_DISABLE_JIT``
+    (the kernel is then Python code, which a KeyboardInterrupt stops at once), nothing is
+    changed.
     """
 
     def __enter__(self):
+        import numba
+
         self.hit = False
         self.old = None
-        if threading.current_thread() is threading.main_thread():
+        if (threading.current_thread() is threading.main_thread()
+                and not numba.config.DISABLE_JIT):
             old = signal.getsignal(signal.SIGINT)
             if callable(old):
                 self.old = old
