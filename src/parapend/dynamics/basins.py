@@ -8,12 +8,25 @@ it reaches (0 = "other": chaotic or unresolved within the period budget).
 
 Symmetry. Eq. 1 is invariant under ``(phi, phi') -> (-phi, -phi')`` and the RK4 map of
 :mod:`.simulate` commutes with it exactly (every operation is odd in the state, rounding
-included). On a grid symmetric under it (``dphi_range`` symmetric about 0) only the half
-``0 <= i <= n_phi/2`` is integrated and the other half is the mirror image, with each
-attractor replaced by its mirror (``P1 rotation (+)`` <-> ``P1 rotation (-)``). The
-integrated initial angles are ``theta_i = pi*m_i/n_phi`` (project convention, ``m_i`` an
-even integer in ``(-n_phi, n_phi]``) so that mirror pairs are exact negatives; this is the
-same point as ``phi_i`` up to one rounding.
+included). On a grid symmetric under it (``dphi_range`` symmetric about 0, the whole
+circle in ``phi``) the map is mirror-symmetric by construction: only the columns
+``0 <= i <= n_phi/2`` are integrated, the two that are their own mirror image (``phi = -pi``
+and, ``n_phi`` even, ``phi = 0``) only for ``phi' >= 0``, and every other point is the mirror
+image of an integrated one, with each attractor replaced by its mirror (``P1 rotation (+)``
+<-> ``P1 rotation (-)``). The integrated initial angles are ``theta_i = pi*m_i/n_phi``
+(project convention, ``m_i`` an even integer in ``(-n_phi, n_phi]``) so that mirror pairs
+are exact negatives; this is the same point as ``phi_i`` up to one rounding. (The column
+``phi = 0``, ``theta = pi``, is the exception: its mirror ``theta = -pi`` is the same state
+with other bits, so integrating both of its halves broke the symmetry where basins are
+intertwined.)
+
+Accuracy. Where basins are intertwined a label is not a property of the grid point: any
+perturbation below the pixel size can change it. Every map re-runs a seeded random sample of
+its integrated points (a) with twice the steps per period and (b) from the initial
+condition moved by :data:`PERTURBATION`, and reports the share of labels that change as an
+estimate of the mislabelled share with a 95 % interval (Wilson lower bound of the share
+changed by both, upper bound of the share changed by either), and for each basin a bound on
+the shift of its share (``basin_fraction_error``); see ``docs/dynamics.md``.
 """
 
 from __future__ import annotations
@@ -299,15 +312,22 @@ def basin_map(gamma: float, p: float, omega: float, *, n_phi: int = 200, n_dphi:
         the order in which capture becomes available differs (tested on small grids).
     progress : callable, optional
         ``progress(done, total)`` called as parts of the grid are finished (numba engine:
-        up to 20 parts), for a progress display; the library itself never prints.
+        after each kernel call of about half a second), for a progress display; the library
+        itself never prints.
     symmetric : bool
         Use the ``(phi, phi') -> (-phi, -phi')`` symmetry when the grid allows it (halves
-        the work; identical labels, see module docstring).
+        the work; the labels are then exactly mirror-symmetric, see module docstring).
     split_phases : bool
         Give each phase of a period-k attractor its own code, i.e. label by the attractor
         of the ``k*T`` stroboscopic map: the point visited at ``t0 + m*T``, ``m = 0 mod k``
         (e.g. the P2 oscillation becomes ``"P2 oscillation [phase 0]"`` and ``[phase 1]``,
         whose basins are distinct sets). Off by default.
+    accuracy_sample : int
+        Integrated points re-run to estimate the uncertain labels (module docstring);
+        default 1000, at most the integrated points; 0 skips the estimate (the record then
+        says so and ``basin_fraction_error`` is NaN). It costs about 3 points each.
+    accuracy_seed : int
+        Seed of that sample and of the perturbations' directions.
 
     Returns
     -------
@@ -324,8 +344,17 @@ def basin_map(gamma: float, p: float, omega: float, *, n_phi: int = 200, n_dphi:
         - ``poincare_phi``, ``poincare_dphi`` (code, point): the attractor on the section
           ``t0 + m*2*pi/omega`` (``phi`` wrapped to ``[-pi, pi)``).
 
+        - ``basin_fraction_error`` (code): 95 % bound on the shift of ``basin_fraction``
+          when the uncertain labels are recomputed (not the grid's resolution).
+
         Attributes: ``legend`` (JSON ``{code: name}``), the parameters, ``convention``,
-        ``elapsed_s`` (wall time), ``stats`` (JSON work counters) and ``symmetric_used``.
+        ``elapsed_s`` (wall time), ``stats`` (JSON work counters), ``symmetric_used`` and
+        ``mirror_symmetric`` (1: exactly symmetric by construction), ``accuracy`` (JSON: the
+        method, ``sample``, ``population``, ``seed``, ``refined_steps_per_period``,
+        ``perturbation``, the counts ``changed_refined``, ``changed_perturbed``,
+        ``changed_both``, ``changed_either``, ``mislabel_fraction``, ``mislabel_interval``,
+        ``confidence``, ``phases_compared``), and ``mislabel_fraction``,
+        ``mislabel_interval`` (the same two numbers as plain attributes).
     """
     started = time.perf_counter()
     gamma, p, omega = _check_params(gamma, p, omega)
