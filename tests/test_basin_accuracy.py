@@ -223,6 +223,22 @@ def test_basins_ctrl_c_one_line_exit_130():
     assert out == ""
 
 
+@pytest.mark.skipif(os.name != "posix", reason="SIGINT delivery to a child process")
+def test_basins_ctrl_c_during_first_compile_one_line_exit_130(tmp_path):
+    """Ctrl-C while numba compiles the kernel (an empty cache: 10 to 35 s inside LLVM, where
+    Python cannot raise KeyboardInterrupt): still one line and exit code 130, the process
+    ended by the command's watchdog."""
+    env = dict(os.environ, PYTHONPATH=os.pathsep.join(sys.path),
+               NUMBA_CACHE_DIR=str(tmp_path))
+    proc = subprocess.Popen([sys.executable, "-m", "parapend", "basins", "--resolution", "50"],
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env)
+    time.sleep(5.0)
+    proc.send_signal(signal.SIGINT)
+    out, err = proc.communicate(timeout=120)
+    assert proc.returncode == 130, err[-2000:]
+    assert err.strip().splitlines() == ["parapend basins: interrupted"]
+
+
 # --- acceptance: the estimate brackets DOP853's mislabel fraction ------------------------
 def _dop853_label(phi0, dphi0, gamma, p, omega, periods=300, chunk=30):
     """Attractor reached from (phi0, phi0') at t = 0: DOP853 (rtol = atol = 1e-11), Poincare

@@ -228,6 +228,78 @@ def _cmd_simulate(a) -> dict | str:
 
 
 # --- basins --------------------------------------------------------------------------------
+class _PromptInterrupt:
+    """Answer a Ctrl-C within ``grace`` seconds even while compiled code holds the
+    interpreter (the first compile of the basin kernel spends 30 s or more inside LLVM, where
+    Python cannot deliver ``KeyboardInterrupt``: a Ctrl-C waited 15 s there).
+
+    ``signal.set_wakeup_fd`` makes the C-level handler write a byte at once; a daemon thread
+    (which runs while LLVM, called through ctypes, has released the GIL) waits for it, and if
+    the main thread has not ended the command ``grace`` seconds later, prints the command's
+    one line and ends the process with exit code 130 (nothing is half-written then: output
+    files are written after the computation, atomically). Only in the main thread on POSIX.
+    """
+
+    def __init__(self, name: str, grace: float = 1.5):
+        self.name, self.grace = name, grace
+        self.done = False
+        self.fds = None
+
+    def __enter__(self):
+        import os
+        import signal
+        import threading
+
+        if os.name != "posix" or threading.current_thread() is not threading.main_thread():
+            return self
+        try:
+            r, w = os.pipe()
+            os.set_blocking(w, False)
+            self.old_fd = signal.set_wakeup_fd(w, warn_on_full_buffer=False)
+        except (OSError, ValueError):
+            return self
+        self.fds = (r, w)
+        threading.Thread(target=self._watch, daemon=True).start()
+        return self
+
+    def _watch(self):
+        import os
+        import signal
+        import sys
+        import time
+
+        while True:
+            try:
+                data = os.read(self.fds[0], 64)
+            except OSError:
+                return
+            if not data:
+                return
+            if signal.SIGINT in data:
+                time.sleep(self.grace)
+                if not self.done:
+                    try:
+                        print(f"parapend {self.name}: interrupted", file=sys.__stderr__,
+                              flush=True)
+                    finally:
+                        os._exit(130)
+
+    def __exit__(self, *exc):
+        import os
+        import signal
+
+        self.done = True
+        if self.fds is not None:
+            try:
+                signal.set_wakeup_fd(self.old_fd)
+            except (OSError, ValueError):
+                pass
+            for fd in self.fds:
+                os.close(fd)
+        return False
+
+
+# --- basins --------------------------------------------------------------------------------
 def basins_json(ds) -> dict:
     """The JSON object of ``parapend basins`` from a basin Dataset."""
     import json
@@ -293,10 +365,11 @@ def _cmd_basins(a) -> dict | str:
                 raise ParameterError(f"{name}: expected values within +-{cap:g}, got "
                                      f"{rng[0]:g}:{rng[1]:g}")
     bar = _Progress("basins")
-    ds = basin_map(a.gamma, a.p, a.omega, n_phi=n, n_dphi=n, dphi_range=a.dphi_range,
-                   phi_range=a.phi_range, periods=periods, steps_per_period=steps,
-                   split_phases=a.split_phases, engine=a.engine, progress=bar,
-                   accuracy_sample=sample, accuracy_seed=seed)
+    with _PromptInterrupt("basins"):
+        ds = basin_map(a.gamma, a.p, a.omega, n_phi=n, n_dphi=n, dphi_range=a.dphi_range,
+                       phi_range=a.phi_range, periods=periods, steps_per_period=steps,
+                       split_phases=a.split_phases, engine=a.engine, progress=bar,
+                       accuracy_sample=sample, accuracy_seed=seed)
     bar(1, 1)
     if a.save:
         _output.write_dataset(ds, a.save)
