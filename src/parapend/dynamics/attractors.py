@@ -729,13 +729,12 @@ class _Compiled:
         parts = []
         before = numba.get_num_threads()
         numba.set_num_threads(min(self.workers, numba.config.NUMBA_NUM_THREADS))
-        # chunks of about _CHUNK_S seconds: between two kernel calls a Ctrl-C (deferred by
-        # _DeferredSigint while the compiled code runs) is raised as KeyboardInterrupt, and
-        # the progress display moves; labels do not depend on the chunking (points are
-        # independent)
-        # first call: about 4e6 point-periods at 128 steps (16 to 130 ms per thread for the
-        # default budget, where most points stop after 20 to 40 periods; a second or two if
-        # every point ran the largest budget), then calls of about _CHUNK_S seconds
+        # calls of about _CHUNK_S seconds: between two of them a Ctrl-C (held by
+        # _DeferredSigint while compiled code runs) is raised as KeyboardInterrupt and the
+        # progress display moves. The first call is sized for the period budget (a second or
+        # two if every point ran the whole budget; most stop after 20 to 40 periods), the
+        # next ones from the measured time. Labels do not depend on the chunks: every point
+        # is integrated on its own from a reset lane.
         size = min(n, max(_CHUNK_MIN, int(_CHUNK_FIRST * 38400 / (self.max_periods
                                                                    * m.steps))))
         i = 0
