@@ -265,11 +265,13 @@ def _dop853_label(phi0, dphi0, gamma, p, omega, periods=300, chunk=30):
 @pytest.mark.parametrize("case", [INTERTWINED, COEX])
 def test_accuracy_estimate_brackets_dop853_mislabel_fraction(case):
     """60 x 60 map; 240 seeded grid points (independent of the map's own sample) labelled by
-    DOP853. The share whose map label differs lies inside the reported 95 % interval, or
-    (few mislabels) is consistent with it: DOP853's own Wilson interval reaches the
-    reported lower bound, and the share is not above the reported upper bound. The basin
-    shares of the map and of DOP853 on those points differ by no more than the reported
-    bound scaled to 240 points."""
+    DOP853. The share whose map label differs from DOP853's lies inside the reported 95 %
+    interval at the intertwined case (18 to 19 % measured, interval 11.7 to 34.9 %); with few
+    mislabels (the paper's case, 1 %) it is consistent with it: DOP853's own 95 % Wilson
+    interval overlaps the reported one. Each basin's share shifts, from the map to DOP853 on
+    those points, by no more than the reported bound plus the 95 % sampling error of 240
+    points (1.96 sqrt(p/240), p the Wilson upper bound of the share of points whose label
+    differs and involves that basin)."""
     ds = basin_map(*case, n_phi=60, n_dphi=60)
     acc = json.loads(ds.attrs["accuracy"])
     lo, hi = acc["mislabel_interval"]
@@ -282,13 +284,15 @@ def test_accuracy_estimate_brackets_dop853_mislabel_fraction(case):
         j, i = divmod(int(q), 60)
         mine.append(names[int(ds["attractor"].values[j, i])])
         ref.append(_dop853_label(float(ds["phi"][i]), float(ds["dphi"][j]), *case))
-    bad = sum(a != b for a, b in zip(mine, ref))
-    frac = bad / m
-    assert frac <= hi
-    assert lo <= frac or wilson_interval(bad, m)[1] >= lo
+    mine, ref = np.array(mine), np.array(ref)
+    bad = int(np.count_nonzero(mine != ref))
+    dlo, dhi = wilson_interval(bad, m)
+    assert dlo <= hi and dhi >= lo           # the two 95 % intervals overlap
     if case == INTERTWINED:
-        assert lo <= frac          # many mislabels: inside the interval itself
+        assert lo <= bad / m <= hi           # many mislabels: inside the interval itself
     err = ds["basin_fraction_error"].values
     for c, name in enumerate(names):
-        shift = (sum(b == name for b in ref) - sum(a == name for a in mine)) / m
-        assert abs(shift) <= err[c] * math.sqrt(acc["sample"] / m) + 1e-12, name
+        shift = (np.count_nonzero(ref == name) - np.count_nonzero(mine == name)) / m
+        involved = np.count_nonzero((mine != ref) & ((mine == name) | (ref == name)))
+        sampling = 1.959963984540054 * math.sqrt(wilson_interval(involved, m)[1] / m)
+        assert abs(shift) <= err[c] + sampling, name
