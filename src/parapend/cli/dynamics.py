@@ -272,8 +272,9 @@ class _PromptInterrupt:
             try:
                 data = os.read(self.fds[0], 64)
             except OSError:
-                return
-            if not data:
+                data = b""
+            if not data:          # the write end was closed: the command has ended
+                os.close(self.fds[0])
                 return
             if signal.SIGINT in data:
                 time.sleep(self.grace)
@@ -294,8 +295,7 @@ class _PromptInterrupt:
                 signal.set_wakeup_fd(self.old_fd)
             except (OSError, ValueError):
                 pass
-            for fd in self.fds:
-                os.close(fd)
+            os.close(self.fds[1])     # the watcher sees the end of the pipe and closes it
         return False
 
 
