@@ -114,6 +114,11 @@ DYN_MAX_GAMMA = 10.0
 #: t = 5e4 took 150 s under load; 1e5 is about 30 s under load, 10 s idle)
 SIM_MAX_PERIODS = 20000
 SIM_MAX_WORK = 1e5
+#: simulate: |phi0| (rad) and |dphi0| of the initial state; the work above counts the rate
+#: too, periods * 2 pi/omega * (sqrt(1 + |p|) + |dphi0|) (a fast rotation needs DOP853 steps
+#: in proportion to its speed: gamma = 0, dphi0 = 1000, 30 periods (9e4) took 6 s)
+SIM_MAX_PHI0 = 1e3
+SIM_MAX_DPHI0 = 1e3
 #: basins: grid points per axis, period budget, and integrated points x periods (the
 #: default grid is symmetric and integrates half its points: the 1000 x 1000, 300-period
 #: map of issue 10 is 1.5e8; worst case, every point running the whole budget, about 180 s
@@ -121,12 +126,19 @@ SIM_MAX_WORK = 1e5
 BASIN_MAX_RESOLUTION = 2000
 BASIN_MAX_PERIODS = 5000
 BASIN_MAX_WORK = 1.6e8
-#: rotations: omega range, values of omega in one map, and the largest p followed
-#: (continuation to p = 5 at omega = 0.9 took 133 s under load, omega = 0.6 over 200 s;
-#: omega = 0.8 to p = 3 took 21 s, omega = 10 to p = 5 took 15 s)
+#: basins: RK4 steps per forcing period (the work above is counted at 128 steps and scales
+#: with the steps), and the points of the accuracy check (re-run twice: 3 units each)
+BASIN_STEPS_RANGE = (16, 1024)
+BASIN_ACCURACY_RANGE = (100, 100000)
+#: rotations: omega range, values of omega in one map, and the largest p followed; the
+#: work is bounded by a time limit (seconds of continuation per command, the branch is
+#: followed as far as the time allows and the result says where it stopped): continuation
+#: to p = 5 at omega = 0.9 took 133 s under load, omega = 0.6 over 200 s
 ROT_OMEGA_RANGE = (0.8, 10.0)
 ROT_MAX_OMEGAS = 40
-ROT_MAX_P = 3.0
+ROT_MAX_P = 10.0
+ROT_TIME_LIMIT = 100.0
+ROT_MAX_TIME_LIMIT = 600.0
 
 # --- closed-loop control (track) ------------------------------------------------------
 #: forcing periods of one closed-loop run (about 1.7 ms each at 256 samples per period)

@@ -347,5 +347,8 @@ def fig2_right(case=None) -> dict:
     numbers = {**case, "grid": [int(ds.sizes[d]) for d in ds["attractor"].dims],
                "attractors": names,
                "basin_fraction": [float(v) for v in ds["basin_fraction"].values],
+               "basin_fraction_error": [float(v) for v in ds["basin_fraction_error"].values],
+               "mislabel_fraction": float(ds.attrs["mislabel_fraction"]),
+               "mislabel_interval": [float(v) for v in ds.attrs["mislabel_interval"]],
                "convention": "paper Eq. 1 (phi from hanging)"}
     return {"figure": plot_basins(ds), "numbers": numbers}

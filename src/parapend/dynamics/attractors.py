@@ -45,6 +45,9 @@ switches all this off (slower, assumption-free); tests check both give the same 
 from __future__ import annotations
 
 import math
+import signal
+import threading
+import time
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field
 
@@ -634,6 +637,60 @@ def _run_search(th0, v0, gamma, p, omega, *, periods, steps, t0, tol, kmax, rcap
     return s.entries, raw, used, end_th, end_v, stats
 
 
+_CHUNK_S = 0.5        # seconds per kernel call (Ctrl-C latency, progress steps)
+_CHUNK_FIRST = 16384
+_CHUNK_MIN = 64
+
+
+def _groups(n: int, k) -> int:
+    """Work units of one kernel call: at most ``k.MAX_GROUPS``, each at least 8 points per SIMD
+    lane (a lane that finishes waits for the slowest of its group; with 2 points per lane
+    the default map took 15 to 40 % more CPU time)."""
+    return max(1, min(k.MAX_GROUPS, n // (8 * k.LANES)))
+
+
+class _DeferredSigint:
+    """Hold a Ctrl-C (SIGINT) while compiled code runs; :meth:`check` raises it between calls.
+
+    A SIGINT that arrives inside a numba kernel sets Python's pending-signal flag, and the
+    kernel's return then fails with a chain of ``SystemError`` (about 60 lines) instead of a
+    ``KeyboardInterrupt``. Here Python's handler is replaced, while the block runs, by one
+    that only records the signal; ``check()`` (called between kernel calls) and the exit of
+    the block run the original handler, which raises ``KeyboardInterrupt``. Outside the main
+    thread, when SIGINT is not handled by a Python function, or with ``NUMBA_DISABLE_JIT``
+    (the kernel is then Python code, which a KeyboardInterrupt stops at once), nothing is
+    changed.
+    """
+
+    def __enter__(self):
+        import numba
+
+        self.hit = False
+        self.old = None
+        if (threading.current_thread() is threading.main_thread()
+                and not numba.config.DISABLE_JIT):
+            old = signal.getsignal(signal.SIGINT)
+            if callable(old):
+                self.old = old
+                signal.signal(signal.SIGINT, self._record)
+        return self
+
+    def _record(self, signum, frame):
+        self.hit = True
+
+    def check(self):
+        if self.hit:
+            self.hit = False
+            self.old(signal.SIGINT, None)
+
+    def __exit__(self, *exc):
+        if self.old is not None:
+            signal.signal(signal.SIGINT, self.old)
+            if exc[0] is None:
+                self.check()
+        return False
+
+
 class _Compiled:
     """Calls of the compiled kernel (:mod:`._kernel`) for one parameter set."""
 
@@ -668,21 +725,41 @@ class _Compiled:
         th0 = np.ascontiguousarray(th0, dtype=float)
         v0 = np.ascontiguousarray(v0, dtype=float)
         n = th0.size
-        edges = np.linspace(0, n, max(1, min(20, n // 20000)) + 1).astype(np.int64)
+        steps = m.steps
         parts = []
         before = numba.get_num_threads()
         numba.set_num_threads(min(self.workers, numba.config.NUMBA_NUM_THREADS))
+        # calls of about _CHUNK_S seconds: between two of them a Ctrl-C (held by
+        # _DeferredSigint while compiled code runs) is raised as KeyboardInterrupt and the
+        # progress display moves. The first call is sized for the period budget (a second or
+        # two if every point ran the whole budget; most stop after 20 to 40 periods), the
+        # next ones from the measured time. Labels do not depend on the chunks: every point
+        # is integrated on its own from a reset lane.
+        size = min(n, max(_CHUNK_MIN, int(_CHUNK_FIRST * 38400 / (self.max_periods
+                                                                   * m.steps))))
+        i = 0
         try:
-            for c in range(edges.size - 1):
-                sl = slice(edges[c], edges[c + 1])
-                parts.append(self.k.basin_kernel(
-                    th0[sl], v0[sl], m.a, m.gamma, m.h, m.steps, self.tol, kmax,
-                    self.max_periods, rcap, self.match_tol, ent_th, ent_v, ent_k, ent_r,
-                    ent_cap, self.k.n_groups(edges[c + 1] - edges[c])))
-                if progress is not None:
-                    progress(int(edges[c + 1]), n)
+            with _DeferredSigint() as sig:
+                while i < n:
+                    j = min(n, i + max(1, size))
+                    t = time.perf_counter()
+                    parts.append(self.k.basin_kernel(
+                        th0[i:j], v0[i:j], m.a, m.gamma, m.h, steps, self.tol, kmax,
+                        self.max_periods, rcap, self.match_tol, ent_th, ent_v, ent_k, ent_r,
+                        ent_cap, _groups(j - i, self.k)))
+                    sig.check()
+                    dt = time.perf_counter() - t
+                    size = int(min(4 * (j - i), max(_CHUNK_MIN,
+                                                    (j - i) * _CHUNK_S / max(dt, 1e-4))))
+                    i = j
+                    if progress is not None:
+                        progress(int(i), n)
         finally:
             numba.set_num_threads(before)
+        if not parts:
+            parts.append(self.k.basin_kernel(
+                th0, v0, m.a, m.gamma, m.h, steps, self.tol, kmax, self.max_periods, rcap,
+                self.match_tol, ent_th, ent_v, ent_k, ent_r, ent_cap, 1))
         return tuple(np.concatenate(x) for x in zip(*parts))
 
     def catalogue(self, entries, raw, new_k, new_r, cyc_th, cyc_v):
@@ -767,6 +844,30 @@ def _run_compiled(th0, v0, gamma, p, omega, *, periods, steps, t0, tol, kmax, rc
                  entries_before_grid=n_cat,
                  verified=int(sum(e.capture for e in entries)), engine="numba")
     return entries, raw, used, end_th, end_v, stats
+
+
+def _rerun(th0, v0, entries: list[_Entry], gamma, p, omega, *, periods, steps, t0, tol, kmax,
+           rcap, workers, engine):
+    """Labels of ``(th0, v0)`` against an existing catalogue (no pilot, no new verification).
+
+    The entries keep their capture flags; attractors outside the catalogue are appended to
+    ``entries`` (same matching rules). Returns raw labels (indices into ``entries``, -1 for
+    "other"), periods used and the state at retirement, as :func:`_run_search`.
+    """
+    if engine == "numba":
+        c = _Compiled(gamma, p, omega, steps, t0, tol, kmax, periods, workers)
+        out = c.run(th0, v0, entries, rcap)
+        raw = out[0].copy()
+        c.catalogue(entries, raw, *out[4:])
+        return raw, out[1], out[2], out[3]
+    s = _Search(gamma, p, omega, steps, t0, tol, kmax, periods, rcap, workers)
+    for ent in entries:
+        s.entries.append(_Entry(ent.period, ent.winding, ent.theta.copy(), ent.v.copy(),
+                                ent.kind, refined=True, capture=ent.capture))
+    n_old = len(entries)
+    raw, used, end_th, end_v = s.run(np.asarray(th0, dtype=float), np.asarray(v0, dtype=float))
+    entries.extend(s.entries[n_old:])
+    return raw, used, end_th, end_v
 
 
 def find_attractors(phi0: ArrayLike, dphi0: ArrayLike, gamma: float, p: float, omega: float, *,

@@ -30,6 +30,7 @@ repeats this over a list of ``omega`` to trace J, G and E in the ``(omega, p)`` 
 from __future__ import annotations
 
 import math
+import time
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -388,8 +389,9 @@ def _tests(mono):
 
 def continue_rotation(gamma: float, omega: float, p_start: float, *, direction: int = 1,
                       p_min: float = 0.0, p_max: float = 3.0, winding: int = 1,
-                      t0: float = 0.0, ds: float = 0.02, max_steps: int = 400,
-                      stop_at_fold: bool = True, tol: float = 1e-10) -> Branch:
+                      t0: float = 0.0, ds: float = 0.02, max_steps: int | None = None,
+                      stop_at_fold: bool = True, tol: float = 1e-10,
+                      deadline: float | None = None) -> Branch:
     """Continue the period-1 rotation of Eq. 1 in ``p`` at fixed ``omega`` (pseudo-arclength).
 
     Parameters
@@ -406,11 +408,15 @@ def continue_rotation(gamma: float, omega: float, p_start: float, *, direction: 
     t0 : float
     ds : float
         Arclength step in ``(phi0, phi0', p)`` (adapted between ``ds/16`` and ``4*ds``).
-    max_steps : int
+    max_steps : int, optional
+        Default ``400 * max(1, (p_max - p_min)/3)`` (400 reach p = 3 with room).
     stop_at_fold : bool
         Stop at the first fold (the birth of the rotation, curve J).
     tol : float
         Corrector tolerance.
+    deadline : float, optional
+        A ``time.monotonic()`` value: past it the continuation stops with status
+        ``"time_limit"`` (``success`` False; ``extra["p_reached"]`` says how far it got).
 
     Returns
     -------
@@ -420,6 +426,8 @@ def continue_rotation(gamma: float, omega: float, p_start: float, *, direction: 
     if direction not in (1, -1):
         raise ParameterError(f"direction: expected +1 or -1, got {direction!r}")
     ds = check_positive("ds", ds)
+    if max_steps is None:
+        max_steps = int(400 * max(1.0, (p_max - p_min) / 3.0))
     max_steps = check_int("max_steps", max_steps, 1)
     orb = periodic_orbit(gamma, p_start, omega, winding=winding, t0=t0, tol=tol)
     if not orb.success:
@@ -433,6 +441,10 @@ def continue_rotation(gamma: float, omega: float, p_start: float, *, direction: 
     h = ds
     status, message = "max_steps", f"stopped after {max_steps} steps"
     for _ in range(max_steps):
+        if deadline is not None and time.monotonic() > deadline:
+            status, message = "time_limit", (f"time limit reached at p = {X[2]:.6g}; the branch "
+                                             "beyond was not followed")
+            break
         ok = False
         while h >= ds / 16:
             Xp = X + h * t
@@ -491,7 +503,8 @@ def continue_rotation(gamma: float, omega: float, p_start: float, *, direction: 
         attrs={"gamma": gamma, "omega": omega, "winding": winding, "t0": t0,
                "convention": "paper Eq. 1 (phi from hanging)"})
     success = status in ("fold", "p_range", "max_steps")
-    return Branch(data, tuple(bifs), success, status, message)
+    return Branch(data, tuple(bifs), success, status, message,
+                  {"p_reached": float(np.max(ps)) if direction > 0 else float(np.min(ps))})
 
 
 def _refine(Xa, Xb, gamma, omega, t0, r, which, tol, iters=30):
@@ -530,7 +543,8 @@ def _refine(Xa, Xb, gamma, omega, t0, r, which, tol, iters=30):
 
 
 def rotation_boundaries(gamma: float, omegas: ArrayLike, *, p_start: float | None = None,
-                        p_max: float = 3.0, ds: float = 0.02, progress=None) -> xr.Dataset:
+                        p_max: float = 3.0, ds: float = 0.02, progress=None,
+                        time_limit: float | None = None) -> xr.Dataset:
     """Curves J (birth, fold), G (loss of stability) and E (regain) of paper Fig. 2 left.
 
     For each ``omega``, a period-1 rotation is found by shooting at ``p_start`` (default:
@@ -549,45 +563,69 @@ def rotation_boundaries(gamma: float, omegas: ArrayLike, *, p_start: float | Non
     ds : float
     progress : callable, optional
         ``progress(done, total)`` after each ``omega`` (for a progress display).
+    time_limit : float, optional
+        Seconds for the whole map; past them every branch stops where it is and the
+        remaining values of ``omega`` are not computed (attribute ``status`` is then
+        ``"time_limit"``; ``p_reached`` says how far each branch was followed).
 
     Returns
     -------
     xarray.Dataset
         ``p_J``, ``p_G``, ``p_E`` along ``omega`` (NaN where not found: no start found by
-        shooting, or the bifurcation lies above ``p_max``), and ``p_start``.
+        shooting, the bifurcation lies above ``p_max`` or above ``p_reached``), ``p_start``
+        and ``p_reached`` (largest ``p`` followed; NaN: not computed).
     """
     omegas = np.atleast_1d(np.asarray(omegas, dtype=float))
-    out = {"p_J": [], "p_G": [], "p_E": [], "p_start": []}
+    deadline = None if time_limit is None else time.monotonic() + check_positive(
+        "time_limit", time_limit)
+    out = {"p_J": [], "p_G": [], "p_E": [], "p_start": [], "p_reached": []}
+    status = "ok"
     for i, om in enumerate(omegas):
-        bifs, p0 = _bifurcations_at(gamma, om, p_start, p_max, ds)
+        bifs, p0, info = _bifurcations_at(gamma, om, p_start, p_max, ds, deadline)
+        if info["status"] == "time_limit":
+            status = "time_limit"
         pj, pg, pe = _lowest_jge(bifs)
         out["p_J"].append(pj)
         out["p_G"].append(pg)
         out["p_E"].append(pe)
         out["p_start"].append(p0)
+        out["p_reached"].append(info["p_reached"])
         if progress is not None:
             progress(i + 1, omegas.size)
     return xr.Dataset({k: ("omega", np.array(v)) for k, v in out.items()},
                       coords={"omega": omegas},
                       attrs={"gamma": gamma, "p_max": float(p_max),
-                             "convention": "paper Eq. 1 (p, omega)"})
+                             "convention": "paper Eq. 1 (p, omega)", "status": status})
 
 
-def _bifurcations_at(gamma, om, p_start, p_max, ds):
-    """Bifurcations along the period-1 rotation at one ``omega`` and the start used."""
+def _bifurcations_at(gamma, om, p_start, p_max, ds, deadline=None):
+    """Bifurcations along the period-1 rotation at one ``omega``, the start used, and a dict
+    ``status`` (``"ok"``, ``"time_limit"``, ``"no_rotation_found"``),
+    ``message``, ``p_reached`` (the largest ``p`` followed)."""
     starts = [p_start] if p_start is not None else list(np.arange(1, 11) * 0.3)
     for ps in starts:
+        if deadline is not None and time.monotonic() > deadline:
+            return (), math.nan, {"status": "time_limit", "p_reached": math.nan,
+                                  "message": "time limit reached before a rotation was found"}
         orb = periodic_orbit(gamma, ps, om)
         if not orb.success:
             continue
         # down through the fold and back up the other branch (the start may be on the
         # saddle branch), then up from the start
         down = continue_rotation(gamma, om, ps, direction=-1, p_max=p_max, ds=ds,
-                                 stop_at_fold=False)
+                                 stop_at_fold=False, deadline=deadline)
         up = continue_rotation(gamma, om, ps, direction=1, p_max=p_max, ds=ds,
-                               stop_at_fold=False)
-        return down.bifurcations + up.bifurcations, float(ps)
-    return (), math.nan
+                               stop_at_fold=False, deadline=deadline)
+        # how far up in p the start's branch was followed (the down branch turns at the
+        # fold J and comes back up on the saddle branch)
+        reached = float(up.data["p"].max()) if "p" in up.data else float(ps)
+        info = {"status": "ok", "message": "", "p_reached": min(reached, p_max)}
+        for br in (down, up):
+            if br.status == "time_limit":
+                info.update(status=br.status, message=br.message, p_reached=min(reached,
+                                                                                 p_max))
+        return down.bifurcations + up.bifurcations, float(ps), info
+    return (), math.nan, {"status": "no_rotation_found", "p_reached": math.nan, "message": ""}
 
 
 def _lowest_jge(bifs):
@@ -626,9 +664,12 @@ class RotationBoundaries:
         Where shooting started the branch (NaN: no period-1 rotation found by shooting).
     bifurcations : tuple of Bifurcation
     success : bool
-        A branch was found.
+        A branch was found and followed over ``[0, p_max]``.
     status, message : str
-        ``"ok"`` or ``"no_rotation_found"``.
+        ``"ok"``, ``"no_rotation_found"`` or ``"time_limit"`` (the branch was followed only
+        up to ``p_reached``).
+    p_reached : float
+        Largest ``p`` the branch was followed to (``p_max`` unless the time ran out).
     """
 
     gamma: float
@@ -645,6 +686,7 @@ class RotationBoundaries:
     success: bool
     status: str
     message: str
+    p_reached: float = math.nan
 
     def to_dict(self) -> dict:
         return {"gamma": self.gamma, "omega": self.omega, "p_max": self.p_max,
@@ -653,11 +695,13 @@ class RotationBoundaries:
                 "lowest_E": self.lowest_E, "p_start": self.p_start,
                 "bifurcations": [{"label": b.label, "kind": b.kind, "p": b.p,
                                   "phi0": b.phi0, "dphi0": b.dphi0} for b in self.bifurcations],
-                "success": self.success, "status": self.status, "message": self.message}
+                "success": self.success, "status": self.status, "message": self.message,
+                "p_reached": self.p_reached}
 
 
 def rotation_boundaries_at(gamma: float, omega: float, *, p_start: float | None = None,
-                           p_max: float = 3.0, ds: float = 0.02) -> RotationBoundaries:
+                           p_max: float = 3.0, ds: float = 0.02,
+                           time_limit: float | None = None) -> RotationBoundaries:
     """Curves J, G, E of paper Fig. 2 left at one ``omega``, every occurrence listed.
 
     The same computation as one column of :func:`rotation_boundaries` (whose values are
@@ -674,6 +718,9 @@ def rotation_boundaries_at(gamma: float, omega: float, *, p_start: float | None 
         Largest excitation strength ``p`` followed.
     ds : float
         Continuation step.
+    time_limit : float, optional
+        Seconds: past them the continuation stops where it is, with status
+        ``"time_limit"``, ``success`` False and ``p_reached`` the largest ``p`` followed.
 
     Returns
     -------
@@ -681,15 +728,24 @@ def rotation_boundaries_at(gamma: float, omega: float, *, p_start: float | None 
     """
     gamma, _, omega = _check_params(gamma, 0.0, omega)
     p_max = check_positive("p_max", p_max)
-    bifs, p0 = _bifurcations_at(gamma, omega, p_start, p_max, ds)
+    deadline = None if time_limit is None else time.monotonic() + check_positive(
+        "time_limit", time_limit)
+    bifs, p0, info = _bifurcations_at(gamma, omega, p_start, p_max, ds, deadline)
     pj, pg, pe = _lowest_jge(bifs)
-    ok = not math.isnan(p0)
+    ok = not math.isnan(p0) and info["status"] == "ok"
     bifs = tuple(sorted(bifs, key=lambda b: b.p))
+    if info["status"] == "time_limit":
+        status, message = "time_limit", (f"{info['message']} (time limit {time_limit:g} s); "
+                                         "curves above it are not reported")
+    elif ok:
+        status, message = "ok", ""
+    else:
+        status, message = "no_rotation_found", (
+            f"no period-1 rotation found by shooting at p = 0.3, 0.6, ..., 3 "
+            f"(omega = {omega:g}); give p_start where one exists")
     return RotationBoundaries(
         gamma, omega, p_max,
         _distinct([b.p for b in bifs if b.kind == "fold"]),
         _distinct([b.p for b in bifs if b.label == "G"]),
         _distinct([b.p for b in bifs if b.label == "E"]),
-        pj, pg, pe, p0, bifs, ok, "ok" if ok else "no_rotation_found",
-        "" if ok else f"no period-1 rotation found by shooting at p = 0.3, 0.6, ..., 3 "
-                      f"(omega = {omega:g}); give p_start where one exists")
+        pj, pg, pe, p0, bifs, ok, status, message, info["p_reached"])

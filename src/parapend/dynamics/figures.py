@@ -202,11 +202,14 @@ def plot_basins(ds: xr.Dataset, *, path: str | Path | None = None,
               extent=(phi[0] - dx / 2, phi[-1] + dx / 2, dphi[0] - dy / 2, dphi[-1] + dy / 2))
     handles = []
     frac = ds["basin_fraction"].values
+    err = (ds["basin_fraction_error"].values if "basin_fraction_error" in ds
+           else np.full(frac.shape, np.nan))
     for c in range(ncode):
         if c == 0 and frac[0] == 0:
             continue
+        pm = "" if not np.isfinite(err[c]) else rf" $\pm$ {100 * err[c]:.1f}"
         handles.append(Patch(facecolor=colors[c], edgecolor="k", lw=0.5,
-                             label=f"{ds['name'].values[c]}  ({100 * frac[c]:.1f}%)"))
+                             label=f"{ds['name'].values[c]}  ({100 * frac[c]:.1f}{pm}%)"))
     if show_attractors:
         for c in range(1, ncode):
             pp = ds["poincare_phi"].values[c]
@@ -231,6 +234,11 @@ def plot_basins(ds: xr.Dataset, *, path: str | Path | None = None,
         title = (rf"Basins, Eq. 1: $\gamma={a['gamma']:g}$, $p={a['p']:g}$, "
                  rf"$\omega={a['omega']:g}$ ({phi.size}$\times${dphi.size}, "
                  f"{a['periods']} periods max)")
+        lo, hi = (np.asarray(a["mislabel_interval"], dtype=float).ravel().tolist()
+                  if "mislabel_interval" in a else (math.nan, math.nan))
+        if math.isfinite(hi):
+            title += (f"\nuncertain labels {100 * a['mislabel_fraction']:.1f}% "
+                      f"(95% interval {100 * lo:.1f} to {100 * hi:.1f}%)")
     ax.set_title(title, fontsize=10)
     _save(fig, path)
     return fig

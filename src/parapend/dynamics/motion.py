@@ -15,7 +15,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..errors import ParameterError, check_finite, check_int, check_positive
+from .. import limits
+from ..errors import ParameterError, check_finite, check_int, check_positive, check_range
 from .attractors import Classification, classify
 from .simulate import CONVENTION, _check_params, energy, trajectory
 
@@ -100,7 +101,10 @@ def simulate(gamma: float = 0.1, p: float = 0.8, omega: float = 2.1, phi0: float
         Damping (>= 0), excitation strength and frequency (> 0) of Eq. 1. Defaults: the
         paper's coexistence case (Section 1), gamma = 0.1, p = 0.8, omega = 2.1.
     phi0, dphi0 : float
-        Initial angle from the hanging position (rad) and rate at ``t0``.
+        Initial angle from the hanging position (rad) and rate at ``t0``, each of absolute
+        value at most 1000 (``parapend.limits.SIM_MAX_PHI0``, ``SIM_MAX_DPHI0``); the work
+        ``periods * 2 pi/omega * (sqrt(1 + |p|) + |dphi0|)`` is at most
+        ``limits.SIM_MAX_WORK`` (DOP853 steps follow the fastest rate of the motion).
     periods : int
         Forcing periods simulated, 1 to ``MAX_PERIODS``. About 100 are needed for the
         classification to settle at gamma = 0.1 (contraction ``exp(-gamma T/2)`` per period).
@@ -119,8 +123,13 @@ def simulate(gamma: float = 0.1, p: float = 0.8, omega: float = 2.1, phi0: float
     Motion
     """
     gamma, p, omega = _check_params(gamma, p, omega)
-    phi0, dphi0 = check_finite("phi0", phi0), check_finite("dphi0", dphi0)
+    phi0 = check_range("phi0", phi0, 0.0, limits.SIM_MAX_PHI0, absolute=True)
+    dphi0 = check_range("dphi0", dphi0, 0.0, limits.SIM_MAX_DPHI0, absolute=True)
     periods = check_int("periods", periods, 1, MAX_PERIODS)
+    work = periods * 2 * math.pi / omega * (math.sqrt(1 + abs(p)) + abs(dphi0))
+    if work > limits.SIM_MAX_WORK:
+        raise ParameterError(f"periods: expected periods x 2 pi/omega x (sqrt(1 + |p|) + "
+                             f"|dphi0|) <= {limits.SIM_MAX_WORK:g}, got {work:.4g}")
     ppp = check_int("points_per_period", points_per_period, 2, 1024)
     if periods * ppp > MAX_SAMPLES:
         raise ParameterError(f"points_per_period: periods x points_per_period must be at most "
