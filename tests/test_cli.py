@@ -147,3 +147,27 @@ def test_sweeps_save_netcdf(tmp_path, capsys):
                      "--save", str(nc2))
     with xr.open_dataset(nc2) as ds:
         assert code == 0 and ds.sizes["gamma"] == 4 and "damping_threshold" in ds.attrs
+
+
+@pytest.mark.parametrize("delay", [0.15, 0.3, 0.5])
+def test_ctrl_c_while_loading_is_one_line(delay):
+    """Ctrl-C at any moment, loading NumPy and SciPy included, ends in one line and the
+    interrupted exit status: 130, or death by SIGINT (-2 to subprocess, 130 to a shell),
+    which CPython chooses after an interrupt inside some extension modules' import. Where
+    the run printed its result first (the signal came during the interpreter's shutdown),
+    nothing more is said. The first delay lands after the interpreter's own start-up
+    (about 30 ms), which is not parapend's."""
+    import signal
+    import time
+
+    p = subprocess.Popen([sys.executable, "-m", "parapend", "optimize", "--gamma", "0.01",
+                          "--harmonics", "96"], stdout=subprocess.PIPE,
+                         stderr=subprocess.PIPE, text=True)
+    time.sleep(delay)
+    p.send_signal(signal.SIGINT)
+    out, err = p.communicate(timeout=60)
+    if "status:" in out:  # finished before the signal
+        assert p.returncode in (0, 130, -signal.SIGINT) and err.count("\n") <= 1
+    else:
+        assert p.returncode in (130, -signal.SIGINT), (p.returncode, err)
+        assert err.count("\n") == 1 and err.rstrip().endswith("interrupted"), err

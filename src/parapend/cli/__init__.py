@@ -7,7 +7,9 @@ User errors print one line and exit with code 2; only this package prints.
 Exit codes: 0 success; 1 a file or standard output could not be written, or a solver
 error; 2 a usage error (bad value, unknown option, unreadable input file, and a bare
 ``parapend`` with no command, which prints the list of commands to stderr); 130 when
-interrupted (Ctrl-C).
+interrupted (Ctrl-C; a shell also reports 130 for a process that CPython ends by SIGINT,
+as it does after an interrupt during an extension module's import). The console script
+enters through :mod:`parapend._entry`, which loads this package inside its Ctrl-C handler.
 
 Modules: :mod:`._common` (parser helpers, number parsing, tables, progress),
 :mod:`._output` (every file written), :mod:`.optimize` (optimize, threshold, damping-sweep,
