@@ -265,7 +265,7 @@ def test_smallest_damping_converges_and_reports_its_residual_floor(name):
     a long period (omega = 0.1, Tp = 63). Every element meets tol or its floor, the floor is
     reported, and the gap to the limit still falls like epsilon^(2/3) from gamma = 1e-16
     (measured within 0.2 % of 100^(2/3) under the OpenBLAS kernels Haswell, Sandybridge and
-    Zen). The square wave's layers sit where q' = 0 on a plateau: its gap is at rounding."""
+    SkylakeX). The square wave's layers sit where q' = 0 on a plateau: its gap is at rounding."""
     from parapend.limits import MIN_BVP_GAMMA
 
     exc = parapend.harmonic(0.5, 0.1) if name == "slow" else solved(name, 5e-4)[0]

@@ -152,7 +152,7 @@ def test_sea_state_refuses_bad_input(kw, match):
 # Values parapend.optimize gave with these arguments before winding existed (power, peak
 # torque). Winding 1, the default, must still give them. Bit-identity holds only on one
 # machine: the last bits move with the OpenBLAS kernel (OPENBLAS_CORETYPE Haswell,
-# Sandybridge and Zen spread the powers by up to 3e-16 relative and the torques by 4e-16),
+# Sandybridge and SkylakeX spread the powers by up to 3e-16 relative, the torques by 4e-16),
 # the processor and the library versions. So the comparison is to a tolerance: Newton stops
 # at a gradient norm below 1e-11 at a strict maximum, so coefficients carry ~1e-11 / |lambda|
 # of rounding and stopping; the power, stationary there, moves at second order (rel 1e-12

@@ -779,6 +779,7 @@ def _adapt_solve(exc, damping: float, mesh: _Mesh, n: np.ndarray, z: np.ndarray,
     info = _NewtonInfo()
     p_h = math.nan
     emax = math.inf
+    efloor = 0.0
     p = mesh.p
     for npass in range(_MAX_PASSES):
         prob = _Problem(mesh, exc, damping)
