@@ -52,7 +52,13 @@ far above ``tol`` the element sizes are re-equidistributed (element ``e`` asks f
 ``r_e/h_e``, ``r_e = (eta_e/(0.1 tol))**(1/(p-1))`` clipped to [1/2, 4], graded to a
 neighbour ratio of at most 2, element ends at equal quantiles of the integrated density);
 near ``tol`` only the offending elements are bisected. The old polynomial solution,
-interpolated onto the new mesh, starts the next Newton solve.
+interpolated onto the new mesh, starts the next Newton solve. An element also passes when
+its residual is below the residual's rounding floor (:func:`_indicators`): at the centre of
+a boundary layer, for ``epsilon`` below about ``1e-15``, ``q'`` at times known to
+``eps_mach Tp`` leaves more error in ``f`` than ``tol`` allows, and bisecting only raises it;
+the result reports the largest such floor as ``residual_floor``. Newton steps whose
+predicted gain is below the rounding of ``P_h`` (moving a layer of ``epsilon = 2e-18`` by
+``1e-12``) are taken without the line search, which cannot judge them.
 
 *Globalization.* Two candidate local maxima are computed and the better one is returned:
 
