@@ -149,29 +149,40 @@ def test_sea_state_refuses_bad_input(kw, match):
 
 
 # --- winding ------------------------------------------------------------------------------
-# values of the main branch before winding existed (float.hex), computed by
-# parapend.optimize with these arguments: winding 1 must give them bit for bit
-MAIN_VALUES = [
-    (dict(omega=1.8, delta=-0.3, gamma=0.0, harmonics=24),
-     "0x1.5fb5fbb273cb3p-2", "limit", "0x1.25b274fcedbc0p+9"),
+# Values parapend.optimize gave with these arguments before winding existed (power, peak
+# torque). Winding 1, the default, must still give them. Bit-identity holds only on one
+# machine: the last bits move with the OpenBLAS kernel (OPENBLAS_CORETYPE Haswell,
+# Sandybridge and SkylakeX spread the powers by up to 3e-16 relative, the torques by 4e-16),
+# the processor and the library versions. So the comparison is to a tolerance: Newton stops
+# at a gradient norm below 1e-11 at a strict maximum, so coefficients carry ~1e-11 / |lambda|
+# of rounding and stopping; the power, stationary there, moves at second order (rel 1e-12
+# is ample), the peak torque at first order, weighted by k^2 up to N^2 (rel 1e-9).
+# Bit-identity is asserted only where it is the property: the default call against
+# winding=1 in the same run.
+REFERENCE_VALUES = [
+    (dict(omega=1.8, delta=-0.3, gamma=0.0, harmonics=24), 0.34346764828382986,
+     587.3941951905072),
     (dict(omega=1.8, gamma=0.01, harmonics=24, fourier="1:0.2:0,3:0.15:0.4,5:0.06:0"),
-     "0x1.021c30f6f70f2p-2", "limit", "0x1.4a6f25ff554e7p+5"),
+     0.2520606661544341, 41.30427169303021),
     (dict(omega=1.8, gamma=0.0, harmonics=16, fourier="1:0.2:0,3:0.15:0.4,5:0.06:0"),
-     "0x1.1f88406592b94p-1", "limit-11", "0x1.9ce5736dd580ep+8"),
+     0.5615863918295525, 412.8962925573586),
     (dict(omega=1.5, gamma=0.01, harmonics=32, fourier="1:0.2:0,7:0.1:0"),
-     "0x1.84c0ecbbab238p-3", "limit", None),
+     0.18982109973639338, None),
 ]
 
 
-@pytest.mark.parametrize("case", MAIN_VALUES, ids=lambda c: str(c[0].get("fourier", "paper")))
-def test_winding_one_reproduces_main_bit_for_bit(case):
-    kw, power, found_by, torque = case
+@pytest.mark.parametrize("case", REFERENCE_VALUES,
+                         ids=lambda c: str(c[0].get("fourier", "paper")))
+def test_winding_one_is_the_default_and_keeps_the_reference_values(case):
+    kw, power, torque = case
     r = parapend.optimize(**kw)
-    assert r.power.hex() == power and r.found_by == found_by and r.winding == 1
+    assert r.success and r.winding == 1
+    assert r.power == pytest.approx(power, rel=1e-12, abs=0)
     if torque is not None:
-        assert r.peak_torque.hex() == torque
+        assert r.peak_torque == pytest.approx(torque, rel=1e-9, abs=0)
     r1 = parapend.optimize(winding=1, **kw)
     assert r1.power == r.power and r1.coefficients == r.coefficients
+    assert r1.peak_torque == r.peak_torque and r1.found_by == r.found_by
 
 
 @pytest.mark.parametrize("winding", [1, 3])
@@ -399,25 +410,29 @@ def test_winding_bvp_agrees_with_the_fourier_optimum_converged_in_n(winding, gam
     assert np.max(np.abs(proj.theta(t) - x)) < 1e-5
 
 
-# solve_bvp_optimum on the main branch before the BVP took a winding (float.hex): winding 1
-# (the default) must give them bit for bit. The "three" value was regenerated on purpose when
-# the extrema of q came to be found once per shape in the phase s = omega t (excitation.py,
-# _phase_extrema): its switch times moved by an ulp, the BVP mesh with them, and the power by
-# 8 ulp (it was 0x1.a28f66e411ab4p-2); the optimize values of MAIN_VALUES did not move.
-_BVP_MAIN = [("harmonic", 5e-4, "0x1.55d009c76c7eep-2", "uniform", 380),
-             ("three", 1e-3, "0x1.a28f66e411abcp-2", "limit", 1240)]
+# solve_bvp_optimum's power before the BVP took a winding. Winding 1 (the default) must keep
+# it, to the BVP's own accuracy rather than bit for bit (the mesh adaptation and Newton's
+# last step round differently on another BLAS kernel or processor; so can the choice between
+# two starts that reach the same maximum, and the mesh node count): at tol = 1e-8 the power
+# is a lower bound whose error is of the order of the squared H^1 error, and it agrees with
+# the converged Fourier optimum to ~1e-13 (docs/bvp.md). The default call and winding=1
+# are compared bit for bit in the same run.
+_BVP_REFERENCE = [("harmonic", 5e-4, 0.3338014152496943),
+                  ("three", 1e-3, 0.40875015990279073)]
 
 
-@pytest.mark.parametrize("case", _BVP_MAIN)
-def test_bvp_winding_one_reproduces_main_bit_for_bit(case):
+@pytest.mark.parametrize("case", _BVP_REFERENCE, ids=lambda c: str(c))
+def test_bvp_winding_one_is_the_default_and_keeps_the_reference_power(case):
     from parapend.optimal.bvp import solve_bvp_optimum
 
-    name, gamma, power, found_by, nodes = case
+    name, gamma, power = case
     exc = parapend.harmonic() if name == "harmonic" else fourier(
         [(1, 0.3, 0.0), (2, 0.2, 1.0), (3, 0.1, 2.0)], omega=1.5)
-    for sol in (solve_bvp_optimum(exc, gamma), solve_bvp_optimum(exc, gamma, winding=1)):
-        assert sol.power.hex() == power and sol.found_by == found_by
-        assert sol.mesh_nodes == nodes and sol.winding == 1
+    sol, sol1 = solve_bvp_optimum(exc, gamma), solve_bvp_optimum(exc, gamma, winding=1)
+    assert sol.success and sol.winding == sol1.winding == 1
+    assert sol.power == pytest.approx(power, abs=1e-12)
+    assert sol1.power == sol.power and sol1.found_by == sol.found_by
+    assert sol1.mesh_nodes == sol.mesh_nodes and np.array_equal(sol1.theta, sol.theta)
 
 
 def test_winding_bvp_cli(capsys):

@@ -300,7 +300,8 @@ def cluster():
     # a real scheduler and two workers talking TCP on loopback (threads of this process:
     # quick to start, and the blocks they compute are the same)
     with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=False,
-                                  protocol="tcp", host="127.0.0.1", dashboard_address=":0",
+                                  protocol="tcp", host="127.0.0.1",
+                                  dashboard_address="127.0.0.1:0",
                                   silence_logs=50) as c:
         yield c
 

@@ -391,6 +391,7 @@ def _optimize_bvp(exc, gamma: float, n: int, common: dict, winding: int = 1) -> 
         mean_square_speed=sol.mean_square_speed,
         mesh_nodes=sol.mesh_nodes,
         max_residual=sol.max_residual,
+        residual_floor=sol.residual_floor,
         search="bvp-starts",
         patterns_tried=len(sol.candidates),
         polished=sum(v is not None and math.isfinite(v) for v in sol.candidates.values()),

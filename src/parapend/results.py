@@ -67,7 +67,9 @@ class OptimizeResult(_Result):
     method : str
         "fourier" (Eq. 10, N harmonics) or "bvp" (Euler-Lagrange BVP, Eqs. 13/22/27); for
         "bvp", ``coefficients`` is the N-harmonic Fourier projection of the BVP motion, and
-        ``mesh_nodes``, ``max_residual``, ``continuation_steps`` describe the solve.
+        ``mesh_nodes``, ``max_residual``, ``residual_floor`` (> 0 where elements passed at
+        the residual's rounding floor, not at tol: boundary layers at gamma below about
+        1e-15), ``continuation_steps`` describe the solve.
     search, candidate_patterns, patterns_tried, polished, abandoned : the evidence of the
         global search (docs/global.md): ``search`` is "exhaustive" (every half-turn
         direction pattern of the limit motion, ``candidate_patterns`` of them, was a seed;
@@ -160,6 +162,7 @@ class OptimizeResult(_Result):
     bound_gap: float = float("nan")
     mesh_nodes: int | None = None
     max_residual: float | None = None
+    residual_floor: float | None = None
     continuation_steps: int | None = None
     excitation: dict = field(default_factory=dict)
     torque_limit: float | None = None

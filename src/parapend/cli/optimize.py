@@ -186,7 +186,9 @@ def _cmd_optimize(a) -> dict | str:
         how = (f"{r.iterations} interior-point iterations, {r.intervals} Hermite-Simpson "
                f"intervals, started from the {r.found_by}")
     else:
-        how = (f"{r.mesh_nodes} mesh nodes, max residual {r.max_residual:.2g}, "
+        floor = (f" (rounding floor {r.residual_floor:.2g} near the layer centres)"
+                 if r.residual_floor else "")
+        how = (f"{r.mesh_nodes} mesh nodes, max residual {r.max_residual:.2g}{floor}, "
                f"{r.continuation_steps} continuation steps, found from the {r.found_by} start")
     out = [f"excitation: {_describe(r.excitation)}; damping gamma = {r.gamma:g}", "",
            _table(rows, ["motion", "power P", "vs uniform"]), "",

@@ -52,7 +52,13 @@ far above ``tol`` the element sizes are re-equidistributed (element ``e`` asks f
 ``r_e/h_e``, ``r_e = (eta_e/(0.1 tol))**(1/(p-1))`` clipped to [1/2, 4], graded to a
 neighbour ratio of at most 2, element ends at equal quantiles of the integrated density);
 near ``tol`` only the offending elements are bisected. The old polynomial solution,
-interpolated onto the new mesh, starts the next Newton solve.
+interpolated onto the new mesh, starts the next Newton solve. An element also passes when
+its residual is below the residual's rounding floor (:func:`_indicators`): at the centre of
+a boundary layer, for ``epsilon`` below about ``1e-15``, ``q'`` at times known to
+``eps_mach Tp`` leaves more error in ``f`` than ``tol`` allows, and bisecting only raises it;
+the result reports the largest such floor as ``residual_floor``. Newton steps whose
+predicted gain is below the rounding of ``P_h`` (moving a layer of ``epsilon = 2e-18`` by
+``1e-12``) are taken without the line search, which cannot judge them.
 
 *Globalization.* Two candidate local maxima are computed and the better one is returned:
 
@@ -97,6 +103,7 @@ _MIN_ELEMENTS = 8
 _MAX_PASSES = 12  # mesh-adaptation passes per epsilon
 _NEWTON_MAXITER = 60
 _STEP_TOL = 1e-11  # Newton stops when the full step moves theta by less than this (radians)
+_EPS = float(np.finfo(float).eps)
 
 
 # ---------------------------------------------------------------------------------------
@@ -382,21 +389,27 @@ def _newton(prob: _Problem, n: np.ndarray, z0: np.ndarray, maxiter: int = _NEWTO
         step = float(np.max(np.abs(d)))
         if step > 1.0:  # at most one radian per step
             d *= 1.0 / step
-        if newton and (step <= _STEP_TOL or (step < 1e-7 and step > 0.25 * prev_step)):
+        slope = float(rhs @ d) / prob.period
+        # rounding level of P_h; a Newton step whose predicted gain slope/2 is below it
+        # cannot be judged by comparing P_h (epsilon ~ 1e-18: the step that moves a
+        # boundary layer by ~1e-12 in t gains ~1e-23)
+        ptol = 1e-15 * max(1.0, abs(p))
+        blind = newton and 0.5 * slope <= ptol
+        if newton and (step <= _STEP_TOL or (step > 0.25 * prev_step
+                                             and (step < 1e-7 or blind))):
             # converged, or Newton steps no longer shrink: rounding level reached
             z = z + d
             p, rhs, diag = prob.parts(n, z)
             info.status = "converged"
             break
         prev_step = step if newton else math.inf
-        slope = float(rhs @ d) / prob.period
         t = 1.0
         accepted = False
         for _ in range(50):
             zn = z + t * d
             pn = prob.power(n, zn)
-            if pn >= p + 1e-4 * t * slope or (newton and t == 1.0 and step < 1e-6
-                                              and pn >= p - 1e-15 * max(1.0, abs(p))):
+            if pn >= p + 1e-4 * t * slope or (newton and t == 1.0 and (step < 1e-6 or blind)
+                                              and pn >= p - ptol):
                 accepted = True
                 break
             t *= 0.5
@@ -456,8 +469,8 @@ def _second_derivative_interpolation(p: int, m: int) -> np.ndarray:
 
 
 def _indicators(mesh: _Mesh, n: np.ndarray, z: np.ndarray, excitation, epsilon: float,
-                dq_nodes: np.ndarray):
-    """Per-element error indicators ``(residual, quadrature)``, each shape (E,).
+                dq_nodes: np.ndarray, tol: float = 0.0):
+    """Per-element error indicators ``(residual, quadrature, floor)``, each shape (E,).
 
     ``residual``: RMS over the element of ``(theta_h'' - f)/(1 + |f|)``,
     ``f = q' sin(theta_h)/epsilon``, the relative residual of the first-order system
@@ -474,6 +487,18 @@ def _indicators(mesh: _Mesh, n: np.ndarray, z: np.ndarray, excitation, epsilon: 
     ``int q' cos(theta_h) dt`` over the element, divided by ``h_e <|q'|>``; it flags
     elements that do not resolve the excitation where the pendulum dwells (there
     ``sin(theta) ~ 0`` hides ``q'`` from the residual).
+
+    ``floor`` (computed where ``residual > tol``, 0 elsewhere): the residual's rounding
+    floor, the same RMS of the error that ``f`` carries
+    in double precision. A time in ``[0, Tp]`` is known to about ``eps_mach Tp`` (node times
+    and phases ``k omega t`` are rounded), so ``q'`` to ``2 eps_mach Tp |q''|``;
+    ``sin`` of an angle relative to the element's first node to ``eps_mach |theta_loc|``.
+    Near the centre of a boundary layer ``q'`` passes through 0 and ``f`` is small, so this
+    error is a large part of it: at ``epsilon = 2e-18`` the floor reaches ``1e-8`` in
+    elements of ``1e-7``, and bisecting such an element raises it (the same error over a
+    smaller ``|f|``). Measured against residuals that only grew under bisection (paper case,
+    ``epsilon = 2e-18``; three harmonics and ``omega = 0.1`` at ``2e-17``): the residual
+    there is 0.1 to 0.4 times this floor.
     """
     m = 2 * mesh.p
     tg, wg, lmat, _, _ = _element_points(mesh, m)
@@ -492,7 +517,23 @@ def _indicators(mesh: _Mesh, n: np.ndarray, z: np.ndarray, excitation, epsilon: 
     lobatto = half * ((dq_nodes[mesh.idx] * sg * np.cos(loc)) @ w_gll)
     qscale = max(float(np.sum(half[:, None] * np.abs(dq) * wg)) / excitation.period, 1e-300)
     quadrature = np.abs(gauss - lobatto) / (mesh.h * qscale)
-    return residual, quadrature
+    # rounding floor (see the docstring), only where the residual exceeds tol: the RMS of
+    # the error f carries in double precision, relative to 1 + |f| as the residual is;
+    # q'' by central differences 1/(64 p) of the element apart
+    floor = np.zeros(mesh.E)
+    sel = np.flatnonzero(residual > tol)
+    if sel.size:
+        tp = excitation.period
+        ts = tg[sel]
+        step = (mesh.h[sel] / (64 * mesh.p))[:, None]
+        up = np.asarray(excitation.dq((ts + step).ravel()), dtype=float).reshape(ts.shape)
+        down = np.asarray(excitation.dq((ts - step).ravel()), dtype=float).reshape(ts.shape)
+        qdd = np.abs(up - down) / (2.0 * step)
+        ths = th[sel]
+        noise = _EPS * (2.0 * tp * qdd * np.abs(np.sin(ths)) + np.abs(ths * dq[sel])) / epsilon
+        g = noise / (1.0 + np.abs(f[sel]))
+        floor[sel] = np.sqrt(0.5 * (g * g) @ wg)
+    return residual, quadrature, floor
 
 
 def _accurate_power(mesh: _Mesh, n: np.ndarray, z: np.ndarray, excitation, damping: float):
@@ -646,7 +687,14 @@ class BVPSolution:
     max_residual : float
         Largest element RMS of the relative residual ``(theta'' - f)/(1 + |f|)``,
         ``f = q' sin(theta)/epsilon``, of the first-order system (SciPy ``solve_bvp``
-        convention); ``<= tol`` on success.
+        convention); on success every element's is ``<= tol`` or ``<=`` its rounding floor
+        (``residual_floor``).
+    residual_floor : float
+        0 when every element met ``tol``; else the largest rounding floor of the residual
+        among the elements that did not: the part of ``(theta'' - f)/(1 + |f|)`` that double
+        precision cannot resolve, from ``q'`` at times known to ``~eps_mach Tp``. It
+        matters only near the centres of boundary layers at ``epsilon`` below about 1e-15,
+        where ``q'`` passes through 0 (docs/bvp.md, section 3).
     slope_jump : float
         Largest jump of ``theta'`` across element ends, relative to ``max|theta'|``.
     continuation_steps : int
@@ -698,6 +746,7 @@ class BVPSolution:
     limit_power: float
     mean_square_speed: float
     winding: int = 1
+    residual_floor: float = 0.0
     _motion: SpectralElementMotion = field(repr=False, default=None)
 
     def motion(self) -> SpectralElementMotion:
@@ -718,13 +767,17 @@ class _Candidate:
     steps: int
     iterations: int
     seed: str
+    floor: float = 0.0
 
 
 def _adapt_solve(exc, damping: float, mesh: _Mesh, n: np.ndarray, z: np.ndarray,
                  tol: float, max_nodes: int):
     """Newton + residual-driven re-meshing at one damping until every element meets tol.
 
-    Returns ``(mesh, n, z, P_h, max_residual, status, strict_maximum, iterations)``.
+    Returns ``(mesh, n, z, P_h, max_residual, status, strict_maximum, iterations,
+    residual_floor)``: an element passes when its residual is below ``tol`` or below its
+    rounding floor (:func:`_indicators`); ``residual_floor`` is the largest floor an element
+    needed (0 when every element met ``tol``).
     """
     eps = 2.0 * damping
     its = 0
@@ -732,6 +785,7 @@ def _adapt_solve(exc, damping: float, mesh: _Mesh, n: np.ndarray, z: np.ndarray,
     info = _NewtonInfo()
     p_h = math.nan
     emax = math.inf
+    efloor = 0.0
     p = mesh.p
     for npass in range(_MAX_PASSES):
         prob = _Problem(mesh, exc, damping)
@@ -741,23 +795,28 @@ def _adapt_solve(exc, damping: float, mesh: _Mesh, n: np.ndarray, z: np.ndarray,
         if info.status != "converged":
             status = "not_converged"
             break
-        res, quad = _indicators(mesh, n, z, exc, eps, prob.dq)
+        res, quad, floor = _indicators(mesh, n, z, exc, eps, prob.dq, tol)
         emax = float(np.max(res))
-        eta = np.maximum(res, quad)
-        bad = eta > tol
+        # an element passes below tol, or below its residual's rounding floor: refining
+        # it cannot help there (the floor grows as the element shrinks)
+        allowed = np.maximum(tol, floor)
+        bad = (res > allowed) | (quad > tol)
+        efloor = float(np.max(floor, where=res > tol, initial=0.0))
         if not np.any(bad):
             status = "converged"
             break
         if npass == _MAX_PASSES - 1:
             status = "not_converged"
             break
-        if float(np.max(eta)) < 100.0 * tol and np.count_nonzero(bad) <= 0.25 * mesh.E:
+        if (np.all((res < 100.0 * allowed) & (quad < 100.0 * tol))
+                and np.count_nonzero(bad) <= 0.25 * mesh.E):
             # nearly there: bisect the offending elements only (no coarsening)
             edges = np.sort(np.concatenate((mesh.edges, mesh.edges[:-1][bad]
                                             + 0.5 * mesh.h[bad])))
         else:
             # re-equidistribute the density each element asks for
-            r = np.clip((eta / (0.1 * tol)) ** (1.0 / (p - 1)), 0.5, 4.0)
+            excess = np.maximum(res / (0.1 * allowed), quad / (0.1 * tol))
+            r = np.clip(excess ** (1.0 / (p - 1)), 0.5, 4.0)
             edges = _equidistribute(mesh.edges, _grade(r / mesh.h), _MIN_ELEMENTS)
         if (edges.size - 1) * p > max_nodes:
             status = "max_nodes"
@@ -765,7 +824,7 @@ def _adapt_solve(exc, damping: float, mesh: _Mesh, n: np.ndarray, z: np.ndarray,
         new = _Mesh(edges, p, mesh.winding)
         n, z = _interpolate(mesh, n, z, new)
         mesh = new
-    return mesh, n, z, p_h, emax, status, info.maximum, its
+    return mesh, n, z, p_h, emax, status, info.maximum, its, efloor
 
 
 def _uniform_branch(exc, damping: float, tol: float, max_nodes: int, p: int,
@@ -792,14 +851,14 @@ def _uniform_branch(exc, damping: float, tol: float, max_nodes: int, p: int,
     while True:
         final = eps <= eps_target * (1 + 1e-12)
         res = _adapt_solve(exc, 0.5 * eps, *state, tol if final else tol_mid, max_nodes)
-        its += res[-1]
+        its += res[7]
         status = res[5]
         if status == "converged":
             steps += 1
             if final:
                 break
             state = res[:3]
-            if res[-1] <= 12:  # an easy step: take longer ones
+            if res[7] <= 12:  # an easy step: take longer ones
                 factor = max(factor * factor, 1e-3)
             eps_prev = eps
             eps = max(eps * factor, eps_target)
@@ -810,8 +869,8 @@ def _uniform_branch(exc, damping: float, tol: float, max_nodes: int, p: int,
         if steps == 0 or status == "max_nodes" or factor > 0.9:
             break
         eps = max(eps_prev * factor, eps_target)
-    mesh, n, z, p_h, eta, status, maximum, _ = res
-    return _Candidate(mesh, n, z, p_h, eta, status, maximum, steps, its, "uniform")
+    mesh, n, z, p_h, eta, status, maximum, _, floor = res
+    return _Candidate(mesh, n, z, p_h, eta, status, maximum, steps, its, "uniform", floor)
 
 
 def _pattern_of(exc, motion):
@@ -881,9 +940,9 @@ def _limit_seed(exc, epsilon: float, p: int, pattern=None, winding: int = 1):
 def _limit_branch(exc, damping: float, tol: float, max_nodes: int, p: int,
                   pattern=None, name: str = "limit", winding: int = 1) -> _Candidate:
     mesh, n, z = _limit_seed(exc, 2.0 * damping, p, pattern, winding)
-    mesh, n, z, p_h, eta, status, maximum, its = _adapt_solve(exc, damping, mesh, n, z, tol,
-                                                             max_nodes)
-    return _Candidate(mesh, n, z, p_h, eta, status, maximum, 1, its, name)
+    mesh, n, z, p_h, eta, status, maximum, its, floor = _adapt_solve(exc, damping, mesh, n, z,
+                                                                    tol, max_nodes)
+    return _Candidate(mesh, n, z, p_h, eta, status, maximum, 1, its, name, floor)
 
 
 #: Harmonics of the Fourier search whose optimum's turn pattern seeds the BVP.
@@ -1019,7 +1078,9 @@ def solve_bvp_optimum(excitation, damping: float, *, tol: float = 1e-8,
         continuation_steps=best.steps,
         success=status == "converged",
         status=status,
-        message=_MESSAGES.get(status, status),
+        message=_MESSAGES.get(status, status) + (
+            f" (or below the residual's rounding floor, at most {best.floor:.2g}, near the "
+            f"centres of boundary layers)" if status == "converged" and best.floor else ""),
         iterations=iterations,
         strict_maximum=best.maximum,
         found_by=best.seed,
@@ -1028,6 +1089,7 @@ def solve_bvp_optimum(excitation, damping: float, *, tol: float = 1e-8,
         limit_power=lim.power,
         mean_square_speed=kin,
         winding=k,
+        residual_floor=best.floor,
         _motion=motion,
     )
     if throw and not sol.success:
