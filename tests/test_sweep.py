@@ -19,6 +19,8 @@ import parapend
 from parapend import sweep as sw
 from parapend.cli import main
 from parapend.errors import ParameterError
+from parapend.sweep import compute as sw_compute
+from parapend.sweep import store as sw_store
 
 SRC = str(Path(__file__).resolve().parents[1] / "src")
 # a 4 x 3 map in 4 blocks of 3 points (runs along delta): small, but several blocks
@@ -259,7 +261,7 @@ def test_kill_9_then_resume_equals_uninterrupted(reference, tmp_path):
 def test_lock_refuses_a_second_sweep(tmp_path):
     store = tmp_path / "locked.zarr"
     store.mkdir()
-    with sw._locked(store), pytest.raises(ParameterError,
+    with sw_store._locked(store), pytest.raises(ParameterError,
                                           match="^store: .* is being written by another"):
         sw.sweep(store, **GRID, workers=1)
     # after the lock is gone (its process ended), the sweep runs
@@ -282,7 +284,7 @@ def test_store_of_another_sweep_is_refused(reference, tmp_path):
     cut = tmp_path / "cut.zarr"
     (cut / "power").mkdir(parents=True)
     (cut / "power" / "zarr.json").write_text("{")
-    sw._write_marker(cut)
+    sw_store._write_marker(cut)
     assert sw.sweep(cut, omega="1.8,1.9", workers=1).computed_points == 2
     assert bool(sw.open_sweep(cut, complete=True)["done"].all())
     # arrays without that root are not recognised as parapend's: refused, kept
@@ -869,7 +871,8 @@ def test_ctrl_c_with_local_processes_is_one_line(tmp_path):
     env = {**os.environ, "PYTHONPATH": SRC}
     proc = subprocess.Popen(argv, cwd=tmp_path, env=env, stdout=subprocess.PIPE,
                             stderr=subprocess.PIPE, text=True)
-    rc, err = _interrupt(proc, lambda: "sweep" in (sw._root_attrs(tmp_path / "m.zarr") or {}))
+    rc, err = _interrupt(proc,
+                         lambda: "sweep" in (sw_store._root_attrs(tmp_path / "m.zarr") or {}))
     assert rc == 130 and err == "parapend sweep: interrupted\n"
     sw.open_sweep(tmp_path / "m.zarr")  # verified: no damage
 
@@ -907,7 +910,7 @@ def test_silent_scheduler_is_one_line_and_ctrl_c_during_connect(tmp_path):
 
     srv, address = listener()
     with srv:
-        code = ("import sys; from parapend import sweep as sw; sw._CONNECT_SECONDS = 1\n"
+        code = ("import sys; from parapend.sweep import run; run._CONNECT_SECONDS = 1\n"
                 "from parapend.cli import main\n"
                 f"sys.exit(main(['sweep', '--omega', '1,2', '--scheduler', {address!r}]))\n")
         p = subprocess.run([sys.executable, "-c", code], cwd=tmp_path, env=env,
@@ -945,13 +948,13 @@ def test_a_success_without_a_finite_power_is_recorded_as_nonfinite(tmp_path, mon
     """What a store's check relies on holds by construction: a point whose solver says
     converged but whose power is NaN is stored as "nonfinite" (and is then a legitimate NaN,
     not damage)."""
-    real = sw._continue
+    real = sw_compute._continue
 
     def nan_power(*a, **k):
         power, status, gap, x = real(*a, **k)
         return math.nan, status, gap, x
 
-    monkeypatch.setattr(sw, "_continue", nan_power)
+    monkeypatch.setattr(sw_compute, "_continue", nan_power)
     store = tmp_path / "m.zarr"
     run = sw.sweep(store, omega="1.8,1.9", workers=1)
     assert (run.dataset["status"].values == sw.STATUSES.index("nonfinite")).all()
