@@ -19,6 +19,8 @@ import parapend
 from parapend import sweep as sw
 from parapend.cli import main
 from parapend.errors import ParameterError
+from parapend.sweep import compute as sw_compute
+from parapend.sweep import store as sw_store
 
 SRC = str(Path(__file__).resolve().parents[1] / "src")
 # a 4 x 3 map in 4 blocks of 3 points (runs along delta): small, but several blocks
@@ -259,7 +261,7 @@ def test_kill_9_then_resume_equals_uninterrupted(reference, tmp_path):
 def test_lock_refuses_a_second_sweep(tmp_path):
     store = tmp_path / "locked.zarr"
     store.mkdir()
-    with sw._locked(store), pytest.raises(ParameterError,
+    with sw_store._locked(store), pytest.raises(ParameterError,
                                           match="^store: .* is being written by another"):
         sw.sweep(store, **GRID, workers=1)
     # after the lock is gone (its process ended), the sweep runs
@@ -282,7 +284,7 @@ def test_store_of_another_sweep_is_refused(reference, tmp_path):
     cut = tmp_path / "cut.zarr"
     (cut / "power").mkdir(parents=True)
     (cut / "power" / "zarr.json").write_text("{")
-    sw._write_marker(cut)
+    sw_store._write_marker(cut)
     assert sw.sweep(cut, omega="1.8,1.9", workers=1).computed_points == 2
     assert bool(sw.open_sweep(cut, complete=True)["done"].all())
     # arrays without that root are not recognised as parapend's: refused, kept
@@ -508,7 +510,86 @@ def test_map_of_three_axes_selects_the_third(tmp_path):
     fig = sw.plot_map(ds, "gain", at={"gamma": 0.0}, path=tmp_path / "g.svg")
     assert (tmp_path / "g.svg").read_text().startswith("<?xml")
     # the paper's case is inside the map: the star is drawn
-    assert any("paper" in t.get_text() for t in fig.axes[0].get_legend().get_texts())
+    assert any("paper" in t.get_text() for t in fig.legends[0].get_texts())
+
+
+def test_colour_scale_covers_the_data_and_compresses_a_long_tail():
+    """The colours of a heat map span the whole range of the values; only a tail longer than
+    half the 1st-to-99th-percentile span is compressed, into the last 15 % of the bar."""
+    from parapend.sweep.figures import colour_scale
+
+    z = np.linspace(-2.0, 3.0, 400).reshape(20, 20)
+    z[0, 0] = np.nan
+    assert colour_scale(z) == ((z[0, 1], 3.0), (0.0, 1.0))
+    rng = np.random.default_rng(7)
+    z = rng.normal(10.0, 1.0, 1000)  # a normal sample: no long tail
+    assert colour_scale(z) == ((z.min(), z.max()), (0.0, 1.0))
+    z[:5] = [70.0, 50.0, 40.0, 30.0, np.nan]  # the gain where the uniform power tends to 0
+    knots, shares = colour_scale(z)
+    p1, p99 = np.nanpercentile(z, [1, 99])
+    assert knots == (np.nanmin(z), p99, 70.0) and shares == (0.0, 0.85, 1.0)
+    assert p1 - np.nanmin(z) < 0.5 * (p99 - p1)  # the low end is not a long tail
+    knots, shares = colour_scale(-z)
+    assert knots == (-70.0, -p99, -np.nanmin(z)) and shares == (0.0, 0.15, 1.0)
+    assert colour_scale(np.full(4, np.nan)) == ((0.0, 1.0), (0.0, 1.0))
+    assert colour_scale(np.ones(4)) == ((0.5, 1.5), (0.0, 1.0))
+
+
+def _gain_store(n=12):
+    """A map's Dataset, made up: the uniform rotation's power nearly vanishes at one corner
+    (omega, delta) = (2.4, -0.05), so the gain has a long tail there (as on the documented
+    128 x 128 map)."""
+    import xarray as xr
+
+    om = np.linspace(1.2, 2.4, n)
+    de = np.linspace(-0.5, -0.05, n)
+    o, d = np.meshgrid(om, de, indexing="ij")
+    uniform = 0.3 * (-d) * o
+    uniform[-1, -1] *= 0.2
+    power = 1.15 * 0.3 * (-d) * o + 0.01 * o
+    return xr.Dataset(
+        {"power": (("omega", "delta"), power), "uniform_power": (("omega", "delta"), uniform),
+         "status": (("omega", "delta"), np.zeros((n, n), dtype=np.int8)),
+         "done": (("omega", "delta"), np.ones((n, n), dtype=bool))},
+        coords={"omega": om, "delta": de, "gamma": 0.01}, attrs={"sweep": "{}"})
+
+
+@pytest.mark.parametrize("quantity", ["gain", "power"])
+def test_heat_map_colour_bar_covers_the_data_range(quantity, tmp_path):
+    """The colour bar of ``parapend map`` reaches the smallest and the largest value, and
+    says where its scale is compressed; the contour labels are inside the map; the axes
+    have units; the legend is not over the map."""
+    from matplotlib.collections import QuadMesh
+
+    ds = _gain_store()
+    z, *_ = sw.map_data(ds, quantity)
+    fig = sw.plot_map(ds, quantity, path=tmp_path / "m.png")
+    ax = fig.axes[0]
+    mesh = next(c for c in ax.collections if isinstance(c, QuadMesh))
+    lo, hi = float(np.nanmin(z)), float(np.nanmax(z))
+    assert mesh.norm.vmin <= lo and mesh.norm.vmax >= hi
+    cb = mesh.colorbar
+    ticks = cb.get_ticks()
+    assert ticks.min() <= lo * (1 + 1e-12) or quantity == "power"
+    label = cb.ax.get_ylabel()
+    if quantity == "gain":  # 12 % in the bulk, up to 437 % in the last row
+        assert hi > 5 * np.nanpercentile(z, 99)
+        p99 = np.nanpercentile(z, 99)
+        assert f"compressed above {p99:.3g}" in label
+        assert np.isclose(ticks, hi).any() and np.isclose(ticks, p99).any()
+        # the bulk takes 85 % of the bar, the tail the rest
+        assert mesh.norm(p99) == pytest.approx(0.85)
+    else:  # no long tail: one linear scale over the data
+        assert "compressed" not in label
+        assert (mesh.norm.vmin, mesh.norm.vmax) == (lo, hi)
+    texts = [t for t in ax.texts if t.get_text()]
+    assert texts  # labelled contours
+    to_axes = ax.transData + ax.transAxes.inverted()
+    for t in texts:
+        u, v = to_axes.transform(t.get_position())
+        assert 0.05 < u < 0.95 and 0.05 < v < 0.95, t.get_text()
+    assert "(sqrt(g/l))" in ax.get_xlabel() and "/ $g$)" in ax.get_ylabel()
+    assert ax.get_legend() is None and "paper" in fig.legends[0].get_texts()[0].get_text()
 
 
 def test_delta_through_zero_symmetric_and_constant_case():
@@ -870,7 +951,8 @@ def test_ctrl_c_with_local_processes_is_one_line(tmp_path):
     env = {**os.environ, "PYTHONPATH": SRC}
     proc = subprocess.Popen(argv, cwd=tmp_path, env=env, stdout=subprocess.PIPE,
                             stderr=subprocess.PIPE, text=True)
-    rc, err = _interrupt(proc, lambda: "sweep" in (sw._root_attrs(tmp_path / "m.zarr") or {}))
+    rc, err = _interrupt(proc,
+                         lambda: "sweep" in (sw_store._root_attrs(tmp_path / "m.zarr") or {}))
     assert rc == 130 and err == "parapend sweep: interrupted\n"
     sw.open_sweep(tmp_path / "m.zarr")  # verified: no damage
 
@@ -908,7 +990,7 @@ def test_silent_scheduler_is_one_line_and_ctrl_c_during_connect(tmp_path):
 
     srv, address = listener()
     with srv:
-        code = ("import sys; from parapend import sweep as sw; sw._CONNECT_SECONDS = 1\n"
+        code = ("import sys; from parapend.sweep import run; run._CONNECT_SECONDS = 1\n"
                 "from parapend.cli import main\n"
                 f"sys.exit(main(['sweep', '--omega', '1,2', '--scheduler', {address!r}]))\n")
         p = subprocess.run([sys.executable, "-c", code], cwd=tmp_path, env=env,
@@ -946,13 +1028,13 @@ def test_a_success_without_a_finite_power_is_recorded_as_nonfinite(tmp_path, mon
     """What a store's check relies on holds by construction: a point whose solver says
     converged but whose power is NaN is stored as "nonfinite" (and is then a legitimate NaN,
     not damage)."""
-    real = sw._continue
+    real = sw_compute._continue
 
     def nan_power(*a, **k):
         power, status, gap, x = real(*a, **k)
         return math.nan, status, gap, x
 
-    monkeypatch.setattr(sw, "_continue", nan_power)
+    monkeypatch.setattr(sw_compute, "_continue", nan_power)
     store = tmp_path / "m.zarr"
     run = sw.sweep(store, omega="1.8,1.9", workers=1)
     assert (run.dataset["status"].values == sw.STATUSES.index("nonfinite")).all()

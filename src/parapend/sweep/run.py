@@ -1,0 +1,408 @@
+"""Running a sweep: :func:`sweep` (check, connect, lock, prepare, execute, write block by
+block) on local worker processes or a Dask cluster, and its outcome :class:`SweepRun`.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import dataclasses
+import logging
+import os
+import threading
+import time
+
+import numpy as np
+
+from ..errors import OutputError, ParameterError, SolverError, check_int
+from .compute import compute_block
+from .spec import sweep_spec
+from .store import (
+    _check_store_path,
+    _chunk_key,
+    _damage_line,
+    _locked,
+    _prepare,
+    _quiet_zarr,
+    _short,
+    _store_spec,
+    _template,
+    _verify,
+    open_sweep,
+)
+
+__all__ = ["SweepRun", "sweep"]
+
+log = logging.getLogger(__name__)
+
+
+# -- running -------------------------------------------------------------------------------
+
+@dataclasses.dataclass(frozen=True)
+class SweepRun:
+    """Outcome of :func:`sweep`: the map and what this run did.
+
+    ``dataset`` has one variable per quantity (see :data:`VARIABLES`) over the swept
+    dimensions, plus ``done``; ``computed_points`` were computed by this run,
+    ``resumed_points`` found finished in the store; ``repaired_points`` (of the computed)
+    were marked finished in the store but had missing or unreadable data.
+    """
+
+    dataset: object
+    store: str | None
+    points: int
+    blocks: int
+    computed_points: int
+    resumed_points: int
+    seconds: float
+    executor: str
+    repaired_points: int = 0
+
+
+def _worker_init(parent: int) -> None:
+    """A pool worker ignores Ctrl-C (the parent handles it) and exits when the parent is
+    gone (``kill -9``: the pool's queues would keep it waiting for ever)."""
+    import signal
+    import threading
+
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+
+    def watch():
+        while True:
+            time.sleep(0.5)
+            try:
+                os.kill(parent, 0)
+            except ProcessLookupError:
+                os._exit(1)
+            except OSError:
+                pass
+
+    threading.Thread(target=watch, daemon=True).start()
+
+
+class _LocalPool:
+    """The local worker processes (a ``forkserver`` pool), started in the background as soon
+    as the sweep's parameters are checked: the server's imports and the workers' start (about
+    a second) then overlap the preparation of the store instead of preceding the first block.
+    """
+
+    def __init__(self, workers: int, start: bool = True):
+        self.workers = workers
+        self.executor = None
+        self._boot = None
+        if start:
+            self.start()
+
+    def start(self):
+        """Start the processes in the background (once)."""
+        import concurrent.futures as cf
+        import multiprocessing as mp
+        import threading
+
+        if self.executor is not None:
+            return
+        ctx = mp.get_context("forkserver")
+        ctx.set_forkserver_preload(["parapend.sweep", "parapend.api", "parapend.optimal.fourier",
+                                    "parapend.optimal.batch"])
+        self.executor = cf.ProcessPoolExecutor(max_workers=self.workers, mp_context=ctx,
+                                               initializer=_worker_init,
+                                               initargs=(os.getpid(),))
+        self._boot = threading.Thread(target=self._submit_first, daemon=True)
+        self._boot.start()
+
+    def _submit_first(self):
+        # the first submit starts every worker (in this thread, not the caller's)
+        with contextlib.suppress(Exception):
+            self.executor.submit(_ready)
+
+    def shutdown(self):
+        if self.executor is not None:
+            self._boot.join()
+            self.executor.shutdown(wait=True, cancel_futures=True)
+
+
+def _ready() -> None:
+    """A first task: it makes the pool start its processes."""
+
+
+def _run_local(spec, todo, pool, done_cb):
+    import concurrent.futures as cf
+
+    if pool is None or len(todo) <= 1:
+        for b in todo:
+            done_cb(b, compute_block(spec, b))
+        return "serial"
+    pool.start()
+    pool._boot.join()
+    ex = pool.executor
+    try:
+        futs = {ex.submit(compute_block, spec, b): b for b in todo}
+        for f in cf.as_completed(futs):
+            try:
+                vals = f.result()
+            except cf.process.BrokenProcessPool:
+                raise SolverError("a worker process died (killed, or out of memory); the "
+                                  "finished blocks are in the store: run the same command "
+                                  "again to resume") from None
+            done_cb(futs[f], vals)
+    except BaseException:
+        # Ctrl-C or an error: the running blocks would not be written, so they are not
+        # waited for (a block with a power take-off can take half a minute)
+        _stop_workers(ex)
+        raise
+    finally:
+        ex.shutdown(wait=True, cancel_futures=True)
+    return f"{pool.workers} local processes"
+
+
+def _stop_workers(ex) -> None:
+    """End the worker processes of the executor ``ex`` now (SIGTERM)."""
+    terminate = getattr(ex, "terminate_workers", None)  # Python 3.14
+    if terminate is not None:
+        with contextlib.suppress(Exception):
+            terminate()
+        return
+    for proc in list((getattr(ex, "_processes", None) or {}).values()):
+        with contextlib.suppress(Exception):
+            proc.terminate()
+
+
+def _connect(scheduler):
+    """A distributed Client for ``scheduler`` (an address or a Client), and whether we own it:
+    connected before the store is touched, so a wrong address leaves nothing behind."""
+    try:
+        from distributed import Client
+    except ImportError:
+        raise ParameterError("scheduler: needs the 'distributed' package (python -m pip "
+                             "install distributed)") from None
+    if hasattr(scheduler, "submit"):
+        return scheduler, False
+    address = str(scheduler).strip()
+    try:
+        from distributed.comm.addressing import parse_address, parse_host_port
+
+        scheme, location = parse_address(address)
+        if scheme in ("tcp", "tls"):
+            parse_host_port(location)
+    except (ValueError, TypeError) as err:
+        raise ParameterError(f"scheduler: expected an address such as tcp://host:8786, got "
+                             f"{address!r:.80} ({_short(err)})") from None
+    # made in two steps so that a client whose start fails can be discarded here (left to
+    # the garbage collector it would wait 20 s to close, then print a traceback), and in a
+    # thread: distributed waits for ever on a server that accepts the connection but never
+    # answers its handshake, and Ctrl-C must not wait for it either
+    client = Client.__new__(Client)
+    failed: list = []
+
+    def start():
+        try:
+            client.__init__(address, timeout=f"{_CONNECT_SECONDS}s", set_as_default=False)
+        except BaseException as err:  # noqa: BLE001 - handed to the caller's thread
+            failed.append(err)
+
+    thread = threading.Thread(target=start, name="parapend-connect", daemon=True)
+    thread.start()
+    try:
+        thread.join(2 * _CONNECT_SECONDS)
+    except BaseException:  # Ctrl-C
+        _discard(client)
+        raise
+    if thread.is_alive():
+        _discard(client)
+        raise ParameterError(f"scheduler: cannot connect to {address!r:.80}: no answer within "
+                             f"{2 * _CONNECT_SECONDS} s (is it a Dask scheduler?)")
+    if failed:
+        err = failed[0]
+        _discard(client)
+        why = (_short(err) if isinstance(err, (OSError, TimeoutError, ValueError))
+               else "what answers there is not a Dask scheduler")
+        raise ParameterError(f"scheduler: cannot connect to {address!r:.80}: {why}") \
+            from None
+    return client, True
+
+
+#: seconds to connect to a Dask scheduler (twice that for its first answer)
+_CONNECT_SECONDS = 10
+
+
+def _discard(client) -> None:
+    """Forget a Client that did not start or did not close: no 20 s close at collection."""
+    with contextlib.suppress(Exception):
+        client.status = "closed"
+    with contextlib.suppress(Exception):
+        client._loop_runner.stop()
+
+
+def _close(client) -> None:
+    """Close a Client we opened, within 2 s (a Ctrl-C must not wait for a slow scheduler)."""
+    try:
+        client.close(timeout=2)
+    except Exception:  # noqa: BLE001 - a scheduler that does not answer: let it be
+        _discard(client)
+
+
+def _run_dask(spec, todo, client, done_cb):
+    from distributed import as_completed
+
+    futs = {client.submit(compute_block, spec, b, pure=False): b for b in todo}
+    for f in as_completed(list(futs), loop=client.loop):
+        try:
+            vals = f.result()
+        except (KeyboardInterrupt, ParameterError):
+            raise
+        except Exception as err:  # a lost worker, a worker without parapend, ...
+            raise SolverError(f"a block failed on the Dask cluster ({type(err).__name__}: "
+                              f"{' '.join(str(err).split())[:160]}); the finished blocks are "
+                              "in the store: run the same command again to resume") from None
+        done_cb(futs[f], vals)
+        f.release()
+    return f"Dask cluster at {client.scheduler.address}"
+
+
+def sweep(store=None, *, omega=1.8, delta=None, gamma=0.0, torque_limit=None, efficiency=None,
+          harmonics: int = 24, excitation=None, square_alpha=None, fourier=None,
+          threshold: bool = False, workers: int | None = None, scheduler=None,
+          overwrite: bool = False, command: str | None = None, progress=None,
+          block_points: int | None = None) -> SweepRun:
+    """A design map: the optimum (and more) at every point of a grid; see the module text.
+
+    Parameters
+    ----------
+    store : path or None
+        Zarr store (a directory, e.g. ``map.zarr``) written block by block and resumed when
+        it already holds this sweep; None computes in memory.
+    omega, delta, gamma, torque_limit, efficiency : number, sequence, or str
+        One value, a sequence, ``"START:STOP:COUNT"`` or ``"A,B,C"`` (:func:`parse_axis`).
+        ``torque_limit`` or ``efficiency`` makes each point :func:`parapend.pto.optimize_pto`.
+    harmonics : int
+        N of every solve (at most 128).
+    excitation, square_alpha, fourier
+        As :func:`parapend.optimize` (not "file").
+    threshold : bool
+        Also compute gamma* (:func:`parapend.threshold`) for every (omega, delta).
+    workers : int or None
+        Local processes (default: the number of CPUs, at most the number of blocks).
+    scheduler : str or distributed.Client or None
+        Address of a Dask distributed scheduler (``tcp://host:8786``), or a Client: the
+        blocks run there, and are written here as they finish.
+    overwrite : bool
+        Replace a store that holds a different sweep. A directory that is not a parapend
+        sweep store (or a store holding files a sweep does not write) is refused either
+        way, never deleted.
+    command : str or None
+        The command line, recorded in the attributes (the first run's stays).
+    progress : callable or None
+        ``progress(done_points, total_points)`` after each block.
+    block_points : int or None
+        Points per block (one chunk, one task), about: default 512 (8 with a power
+        take-off). Part of the sweep's identity, as it sets where continuation runs start.
+    """
+    spec = sweep_spec(omega=omega, delta=delta, gamma=gamma, torque_limit=torque_limit,
+                      efficiency=efficiency, harmonics=harmonics, excitation=excitation,
+                      square_alpha=square_alpha, fourier=fourier, threshold=threshold,
+                      block_points=block_points)
+    if workers is not None:
+        workers = check_int("workers", workers, 1, 256)
+    else:
+        workers = max(1, min(os.cpu_count() or 1, spec.blocks))
+    t0 = time.monotonic()
+    client, own = _connect(scheduler) if scheduler is not None else (None, False)
+    # the pool starts at once unless the store holds this sweep already (a resume, where
+    # there may be nothing left to do): then only when blocks are left
+    resume = (store is not None and not overwrite
+              and _store_spec(_check_store_path(store)) == spec.to_json())
+    pool = (_LocalPool(workers, start=not resume)
+            if client is None and workers > 1 and spec.blocks > 1 else None)
+    try:
+        return _sweep(spec, store, pool, client, overwrite, command, progress, t0)
+    finally:
+        if pool is not None:
+            pool.shutdown()
+        if own:
+            _close(client)
+
+
+def _sweep(spec, store, pool, client, overwrite, command, progress, t0) -> SweepRun:
+    total = spec.points
+    sizes = [int(np.prod([s.stop - s.start for s in spec.block_slices(b)]))
+             for b in range(spec.blocks)]
+    if store is None:
+        ds, _ = _template(spec, command)
+        ds = ds.compute()
+        arrays = {v: ds[v].values.copy() for v in (*spec.variables, "done")}
+        counted = [0]
+
+        def write(b, vals):
+            sl = spec.block_slices(b)
+            for k, v in vals.items():
+                arrays[k][sl] = v
+            arrays["done"][sl] = True
+            counted[0] += sizes[b]
+            if progress is not None:
+                progress(counted[0], total)
+
+        how = _execute(spec, list(range(spec.blocks)), pool, client, write)
+        for k, v in arrays.items():
+            ds[k] = (spec.dims, v, ds[k].attrs)
+        return SweepRun(ds, None, total, spec.blocks, total, 0, time.monotonic() - t0, how)
+    path = _check_store_path(store)
+    path.mkdir(exist_ok=True)
+    try:
+        return _sweep_store(spec, path, pool, client, overwrite, command, progress, t0,
+                            sizes)
+    except OSError as exc:  # a full disk, a store made read-only, ...
+        raise OutputError(f"cannot write {str(path)!r}: {_short_os(exc)}; the finished blocks "
+                          "are in the store: run the same command again to resume") from None
+
+
+def _short_os(exc: OSError) -> str:
+    return " ".join(str(exc.strerror or exc).split())[:160]
+
+
+def _sweep_store(spec, path, pool, client, overwrite, command, progress, t0, sizes):
+    import zarr
+
+    total = spec.points
+    with _locked(path):
+        _prepare(path, spec, command, overwrite)
+        done, damaged = _verify(path, spec)
+        with _quiet_zarr():
+            group = zarr.open_group(path, mode="r+", zarr_format=3)
+            # every chunk of a finished block is written, also one that equals the fill
+            # value (all NaN): so a missing chunk is always damage (_verify)
+            arrays = {k: group[k].with_config({"write_empty_chunks": True})
+                      for k in spec.variables}
+            mask = group["done"]
+        if damaged:
+            log.warning("store %s: %s; recomputed", path, _damage_line(spec, damaged))
+            # not finished until recomputed: the mask's chunk goes first, then the data's
+            # (a chunk that cannot be decoded is never read back to be updated)
+            for b in sorted(damaged):
+                for k in ("done", *spec.variables):
+                    with contextlib.suppress(FileNotFoundError):
+                        os.unlink(path / k / _chunk_key(mask, spec, b))
+        todo = [b for b in range(spec.blocks) if not done[b]]
+        repaired = sum(sizes[b] for b in damaged)
+        resumed = total - sum(sizes[b] for b in todo)
+        counted = [resumed]
+        if progress is not None:
+            progress(resumed, total)
+
+        def write(b, vals):
+            sl = spec.block_slices(b)
+            for k in spec.variables:  # the data first, then the mask
+                arrays[k][sl] = vals[k]
+            mask[sl] = np.ones(vals["status"].shape, dtype=bool)
+            counted[0] += sizes[b]
+            if progress is not None:
+                progress(counted[0], total)
+
+        how = _execute(spec, todo, pool, client, write) if todo else "nothing to do"
+    ds = open_sweep(path)
+    return SweepRun(ds, str(path), total, spec.blocks, total - resumed, resumed,
+                    time.monotonic() - t0, how, repaired)
+
+
+def _execute(spec, todo, pool, client, write) -> str:
+    if client is not None:
+        return _run_dask(spec, todo, client, write)
+    return _run_local(spec, todo, pool, write)
