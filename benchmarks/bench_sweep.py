@@ -22,7 +22,7 @@ os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 import numpy as np  # noqa: E402
 
 import parapend  # noqa: E402
-from parapend.sweep import sweep  # noqa: E402
+from parapend.maps import sweep  # noqa: E402
 
 
 def main() -> None:

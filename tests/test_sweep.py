@@ -16,11 +16,11 @@ import numpy as np
 import pytest
 
 import parapend
-from parapend import sweep as sw
+from parapend import maps as sw
 from parapend.cli import main
 from parapend.errors import ParameterError
-from parapend.sweep import compute as sw_compute
-from parapend.sweep import store as sw_store
+from parapend.maps import compute as sw_compute
+from parapend.maps import store as sw_store
 
 SRC = str(Path(__file__).resolve().parents[1] / "src")
 # a 4 x 3 map in 4 blocks of 3 points (runs along delta): small, but several blocks
@@ -231,7 +231,7 @@ def test_resume_after_partial_store(reference, tmp_path):
 def test_kill_9_then_resume_equals_uninterrupted(reference, tmp_path):
     ref_store, _ = reference
     store = tmp_path / "killed.zarr"
-    code = ("import sys, time; from parapend import sweep as sw\n"
+    code = ("import sys, time; from parapend import maps as sw\n"
             "def slow(done, total):\n"
             "    print(done, flush=True)\n"
             "    time.sleep(0.3)\n"
@@ -516,7 +516,7 @@ def test_map_of_three_axes_selects_the_third(tmp_path):
 def test_colour_scale_covers_the_data_and_compresses_a_long_tail():
     """The colours of a heat map span the whole range of the values; only a tail longer than
     half the 1st-to-99th-percentile span is compressed, into the last 15 % of the bar."""
-    from parapend.sweep.figures import colour_scale
+    from parapend.maps.figures import colour_scale
 
     z = np.linspace(-2.0, 3.0, 400).reshape(20, 20)
     z[0, 0] = np.nan
@@ -668,7 +668,7 @@ def test_kill_9_during_creation_leaves_nothing_behind(reference, tmp_path, capsy
     work.mkdir()
     store = work / "map.zarr"
     code = ("import os, signal, sys\n"
-            "from parapend import sweep as sw\n"
+            "from parapend import maps as sw\n"
             "from pathlib import Path\n"
             "real, calls = os.replace, [0]\n"
             "def replace(a, b):\n"
@@ -990,7 +990,7 @@ def test_silent_scheduler_is_one_line_and_ctrl_c_during_connect(tmp_path):
 
     srv, address = listener()
     with srv:
-        code = ("import sys; from parapend.sweep import run; run._CONNECT_SECONDS = 1\n"
+        code = ("import sys; from parapend.maps import run; run._CONNECT_SECONDS = 1\n"
                 "from parapend.cli import main\n"
                 f"sys.exit(main(['sweep', '--omega', '1,2', '--scheduler', {address!r}]))\n")
         p = subprocess.run([sys.executable, "-c", code], cwd=tmp_path, env=env,

@@ -1,6 +1,6 @@
 """``parapend sweep`` and ``parapend map``: resumable design maps and their heat maps.
 
-A thin shell over :mod:`parapend.sweep` (docs/sweep.md).
+A thin shell over :mod:`parapend.maps` (docs/sweep.md).
 """
 
 from __future__ import annotations
@@ -95,7 +95,7 @@ def add_parsers(sub) -> None:
     m._negative_number_matcher = _NEGATIVE_VALUE
     m.add_argument("--store", default="map.zarr",
                    help="a sweep store (Zarr directory) or its NetCDF export")
-    from ..sweep import MAP_QUANTITIES
+    from ..maps import MAP_QUANTITIES
 
     m.add_argument("--variable", default="power", choices=MAP_QUANTITIES,
                    help="gain = power / uniform_power - 1 in percent (default power)")
@@ -118,7 +118,7 @@ def _command_line() -> str:
 
 
 def _cmd_sweep(a) -> dict | str:
-    from .. import sweep as sw
+    from .. import maps as sw
 
     _check_output(a.netcdf, "--netcdf", (".nc",))
     if a.scheduler is not None and a.workers is not None:
@@ -184,7 +184,7 @@ def _cmd_sweep(a) -> dict | str:
 
 
 def _cmd_map(a) -> dict | str:
-    from .. import sweep as sw
+    from .. import maps as sw
     from . import _output
 
     _check_output(a.plot, "--plot", FIGURE_SUFFIXES)

@@ -1,7 +1,7 @@
 r"""Many Fourier problems at once: the global search of :func:`.fourier.search_fourier` over a
 run of points, with the array work of every Newton iteration done for all points together.
 
-A design map (:mod:`parapend.sweep`) solves the same N-harmonic problem (Eqs. 10-11) at many
+A design map (:mod:`parapend.maps`) solves the same N-harmonic problem (Eqs. 10-11) at many
 points that differ only in the numbers ``omega``, ``delta`` and ``gamma``. Point by point,
 one Newton iteration at N = 24 is a few dozen small NumPy calls (two FFTs of 256 points, a
 sine and a cosine, the Hessian read off the FFT tables) whose cost is mostly the call, not

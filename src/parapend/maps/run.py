@@ -101,7 +101,7 @@ class _LocalPool:
         if self.executor is not None:
             return
         ctx = mp.get_context("forkserver")
-        ctx.set_forkserver_preload(["parapend.sweep", "parapend.api", "parapend.optimal.fourier",
+        ctx.set_forkserver_preload(["parapend.maps", "parapend.api", "parapend.optimal.fourier",
                                     "parapend.optimal.batch"])
         self.executor = cf.ProcessPoolExecutor(max_workers=self.workers, mp_context=ctx,
                                                initializer=_worker_init,

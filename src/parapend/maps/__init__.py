@@ -1,4 +1,5 @@
-r"""Design maps: resumable parameter sweeps over omega, delta, gamma, T_max and efficiency.
+r"""Design maps (``parapend sweep``, ``parapend map``): resumable parameter sweeps over
+omega, delta, gamma, T_max and efficiency.
 
 One sweep computes, at every point of a grid, what :func:`parapend.optimize` computes (the
 optimum of the truncated Fourier problem, Eqs. 10-11, by the global search of

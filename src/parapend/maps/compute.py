@@ -1,6 +1,6 @@
 """One block of a sweep: the global searches of its points together, then the continuation
 along each run (:func:`compute_block`). Runs in the worker processes (local pool or Dask):
-they import it as ``parapend.sweep.compute``; it reads the spec and writes nothing.
+they import it as ``parapend.maps.compute``; it reads the spec and writes nothing.
 """
 
 from __future__ import annotations
