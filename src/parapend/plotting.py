@@ -24,9 +24,11 @@ TAU_LABEL = r"$\tau = \omega t / 2\pi$"
 LIMIT_LABEL = r"limit $\gamma \to 0$"
 
 
-def _finish(fig, path):
-    """Lay out, save if ``path`` is given, and return the figure."""
-    fig.tight_layout()
+def _finish(fig, path, layout: bool = True):
+    """Lay out (``tight_layout`` unless ``layout`` is false: the figure has its own layout
+    engine), save if ``path`` is given, and return the figure."""
+    if layout:
+        fig.tight_layout()
     if path is not None:
         save_figure(fig, path)
     return fig
