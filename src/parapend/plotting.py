@@ -86,7 +86,7 @@ def plot_optimum(result, path=None, points: int = 2000):
     ax1.set_title(f"Optimal {what} ({desc}, $\\gamma = {result.gamma:g}$)")
     tq = torque(motion, exc, result.gamma, t)
     ax2.plot(tau, tq, color="C3", lw=1.2)
-    ax2.set_ylabel("torque $T$ (non-dim.)")
+    ax2.set_ylabel("torque $T$ ($mgl$)")
     ax2.set_xlabel(TAU_LABEL)
     ax2.set_xlim(0, 1)
     return _finish(fig, path)
