@@ -122,7 +122,7 @@ def plot_damping_sweep(ds, path=None, extra=None):
                 color="C3", ha="left", arrowprops={"arrowstyle": "-", "color": "C3", "lw": 0.6})
     ax.plot([0], [plim], "k*", ms=9, label=LIMIT_LABEL, zorder=3)
     ax.set_xlabel(r"damping $\gamma$")
-    ax.set_ylabel("mean extracted power $P$")
+    ax.set_ylabel("mean extracted power $P$ ($mgl/t_0$)")
     ax.set_title("power against damping (linear axes)")
     ax.legend()
     if not extra:
@@ -135,7 +135,7 @@ def plot_damping_sweep(ds, path=None, extra=None):
                    color=f"C{i + 2}", label=label)
     axr.axvline(gs, color="C3", lw=0.8, ls=":")
     axr.set_xlabel(r"damping $\gamma$ (log)")
-    axr.set_ylabel(r"$P_{\mathrm{lim}} - P$ (log)")
+    axr.set_ylabel(r"$P_{\mathrm{lim}} - P$ ($mgl/t_0$, log)")
     axr.set_title(rf"deficit below the limit $P_{{\mathrm{{lim}}}} = {plim:.6f}$")
     axr.legend(loc="upper left")
     return _finish(fig, path)
@@ -149,7 +149,7 @@ def plot_harmonic_table(ds, path=None):
     ax.axhline(ds.attrs["limit_power"], color="k", ls="--", label=LIMIT_LABEL)
     ax.axhline(ds.attrs["uniform_power"], color="gray", ls=":", label="best uniform rotation")
     ax.set_xlabel("harmonics $N$")
-    ax.set_ylabel("mean extracted power $P$")
+    ax.set_ylabel("mean extracted power $P$ ($mgl/t_0$)")
     ax.legend()
     return _finish(fig, path)
 
@@ -203,8 +203,8 @@ def plot_square_approximations(omega: float, alphas, path=None):
             label="unit square wave")
     for a in alphas:
         ax.plot(t, square(1.0, omega, a).q(t), lw=1.1, label=rf"Eq. 26, $\alpha = {a:g}$")
-    ax.set_xlabel("$t$")
-    ax.set_ylabel("$H(t)$")
+    ax.set_xlabel(r"$t$ (units of $\sqrt{l/g}$)")
+    ax.set_ylabel("$H(t)$ (-)")
     ax.set_title(rf"Square wave and tanh approximations over one period ($\omega = {omega:g}$)")
     ax.legend()
     return _finish(fig, path)

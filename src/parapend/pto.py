@@ -31,6 +31,7 @@ from .api import _coefficients, build_excitation, optimize
 from .errors import ParameterError, SolverError, check_finite, check_int, check_range
 from .optimal.profile import PTOSolution, pto_profile
 from .power import uniform_power
+from .style import figure_style
 from .trajectory import FourierMotion
 
 __all__ = ["VARY", "efficiencies", "optimize_pto", "physical_fields", "pto_curve"]
@@ -629,6 +630,7 @@ def pto_curve(vary: str = "torque-limit", *, values=None, points: int = 12,
     return ds
 
 
+@figure_style()
 def plot_pto_profile(result, path=None, points: int = 2000):
     """Torque ``T(t)`` and instantaneous power ``p = -T theta'`` of an optimum over one period.
 
@@ -669,6 +671,7 @@ def plot_pto_profile(result, path=None, points: int = 2000):
     return _finish(fig, path)
 
 
+@figure_style()
 def plot_pto_curve(ds, path=None):
     """Optimal (mechanical and electrical) power against the varied PTO parameter."""
     from .plotting import _finish, plt

@@ -133,20 +133,21 @@ def plot_coexistence(gamma: float = 0.1, p: float = 0.8, omega: float = 2.1, *,
         strobe = strobe[strobe < tr.t.size]
         ps = tr.phi[strobe] - 2 * math.pi * np.floor((tr.phi[strobe] + math.pi) / (2 * math.pi))
         ax2.plot(ps, tr.dphi[strobe], "o", color=color, mec="k", ms=7, zorder=3)
-    ax1.set_xlabel(r"$t/T$,  $T = 2\pi/\omega$")
+    ax1.set_xlabel(r"$t/T$ (forcing periods, $T = 2\pi/\omega$)")
     ax1.set_ylabel(r"$\varphi$ (rad, wrapped to $[-\pi, \pi)$)")
     ax1.set_ylim(-math.pi, math.pi)
     ax1.set_yticks([-math.pi, -math.pi / 2, 0, math.pi / 2, math.pi],
                    [r"$-\pi$", r"$-\pi/2$", "0", r"$\pi/2$", r"$\pi$"])
     ax1.grid(alpha=0.3)
     if motions:
-        ax1.legend(loc="lower right", fontsize=9)
+        ax1.legend(loc="lower left", bbox_to_anchor=(0.0, 1.0), ncol=len(motions),
+                   frameon=False, fontsize=9, borderaxespad=0.2)
     else:
         ax1.text(0.5, 0.5, "no periodic attractor found", transform=ax1.transAxes,
                  ha="center")
-    ax1.set_title(rf"Eq. 1: $\gamma={gamma:g}$, $p={p:g}$, $\omega={omega:g}$")
-    ax2.set_xlabel(r"$\varphi$ mod $2\pi$")
-    ax2.set_ylabel(r"$\dot\varphi$")
+    fig.suptitle(rf"Eq. 1: $\gamma={gamma:g}$, $p={p:g}$, $\omega={omega:g}$", fontsize=10)
+    ax2.set_xlabel(r"$\varphi$ mod $2\pi$ (rad)")
+    ax2.set_ylabel(r"$\dot\varphi$ (rad per $\sqrt{l/g}$)")
     ax2.set_xlim(-math.pi, math.pi)
     ax2.set_xticks([-math.pi, 0, math.pi], [r"$-\pi$", "0", r"$\pi$"])
     ax2.grid(alpha=0.3)
@@ -224,7 +225,7 @@ def plot_basins(ds: xr.Dataset, *, path: str | Path | None = None,
     ax.legend(handles=handles, loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=9,
               frameon=False)
     ax.set_xlabel(r"$\varphi(t_0)$ (rad, from hanging)")
-    ax.set_ylabel(r"$\dot\varphi(t_0)$")
+    ax.set_ylabel(r"$\dot\varphi(t_0)$ (rad per $\sqrt{l/g}$)")
     ax.set_xticks([-math.pi, -math.pi / 2, 0, math.pi / 2, math.pi],
                   [r"$-\pi$", r"$-\pi/2$", "0", r"$\pi/2$", r"$\pi$"])
     ax.set_xlim(phi[0] - dx / 2, phi[-1] + dx / 2)
@@ -293,8 +294,8 @@ def plot_rotation_boundaries(ds: xr.Dataset, *, path: str | Path | None = None,
     if om.size > 1:
         ax.set_xlim(om[0], om[-1])
     ax.set_ylim(0, top)
-    ax.set_xlabel(r"$\omega$")
-    ax.set_ylabel(r"$p$")
+    ax.set_xlabel(r"forcing frequency $\omega$ (units of $\sqrt{g/l}$)")
+    ax.set_ylabel(r"excitation strength $p$ (-)")
     ax.set_title(rf"Period-1 rotation of Eq. 1, $\gamma = {ds.attrs['gamma']:g}$")
     ax.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), borderaxespad=0, frameon=False)
     _save(fig, path)
