@@ -27,7 +27,9 @@ __all__ = ["all_problems", "axes_with_data", "colorbar_problems", "label_problem
 #: a unit in brackets, ``(rad)``, ``(m g l / t0)``, or after a comma, ``, s``
 UNIT = re.compile(r"\([^()]*\S[^()]*\)|\[[^\]]+\]|,\s*\S+\s*$")
 #: units that make a label SI
-SI_UNIT = re.compile(r"\b(s|m|W|J|kJ|MJ|kg|N\s*m|Hz|rad|turns|-)\b|\(-\)|N m s/rad")
+SI_UNIT = re.compile(r"\b(s|m|W|J|kJ|MJ|kg|N\s*m|Hz|rad|turns)\b|\(-\)|N m s/rad")
+#: units of the non-dimensional model, not SI
+MODEL_UNIT = re.compile(r"m\s*g\s*l|t_?0|\\sqrt|units of|forcing period|non-dim")
 
 
 def render(fig, dpi: float = 200):
@@ -80,7 +82,8 @@ def label_problems(fig, *, units: bool = True, unitless=(), si: bool = False) ->
             unit = UNIT.search(label)
             if unit is None:
                 out.append(f"axes {i}: {axis} label {label!r} has no unit")
-            elif si and not SI_UNIT.search(unit.group(0)):
+            elif si and (not SI_UNIT.search(unit.group(0))
+                         or MODEL_UNIT.search(unit.group(0))):
                 out.append(f"axes {i}: {axis} label {label!r} has no SI unit")
     return out
 

@@ -240,7 +240,7 @@ def plot_basins(ds: xr.Dataset, *, path: str | Path | None = None,
         if math.isfinite(hi):
             title += (f"\nuncertain labels {100 * a['mislabel_fraction']:.1f}% "
                       f"(95% interval {100 * lo:.1f} to {100 * hi:.1f}%)")
-    ax.set_title(title, fontsize=10)
+    ax.set_title(title, fontsize=10, pad=8)
     _save(fig, path)
     return fig
 
