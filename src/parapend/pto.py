@@ -679,8 +679,12 @@ def plot_pto_curve(ds, path=None):
     fig, ax = plt.subplots(figsize=(7, 4.2))
     ok = np.isin(ds["status"].values, ["converged", "no_power"])
     v = ds["value"].values
-    ax.plot(v[ok], ds["power"].values[ok], "o-", label="mechanical P")
-    ax.plot(v[ok], ds["electrical_power"].values[ok], "s--", label="electrical")
+    mech, elec = ds["power"].values, ds["electrical_power"].values
+    lossless = np.allclose(mech[ok], elec[ok], rtol=1e-12, atol=1e-14)
+    ax.plot(v[ok], mech[ok], "o-",
+            label="mechanical = electrical $P$ (lossless)" if lossless else "mechanical $P$")
+    if not lossless:  # a curve of its own only where it differs
+        ax.plot(v[ok], elec[ok], "s--", label="electrical")
     if not ok.all():
         ax.plot(v[~ok], ds["power"].values[~ok], "x", color="C3", ms=8,
                 label="not converged (status)")
