@@ -24,9 +24,11 @@ TAU_LABEL = r"$\tau = \omega t / 2\pi$"
 LIMIT_LABEL = r"limit $\gamma \to 0$"
 
 
-def _finish(fig, path):
-    """Lay out, save if ``path`` is given, and return the figure."""
-    fig.tight_layout()
+def _finish(fig, path, layout: bool = True):
+    """Lay out (``tight_layout`` unless ``layout`` is false: the figure has its own layout
+    engine), save if ``path`` is given, and return the figure."""
+    if layout:
+        fig.tight_layout()
     if path is not None:
         save_figure(fig, path)
     return fig
@@ -84,7 +86,7 @@ def plot_optimum(result, path=None, points: int = 2000):
     ax1.set_title(f"Optimal {what} ({desc}, $\\gamma = {result.gamma:g}$)")
     tq = torque(motion, exc, result.gamma, t)
     ax2.plot(tau, tq, color="C3", lw=1.2)
-    ax2.set_ylabel("torque $T$ (non-dim.)")
+    ax2.set_ylabel("torque $T$ ($mgl$)")
     ax2.set_xlabel(TAU_LABEL)
     ax2.set_xlim(0, 1)
     return _finish(fig, path)
@@ -120,7 +122,7 @@ def plot_damping_sweep(ds, path=None, extra=None):
                 color="C3", ha="left", arrowprops={"arrowstyle": "-", "color": "C3", "lw": 0.6})
     ax.plot([0], [plim], "k*", ms=9, label=LIMIT_LABEL, zorder=3)
     ax.set_xlabel(r"damping $\gamma$")
-    ax.set_ylabel("mean extracted power $P$")
+    ax.set_ylabel("mean extracted power $P$ ($mgl/t_0$)")
     ax.set_title("power against damping (linear axes)")
     ax.legend()
     if not extra:
@@ -133,7 +135,7 @@ def plot_damping_sweep(ds, path=None, extra=None):
                    color=f"C{i + 2}", label=label)
     axr.axvline(gs, color="C3", lw=0.8, ls=":")
     axr.set_xlabel(r"damping $\gamma$ (log)")
-    axr.set_ylabel(r"$P_{\mathrm{lim}} - P$ (log)")
+    axr.set_ylabel(r"$P_{\mathrm{lim}} - P$ ($mgl/t_0$, log)")
     axr.set_title(rf"deficit below the limit $P_{{\mathrm{{lim}}}} = {plim:.6f}$")
     axr.legend(loc="upper left")
     return _finish(fig, path)
@@ -147,7 +149,7 @@ def plot_harmonic_table(ds, path=None):
     ax.axhline(ds.attrs["limit_power"], color="k", ls="--", label=LIMIT_LABEL)
     ax.axhline(ds.attrs["uniform_power"], color="gray", ls=":", label="best uniform rotation")
     ax.set_xlabel("harmonics $N$")
-    ax.set_ylabel("mean extracted power $P$")
+    ax.set_ylabel("mean extracted power $P$ ($mgl/t_0$)")
     ax.legend()
     return _finish(fig, path)
 
@@ -201,8 +203,8 @@ def plot_square_approximations(omega: float, alphas, path=None):
             label="unit square wave")
     for a in alphas:
         ax.plot(t, square(1.0, omega, a).q(t), lw=1.1, label=rf"Eq. 26, $\alpha = {a:g}$")
-    ax.set_xlabel("$t$")
-    ax.set_ylabel("$H(t)$")
+    ax.set_xlabel(r"$t$ (units of $\sqrt{l/g}$)")
+    ax.set_ylabel("$H(t)$ (-)")
     ax.set_title(rf"Square wave and tanh approximations over one period ($\omega = {omega:g}$)")
     ax.legend()
     return _finish(fig, path)

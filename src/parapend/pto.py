@@ -31,6 +31,7 @@ from .api import _coefficients, build_excitation, optimize
 from .errors import ParameterError, SolverError, check_finite, check_int, check_range
 from .optimal.profile import PTOSolution, pto_profile
 from .power import uniform_power
+from .style import figure_style
 from .trajectory import FourierMotion
 
 __all__ = ["VARY", "efficiencies", "optimize_pto", "physical_fields", "pto_curve"]
@@ -629,13 +630,14 @@ def pto_curve(vary: str = "torque-limit", *, values=None, points: int = 12,
     return ds
 
 
+@figure_style()
 def plot_pto_profile(result, path=None, points: int = 2000):
     """Torque ``T(t)`` and instantaneous power ``p = -T theta'`` of an optimum over one period.
 
     The torque limit (if any) is drawn as dashed lines; motoring (``p < 0``) is shaded.
     Returns the figure (saved through :func:`parapend.plotting.save_figure` if ``path``).
     """
-    from .plotting import _finish, plt
+    from .plotting import TAU_LABEL, _finish, plt
 
     exc = result._excitation
     eff = None if result.efficiency_generating is None else (result.efficiency_generating,
@@ -646,27 +648,30 @@ def plot_pto_profile(result, path=None, points: int = 2000):
     prof = pto_profile(result.motion, exc, result.gamma, points=points, efficiency=eff)
     tau = prof["tau"]
     fig, (ax1, ax2) = plt.subplots(2, 1, figsize=(7, 5.5), sharex=True)
-    ax1.plot(tau, prof["torque"], color="C3", lw=1.2, label="torque T (Eq. 14)")
+    ax1.plot(tau, prof["torque"], color="C3", lw=1.2)
     if result.torque_limit is not None:
         for s in (1, -1):
             ax1.axhline(s * result.torque_limit, color="k", ls="--", lw=0.8)
-    ax1.set_ylabel("torque (m g l)")
-    ax1.set_title(f"Power take-off: P = {result.power:.5f}, peak |T| = "
-                  f"{result.peak_torque:.4g}, gamma = {result.gamma:g}", fontsize=9)
+    ax1.set_ylabel("torque $T$ ($mgl$)")
+    ax1.set_title(f"Power take-off: $P$ = {result.power:.5f}, peak $|T|$ = "
+                  f"{result.peak_torque:.4g}, $\\gamma$ = {result.gamma:g}", fontsize=9)
     ax1.grid(alpha=0.3)
     p = prof["power"]
-    ax2.plot(tau, p, color="C0", lw=1.2, label="mechanical p = -T theta'")
-    ax2.fill_between(tau, p, 0, where=p < 0, color="C1", alpha=0.4, label="motoring")
+    ax2.plot(tau, p, color="C0", lw=1.2, label=r"mechanical $p = -T\dot\theta$")
+    if np.any(p < 0):  # a legend entry only for what is drawn
+        ax2.fill_between(tau, p, 0, where=p < 0, color="C1", alpha=0.4,
+                         label="motoring ($p < 0$)")
     if "electrical_power" in prof:
         ax2.plot(tau, prof["electrical_power"], color="C2", lw=1, label="electrical")
-    ax2.set_ylabel("power (m g l / t0)")
-    ax2.set_xlabel("tau = omega t / 2 pi")
+    ax2.set_ylabel(r"power $p$ ($mgl/t_0$)")
+    ax2.set_xlabel(TAU_LABEL)
     ax2.grid(alpha=0.3)
-    ax2.legend(fontsize=8)
+    ax2.legend(fontsize=8, loc="best")
     ax2.set_xlim(0, 1)
     return _finish(fig, path)
 
 
+@figure_style()
 def plot_pto_curve(ds, path=None):
     """Optimal (mechanical and electrical) power against the varied PTO parameter."""
     from .plotting import _finish, plt
@@ -674,8 +679,12 @@ def plot_pto_curve(ds, path=None):
     fig, ax = plt.subplots(figsize=(7, 4.2))
     ok = np.isin(ds["status"].values, ["converged", "no_power"])
     v = ds["value"].values
-    ax.plot(v[ok], ds["power"].values[ok], "o-", label="mechanical P")
-    ax.plot(v[ok], ds["electrical_power"].values[ok], "s--", label="electrical")
+    mech, elec = ds["power"].values, ds["electrical_power"].values
+    lossless = np.allclose(mech[ok], elec[ok], rtol=1e-12, atol=1e-14)
+    ax.plot(v[ok], mech[ok], "o-",
+            label="mechanical = electrical $P$ (lossless)" if lossless else "mechanical $P$")
+    if not lossless:  # a curve of its own only where it differs
+        ax.plot(v[ok], elec[ok], "s--", label="electrical")
     if not ok.all():
         ax.plot(v[~ok], ds["power"].values[~ok], "x", color="C3", ms=8,
                 label="not converged (status)")
@@ -687,12 +696,12 @@ def plot_pto_curve(ds, path=None):
         tb = np.geomspace(v.min(), v.max(), 200)
         keep = tb * ds.attrs["omega"] <= ds.attrs["unconstrained_power"]
         ax.plot(tb[keep], tb[keep] * ds.attrs["omega"], color="C2", ls="-.", lw=1,
-                label="T_max omega (constant brake)")
+                label=r"$T_{\max}\,\omega$ (constant brake)")
         ax.set_xscale("log")
-        ax.set_xlabel("torque limit T_max (m g l)")
+        ax.set_xlabel(r"torque limit $T_{\max}$ ($mgl$)")
     else:
-        ax.set_xlabel("efficiency eta (generating = motoring)")
-    ax.set_ylabel("mean power (m g l / t0)")
+        ax.set_xlabel(r"efficiency $\eta$ (generating = motoring) (-)")
+    ax.set_ylabel(r"mean power $P$ ($mgl/t_0$)")
     ax.grid(alpha=0.3)
-    ax.legend(fontsize=8)
+    ax.legend(fontsize=8, loc="best")
     return _finish(fig, path)

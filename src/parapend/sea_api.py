@@ -284,17 +284,20 @@ def plot_sea(result: SeaResult, path=None, zoom_waves: float = 8.0):
     s = sea_samples(result)
     t = s["t"]
     tp = result.record.get("tp", result.record.get("peak_period"))
+    t_zoom = min(float(t[-1]), zoom_waves * tp)
+    above = {"loc": "lower left", "bbox_to_anchor": (0.0, 1.0), "ncol": 3, "frameon": False,
+             "borderaxespad": 0.2}
     with figure_style():
-        fig, ax = plt.subplots(4, 1, figsize=(8.0, 9.0))
+        fig, ax = plt.subplots(4, 1, figsize=(8.0, 10.0), layout="constrained")
         ax[0].plot(t, s["z"], lw=0.6)
         ax[0].set_ylabel("heave $z$ (m)")
-        ax[0].set_title(_title(result))
+        ax[0].set_title(_title(result), fontsize=9)
         turns = s["theta"] / (2 * math.pi)
         ax[1].plot(t, turns, lw=0.8, label=f"optimum (winding K = {result.winding})")
         ax[1].plot(t, turns[0] + result.uniform_winding * t / t[-1], "--", lw=0.8,
                    label=f"uniform, K = {result.uniform_winding} (mean wave frequency)")
         ax[1].set_ylabel(r"$\theta / 2\pi$ (turns)")
-        ax[1].legend(loc="upper left", fontsize=8)
+        ax[1].legend(**above)
         ax[2].plot(t, s["energy"] / 1e3, lw=0.9,
                    label=f"optimum: {result.power_w:.4g} W mean")
         ax[2].plot(t, s["energy_uniform"] / 1e3, "--", lw=0.9,
@@ -302,18 +305,23 @@ def plot_sea(result: SeaResult, path=None, zoom_waves: float = 8.0):
         ax[2].plot(t, t * result.limit_power_w / 1e3, ":", lw=0.9,
                    label=f"limit $\\gamma \\to 0$: {result.limit_power_w:.4g} W")
         ax[2].set_ylabel("energy harvested (kJ)")
-        ax[2].legend(loc="upper left", fontsize=8)
-        sel = t <= zoom_waves * tp
+        ax[2].legend(**above)
+        sel = t <= t_zoom
         ax[3].plot(t[sel], s["q"][sel] / max(np.max(np.abs(s["q"])), 1e-300), lw=0.9,
-                   label=r"$q / \max|q|$")
+                   label=r"$q / \max|q|$ (excitation)")
         ax[3].plot(t[sel], np.cos(s["theta"][sel]), lw=0.9,
                    label=r"$\cos\theta$ (1 upright, -1 hanging)")
-        ax[3].set_xlabel("time (s)")
-        ax[3].set_ylabel(f"first {zoom_waves:g} peak periods")
-        ax[3].legend(loc="upper right", fontsize=8)
+        ax[3].set_ylabel(r"$q/\max|q|$, $\cos\theta$ (-)")
+        ax[3].legend(**above)
+        ax[3].set_xlim(0, t_zoom)
         for a in ax[:3]:
             a.set_xlim(0, t[-1])
-        return _finish(fig, path)
+            a.axvspan(0, t_zoom, color="0.9", lw=0, zorder=0)
+        for a in ax[:3]:
+            a.set_xlabel("time (s)")
+        ax[3].set_xlabel(f"time (s): zoom on the first {zoom_waves:g} peak periods "
+                         "(shaded above)")
+        return _finish(fig, path, layout=False)
 
 
 def _title(r: SeaResult) -> str:

@@ -11,12 +11,19 @@ from .closedloop import energy_series
 __all__ = ["plot_track"]
 
 
-def plot_track(result, path=None):
-    """Four panels against time in forcing periods: ``theta - omega t`` (``theta`` from the
-    upright, unwrapped: bounded on a period-1 rotation) with the target orbit's, the wrapped
-    angle error (log scale: the lock shows as the drop below the tolerance), the applied
-    torque with ``+-T_max``, and the cumulative extracted energy ``W(t)`` with the predicted
-    optimum's slope from the lock on."""
+def plot_track(result, path=None, zoom_periods: int = 3):
+    """Swing-up and catch, the locked orbit against its target, the tracking error and the
+    extracted energy of a closed-loop run.
+
+    Panels, against time in forcing periods: top row, ``theta - omega t`` (``theta`` from the
+    upright, unwrapped: bounded on a period-1 rotation) from rest to a few periods past the
+    lock (left) and over the last ``zoom_periods`` periods (right), the target orbit
+    dashed (shifted by the whole turns the run gained or lost while it was caught); second
+    row, the applied (held) torque over the same windows with ``+-T_max``; third, the
+    largest wrapped angle error of each period on a log axis with the lock tolerance;
+    bottom, the cumulative extracted energy ``W`` at the end of each period with the
+    predicted optimum's slope from the lock on.
+    """
     from ..plotting import _finish, plt
     from ..style import figure_style
 
@@ -26,45 +33,74 @@ def plot_track(result, path=None):
     k = np.arange(run.t.size)
     ref = tg.theta[k % m] + 2 * math.pi * (k // m)
     err = np.abs((run.theta - ref + math.pi) % (2 * math.pi) - math.pi)
+    total = (run.t.size - 1) // m
+    tail = slice(max(0, run.t.size - m - 1), run.t.size)
+    ref = ref + 2 * math.pi * round(float(np.median(run.theta[tail] - ref[tail])) / (2 * math.pi))
     w = energy_series(run)
+    rel, rel_ref = run.theta - tg.omega * run.t, ref - tg.omega * run.t
+    locked = bool(result.locked)
+    head = min(total, (int(result.lock_period) + 5) if locked else 20)
+    zoom = max(1, min(int(zoom_periods), total))
+    first = per <= head + 1e-9
+    last = per >= per[-1] - zoom - 1e-9
     with figure_style():
-        fig, (a1, a0, a2, a3) = plt.subplots(4, 1, figsize=(7.5, 8.5), sharex=True)
-        a1.plot(per, run.theta - tg.omega * run.t, lw=0.5, color="C0",
-                label=r"run")
-        a1.plot(per, ref - tg.omega * run.t, lw=0.5, color="C3", alpha=0.6,
-                label=r"target $\theta^*$")
-        a1.set_ylabel(r"$\theta - \omega t$ (rad)")
-        a1.legend(fontsize=8, loc="upper right")
-        a1.set_title(f"track: gamma = {result.gamma:g}, omega = {result.omega:g}, "
-                     f"T_max = {_num(result.torque_limit)}; "
-                     + (f"locked after {result.lock_period} periods" if result.locked
-                        else "not locked"), fontsize=9)
-        floor = max(1e-12, 0.3 * float(np.percentile(err[err > 0], 1))) if np.any(err > 0) \
-            else 1e-12
-        a0.semilogy(per, np.maximum(err, floor), lw=0.5, color="C1")
-        a0.set_ylim(bottom=floor)
-        a0.axhline(result.lock_tolerance, color="k", ls="--", lw=0.7)
-        a0.set_ylabel("|angle error| (rad)")
-        a2.plot(per, run.torque, lw=0.5, color="C2")
-        if result.torque_limit is not None:
-            for s in (1, -1):
-                a2.axhline(s * result.torque_limit, color="k", ls="--", lw=0.7)
-        a2.set_ylabel("torque T (m g l)")
-        a3.plot(per, w, color="C0", lw=1.2, label="extracted energy W (run)")
-        if result.locked:
-            tl = result.lock_period
-            a3.plot(per[tl * m:], w[tl * m] + tg.power * (run.t[tl * m:] - run.t[tl * m]),
-                    "k:", lw=1, label=f"predicted P = {tg.power:.5g} from the lock")
-            for a in (a1, a0, a2, a3):
+        fig = plt.figure(figsize=(9.0, 9.5), layout="constrained")
+        grid = fig.add_gridspec(4, 2, height_ratios=(1.2, 1, 1, 1))
+        a_up = fig.add_subplot(grid[0, 0])
+        a_zoom = fig.add_subplot(grid[0, 1])
+        t_up = fig.add_subplot(grid[1, 0], sharex=a_up)
+        t_zoom = fig.add_subplot(grid[1, 1], sharex=a_zoom)
+        a_err = fig.add_subplot(grid[2, :])
+        a_w = fig.add_subplot(grid[3, :], sharex=a_err)
+        for ax, sel in ((a_up, first), (a_zoom, last)):
+            ax.plot(per[sel], rel[sel], lw=1.2, color="C0")
+            ax.plot(per[sel], rel_ref[sel], lw=1.2, ls="--", color="C3")
+            ax.set_ylabel(r"$\theta - \omega t$ (rad)")
+        key = r"(solid: run; dashed: target $\theta^*$)"
+        a_up.set_title(("swing-up and catch " if locked else f"first {head} periods ") + key,
+                       fontsize=9)
+        a_zoom.set_title(f"last {zoom} period{'s' if zoom > 1 else ''} {key}", fontsize=9)
+        for ax, sel in ((t_up, first), (t_zoom, last)):
+            ax.plot(per[sel], run.torque[sel], lw=1.0, color="C2", drawstyle="steps-post")
+            if result.torque_limit is not None:
+                for s in (1, -1):
+                    ax.axhline(s * result.torque_limit, color="k", ls="--", lw=0.7)
+            ax.set_ylabel("torque $T$ ($mgl$)")
+            ax.set_xlabel("time (forcing periods)")
+        a_up.set_xlim(0, per[first][-1])
+        a_zoom.set_xlim(per[last][0], per[-1])
+        a_up.tick_params(labelbottom=False)
+        a_zoom.tick_params(labelbottom=False)
+        # the largest error of each period: one point per period instead of a band
+        n = max(1, total)
+        emax = np.array([err[i * m:(i + 1) * m + 1].max() for i in range(n)])
+        floor = max(1e-12, 0.3 * float(emax[emax > 0].min())) if np.any(emax > 0) else 1e-12
+        a_err.semilogy(np.arange(n) + 1, np.maximum(emax, floor), ".-", ms=3, lw=0.8,
+                       color="C1", label="largest |angle error| of the period")
+        a_err.axhline(result.lock_tolerance, color="k", ls="--", lw=0.7,
+                      label=f"lock tolerance {result.lock_tolerance:g} rad")
+        a_err.set_ylabel("angle error (rad)")
+        a_err.set_xlabel("time (forcing periods)")
+        a_err.legend(loc="best")
+        ends = m * np.arange(n + 1)
+        a_w.plot(per[ends], w[ends], ".-", ms=3, color="C0", lw=1.0,
+                 label="extracted energy $W$ at the end of each period")
+        if locked:
+            tl = int(result.lock_period)
+            a_w.plot(per[tl * m:], w[tl * m] + tg.power * (run.t[tl * m:] - run.t[tl * m]),
+                     "k:", lw=1, label=f"predicted $P = {tg.power:.5g}$ from the lock")
+            for a in (a_up, t_up, a_err, a_w):
                 a.axvline(tl, color="gray", lw=0.7)
-        a3.axhline(0, color="gray", lw=0.5)
-        a3.set_ylabel("energy (m g l)")
-        a3.set_xlabel("time (forcing periods)")
-        a3.legend(fontsize=8)
-        for a in (a1, a0, a2, a3):
-            a.grid(alpha=0.3)
-        a1.set_xlim(0, per[-1])
-        return _finish(fig, path)
+        a_w.axhline(0, color="gray", lw=0.5)
+        a_w.set_ylabel("energy $W$ ($mgl$)")
+        a_w.set_xlabel("time (forcing periods)")
+        a_w.legend(loc="best")
+        a_err.set_xlim(0, per[-1])
+        fig.suptitle(f"track: $\\gamma$ = {result.gamma:g}, $\\omega$ = {result.omega:g}, "
+                     f"$T_{{\\max}}$ = {_num(result.torque_limit)}; "
+                     + (f"locked after {result.lock_period} periods" if locked
+                        else "not locked"), fontsize=10)
+        return _finish(fig, path, layout=False)
 
 
 def _num(x) -> str:

@@ -133,20 +133,21 @@ def plot_coexistence(gamma: float = 0.1, p: float = 0.8, omega: float = 2.1, *,
         strobe = strobe[strobe < tr.t.size]
         ps = tr.phi[strobe] - 2 * math.pi * np.floor((tr.phi[strobe] + math.pi) / (2 * math.pi))
         ax2.plot(ps, tr.dphi[strobe], "o", color=color, mec="k", ms=7, zorder=3)
-    ax1.set_xlabel(r"$t/T$,  $T = 2\pi/\omega$")
+    ax1.set_xlabel(r"$t/T$ (forcing periods, $T = 2\pi/\omega$)")
     ax1.set_ylabel(r"$\varphi$ (rad, wrapped to $[-\pi, \pi)$)")
     ax1.set_ylim(-math.pi, math.pi)
     ax1.set_yticks([-math.pi, -math.pi / 2, 0, math.pi / 2, math.pi],
                    [r"$-\pi$", r"$-\pi/2$", "0", r"$\pi/2$", r"$\pi$"])
     ax1.grid(alpha=0.3)
     if motions:
-        ax1.legend(loc="lower right", fontsize=9)
+        ax1.legend(loc="lower left", bbox_to_anchor=(0.0, 1.0), ncol=len(motions),
+                   frameon=False, fontsize=9, borderaxespad=0.2)
     else:
         ax1.text(0.5, 0.5, "no periodic attractor found", transform=ax1.transAxes,
                  ha="center")
-    ax1.set_title(rf"Eq. 1: $\gamma={gamma:g}$, $p={p:g}$, $\omega={omega:g}$")
-    ax2.set_xlabel(r"$\varphi$ mod $2\pi$")
-    ax2.set_ylabel(r"$\dot\varphi$")
+    fig.suptitle(rf"Eq. 1: $\gamma={gamma:g}$, $p={p:g}$, $\omega={omega:g}$", fontsize=10)
+    ax2.set_xlabel(r"$\varphi$ mod $2\pi$ (rad)")
+    ax2.set_ylabel(r"$\dot\varphi$ (rad per $\sqrt{l/g}$)")
     ax2.set_xlim(-math.pi, math.pi)
     ax2.set_xticks([-math.pi, 0, math.pi], [r"$-\pi$", "0", r"$\pi$"])
     ax2.grid(alpha=0.3)
@@ -224,7 +225,7 @@ def plot_basins(ds: xr.Dataset, *, path: str | Path | None = None,
     ax.legend(handles=handles, loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=9,
               frameon=False)
     ax.set_xlabel(r"$\varphi(t_0)$ (rad, from hanging)")
-    ax.set_ylabel(r"$\dot\varphi(t_0)$")
+    ax.set_ylabel(r"$\dot\varphi(t_0)$ (rad per $\sqrt{l/g}$)")
     ax.set_xticks([-math.pi, -math.pi / 2, 0, math.pi / 2, math.pi],
                   [r"$-\pi$", r"$-\pi/2$", "0", r"$\pi/2$", r"$\pi$"])
     ax.set_xlim(phi[0] - dx / 2, phi[-1] + dx / 2)
@@ -239,7 +240,7 @@ def plot_basins(ds: xr.Dataset, *, path: str | Path | None = None,
         if math.isfinite(hi):
             title += (f"\nuncertain labels {100 * a['mislabel_fraction']:.1f}% "
                       f"(95% interval {100 * lo:.1f} to {100 * hi:.1f}%)")
-    ax.set_title(title, fontsize=10)
+    ax.set_title(title, fontsize=10, pad=8)
     _save(fig, path)
     return fig
 
@@ -264,15 +265,17 @@ def plot_rotation_boundaries(ds: xr.Dataset, *, path: str | Path | None = None,
     -------
     matplotlib.figure.Figure
     """
-    fig = _new_figure((7.2, 5.0))
+    fig = _new_figure((9.6, 5.0))
     ax = fig.add_subplot()
     om = ds["omega"].values
     pj, pg, pe = (ds[k].values for k in ("p_J", "p_G", "p_E"))
-    top = 1.05 * float(np.nanmax(np.concatenate([pj, pg, pe, [1.0]])))
-    band = np.isfinite(pg)
-    ax.fill_between(om, np.where(band, pg, np.nan), np.where(np.isfinite(pe), pe, top),
-                    where=band, color="C3", alpha=0.13, lw=0,
-                    label="rotation unstable (between G and E)")
+    p_max = float(ds.attrs.get("p_max", np.nan))
+    open_top = bool(np.any(np.isfinite(pg) & ~np.isfinite(pe))) and math.isfinite(p_max)
+    top = 1.05 * float(np.nanmax(np.concatenate([pj, pg, pe, [1.0],
+                                                 [p_max] if open_top else []])))
+    for k, (x, y) in enumerate(_unstable_band(om, pg, pe, p_max)):
+        ax.fill(x, y, color="C3", alpha=0.13, lw=0,
+                label=None if k else "rotation unstable (between G and E)")
     ax.fill_between(om, 0, pj, where=np.isfinite(pj), color="0.5", alpha=0.12, lw=0,
                     label="no period-1 rotation (below J)")
     styles = {"p_J": ("k", "-", "J: birth (fold)"),
@@ -280,6 +283,9 @@ def plot_rotation_boundaries(ds: xr.Dataset, *, path: str | Path | None = None,
               "p_E": ("C0", "-.", "E: stability regained (period doubling)")}
     for key, (c, ls, lab) in styles.items():
         ax.plot(om, ds[key].values, color=c, ls=ls, lw=1.5, label=lab)
+    if open_top:
+        ax.axhline(p_max, color="0.4", ls=":", lw=1,
+                   label=r"$p_{\max}$ of the continuation (E not found below it)")
     for i, (label, (w, p)) in enumerate((points or {}).items()):
         ax.plot([w], [p], marker="*o^s"[i % 4], ms=11, color="gold", mec="k", ls="none",
                 zorder=4)
@@ -288,16 +294,55 @@ def plot_rotation_boundaries(ds: xr.Dataset, *, path: str | Path | None = None,
     if om.size > 1:
         ax.set_xlim(om[0], om[-1])
     ax.set_ylim(0, top)
-    ax.set_xlabel(r"$\omega$")
-    ax.set_ylabel(r"$p$")
+    ax.set_xlabel(r"forcing frequency $\omega$ (units of $\sqrt{g/l}$)")
+    ax.set_ylabel(r"excitation strength $p$ (-)")
     ax.set_title(rf"Period-1 rotation of Eq. 1, $\gamma = {ds.attrs['gamma']:g}$")
-    ax.legend(loc="upper left")
+    ax.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), borderaxespad=0, frameon=False)
     _save(fig, path)
     return fig
 
 
-def plot_motion(motion, *, path: str | Path | None = None) -> Figure:
-    """Time history and phase portrait of one motion of Eq. 1 (paper Fig. 1 right).
+def _unstable_band(om, pg, pe, p_max):
+    """Polygons ``(x, y)`` of the band between G and E, one per run of omegas where G exists.
+
+    Where E was not found below the continuation's ``p_max`` the band reaches ``p_max``. A
+    change between the two (E found at one grid omega, not at its neighbour) is drawn as a
+    vertical step halfway between them: E crosses ``p_max`` somewhere in that interval, and
+    joining ``p_max`` to E's value by a straight edge would draw a boundary no computation
+    found.
+    """
+    ok = np.isfinite(pg)
+    bands = []
+    i = 0
+    while i < om.size:
+        if not ok[i]:
+            i += 1
+            continue
+        j = i
+        while j + 1 < om.size and ok[j + 1]:
+            j += 1
+        found = np.isfinite(pe[i:j + 1])
+        upper = np.where(found, pe[i:j + 1], p_max)
+        if not np.all(np.isfinite(upper)):
+            upper = np.where(np.isfinite(upper), upper, np.nanmax(np.append(pg, 1.0)))
+        ux, uy = [om[i]], [upper[0]]
+        for a in range(1, j - i + 1):
+            if found[a] != found[a - 1]:
+                mid = 0.5 * (om[i + a - 1] + om[i + a])
+                ux += [mid, mid]
+                uy += [upper[a - 1], upper[a]]
+            ux.append(om[i + a])
+            uy.append(upper[a])
+        x = np.concatenate([om[i:j + 1], ux[::-1]])
+        y = np.concatenate([pg[i:j + 1], uy[::-1]])
+        bands.append((x, y))
+        i = j + 1
+    return bands
+
+
+@figure_style()
+def plot_motion(motion, *, path: str | Path | None = None, last_periods: int = 5) -> Figure:
+    """Time history, stroboscopic samples and phase portrait of one motion of Eq. 1.
 
     Parameters
     ----------
@@ -305,33 +350,62 @@ def plot_motion(motion, *, path: str | Path | None = None) -> Figure:
         From :func:`parapend.dynamics.motion.simulate`.
     path : str or Path, optional
         Save the figure there.
+    last_periods : int
+        Forcing periods shown in the time histories (the last ones of the run).
 
     Returns
     -------
     matplotlib.figure.Figure
-        Left: ``phi(t)`` (unwrapped) and ``phi'(t)``; right: the phase portrait, ``phi``
-        wrapped to ``[-pi, pi)``, the last half of the run darker, Poincare points marked.
+        Left: ``phi`` (wrapped to ``[-pi, pi)``) and ``phi'`` on separate axes over the last
+        ``last_periods`` forcing periods. Right, top: the stroboscopic samples
+        ``phi(t0 + m T)`` against the period ``m`` over the whole run (the transient and the
+        settling). Right, bottom: the phase portrait, the first half of the run light, the
+        second half dark, the Poincare points marked.
     """
     m = motion
-    fig = _new_figure((10.0, 4.2))
-    ax1, ax2 = fig.subplots(1, 2)
-    ax1.plot(m.t, m.phi, lw=0.8, label=r"$\varphi$ (unwrapped)")
-    ax1.plot(m.t, m.dphi, lw=0.8, label=r"$\dot\varphi$")
-    ax1.set_xlabel("t")
-    ax1.legend(fontsize=8)
-    ax1.grid(alpha=0.3)
+    period = 2 * math.pi / m.omega
+    fig = _new_figure((10.0, 6.2))
+    grid = fig.add_gridspec(2, 2, width_ratios=(1.25, 1))
+    ax_phi = fig.add_subplot(grid[0, 0])
+    ax_dphi = fig.add_subplot(grid[1, 0], sharex=ax_phi)
+    ax_strobe = fig.add_subplot(grid[0, 1])
+    ax_phase = fig.add_subplot(grid[1, 1])
+    tau = (m.t - m.t0) / period
+    last = max(1, min(int(last_periods), int(m.periods)))
+    sel = tau >= tau[-1] - last - 1e-9
+    w, tau_w, dphi_w = _wrap_for_plot(m.phi[sel], tau[sel], m.dphi[sel])
+    ax_phi.plot(tau_w, w, color="C0", lw=1.2)
+    ax_phi.set_ylabel(r"$\varphi$ (rad, wrapped)")
+    ax_phi.set_ylim(-math.pi, math.pi)
+    ax_phi.set_yticks([-math.pi, 0, math.pi], [r"$-\pi$", "0", r"$\pi$"])
+    ax_phi.tick_params(labelbottom=False)
+    ax_phi.set_title(f"last {last} forcing period{'s' if last > 1 else ''}")
+    ax_dphi.plot(tau[sel], m.dphi[sel], color="C1", lw=1.2)
+    ax_dphi.set_ylabel(r"$\dot\varphi$ (rad per $\sqrt{l/g}$)")
+    ax_dphi.set_xlabel(r"$t/T$ (forcing periods, $T = 2\pi/\omega$)")
+    ax_dphi.set_xlim(tau[sel][0], tau[sel][-1])
+    mm = np.arange(m.poincare_phi.size)
+    ps = m.poincare_phi - 2 * math.pi * np.floor((m.poincare_phi + math.pi) / (2 * math.pi))
+    ax_strobe.plot(mm, ps, "o", ms=2.5 if mm.size > 60 else 4, color="C0")
+    ax_strobe.set_ylim(-math.pi, math.pi)
+    ax_strobe.set_yticks([-math.pi, 0, math.pi], [r"$-\pi$", "0", r"$\pi$"])
+    ax_strobe.set_xlabel(r"period $m$")
+    ax_strobe.set_ylabel(r"$\varphi(t_0 + mT)$ (rad)")
+    ax_strobe.set_title("stroboscopic samples, whole run")
     half = m.t.size // 2
     w, dp = _wrap_for_plot(m.phi[:half + 1], m.dphi[:half + 1])
-    ax2.plot(w, dp, lw=0.5, color="0.75")
+    ax_phase.plot(w, dp, lw=0.5, color="0.75")
     w, dp = _wrap_for_plot(m.phi[half:], m.dphi[half:])
-    ax2.plot(w, dp, lw=0.8, color="k")
+    ax_phase.plot(w, dp, lw=0.8, color="k")
     c = m.classification
     if c.phi.size:
-        ax2.plot(c.phi, c.dphi, "o", ms=7, mfc="#d62728", mec="k", label="Poincare points")
-        ax2.legend(fontsize=8)
-    ax2.set_xlim(-math.pi, math.pi)
-    ax2.set_xlabel(r"$\varphi$ (rad, from hanging)")
-    ax2.set_ylabel(r"$\dot\varphi$")
+        ax_phase.plot(c.phi, c.dphi, "o", ms=7, mfc="#d62728", mec="k")
+    ax_phase.set_xlim(-math.pi, math.pi)
+    ax_phase.set_xticks([-math.pi, 0, math.pi], [r"$-\pi$", "0", r"$\pi$"])
+    ax_phase.set_xlabel(r"$\varphi$ (rad, from hanging)")
+    ax_phase.set_ylabel(r"$\dot\varphi$ (rad per $\sqrt{l/g}$)")
+    ax_phase.set_title("phase portrait (light: first half; dots: Poincare points)",
+                       fontsize=9)
     fig.suptitle(rf"Eq. 1: $\gamma={m.gamma:g}$, $p={m.p:g}$, $\omega={m.omega:g}$, "
                  rf"$(\varphi_0, \dot\varphi_0) = ({m.phi0:g}, {m.dphi0:g})$: {c.name}",
                  fontsize=10)
