@@ -29,7 +29,7 @@ _EXPORTS = {
     "limit": ".optimal.limit",
     "mean_power": ".power", "uniform_power": ".power",
     "OptimizeResult": ".results", "ThresholdResult": ".results",
-    "SeaResult": ".sea_api", "sea": ".sea_api",
+    "SeaResult": ".irregular", "sea": ".irregular",
 }
 
 __all__ = sorted([*_EXPORTS, "__version__"])

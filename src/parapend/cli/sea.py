@@ -70,7 +70,7 @@ def add_parsers(sub) -> None:
 
 
 def _cmd_sea(a) -> dict | str:
-    from ..sea_api import plot_sea, sea, sea_samples
+    from ..irregular import plot_sea, sea, sea_samples
 
     _check_output(a.plot, "--plot", FIGURE_SUFFIXES)
     _check_output(a.save, "--save", (".csv",))
