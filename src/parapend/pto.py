@@ -33,7 +33,8 @@ from .optimal.profile import PTOSolution, pto_profile
 from .power import uniform_power
 from .trajectory import FourierMotion
 
-__all__ = ["VARY", "efficiencies", "optimize_pto", "physical_fields", "pto_curve"]
+__all__ = ["VARY", "efficiencies", "optimize_pto", "physical_fields", "pto_curve",
+           "uniform_under_pto"]
 
 VARY = ("torque-limit", "efficiency")
 
@@ -116,7 +117,25 @@ def physical_fields(result, units) -> dict:
         out["electrical_power_w"] = units.to_watts(result.electrical_power)
     if result.motoring_energy is not None:
         out["motoring_energy_j"] = units.to_joules(result.motoring_energy)
+    if getattr(result, "uniform_pto_power", None) is not None:
+        out["uniform_pto_power_w"] = units.to_watts(result.uniform_pto_power)
+        out["uniform_pto_electrical_power_w"] = units.to_watts(
+            result.uniform_pto_electrical_power)
     return out
+
+
+def _uniform_fields(res, exc, tmax, eff, r_cu) -> dict:
+    """The ``uniform_pto_*`` fields of a PTO result: the best uniform rotation through the
+    same take-off, and the like-for-like gain over it."""
+    u = uniform_under_pto(exc, res.gamma, torque_limit=tmax, efficiency=eff,
+                          copper_loss=r_cu, winding=res.winding)
+    mine = res.electrical_power if res.electrical_power is not None else res.power
+    base = u["electrical_power"]
+    return {"uniform_pto_feasible": u["feasible"], "uniform_pto_power": u["power"],
+            "uniform_pto_electrical_power": base,
+            "uniform_pto_peak_torque": u["peak_torque"], "uniform_pto_phase": u["phase"],
+            "gain_over_uniform_pto": (mine / base - 1.0) if base is not None and base > 0
+            else None}
 
 
 def optimize_pto(*, torque_limit=None, efficiency=None, efficiency_generating=None,
@@ -194,6 +213,7 @@ def optimize_pto(*, torque_limit=None, efficiency=None, efficiency_generating=No
                                   peak_power=prof["peak_power"],
                                   motoring_energy=prof["motoring_energy"],
                                   harvested_energy=prof["harvested_energy"])
+        res = dataclasses.replace(res, **_uniform_fields(res, exc, tmax, eff, r_cu))
         return dataclasses.replace(res, **physical_fields(res, units))
     check_pto_excitation(exc)
     cap = limits.MAX_PTO_INTERVALS if max_intervals is None else \
@@ -266,10 +286,78 @@ def optimize_pto(*, torque_limit=None, efficiency=None, efficiency_generating=No
         peak_power=prof["peak_power"], motoring_energy=prof["motoring_energy"],
         harvested_energy=prof["harvested_energy"], max_violation=sol.max_violation,
         peak_torque_converged=peak_conv, _motion=motion, **extra)
+    res = dataclasses.replace(res, **_uniform_fields(res, exc, tmax, eff, r_cu))
     res = dataclasses.replace(res, **physical_fields(res, units))
     if throw and not res.success:
         raise SolverError(f"optimize: {res.message}")
     return res
+
+
+def uniform_under_pto(exc, gamma: float, *, torque_limit=None, efficiency=None,
+                      copper_loss: float = 0.0, winding: int = 1, points: int = 4096,
+                      phases: int = 720) -> dict:
+    """The best uniform rotation ``theta = K omega t + phi`` through the same power take-off.
+
+    The uniform rotation's torque (Eq. 14 with ``theta'' = 0``) is ``T(t) = gamma K omega -
+    (1 + q(t)) sin(K omega t + phi)``; its mechanical power is ``p = -T K omega``, its
+    electrical power ``eta_g p`` generating and ``p / eta_m`` motoring, less ``r T^2``. The
+    phase maximizes the mean electrical power (the mechanical power without an efficiency or
+    copper loss) among the phases whose peak ``|T|`` is within ``torque_limit``: a grid of
+    ``phases`` phases, then Brent's method on the best one's neighbourhood, cut at the
+    phases where the peak torque reaches the limit (found by bisection).
+
+    Returns
+    -------
+    dict
+        ``feasible`` (some phase meets the limit), ``phase``, ``power`` (mechanical),
+        ``electrical_power``, ``peak_torque``; the last four None when infeasible.
+    """
+    from scipy.optimize import brentq, minimize_scalar
+
+    k = int(winding)
+    om = k * exc.omega
+    t = exc.period * np.arange(points) / points
+    one_q = 1.0 + exc.q_uniform(points)
+    a, b = one_q * np.sin(om * t), one_q * np.cos(om * t)
+    eg, em = (1.0, 1.0) if efficiency is None else efficiency
+    r_cu = float(copper_loss)
+
+    def torque(phi):
+        phi = np.atleast_1d(phi)[:, None]
+        return gamma * om - a * np.cos(phi) - b * np.sin(phi)
+
+    def measures(phi):
+        tq = torque(phi)
+        p = -tq * om
+        elec = np.where(p > 0, eg * p, p / em) - r_cu * tq * tq
+        return p.mean(axis=1), elec.mean(axis=1), np.abs(tq).max(axis=1)
+
+    grid = 2 * math.pi * np.arange(phases) / phases
+    mech, elec, peak = measures(grid)
+    ok = np.ones(phases, bool) if torque_limit is None else peak <= torque_limit
+    if not ok.any():
+        return {"feasible": False, "phase": None, "power": None, "electrical_power": None,
+                "peak_torque": None}
+    j = int(np.argmax(np.where(ok, elec, -np.inf)))
+    h = 2 * math.pi / phases
+
+    def edge(inside, outside):
+        return brentq(lambda x: measures(x)[2][0] - torque_limit, inside, outside,
+                      xtol=1e-13)
+
+    lo = grid[j] - h if ok[(j - 1) % phases] else edge(grid[j], grid[j] - h)
+    hi = grid[j] + h if ok[(j + 1) % phases] else edge(grid[j], grid[j] + h)
+    best = [grid[j], lo, hi]
+    if hi > lo:
+        best.append(minimize_scalar(lambda x: -measures(x)[1][0], bounds=(lo, hi),
+                                    method="bounded", options={"xatol": 1e-10}).x)
+    cand = np.array(best)
+    mech, elec, peak = measures(cand)
+    if torque_limit is not None:
+        elec = np.where(peak <= torque_limit * (1 + 1e-12), elec, -np.inf)
+    i = int(np.argmax(elec))
+    return {"feasible": True, "phase": float(cand[i] % (2 * math.pi)), "power": float(mech[i]),
+            "electrical_power": float(elec[i]), "peak_torque": float(peak[i])}
 
 
 def _torque_scale(exc) -> float:
