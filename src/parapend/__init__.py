@@ -6,6 +6,14 @@ The public API mirrors the ``parapend`` command line::
     import parapend
     r = parapend.optimize(omega=1.8, delta=-0.3, harmonics=24)
     r.power, r.uniform_power, r.limit_power
+    r = parapend.optimize(gamma=0.03, torque_limit=2.5)      # through a power take-off
+    t = parapend.threshold(length=1, mass=10, frequency=0.9, amplitude=0.09)
+    t.damping_threshold, t.damping_threshold_coefficient     # gamma*, and in N m s/rad
+
+Every command of the ``parapend`` program is a function of the same name here (dashes as
+underscores: ``damping_sweep``, ``pto_curve``), taking the command's options as keyword
+arguments with the same defaults and returning a frozen result whose fields are the
+command's ``--json`` keys (:mod:`parapend.commands`).
 
 The names below are imported on first use (PEP 562), so ``import parapend`` is cheap and the
 command line can answer Ctrl-C while it is still loading NumPy and SciPy; the subpackages
@@ -15,28 +23,59 @@ command line can answer Ctrl-C while it is still loading NumPy and SciPy; the su
 from __future__ import annotations
 
 import importlib
+import sys
+import types
 
 __version__ = "0.1.0"
 
-#: public name -> the module that defines it
+#: public name -> the module that defines it. One function per command of the command line
+#: (parapend.commands: same name, dashes as underscores, the options as parameters).
+_COMMANDS = ("optimize", "threshold", "damping_sweep", "harmonics", "figure", "reproduce",
+             "pto_curve", "simulate", "basins", "rotations", "track", "sea", "sweep", "map")
 _EXPORTS = {
-    "EXCITATIONS": ".api", "build_excitation": ".api", "damping_sweep": ".api",
-    "harmonic_table": ".api", "optimize": ".api", "threshold": ".api",
+    **{name: ".commands" for name in _COMMANDS},
+    "EXCITATIONS": ".api", "build_excitation": ".api", "harmonic_table": ".api",
     "ParameterError": ".errors", "SolverError": ".errors",
     "fourier": ".excitation", "from_csv": ".excitation", "harmonic": ".excitation",
     "square": ".excitation", "two_harmonic": ".excitation",
     "BVPSolution": ".optimal.bvp", "solve_bvp_optimum": ".optimal.bvp",
     "limit": ".optimal.limit",
     "mean_power": ".power", "uniform_power": ".power",
-    "OptimizeResult": ".results", "ThresholdResult": ".results",
-    "SeaResult": ".irregular", "sea": ".irregular",
+    "OptimizeResult": ".results", "Record": ".results", "ThresholdResult": ".results",
+    "SeaResult": ".irregular",
 }
 
 __all__ = sorted([*_EXPORTS, "__version__"])
 
 
+class _Package(types.ModuleType):
+    """The package's module type: ``parapend.sweep`` is both the design-map module and the
+    ``sweep`` command's function. The import system sets a submodule as an attribute of its
+    package; this one is given a module type that calls :func:`parapend.commands.sweep`, so
+    ``parapend.sweep(...)`` runs the command and ``parapend.sweep.open_sweep`` still reads
+    the module, however it was first imported."""
+
+    def __setattr__(self, name, value):
+        if name == "sweep" and isinstance(value, types.ModuleType) and \
+                type(value) is types.ModuleType:
+            value.__class__ = _CallableSweep
+        super().__setattr__(name, value)
+
+
+class _CallableSweep(types.ModuleType):
+    def __call__(self, *args, **kwargs):
+        from .commands import sweep
+
+        return sweep(*args, **kwargs)
+
+
+sys.modules[__name__].__class__ = _Package
+
+
 def __getattr__(name: str):
     """Import a public name, or a subpackage, on first access."""
+    if name == "sweep":
+        return importlib.import_module(".sweep", __name__)
     where = _EXPORTS.get(name)
     if where is not None:
         value = getattr(importlib.import_module(where, __name__), name)

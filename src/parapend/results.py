@@ -252,7 +252,9 @@ class Record(_Result):
     commands whose result is not one of the dataclasses above: ``figure``, ``reproduce``,
     ``sweep``, ``map``, ``optimize --method all``). Fields read as attributes or with
     ``record["key"]``; ``to_dict`` gives the JSON object. Objects that are not JSON (a
-    figure, a Dataset) ride along as private attributes (``_figure``, ``_dataset``).
+    figure, a Dataset) ride along as private attributes (``_figure``, ``_dataset``); the
+    attributes of ``_source`` (the object the record describes, e.g. a simulated motion)
+    read through.
     """
 
     __slots__ = ("_kind", "_data", "_private")
@@ -269,6 +271,8 @@ class Record(_Result):
         private = object.__getattribute__(self, "_private")
         if name.startswith("_") and name[1:] in private:
             return private[name[1:]]
+        if "source" in private and not name.startswith("_"):
+            return getattr(private["source"], name)
         raise AttributeError(f"{object.__getattribute__(self, '_kind')} result has no field "
                              f"{name!r}")
 
