@@ -259,3 +259,13 @@ def _dataset_json(ds) -> dict:
     out = {name: ds[name].values for name in ds.coords}
     out.update({name: ds[name].values for name in ds.data_vars})
     return {**out, **ds.attrs}
+
+
+def _run(a, **extra):
+    """Call the command's public function (:mod:`parapend.commands`, the command's name with
+    underscores) with every option of the command but the presentation ones."""
+    from .. import commands
+
+    skip = commands.presentation(a.command) | {"command"}
+    opts = {k: v for k, v in vars(a).items() if k not in skip}
+    return getattr(commands, a.command.replace("-", "_"))(**opts, **extra)
