@@ -267,3 +267,30 @@ def test_no_issue_numbers_in_help(capsys):
     for name, p in _subparsers().items():
         text = p.format_help()
         assert "issue" not in text.lower(), name
+
+
+def test_plots_with_physical_options_have_si_axes(tmp_path):
+    """The SI axis beside every non-dimensional torque, power and damping axis, scaled by
+    the units (a tick of the SI axis is the non-dimensional value times the unit)."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from parapend.units import Units, add_si_axes
+
+    u = Units(1.0, 10.0)
+    fig, (a, b) = plt.subplots(2)
+    a.set_ylabel("torque (m g l)")
+    b.set_ylabel("mean power (m g l / t0)")
+    b.set_xlabel(r"damping $\gamma$")
+    add_si_axes(fig, u)
+    labels = [ax.get_ylabel() for ax in fig.axes] + [ax.get_xlabel() for ax in fig.axes]
+    assert "torque (N m)" in labels and "power (W)" in labels
+    assert "damping c (N m s/rad)" in labels
+    sec = [ax for ax in fig.axes if ax.get_ylabel() == "power (W)"][0]
+    assert math.isclose(sec._functions[0](1.0), u.power, rel_tol=1e-15)
+    plt.close(fig)
+    png = str(tmp_path / "p.png")
+    assert main(["harmonics", "--from", "2", "--to", "3", "--length", "1", "--mass", "10",
+                 "--plot", png]) == 0

@@ -127,7 +127,7 @@ def _cmd_optimize(a) -> dict | str:
         else:
             from ..plotting import plot_optimum as plot_fn
 
-        _output.plot(plot_fn, r, a.plot)
+        _output.plot(plot_fn, r, a.plot, units=units)
     if a.json:
         return r.to_dict()
     name = (f"Fourier optimum, N = {r.harmonics} (Eq. 10)" if r.method == "fourier"
@@ -283,7 +283,7 @@ def _plot_and_save(ds, a, plotter: str) -> None:
     if a.plot:
         from .. import plotting
 
-        _output.plot(getattr(plotting, plotter), ds, a.plot)
+        _output.plot(getattr(plotting, plotter), ds, a.plot, units=_pto.units_of(ds))
     if a.save:
         _output.write_dataset(ds, a.save)
 

@@ -63,10 +63,13 @@ def add_unit_options(p, damping: bool = True, torque: bool = False) -> None:
 
 
 def units_of(r):
-    """The :class:`parapend.units.Units` of a result's ``units`` description."""
+    """The :class:`parapend.units.Units` of a result's ``units`` description, or of a
+    Dataset's attributes (None when it has none)."""
     from ..units import Units
 
-    u = r.units
+    u = r.attrs if hasattr(r, "attrs") else r.units
+    if u is None or "length_m" not in u:
+        return None
     return Units(length=u["length_m"], mass=u["mass_kg"], gravity=u["gravity_m_s2"],
                  inertia=u["inertia_kg_m2"])
 
@@ -198,7 +201,7 @@ def _cmd_pto_curve(a) -> dict | str:
     ds = _run(a, progress=_Progress("pto-curve"))
     units = ds.attrs.get("power_unit_w")
     if a.plot:
-        _output.plot(plot_pto_curve, ds, a.plot)
+        _output.plot(plot_pto_curve, ds, a.plot, units=units_of(ds))
     if a.save:
         _output.write_dataset(ds, a.save)
     if a.json:
