@@ -285,10 +285,11 @@ def test_plots_with_physical_options_have_si_axes(tmp_path):
     b.set_ylabel("mean power (m g l / t0)")
     b.set_xlabel(r"damping $\gamma$")
     add_si_axes(fig, u)
-    labels = [ax.get_ylabel() for ax in fig.axes] + [ax.get_xlabel() for ax in fig.axes]
+    axes = [c for ax in fig.axes for c in ax.child_axes]  # the secondary axes
+    labels = [ax.get_ylabel() for ax in axes] + [ax.get_xlabel() for ax in axes]
     assert "torque (N m)" in labels and "power (W)" in labels
     assert "damping c (N m s/rad)" in labels
-    sec = [ax for ax in fig.axes if ax.get_ylabel() == "power (W)"][0]
+    sec = [ax for ax in axes if ax.get_ylabel() == "power (W)"][0]
     assert math.isclose(sec._functions[0](1.0), u.power, rel_tol=1e-15)
     plt.close(fig)
     png = str(tmp_path / "p.png")
