@@ -463,15 +463,22 @@ def track(*, excitation=None, omega=OMEGA, delta=None, square_alpha=None, fourie
           theta0: float = math.pi, theta_dot0: float = 0.0, periods: int = 100, seed: int = 0,
           runs: int = 1, gamma_error: float = 0.0, delta_error: float = 0.0,
           noise_theta: float = 0.0, noise_speed: float = 0.0, irregular: bool = False,
-          progress=None):
+          length=None, mass=None, inertia=None, gravity=None, frequency=None,
+          amplitude=None, damping_coefficient=None, torque_limit_nm=None, progress=None):
     """Swing up from rest, catch and hold the optimal rotation (command ``track``): a
     :class:`~parapend.control.track.TrackResult` (``runs`` 1) or a
-    :class:`~parapend.control.robustness.RobustnessResult` (more seeded runs)."""
+    :class:`~parapend.control.robustness.RobustnessResult` (more seeded runs). With
+    ``length`` and ``mass`` the result adds ``mean_power_w``, ``predicted_power_w``,
+    ``peak_torque_nm``, ``torque_limit_nm`` and the forcing period ``period_s``."""
     from .control.robustness import track_runs
     from .control.track import track as _track
 
     kw = {"gamma": gamma, "harmonics": harmonics,
           **_excitation(excitation, omega, delta, square_alpha, fourier, file)}
+    units, kw, torque_limit = _physical(
+        kw, length=length, mass=mass, inertia=inertia, gravity=gravity, frequency=frequency,
+        amplitude=amplitude, damping_coefficient=damping_coefficient,
+        torque_limit=torque_limit, torque_limit_nm=torque_limit_nm)
     common = dict(torque_limit=torque_limit, torque_margin=torque_margin, periods=periods,
                   seed=seed, gamma_error=gamma_error, delta_error=delta_error,
                   noise_theta=noise_theta, noise_speed=noise_speed, irregular=irregular,
@@ -480,8 +487,18 @@ def track(*, excitation=None, omega=OMEGA, delta=None, square_alpha=None, fourie
         if theta0 != math.pi or theta_dot0 != 0.0:
             raise ParameterError("runs: a batch starts from the hanging rest; drop --theta0 "
                                  "and --theta-dot0 or use --runs 1")
-        return track_runs(runs=runs, progress=progress, **common)
-    return _track(theta0=theta0, theta_dot0=theta_dot0, **common)
+        r = track_runs(runs=runs, progress=progress, **common)
+    else:
+        r = _track(theta0=theta0, theta_dot0=theta_dot0, **common)
+    if units is None:
+        return r
+    return dataclasses.replace(
+        r, units=units.describe(), mean_power_w=units.to_watts(r.mean_power),
+        predicted_power_w=units.to_watts(r.predicted_power),
+        peak_torque_nm=units.to_newton_metres(r.peak_torque),
+        torque_limit_nm=None if r.torque_limit is None else
+        units.to_newton_metres(r.torque_limit),
+        period_s=units.to_seconds(2 * math.pi / r.omega))
 
 
 # --- sea -----------------------------------------------------------------------------------

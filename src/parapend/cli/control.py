@@ -69,6 +69,9 @@ def add_parsers(sub) -> None:
     g.add_argument("--irregular", action="store_true",
                    help="drive the plant with a seeded JONSWAP sea record (parapend.seas) "
                         "peaked at omega, with the rms of q, instead of q")
+    from .pto import add_unit_options
+
+    add_unit_options(p, torque=True)
     p.add_argument("--save", metavar="CSV",
                    help="write the run: t,theta,theta_dot,torque,q, 256 samples per period "
                         "(torque held on [t, t + h)); one run only")
@@ -80,6 +83,18 @@ def add_parsers(sub) -> None:
 def _mult(ms) -> str:
     return ", ".join(f"{complex(re, im):.4g} (|.| {abs(complex(re, im)):.4g})"
                      for re, im in ms)
+
+
+def _si_lines(r) -> list[str]:
+    """Watts, N m and seconds beside the non-dimensional numbers (with --length, --mass)."""
+    if r.units is None:
+        return []
+    u = r.units
+    return [f"physical (l = {u['length_m']:g} m, m = {u['mass_kg']:g} kg): forcing period "
+            f"{r.period_s:.6g} s; mean power {r.mean_power_w:.6g} W (predicted "
+            f"{r.predicted_power_w:.6g} W); peak torque {r.peak_torque_nm:.6g} N m"
+            + (f", limit {r.torque_limit_nm:.6g} N m" if r.torque_limit_nm is not None
+               else "")]
 
 
 def _cmd_track(a) -> dict | str:
@@ -105,7 +120,7 @@ def _cmd_track(a) -> dict | str:
             f"mean power over the last 10 periods: mean {_fmt(r.mean_power, 6)} (min "
             f"{_fmt(r.power_min, 6)}, max {_fmt(r.power_max, 6)}); locked runs "
             f"{_fmt(r.locked_mean_power, 6)}; predicted {_fmt(r.predicted_power, 6)}",
-            f"peak torque {_fmt(r.peak_torque, 5)}"])
+            f"peak torque {_fmt(r.peak_torque, 5)}", *_si_lines(r)])
     if r._run is not None and a.save:
         run = r._run
         _output.write_columns(a.save, {"t": run.t, "theta": run.theta,
@@ -113,8 +128,9 @@ def _cmd_track(a) -> dict | str:
                                        "q": run.q})
     if r._run is not None and a.plot:
         from ..control.figures import plot_track
+        from .pto import units_of
 
-        _output.plot(plot_track, r, a.plot)
+        _output.plot(plot_track, r, a.plot, units=units_of(r))
     if a.json:
         return r.to_dict()
     out = [f"{r.status}: {r.message}",
@@ -142,6 +158,7 @@ def _cmd_track(a) -> dict | str:
                    f"{sea['hs']:.4g} (units g t0^2), rms of q {sea['rms_q']:.4g}, "
                    f"{sea['components']} components, repeating every "
                    f"{sea['repeat_periods']} peak periods, seed {sea['seed']}")
+    out += _si_lines(r)
     if a.save:
         out.append(f"run written to {a.save}")
     if a.plot:
