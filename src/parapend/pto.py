@@ -717,7 +717,13 @@ def pto_curve(vary: str = "torque-limit", *, values=None, points: int = 12,
          "peak_torque_converged": ("value", np.array(
              [-1 if r.peak_torque_converged is None else int(r.peak_torque_converged)
               for r in rows], dtype=np.int8)),
-         "status": ("value", [r.status for r in rows])},
+         "status": ("value", [r.status for r in rows]),
+         # the best uniform rotation through the same take-off (NaN: none within the limit)
+         "uniform_pto_power": ("value", [np.nan if r.uniform_pto_power is None
+                                         else r.uniform_pto_power for r in rows]),
+         "uniform_pto_electrical_power": ("value", [
+             np.nan if r.uniform_pto_electrical_power is None
+             else r.uniform_pto_electrical_power for r in rows])},
         coords={"value": [float(v) for v in vals[:len(rows)]]},
         attrs={"vary": vary, "unconstrained_power": ideal.power,
                "uniform_power": ideal.uniform_power, "harmonics": ideal.harmonics,

@@ -207,14 +207,17 @@ def _cmd_pto_curve(a) -> dict | str:
     if a.json:
         return _dataset_json(ds)
     name = "T_max" if a.vary == "torque-limit" else "eta"
-    rows = [[f"{v:.6g}", _fmt(p, 8), _fmt(e, 8), f"{t:.5g}" + ("*" if c == 0 else ""),
-             _fmt(m), str(s)]
-            for v, p, e, t, m, s, c in zip(ds["value"].values, ds["power"].values,
-                                           ds["electrical_power"].values,
-                                           ds["peak_torque"].values,
-                                           ds["motoring_energy"].values, ds["status"].values,
-                                           ds["peak_torque_converged"].values)]
-    head = [name, "mech. P", "electrical", "peak |T|", "motoring E", "status"]
+    rows = [[f"{v:.6g}", _fmt(p, 8), _fmt(e, 8), "-" if math.isnan(u) else _fmt(u, 8),
+             f"{t:.5g}" + ("*" if c == 0 else ""), _fmt(m), str(s)]
+            for v, p, e, u, t, m, s, c in zip(ds["value"].values, ds["power"].values,
+                                              ds["electrical_power"].values,
+                                              ds["uniform_pto_electrical_power"].values,
+                                              ds["peak_torque"].values,
+                                              ds["motoring_energy"].values,
+                                              ds["status"].values,
+                                              ds["peak_torque_converged"].values)]
+    head = [name, "mech. P", "electrical", "uniform, same", "peak |T|", "motoring E",
+            "status"]
     if units is not None:
         for r, w in zip(rows, ds["power_w"].values):
             r.insert(2, f"{w:.5g}")
@@ -222,7 +225,9 @@ def _cmd_pto_curve(a) -> dict | str:
     out = [_table(rows, head), "",
            f"ideal optimum {_fmt(ds.attrs['unconstrained_power'], 8)}, best uniform "
            f"{_fmt(ds.attrs['uniform_power'], 8)} (gamma = {ds.attrs['gamma']:g}, N = "
-           f"{ds.attrs['harmonics']}); units m g l, m g l / t0"]
+           f"{ds.attrs['harmonics']}); units m g l, m g l / t0",
+           "uniform, same: the best uniform rotation through the same take-off, electrical "
+           "('-': no phase within the torque limit)"]
     if (ds["peak_torque_converged"].values == 0).any():
         out.append("* peak torque not converged under mesh refinement (impulsive or singular "
                    "braking): a property of the mesh, not of the motion (optimize --json: "
