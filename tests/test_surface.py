@@ -58,7 +58,7 @@ def test_every_option_is_a_parameter_with_the_same_default(command):
         elif api is inspect.Parameter.empty:
             assert default is None, (command, dest)  # a positional (figure's number)
         else:
-            assert default == api and type(default is None) is type(api is None), \
+            assert default == api and (default is None) == (api is None), \
                 (command, dest, default, api)
 
 

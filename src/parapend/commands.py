@@ -214,10 +214,10 @@ def harmonics(*, excitation=None, omega=OMEGA, delta=None, square_alpha=None, fo
 
     top = limits.MAX_TABLE_HARMONICS
     if not isinstance(n_to, int) or not 1 <= n_to <= top:
-        raise ParameterError(f"to: expected an integer in [1, {top}] (the continuation to "
+        raise ParameterError(f"--to (n_to): expected an integer in [1, {top}] (the continuation to "
                              f"{top} takes about 10 s, to 512 over 10 minutes), got {n_to}")
     if not isinstance(n_from, int) or not 1 <= n_from <= n_to:
-        raise ParameterError(f"from: expected an integer in [1, --to = {n_to}], "
+        raise ParameterError(f"--from (n_from): expected an integer in [1, --to = {n_to}], "
                              f"got {n_from}")
     kw = {"gamma": gamma, **_excitation(excitation, omega, delta, square_alpha, fourier, file)}
     units, kw, _ = _physical(kw, length=length, mass=mass, inertia=inertia, gravity=gravity,
