@@ -117,6 +117,10 @@ CASES = [
     (["rotations", "--p-max", "0.5"], {"p_max": 0.5}, set()),
     (["track", "--periods", "20", "--harmonics", "8"], {"periods": 20, "harmonics": 8},
      set()),
+    (["track", "--periods", "20", "--harmonics", "8", "--length", "1", "--mass", "10"],
+     {"periods": 20, "harmonics": 8, "length": 1.0, "mass": 10.0}, set()),
+    (["sea", "--repeat-period", "80", "--harmonics", "32"],
+     {"repeat_period": 80.0, "harmonics": 32}, set()),
 ]
 
 
@@ -295,3 +299,16 @@ def test_plots_with_physical_options_have_si_axes(tmp_path):
     png = str(tmp_path / "p.png")
     assert main(["harmonics", "--from", "2", "--to", "3", "--length", "1", "--mass", "10",
                  "--plot", png]) == 0
+
+
+def test_track_in_si():
+    """Watts = m g l / t0 times the power, N m = m g l times the torque, the forcing period
+    2 pi / omega times t0 = sqrt(l / g); a limit in N m is the same limit in m g l."""
+    m, length, g = 10.0, 1.0, 9.81
+    t0 = math.sqrt(length / g)
+    r = parapend.track(periods=20, harmonics=8, length=length, mass=m,
+                       torque_limit_nm=3.0 * m * g * length)
+    assert math.isclose(r.torque_limit, 3.0, rel_tol=1e-14)
+    assert math.isclose(r.mean_power_w, r.mean_power * m * g * length / t0, rel_tol=1e-14)
+    assert math.isclose(r.peak_torque_nm, r.peak_torque * m * g * length, rel_tol=1e-14)
+    assert math.isclose(r.period_s, 2 * math.pi / r.omega * t0, rel_tol=1e-14)
