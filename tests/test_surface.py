@@ -110,6 +110,8 @@ CASES = [
     (["pto-curve", "--vary", "efficiency", "--points", "2", "--harmonics", "8"],
      {"vary": "efficiency", "points": 2, "harmonics": 8}, set()),
     (["simulate", "--periods", "2"], {"periods": 2}, set()),
+    (["simulate", "--periods", "2", "--length", "2", "--mass", "3"],
+     {"periods": 2, "length": 2.0, "mass": 3.0}, set()),
     (["basins", "--resolution", "4", "--periods", "2", "--accuracy-sample", "100",
       "--engine", "numpy"],
      {"resolution": 4, "periods": 2, "accuracy_sample": 100, "engine": "numpy"},
@@ -312,3 +314,12 @@ def test_track_in_si():
     assert math.isclose(r.mean_power_w, r.mean_power * m * g * length / t0, rel_tol=1e-14)
     assert math.isclose(r.peak_torque_nm, r.peak_torque * m * g * length, rel_tol=1e-14)
     assert math.isclose(r.period_s, 2 * math.pi / r.omega * t0, rel_tol=1e-14)
+
+
+def test_simulate_in_si():
+    """Eq. 1's time unit is sqrt(l/g) and its energy unit m g l."""
+    r = parapend.simulate(periods=3, length=2.0, mass=3.0, gravity=9.0)
+    t0 = math.sqrt(2.0 / 9.0)
+    assert math.isclose(r.forcing_period_s, 2 * math.pi / 2.1 * t0, rel_tol=1e-14)
+    assert math.isclose(r.duration_s, 3 * 2 * math.pi / 2.1 * t0, rel_tol=1e-12)
+    assert math.isclose(r.final_energy_j, r.energy[-1] * 3.0 * 9.0 * 2.0, rel_tol=1e-14)

@@ -302,12 +302,16 @@ def _check_model(gamma, p, omega=None):
 
 def simulate(*, gamma=GAMMA["simulate"], p=DYNAMICS["p"], omega=DYNAMICS["omega"],
              phi0: float = 0.5, dphi0: float = 0.0, periods: int = 200,
-             points_per_period: int = 64):
+             points_per_period: int = 64, length=None, mass=None, inertia=None,
+             gravity=None):
     """One motion of the uncontrolled pendulum, paper Eq. 1 (command ``simulate``).
 
     Fields are the JSON keys (``final``, ``turns``, ...); the time series (``t``, ``phi``,
     ``dphi``, ``energy``) and the rest of :class:`parapend.dynamics.motion.Motion` read
-    through from ``_source``.
+    through from ``_source``. With ``length`` and ``mass`` (the time unit is
+    ``t0 = sqrt(I / (m g l))``, ``sqrt(l / g)`` for a point mass) it adds ``units``,
+    ``forcing_period_s``, ``forcing_frequency_hz``, ``duration_s`` and ``final_energy_j``
+    (the energy ``phi'^2/2 + 1 - cos(phi)`` is in units of m g l).
     """
     from .dynamics.motion import simulate as _simulate
 
@@ -320,8 +324,16 @@ def simulate(*, gamma=GAMMA["simulate"], p=DYNAMICS["p"], omega=DYNAMICS["omega"
         raise ParameterError(f"periods: expected periods x 2 pi/omega x (sqrt(1 + |p|) + "
                              f"|dphi0|) <= {limits.SIM_MAX_WORK:g}, got {work:.4g}")
     check_int("points-per-period", points_per_period, 2, 1024)
+    units, _, _ = _physical({}, length=length, mass=mass, inertia=inertia, gravity=gravity)
     m = _simulate(gamma, p, omega, phi0, dphi0, periods, points_per_period=points_per_period)
-    return Record("simulate", m.to_dict(), source=m)
+    out = m.to_dict()
+    if units is not None:
+        period = 2 * math.pi / omega
+        out.update(units=units.describe(), forcing_period_s=units.to_seconds(period),
+                   forcing_frequency_hz=1.0 / units.to_seconds(period),
+                   duration_s=units.to_seconds(float(m.t[-1] - m.t[0])),
+                   final_energy_j=units.to_joules(float(m.energy[-1])))
+    return Record("simulate", out, source=m, units=units)
 
 
 def basins_json(ds) -> dict:

@@ -77,7 +77,9 @@ def plot(func, data, path, units=None) -> None:
             fig = func(data, None)
             with figure_style():
                 add_si_axes(fig, units)
-                fig.tight_layout()
+                engine = fig.get_layout_engine()
+                if engine is None or type(engine).__name__ == "TightLayoutEngine":
+                    fig.tight_layout()  # (a constrained layout adapts by itself)
             save_figure(fig, path)
             return
         func(data, path)

@@ -103,6 +103,14 @@ def add_parsers(sub) -> None:
                         "(default 200)")
     p.add_argument("--points-per-period", type=_int, default=64,
                    help="output samples per forcing period, 2 to 1024 (default 64)")
+    u = p.add_argument_group("physical units (docs/units.md): time in s, energy in J")
+    u.add_argument("--length", type=_finite_float("length"), default=None,
+                   help="pivot to centre of mass, m")
+    u.add_argument("--mass", type=_finite_float("mass"), default=None, help="kg")
+    u.add_argument("--inertia", type=_finite_float("inertia"), default=None,
+                   help="moment of inertia about the pivot, kg m^2 (default m l^2)")
+    u.add_argument("--gravity", type=_finite_float("gravity"), default=None,
+                   help="m/s^2 (default 9.81)")
     p.add_argument("--plot", metavar="PNG",
                    help="draw the time history and phase portrait (PNG, SVG or PDF)")
     p.add_argument("--save", metavar="CSV", help="write the time series: t,phi,dphi,energy")
@@ -185,13 +193,16 @@ def _cmd_simulate(a) -> dict | str:
     with _Ticker("simulate"):
         rec = _run(a)
     m = rec._source
+    units = rec._units
     if a.save:
-        _output.write_columns(a.save, {"t": m.t, "phi": m.phi, "dphi": m.dphi,
-                                       "energy": m.energy})
+        cols = {"t": m.t, "phi": m.phi, "dphi": m.dphi, "energy": m.energy}
+        if units is not None:
+            cols.update(t_s=m.t * units.time, energy_j=m.energy * units.energy)
+        _output.write_columns(a.save, cols)
     if a.plot:
         from ..dynamics.figures import plot_motion
 
-        _output.plot(lambda mm, path: plot_motion(mm, path=path), m, a.plot)
+        _output.plot(lambda mm, path: plot_motion(mm, path=path), m, a.plot, units=units)
     if a.json:
         return rec.to_dict()
     c = m.classification
@@ -205,6 +216,11 @@ def _cmd_simulate(a) -> dict | str:
         rows.append([f"Poincare point {j + 1}", f"({_fmt(x)}, {_fmt(y)})"])
     if not m.success:
         rows.append(["status", f"{m.status}: {m.message}"])
+    if units is not None:
+        rows.append(["forcing period, duration (s)",
+                     f"{rec.forcing_period_s:.6g} ({rec.forcing_frequency_hz:.6g} Hz), "
+                     f"{rec.duration_s:.6g}"])
+        rows.append(["final energy (J)", f"{rec.final_energy_j:.6g}"])
     return (f"one motion of {EQ1}\n" + _table(rows, ["quantity", "value"])
             + "\nPoincare section t = m 2 pi/omega; phi wrapped to [-pi, pi).")
 
