@@ -45,7 +45,8 @@ _EXPORTS = {
     "SeaResult": ".irregular",
 }
 
-__all__ = sorted([*_EXPORTS, "__version__"])
+# `map` is left out of the star import, which would hide the builtin: use parapend.map
+__all__ = sorted([*(k for k in _EXPORTS if k != "map"), "__version__"])
 
 
 class _Package(types.ModuleType):
@@ -91,4 +92,4 @@ def __getattr__(name: str):
 
 
 def __dir__():
-    return sorted(set(globals()) | set(__all__))
+    return sorted(set(globals()) | set(_EXPORTS) | {"__version__"})
