@@ -3,7 +3,7 @@ r"""Time ``parapend.sea`` against CasADi + IPOPT direct collocation over the sam
 Records: JONSWAP, Hs = 2 m, Tp = 8 s, seed 0, components up to 3 fp, repeat periods of
 WAVES peak periods; pendulum l = 1 m, m = 10 kg, gamma = 0.01, winding K = 1.
 
-1. **parapend**: :func:`parapend.sea_api.sea` (record, global search with the dynamic
+1. **parapend**: :func:`parapend.irregular.sea` (record, global search with the dynamic
    programme's seeds and the matrix-free Newton-CG kernel at N = 16 harmonics per mean wave,
    and the refinement at 2N). Wall time of the whole call.
 2. **CasADi + IPOPT**: ``tests/casadi_pto.py`` (Hermite-Simpson collocation of Eq. 14 with
@@ -34,7 +34,7 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
 
-from parapend.sea_api import sea  # noqa: E402
+from parapend.irregular import sea  # noqa: E402
 
 INTERVALS = 150
 

@@ -19,11 +19,11 @@ import parapend
 from parapend.cli import main
 from parapend.errors import ParameterError
 from parapend.excitation import fourier
+from parapend.irregular import sea, sea_samples
 from parapend.optimal.dynprog import best_paths_winding
 from parapend.optimal.fourier import FourierProblem, newton_maximize, search_fourier
 from parapend.optimal.limit import limit, pattern_count
 from parapend.power import limit_motion_power, uniform_power
-from parapend.sea_api import sea, sea_samples
 from parapend.seas import (
     jonswap,
     measured_record,

@@ -6,10 +6,19 @@ The public API mirrors the ``parapend`` command line::
     import parapend
     r = parapend.optimize(omega=1.8, delta=-0.3, harmonics=24)
     r.power, r.uniform_power, r.limit_power
+    r = parapend.optimize(gamma=0.03, torque_limit=2.5)      # through a power take-off
+    t = parapend.threshold(length=1, mass=10, frequency=0.9, amplitude=0.09)
+    t.damping_threshold, t.damping_threshold_coefficient     # gamma*, and in N m s/rad
+
+Every command of the ``parapend`` program is a function of the same name here (dashes as
+underscores: ``damping_sweep``, ``pto_curve``), taking the command's options as keyword
+arguments with the same defaults and returning a frozen result whose fields are the
+command's ``--json`` keys (:mod:`parapend.commands`).
 
 The names below are imported on first use (PEP 562), so ``import parapend`` is cheap and the
 command line can answer Ctrl-C while it is still loading NumPy and SciPy; the subpackages
-(``parapend.optimal``, ``parapend.dynamics``, ...) are reachable as attributes as well.
+(``parapend.optimal``, ``parapend.dynamics``, ``parapend.maps``, ...) are reachable as
+attributes as well.
 """
 
 from __future__ import annotations
@@ -18,21 +27,25 @@ import importlib
 
 __version__ = "0.1.0"
 
-#: public name -> the module that defines it
+#: public name -> the module that defines it. One function per command of the command line
+#: (parapend.commands: same name, dashes as underscores, the options as parameters).
+_COMMANDS = ("optimize", "threshold", "damping_sweep", "harmonics", "figure", "reproduce",
+             "pto_curve", "simulate", "basins", "rotations", "track", "sea", "sweep", "map")
 _EXPORTS = {
-    "EXCITATIONS": ".api", "build_excitation": ".api", "damping_sweep": ".api",
-    "harmonic_table": ".api", "optimize": ".api", "threshold": ".api",
+    **{name: ".commands" for name in _COMMANDS},
+    "EXCITATIONS": ".api", "build_excitation": ".api", "harmonic_table": ".api",
     "ParameterError": ".errors", "SolverError": ".errors",
     "fourier": ".excitation", "from_csv": ".excitation", "harmonic": ".excitation",
     "square": ".excitation", "two_harmonic": ".excitation",
     "BVPSolution": ".optimal.bvp", "solve_bvp_optimum": ".optimal.bvp",
     "limit": ".optimal.limit",
     "mean_power": ".power", "uniform_power": ".power",
-    "OptimizeResult": ".results", "ThresholdResult": ".results",
-    "SeaResult": ".sea_api", "sea": ".sea_api",
+    "OptimizeResult": ".results", "Record": ".results", "ThresholdResult": ".results",
+    "SeaResult": ".irregular",
 }
 
-__all__ = sorted([*_EXPORTS, "__version__"])
+# `map` is left out of the star import, which would hide the builtin: use parapend.map
+__all__ = sorted([*(k for k in _EXPORTS if k != "map"), "__version__"])
 
 
 def __getattr__(name: str):
@@ -52,4 +65,4 @@ def __getattr__(name: str):
 
 
 def __dir__():
-    return sorted(set(globals()) | set(__all__))
+    return sorted(set(globals()) | set(_EXPORTS) | {"__version__"})

@@ -7,7 +7,7 @@ from dataclasses import dataclass, field, fields
 
 import numpy as np
 
-__all__ = ["CONVENTION", "OptimizeResult", "ThresholdResult", "to_jsonable"]
+__all__ = ["CONVENTION", "OptimizeResult", "Record", "ThresholdResult", "to_jsonable"]
 
 CONVENTION = ("theta from the upright; non-dimensional time (unit sqrt(l/g)); power positive "
               "when harvested, P = -<T theta'> (paper Eqs. 14-16; the paper's tables list -P "
@@ -124,6 +124,16 @@ class OptimizeResult(_Result):
     units, power_w, uniform_power_w, limit_power_w, peak_torque_nm, electrical_power_w,
     energy_per_cycle_j, motoring_energy_j : physical values (W, N m, J) when a pendulum's
         length and mass were given (:mod:`parapend.units`); None otherwise.
+    uniform_pto_feasible, uniform_pto_power, uniform_pto_electrical_power,
+    uniform_pto_peak_torque, uniform_pto_phase : the best uniform rotation through the same
+        power take-off (:func:`parapend.pto.uniform_under_pto`): its phase maximizes the
+        electrical power among the phases whose peak torque meets the limit; all None
+        (``uniform_pto_feasible`` False) when no phase does, None without a take-off.
+    gain_over_uniform_pto : float or None
+        Like for like: ``electrical_power / uniform_pto_electrical_power - 1`` (the
+        mechanical powers when there is no efficiency or copper loss).
+    uniform_pto_power_w, uniform_pto_electrical_power_w : float or None
+        The same in watts, with physical units.
     winding : int
         K, turns per forcing period, ``theta(t + 2 pi/omega) = theta(t) + 2 pi K`` (1: the
         paper's period-1 rotation); ``uniform_power`` is then the uniform rotation with K
@@ -188,6 +198,14 @@ class OptimizeResult(_Result):
     electrical_power_w: float | None = None
     energy_per_cycle_j: float | None = None
     motoring_energy_j: float | None = None
+    uniform_pto_feasible: bool | None = None
+    uniform_pto_power: float | None = None
+    uniform_pto_electrical_power: float | None = None
+    uniform_pto_peak_torque: float | None = None
+    uniform_pto_phase: float | None = None
+    gain_over_uniform_pto: float | None = None
+    uniform_pto_power_w: float | None = None
+    uniform_pto_electrical_power_w: float | None = None
     winding: int = 1
     convention: str = CONVENTION
     _motion: object = field(default=None, repr=False)
@@ -209,6 +227,9 @@ class ThresholdResult(_Result):
     solver's tolerance); ``uniform_threshold`` is ``|Q1|/(2 omega)``, where the best uniform
     rotation stops extracting. ``harmonics`` is the final N; ``refinement_change`` is
     ``|gamma*(N) - gamma*(N/2)|``, the check by one refinement (NaN when N was given).
+    With a pendulum's length and mass (:mod:`parapend.units`), ``units`` describes them and
+    ``damping_threshold_coefficient`` and ``uniform_threshold_coefficient`` are the two
+    thresholds as viscous damping coefficients ``c = gamma I / t0`` in N m s/rad.
     """
 
     damping_threshold: float
@@ -223,4 +244,57 @@ class ThresholdResult(_Result):
     mean_square_speed: float = float("nan")
     refinement_change: float = float("nan")
     excitation: dict = field(default_factory=dict)
+    units: dict | None = None
+    damping_threshold_coefficient: float | None = None
+    uniform_threshold_coefficient: float | None = None
     convention: str = CONVENTION
+
+
+class Record(_Result):
+    """A frozen result whose fields are the keys of a command's JSON object (for the
+    commands whose result is not one of the dataclasses above: ``figure``, ``reproduce``,
+    ``sweep``, ``map``, ``optimize --method all``). Fields read as attributes or with
+    ``record["key"]``; ``to_dict`` gives the JSON object. Objects that are not JSON (a
+    figure, a Dataset) ride along as private attributes (``_figure``, ``_dataset``); the
+    attributes of ``_source`` (the object the record describes, e.g. a simulated motion)
+    read through.
+    """
+
+    __slots__ = ("_kind", "_data", "_private")
+
+    def __init__(self, kind: str, data: dict, **private):
+        object.__setattr__(self, "_kind", kind)
+        object.__setattr__(self, "_data", dict(data))
+        object.__setattr__(self, "_private", private)
+
+    def __getattr__(self, name):
+        data = object.__getattribute__(self, "_data")
+        if name in data:
+            return data[name]
+        private = object.__getattribute__(self, "_private")
+        if name.startswith("_") and name[1:] in private:
+            return private[name[1:]]
+        if "source" in private and not name.startswith("_"):
+            return getattr(private["source"], name)
+        raise AttributeError(f"{object.__getattribute__(self, '_kind')} result has no field "
+                             f"{name!r}")
+
+    def __getitem__(self, key):
+        return self._data[key]
+
+    def __setattr__(self, name, value):
+        raise AttributeError(f"{self._kind} result is frozen")
+
+    def __dir__(self):
+        return sorted(self._data)
+
+    def __repr__(self) -> str:
+        keys = ", ".join(self._data)
+        return f"{self._kind.capitalize()}Result({keys})"
+
+    def fields(self) -> tuple:
+        """The field names, which are the JSON keys."""
+        return tuple(self._data)
+
+    def to_dict(self) -> dict:
+        return to_jsonable(self._data)

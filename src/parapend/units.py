@@ -216,3 +216,37 @@ def from_options(*, length=None, mass=None, gravity=None, inertia=None, frequenc
     if damping_coefficient is not None:
         params["gamma"] = u.gamma(damping_coefficient)
     return u, params
+
+
+#: axis-label words -> (quantity, SI unit, name of the Units scale)
+_SI_AXES = (("torque", "torque", "N m", "torque"), ("power", "power", "W", "power"),
+            ("energy", "energy", "J", "energy"), ("damping", "damping c", "N m s/rad", "damping"))
+
+
+def add_si_axes(fig, units: Units) -> None:
+    """Give every axis of ``fig`` that shows a torque, a power, an energy, a damping or a time
+    in the non-dimensional units a secondary axis in SI (right or top), labelled with its
+    unit (a time in forcing periods or as the phase tau is left alone).
+
+    The quantity is read from the axis label (a figure keeps its non-dimensional scale and
+    gains the SI one beside it); labels already in SI units (W, N m, J) are left alone.
+    """
+    for ax in list(fig.axes):
+        for which in ("y", "x"):
+            label = (ax.get_ylabel() if which == "y" else ax.get_xlabel()).lower()
+            if not label or any(f"({u.lower()}" in label for u in ("W", "N m", "J", "kJ")):
+                continue
+            bare = label.replace("$", "").strip()
+            is_time = (bare == "t" or bare.startswith(("t ", "t(")) or "time" in bare) and \
+                "period" not in bare and "tau" not in bare and "(s)" not in bare
+            for word, name, unit, scale in _SI_AXES + (("", "time", "s", "time"),):
+                if (word and word in label) or (not word and is_time):
+                    k = float(getattr(units, scale))
+                    funcs = (lambda v, k=k: v * k, lambda v, k=k: v / k)
+                    if which == "y":
+                        sec = ax.secondary_yaxis("right", functions=funcs)
+                        sec.set_ylabel(f"{name} ({unit})")
+                    else:
+                        sec = ax.secondary_xaxis("top", functions=funcs)
+                        sec.set_xlabel(f"{name} ({unit})")
+                    break

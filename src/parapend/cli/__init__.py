@@ -1,4 +1,8 @@
-"""The ``parapend`` command line: a thin layer over :mod:`parapend.api`.
+"""The ``parapend`` command line: a thin layer over :mod:`parapend.commands`.
+
+Each command parses its options, calls the function of the same name in
+:mod:`parapend.commands` (every option but ``--json``, ``--plot``, ``--save``) and formats
+its result.
 
 Every command has ``--help``, defaults to the paper's case (harmonic excitation,
 delta = -0.3, omega = 1.8), prints a plain-text table or, with ``--json``, one JSON object.
@@ -16,7 +20,7 @@ Modules: :mod:`._common` (parser helpers, number parsing, tables, progress),
  harmonics), :mod:`.paper` (figure, reproduce), :mod:`.pto` (pto-curve; the power
  take-off and unit options of optimize), :mod:`.dynamics` (simulate, basins,
  rotations: the uncontrolled pendulum of paper Eq. 1), :mod:`.control` (track: the
- closed loop of issue 11), :mod:`.sea` (sea: irregular seas), :mod:`.sweep` (sweep, map:
+ closed loop), :mod:`.sea` (sea: irregular seas), :mod:`.sweep` (sweep, map:
  design maps).
 """
 

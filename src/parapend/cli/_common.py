@@ -10,6 +10,7 @@ import sys
 import time
 from pathlib import Path
 
+from ..defaults import OMEGA, Default, given  # noqa: F401  (Default, given re-exported)
 from ..errors import ParameterError
 
 EXIT_USAGE = 2
@@ -59,17 +60,6 @@ def _int(text):
         raise argparse.ArgumentTypeError(f"expected an integer, got {text!r:.40}") from None
 
 
-class Default(float):
-    """A default value, told apart from the same number typed on the command line (the
-    option's type function returns a plain float), so that ``--omega 1.8 --frequency 0.9``
-    is refused as a contradiction while ``--frequency 0.9`` alone is not."""
-
-
-def given(value) -> bool:
-    """True when an option's value came from the command line, not its default."""
-    return value is not None and not isinstance(value, Default)
-
-
 def _add_excitation(p):
     g = p.add_argument_group("excitation q(t) (base acceleration over g)")
     g.add_argument("--excitation", default=None,
@@ -77,7 +67,7 @@ def _add_excitation(p):
                    help="harmonic: delta sin(omega t); two-harmonic: Eq. 23; square: Eq. 26; "
                         "fourier: --fourier terms; file: --file CSV (default: file if --file "
                         "is given, fourier if --fourier is given, else harmonic)")
-    g.add_argument("--omega", type=_finite_float("omega"), default=Default(1.8),
+    g.add_argument("--omega", type=_finite_float("omega"), default=OMEGA,
                    help="forcing frequency in [1e-3, 1e3], units sqrt(g/l) (default 1.8)")
     g.add_argument("--delta", type=_finite_float("delta"), default=None,
                    help="amplitude of harmonic, two-harmonic, square, |delta| <= 1e3 "
@@ -269,3 +259,13 @@ def _dataset_json(ds) -> dict:
     out = {name: ds[name].values for name in ds.coords}
     out.update({name: ds[name].values for name in ds.data_vars})
     return {**out, **ds.attrs}
+
+
+def _run(a, **extra):
+    """Call the command's public function (:mod:`parapend.commands`, the command's name with
+    underscores) with every option of the command but the presentation ones."""
+    from .. import commands
+
+    skip = commands.presentation(a.command) | {"command"}
+    opts = {k: v for k, v in vars(a).items() if k not in skip}
+    return getattr(commands, a.command.replace("-", "_"))(**opts, **extra)

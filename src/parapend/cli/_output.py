@@ -65,9 +65,23 @@ def save_figure(fig, path) -> None:
     fileio.save_figure(fig, path)
 
 
-def plot(func, data, path) -> None:
-    """Draw ``func(data, path)`` (a :mod:`parapend.plotting` function that saves to ``path``)."""
+def plot(func, data, path, units=None) -> None:
+    """Draw ``func(data, path)`` (a :mod:`parapend.plotting` function that saves to ``path``);
+    with ``units`` (:class:`parapend.units.Units`), ``func(data, None)`` and SI axes beside
+    the non-dimensional ones (:func:`parapend.units.add_si_axes`) before saving."""
     try:
+        if units is not None:
+            from ..style import figure_style
+            from ..units import add_si_axes
+
+            fig = func(data, None)
+            with figure_style():
+                add_si_axes(fig, units)
+                engine = fig.get_layout_engine()
+                if engine is None or type(engine).__name__ == "TightLayoutEngine":
+                    fig.tight_layout()  # (a constrained layout adapts by itself)
+            save_figure(fig, path)
+            return
         func(data, path)
     except OutputError:
         raise

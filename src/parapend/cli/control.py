@@ -1,21 +1,22 @@
-"""``parapend track``: swing up from rest, catch and hold the optimal rotation (issue 11)."""
+"""``parapend track``: swing up from rest, catch and hold the optimal rotation."""
 
 from __future__ import annotations
 
 import math
 
 from .. import limits
+from ..defaults import GAMMA
 from ..errors import ParameterError
 from . import _output
 from ._common import (
     FIGURE_SUFFIXES,
     _add_excitation,
     _check_output,
-    _excitation_kwargs,
     _finite_float,
     _fmt,
     _int,
     _Progress,
+    _run,
 )
 
 
@@ -29,8 +30,8 @@ def add_parsers(sub) -> None:
                     "the torque-limited optimum at (1 - --torque-margin) T_max is tracked. "
                     "theta is measured from the upright (hanging at rest is pi).")
     _add_excitation(p)
-    p.add_argument("--gamma", type=_finite_float("gamma"), default=0.0,
-                   help="viscous damping gamma in [0, 1e3] (default 0)")
+    p.add_argument("--gamma", type=_finite_float("gamma"), default=GAMMA["track"],
+                   help="viscous damping gamma in [0, 1e3] (default 0; docs/defaults.md)")
     p.add_argument("--harmonics", type=_int, default=24,
                    help=f"N of the optimum, at most {limits.MAX_PTO_HARMONICS} with a torque "
                         "limit (default 24)")
@@ -68,6 +69,9 @@ def add_parsers(sub) -> None:
     g.add_argument("--irregular", action="store_true",
                    help="drive the plant with a seeded JONSWAP sea record (parapend.seas) "
                         "peaked at omega, with the rms of q, instead of q")
+    from .pto import add_unit_options
+
+    add_unit_options(p, torque=True)
     p.add_argument("--save", metavar="CSV",
                    help="write the run: t,theta,theta_dot,torque,q, 256 samples per period "
                         "(torque held on [t, t + h)); one run only")
@@ -81,26 +85,26 @@ def _mult(ms) -> str:
                      for re, im in ms)
 
 
-def _cmd_track(a) -> dict | str:
-    from ..control.robustness import track_runs
-    from ..control.track import track
+def _si_lines(r) -> list[str]:
+    """Watts, N m and seconds beside the non-dimensional numbers (with --length, --mass)."""
+    if r.units is None:
+        return []
+    u = r.units
+    return [f"physical (l = {u['length_m']:g} m, m = {u['mass_kg']:g} kg): forcing period "
+            f"{r.period_s:.6g} s; mean power {r.mean_power_w:.6g} W (predicted "
+            f"{r.predicted_power_w:.6g} W); peak torque {r.peak_torque_nm:.6g} N m"
+            + (f", limit {r.torque_limit_nm:.6g} N m" if r.torque_limit_nm is not None
+               else "")]
 
+
+def _cmd_track(a) -> dict | str:
     _check_output(a.plot, "--plot", FIGURE_SUFFIXES)
     _check_output(a.save, "--save", (".csv",))
-    kw = {"gamma": a.gamma, "harmonics": a.harmonics, **_excitation_kwargs(a)}
-    common = dict(torque_limit=a.torque_limit, torque_margin=a.torque_margin,
-                  periods=a.periods, seed=a.seed, gamma_error=a.gamma_error,
-                  delta_error=a.delta_error, noise_theta=a.noise_theta,
-                  noise_speed=a.noise_speed, irregular=a.irregular,
-                  lock_tolerance=a.lock_tolerance, r_weight=a.r_weight, **kw)
+    if a.runs != 1 and (a.save or a.plot):
+        raise ParameterError("runs: --save and --plot write one run; drop them or use "
+                             "--runs 1")
+    r = _run(a, progress=_Progress("track")) if a.runs != 1 else _run(a)
     if a.runs != 1:
-        if a.save or a.plot:
-            raise ParameterError("runs: --save and --plot write one run; drop them or use "
-                                 "--runs 1")
-        if a.theta0 != math.pi or a.theta_dot0 != 0.0:
-            raise ParameterError("runs: a batch starts from the hanging rest; drop --theta0 "
-                                 "and --theta-dot0 or use --runs 1")
-        r = track_runs(runs=a.runs, progress=_Progress("track"), **common)
         if a.json:
             return r.to_dict()
         return "\n".join([
@@ -116,8 +120,7 @@ def _cmd_track(a) -> dict | str:
             f"mean power over the last 10 periods: mean {_fmt(r.mean_power, 6)} (min "
             f"{_fmt(r.power_min, 6)}, max {_fmt(r.power_max, 6)}); locked runs "
             f"{_fmt(r.locked_mean_power, 6)}; predicted {_fmt(r.predicted_power, 6)}",
-            f"peak torque {_fmt(r.peak_torque, 5)}"])
-    r = track(theta0=a.theta0, theta_dot0=a.theta_dot0, **common)
+            f"peak torque {_fmt(r.peak_torque, 5)}", *_si_lines(r)])
     if r._run is not None and a.save:
         run = r._run
         _output.write_columns(a.save, {"t": run.t, "theta": run.theta,
@@ -125,8 +128,9 @@ def _cmd_track(a) -> dict | str:
                                        "q": run.q})
     if r._run is not None and a.plot:
         from ..control.figures import plot_track
+        from .pto import units_of
 
-        _output.plot(plot_track, r, a.plot)
+        _output.plot(plot_track, r, a.plot, units=units_of(r))
     if a.json:
         return r.to_dict()
     out = [f"{r.status}: {r.message}",
@@ -154,6 +158,7 @@ def _cmd_track(a) -> dict | str:
                    f"{sea['hs']:.4g} (units g t0^2), rms of q {sea['rms_q']:.4g}, "
                    f"{sea['components']} components, repeating every "
                    f"{sea['repeat_periods']} peak periods, seed {sea['seed']}")
+    out += _si_lines(r)
     if a.save:
         out.append(f"run written to {a.save}")
     if a.plot:

@@ -10,10 +10,9 @@ from __future__ import annotations
 import math
 import re
 
-import numpy as np
-
 from .. import limits
-from ..errors import ParameterError, check_int, check_range
+from ..commands import basins_json  # noqa: F401  (its former home)
+from ..defaults import DYNAMICS
 from . import _output
 from ._common import (
     FIGURE_SUFFIXES,
@@ -22,6 +21,7 @@ from ._common import (
     _fmt,
     _int,
     _Progress,
+    _run,
     _table,
 )
 
@@ -72,22 +72,15 @@ def _omega_arg(text):
 
 def _add_model(p, omega=True):
     g = p.add_argument_group("Eq. 1 parameters (defaults: the paper's coexistence case)")
-    g.add_argument("--gamma", type=_finite_float("gamma"), default=0.1,
+    g.add_argument("--gamma", type=_finite_float("gamma"), default=DYNAMICS["gamma"],
                    help=f"damping gamma in [0, {limits.DYN_MAX_GAMMA:g}] (default 0.1)")
-    g.add_argument("--p", type=_finite_float("p"), default=0.8,
+    g.add_argument("--p", type=_finite_float("p"), default=DYNAMICS["p"],
                    help=f"excitation strength p, |p| <= {limits.DYN_MAX_P:g} (default 0.8)")
     if omega:
         lo, hi = limits.DYN_OMEGA_RANGE
-        g.add_argument("--omega", type=_finite_float("omega"), default=2.1,
+        g.add_argument("--omega", type=_finite_float("omega"), default=DYNAMICS["omega"],
                        help=f"forcing frequency in [{lo:g}, {hi:g}], units sqrt(g/l) "
                             "(default 2.1)")
-
-
-def _check_model(a, omega=True):
-    check_range("gamma", a.gamma, 0.0, limits.DYN_MAX_GAMMA)
-    check_range("p", a.p, 0.0, limits.DYN_MAX_P, absolute=True)
-    if omega:
-        check_range("omega", a.omega, *limits.DYN_OMEGA_RANGE)
 
 
 def add_parsers(sub) -> None:
@@ -110,6 +103,14 @@ def add_parsers(sub) -> None:
                         "(default 200)")
     p.add_argument("--points-per-period", type=_int, default=64,
                    help="output samples per forcing period, 2 to 1024 (default 64)")
+    u = p.add_argument_group("physical units (docs/units.md): time in s, energy in J")
+    u.add_argument("--length", type=_finite_float("length"), default=None,
+                   help="pivot to centre of mass, m")
+    u.add_argument("--mass", type=_finite_float("mass"), default=None, help="kg")
+    u.add_argument("--inertia", type=_finite_float("inertia"), default=None,
+                   help="moment of inertia about the pivot, kg m^2 (default m l^2)")
+    u.add_argument("--gravity", type=_finite_float("gravity"), default=None,
+                   help="m/s^2 (default 9.81)")
     p.add_argument("--plot", metavar="PNG",
                    help="draw the time history and phase portrait (PNG, SVG or PDF)")
     p.add_argument("--save", metavar="CSV", help="write the time series: t,phi,dphi,energy")
@@ -163,10 +164,10 @@ def add_parsers(sub) -> None:
                                    "Eq. 1 by continuation in p with Floquet multipliers: "
                                    "for one omega, or for FROM:TO:N the (omega, p) map.")
     p._negative_number_matcher = _RANGE_OR_NUMBER
-    p.add_argument("--gamma", type=_finite_float("gamma"), default=0.1,
+    p.add_argument("--gamma", type=_finite_float("gamma"), default=DYNAMICS["gamma"],
                    help=f"damping gamma in [0, {limits.DYN_MAX_GAMMA:g}] (default 0.1)")
     lo, hi = limits.ROT_OMEGA_RANGE
-    p.add_argument("--omega", type=_omega_arg, default=2.1, metavar="W|FROM:TO:N",
+    p.add_argument("--omega", type=_omega_arg, default=DYNAMICS["omega"], metavar="W|FROM:TO:N",
                    help=f"one frequency, or N (1 to {limits.ROT_MAX_OMEGAS}) from FROM to TO, "
                         f"each in [{lo:g}, {hi:g}] (default 2.1)")
     p.add_argument("--p-max", type=_finite_float("p-max"), default=3.0,
@@ -185,44 +186,41 @@ def add_parsers(sub) -> None:
 
 # --- simulate ------------------------------------------------------------------------------
 def _cmd_simulate(a) -> dict | str:
-    from ..dynamics.motion import simulate
-
-    _check_model(a)
     _check_output(a.plot, "--plot", FIGURE_SUFFIXES)
     _check_output(a.save, "--save", (".csv",))
-    check_range("phi0", a.phi0, 0.0, limits.SIM_MAX_PHI0, absolute=True)
-    check_range("dphi0", a.dphi0, 0.0, limits.SIM_MAX_DPHI0, absolute=True)
-    periods = check_int("periods", a.periods, 1, limits.SIM_MAX_PERIODS)
-    work = periods * 2 * math.pi / a.omega * (math.sqrt(1 + abs(a.p)) + abs(a.dphi0))
-    if work > limits.SIM_MAX_WORK:
-        raise ParameterError(f"periods: expected periods x 2 pi/omega x (sqrt(1 + |p|) + "
-                             f"|dphi0|) <= {limits.SIM_MAX_WORK:g}, got {work:.4g}")
-    check_int("points-per-period", a.points_per_period, 2, 1024)
     from ._common import _Ticker
 
     with _Ticker("simulate"):
-        m = simulate(a.gamma, a.p, a.omega, a.phi0, a.dphi0, periods,
-                     points_per_period=a.points_per_period)
+        rec = _run(a)
+    m = rec._source
+    units = rec._units
     if a.save:
-        _output.write_columns(a.save, {"t": m.t, "phi": m.phi, "dphi": m.dphi,
-                                       "energy": m.energy})
+        cols = {"t": m.t, "phi": m.phi, "dphi": m.dphi, "energy": m.energy}
+        if units is not None:
+            cols.update(t_s=m.t * units.time, energy_j=m.energy * units.energy)
+        _output.write_columns(a.save, cols)
     if a.plot:
         from ..dynamics.figures import plot_motion
 
-        _output.plot(lambda mm, path: plot_motion(mm, path=path), m, a.plot)
+        _output.plot(lambda mm, path: plot_motion(mm, path=path), m, a.plot, units=units)
     if a.json:
-        return m.to_dict()
+        return rec.to_dict()
     c = m.classification
     rows = [["gamma, p, omega", f"{_fmt(m.gamma)}, {_fmt(m.p)}, {_fmt(m.omega)}"],
             ["initial (phi, dphi)", f"({_fmt(m.phi0)}, {_fmt(m.dphi0)})"],
             ["periods simulated", str(m.periods)],
             ["final motion", c.name],
             ["kind, period, winding", f"{c.kind}, {c.period}, {c.winding}"],
-            ["net turns of phi", str(m.to_dict()["turns"])]]
+            ["net turns of phi", str(rec.turns)]]
     for j, (x, y) in enumerate(zip(c.phi, c.dphi)):
         rows.append([f"Poincare point {j + 1}", f"({_fmt(x)}, {_fmt(y)})"])
     if not m.success:
         rows.append(["status", f"{m.status}: {m.message}"])
+    if units is not None:
+        rows.append(["forcing period, duration (s)",
+                     f"{rec.forcing_period_s:.6g} ({rec.forcing_frequency_hz:.6g} Hz), "
+                     f"{rec.duration_s:.6g}"])
+        rows.append(["final energy (J)", f"{rec.final_energy_j:.6g}"])
     return (f"one motion of {EQ1}\n" + _table(rows, ["quantity", "value"])
             + "\nPoincare section t = m 2 pi/omega; phi wrapped to [-pi, pi).")
 
@@ -299,85 +297,23 @@ class _PromptInterrupt:
         return False
 
 
-# --- basins --------------------------------------------------------------------------------
-def basins_json(ds) -> dict:
-    """The JSON object of ``parapend basins`` from a basin Dataset."""
-    import json
-
-    frac = ds["basin_fraction"].values
-    err = (ds["basin_fraction_error"].values if "basin_fraction_error" in ds
-           else np.full(frac.shape, np.nan))
-    atts = []
-    for c in range(ds.sizes["code"]):
-        if c == 0 and frac[0] == 0:
-            continue
-        pp = ds["poincare_phi"].values[c]
-        pd = ds["poincare_dphi"].values[c]
-        ok = np.isfinite(pp)
-        atts.append({"code": c, "name": str(ds["name"].values[c]),
-                     "kind": str(ds["kind"].values[c]),
-                     "period": int(ds["period"].values[c]),
-                     "winding": int(ds["winding"].values[c]),
-                     "direction": str(ds["direction"].values[c]),
-                     "basin_fraction": float(frac[c]),
-                     "basin_fraction_error": float(err[c]),
-                     "poincare_phi": [float(x) for x in pp[ok]],
-                     "poincare_dphi": [float(x) for x in pd[ok]]})
-    keys = ("gamma", "p", "omega", "t0", "periods", "steps_per_period", "tol",
-            "capture_radius", "engine", "workers", "elapsed_s", "convention")
-    out = {k: ds.attrs[k] for k in keys if k in ds.attrs}
-    out.update(resolution=[int(ds.sizes["phi"]), int(ds.sizes["dphi"])],
-               phi_range=[float(ds["phi"].values[0]), float(ds["phi"].values[-1])],
-               dphi_range=[float(ds["dphi"].values[0]), float(ds["dphi"].values[-1])],
-               attractors=atts, stats=json.loads(ds.attrs.get("stats", "{}")),
-               accuracy=json.loads(ds.attrs.get("accuracy", "{}")),
-               mirror_symmetric=bool(ds.attrs.get("mirror_symmetric", 0)))
-    return out
-
-
 def _cmd_basins(a) -> dict | str:
-    from ..dynamics.basins import basin_map
-
-    _check_model(a)
     _check_output(a.plot, "--plot", FIGURE_SUFFIXES)
     _check_output(a.save, "--save", (".nc",))
-    n = check_int("resolution", a.resolution, 2, limits.BASIN_MAX_RESOLUTION)
-    periods = check_int("periods", a.periods, 1, limits.BASIN_MAX_PERIODS)
-    steps = check_int("steps-per-period", a.steps_per_period, *limits.BASIN_STEPS_RANGE)
-    sample = check_int("accuracy-sample", a.accuracy_sample, *limits.BASIN_ACCURACY_RANGE)
-    seed = check_int("accuracy-seed", a.accuracy_seed, 0, 2**63 - 1)
-    # the default grid (whole circle, dphi range symmetric about 0) integrates half its
-    # columns (symmetry of Eq. 1); the bound is on the trajectories actually integrated,
-    # the accuracy check's included (twice at double steps and once: 3 units per point)
-    sym = a.phi_range is None and a.dphi_range[0] == -a.dphi_range[1]
-    points = n * (n // 2 + 1) if sym else n * n
-    work = (points + 3 * min(sample, points)) * periods * steps / 128
-    if work > limits.BASIN_MAX_WORK:
-        raise ParameterError(f"periods: expected integrated points x periods x steps/128 <= "
-                             f"{limits.BASIN_MAX_WORK:g} (1000 x 1000 at 300 periods), got "
-                             f"{work:.3g} ({n} x {n}{', half by symmetry' if sym else ''}, "
-                             f"{periods} periods, {steps} steps, accuracy sample included)")
-    for name, rng, cap in (("phi-range", a.phi_range, 1e3), ("dphi-range", a.dphi_range, 1e3)):
-        if rng is not None:
-            if rng[1] <= rng[0]:
-                raise ParameterError(f"{name}: expected LOW < HIGH, got {rng[0]:g}:{rng[1]:g}")
-            if max(abs(rng[0]), abs(rng[1])) > cap:
-                raise ParameterError(f"{name}: expected values within +-{cap:g}, got "
-                                     f"{rng[0]:g}:{rng[1]:g}")
     bar = _Progress("basins")
     with _PromptInterrupt("basins"):
-        ds = basin_map(a.gamma, a.p, a.omega, n_phi=n, n_dphi=n, dphi_range=a.dphi_range,
-                       phi_range=a.phi_range, periods=periods, steps_per_period=steps,
-                       split_phases=a.split_phases, engine=a.engine, progress=bar,
-                       accuracy_sample=sample, accuracy_seed=seed)
+        rec = _run(a, progress=bar)
     bar(1, 1)
+    ds = rec._dataset
+    n = ds.sizes["phi"]
+    periods, steps = ds.attrs["periods"], ds.attrs["steps_per_period"]
     if a.save:
         _output.write_dataset(ds, a.save)
     if a.plot:
         from ..dynamics.figures import plot_basins
 
         _output.plot(lambda d, path: plot_basins(d, path=path), ds, a.plot)
-    out = basins_json(ds)
+    out = rec.to_dict()
     if a.json:
         return out
     rows = [[str(t["code"]), t["name"], t["kind"], str(t["period"]), str(t["winding"]),
@@ -403,53 +339,20 @@ def _cmd_basins(a) -> dict | str:
 
 
 # --- rotations -----------------------------------------------------------------------------
-def _omegas(a) -> np.ndarray:
-    lo, hi = limits.ROT_OMEGA_RANGE
-    if isinstance(a.omega, tuple):
-        w0, w1, n = a.omega
-        if n != int(n):
-            raise ParameterError(f"omega: expected an integer N in FROM:TO:N, got {n:g}")
-        n = check_int("omega", int(n), 1, limits.ROT_MAX_OMEGAS)
-        check_range("omega", w0, lo, hi)
-        check_range("omega", w1, lo, hi)
-        if n > 1 and w1 <= w0:
-            raise ParameterError(f"omega: expected FROM < TO, got {w0:g}:{w1:g}")
-        return np.linspace(w0, w1, n)
-    return np.array([check_range("omega", a.omega, lo, hi)])
-
-
 def _cmd_rotations(a) -> dict | str:
-    from ..dynamics.continuation import rotation_boundaries, rotation_boundaries_at
-
-    check_range("gamma", a.gamma, 0.0, limits.DYN_MAX_GAMMA)
-    if not 0 < a.p_max <= limits.ROT_MAX_P:
-        raise ParameterError(f"p-max: expected a number in (0, {limits.ROT_MAX_P:g}], got "
-                             f"{a.p_max:g}")
-    if not 0 < a.time_limit <= limits.ROT_MAX_TIME_LIMIT:
-        raise ParameterError(f"time-limit: expected seconds in (0, "
-                             f"{limits.ROT_MAX_TIME_LIMIT:g}], got {a.time_limit:g}")
     _check_output(a.plot, "--plot", FIGURE_SUFFIXES)
     _check_output(a.save, "--save", (".nc",))
-    oms = _omegas(a)
     single = not isinstance(a.omega, tuple)
     if single:
         from ._common import _Ticker
 
         with _Ticker("rotations"):
-            r = rotation_boundaries_at(a.gamma, float(oms[0]), p_max=a.p_max,
-                                       time_limit=a.time_limit)
-        import xarray as xr
-
-        ds = xr.Dataset({k: ("omega", np.array([v])) for k, v in
-                         (("p_J", r.lowest_J), ("p_G", r.lowest_G), ("p_E", r.lowest_E),
-                          ("p_start", r.p_start), ("p_reached", r.p_reached))},
-                        coords={"omega": oms},
-                        attrs={"gamma": a.gamma, "p_max": float(a.p_max),
-                               "convention": "paper Eq. 1 (p, omega)", "status": r.status})
+            rec = _run(a)
+        r = rec._source
     else:
-        bar = _Progress("rotations")
-        ds = rotation_boundaries(a.gamma, oms, p_max=a.p_max, progress=bar,
-                                 time_limit=a.time_limit)
+        rec = _run(a, progress=_Progress("rotations"))
+    ds = rec._dataset
+    oms = ds["omega"].values
     if a.save:
         _output.write_dataset(ds, a.save)
     if a.plot:
@@ -458,7 +361,7 @@ def _cmd_rotations(a) -> dict | str:
         _output.plot(lambda d, path: plot_rotation_boundaries(d, path=path), ds, a.plot)
     if single:
         if a.json:
-            return r.to_dict()
+            return rec.to_dict()
         rows = [["J (birth, fold)", ", ".join(_fmt(x) for x in r.p_J) or "-"],
                 ["G (stability lost, period doubling)", ", ".join(_fmt(x) for x in r.p_G)
                  or "-"],
@@ -470,12 +373,7 @@ def _cmd_rotations(a) -> dict | str:
                 + "\nstable for J < p < G and above E (Floquet multipliers inside the unit "
                   "circle)" + note)
     if a.json:
-        return {"gamma": a.gamma, "p_max": a.p_max,
-                "omega": [float(x) for x in ds["omega"].values],
-                **{k: [None if math.isnan(x) else float(x) for x in ds[k].values]
-                   for k in ("p_J", "p_G", "p_E", "p_start", "p_reached")},
-                "convention": ds.attrs["convention"], "status": ds.attrs["status"],
-                "success": ds.attrs["status"] == "ok"}
+        return rec.to_dict()
     rows = [[_fmt(w), _fmt(j), _fmt(g), _fmt(e), _fmt(r_)] for w, j, g, e, r_ in
             zip(*(ds[k].values for k in ("omega", "p_J", "p_G", "p_E", "p_reached")))]
     note = ("" if ds.attrs["status"] == "ok" else

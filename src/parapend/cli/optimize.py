@@ -5,22 +5,22 @@ from __future__ import annotations
 import math
 
 from .. import limits
+from ..defaults import GAMMA
 from ..errors import ParameterError
 from ..results import CONVENTION
 from . import _output
 from . import pto as _pto
 from ._common import (
     FIGURE_SUFFIXES,
-    Default,
     _add_excitation,
     _check_output,
     _dataset_json,
     _describe,
-    _excitation_kwargs,
     _finite_float,
     _fmt,
     _int,
     _Progress,
+    _run,
     _table,
 )
 
@@ -33,8 +33,8 @@ def add_parsers(sub) -> None:
                                    "22, 27), beside the best uniform rotation (Eq. 17) and the "
                                    "gamma -> 0 limit (Eqs. 19, 24, 32 generalized).")
     _add_excitation(p)
-    p.add_argument("--gamma", type=_finite_float("gamma"), default=Default(0.0),
-                   help="viscous damping gamma in [0, 1e3] (default 0)")
+    p.add_argument("--gamma", type=_finite_float("gamma"), default=GAMMA["optimize"],
+                   help="viscous damping gamma in [0, 1e3] (default 0; docs/defaults.md)")
     p.add_argument("--harmonics", type=_int, default=24,
                    help=f"number N of harmonics, at most {limits.MAX_HARMONICS} (default 24)")
     p.add_argument("--method", choices=["fourier", "bvp", "all"], default="fourier",
@@ -62,6 +62,7 @@ def add_parsers(sub) -> None:
                    help=f"fixed N, at most {limits.MAX_THRESHOLD_HARMONICS} (default: doubled "
                         "from 8 until gamma* converges)")
     p.add_argument("--json", action="store_true", help="print one JSON object")
+    _pto.add_unit_options(p, damping=False)
 
     p = sub.add_parser("damping-sweep", help="optimal power against damping (paper Fig. 6)",
                        description="Optimal and uniform power against damping gamma, from 0 "
@@ -79,51 +80,36 @@ def add_parsers(sub) -> None:
                    help="draw power against damping (PNG, SVG or PDF)")
     p.add_argument("--save", metavar="NC", help="write the sweep as a NetCDF file (.nc)")
     p.add_argument("--json", action="store_true", help="print one JSON object")
+    _pto.add_unit_options(p, damping=False)
 
     p = sub.add_parser("harmonics", help="optimal power against the number of harmonics",
                        description="Fourier optimum for N = FROM..TO by continuation in N "
                                    "(nondecreasing in N), beside the uniform and limit powers.")
     _add_excitation(p)
-    p.add_argument("--gamma", type=_finite_float("gamma"), default=Default(0.0),
-                   help="viscous damping gamma in [0, 1e3] (default 0)")
+    p.add_argument("--gamma", type=_finite_float("gamma"), default=GAMMA["harmonics"],
+                   help="viscous damping gamma in [0, 1e3] (default 0; docs/defaults.md)")
     p.add_argument("--from", dest="n_from", type=_int, default=2, help="smallest N (default 2)")
     p.add_argument("--to", dest="n_to", type=_int, default=64,
                    help=f"largest N, at most {limits.MAX_TABLE_HARMONICS} (default 64)")
     p.add_argument("--plot", metavar="PNG", help="draw power against N (PNG, SVG or PDF)")
     p.add_argument("--save", metavar="NC", help="write the table as a NetCDF file (.nc)")
     p.add_argument("--json", action="store_true", help="print one JSON object")
+    _pto.add_unit_options(p)
 
 
 def _cmd_optimize(a) -> dict | str:
-    from ..api import motion_samples, optimize
+    from ..api import motion_samples
 
     _check_output(a.plot, "--plot", FIGURE_SUFFIXES)
     _check_output(a.save, "--save", (".csv",))
-    kw = {"gamma": a.gamma, "harmonics": a.harmonics, **_excitation_kwargs(a)}
-    units, kw = _pto.apply_units(a, kw)
-    pto = _pto.wants_pto(a)
-    if a.winding != 1:
-        if a.method == "all":
-            raise ParameterError("winding: K > 1 works with method fourier or bvp (and the "
-                                 "power take-off options); drop --winding or use one method")
-        kw["winding"] = a.winding
+    if a.method == "all" and (a.save or a.plot):
+        raise ParameterError("--method all: --save and --plot need a single method "
+                             "(fourier or bvp)")
+    r = _run(a)
     if a.method == "all":
-        if pto or units is not None:
-            raise ParameterError("method: 'all' compares the ideal methods; the power "
-                                 "take-off and unit options need fourier (or bvp for units)")
-        return _optimize_all(a, kw)
-    if pto:
-        from ..pto import optimize_pto
-
-        r = optimize_pto(units=units, method=a.method, **_pto.pto_kwargs(a), **kw)
-    else:
-        r = optimize(method=a.method, **kw)
-        if units is not None:
-            import dataclasses
-
-            from ..pto import physical_fields
-
-            r = dataclasses.replace(r, **physical_fields(r, units))
+        return _optimize_all(a, r)
+    pto = r.unconstrained_power is not None
+    units = None if r.units is None else _pto.units_of(r)
     if a.save:
         s = motion_samples(r)
         cols = ["t", "tau", "theta", "theta_dot", "torque"]
@@ -141,7 +127,7 @@ def _cmd_optimize(a) -> dict | str:
         else:
             from ..plotting import plot_optimum as plot_fn
 
-        _output.plot(plot_fn, r, a.plot)
+        _output.plot(plot_fn, r, a.plot, units=units)
     if a.json:
         return r.to_dict()
     name = (f"Fourier optimum, N = {r.harmonics} (Eq. 10)" if r.method == "fourier"
@@ -161,6 +147,8 @@ def _cmd_optimize(a) -> dict | str:
         ["limit gamma -> 0 (Eqs. 19/24/32)", _fmt(r.limit_power),
          _gain(r.limit_power, r.uniform_power)],
     ]
+    if pto:
+        rows = _pto.like_for_like_rows(r, name)
     if r.found_by == "constant excitation":
         how = "q is constant: the motion is the uniform rotation theta = omega t"
     elif r.method == "fourier":
@@ -227,19 +215,11 @@ def _gain(p, pu) -> str:
     return f"{100 * (p / pu - 1):+.2f} %" if pu > 0 else "-"
 
 
-def _optimize_all(a, kw) -> dict | str:
+def _optimize_all(a, rec) -> dict | str:
     """Uniform, Fourier, BVP (gamma > 0 only) and limit for one case."""
-    from ..api import optimize
-
-    if a.save or a.plot:
-        raise ParameterError("--method all: --save and --plot need a single method "
-                             "(fourier or bvp)")
-    f = optimize(method="fourier", **kw)
-    b = optimize(method="bvp", **kw) if a.gamma >= limits.MIN_BVP_GAMMA else None
+    f, b = rec._fourier, rec._bvp
     if a.json:
-        return {"uniform_power": f.uniform_power, "limit_power": f.limit_power,
-                "gamma": f.gamma, "omega": f.omega, "excitation": f.excitation,
-                "fourier": f.to_dict(), "bvp": None if b is None else b.to_dict()}
+        return rec.to_dict()
     rows = [[f"best uniform rotation at gamma = {f.gamma:g} (Eq. 17)",
              _fmt(f.uniform_power, 10), "", "closed form"],
             [f"Fourier, N = {f.harmonics} (Eq. 10)", _fmt(f.power, 10),
@@ -273,18 +253,31 @@ def _count(r) -> str:
 
 
 def _cmd_threshold(a) -> dict | str:
-    from ..api import threshold
-
-    r = threshold(harmonics=a.harmonics, **_excitation_kwargs(a))
+    r = _run(a)
     if a.json:
         return r.to_dict()
+    si = []
+    if r.units is not None:
+        u = r.units
+        si = [f"damping threshold as a coefficient c*: {r.damping_threshold_coefficient:.6g} "
+              f"N m s/rad (c = gamma I / t0; I = {u['inertia_kg_m2']:g} kg m^2, t0 = "
+              f"{u['time_unit_s']:.6g} s)",
+              f"uniform-rotation threshold as a coefficient: "
+              f"{r.uniform_threshold_coefficient:.6g} N m s/rad"]
     return "\n".join([
         f"excitation: {_describe(r.excitation)}",
         f"damping threshold gamma*: {_fmt(r.damping_threshold, 10)}  (optimal power vanishes)",
         f"uniform-rotation threshold: {_fmt(r.uniform_threshold, 10)}  (|Q1| / 2 omega)",
         f"status: {r.status} (N = {r.harmonics}, {r.iterations} Newton steps in gamma; "
         f"change from N/2: {_fmt(r.refinement_change, 3)})",
-    ])
+        *si])
+
+
+def _si_table(ds, coord: str, cols) -> str:
+    """The SI columns of a one-dimensional Dataset, beside its coordinate."""
+    rows = [[_fmt(v)] + [f"{ds[c].values[i]:.6g}" for c, _ in cols]
+            for i, v in enumerate(ds[coord].values)]
+    return "in SI units:\n" + _table(rows, [coord] + [h for _, h in cols])
 
 
 def _plot_and_save(ds, a, plotter: str) -> None:
@@ -292,18 +285,15 @@ def _plot_and_save(ds, a, plotter: str) -> None:
     if a.plot:
         from .. import plotting
 
-        _output.plot(getattr(plotting, plotter), ds, a.plot)
+        _output.plot(getattr(plotting, plotter), ds, a.plot, units=_pto.units_of(ds))
     if a.save:
         _output.write_dataset(ds, a.save)
 
 
 def _cmd_damping_sweep(a) -> dict | str:
-    from ..api import damping_sweep
-
     _check_output(a.plot, "--plot", FIGURE_SUFFIXES)
     _check_output(a.save, "--save", (".nc",))
-    ds = damping_sweep(harmonics=a.harmonics, gamma_max=a.gamma_max, points=a.points,
-                       progress=_Progress("damping sweep"), **_excitation_kwargs(a))
+    ds = _run(a, progress=_Progress("damping sweep"))
     _plot_and_save(ds, a, "plot_damping_sweep")
     if a.json:
         return _dataset_json(ds)
@@ -314,30 +304,27 @@ def _cmd_damping_sweep(a) -> dict | str:
     out = [f"excitation: {ds.attrs['excitation']}, omega={ds.attrs['omega']}; "
            f"N = {ds.attrs['harmonics']}", "",
            _table(rows, ["gamma", "optimal P", "uniform P", "peak |T|", "status"]), "",
-           f"damping threshold gamma*: {_fmt(ds.attrs['damping_threshold'], 10)}",
+           f"damping threshold gamma*: {_fmt(ds.attrs['damping_threshold'], 10)}"
+           + (f" (c* = {ds.attrs['damping_threshold_coefficient']:.6g} N m s/rad)"
+              if "damping_threshold_coefficient" in ds.attrs else ""),
            f"resolution check: end points with 2N change by at most "
            f"{_fmt(ds.attrs['refinement_change'], 3)}"]
     if (ds["gamma"].values == 0).any():
         out.append(f"* {ds.attrs['peak_torque_note']}")
+    if "power_w" in ds:
+        out.append(_si_table(ds, "gamma", [("damping_coefficient", "c (N m s/rad)"),
+                                           ("power_w", "optimal P (W)"),
+                                           ("uniform_power_w", "uniform P (W)"),
+                                           ("peak_torque_nm", "peak |T| (N m)")]))
     if a.plot:
         out.append(f"figure written to {a.plot}")
     return "\n".join(out)
 
 
 def _cmd_harmonics(a) -> dict | str:
-    from ..api import harmonic_table
-
     _check_output(a.plot, "--plot", FIGURE_SUFFIXES)
     _check_output(a.save, "--save", (".nc",))
-    top = limits.MAX_TABLE_HARMONICS
-    if not 1 <= a.n_to <= top:
-        raise ParameterError(f"--to: expected an integer in [1, {top}] (the continuation to "
-                             f"{top} takes about 10 s, to 512 over 10 minutes), got {a.n_to}")
-    if not 1 <= a.n_from <= a.n_to:
-        raise ParameterError(f"--from: expected an integer in [1, --to = {a.n_to}], "
-                             f"got {a.n_from}")
-    ds = harmonic_table(range(a.n_from, a.n_to + 1), gamma=a.gamma,
-                        progress=_Progress("harmonics"), **_excitation_kwargs(a))
+    ds = _run(a, progress=_Progress("harmonics"))
     _plot_and_save(ds, a, "plot_harmonic_table")
     if a.json:
         return _dataset_json(ds)
@@ -349,6 +336,10 @@ def _cmd_harmonics(a) -> dict | str:
            f"limit gamma -> 0 (undamped): {_fmt(ds.attrs['limit_power'], 8)}",
            f"band of q: {ds.attrs['spectrum_harmonics']} harmonics; last row with 2N changes "
            f"by {_fmt(ds.attrs['refinement_change'], 3)}"]
+    if "power_w" in ds:
+        out.append(f"in watts: best uniform {ds.attrs['uniform_power_w']:.6g} W, limit "
+                   f"{ds.attrs['limit_power_w']:.6g} W; optimal P at N = "
+                   f"{int(ds['harmonics'].values[-1])}: {float(ds['power_w'].values[-1]):.6g} W")
     if a.plot:
         out.append(f"figure written to {a.plot}")
     return "\n".join(out)

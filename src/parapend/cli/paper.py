@@ -12,6 +12,7 @@ from ._common import (
     _check_output,
     _fmt,
     _Progress,
+    _run,
     _table,
     _Ticker,
 )
@@ -41,23 +42,18 @@ def add_parsers(sub) -> None:
 
 
 def _cmd_figure(a) -> dict | str:
-    from ..report import paper_figure
-
     default = a.plot is None
     path = f"fig{a.number}.png" if default else a.plot
     _check_output(path, "--plot", FIGURE_SUFFIXES)
     with _Ticker(f"figure {a.number}"):
-        fig, numbers = paper_figure(f"fig{a.number}")
-    _output.save_figure(fig, path)
+        r = _run(a)
     if a.json:
-        return {"figure": a.number, "file": path, "numbers": numbers}
+        return r.to_dict()
     how = " (default name; choose another with --plot)" if default else ""
-    return f"figure {a.number} written to {path}{how}"
+    return f"figure {a.number} written to {r.file}{how}"
 
 
 def _cmd_reproduce(a) -> dict | str:
-    from ..report import reproduce
-
     if not a.out.strip():
         raise ParameterError("--out: expected a directory name, got an empty string")
     out = Path(a.out)
@@ -73,9 +69,9 @@ def _cmd_reproduce(a) -> dict | str:
     except _output.OutputError as exc:
         raise ParameterError(f"--out: {exc}") from None
     bar = _Progress("reproduce", delay=0.0)
-    res = reproduce(out, progress=lambda done, total, label: bar(done, total, label))
+    res = _run(a, progress=lambda done, total, label: bar(done, total, label))
     if a.json:
-        return res
+        return res.to_dict()
     rows = []
     for key in ("table1", "table2", "table3", "scalars"):
         for r in res["tables"][key]:

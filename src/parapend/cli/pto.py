@@ -5,27 +5,25 @@ from __future__ import annotations
 import math
 
 from .. import limits
-from ..errors import ParameterError
+from ..defaults import GAMMA
 from . import _output
 from ._common import (
     FIGURE_SUFFIXES,
-    Default,
     _add_excitation,
     _check_output,
     _dataset_json,
-    _excitation_kwargs,
     _finite_float,
     _fmt,
     _int,
     _Progress,
+    _run,
     _table,
-    given,
 )
 
 
 def add_pto_options(p, torque_limit: bool = True) -> None:
     """``--torque-limit``, ``--efficiency``, ``--efficiency-generating/-motoring``."""
-    g = p.add_argument_group("power take-off (issue 9)")
+    g = p.add_argument_group("power take-off")
     if torque_limit:
         g.add_argument("--torque-limit", type=_finite_float("torque-limit"), default=None,
                        help="|T(t)| <= this, units m g l (> 0)")
@@ -40,8 +38,10 @@ def add_pto_options(p, torque_limit: bool = True) -> None:
                    default=None, help="eta_m in (0, 1] (overrides --efficiency)")
 
 
-def add_unit_options(p) -> None:
-    """Physical pendulum: ``--length --mass --gravity --frequency --amplitude ...``."""
+def add_unit_options(p, damping: bool = True, torque: bool = False) -> None:
+    """Physical pendulum: ``--length --mass --gravity --frequency --amplitude ...``
+    (``--damping-coefficient`` where the command takes a damping, ``--torque-limit-nm``
+    with ``torque``, for commands that have no other take-off options)."""
     g = p.add_argument_group("physical units (docs/units.md); output adds W, N m, J")
     g.add_argument("--length", type=_finite_float("length"), default=None,
                    help="pivot to centre of mass, m")
@@ -54,49 +54,24 @@ def add_unit_options(p) -> None:
                    help="base heave frequency, Hz (sets omega = 2 pi f sqrt(l/g))")
     g.add_argument("--amplitude", type=_finite_float("amplitude"), default=None,
                    help="base heave displacement amplitude A, m (sets delta = -A (2 pi f)^2/g)")
-    g.add_argument("--damping-coefficient", type=_finite_float("damping-coefficient"),
-                   default=None, help="viscous damping c, N m s/rad (sets gamma)")
+    if damping:
+        g.add_argument("--damping-coefficient", type=_finite_float("damping-coefficient"),
+                       default=None, help="viscous damping c, N m s/rad (sets gamma)")
+    if torque:
+        g.add_argument("--torque-limit-nm", type=_finite_float("torque-limit-nm"),
+                       default=None, help="the torque limit in N m (needs --length, --mass)")
 
 
-def wants_pto(a) -> bool:
-    return any(getattr(a, k, None) is not None for k in (
-        "torque_limit", "torque_limit_nm", "efficiency", "efficiency_generating",
-        "efficiency_motoring"))
+def units_of(r):
+    """The :class:`parapend.units.Units` of a result's ``units`` description, or of a
+    Dataset's attributes (None when it has none)."""
+    from ..units import Units
 
-
-def apply_units(a, kw: dict):
-    """Units from the options, and ``kw`` (optimize's parameters) with omega, delta, gamma
-    replaced by the physical ones; refuses a non-dimensional value given beside its
-    physical counterpart."""
-    from ..units import from_options
-
-    units, params = from_options(length=a.length, mass=a.mass, gravity=a.gravity,
-                                 inertia=a.inertia, frequency=a.frequency,
-                                 amplitude=a.amplitude,
-                                 damping_coefficient=a.damping_coefficient)
-    kw = dict(kw)
-    if "omega" in params and given(kw.get("omega")):
-        raise ParameterError("frequency: give either --frequency or --omega, not both")
-    if "delta" in params and kw.get("delta") is not None:
-        raise ParameterError("amplitude: give either --amplitude or --delta, not both")
-    if "gamma" in params and given(kw.get("gamma")):
-        raise ParameterError("damping-coefficient: give either --damping-coefficient or "
-                             "--gamma, not both")
-    kw.update(params)
-    if getattr(a, "torque_limit_nm", None) is not None:
-        if units is None:
-            raise ParameterError("torque-limit-nm: needs --length and --mass")
-        if a.torque_limit is not None:
-            raise ParameterError("torque-limit-nm: give either --torque-limit or "
-                                 "--torque-limit-nm, not both")
-        a.torque_limit = units.from_newton_metres(a.torque_limit_nm)
-    return units, kw
-
-
-def pto_kwargs(a) -> dict:
-    return {"torque_limit": getattr(a, "torque_limit", None), "efficiency": a.efficiency,
-            "efficiency_generating": a.efficiency_generating,
-            "efficiency_motoring": a.efficiency_motoring}
+    u = r.attrs if hasattr(r, "attrs") else r.units
+    if u is None or "length_m" not in u:
+        return None
+    return Units(length=u["length_m"], mass=u["mass_kg"], gravity=u["gravity_m_s2"],
+                 inertia=u["inertia_kg_m2"])
 
 
 def physical_lines(r, units) -> list[str]:
@@ -113,7 +88,34 @@ def physical_lines(r, units) -> list[str]:
         out.append(f"  electrical power {r.electrical_power_w:.6g} W")
     if r.motoring_energy_j is not None:
         out.append(f"  motoring energy {r.motoring_energy_j:.6g} J per cycle")
+    if r.uniform_pto_power_w is not None:
+        out.append(f"  best uniform rotation through the same take-off: mechanical "
+                   f"{r.uniform_pto_power_w:.6g} W, electrical "
+                   f"{r.uniform_pto_electrical_power_w:.6g} W")
     return out
+
+
+def like_for_like_rows(r, name: str) -> list[list[str]]:
+    """The rows of ``optimize`` with a power take-off: the ideal uniform rotation, the
+    uniform rotation through the same take-off, the optimum, the limit; "vs uniform"
+    compares the optimum with the uniform rotation through the same take-off, electrical
+    with electrical (mechanical without an efficiency or copper loss)."""
+    elec = r.efficiency_generating is not None or r.electrical_power != r.power
+    what = "electrical" if elec else "mechanical"
+    if r.uniform_pto_feasible:
+        uni = [f"best uniform rotation, same take-off ({what})",
+               _fmt(r.uniform_pto_electrical_power if elec else r.uniform_pto_power), ""]
+        gain = (f"{100 * r.gain_over_uniform_pto:+.2f} %" if r.gain_over_uniform_pto
+                is not None else "- (uniform delivers nothing)")
+    else:
+        uni = ["best uniform rotation, same take-off", "infeasible",
+               "no phase within the torque limit"]
+        gain = "- (uniform infeasible)"
+    mine = r.electrical_power if elec else r.power
+    return [["best uniform rotation, ideal (Eq. 17)", _fmt(r.uniform_power), ""],
+            uni,
+            [f"{name} ({what})", _fmt(mine), gain],
+            ["limit gamma -> 0, ideal (Eqs. 19/24/32)", _fmt(r.limit_power), ""]]
 
 
 def pto_lines(r) -> list[str]:
@@ -178,8 +180,8 @@ def add_parsers(sub) -> None:
     _add_excitation(p)
     p.add_argument("--vary", choices=["torque-limit", "efficiency"], default="torque-limit",
                    help="the varied parameter (default torque-limit)")
-    p.add_argument("--gamma", type=_finite_float("gamma"), default=Default(0.03),
-                   help="viscous damping gamma in [0, 1e3] (default 0.03)")
+    p.add_argument("--gamma", type=_finite_float("gamma"), default=GAMMA["pto-curve"],
+                   help="viscous damping gamma in [0, 1e3] (default 0.03; docs/defaults.md)")
     p.add_argument("--harmonics", type=_int, default=24,
                    help=f"N, at most {limits.MAX_PTO_HARMONICS} (default 24)")
     p.add_argument("--points", type=_int, default=10,
@@ -187,39 +189,35 @@ def add_parsers(sub) -> None:
     add_pto_options(p)
     add_unit_options(p)
     p.add_argument("--plot", metavar="PNG", help="draw the curve (PNG, SVG or PDF)")
+    p.add_argument("--save", metavar="NC", help="write the curve as a NetCDF file (.nc)")
     p.add_argument("--json", action="store_true", help="print one JSON object")
 
 
 def _cmd_pto_curve(a) -> dict | str:
-    from ..pto import plot_pto_curve, pto_curve
+    from ..pto import plot_pto_curve
 
     _check_output(a.plot, "--plot", FIGURE_SUFFIXES)
-    kw = {"gamma": a.gamma, "harmonics": a.harmonics, **_excitation_kwargs(a)}
-    units, kw = apply_units(a, kw)
-    if a.vary == "torque-limit" and (a.torque_limit is not None):
-        raise ParameterError("torque-limit: it is the varied quantity with --vary "
-                             "torque-limit; drop it")
-    from .. import errors
-
-    errors.check_int("harmonics", a.harmonics, 1, limits.MAX_PTO_HARMONICS)
-    extra = pto_kwargs(a)
-    if a.vary == "torque-limit":
-        extra.pop("torque_limit")
-    ds = pto_curve(a.vary, points=a.points, units=units, progress=_Progress("pto-curve"),
-                   **extra, **kw)
+    _check_output(a.save, "--save", (".nc",))
+    ds = _run(a, progress=_Progress("pto-curve"))
+    units = ds.attrs.get("power_unit_w")
     if a.plot:
-        _output.plot(plot_pto_curve, ds, a.plot)
+        _output.plot(plot_pto_curve, ds, a.plot, units=units_of(ds))
+    if a.save:
+        _output.write_dataset(ds, a.save)
     if a.json:
         return _dataset_json(ds)
     name = "T_max" if a.vary == "torque-limit" else "eta"
-    rows = [[f"{v:.6g}", _fmt(p, 8), _fmt(e, 8), f"{t:.5g}" + ("*" if c == 0 else ""),
-             _fmt(m), str(s)]
-            for v, p, e, t, m, s, c in zip(ds["value"].values, ds["power"].values,
-                                           ds["electrical_power"].values,
-                                           ds["peak_torque"].values,
-                                           ds["motoring_energy"].values, ds["status"].values,
-                                           ds["peak_torque_converged"].values)]
-    head = [name, "mech. P", "electrical", "peak |T|", "motoring E", "status"]
+    rows = [[f"{v:.6g}", _fmt(p, 8), _fmt(e, 8), "-" if math.isnan(u) else _fmt(u, 8),
+             f"{t:.5g}" + ("*" if c == 0 else ""), _fmt(m), str(s)]
+            for v, p, e, u, t, m, s, c in zip(ds["value"].values, ds["power"].values,
+                                              ds["electrical_power"].values,
+                                              ds["uniform_pto_electrical_power"].values,
+                                              ds["peak_torque"].values,
+                                              ds["motoring_energy"].values,
+                                              ds["status"].values,
+                                              ds["peak_torque_converged"].values)]
+    head = [name, "mech. P", "electrical", "uniform, same", "peak |T|", "motoring E",
+            "status"]
     if units is not None:
         for r, w in zip(rows, ds["power_w"].values):
             r.insert(2, f"{w:.5g}")
@@ -227,7 +225,9 @@ def _cmd_pto_curve(a) -> dict | str:
     out = [_table(rows, head), "",
            f"ideal optimum {_fmt(ds.attrs['unconstrained_power'], 8)}, best uniform "
            f"{_fmt(ds.attrs['uniform_power'], 8)} (gamma = {ds.attrs['gamma']:g}, N = "
-           f"{ds.attrs['harmonics']}); units m g l, m g l / t0"]
+           f"{ds.attrs['harmonics']}); units m g l, m g l / t0",
+           "uniform, same: the best uniform rotation through the same take-off, electrical "
+           "('-': no phase within the torque limit)"]
     if (ds["peak_torque_converged"].values == 0).any():
         out.append("* peak torque not converged under mesh refinement (impulsive or singular "
                    "braking): a property of the mesh, not of the motion (optimize --json: "
@@ -244,6 +244,8 @@ def _cmd_pto_curve(a) -> dict | str:
             out.append(f"smallest limit solved: {ds.attrs['smallest_solved_limit']:.6g}")
     if a.plot:
         out.append(f"figure written to {a.plot}")
+    if a.save:
+        out.append(f"curve written to {a.save}")
     return "\n".join(out)
 
 

@@ -3,9 +3,9 @@
 from __future__ import annotations
 
 from .. import limits
-from ..errors import ParameterError
+from ..defaults import SEA
 from . import _output
-from ._common import FIGURE_SUFFIXES, _check_output, _finite_float, _fmt, _int, _table
+from ._common import FIGURE_SUFFIXES, _check_output, _finite_float, _fmt, _int, _run, _table
 
 
 def _winding(text):
@@ -46,15 +46,16 @@ def add_parsers(sub) -> None:
                    help="with --record: fraction of the record under the Tukey taper that "
                         "makes it periodic (default 0.1)")
     g = p.add_argument_group("pendulum (SI units)")
-    g.add_argument("--length", type=_finite_float("length"), default=1.0,
+    g.add_argument("--length", type=_finite_float("length"), default=SEA["length"],
                    help="pivot to centre of mass, m (default 1)")
-    g.add_argument("--mass", type=_finite_float("mass"), default=10.0, help="kg (default 10)")
+    g.add_argument("--mass", type=_finite_float("mass"), default=SEA["mass"],
+                   help="kg (default 10)")
     g.add_argument("--inertia", type=_finite_float("inertia"), default=None,
                    help="about the pivot, kg m^2 (default m l^2)")
-    g.add_argument("--gravity", type=_finite_float("gravity"), default=9.81,
+    g.add_argument("--gravity", type=_finite_float("gravity"), default=SEA["gravity"],
                    help="m/s^2 (default 9.81)")
     g.add_argument("--gamma", type=_finite_float("gamma"), default=None,
-                   help="viscous damping, non-dimensional (default 0.01)")
+                   help="viscous damping, non-dimensional (default 0.01; docs/defaults.md)")
     g.add_argument("--damping-coefficient", type=_finite_float("damping-coefficient"),
                    default=None, help="viscous damping c, N m s/rad (instead of --gamma)")
     g = p.add_argument_group("motion")
@@ -70,25 +71,11 @@ def add_parsers(sub) -> None:
 
 
 def _cmd_sea(a) -> dict | str:
-    from ..sea_api import plot_sea, sea, sea_samples
+    from ..irregular import plot_sea, sea_samples
 
     _check_output(a.plot, "--plot", FIGURE_SUFFIXES)
     _check_output(a.save, "--save", (".csv",))
-    if a.record is not None:
-        bad = [n for n, v in (("hs", a.hs), ("tp", a.tp), ("seed", a.seed),
-                              ("repeat-period", a.repeat_period), ("response", a.response))
-               if v is not None]
-        if bad:
-            raise ParameterError(f"{', '.join(bad)}: not used with --record; drop it")
-        kw = {"record": a.record, "taper": a.taper}
-    else:
-        kw = {"hs": 2.0 if a.hs is None else a.hs, "tp": 8.0 if a.tp is None else a.tp,
-              "spectrum": a.spectrum, "gamma_peak": a.gamma_peak,
-              "repeat_period": a.repeat_period, "seed": 0 if a.seed is None else a.seed,
-              "response": a.response}
-    r = sea(cutoff=a.cutoff, length=a.length, mass=a.mass, inertia=a.inertia,
-            gravity=a.gravity, gamma=a.gamma, damping_coefficient=a.damping_coefficient,
-            winding=a.winding, harmonics=a.harmonics, **kw)
+    r = _run(a)
     if a.save:
         s = sea_samples(r)
         cols = ["t", "z", "q", "theta", "theta_dot", "power", "energy"]

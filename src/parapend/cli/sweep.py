@@ -10,11 +10,17 @@ import shlex
 import sys
 import time
 
-import numpy as np
-
 from .. import limits
-from ..errors import ParameterError
-from ._common import FIGURE_SUFFIXES, _check_output, _finite_float, _fmt, _int, _Progress
+from ..defaults import GAMMA
+from ._common import (
+    FIGURE_SUFFIXES,
+    _check_output,
+    _finite_float,
+    _fmt,
+    _int,
+    _Progress,
+    _run,
+)
 
 # '-0.5:-0.05:128' and '-0.3,-0.2' are values, not options
 _NEGATIVE_VALUE = re.compile(r"^-(\d+\.?\d*|\.\d+)([eE][-+]?\d+)?$|^-(inf|infinity|nan)$"
@@ -53,7 +59,7 @@ def add_parsers(sub) -> None:
     g = p.add_argument_group("axes (" + _AXIS_HELP + ")")
     g.add_argument("--omega", default="1.8", help="forcing frequency (default 1.8)")
     g.add_argument("--delta", default=None, help="excitation amplitude (default -0.3)")
-    g.add_argument("--gamma", default="0", help="viscous damping (default 0)")
+    g.add_argument("--gamma", default=GAMMA["sweep"], help="viscous damping (default 0)")
     g.add_argument("--torque-limit", default=None,
                    help="T_max of the power take-off, units m g l (each point then solves "
                         "the power take-off problem: 0.2 to 2 s a point)")
@@ -118,49 +124,10 @@ def _command_line() -> str:
 
 
 def _cmd_sweep(a) -> dict | str:
-    from .. import maps as sw
-
     _check_output(a.netcdf, "--netcdf", (".nc",))
-    if a.scheduler is not None and a.workers is not None:
-        raise ParameterError("workers: the processes are the cluster's with --scheduler; "
-                             "drop --workers")
-    if a.scheduler is not None:
-        try:
-            import distributed  # noqa: F401
-        except ImportError:
-            raise ParameterError("scheduler: needs the 'distributed' package (python -m pip "
-                                 "install distributed)") from None
-    run = sw.sweep(a.store, omega=a.omega, delta=a.delta, gamma=a.gamma,
-                   torque_limit=a.torque_limit, efficiency=a.efficiency,
-                   harmonics=a.harmonics, excitation=a.excitation,
-                   square_alpha=a.square_alpha, fourier=a.fourier, threshold=a.threshold,
-                   workers=a.workers, scheduler=a.scheduler, overwrite=a.overwrite,
-                   command=_command_line(), progress=_EtaProgress("sweep"),
-                   block_points=a.block_points)
-    ds = run.dataset
-    if a.netcdf:
-        from . import _output
-
-        _output.write_dataset(ds, a.netcdf)
-    codes = ds["status"].values[ds["done"].values]
-    counts = {s: int(np.sum(codes == i)) for i, s in enumerate(sw.STATUSES)
-              if np.any(codes == i)}
-    p = ds["power"].values
-    ok = ds["done"].values & np.isin(ds["status"].values, [0, 1])
-    best = None
-    if ok.any():
-        k = np.unravel_index(np.nanargmax(np.where(ok, p, -np.inf)), p.shape)
-        best = {"power": float(p[k]), **{d: float(ds[d].values[i])
-                                          for d, i in zip(ds["power"].dims, k)}}
-    out = {"store": run.store, "dims": {d: int(ds.sizes[d]) for d in ds["power"].dims},
-           "points": run.points, "blocks": run.blocks,
-           "computed_points": run.computed_points, "resumed_points": run.resumed_points,
-           "repaired_points": run.repaired_points,
-           "seconds": run.seconds, "executor": run.executor, "status_counts": counts,
-           "largest_power": best, "largest_branch_gap": (
-               float(np.nanmax(ds["branch_gap"].values)) if "branch_gap" in ds
-               and ok.any() else None),
-           "netcdf": a.netcdf}
+    rec = _run(a, command=_command_line(), progress=_EtaProgress("sweep"))
+    run, out = rec._run, rec.to_dict()
+    counts, best = out["status_counts"], out["largest_power"]
     if a.json:
         return out
     lines = [f"map over {' x '.join(f'{d} ({n})' for d, n in out['dims'].items())}: "
@@ -184,41 +151,16 @@ def _cmd_sweep(a) -> dict | str:
 
 
 def _cmd_map(a) -> dict | str:
-    from .. import maps as sw
-    from . import _output
-
     _check_output(a.plot, "--plot", FIGURE_SUFFIXES)
-    at = {}
-    for item in a.at:
-        name, sep, value = item.partition("=")
-        name = name.strip().replace("-", "_")
-        if not sep or name not in sw.AXES:
-            raise ParameterError(f"at: expected AXIS=VALUE with AXIS one of "
-                                 f"{', '.join(sw.AXES)}, got {item!r:.40}")
-        try:
-            at[name] = float(value)
-        except ValueError:
-            raise ParameterError(f"at: expected a number after '=', got {item!r:.40}") \
-                from None
-    ds = sw.open_sweep(a.store)
-    x = a.x.replace("-", "_") if a.x else None
-    y = a.y.replace("-", "_") if a.y else None
-    z, failed, xs, ys, xn, yn, label, title = sw.map_data(ds, a.variable, x, y, at)
-    _output.plot(lambda d, path: sw.plot_map(d, a.variable, xn, yn, at, path), ds, a.plot)
-    finite = np.isfinite(z)
-    out = {"plot": a.plot, "variable": a.variable, "x": xn, "y": yn, "fixed": title,
-           "points": int(z.size), "failed": int(failed.sum()),
-           "not_computed": int(z.size - finite.sum() - failed.sum()),
-           "min": float(np.nanmin(z)) if finite.any() else None,
-           "max": float(np.nanmax(z)) if finite.any() else None}
-    if finite.any():
-        i, j = np.unravel_index(np.nanargmax(z), z.shape)
-        out["max_at"] = {xn: float(xs[j]), yn: float(ys[i])}
+    rec = _run(a)
+    out = rec.to_dict()
+    xn, yn, title, label = out["x"], out["y"], out["fixed"], rec._label
+    finite = out["min"] is not None
     if a.json:
         return out
     lines = [f"heat map of {a.variable} over ({xn}, {yn}) written to {a.plot}"
              + (f" ({title})" if title else "")]
-    if finite.any():
+    if finite:
         lines.append(f"range {_fmt(out['min'], 6)} to {_fmt(out['max'], 6)} ({label}); "
                      f"largest at {xn} = {out['max_at'][xn]:.6g}, {yn} = "
                      f"{out['max_at'][yn]:.6g}")

@@ -1,4 +1,4 @@
-"""Closed-loop realization of an optimal rotation (issue 11).
+"""Closed-loop realization of an optimal rotation.
 
 - :mod:`.target`: the tracked orbit and its feedforward torque (Eq. 14 on the motion).
 - :mod:`.riccati`: the sampled linearization and the discrete periodic Riccati equation

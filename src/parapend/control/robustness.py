@@ -66,6 +66,12 @@ class RobustnessResult(_Result):
     status: str = "done"
     message: str = ""
     excitation: dict = field(default_factory=dict)
+    units: dict | None = None
+    mean_power_w: float | None = None
+    predicted_power_w: float | None = None
+    peak_torque_nm: float | None = None
+    torque_limit_nm: float | None = None
+    period_s: float | None = None
 
 
 def track_runs(*, runs: int = 20, seed: int = 0, periods: int = 100, torque_limit=None,

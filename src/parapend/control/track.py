@@ -112,6 +112,12 @@ class TrackResult(_Result):
     riccati_residual: float
     excitation: dict = field(default_factory=dict)
     sea: dict | None = None
+    units: dict | None = None
+    mean_power_w: float | None = None
+    predicted_power_w: float | None = None
+    peak_torque_nm: float | None = None
+    torque_limit_nm: float | None = None
+    period_s: float | None = None
     convention: str = ("theta from the upright (hanging at rest is theta = pi); power "
                        "positive when harvested, P = -<T theta'>; torque units m g l")
     _run: object = field(default=None, repr=False)
