@@ -25,6 +25,10 @@ import math
 import numba as nb
 import numpy as np
 
+from .._jit import announce_compiles
+
+announce_compiles()  # log a first-use compile (parapend._jit)
+
 LANES = 16
 MAX_GROUPS = 256      # static work units, points interleaved (balances the cores)
 NEW = -3              # converged to an attractor outside the catalogue

@@ -52,7 +52,10 @@ import numba as nb
 import numpy as np
 from scipy.linalg.lapack import dgbsv
 
+from .._jit import announce_compiles
 from .hermite import _fold, locate, q_on_intervals  # _fold: node order 0, K-1, 1, K-2, ...
+
+announce_compiles()  # log a first-use compile (parapend._jit)
 
 __all__ = ["CollocationMotion", "CollocationSolution", "solve_collocation"]
 
