@@ -27,7 +27,7 @@ import math
 import numpy as np
 
 
-def collocate(excitation, damping: float, *, intervals: int = 200, torque_limit=None,
+def collocate(excitation, gamma: float, *, intervals: int = 200, torque_limit=None,
               efficiency=None, guess=None, tol: float = 1e-10, winding: int = 1,
               max_iter: int = 3000, copper_loss: float = 0.0):
     """Maximize the mean (electrical) power by direct collocation.
@@ -67,7 +67,7 @@ def collocate(excitation, damping: float, *, intervals: int = 200, torque_limit=
     u = opti.variable(2 * k + 1)
 
     def f(i):
-        return v[i], -damping * v[i] + q1[i] * ca.sin(th[i]) + u[i]
+        return v[i], -gamma * v[i] + q1[i] * ca.sin(th[i]) + u[i]
 
     for j in range(k):
         a, m, b = 2 * j, 2 * j + 1, 2 * j + 2
@@ -89,7 +89,7 @@ def collocate(excitation, damping: float, *, intervals: int = 200, torque_limit=
     elif efficiency is None:
         # P = <(1 + q) sin(theta) theta'> - gamma <theta'^2> (Eq. 15; = -<T theta'> by the
         # energy balance): the torque does not enter, so it cannot chatter to exploit the rule
-        obj = ca.dot(ca.DM(w), q1 * ca.sin(th) * v - damping * v * v)
+        obj = ca.dot(ca.DM(w), q1 * ca.sin(th) * v - gamma * v * v)
     else:
         eg, em = efficiency
         pp = opti.variable(2 * k + 1)
@@ -104,11 +104,11 @@ def collocate(excitation, damping: float, *, intervals: int = 200, torque_limit=
         opti.subject_to(opti.bounded(-torque_limit, u, torque_limit))
     opti.minimize(-obj)
     if guess is None:
-        _, phi = (uniform_power(excitation, damping) if winding == 1
-                  else uniform_power(excitation, damping, winding))
+        _, phi = (uniform_power(excitation, gamma) if winding == 1
+                  else uniform_power(excitation, gamma, winding))
         g_th = winding * om * t + phi
         g_v = winding * om * np.ones_like(t)
-        g_u = damping * om - q1 * np.sin(g_th)
+        g_u = gamma * om - q1 * np.sin(g_th)
         if torque_limit is not None:
             g_u = np.clip(g_u, -torque_limit, torque_limit)
     else:

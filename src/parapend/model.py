@@ -15,20 +15,20 @@ import numpy as np
 __all__ = ["peak_torque", "rhs", "torque"]
 
 
-def torque(motion, excitation, damping: float, t):
+def torque(motion, excitation, gamma: float, t):
     """Torque ``T(t)`` that makes the pendulum follow ``motion`` exactly (Eq. 14 solved for T).
 
     Parameters
     ----------
     motion : object with ``theta``, ``theta_dot``, ``theta_ddot``
     excitation : Excitation
-    damping : float
-        Viscous damping ``gamma`` >= 0.
+    gamma : float
+        Viscous damping >= 0 (Eq. 14), non-dimensional.
     t : array_like
         Times (non-dimensional).
     """
     th = motion.theta(t)
-    return (motion.theta_ddot(t) + damping * motion.theta_dot(t)
+    return (motion.theta_ddot(t) + gamma * motion.theta_dot(t)
             - (1.0 + excitation.q(t)) * np.sin(th))
 
 
@@ -44,7 +44,7 @@ def _sample_points(motion, excitation) -> int:
     return min(1 << int(np.ceil(np.log2(16 * k))), 1 << 20)
 
 
-def peak_torque(motion, excitation, damping: float, points: int | None = None) -> float:
+def peak_torque(motion, excitation, gamma: float, points: int | None = None) -> float:
     """``max |T(t)|`` over one period, taken from the motion's own resolution.
 
     The samples come from the motion itself: a motion with its own ``peak_torque`` (the
@@ -60,30 +60,30 @@ def peak_torque(motion, excitation, damping: float, points: int | None = None) -
     from scipy.optimize import minimize_scalar
 
     if hasattr(motion, "peak_torque"):
-        return motion.peak_torque(excitation, damping)
+        return motion.peak_torque(excitation, gamma)
     period = 2 * np.pi / motion.omega
     if points is None and hasattr(motion, "sample_times"):
         t = np.asarray(motion.sample_times(), dtype=float)
-        tq = np.abs(torque(motion, excitation, damping, t))
+        tq = np.abs(torque(motion, excitation, gamma, t))
     else:
         points = points or _sample_points(motion, excitation)
         t = period * np.arange(points) / points
         if hasattr(motion, "on_grid") and points > 2 * motion.harmonics:
             th, thd, thdd = motion.on_grid(points)
-            tq = np.abs(thdd + damping * thd
+            tq = np.abs(thdd + gamma * thd
                         - (1.0 + excitation.q_uniform(points)) * np.sin(th))
         else:
-            tq = np.abs(torque(motion, excitation, damping, t))
+            tq = np.abs(torque(motion, excitation, gamma, t))
     i = int(np.argmax(tq))
     lo = t[i - 1] if i > 0 else t[-1] - period
     hi = t[i + 1] if i + 1 < t.size else t[0] + period
-    r = minimize_scalar(lambda x: -abs(float(torque(motion, excitation, damping, x))),
+    r = minimize_scalar(lambda x: -abs(float(torque(motion, excitation, gamma, x))),
                         bounds=(lo, hi), method="bounded",
                         options={"xatol": 1e-12 * period})
     return float(max(tq[i], -r.fun))
 
 
-def rhs(excitation, damping: float, control=None):
+def rhs(excitation, gamma: float, control=None):
     """Right-hand side ``f(t, y)``, ``y = (theta, theta')``, of Eq. 14 for ``solve_ivp``.
 
     ``control(t, theta, theta_dot)`` gives the applied torque (zero if None).
@@ -92,6 +92,6 @@ def rhs(excitation, damping: float, control=None):
     def f(t, y):
         th, om = y
         tq = 0.0 if control is None else control(t, th, om)
-        return np.array([om, (1.0 + excitation.q(t)) * np.sin(th) - damping * om + tq])
+        return np.array([om, (1.0 + excitation.q(t)) * np.sin(th) - gamma * om + tq])
 
     return f

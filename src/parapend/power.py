@@ -48,42 +48,42 @@ def _check_motion(motion):
     return motion
 
 
-def _check_common(motion, excitation, damping, points):
+def _check_common(motion, excitation, gamma, points):
     _check_motion(motion)
     _check_excitation(excitation)
-    gamma = check_range("gamma", damping, 0.0, limits.MAX_GAMMA)
+    gamma = check_range("gamma", gamma, 0.0, limits.MAX_GAMMA)
     npts = check_int("points", points, 2, 1 << 24)
     return gamma, npts
 
 
-def mean_power(motion, excitation, damping: float = 0.0, points: int = 4096) -> float:
+def mean_power(motion, excitation, gamma: float = 0.0, points: int = 4096) -> float:
     """Mean extracted power (Eqs. 15-16) of a smooth motion by the periodic trapezoidal rule.
 
     Parameters
     ----------
     motion : FourierMotion or any object with ``theta`` and ``theta_dot``
     excitation : Excitation
-    damping : float
-        ``gamma`` >= 0.
+    gamma : float
+        Viscous damping >= 0 (Eq. 14), non-dimensional.
     points : int
         Quadrature points per period.
     """
-    damping, points = _check_common(motion, excitation, damping, points)
+    gamma, points = _check_common(motion, excitation, gamma, points)
     t = _grid(motion.omega, points)
     th, thd = motion.theta(t), motion.theta_dot(t)
     q = excitation.q(t)
-    return float(np.mean((1.0 + q) * np.sin(th) * thd) - damping * np.mean(thd * thd))
+    return float(np.mean((1.0 + q) * np.sin(th) * thd) - gamma * np.mean(thd * thd))
 
 
-def power_by_parts(motion, excitation, damping: float = 0.0, points: int = 4096) -> float:
+def power_by_parts(motion, excitation, gamma: float = 0.0, points: int = 4096) -> float:
     """Same power in the integrated-by-parts form ``<q' cos(theta)> - gamma <theta'^2>``."""
-    damping, points = _check_common(motion, excitation, damping, points)
+    gamma, points = _check_common(motion, excitation, gamma, points)
     t = _grid(motion.omega, points)
     th, thd = motion.theta(t), motion.theta_dot(t)
-    return float(np.mean(excitation.dq(t) * np.cos(th)) - damping * np.mean(thd * thd))
+    return float(np.mean(excitation.dq(t) * np.cos(th)) - gamma * np.mean(thd * thd))
 
 
-def uniform_power(excitation, damping: float = 0.0, winding: int = 1) -> tuple[float, float]:
+def uniform_power(excitation, gamma: float = 0.0, winding: int = 1) -> tuple[float, float]:
     """Best uniform rotation ``theta = omega t + phi`` (Eq. 17 generalized): (power, phi).
 
     Only the first harmonic ``Q1`` of ``q`` does work on a uniform rotation:
@@ -95,17 +95,17 @@ def uniform_power(excitation, damping: float = 0.0, winding: int = 1) -> tuple[f
     ``P = K omega |Q_K| / 2 - gamma K^2 omega^2`` at ``phi = arg(1j Q_K)``.
     """
     _check_excitation(excitation)
-    damping = check_range("gamma", damping, 0.0, limits.MAX_GAMMA)
+    gamma = check_range("gamma", gamma, 0.0, limits.MAX_GAMMA)
     if winding != 1:
         spec = excitation.spectrum
         qk = complex(spec[winding]) if 0 < winding < spec.size else 0j
         om = excitation.omega * winding
         phi = float(np.angle(1j * qk)) if qk != 0 else 0.0
-        return float(om * abs(qk) / 2 - damping * om * om), phi
+        return float(om * abs(qk) / 2 - gamma * om * om), phi
     q1 = excitation.first_harmonic
     om = excitation.omega
     phi = float(np.angle(1j * q1)) if q1 != 0 else 0.0
-    return float(om * abs(q1) / 2 - damping * om * om), phi
+    return float(om * abs(q1) / 2 - gamma * om * om), phi
 
 
 def limit_motion_power(motion, excitation) -> float:

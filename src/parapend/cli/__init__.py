@@ -41,6 +41,7 @@ from . import pto as _pto_cmds
 from . import sea as _sea_cmds
 from . import sweep as _sweep_cmds
 from ._common import EXIT_USAGE, _Parser
+from ._notice import install as _compile_notice
 from ._output import OutputError
 
 EXIT_FAILURE = 1
@@ -116,6 +117,7 @@ def main(argv=None) -> int:
     if closed:  # keep fd 1 from being reused by an output file opened later
         _silence_stdout()
     _one_blas_thread()
+    _compile_notice()  # a first-use compile of the numba kernels: one line on stderr
     parser = build_parser()
     try:
         a = parser.parse_args(argv)

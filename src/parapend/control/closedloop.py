@@ -116,7 +116,7 @@ def run_closed_loop(target, gains, *, periods: int, torque_limit: float | None,
     ref_om = target.theta_dot.tolist()
     ff = target.feedforward.tolist()
     k1s, k2s = gains[:, 0].tolist(), gains[:, 1].tolist()
-    g = float(plant_gamma)
+    gamma_p = float(plant_gamma)
     two_pi = 2 * math.pi
     th, om = float(state0[0]), float(state0[1])
     out_th = [0.0] * (nk + 1)
@@ -155,13 +155,13 @@ def run_closed_loop(target, gains, *, periods: int, torque_limit: float | None,
             i = base + 2 * s
             qa, qb, qc = qg[i], qg[i + 1], qg[i + 2]
             a1 = om
-            b1 = (1.0 + qa) * sin(th) - g * om + u
+            b1 = (1.0 + qa) * sin(th) - gamma_p * om + u
             a2 = om + 0.5 * dt * b1
-            b2 = (1.0 + qb) * sin(th + 0.5 * dt * a1) - g * a2 + u
+            b2 = (1.0 + qb) * sin(th + 0.5 * dt * a1) - gamma_p * a2 + u
             a3 = om + 0.5 * dt * b2
-            b3 = (1.0 + qb) * sin(th + 0.5 * dt * a2) - g * a3 + u
+            b3 = (1.0 + qb) * sin(th + 0.5 * dt * a2) - gamma_p * a3 + u
             a4 = om + dt * b3
-            b4 = (1.0 + qc) * sin(th + dt * a3) - g * a4 + u
+            b4 = (1.0 + qc) * sin(th + dt * a3) - gamma_p * a4 + u
             th += dt / 6.0 * (a1 + 2 * a2 + 2 * a3 + a4)
             om += dt / 6.0 * (b1 + 2 * b2 + 2 * b3 + b4)
             if not -DIVERGED_SPEED < om < DIVERGED_SPEED:  # also NaN

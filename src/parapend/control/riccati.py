@@ -43,7 +43,7 @@ def sampled_linearization(target, excitation=None, gamma=None, substeps: int = 1
     ``excitation`` and ``gamma`` default to the target's (the design model).
     """
     exc = target.excitation if excitation is None else excitation
-    g = target.gamma if gamma is None else float(gamma)
+    gamma = target.gamma if gamma is None else float(gamma)
     m, h = target.samples, target.step
     dt = h / substeps
     # stage times t_k + j dt/2, j = 0 .. 2 substeps
@@ -57,7 +57,7 @@ def sampled_linearization(target, excitation=None, gamma=None, substeps: int = 1
     def f(y, c):
         d = np.empty_like(y)
         d[:, 0, :] = y[:, 1, :]
-        d[:, 1, :] = c[:, None] * y[:, 0, :] - g * y[:, 1, :]
+        d[:, 1, :] = c[:, None] * y[:, 0, :] - gamma * y[:, 1, :]
         d[:, 1, 2] += 1.0
         return d
 

@@ -25,6 +25,10 @@ import math
 import numba as nb
 import numpy as np
 
+from .._jit import announce_compiles
+
+announce_compiles()  # log a first-use compile (parapend._jit)
+
 LANES = 16
 MAX_GROUPS = 256      # static work units, points interleaved (balances the cores)
 NEW = -3              # converged to an attractor outside the catalogue
@@ -85,7 +89,7 @@ def _sin(x):
 
 
 @nb.njit(inline="always", cache=True)
-def _period(th, v, a, g, h, steps, tt, vv, ath, av):
+def _period(th, v, a, gamma, h, steps, tt, vv, ath, av):
     """Advance the ``LANES`` states ``th, v`` by one forcing period (``_RK4Map.advance``).
 
     ``tt, vv, ath, av`` are scratch arrays of ``LANES``. Stage by stage over the lanes
@@ -98,25 +102,25 @@ def _period(th, v, a, g, h, steps, tt, vv, ath, av):
         ah = a[2 * j + 1]
         a1 = a[2 * j + 2]
         for lane in range(LANES):
-            kk = _sin(th[lane]) * a0 - v[lane] * g
+            kk = _sin(th[lane]) * a0 - v[lane] * gamma
             ath[lane] = v[lane]
             av[lane] = kk
             tt[lane] = v[lane] * h2 + th[lane]
             vv[lane] = kk * h2 + v[lane]
         for lane in range(LANES):
-            kk = _sin(tt[lane]) * ah - vv[lane] * g
+            kk = _sin(tt[lane]) * ah - vv[lane] * gamma
             ath[lane] += vv[lane] * 2.0
             av[lane] += kk * 2.0
             tt[lane] = vv[lane] * h2 + th[lane]
             vv[lane] = kk * h2 + v[lane]
         for lane in range(LANES):
-            kk = _sin(tt[lane]) * ah - vv[lane] * g
+            kk = _sin(tt[lane]) * ah - vv[lane] * gamma
             ath[lane] += vv[lane] * 2.0
             av[lane] += kk * 2.0
             tt[lane] = vv[lane] * h + th[lane]
             vv[lane] = kk * h + v[lane]
         for lane in range(LANES):
-            kk = _sin(tt[lane]) * a1 - vv[lane] * g
+            kk = _sin(tt[lane]) * a1 - vv[lane] * gamma
             x = ath[lane] + vv[lane]
             y = av[lane] + kk
             x *= h6
@@ -139,7 +143,7 @@ def _dist_entry(th, v, eth, ev, k):
 
 
 @nb.njit(parallel=True, cache=True)
-def basin_kernel(th0, v0, a, g, h, steps, tol, kmax, max_periods, rcap, match_tol,
+def basin_kernel(th0, v0, a, gamma, h, steps, tol, kmax, max_periods, rcap, match_tol,
                  ent_th, ent_v, ent_k, ent_r, ent_cap, groups):
     """Label every initial condition ``(th0[i], v0[i])`` (project convention, theta wrapped).
 
@@ -189,7 +193,7 @@ def basin_kernel(th0, v0, a, g, h, steps, tol, kmax, max_periods, rcap, match_to
                 nxt += groups
                 active += 1
         while active > 0:
-            _period(th, v, a, g, h, steps, tt, vv, ath, av)
+            _period(th, v, a, gamma, h, steps, tt, vv, ath, av)
             for lane in range(LANES):
                 i = idx[lane]
                 if i < 0:
@@ -291,7 +295,7 @@ def n_groups(n: int) -> int:
 
 
 @nb.njit(parallel=True, cache=True)
-def full_time_kernel(th0, v0, a, g, h, steps, periods):
+def full_time_kernel(th0, v0, a, gamma, h, steps, periods):
     """Plain compiled integrator (benchmark peer): every point for ``periods`` periods, no
     classification or early termination; returns the final ``(theta, v)``, theta wrapped
     each period as in the engine."""
@@ -312,7 +316,7 @@ def full_time_kernel(th0, v0, a, g, h, steps, periods):
                 th[lane] = out_th[i]
                 v[lane] = out_v[i]
         for _ in range(periods):
-            _period(th, v, a, g, h, steps, tt, vv, ath, av)
+            _period(th, v, a, gamma, h, steps, tt, vv, ath, av)
             for lane in range(LANES):
                 th[lane] -= _TWO_PI * _rint(th[lane] / _TWO_PI)
         for lane in range(LANES):

@@ -275,7 +275,7 @@ class _RK4Map:
         n = th.size
         s, tt, vv, kk, ath, av, w1, w2 = self._buffers(n)
         work = (w1, w2)
-        g, h = self.gamma, self.h
+        gamma, h = self.gamma, self.h
         h2, h6 = 0.5 * h, h / 6.0
         a = self.a
         for _ in range(periods):
@@ -284,7 +284,7 @@ class _RK4Map:
                 # stage 1
                 fast_sin(th, s, work)
                 np.multiply(s, a0, out=kk)
-                np.multiply(v, g, out=w1)
+                np.multiply(v, gamma, out=w1)
                 kk -= w1
                 np.copyto(ath, v)
                 np.copyto(av, kk)
@@ -296,7 +296,7 @@ class _RK4Map:
                 for c in (h2, h):
                     fast_sin(tt, s, work)
                     np.multiply(s, ah, out=kk)
-                    np.multiply(vv, g, out=w1)
+                    np.multiply(vv, gamma, out=w1)
                     kk -= w1
                     np.multiply(vv, 2.0, out=w1)
                     ath += w1
@@ -309,7 +309,7 @@ class _RK4Map:
                 # stage 4
                 fast_sin(tt, s, work)
                 np.multiply(s, a1, out=kk)
-                np.multiply(vv, g, out=w1)
+                np.multiply(vv, gamma, out=w1)
                 kk -= w1
                 ath += vv
                 av += kk

@@ -24,7 +24,11 @@ import math
 import numba as nb
 import numpy as np
 
+from .._jit import announce_compiles
+
 NONE, LIMIT, PHASE1, ELASTIC = 0, 1, 2, 3
+
+announce_compiles()  # log a first-use compile (parapend._jit)
 
 
 @nb.njit(cache=True)

@@ -78,8 +78,8 @@ class ProblemBatch:
         self.w = np.stack([p.w for p in problems])
         # the scalars of FourierProblem.kinetic, .power and .evaluate, per member
         self.omega2 = [p.omega**2 for p in problems]
-        self.damping = [p.damping for p in problems]
-        self.gw = [p.damping * p.omega**2 for p in problems]
+        self.gamma = [p.gamma for p in problems]
+        self.gw = [p.gamma * p.omega**2 for p in problems]
         self.scale = [max(float(np.abs(p.w).max()), 1e-300) for p in problems]
 
     def _theta(self, x: np.ndarray) -> np.ndarray:
@@ -96,7 +96,7 @@ class ProblemBatch:
         """``FourierProblem.power`` of member ``rows[j]`` at ``x[j]``, for every j."""
         means = np.mean(self.w[rows] * np.cos(self._theta(x)), axis=-1)
         k0 = self._k0
-        return [float(mn) - self.damping[i] * (self.omega2[i] * (k0 + 0.5 * dt))
+        return [float(mn) - self.gamma[i] * (self.omega2[i] * (k0 + 0.5 * dt))
                 for i, mn, dt in zip(rows, means, self._dots(x))]
 
     def evaluate(self, rows, x: np.ndarray):
@@ -218,7 +218,7 @@ def newton_maximize_batch(batch: ProblemBatch, x0: np.ndarray, seeds, *, gtol: f
 
 
 def _problems(points, harmonics: int, grids=None) -> list:
-    """``FourierProblem(excitation, harmonics, damping, grid)`` for every point, with
+    """``FourierProblem(excitation, harmonics, gamma, grid)`` for every point, with
     ``dq/dt`` on the grids of all points with the same M and spectrum length synthesized by
     one inverse FFT (row by row the numbers of ``Excitation.dq_grid``)."""
     ms = [_problem_points(harmonics, e, None if grids is None else grids[i], 1)
@@ -278,8 +278,8 @@ def _groups(keys):
 
 def search_fourier_batch(points, harmonics: int, *, gtol: float = 1e-11,
                          maxiter: int = 200, limits=None) -> list:
-    """:func:`.fourier.search_fourier` ``(excitation, harmonics, damping)`` for every
-    ``(excitation, damping)`` of ``points``, with the default seeds: one
+    """:func:`.fourier.search_fourier` ``(excitation, harmonics, gamma)`` for every
+    ``(excitation, gamma)`` of ``points``, with the default seeds: one
     :class:`.fourier.FourierSearch` each, equal to search_fourier's (see the module text).
 
     ``limits``: the points' :func:`.limit.limit` results when the caller has them already.

@@ -79,7 +79,7 @@ def _newton(x, n, omega, gamma, q1, s, torque_limit, winding, maxiter=50):
     return x, bool(np.max(np.abs(r)) <= 1e-10 * scale)
 
 
-def multipliers(motion, excitation, damping: float) -> np.ndarray:
+def multipliers(motion, excitation, gamma: float) -> np.ndarray:
     """Floquet multipliers of a rotation under a constant torque: the eigenvalues of the
     monodromy matrix of Eq. 14 linearized about it, ``d(dtheta)/dt = dv``,
     ``d(dv)/dt = (1 + q) cos(theta) dtheta - gamma dv`` (SciPy DOP853 over one period)."""
@@ -87,14 +87,14 @@ def multipliers(motion, excitation, damping: float) -> np.ndarray:
 
     def rhs(t, y):
         c = (1.0 + excitation.q(t)) * math.cos(float(motion.theta(t)))
-        return [y[2], y[3], c * y[0] - damping * y[2], c * y[1] - damping * y[3]]
+        return [y[2], y[3], c * y[0] - gamma * y[2], c * y[1] - gamma * y[3]]
 
     y = solve_ivp(rhs, (0.0, 2 * math.pi / excitation.omega), [1.0, 0.0, 0.0, 1.0],
                   method="DOP853", rtol=1e-10, atol=1e-12).y[:, -1]
     return np.linalg.eigvals(y.reshape(2, 2))
 
 
-def constant_brake(excitation, damping: float, torque_limit: float, start, *,
+def constant_brake(excitation, gamma: float, torque_limit: float, start, *,
                    winding: int = 1, max_harmonics: int = 1024, phases: int = 8):
     """The rotation under the constant torque ``-torque_limit``: Newton's method from
     ``start`` (a motion near it, e.g. the torque-limited optimum) and from the uniform
@@ -117,7 +117,7 @@ def constant_brake(excitation, damping: float, torque_limit: float, start, *,
                                       np.zeros(1), winding) for j in range(phases)]
     found = []
     for st in starts:
-        f = _one_brake(excitation, damping, torque_limit, st, winding, max_harmonics)
+        f = _one_brake(excitation, gamma, torque_limit, st, winding, max_harmonics)
         if f is None:
             continue
         t0 = np.array([0.0])
@@ -129,11 +129,11 @@ def constant_brake(excitation, damping: float, torque_limit: float, start, *,
         return None
     if len(found) == 1:
         return found[0][1]
-    worst = [float(np.max(np.abs(multipliers(f[0], excitation, damping)))) for _, f in found]
+    worst = [float(np.max(np.abs(multipliers(f[0], excitation, gamma)))) for _, f in found]
     return found[int(np.argmin(worst))][1]
 
 
-def _one_brake(excitation, damping, torque_limit, start, winding, max_harmonics):
+def _one_brake(excitation, gamma, torque_limit, start, winding, max_harmonics):
     """Newton's method from one start (:func:`constant_brake`), ``N`` doubled until the
     coefficients settle."""
     omega = excitation.omega
@@ -154,7 +154,7 @@ def _one_brake(excitation, damping, torque_limit, start, winding, max_harmonics)
         x0[n + 1:n + 1 + take] = src[pn + 1:pn + 1 + take]
         s = 2 * math.pi * np.arange(2 * n + 1) / (2 * n + 1)
         q1 = 1.0 + excitation.q(s / omega)
-        x, ok = _newton(x0, n, omega, damping, q1, s, torque_limit, winding)
+        x, ok = _newton(x0, n, omega, gamma, q1, s, torque_limit, winding)
         if not ok:
             return None
         if prev is not None:

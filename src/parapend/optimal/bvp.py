@@ -268,13 +268,13 @@ class _Problem:
     The state is ``theta_j = pi n_j + z_j`` at the nodes; ``n`` is fixed, ``z`` varies.
     """
 
-    def __init__(self, mesh: _Mesh, excitation, damping: float):
+    def __init__(self, mesh: _Mesh, excitation, gamma: float):
         self.mesh = mesh
-        self.gamma = damping
+        self.gamma = gamma
         self.period = excitation.period
         self.dq = np.asarray(excitation.dq(mesh.t), dtype=float)
         self.wq = mesh.W * self.dq
-        self.kband2 = 2.0 * damping * mesh.kband
+        self.kband2 = 2.0 * gamma * mesh.kband
 
     def power(self, n: np.ndarray, z: np.ndarray) -> float:
         _, loc = self.mesh.local(n, z)
@@ -536,7 +536,7 @@ def _indicators(mesh: _Mesh, n: np.ndarray, z: np.ndarray, excitation, epsilon: 
     return residual, quadrature, floor
 
 
-def _accurate_power(mesh: _Mesh, n: np.ndarray, z: np.ndarray, excitation, damping: float):
+def _accurate_power(mesh: _Mesh, n: np.ndarray, z: np.ndarray, excitation, gamma: float):
     """``(P_eq15, P_by_parts, <theta'^2>)`` by 2p-point Gauss-Legendre per element."""
     tg, wg, lmat, l1, _ = _element_points(mesh, 2 * mesh.p)
     base, loc = mesh.local(n, z)
@@ -549,8 +549,8 @@ def _accurate_power(mesh: _Mesh, n: np.ndarray, z: np.ndarray, excitation, dampi
     jac = 0.5 * mesh.h[:, None] * wg[None, :]
     period = excitation.period
     kin = mesh.kinetic(loc) / period
-    p15 = float(np.sum(jac * (1.0 + q) * sg * np.sin(th) * thd)) / period - damping * kin
-    pbp = float(np.sum(jac * dq * sg * np.cos(th))) / period - damping * kin
+    p15 = float(np.sum(jac * (1.0 + q) * sg * np.sin(th) * thd)) / period - gamma * kin
+    pbp = float(np.sum(jac * dq * sg * np.cos(th))) / period - gamma * kin
     return p15, pbp, kin
 
 
@@ -770,7 +770,7 @@ class _Candidate:
     floor: float = 0.0
 
 
-def _adapt_solve(exc, damping: float, mesh: _Mesh, n: np.ndarray, z: np.ndarray,
+def _adapt_solve(exc, gamma: float, mesh: _Mesh, n: np.ndarray, z: np.ndarray,
                  tol: float, max_nodes: int):
     """Newton + residual-driven re-meshing at one damping until every element meets tol.
 
@@ -779,7 +779,7 @@ def _adapt_solve(exc, damping: float, mesh: _Mesh, n: np.ndarray, z: np.ndarray,
     rounding floor (:func:`_indicators`); ``residual_floor`` is the largest floor an element
     needed (0 when every element met ``tol``).
     """
-    eps = 2.0 * damping
+    eps = 2.0 * gamma
     its = 0
     status = "not_converged"
     info = _NewtonInfo()
@@ -788,7 +788,7 @@ def _adapt_solve(exc, damping: float, mesh: _Mesh, n: np.ndarray, z: np.ndarray,
     efloor = 0.0
     p = mesh.p
     for npass in range(_MAX_PASSES):
-        prob = _Problem(mesh, exc, damping)
+        prob = _Problem(mesh, exc, gamma)
         z, p_h, info = _newton(prob, n, z)
         its += info.iterations
         n, z = _rebase(n, z)
@@ -827,7 +827,7 @@ def _adapt_solve(exc, damping: float, mesh: _Mesh, n: np.ndarray, z: np.ndarray,
     return mesh, n, z, p_h, emax, status, info.maximum, its, efloor
 
 
-def _uniform_branch(exc, damping: float, tol: float, max_nodes: int, p: int,
+def _uniform_branch(exc, gamma: float, tol: float, max_nodes: int, p: int,
                     winding: int = 1) -> _Candidate:
     """Continuation in epsilon from the best uniform rotation (large epsilon) down.
 
@@ -835,8 +835,8 @@ def _uniform_branch(exc, damping: float, tol: float, max_nodes: int, p: int,
     winding K, :func:`parapend.power.uniform_power`), from ``epsilon_0 = 2 max|q'| /
     (K omega)^2``, on ``16 K`` elements (16 per turn).
     """
-    eps_target = 2.0 * damping
-    _, phi = uniform_power(exc, damping, winding)
+    eps_target = 2.0 * gamma
+    _, phi = uniform_power(exc, gamma, winding)
     tp = exc.period
     tgrid = tp * np.arange(1024) / 1024
     dqmax = float(np.max(np.abs(exc.dq(tgrid))))
@@ -937,10 +937,10 @@ def _limit_seed(exc, epsilon: float, p: int, pattern=None, winding: int = 1):
     return mesh, n, z
 
 
-def _limit_branch(exc, damping: float, tol: float, max_nodes: int, p: int,
+def _limit_branch(exc, gamma: float, tol: float, max_nodes: int, p: int,
                   pattern=None, name: str = "limit", winding: int = 1) -> _Candidate:
-    mesh, n, z = _limit_seed(exc, 2.0 * damping, p, pattern, winding)
-    mesh, n, z, p_h, eta, status, maximum, its, floor = _adapt_solve(exc, damping, mesh, n, z,
+    mesh, n, z = _limit_seed(exc, 2.0 * gamma, p, pattern, winding)
+    mesh, n, z, p_h, eta, status, maximum, its, floor = _adapt_solve(exc, gamma, mesh, n, z,
                                                                     tol, max_nodes)
     return _Candidate(mesh, n, z, p_h, eta, status, maximum, 1, its, name, floor)
 
@@ -949,7 +949,7 @@ def _limit_branch(exc, damping: float, tol: float, max_nodes: int, p: int,
 _FOURIER_SEED_HARMONICS = 24
 
 
-def _fourier_branch(exc, damping: float, tol: float, max_nodes: int, p: int,
+def _fourier_branch(exc, gamma: float, tol: float, max_nodes: int, p: int,
                     winding: int = 1) -> _Candidate:
     """Start from the turn pattern of the global Fourier optimum (docs/global.md): with
     several extrema per period the canonical limit pattern is often not the best one.
@@ -958,13 +958,13 @@ def _fourier_branch(exc, damping: float, tol: float, max_nodes: int, p: int,
     from .fourier import search_fourier
 
     if winding == 1:
-        found = search_fourier(exc, _FOURIER_SEED_HARMONICS, damping)
+        found = search_fourier(exc, _FOURIER_SEED_HARMONICS, gamma)
     else:
         nh = max(_FOURIER_SEED_HARMONICS, 4 * winding)
-        found = search_fourier(exc, nh, damping, winding=winding,
+        found = search_fourier(exc, nh, gamma, winding=winding,
                                hessian="dense" if nh <= 256 else "operator")
     motion = FourierMotion.from_vector(exc.omega, found.best.x, winding)
-    return _limit_branch(exc, damping, tol, max_nodes, p, _pattern_of(exc, motion), "fourier",
+    return _limit_branch(exc, gamma, tol, max_nodes, p, _pattern_of(exc, motion), "fourier",
                          winding)
 
 
@@ -977,7 +977,7 @@ _MESSAGES = {
 }
 
 
-def solve_bvp_optimum(excitation, damping: float, *, tol: float = 1e-8,
+def solve_bvp_optimum(excitation, gamma: float, *, tol: float = 1e-8,
                       max_nodes: int = 200_000, degree: int = 10,
                       seeds: tuple[str, ...] = ("uniform", "limit", "fourier"),
                       winding: int = 1, throw: bool = False) -> BVPSolution:
@@ -988,7 +988,7 @@ def solve_bvp_optimum(excitation, damping: float, *, tol: float = 1e-8,
     excitation : Excitation
         Any excitation of :mod:`parapend.excitation` (harmonic, two-harmonic, Eq. 26
         square wave, Fourier series, sampled).
-    damping : float
+    gamma : float
         Viscous damping ``gamma > 0`` (Eq. 14); the penalty is ``epsilon = 2 gamma``.
         ``gamma = 0`` has no smooth optimum (use :func:`parapend.optimal.limit.limit`).
     tol : float
@@ -1013,10 +1013,11 @@ def solve_bvp_optimum(excitation, damping: float, *, tol: float = 1e-8,
     -------
     BVPSolution
     """
-    gamma = check_finite("gamma", damping)
+    given = gamma
+    gamma = check_finite("gamma", gamma)
     if gamma <= 0:
         raise ParameterError(f"gamma: expected a damping > 0 (epsilon = 2 gamma penalizes "
-                             f"speed; for gamma = 0 use parapend.limit), got {damping!r}")
+                             f"speed; for gamma = 0 use parapend.limit), got {given!r}")
     tol = check_finite("tol", tol)
     if not 1e-14 <= tol <= 1e-1:
         raise ParameterError(f"tol: expected a number in [1e-14, 0.1], got {tol!r}")

@@ -52,7 +52,10 @@ import numba as nb
 import numpy as np
 from scipy.linalg.lapack import dgbsv
 
+from .._jit import announce_compiles
 from .hermite import _fold, locate, q_on_intervals  # _fold: node order 0, K-1, 1, K-2, ...
+
+announce_compiles()  # log a first-use compile (parapend._jit)
 
 __all__ = ["CollocationMotion", "CollocationSolution", "solve_collocation"]
 
@@ -472,7 +475,7 @@ class CollocationMotion:
     v_nodes: np.ndarray
     u_nodes: np.ndarray
     excitation: object
-    damping: float
+    gamma: float
     winding: int = 1
 
     @property
@@ -489,7 +492,7 @@ class CollocationMotion:
 
     def _f_nodes(self):
         tn = self.period / self.intervals * np.arange(self.intervals)
-        return (-self.damping * self.v_nodes
+        return (-self.gamma * self.v_nodes
                 + (1.0 + self.excitation.q(tn)) * np.sin(self.theta_nodes) + self.u_nodes)
 
     def theta(self, t):
@@ -509,10 +512,10 @@ class CollocationMotion:
 
     def theta_ddot(self, t):
         t = np.asarray(t, dtype=float)
-        return (-self.damping * self.theta_dot(t)
+        return (-self.gamma * self.theta_dot(t)
                 + (1.0 + self.excitation.q(t)) * np.sin(self.theta(t)) + self.torque(t))
 
-    def peak_torque(self, excitation=None, damping=None) -> float:
+    def peak_torque(self, excitation=None, gamma=None) -> float:
         """``max |u|``: at a node (the torque is linear in between), exact."""
         return float(np.max(np.abs(self.u_nodes)))
 
@@ -557,7 +560,7 @@ class CollocationSolution:
     infeasibility: float = math.nan
 
 
-def solve_collocation(excitation, damping: float, intervals: int, start, *,
+def solve_collocation(excitation, gamma: float, intervals: int, start, *,
                       efficiency=None, torque_limit=None, copper_loss: float = 0.0,
                       winding: int = 1, tol: float = 1e-10, maxiter: int = 200,
                       mu0: float | None = None) -> CollocationSolution:
@@ -594,7 +597,7 @@ def solve_collocation(excitation, damping: float, intervals: int, start, *,
         th = np.asarray(start.theta(tn), dtype=float).copy()
         v = np.asarray(start.theta_dot(tn), dtype=float).copy()
         u = (np.asarray(start.torque(tn), dtype=float).copy() if hasattr(start, "torque")
-             else np.asarray(inverse_dynamics(start, excitation, damping, tn), dtype=float))
+             else np.asarray(inverse_dynamics(start, excitation, gamma, tn), dtype=float))
     if tmax > 0:
         u = np.clip(u, -0.99 * tmax, 0.99 * tmax)
     if mu0 is None:
@@ -604,7 +607,7 @@ def solve_collocation(excitation, damping: float, intervals: int, start, *,
     mu = mu0
     mu_min = tol / 10
     n2 = 2 * k
-    p, _ = _points(th, v, u, q1n, q1m, h, damping, wrap)
+    p, _ = _points(th, v, u, q1n, q1m, h, gamma, wrap)
     w = np.tile([1.0, 2.0], k)
     push = 1e-2 * max(1.0, float(np.max(np.abs(p))))
     if slack:
@@ -642,7 +645,7 @@ def solve_collocation(excitation, damping: float, intervals: int, start, *,
     it = 0
     for it in range(1, maxiter + 1):  # noqa: B007
         dual_inf, prim_inf, comp = _kkt(th, v, u, a, b, xi, za, zb, y, al, be, q1n, q1m, h,
-                                        damping, wrap, pos, mu, eg, em, r, tmax, slack, ab,
+                                        gamma, wrap, pos, mu, eg, em, r, tmax, slack, ab,
                                         rhs, dpc, gp)
         err_mu = max(dual_inf, prim_inf, comp)
         # the error of the unperturbed KKT conditions: complementarity without mu
@@ -728,13 +731,13 @@ def solve_collocation(excitation, damping: float, intervals: int, start, *,
         # is accepted if it reduces the infeasibility theta or the barrier objective phi
         # enough and is not dominated by the filter; an objective step (theta small, phi
         # decreasing along the step) must satisfy Armijo on phi
-        phi0, th0 = _merit(th, v, u, a, b, q1n, q1m, h, damping, wrap, mu, eg, em, r, tmax,
+        phi0, th0 = _merit(th, v, u, a, b, q1n, q1m, h, gamma, wrap, mu, eg, em, r, tmax,
                            slack)
         if theta_max is None:
             theta_max = 1e4 * max(1.0, th0)
             theta_min = 1e-4 * max(1.0, th0)
         slope = _slope(th, v, u, a, b, dz, da if slack else None, db if slack else None,
-                       q1n, q1m, h, damping, wrap, mu, eg, em, r, tmax, w, slack, gp, jb)
+                       q1n, q1m, h, gamma, wrap, mu, eg, em, r, tmax, w, slack, gp, jb)
         alpha = amax
         accepted = False
         ftype = False
@@ -742,7 +745,7 @@ def solve_collocation(excitation, damping: float, intervals: int, start, *,
             thn, vn, un = th + alpha * dth, v + alpha * dv, u + alpha * du
             an = a + alpha * da if slack else a
             bn = b + alpha * db if slack else b
-            phi1, th1 = _merit(thn, vn, un, an, bn, q1n, q1m, h, damping, wrap, mu, eg, em,
+            phi1, th1 = _merit(thn, vn, un, an, bn, q1n, q1m, h, gamma, wrap, mu, eg, em,
                                r, tmax, slack)
             if math.isfinite(phi1) and th1 <= theta_max and not any(
                     th1 >= tf and phi1 >= pf for tf, pf in filt):
@@ -784,8 +787,8 @@ def solve_collocation(excitation, damping: float, intervals: int, start, *,
         if tmax > 0:
             al = al + dmax * dal
             be = be + dmax * dbe
-    motion = CollocationMotion(om, th, v, u, excitation, float(damping), int(winding))
-    p, mid = _points(th, v, u, q1n, q1m, h, damping, wrap)
+    motion = CollocationMotion(om, th, v, u, excitation, float(gamma), int(winding))
+    p, mid = _points(th, v, u, q1n, q1m, h, gamma, wrap)
     uu = np.empty(n2)
     uu[0::2] = u
     uu[1::2] = mid[:, 2]
@@ -794,7 +797,7 @@ def solve_collocation(excitation, damping: float, intervals: int, start, *,
     ele = float(ws @ np.where(p > 0, eg * p, p / em)) - r * float(ws @ (uu * uu))
     g = np.zeros((9, 6))
     defect = max((max(abs(c[0]), abs(c[1])) for c in (
-        _interval(j, k, th, v, u, q1n, q1m, h, damping, wrap, g) for j in range(k))),
+        _interval(j, k, th, v, u, q1n, q1m, h, gamma, wrap, g) for j in range(k))),
         default=0.0)
     # iterations: the Newton steps (KKT solves), not the barrier updates
     return CollocationSolution(motion, mech, ele, float(np.max(np.abs(u))), status,

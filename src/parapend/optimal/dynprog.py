@@ -45,16 +45,16 @@ ANGLES = 32
 MAX_JUMP = ANGLES // 4
 
 
-def _effective_damping(excitation, harmonics: int, damping: float) -> float:
+def _effective_gamma(excitation, harmonics: int, gamma: float) -> float:
     """``max(gamma, gamma_N)`` with the boundary layer of width ``T/(2N)`` at typical |q''|."""
     spec = excitation.spectrum
     k = np.arange(spec.size)
     qdd = excitation.omega**2 * math.sqrt(float(np.sum((k * k * np.abs(spec)) ** 2)) / 2.0)
     width = excitation.period / (2.0 * harmonics)
-    return max(damping, 0.5 * qdd * width**3)
+    return max(gamma, 0.5 * qdd * width**3)
 
 
-def best_paths(excitation, damping: float, steps: int, angles: int = ANGLES,
+def best_paths(excitation, gamma: float, steps: int, angles: int = ANGLES,
                max_jump: int = MAX_JUMP):
     """Best closed path of the discrete programme for every start angle.
 
@@ -77,7 +77,7 @@ def best_paths(excitation, damping: float, steps: int, angles: int = ANGLES,
     # reward of node i for start s at offset j: q'(t_i) cos(theta_0 + j dth) / M
     cos_tab = np.cos(dth * (starts[:, None] + offs[None, :]))  # (angles, nstate)
     jumps = np.arange(-max_jump, max_jump + 1)
-    jump_cost = damping * (jumps * dth) ** 2 / h**2 / steps
+    jump_cost = gamma * (jumps * dth) ** 2 / h**2 / steps
     v = np.full((angles, nstate), -np.inf)
     v[:, -lo] = 0.0
     arg = np.empty((steps, angles, nstate), dtype=np.int8)
@@ -114,7 +114,7 @@ def best_paths(excitation, damping: float, steps: int, angles: int = ANGLES,
 WINDOW = 3
 
 
-def best_paths_winding(excitation, damping: float, steps: int, winding: int,
+def best_paths_winding(excitation, gamma: float, steps: int, winding: int,
                        angles: int = ANGLES, max_jump: int = MAX_JUMP, starts: int = 8,
                        window: int = WINDOW):
     """Best closed paths with ``theta_steps = theta_0 + 2 pi K`` (see the module docstring).
@@ -136,7 +136,7 @@ def best_paths_winding(excitation, damping: float, steps: int, winding: int,
     dth = 2 * math.pi / angles
     centre = np.rint(winding * angles * np.arange(steps + 1) / steps).astype(int)
     jumps = np.arange(-max_jump, max_jump + 1)
-    jump_cost = damping * (jumps * dth) ** 2 / h**2 / steps
+    jump_cost = gamma * (jumps * dth) ** 2 / h**2 / steps
     v = np.full((starts, nstate), -np.inf)
     v[:, half] = 0.0
     arg = np.empty((steps, starts, nstate), dtype=np.int8)
@@ -186,17 +186,17 @@ def _project(path: np.ndarray, omega: float, harmonics: int, winding: int = 1) -
 MAX_STEPS_WINDING = 16384
 
 
-def propose_seeds(excitation, harmonics: int, damping: float, count: int, winding: int = 1):
+def propose_seeds(excitation, harmonics: int, gamma: float, count: int, winding: int = 1):
     """Up to ``count`` distinct seeds from the best paths, best first, as ``(name, x)``."""
     if winding == 1:
         steps = int(min(4096, max(128, 4 * harmonics, 8 * excitation.extrema.t.size)))
         values, paths = best_paths(excitation,
-                                   _effective_damping(excitation, harmonics, damping), steps)
+                                   _effective_gamma(excitation, harmonics, gamma), steps)
     else:
         steps = int(min(MAX_STEPS_WINDING, max(128, 2 * harmonics,
                                                8 * excitation.extrema.t.size, 8 * winding)))
         values, paths = best_paths_winding(
-            excitation, _effective_damping(excitation, harmonics, damping), steps, winding)
+            excitation, _effective_gamma(excitation, harmonics, gamma), steps, winding)
     out, seen = [], []
     for s in np.argsort(-values, kind="stable"):
         if not math.isfinite(values[s]):

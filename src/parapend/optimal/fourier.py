@@ -128,8 +128,8 @@ class FourierProblem:
     excitation : Excitation
     harmonics : int
         N >= 1.
-    damping : float
-        gamma >= 0.
+    gamma : float
+        Viscous damping >= 0 (Eq. 14).
     points : int, optional
         Quadrature points M (power of two, > 4N); chosen from N and the excitation if None.
     winding : int, optional
@@ -143,14 +143,14 @@ class FourierProblem:
         ``excitation.dq_grid(M)``, when the caller has it (the same numbers).
     """
 
-    def __init__(self, excitation, harmonics: int, damping: float, points: int | None = None,
+    def __init__(self, excitation, harmonics: int, gamma: float, points: int | None = None,
                  winding: int = 1, hessian: str = "dense", dq: np.ndarray | None = None):
         if hessian not in HESSIANS:
             raise ValueError(f"hessian: expected one of {HESSIANS}, got {hessian!r}")
         self.excitation = excitation
         self.omega = excitation.omega
         self.harmonics = n = harmonics
-        self.damping = damping
+        self.gamma = gamma
         self.winding = int(winding)
         self.hessian = hessian
         self.points = m = _problem_points(n, excitation, points, self.winding)
@@ -180,7 +180,7 @@ class FourierProblem:
 
     def power(self, x: np.ndarray) -> float:
         """Objective ``P(x)`` only."""
-        return float(np.mean(self.w * np.cos(self.theta(x)))) - self.damping * self.kinetic(x)
+        return float(np.mean(self.w * np.cos(self.theta(x)))) - self.gamma * self.kinetic(x)
 
     def evaluate(self, x: np.ndarray):
         """Return ``(P, gradient, Hessian)`` at ``x`` (exact to quadrature accuracy).
@@ -194,7 +194,7 @@ class FourierProblem:
         v = self.w * cs
         U = np.fft.rfft(u)[: n + 1] / m
         V = np.fft.rfft(v)[: 2 * n + 1] / m
-        gw = self.damping * self.omega**2
+        gw = self.gamma * self.omega**2
         p = V[0].real - gw * (self._k0 + 0.5 * float(np.dot(self._k2, x * x)))
         g = np.empty(2 * n + 1)
         g[0] = -U[0].real
@@ -508,9 +508,9 @@ def newton_maximize(problem: FourierProblem, x0: np.ndarray, seed: str, *,
 _ABANDON_SAFETY = 4.0
 
 
-def _uniform_seed(excitation, harmonics: int, damping: float, winding: int = 1) -> np.ndarray:
-    _, phi = (uniform_power(excitation, damping) if winding == 1
-              else uniform_power(excitation, damping, winding))
+def _uniform_seed(excitation, harmonics: int, gamma: float, winding: int = 1) -> np.ndarray:
+    _, phi = (uniform_power(excitation, gamma) if winding == 1
+              else uniform_power(excitation, gamma, winding))
     x = np.zeros(2 * harmonics + 1)
     x[0] = phi
     return x
@@ -519,7 +519,7 @@ def _uniform_seed(excitation, harmonics: int, damping: float, winding: int = 1) 
 _UNIFORM_HARMONICS = 8
 
 
-def _uniform_start(excitation, harmonics: int, damping: float, gtol: float) -> np.ndarray:
+def _uniform_start(excitation, harmonics: int, gamma: float, gtol: float) -> np.ndarray:
     """The best uniform rotation, first optimized with at most 8 harmonics, then padded.
 
     Continuation in N: from the uniform rotation a Newton run with many harmonics creeps
@@ -527,10 +527,10 @@ def _uniform_start(excitation, harmonics: int, damping: float, gtol: float) -> n
     stop on a lower local maximum); with 8 harmonics it converges in a few steps, and the
     padded result starts the N-harmonic run with that power already reached.
     """
-    x = _uniform_seed(excitation, min(harmonics, _UNIFORM_HARMONICS), damping)
+    x = _uniform_seed(excitation, min(harmonics, _UNIFORM_HARMONICS), gamma)
     if harmonics <= _UNIFORM_HARMONICS:
         return x
-    small = FourierProblem(excitation, _UNIFORM_HARMONICS, damping)
+    small = FourierProblem(excitation, _UNIFORM_HARMONICS, gamma)
     return _pad(newton_maximize(small, x, "uniform", gtol=gtol).x, harmonics)
 
 
@@ -644,7 +644,7 @@ class FourierSearch:
     evidence: SearchEvidence
 
 
-def _seeds(excitation, lim, harmonics: int, damping: float, warm, seeds, gtol: float):
+def _seeds(excitation, lim, harmonics: int, gamma: float, warm, seeds, gtol: float):
     """Primary seeds (polished to convergence): warm start, canonical limit, uniform.
 
     Winding K != 1: the uniform rotation ``K s + phi`` is padded without the 8-harmonic
@@ -657,15 +657,15 @@ def _seeds(excitation, lim, harmonics: int, damping: float, warm, seeds, gtol: f
         if name == "limit":
             out.append(("limit", limit_seed(lim, harmonics).vector))
         elif name == "uniform" and lim.winding != 1:
-            out.append(("uniform", _uniform_seed(excitation, harmonics, damping, lim.winding)))
+            out.append(("uniform", _uniform_seed(excitation, harmonics, gamma, lim.winding)))
         elif name == "uniform":
-            out.append(("uniform", _uniform_start(excitation, harmonics, damping, gtol)))
+            out.append(("uniform", _uniform_start(excitation, harmonics, gamma, gtol)))
         else:
             raise ValueError(f"seeds: unknown seed {name!r}")
     return out
 
 
-def _pattern_seeds(excitation, lim, harmonics: int, damping: float,
+def _pattern_seeds(excitation, lim, harmonics: int, gamma: float,
                    propose: int = None):
     """Further seeds from the half-turn direction patterns: all, or proposed ones.
 
@@ -674,7 +674,7 @@ def _pattern_seeds(excitation, lim, harmonics: int, damping: float,
     """
     count = pattern_count(lim)
     if lim.winding != 1:
-        return _winding_seeds(excitation, lim, harmonics, damping, count, propose)
+        return _winding_seeds(excitation, lim, harmonics, gamma, count, propose)
     if count <= 1:
         return "exhaustive", count, []
     if count <= ENUMERATE_MAX:
@@ -686,17 +686,17 @@ def _pattern_seeds(excitation, lim, harmonics: int, damping: float,
     propose = PROPOSE_COUNT if propose is None else propose
     if lim.winding == 1:
         out = [(name, x, None) for name, x in
-               propose_seeds(excitation, harmonics, damping, propose)]
+               propose_seeds(excitation, harmonics, gamma, propose)]
     else:
         out = [(name, x, None) for name, x in
-               propose_seeds(excitation, harmonics, damping, propose, winding=lim.winding)]
+               propose_seeds(excitation, harmonics, gamma, propose, winding=lim.winding)]
     pats = direction_patterns(lim, propose + 1, seed=0)[1:]
     out += [(f"limit-{i + 1}", limit_seed(lim, harmonics, d).vector, d)
             for i, d in enumerate(pats)]
     return "dynamic-programme", count, out
 
 
-def _winding_seeds(excitation, lim, harmonics: int, damping: float, count: int, propose):
+def _winding_seeds(excitation, lim, harmonics: int, gamma: float, count: int, propose):
     """Winding K != 1: the dynamic programme's seeds, always, then every pattern (at most
     ENUMERATE_MAX) or a seeded sample of them.
 
@@ -710,7 +710,7 @@ def _winding_seeds(excitation, lim, harmonics: int, damping: float, count: int, 
 
     propose = PROPOSE_COUNT if propose is None else propose
     out = [(name, x, None) for name, x in
-           propose_seeds(excitation, harmonics, damping, propose, winding=lim.winding)]
+           propose_seeds(excitation, harmonics, gamma, propose, winding=lim.winding)]
     if count <= ENUMERATE_MAX:
         pats = list(all_patterns(lim))[1:]
         strategy = "patterns+dynamic-programme"
@@ -733,14 +733,14 @@ SCREEN_KEEP = 8
 ENUMERATE_WORK = 792 * 96**3
 
 
-def _screen_harmonics(count: int, harmonics: int, damping: float) -> int | None:
+def _screen_harmonics(count: int, harmonics: int, gamma: float) -> int | None:
     """N at which to compare the patterns, or None for the full N (docs/global.md).
 
     gamma > 0: N = SCREEN_HARMONICS (the ranking is that of the full N: checked). gamma = 0:
     the ranking depends on N itself, so the full N unless that exceeds ENUMERATE_WORK, and
     then the largest N within it (the evidence says so: ``screen_harmonics``).
     """
-    if damping > 0:
+    if gamma > 0:
         return SCREEN_HARMONICS if harmonics > SCREEN_HARMONICS else None
     seeds = count if count <= ENUMERATE_MAX else 2 * PROPOSE_COUNT + SWAP_BUDGET
     if seeds * harmonics**3 <= ENUMERATE_WORK:
@@ -795,7 +795,7 @@ def _swap_search(lim, harmonics: int, pattern, run):
     return tried, best
 
 
-def search_fourier(excitation, harmonics: int, damping: float, *, warm: np.ndarray | None = None,
+def search_fourier(excitation, harmonics: int, gamma: float, *, warm: np.ndarray | None = None,
                    seeds: tuple[str, ...] = ("limit", "uniform"), gtol: float = 1e-11,
                    maxiter: int = 200, points: int | None = None, winding: int = 1,
                    hessian: str = "dense", propose: int | None = None) -> FourierSearch:
@@ -813,18 +813,18 @@ def search_fourier(excitation, harmonics: int, damping: float, *, warm: np.ndarr
     ``hessian="operator"``: matrix-free Newton-CG (:class:`HessianOperator`), for N in the
     thousands. ``propose``: dynamic-programme and sampled seeds (default PROPOSE_COUNT).
     """
-    problem = FourierProblem(excitation, harmonics, damping, points, winding=winding,
+    problem = FourierProblem(excitation, harmonics, gamma, points, winding=winding,
                              hessian=hessian)
     lim = limit(excitation) if winding == 1 else limit(excitation, winding)
     runs = [newton_maximize(problem, x0, name, gtol=gtol, maxiter=maxiter)
-            for name, x0 in _seeds(excitation, lim, harmonics, damping, warm, seeds, gtol)]
+            for name, x0 in _seeds(excitation, lim, harmonics, gamma, warm, seeds, gtol)]
     strategy, count, extra = "local", pattern_count(lim), []
     screen = None
     if "limit" in seeds and count > 1 and winding == 1:
-        screen = _screen_harmonics(count, harmonics, damping)
+        screen = _screen_harmonics(count, harmonics, gamma)
     if screen is not None:
         # compare the patterns at N = screen, polish the best few at N
-        coarse = search_fourier(excitation, screen, damping, seeds=seeds, gtol=gtol,
+        coarse = search_fourier(excitation, screen, gamma, seeds=seeds, gtol=gtol,
                                 maxiter=maxiter)
         strategy = coarse.evidence.strategy
         ranked = sorted((r for r in coarse.runs if r.status == "converged"),
@@ -837,7 +837,7 @@ def search_fourier(excitation, harmonics: int, damping: float, *, warm: np.ndarr
                 break
         extra = [(f"{r.seed}@N={screen}", _pad(r.x, harmonics), None) for r in kept]
     elif "limit" in seeds:
-        strategy, count, extra = _pattern_seeds(excitation, lim, harmonics, damping, propose)
+        strategy, count, extra = _pattern_seeds(excitation, lim, harmonics, gamma, propose)
     best_pattern = np.asarray(lim.directions)
     # the best power so far (the bar a new run must beat), kept as runs finish rather than
     # recomputed over all runs for each of up to 1024 seeds
@@ -857,14 +857,14 @@ def search_fourier(excitation, harmonics: int, damping: float, *, warm: np.ndarr
         if better and pattern is not None:
             best_pattern = pattern
     swaps = 0
-    if strategy == "dynamic-programme" and damping == 0 and screen is None:
+    if strategy == "dynamic-programme" and gamma == 0 and screen is None:
         # at gamma = 0 the programme ranks patterns poorly (docs/global.md): search near the
         # best one by swaps
         swaps, _ = _swap_search(lim, harmonics, best_pattern, run)
     best = _best(runs)
     # grid refinement: double M until the power of the optimum no longer moves
     for _ in range(8):
-        fine = FourierProblem(excitation, harmonics, damping, 2 * problem.points,
+        fine = FourierProblem(excitation, harmonics, gamma, 2 * problem.points,
                               winding=winding, hessian=hessian)
         if abs(fine.power(best.x) - best.power) <= 1e-14 * max(1.0, abs(best.power)):
             break
@@ -880,15 +880,15 @@ def search_fourier(excitation, harmonics: int, damping: float, *, warm: np.ndarr
         polished=sum(r.status == "converged" for r in runs),
         abandoned=sum(r.status == "abandoned" for r in runs),
         second_power=second,
-        upper_bound=(lim.power - damping * excitation.omega**2 if winding == 1
-                     else lim.power - damping * (winding * excitation.omega) ** 2),
+        upper_bound=(lim.power - gamma * excitation.omega**2 if winding == 1
+                     else lim.power - gamma * (winding * excitation.omega) ** 2),
         screen_harmonics=screen,
         second_distance=dist,
     )
     return FourierSearch(best, runs, evidence)
 
 
-def solve_fourier(excitation, harmonics: int, damping: float, *, warm: np.ndarray | None = None,
+def solve_fourier(excitation, harmonics: int, gamma: float, *, warm: np.ndarray | None = None,
                   seeds: tuple[str, ...] = ("limit", "uniform"), gtol: float = 1e-11,
                   maxiter: int = 200, points: int | None = None):
     """Best local maximum of the N-harmonic problem (:func:`search_fourier` without evidence).
@@ -900,6 +900,6 @@ def solve_fourier(excitation, harmonics: int, damping: float, *, warm: np.ndarra
     runs : list of LocalSolution
         Every local run, for the record.
     """
-    r = search_fourier(excitation, harmonics, damping, warm=warm, seeds=seeds, gtol=gtol,
+    r = search_fourier(excitation, harmonics, gamma, warm=warm, seeds=seeds, gtol=gtol,
                        maxiter=maxiter, points=points)
     return r.best, r.runs

@@ -157,11 +157,11 @@ class HermiteMotion:
         t = h * (np.arange(k)[:, None] + np.asarray(tau)[None, :])
         return t, y @ b0.T, y @ b1.T, y @ b2.T
 
-    def peak_torque(self, excitation, damping: float, samples: int = 16) -> float:
+    def peak_torque(self, excitation, gamma: float, samples: int = 16) -> float:
         """``max |T|`` of the motion (:meth:`interval_peaks`)."""
-        return float(np.max(self.interval_peaks(excitation, damping, samples=samples)))
+        return float(np.max(self.interval_peaks(excitation, gamma, samples=samples)))
 
-    def interval_peaks(self, excitation, damping: float, floor: float | None = None,
+    def interval_peaks(self, excitation, gamma: float, floor: float | None = None,
                        samples: int = 16) -> np.ndarray:
         """``max |T|`` over each interval, shape (K,): every interval sampled at
         ``samples + 1`` points (both ends: ``T`` jumps at nodes), and those whose sampled
@@ -176,7 +176,7 @@ class HermiteMotion:
         q1s = 1.0 + np.asarray(excitation.q_uniform(m), dtype=float)
         q1s = np.append(q1s, q1s[0])  # the end of the period
         return _k.interval_peaks(x, self.intervals, 2 * math.pi * self.winding,
-                                 self.period / self.intervals, float(damping),
+                                 self.period / self.intervals, float(gamma),
                                  np.asarray(excitation.spectrum, dtype=complex),
                                  float(self.omega), int(samples),
                                  -1.0 if floor is None else float(floor), q1s)
@@ -224,8 +224,8 @@ class HermiteProblem:
     excitation : Excitation
     intervals : int
         ``K``.
-    damping : float
-        gamma >= 0.
+    gamma : float
+        Viscous damping >= 0 (Eq. 14).
     torque_limit : float or None
         ``T_max`` (m g l); with ``phase1=True`` ignored (the bound is the variable ``t``).
     copper_loss : float
@@ -240,13 +240,13 @@ class HermiteProblem:
         Turns per forcing period.
     """
 
-    def __init__(self, excitation, intervals: int, damping: float, *, torque_limit=None,
+    def __init__(self, excitation, intervals: int, gamma: float, *, torque_limit=None,
                  copper_loss: float = 0.0, phase1: bool = False,
                  elastic: float | None = None, winding: int = 1):
         self.excitation = excitation
         self.omega = om = excitation.omega
         self.k = k = int(intervals)
-        self.damping = float(damping)
+        self.gamma = float(gamma)
         self.period = period = 2 * math.pi / om
         self.h = h = period / k
         self.winding = int(winding)
@@ -266,8 +266,8 @@ class HermiteProblem:
         self.q1_g = 1.0 + q_on_intervals(excitation, k, self.tau_g)
         self.q1_c = 1.0 + q_on_intervals(excitation, k, TORQUE_TAU)
         # torque rows, linear part: theta'' + gamma theta'
-        self.lin_g = self.rows_g[2] + damping * self.rows_g[1]
-        self.lin_c = self.rows_c[2] + damping * self.rows_c[1]
+        self.lin_g = self.rows_g[2] + gamma * self.rows_g[1]
+        self.lin_c = self.rows_c[2] + gamma * self.rows_c[1]
         self.wrap_turns = 2 * math.pi * self.winding
         # folded positions of every interval's variables (the banded assembly)
         pos = _fold(k)
@@ -319,7 +319,7 @@ class HermiteProblem:
     def _power_terms(self, x):
         return _k.power_terms(np.asarray(x, dtype=float), self.k, self.wrap_turns,
                               self.rows_g[0], self.rows_g[1], self.lin_g, self.q1_g,
-                              self.wg, self.damping)
+                              self.wg, self.gamma)
 
     def power(self, x) -> float:
         """Mean mechanical power ``P`` (Eq. 15, state form)."""
@@ -365,7 +365,7 @@ class HermiteProblem:
         return _k.trial(x, dx, float(alpha), 0.0 if t is None else float(t),
                         0.0 if dt is None else float(dt), s, float(mu), float(floor), self.k,
                         self.wrap_turns, self.rows_g[0], self.rows_g[1], self.lin_g,
-                        self.q1_g, self.wg, self.damping, self.copper_loss, self.rows_c[0],
+                        self.q1_g, self.wg, self.gamma, self.copper_loss, self.rows_c[0],
                         self.lin_c, self.q1_c, self.mode, self._scale,
                         float(self.torque_limit or 0.0), float(self.elastic or 0.0))
 
@@ -380,7 +380,7 @@ class HermiteProblem:
         ab, rhs, border, rhs_t, d_tt = _k.newton(
             np.asarray(x, dtype=float), 0.0 if t is None else float(t),
             np.asarray(lam, dtype=float), float(mu), self.k, self.wrap_turns,
-            self.rows_g[0], self.rows_g[1], self.lin_g, self.q1_g, self.wg, self.damping,
+            self.rows_g[0], self.rows_g[1], self.lin_g, self.q1_g, self.wg, self.gamma,
             self.copper_loss, self.rows_c[0], self.lin_c, self.q1_c, self.mode, self._scale,
             float(self.torque_limit or 0.0), float(self.elastic or 0.0), self._gvar,
             self._jtc)
@@ -568,14 +568,14 @@ def _blend_feasible(problem: HermiteProblem, x, anchor, t=None):
     return None
 
 
-def _elastic(excitation, damping, k, x, torque_limit, copper_loss, winding, stages):
+def _elastic(excitation, gamma, k, x, torque_limit, copper_loss, winding, stages):
     """Elastic mode from ``x``: ``|T| <= L + t``, ``t >= 0``, penalty ``M t``, ``M`` raised
     tenfold until ``t`` vanishes (at most ``1e5``); ``L`` a little below the limit so that
     the optimum is strictly inside. Returns ``(x, t, iterations)``."""
     weight = 10.0 * max(1.0, excitation.omega)
     t, iters = None, 0
     while True:
-        el = HermiteProblem(excitation, k, damping, torque_limit=torque_limit * (1 - 1e-4),
+        el = HermiteProblem(excitation, k, gamma, torque_limit=torque_limit * (1 - 1e-4),
                             copper_loss=copper_loss, elastic=weight, winding=winding)
         sol = interior_point(el, x, t=t)
         iters += sol.iterations
@@ -587,22 +587,22 @@ def _elastic(excitation, damping, k, x, torque_limit, copper_loss, winding, stag
         t = t * 1.5 + 1e-3 * torque_limit  # strictly inside again
 
 
-def minimum_peak_torque(excitation, damping: float, intervals: int, start, *,
+def minimum_peak_torque(excitation, gamma: float, intervals: int, start, *,
                         stop_below: float | None = None, winding: int = 1):
     """Phase 1: the rotation of smallest peak torque near ``start`` (a motion).
 
     Returns ``(HermiteSolution, problem)``; ``solution.t`` is the peak at the constraint
     points (``stop_below``: stop once it is below that).
     """
-    pr = HermiteProblem(excitation, intervals, damping, phase1=True, winding=winding)
+    pr = HermiteProblem(excitation, intervals, gamma, phase1=True, winding=winding)
     x0 = pr.start(start)
     sol = interior_point(pr, x0, stop_below=stop_below)
-    sol.peak_torque = pr.motion(sol.x).peak_torque(excitation, damping)
+    sol.peak_torque = pr.motion(sol.x).peak_torque(excitation, gamma)
     sol.intervals = intervals
     return sol, pr
 
 
-def solve_hermite(excitation, damping: float, intervals: int, start, *, torque_limit=None,
+def solve_hermite(excitation, gamma: float, intervals: int, start, *, torque_limit=None,
                   copper_loss: float = 0.0, tol: float = 1e-9,
                   anchor=None, winding: int = 1) -> HermiteSolution:
     """Optimal PTO motion on ``intervals`` Hermite intervals, from the motion ``start``.
@@ -619,7 +619,7 @@ def solve_hermite(excitation, damping: float, intervals: int, start, *, torque_l
     from ..trajectory import FourierMotion
 
     k = int(intervals)
-    pr = HermiteProblem(excitation, k, damping, torque_limit=torque_limit,
+    pr = HermiteProblem(excitation, k, gamma, torque_limit=torque_limit,
                         copper_loss=copper_loss, winding=winding)
     x = pr.start(start)
     stages = []
@@ -627,7 +627,7 @@ def solve_hermite(excitation, damping: float, intervals: int, start, *, torque_l
     x_start = x
     if torque_limit is not None:
         if anchor is None:
-            _, phi = uniform_power(excitation, damping, winding)
+            _, phi = uniform_power(excitation, gamma, winding)
             anchor = FourierMotion(excitation.omega, phi, np.zeros(1), np.zeros(1), winding)
         xa = pr.start(anchor)
         # blend towards the anchor when it is strictly inside; otherwise elastic mode below
@@ -642,12 +642,12 @@ def solve_hermite(excitation, damping: float, intervals: int, start, *, torque_l
     if torque_limit is not None and (x is None or sol.status != "converged"):
         # no strictly feasible start, or the solve from it stalled: elastic mode from the
         # start itself (it keeps the start's basin)
-        xe, te, it_e = _elastic(excitation, damping, k, x_start, torque_limit, copper_loss,
+        xe, te, it_e = _elastic(excitation, gamma, k, x_start, torque_limit, copper_loss,
                                 winding, stages)
         iters += it_e
         if not te < 1e-5 * torque_limit:
             # the limit is not met near the start: the smallest peak near it (phase 1)
-            ph1, _ = minimum_peak_torque(excitation, damping, k, pr.motion(xe),
+            ph1, _ = minimum_peak_torque(excitation, gamma, k, pr.motion(xe),
                                          winding=winding)
             iters += ph1.iterations
             stages.append(("phase1", ph1.t, ph1.status))
@@ -661,7 +661,7 @@ def solve_hermite(excitation, damping: float, intervals: int, start, *, torque_l
         stages.append(("solve", torque_limit, sol.status))
 
     motion = pr.motion(sol.x)
-    peaks = motion.interval_peaks(excitation, damping, torque_limit)
+    peaks = motion.interval_peaks(excitation, gamma, torque_limit)
     peak = float(np.max(peaks))
     # the optimum on the untightened grid bounds every motion within the limit everywhere
     bound = pr.power(sol.x) if sol.status == "converged" else math.inf
@@ -682,7 +682,7 @@ def solve_hermite(excitation, damping: float, intervals: int, start, *, torque_l
         pr.grid_limit = lim
         x = _blend_feasible(pr, sol.x, xa)
         if x is None:  # the anchor is not inside the tightened limits: a new one, or stop
-            ph1, _ = minimum_peak_torque(excitation, damping, k, pr.motion(xa),
+            ph1, _ = minimum_peak_torque(excitation, gamma, k, pr.motion(xa),
                                          stop_below=float(np.min(lim)) * (1 - 1e-3),
                                          winding=winding)
             iters += ph1.iterations
@@ -697,7 +697,7 @@ def solve_hermite(excitation, damping: float, intervals: int, start, *, torque_l
         iters += sol.iterations
         stages.append(("tighten", float(np.min(lim)), sol.status))
         motion = pr.motion(sol.x)
-        peaks = motion.interval_peaks(excitation, damping, torque_limit)
+        peaks = motion.interval_peaks(excitation, gamma, torque_limit)
         peak = float(np.max(peaks))
     status = sol.status
     if torque_limit is not None and peak > torque_limit * (1 + tol) and status == "converged":

@@ -66,7 +66,7 @@ class PTOSolution:
     stages: list = field(default_factory=list)
 
 
-def pto_profile(motion, excitation, damping: float, points: int = 4096,
+def pto_profile(motion, excitation, gamma: float, points: int = 4096,
                 efficiency=None) -> dict:
     """Torque and power of a motion over one period, and what the machine must deliver.
 
@@ -74,8 +74,8 @@ def pto_profile(motion, excitation, damping: float, points: int = 4096,
     ----------
     motion : FourierMotion (or any motion with ``on_grid`` or theta/theta_dot/theta_ddot)
     excitation : Excitation
-    damping : float
-        gamma.
+    gamma : float
+        Viscous damping >= 0 (Eq. 14).
     points : int
         Uniform samples of one period.
     efficiency : (eta_g, eta_m) or None
@@ -97,12 +97,12 @@ def pto_profile(motion, excitation, damping: float, points: int = 4096,
         th, thd, thdd = motion.on_grid(points)
     else:
         th, thd, thdd = motion.theta(t), motion.theta_dot(t), motion.theta_ddot(t)
-    tq = thdd + damping * thd - (1.0 + excitation.q_uniform(points)) * np.sin(th)
+    tq = thdd + gamma * thd - (1.0 + excitation.q_uniform(points)) * np.sin(th)
     p = -tq * thd
     dt = period / points
     out = {"t": t, "tau": t / period, "theta": th, "theta_dot": thd, "torque": tq,
            "power": p,
-           "peak_torque": peak_torque(motion, excitation, damping, points=points),
+           "peak_torque": peak_torque(motion, excitation, gamma, points=points),
            "peak_power": float(np.max(p)), "peak_motoring_power": float(max(-np.min(p), 0.0)),
            "harvested_energy": float(np.sum(np.maximum(p, 0.0)) * dt),
            "motoring_energy": float(np.sum(np.maximum(-p, 0.0)) * dt)}
