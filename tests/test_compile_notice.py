@@ -106,3 +106,19 @@ def test_a_run_without_compiled_kernels_says_nothing(tmp_path, capsys):
     assert main(["optimize", "--gamma", "0.01", "--harmonics", "8", "--json"]) == 0
     out, err = capsys.readouterr()
     assert err == "" and json.loads(out)["success"]
+
+
+@pytest.mark.slow
+def test_sweep_compiles_once_before_its_workers(tmp_path):
+    """A power take-off sweep on worker processes compiles the kernels in the main process
+    first (one notice; the workers then load them from the cache) and gives the same map as
+    a run on a warm cache."""
+    args = ("sweep", "--torque-limit", "1,2", "--omega", "1.7,1.8", "--workers", "2",
+            "--block-points", "1", "--json")
+    cold = _run(tmp_path / "cache", *args, "--store", str(tmp_path / "a.zarr"))
+    assert cold.returncode == 0, cold.stderr
+    assert cold.stderr.count("compiling") == 1 and cold.stderr.count("\n") == 1
+    warm = _run(tmp_path / "cache", *args, "--store", str(tmp_path / "b.zarr"))
+    assert warm.returncode == 0 and warm.stderr == ""
+    a, b = json.loads(cold.stdout), json.loads(warm.stdout)
+    assert a["largest_power"] == b["largest_power"] and a["status_counts"] == b["status_counts"]

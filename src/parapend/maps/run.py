@@ -124,6 +124,21 @@ def _ready() -> None:
     """A first task: it makes the pool start its processes."""
 
 
+def _compile_kernels(spec) -> None:
+    """Compile, or load from numba's disk cache, the power take-off kernels that the sweep's
+    points use, here, before the worker processes start. On a cold cache every worker would
+    otherwise compile the same kernels at the same time, with no notice (a two-worker sweep
+    took 37 s against 8 s warm); compiled once here, the workers load them from the cache
+    and the command line shows its first-use notice once. A tiny solve of each kind: about
+    0.1 s each when the cache is warm."""
+    from ..pto import optimize_pto
+
+    if spec.values["torque_limit"] and not spec.values["efficiency"]:
+        optimize_pto(torque_limit=2.5, gamma=0.03, harmonics=4)
+    if spec.values["efficiency"]:
+        optimize_pto(efficiency=0.9, gamma=0.03, harmonics=4)
+
+
 def _run_local(spec, todo, pool, done_cb):
     import concurrent.futures as cf
 
@@ -310,8 +325,10 @@ def sweep(store=None, *, omega=1.8, delta=None, gamma=0.0, torque_limit=None, ef
     # there may be nothing left to do): then only when blocks are left
     resume = (store is not None and not overwrite
               and _store_spec(_check_store_path(store)) == spec.to_json())
-    pool = (_LocalPool(workers, start=not resume)
-            if client is None and workers > 1 and spec.blocks > 1 else None)
+    local = client is None and workers > 1 and spec.blocks > 1
+    if local and spec.pto and not resume:
+        _compile_kernels(spec)
+    pool = _LocalPool(workers, start=not resume) if local else None
     try:
         return _sweep(spec, store, pool, client, overwrite, command, progress, t0)
     finally:
