@@ -22,7 +22,7 @@ import re
 import numpy as np
 
 __all__ = ["all_problems", "axes_with_data", "colorbar_problems", "label_problems",
-           "legend_problems", "render", "text_problems"]
+           "legend_problems", "render", "si_axis_problems", "text_problems"]
 
 #: a unit in brackets, ``(rad)``, ``(m g l / t0)``, or after a comma, ``, s``
 UNIT = re.compile(r"\([^()]*\S[^()]*\)|\[[^\]]+\]|,\s*\S+\s*$")
@@ -85,6 +85,42 @@ def label_problems(fig, *, units: bool = True, unitless=(), si: bool = False) ->
             elif si and (not SI_UNIT.search(unit.group(0))
                          or MODEL_UNIT.search(unit.group(0))):
                 out.append(f"axes {i}: {axis} label {label!r} has no SI unit")
+    return out
+
+
+#: a time counted in forcing periods: a count, read the same in any units
+FORCING_PERIODS = re.compile(r"^\(forcing periods")
+
+
+def _last_unit(label: str) -> str | None:
+    """The unit of ``label``: its last bracket (``$\\varphi(t_0 + mT)$ (rad)`` is in rad)."""
+    found = [m.group(0) for m in UNIT.finditer(label)]
+    return found[-1] if found else None
+
+
+def _is_si(unit: str) -> bool:
+    return bool(SI_UNIT.search(unit)) and not MODEL_UNIT.search(unit)
+
+
+def si_axis_problems(fig, *, unitless=()) -> list[str]:
+    """Axes with data whose x or y label has a non-SI unit (the model's ``m g l``, ``t0``)
+    and no SI scale beside it: a secondary axis of the same direction (``secondary_xaxis``
+    or ``secondary_yaxis``, a child of the axes) labelled with an SI unit. A figure made
+    with physical options then reads in SI on every axis that carries a dimension (a time
+    counted in forcing periods is a count, the same in any units)."""
+    out = []
+    for i, ax in enumerate(axes_with_data(fig)):
+        for axis in ("x", "y"):
+            label = getattr(ax, f"get_{axis}label")()
+            if not label.strip() or any(re.fullmatch(u, _plain(label)) for u in unitless):
+                continue
+            unit = _last_unit(label)
+            if unit is None or _is_si(unit) or FORCING_PERIODS.search(unit):
+                continue
+            beside = [getattr(c, f"get_{axis}label")() for c in ax.child_axes
+                      if type(c).__name__ == "SecondaryAxis"]
+            if not any((u := _last_unit(b)) and _is_si(u) for b in beside):
+                out.append(f"axes {i}: {axis} label {label!r} has no SI scale beside it")
     return out
 
 

@@ -93,6 +93,55 @@ def test_figure_si_units(argv, tmp_path, monkeypatch):
     _assert_clean(_render(argv, tmp_path, monkeypatch, si=True), argv)
 
 
+#: physical options of a 1 m, 10 kg pendulum at 0.9 Hz and 9 cm: every plot made with them
+#: shows each dimensional axis in SI (its own label, or an SI scale beside it)
+PHYSICAL = ["--length", "1", "--mass", "10", "--frequency", "0.9", "--amplitude", "0.09"]
+SI_BESIDE = [
+    ("optimize", ["optimize", "--harmonics", "8", *PHYSICAL]),
+    ("optimize-pto", ["optimize", "--torque-limit", "2.5", "--gamma", "0.03", *PHYSICAL]),
+    ("damping-sweep", ["damping-sweep", "--points", "5", "--harmonics", "8", *PHYSICAL]),
+    ("harmonics", ["harmonics", "--from", "2", "--to", "6", *PHYSICAL]),
+    ("pto-curve", ["pto-curve", "--points", "3", *PHYSICAL]),
+    ("track", ["track", "--omega", "2", "--delta", "-0.2", "--periods", "20", "--length", "1",
+               "--mass", "10"]),
+    ("simulate", ["simulate", "--periods", "20", "--length", "1", "--mass", "10"]),
+]
+
+
+@pytest.mark.parametrize("argv", [a for _, a in SI_BESIDE], ids=[n for n, _ in SI_BESIDE])
+def test_physical_options_give_si_axes(argv, tmp_path, monkeypatch):
+    from parapend import fileio
+
+    found = []
+    save = fileio.figure_bytes
+
+    def checked(fig, *args, **kwargs):
+        fc.render(fig)
+        found.extend(fc.si_axis_problems(fig, unitless=UNITLESS))
+        found.append("checked")
+        return save(fig, *args, **kwargs)
+
+    monkeypatch.setattr(fileio, "figure_bytes", checked)
+    _render(argv, tmp_path, monkeypatch)  # the same figures without units: FAST checks them
+    assert "checked" in found
+    problems = [p for p in found if p != "checked"]
+    assert not problems, f"parapend {' '.join(argv)}:\n  " + "\n  ".join(problems)
+
+
+def test_si_check_catches_a_model_unit_alone():
+    import matplotlib.pyplot as plt
+
+    fig, ax = plt.subplots()
+    ax.plot([0, 1], [0, 1])
+    ax.set_xlabel("time (s)")
+    ax.set_ylabel("power $P$ ($mgl/t_0$)")
+    assert len(fc.si_axis_problems(fig)) == 1
+    ax.secondary_yaxis("right", functions=(lambda v: 2 * v, lambda v: v / 2)).set_ylabel(
+        "power (W)")
+    assert fc.si_axis_problems(fig) == []
+    plt.close(fig)
+
+
 @pytest.mark.slow
 def test_report_figures(tmp_path, monkeypatch):
     """``parapend reproduce``: every figure of the report (PNG and SVG of each)."""

@@ -224,9 +224,9 @@ _SI_AXES = (("torque", "torque", "N m", "torque"), ("power", "power", "W", "powe
 
 
 def add_si_axes(fig, units: Units) -> None:
-    """Give every axis of ``fig`` that shows a torque, a power, an energy, a damping or a time
-    in the non-dimensional units a secondary axis in SI (right or top), labelled with its
-    unit (a time in forcing periods or as the phase tau is left alone).
+    """Give every axis of ``fig`` that shows a torque, a power, an energy, a damping, a time
+    or an angular rate in the non-dimensional units a secondary axis in SI (right or top),
+    labelled with its unit (a time in forcing periods or as the phase tau is left alone).
 
     The quantity is read from the axis label (a figure keeps its non-dimensional scale and
     gains the SI one beside it); labels already in SI units (W, N m, J) are left alone.
@@ -239,9 +239,18 @@ def add_si_axes(fig, units: Units) -> None:
             bare = label.replace("$", "").strip()
             is_time = (bare == "t" or bare.startswith(("t ", "t(")) or "time" in bare) and \
                 "period" not in bare and "tau" not in bare and "(s)" not in bare
-            for word, name, unit, scale in _SI_AXES + (("", "time", "s", "time"),):
-                if (word and word in label) or (not word and is_time):
-                    k = float(getattr(units, scale))
+            # an angular rate in rad per sqrt(l/g) (the unit of time), or a power named only by
+            # its unit m g l / t0 (a gap to the limit, say)
+            is_rate = "rad per" in bare and "sqrt" in bare
+            is_power = "mgl/t_0" in bare.replace(" ", "")
+            for word, name, unit, scale in _SI_AXES + (("", "time", "s", "time"),
+                                                       ("", "angular rate", "rad/s", "rate"),
+                                                       ("", "power", "W", "power")):
+                if (word and word in label) or (not word and (
+                        (name == "time" and is_time) or (name == "angular rate" and is_rate)
+                        or (name == "power" and is_power))):
+                    k = (1.0 / float(units.time) if scale == "rate"
+                         else float(getattr(units, scale)))
                     funcs = (lambda v, k=k: v * k, lambda v, k=k: v / k)
                     if which == "y":
                         sec = ax.secondary_yaxis("right", functions=funcs)
