@@ -649,9 +649,15 @@ def test_a_foreign_directory_is_never_deleted(reference, tmp_path, capsys, monke
     with pytest.raises(ParameterError, match="also holds 'notes.txt', which parapend did not"):
         sw.sweep(store, omega="1.8,1.9", workers=1, overwrite=True)
     assert (store / "notes.txt").read_text() == "mine"
-    # without it, --overwrite replaces the store (another sweep) and an empty directory is
-    # used as it is
+    # nor one inside an array's directory (it was deleted with the store)
     (store / "notes.txt").unlink()
+    (store / "power" / "notes.txt").write_text("mine")
+    with pytest.raises(ParameterError, match="also holds 'power/notes.txt'"):
+        sw.sweep(store, omega="1.8,1.9", workers=1, overwrite=True)
+    assert (store / "power" / "notes.txt").read_text() == "mine"
+    # without them, --overwrite replaces the store (another sweep) and an empty directory is
+    # used as it is
+    (store / "power" / "notes.txt").unlink()
     assert sw.sweep(store, omega="1.8,1.9", workers=1, overwrite=True).computed_points == 2
     (tmp_path / "empty").mkdir()
     assert sw.sweep(tmp_path / "empty", omega="1.8,1.9", workers=1).computed_points == 2
@@ -737,7 +743,8 @@ def _reference_blocks(tmp_path, **kw):
 
 
 @pytest.mark.parametrize("damage", ["delete power", "garbage status", "flip limit_power",
-                                    "garbage done", "delete done", "truncate branch_gap"])
+                                    "garbage done", "delete done", "truncate branch_gap",
+                                    "huge power", "link power", "link done"])
 def test_damaged_chunks_are_found_and_recomputed(reference, tmp_path, capsys, damage):
     """A chunk of a finished block deleted by hand, replaced by garbage, with one bit
     flipped (zstd's checksum), or truncated: `map` says the store is damaged (one line,
@@ -756,6 +763,13 @@ def test_damaged_chunks_are_found_and_recomputed(reference, tmp_path, capsys, da
         b = bytearray(data)
         b[len(b) // 2] ^= 1
         chunk.write_bytes(bytes(b))
+    elif action == "huge":  # a sparse file far larger than any chunk: never read (1 GB of
+        chunk.unlink()      # it took 2.2 GB of memory to be found undecodable)
+        with open(chunk, "wb") as f:
+            f.truncate(1 << 30)
+    elif action == "link":  # not a regular file (a link to /dev/zero was read until memory
+        chunk.unlink()      # ran out): never read, and removed, not followed, on resume
+        chunk.symlink_to(os.devnull if sys.platform == "win32" else "/dev/zero")
     else:
         chunk.write_bytes(data[: len(data) // 2])
     if damage == "delete done":  # the block is not marked finished: as if never computed

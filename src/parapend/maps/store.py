@@ -11,6 +11,7 @@ import json
 import math
 import os
 import shutil
+import stat
 import tempfile
 import time
 import warnings
@@ -264,6 +265,8 @@ def _prepare(path: Path, spec: SweepSpec, command: str | None, overwrite: bool) 
     entries = list(path.iterdir())
     extra = sorted(e.name for e in entries
                    if e.name not in own and not e.name.startswith(TEMP_PREFIX))
+    extra += _foreign_inside(path, [e for e in entries if e.name in own and e.is_dir()
+                                    and not e.is_symlink()])
     if extra:
         raise ParameterError(f"store: {str(path)!r} also holds {extra[0]!r}, which parapend "
                              "did not write; move it away or choose another --store")
@@ -273,6 +276,21 @@ def _prepare(path: Path, spec: SweepSpec, command: str | None, overwrite: bool) 
             with contextlib.suppress(FileNotFoundError):
                 _remove(e)
     _create(path, spec, command)
+
+
+def _foreign_inside(path: Path, arrays) -> list[str]:
+    """Files inside the array directories ``arrays`` that a sweep does not write (its own are
+    ``zarr.json`` and the chunks: ``c`` of a scalar, under ``c/`` otherwise, ``.partial``
+    writes cut short among them): a user's note in ``power/`` was deleted with the store."""
+    out = []
+    for a in arrays:
+        for d, _, files in os.walk(a):
+            rel = Path(d).relative_to(a).parts
+            for f in files:
+                if (not rel and f in ("zarr.json", "c")) or (rel and rel[0] == "c"):
+                    continue
+                out.append(str(Path(d, f).relative_to(path)))
+    return sorted(out)
 
 
 def _check_store_path(store) -> Path:
@@ -371,33 +389,56 @@ def _check_coords(group, path: Path, spec: SweepSpec) -> None:
             raise _damaged(path, f"coordinate {a!r} differs from the sweep's values")
 
 
-def _read(a, name: str, spec: SweepSpec, blocks) -> tuple[np.ndarray, set]:
+def _read(a, name: str, spec: SweepSpec, blocks, skip=frozenset()) -> tuple[np.ndarray, set]:
     """All of array ``a`` and the blocks (of ``blocks``) whose chunk cannot be read: at
-    once, or block by block when that fails (the others then hold the fill value)."""
-    try:
-        return np.asarray(a[...]), set()
-    except Exception:  # noqa: BLE001 - a chunk that cannot be decoded: found below
-        dtype, fill = _expected(name)
-        out, bad = np.full(spec.shape, fill, dtype=dtype), set()
-        for b in blocks:
-            sl = spec.block_slices(b)
-            try:
-                out[sl] = a[sl]
-            except Exception:  # noqa: BLE001 - recorded
-                bad.add(b)
-        return out, bad
+    once, or block by block when that fails or when some chunks must not be read at all
+    (``skip``: not chunk files, :func:`_chunk_files`); the others hold the fill value."""
+    if not skip:
+        try:
+            return np.asarray(a[...]), set()
+        except Exception:  # noqa: BLE001 - a chunk that cannot be decoded: found below
+            pass
+    dtype, fill = _expected(name)
+    out, bad = np.full(spec.shape, fill, dtype=dtype), set()
+    for b in blocks:
+        if b in skip:
+            continue
+        sl = spec.block_slices(b)
+        try:
+            out[sl] = a[sl]
+        except Exception:  # noqa: BLE001 - recorded
+            bad.add(b)
+    return out, bad
 
 
-def _chunk_files(path: Path, name: str) -> set:
-    """The chunk keys present in array ``name``'s directory (``c/0/3``, ...)."""
+def _chunk_bytes(name: str, spec: SweepSpec) -> int:
+    """The most bytes a chunk of array ``name`` can take: its values uncompressed, zstd's
+    worst-case expansion (under 1 %) and the frame and checksum."""
+    raw = int(np.prod(spec.chunks)) * _expected(name)[0].itemsize
+    return raw + raw // 64 + 4096
+
+
+def _chunk_files(path: Path, name: str, limit: int) -> tuple[set, set]:
+    """The chunk keys present in array ``name``'s directory (``c/0/3``, ...), and those of
+    them that cannot be a chunk of this array and are never read: not a regular file (a
+    link, a FIFO, a device: a link to /dev/zero was read until memory ran out) or larger
+    than ``limit`` bytes (a 1 GB file took 2.2 GB to find undecodable)."""
     root = path / name
-    out = set()
+    out, bad = set(), set()
     for d, _, files in os.walk(root):
         rel = os.path.relpath(d, root)
         for f in files:
             if f != "zarr.json" and not f.endswith(".partial"):
-                out.add(f if rel == "." else f"{rel}/{f}".replace(os.sep, "/"))
-    return out
+                key = f if rel == "." else f"{rel}/{f}".replace(os.sep, "/")
+                out.add(key)
+                try:
+                    st = os.lstat(os.path.join(d, f))
+                except OSError:
+                    bad.add(key)
+                    continue
+                if not stat.S_ISREG(st.st_mode) or st.st_size > limit:
+                    bad.add(key)
+    return out, bad
 
 
 def _chunk_key(array, spec: SweepSpec, block: int) -> str:
@@ -427,22 +468,32 @@ def _verify(path: Path, spec: SweepSpec) -> tuple[np.ndarray, dict]:
             raise _damaged(path, f"its root cannot be read: {_short(err)}") from None
         arrays = {v: _array(group, path, spec, v) for v in ("done", *spec.variables)}
         _check_coords(group, path, spec)
-        mask, unreadable = _read(arrays["done"], "done", spec, range(nb))
-        damaged = {b: "done: unreadable chunk" for b in unreadable}
+        keys = [_chunk_key(arrays["done"], spec, b) for b in range(nb)]
+        block_of = {k: b for b, k in enumerate(keys)}
+        # files that cannot be chunks are never read, whichever block they belong to
+        foreign = {}
+        for v in ("done", *spec.variables):
+            present, bad = _chunk_files(path, v, _chunk_bytes(v, spec))
+            foreign[v] = (present, {block_of[k] for k in bad if k in block_of})
+        damaged = {b: f"{v}: not a chunk file" for v in reversed(("done", *spec.variables))
+                   for b in foreign[v][1]}
+        mask, unreadable = _read(arrays["done"], "done", spec, range(nb),
+                                 skip=foreign["done"][1])
+        damaged.update({b: "done: unreadable chunk" for b in unreadable})
         slices = [spec.block_slices(b) for b in range(nb)]
         done = np.array([b not in damaged and bool(mask[slices[b]].all()) for b in range(nb)],
                         dtype=bool)
         finished = np.flatnonzero(done).tolist()
         if not finished:
             return done, damaged
-        keys = [_chunk_key(arrays["done"], spec, b) for b in range(nb)]
         values = {}
         for v in spec.variables:
-            present = _chunk_files(path, v)
+            present, skip = foreign[v]
             for b in finished:
                 if b not in damaged and keys[b] not in present:
                     damaged[b] = f"{v}: chunk missing"
-            values[v], bad = _read(arrays[v], v, spec, [b for b in finished if b not in damaged])
+            values[v], bad = _read(arrays[v], v, spec, [b for b in finished if b not in damaged],
+                                   skip=skip | set(damaged))
             for b in sorted(bad):
                 damaged.setdefault(b, f"{v}: chunk unreadable")
     success = [_CODE[s] for s in _SUCCESS]
