@@ -565,3 +565,20 @@ def test_any_real_number_accepted_anything_else_refused():
     for bad in ("1.8", 1.8 + 0j, [1.8], np.array([1.8]), None, True, Decimal("NaN")):
         with pytest.raises(ParameterError, match=r"^omega: expected a (real|finite) number"):
             parapend.optimize(omega=bad, harmonics=4)
+
+
+def test_an_oversized_record_is_described_as_a_record(tmp_path):
+    """A measured record over its size cap (64 bytes for each of its most rows: a full
+    record at full precision fits, where the 4 MiB of a 'tau,q' file did not) is refused
+    before reading with what a record holds ('t,z' rows), not a forcing period's 'tau,q'."""
+    from parapend import limits
+    from parapend.seas import measured_record
+    from parapend.units import Units
+
+    p = tmp_path / "big.csv"
+    with open(p, "wb") as f:
+        f.write(b"t,z\n")
+        f.truncate(64 * limits.SEA_MAX_RECORD_ROWS + 1)
+    with pytest.raises(ParameterError, match=r"^record: .* larger than 8 MiB; expected a CSV "
+                                             r"of at most 131072 rows 't,z'"):
+        measured_record(Units(length=1.0, mass=10.0), p)

@@ -646,13 +646,17 @@ def _resample_points(rows: int) -> int:
     return int(min(4096, max(256, 8 * (1 << max(0, int(rows) - 1).bit_length()))))
 
 
-def _read_bounded(path: Path) -> str:
-    """The text of ``path``: at most ``MAX_BYTES_FILE`` bytes, UTF-8 (a BOM is accepted).
+def _read_bounded(path: Path, expected: str | None = None, max_bytes: int | None = None) -> str:
+    """The text of ``path``: at most ``max_bytes`` (default ``MAX_BYTES_FILE``) bytes, UTF-8
+    (a BOM is accepted). ``expected`` says what the file should hold, for the message when it
+    is too large (default: one period of ``tau,q``).
 
     Only a regular file is read: the file is opened without blocking (a FIFO would wait for
     a writer forever), then refused unless ``fstat`` says it is a regular file, and refused
     before reading if its size is over the cap; the read itself is bounded as well (a
     file that grows meanwhile)."""
+    expected = expected or f"one period of at most {limits.MAX_FILE_ROWS} rows 'tau,q'"
+    cap = int(max_bytes or limits.MAX_BYTES_FILE)
     if path.is_dir():
         raise ParameterError(f"file: expected a CSV file, got the directory {str(path)!r}")
     try:
@@ -669,24 +673,21 @@ def _read_bounded(path: Path) -> str:
                     "a socket" if stat.S_ISSOCK(st.st_mode) else "not a regular file")
             raise ParameterError(f"file: expected a regular CSV file, got {kind}: {path} "
                                  "(save the data to a file first)")
-        if st.st_size > limits.MAX_BYTES_FILE:
-            raise ParameterError(f"file: {path} is larger than {limits.MAX_BYTES_FILE >> 20} "
-                                 f"MiB; expected one period of at most {limits.MAX_FILE_ROWS} "
-                                 "rows 'tau,q'")
+        if st.st_size > cap:
+            raise ParameterError(f"file: {path} is larger than {cap >> 20} MiB; "
+                                 f"expected {expected}")
         if hasattr(os, "set_blocking"):
             os.set_blocking(fd, True)
         with os.fdopen(fd, "rb") as fh:
             fd = None
-            data = fh.read(limits.MAX_BYTES_FILE + 1)
+            data = fh.read(cap + 1)
     except OSError as exc:
         raise ParameterError(f"file: cannot read {path}: {exc.strerror or exc}") from None
     finally:
         if fd is not None:
             os.close(fd)
-    if len(data) > limits.MAX_BYTES_FILE:
-        raise ParameterError(f"file: {path} is larger than {limits.MAX_BYTES_FILE >> 20} MiB; "
-                             f"expected one period of at most {limits.MAX_FILE_ROWS} rows "
-                             "'tau,q'")
+    if len(data) > cap:
+        raise ParameterError(f"file: {path} is larger than {cap >> 20} MiB; expected {expected}")
     if b"\0" in data:
         raise ParameterError(f"file: {path} is not a text CSV (it contains NUL bytes: binary, "
                              "or UTF-16); save it as UTF-8")

@@ -169,7 +169,10 @@ def _csv_rows(path, header: list, name: str, max_rows: int = None) -> list:
         raise ParameterError(f"{name}: expected a CSV path, got {path!r:.60}")
     path = Path(path)
     try:
-        text = _read_bounded(path)
+        rows = max_rows or limits.MAX_FILE_ROWS
+        # 64 bytes a row: two numbers at full precision (about 45) and room to spare
+        text = _read_bounded(path, f"a CSV of at most {rows} rows '{','.join(header)}'",
+                             max_bytes=max(limits.MAX_BYTES_FILE, 64 * rows))
     except ParameterError as exc:  # name the parameter the user gave, not "file"
         msg = str(exc)
         raise ParameterError(f"{name}:{msg[5:]}" if msg.startswith("file:") else msg) from None
