@@ -91,7 +91,7 @@ UNIT_GRAVITY_RANGE = (1e-3, 1e3)
 #: moment of inertia about the pivot, as a multiple of m l^2 (I = I_cm + m l^2 >= m l^2)
 UNIT_INERTIA_RATIO = (1.0, 1e6)
 
-# --- design maps (parapend sweep, issue 13) ------------------------------------------------
+# --- design maps (parapend sweep) ------------------------------------------------
 #: points of one map (the issue asks for 10^4 to 10^6; at N = 24 about 1 ms of CPU each
 #: for a harmonic excitation, so 2^20 points are about 15 to 20 CPU-minutes, resumable)
 MAP_MAX_POINTS = 1 << 20
@@ -121,7 +121,7 @@ SIM_MAX_PHI0 = 1e3
 SIM_MAX_DPHI0 = 1e3
 #: basins: grid points per axis, period budget, and integrated points x periods (the
 #: default grid is symmetric and integrates half its points: the 1000 x 1000, 300-period
-#: map of issue 10 is 1.5e8; worst case, every point running the whole budget, about 180 s
+#: map is 1.5e8; worst case, every point running the whole budget, about 180 s
 #: of CPU, 1.5 minutes on two idle cores)
 BASIN_MAX_RESOLUTION = 2000
 BASIN_MAX_PERIODS = 5000
