@@ -1054,3 +1054,59 @@ def test_a_success_without_a_finite_power_is_recorded_as_nonfinite(tmp_path, mon
     assert (run.dataset["status"].values == sw.STATUSES.index("nonfinite")).all()
     again = sw.sweep(store, omega="1.8,1.9", workers=1)
     assert (again.computed_points, again.repaired_points) == (0, 0)
+
+
+def test_map_and_sweep_in_si_for_a_stated_pendulum(reference, tmp_path, capsys):
+    """The store is non-dimensional; with --length and --mass, `sweep` reports its largest
+    power in W and `map` draws the quantity in W (or gamma* in N m s/rad) with omega as the
+    base frequency in Hz: the scales of a 1 m, 10 kg pendulum, m g^1.5 l^0.5 = 307.26 W and
+    f = omega / (2 pi sqrt(l/g)), written out here."""
+    import math
+
+    import matplotlib.pyplot as plt
+
+    from parapend import fileio
+
+    ref_store = _copy(reference[0], tmp_path / "c.zarr")
+    watt = 10.0 * 9.81 ** 1.5 * 1.0 ** 0.5
+    axes = [a for k, v in GRID.items() for a in (f"--{k}", str(v))]
+    assert main(["sweep", "--store", str(ref_store), *axes, "--block-points", "3",
+                 "--length", "1", "--mass", "10", "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert out["computed_points"] == 0  # the store is the same sweep: units change nothing
+    assert out["largest_power_w"] == pytest.approx(out["largest_power"]["power"] * watt,
+                                                   rel=1e-12)
+    seen = []
+    save = fileio.save_figure
+
+    def keep(fig, path, *a, **k):
+        seen.append(fig)
+        return save(fig, path, *a, close=False, **k)
+
+    fileio.save_figure = keep
+    try:
+        assert main(["map", "--store", str(ref_store), "--plot", str(tmp_path / "m.png"),
+                     "--length", "1", "--mass", "10", "--json"]) == 0
+    finally:
+        fileio.save_figure = save
+    m = json.loads(capsys.readouterr().out)
+    assert m["unit_si"] == "W"
+    assert m["min_si"] == pytest.approx(m["min"] * watt, rel=1e-12)
+    assert m["max_si"] == pytest.approx(m["max"] * watt, rel=1e-12)
+    fig = seen[0]
+    bar = [a for a in fig.axes if getattr(a, "_colorbar", None) is not None][0]
+    assert bar.get_ylabel().endswith("(W)")
+    lo, hi = bar.get_ylim()
+    assert lo <= m["min_si"] * (1 + 1e-9) and hi >= m["max_si"] * (1 - 1e-9)
+    ax = [a for a in fig.axes if a is not bar][0]
+    top = [c for c in ax.child_axes if c.get_xlabel() == "frequency (Hz)"][0]
+    t0 = math.sqrt(1.0 / 9.81)
+    assert top._functions[0](1.8) == pytest.approx(1.8 / (2 * math.pi * t0), rel=1e-12)
+    plt.close(fig)
+    # a ratio has no SI unit; frequency and amplitude belong to the axes, not to the map
+    assert main(["map", "--store", str(ref_store), "--variable", "gain", "--plot",
+                 str(tmp_path / "g.png"), "--length", "1", "--mass", "10", "--json"]) == 0
+    assert json.loads(capsys.readouterr().out)["unit_si"] is None
+    assert main(["map", "--store", str(ref_store), "--frequency", "1", "--plot",
+                 str(tmp_path / "g.png")]) == 2
+    capsys.readouterr()

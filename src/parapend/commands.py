@@ -546,16 +546,20 @@ def sweep(*, omega="1.8", delta=None, gamma=GAMMA["sweep"], torque_limit=None,
           efficiency=None, excitation=None, square_alpha=None, fourier=None,
           harmonics: int = 24, threshold: bool = False, store: str = "map.zarr",
           overwrite: bool = False, netcdf=None, workers=None, scheduler=None,
-          block_points=None, command=None, progress=None):
+          block_points=None, command=None, progress=None, length=None, mass=None,
+          inertia=None, gravity=None):
     """A resumable design map (command ``sweep``; :func:`parapend.maps.sweep`): axes as
     one value, ``"START:STOP:COUNT"`` or a comma list (or numbers). Fields are the JSON
     keys; ``_run`` is the :class:`~parapend.maps.SweepRun`, ``_dataset`` its Dataset.
-    ``netcdf`` also exports the finished map."""
+    ``netcdf`` also exports the finished map. The store is non-dimensional (one store
+    serves every pendulum); with ``length`` and ``mass`` the largest power is also given in
+    W (``largest_power_w``) and ``parapend.map`` draws it in SI with the same options."""
     import importlib
 
     import numpy as np
 
     sw = importlib.import_module(".maps", __package__)
+    units, _, _ = _physical({}, length=length, mass=mass, inertia=inertia, gravity=gravity)
     if scheduler is not None and workers is not None:
         raise ParameterError("workers: the processes are the cluster's with --scheduler; "
                              "drop --workers")
@@ -585,7 +589,7 @@ def sweep(*, omega="1.8", delta=None, gamma=GAMMA["sweep"], torque_limit=None,
         k = np.unravel_index(np.nanargmax(np.where(ok, p, -np.inf)), p.shape)
         best = {"power": float(p[k]), **{d: float(ds[d].values[i])
                                           for d, i in zip(ds["power"].dims, k)}}
-    return Record("sweep", {
+    out = {
         "store": run.store, "dims": {d: int(ds.sizes[d]) for d in ds["power"].dims},
         "points": run.points, "blocks": run.blocks, "computed_points": run.computed_points,
         "resumed_points": run.resumed_points, "repaired_points": run.repaired_points,
@@ -593,13 +597,29 @@ def sweep(*, omega="1.8", delta=None, gamma=GAMMA["sweep"], torque_limit=None,
         "largest_power": best,
         "largest_branch_gap": (float(np.nanmax(ds["branch_gap"].values))
                                if "branch_gap" in ds and ok.any() else None),
-        "netcdf": netcdf}, run=run, dataset=ds)
+        "netcdf": netcdf}
+    if units is not None:
+        out.update(units=units.describe(), largest_power_w=(
+            None if best is None else units.to_watts(best["power"])))
+    return Record("sweep", out, run=run, dataset=ds)
+
+
+#: a design map's quantities in SI: the Units attribute that scales each (None: a ratio)
+MAP_SI = {"power": ("power", "W"), "uniform_power": ("power", "W"),
+          "limit_power": ("power", "W"), "electrical_power": ("power", "W"),
+          "branch_gap": ("power", "W"), "damping_threshold": ("damping", "N m s/rad"),
+          "gain": None}
 
 
 def map(*, store: str = "map.zarr", variable: str = "power", x=None, y=None, at=(),  # noqa: A001
-        plot: str = "map.png"):
+        plot: str = "map.png", length=None, mass=None, inertia=None, gravity=None):
     """Heat map of a sweep store over two of its axes, written to ``plot`` (command
-    ``map``). ``at``: ``{"axis": value}`` or ``["axis=value", ...]`` for further axes."""
+    ``map``). ``at``: ``{"axis": value}`` or ``["axis=value", ...]`` for further axes.
+
+    With ``length`` and ``mass`` (m, kg; ``inertia``, ``gravity`` optional) the map is of that
+    pendulum: the store is non-dimensional (one store serves every size), and the figure gains
+    SI scales (the colour bar in W or N m s/rad, omega in Hz, gamma in N m s/rad, the torque
+    limit in N m) and the result ``min_si``, ``max_si`` and ``unit_si``."""
     import importlib
 
     import numpy as np
@@ -620,12 +640,24 @@ def map(*, store: str = "map.zarr", variable: str = "power", x=None, y=None, at=
         except (TypeError, ValueError):
             raise ParameterError(f"at: expected a number after '=', got {text!r:.40}") \
                 from None
+    units, _, _ = _physical({}, length=length, mass=mass, inertia=inertia, gravity=gravity)
     ds = sw.open_sweep(store)
     xn = x.replace("-", "_") if x else None
     yn = y.replace("-", "_") if y else None
     z, failed, xs, ys, xn, yn, label, title = sw.map_data(ds, variable, xn, yn, fixed)
     try:
-        sw.plot_map(ds, variable, xn, yn, fixed, plot)
+        if units is None:
+            sw.plot_map(ds, variable, xn, yn, fixed, plot)
+        else:
+            from .style import figure_style
+            from .units import add_si_axes
+
+            si = MAP_SI.get(variable)
+            fig = sw.plot_map(ds, variable, xn, yn, fixed, None, scale=None if si is None else
+                              (float(getattr(units, si[0])), si[1]))
+            with figure_style():
+                add_si_axes(fig, units)
+            fileio.save_figure(fig, plot)
     except OutputError:
         raise
     except OSError as exc:
@@ -639,4 +671,10 @@ def map(*, store: str = "map.zarr", variable: str = "power", x=None, y=None, at=
     if finite.any():
         i, j = np.unravel_index(np.nanargmax(z), z.shape)
         out["max_at"] = {xn: float(xs[j]), yn: float(ys[i])}
+    if units is not None:
+        si = MAP_SI.get(variable)
+        k = None if si is None else float(getattr(units, si[0]))
+        out.update(units=units.describe(), unit_si=None if si is None else si[1],
+                   min_si=None if k is None or out["min"] is None else out["min"] * k,
+                   max_si=None if k is None or out["max"] is None else out["max"] * k)
     return Record("map", out, dataset=ds, label=label)

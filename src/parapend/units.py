@@ -224,14 +224,17 @@ _SI_AXES = (("torque", "torque", "N m", "torque"), ("power", "power", "W", "powe
 
 
 def add_si_axes(fig, units: Units) -> None:
-    """Give every axis of ``fig`` that shows a torque, a power, an energy, a damping, a time
-    or an angular rate in the non-dimensional units a secondary axis in SI (right or top),
+    """Give every axis of ``fig`` that shows a torque, a power, an energy, a damping, a time,
+    an angular rate or the forcing frequency omega in the non-dimensional units a secondary
+    axis in SI (right or top: omega as the base frequency in Hz),
     labelled with its unit (a time in forcing periods or as the phase tau is left alone).
 
     The quantity is read from the axis label (a figure keeps its non-dimensional scale and
     gains the SI one beside it); labels already in SI units (W, N m, J) are left alone.
     """
     for ax in list(fig.axes):
+        if getattr(ax, "_colorbar", None) is not None:
+            continue  # a colour bar is drawn in the units its figure chose
         for which in ("y", "x"):
             label = (ax.get_ylabel() if which == "y" else ax.get_xlabel()).lower()
             if not label or any(f"({u.lower()}" in label for u in ("W", "N m", "J", "kJ")):
@@ -242,14 +245,18 @@ def add_si_axes(fig, units: Units) -> None:
             # an angular rate in rad per sqrt(l/g) (the unit of time), or a power named only by
             # its unit m g l / t0 (a gap to the limit, say)
             is_rate = "rad per" in bare and "sqrt" in bare
+            is_omega = bare.startswith("\\omega") and "sqrt(g/l)" in bare.replace(" ", "")
             is_power = "mgl/t_0" in bare.replace(" ", "")
             for word, name, unit, scale in _SI_AXES + (("", "time", "s", "time"),
                                                        ("", "angular rate", "rad/s", "rate"),
-                                                       ("", "power", "W", "power")):
+                                                       ("", "power", "W", "power"),
+                                                       ("", "frequency", "Hz", "frequency")):
                 if (word and word in label) or (not word and (
                         (name == "time" and is_time) or (name == "angular rate" and is_rate)
-                        or (name == "power" and is_power))):
+                        or (name == "power" and is_power)
+                        or (name == "frequency" and is_omega))):
                     k = (1.0 / float(units.time) if scale == "rate"
+                         else 1.0 / (2 * math.pi * float(units.time)) if scale == "frequency"
                          else float(getattr(units, scale)))
                     funcs = (lambda v, k=k: v * k, lambda v, k=k: v / k)
                     if which == "y":
@@ -258,4 +265,6 @@ def add_si_axes(fig, units: Units) -> None:
                     else:
                         sec = ax.secondary_xaxis("top", functions=funcs)
                         sec.set_xlabel(f"{name} ({unit})")
+                        if ax.get_title():  # above the new scale, not over it
+                            ax.set_title(ax.get_title(), pad=36)
                     break

@@ -38,10 +38,12 @@ def add_pto_options(p, torque_limit: bool = True) -> None:
                    default=None, help="eta_m in (0, 1] (overrides --efficiency)")
 
 
-def add_unit_options(p, damping: bool = True, torque: bool = False) -> None:
+def add_unit_options(p, damping: bool = True, torque: bool = False,
+                     excitation: bool = True) -> None:
     """Physical pendulum: ``--length --mass --gravity --frequency --amplitude ...``
     (``--damping-coefficient`` where the command takes a damping, ``--torque-limit-nm``
-    with ``torque``, for commands that have no other take-off options)."""
+    with ``torque``, for commands that have no other take-off options; ``--frequency`` and
+    ``--amplitude`` only with ``excitation``: a design map's axes stay non-dimensional)."""
     g = p.add_argument_group("physical units (docs/units.md); output adds W, N m, J")
     g.add_argument("--length", type=_finite_float("length"), default=None,
                    help="pivot to centre of mass, m")
@@ -50,10 +52,12 @@ def add_unit_options(p, damping: bool = True, torque: bool = False) -> None:
                    help="moment of inertia about the pivot, kg m^2 (default m l^2)")
     g.add_argument("--gravity", type=_finite_float("gravity"), default=None,
                    help="m/s^2 (default 9.81)")
-    g.add_argument("--frequency", type=_finite_float("frequency"), default=None,
-                   help="base heave frequency, Hz (sets omega = 2 pi f sqrt(l/g))")
-    g.add_argument("--amplitude", type=_finite_float("amplitude"), default=None,
-                   help="base heave displacement amplitude A, m (sets delta = -A (2 pi f)^2/g)")
+    if excitation:
+        g.add_argument("--frequency", type=_finite_float("frequency"), default=None,
+                       help="base heave frequency, Hz (sets omega = 2 pi f sqrt(l/g))")
+        g.add_argument("--amplitude", type=_finite_float("amplitude"), default=None,
+                       help="base heave displacement amplitude A, m (sets delta = "
+                            "-A (2 pi f)^2/g)")
     if damping:
         g.add_argument("--damping-coefficient", type=_finite_float("damping-coefficient"),
                        default=None, help="viscous damping c, N m s/rad (sets gamma)")

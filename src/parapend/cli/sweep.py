@@ -12,6 +12,7 @@ import time
 
 from .. import limits
 from ..defaults import GAMMA
+from . import pto as _pto
 from ._common import (
     FIGURE_SUFFIXES,
     _check_output,
@@ -91,6 +92,7 @@ def add_parsers(sub) -> None:
     p.add_argument("--block-points", type=_int, default=None,
                    help="points per block, one chunk of the store (default 512, 8 with a "
                         "power take-off)")
+    _pto.add_unit_options(p, damping=False, excitation=False)
     p.add_argument("--json", action="store_true", help="print one JSON object")
 
     m = sub.add_parser("map", help="heat map of a sweep store over two of its axes",
@@ -115,6 +117,7 @@ def add_parsers(sub) -> None:
                         "repeatable")
     m.add_argument("--plot", metavar="PNG", default="map.png",
                    help="figure file, PNG, SVG or PDF (default map.png)")
+    _pto.add_unit_options(m, damping=False, excitation=False)
     m.add_argument("--json", action="store_true", help="print one JSON object")
 
 
@@ -140,7 +143,9 @@ def _cmd_sweep(a) -> dict | str:
              "status: " + ", ".join(f"{s} {n}" for s, n in counts.items())]
     if best is not None:
         where = ", ".join(f"{k} = {v:.6g}" for k, v in best.items() if k != "power")
-        lines.append(f"largest power {_fmt(best['power'], 8)} at {where}")
+        watts = (f" ({out['largest_power_w']:.6g} W)" if out.get("largest_power_w") is not None
+                 else "")
+        lines.append(f"largest power {_fmt(best['power'], 8)}{watts} at {where}")
     if out["largest_branch_gap"]:
         lines.append(f"continuation found a higher branch than the global search, by up to "
                      f"{out['largest_branch_gap']:.3g} (variable branch_gap)")
@@ -161,7 +166,9 @@ def _cmd_map(a) -> dict | str:
     lines = [f"heat map of {a.variable} over ({xn}, {yn}) written to {a.plot}"
              + (f" ({title})" if title else "")]
     if finite:
-        lines.append(f"range {_fmt(out['min'], 6)} to {_fmt(out['max'], 6)} ({label}); "
+        si = (f" = {out['min_si']:.6g} to {out['max_si']:.6g} {out['unit_si']}"
+              if out.get("unit_si") else "")
+        lines.append(f"range {_fmt(out['min'], 6)} to {_fmt(out['max'], 6)} ({label}){si}; "
                      f"largest at {xn} = {out['max_at'][xn]:.6g}, {yn} = "
                      f"{out['max_at'][yn]:.6g}")
     lines.append(f"{out['points']} points: {out['failed']} failed, {out['not_computed']} not "

@@ -173,10 +173,12 @@ def _axis_label(name: str) -> str:
     return _LABELS[name] + (" (dimensionless)" if unit == "1" else f" ({unit})")
 
 
-def plot_map(ds, quantity: str = "power", x=None, y=None, at=None, path=None):
+def plot_map(ds, quantity: str = "power", x=None, y=None, at=None, path=None, scale=None):
     """Heat map of ``quantity`` over two axes, with labelled contour lines, the zero
     contour of the power (where it crosses gamma*) in black, failed points crossed, and the
     paper's case (omega = 1.8, delta = -0.3, gamma = 0) marked when inside the map.
+    ``scale``: ``(factor, unit)`` to draw the quantity in another unit (SI: W for a power,
+    N m s/rad for gamma*), named on the colour bar.
 
     The colour bar covers the whole range of the values; a long tail is compressed into its
     end, and the bar says so (:func:`colour_scale`). The contours are at round values inside
@@ -192,6 +194,9 @@ def plot_map(ds, quantity: str = "power", x=None, y=None, at=None, path=None):
     from ..style import figure_style
 
     z, failed, xs, ys, xn, yn, label, title = map_data(ds, quantity, x, y, at)
+    if scale is not None:
+        z = z * float(scale[0])
+        label = f"{label.split(' (')[0]} ({scale[1]})"
     with figure_style():
         fig, ax = plt.subplots(figsize=(6.4, 4.8), layout="constrained")
         cmap = plt.get_cmap("viridis").with_extremes(bad="0.85")
