@@ -171,3 +171,22 @@ def test_ctrl_c_while_loading_is_one_line(delay):
     else:
         assert p.returncode in (130, -signal.SIGINT), (p.returncode, err)
         assert err.count("\n") == 1 and err.rstrip().endswith("interrupted"), err
+
+
+def test_an_interrupt_a_library_turned_into_its_own_error_is_still_an_interrupt(
+        monkeypatch, capsys):
+    """numba, interrupted while it compiles, raises its own error: after SIGINT under the
+    console script's handler any exception ends as the command's one interrupted line."""
+    from parapend import _entry
+    from parapend import cli as cli_pkg
+
+    def compiling(a):
+        raise RuntimeError("numba: lowering failed: KeyboardInterrupt")
+
+    monkeypatch.setitem(cli_pkg.COMMANDS, "threshold", compiling)
+    monkeypatch.setattr(_entry, "_interrupted", True)
+    assert main(["threshold"]) == 130
+    assert capsys.readouterr().err == "parapend threshold: interrupted\n"
+    monkeypatch.setattr(_entry, "_interrupted", False)  # no interrupt: the error is a bug
+    with pytest.raises(RuntimeError, match="lowering"):
+        main(["threshold"])

@@ -23,6 +23,11 @@ def _on_sigint(signum, frame):
     raise KeyboardInterrupt
 
 
+def interrupted() -> bool:
+    """Whether this process has received SIGINT under the console script's handler."""
+    return _interrupted
+
+
 def main(argv=None) -> int:
     """Run ``parapend``; one line and exit code 130 when interrupted at any point."""
     try:

@@ -30,7 +30,7 @@ import json
 import os
 import sys
 
-from .. import __version__
+from .. import __version__, _entry
 from ..errors import ParameterError, SolverError
 from ..results import to_jsonable
 from . import control as _control_cmds
@@ -128,7 +128,14 @@ def main(argv=None) -> int:
         return EXIT_USAGE
     name = f"parapend {a.command}"
     try:
-        out = COMMANDS[a.command](a)
+        try:
+            out = COMMANDS[a.command](a)
+        except Exception:
+            # an interrupt that a library turned into its own error (numba while it compiles,
+            # pybind11 while a module loads) is still an interrupt
+            if _entry.interrupted():
+                raise KeyboardInterrupt from None
+            raise
     except OutputError as exc:  # before ParameterError, of which it is a subclass
         _err(f"{name}: error: {exc}")
         return EXIT_FAILURE
