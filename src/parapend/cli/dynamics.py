@@ -14,6 +14,7 @@ from .. import limits
 from ..commands import basins_json  # noqa: F401  (its former home)
 from ..defaults import DYNAMICS
 from . import _output
+from . import pto as _pto
 from ._common import (
     FIGURE_SUFFIXES,
     _check_output,
@@ -103,14 +104,7 @@ def add_parsers(sub) -> None:
                         "(default 200)")
     p.add_argument("--points-per-period", type=_int, default=64,
                    help="output samples per forcing period, 2 to 1024 (default 64)")
-    u = p.add_argument_group("physical units (docs/units.md): time in s, energy in J")
-    u.add_argument("--length", type=_finite_float("length"), default=None,
-                   help="pivot to centre of mass, m")
-    u.add_argument("--mass", type=_finite_float("mass"), default=None, help="kg")
-    u.add_argument("--inertia", type=_finite_float("inertia"), default=None,
-                   help="moment of inertia about the pivot, kg m^2 (default m l^2)")
-    u.add_argument("--gravity", type=_finite_float("gravity"), default=None,
-                   help="m/s^2 (default 9.81)")
+    _pto.add_unit_options(p, damping=False, excitation=False, adds="time in s, energy in J")
     p.add_argument("--plot", metavar="PNG",
                    help="draw the time history and phase portrait (PNG, SVG or PDF)")
     p.add_argument("--save", metavar="CSV", help="write the time series: t,phi,dphi,energy")

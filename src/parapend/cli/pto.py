@@ -39,12 +39,13 @@ def add_pto_options(p, torque_limit: bool = True) -> None:
 
 
 def add_unit_options(p, damping: bool = True, torque: bool = False,
-                     excitation: bool = True) -> None:
+                     excitation: bool = True,
+                     adds: str = "output adds W, N m, J") -> None:
     """Physical pendulum: ``--length --mass --gravity --frequency --amplitude ...``
     (``--damping-coefficient`` where the command takes a damping, ``--torque-limit-nm``
     with ``torque``, for commands that have no other take-off options; ``--frequency`` and
     ``--amplitude`` only with ``excitation``: a design map's axes stay non-dimensional)."""
-    g = p.add_argument_group("physical units (docs/units.md); output adds W, N m, J")
+    g = p.add_argument_group(f"physical units (docs/units.md); {adds}")
     g.add_argument("--length", type=_finite_float("length"), default=None,
                    help="pivot to centre of mass, m")
     g.add_argument("--mass", type=_finite_float("mass"), default=None, help="kg")
