@@ -100,6 +100,19 @@ def test_dataset_round_trip_and_convention(tmp_path, how):
     assert back.water_depth == math.inf
 
 
+def test_dataset_indexed_by_period(tmp_path):
+    from capytaine.io.xarray import save_dataset_as_netcdf
+
+    h = synthetic(n=12)
+    ds = h.to_dataset()
+    ds = ds.assign_coords(period=("omega", 2 * np.pi / ds["omega"].values))
+    ds = ds.swap_dims(omega="period").drop_vars("omega")
+    save_dataset_as_netcdf(tmp_path / "p.nc", ds)
+    back = hy.load(tmp_path / "p.nc")
+    assert np.allclose(back.omega, h.omega, rtol=1e-14)
+    assert np.allclose(back.excitation, h.excitation, rtol=1e-14)
+
+
 def _write(ds, path):
     from capytaine.io.xarray import save_dataset_as_netcdf
 
@@ -225,9 +238,11 @@ def test_cylinder_haskind_and_resonance(cyl):
     a, b, f = cyl.coefficients(w)
     # Haskind (deep water, axisymmetric body): B = w^3 |F|^2 / (2 rho g^3), an independent
     # relation between the radiation and the diffraction solutions
+    # (to 2 % of the peak: without a lid, the irregular frequencies of the interior problem,
+    # from about 5.6 rad/s here, disturb the small high-frequency values)
     sel = b > 1e-2 * b.max()
     hask = w[sel] ** 3 * np.abs(f[sel]) ** 2 / (2 * RHO * G**3)
-    assert np.allclose(hask, b[sel], rtol=0.03)
+    assert np.allclose(hask, b[sel], rtol=0.02, atol=0.02 * b.max())
     # the +iwt convention: long waves lift the body in phase, F -> C, and Im F ~ w B > 0
     assert f[0].real == pytest.approx(cyl.hydrostatic_stiffness, rel=0.02)
     assert np.all(f[sel].imag > 0)
@@ -246,11 +261,14 @@ def test_cylinder_haskind_and_resonance(cyl):
 
 
 @pytest.mark.slow
-def test_cylinder_mesh_refinement(cyl):
-    fine = hy.cylinder(R, D, refine=1.5)
-    w = cyl.omega[cyl.omega < 6.0]
-    a1, b1, f1 = cyl.coefficients(w)
+def test_cylinder_mesh_refinement():
+    # the automatic panel for w up to 6 rad/s against one 1.5 times finer
+    w = np.linspace(0.5, 6.0, 8)
+    coarse = hy.cylinder(R, D, omega=w)
+    fine = hy.cylinder(R, D, omega=w, refine=1.5)
+    a1, b1, f1 = coarse.coefficients(w)
     a2, b2, f2 = fine.coefficients(w)
+    # measured: 0.25 % (A), 0.4 % (B) of the peak; the next refinement changes less
     assert np.max(np.abs(a1 - a2)) < 0.01 * np.max(a2)
     assert np.max(np.abs(b1 - b2)) < 0.01 * np.max(b2)
     assert np.max(np.abs(f1 - f2)) < 0.01 * np.max(np.abs(f2))
@@ -285,9 +303,38 @@ def test_from_mesh_matches_cylinder(tmp_path):
     h = hy.mesh_size(0.5, 6.0)
     mesh = cpt.mesh_vertical_cylinder(length=1.0, radius=0.5, center=(0, 0, 0),
                                       faces_max_radius=h)
-    w = np.linspace(0.5, 6.0, 6)
+    w = np.array([1.0, 3.0, 6.0])
     from_file = hy.from_mesh(_gdf(tmp_path / "cyl.gdf", mesh), omega=w)
     ref = hy.cylinder(0.5, 0.5, omega=w)
     assert from_file.hydrostatic_stiffness == pytest.approx(ref.hydrostatic_stiffness, rel=1e-6)
     assert np.allclose(from_file.added_mass, ref.added_mass, rtol=1e-3)
     assert np.allclose(from_file.excitation, ref.excitation, rtol=1e-3)
+
+
+@pytest.mark.slow
+def test_load_a_dataset_capytaine_wrote(tmp_path):
+    # a dataset as a user's own BEM run gives it: several dofs and directions, hydrostatics
+    # from Capytaine, omega = inf included (ignored), saved the standard way
+    import capytaine as cpt
+    from capytaine.io.xarray import save_dataset_as_netcdf
+
+    mesh = cpt.mesh_vertical_cylinder(length=1.0, radius=0.5, center=(0, 0, 0),
+                                      resolution=(3, 12, 4)).immersed_part()
+    body = cpt.FloatingBody(mesh=mesh, dofs=cpt.rigid_body_dofs(), center_of_mass=(0, 0, -0.2))
+    body.inertia_matrix = body.compute_rigid_body_inertia(rho=RHO)
+    body.hydrostatic_stiffness = body.compute_hydrostatic_stiffness(rho=RHO, g=G)
+    test = xr.Dataset(coords={"omega": [1.0, 2.0, 3.0, np.inf], "wave_direction": [0.0, 1.0],
+                              "radiating_dof": list(body.dofs), "water_depth": [np.inf],
+                              "rho": [RHO], "g": [G]})
+    ds = cpt.BEMSolver().fill_dataset(test, body, progress_bar=False)
+    save_dataset_as_netcdf(tmp_path / "user.nc", ds)
+    h = hy.load(tmp_path / "user.nc")
+    assert np.array_equal(h.omega, [1.0, 2.0, 3.0])
+    heave = ds.sel(radiating_dof="Heave", influenced_dof="Heave", omega=[1.0, 2.0, 3.0])
+    assert np.allclose(h.added_mass, heave["added_mass"].values)
+    f = ds["excitation_force"].sel(influenced_dof="Heave", wave_direction=0.0,
+                                   omega=[1.0, 2.0, 3.0]).values
+    assert np.allclose(h.excitation, np.conj(f))
+    assert h.mass == pytest.approx(RHO * float(body.disp_volume), rel=1e-6)
+    assert h.hydrostatic_stiffness == pytest.approx(
+        float(body.hydrostatic_stiffness.sel(influenced_dof="Heave", radiating_dof="Heave")))
