@@ -115,3 +115,23 @@ def test_bad_input():
         td.simulate(HYDRO, mass=-1.0, length=1.0, inertia=5.0, t_end=1.0)
     with pytest.raises(ParameterError, match="mass"):
         td.simulate(HYDRO, mass=1e6, length=0.0, inertia=5.0, t_end=1.0)
+
+
+def test_spinning_flywheel_drives_the_heave_as_the_harmonic_balance_says():
+    # A pendulum of huge inertia spins at a constant rate W: cos(theta) = Re(exp(i W t)), so
+    # Chat_1 = 1 and the interface's per-harmonic heave equation gives
+    # D(W) Z = m l W^2 Chat_1 (no wave). The simulation knows nothing of that formula.
+    m, ell, spin = 50.0, 0.5, 2.6
+    d = complex(HYDRO.impedance(spin))
+    z = m * ell * spin**2 / d
+    hist = lambda t: np.real(1j * spin * z * np.exp(1j * spin * t))  # noqa: E731
+    dt = 2 * math.pi / spin / 200
+    r = td.simulate(HYDRO, mass=m, length=ell, inertia=1e9, t_end=4 * 2 * math.pi / spin,
+                    omega0=spin, z0=z.real, zdot0=(1j * spin * z).real, history=hist, dt=dt,
+                    match_omega=spin, memory=15.0)
+    assert np.ptp(r["omega"]) < 1e-6 * spin  # the flywheel's rate stays put
+    n = round(2 * math.pi / spin / r["dt"])
+    zf = 2 * np.mean(r["z"][-n:] * np.exp(-1j * spin * r["t"][-n:]))
+    model = td.model_impedance(HYDRO, spin, dt=r["dt"], memory=r["memory"], match_omega=spin)
+    tol = abs(d / complex(model) - 1) + 2e-3
+    assert abs(zf / z - 1) < tol
