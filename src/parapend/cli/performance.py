@@ -9,7 +9,7 @@ import sys
 from ..defaults import SEA
 from . import _output
 from ._common import FIGURE_SUFFIXES, _check_output, _finite_float, _int, _run
-from .sweep import _EtaProgress
+from .sweep import _NEGATIVE_VALUE, _EtaProgress
 
 _BINS = "FROM:TO:N (N centres, ends included) or a comma list"
 
@@ -27,6 +27,7 @@ def add_parsers(sub) -> None:
                     "rotation), the wave energy flux and capture width of each bin, and the "
                     "mean annual energy at a site (IEC TS 62600-100; MHKiT's layout). "
                     "Resumable with --store.")
+    p._negative_number_matcher = _NEGATIVE_VALUE
     g = p.add_argument_group("bins (bin centres: " + _BINS + ")")
     g.add_argument("--hs", default="1:3:3", help="significant wave height Hm0, m (default "
                                                  "1:3:3)")

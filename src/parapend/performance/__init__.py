@@ -146,8 +146,10 @@ def _stats(x: np.ndarray, ok: np.ndarray) -> dict:
     """Statistics over the last axis of ``x`` where ``ok``; NaN where nothing is."""
     v = np.where(ok, x, np.nan)
     n = ok.sum(axis=-1)
-    with np.errstate(invalid="ignore"), np.testing.suppress_warnings() as sup:
-        sup.filter(RuntimeWarning)
+    import warnings
+
+    with np.errstate(invalid="ignore"), warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)  # all-NaN bins: NaN, count 0
         out = {"mean": np.nanmean(v, axis=-1), "std": np.nanstd(v, axis=-1),
                "min": np.nanmin(v, axis=-1), "max": np.nanmax(v, axis=-1)}
     out = {k: np.where(n > 0, a, np.nan) for k, a in out.items()}

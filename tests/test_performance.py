@@ -1,0 +1,289 @@
+"""Power matrix, wave resource and annual energy (docs/performance.md).
+
+Independent sources: MHKiT's ``wave.performance`` and ``wave.resource`` on the same inputs
+(1e-10 relative), closed forms (the Pierson-Moskowitz Te/Tp, deep-water J from m_-1), a
+hand-made 3 x 3 annual energy written out in the docs, and ``sea`` run by hand on the
+seeds of a bin.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import signal
+import subprocess
+import sys
+import time
+import warnings
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import parapend
+from parapend.cli import main
+from parapend.performance import bin_edges, power_matrix
+from parapend.performance.annual import (
+    HOURS_PER_YEAR,
+    annual_energy,
+    bin_series,
+    read_scatter,
+)
+from parapend.performance.resource import (
+    energy_flux,
+    record_spectrum,
+    te_over_tp,
+    wave_number,
+)
+
+SRC = str(Path(parapend.__file__).resolve().parents[1])
+TINY = {"hs": "1,2", "te": "6,7", "realizations": 2, "waves": 4, "workers": 1}
+
+
+@pytest.fixture(scope="module")
+def tiny(tmp_path_factory):
+    store = tmp_path_factory.mktemp("pm") / "tiny.zarr"
+    ds, annual, run, _ = power_matrix(**TINY, store=str(store))
+    return ds, store
+
+
+def _rel(a, b):
+    a, b = np.asarray(a, float), np.asarray(b, float)
+    return float(np.max(np.abs(a - b) / np.maximum(np.abs(b), 1e-300)))
+
+
+# -- the resource -------------------------------------------------------------------------
+
+def test_te_over_tp_closed_form_and_ittc():
+    pm = math.gamma(1.25) * 1.25 ** -0.25
+    assert te_over_tp("pierson-moskowitz") == pytest.approx(0.857222537, abs=1e-9)
+    # JONSWAP at gamma_p = 1 is Pierson-Moskowitz: the quadrature against the closed form
+    assert te_over_tp("jonswap", 1.0) == pytest.approx(pm, rel=1e-9)
+    # the ITTC fit MHKiT uses (energy_period_to_peak_period), within its stated accuracy
+    for g in (2.0, 3.3, 7.0):
+        ittc = 0.8255 + 0.03852 * g - 0.005537 * g**2 + 0.0003154 * g**3
+        assert te_over_tp("jonswap", g) == pytest.approx(ittc, rel=5e-3)
+
+
+def test_energy_flux_deep_closed_form_and_mhkit():
+    pd = pytest.importorskip("pandas")
+    resource = pytest.importorskip("mhkit.wave.resource")
+    f, s = record_spectrum(2.0, 8.0, 400.0)
+    rho, g = 1025.0, 9.81
+    j = energy_flux(f, s, density=rho, gravity=g)
+    m_1 = np.sum(s / f) / 400.0
+    assert j == pytest.approx(rho * g**2 * m_1 / (4 * math.pi), rel=1e-13)
+    spec = pd.Series(s, index=pd.Index(f, name="Frequency"))
+    assert _rel(j, resource.energy_flux(spec, 100.0, deep=True, rho=rho, g=g)) < 1e-10
+    for depth in (5.0, 20.0, 60.0, 500.0):
+        mine = energy_flux(f, s, depth=depth, density=rho, gravity=g)
+        theirs = float(resource.energy_flux(spec, depth, deep=False, rho=rho, g=g))
+        assert _rel(mine, theirs) < 1e-10, depth
+    # shallow water carries less flux than deep at these periods' group velocity peak? no:
+    # the limit of great depth is the deep-water flux
+    assert energy_flux(f, s, depth=5000.0, density=rho, gravity=g) == pytest.approx(j,
+                                                                                   rel=1e-9)
+
+
+def test_wave_number_solves_the_dispersion_relation():
+    f = np.linspace(0.02, 1.0, 50)
+    for h in (1.0, 10.0, 1000.0):
+        k = wave_number(f, h, 9.81)
+        w2 = (2 * math.pi * f) ** 2
+        assert np.max(np.abs(9.81 * k * np.tanh(k * h) - w2) / w2) < 1e-14
+
+
+def test_bin_edges_are_mhkits():
+    perf = pytest.importorskip("mhkit.wave.performance")
+    xr = pytest.importorskip("xarray")
+    c = np.array([0.5, 1.0, 1.5, 2.5])
+    e = bin_edges(c)
+    assert e.tolist() == [0.0, 0.75, 1.25, 2.0, 3.0]
+    # MHKiT's counts of a series binned on these centres = ours
+    rng = np.random.default_rng(3)
+    hs = rng.uniform(0.0, 3.2, 400)
+    te = rng.uniform(0.0, 9.5, 400)
+    tc = np.array([4.0, 6.0, 8.0])
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        theirs = perf.capture_width_matrix(xr.DataArray(hs), xr.DataArray(te),
+                                           xr.DataArray(np.ones(400)), "count", c, tc,
+                                           to_pandas=False).values
+    mine, outside = bin_series(hs, te, e, bin_edges(tc))
+    assert np.array_equal(np.nan_to_num(theirs), mine)
+    assert outside == 400 - int(mine.sum())
+
+
+# -- MHKiT on the same matrix -------------------------------------------------------------
+
+def test_matrix_equals_mhkit(tiny):
+    xr = pytest.importorskip("xarray")
+    perf = pytest.importorskip("mhkit.wave.performance")
+    resource = pytest.importorskip("mhkit.wave.resource")
+    pd = pytest.importorskip("pandas")
+    ds, _ = tiny
+    hm0, te = ds["hm0"].values, ds["te"].values
+    j = ds["wave_energy_flux_matrix"].values
+    p = ds["power"].values  # (hm0, te, realization)
+    # one "sea state" per realization, as MHKiT's series
+    ii, kk, rr = np.meshgrid(range(hm0.size), range(te.size), range(p.shape[2]),
+                             indexing="ij")
+    h_s = xr.DataArray(hm0[ii].ravel())
+    t_s = xr.DataArray(te[kk].ravel())
+    j_s = xr.DataArray(j[ii, kk].ravel())
+    cw = xr.DataArray(p.ravel() / j[ii, kk].ravel())
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")  # MHKiT warns of bins wider than IEC's 0.5 m, 1 s
+        cwm = {s: perf.capture_width_matrix(h_s, t_s, cw, s, hm0, te, to_pandas=False)
+               for s in ("mean", "std", "min", "max", "count")}
+        old = perf.capture_length_maxtrix(h_s, t_s, cw, "mean", hm0, te, to_pandas=False)
+        jm = perf.wave_energy_flux_matrix(h_s, t_s, j_s, "mean", hm0, te, to_pandas=False)
+        pm = perf.power_matrix(cwm["mean"], jm)
+        cw1 = perf.capture_width(xr.DataArray(p[0, 0]), xr.DataArray(j[0, 0]),
+                                 to_pandas=False)
+    assert _rel(ds["capture_width_matrix"], cwm["mean"]) < 1e-10
+    assert _rel(ds["capture_width_matrix"], old) < 1e-10
+    for s in ("std", "min", "max"):
+        assert _rel(ds[f"capture_width_{s}"], cwm[s]) < 1e-10 or np.allclose(
+            ds[f"capture_width_{s}"], cwm[s], rtol=1e-10, atol=1e-10 * float(
+                ds["capture_width_matrix"].max())), s
+    assert np.array_equal(ds["power_count"].values, cwm["count"].values)
+    assert _rel(ds["wave_energy_flux_matrix"], jm) < 1e-10
+    assert _rel(ds["power_matrix"], pm) < 1e-10
+    assert _rel(ds["power_mean"], pm) < 1e-10
+    assert _rel(cw1 * j[0, 0], p[0, 0]) < 1e-13
+    # the annual energy of a site (a frequency matrix summing to 1)
+    freq = np.array([[0.1, 0.2], [0.3, 0.4]])
+    ours = annual_energy(ds["power_mean"].values, freq)["wh"]
+    theirs = perf.mean_annual_energy_production_matrix(
+        parapend.performance.to_mhkit(ds["capture_width_matrix"]),
+        parapend.performance.to_mhkit(ds["wave_energy_flux_matrix"]),
+        xr.DataArray(freq, dims=("x_centers", "y_centers")))
+    assert _rel(ours, theirs) < 1e-10
+    # J of each bin: MHKiT's energy_flux of the bin's record spectrum
+    ratio = ds.attrs["te_over_tp"]
+    for a, h in enumerate(hm0):
+        for b, t in enumerate(te):
+            tp = t / ratio
+            f, s = record_spectrum(h, tp, 4 * tp)
+            spec = pd.Series(s, index=pd.Index(f, name="Frequency"))
+            ref = float(resource.energy_flux(spec, 100.0, deep=True, rho=1025.0, g=9.81))
+            assert _rel(j[a, b], ref) < 1e-10
+
+
+def test_std_is_ddof0_and_dims_follow_mhkit(tiny):
+    ds, _ = tiny
+    p = ds["power"].values
+    assert np.allclose(ds["power_std"].values, p.std(axis=-1, ddof=0), rtol=0, atol=1e-15)
+    assert ds["power_matrix"].dims == ("hm0", "te")
+    assert ds["hm0_edges"].values.tolist() == [0.0, 1.5, 2.5]
+    assert ds["te_edges"].values.tolist() == [0.0, 6.5, 7.5]
+
+
+def test_each_bin_mean_is_sea_by_hand(tiny):
+    ds, _ = tiny
+    ratio = te_over_tp("jonswap", 3.3)
+    for a, b in ((0, 1), (1, 0)):
+        hs, te = float(ds["hm0"][a]), float(ds["te"][b])
+        tp = te / ratio
+        runs = [parapend.sea(hs=hs, tp=tp, repeat_period=4 * tp, seed=r) for r in (0, 1)]
+        got = [r.power_w for r in runs]
+        assert ds["power_mean"].values[a, b] == pytest.approx(np.mean(got), rel=1e-12)
+        assert ds["power_min"].values[a, b] == pytest.approx(min(got), rel=1e-12)
+        lim = [r.limit_power_w for r in runs]
+        assert ds["limit_power_mean"].values[a, b] == pytest.approx(np.mean(lim), rel=1e-12)
+        # no motion beats the limit
+        assert np.all(ds["power"].values <= ds["limit_power"].values)
+
+
+# -- the annual energy --------------------------------------------------------------------
+
+#: the hand-made 3 x 3 example of docs/performance.md
+HAND_P = np.array([[1.0, 2.0, 3.0], [4.0, 5.0, 6.0], [7.0, 8.0, 9.0]])
+HAND_F = np.array([[0.1, 0.1, 0.0], [0.2, 0.2, 0.1], [0.0, 0.2, 0.1]])
+
+
+def test_hand_made_annual_energy(tmp_path):
+    # 0.1 + 0.2 + 0.8 + 1.0 + 0.6 + 1.6 + 0.9 = 5.2 W on average; x 8766 h = 45583.2 Wh
+    a = annual_energy(HAND_P, HAND_F)
+    assert a["wh"] == pytest.approx(45583.2, rel=1e-14)
+    assert a["mwh"] == pytest.approx(0.0455832, rel=1e-14)
+    assert a["mean_power_w"] == pytest.approx(5.2, rel=1e-14)
+    # the same through a scatter CSV, in frequencies and in hours
+    hs, te = (1.0, 2.0, 3.0), (6.0, 7.0, 8.0)
+    lines = ["hs,te,frequency"] + [f"{hs[i]},{te[k]},{HAND_F[i, k]}" for i in range(3)
+                                   for k in range(3) if HAND_F[i, k] > 0]
+    (tmp_path / "s.csv").write_text("\n".join(lines) + "\n")
+    assert np.allclose(read_scatter(tmp_path / "s.csv", hs, te, "te"), HAND_F, atol=0)
+    hours = ["hs,te,count"] + [f"{hs[i]},{te[k]},{HAND_F[i, k] * 8766}" for i in range(3)
+                               for k in range(3)]
+    (tmp_path / "h.csv").write_text("\n".join(hours) + "\n")
+    assert np.allclose(read_scatter(tmp_path / "h.csv", hs, te, "te"), HAND_F, rtol=1e-14,
+                       atol=1e-17)
+    # a bin of the site without power is listed, and left out of the sum
+    p = HAND_P.copy()
+    p[2, 1] = np.nan
+    b = annual_energy(p, HAND_F)
+    assert b["missing"] == [[2, 1]] and not b["complete"]
+    assert b["wh"] == pytest.approx((5.2 - 1.6) * HOURS_PER_YEAR, rel=1e-14)
+    assert b["missing_frequency"] == pytest.approx(0.2)
+
+
+def test_site_through_the_command(tiny, tmp_path, capsys):
+    ds, _ = tiny
+    (tmp_path / "s.csv").write_text("hs,te,frequency\n1,6,0.5\n2,7,0.5\n")
+    (tmp_path / "t.csv").write_text("hs,te\n1.2,6.1\n2.1,6.9\n9,6\n1.4,5.9\n")
+    # the fixture's store: the command resumes it (nothing to compute)
+    argv = ["power-matrix", "--hs", "1,2", "--te", "6,7", "--realizations", "2", "--waves",
+            "4", "--workers", "1", "--json", "--store", str(tiny[1])]
+    import json
+
+    assert main(argv + ["--scatter", str(tmp_path / "s.csv"), "--rated-power", "10"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert out["computed_bins"] == 0 and out["resumed_bins"] == 4
+    want = 8766 * (0.5 * ds["power_mean"].values[0, 0] + 0.5 * ds["power_mean"].values[1, 1])
+    assert out["annual_energy"]["power"]["wh"] == pytest.approx(want, rel=1e-12)
+    assert out["capacity_factor"] == pytest.approx(want / 8766 / 10, rel=1e-12)
+    assert main(argv + ["--timeseries", str(tmp_path / "t.csv")]) == 0
+    out = json.loads(capsys.readouterr().out)
+    a = out["annual_energy"]["power"]
+    assert a["outside_frequency"] == {"sea_states": 1, "frequency": 0.25}
+    want = 8766 * (0.5 * ds["power_mean"].values[0, 0] + 0.25 * ds["power_mean"].values[1, 1])
+    assert a["wh"] == pytest.approx(want, rel=1e-12)
+
+
+_SCATTER = {"SUM": "hs,te,frequency\n1,6,0.5\n2,7,0.4\n",
+            "EDGES": "hs,te,frequency\n1.25,6,0.5\n2,7,0.5\n",
+            "TP": "hs,tp,frequency\n1,6,1\n",
+            "NEG": "hs,te,frequency\n-1,6,0.5\n2,7,0.5\n",
+            "EMPTY": "hs,te,frequency\n"}
+
+
+@pytest.mark.parametrize("extra, needle", [
+    (["--hs", "1:2:0"], "hs: expected at least 2 bins"),
+    (["--hs", "1"], "hs: expected at least 2 bin centres"),
+    (["--hs", "-1,2"], "hs: expected positive"),
+    (["--te", "7,6"], "te: expected increasing"),
+    (["--tp", "7,8"], "te, tp:"),
+    (["--torque-limit", "2"], "torque-limit: not supported"),
+    (["--horizon", "10"], "horizon: the causal controller is not available"),
+    (["--waves", "1"], "waves:"),
+    (["--rated-power", "5"], "rated-power: the capacity factor needs a site"),
+    (["--scatter", "SUM"], "scatter: expected frequencies summing to 1"),
+    (["--scatter", "EDGES"], "scatter: hs = 1.25 is not a bin centre"),
+    (["--scatter", "TP"], "scatter: its periods are tp"),
+    (["--scatter", "NEG"], "scatter: expected positive heights"),
+    (["--scatter", "EMPTY"], "scatter: expected at least one bin"),
+])
+def test_bad_input_one_line_exit_2(extra, needle, tmp_path, capsys):
+    if extra[0] == "--scatter":
+        (tmp_path / "s.csv").write_text(_SCATTER[extra[1]])
+        extra = ["--scatter", str(tmp_path / "s.csv")]
+    opts = {"--hs": "1,2", "--te": "6,7", "--realizations": "1", "--waves": "3",
+            "--workers": "1"}
+    opts.update(zip(extra[::2], extra[1::2]))
+    code = main(["power-matrix", *(x for kv in opts.items() for x in kv)])
+    err = capsys.readouterr().err
+    assert code == 2
+    assert len(err.strip().splitlines()) == 1, err
+    assert needle in err, err
