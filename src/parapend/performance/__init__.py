@@ -161,8 +161,6 @@ def matrix_dataset(raw, spec: MatrixSpec, *, depth=None, density: float = 1025.0
                    width=None, frequency=None, outside=None, rated_power=None):
     """The full Dataset from the engine's per-realization Dataset ``raw``: statistics,
     resource, capture width, and with ``frequency`` the annual energy."""
-    import xarray as xr
-
     from ..maps.spec import _CODE
     from .annual import annual_energy, capacity_factor
 
