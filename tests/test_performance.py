@@ -250,6 +250,14 @@ def test_site_through_the_command(tiny, tmp_path, capsys):
     assert a["outside_frequency"] == {"sea_states": 1, "frequency": 0.25}
     want = 8766 * (0.5 * ds["power_mean"].values[0, 0] + 0.25 * ds["power_mean"].values[1, 1])
     assert a["wh"] == pytest.approx(want, rel=1e-12)
+    # the text report and the three figures
+    plot = tmp_path / "pm"
+    assert main([x for x in argv if x != "--json"]
+                + ["--scatter", str(tmp_path / "s.csv"), "--plot", str(plot)]) == 0
+    text = capsys.readouterr().out
+    assert "mean annual energy (8766 h/yr): optimum" in text
+    for name in ("matrix", "capture-width", "scatter"):
+        assert (tmp_path / f"pm-{name}.png").stat().st_size > 1000
 
 
 _SCATTER = {"SUM": "hs,te,frequency\n1,6,0.5\n2,7,0.4\n",
@@ -378,3 +386,26 @@ def test_kill_9_then_resume_equals_uninterrupted(tmp_path):
     _, _, run, _ = power_matrix(**grid, workers=2, store=str(store), command="test")
     assert 0 < run.computed_points < 12 and run.resumed_points >= 4, time.monotonic() - t
     assert _files(store) == _files(ref)
+
+
+def test_outputs_read_back(tiny, tmp_path):
+    import xarray as xr
+
+    ds, store = tiny
+    nc, zr, csv = tmp_path / "m.nc", tmp_path / "m.zarr", tmp_path / "m.csv"
+    out, _, run, _ = power_matrix(**TINY, store=str(store), netcdf=str(nc), zarr=str(zr),
+                                  csv=str(csv), width=0.5)
+    assert run.computed_points == 0  # resumed: nothing computed
+    back = xr.open_dataset(nc)
+    assert np.array_equal(back["power_matrix"].values, ds["power_matrix"].values)
+    back.close()
+    z = xr.open_zarr(zr, consolidated=False).load()
+    assert np.array_equal(z["capture_width_matrix"].values, ds["capture_width_matrix"].values)
+    rows = csv.read_text().splitlines()
+    head = rows[0].split(",")
+    assert len(rows) == 1 + 4 and head[:3] == ["hm0", "te", "tp"]
+    row = dict(zip(head, rows[2].split(",")))  # hm0 = 1, te = 7
+    assert float(row["power_mean"]) == ds["power_mean"].values[0, 1]
+    assert float(row["capture_width_ratio_matrix"]) == pytest.approx(
+        ds["capture_width_matrix"].values[0, 1] / 0.5, rel=1e-15)
+    assert int(row["power_count"]) == 2
