@@ -95,8 +95,9 @@ def matrix_spec(*, hs="1:3:3", te=None, tp=None, realizations: int = 3, waves: f
         raise ParameterError("te, tp: give the period bins as one of --te or --tp")
     kind, per = ("tp", tp) if tp is not None else ("te", "6:10:3" if te is None else te)
     period = parse_bins(kind, per)
-    ratio = te_over_tp(spectrum if spectrum in ("jonswap", "pierson-moskowitz") else "jonswap",
-                       gamma_peak if spectrum == "jonswap" else 3.3)
+    # the spectrum's options first (a valid sea state stands in for the bins, checked below)
+    _, _, gamma_peak, _, cutoff = _check_sea(1.0, 8.0, spectrum, gamma_peak, None, cutoff)
+    ratio = te_over_tp(spectrum, gamma_peak)
     tps = tuple(p / ratio for p in period) if kind == "te" else period
     realizations = check_int("realizations", realizations, 1, 1000)
     waves = check_range("waves", waves, *limits.SEA_WAVES_RANGE,
@@ -112,8 +113,6 @@ def matrix_spec(*, hs="1:3:3", te=None, tp=None, realizations: int = 3, waves: f
                                  f"{limits.SEA_TP_RANGE[0]:g} to {limits.SEA_TP_RANGE[1]:g} s, "
                                  f"got {t:g} s" + (f" (Te {t * ratio:g} s)" if kind == "te"
                                                    else ""))
-    _, _, gamma_peak, _, cutoff = _check_sea(hm0[0], tps[0], spectrum, gamma_peak, None,
-                                             cutoff)
     units = Units(length, mass, gravity, inertia)
     if gamma is not None and damping_coefficient is not None:
         raise ParameterError("gamma: give either gamma or damping-coefficient, not both")
