@@ -112,6 +112,10 @@ def plot_capture_width(ds, path=None):
             ax.fill_between(x, ds["capture_width_min"].values[i],
                             ds["capture_width_max"].values[i], color=line.get_color(),
                             alpha=0.15, lw=0)
+        cw = ds["capture_width_matrix"].values
+        cw = cw[np.isfinite(cw)]
+        if cw.size and cw.min() > 0 and cw.max() > 20 * cw.min():
+            ax.set_yscale("log")  # two decades and more: every line readable
         ax.set_xlabel(_label(pk))
         ax.set_ylabel("capture width $P/J$ (m)")
         ax.set_title("capture width of the mean optimum (shaded: min to max over the "
