@@ -171,6 +171,36 @@ def test_matrix_equals_mhkit(tiny):
             assert _rel(j[a, b], ref) < 1e-10
 
 
+def test_statistics_and_timeseries_energy_equal_mhkit(tiny):
+    xr = pytest.importorskip("xarray")
+    perf = pytest.importorskip("mhkit.wave.performance")
+    ds, _ = tiny
+    for a, b in ((0, 0), (1, 1)):
+        st = perf.statistics(xr.DataArray(ds["power"].values[a, b]), to_pandas=False)
+        for s in ("mean", "std", "min", "max"):
+            assert _rel(ds[f"power_{s}"].values[a, b], float(st.sel(index=s))) < 1e-10, s
+        assert int(st.sel(index="count")) == ds["power_count"].values[a, b]
+    # a time series of sea states: MHKiT's mean_annual_energy_production_timeseries with each
+    # state's bin (capture width, flux) equals the AEP of the binned frequencies
+    hs = np.array([1.1, 1.9, 2.2, 0.9, 1.3, 2.4, 6.0])
+    te = np.array([6.2, 6.8, 7.1, 5.5, 6.9, 6.1, 6.0])
+    counts, outside = bin_series(hs, te, ds["hm0_edges"].values, ds["te_edges"].values)
+    assert outside == 1  # Hs = 6 m lies above the last edge (2.5 m)
+    ours = annual_energy(ds["power_mean"].values, counts / hs.size)["wh"]
+    i = np.searchsorted(ds["hm0_edges"].values, hs[:-1], side="right") - 1
+    k = np.searchsorted(ds["te_edges"].values, te[:-1], side="right") - 1
+    cw = np.append(ds["capture_width_matrix"].values[i, k], 0.0)  # outside: nothing
+    j = np.append(ds["wave_energy_flux_matrix"].values[i, k], 0.0)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        theirs = perf.mean_annual_energy_production_timeseries(xr.DataArray(cw),
+                                                               xr.DataArray(j))
+        old = perf.capture_length(xr.DataArray(ds["power"].values[0, 0]),
+                                  xr.DataArray(j[0]), to_pandas=False)
+    assert _rel(ours, theirs) < 1e-10
+    assert old.size == ds.sizes["realization"]
+
+
 def test_std_is_ddof0_and_dims_follow_mhkit(tiny):
     ds, _ = tiny
     p = ds["power"].values
