@@ -443,3 +443,10 @@ def test_outputs_read_back(tiny, tmp_path):
     assert float(row["capture_width_ratio_matrix"]) == pytest.approx(
         ds["capture_width_matrix"].values[0, 1] / 0.5, rel=1e-15)
     assert int(row["power_count"]) == 2
+
+
+def test_map_refuses_a_power_matrix_store(tiny, capsys):
+    _, store = tiny
+    assert main(["map", "--store", str(store), "--plot", "x.png"]) == 2
+    err = capsys.readouterr().err
+    assert "holds a power matrix" in err and len(err.strip().splitlines()) == 1
