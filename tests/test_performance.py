@@ -443,6 +443,11 @@ def test_outputs_read_back(tiny, tmp_path):
     assert float(row["capture_width_ratio_matrix"]) == pytest.approx(
         ds["capture_width_matrix"].values[0, 1] / 0.5, rel=1e-15)
     assert int(row["power_count"]) == 2
+    # an export is replaced; the store (or any other directory) never is
+    power_matrix(**TINY, store=str(store), zarr=str(zr))
+    with pytest.raises(parapend.ParameterError, match="not an export of a power matrix"):
+        power_matrix(**TINY, store=str(store), zarr=str(store))
+    assert (store / "power").is_dir()
 
 
 def test_map_refuses_a_power_matrix_store(tiny, capsys):

@@ -296,8 +296,13 @@ def power_matrix(*, hs="1:3:3", te=None, tp=None, realizations: int = 3, waves: 
     return ds, annual, run, seconds
 
 
+#: the root attribute ``export`` of a Dataset written by ``--zarr``
+_EXPORT = "parapend power matrix dataset"
+
+
 def _write_zarr(ds, path) -> None:
     """The full Dataset as a Zarr 3 store written beside, then moved in (atomic rename)."""
+    import json
     import os
     import shutil
     import tempfile
@@ -306,13 +311,22 @@ def _write_zarr(ds, path) -> None:
     from ..errors import OutputError
 
     path = Path(path)
-    if path.exists() and not (path / "zarr.json").exists():
-        raise ParameterError(f"zarr: {str(path)!r} exists and is not a Zarr store; choose "
-                             "another name")
+    if path.exists():
+        # only an earlier export of a power matrix is replaced (never a --store, whose raw
+        # results it would destroy, nor any other directory)
+        try:
+            attrs = json.loads((path / "zarr.json").read_text())["attributes"]
+            ours = attrs.get("export") == _EXPORT
+        except (OSError, ValueError, KeyError, TypeError):
+            ours = False
+        if not ours:
+            raise ParameterError(f"zarr: {str(path)!r} exists and is not an export of a power "
+                                 "matrix (parapend replaces only those); choose another name")
     tmp = Path(tempfile.mkdtemp(prefix=".parapend-", dir=path.parent if str(path.parent)
                                 else "."))
     try:
         out = ds.copy()
+        out.attrs["export"] = _EXPORT
         for v in out.variables.values():
             v.encoding = {}
         out.to_zarr(tmp / "s", mode="w", zarr_format=3, consolidated=False)
