@@ -130,9 +130,12 @@ _STALE_SECONDS = 600
 
 
 def _own_names(spec=None) -> set:
-    """The names a sweep writes at the top of its store (its temporaries aside)."""
-    return {*VARIABLES, "done", *AXES, "zarr.json", *getattr(spec, "names", ()),
-            *getattr(spec, "variables", ())}
+    """The names a sweep (or a power matrix) writes at the top of its store (its
+    temporaries aside): either may replace the other's store with ``--overwrite``."""
+    from ..performance.spec import STORE_NAMES
+
+    return {*VARIABLES, "done", *AXES, "zarr.json", *STORE_NAMES,
+            *getattr(spec, "names", ()), *getattr(spec, "variables", ())}
 
 
 def _short(err: BaseException) -> str:

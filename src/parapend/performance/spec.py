@@ -17,7 +17,7 @@ import math
 
 import numpy as np
 
-__all__ = ["MatrixSpec", "QUANTITIES"]
+__all__ = ["MatrixSpec", "QUANTITIES", "STORE_NAMES"]
 
 log = logging.getLogger(__name__)
 
@@ -30,6 +30,8 @@ QUANTITIES = {
                         "of the given efficiency (generating x eta, motoring / eta)",
 }
 _TITLE = "parapend design map"
+#: every top-level name a power-matrix store holds (coordinates and variables)
+STORE_NAMES = ("hm0", "te", "tp", "realization", "seed", "done", "status", *QUANTITIES)
 #: devices a matrix can be computed for (the coupled buoy joins when it lands)
 DEVICES = ("prescribed-heave",)
 
