@@ -123,6 +123,10 @@ CASES = [
      {"periods": 20, "harmonics": 8, "length": 1.0, "mass": 10.0}, set()),
     (["sea", "--repeat-period", "80", "--harmonics", "32"],
      {"repeat_period": 80.0, "harmonics": 32}, set()),
+    (["power-matrix", "--hs", "1,2", "--te", "6,7", "--realizations", "1", "--waves", "3",
+      "--workers", "1"],
+     {"hs": "1,2", "te": "6,7", "realizations": 1, "waves": 3.0, "workers": 1},
+     {"seconds"}),
 ]
 
 

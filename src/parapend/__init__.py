@@ -30,7 +30,8 @@ __version__ = "0.1.0"
 #: public name -> the module that defines it. One function per command of the command line
 #: (parapend.commands: same name, dashes as underscores, the options as parameters).
 _COMMANDS = ("optimize", "threshold", "damping_sweep", "harmonics", "figure", "reproduce",
-             "pto_curve", "simulate", "basins", "rotations", "track", "sea", "sweep", "map")
+             "pto_curve", "simulate", "basins", "rotations", "track", "sea", "sweep", "map",
+             "power_matrix")
 _EXPORTS = {
     **{name: ".commands" for name in _COMMANDS},
     "EXCITATIONS": ".api", "build_excitation": ".api", "harmonic_table": ".api",

@@ -34,7 +34,8 @@ from .results import Record
 
 __all__ = ["PRESENTATION", "basins", "damping_sweep", "figure", "harmonics", "map",
            "optimize", "pto_curve", "reproduce", "rotations", "sea", "simulate", "sweep",
-           "threshold", "track"]
+           "threshold", "track",
+           "power_matrix"]
 
 #: command-line options that are not parameters of the functions: how to show or where to
 #: write a result (``figure`` and ``map`` keep ``plot``: the figure file is their product)
@@ -678,3 +679,71 @@ def map(*, store: str = "map.zarr", variable: str = "power", x=None, y=None, at=
                    min_si=None if k is None or out["min"] is None else out["min"] * k,
                    max_si=None if k is None or out["max"] is None else out["max"] * k)
     return Record("map", out, dataset=ds, label=label)
+
+
+# --- power-matrix ----------------------------------------------------------------------------
+def power_matrix(*, hs: str = "1:3:3", te=None, tp=None, realizations: int = 3,
+                 waves: float = 50.0, seed: int = 0, spectrum: str = "jonswap",
+                 gamma_peak: float = 3.3, cutoff: float = 3.0, response=None,
+                 device: str = "prescribed-heave", horizon=None,
+                 length: float = SEA["length"], mass: float = SEA["mass"], inertia=None,
+                 gravity: float = SEA["gravity"], gamma=None, damping_coefficient=None,
+                 winding=1, harmonics=None, efficiency=None, torque_limit=None, depth=None,
+                 density: float = 1025.0, width=None, scatter=None, timeseries=None,
+                 rated_power=None, store=None, overwrite: bool = False, workers=None,
+                 scheduler=None, netcdf=None, zarr=None, csv=None, command=None,
+                 progress=None):
+    """Power matrix over sea-state bins, capture width and annual energy (command
+    ``power-matrix``; :func:`parapend.performance.power_matrix`, docs/performance.md).
+    ``te`` default ``"6:10:3"`` when neither ``te`` nor ``tp`` is given. Fields are the JSON
+    keys; ``_dataset`` is the full Dataset (MHKiT's layout), ``_run`` the engine's run."""
+    from .performance import STATISTICS
+    from .performance import power_matrix as _pm
+
+    if scheduler is not None and workers is not None:
+        raise ParameterError("workers: the processes are the cluster's with --scheduler; "
+                             "drop --workers")
+    ds, annual, run, seconds = _pm(
+        hs=hs, te=te, tp=tp, realizations=realizations, waves=waves, seed=seed,
+        spectrum=spectrum, gamma_peak=gamma_peak, cutoff=cutoff, response=response,
+        device=device, horizon=horizon, length=length, mass=mass, inertia=inertia,
+        gravity=gravity, gamma=gamma, damping_coefficient=damping_coefficient,
+        winding=winding, harmonics=harmonics, efficiency=efficiency,
+        torque_limit=torque_limit, depth=depth, density=density, width=width,
+        scatter=scatter, timeseries=timeseries, rated_power=rated_power, store=store,
+        overwrite=overwrite, workers=workers, scheduler=scheduler, netcdf=netcdf, zarr=zarr,
+        csv=csv, command=command, progress=progress)
+    pk = "tp" if "tp" in ds.dims else "te"
+
+    def grid(name):
+        return [[None if not math.isfinite(float(v)) else float(v) for v in row]
+                for row in ds[name].values]
+
+    quantities = [q for q in ("power", "limit_power", "uniform_power", "electrical_power")
+                  if q in ds]
+    stats = {q: {s: (ds[f"{q}_{s}"].values.astype(int).tolist() if s == "count"
+                     else grid(f"{q}_{s}")) for s in STATISTICS} for q in quantities}
+    codes = ds["status"].values
+    failed = int(((codes != 0) & ds["done"].values).sum())
+    out = {"hm0": [float(v) for v in ds["hm0"].values], pk: [float(v) for v in ds[pk].values],
+           "tp" if pk == "te" else "te":
+               [float(v) for v in ds["tp" if pk == "te" else "te"].values],
+           "hm0_edges": ds["hm0_edges"].values.tolist(),
+           f"{pk}_edges": ds[f"{pk}_edges"].values.tolist(),
+           "te_over_tp": float(ds.attrs["te_over_tp"]),
+           "realizations": int(ds.sizes["realization"]),
+           "seeds": ds["seed"].values.tolist(), "waves": float(waves),
+           "device": device, "power_matrix": grid("power_matrix"),
+           "wave_energy_flux_matrix": grid("wave_energy_flux_matrix"),
+           "capture_width_matrix": grid("capture_width_matrix"),
+           "capture_width_ratio_matrix": (grid("capture_width_ratio_matrix")
+                                          if "capture_width_ratio_matrix" in ds else None),
+           "statistics": stats, "failed_solves": failed,
+           "depth": depth, "width": width, "annual_energy": annual,
+           "annual_energy_mwh": None if annual is None else annual["power"]["mwh"],
+           "capacity_factor": (None if annual is None
+                               else annual["power"].get("capacity_factor")),
+           "store": run.store, "computed_bins": run.computed_points // int(realizations),
+           "resumed_bins": run.resumed_points // int(realizations), "seconds": seconds,
+           "executor": run.executor, "netcdf": netcdf, "zarr": zarr, "csv": csv}
+    return Record("power-matrix", out, dataset=ds, run=run)

@@ -37,6 +37,7 @@ from . import control as _control_cmds
 from . import dynamics as _dynamics_cmds
 from . import optimize as _optimize_cmds
 from . import paper as _paper_cmds
+from . import performance as _performance_cmds
 from . import pto as _pto_cmds
 from . import sea as _sea_cmds
 from . import sweep as _sweep_cmds
@@ -50,7 +51,8 @@ __all__ = ["build_parser", "main"]
 
 COMMANDS = {**_optimize_cmds.COMMANDS, **_paper_cmds.COMMANDS, **_pto_cmds.COMMANDS,
             **_dynamics_cmds.COMMANDS, **_control_cmds.COMMANDS, **_sea_cmds.COMMANDS,
-            **_sweep_cmds.COMMANDS}
+            **_sweep_cmds.COMMANDS,
+            **_performance_cmds.COMMANDS}
 
 
 def build_parser():
@@ -69,6 +71,7 @@ def build_parser():
     _control_cmds.add_parsers(sub)
     _sea_cmds.add_parsers(sub)
     _sweep_cmds.add_parsers(sub)
+    _performance_cmds.add_parsers(sub)
     return parser
 
 

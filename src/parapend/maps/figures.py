@@ -38,6 +38,10 @@ def map_data(ds, quantity: str = "power", x: str | None = None, y: str | None = 
     Dimensions other than ``x`` and ``y`` are selected by ``at`` (nearest value; default
     their first value).
     """
+    if ds.attrs.get("product") == "power matrix":
+        raise ParameterError("store: it holds a power matrix, not a design map; draw it with "
+                             "parapend power-matrix --plot PREFIX (the same options and "
+                             "--store resume it without computing)")
     if quantity not in MAP_QUANTITIES:
         raise ParameterError(f"variable: expected one of {', '.join(MAP_QUANTITIES)}, got "
                              f"{quantity!r:.40}")

@@ -30,7 +30,7 @@ from .store import (
     open_sweep,
 )
 
-__all__ = ["SweepRun", "sweep"]
+__all__ = ["SweepRun", "run_spec", "sweep"]
 
 log = logging.getLogger(__name__)
 
@@ -315,6 +315,16 @@ def sweep(store=None, *, omega=1.8, delta=None, gamma=0.0, torque_limit=None, ef
                       efficiency=efficiency, harmonics=harmonics, excitation=excitation,
                       square_alpha=square_alpha, fourier=fourier, threshold=threshold,
                       block_points=block_points)
+    return run_spec(spec, store, workers=workers, scheduler=scheduler, overwrite=overwrite,
+                    command=command, progress=progress)
+
+
+def run_spec(spec, store=None, *, workers: int | None = None, scheduler=None,
+             overwrite: bool = False, command: str | None = None,
+             progress=None) -> SweepRun:
+    """Run a checked spec (a :class:`SweepSpec`, or another product's spec with the same
+    layout, e.g. :class:`parapend.performance.spec.MatrixSpec`) on the engine: store,
+    resume, local processes or Dask; the parameters are :func:`sweep`'s."""
     if workers is not None:
         workers = check_int("workers", workers, 1, 256)
     else:

@@ -56,6 +56,9 @@ def _var_attrs(name: str) -> dict:
 
 def _template(spec: SweepSpec, command: str | None):
     """The whole store as a lazy Dataset (dask arrays of fill values) and its encoding."""
+    own = getattr(spec, "template", None)  # another product on the engine (a power matrix)
+    if own is not None:
+        return own(command)
     import dask.array as da
     import xarray as xr
     from zarr.codecs import ZstdCodec
@@ -126,9 +129,13 @@ _CREATING = "creating"
 _STALE_SECONDS = 600
 
 
-def _own_names() -> set:
-    """The names a sweep writes at the top of its store (its temporaries aside)."""
-    return {*VARIABLES, "done", *AXES, "zarr.json"}
+def _own_names(spec=None) -> set:
+    """The names a sweep (or a power matrix) writes at the top of its store (its
+    temporaries aside): either may replace the other's store with ``--overwrite``."""
+    from ..performance.spec import STORE_NAMES
+
+    return {*VARIABLES, "done", *AXES, "zarr.json", *STORE_NAMES,
+            *getattr(spec, "names", ()), *getattr(spec, "variables", ())}
 
 
 def _short(err: BaseException) -> str:
@@ -261,7 +268,7 @@ def _prepare(path: Path, spec: SweepSpec, command: str | None, overwrite: bool) 
         return
     # an empty directory, a creation cut short, or --overwrite of a sweep store: emptied,
     # after its root says "being created", and only of the names a sweep writes
-    own = _own_names()
+    own = _own_names(spec)
     entries = list(path.iterdir())
     extra = sorted(e.name for e in entries
                    if e.name not in own and not e.name.startswith(TEMP_PREFIX))
@@ -323,6 +330,10 @@ def _spec_of(identity) -> SweepSpec | None:
     """The :class:`SweepSpec` (its layout) of a store's recorded identity, or None."""
     try:
         d = json.loads(identity)
+        if isinstance(d, dict) and d.get("kind") == "power_matrix":
+            from ..performance.spec import MatrixSpec
+
+            return MatrixSpec.from_json(identity)
         values = {a: tuple(float(v) for v in d["axes"][a]) for a in AXES}
         spec = _StoredSpec(values, str(d["excitation"]), d["square_alpha"], d["fourier"],
                            int(d["harmonics"]), bool(d["threshold"]), None,
@@ -375,16 +386,16 @@ def _array(group, path: Path, spec: SweepSpec, name: str):
 
 
 def _check_coords(group, path: Path, spec: SweepSpec) -> None:
-    for a in AXES:
-        vals = spec.values[a]
-        if not vals:
-            continue
+    own = getattr(spec, "coordinates", None)
+    wanted = (own() if own is not None else
+              {a: (np.array(spec.values[a]) if len(spec.values[a]) >= 2
+                   else np.array(spec.values[a][0])) for a in AXES if spec.values[a]})
+    for a, want in wanted.items():
         try:
             got = np.asarray(group[a][...], dtype=float)
         except Exception as err:  # noqa: BLE001 - missing or unreadable
             raise _damaged(path, f"coordinate {a!r} is missing or unreadable: "
                                  f"{_short(err)}") from None
-        want = np.array(vals) if len(vals) >= 2 else np.array(vals[0])
         if got.shape != want.shape or not np.array_equal(got, want):
             raise _damaged(path, f"coordinate {a!r} differs from the sweep's values")
 

@@ -1,0 +1,131 @@
+"""``parapend power-matrix``: the power matrix over sea states, capture width and annual
+energy (docs/performance.md). A thin shell over :mod:`parapend.performance`."""
+
+from __future__ import annotations
+
+import shlex
+import sys
+
+from ..defaults import SEA
+from . import _output
+from ._common import FIGURE_SUFFIXES, _check_output, _finite_float, _int, _run
+from .sweep import _NEGATIVE_VALUE, _EtaProgress
+
+_BINS = "FROM:TO:N (N centres, ends included) or a comma list"
+
+
+def _winding(text):
+    t = text.strip()
+    return t if t == "auto" else _int(t)
+
+
+def add_parsers(sub) -> None:
+    p = sub.add_parser(
+        "power-matrix", help="power matrix over Hs x Te bins, capture width, annual energy",
+        description="Mean, std, min, max and count of the power over seeded records in each "
+                    "sea-state bin (the non-causal optimum, the gamma -> 0 limit, the uniform "
+                    "rotation), the wave energy flux and capture width of each bin, and the "
+                    "mean annual energy at a site (IEC TS 62600-100; MHKiT's layout). "
+                    "Resumable with --store.")
+    p._negative_number_matcher = _NEGATIVE_VALUE
+    g = p.add_argument_group("bins (bin centres: " + _BINS + ")")
+    g.add_argument("--hs", default="1:3:3", help="significant wave height Hm0, m (default "
+                                                 "1:3:3)")
+    g.add_argument("--te", default=None, help="energy period, s (default 6:10:3)")
+    g.add_argument("--tp", default=None, help="peak period, s, instead of --te (Te = "
+                                              "(Te/Tp of the spectrum) Tp)")
+    g.add_argument("--realizations", type=_int, default=3,
+                   help="seeded records per bin (default 3)")
+    g.add_argument("--waves", type=_finite_float("waves"), default=50.0,
+                   help="record length in peak periods, 2 to 400 (default 50)")
+    g.add_argument("--seed", type=_int, default=0,
+                   help="seed of realization 0; realization r has seed + r (default 0)")
+    g.add_argument("--spectrum", choices=["jonswap", "pierson-moskowitz"], default="jonswap")
+    g.add_argument("--gamma-peak", type=_finite_float("gamma-peak"), default=3.3,
+                   help="JONSWAP peak enhancement (default 3.3)")
+    g.add_argument("--cutoff", type=_finite_float("cutoff"), default=3.0,
+                   help="highest frequency in units of the peak frequency (default 3)")
+    g.add_argument("--response", metavar="CSV", default=None,
+                   help="heave response 'f,gain,phase' (default: the base follows the "
+                        "surface)")
+    g = p.add_argument_group("device")
+    g.add_argument("--device", choices=["prescribed-heave"], default="prescribed-heave",
+                   help="the prescribed-heave pendulum (the coupled buoy is not available "
+                        "yet)")
+    g.add_argument("--horizon", type=_finite_float("horizon"), default=None,
+                   help="causal controller's horizon, s (not available yet: refused)")
+    g.add_argument("--length", type=_finite_float("length"), default=SEA["length"],
+                   help="m (default 1)")
+    g.add_argument("--mass", type=_finite_float("mass"), default=SEA["mass"],
+                   help="kg (default 10)")
+    g.add_argument("--inertia", type=_finite_float("inertia"), default=None,
+                   help="kg m^2 (default m l^2)")
+    g.add_argument("--gravity", type=_finite_float("gravity"), default=SEA["gravity"],
+                   help="m/s^2 (default 9.81; also the waves')")
+    g.add_argument("--gamma", type=_finite_float("gamma"), default=None,
+                   help="viscous damping, non-dimensional (default 0.01)")
+    g.add_argument("--damping-coefficient", type=_finite_float("damping-coefficient"),
+                   default=None, help="N m s/rad (instead of --gamma)")
+    g.add_argument("--winding", type=_winding, default=1, help="as sea (default 1)")
+    g.add_argument("--harmonics", type=_int, default=None, help="as sea (default 16 per wave)")
+    g.add_argument("--efficiency", type=_finite_float("efficiency"), default=None,
+                   help="power take-off efficiency in (0, 1]: adds the electrical power")
+    g.add_argument("--torque-limit", type=_finite_float("torque-limit"), default=None,
+                   help="not supported over a sea record (refused)")
+    g = p.add_argument_group("resource and site")
+    g.add_argument("--depth", type=_finite_float("depth"), default=None,
+                   help="water depth, m (default deep water)")
+    g.add_argument("--density", type=_finite_float("density"), default=1025.0,
+                   help="water density, kg/m^3 (default 1025)")
+    g.add_argument("--width", type=_finite_float("width"), default=None,
+                   help="characteristic width, m: adds the capture-width ratio")
+    g.add_argument("--scatter", metavar="CSV", default=None,
+                   help="scatter diagram 'hs,te,frequency' (shares summing to 1) or "
+                        "'hs,te,count'; bin centres of the matrix")
+    g.add_argument("--timeseries", metavar="CSV", default=None,
+                   help="sea states 'hs,te', one a row, binned with the matrix's edges")
+    g.add_argument("--rated-power", type=_finite_float("rated-power"), default=None,
+                   help="W: adds the capacity factor")
+    g = p.add_argument_group("engine and output")
+    g.add_argument("--store", default=None,
+                   help="Zarr store of the per-realization results, resumed if it holds this "
+                        "matrix (default: in memory)")
+    g.add_argument("--overwrite", action="store_true",
+                   help="replace a store that holds another matrix")
+    g.add_argument("--workers", type=_int, default=None, help="local processes (default all)")
+    g.add_argument("--scheduler", metavar="ADDRESS", help="Dask scheduler tcp://host:8786")
+    g.add_argument("--netcdf", metavar="FILE.nc", help="the full Dataset as NetCDF")
+    g.add_argument("--zarr", metavar="DIR", help="the full Dataset as a Zarr store")
+    g.add_argument("--csv", metavar="FILE.csv", help="the matrix as a table, one row a bin")
+    p.add_argument("--plot", metavar="PREFIX",
+                   help="figures PREFIX-matrix.png, PREFIX-capture-width.png and, with a "
+                        "site, PREFIX-scatter.png")
+    p.add_argument("--json", action="store_true",
+                   help="print one JSON object (annual energy, matrix, statistics)")
+
+
+def _cmd_power_matrix(a) -> dict | str:
+    from ..performance import figures
+
+    if a.plot:
+        for s in ("matrix", "capture-width", "scatter"):
+            _check_output(f"{a.plot}-{s}.png", "--plot", FIGURE_SUFFIXES)
+    argv = sys.argv[1:] if sys.argv and sys.argv[0] else []
+    rec = _run(a, command="parapend " + " ".join(shlex.quote(x) for x in argv),
+               progress=_EtaProgress("power-matrix"))
+    ds = rec._dataset
+    drawn = []
+    if a.plot:
+        _output.plot(figures.plot_matrix, ds, f"{a.plot}-matrix.png")
+        _output.plot(figures.plot_capture_width, ds, f"{a.plot}-capture-width.png")
+        drawn += [f"{a.plot}-matrix.png", f"{a.plot}-capture-width.png"]
+        if "frequency" in ds:
+            _output.plot(figures.plot_scatter, ds, f"{a.plot}-scatter.png")
+            drawn.append(f"{a.plot}-scatter.png")
+    out = rec.to_dict()
+    if a.json:
+        return out
+    return figures.text_report(ds, out, drawn)
+
+
+COMMANDS = {"power-matrix": _cmd_power_matrix}

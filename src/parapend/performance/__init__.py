@@ -1,0 +1,365 @@
+r"""Performance as the field reports it (IEC TS 62600-100): the power matrix over sea states,
+the wave energy flux and capture width of each bin, and the mean annual energy production
+at a site; the Dataset follows MHKiT's ``wave.performance`` (docs/performance.md).
+
+Flow: :func:`power_matrix` checks the bins and builds a :class:`.spec.MatrixSpec`; the
+design-map engine (:func:`parapend.maps.run.run_spec`: Zarr store, resume, local processes
+or Dask) computes every bin (:mod:`.solve`: ``parapend sea`` per realization); then
+:func:`matrix_dataset` draws the statistics, the resource (:mod:`.resource`) and the annual
+energy (:mod:`.annual`); :mod:`.figures` draws the three figures.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+
+import numpy as np
+
+from .. import limits
+from ..errors import ParameterError, check_int, check_positive, check_range
+from .annual import HOURS_PER_YEAR
+from .resource import bin_edges, energy_flux, record_spectrum, te_over_tp
+from .spec import DEVICES, QUANTITIES, MatrixSpec
+
+__all__ = ["HOURS_PER_YEAR", "STATISTICS", "MatrixSpec", "matrix_dataset", "matrix_spec",
+           "parse_bins", "power_matrix", "to_mhkit"]
+
+#: the statistics of each bin over its realizations (IEC TS 62600-100; std with ddof 0)
+STATISTICS = ("mean", "std", "min", "max", "count")
+
+
+def parse_bins(name: str, value) -> tuple:
+    """Bin centres: ``FROM:TO:N`` (N values, ends included), ``A,B,C`` or a sequence;
+    positive, increasing, at least two (the edges need a step)."""
+    if isinstance(value, str):
+        text = value.strip()
+        if text.count(":") == 2:
+            a, b, c = text.split(":")
+            try:
+                lo, hi, n = float(a), float(b), int(c)
+            except ValueError:
+                raise ParameterError(f"{name}: expected FROM:TO:N with numbers and an integer "
+                                     f"N, got {value!r:.60}") from None
+            if n < 2:
+                raise ParameterError(f"{name}: expected at least 2 bins, got {n}")
+            vals = np.linspace(lo, hi, n)
+        elif ":" in text:
+            raise ParameterError(f"{name}: expected FROM:TO:N or a comma list, got "
+                                 f"{value!r:.60}")
+        else:
+            try:
+                vals = np.array([float(p) for p in text.split(",")]) if text else np.array([])
+            except ValueError:
+                raise ParameterError(f"{name}: expected numbers separated by commas, got "
+                                     f"{value!r:.60}") from None
+    else:
+        try:
+            vals = np.atleast_1d(np.asarray(value, dtype=float))
+        except (TypeError, ValueError):
+            raise ParameterError(f"{name}: expected FROM:TO:N, a comma list or numbers") \
+                from None
+    if vals.ndim != 1 or vals.size < 2:
+        raise ParameterError(f"{name}: expected at least 2 bin centres, got {vals.size}")
+    if vals.size > 1000:
+        raise ParameterError(f"{name}: expected at most 1000 bins, got {vals.size}")
+    if not np.all(np.isfinite(vals)) or np.any(vals <= 0):
+        raise ParameterError(f"{name}: expected positive bin centres, got "
+                             f"{', '.join(f'{v:g}' for v in vals[:6])}")
+    if np.any(np.diff(vals) <= 0):
+        raise ParameterError(f"{name}: expected increasing bin centres (empty bins otherwise)")
+    return tuple(float(v) for v in vals)
+
+
+def matrix_spec(*, hs="1:3:3", te=None, tp=None, realizations: int = 3, waves: float = 50,
+                seed: int = 0, spectrum: str = "jonswap", gamma_peak: float = 3.3,
+                cutoff: float = 3.0, response=None, device: str = "prescribed-heave",
+                horizon=None, length: float = 1.0, mass: float = 10.0, inertia=None,
+                gravity: float = 9.81, gamma=None, damping_coefficient=None, winding=1,
+                harmonics=None, efficiency=None, torque_limit=None) -> MatrixSpec:
+    """Check everything a matrix's bins depend on (one line naming the parameter)."""
+    from ..seas import _check_sea, check_response, read_response
+    from ..units import Units
+
+    if device not in DEVICES:
+        raise ParameterError(f"device: expected one of {', '.join(DEVICES)} (the coupled buoy "
+                             f"is not available yet), got {device!r:.60}")
+    if horizon is not None:
+        raise ParameterError("horizon: the causal controller is not available yet; the matrix "
+                             "gives the non-causal optimum, the limit and the uniform rotation")
+    if torque_limit is not None:
+        raise ParameterError("torque-limit: not supported over a sea record (parapend sea "
+                             "solves the unconstrained optimum); drop --torque-limit")
+    hm0 = parse_bins("hs", hs)
+    if te is not None and tp is not None:
+        raise ParameterError("te, tp: give the period bins as one of --te or --tp")
+    kind, per = ("tp", tp) if tp is not None else ("te", "6:10:3" if te is None else te)
+    period = parse_bins(kind, per)
+    # the spectrum's options first (a valid sea state stands in for the bins, checked below)
+    _, _, gamma_peak, _, cutoff = _check_sea(1.0, 8.0, spectrum, gamma_peak, None, cutoff)
+    ratio = te_over_tp(spectrum, gamma_peak)
+    tps = tuple(p / ratio for p in period) if kind == "te" else period
+    realizations = check_int("realizations", realizations, 1, 1000)
+    waves = check_range("waves", waves, *limits.SEA_WAVES_RANGE,
+                        why="record length in peak periods")
+    seed = check_int("seed", seed, 0, 2**62)
+    for h in (hm0[0], hm0[-1]):
+        if h > limits.SEA_MAX_HS:
+            raise ParameterError(f"hs: expected bin centres up to {limits.SEA_MAX_HS:g} m, "
+                                 f"got {h:g}")
+    for t in (tps[0], tps[-1]):
+        if not limits.SEA_TP_RANGE[0] <= t <= limits.SEA_TP_RANGE[1]:
+            raise ParameterError(f"{kind}: expected peak periods from "
+                                 f"{limits.SEA_TP_RANGE[0]:g} to {limits.SEA_TP_RANGE[1]:g} s, "
+                                 f"got {t:g} s" + (f" (Te {t * ratio:g} s)" if kind == "te"
+                                                   else ""))
+    units = Units(length, mass, gravity, inertia)
+    if gamma is not None and damping_coefficient is not None:
+        raise ParameterError("gamma: give either gamma or damping-coefficient, not both")
+    if damping_coefficient is not None:
+        gamma = units.gamma(damping_coefficient)
+    gamma = check_range("gamma", 0.01 if gamma is None else gamma, 0.0, limits.MAX_GAMMA)
+    if efficiency is not None:
+        efficiency = check_range("efficiency", efficiency, 0.0, 1.0)
+        if efficiency <= 0:
+            raise ParameterError(f"efficiency: expected a number in (0, 1], got {efficiency}")
+    if response is not None:
+        rf, rg, rp = (read_response(response) if isinstance(response, str)
+                      else check_response(*response))
+        response = tuple(tuple(float(v) for v in c) for c in (rf, rg, rp))
+    if harmonics is not None:
+        harmonics = check_int("harmonics", harmonics, 1, limits.SEA_MAX_HARMONICS // 2)
+    if not isinstance(winding, str):
+        winding = check_int("winding", winding, 1, limits.SEA_MAX_HARMONICS // 8)
+    elif winding != "auto":
+        raise ParameterError(f"winding: expected a positive integer or 'auto', got "
+                             f"{winding!r:.60}")
+    return MatrixSpec(hm0, period, kind, tps, realizations, float(waves), seed, spectrum,
+                      float(gamma_peak), float(cutoff), response, float(length), float(mass),
+                      None if inertia is None else float(inertia), float(gravity),
+                      float(gamma), winding, harmonics,
+                      None if efficiency is None else float(efficiency), device)
+
+
+def _stats(x: np.ndarray, ok: np.ndarray) -> dict:
+    """Statistics over the last axis of ``x`` where ``ok``; NaN where nothing is."""
+    v = np.where(ok, x, np.nan)
+    n = ok.sum(axis=-1)
+    import warnings
+
+    with np.errstate(invalid="ignore"), warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)  # all-NaN bins: NaN, count 0
+        out = {"mean": np.nanmean(v, axis=-1), "std": np.nanstd(v, axis=-1),
+               "min": np.nanmin(v, axis=-1), "max": np.nanmax(v, axis=-1)}
+    out = {k: np.where(n > 0, a, np.nan) for k, a in out.items()}
+    out["count"] = n.astype(np.int64)
+    return out
+
+
+def matrix_dataset(raw, spec: MatrixSpec, *, depth=None, density: float = 1025.0,
+                   width=None, frequency=None, outside=None, rated_power=None):
+    """The full Dataset from the engine's per-realization Dataset ``raw``: statistics,
+    resource, capture width, and with ``frequency`` the annual energy."""
+    from ..maps.spec import _CODE
+    from .annual import annual_energy, capacity_factor
+
+    pk = spec.period_kind
+    ds = raw.copy()
+    status = ds["status"].values
+    done = ds["done"].values.astype(bool)
+    conv = done & (status == _CODE["converged"])
+    dims2 = ("hm0", pk)
+    for q in spec.variables[:-1]:
+        ok = conv if q in ("power", "electrical_power") else done & np.isfinite(ds[q].values)
+        st = _stats(ds[q].values, ok)
+        for s in STATISTICS:
+            ds[f"{q}_{s}"] = (dims2, st[s], {
+                "long_name": f"{s} over the realizations of the {QUANTITIES[q]}"
+                             + (" (converged solves only)" if q in ("power", "electrical_power")
+                                else ""),
+                **({"units": "W"} if s != "count" else {})})
+    # the resource of each bin
+    j = np.empty((len(spec.hm0), len(spec.period)))
+    te_rec = np.empty_like(j)
+    for a, h in enumerate(spec.hm0):
+        for b, tp in enumerate(spec.tp):
+            f, s = record_spectrum(h, tp, spec.waves * tp, spectrum=spec.spectrum,
+                                   gamma_peak=spec.gamma_peak, cutoff=spec.cutoff)
+            j[a, b] = energy_flux(f, s, depth=depth, density=density, gravity=spec.gravity)
+            te_rec[a, b] = float(np.sum(s / f) / np.sum(s))
+    ds["wave_energy_flux_matrix"] = (dims2, j, {
+        "long_name": "omnidirectional wave energy flux J = rho g sum S c_g df of the record's "
+                     "spectrum", "units": "W/m",
+        "depth": "deep water" if depth is None else f"{depth:g} m", "density": density})
+    ds["te_record"] = (dims2, te_rec, {"long_name": "energy period m_-1/m0 of the record's "
+                                                    "(cut) spectrum", "units": "s"})
+    ds["power_matrix"] = (dims2, ds["power_mean"].values, {
+        "long_name": "power matrix: mean optimum power of the bin (= power_mean)", "units": "W"})
+    ds["capture_width_matrix"] = (dims2, ds["power_mean"].values / j, {
+        "long_name": "capture width P / J of the mean optimum power", "units": "m"})
+    for s in ("std", "min", "max"):
+        ds[f"capture_width_{s}"] = (dims2, ds[f"power_{s}"].values / j, {
+            "long_name": f"capture width P / J, {s} over the realizations", "units": "m"})
+    if width is not None:
+        ds["capture_width_ratio_matrix"] = (dims2, ds["power_mean"].values / j / width, {
+            "long_name": f"capture width ratio P / (J w), w = {width:g} m", "units": "1"})
+    ds = ds.assign_coords({
+        "hm0_edges": ("hm0_edge", bin_edges(spec.hm0), {"long_name": "Hm0 bin edges (MHKiT)",
+                                                         "units": "m"}),
+        f"{pk}_edges": (f"{pk}_edge", bin_edges(spec.period),
+                        {"long_name": f"{pk} bin edges (MHKiT)", "units": "s"})})
+    annual = None
+    if frequency is not None:
+        ds["frequency"] = (dims2, frequency, {"long_name": "share of the year of the bin"})
+        annual = {}
+        for q in spec.variables[:-1]:
+            a = annual_energy(ds[f"{q}_mean"].values, frequency)
+            a["bins_without_power"] = [{"hm0": spec.hm0[i], pk: spec.period[k],
+                                        "frequency": float(frequency[i, k])}
+                                       for i, k in a.pop("missing")]
+            if outside:
+                a["outside_frequency"] = outside
+            if rated_power is not None:
+                a["capacity_factor"] = capacity_factor(a["wh"], rated_power)
+            annual[q] = a
+        ds.attrs["annual_energy_mwh"] = annual["power"]["mwh"]
+    ds.attrs["hours_per_year"] = HOURS_PER_YEAR
+    return ds, annual
+
+
+def to_mhkit(da):
+    """A matrix variable with MHKiT's dimension names (``x_centers``, ``y_centers``), for
+    ``mhkit.wave.performance`` (e.g. ``mean_annual_energy_production_matrix``)."""
+    return da.rename({da.dims[0]: "x_centers", da.dims[1]: "y_centers"})
+
+
+def power_matrix(*, hs="1:3:3", te=None, tp=None, realizations: int = 3, waves: float = 50,
+                 seed: int = 0, spectrum: str = "jonswap", gamma_peak: float = 3.3,
+                 cutoff: float = 3.0, response=None, device: str = "prescribed-heave",
+                 horizon=None, length: float = 1.0, mass: float = 10.0, inertia=None,
+                 gravity: float = 9.81, gamma=None, damping_coefficient=None, winding=1,
+                 harmonics=None, efficiency=None, torque_limit=None, depth=None,
+                 density: float = 1025.0, width=None, scatter=None, timeseries=None,
+                 rated_power=None, store=None, overwrite: bool = False, workers=None,
+                 scheduler=None, netcdf=None, zarr=None, csv=None, command=None,
+                 progress=None):
+    """The power matrix of a device over bins of ``Hs x Te`` (or ``Tp``); see the module
+    text and docs/performance.md. Returns ``(dataset, annual, run)``."""
+    from ..maps.run import run_spec
+    from .annual import bin_series, read_scatter, read_series
+
+    spec = matrix_spec(hs=hs, te=te, tp=tp, realizations=realizations, waves=waves, seed=seed,
+                       spectrum=spectrum, gamma_peak=gamma_peak, cutoff=cutoff,
+                       response=response, device=device, horizon=horizon, length=length,
+                       mass=mass, inertia=inertia, gravity=gravity, gamma=gamma,
+                       damping_coefficient=damping_coefficient, winding=winding,
+                       harmonics=harmonics, efficiency=efficiency, torque_limit=torque_limit)
+    if depth is not None:
+        depth = check_positive("depth", depth)
+    density = check_range("density", density, 500.0, 2000.0, why="kg/m^3")
+    if width is not None:
+        width = check_positive("width", width)
+    if rated_power is not None:
+        rated_power = check_positive("rated-power", rated_power)
+    if scatter is not None and timeseries is not None:
+        raise ParameterError("scatter, timeseries: give the site as one of them")
+    frequency, outside = None, None
+    pk = spec.period_kind
+    if scatter is not None:
+        frequency = read_scatter(scatter, spec.hm0, spec.period, pk)
+    elif timeseries is not None:
+        hs_t, per_t = read_series(timeseries, pk)
+        counts, out = bin_series(hs_t, per_t, bin_edges(spec.hm0), bin_edges(spec.period))
+        frequency = counts / hs_t.size
+        outside = {"sea_states": out, "frequency": out / hs_t.size} if out else None
+    if rated_power is not None and frequency is None:
+        raise ParameterError("rated-power: the capacity factor needs a site: give --scatter "
+                             "or --timeseries")
+    for path, flag, sfx in ((netcdf, "netcdf", ".nc"), (csv, "csv", ".csv")):
+        if path is not None and not str(path).endswith(sfx):
+            raise ParameterError(f"{flag}: expected a file name ending in {sfx}, got "
+                                 f"{str(path)!r:.60}")
+    t0 = time.monotonic()
+    run = run_spec(spec, store, workers=workers, scheduler=scheduler, overwrite=overwrite,
+                   command=command, progress=progress)
+    ds, annual = matrix_dataset(run.dataset, spec, depth=depth, density=density, width=width,
+                                frequency=frequency, outside=outside, rated_power=rated_power)
+    seconds = time.monotonic() - t0
+    from .. import fileio
+
+    if netcdf is not None:
+        fileio.write_dataset(ds, netcdf)
+    if zarr is not None:
+        _write_zarr(ds, zarr)
+    if csv is not None:
+        fileio.write_text(csv, matrix_csv(ds, spec))
+    return ds, annual, run, seconds
+
+
+#: the root attribute ``export`` of a Dataset written by ``--zarr``
+_EXPORT = "parapend power matrix dataset"
+
+
+def _write_zarr(ds, path) -> None:
+    """The full Dataset as a Zarr 3 store written beside, then moved in (atomic rename)."""
+    import json
+    import os
+    import shutil
+    import tempfile
+    from pathlib import Path
+
+    from ..errors import OutputError
+
+    path = Path(path)
+    if path.exists():
+        # only an earlier export of a power matrix is replaced (never a --store, whose raw
+        # results it would destroy, nor any other directory)
+        try:
+            attrs = json.loads((path / "zarr.json").read_text())["attributes"]
+            ours = attrs.get("export") == _EXPORT
+        except (OSError, ValueError, KeyError, TypeError):
+            ours = False
+        if not ours:
+            raise ParameterError(f"zarr: {str(path)!r} exists and is not an export of a power "
+                                 "matrix (parapend replaces only those); choose another name")
+    tmp = Path(tempfile.mkdtemp(prefix=".parapend-", dir=path.parent if str(path.parent)
+                                else "."))
+    try:
+        out = ds.copy()
+        out.attrs["export"] = _EXPORT
+        for v in out.variables.values():
+            v.encoding = {}
+        out.to_zarr(tmp / "s", mode="w", zarr_format=3, consolidated=False)
+        if path.exists():
+            shutil.rmtree(path)
+        os.replace(tmp / "s", path)
+    except OSError as exc:
+        raise OutputError(f"cannot write {str(path)!r}: {exc.strerror or exc}") from None
+    finally:
+        shutil.rmtree(tmp, ignore_errors=True)
+
+
+def matrix_csv(ds, spec: MatrixSpec) -> str:
+    """The matrix as a table, one row per bin: centres, J, the statistics of each quantity,
+    the capture width (and ratio), the frequency."""
+    pk = spec.period_kind
+    cols = ["wave_energy_flux_matrix", "capture_width_matrix"]
+    if "capture_width_ratio_matrix" in ds:
+        cols.append("capture_width_ratio_matrix")
+    for q in spec.variables[:-1]:
+        cols += [f"{q}_{s}" for s in STATISTICS]
+    if "frequency" in ds:
+        cols.append("frequency")
+    lines = [",".join(["hm0", pk, "tp" if pk == "te" else "te", *cols])]
+    other = ds["tp" if pk == "te" else "te"].values
+    for i, h in enumerate(spec.hm0):
+        for k, t in enumerate(spec.period):
+            vals = [ds[c].values[i, k] for c in cols]
+            lines.append(",".join([repr(h), repr(t), repr(float(other[k])),
+                                   *(str(int(v)) if c.endswith("count") else repr(float(v))
+                                     for c, v in zip(cols, vals))]))
+    return "\n".join(lines) + "\n"
+
+
+def _finite(x):
+    return None if x is None or not math.isfinite(x) else x

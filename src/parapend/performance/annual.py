@@ -1,0 +1,151 @@
+r"""Mean annual energy production from a scatter diagram or a time series of sea states.
+
+``AEP = 8766 h * sum_ij P_ij f_ij`` (IEC TS 62600-100; MHKiT's
+``mean_annual_energy_production_matrix`` is ``8766 sum CW_ij J_ij f_ij`` with ``CW = P/J``,
+the same sum). ``P_ij`` is the bin's mean power (W), ``f_ij`` its share of the year.
+
+Scatter CSV, long format, one row per bin: ``hs,te,frequency`` (or ``hs,tp,...``). The
+``frequency`` column holds shares of the year that must sum to 1 within 1e-6 (MHKiT's
+rule); a column named ``count`` instead holds occurrences or hours, any non-negative
+numbers, divided by their total. Each row's centres must be centres of the matrix (to a
+relative 1e-9); bins of the matrix missing from the CSV have frequency 0. A time series
+CSV ``hs,te`` (or ``hs,tp``), one row per sea state, is binned with the matrix's edges
+(MHKiT's: half-open bins, the last one closed); rows outside every bin are counted and
+reported, and their share of the year contributes nothing (stated, never silent).
+"""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import numpy as np
+
+from ..errors import ParameterError
+from ..seas import _csv_rows
+
+__all__ = ["HOURS_PER_YEAR", "bin_series", "read_scatter", "read_series"]
+
+#: average length of a year in hours (MHKiT, IEC TS 62600-100)
+HOURS_PER_YEAR = 8766.0
+_SUM_TOL = 1e-6
+_MATCH = 1e-9
+
+
+def _header(path, name: str) -> list:
+    try:
+        with open(path, encoding="utf-8", errors="replace") as fh:
+            line = fh.readline()
+    except OSError as exc:
+        raise ParameterError(f"{name}: cannot read {str(path)!r}: "
+                             f"{exc.strerror or exc}") from None
+    return [c.strip().lower() for c in line.strip().split(",")]
+
+
+def _index(values, centres, name: str, axis: str) -> np.ndarray:
+    c = np.asarray(centres, dtype=float)
+    out = []
+    for v in values:
+        k = np.flatnonzero(np.abs(c - v) <= _MATCH * np.maximum(1.0, np.abs(c)))
+        if k.size != 1:
+            raise ParameterError(
+                f"{name}: {axis} = {v:g} is not a bin centre of the matrix ({axis} centres "
+                f"{', '.join(f'{x:g}' for x in c)}): the scatter's bins must be the matrix's")
+        out.append(int(k[0]))
+    return np.array(out, dtype=int)
+
+
+def read_scatter(path, hm0, period, period_kind: str, name: str = "scatter") -> np.ndarray:
+    """The frequency of each bin of the matrix (shape ``(len(hm0), len(period))``) from a
+    long-format scatter CSV; see the module text."""
+    if not isinstance(path, (str, Path)) or not str(path):
+        raise ParameterError(f"{name}: expected a CSV path, got {path!r:.60}")
+    head = _header(path, name)
+    if len(head) != 3 or head[0] != "hs" or head[1] not in ("te", "tp") \
+            or head[2] not in ("frequency", "count"):
+        raise ParameterError(f"{name}: expected a CSV header 'hs,{period_kind},frequency' (or "
+                             f"'hs,{period_kind},count') in {path}")
+    if head[1] != period_kind:
+        raise ParameterError(f"{name}: its periods are {head[1]}, the matrix's {period_kind}; "
+                             f"give the matrix with --{head[1]} or the scatter in "
+                             f"{period_kind}")
+    rows = np.array(_csv_rows(path, head, name), dtype=float).reshape(-1, 3)
+    if rows.shape[0] == 0:
+        raise ParameterError(f"{name}: expected at least one bin in {path}, got none")
+    if np.any(rows[:, 0] <= 0) or np.any(rows[:, 1] <= 0):
+        raise ParameterError(f"{name}: expected positive heights and periods in {path}")
+    if np.any(rows[:, 2] < 0):
+        raise ParameterError(f"{name}: expected non-negative {head[2]}s in {path}")
+    i = _index(rows[:, 0], hm0, name, "hs")
+    j = _index(rows[:, 1], period, name, period_kind)
+    freq = np.zeros((len(hm0), len(period)))
+    seen = set()
+    for a, b, f in zip(i, j, rows[:, 2]):
+        if (a, b) in seen:
+            raise ParameterError(f"{name}: bin hs = {hm0[a]:g}, {period_kind} = "
+                                 f"{period[b]:g} appears twice in {path}")
+        seen.add((a, b))
+        freq[a, b] = f
+    total = float(freq.sum())
+    if head[2] == "count":
+        if total <= 0:
+            raise ParameterError(f"{name}: expected a positive total count in {path}")
+        return freq / total
+    if abs(total - 1.0) >= _SUM_TOL:
+        raise ParameterError(f"{name}: expected frequencies summing to 1 (within 1e-6), got "
+                             f"{total:.10g} in {path}; give shares of the year, or name the "
+                             "column 'count' for occurrences or hours")
+    return freq
+
+
+def bin_series(hs, per, hm0_edges, period_edges) -> tuple[np.ndarray, int]:
+    """Counts of sea states per bin (MHKiT's edges: half-open, the last bin closed) and the
+    number of sea states outside every bin."""
+    hs = np.asarray(hs, dtype=float)
+    per = np.asarray(per, dtype=float)
+
+    def which(x, e):
+        k = np.searchsorted(e, x, side="right") - 1
+        k = np.where(x == e[-1], e.size - 2, k)
+        return np.where((x < e[0]) | (x > e[-1]), -1, k)
+
+    i, j = which(hs, hm0_edges), which(per, period_edges)
+    inside = (i >= 0) & (j >= 0)
+    counts = np.zeros((hm0_edges.size - 1, period_edges.size - 1))
+    np.add.at(counts, (i[inside], j[inside]), 1.0)
+    return counts, int(np.count_nonzero(~inside))
+
+
+def read_series(path, period_kind: str, name: str = "timeseries") -> tuple:
+    """``(hs, period)`` arrays of a sea-state time series CSV ``hs,te`` (or ``hs,tp``)."""
+    if not isinstance(path, (str, Path)) or not str(path):
+        raise ParameterError(f"{name}: expected a CSV path, got {path!r:.60}")
+    head = _header(path, name)
+    if head not in (["hs", "te"], ["hs", "tp"]):
+        raise ParameterError(f"{name}: expected a CSV header 'hs,{period_kind}' in {path}")
+    if head[1] != period_kind:
+        raise ParameterError(f"{name}: its periods are {head[1]}, the matrix's {period_kind}; "
+                             f"give the matrix with --{head[1]}")
+    rows = np.array(_csv_rows(path, head, name), dtype=float).reshape(-1, 2)
+    if rows.shape[0] == 0:
+        raise ParameterError(f"{name}: expected at least one sea state in {path}, got none")
+    if np.any(rows <= 0):
+        raise ParameterError(f"{name}: expected positive heights and periods in {path}")
+    return rows[:, 0], rows[:, 1]
+
+
+def annual_energy(mean_power, frequency) -> dict:
+    """AEP (Wh, MWh) of a matrix of mean powers (W) and bin frequencies: the sum over the
+    bins with a frequency; the bins with a frequency and no power are listed."""
+    p = np.asarray(mean_power, dtype=float)
+    f = np.asarray(frequency, dtype=float)
+    used = f > 0
+    missing = used & ~np.isfinite(p)
+    wh = HOURS_PER_YEAR * float(np.sum(np.where(used & ~missing, p * f, 0.0)))
+    return {"wh": wh, "mwh": wh / 1e6, "missing": np.argwhere(missing).tolist(),
+            "missing_frequency": float(f[missing].sum()),
+            "mean_power_w": wh / HOURS_PER_YEAR, "complete": not bool(missing.any())}
+
+
+def capacity_factor(aep_wh: float, rated_power: float) -> float:
+    return aep_wh / (HOURS_PER_YEAR * rated_power) if math.isfinite(aep_wh) else math.nan

@@ -1,0 +1,202 @@
+"""The figures a reader of a WEC paper expects, drawn from a power-matrix Dataset: the power
+matrix as a table of numbers on a colour scale, the capture width against the period, and
+the scatter diagram with each bin's energy-weighted contribution; and the text report."""
+
+from __future__ import annotations
+
+import numpy as np
+
+__all__ = ["plot_capture_width", "plot_matrix", "plot_scatter", "text_report"]
+
+
+def _period(ds) -> str:
+    return "tp" if "tp" in ds.dims else "te"
+
+
+def _label(pk: str) -> str:
+    return "energy period $T_e$ (s)" if pk == "te" else "peak period $T_p$ (s)"
+
+
+def _table_image(ax, ds, values, cmap, fmt, cbar_label, fig, mask=None, labels=None):
+    """``values`` (hm0 x period) as coloured cells with their numbers written in."""
+    import matplotlib.colors as mcolors
+
+    pk = _period(ds)
+    x = ds[pk].values
+    y = ds["hm0"].values
+    v = np.ma.masked_invalid(values if mask is None else np.where(mask, values, np.nan))
+    xe = ds[f"{pk}_edges"].values.copy()
+    ye = ds["hm0_edges"].values.copy()
+    # the first MHKiT edge is 0: draw the first cell as wide as its neighbour
+    xe[0] = x[0] - (xe[1] - x[0])
+    ye[0] = y[0] - (ye[1] - y[0])
+    finite = v.compressed()
+    norm = mcolors.Normalize(vmin=float(finite.min()) if finite.size else 0.0,
+                             vmax=float(finite.max()) if finite.size else 1.0)
+    mesh = ax.pcolormesh(xe, ye, v, cmap=cmap, norm=norm, shading="flat")
+    cm = mesh.get_cmap()
+    ax.grid(False)
+    size = 8 if max(x.size, y.size) <= 12 else 6
+    for i, h in enumerate(y):
+        for k, t in enumerate(x):
+            val = values[i, k]
+            if mask is not None and not mask[i, k]:
+                continue
+            text = None if labels is None else labels[i][k]
+            if labels is not None and text is None:
+                continue
+            if not np.isfinite(val):
+                ax.text(t, h, text or "n/a", ha="center", va="center", fontsize=size,
+                        color="0.3")
+                continue
+            r, g, b, _ = cm(norm(val))
+            dark = 0.299 * r + 0.587 * g + 0.114 * b < 0.5
+            ax.text(t, h, text or format(val, fmt), ha="center", va="center", fontsize=size,
+                    color="white" if dark else "black")
+    ax.set_xticks(x)
+    ax.set_yticks(y)
+    ax.set_xticklabels([f"{t:g}" for t in x], rotation=90 if x.size > 8 else 0)
+    ax.set_yticklabels([f"{h:g}" for h in y])
+    ax.set_xlabel(_label(pk))
+    ax.set_ylabel("significant wave height $H_{m0}$ (m)")
+    cb = fig.colorbar(mesh, ax=ax)
+    cb.set_label(cbar_label)
+    return mesh
+
+
+def plot_matrix(ds, path=None):
+    """The power matrix: mean optimum power (W) of each bin, numbers on a colour scale."""
+    import matplotlib
+
+    matplotlib.use("Agg", force=False)
+    import matplotlib.pyplot as plt
+
+    from ..plotting import _finish
+    from ..style import figure_style
+
+    with figure_style():
+        n = ds.sizes[_period(ds)]
+        fig, ax = plt.subplots(figsize=(max(6.0, 0.75 * n + 2.5), max(4.0, 0.45 *
+                                                                       ds.sizes["hm0"] + 2)))
+        _table_image(ax, ds, ds["power_mean"].values, "viridis", ".3g",
+                     "mean optimum power (W)", fig)
+        ax.set_title(f"power matrix: mean over {ds.sizes['realization']} records of "
+                     f"{_waves(ds)} peak periods per bin", fontsize=9)
+        return _finish(fig, path)
+
+
+def _waves(ds) -> str:
+    import json
+
+    return f"{json.loads(ds.attrs['sweep'])['waves']:g}"
+
+
+def plot_capture_width(ds, path=None):
+    """Capture width P / J (m) against the period, one line per Hm0 bin, with the range
+    (min to max over the realizations) shaded."""
+    import matplotlib
+
+    matplotlib.use("Agg", force=False)
+    import matplotlib.pyplot as plt
+
+    from ..plotting import _finish
+    from ..style import figure_style
+
+    pk = _period(ds)
+    x = ds[pk].values
+    with figure_style():
+        fig, ax = plt.subplots(figsize=(6.5, 4.2))
+        for i, h in enumerate(ds["hm0"].values):
+            y = ds["capture_width_matrix"].values[i]
+            line, = ax.plot(x, y, "o-", ms=3, lw=1.0, label=f"$H_{{m0}}$ = {h:g} m")
+            ax.fill_between(x, ds["capture_width_min"].values[i],
+                            ds["capture_width_max"].values[i], color=line.get_color(),
+                            alpha=0.15, lw=0)
+        cw = ds["capture_width_matrix"].values
+        cw = cw[np.isfinite(cw)]
+        if cw.size and cw.min() > 0 and cw.max() > 20 * cw.min():
+            ax.set_yscale("log")  # two decades and more: every line readable
+        ax.set_xlabel(_label(pk))
+        ax.set_ylabel("capture width $P/J$ (m)")
+        ax.set_title("capture width of the mean optimum (shaded: min to max over the "
+                     "records)", fontsize=9)
+        ax.legend(loc="lower left", bbox_to_anchor=(1.01, 0.0), frameon=False, fontsize=7)
+        return _finish(fig, path)
+
+
+def plot_scatter(ds, path=None):
+    """The site's scatter diagram (share of the year, %) with each bin's energy-weighted
+    contribution to the annual energy (% of the AEP) written in the cells."""
+    import matplotlib
+
+    matplotlib.use("Agg", force=False)
+    import matplotlib.pyplot as plt
+
+    from ..plotting import _finish
+    from ..style import figure_style
+
+    f = ds["frequency"].values
+    p = ds["power_mean"].values
+    e = np.where(f > 0, np.nan_to_num(p) * f, 0.0)
+    share = 100 * e / e.sum() if e.sum() > 0 else np.zeros_like(e)
+    with figure_style():
+        n = ds.sizes[_period(ds)]
+        fig, ax = plt.subplots(figsize=(max(6.0, 0.75 * n + 2.5), max(4.0, 0.45 *
+                                                                       ds.sizes["hm0"] + 2)))
+        labels = [[(f"{100 * f[i, k]:.2g}% yr\n{share[i, k]:.2g}% E"
+                    + ("" if np.isfinite(p[i, k]) else "\nno power")) if f[i, k] > 0 else None
+                   for k in range(f.shape[1])] for i in range(f.shape[0])]
+        _table_image(ax, ds, 100 * f, "Blues", ".2g", "share of the year (%)", fig,
+                     labels=labels)
+        aep = ds.attrs.get("annual_energy_mwh")
+        ax.set_title("scatter diagram: share of the year (% yr, colour) and of the annual "
+                     f"energy (% E; {aep:.4g} MWh/yr)" if aep is not None
+                     else "scatter diagram", fontsize=9)
+        return _finish(fig, path)
+
+
+def text_report(ds, out: dict, drawn: list) -> str:
+    """The plain-text summary of ``parapend power-matrix``."""
+    from ..cli._common import _table
+
+    pk = _period(ds)
+    hm0, per = ds["hm0"].values, ds[pk].values
+    lines = [f"power matrix, {out['device']} pendulum: {hm0.size} Hm0 x {per.size} {pk} bins, "
+             f"{out['realizations']} records of {out['waves']:g} peak periods each (seeds "
+             f"{out['seeds'][0]}..{out['seeds'][-1]}); Te/Tp = {out['te_over_tp']:.6g}",
+             f"computed now {out['computed_bins']} bins, found finished "
+             f"{out['resumed_bins']}; {out['seconds']:.1f} s ({out['executor']})"
+             + (f"; store {out['store']}" if out["store"] else ""), "",
+             "mean optimum power (W), rows Hm0 (m), columns " + pk + " (s):"]
+    rows = [[f"{h:g}", *(("n/a" if not np.isfinite(v) else f"{v:.4g}")
+                         for v in ds["power_mean"].values[i])] for i, h in enumerate(hm0)]
+    lines += [_table(rows, ["Hm0 \\ " + pk, *(f"{t:g}" for t in per)]), ""]
+    if out["failed_solves"]:
+        lines.append(f"{out['failed_solves']} solves did not converge (status in the store; "
+                     "left out of the statistics: see the count)")
+    a = out["annual_energy"]
+    if a is not None:
+        p = a["power"]
+        lines.append(f"mean annual energy (8766 h/yr): optimum {p['mwh']:.6g} MWh/yr, limit "
+                     f"{a['limit_power']['mwh']:.6g}, uniform rotation "
+                     f"{a['uniform_power']['mwh']:.6g}"
+                     + (f", electrical {a['electrical_power']['mwh']:.6g}"
+                        if "electrical_power" in a else ""))
+        if p.get("capacity_factor") is not None:
+            lines.append(f"capacity factor {p['capacity_factor']:.4g}")
+        if p["bins_without_power"]:
+            miss = ", ".join(f"(Hm0 {b['hm0']:g}, {pk} {b[pk]:g})"
+                             for b in p["bins_without_power"][:8])
+            lines.append(f"bins of the site without power (left out of the sum): {miss}"
+                         f"{' ...' if len(p['bins_without_power']) > 8 else ''}; "
+                         f"{p['missing_frequency']:.4g} of the year")
+        if p.get("outside_frequency"):
+            o = p["outside_frequency"]
+            lines.append(f"{o['sea_states']} sea states ({o['frequency']:.4g} of the year) "
+                         "lie outside the matrix's bins and contribute nothing")
+    for key in ("netcdf", "zarr", "csv"):
+        if out[key]:
+            lines.append(f"{key} written to {out[key]}")
+    for d in drawn:
+        lines.append(f"figure written to {d}")
+    return "\n".join(lines)

@@ -1,0 +1,228 @@
+"""What a power matrix computes (:class:`MatrixSpec`) and one block of it (one bin, all its
+realizations): the spec the design-map engine (:mod:`parapend.maps`) runs, stores and
+resumes like a sweep's.
+
+A block is one bin: ``R`` records of ``W`` waves, realization ``r`` seeded ``seed + r`` (the
+same phases in every bin: common random numbers), each solved by
+:func:`parapend.irregular.sea` exactly as ``parapend sea`` would. The store holds the
+per-realization powers (W) and statuses; the statistics are drawn from them afterwards.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+import logging
+import math
+
+import numpy as np
+
+__all__ = ["MatrixSpec", "QUANTITIES", "STORE_NAMES"]
+
+log = logging.getLogger(__name__)
+
+#: the stored per-realization quantities (W): name -> long name
+QUANTITIES = {
+    "power": "non-causal optimum over the record (parapend sea), mechanical power",
+    "limit_power": "gamma -> 0 limit omega_r TV(q) / 2 pi: no motion extracts more",
+    "uniform_power": "best uniform rotation at the mean wave frequency (K_m turns per record)",
+    "electrical_power": "electrical power of the optimum's motion through a power take-off "
+                        "of the given efficiency (generating x eta, motoring / eta)",
+}
+_TITLE = "parapend design map"
+#: every top-level name a power-matrix store holds (coordinates and variables)
+STORE_NAMES = ("hm0", "te", "tp", "realization", "seed", "done", "status", *QUANTITIES)
+#: devices a matrix can be computed for (the coupled buoy joins when it lands)
+DEVICES = ("prescribed-heave",)
+
+
+@dataclasses.dataclass(frozen=True)
+class MatrixSpec:
+    """The bins and everything a bin's solve depends on (its identity in the store)."""
+
+    hm0: tuple
+    period: tuple          # the bin centres of the period axis (te or tp)
+    period_kind: str       # "te" or "tp"
+    tp: tuple              # the peak period of each period bin (s)
+    realizations: int
+    waves: float
+    seed: int
+    spectrum: str
+    gamma_peak: float
+    cutoff: float
+    response: tuple | None  # (f, gain, phase) tuples or None
+    length: float
+    mass: float
+    inertia: float | None
+    gravity: float
+    gamma: float
+    winding: object
+    harmonics: int | None
+    efficiency: float | None
+    device: str = "prescribed-heave"
+
+    kind = "power_matrix"
+    pto = False
+
+    # -- the layout the maps engine reads ------------------------------------------------
+    @property
+    def dims(self) -> tuple:
+        return ("hm0", self.period_kind, "realization")
+
+    @property
+    def shape(self) -> tuple:
+        return (len(self.hm0), len(self.period), self.realizations)
+
+    @property
+    def points(self) -> int:
+        return int(np.prod(self.shape))
+
+    @property
+    def chunks(self) -> tuple:
+        return (1, 1, self.realizations)
+
+    @property
+    def block_grid(self) -> tuple:
+        return (len(self.hm0), len(self.period), 1)
+
+    @property
+    def blocks(self) -> int:
+        return len(self.hm0) * len(self.period)
+
+    def block_slices(self, block: int) -> tuple:
+        i, j, _ = np.unravel_index(block, self.block_grid)
+        return (slice(int(i), int(i) + 1), slice(int(j), int(j) + 1),
+                slice(0, self.realizations))
+
+    @property
+    def variables(self) -> tuple:
+        out = ["power", "limit_power", "uniform_power"]
+        if self.efficiency is not None:
+            out.append("electrical_power")
+        return (*out, "status")
+
+    @property
+    def names(self) -> tuple:
+        """Top-level names the store holds besides the variables and ``done``."""
+        return ("hm0", "te", "tp", "realization", "seed")
+
+    @property
+    def seeds(self) -> np.ndarray:
+        return self.seed + np.arange(self.realizations, dtype=np.int64)
+
+    def to_json(self) -> str:
+        d = dataclasses.asdict(self)
+        d["kind"] = self.kind
+        d["chunks"] = list(self.chunks)
+        return json.dumps(d, sort_keys=True)
+
+    @classmethod
+    def from_json(cls, text: str) -> MatrixSpec:
+        d = json.loads(text)
+        d.pop("kind")
+        d.pop("chunks")
+        for k in ("hm0", "period", "tp"):
+            d[k] = tuple(float(v) for v in d[k])
+        if d["response"] is not None:
+            d["response"] = tuple(tuple(float(v) for v in c) for c in d["response"])
+        return cls(**d)
+
+    def coordinates(self) -> dict:
+        """Coordinate name -> values (checked on resume)."""
+        return {"hm0": np.array(self.hm0), self.period_kind: np.array(self.period),
+                "realization": np.arange(self.realizations)}
+
+    def sea_kwargs(self, i: int, j: int, r: int) -> dict:
+        """The arguments of :func:`parapend.irregular.sea` for bin (i, j), realization r."""
+        tp = self.tp[j]
+        kw = {"hs": self.hm0[i], "tp": tp, "spectrum": self.spectrum,
+              "repeat_period": self.waves * tp, "seed": int(self.seeds[r]),
+              "cutoff": self.cutoff, "length": self.length, "mass": self.mass,
+              "inertia": self.inertia, "gravity": self.gravity, "gamma": self.gamma,
+              "winding": self.winding, "harmonics": self.harmonics}
+        if self.spectrum == "jonswap":
+            kw["gamma_peak"] = self.gamma_peak
+        if self.response is not None:
+            kw["response"] = tuple(np.array(c) for c in self.response)
+        return kw
+
+    # -- the store -------------------------------------------------------------------------
+    def template(self, command: str | None):
+        """The whole store as a lazy Dataset (dask arrays of fill values) and its encoding."""
+        import dask.array as da
+        import xarray as xr
+        from zarr.codecs import ZstdCodec
+
+        from .. import __version__
+        from ..maps.spec import STATUSES
+
+        data, enc = {}, {}
+        for v in (*self.variables, "done"):
+            if v == "done":
+                arr, fill = da.zeros(self.shape, dtype=bool, chunks=self.chunks), False
+                attrs = {"long_name": "bin finished (written after the bin's data)"}
+            elif v == "status":
+                arr = da.full(self.shape, -1, dtype=np.int8, chunks=self.chunks)
+                fill = -1
+                attrs = {"long_name": "solver status of the optimum",
+                         "flag_values": list(range(len(STATUSES))),
+                         "flag_meanings": " ".join(STATUSES),
+                         "comment": "-1: not computed; success: converged"}
+            else:
+                arr = da.full(self.shape, np.nan, dtype=float, chunks=self.chunks)
+                fill, attrs = np.nan, {"long_name": QUANTITIES[v], "units": "W"}
+            data[v] = (self.dims, arr, attrs)
+            enc[v] = {"chunks": self.chunks, "fill_value": fill,
+                      "compressors": (ZstdCodec(level=0, checksum=True),)}
+        pk = self.period_kind
+        other = "tp" if pk == "te" else "te"
+        from .resource import te_over_tp
+
+        ratio = te_over_tp(self.spectrum, self.gamma_peak)
+        others = (np.array(self.tp) * ratio if pk == "tp" else np.array(self.tp))
+        coords = {
+            "hm0": ("hm0", np.array(self.hm0),
+                    {"long_name": "significant wave height Hm0 (bin centre)", "units": "m"}),
+            pk: (pk, np.array(self.period),
+                 {"long_name": ("energy period Te" if pk == "te" else "peak period Tp")
+                  + " (bin centre)", "units": "s"}),
+            other: (pk, others, {"long_name": ("peak period Tp" if other == "tp" else
+                                               "energy period Te")
+                                 + f" of the bin (Te = {ratio:.12g} Tp)", "units": "s"}),
+            "realization": ("realization", np.arange(self.realizations),
+                            {"long_name": "realization"}),
+            "seed": ("realization", self.seeds, {"long_name": "seed of the record's phases"}),
+        }
+        attrs = {"title": _TITLE, "product": "power matrix", "parapend_version": __version__,
+                 "command": command or "parapend.power_matrix()", "sweep": self.to_json(),
+                 "device": self.device,
+                 "te_over_tp": ratio,
+                 "conventions": "powers in W, positive = harvested; per realization; "
+                                "parapend.performance adds the statistics (docs/performance.md)"}
+        return xr.Dataset(data, coords=coords, attrs=attrs), enc
+
+    # -- one block ---------------------------------------------------------------------------
+    def compute_block(self, block: int) -> dict:
+        from ..maps.spec import _CODE
+        from .solve import solve_bin
+
+        i, j, _ = (s.start for s in self.block_slices(block))
+        out = {v: (np.full(self.chunks, -1, dtype=np.int8) if v == "status"
+                   else np.full(self.chunks, np.nan)) for v in self.variables}
+        for r in range(self.realizations):
+            try:
+                vals = solve_bin(self, i, j, r)
+            except Exception as err:  # noqa: BLE001 - recorded as status "error"
+                log.warning("power matrix bin hm0=%g %s=%g realization %d failed: %s: %s",
+                            self.hm0[i], self.period_kind, self.period[j], r,
+                            type(err).__name__, err)
+                vals = {"status": "error"}
+            if vals.get("status") == "converged" and not math.isfinite(vals.get("power",
+                                                                                math.nan)):
+                vals["status"] = "nonfinite"
+            for k, v in vals.items():
+                if k == "status":
+                    out[k][0, 0, r] = _CODE.get(v, _CODE["other"])
+                else:
+                    out[k][0, 0, r] = v
+        return out
