@@ -24,7 +24,9 @@ SRC = ROOT / "src"
 sys.path.insert(0, str(SRC))
 os.environ["PYTHONPATH"] = os.pathsep.join(
     [str(SRC), *filter(None, [os.environ.get("PYTHONPATH")])])
-os.environ.setdefault("MPLBACKEND", "Agg")
+# Notebooks draw inline (ipykernel's backend): a backend set in the environment would
+# send their figures nowhere.
+os.environ.pop("MPLBACKEND", None)
 
 import parapend  # noqa: E402
 
