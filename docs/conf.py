@@ -149,8 +149,10 @@ html_theme = "pydata_sphinx_theme"
 html_title = f"parapend {release}"
 html_static_path = ["_static"]
 html_css_files = ["parapend.css"]
+html_sidebars = {"**": ["sidebar-global.html"]}
 html_theme_options = {
     "navigation_with_keys": False,
+    "navbar_center": [],
     "show_toc_level": 2,
     "secondary_sidebar_items": ["page-toc"],
 }
