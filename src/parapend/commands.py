@@ -208,7 +208,7 @@ def harmonics(*, excitation=None, omega=OMEGA, delta=None, square_alpha=None, fo
               length=None, mass=None, inertia=None, gravity=None, frequency=None,
               amplitude=None, damping_coefficient=None, progress=None):
     """Optimal power against the number of harmonics N = n_from..n_to (command
-    ``harmonics``): a Dataset over ``harmonics`` (:func:`parapend.api.harmonic_table`); with
+    ``harmonics``): a Dataset over ``harmonics`` (:func:`parapend.harmonic_table`); with
     ``length`` and ``mass`` it adds ``power_w`` and the attributes ``uniform_power_w`` and
     ``limit_power_w``."""
     from .api import harmonic_table

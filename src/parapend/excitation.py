@@ -147,7 +147,7 @@ def max_abs_q(exc: Excitation, cap: float | None = None) -> float:
     uniform points (by one FFT) the largest ``|q|`` is within a factor ``1 - pi K / m``
     (Bernstein's inequality ``|q'| <= K max|q|`` over half a grid step) of the true maximum.
     When that bracket straddles ``cap`` (or no ``cap`` is given) the maximum is taken
-    exactly at the extrema of ``q`` (the roots of ``dq/dt``, :attr:`Excitation.extrema`),
+    exactly at the extrema of ``q`` (the roots of ``dq/dt``, ``Excitation.extrema``),
     where ``|q|`` attains it. With a ``cap``, any value above it is returned as soon as it is
     certain to exceed it.
     """

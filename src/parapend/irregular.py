@@ -273,9 +273,9 @@ def sea_samples(result: SeaResult, points: int | None = None) -> dict:
 
 def plot_sea(result: SeaResult, path=None, zoom_waves: float = 8.0):
     """Record, motion and harvested energy over the record, and a zoom of a few waves."""
-    import matplotlib
+    from .style import use_agg
 
-    matplotlib.use("Agg", force=False)
+    use_agg()
     import matplotlib.pyplot as plt
 
     from .plotting import _finish

@@ -6,9 +6,9 @@ from __future__ import annotations
 
 import math
 
-import matplotlib
+from .style import use_agg
 
-matplotlib.use("Agg", force=False)
+use_agg()
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 

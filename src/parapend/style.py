@@ -10,7 +10,7 @@ from __future__ import annotations
 import contextlib
 from collections.abc import Iterator
 
-__all__ = ["RC", "figure_style"]
+__all__ = ["RC", "figure_style", "use_agg"]
 
 #: rcParams of every figure; :func:`figure_style` applies them while a figure is built, and
 #: :func:`parapend.fileio.save_figure` while it is rendered.
@@ -40,3 +40,15 @@ def figure_style() -> Iterator[None]:
 
     with rc_context(RC):
         yield
+
+
+def use_agg() -> None:
+    """Draw with matplotlib's Agg backend (figures are written to files), except in a Jupyter
+    kernel: there ``MPLBACKEND`` names the inline backend, which shows the figures the
+    plotting functions return, and switching to Agg would hide them."""
+    import os
+
+    import matplotlib
+
+    if "inline" not in os.environ.get("MPLBACKEND", ""):
+        matplotlib.use("Agg", force=False)

@@ -17,7 +17,9 @@ __all__ = ["FourierMotion", "PiecewiseConstantMotion", "SampledMotion"]
 
 @dataclass(frozen=True, eq=False)
 class FourierMotion:
-    """Truncated Fourier rotation of paper Eq. 10, ``s = omega*t``::
+    """Truncated Fourier rotation of paper Eq. 10, with ``s = omega*t``.
+
+    The motion is::
 
         theta = s + a0 + sum_{n=1}^{N} (a[n-1] sin(n s) + b[n-1] cos(n s))
 

@@ -82,7 +82,7 @@ def track_runs(*, runs: int = 20, seed: int = 0, periods: int = 100, torque_limi
     """``runs`` seeded closed-loop runs from hanging rest (module docstring); the other
     parameters as :func:`parapend.control.track` (the errors are the bounds of the draws).
     At most ``runs * periods <= 10000`` (:data:`parapend.limits.MAX_TRACK_WORK`);
-    ``design``: a :func:`~parapend.control.track.prepare` result to reuse."""
+    ``design``: a :func:`~parapend.control.prepare` result to reuse."""
     from .track import _design, _multipliers
 
     runs = check_int("runs", runs, 1, 1000)

@@ -22,7 +22,7 @@ true period ``d`` is awaited. Anything else within the period budget is ``"other
 Two entry points:
 
 * :func:`classify` -- classify given stroboscopic samples (e.g. from
-  :func:`parapend.dynamics.simulate.stroboscopic` or a DOP853 trajectory): a direct,
+  :func:`parapend.dynamics.stroboscopic` or a DOP853 trajectory): a direct,
   unvectorized check of the tail of one sequence; the reference implementation.
 * :func:`find_attractors` -- vectorized engine for many initial conditions: integrates all
   of them together (fixed-step RK4 of :mod:`.simulate`), retires each trajectory as soon as
@@ -148,7 +148,7 @@ class Classification:
     Attributes
     ----------
     name : str
-        As :attr:`Attractor.name`, or ``"other"``.
+        As ``Attractor.name``, or ``"other"``.
     kind : str
         ``"rest"``, ``"oscillation"``, ``"rotation"`` or ``"other"``.
     period, winding : int
@@ -885,7 +885,7 @@ def find_attractors(phi0: ArrayLike, dphi0: ArrayLike, gamma: float, p: float, o
     periods : int
         Budget of forcing periods per trajectory; unconverged trajectories are "other".
     steps_per_period : int
-        RK4 steps per forcing period (see :func:`~parapend.dynamics.simulate.stroboscopic`).
+        RK4 steps per forcing period (see :func:`~parapend.dynamics.stroboscopic`).
     t0 : float
         Initial time (the Poincare section is ``t0 + m*T``).
     tol : float

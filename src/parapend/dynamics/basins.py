@@ -298,7 +298,7 @@ def basin_map(gamma: float, p: float, omega: float, *, n_phi: int = 200, n_dphi:
     periods : int
         Budget of forcing periods per trajectory.
     steps_per_period, t0, tol, max_period, capture_radius, pilot
-        As :func:`parapend.dynamics.attractors.find_attractors`.
+        As :func:`parapend.dynamics.find_attractors`.
     workers : int, optional
         Threads: default every core for ``engine="numba"``, 1 for ``"numpy"``. Labels do
         not depend on it.
@@ -307,7 +307,7 @@ def basin_map(gamma: float, p: float, omega: float, *, n_phi: int = 200, n_dphi:
         parallel over the points, the same RK4 arithmetic and the same decision rules
         (capture, lag-k convergence, budget) as the NumPy engine; the attractor catalogue
         (pilot and capture verification) is built first by the NumPy engine. ``"numpy"``:
-        the vectorized engine of :func:`~parapend.dynamics.attractors.find_attractors`.
+        the vectorized engine of :func:`~parapend.dynamics.find_attractors`.
         The two give identical labels except, rarely, on fractal basin boundaries where
         the order in which capture becomes available differs (tested on small grids).
     progress : callable, optional

@@ -4,7 +4,7 @@ the classification of where it ends up (paper Fig. 1 right).
 The trajectory is integrated by DOP853 (:func:`parapend.dynamics.simulate.trajectory`) on a
 time grid with ``points_per_period`` samples per forcing period ``T = 2*pi/omega``, so that
 every ``points_per_period``-th sample lies on the Poincare section ``t0 + m*T``; those
-samples are classified by :func:`parapend.dynamics.attractors.classify` (period-k
+samples are classified by :func:`parapend.dynamics.classify` (period-k
 oscillation, rotation, rest, or "other").
 """
 
@@ -42,7 +42,7 @@ class Motion:
     poincare_t, poincare_phi, poincare_dphi : ndarray, shape (periods + 1,)
         Samples on the section ``t0 + m*T``.
     classification : Classification
-        Of the Poincare samples (see :func:`parapend.dynamics.attractors.classify`).
+        Of the Poincare samples (see :func:`parapend.dynamics.classify`).
     gamma, p, omega, phi0, dphi0, t0 : float
     periods, points_per_period : int
     success : bool
@@ -114,7 +114,7 @@ def simulate(gamma: float = 0.1, p: float = 0.8, omega: float = 2.1, phi0: float
     t0 : float
         Initial time (forcing phase ``omega t0``).
     tol, max_period : float, int
-        Of :func:`~parapend.dynamics.attractors.classify`.
+        Of :func:`~parapend.dynamics.classify`.
     rtol, atol : float
         DOP853 tolerances.
 

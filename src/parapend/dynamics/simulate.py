@@ -331,7 +331,7 @@ class Stroboscopic:
     ----------
     t : ndarray, shape (periods + 1,)
         Sampling times.
-    phi, dphi : ndarray, shape (periods + 1, *shape)
+    phi, dphi : ndarray, shape ``(periods + 1, *shape)``
         Angle from hanging (unwrapped, radians) and rate; ``shape`` is the broadcast shape
         of the initial conditions.
     gamma, p, omega : float

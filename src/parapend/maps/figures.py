@@ -187,9 +187,9 @@ def plot_map(ds, quantity: str = "power", x=None, y=None, at=None, path=None, sc
     The colour bar covers the whole range of the values; a long tail is compressed into its
     end, and the bar says so (:func:`colour_scale`). The contours are at round values inside
     the uncompressed part, labelled away from the edges."""
-    import matplotlib
+    from ..style import use_agg
 
-    matplotlib.use("Agg", force=False)
+    use_agg()
     import matplotlib.pyplot as plt
     from matplotlib.colors import FuncNorm, Normalize
     from matplotlib.ticker import MaxNLocator

@@ -990,7 +990,7 @@ def solve_bvp_optimum(excitation, gamma: float, *, tol: float = 1e-8,
         square wave, Fourier series, sampled).
     gamma : float
         Viscous damping ``gamma > 0`` (Eq. 14); the penalty is ``epsilon = 2 gamma``.
-        ``gamma = 0`` has no smooth optimum (use :func:`parapend.optimal.limit.limit`).
+        ``gamma = 0`` has no smooth optimum (use :func:`parapend.limit`).
     tol : float
         Bound on the element RMS of the relative residual (as SciPy's ``solve_bvp``).
     max_nodes : int
