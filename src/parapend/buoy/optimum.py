@@ -250,6 +250,8 @@ def _dual(w: np.ndarray, beta: np.ndarray, lam0: np.ndarray | None = None):
     b = beta[:kc]
     pos = b > 0
 
+    if not pos.any():
+        return _abs_mean(w)[0], np.zeros(kc, dtype=complex)
     sb = np.sqrt(b[pos])  # lam = sqrt(beta) mu: the quadratic term is |mu|^2 / 2
 
     def unpack(z):
@@ -272,7 +274,7 @@ def _dual(w: np.ndarray, beta: np.ndarray, lam0: np.ndarray | None = None):
     z0 = np.zeros(2 * int(pos.sum())) if lam0 is None else np.concatenate(
         (lam0[:kc][pos].real / sb, lam0[:kc][pos].imag / sb))
     r = minimize(f, z0, jac=True, method="L-BFGS-B",
-                 options={"maxiter": 5000, "maxcor": 50, "ftol": 1e-15, "gtol": 1e-12})
+                 options={"maxiter": 5000, "maxcor": 10, "ftol": 1e-15, "gtol": 1e-12})
     lam = unpack(r.x)
     return float(r.fun), lam
 
