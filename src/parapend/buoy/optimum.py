@@ -145,18 +145,31 @@ class CoupledSolution:
         return {"theta": th, "theta_dot": thd, "theta_ddot": thdd, "z": z, "z_dot": zd,
                 "z_ddot": zdd, "tau": tau}
 
+    def torque_grid(self, m: int) -> np.ndarray:
+        """``tau`` (N m) at ``t_j = j T / m``, j = 0..m-1 (``m`` even; by FFTs)."""
+        w = self.omega
+        x = np.asarray(self.theta_coefficients["x"], dtype=float)
+        th, ths, thss = _grid_motion(x, self.winding, m)
+        zf = self._full_heave[: m // 2]
+        c = np.zeros(m // 2 + 1, dtype=complex)
+        c[: zf.size] = -((np.arange(zf.size) * w) ** 2) * zf * (m / 2.0)
+        zdd = np.fft.irfft(c, m)
+        p = self._pendulum
+        return (p.inertia * w**2 * thss + p.damping_coefficient * w * ths
+                - p.mass * p.length * (self._g + zdd) * np.sin(th))
+
     def peak_torque(self) -> float:
         """``max |tau|`` over one period, N m: on a grid, the largest local maxima refined."""
         from scipy.optimize import minimize_scalar
 
-        m = max(2048, 16 * self.harmonics)
-        t = self.period * np.arange(m) / m
-        a = np.abs(self.sample(t)["tau"])
+        m = 1 << int(math.ceil(math.log2(max(2048, 16 * self.harmonics,
+                                                4 * self._full_heave.size))))
+        a = np.abs(self.torque_grid(m))
         dt = self.period / m
         best = float(np.max(a))
         for j in np.argsort(a)[-3:]:
             r = minimize_scalar(lambda tt: -abs(float(self.sample(np.array([tt]))["tau"][0])),
-                                bounds=(t[j] - dt, t[j] + dt), method="bounded",
+                                bounds=(j * dt - dt, j * dt + dt), method="bounded",
                                 options={"xatol": 1e-10 * self.period})
             best = max(best, -float(r.fun))
         return best
