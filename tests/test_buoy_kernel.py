@@ -191,3 +191,40 @@ def test_wave_from_record_round_trip():
     assert wave.omega == pytest.approx(2 * np.pi / 32)
     assert wave.amplitudes[2] == pytest.approx(0.3 * np.exp(0.4j), abs=1e-12)
     assert np.max(np.abs(np.delete(wave.amplitudes, 2))) < 1e-12
+
+
+def test_aliased_optimum_is_rejected():
+    """On a grid too coarse for its coefficients a run's power does not survive the fine
+    grid: it is marked aliased and not returned."""
+    from parapend.buoy.optimum import _polish
+
+    p = Pendulum(4000.0, 1.0, 4500.0, 0.0)
+    sc = scales(HYDRO, p, Wave.regular(1.5, 6.0))
+    pr = CoupledProblem(free_excitation(sc), sc.beta_nd, 8, 0.0, points=16)
+    big = np.zeros(17)
+    big[8], big[16] = 40.0, 25.0
+    best, runs, rejected = _polish(pr, [("big", big), ("zero", np.zeros(17))], 1024)
+    assert rejected == 1 and runs[0].status == "aliased"
+    assert best.seed == "zero"
+
+
+def test_zero_damping_is_a_lower_bound():
+    p = Pendulum(4000.0, 1.0, 4500.0, 0.0)
+    r = coupled_optimum(HYDRO, p, Wave.regular(1.5, 6.0), harmonics=8, starts=6)
+    assert "lower bound" in r.status
+    assert r.power <= r.limit
+
+
+@pytest.mark.slow
+def test_irregular_record_twenty_waves():
+    """A 20-wave JONSWAP record (matrix-free Newton-CG): balance, bounds, and the reaction
+    costs power against the one-way answer."""
+    h = toy_hydro(radius=2.0, top=6.0)
+    p = Pendulum(2000.0, 1.0, 2500.0, 50.0)
+    rec = Wave.from_spectrum(hs=2.0, tp=8.0, repeat_period=160.0, seed=0)
+    r = coupled_optimum(h, p, rec)
+    assert r.success, r.status
+    assert r.energy_balance_residual <= BALANCE_TOL
+    assert 0 < r.power <= r.limit <= r.radiation_bound
+    assert r.power < r.evidence["one_way_power"]
+    assert r.refinement_change <= 1e-3 * r.power
