@@ -53,8 +53,9 @@ HARMONICS_PER_TURN = 24
 HARMONICS_PER_WAVE = 16
 #: a torque-limited optimum may exceed the limit between its grid points by this fraction
 TORQUE_SLACK = 1e-3
-#: dense Hessian up to this many harmonics, matrix-free Newton-CG above
-DENSE_MAX = 256
+#: dense Hessian for a regular wave up to this many harmonics, matrix-free Newton-CG above
+#: and for every record (the dense Newton from the swinging-back seeds took minutes at N = 192)
+DENSE_MAX = 96
 
 
 @dataclass(frozen=True, eq=False)
@@ -339,7 +340,7 @@ def _check_hydro(hydro, wave: Wave):
     sig = np.nonzero(a >= 1e-3 * a.max())[0]
     fr = wave.frequencies
     hydro.check_covers(float(fr[sig[0]]), float(fr[sig[-1]]))
-    top = wave.omega * (1 + np.nonzero(a > 0)[0][-1])
+    top = wave.omega * (1 + np.nonzero(a > 1e-9 * a.max())[0][-1])
     if bool(np.any(hydro.above_range(np.array([top])))):
         warnings.warn("wave: components above the dataset's highest frequency are taken "
                       "with B = F = 0", RuntimeWarning, stacklevel=3)
@@ -521,7 +522,7 @@ def coupled_optimum(hydro, pendulum: Pendulum, wave: Wave, *, winding: int = 1,
     pu = sc.power_unit
     if n is None:
         n = _default_harmonics(sc, k, regular)
-    hess = "dense" if n <= DENSE_MAX else "operator"
+    hess = "dense" if regular and n <= DENSE_MAX else "operator"
     bound = hydro.radiation_bound(wave.frequencies, wave.amplitudes)
     kw = {"winding": k, "hessian": hess}
     if not regular:
@@ -541,7 +542,7 @@ def coupled_optimum(hydro, pendulum: Pendulum, wave: Wave, *, winding: int = 1,
                        pendulum)
     # one refinement: 2N from the N optimum
     n2 = 2 * n
-    hess2 = "dense" if n2 <= DENSE_MAX else "operator"
+    hess2 = "dense" if regular and n2 <= DENSE_MAX else "operator"
     fine = CoupledProblem(exc, sc.beta_nd, n2, sc.gamma, winding=k, hessian=hess2)
     ref = newton_maximize(fine, _pad(best.x, n2), best.seed)
     change = abs(ref.power - best.power)
@@ -551,7 +552,7 @@ def coupled_optimum(hydro, pendulum: Pendulum, wave: Wave, *, winding: int = 1,
         sol, n = ref, n2
     tl_note = None
     if torque_limit is not None:
-        if n > DENSE_MAX:
+        if not regular:
             raise ParameterError("torque-limit: supported with the buoy for a regular wave "
                                  "only (not for a record); drop --torque-limit")
         lim_t = torque_limit / sc.torque_unit
