@@ -41,7 +41,7 @@ from ..optimal.fourier import _pad, motion_distance, newton_maximize, search_fou
 from ..optimal.limit import limit as uncoupled_limit
 from .coupled import CoupledProblem, Pendulum, Wave, free_excitation, scales
 
-__all__ = ["CoupledSolution", "coupled_limit", "coupled_optimum"]
+__all__ = ["CoupledSolution", "coupled_limit", "coupled_optimum", "radiation_bound"]
 
 #: relative change of the optimum's power between its grid and one four times finer above
 #: which the optimum is rejected as aliased
@@ -346,6 +346,17 @@ def _check_hydro(hydro, wave: Wave):
                       "with B = F = 0", RuntimeWarning, stacklevel=3)
 
 
+def radiation_bound(hydro, wave: Wave) -> float:
+    """``sum_k |F_k a_k|^2 / (8 B_k)`` over the wave's components with ``B_k > 0``, W (each
+    component's bound for a heaving body; the harmonics of a periodic motion are orthogonal
+    in the mean power, so the bounds add)."""
+    _, b, f = hydro.coefficients(wave.frequencies)
+    b = np.asarray(b, dtype=float)
+    e = np.abs(np.asarray(f) * wave.amplitudes) ** 2
+    ok = b > 0
+    return float(np.sum(e[ok] / (8.0 * b[ok])))
+
+
 def _default_harmonics(sc, winding: int, regular: bool) -> int:
     if regular:
         return HARMONICS_PER_TURN * winding
@@ -523,7 +534,7 @@ def coupled_optimum(hydro, pendulum: Pendulum, wave: Wave, *, winding: int = 1,
     if n is None:
         n = _default_harmonics(sc, k, regular)
     hess = "dense" if regular and n <= DENSE_MAX else "operator"
-    bound = hydro.radiation_bound(wave.frequencies, wave.amplitudes)
+    bound = radiation_bound(hydro, wave)
     kw = {"winding": k, "hessian": hess}
     if not regular:
         kw["propose"] = 4
