@@ -1,0 +1,1 @@
+"""The pendulum inside a floating buoy, coupled both ways (see the submodules)."""
