@@ -187,7 +187,6 @@ def test_result_numbers_against_their_definitions(solved):
 
 def test_cli_json_plot_and_save(sphere_nc, tmp_path, capsys, solved):
     import xarray as xr
-
     from figure_checks import all_problems
 
     out = tmp_path / "figs"
