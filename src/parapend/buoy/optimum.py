@@ -1,0 +1,485 @@
+r"""The coupled optimum of a pendulum inside a heaving buoy: :func:`coupled_optimum`.
+
+The problem in ``theta`` alone (:mod:`.coupled`) is solved by the safeguarded Newton method
+of :mod:`parapend.optimal.fourier` (dense Hessian for a regular wave, matrix-free Newton-CG
+for a record), started from several seeds (global search):
+
+- the one-way optimum (the free buoy's motion fed to the uncoupled global search) and every
+  other distinct local maximum that search found;
+- the same motions with their periodic part halved (a heavy pendulum moves the buoy less);
+- uniform rotations at 8 phases;
+- swinging-back motions ``K s + alpha sin(K s + psi)`` with ``alpha > 1`` (the rotation
+  runs backwards for part of the cycle: a heavy pendulum can have such a second maximum).
+
+Every optimum is re-evaluated on a grid four times finer; a run whose power changes there by
+more than :data:`ALIAS_TOL` (relative) is rejected (aliasing: on a coarse grid the objective
+can be driven to absurd values by large coefficients). The harmonics ``N`` are chosen from
+the problem and checked by one refinement (``2N`` polished from the ``N`` optimum).
+
+Checks reported in every result: the energy balance
+``P + c <theta'^2> = <F_exc z'> - sum_k 1/2 B_k (k w)^2 |Z_k|^2`` (the left side from the
+torque in the time domain on a fine grid, the right side from the heave harmonics), the
+radiation bound ``sum_k |F_k a_k|^2 / (8 B_k)``, and the coupled ``c = 0`` supremum
+(:func:`coupled_limit`): with ``c = 0``, ``P = m l <z_w''' u> - 1/2 sum beta_k |U_k|^2``
+depends on ``u = cos(theta)`` only, and a rotation can approach any measurable
+``u(t)`` in ``[-1, 1]`` (fast turns cost nothing without damping), so the supremum is the
+concave box-constrained quadratic programme over ``u``, solved on a fine grid; without the
+box its value is the radiation bound.
+"""
+
+from __future__ import annotations
+
+import math
+import warnings
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..errors import ParameterError, check_int
+from ..excitation import _evaluate
+from ..optimal.fourier import _pad, motion_distance, newton_maximize, search_fourier
+from ..optimal.limit import limit as uncoupled_limit
+from .coupled import CoupledProblem, Pendulum, Wave, free_excitation, scales
+
+__all__ = ["CoupledSolution", "coupled_limit", "coupled_optimum"]
+
+#: relative change of the optimum's power between its grid and one four times finer above
+#: which the optimum is rejected as aliased
+ALIAS_TOL = 1e-8
+#: relative energy-balance residual every result must meet
+BALANCE_TOL = 1e-9
+#: harmonics of the motion per turn (regular wave) and per mean wave (record)
+HARMONICS_PER_TURN = 24
+HARMONICS_PER_WAVE = 16
+#: dense Hessian up to this many harmonics, matrix-free Newton-CG above
+DENSE_MAX = 256
+
+
+@dataclass(frozen=True, eq=False)
+class CoupledSolution:
+    """The coupled optimum (SI units).
+
+    Attributes
+    ----------
+    success, status : bool, str
+        ``success``: the Newton run converged, the fine-grid re-evaluation agrees and the
+        energy balance holds to :data:`BALANCE_TOL`; ``status`` says what was found
+        (at ``c = 0`` that the power is a lower bound of ``limit``).
+    power : float
+        ``P = -<tau theta'>``, W.
+    harmonics : int
+        N of the motion (chosen from the problem, checked by one refinement).
+    theta_coefficients : dict
+        ``{"x": [a0, a_1..a_N, b_1..b_N], "winding": K, "omega": w}``: ``theta(t) = K w t +
+        a0 + sum a_n sin(n w t) + b_n cos(n w t)``.
+    heave : ndarray, complex
+        ``Z_k``, k = 0..N (m).
+    energy_balance_residual : float
+        ``|P + c<theta'^2> - (<F_exc z'> - sum 1/2 B_k (kw)^2 |Z_k|^2)| / scale`` (one-way:
+        the pendulum's balance ``P + c<theta'^2> = m l <z''' cos(theta)>``).
+    radiation_bound : float
+        ``sum_k |F_k a_k|^2 / (8 B_k)``, W.
+    limit : float
+        The coupled ``c = 0`` supremum (one-way: the uncoupled ``w TV(q) / 2 pi``), W.
+    evidence : dict
+        The global search: starts, converged, abandoned, rejected (aliased), the distinct
+        maxima (power in W and seed), the seed of the optimum.
+    one_way : bool
+        The pendulum's reaction left out (the pivot moves as the free buoy).
+    refinement_change : float
+        ``|P(2N) - P(N)|``, W.
+    limit_change : float
+        Change of ``limit`` under one refinement of its grid, W.
+    free_heave : ndarray, complex
+        The free buoy's ``Z_k = F_k a_k / D_k``, k = 0..K (m).
+    """
+
+    success: bool
+    status: str
+    power: float
+    harmonics: int
+    theta_coefficients: dict
+    heave: np.ndarray
+    energy_balance_residual: float
+    radiation_bound: float
+    limit: float
+    evidence: dict
+    one_way: bool = False
+    refinement_change: float = 0.0
+    limit_change: float = 0.0
+    free_heave: np.ndarray = field(default=None, repr=False)
+    omega: float = 0.0
+    winding: int = 1
+    _full_heave: np.ndarray = field(default=None, repr=False)
+    _pendulum: Pendulum = field(default=None, repr=False)
+    _g: float = 9.81
+
+    @property
+    def period(self) -> float:
+        """The period of the motion, s."""
+        return 2 * math.pi / self.omega
+
+    def sample(self, t) -> dict:
+        """``theta`` (rad), ``theta_dot`` (rad/s), ``theta_ddot``, ``z`` (m), ``z_dot``,
+        ``z_ddot`` and ``tau`` (N m) at times ``t`` (s)."""
+        t = np.asarray(t, dtype=float)
+        w, kw = self.omega, self.winding
+        x = np.asarray(self.theta_coefficients["x"], dtype=float)
+        n = (x.size - 1) // 2
+        spec = np.zeros(n + 1, dtype=complex)
+        spec[0] = x[0]
+        spec[1:] = x[n + 1:] - 1j * x[1:n + 1]
+        k = np.arange(n + 1)
+        s = w * t
+        th = kw * s + _evaluate(spec, s)
+        thd = w * (kw + _evaluate(1j * k * spec, s))
+        thdd = w**2 * _evaluate(-(k**2) * spec, s)
+        zf = self._full_heave
+        kz = np.arange(zf.size) * w
+        z = _evaluate(zf, s)
+        zd = _evaluate(1j * kz * zf, s)
+        zdd = _evaluate(-(kz**2) * zf, s)
+        p = self._pendulum
+        tau = (p.inertia * thdd + p.damping_coefficient * thd
+               - p.mass * p.length * (self._g + zdd) * np.sin(th))
+        return {"theta": th, "theta_dot": thd, "theta_ddot": thdd, "z": z, "z_dot": zd,
+                "z_ddot": zdd, "tau": tau}
+
+    def peak_torque(self) -> float:
+        """``max |tau|`` over one period, N m: on a grid, the largest local maxima refined."""
+        from scipy.optimize import minimize_scalar
+
+        m = max(2048, 16 * self.harmonics)
+        t = self.period * np.arange(m) / m
+        a = np.abs(self.sample(t)["tau"])
+        dt = self.period / m
+        best = float(np.max(a))
+        for j in np.argsort(a)[-3:]:
+            r = minimize_scalar(lambda tt: -abs(float(self.sample(np.array([tt]))["tau"][0])),
+                                bounds=(t[j] - dt, t[j] + dt), method="bounded",
+                                options={"xatol": 1e-10 * self.period})
+            best = max(best, -float(r.fun))
+        return best
+
+
+# ------------------------------------------------------------------------------------------
+def _grid_motion(x: np.ndarray, winding: int, m: int):
+    """``theta``, ``dtheta/ds``, ``d2theta/ds2`` on ``m`` points of one period of ``s``."""
+    n = (x.size - 1) // 2
+    c = np.zeros(m // 2 + 1, dtype=complex)
+    c[0] = m * x[0]
+    c[1:n + 1] = 0.5 * m * (x[n + 1:] - 1j * x[1:n + 1])
+    k = np.arange(m // 2 + 1)
+    s = 2 * np.pi * np.arange(m) / m
+    th = winding * s + np.fft.irfft(c, m)
+    ths = winding + np.fft.irfft(1j * k * c, m)
+    thss = np.fft.irfft(-(k**2) * c, m)
+    return th, ths, thss
+
+
+def _heave_and_balance(hydro, pendulum: Pendulum, wave: Wave, x: np.ndarray, winding: int,
+                       m: int, coupled: bool):
+    """Power from the torque in the time domain, the heave harmonics and the energy balance.
+
+    Returns ``(power_w, heave, residual)``: ``heave`` the ``Z_k``, k = 0..m/2 - 1.
+    """
+    w = wave.omega
+    mass, l_, inertia = pendulum.mass, pendulum.length, pendulum.inertia
+    c = pendulum.damping_coefficient
+    g = float(hydro.g)
+    th, ths, thss = _grid_motion(x, winding, m)
+    thd, thdd = w * ths, w**2 * thss
+    u = np.cos(th)
+    kk = np.arange(m // 2)
+    ch = 2.0 * np.fft.rfft(u)[: m // 2] / m
+    ch[0] = 0.0
+    om = kk * w
+    fa = np.zeros(m // 2, dtype=complex)
+    ka = min(wave.amplitudes.size, m // 2 - 1)
+    _, _, F = hydro.coefficients(om[1:ka + 1])
+    fa[1:ka + 1] = F * wave.amplitudes[:ka]
+    A, B, _ = hydro.coefficients(om)
+    D = -om**2 * (hydro.mass + A) + 1j * om * B + hydro.hydrostatic_stiffness
+    Z = np.zeros(m // 2, dtype=complex)
+    Z[1:] = (fa[1:] + (mass * l_ * om[1:] ** 2 * ch[1:] if coupled else 0.0)) / D[1:]
+    zspec = np.zeros(m // 2 + 1, dtype=complex)
+    zspec[: m // 2] = -(om**2) * Z * (m / 2.0)
+    zdd = np.fft.irfft(zspec, m)
+    tau = inertia * thdd + c * thd - mass * l_ * (g + zdd) * np.sin(th)
+    p = -float(np.mean(tau * thd))
+    diss = c * float(np.mean(thd**2))
+    if coupled:
+        exc = 0.5 * float(np.sum((fa * np.conj(1j * om * Z)).real))
+        rad = 0.5 * float(np.sum(B * om**2 * np.abs(Z) ** 2))
+        rhs = exc - rad
+        scale = max(abs(p), diss, abs(exc), rad, 1e-300)
+    else:
+        # the pendulum's own balance: P + c<theta'^2> = m l <z''' cos(theta)>
+        rhs = mass * l_ * 0.5 * float(np.sum(((-1j * om**3) * Z * np.conj(ch)).real))
+        scale = max(abs(p), diss, abs(rhs), 1e-300)
+    return p, Z, abs(p + diss - rhs) / scale
+
+
+# ------------------------------------------------------------------------------------------
+def _qp_value(w: np.ndarray, beta: np.ndarray, u: np.ndarray) -> float:
+    m = u.size
+    kc = min(beta.size, m // 2 - 1)
+    uh = np.fft.rfft(u)[1:kc + 1] / m
+    return float(np.mean(w * u)) - 2.0 * float(np.dot(beta[:kc], np.abs(uh) ** 2))
+
+
+def _solve_qp(w: np.ndarray, beta: np.ndarray, u0: np.ndarray) -> np.ndarray:
+    """``max <w u> - 2 sum beta_k |<u e^{-iks}>|^2`` over ``u`` in [-1, 1]^m (L-BFGS-B)."""
+    from scipy.optimize import minimize
+
+    m = w.size
+    kc = min(beta.size, m // 2 - 1)
+    b = beta[:kc]
+
+    def f(u):
+        uh = np.fft.rfft(u)[1:kc + 1] / m
+        val = float(np.dot(w, u)) / m - 2.0 * float(np.dot(b, uh.real**2 + uh.imag**2))
+        c = np.zeros(m // 2 + 1, dtype=complex)
+        c[1:kc + 1] = -2.0 * m * b * uh
+        grad = (w + np.fft.irfft(c, m)) / m
+        return -val * m, -grad * m
+
+    r = minimize(f, u0, jac=True, method="L-BFGS-B", bounds=[(-1.0, 1.0)] * m,
+                 options={"maxiter": 20000, "maxcor": 30, "ftol": 1e-16, "gtol": 1e-13})
+    return np.clip(r.x, -1.0, 1.0)
+
+
+def coupled_limit(sc, points: int = 1024) -> tuple[float, float, np.ndarray]:
+    """The coupled ``c = 0`` supremum (non-dimensional) on ``points`` and on twice as many.
+
+    Returns ``(value, change, u)``: the value on the finer grid, its change from the coarser
+    one, and the optimal ``u = cos(theta)`` there.
+    """
+    exc = free_excitation(sc)
+    beta = np.asarray(sc.beta_nd, dtype=float)
+    m = max(points, 1 << int(math.ceil(math.log2(8 * max(beta.size, exc.spectrum.size)))))
+    w = exc.dq_grid(m)
+    u = _solve_qp(w, beta, np.sign(w))
+    v1 = _qp_value(w, beta, u)
+    w2 = exc.dq_grid(2 * m)
+    u2 = _solve_qp(w2, beta, np.repeat(u, 2))
+    v2 = _qp_value(w2, beta, u2)
+    return v2, abs(v2 - v1), u2
+
+
+# ------------------------------------------------------------------------------------------
+def _check_args(winding, harmonics, torque_limit, efficiency, starts):
+    if torque_limit is not None:
+        raise ParameterError("torque-limit: not yet supported with the buoy (the ideal "
+                             "coupled optimum only); drop --torque-limit")
+    if efficiency is not None:
+        raise ParameterError("efficiency: not yet supported with the buoy (the ideal coupled "
+                             "optimum only); drop --efficiency")
+    k = check_int("winding", winding, 1, 4096)
+    n = None if harmonics is None else check_int("harmonics", harmonics, 1, 8192)
+    if n is not None and n < 2 * k:
+        raise ParameterError(f"harmonics: expected at least 2 K = {2 * k} harmonics to draw "
+                             f"{k} turns, got {n}")
+    if starts is not None:
+        starts = check_int("starts", starts, 1, 1000)
+    return k, n, starts
+
+
+def _check_hydro(hydro, wave: Wave):
+    a = np.abs(wave.amplitudes)
+    sig = np.nonzero(a >= 1e-3 * a.max())[0]
+    fr = wave.frequencies
+    hydro.check_covers(float(fr[sig[0]]), float(fr[sig[-1]]))
+    top = wave.omega * (1 + np.nonzero(a > 0)[0][-1])
+    if bool(np.any(hydro.above_range(np.array([top])))):
+        warnings.warn("wave: components above the dataset's highest frequency are taken "
+                      "with B = F = 0", RuntimeWarning, stacklevel=3)
+
+
+def _default_harmonics(sc, winding: int, regular: bool) -> int:
+    if regular:
+        return HARMONICS_PER_TURN * winding
+    e = np.abs(sc.free_heave) ** 2
+    k = np.arange(e.size)
+    km = max(1, int(round(float(np.sum(k * e) / np.sum(e))))) if np.sum(e) > 0 else 1
+    return min(HARMONICS_PER_WAVE * max(km, winding), 8192)
+
+
+def _seeds(one_way_runs, n: int, winding: int, best_x, count):
+    """Seeds of the coupled search (see the module docstring)."""
+    out = [("one-way", _pad(best_x, n))]
+    distinct = []
+    for r in sorted((r for r in one_way_runs if r.status == "converged"),
+                    key=lambda r: -r.power):
+        xr = _pad(r.x, n)
+        if all(motion_distance(xr, d) > 1e-6 for d in [out[0][1], *distinct]):
+            distinct.append(xr)
+    out += [(f"one-way-{i + 2}", d) for i, d in enumerate(distinct[:4])]
+    half = out[0][1].copy()
+    half[1:] *= 0.5
+    out.append(("one-way-half", half))
+    for j in range(8):
+        x = np.zeros(2 * n + 1)
+        x[0] = 2 * math.pi * j / 8
+        out.append((f"uniform-{j}", x))
+    if n >= winding:
+        for alpha in (1.5, 3.0):
+            for j in range(4):
+                psi = 2 * math.pi * j / 4
+                x = np.zeros(2 * n + 1)
+                x[winding] = alpha * math.cos(psi)       # a_K sin(K s)
+                x[n + winding] = alpha * math.sin(psi)   # b_K cos(K s)
+                out.append((f"swing-back-{alpha:g}-{j}", x))
+    return out[:count] if count is not None else out
+
+
+def _polish(problem, seeds, fine_points):
+    """Newton from every seed; reject aliased runs. Returns ``(best, runs, rejected)``."""
+    runs, rejected = [], 0
+    scale = float(np.max(np.abs(problem.w)))
+    bar = -math.inf
+    best = None
+    for name, x0 in seeds:
+        r = newton_maximize(problem, x0, name, abandon_below=bar if runs else -math.inf)
+        runs.append(r)
+        if r.status == "abandoned" or not math.isfinite(r.power):
+            continue
+        fine = CoupledProblem(problem.excitation, problem.beta, problem.harmonics,
+                              problem.gamma, fine_points, winding=problem.winding,
+                              hessian="operator")
+        pf = fine.power(r.x)
+        if abs(pf - r.power) > ALIAS_TOL * max(abs(r.power), abs(pf), scale):
+            rejected += 1
+            runs[-1] = type(r)(r.x, r.power, r.gradient_norm, r.iterations, "aliased", r.seed,
+                               r.points, r.strict_maximum)
+            continue
+        if best is None or r.power > best.power:
+            best = r
+        bar = max(bar, r.power)
+    return best, runs, rejected
+
+
+def _distinct_maxima(runs, pu):
+    out = []
+    for r in sorted((r for r in runs if r.status == "converged"), key=lambda r: -r.power):
+        if all(motion_distance(r.x, o[2]) > 1e-6 and abs(r.power - o[0] / pu) > 1e-10
+               for o in out):
+            out.append((r.power * pu, r.seed, r.x))
+    return [{"power": p, "found_by": s} for p, s, _ in out]
+
+
+def coupled_optimum(hydro, pendulum: Pendulum, wave: Wave, *, winding: int = 1,
+                    harmonics: int | None = None, torque_limit=None, efficiency=None,
+                    starts: int | None = None, one_way: bool = False) -> CoupledSolution:
+    """The best periodic rotation of a pendulum inside a heaving buoy (see module docstring).
+
+    Parameters
+    ----------
+    hydro : Hydro
+        The buoy's heave coefficients.
+    pendulum : Pendulum
+    wave : Wave
+        A regular wave or one period of a periodic record.
+    winding : int
+        K, turns per period of the wave (or of the record).
+    harmonics : int or None
+        N; None: 24 K (regular wave) or 16 per mean wave of the free heave (record), then
+        checked by one refinement (the result is the ``2N`` optimum).
+    torque_limit, efficiency : None
+        Not yet supported with the buoy (ParameterError).
+    starts : int or None
+        At most this many seeds of the global search (None: all).
+    one_way : bool
+        Leave the pendulum's reaction out: the pivot moves as the free buoy (the uncoupled
+        global search of :func:`parapend.optimal.fourier.search_fourier`).
+    """
+    if not isinstance(pendulum, Pendulum):
+        raise ParameterError("pendulum: expected a Pendulum(mass, length, inertia, "
+                             "damping_coefficient)")
+    if not isinstance(wave, Wave):
+        raise ParameterError("wave: expected a Wave (Wave.regular or Wave.from_record)")
+    k, n, starts = _check_args(winding, harmonics, torque_limit, efficiency, starts)
+    _check_hydro(hydro, wave)
+    regular = wave.amplitudes.size == 1
+    sc = scales(hydro, pendulum, wave, coupled=not one_way)
+    exc = free_excitation(sc)
+    pu = sc.power_unit
+    if n is None:
+        n = _default_harmonics(sc, k, regular)
+    hess = "dense" if n <= DENSE_MAX else "operator"
+    bound = hydro.radiation_bound(wave.frequencies, wave.amplitudes)
+    kw = {"winding": k, "hessian": hess}
+    if not regular:
+        kw["propose"] = 4
+    ow = search_fourier(exc, n, sc.gamma, **kw)
+    if one_way:
+        best, runs, rejected = ow.best, ow.runs, 0
+        problem_n = CoupledProblem(exc, sc.beta_nd, n, sc.gamma, winding=k, hessian=hess)
+        lim_nd, lim_change = uncoupled_limit(exc).power, 0.0
+    else:
+        problem_n = CoupledProblem(exc, sc.beta_nd, n, sc.gamma, winding=k, hessian=hess)
+        best, runs, rejected = _polish(problem_n, _seeds(ow.runs, n, k, ow.best.x, starts),
+                                       4 * problem_n.points)
+        lim_nd, lim_change, _ = coupled_limit(sc, 2 * problem_n.points)
+    if best is None:
+        return _failed(sc, wave, n, k, bound, lim_nd * pu, runs, rejected, one_way, hydro,
+                       pendulum)
+    # one refinement: 2N from the N optimum
+    n2 = 2 * n
+    hess2 = "dense" if n2 <= DENSE_MAX else "operator"
+    fine = CoupledProblem(exc, sc.beta_nd, n2, sc.gamma, winding=k, hessian=hess2)
+    ref = newton_maximize(fine, _pad(best.x, n2), best.seed)
+    change = abs(ref.power - best.power)
+    sol = best
+    if ref.status == "converged" and ref.power >= best.power - 1e-12 * max(1.0, abs(
+            best.power)):
+        sol, n = ref, n2
+    # fine grid: the power from the torque, the heave, the energy balance
+    mf = max(4096, 4 * fine.points)
+    p_w, Z, resid = _heave_and_balance(hydro, pendulum, wave, sol.x, k, mf, not one_way)
+    alias = abs(p_w - sol.power * pu) / max(abs(p_w), float(np.max(np.abs(fine.w))) * pu)
+    ok = sol.status == "converged" and resid <= BALANCE_TOL and alias <= ALIAS_TOL
+    parts = [f"{'one-way' if one_way else 'coupled'} optimum: {sol.status} (found by "
+             f"{sol.seed})"]
+    if not ok:
+        if resid > BALANCE_TOL:
+            parts.append(f"energy balance residual {resid:.2g} above {BALANCE_TOL:g}")
+        if alias > ALIAS_TOL:
+            parts.append(f"power on a fine grid differs by {alias:.2g} (relative)")
+    if pendulum.damping_coefficient == 0:
+        parts.append("c = 0: the supremum (limit) is approached by switching motions and not "
+                     "attained; this finite-N power is a lower bound of it")
+    if change > 1e-6 * max(abs(sol.power), 1e-300):
+        parts.append(f"refinement N -> 2N changed the power by {change * pu:.3g} W")
+    evid = {"starts": len(runs), "converged": sum(r.status == "converged" for r in runs),
+            "abandoned": sum(r.status == "abandoned" for r in runs), "rejected_aliased":
+            rejected, "maxima": _distinct_maxima(runs, pu), "found_by": sol.seed,
+            "one_way_power": ow.best.power * pu, "one_way_strategy": ow.evidence.strategy}
+    second = [d["power"] for d in evid["maxima"][1:]]
+    evid["second_power"] = second[0] if second else None
+    zfull = Z
+    nz = np.nonzero(np.abs(zfull) > 1e-15 * max(float(np.max(np.abs(zfull))), 1e-300))[0]
+    zfull = zfull[: (nz[-1] + 1 if nz.size else 1)]
+    heave = np.zeros(n + 1, dtype=complex)
+    heave[: min(n + 1, Z.size)] = Z[: n + 1]
+    return CoupledSolution(
+        success=bool(ok), status="; ".join(parts), power=float(p_w), harmonics=n,
+        theta_coefficients={"x": np.asarray(sol.x), "winding": k, "omega": wave.omega},
+        heave=heave, energy_balance_residual=float(resid), radiation_bound=float(bound),
+        limit=float(lim_nd * pu), evidence=evid, one_way=bool(one_way),
+        refinement_change=float(change * pu), limit_change=float(lim_change * pu),
+        free_heave=np.asarray(sc.free_heave), omega=wave.omega, winding=k,
+        _full_heave=zfull, _pendulum=pendulum, _g=float(hydro.g))
+
+
+def _failed(sc, wave, n, k, bound, lim, runs, rejected, one_way, hydro, pendulum):
+    return CoupledSolution(
+        success=False, status=f"no acceptable local maximum: {len(runs)} starts, {rejected} "
+        "rejected as aliased", power=float("nan"), harmonics=n,
+        theta_coefficients={"x": np.zeros(2 * n + 1), "winding": k, "omega": wave.omega},
+        heave=np.zeros(n + 1, dtype=complex), energy_balance_residual=float("nan"),
+        radiation_bound=float(bound), limit=float(lim),
+        evidence={"starts": len(runs), "rejected_aliased": rejected, "maxima": []},
+        one_way=bool(one_way), free_heave=np.asarray(sc.free_heave), omega=wave.omega,
+        winding=k, _full_heave=np.zeros(1, dtype=complex), _pendulum=pendulum,
+        _g=float(hydro.g))
