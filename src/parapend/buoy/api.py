@@ -310,8 +310,9 @@ def _irregular_wave(hs, tp, spectrum, gamma_peak, repeat_period, seed, cutoff, r
     return wave, info
 
 
-def _hydro(body, radius, draft, mesh, hydro, periods, harmonics):
-    """The body's coefficients over the frequencies the problem needs, and the width."""
+def _hydro(body, radius, draft, mesh, hydro, omegas, harmonics):
+    """The body's coefficients over the frequencies the problem needs (the wave's
+    ``omegas`` up to ``harmonics`` times the highest, rad/s), and the body's width."""
     from . import hydro as hy
 
     given = [n for n, v in (("mesh", mesh), ("hydro", hydro)) if v is not None]
@@ -322,7 +323,7 @@ def _hydro(body, radius, draft, mesh, hydro, periods, harmonics):
                              f"from --{given[0]}; drop it")
     if hydro is not None:
         return hy.load(hydro), None
-    omega = hy.frequencies_for(np.asarray(periods, dtype=float), harmonics)
+    omega = hy.frequencies_for(np.asarray(omegas, dtype=float), harmonics)
     if mesh is not None:
         return hy.from_mesh(mesh, omega=omega), None
     if body not in ("cylinder", "sphere"):
@@ -479,27 +480,27 @@ def buoy(*, wave_height=None, wave_period=None, hs=None, tp=None, spectrum="jons
                          else wave_height, 1e-4, 30.0, why="regular wave height, m")
     if periods is not None and variables:
         raise ParameterError("optimize-design: one wave period at a time (drop FROM:TO:N)")
-    nb = harmonics or BUOY["bem_harmonics"]
+    nb = BUOY["bem_harmonics"]
     if irregular:
         from ..units import Units
 
         wave, info = _irregular_wave(hs, tp, spectrum, gamma_peak, repeat_period, seed, cutoff,
                                      record, taper, Units(pend.length, pend.mass, 9.81,
                                                           pend.inertia))
-        tr = float(info["repeat_period"])
         amps = np.abs(np.asarray(wave.amplitudes))
-        kmax = int(np.max(np.nonzero(amps)[0])) + 1
+        sig = np.nonzero(amps >= 1e-3 * amps.max())[0]  # the components that matter
+        top = np.nonzero(amps)[0][-1]
         h, width = _hydro(body, radius, draft, mesh, hydro,
-                          np.array([tr / kmax, tr / max(1, kmax // 8)]), 1)
-        h.check_covers(wave.omega, wave.omega * kmax, name="hs" if record is None
-                       else "record")
+                          wave.omega * np.array([sig[0] + 1.0, top + 1.0]), 2)
+        h.check_covers(wave.omega * (sig[0] + 1), wave.omega * (sig[-1] + 1),
+                       name="tp" if record is None else "record")
     else:
         if periods is None:
             period = _period(BUOY["wave_period"] if wave_period is None else wave_period)
             periods_all = np.array([period])
         else:
             periods_all = np.array([_period(p) for p in periods])
-        h, width = _hydro(body, radius, draft, mesh, hydro, periods_all, nb)
+        h, width = _hydro(body, radius, draft, mesh, hydro, 2 * math.pi / periods_all, nb)
         w = 2 * math.pi / periods_all
         h.check_covers(float(np.min(w)), float(np.max(w)), name="wave-period")
         if periods is not None:
