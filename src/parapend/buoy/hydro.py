@@ -1,27 +1,92 @@
-"""Stand-in for the hydrodynamic coefficients of a heaving buoy (the interface of ``Hydro``).
+"""Heave hydrodynamics of a floating buoy: coefficients from Capytaine, cached, or loaded.
 
-Only the dataclass and its evaluation methods: the BEM front ends (Capytaine) live in the
-full module. Coefficients between the given frequencies are interpolated linearly in ``w``
-(real and imaginary parts separately); above the highest frequency ``A`` is held and
-``B = F = 0``; below the lowest ``A`` is held and ``B``, ``F`` go linearly to ``B(0) = 0``,
-``F(0) = C``.
+A :class:`Hydro` holds the linear potential-flow coefficients of a rigid body heaving at
+the free surface, in this project's time convention ``x(t) = Re(X exp(+i w t))``:
+
+- ``added_mass`` ``A(w)`` (kg) and ``radiation_damping`` ``B(w) >= 0`` (N s/m);
+- ``excitation`` ``F(w)`` (N per metre of wave amplitude), the complex amplitude of the
+  heave force of a regular wave whose elevation at the body's origin is ``Re(exp(+i w t))``;
+- ``hydrostatic_stiffness`` ``C`` (N/m) and ``mass`` ``M`` (kg), the displaced mass: a body
+  floating at its draft weighs what it displaces, the pendulum inside it included.
+
+Capytaine uses ``x(t) = Re(X exp(-i w t))`` (its manual, "Conventions"): its complex
+amplitudes are conjugated here on the way in, and nowhere else. ``A`` and ``B`` are real
+and the same in both conventions.
+
+Bodies come from parameters (:func:`cylinder`, :func:`sphere`), from any mesh file Capytaine
+reads (:func:`from_mesh`), or from a dataset written by Capytaine (:func:`load`). BEM results
+are cached on disk (see :func:`cache_dir`), keyed by a hash of the mesh, the frequencies,
+``rho``, ``g`` and the water depth, so a second run is instant.
+
+Between the dataset's frequencies the coefficients are interpolated linearly in ``w``
+(real and imaginary parts separately). Above the highest frequency ``A`` is held and
+``B = F = 0`` (:meth:`Hydro.above_range` says where; the caller warns). Below the lowest,
+``A`` is held and ``B`` and ``F`` go linearly to their hydrostatic limits ``B(0) = 0``,
+``F(0) = C`` (a long wave lifts the body by the wave's height).
 """
 
 from __future__ import annotations
 
+import contextlib
+import hashlib
+import io
+import json
 import math
-from dataclasses import dataclass
+import os
+from dataclasses import dataclass, field
+from pathlib import Path
 
 import numpy as np
 
-from ..errors import ParameterError
+from ..errors import ParameterError, check_int, check_positive
 
-__all__ = ["Hydro"]
+__all__ = ["Hydro", "cache_dir", "cylinder", "frequencies_for", "from_mesh", "load",
+           "mesh_size", "sphere"]
+
+#: Bump when the cached content or the meshing rule changes (old entries are then ignored).
+CACHE_VERSION = 1
+
+#: Panels per shortest wavelength: the largest panel radius is ``wavelength / PANELS_PER_WAVE``
+#: (Capytaine's own lower limit is 8 panel radii per wavelength).
+PANELS_PER_WAVE = 10
+
+#: Panel radius from the geometry alone: ``scale / GEOMETRY_PANELS`` (``scale`` the smaller of
+#: radius and draft), fine enough for the waterplane area to 0.6 %.
+GEOMETRY_PANELS = 8
+
+#: The finest panel the automatic rule uses: ``scale / FINEST_PANELS``; frequencies whose
+#: wavelength that panel cannot resolve are left out of the BEM (they are then above range).
+FINEST_PANELS = 20
 
 
-@dataclass(frozen=True)
+def _as_omega(w) -> np.ndarray:
+    return np.asarray(w, dtype=float)
+
+
+@dataclass(frozen=True, eq=False)
 class Hydro:
-    """Heave coefficients of a floating body (SI, convention ``exp(+i w t)``)."""
+    """Heave coefficients of a floating body (SI units, convention ``exp(+i w t)``).
+
+    Parameters
+    ----------
+    omega : numpy.ndarray
+        Angular frequencies (rad/s), strictly increasing, all > 0.
+    added_mass : numpy.ndarray
+        Heave added mass ``A(w)`` (kg).
+    radiation_damping : numpy.ndarray
+        Heave radiation damping ``B(w) >= 0`` (N s/m).
+    excitation : numpy.ndarray
+        Complex heave excitation force per metre of wave amplitude (N/m), phase relative to
+        the wave elevation at the body's origin.
+    hydrostatic_stiffness : float
+        ``C`` (N/m).
+    mass : float
+        The floating body's total mass ``M = rho * displaced volume`` (kg).
+    rho, g, water_depth : float
+        Water density (kg/m^3), gravity (m/s^2), depth (m, ``inf`` for deep water).
+    description : str
+        What the coefficients are of (geometry, panels, source).
+    """
 
     omega: np.ndarray
     added_mass: np.ndarray
@@ -33,42 +98,662 @@ class Hydro:
     g: float = 9.81
     water_depth: float = math.inf
     description: str = ""
+    _key: str = field(default="", repr=False, compare=False)
 
+    def __post_init__(self):
+        w = np.array(self.omega, dtype=float).ravel()
+        a = np.array(self.added_mass, dtype=float).ravel()
+        b = np.array(self.radiation_damping, dtype=float).ravel()
+        f = np.array(self.excitation, dtype=complex).ravel()
+        if not (w.size >= 1 and a.size == b.size == f.size == w.size):
+            raise ParameterError("hydro: expected omega, added_mass, radiation_damping and "
+                                 "excitation of one common length >= 1")
+        if not (np.all(np.isfinite(w)) and np.all(np.isfinite(a)) and np.all(np.isfinite(b))
+                and np.all(np.isfinite(f))):
+            raise ParameterError("hydro: expected finite coefficients (a dataset with NaN or "
+                                 "infinite values)")
+        if w[0] <= 0 or np.any(np.diff(w) <= 0):
+            raise ParameterError("hydro: expected frequencies > 0, strictly increasing")
+        c = check_positive("hydrostatic_stiffness", self.hydrostatic_stiffness)
+        m = check_positive("mass", self.mass)
+        # small negative damping is BEM noise at high frequency; passivity requires B >= 0
+        b = np.maximum(b, 0.0)
+        for name, arr in (("omega", w), ("added_mass", a), ("radiation_damping", b),
+                          ("excitation", f)):
+            arr.setflags(write=False)
+            object.__setattr__(self, name, arr)
+        object.__setattr__(self, "hydrostatic_stiffness", c)
+        object.__setattr__(self, "mass", m)
+        object.__setattr__(self, "rho", check_positive("rho", self.rho))
+        object.__setattr__(self, "g", check_positive("g", self.g))
+        depth = float(self.water_depth)
+        if not depth > 0:
+            raise ParameterError(f"water_depth: expected a depth > 0 or inf, got {depth!r}")
+        object.__setattr__(self, "water_depth", depth)
+
+    # -- coefficients ------------------------------------------------------------------
     def coefficients(self, w):
-        """``(A, B, F)`` at frequencies ``w`` (rad/s)."""
-        w = np.asarray(w, dtype=float)
-        om = np.concatenate(([0.0], np.asarray(self.omega, dtype=float)))
-        a = np.asarray(self.added_mass, dtype=float)
-        b = np.concatenate(([0.0], np.asarray(self.radiation_damping, dtype=float)))
-        f = np.concatenate(([complex(self.hydrostatic_stiffness)],
-                            np.asarray(self.excitation, dtype=complex)))
-        A = np.interp(w, om[1:], a)
-        B = np.interp(w, om, b, right=0.0)
-        F = np.interp(w, om, f.real, right=0.0) + 1j * np.interp(w, om, f.imag, right=0.0)
-        return A, B, F
+        """``(A, B, F)`` at angular frequencies ``w`` (rad/s; arrays shaped like ``w``).
+
+        Linear interpolation in ``w`` between the dataset's frequencies (real and imaginary
+        parts of ``F`` separately). Above the highest frequency ``A`` is held and
+        ``B = F = 0``; below the lowest ``A`` is held and ``B``, ``F`` are interpolated
+        linearly towards ``B(0) = 0``, ``F(0) = C``. ``w = 0`` gives ``(A(w_min), 0, C)``.
+        """
+        w = np.abs(_as_omega(w))
+        wd = np.concatenate(([0.0], self.omega))
+        bd = np.concatenate(([0.0], self.radiation_damping))
+        fd = np.concatenate(([self.hydrostatic_stiffness], self.excitation))
+        a = np.interp(w, self.omega, self.added_mass)
+        b = np.interp(w, wd, bd, right=0.0)
+        f = np.interp(w, wd, fd.real, right=0.0) + 1j * np.interp(w, wd, fd.imag, right=0.0)
+        above = self.above_range(w)
+        b = np.where(above, 0.0, b)
+        f = np.where(above, 0.0, f)
+        return a, b, f
 
     def above_range(self, w) -> np.ndarray:
-        return np.asarray(w, dtype=float) > float(np.asarray(self.omega)[-1])
+        """Boolean array: where :meth:`coefficients` extrapolates above the data."""
+        return np.abs(_as_omega(w)) > self.omega[-1] * (1 + 1e-12)
 
     def impedance(self, w):
-        A, B, _ = self.coefficients(w)
-        w = np.asarray(w, dtype=float)
-        return -w**2 * (self.mass + A) + 1j * w * B + self.hydrostatic_stiffness
+        """``D(w) = -w^2 (M + A) + i w B + C`` (N/m), the free buoy's heave impedance."""
+        w = _as_omega(w)
+        a, b, _ = self.coefficients(w)
+        return -w**2 * (self.mass + a) + 1j * w * b + self.hydrostatic_stiffness
 
     def free_response(self, w):
-        _, _, F = self.coefficients(w)
-        return F / self.impedance(w)
+        """Heave of the free buoy per metre of wave amplitude, ``Z/a = F / D`` (complex)."""
+        w = _as_omega(w)
+        _, _, f = self.coefficients(w)
+        return f / self.impedance(w)
 
     def radiation_bound(self, w, amplitude) -> float:
-        _, B, F = self.coefficients(w)
-        B = np.atleast_1d(B)
-        e = np.atleast_1d(np.abs(F * amplitude) ** 2)
-        ok = B > 0
-        return float(np.sum(e[ok] / (8.0 * B[ok])))
+        """Most power a heaving body can absorb from a regular wave: ``|F a|^2 / (8 B)`` (W).
+
+        ``amplitude`` is the wave amplitude (m, half the height). 0 where ``B == 0``.
+        """
+        _, b, f = self.coefficients(float(w))
+        b = float(b)
+        if b <= 0:
+            return 0.0
+        return float(abs(complex(f) * amplitude) ** 2 / (8.0 * b))
 
     def check_covers(self, w_min, w_max, name="wave-period"):
-        lo, hi = float(np.asarray(self.omega)[0]), float(np.asarray(self.omega)[-1])
-        if w_min < lo * (1 - 1e-12) or w_max > hi * (1 + 1e-12):
-            raise ParameterError(
-                f"{name}: expected wave frequencies within the dataset's [{lo:.4g}, {hi:.4g}] "
-                f"rad/s, got [{w_min:.4g}, {w_max:.4g}] rad/s")
+        """Raise :class:`ParameterError` unless ``[w_min, w_max]`` (rad/s) lies in the data."""
+        lo, hi = float(self.omega[0]), float(self.omega[-1])
+        w_min, w_max = float(w_min), float(w_max)
+        tol = 1e-9
+        if w_min >= lo * (1 - tol) and w_max <= hi * (1 + tol):
+            return
+        if "period" in name:
+            need = f"{2 * math.pi / w_max:.4g} s to {2 * math.pi / w_min:.4g} s"
+            have = f"{2 * math.pi / hi:.4g} s to {2 * math.pi / lo:.4g} s"
+        else:
+            need = f"{w_min:.4g} to {w_max:.4g} rad/s"
+            have = f"{lo:.4g} to {hi:.4g} rad/s"
+        raise ParameterError(f"{name}: {need} lies outside the hydrodynamic data, which cover "
+                             f"{have}")
+
+    def natural_frequency(self) -> float:
+        """The undamped heave natural frequency (rad/s): the root of ``C = w^2 (M + A(w))``.
+
+        Found by bisection on the interpolated ``A``; ``nan`` if ``C - w^2 (M + A(w))`` does
+        not change sign on the data's range.
+        """
+        def g(w):
+            a, _, _ = self.coefficients(w)
+            return self.hydrostatic_stiffness - w**2 * (self.mass + float(a))
+        lo, hi = 1e-9, float(self.omega[-1])
+        if g(lo) * g(hi) > 0:
+            return math.nan
+        for _ in range(200):
+            mid = 0.5 * (lo + hi)
+            if g(lo) * g(mid) <= 0:
+                hi = mid
+            else:
+                lo = mid
+        return 0.5 * (lo + hi)
+
+    def to_dataset(self):
+        """The coefficients as a Capytaine-style :class:`xarray.Dataset` (``exp(-i w t)``).
+
+        Write it with ``capytaine.io.xarray.save_dataset_as_netcdf``; :func:`load` reads it
+        back.
+        """
+        import xarray as xr
+
+        dof = ["Heave"]
+        ds = xr.Dataset(
+            {
+                "added_mass": (("omega", "radiating_dof", "influenced_dof"),
+                               self.added_mass[:, None, None]),
+                "radiation_damping": (("omega", "radiating_dof", "influenced_dof"),
+                                      self.radiation_damping[:, None, None]),
+                "excitation_force": (("omega", "wave_direction", "influenced_dof"),
+                                     np.conj(self.excitation)[:, None, None]),
+                "hydrostatic_stiffness": (("influenced_dof", "radiating_dof"),
+                                          [[self.hydrostatic_stiffness]]),
+                "inertia_matrix": (("influenced_dof", "radiating_dof"), [[self.mass]]),
+            },
+            coords={"omega": self.omega, "radiating_dof": dof, "influenced_dof": dof,
+                    "wave_direction": [0.0], "rho": self.rho, "g": self.g,
+                    "water_depth": self.water_depth},
+            attrs={"description": self.description},
+        )
+        return ds
+
+
+# -- frequencies ---------------------------------------------------------------------------
+def frequencies_for(omegas, harmonics=3, *, count=30, low=0.5):
+    """The frequency grid (rad/s) a problem on the wave frequencies ``omegas`` needs.
+
+    Parameters
+    ----------
+    omegas : float or array_like
+        The wave's angular frequencies (rad/s): one for a regular wave, several for a sweep
+        over periods (``2 pi / period``) or the band of an irregular record.
+    harmonics : int
+        The highest multiple of the highest wave frequency at which the coupled problem
+        needs ``A`` and ``B`` (the pendulum's reaction has harmonics ``k w``).
+    count : int
+        Number of frequencies, evenly spaced.
+    low : float
+        The grid starts at ``low * min(omegas)``.
+
+    Returns
+    -------
+    numpy.ndarray
+        ``count`` frequencies from ``low * min(omegas)`` to ``harmonics * max(omegas)``.
+        The lowest and highest wave frequencies are grid points when ``harmonics == 1``;
+        otherwise the wave band lies strictly inside the grid.
+    """
+    w = np.atleast_1d(np.asarray(omegas, dtype=float)).ravel()
+    if w.size == 0 or not np.all(np.isfinite(w)) or np.any(w <= 0):
+        raise ParameterError("omegas: expected angular frequencies > 0 (rad/s)")
+    harmonics = check_int("harmonics", harmonics, 1)
+    count = check_int("count", count, 2)
+    low = check_positive("low", low)
+    if low > 1:
+        raise ParameterError(f"low: expected a number in (0, 1], got {low!r}")
+    return np.linspace(low * w.min(), harmonics * w.max(), count)
+
+
+def _wavenumber(w, g, depth):
+    """Wavenumber (1/m) from the dispersion relation ``w^2 = g k tanh(k h)``."""
+    k0 = w * w / g
+    if not math.isfinite(depth):
+        return k0
+    k = max(k0, w / math.sqrt(g * depth))
+    for _ in range(100):
+        t = math.tanh(k * depth)
+        f = g * k * t - w * w
+        fp = g * t + g * k * depth * (1 - t * t)
+        step = f / fp
+        k -= step
+        if abs(step) < 1e-14 * k:
+            break
+    return k
+
+
+def mesh_size(scale, omega_max, *, g=9.81, water_depth=math.inf, refine=1.0):
+    """The panel radius (m) for a body of size ``scale`` (m) up to ``omega_max`` (rad/s).
+
+    ``min(scale / 8, wavelength / 10)``, not finer than ``scale / 20`` (each divided by
+    ``refine``): the panel is a fraction of the shortest wavelength and of the geometry.
+    """
+    k = _wavenumber(float(omega_max), g, water_depth)
+    wavelength = 2 * math.pi / k
+    h = min(scale / GEOMETRY_PANELS, wavelength / PANELS_PER_WAVE)
+    return max(h, scale / FINEST_PANELS) / refine
+
+
+def _resolvable(omega, h, g, depth):
+    """Mask of the frequencies whose wavelength is at least 8 panel radii ``h``."""
+    return np.array([2 * math.pi / _wavenumber(float(w), g, depth) >= 8 * h * (1 - 1e-9)
+                     for w in omega])
+
+
+# -- the cache -------------------------------------------------------------------------------
+def cache_dir() -> Path:
+    """Where BEM results are cached: ``$PARAPEND_CACHE/hydro`` or ``~/.cache/parapend/hydro``."""
+    root = os.environ.get("PARAPEND_CACHE")
+    base = Path(root) if root else Path.home() / ".cache" / "parapend"
+    return base / "hydro"
+
+
+def _cache_key(parts: bytes, omega, rho, g, depth) -> str:
+    from importlib.metadata import version
+
+    h = hashlib.sha256()
+    meta = {"version": CACHE_VERSION, "capytaine": version("capytaine"), "rho": float(rho),
+            "g": float(g), "depth": repr(float(depth))}
+    h.update(json.dumps(meta, sort_keys=True).encode())
+    h.update(np.ascontiguousarray(np.asarray(omega, dtype=float)).tobytes())
+    h.update(parts)
+    return h.hexdigest()
+
+
+def _cache_read(key: str) -> Hydro | None:
+    """The cached :class:`Hydro` for ``key``, or None (missing, unreadable or corrupt)."""
+    path = cache_dir() / f"{key}.npz"
+    try:
+        with np.load(path, allow_pickle=False) as z:
+            if str(z["key"]) != key:
+                return None
+            meta = json.loads(str(z["meta"]))
+            body = _array_digest(z)
+            if body != str(z["digest"]):
+                return None
+            return Hydro(omega=z["omega"], added_mass=z["added_mass"],
+                         radiation_damping=z["radiation_damping"],
+                         excitation=z["excitation"],
+                         hydrostatic_stiffness=float(meta["C"]), mass=float(meta["M"]),
+                         rho=float(meta["rho"]), g=float(meta["g"]),
+                         water_depth=float(meta["depth"]),
+                         description=str(meta["description"]), _key=key)
+    except Exception:  # noqa: BLE001 - any failure means: recompute, never trust it
+        return None
+
+
+_ARRAYS = ("omega", "added_mass", "radiation_damping", "excitation")
+
+
+def _array_digest(arrays) -> str:
+    h = hashlib.sha256()
+    for name in _ARRAYS:
+        h.update(np.ascontiguousarray(np.asarray(arrays[name])).tobytes())
+    h.update(str(arrays["meta"]).encode())
+    return h.hexdigest()
+
+
+def _cache_write(key: str, hydro: Hydro) -> None:
+    """Store ``hydro`` under ``key`` atomically; a cache that cannot be written is skipped."""
+    from ..fileio import write_bytes
+
+    meta = json.dumps({"C": hydro.hydrostatic_stiffness, "M": hydro.mass, "rho": hydro.rho,
+                       "g": hydro.g, "depth": repr(hydro.water_depth),
+                       "description": hydro.description})
+    arrays = {name: np.asarray(getattr(hydro, name)) for name in _ARRAYS}
+    arrays["meta"] = np.array(meta)
+    arrays["digest"] = np.array(_array_digest(arrays))
+    arrays["key"] = np.array(key)
+    buf = io.BytesIO()
+    np.savez(buf, **arrays)
+    with contextlib.suppress(Exception):
+        d = cache_dir()
+        d.mkdir(parents=True, exist_ok=True)
+        write_bytes(d / f"{key}.npz", buf.getvalue())
+
+
+# -- BEM -------------------------------------------------------------------------------------
+def _quiet_capytaine():
+    import capytaine as cpt
+
+    cpt.set_logging("ERROR")
+    return cpt
+
+
+def _params(**kw) -> bytes:
+    return json.dumps({k: repr(v) for k, v in kw.items()}, sort_keys=True).encode()
+
+
+def _solve(build, omega, *, rho, g, water_depth, description, cache, key_parts):
+    """Hydrostatics and heave BEM of the body ``build()`` returns, cached on disk.
+
+    ``build()`` gives ``(mesh, hull)``: the immersed surface for the BEM (possibly
+    rotation-symmetric) and the same surface as a plain mesh for the hydrostatics.
+    ``key_parts`` (bytes) determine the mesh: the parameters of a generated mesh, or the
+    bytes of a mesh file; with the frequencies, ``rho``, ``g`` and the depth they make the
+    cache key, so a cached result is found without meshing.
+    """
+    omega = np.asarray(omega, dtype=float)
+    key = _cache_key(key_parts, omega, rho, g, water_depth)
+    if cache:
+        hit = _cache_read(key)
+        if hit is not None:
+            return hit
+    cpt = _quiet_capytaine()
+    import xarray as xr
+
+    mesh, hull = build()
+    dofs = cpt.rigid_body_dofs(only=["Heave"])
+    plain = cpt.FloatingBody(mesh=hull, dofs=dofs, center_of_mass=(0.0, 0.0, 0.0))
+    c = float(np.asarray(plain.compute_hydrostatic_stiffness(rho=rho, g=g)).ravel()[0])
+    volume = float(plain.disp_volume)
+    mass = rho * volume
+    body = cpt.FloatingBody(mesh=mesh, dofs=dofs, center_of_mass=(0.0, 0.0, 0.0))
+    test = xr.Dataset(coords={"omega": omega, "wave_direction": [0.0],
+                              "radiating_dof": ["Heave"], "water_depth": [water_depth],
+                              "rho": [rho], "g": [g]})
+    ds = cpt.BEMSolver().fill_dataset(test, body, n_jobs=1, progress_bar=False)
+    hydro = _from_dataset(ds, c=c, mass=mass,
+                          description=f"{description}, {hull.nb_faces} panels")
+    object.__setattr__(hydro, "_key", key)
+    if cache:
+        _cache_write(key, hydro)
+    return hydro
+
+
+def _omega_grid(omega):
+    if omega is None:
+        return None
+    w = np.atleast_1d(np.asarray(omega, dtype=float)).ravel()
+    if w.size == 0 or not np.all(np.isfinite(w)) or np.any(w <= 0) or np.any(np.diff(w) <= 0):
+        raise ParameterError("omega: expected angular frequencies > 0 (rad/s), strictly "
+                             "increasing")
+    return w
+
+
+#: The default frequency grid of the parametric bodies: 0.3 to 12 rad/s (periods 0.52 s to
+#: 21 s), 30 points.
+DEFAULT_OMEGA = np.linspace(0.3, 12.0, 30)
+
+
+def _keep_resolvable(omega, h, g, depth):
+    keep = _resolvable(omega, h, g, depth)
+    if not np.any(keep):
+        raise ParameterError(f"omega: every frequency is too high for a mesh of panel radius "
+                             f"{h:.3g} m")
+    # a contiguous lower part: the resolvable frequencies are those below a limit
+    return omega[keep]
+
+
+def cylinder(radius, draft, *, omega=None, rho=1025.0, g=9.81, water_depth=math.inf,
+             cache=True, refine=1.0) -> Hydro:
+    """Heave coefficients of a vertical circular cylinder floating at ``draft``.
+
+    Parameters
+    ----------
+    radius, draft : float
+        Radius and draft (m), both > 0.
+    omega : array_like, optional
+        Angular frequencies (rad/s) for the BEM (default :data:`DEFAULT_OMEGA`; see
+        :func:`frequencies_for`). Frequencies too high for the finest panel the meshing
+        rule allows are left out (the coefficients are then above range there).
+    rho, g, water_depth : float
+        Water density (kg/m^3), gravity (m/s^2), depth (m; ``inf`` deep water).
+    cache : bool
+        Read and write the on-disk cache.
+    refine : float
+        Divide the automatic panel radius (:func:`mesh_size`) by this factor.
+
+    Returns
+    -------
+    Hydro
+    """
+    radius = check_positive("radius", radius)
+    draft = check_positive("draft", draft)
+    rho, g, water_depth, refine = _common(rho, g, water_depth, refine)
+    omega = DEFAULT_OMEGA if omega is None else _omega_grid(omega)
+    h = mesh_size(min(radius, draft), omega[-1], g=g, water_depth=water_depth, refine=refine)
+    omega = _keep_resolvable(omega, h, g, water_depth)
+    if math.isfinite(water_depth) and draft >= water_depth:
+        raise ParameterError(f"draft: expected less than the water depth {water_depth:g} m, "
+                             f"got {draft!r}")
+    kw = dict(length=2 * draft, radius=radius, center=(0.0, 0.0, 0.0), faces_max_radius=h)
+
+    def build():
+        cpt = _quiet_capytaine()
+        return (cpt.mesh_vertical_cylinder(axial_symmetry=True, **kw).immersed_part(),
+                cpt.mesh_vertical_cylinder(**kw).immersed_part())
+
+    desc = f"vertical cylinder, radius {radius:g} m, draft {draft:g} m"
+    return _solve(build, omega, rho=rho, g=g, water_depth=water_depth, description=desc,
+                  cache=cache, key_parts=_params(body="cylinder", **kw))
+
+
+def sphere(radius, *, omega=None, rho=1025.0, g=9.81, water_depth=math.inf, cache=True,
+           refine=1.0) -> Hydro:
+    """Heave coefficients of a sphere floating at its centre (half immersed).
+
+    Parameters as :func:`cylinder`; ``radius`` (m) > 0.
+    """
+    radius = check_positive("radius", radius)
+    rho, g, water_depth, refine = _common(rho, g, water_depth, refine)
+    omega = DEFAULT_OMEGA if omega is None else _omega_grid(omega)
+    h = mesh_size(radius, omega[-1], g=g, water_depth=water_depth, refine=refine)
+    omega = _keep_resolvable(omega, h, g, water_depth)
+    if math.isfinite(water_depth) and radius >= water_depth:
+        raise ParameterError(f"radius: expected less than the water depth {water_depth:g} m, "
+                             f"got {radius!r}")
+    kw = dict(radius=radius, center=(0.0, 0.0, 0.0), faces_max_radius=h)
+
+    def build():
+        cpt = _quiet_capytaine()
+        return (cpt.mesh_sphere(axial_symmetry=True, **kw).immersed_part(),
+                cpt.mesh_sphere(**kw).immersed_part())
+
+    desc = f"sphere floating at its centre, radius {radius:g} m"
+    return _solve(build, omega, rho=rho, g=g, water_depth=water_depth, description=desc,
+                  cache=cache, key_parts=_params(body="sphere", **kw))
+
+
+def _common(rho, g, water_depth, refine):
+    rho = check_positive("rho", rho)
+    g = check_positive("g", g)
+    depth = float(water_depth)
+    if not depth > 0:
+        raise ParameterError(f"water-depth: expected a depth > 0 m or inf, got {water_depth!r}")
+    refine = check_positive("refine", refine)
+    return rho, g, depth, refine
+
+
+def _open_edges(mesh, tol):
+    """Edges of ``mesh`` used by exactly one face, as pairs of vertex coordinates."""
+    verts = np.asarray(mesh.vertices, dtype=float)
+    faces = np.asarray(mesh.faces)
+    # merge coincident vertices (many file formats repeat them face by face)
+    keys = np.round(verts / tol).astype(np.int64)
+    _, ids = np.unique(keys, axis=0, return_inverse=True)
+    ids = ids.ravel()
+    count: dict = {}
+    for face in faces:
+        f = [ids[i] for i in face]
+        ring = [v for j, v in enumerate(f) if v != f[j - 1]]  # drop degenerate edges
+        for j in range(len(ring)):
+            e = (min(ring[j - 1], ring[j]), max(ring[j - 1], ring[j]))
+            if e[0] != e[1]:
+                count[e] = count.get(e, 0) + 1
+    first = {}
+    for i, k in enumerate(ids):
+        first.setdefault(k, i)
+    return [(verts[first[a]], verts[first[b]]) for (a, b), n in count.items() if n == 1]
+
+
+def from_mesh(path, *, omega=None, rho=1025.0, g=9.81, water_depth=math.inf, cache=True,
+              file_format=None) -> Hydro:
+    """Heave coefficients of the body in a mesh file (any format Capytaine reads).
+
+    The mesh is in the body's floating position (``z = 0`` the free surface, ``z`` up). It
+    may be the whole hull or only its wetted part; its immersed part must be closed up to
+    the waterline: every edge used by one panel only must lie on ``z = 0``.
+
+    Parameters as :func:`cylinder`; the panel size is the file's.
+    """
+    rho, g, water_depth, _ = _common(rho, g, water_depth, 1.0)
+    omega = DEFAULT_OMEGA if omega is None else _omega_grid(omega)
+    p = Path(path)
+    name = "mesh"
+    if not p.is_file():
+        raise ParameterError(f"{name}: cannot read {str(p)!r}: no such file")
+    cpt = _quiet_capytaine()
+    try:
+        raw = cpt.load_mesh(p, file_format)
+    except Exception as exc:  # noqa: BLE001 - Capytaine raises many types for bad files
+        reason = " ".join(str(exc).split())[:120] or type(exc).__name__
+        raise ParameterError(f"{name}: cannot read {str(p)!r} as a mesh: {reason}") from None
+    raw = _plain(raw)
+    if raw.nb_faces == 0:
+        raise ParameterError(f"{name}: {str(p)!r} has no panels")
+    try:
+        hull = raw.immersed_part()
+    except Exception:  # noqa: BLE001
+        hull = None
+    if hull is None or hull.nb_faces == 0:
+        raise ParameterError(f"{name}: {str(p)!r} has no immersed part (no panel below z = 0; "
+                             "the mesh must be in its floating position)")
+    size = float(np.ptp(np.asarray(hull.vertices), axis=0).max())
+    tol = 1e-6 * size
+    bad = [e for e in _open_edges(hull, tol)
+           if abs(e[0][2]) > 1e-4 * size or abs(e[1][2]) > 1e-4 * size]
+    if bad:
+        z = min(min(e[0][2], e[1][2]) for e in bad)
+        raise ParameterError(f"{name}: {str(p)!r} is not closed: {len(bad)} panel edges "
+                             f"below the waterline belong to one panel only (the lowest at "
+                             f"z = {z:.3g} m)")
+    volume = float(cpt.FloatingBody(mesh=hull).disp_volume)
+    if not volume > 0:
+        raise ParameterError(f"{name}: {str(p)!r} encloses no displaced volume (are its "
+                             "normals pointing outwards?)")
+    radii = np.asarray(hull.faces_radiuses)
+    h = float(radii.max())
+    omega = _keep_resolvable(omega, h, g, water_depth)
+    desc = f"mesh {p.name}, immersed part"
+    parts = b"file|" + str(file_format).encode() + b"|" + p.read_bytes()
+    return _solve(lambda: (hull, hull), omega, rho=rho, g=g, water_depth=water_depth,
+                  description=desc, cache=cache, key_parts=parts)
+
+
+def _plain(mesh):
+    """``mesh`` as a plain Capytaine Mesh (symmetric meshes merged)."""
+    if hasattr(mesh, "merged") and type(mesh).__name__ != "Mesh":
+        with contextlib.suppress(Exception):
+            return mesh.merged()
+    return mesh
+
+
+# -- datasets --------------------------------------------------------------------------------
+def _pick(da, dim, label, name, path):
+    if dim not in da.dims:
+        return da
+    labels = [str(v) for v in da[dim].values]
+    if label not in labels:
+        raise ParameterError(f"hydro: {path} has no heave degree of freedom ({dim} "
+                             f"{', '.join(labels) or 'empty'}; expected 'Heave') in {name}")
+    return da.isel({dim: labels.index(label)})
+
+
+def _scalar(ds, name, default):
+    if name in ds.coords or name in ds.variables:
+        v = np.asarray(ds[name].values).ravel()
+        if v.size != 1:
+            raise ParameterError(f"hydro: expected one value of {name}, got {v.size}")
+        return float(v[0])
+    return default
+
+
+def _from_dataset(ds, *, c=None, mass=None, description="", path="the dataset"):
+    """A :class:`Hydro` from a Capytaine dataset (complex values merged, ``exp(-i w t)``)."""
+    from capytaine.io.xarray import merge_complex_values
+
+    if "complex" in ds.dims:
+        ds = merge_complex_values(ds)
+    for dim in ("radiating_dof", "influenced_dof"):
+        if dim in ds.coords:
+            labels = [str(v) for v in ds[dim].values]
+            if "Heave" not in labels:
+                raise ParameterError(f"hydro: {path} has no heave degree of freedom "
+                                     f"({dim}: {', '.join(labels) or 'none'})")
+    for var in ("added_mass", "radiation_damping"):
+        if var not in ds:
+            raise ParameterError(f"hydro: {path} has no {var} (a radiation problem in heave "
+                                 "is needed)")
+    if "excitation_force" in ds:
+        fx = ds["excitation_force"]
+    elif "diffraction_force" in ds and "Froude_Krylov_force" in ds:
+        fx = ds["diffraction_force"] + ds["Froude_Krylov_force"]
+    else:
+        raise ParameterError(f"hydro: {path} has no excitation_force (nor diffraction_force "
+                             "and Froude_Krylov_force)")
+    if "omega" in ds.coords:
+        omega_name = "omega"
+    else:
+        raise ParameterError(f"hydro: {path} has no omega coordinate")
+    a = _pick(_pick(ds["added_mass"], "radiating_dof", "Heave", "added_mass", path),
+              "influenced_dof", "Heave", "added_mass", path)
+    b = _pick(_pick(ds["radiation_damping"], "radiating_dof", "Heave", "radiation_damping",
+                    path), "influenced_dof", "Heave", "radiation_damping", path)
+    fx = _pick(fx, "influenced_dof", "Heave", "excitation_force", path)
+    if "wave_direction" in fx.dims:
+        dirs = np.asarray(fx["wave_direction"].values, dtype=float)
+        fx = fx.isel(wave_direction=int(np.argmin(np.abs(np.angle(np.exp(1j * dirs))))))
+    for extra in [d for d in a.dims if d != omega_name]:
+        a = a.isel({extra: 0})
+    for extra in [d for d in b.dims if d != omega_name]:
+        b = b.isel({extra: 0})
+    for extra in [d for d in fx.dims if d != omega_name]:
+        fx = fx.isel({extra: 0})
+    w = np.asarray(ds[omega_name].values, dtype=float)
+    a = np.asarray(a.transpose(omega_name).values, dtype=float)
+    b = np.asarray(b.transpose(omega_name).values, dtype=float)
+    f = np.conj(np.asarray(fx.transpose(omega_name).values, dtype=complex))
+    finite = np.isfinite(w) & (w > 0)  # omega = 0 or inf rows carry no excitation
+    order = np.argsort(w[finite])
+    w, a, b, f = (x[finite][order] for x in (w, a, b, f))
+    if w.size == 0:
+        raise ParameterError(f"hydro: {path} has no finite frequency > 0")
+    if np.any(np.diff(w) <= 0):
+        raise ParameterError(f"hydro: {path} repeats a frequency")
+    if c is None:
+        if "hydrostatic_stiffness" not in ds:
+            raise ParameterError(f"hydro: {path} has no hydrostatics: hydrostatic_stiffness is "
+                                 "missing (compute it with body.compute_hydrostatics)")
+        cs = _pick(_pick(ds["hydrostatic_stiffness"], "radiating_dof", "Heave",
+                         "hydrostatic_stiffness", path), "influenced_dof", "Heave",
+                   "hydrostatic_stiffness", path)
+        c = float(np.asarray(cs.values).ravel()[0])
+    if mass is None:
+        if "inertia_matrix" in ds:
+            ms = _pick(_pick(ds["inertia_matrix"], "radiating_dof", "Heave", "inertia_matrix",
+                             path), "influenced_dof", "Heave", "inertia_matrix", path)
+            mass = float(np.asarray(ms.values).ravel()[0])
+        elif "disp_mass" in ds:
+            mass = float(np.asarray(ds["disp_mass"].values).ravel()[0])
+        else:
+            raise ParameterError(f"hydro: {path} has no hydrostatics: the mass is missing "
+                                 "(expected inertia_matrix or disp_mass)")
+    if not (math.isfinite(c) and c > 0):
+        raise ParameterError(f"hydro: {path}: expected a heave hydrostatic_stiffness > 0, "
+                             f"got {c!r}")
+    if not (math.isfinite(mass) and mass > 0):
+        raise ParameterError(f"hydro: {path}: expected a heave mass > 0, got {mass!r}")
+    rho = _scalar(ds, "rho", 1025.0)
+    g = _scalar(ds, "g", 9.81)
+    depth = _scalar(ds, "water_depth", math.inf)
+    return Hydro(omega=w, added_mass=a, radiation_damping=b, excitation=f,
+                 hydrostatic_stiffness=c, mass=mass, rho=rho, g=g, water_depth=depth,
+                 description=description or str(ds.attrs.get("description", "")))
+
+
+def load(path) -> Hydro:
+    """Read heave coefficients from a NetCDF dataset written by Capytaine.
+
+    Either ``capytaine.io.xarray.save_dataset_as_netcdf(path, ds)`` or
+    ``separate_complex_values(ds).to_netcdf(path)``: complex values split along a
+    ``complex`` dimension, Capytaine's convention ``exp(-i w t)``. The dataset needs a
+    ``Heave`` degree of freedom, ``added_mass``, ``radiation_damping``, the excitation
+    (``excitation_force``, or ``diffraction_force`` and ``Froude_Krylov_force``), the
+    ``hydrostatic_stiffness`` and the mass (``inertia_matrix`` or ``disp_mass``).
+    Rows at ``omega = 0`` or ``inf`` are ignored.
+
+    Raises
+    ------
+    ParameterError
+        One line naming what is missing.
+    """
+    import xarray as xr
+
+    p = Path(path)
+    shown = repr(str(p))
+    if not p.is_file():
+        raise ParameterError(f"hydro: cannot read {shown}: no such file")
+    try:
+        ds = xr.load_dataset(p)
+    except Exception as exc:  # noqa: BLE001 - xarray's engines raise many types
+        reason = " ".join(str(exc).split())[:120] or type(exc).__name__
+        raise ParameterError(f"hydro: cannot read {shown} as a NetCDF dataset: {reason}") \
+            from None
+    desc = str(ds.attrs.get("description", "")) or f"dataset {p.name}"
+    return _from_dataset(ds, description=desc, path=shown)
+
