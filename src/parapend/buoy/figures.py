@@ -11,6 +11,7 @@ __all__ = ["plot_motion", "plot_sweep"]
 
 
 def _finish(fig, path):
+    fig.align_ylabels()  # one column of labels, clear of the widest tick labels
     fig.tight_layout()
     if path is not None:
         from ..fileio import save_figure
