@@ -24,7 +24,7 @@ from parapend.errors import ParameterError
 
 # the small sphere's design: resonance near 1.3 s
 PERIOD = 1.3
-PEND = ["--mass", "20", "--length", "0.3", "--damping-coefficient", "0.5"]
+PEND = ["--mass", "20", "--length", "0.3", "--damping-coefficient", "0.5", "--harmonics", "8"]
 
 
 def _capytaine_dataset(path, *, dofs=("Heave",), hydrostatics=True):
@@ -60,7 +60,7 @@ def sphere_nc(tmp_path_factory):
 @pytest.fixture(scope="module")
 def solved(sphere_nc):
     return parapend.buoy(hydro=sphere_nc, wave_period=PERIOD, mass=20.0, length=0.3,
-                         damping_coefficient=0.5)
+                         damping_coefficient=0.5, harmonics=8)
 
 
 def _fail(argv, capsys, tmp_path, match):
@@ -187,6 +187,7 @@ def test_result_numbers_against_their_definitions(solved):
     assert math.isclose(r.peak_torque_nm, np.max(np.abs(s["tau"])), rel_tol=1e-2)
 
 
+@pytest.mark.slow
 def test_cli_json_plot_and_save(sphere_nc, tmp_path, capsys, solved):
     import xarray as xr
     from figure_checks import all_problems
@@ -215,13 +216,14 @@ def test_cli_json_plot_and_save(sphere_nc, tmp_path, capsys, solved):
     assert "coupled optimum: power" in text and "radiation bound" in text
 
 
+@pytest.mark.slow
 def test_power_against_wave_period(sphere_nc, tmp_path, capsys):
     from figure_checks import all_problems
 
     from parapend.buoy.figures import plot_sweep
 
     r = parapend.buoy(hydro=sphere_nc, wave_period="1.1:1.5:3", mass=20.0, length=0.3,
-                      damping_coefficient=0.5)
+                      damping_coefficient=0.5, harmonics=8)
     assert r.period_s.shape == r.power_w.shape == r.radiation_bound_w.shape == (3,)
     assert np.all(r.power_w <= r.radiation_bound_w * (1 + 1e-9))
     assert np.all(r.energy_balance_residual < 1e-9)
@@ -259,6 +261,9 @@ def test_bad_input_with_a_dataset(sphere_nc, capsys, tmp_path):
                 "cannot rotate")
     assert err.startswith("parapend buoy: error: damping-coefficient")
     _fail(["--hydro", sphere_nc, "--radius", "1", *save], capsys, tmp_path, "radius")
+    # the design search needs a design variable for its bounds, and one wave period
+    _fail(["--hydro", sphere_nc, "--wave-period", "1.1:1.5:3", "--optimize-design", "length",
+           *save], capsys, tmp_path, "one wave period")
 
 
 def test_datasets_without_heave_or_hydrostatics(tmp_path_factory, capsys, tmp_path):

@@ -180,7 +180,11 @@ def period_sweep(hydro, width, pendulum, height, periods, *, winding=1, harmonic
         return np.array([np.nan if getattr(r, name) is None else getattr(r, name)
                          for r in rows], dtype=float)
 
-    notes = sorted({w for r in rows for w in r.warnings})
+    above = sum(1 for r in rows if r.warnings)
+    notes = ([f"at {above} of {len(rows)} periods, harmonics of the motion lie above the "
+              f"dataset's highest frequency {float(max(hydro.omega)):.4g} rad/s: there A is "
+              "held and B = F = 0 (each period's note: the results in _results)"]
+             if above else [])
     return BuoySweepResult(
         period_s=np.asarray(periods, dtype=float), power_w=col("power_w"),
         one_way_power_w=col("one_way_power_w"), radiation_bound_w=col("radiation_bound_w"),
