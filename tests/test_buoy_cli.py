@@ -310,3 +310,15 @@ def test_the_default_design_says_something(capsys):
     assert r.capture_width_ratio is not None and r.capture_width_ratio > 0
     assert main(["buoy"]) == 0
     assert "coupled optimum: power" in capsys.readouterr().out
+
+
+@pytest.mark.slow
+def test_an_irregular_record(sphere_nc):
+    """A periodic JONSWAP record of four waves, the pendulum turning once per wave."""
+    r = parapend.buoy(hydro=sphere_nc, hs=0.1, tp=1.5, repeat_period=6.0, cutoff=1.8,
+                      winding=4, mass=20.0, length=0.3, damping_coefficient=0.1, harmonics=32)
+    assert r.wave["kind"] == "irregular" and r.winding == 4
+    assert r.success and r.power_w > 0
+    assert r.energy_balance_residual < 1e-9
+    assert r.power_w <= r.limit_w * (1 + 1e-9) <= r.radiation_bound_w * (1 + 1e-9)
+    assert math.isclose(r.capture_width_m * r.energy_flux_w_per_m, r.power_w, rel_tol=1e-12)
