@@ -33,7 +33,7 @@ import io
 import json
 import math
 import os
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
@@ -51,12 +51,12 @@ CACHE_VERSION = 1
 PANELS_PER_WAVE = 10
 
 #: Panel radius from the geometry alone: ``scale / GEOMETRY_PANELS`` (``scale`` the smaller of
-#: radius and draft), fine enough for the waterplane area to 0.6 %.
-GEOMETRY_PANELS = 8
+#: radius and draft): the waterplane area to 0.3 %, A and B to about 1 %.
+GEOMETRY_PANELS = 12
 
 #: The finest panel the automatic rule uses: ``scale / FINEST_PANELS``; frequencies whose
 #: wavelength that panel cannot resolve are left out of the BEM (they are then above range).
-FINEST_PANELS = 20
+FINEST_PANELS = 24
 
 
 def _as_omega(w) -> np.ndarray:
@@ -98,7 +98,6 @@ class Hydro:
     g: float = 9.81
     water_depth: float = math.inf
     description: str = ""
-    _key: str = field(default="", repr=False, compare=False)
 
     def __post_init__(self):
         w = np.array(self.omega, dtype=float).ravel()
@@ -299,7 +298,7 @@ def _wavenumber(w, g, depth):
 def mesh_size(scale, omega_max, *, g=9.81, water_depth=math.inf, refine=1.0):
     """The panel radius (m) for a body of size ``scale`` (m) up to ``omega_max`` (rad/s).
 
-    ``min(scale / 8, wavelength / 10)``, not finer than ``scale / 20`` (each divided by
+    ``min(scale / 12, wavelength / 10)``, not finer than ``scale / 24`` (each divided by
     ``refine``): the panel is a fraction of the shortest wavelength and of the geometry.
     """
     k = _wavenumber(float(omega_max), g, water_depth)
@@ -351,7 +350,7 @@ def _cache_read(key: str) -> Hydro | None:
                          hydrostatic_stiffness=float(meta["C"]), mass=float(meta["M"]),
                          rho=float(meta["rho"]), g=float(meta["g"]),
                          water_depth=float(meta["depth"]),
-                         description=str(meta["description"]), _key=key)
+                         description=str(meta["description"]))
     except Exception:  # noqa: BLE001 - any failure means: recompute, never trust it
         return None
 
@@ -429,7 +428,6 @@ def _solve(build, omega, *, rho, g, water_depth, description, cache, key_parts):
     ds = cpt.BEMSolver().fill_dataset(test, body, n_jobs=1, progress_bar=False)
     hydro = _from_dataset(ds, c=c, mass=mass,
                           description=f"{description}, {hull.nb_faces} panels")
-    object.__setattr__(hydro, "_key", key)
     if cache:
         _cache_write(key, hydro)
     return hydro
@@ -649,6 +647,17 @@ def _from_dataset(ds, *, c=None, mass=None, description="", path="the dataset"):
 
     if "complex" in ds.dims:
         ds = merge_complex_values(ds)
+    omega_name = "omega"
+    if "omega" not in ds.dims:
+        # a dataset indexed by period or frequency only (assemble_dataset(omega=False))
+        if "period" in ds.dims:
+            ds = ds.assign_coords(omega=("period", 2 * math.pi / ds["period"].values))
+            ds = ds.swap_dims(period="omega")
+        elif "freq" in ds.dims:
+            ds = ds.assign_coords(omega=("freq", 2 * math.pi * ds["freq"].values))
+            ds = ds.swap_dims(freq="omega")
+        else:
+            raise ParameterError(f"hydro: {path} has no omega (nor period, freq) coordinate")
     for dim in ("radiating_dof", "influenced_dof"):
         if dim in ds.coords:
             labels = [str(v) for v in ds[dim].values]
@@ -666,10 +675,6 @@ def _from_dataset(ds, *, c=None, mass=None, description="", path="the dataset"):
     else:
         raise ParameterError(f"hydro: {path} has no excitation_force (nor diffraction_force "
                              "and Froude_Krylov_force)")
-    if "omega" in ds.coords:
-        omega_name = "omega"
-    else:
-        raise ParameterError(f"hydro: {path} has no omega coordinate")
     a = _pick(_pick(ds["added_mass"], "radiating_dof", "Heave", "added_mass", path),
               "influenced_dof", "Heave", "added_mass", path)
     b = _pick(_pick(ds["radiation_damping"], "radiating_dof", "Heave", "radiation_damping",
