@@ -284,7 +284,6 @@ def _irregular_wave(hs, tp, spectrum, gamma_peak, repeat_period, seed, cutoff, r
                     units):
     """The Wave of a periodic irregular record (``sea``'s parsing and checks) and its
     description."""
-    from ..excitation import _evaluate_uniform
     from ..seas import measured_record, sea_record
     from .coupled import Wave
 
@@ -302,10 +301,8 @@ def _irregular_wave(hs, tp, spectrum, gamma_peak, repeat_period, seed, cutoff, r
     info = dict(exc.info)
     info.pop("response", None)
     tr = float(info["repeat_period"])
-    m = max(64, 4 * exc.heave.size)
-    eta = _evaluate_uniform(np.asarray(exc.heave), m)
-    t = tr * np.arange(m) / m
-    wave = Wave.from_record(t, eta)
+    # the record's own components (an FFT of samples would add round-off at every harmonic)
+    wave = Wave(2 * math.pi / tr, np.asarray(exc.heave[1:], dtype=complex))
     info = {"kind": "irregular", **info}
     return wave, info
 
@@ -384,6 +381,10 @@ def _check_floats(h, pendulum):
 
 
 def _solve(h, pendulum, wave, *, winding, harmonics, torque_limit, efficiency, one_way=True):
+    """The coupled optimum, the one-way one (``one_way``), and the solver's warnings as
+    notes for the result (never as Python warnings)."""
+    import warnings
+
     from .optimum import coupled_optimum
 
     kw = {"winding": winding, "harmonics": harmonics}
@@ -391,13 +392,16 @@ def _solve(h, pendulum, wave, *, winding, harmonics, torque_limit, efficiency, o
         kw["torque_limit"] = torque_limit
     if efficiency is not None:
         kw["efficiency"] = efficiency
-    sol = coupled_optimum(h, pendulum, wave, **kw)
-    ow = coupled_optimum(h, pendulum, wave, one_way=True, **kw) if one_way else None
-    return sol, ow
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        sol = coupled_optimum(h, pendulum, wave, **kw)
+        ow = coupled_optimum(h, pendulum, wave, one_way=True, **kw) if one_way else None
+    notes = list(dict.fromkeys(str(w.message) for w in caught))
+    return sol, ow, notes
 
 
 def _result(h, width, pendulum, wave, wave_info, sol, ow, *, torque_limit, efficiency,
-            winding, design=None) -> BuoyResult:
+            winding, design=None, notes=()) -> BuoyResult:
     period = 2 * math.pi / wave.omega
     t = period * np.arange(801) / 800
     s = sol.sample(t)
@@ -406,7 +410,7 @@ def _result(h, width, pendulum, wave, wave_info, sol, ow, *, torque_limit, effic
     p = float(sol.power)
     bound = float(sol.radiation_bound)
     cw = p / flux if flux > 0 else math.nan
-    notes = []
+    notes = list(notes)
     n = int(sol.harmonics)
     above = np.asarray(h.above_range(wave.omega * np.arange(1, n + 1)))
     if above.any():
@@ -549,9 +553,9 @@ def buoy(*, wave_height=None, wave_period=None, hs=None, tp=None, spectrum="jons
         found = _outer(lambda p: _solve(h, p, wave, one_way=False, **opts)[0], pend,
                        variables, bounds, check=lambda p: _check_floats(h, p))
         pend, design = found.pendulum, found.to_dict()
-    sol, ow = _solve(h, pend, wave, **opts)
+    sol, ow, notes = _solve(h, pend, wave, **opts)
     return _result(h, width, pend, wave, info, sol, ow, torque_limit=torque_limit,
-                   efficiency=efficiency, winding=winding, design=design)
+                   efficiency=efficiency, winding=winding, design=design, notes=notes)
 
 
 def _bounds(name, text, value):

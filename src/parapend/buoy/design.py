@@ -170,11 +170,12 @@ def period_sweep(hydro, width, pendulum, height, periods, *, winding=1, harmonic
     rows = []
     for period in periods:
         wave = Wave.regular(height, float(period))
-        sol, ow = _solve(hydro, pendulum, wave, winding=winding, harmonics=harmonics,
-                         torque_limit=torque_limit, efficiency=efficiency)
+        sol, ow, notes = _solve(hydro, pendulum, wave, winding=winding, harmonics=harmonics,
+                                torque_limit=torque_limit, efficiency=efficiency)
         info = {"kind": "regular", "height_m": height, "period_s": float(period)}
         rows.append(_result(hydro, width, pendulum, wave, info, sol, ow,
-                            torque_limit=torque_limit, efficiency=efficiency, winding=winding))
+                            torque_limit=torque_limit, efficiency=efficiency, winding=winding,
+                            notes=notes))
 
     def col(name):
         return np.array([np.nan if getattr(r, name) is None else getattr(r, name)
