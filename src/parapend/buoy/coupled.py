@@ -277,12 +277,29 @@ class CoupledProblem(FourierProblem):
         h.flat[:: h.shape[0] + 1] -= gw * self._k2
         kc = self.coupling_harmonics
         if kc:
-            basis = self.basis()
-            W = np.fft.rfft(basis * sn, axis=1)[:, 1:kc + 1] / m
+            W = self._sine_products(sn, kc)
             sb = np.sqrt(self.beta)
             wr, wi = W.real * sb, W.imag * sb
             h -= 4.0 * (wr @ wr.T + wi @ wi.T)
         return p, g, h
+
+    def _sine_products(self, sn: np.ndarray, kc: int) -> np.ndarray:
+        """``W[i, j] = <sin(theta) phi_i e^{-ijs}>``, j = 1..Kc, from the FFT of
+        ``sin(theta)`` alone (products of trigonometric functions as sums at ``j -+ n``)."""
+        n, m = self.harmonics, self.points
+        top = min(n + kc, m // 2)
+        S = np.zeros(n + kc + 1, dtype=complex)
+        S[: top + 1] = np.fft.rfft(sn)[: top + 1] / m
+        j = np.arange(1, kc + 1)[None, :]
+        k = np.arange(1, n + 1)[:, None]
+        d = j - k
+        lo = np.where(d >= 0, S[np.abs(d)], np.conj(S[np.abs(d)]))
+        hi = S[j + k]
+        W = np.empty((2 * n + 1, kc), dtype=complex)
+        W[0] = S[1:kc + 1]
+        W[1:n + 1] = (lo - hi) / 2j
+        W[n + 1:] = (lo + hi) / 2
+        return W
 
     def basis(self) -> np.ndarray:
         """The (2N+1) x M matrix of ``1, sin(ns), cos(ns)`` on the grid."""

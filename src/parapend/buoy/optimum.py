@@ -145,18 +145,31 @@ class CoupledSolution:
         return {"theta": th, "theta_dot": thd, "theta_ddot": thdd, "z": z, "z_dot": zd,
                 "z_ddot": zdd, "tau": tau}
 
+    def torque_grid(self, m: int) -> np.ndarray:
+        """``tau`` (N m) at ``t_j = j T / m``, j = 0..m-1 (``m`` even; by FFTs)."""
+        w = self.omega
+        x = np.asarray(self.theta_coefficients["x"], dtype=float)
+        th, ths, thss = _grid_motion(x, self.winding, m)
+        zf = self._full_heave[: m // 2]
+        c = np.zeros(m // 2 + 1, dtype=complex)
+        c[: zf.size] = -((np.arange(zf.size) * w) ** 2) * zf * (m / 2.0)
+        zdd = np.fft.irfft(c, m)
+        p = self._pendulum
+        return (p.inertia * w**2 * thss + p.damping_coefficient * w * ths
+                - p.mass * p.length * (self._g + zdd) * np.sin(th))
+
     def peak_torque(self) -> float:
         """``max |tau|`` over one period, N m: on a grid, the largest local maxima refined."""
         from scipy.optimize import minimize_scalar
 
-        m = max(2048, 16 * self.harmonics)
-        t = self.period * np.arange(m) / m
-        a = np.abs(self.sample(t)["tau"])
+        m = 1 << int(math.ceil(math.log2(max(2048, 16 * self.harmonics,
+                                                4 * self._full_heave.size))))
+        a = np.abs(self.torque_grid(m))
         dt = self.period / m
         best = float(np.max(a))
         for j in np.argsort(a)[-3:]:
             r = minimize_scalar(lambda tt: -abs(float(self.sample(np.array([tt]))["tau"][0])),
-                                bounds=(t[j] - dt, t[j] + dt), method="bounded",
+                                bounds=(j * dt - dt, j * dt + dt), method="bounded",
                                 options={"xatol": 1e-10 * self.period})
             best = max(best, -float(r.fun))
         return best
@@ -221,50 +234,82 @@ def _heave_and_balance(hydro, pendulum: Pendulum, wave: Wave, x: np.ndarray, win
 
 
 # ------------------------------------------------------------------------------------------
-def _qp_value(w: np.ndarray, beta: np.ndarray, u: np.ndarray) -> float:
-    m = u.size
-    kc = min(beta.size, m // 2 - 1)
-    uh = np.fft.rfft(u)[1:kc + 1] / m
-    return float(np.mean(w * u)) - 2.0 * float(np.dot(beta[:kc], np.abs(uh) ** 2))
+def _abs_mean(f: np.ndarray):
+    """``<|f|>`` of the piecewise-linear periodic interpolant of the samples ``f``, exactly,
+    and its gradient with respect to the samples (continuous: the dual below is C^1)."""
+    m = f.size
+    a, b = f, np.roll(f, -1)
+    aa, ab = np.abs(a), np.abs(b)
+    same = a * b >= 0
+    den = np.where(same, 1.0, aa + ab)
+    val = np.where(same, 0.5 * (aa + ab), (a * a + b * b) / (2 * den))
+    sa, sb = np.sign(a), np.sign(b)
+    ga = np.where(same, 0.5 * sa, (2 * a * den - (a * a + b * b) * sa) / (2 * den**2))
+    gb = np.where(same, 0.5 * sb, (2 * b * den - (a * a + b * b) * sb) / (2 * den**2))
+    return float(np.sum(val)) / m, (ga + np.roll(gb, 1)) / m
 
 
-def _solve_qp(w: np.ndarray, beta: np.ndarray, u0: np.ndarray) -> np.ndarray:
-    """``max <w u> - 2 sum beta_k |<u e^{-iks}>|^2`` over ``u`` in [-1, 1]^m (L-BFGS-B)."""
+def _dual(w: np.ndarray, beta: np.ndarray, lam0: np.ndarray | None = None):
+    """Minimize the dual ``D(lam) = <|w - rho|> + sum |lam_k|^2 / (2 beta_k)``,
+    ``rho = 2 Re sum lam_k e^{iks}``, over ``lam`` (2 Kc reals; L-BFGS).
+
+    By weak duality every ``D(lam)`` bounds the box QP from above; at the minimum the
+    optimal ``u`` is ``sign(w - rho)`` (bang-bang, as ``w - rho`` is band-limited).
+    """
     from scipy.optimize import minimize
 
     m = w.size
     kc = min(beta.size, m // 2 - 1)
     b = beta[:kc]
+    pos = b > 0
 
-    def f(u):
-        uh = np.fft.rfft(u)[1:kc + 1] / m
-        val = float(np.dot(w, u)) / m - 2.0 * float(np.dot(b, uh.real**2 + uh.imag**2))
+    if not pos.any():
+        return _abs_mean(w)[0], np.zeros(kc, dtype=complex)
+    sb = np.sqrt(b[pos])  # lam = sqrt(beta) mu: the quadratic term is |mu|^2 / 2
+
+    def unpack(z):
+        lam = np.zeros(kc, dtype=complex)
+        h = pos.sum()
+        lam[pos] = sb * (z[:h] + 1j * z[h:])
+        return lam
+
+    def f(z):
+        lam = unpack(z)
         c = np.zeros(m // 2 + 1, dtype=complex)
-        c[1:kc + 1] = -2.0 * m * b * uh
-        grad = (w + np.fft.irfft(c, m)) / m
-        return -val * m, -grad * m
+        c[1:kc + 1] = m * lam  # irfft: Re sum 2 lam_k e^{iks}
+        rho = np.fft.irfft(c, m)
+        v, gf = _abs_mean(w - rho)
+        v += 0.5 * float(np.dot(z, z))
+        # d/d lam of <|w - rho|>: -sum_j gf_j * 2 e^{iks_j} (Re, Im parts)
+        G = np.fft.rfft(gf)[1:kc + 1][pos]  # sum_j gf_j e^{-iks_j}
+        return v, np.concatenate((-2 * G.real * sb, -2 * G.imag * sb)) + z
 
-    r = minimize(f, u0, jac=True, method="L-BFGS-B", bounds=[(-1.0, 1.0)] * m,
-                 options={"maxiter": 20000, "maxcor": 30, "ftol": 1e-16, "gtol": 1e-13})
-    return np.clip(r.x, -1.0, 1.0)
+    z0 = np.zeros(2 * int(pos.sum())) if lam0 is None else np.concatenate(
+        (lam0[:kc][pos].real / sb, lam0[:kc][pos].imag / sb))
+    r = minimize(f, z0, jac=True, method="L-BFGS-B",
+                 options={"maxiter": 5000, "maxcor": 10, "ftol": 1e-15, "gtol": 1e-12})
+    lam = unpack(r.x)
+    return float(r.fun), lam
 
 
 def coupled_limit(sc, points: int = 1024) -> tuple[float, float, np.ndarray]:
-    """The coupled ``c = 0`` supremum (non-dimensional) on ``points`` and on twice as many.
+    """The coupled ``c = 0`` supremum (non-dimensional) by its dual, on ``points`` and on
+    twice as many.
 
-    Returns ``(value, change, u)``: the value on the finer grid, its change from the coarser
-    one, and the optimal ``u = cos(theta)`` there.
+    Returns ``(value, change, u)``: the dual value on the finer grid (an upper bound of the
+    box QP up to the linear interpolation of ``w - rho`` between grid points), its change
+    from the coarser grid, and the optimal ``u = cos(theta) = sign(w - rho)`` there.
     """
     exc = free_excitation(sc)
     beta = np.asarray(sc.beta_nd, dtype=float)
     m = max(points, 1 << int(math.ceil(math.log2(8 * max(beta.size, exc.spectrum.size)))))
-    w = exc.dq_grid(m)
-    u = _solve_qp(w, beta, np.sign(w))
-    v1 = _qp_value(w, beta, u)
+    v1, lam = _dual(exc.dq_grid(m), beta)
     w2 = exc.dq_grid(2 * m)
-    u2 = _solve_qp(w2, beta, np.repeat(u, 2))
-    v2 = _qp_value(w2, beta, u2)
-    return v2, abs(v2 - v1), u2
+    v2, lam2 = _dual(w2, beta, lam)
+    c = np.zeros(m + 1, dtype=complex)
+    c[1:lam2.size + 1] = 2 * m * lam2
+    u = np.sign(w2 - np.fft.irfft(c, 2 * m))
+    return v2, abs(v2 - v1), u
 
 
 # ------------------------------------------------------------------------------------------
@@ -420,7 +465,7 @@ def coupled_optimum(hydro, pendulum: Pendulum, wave: Wave, *, winding: int = 1,
         problem_n = CoupledProblem(exc, sc.beta_nd, n, sc.gamma, winding=k, hessian=hess)
         best, runs, rejected = _polish(problem_n, _seeds(ow.runs, n, k, ow.best.x, starts),
                                        4 * problem_n.points)
-        lim_nd, lim_change, _ = coupled_limit(sc, 2 * problem_n.points)
+        lim_nd, lim_change, _ = coupled_limit(sc, 1024)
     if best is None:
         return _failed(sc, wave, n, k, bound, lim_nd * pu, runs, rejected, one_way, hydro,
                        pendulum)
