@@ -147,7 +147,7 @@ def test_limit_tends_to_bound_for_a_small_wave():
     wave = Wave.regular(1e-3, 6.0)
     sc = scales(HYDRO, p, wave)
     lim, _, u = coupled_limit(sc, 1024)
-    bound = HYDRO.radiation_bound(wave.frequencies, wave.amplitudes) / sc.power_unit
+    bound = HYDRO.radiation_bound(wave.omega, abs(wave.amplitudes[0])) / sc.power_unit
     assert np.max(np.abs(u)) <= 1.0
     assert lim == pytest.approx(bound, rel=1e-3)
     sc0 = scales(HYDRO, p, Wave.regular(1.5, 6.0), coupled=False)
@@ -173,8 +173,8 @@ def test_balance_and_bounds_over_designs(mass, ratio, length, damping, period, h
 def test_not_yet_supported_and_bad_input():
     p = Pendulum(500.0, 1.0, 600.0, 20.0)
     wave = Wave.regular(1.5, 6.0)
-    with pytest.raises(ParameterError, match="torque-limit: not yet supported"):
-        coupled_optimum(HYDRO, p, wave, torque_limit=100.0)
+    with pytest.raises(ParameterError, match="torque-limit: expected a positive"):
+        coupled_optimum(HYDRO, p, wave, torque_limit=-1.0)
     with pytest.raises(ParameterError, match="efficiency: not yet supported"):
         coupled_optimum(HYDRO, p, wave, efficiency=0.9)
     with pytest.raises(ParameterError, match="inertia"):
@@ -228,3 +228,22 @@ def test_irregular_record_twenty_waves():
     assert 0 < r.power <= r.limit <= r.radiation_bound
     assert r.power < r.evidence["one_way_power"]
     assert r.refinement_change <= 1e-3 * r.power
+
+
+def test_torque_limit():
+    """An active limit lowers the power a little and holds on the grid (between its points
+    within TORQUE_SLACK); an inactive one changes nothing."""
+    from parapend.buoy.optimum import TORQUE_SLACK
+
+    h = toy_hydro(radius=1.5)
+    p = Pendulum(4000.0, 1.0, 4500.0, 40.0)
+    wave = Wave.regular(1.5, 6.0)
+    ideal = coupled_optimum(h, p, wave, harmonics=6, starts=4)
+    peak = ideal.peak_torque()
+    same = coupled_optimum(h, p, wave, harmonics=6, starts=4, torque_limit=2 * peak)
+    assert same.power == ideal.power and "inactive" in same.status
+    r = coupled_optimum(h, p, wave, harmonics=6, starts=4, torque_limit=0.8 * peak)
+    assert r.success, r.status
+    assert r.power < ideal.power
+    assert r.peak_torque() <= 0.8 * peak * (1 + TORQUE_SLACK)
+    assert r.energy_balance_residual <= BALANCE_TOL

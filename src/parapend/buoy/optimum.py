@@ -31,7 +31,7 @@ from __future__ import annotations
 
 import math
 import warnings
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -41,7 +41,7 @@ from ..optimal.fourier import _pad, motion_distance, newton_maximize, search_fou
 from ..optimal.limit import limit as uncoupled_limit
 from .coupled import CoupledProblem, Pendulum, Wave, free_excitation, scales
 
-__all__ = ["CoupledSolution", "coupled_limit", "coupled_optimum"]
+__all__ = ["CoupledSolution", "coupled_limit", "coupled_optimum", "radiation_bound"]
 
 #: relative change of the optimum's power between its grid and one four times finer above
 #: which the optimum is rejected as aliased
@@ -51,8 +51,11 @@ BALANCE_TOL = 1e-9
 #: harmonics of the motion per turn (regular wave) and per mean wave (record)
 HARMONICS_PER_TURN = 24
 HARMONICS_PER_WAVE = 16
-#: dense Hessian up to this many harmonics, matrix-free Newton-CG above
-DENSE_MAX = 256
+#: a torque-limited optimum may exceed the limit between its grid points by this fraction
+TORQUE_SLACK = 1e-3
+#: dense Hessian for a regular wave up to this many harmonics, matrix-free Newton-CG above
+#: and for every record (the dense Newton from the swinging-back seeds took minutes at N = 192)
+DENSE_MAX = 96
 
 
 @dataclass(frozen=True, eq=False)
@@ -314,9 +317,11 @@ def coupled_limit(sc, points: int = 1024) -> tuple[float, float, np.ndarray]:
 
 # ------------------------------------------------------------------------------------------
 def _check_args(winding, harmonics, torque_limit, efficiency, starts):
-    if torque_limit is not None:
-        raise ParameterError("torque-limit: not yet supported with the buoy (the ideal "
-                             "coupled optimum only); drop --torque-limit")
+    if torque_limit is not None and not (
+            isinstance(torque_limit, (int, float, np.floating)) and math.isfinite(torque_limit)
+            and torque_limit > 0):
+        raise ParameterError(f"torque-limit: expected a positive torque in N m, got "
+                             f"{torque_limit!r}")
     if efficiency is not None:
         raise ParameterError("efficiency: not yet supported with the buoy (the ideal coupled "
                              "optimum only); drop --efficiency")
@@ -335,10 +340,21 @@ def _check_hydro(hydro, wave: Wave):
     sig = np.nonzero(a >= 1e-3 * a.max())[0]
     fr = wave.frequencies
     hydro.check_covers(float(fr[sig[0]]), float(fr[sig[-1]]))
-    top = wave.omega * (1 + np.nonzero(a > 0)[0][-1])
+    top = wave.omega * (1 + np.nonzero(a > 1e-9 * a.max())[0][-1])
     if bool(np.any(hydro.above_range(np.array([top])))):
         warnings.warn("wave: components above the dataset's highest frequency are taken "
                       "with B = F = 0", RuntimeWarning, stacklevel=3)
+
+
+def radiation_bound(hydro, wave: Wave) -> float:
+    """``sum_k |F_k a_k|^2 / (8 B_k)`` over the wave's components with ``B_k > 0``, W (each
+    component's bound for a heaving body; the harmonics of a periodic motion are orthogonal
+    in the mean power, so the bounds add)."""
+    _, b, f = hydro.coefficients(wave.frequencies)
+    b = np.asarray(b, dtype=float)
+    e = np.abs(np.asarray(f) * wave.amplitudes) ** 2
+    ok = b > 0
+    return float(np.sum(e[ok] / (8.0 * b[ok])))
 
 
 def _default_harmonics(sc, winding: int, regular: bool) -> int:
@@ -404,6 +420,67 @@ def _polish(problem, seeds, fine_points):
     return best, runs, rejected
 
 
+class _Torque:
+    """Non-dimensional torque ``tau = Omega^2 theta_ss + gamma Omega theta_s - (1 + q)
+    sin(theta)`` on the problem's grid and its Jacobian, ``q = q_w + L cos(theta)`` with
+    ``L`` the pendulum's reaction on the buoy (harmonics ``-(kw)^4 m l / (g D_k)``; every
+    harmonic of the grid, the reactive ones above the dataset included)."""
+
+    def __init__(self, problem, hydro, pendulum, wave, coupled: bool):
+        self.pr = problem
+        m = problem.points
+        k = np.arange(m // 2 + 1)
+        om = k * wave.omega
+        gk = np.zeros(m // 2 + 1, dtype=complex)
+        if coupled:
+            d = hydro.impedance(om[1:m // 2])
+            gk[1:m // 2] = -(om[1:m // 2] ** 4) * pendulum.mass * pendulum.length / (
+                float(hydro.g) * d)
+        self.gk = gk
+        self.qw = problem.excitation.q_grid(m)
+        self.basis = problem.basis()
+        n = problem.harmonics
+        kk = np.arange(1, n + 1)[:, None]
+        s = problem.s[None, :]
+        self.d1 = np.vstack((np.zeros((1, m)), kk * np.cos(kk * s), -kk * np.sin(kk * s)))
+        self.d2 = np.vstack((np.zeros((1, m)), -(kk**2) * np.sin(kk * s),
+                             -(kk**2) * np.cos(kk * s)))
+
+    def _l(self, f):
+        m = self.pr.points
+        return np.fft.irfft(self.gk * np.fft.rfft(f, axis=-1), m, axis=-1)
+
+    def __call__(self, x):
+        pr = self.pr
+        om, k = pr.omega, pr.winding
+        th = pr.theta(x)
+        ths = k + x @ self.d1
+        thss = x @ self.d2
+        sn, cs = np.sin(th), np.cos(th)
+        q = self.qw + self._l(cs)
+        tau = om**2 * thss + pr.gamma * om * ths - (1 + q) * sn
+        jac = (om**2 * self.d2 + pr.gamma * om * self.d1 - ((1 + q) * cs) * self.basis
+               + sn * self._l(sn * self.basis))
+        return tau, jac.T
+
+
+def _torque_limited(problem, x0, limit_nd, torque):
+    """Maximize P subject to ``|tau| <= limit`` on the grid (SLSQP, exact gradients)."""
+    from scipy.optimize import minimize
+
+    def f(x):
+        p, g, _ = problem.evaluate(x)
+        return -p, -g
+
+    cons = [{"type": "ineq", "fun": lambda x: limit_nd - torque(x)[0],
+             "jac": lambda x: -torque(x)[1]},
+            {"type": "ineq", "fun": lambda x: limit_nd + torque(x)[0],
+             "jac": lambda x: torque(x)[1]}]
+    r = minimize(f, x0, jac=True, method="SLSQP", constraints=cons,
+                 options={"maxiter": 500, "ftol": 1e-13})
+    return r
+
+
 def _distinct_maxima(runs, pu):
     out = []
     for r in sorted((r for r in runs if r.status == "converged"), key=lambda r: -r.power):
@@ -430,7 +507,12 @@ def coupled_optimum(hydro, pendulum: Pendulum, wave: Wave, *, winding: int = 1,
     harmonics : int or None
         N; None: 24 K (regular wave) or 16 per mean wave of the free heave (record), then
         checked by one refinement (the result is the ``2N`` optimum).
-    torque_limit, efficiency : None
+    torque_limit : float or None
+        ``|tau| <= torque_limit`` (N m), regular wave only: SLSQP with exact gradients of
+        ``P`` and of the torque on the grid, from the ideal optimum, at N and 2N; the peak
+        between grid points is checked (within :data:`TORQUE_SLACK`, else ``success`` is
+        False) and stated in ``status``.
+    efficiency : None
         Not yet supported with the buoy (ParameterError).
     starts : int or None
         At most this many seeds of the global search (None: all).
@@ -451,8 +533,8 @@ def coupled_optimum(hydro, pendulum: Pendulum, wave: Wave, *, winding: int = 1,
     pu = sc.power_unit
     if n is None:
         n = _default_harmonics(sc, k, regular)
-    hess = "dense" if n <= DENSE_MAX else "operator"
-    bound = hydro.radiation_bound(wave.frequencies, wave.amplitudes)
+    hess = "dense" if regular and n <= DENSE_MAX else "operator"
+    bound = radiation_bound(hydro, wave)
     kw = {"winding": k, "hessian": hess}
     if not regular:
         kw["propose"] = 4
@@ -471,7 +553,7 @@ def coupled_optimum(hydro, pendulum: Pendulum, wave: Wave, *, winding: int = 1,
                        pendulum)
     # one refinement: 2N from the N optimum
     n2 = 2 * n
-    hess2 = "dense" if n2 <= DENSE_MAX else "operator"
+    hess2 = "dense" if regular and n2 <= DENSE_MAX else "operator"
     fine = CoupledProblem(exc, sc.beta_nd, n2, sc.gamma, winding=k, hessian=hess2)
     ref = newton_maximize(fine, _pad(best.x, n2), best.seed)
     change = abs(ref.power - best.power)
@@ -479,6 +561,27 @@ def coupled_optimum(hydro, pendulum: Pendulum, wave: Wave, *, winding: int = 1,
     if ref.status == "converged" and ref.power >= best.power - 1e-12 * max(1.0, abs(
             best.power)):
         sol, n = ref, n2
+    tl_note = None
+    if torque_limit is not None:
+        if not regular:
+            raise ParameterError("torque-limit: supported with the buoy for a regular wave "
+                                 "only (not for a record); drop --torque-limit")
+        lim_t = torque_limit / sc.torque_unit
+        coarse = problem_n
+        tq_f = _Torque(fine, hydro, pendulum, wave, not one_way)
+        if float(np.max(np.abs(tq_f(_pad(sol.x, n2))[0]))) <= lim_t:
+            tl_note = "torque limit inactive: the ideal optimum stays within it"
+        else:
+            tq_c = _Torque(coarse, hydro, pendulum, wave, not one_way)
+            rc = _torque_limited(coarse, best.x, lim_t, tq_c)
+            rf = _torque_limited(fine, _pad(rc.x, n2), lim_t, tq_f)
+            change = abs(-rf.fun + rc.fun)
+            status = "converged" if (rf.success and rc.success) else "stalled"
+            sol = type(sol)(rf.x, -float(rf.fun), 0.0, int(rf.nit), status, best.seed,
+                            fine.points, False)
+            n = n2
+            tl_note = (f"torque limit {torque_limit:g} N m active (SLSQP on the {fine.points}-"
+                       f"point grid: {rf.message})")
     # fine grid: the power from the torque, the heave, the energy balance
     mf = max(4096, 4 * fine.points)
     p_w, Z, resid = _heave_and_balance(hydro, pendulum, wave, sol.x, k, mf, not one_way)
@@ -491,6 +594,11 @@ def coupled_optimum(hydro, pendulum: Pendulum, wave: Wave, *, winding: int = 1,
             parts.append(f"energy balance residual {resid:.2g} above {BALANCE_TOL:g}")
         if alias > ALIAS_TOL:
             parts.append(f"power on a fine grid differs by {alias:.2g} (relative)")
+    if tl_note:
+        parts.append(tl_note)
+    if p_w <= 0:
+        parts.append("no power: the best motion extracts nothing (P <= 0; the damping is too "
+                     "large or the buoy barely moves)")
     if pendulum.damping_coefficient == 0:
         parts.append("c = 0: the supremum (limit) is approached by switching motions and not "
                      "attained; this finite-N power is a lower bound of it")
@@ -507,7 +615,7 @@ def coupled_optimum(hydro, pendulum: Pendulum, wave: Wave, *, winding: int = 1,
     zfull = zfull[: (nz[-1] + 1 if nz.size else 1)]
     heave = np.zeros(n + 1, dtype=complex)
     heave[: min(n + 1, Z.size)] = Z[: n + 1]
-    return CoupledSolution(
+    res = CoupledSolution(
         success=bool(ok), status="; ".join(parts), power=float(p_w), harmonics=n,
         theta_coefficients={"x": np.asarray(sol.x), "winding": k, "omega": wave.omega},
         heave=heave, energy_balance_residual=float(resid), radiation_bound=float(bound),
@@ -515,6 +623,15 @@ def coupled_optimum(hydro, pendulum: Pendulum, wave: Wave, *, winding: int = 1,
         refinement_change=float(change * pu), limit_change=float(lim_change * pu),
         free_heave=np.asarray(sc.free_heave), omega=wave.omega, winding=k,
         _full_heave=zfull, _pendulum=pendulum, _g=float(hydro.g))
+    if torque_limit is not None:
+        # the limit is imposed on the solve grid: check it between the points
+        peak = res.peak_torque()
+        if peak > torque_limit * (1 + 1e-12):
+            over = peak / torque_limit - 1
+            res = replace(res, success=res.success and over <= TORQUE_SLACK,
+                          status=res.status + f"; between the grid points the peak torque is "
+                          f"{peak:.6g} N m ({over:.1e} above the limit)")
+    return res
 
 
 def _failed(sc, wave, n, k, bound, lim, runs, rejected, one_way, hydro, pendulum):
