@@ -16,12 +16,10 @@ import numpy as np
 from buoy_synthetic import synthetic
 
 from parapend.buoy import timedomain as td
-from parapend.buoy.api import _summed_bound
 from parapend.buoy.coupled import Pendulum, Wave
 from parapend.buoy.optimum import coupled_optimum
 
-# (_summed_bound: the optimum asks the bound of all the wave's components at once)
-HYDRO = _summed_bound(synthetic())
+HYDRO = synthetic()
 
 
 def test_the_optimal_torque_reproduces_the_optimal_motion_and_power():

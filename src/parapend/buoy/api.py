@@ -319,10 +319,10 @@ def _hydro(body, radius, draft, mesh, hydro, omegas, harmonics):
         raise ParameterError(f"{'radius' if radius is not None else 'draft'}: the body comes "
                              f"from --{given[0]}; drop it")
     if hydro is not None:
-        return _summed_bound(hy.load(hydro)), None
+        return hy.load(hydro), None
     omega = hy.frequencies_for(np.asarray(omegas, dtype=float), harmonics)
     if mesh is not None:
-        return _summed_bound(hy.from_mesh(mesh, omega=omega)), None
+        return hy.from_mesh(mesh, omega=omega), None
     if body not in ("cylinder", "sphere"):
         raise ParameterError(f"body: expected cylinder or sphere, got {body!r:.40}")
     r = check_positive("radius", BUOY["radius"] if radius is None else radius)
@@ -330,35 +330,9 @@ def _hydro(body, radius, draft, mesh, hydro, omegas, harmonics):
         if draft is not None:
             raise ParameterError("draft: a sphere floats at its centre (draft = radius); "
                                  "drop --draft")
-        return _summed_bound(hy.sphere(r, omega=omega)), 2 * r
+        return hy.sphere(r, omega=omega), 2 * r
     d = check_positive("draft", BUOY["draft"] if draft is None else draft)
-    return _summed_bound(hy.cylinder(r, d, omega=omega)), 2 * r
-
-
-_SUMMED: dict = {}
-
-
-def _summed_bound(h):
-    """``h`` whose ``radiation_bound(w, amplitude)`` also takes the arrays of a wave's
-    components (the sum of the single-frequency bounds): :mod:`.optimum` passes arrays."""
-    try:
-        h.radiation_bound(np.array([1.0, 2.0]), np.array([0.0, 0.0]))
-        return h
-    except TypeError:
-        pass
-    import dataclasses
-
-    base = type(h)
-    if base not in _SUMMED:
-        def radiation_bound(self, w, amplitude):
-            w = np.atleast_1d(np.asarray(w, dtype=float))
-            a = np.broadcast_to(np.atleast_1d(amplitude), w.shape)
-            return float(sum(base.radiation_bound(self, float(x), complex(y))
-                             for x, y in zip(w, a)))
-
-        _SUMMED[base] = type(base.__name__, (base,), {"radiation_bound": radiation_bound,
-                                                      "__doc__": base.__doc__})
-    return _SUMMED[base](**{f.name: getattr(h, f.name) for f in dataclasses.fields(h)})
+    return hy.cylinder(r, d, omega=omega), 2 * r
 
 
 def _body_info(h, width) -> dict:
