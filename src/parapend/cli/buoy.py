@@ -189,6 +189,8 @@ def _text_result(r) -> list:
             ["one-way (reaction left out): power", _w(r.one_way_power_w), "W"],
             ["  one-way / coupled", _w(r.one_way_ratio), "-"],
             ["free buoy: heave amplitude", _w(r.free_heave_amplitude_m), "m"]]
+    if r.torque_limit_nm is not None:
+        rows.insert(3, ["  torque limit", _w(r.torque_limit_nm), "N m"])
     out = [wave, *_head(r), "", _table(rows, ["quantity", "value", "unit"]), ""]
     if r.design:
         d = r.design
