@@ -44,6 +44,11 @@ _EXPORTS = {
     "OptimizeResult": ".results", "Record": ".results", "ThresholdResult": ".results",
     "SeaResult": ".irregular",
 }
+# the pendulum inside a floating buoy: ``parapend.buoy`` is the subpackage, which is callable
+# (``parapend.buoy(...)`` is commands.buoy): a plain function of that name would be rebound to
+# the subpackage as soon as one of its modules is imported
+_COMMANDS += ("buoy",)
+_EXPORTS.update({"BuoyResult": ".buoy.api", "BuoySweepResult": ".buoy.api"})
 
 # `map` is left out of the star import, which would hide the builtin: use parapend.map
 __all__ = sorted([*(k for k in _EXPORTS if k != "map"), "__version__"])

@@ -747,3 +747,33 @@ def power_matrix(*, hs: str = "1:3:3", te=None, tp=None, realizations: int = 3,
            "resumed_bins": run.resumed_points // int(realizations), "seconds": seconds,
            "executor": run.executor, "netcdf": netcdf, "zarr": zarr, "csv": csv}
     return Record("power-matrix", out, dataset=ds, run=run)
+# --- buoy ----------------------------------------------------------------------------------
+from .defaults import BUOY  # noqa: E402
+
+__all__ += ["buoy"]
+
+
+def buoy(*, wave_height=None, wave_period=None, hs=None, tp=None, spectrum="jonswap",
+         gamma_peak=3.3, repeat_period=None, seed=None, cutoff=3.0, record=None, taper=0.1,
+         mass=BUOY["mass"], length=BUOY["length"], inertia=BUOY["inertia"],
+         damping_coefficient=BUOY["damping_coefficient"], body="cylinder", radius=None,
+         draft=None, mesh=None, hydro=None, winding=1, harmonics=None, torque_limit=None,
+         efficiency=None, optimize_design=None, mass_bounds=None, length_bounds=None,
+         inertia_bounds=None, damping_coefficient_bounds=None):
+    """The coupled optimum of a pendulum inside a floating buoy, in SI units (command
+    ``buoy``; :func:`parapend.buoy.api.buoy`, parameters there): a
+    :class:`~parapend.buoy.api.BuoyResult`, or a :class:`~parapend.buoy.api.BuoySweepResult`
+    for ``wave_period="FROM:TO:N"``. With no arguments: the embedded default design
+    (:data:`parapend.defaults.BUOY`, docs/defaults.md)."""
+    from .buoy.api import buoy as _buoy
+
+    return _buoy(wave_height=wave_height, wave_period=wave_period, hs=hs, tp=tp,
+                 spectrum=spectrum, gamma_peak=gamma_peak, repeat_period=repeat_period,
+                 seed=seed, cutoff=cutoff, record=record, taper=taper, mass=mass,
+                 length=length, inertia=inertia, damping_coefficient=damping_coefficient,
+                 body=body, radius=radius, draft=draft, mesh=mesh, hydro=hydro,
+                 winding=winding, harmonics=harmonics, torque_limit=torque_limit,
+                 efficiency=efficiency, optimize_design=optimize_design,
+                 mass_bounds=mass_bounds, length_bounds=length_bounds,
+                 inertia_bounds=inertia_bounds,
+                 damping_coefficient_bounds=damping_coefficient_bounds)

@@ -8,7 +8,7 @@ named for it.
 
 from __future__ import annotations
 
-__all__ = ["Default", "given", "OMEGA", "DELTA", "GAMMA", "DYNAMICS", "SEA"]
+__all__ = ["Default", "given", "OMEGA", "DELTA", "GAMMA", "DYNAMICS", "SEA", "BUOY"]
 
 
 class Default(float):
@@ -51,3 +51,13 @@ DYNAMICS = {"gamma": GAMMA["simulate"], "p": 0.8, "omega": 2.1}
 #: the sea state and the pendulum of ``sea`` (a 1 m, 10 kg pendulum on a small buoy)
 SEA = {"hs": 2.0, "tp": 8.0, "seed": 0, "length": 1.0, "mass": 10.0, "gravity": 9.81,
        "gamma": GAMMA["sea"]}
+
+#: the embedded design of ``buoy`` (docs/defaults.md): a heavy pendulum in a small floating
+#: cylinder, in a regular wave near the buoy's heave resonance, where the pendulum's reaction
+#: changes the answer. SI units; ``design_bounds`` are the ranges ``--optimize-design`` searches
+#: without ``--<name>-bounds``, as factors of the design's value (damping: N m s/rad).
+BUOY = {"wave_height": 0.2, "wave_period": 1.8, "hs": 0.5, "tp": 2.5,
+        "radius": 0.5, "draft": 0.5, "mass": 80.0, "length": 0.3, "inertia": None,
+        "damping_coefficient": 1.0, "bem_harmonics": 3,
+        "design_bounds": {"mass": (0.25, 4.0), "length": (0.25, 4.0), "inertia": (1.0, 4.0),
+                          "damping_coefficient": (0.0, 20.0)}}

@@ -21,7 +21,7 @@ Modules: :mod:`._common` (parser helpers, number parsing, tables, progress),
  take-off and unit options of optimize), :mod:`.dynamics` (simulate, basins,
  rotations: the uncontrolled pendulum of paper Eq. 1), :mod:`.control` (track: the
  closed loop), :mod:`.sea` (sea: irregular seas), :mod:`.sweep` (sweep, map:
- design maps).
+ design maps), :mod:`.buoy` (buoy: the pendulum inside a floating buoy).
 """
 
 from __future__ import annotations
@@ -33,6 +33,7 @@ import sys
 from .. import __version__, _entry
 from ..errors import ParameterError, SolverError
 from ..results import to_jsonable
+from . import buoy as _buoy_cmds
 from . import control as _control_cmds
 from . import dynamics as _dynamics_cmds
 from . import optimize as _optimize_cmds
@@ -52,7 +53,7 @@ __all__ = ["build_parser", "main"]
 COMMANDS = {**_optimize_cmds.COMMANDS, **_paper_cmds.COMMANDS, **_pto_cmds.COMMANDS,
             **_dynamics_cmds.COMMANDS, **_control_cmds.COMMANDS, **_sea_cmds.COMMANDS,
             **_sweep_cmds.COMMANDS,
-            **_performance_cmds.COMMANDS}
+            **_performance_cmds.COMMANDS, **_buoy_cmds.COMMANDS}
 
 
 def build_parser():
@@ -72,6 +73,7 @@ def build_parser():
     _sea_cmds.add_parsers(sub)
     _sweep_cmds.add_parsers(sub)
     _performance_cmds.add_parsers(sub)
+    _buoy_cmds.add_parsers(sub)
     return parser
 
 

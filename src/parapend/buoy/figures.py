@@ -1,0 +1,84 @@
+"""Figures of ``parapend buoy`` (house style: :mod:`parapend.style`): the coupled optimum over
+one wave period, and power against wave period with the radiation bound."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..style import figure_style
+
+__all__ = ["plot_motion", "plot_sweep"]
+
+
+def _finish(fig, path):
+    fig.align_ylabels()  # one column of labels, clear of the widest tick labels
+    fig.tight_layout()
+    if path is not None:
+        from ..fileio import save_figure
+
+        save_figure(fig, path, close=False)
+    return fig
+
+
+@figure_style()
+def plot_motion(result, path=None, points: int = 600):
+    """theta, the buoy's heave and the generator torque over one period of the coupled
+    optimum (a :class:`~parapend.buoy.api.BuoyResult`), with the free buoy's heave."""
+    import matplotlib.pyplot as plt
+
+    s = result.samples(points)
+    t = s["t"]
+    fig, (ax1, ax2, ax3) = plt.subplots(3, 1, figsize=(7, 7.5), sharex=True)
+    ax1.plot(t, s["theta"], lw=1.6, color="C0")
+    ax1.set_ylabel(r"$\theta$ (rad, from upright)")
+    w = result.wave
+    what = (f"H = {w['height_m']:g} m, T = {w['period_s']:g} s" if w.get("kind") == "regular"
+            else "irregular record")
+    ax1.set_title(f"Coupled optimum ({what}): P = {result.power_w:.4g} W, "
+                  f"one-way {_w(result.one_way_power_w)}")
+    ax2.plot(t, s["z"], lw=1.6, color="C1", label="coupled (with the pendulum)")
+    ax2.plot(t, s["z_free"], "--", lw=1.0, color="gray", label="free buoy")
+    ax2.set_ylabel("heave z (m)")
+    ax2.legend(loc="best", fontsize="small")
+    ax3.plot(t, s["tau"], lw=1.4, color="C3")
+    ax3.axhline(0.0, color="k", lw=0.5)
+    ax3.set_ylabel(r"torque $\tau$ (N m)")
+    ax3.set_xlabel("time t (s)")
+    ax3.set_xlim(t[0], t[-1])
+    return _finish(fig, path)
+
+
+def _w(p):
+    return "-" if p is None else f"{p:.4g} W"
+
+
+@figure_style()
+def plot_sweep(sweep, path=None):
+    """Power against wave period (a :class:`~parapend.buoy.api.BuoySweepResult`): the
+    coupled optimum, the one-way answer, the radiation bound and the coupled limit."""
+    import matplotlib.pyplot as plt
+
+    t = np.asarray(sweep.period_s)
+    fig, (ax1, ax2) = plt.subplots(2, 1, figsize=(7, 6.5), sharex=True,
+                                   gridspec_kw={"height_ratios": [3, 2]})
+    def pos(y):  # a log axis: no power is drawn as a gap
+        y = np.asarray(y, dtype=float)
+        return np.where(y > 0, y, np.nan)
+
+    ax1.plot(t, pos(sweep.radiation_bound_w), "k-", lw=1.0, label="radiation bound")
+    ax1.plot(t, pos(sweep.limit_w), "k:", lw=1.2, label="coupled limit (c = 0)")
+    ax1.plot(t, pos(sweep.one_way_power_w), "--", color="C2", lw=1.4, marker="s", ms=3,
+             label="one-way (reaction left out)")
+    ax1.plot(t, pos(sweep.power_w), "-", color="C0", lw=1.8, marker="o", ms=3,
+             label="coupled optimum")
+    ax1.set_yscale("log")
+    ax1.set_ylabel("power (W)")
+    ax1.legend(loc="best", fontsize="small")
+    ax1.set_title(f"Power against wave period, H = {sweep.wave_height_m:g} m")
+    ax2.plot(t, sweep.heave_amplitude_m, "-", color="C1", lw=1.6, label="coupled")
+    ax2.plot(t, sweep.free_heave_amplitude_m, "--", color="gray", lw=1.0, label="free buoy")
+    ax2.set_ylabel("heave amplitude (m)")
+    ax2.set_xlabel("wave period T (s)")
+    ax2.legend(loc="best", fontsize="small")
+    ax2.set_xlim(t[0], t[-1])
+    return _finish(fig, path)

@@ -1,0 +1,219 @@
+"""``parapend buoy``: the pendulum inside a floating buoy, coupled both ways (docs/buoy.md)."""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+from ..defaults import BUOY
+from ..errors import ParameterError
+from . import _output
+from ._common import _check_output, _finite_float, _fmt, _int, _run, _table
+
+
+def _text(name):
+    def conv(text):
+        return text
+
+    conv.__name__ = name
+    return conv
+
+
+def add_parsers(sub) -> None:
+    p = sub.add_parser(
+        "buoy", help="a pendulum inside a floating buoy: the coupled optimum, with Capytaine "
+                     "hydrodynamics",
+        description="The largest power a pendulum inside a heaving buoy harvests, with the "
+                    "pendulum's reaction on the buoy (coupled both ways), beside the radiation "
+                    "bound, the one-way answer (reaction left out) and the free buoy. SI "
+                    "units. With no options: the embedded default design (docs/buoy.md, "
+                    "docs/defaults.md).")
+    g = p.add_argument_group("regular wave")
+    g.add_argument("--wave-height", type=_finite_float("wave-height"), default=None,
+                   help=f"H, m, crest to trough (default {BUOY['wave_height']:g})")
+    g.add_argument("--wave-period", type=_text("wave-period"), default=None, metavar="T",
+                   help=f"s (default {BUOY['wave_period']:g}); FROM:TO:N for power against "
+                        "period")
+    g = p.add_argument_group("irregular sea (as 'parapend sea' takes it)")
+    g.add_argument("--hs", type=_finite_float("hs"), default=None,
+                   help=f"significant wave height, m (default {BUOY['hs']:g} with --tp)")
+    g.add_argument("--tp", type=_finite_float("tp"), default=None,
+                   help=f"peak period, s (default {BUOY['tp']:g} with --hs)")
+    g.add_argument("--spectrum", choices=["jonswap", "pierson-moskowitz"], default="jonswap",
+                   help="spectrum shape (default jonswap)")
+    g.add_argument("--gamma-peak", type=_finite_float("gamma-peak"), default=3.3,
+                   help="JONSWAP peak enhancement in [1, 20] (default 3.3)")
+    g.add_argument("--repeat-period", type=_finite_float("repeat-period"), default=None,
+                   help="T_r, s: the record repeats with it (default 100 Tp)")
+    g.add_argument("--seed", type=_int, default=None, help="seed of the random phases "
+                                                           "(default 0)")
+    g.add_argument("--cutoff", type=_finite_float("cutoff"), default=3.0,
+                   help="highest frequency, in units of the peak frequency (default 3)")
+    g.add_argument("--record", metavar="CSV", default=None,
+                   help="measured surface elevation at the body, CSV 't,z' (s, m)")
+    g.add_argument("--taper", type=_finite_float("taper"), default=0.1,
+                   help="with --record: fraction under the Tukey taper (default 0.1)")
+    g = p.add_argument_group("pendulum (SI units)")
+    g.add_argument("--mass", type=_finite_float("mass"), default=BUOY["mass"],
+                   help=f"m, kg (default {BUOY['mass']:g})")
+    g.add_argument("--length", type=_finite_float("length"), default=BUOY["length"],
+                   help=f"pivot to centre of mass l, m (default {BUOY['length']:g})")
+    g.add_argument("--inertia", type=_finite_float("inertia"), default=BUOY["inertia"],
+                   help="about the pivot, kg m^2, at least m l^2 (default m l^2)")
+    g.add_argument("--damping-coefficient", type=_finite_float("damping-coefficient"),
+                   default=BUOY["damping_coefficient"],
+                   help=f"viscous c, N m s/rad (default {BUOY['damping_coefficient']:g})")
+    g = p.add_argument_group("body (Capytaine; the BEM result is cached on disk)")
+    g.add_argument("--body", choices=["cylinder", "sphere"], default="cylinder",
+                   help="vertical cylinder or sphere floating at its centre (default cylinder)")
+    g.add_argument("--radius", type=_finite_float("radius"), default=None,
+                   help=f"m (default {BUOY['radius']:g})")
+    g.add_argument("--draft", type=_finite_float("draft"), default=None,
+                   help=f"cylinder's draft, m (default {BUOY['draft']:g})")
+    g.add_argument("--mesh", metavar="FILE", default=None,
+                   help="a mesh file Capytaine reads, instead of --body")
+    g.add_argument("--hydro", metavar="FILE", default=None,
+                   help="a Capytaine dataset (NetCDF), instead of solving (docs/buoy.md)")
+    g = p.add_argument_group("motion and power take-off")
+    g.add_argument("--winding", type=_int, default=1,
+                   help="turns per wave (per record in an irregular sea) (default 1)")
+    g.add_argument("--harmonics", type=_int, default=None,
+                   help="N of the motion (default chosen from the problem and checked)")
+    g.add_argument("--torque-limit", type=_finite_float("torque-limit"), default=None,
+                   help="largest |torque|, N m")
+    g.add_argument("--efficiency", type=_finite_float("efficiency"), default=None,
+                   help="power take-off efficiency in (0, 1]")
+    g = p.add_argument_group("design")
+    g.add_argument("--optimize-design", metavar="NAMES", default=None,
+                   help="choose these pendulum parameters for the most power: a comma list "
+                        "of mass, length, inertia, damping-coefficient")
+    for name, what in (("mass", "kg"), ("length", "m"), ("inertia", "kg m^2"),
+                       ("damping-coefficient", "N m s/rad")):
+        g.add_argument(f"--{name}-bounds", metavar="LO:HI", default=None,
+                       help=f"range of {name} searched, {what} (default "
+                            + ("0:20" if name.startswith("damping") else
+                               f"{BUOY['design_bounds'][name][0]:g} to "
+                               f"{BUOY['design_bounds'][name][1]:g} x the design's") + ")")
+    p.add_argument("--plot", metavar="DIR",
+                   help="draw the figures (PNG and SVG) into this directory")
+    p.add_argument("--save", metavar="NC", help="write the motion (or the sweep) as NetCDF")
+    p.add_argument("--json", action="store_true", help="print one JSON object")
+
+
+def _check_dir(path):
+    if path is None:
+        return
+    if not path.strip():
+        raise ParameterError("plot: expected a directory name, got an empty string")
+    d = Path(path)
+    if d.exists() and not d.is_dir():
+        raise ParameterError(f"plot: {path!r} is a file, expected a directory")
+    parent = d if d.exists() else (d.parent if str(d.parent) else Path("."))
+    if not parent.is_dir():
+        raise ParameterError(f"plot: directory {str(parent)!r} does not exist")
+    if not os.access(parent, os.W_OK):
+        raise ParameterError(f"plot: directory {str(parent)!r} is not writable")
+
+
+def _figures(r, directory) -> list:
+    from ..buoy.figures import plot_motion, plot_sweep
+    from ..fileio import output_error, save_figure
+
+    d = Path(directory)
+    try:
+        d.mkdir(exist_ok=True)
+    except OSError as exc:
+        raise output_error(directory, exc) from None
+    sweep = hasattr(r, "period_s")
+    fig = plot_sweep(r) if sweep else plot_motion(r)
+    name = "buoy_power" if sweep else "buoy_motion"
+    out = []
+    for ext in ("png", "svg"):
+        path = d / f"{name}.{ext}"
+        save_figure(fig, path, close=ext == "svg")
+        out.append(str(path))
+    return out
+
+
+def _cmd_buoy(a) -> dict | str:
+    _check_dir(a.plot)
+    _check_output(a.save, "--save", (".nc",))
+    r = _run(a)
+    sweep = hasattr(r, "period_s")
+    if not sweep and r.status == "no_power":
+        raise ParameterError(f"damping-coefficient: {r.message}")
+    written = []
+    if a.save:
+        _output.write_dataset(r.to_dataset(), a.save)
+        written.append(a.save)
+    if a.plot:
+        written += _figures(r, a.plot)
+    if a.json:
+        return r.to_dict()
+    out = _sweep_text(r) if sweep else _text_result(r)
+    out += [f"written: {w}" for w in written]
+    return "\n".join(out)
+
+
+def _w(x):
+    return "-" if x is None else f"{x:.6g}"
+
+
+def _head(r) -> list:
+    p, b = r.pendulum, r.body
+    return [f"body: {b['description']}; M = {b['mass_kg']:.6g} kg (floating, pendulum "
+            f"included), C = {b['hydrostatic_stiffness_n_per_m']:.6g} N/m",
+            f"pendulum: m = {p['mass_kg']:g} kg, l = {p['length_m']:g} m, I = "
+            f"{p['inertia_kg_m2']:.6g} kg m^2, c = "
+            f"{p['damping_coefficient_nm_s_per_rad']:g} N m s/rad"]
+
+
+def _text_result(r) -> list:
+    w = r.wave
+    if w["kind"] == "regular":
+        wave = (f"wave: regular, H = {w['height_m']:g} m, T = {w['period_s']:g} s "
+                f"(energy flux J = {r.energy_flux_w_per_m:.6g} W/m)")
+    else:
+        src = (f"{w['spectrum']}, Hs = {w['hs']:g} m, Tp = {w['tp']:g} s, seed {w['seed']}"
+               if "hs" in w else f"record {w['record']}")
+        wave = (f"wave: irregular, {src}, repeat period {w['repeat_period']:.6g} s "
+                f"(energy flux J = {r.energy_flux_w_per_m:.6g} W/m)")
+    rows = [["coupled optimum: power", _w(r.power_w), "W"],
+            ["  heave amplitude (half peak-to-peak)", _w(r.heave_amplitude_m), "m"],
+            ["  peak torque", _w(r.peak_torque_nm), "N m"],
+            ["  capture width P / J", _w(r.capture_width_m), "m"],
+            ["  capture-width ratio (over 2 radius)", _w(r.capture_width_ratio), "-"],
+            ["radiation bound |F a|^2 / 8B", _w(r.radiation_bound_w), "W"],
+            ["  fraction reached", _w(r.bound_fraction), "-"],
+            ["coupled limit (c = 0 supremum)", _w(r.limit_w), "W"],
+            ["one-way (reaction left out): power", _w(r.one_way_power_w), "W"],
+            ["  one-way / coupled", _w(r.one_way_ratio), "-"],
+            ["free buoy: heave amplitude", _w(r.free_heave_amplitude_m), "m"]]
+    if r.torque_limit_nm is not None:
+        rows.insert(3, ["  torque limit", _w(r.torque_limit_nm), "N m"])
+    out = [wave, *_head(r), "", _table(rows, ["quantity", "value", "unit"]), ""]
+    if r.design:
+        d = r.design
+        out.append(f"design: {', '.join(d['variables'])} chosen within "
+                   + ", ".join(f"{k} [{lo:g}, {hi:g}]" for k, (lo, hi) in d["bounds"].items())
+                   + f" ({d['method']}; {d['evaluations']} inner optima)")
+    out.append(f"status: {r.status}; N = {r.harmonics}, winding {r.winding}; energy balance "
+               f"residual {r.energy_balance_residual:.1e}")
+    out += [f"note: {n}" for n in r.warnings]
+    return out
+
+
+def _sweep_text(r) -> list:
+    rows = [[f"{t:g}", _fmt(p), _fmt(o), _fmt(b), _fmt(lim), _fmt(f), _fmt(z), s]
+            for t, p, o, b, lim, f, z, s in zip(r.period_s, r.power_w, r.one_way_power_w,
+                                                r.radiation_bound_w, r.limit_w,
+                                                r.bound_fraction, r.heave_amplitude_m,
+                                                r.status)]
+    out = [f"regular waves, H = {r.wave_height_m:g} m", *_head(r), "",
+           _table(rows, ["T (s)", "power (W)", "one-way (W)", "bound (W)", "limit (W)",
+                         "fraction", "heave (m)", "status"])]
+    out += [f"note: {n}" for n in r.warnings]
+    return out
+
+
+COMMANDS = {"buoy": _cmd_buoy}
