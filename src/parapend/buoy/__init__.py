@@ -1,6 +1,6 @@
 """The pendulum inside a floating buoy, coupled both ways (docs/buoy.md).
 
-The package is itself callable: ``parapend.buoy(...)`` is :func:`parapend.commands.buoy`
+The package is itself callable: ``parapend.buoy(...)`` is :func:`parapend.buoy.api.buoy`
 (the command ``parapend buoy``), whichever of its modules was imported first (importing
 ``parapend.buoy.hydro`` binds the name ``parapend.buoy`` to this package, so the package
 answers the call)::

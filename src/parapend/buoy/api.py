@@ -48,15 +48,17 @@ class BuoyResult(_Result):
     bound_fraction : ``power_w / radiation_bound_w``.
     limit_w : the coupled undamped supremum (``c = 0``: switching motions approach it).
     capture_width_m : ``power_w / J``, ``J`` the wave's energy flux per metre of crest
-        (:func:`energy_flux`); capture_width_ratio : over the body's width ``2 radius``
-        (None where the width is not known: a mesh file or a dataset).
+        (:func:`~parapend.buoy.api.energy_flux`); capture_width_ratio : over the body's
+        width ``2 radius`` (None where the width is not known: a mesh file or a dataset).
     energy_flux_w_per_m : ``J``.
     one_way_power_w : the optimum when the pendulum's reaction is left out (the pivot moves
         as the free buoy): what a one-way model predicts; one_way_ratio : ``one_way_power_w /
         power_w``.
     free_heave_amplitude_m : half the free buoy's peak-to-peak heave (no pendulum).
-    energy_balance_residual : relative residual of ``P + c <theta'^2> = <F_exc z'> -
-        sum_k B_k (k w)^2 |Z_k|^2 / 2`` (below 1e-9 when the solve is right).
+    energy_balance_residual
+        The relative residual of the energy balance
+        ``P + c <theta'^2> = <F_exc z'> - sum_k B_k (k w)^2 |Z_k|^2 / 2`` (below 1e-9 when
+        the solve is right).
     harmonics : N of the motion; winding : turns per wave (or per record).
     success, status, message : the coupled solve's verdict; "no_power" when no rotation
         harvests anything.

@@ -204,7 +204,7 @@ class CoupledProblem(FourierProblem):
     Parameters
     ----------
     excitation : Excitation
-        The free buoy's ``q_w`` (:func:`free_excitation`), non-dimensional.
+        The free buoy's ``q_w`` (``free_excitation``), non-dimensional.
     beta : ndarray
         Non-dimensional ``beta_k``, k = 1..Kc (radiation of the pendulum's reaction).
     harmonics, gamma, points, winding, hessian :
@@ -252,7 +252,7 @@ class CoupledProblem(FourierProblem):
         return float(np.mean(self.w * u)) + pc - self.gamma * self.kinetic(x)
 
     def evaluate(self, x: np.ndarray):
-        """``(P, gradient, Hessian)`` (dense array or :class:`CoupledOperator`)."""
+        """``(P, gradient, Hessian)`` (dense array or ``CoupledOperator``)."""
         n, m = self.harmonics, self.points
         th = self.theta(x)
         sn, cs = np.sin(th), np.cos(th)

@@ -179,7 +179,8 @@ class Hydro:
         return float(abs(complex(f) * amplitude) ** 2 / (8.0 * b))
 
     def check_covers(self, w_min, w_max, name="wave-period"):
-        """Raise :class:`ParameterError` unless ``[w_min, w_max]`` (rad/s) lies in the data."""
+        """Raise :class:`~parapend.errors.ParameterError` unless ``[w_min, w_max]`` (rad/s)
+        lies in the data."""
         lo, hi = float(self.omega[0]), float(self.omega[-1])
         w_min, w_max = float(w_min), float(w_max)
         tol = 1e-9
@@ -466,7 +467,7 @@ def cylinder(radius, draft, *, omega=None, rho=1025.0, g=9.81, water_depth=math.
     radius, draft : float
         Radius and draft (m), both > 0.
     omega : array_like, optional
-        Angular frequencies (rad/s) for the BEM (default :data:`DEFAULT_OMEGA`; see
+        Angular frequencies (rad/s) for the BEM (default ``DEFAULT_OMEGA``; see
         :func:`frequencies_for`). Frequencies too high for the finest panel the meshing
         rule allows are left out (the coefficients are then above range there).
     rho, g, water_depth : float

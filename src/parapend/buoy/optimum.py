@@ -66,7 +66,7 @@ class CoupledSolution:
     ----------
     success, status : bool, str
         ``success``: the Newton run converged, the fine-grid re-evaluation agrees and the
-        energy balance holds to :data:`BALANCE_TOL`; ``status`` says what was found
+        energy balance holds to ``BALANCE_TOL``; ``status`` says what was found
         (at ``c = 0`` that the power is a lower bound of ``limit``).
     power : float
         ``P = -<tau theta'>``, W.
@@ -510,7 +510,7 @@ def coupled_optimum(hydro, pendulum: Pendulum, wave: Wave, *, winding: int = 1,
     torque_limit : float or None
         ``|tau| <= torque_limit`` (N m), regular wave only: SLSQP with exact gradients of
         ``P`` and of the torque on the grid, from the ideal optimum, at N and 2N; the peak
-        between grid points is checked (within :data:`TORQUE_SLACK`, else ``success`` is
+        between grid points is checked (within ``TORQUE_SLACK``, else ``success`` is
         False) and stated in ``status``.
     efficiency : None
         Not yet supported with the buoy (ParameterError).
@@ -518,7 +518,7 @@ def coupled_optimum(hydro, pendulum: Pendulum, wave: Wave, *, winding: int = 1,
         At most this many seeds of the global search (None: all).
     one_way : bool
         Leave the pendulum's reaction out: the pivot moves as the free buoy (the uncoupled
-        global search of :func:`parapend.optimal.fourier.search_fourier`).
+        global search of ``parapend.optimal.fourier.search_fourier``).
     """
     if not isinstance(pendulum, Pendulum):
         raise ParameterError("pendulum: expected a Pendulum(mass, length, inertia, "

@@ -17,7 +17,7 @@ the symmetric 2x2 mass matrix
 ``I >= m l^2`` and ``M >= m``), the mass matrix of the Lagrangian
 ``1/2 M z'^2 - m l sin(theta) z' theta' + 1/2 I theta'^2``.
 
-``K`` is the exact cosine transform of ``B`` as :meth:`Hydro.coefficients` interpolates it
+``K`` is the exact cosine transform of ``B`` as ``Hydro.coefficients`` interpolates it
 (piecewise linear from ``B(0) = 0``, zero above the data), so the simulation and the
 frequency domain use the same damping. ``A_inf`` follows from the Kramers-Kronig relation
 ``A(w) = A_inf - (2/pi) PV int_0^inf B(v) / (w^2 - v^2) dv``, evaluated exactly for the
@@ -51,7 +51,7 @@ def _b_nodes(hydro):
 
 def radiation_kernel(hydro, t):
     """``K(t) = (2/pi) int_0^inf B(w) cos(w t) dw`` (N/m, per second), exact for the
-    piecewise-linear ``B`` of :meth:`Hydro.coefficients` (zero above the data).
+    piecewise-linear ``B`` that ``Hydro.coefficients`` interpolates (zero above the data).
 
     Parameters
     ----------
@@ -156,7 +156,7 @@ def model_impedance(hydro, w, *, dt, memory=None, a_inf=None, match_omega=None):
     ``D_td(w) = -w^2 (M + A_inf - Ks(w) / w) + i w Kc(w) + C`` with ``Kc``, ``Ks`` the
     cosine and sine sums of the discrete memory (the same weights as :func:`simulate`
     with these ``dt``, ``memory``, ``a_inf``, ``match_omega``). Its difference from
-    :meth:`Hydro.impedance` is the model error that is not the integrator's.
+    :meth:`parapend.buoy.hydro.Hydro.impedance` is the model error that is not the integrator's.
     """
     w = np.asarray(w, dtype=float)
     weights, nk = _memory_weights(hydro, check_positive("dt", dt), memory)
