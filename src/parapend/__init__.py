@@ -30,7 +30,8 @@ __version__ = "0.1.0"
 #: public name -> the module that defines it. One function per command of the command line
 #: (parapend.commands: same name, dashes as underscores, the options as parameters).
 _COMMANDS = ("optimize", "threshold", "damping_sweep", "harmonics", "figure", "reproduce",
-             "pto_curve", "simulate", "basins", "rotations", "track", "sea", "sweep", "map")
+             "pto_curve", "simulate", "basins", "rotations", "track", "sea", "sweep", "map",
+             "horizon")
 _EXPORTS = {
     **{name: ".commands" for name in _COMMANDS},
     "EXCITATIONS": ".api", "build_excitation": ".api", "harmonic_table": ".api",
@@ -42,6 +43,7 @@ _EXPORTS = {
     "mean_power": ".power", "uniform_power": ".power",
     "OptimizeResult": ".results", "Record": ".results", "ThresholdResult": ".results",
     "SeaResult": ".irregular",
+    "HorizonResult": ".control.horizon",
 }
 
 # `map` is left out of the star import, which would hide the builtin: use parapend.map

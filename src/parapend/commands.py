@@ -28,13 +28,13 @@ import dataclasses
 import math
 
 from . import limits
-from .defaults import DELTA, DYNAMICS, GAMMA, OMEGA, SEA, given  # noqa: F401
+from .defaults import DELTA, DYNAMICS, GAMMA, HORIZON, OMEGA, SEA, given  # noqa: F401
 from .errors import OutputError, ParameterError, check_int, check_range
 from .results import Record
 
 __all__ = ["PRESENTATION", "basins", "damping_sweep", "figure", "harmonics", "map",
            "optimize", "pto_curve", "reproduce", "rotations", "sea", "simulate", "sweep",
-           "threshold", "track"]
+           "threshold", "track", "horizon"]
 
 #: command-line options that are not parameters of the functions: how to show or where to
 #: write a result (``figure`` and ``map`` keep ``plot``: the figure file is their product)
@@ -678,3 +678,28 @@ def map(*, store: str = "map.zarr", variable: str = "power", x=None, y=None, at=
                    min_si=None if k is None or out["min"] is None else out["min"] * k,
                    max_si=None if k is None or out["max"] is None else out["max"] * k)
     return Record("map", out, dataset=ds, label=label)
+
+
+# --- horizon -------------------------------------------------------------------------------
+def horizon(*, hs=None, tp=None, spectrum: str = "jonswap", gamma_peak: float = 3.3,
+            repeat_period=None, seed=None, cutoff: float = 3.0, length: float = SEA["length"],
+            mass: float = SEA["mass"], inertia=None, gravity: float = SEA["gravity"],
+            gamma=None, damping_coefficient=None, torque_limit=None, efficiency=None,
+            horizons: str = HORIZON["horizons"], forecasts: str = HORIZON["forecasts"],
+            baselines: str = HORIZON["baselines"], records: int = HORIZON["records"],
+            update_interval: float = HORIZON["update_interval"], progress=None):
+    """Mean power of causal control against the forecast horizon, as a fraction of the
+    record's non-causal optimum and of its limit (command ``horizon``;
+    :func:`parapend.control.horizon.horizon_curve`). The sea state and the pendulum as
+    ``sea`` (default 2 m, 8 s, seed 0; ``gamma`` 0.01); ``records`` seeded records."""
+    from .control.horizon import horizon_curve
+
+    return horizon_curve(hs=SEA["hs"] if hs is None else hs,
+                         tp=SEA["tp"] if tp is None else tp, spectrum=spectrum,
+                         gamma_peak=gamma_peak, repeat_period=repeat_period,
+                         seed=SEA["seed"] if seed is None else seed, cutoff=cutoff,
+                         length=length, mass=mass, inertia=inertia, gravity=gravity,
+                         gamma=gamma, damping_coefficient=damping_coefficient,
+                         torque_limit=torque_limit, efficiency=efficiency, horizons=horizons,
+                         forecasts=forecasts, baselines=baselines, records=records,
+                         update_interval=update_interval, progress=progress)

@@ -51,3 +51,8 @@ DYNAMICS = {"gamma": GAMMA["simulate"], "p": 0.8, "omega": 2.1}
 #: the sea state and the pendulum of ``sea`` (a 1 m, 10 kg pendulum on a small buoy)
 SEA = {"hs": 2.0, "tp": 8.0, "seed": 0, "length": 1.0, "mass": 10.0, "gravity": 9.81,
        "gamma": GAMMA["sea"]}
+
+#: ``horizon``: the horizons (peak periods), forecasts and baselines of the curve, the
+#: number of seeded records and the update interval of the receding-horizon controller
+HORIZON = {"horizons": "0.25,0.5,1,2,4", "forecasts": "perfect,ar",
+           "baselines": "tracker,extremum", "records": 1, "update_interval": 0.125}

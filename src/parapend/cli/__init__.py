@@ -21,7 +21,8 @@ Modules: :mod:`._common` (parser helpers, number parsing, tables, progress),
  take-off and unit options of optimize), :mod:`.dynamics` (simulate, basins,
  rotations: the uncontrolled pendulum of paper Eq. 1), :mod:`.control` (track: the
  closed loop), :mod:`.sea` (sea: irregular seas), :mod:`.sweep` (sweep, map:
- design maps).
+ design maps), :mod:`.horizon` (horizon: causal control against the forecast
+ horizon).
 """
 
 from __future__ import annotations
@@ -35,6 +36,7 @@ from ..errors import ParameterError, SolverError
 from ..results import to_jsonable
 from . import control as _control_cmds
 from . import dynamics as _dynamics_cmds
+from . import horizon as _horizon_cmds
 from . import optimize as _optimize_cmds
 from . import paper as _paper_cmds
 from . import pto as _pto_cmds
@@ -50,7 +52,7 @@ __all__ = ["build_parser", "main"]
 
 COMMANDS = {**_optimize_cmds.COMMANDS, **_paper_cmds.COMMANDS, **_pto_cmds.COMMANDS,
             **_dynamics_cmds.COMMANDS, **_control_cmds.COMMANDS, **_sea_cmds.COMMANDS,
-            **_sweep_cmds.COMMANDS}
+            **_sweep_cmds.COMMANDS, **_horizon_cmds.COMMANDS}
 
 
 def build_parser():
@@ -69,6 +71,7 @@ def build_parser():
     _control_cmds.add_parsers(sub)
     _sea_cmds.add_parsers(sub)
     _sweep_cmds.add_parsers(sub)
+    _horizon_cmds.add_parsers(sub)
     return parser
 
 
