@@ -123,6 +123,8 @@ CASES = [
      {"periods": 20, "harmonics": 8, "length": 1.0, "mass": 10.0}, set()),
     (["sea", "--repeat-period", "80", "--harmonics", "32"],
      {"repeat_period": 80.0, "harmonics": 32}, set()),
+    (["horizon", "--repeat-period", "48", "--forecasts", "none", "--baselines", "extremum"],
+     {"repeat_period": 48.0, "forecasts": "none", "baselines": "extremum"}, set()),
 ]
 
 

@@ -199,10 +199,11 @@ def horizon_curve(*, hs: float = 2.0, tp: float = 8.0, spectrum: str = "jonswap"
         torque_limit = check_range("torque-limit", torque_limit, 0.0, limits.MAX_TORQUE_LIMIT)
         if torque_limit <= 0:
             raise ParameterError(f"torque-limit: expected a number > 0, got {torque_limit!r}")
+    eff = None
     if efficiency is not None:
         from ..pto import efficiencies
 
-        efficiencies(efficiency)
+        eff = efficiencies(efficiency)
     sea_kw = dict(hs=hs, tp=tp, spectrum=spectrum, gamma_peak=gamma_peak,
                   repeat_period=repeat_period, cutoff=cutoff)
     excs = [sea_record(units, seed=seed + r, **sea_kw) for r in range(records)]
@@ -235,9 +236,10 @@ def horizon_curve(*, hs: float = 2.0, tp: float = 8.0, spectrum: str = "jonswap"
                     fo = None if name == "perfect" else ARForecast(tp_n)
                     res = mpc_run(exc.q, gamma=gamma, horizon=h * tp_n,
                                   update_interval=upd * tp_n, dt=tp_n / 64,
-                                  torque_limit=torque_limit, efficiency=efficiency,
+                                  torque_limit=torque_limit, efficiency=eff,
                                   forecast=fo, t_end=exc.period, seed=seed + r)
-                    mpc_p[i][j][r] = float(res.mean_power) if res.success else math.nan
+                    mpc_p[i][j][r] = (float(res.mean_electrical_power) if res.success
+                                      else math.nan)
                     mpc_st[i][j][r] = str(res.status)
                     tick()
     base_p = [[math.nan] * records for _ in bl]
