@@ -13,11 +13,12 @@ motors costs ``w / eta_m``.
   record's root mean square, ``q = -sqrt(2) rms(q) sin(omega_p t)``, while the record
   drives the plant.
 - :func:`extremum_baseline`: a causal rule read off the ``gamma -> 0`` limit motion
-  (docs/limit.md): upright while ``q`` rises, hanging while it falls, a forward half-turn
-  at each extremum of ``q``. The extrema are detected as they pass, from the measured
+  (docs/limit.md): upright while ``q`` rises, hanging while it falls, a half-turn at each
+  extremum of ``q``. The extrema are detected as they pass, from the measured
   samples of ``q`` alone: a maximum when ``q`` has fallen by ``hysteresis rms(q)`` below its
   running maximum (a zig-zag filter; 0: every change of sign of the sampled slope). At each
-  one the reference angle steps forward by ``pi``. The torque is a computed-torque PD law
+  one the reference angle steps by ``pi`` (the pendulum turns whichever way the error,
+  wrapped to a turn, points). The torque is a computed-torque PD law
   toward it, ``T = -(1 + q) sin(theta) + gamma theta' - w^2 e - 2 w theta'`` with the wrapped
   error ``e``, saturated at the torque limit; when a limited torque cannot hold the
   pendulum against gravity the same law pushes it forward through the half-turn.
