@@ -476,14 +476,40 @@ def track(*, excitation=None, omega=OMEGA, delta=None, square_alpha=None, fourie
           runs: int = 1, gamma_error: float = 0.0, delta_error: float = 0.0,
           noise_theta: float = 0.0, noise_speed: float = 0.0, irregular: bool = False,
           length=None, mass=None, inertia=None, gravity=None, frequency=None,
-          amplitude=None, damping_coefficient=None, torque_limit_nm=None, progress=None):
+          amplitude=None, damping_coefficient=None, torque_limit_nm=None, progress=None,
+          controller: str = "lqr", horizon: float = 2.0, update_interval: float = 0.125,
+          forecast: str = "perfect"):
     """Swing up from rest, catch and hold the optimal rotation (command ``track``): a
     :class:`~parapend.control.track.TrackResult` (``runs`` 1) or a
     :class:`~parapend.control.robustness.RobustnessResult` (more seeded runs). With
     ``length`` and ``mass`` the result adds ``mean_power_w``, ``predicted_power_w``,
-    ``peak_torque_nm``, ``torque_limit_nm`` and the forcing period ``period_s``."""
+    ``peak_torque_nm``, ``torque_limit_nm`` and the forcing period ``period_s``.
+
+    ``controller="mpc"``: receding-horizon control instead
+    (:func:`parapend.control.mpc.track_mpc`, an
+    :class:`~parapend.control.mpc.MPCTrackResult`), with ``horizon`` and
+    ``update_interval`` in forcing (peak) periods and the wave ``forecast`` ("perfect" or
+    "ar"); one run, no model error or noise."""
     from .control.robustness import track_runs
     from .control.track import track as _track
+
+    if controller not in ("lqr", "mpc"):
+        raise ParameterError(f"controller: expected lqr or mpc, got {controller!r:.40}")
+    if controller == "mpc":
+        return _track_mpc(
+            excitation=excitation, omega=omega, delta=delta, square_alpha=square_alpha,
+            fourier=fourier, file=file, gamma=gamma, torque_limit=torque_limit,
+            theta0=theta0, theta_dot0=theta_dot0, periods=periods, seed=seed, runs=runs,
+            errors={"gamma-error": gamma_error, "delta-error": delta_error,
+                    "noise-theta": noise_theta, "noise-speed": noise_speed},
+            irregular=irregular, units_kw=dict(
+                length=length, mass=mass, inertia=inertia, gravity=gravity,
+                frequency=frequency, amplitude=amplitude,
+                damping_coefficient=damping_coefficient, torque_limit_nm=torque_limit_nm),
+            horizon=horizon, update_interval=update_interval, forecast=forecast)
+    if (horizon, update_interval, forecast) != (2.0, 0.125, "perfect"):
+        raise ParameterError("horizon: --horizon, --update-interval and --forecast belong to "
+                             "--controller mpc")
 
     kw = {"gamma": gamma, "harmonics": harmonics,
           **_excitation(excitation, omega, delta, square_alpha, fourier, file)}
@@ -511,6 +537,46 @@ def track(*, excitation=None, omega=OMEGA, delta=None, square_alpha=None, fourie
         torque_limit_nm=None if r.torque_limit is None else
         units.to_newton_metres(r.torque_limit),
         period_s=units.to_seconds(2 * math.pi / r.omega))
+
+
+def _track_mpc(*, excitation, omega, delta, square_alpha, fourier, file, gamma, torque_limit,
+               theta0, theta_dot0, periods, seed, runs, errors, irregular, units_kw, horizon,
+               update_interval, forecast):
+    """``track --controller mpc`` (:func:`parapend.control.mpc.track_mpc`)."""
+    from .api import build_excitation
+    from .control.mpc import track_mpc
+
+    if runs != 1:
+        raise ParameterError("runs: --controller mpc runs one record; use parapend horizon "
+                             "for seeded batches")
+    given = [k for k, v in errors.items() if v != 0.0]
+    if given:
+        raise ParameterError(f"{given[0]}: not offered with --controller mpc (the plant is "
+                             "the model); drop it or use --controller lqr")
+    kw = {"gamma": gamma, "harmonics": 24,
+          **_excitation(excitation, omega, delta, square_alpha, fourier, file)}
+    units, kw, torque_limit = _physical(kw, torque_limit=torque_limit, **units_kw)
+    kw.pop("harmonics", None)
+    gamma = check_range("gamma", kw.pop("gamma"), 0.0, limits.MAX_GAMMA)
+    if torque_limit is not None and not torque_limit > 0:
+        raise ParameterError(f"torque-limit: expected a number > 0, got {torque_limit!r}")
+    periods = check_int("periods", periods, 20, limits.MAX_TRACK_PERIODS)
+    seed = check_int("seed", seed, 0, 2**63 - 1)
+    exc = build_excitation(kw.pop("excitation", None), **kw)
+    r = track_mpc(exc, gamma=gamma, horizon=horizon, update_interval=update_interval,
+                  forecast=forecast, torque_limit=torque_limit, periods=periods, seed=seed,
+                  irregular=irregular, theta0=theta0, theta_dot0=theta_dot0)
+    if units is None:
+        return r
+    tp = 2 * math.pi / r.omega
+    return dataclasses.replace(
+        r, units=units.describe(), mean_power_w=units.to_watts(r.mean_power),
+        record_power_w=None if r.record_power is None else units.to_watts(r.record_power),
+        peak_torque_nm=units.to_newton_metres(r.peak_torque),
+        torque_limit_nm=None if r.torque_limit is None else
+        units.to_newton_metres(r.torque_limit),
+        period_s=units.to_seconds(tp), update_interval_s=units.to_seconds(tp)
+        * r.update_interval)
 
 
 # --- sea -----------------------------------------------------------------------------------

@@ -338,3 +338,134 @@ def mpc_run(q_record, *, gamma, horizon, update_interval, dt, torque_limit=None,
         failed_solves=failed, peak_torque=float(np.max(np.abs(u_all))) if total else 0.0,
         forecast="perfect" if forecast is None else type(forecast).__name__,
         success=success, status=status, message=msg)
+
+
+# --- track --controller mpc ----------------------------------------------------------------
+#: MPC torque samples per peak (forcing) period in ``track``
+TRACK_SAMPLES = 64
+#: periods at the start of a ``track`` run left out of ``run_power`` (swing-up and catch)
+WARMUP_PERIODS = 10
+
+
+@dataclass(frozen=True, eq=False)
+class MPCTrackResult(_Result):
+    """``parapend track --controller mpc`` (fields = JSON keys).
+
+    Attributes
+    ----------
+    mean_power : float
+        Mean power over the last 10 periods (as ``track``), exact for the held torque.
+    run_power : float
+        Mean power from period 10 to the end (after the swing-up).
+    record_power : float or None
+        With ``irregular`` and at least 110 periods: the mean over the last full repeat of
+        the record (100 peak periods), the number comparable with ``parapend sea`` on the
+        same record.
+    horizon, update_interval : float
+        In peak (forcing) periods.
+    solve_time_median, solve_time_max : float
+        Wall time (s) of one horizon solve.
+    """
+
+    controller: str
+    mean_power: float
+    run_power: float
+    record_power: float | None
+    electrical_power: float
+    catch_period: float | None
+    peak_torque: float
+    horizon: float
+    update_interval: float
+    samples_per_period: int
+    forecast: str
+    terminal_weight: float
+    solves: int
+    failed_solves: int
+    solve_time_median: float
+    solve_time_max: float
+    iterations_median: float
+    success: bool
+    status: str
+    message: str
+    gamma: float
+    omega: float
+    torque_limit: float | None
+    periods: int
+    seed: int
+    irregular: bool
+    excitation: dict = field(default_factory=dict)
+    sea: dict | None = None
+    units: dict | None = None
+    mean_power_w: float | None = None
+    record_power_w: float | None = None
+    peak_torque_nm: float | None = None
+    torque_limit_nm: float | None = None
+    period_s: float | None = None
+    update_interval_s: float | None = None
+    convention: str = ("theta from the upright (hanging at rest is theta = pi); power "
+                       "positive when harvested, P = -<T theta'>; torque units m g l")
+    _run: object = field(default=None, repr=False)
+    _q: object = field(default=None, repr=False)
+
+
+def track_mpc(excitation, *, gamma, horizon=2.0, update_interval=0.125, forecast="perfect",
+              torque_limit=None, efficiency=None, periods=100, seed=0, irregular=False,
+              theta0=math.pi, theta_dot0=0.0, terminal_weight=None,
+              samples=TRACK_SAMPLES) -> MPCTrackResult:
+    """Receding-horizon control of the case ``excitation`` (or, with ``irregular``, of the
+    seeded sea record of :func:`parapend.control.track.design_sea` built from it, the same
+    record as ``track --irregular`` with the same seed); ``horizon`` and ``update_interval``
+    in forcing (peak) periods."""
+    from .track import SEA_WAVES, _on_grid, design_sea
+
+    horizon = check_range("horizon", horizon, 0.01, 20.0)
+    update_interval = check_range("update-interval", update_interval, 1.0 / samples, 20.0)
+    if update_interval > horizon:
+        raise ParameterError(f"update-interval: expected at most the horizon {horizon:g} "
+                             f"peak periods, got {update_interval:g}")
+    if forecast not in ("perfect", "ar"):
+        raise ParameterError(f"forecast: expected perfect or ar, got {forecast!r:.40}")
+    tp = excitation.period
+    omega = excitation.omega
+    sea_info = None
+    if irregular:
+        rng = np.random.default_rng(seed)
+        rms = math.sqrt(float(np.mean(excitation.q_uniform(1024) ** 2)))
+        sea, sea_info = design_sea(omega, rms, int(rng.integers(0, 2**63 - 1)))
+        qf = _on_grid(sea, SEA_WAVES * 2 * samples * PLANT_STEPS)
+    else:
+        qf = excitation.q
+    fo = None
+    if forecast == "ar":
+        try:
+            from .forecast import make_forecast
+        except ImportError:
+            raise ParameterError("forecast: 'ar' needs parapend.control.forecast, which this "
+                                 "installation lacks") from None
+        fo = make_forecast("ar", qf, tp)
+    dt = tp / samples
+    r = mpc_run(qf, gamma=gamma, horizon=horizon * tp, update_interval=update_interval * tp,
+                dt=dt, torque_limit=torque_limit, efficiency=efficiency, forecast=fo,
+                theta0=theta0, theta_dot0=theta_dot0, t_end=periods * tp, seed=seed,
+                terminal_weight=terminal_weight, average_from=WARMUP_PERIODS * tp)
+    p = r.power_series
+    last = min(p.size, 10 * samples)
+    mean_power = float(np.mean(p[-last:])) if p.size else math.nan
+    record_power = None
+    if irregular and p.size >= (SEA_WAVES + WARMUP_PERIODS) * samples:
+        record_power = float(np.mean(p[-SEA_WAVES * samples:]))
+    st = r.solve_times
+    return MPCTrackResult(
+        controller="mpc", mean_power=mean_power, run_power=r.mean_power,
+        record_power=record_power, electrical_power=r.mean_electrical_power,
+        catch_period=None if r.catch_time is None else r.catch_time / tp,
+        peak_torque=r.peak_torque, horizon=r.horizon / tp,
+        update_interval=r.update_interval / tp, samples_per_period=samples,
+        forecast=forecast, terminal_weight=r.terminal_weight, solves=r.solves,
+        failed_solves=r.failed_solves,
+        solve_time_median=float(np.median(st)) if st.size else 0.0,
+        solve_time_max=float(np.max(st)) if st.size else 0.0,
+        iterations_median=float(np.median(r.iterations)) if st.size else 0.0,
+        success=r.success, status=r.status, message=r.message, gamma=r.gamma, omega=omega,
+        torque_limit=torque_limit, periods=periods, seed=seed, irregular=bool(irregular),
+        excitation=excitation.describe(), sea=sea_info, _run=r, _q=qf)
