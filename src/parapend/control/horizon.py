@@ -362,7 +362,7 @@ def plot_horizon(r: HorizonResult, path=None):
                                 color=line.get_color(), alpha=0.2, lw=0)
         styles = {"tracker": "--", "extremum": ":"}
         labels = {"tracker": "regular-wave tracker", "extremum": "half-turn rule at extrema"}
-        x = [min(hz.min(), 0.25) * 0.9, max(hz.max(), 4.0) * 1.1] if hz.size else [0.2, 5]
+        x = [hz.min() / 1.25, hz.max() * 1.25]
         for b, name in enumerate(r.baselines):
             line, = ax.plot(x, [r.baseline_fraction_mean[b]] * 2, styles[name], lw=1.2,
                             color=f"C{len(r.forecasts) + b}", label=labels[name])
