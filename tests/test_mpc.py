@@ -166,3 +166,21 @@ def test_cli_errors_are_one_line(args, word, capsys):
     assert main(["track", *args]) == 2
     err = capsys.readouterr().err.strip()
     assert len(err.splitlines()) == 1 and word in err
+
+
+@pytest.mark.slow
+def test_perfect_forecast_harvests_most_of_the_noncausal_optimum():
+    """The README's sea state on a 10-wave record: after 4 peak periods of warm-up, the MPC
+    with a perfect forecast of one peak period over a whole repeat against ``sea``'s
+    periodic optimum on the same record (docs/control.md)."""
+    from parapend.irregular import sea
+
+    s = sea(seed=0, repeat_period=80.0)
+    exc = s.excitation
+    tp = exc.period / 10
+    r = mpc_run(exc, gamma=0.01, horizon=tp, update_interval=tp / 8, dt=tp / 32,
+                t_end=exc.period + 4 * tp, average_from=4 * tp)
+    assert r.success and r.catch_time is not None
+    assert r.mean_power > 0
+    assert r.mean_power / s.power > 0.5
+    assert r.mean_power < s.limit_power
