@@ -49,9 +49,9 @@ def test_objective_is_the_work_of_the_held_torque_plus_the_terminal_energy():
     y = np.array([math.pi - 1.0, 0.5])
     work = 0.0
     for j in range(n):
-        s = solve_ivp(lambda tt, z: [z[1], (1 + exc.q(tt)) * math.sin(z[0]) - GAMMA * z[1]
-                                     + u[j]], (j * dt, (j + 1) * dt), y, method="DOP853",
-                      rtol=1e-12, atol=1e-12)
+        s = solve_ivp(lambda tt, z, uj=u[j]: [z[1], (1 + exc.q(tt)) * math.sin(z[0])
+                                              - GAMMA * z[1] + uj],
+                      (j * dt, (j + 1) * dt), y, method="DOP853", rtol=1e-12, atol=1e-12)
         y1 = s.y[:, -1]
         work += -u[j] * (y1[0] - y[0])
         y = y1
@@ -77,7 +77,7 @@ def mpc_saved(tmp_path_factory):
     assert code == 0
     r = json.loads(out.getvalue())
     # the record the plant saw (the same seed gives the same sea as track --irregular)
-    from parapend.control.track import SEA_WAVES, _on_grid, design_sea
+    from parapend.control.track import design_sea
 
     rng = np.random.default_rng(0)
     exc = build_excitation(omega=1.8, delta=-0.3)
@@ -166,3 +166,21 @@ def test_cli_errors_are_one_line(args, word, capsys):
     assert main(["track", *args]) == 2
     err = capsys.readouterr().err.strip()
     assert len(err.splitlines()) == 1 and word in err
+
+
+@pytest.mark.slow
+def test_perfect_forecast_harvests_most_of_the_noncausal_optimum():
+    """The README's sea state on a 10-wave record: after 4 peak periods of warm-up, the MPC
+    with a perfect forecast of one peak period over a whole repeat against ``sea``'s
+    periodic optimum on the same record (docs/control.md)."""
+    from parapend.irregular import sea
+
+    s = sea(seed=0, repeat_period=80.0)
+    exc = s.excitation
+    tp = exc.period / 10
+    r = mpc_run(exc, gamma=0.01, horizon=tp, update_interval=tp / 8, dt=tp / 32,
+                t_end=exc.period + 4 * tp, average_from=4 * tp)
+    assert r.success and r.catch_time is not None
+    assert r.mean_power > 0
+    assert r.mean_power / s.power > 0.5
+    assert r.mean_power < s.limit_power

@@ -59,7 +59,6 @@ def _rk4_adjoint(th, v, u, q0, qm, q1, h, gamma, lt, lv):
     k2v = (1.0 + qm) * math.sin(bt) - gamma * bv + u
     ct = th + 0.5 * h * bv
     cv = v + 0.5 * h * k2v
-    k3v = (1.0 + qm) * math.sin(ct) - gamma * cv + u
     dt_ = th + h * cv
     # adjoints of the stages
     g1t = h / 6.0 * lt
