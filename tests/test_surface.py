@@ -127,6 +127,8 @@ CASES = [
       "--workers", "1"],
      {"hs": "1,2", "te": "6,7", "realizations": 1, "waves": 3.0, "workers": 1},
      {"seconds"}),
+    (["horizon", "--repeat-period", "48", "--forecasts", "none", "--baselines", "extremum"],
+     {"repeat_period": 48.0, "forecasts": "none", "baselines": "extremum"}, set()),
 ]
 
 

@@ -31,7 +31,7 @@ __version__ = "0.1.0"
 #: (parapend.commands: same name, dashes as underscores, the options as parameters).
 _COMMANDS = ("optimize", "threshold", "damping_sweep", "harmonics", "figure", "reproduce",
              "pto_curve", "simulate", "basins", "rotations", "track", "sea", "sweep", "map",
-             "power_matrix")
+             "power_matrix", "horizon")
 _EXPORTS = {
     **{name: ".commands" for name in _COMMANDS},
     "EXCITATIONS": ".api", "build_excitation": ".api", "harmonic_table": ".api",
@@ -43,6 +43,7 @@ _EXPORTS = {
     "mean_power": ".power", "uniform_power": ".power",
     "OptimizeResult": ".results", "Record": ".results", "ThresholdResult": ".results",
     "SeaResult": ".irregular",
+    "HorizonResult": ".control.horizon",
 }
 # the pendulum inside a floating buoy: ``parapend.buoy`` is the subpackage, which is callable
 # (``parapend.buoy(...)`` is commands.buoy): a plain function of that name would be rebound to

@@ -33,6 +33,7 @@ KERNELS = {
     "parapend.optimal._hermite_kernel": ("the torque-limited solver's kernels", 10),
     "parapend.optimal.collocation": ("the efficiency solver's kernels", 10),
     "parapend.dynamics._kernel": ("the basin-map kernel", 15),
+    "parapend.control._mpc_kernel": ("the receding-horizon controller's kernels", 10),
 }
 
 _lock = threading.Lock()

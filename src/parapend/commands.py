@@ -28,14 +28,14 @@ import dataclasses
 import math
 
 from . import limits
-from .defaults import DELTA, DYNAMICS, GAMMA, OMEGA, SEA, given  # noqa: F401
+from .defaults import DELTA, DYNAMICS, GAMMA, HORIZON, OMEGA, SEA, given  # noqa: F401
 from .errors import OutputError, ParameterError, check_int, check_range
 from .results import Record
 
 __all__ = ["PRESENTATION", "basins", "damping_sweep", "figure", "harmonics", "map",
            "optimize", "pto_curve", "reproduce", "rotations", "sea", "simulate", "sweep",
            "threshold", "track",
-           "power_matrix"]
+           "power_matrix", "horizon"]
 
 #: command-line options that are not parameters of the functions: how to show or where to
 #: write a result (``figure`` and ``map`` keep ``plot``: the figure file is their product)
@@ -477,14 +477,40 @@ def track(*, excitation=None, omega=OMEGA, delta=None, square_alpha=None, fourie
           runs: int = 1, gamma_error: float = 0.0, delta_error: float = 0.0,
           noise_theta: float = 0.0, noise_speed: float = 0.0, irregular: bool = False,
           length=None, mass=None, inertia=None, gravity=None, frequency=None,
-          amplitude=None, damping_coefficient=None, torque_limit_nm=None, progress=None):
+          amplitude=None, damping_coefficient=None, torque_limit_nm=None, progress=None,
+          controller: str = "lqr", horizon: float = 2.0, update_interval: float = 0.125,
+          forecast: str = "perfect"):
     """Swing up from rest, catch and hold the optimal rotation (command ``track``): a
     :class:`~parapend.control.track.TrackResult` (``runs`` 1) or a
     :class:`~parapend.control.robustness.RobustnessResult` (more seeded runs). With
     ``length`` and ``mass`` the result adds ``mean_power_w``, ``predicted_power_w``,
-    ``peak_torque_nm``, ``torque_limit_nm`` and the forcing period ``period_s``."""
+    ``peak_torque_nm``, ``torque_limit_nm`` and the forcing period ``period_s``.
+
+    ``controller="mpc"``: receding-horizon control instead
+    (:func:`parapend.control.mpc.track_mpc`, an
+    :class:`~parapend.control.mpc.MPCTrackResult`), with ``horizon`` and
+    ``update_interval`` in forcing (peak) periods and the wave ``forecast`` ("perfect" or
+    "ar"); one run, no model error or noise."""
     from .control.robustness import track_runs
     from .control.track import track as _track
+
+    if controller not in ("lqr", "mpc"):
+        raise ParameterError(f"controller: expected lqr or mpc, got {controller!r:.40}")
+    if controller == "mpc":
+        return _track_mpc(
+            excitation=excitation, omega=omega, delta=delta, square_alpha=square_alpha,
+            fourier=fourier, file=file, gamma=gamma, torque_limit=torque_limit,
+            theta0=theta0, theta_dot0=theta_dot0, periods=periods, seed=seed, runs=runs,
+            errors={"gamma-error": gamma_error, "delta-error": delta_error,
+                    "noise-theta": noise_theta, "noise-speed": noise_speed},
+            irregular=irregular, units_kw=dict(
+                length=length, mass=mass, inertia=inertia, gravity=gravity,
+                frequency=frequency, amplitude=amplitude,
+                damping_coefficient=damping_coefficient, torque_limit_nm=torque_limit_nm),
+            horizon=horizon, update_interval=update_interval, forecast=forecast)
+    if (horizon, update_interval, forecast) != (2.0, 0.125, "perfect"):
+        raise ParameterError("horizon: --horizon, --update-interval and --forecast belong to "
+                             "--controller mpc")
 
     kw = {"gamma": gamma, "harmonics": harmonics,
           **_excitation(excitation, omega, delta, square_alpha, fourier, file)}
@@ -512,6 +538,46 @@ def track(*, excitation=None, omega=OMEGA, delta=None, square_alpha=None, fourie
         torque_limit_nm=None if r.torque_limit is None else
         units.to_newton_metres(r.torque_limit),
         period_s=units.to_seconds(2 * math.pi / r.omega))
+
+
+def _track_mpc(*, excitation, omega, delta, square_alpha, fourier, file, gamma, torque_limit,
+               theta0, theta_dot0, periods, seed, runs, errors, irregular, units_kw, horizon,
+               update_interval, forecast):
+    """``track --controller mpc`` (:func:`parapend.control.mpc.track_mpc`)."""
+    from .api import build_excitation
+    from .control.mpc import track_mpc
+
+    if runs != 1:
+        raise ParameterError("runs: --controller mpc runs one record; use parapend horizon "
+                             "for seeded batches")
+    given = [k for k, v in errors.items() if v != 0.0]
+    if given:
+        raise ParameterError(f"{given[0]}: not offered with --controller mpc (the plant is "
+                             "the model); drop it or use --controller lqr")
+    kw = {"gamma": gamma, "harmonics": 24,
+          **_excitation(excitation, omega, delta, square_alpha, fourier, file)}
+    units, kw, torque_limit = _physical(kw, torque_limit=torque_limit, **units_kw)
+    kw.pop("harmonics", None)
+    gamma = check_range("gamma", kw.pop("gamma"), 0.0, limits.MAX_GAMMA)
+    if torque_limit is not None and not torque_limit > 0:
+        raise ParameterError(f"torque-limit: expected a number > 0, got {torque_limit!r}")
+    periods = check_int("periods", periods, 20, limits.MAX_TRACK_PERIODS)
+    seed = check_int("seed", seed, 0, 2**63 - 1)
+    exc = build_excitation(kw.pop("excitation", None), **kw)
+    r = track_mpc(exc, gamma=gamma, horizon=horizon, update_interval=update_interval,
+                  forecast=forecast, torque_limit=torque_limit, periods=periods, seed=seed,
+                  irregular=irregular, theta0=theta0, theta_dot0=theta_dot0)
+    if units is None:
+        return r
+    tp = 2 * math.pi / r.omega
+    return dataclasses.replace(
+        r, units=units.describe(), mean_power_w=units.to_watts(r.mean_power),
+        record_power_w=None if r.record_power is None else units.to_watts(r.record_power),
+        peak_torque_nm=units.to_newton_metres(r.peak_torque),
+        torque_limit_nm=None if r.torque_limit is None else
+        units.to_newton_metres(r.torque_limit),
+        period_s=units.to_seconds(tp), update_interval_s=units.to_seconds(tp)
+        * r.update_interval)
 
 
 # --- sea -----------------------------------------------------------------------------------
@@ -777,3 +843,26 @@ def buoy(*, wave_height=None, wave_period=None, hs=None, tp=None, spectrum="jons
                  mass_bounds=mass_bounds, length_bounds=length_bounds,
                  inertia_bounds=inertia_bounds,
                  damping_coefficient_bounds=damping_coefficient_bounds)
+# --- horizon -------------------------------------------------------------------------------
+def horizon(*, hs=None, tp=None, spectrum: str = "jonswap", gamma_peak: float = 3.3,
+            repeat_period=None, seed=None, cutoff: float = 3.0, length: float = SEA["length"],
+            mass: float = SEA["mass"], inertia=None, gravity: float = SEA["gravity"],
+            gamma=None, damping_coefficient=None, torque_limit=None, efficiency=None,
+            horizons: str = HORIZON["horizons"], forecasts: str = HORIZON["forecasts"],
+            baselines: str = HORIZON["baselines"], records: int = HORIZON["records"],
+            update_interval: float = HORIZON["update_interval"], progress=None):
+    """Mean power of causal control against the forecast horizon, as a fraction of the
+    record's non-causal optimum and of its limit (command ``horizon``;
+    :func:`parapend.control.horizon.horizon_curve`). The sea state and the pendulum as
+    ``sea`` (default 2 m, 8 s, seed 0; ``gamma`` 0.01); ``records`` seeded records."""
+    from .control.horizon import horizon_curve
+
+    return horizon_curve(hs=SEA["hs"] if hs is None else hs,
+                         tp=SEA["tp"] if tp is None else tp, spectrum=spectrum,
+                         gamma_peak=gamma_peak, repeat_period=repeat_period,
+                         seed=SEA["seed"] if seed is None else seed, cutoff=cutoff,
+                         length=length, mass=mass, inertia=inertia, gravity=gravity,
+                         gamma=gamma, damping_coefficient=damping_coefficient,
+                         torque_limit=torque_limit, efficiency=efficiency, horizons=horizons,
+                         forecasts=forecasts, baselines=baselines, records=records,
+                         update_interval=update_interval, progress=progress)

@@ -61,3 +61,8 @@ BUOY = {"wave_height": 0.2, "wave_period": 1.8, "hs": 0.5, "tp": 2.5,
         "damping_coefficient": 1.0, "bem_harmonics": 3,
         "design_bounds": {"mass": (0.25, 4.0), "length": (0.25, 4.0), "inertia": (1.0, 4.0),
                           "damping_coefficient": (0.0, 20.0)}}
+
+#: ``horizon``: the horizons (peak periods), forecasts and baselines of the curve, the
+#: number of seeded records and the update interval of the receding-horizon controller
+HORIZON = {"horizons": "0.25,0.5,1,2,4", "forecasts": "perfect,ar",
+           "baselines": "tracker,extremum", "records": 1, "update_interval": 0.125}

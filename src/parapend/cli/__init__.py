@@ -21,7 +21,8 @@ Modules: :mod:`._common` (parser helpers, number parsing, tables, progress),
  take-off and unit options of optimize), :mod:`.dynamics` (simulate, basins,
  rotations: the uncontrolled pendulum of paper Eq. 1), :mod:`.control` (track: the
  closed loop), :mod:`.sea` (sea: irregular seas), :mod:`.sweep` (sweep, map:
- design maps), :mod:`.buoy` (buoy: the pendulum inside a floating buoy).
+ design maps), :mod:`.buoy` (buoy: the pendulum inside a floating buoy), :mod:`.horizon`
+ (horizon: causal control against the forecast horizon).
 """
 
 from __future__ import annotations
@@ -36,6 +37,7 @@ from ..results import to_jsonable
 from . import buoy as _buoy_cmds
 from . import control as _control_cmds
 from . import dynamics as _dynamics_cmds
+from . import horizon as _horizon_cmds
 from . import optimize as _optimize_cmds
 from . import paper as _paper_cmds
 from . import performance as _performance_cmds
@@ -53,7 +55,7 @@ __all__ = ["build_parser", "main"]
 COMMANDS = {**_optimize_cmds.COMMANDS, **_paper_cmds.COMMANDS, **_pto_cmds.COMMANDS,
             **_dynamics_cmds.COMMANDS, **_control_cmds.COMMANDS, **_sea_cmds.COMMANDS,
             **_sweep_cmds.COMMANDS,
-            **_performance_cmds.COMMANDS, **_buoy_cmds.COMMANDS}
+            **_performance_cmds.COMMANDS, **_buoy_cmds.COMMANDS, **_horizon_cmds.COMMANDS}
 
 
 def build_parser():
@@ -74,6 +76,7 @@ def build_parser():
     _sweep_cmds.add_parsers(sub)
     _performance_cmds.add_parsers(sub)
     _buoy_cmds.add_parsers(sub)
+    _horizon_cmds.add_parsers(sub)
     return parser
 
 

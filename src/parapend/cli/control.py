@@ -69,6 +69,19 @@ def add_parsers(sub) -> None:
     g.add_argument("--irregular", action="store_true",
                    help="drive the plant with a seeded JONSWAP sea record (parapend.seas) "
                         "peaked at omega, with the rms of q, instead of q")
+    g = p.add_argument_group("receding-horizon control (--controller mpc)")
+    g.add_argument("--controller", choices=("lqr", "mpc"), default="lqr",
+                   help="lqr: hold the regular-wave optimum (feedforward + periodic LQR); "
+                        "mpc: receding-horizon control on the full model with a wave "
+                        "forecast (docs/control.md; default lqr)")
+    g.add_argument("--horizon", type=_finite_float("horizon"), default=2.0,
+                   help="MPC horizon in peak (forcing) periods, in [0.01, 20] (default 2)")
+    g.add_argument("--update-interval", type=_finite_float("update-interval"), default=0.125,
+                   help="MPC update interval in peak periods, at most the horizon "
+                        "(default 0.125)")
+    g.add_argument("--forecast", choices=("perfect", "ar"), default="perfect",
+                   help="MPC wave forecast: perfect (the record's own future) or ar "
+                        "(autoregressive, fitted on the past; default perfect)")
     from .pto import add_unit_options
 
     add_unit_options(p, torque=True)
@@ -100,10 +113,14 @@ def _si_lines(r) -> list[str]:
 def _cmd_track(a) -> dict | str:
     _check_output(a.plot, "--plot", FIGURE_SUFFIXES)
     _check_output(a.save, "--save", (".csv",))
+    if a.controller == "mpc" and a.plot:
+        raise ParameterError("plot: not drawn for --controller mpc; use --save")
     if a.runs != 1 and (a.save or a.plot):
         raise ParameterError("runs: --save and --plot write one run; drop them or use "
                              "--runs 1")
     r = _run(a, progress=_Progress("track")) if a.runs != 1 else _run(a)
+    if getattr(r, "controller", None) == "mpc":
+        return _mpc_out(a, r)
     if a.runs != 1:
         if a.json:
             return r.to_dict()
@@ -163,6 +180,48 @@ def _cmd_track(a) -> dict | str:
         out.append(f"run written to {a.save}")
     if a.plot:
         out.append(f"figure written to {a.plot}")
+    return "\n".join(out)
+
+
+def _mpc_out(a, r) -> dict | str:
+    """Save, plot and print a ``--controller mpc`` run."""
+    import numpy as np
+
+    run = r._run
+    if a.save:
+        tq = np.append(run.torque, np.nan)
+        _output.write_columns(a.save, {"t": run.t, "theta": run.theta,
+                                       "theta_dot": run.theta_dot, "torque": tq,
+                                       "q": r._q(run.t)})
+    if a.json:
+        return r.to_dict()
+    out = [f"{r.status}: {r.message}",
+           f"receding-horizon control, {r.forecast} forecast: horizon {r.horizon:g} "
+           f"periods, update every {r.update_interval:g} periods, {r.samples_per_period} "
+           f"torque samples per period; gamma = {r.gamma:g}, omega = {r.omega:g}, T_max = "
+           f"{_fmt(r.torque_limit)}",
+           f"mean power (last 10 periods) {_fmt(r.mean_power, 8)}; from period 10 to the "
+           f"end {_fmt(r.run_power, 8)}"
+           + (f"; over the last repeat of the record {_fmt(r.record_power, 8)}"
+              if r.record_power is not None else ""),
+           f"swing-up handed over after {_fmt(r.catch_period, 4)} periods; peak torque "
+           f"{_fmt(r.peak_torque, 5)}",
+           f"{r.solves} horizon solves: median {1e3 * r.solve_time_median:.3g} ms, "
+           f"max {1e3 * r.solve_time_max:.3g} ms, median {r.iterations_median:g} "
+           "L-BFGS-B iterations"]
+    if r.sea is not None:
+        sea = r.sea
+        out.append(f"irregular sea: JONSWAP peaked at omega {sea['peak_omega']:g}, Hs "
+                   f"{sea['hs']:.4g} (units g t0^2), rms of q {sea['rms_q']:.4g}, "
+                   f"{sea['components']} components, repeating every "
+                   f"{sea['repeat_periods']} peak periods, seed {sea['seed']}")
+    if r.units is not None:
+        u = r.units
+        out.append(f"physical (l = {u['length_m']:g} m, m = {u['mass_kg']:g} kg): period "
+                   f"{r.period_s:.6g} s, update interval {r.update_interval_s:.4g} s; mean "
+                   f"power {r.mean_power_w:.6g} W; peak torque {r.peak_torque_nm:.6g} N m")
+    if a.save:
+        out.append(f"run written to {a.save}")
     return "\n".join(out)
 
 

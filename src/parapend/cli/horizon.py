@@ -1,0 +1,138 @@
+"""``parapend horizon``: mean power of causal control against the forecast horizon
+(docs/control.md)."""
+
+from __future__ import annotations
+
+from .. import limits
+from ..defaults import HORIZON, SEA
+from . import _output
+from ._common import FIGURE_SUFFIXES, _check_output, _finite_float, _int, _run, _table
+
+
+def add_parsers(sub) -> None:
+    p = sub.add_parser(
+        "horizon", help="mean power of receding-horizon control against the forecast "
+                        "horizon in an irregular sea, beside causal baselines",
+        description="For a sea state and a pendulum: the mean power of receding-horizon "
+                    "control with a perfect and an autoregressive forecast, against the "
+                    "horizon, and of two causal baselines, as fractions of each record's "
+                    "non-causal optimum (parapend sea) and of its limit (docs/control.md).")
+    g = p.add_argument_group("sea state (IEC TS 62600-2 spectra)")
+    g.add_argument("--hs", type=_finite_float("hs"), default=None,
+                   help="significant wave height, m (default 2)")
+    g.add_argument("--tp", type=_finite_float("tp"), default=None,
+                   help="peak period, s (default 8)")
+    g.add_argument("--spectrum", choices=["jonswap", "pierson-moskowitz"], default="jonswap",
+                   help="spectrum shape (default jonswap)")
+    g.add_argument("--gamma-peak", type=_finite_float("gamma-peak"), default=3.3,
+                   help="JONSWAP peak enhancement in [1, 20] (default 3.3)")
+    g.add_argument("--repeat-period", type=_finite_float("repeat-period"), default=None,
+                   help=f"T_r, s: the length of each record; {limits.SEA_WAVES_RANGE[0]:g} "
+                        f"to {limits.SEA_WAVES_RANGE[1]:g} peak periods (default 100 Tp)")
+    g.add_argument("--seed", type=_int, default=None,
+                   help="seed of the first record's phases; record r has seed + r "
+                        "(default 0)")
+    g.add_argument("--cutoff", type=_finite_float("cutoff"), default=3.0,
+                   help="highest frequency, in units of the peak frequency (default 3)")
+    g.add_argument("--records", type=_int, default=HORIZON["records"],
+                   help="seeded records, 1 to 20 (default 1)")
+    g = p.add_argument_group("pendulum (SI units) and power take-off")
+    g.add_argument("--length", type=_finite_float("length"), default=SEA["length"],
+                   help="pivot to centre of mass, m (default 1)")
+    g.add_argument("--mass", type=_finite_float("mass"), default=SEA["mass"],
+                   help="kg (default 10)")
+    g.add_argument("--inertia", type=_finite_float("inertia"), default=None,
+                   help="about the pivot, kg m^2 (default m l^2)")
+    g.add_argument("--gravity", type=_finite_float("gravity"), default=SEA["gravity"],
+                   help="m/s^2 (default 9.81)")
+    g.add_argument("--gamma", type=_finite_float("gamma"), default=None,
+                   help="viscous damping, non-dimensional (default 0.01)")
+    g.add_argument("--damping-coefficient", type=_finite_float("damping-coefficient"),
+                   default=None, help="viscous damping c, N m s/rad (instead of --gamma)")
+    g.add_argument("--torque-limit", type=_finite_float("torque-limit"), default=None,
+                   help="|T| <= T_max, units m g l, for every controller (default none)")
+    g.add_argument("--efficiency", type=_finite_float("efficiency"), default=None,
+                   help="PTO efficiency in (0, 1], generating and motoring (default none: "
+                        "lossless)")
+    g = p.add_argument_group("controllers")
+    g.add_argument("--horizons", default=HORIZON["horizons"],
+                   help="horizons in peak periods, comma separated (default "
+                        f"{HORIZON['horizons']})")
+    g.add_argument("--forecasts", default=HORIZON["forecasts"],
+                   help="forecasts of the receding-horizon controller: perfect, ar, or none "
+                        f"(default {HORIZON['forecasts']})")
+    g.add_argument("--baselines", default=HORIZON["baselines"],
+                   help="causal baselines: tracker, extremum, or none (default "
+                        f"{HORIZON['baselines']})")
+    g.add_argument("--update-interval", type=_finite_float("update-interval"),
+                   default=HORIZON["update_interval"],
+                   help="receding-horizon update interval, peak periods (default "
+                        f"{HORIZON['update_interval']:g})")
+    p.add_argument("--plot", metavar="PNG", help="draw the fraction of the optimum against "
+                                                  "the horizon")
+    p.add_argument("--save", metavar="NC", help="write the curve and every run as NetCDF")
+    p.add_argument("--json", action="store_true", help="print one JSON object")
+
+
+def _pct(x) -> str:
+    return "nan" if x != x else f"{100 * x:.1f} %"
+
+
+def _cmd_horizon(a) -> dict | str:
+    from ..control.horizon import horizon_dataset, plot_horizon
+    from ._common import _Progress
+
+    _check_output(a.plot, "--plot", FIGURE_SUFFIXES)
+    _check_output(a.save, "--save", (".nc",))
+    r = _run(a, progress=None if a.json else _Progress("horizon"))
+    if a.save:
+        _output.write_dataset(horizon_dataset(r), a.save)
+    if a.plot:
+        _output.plot(plot_horizon, r, a.plot)
+    if a.json:
+        return r.to_dict()
+    rec, u = r.record, r.units
+    head = (f"horizon: {rec.get('spectrum')}, Hs = {rec.get('hs'):g} m, Tp = "
+            f"{rec.get('tp'):g} s, records of {rec.get('repeat_period'):g} s, seeds "
+            f"{r.seeds[0]}..{r.seeds[-1]}; pendulum l = {u['length_m']:g} m, m = "
+            f"{u['mass_kg']:g} kg, gamma = {r.gamma:g}"
+            + ("" if r.torque_limit is None else f", T_max = {r.torque_limit:g}")
+            + ("" if r.efficiency is None else f", efficiency {r.efficiency:g}"))
+    nopt = sum(r.optimum_power_w) / len(r.optimum_power_w)
+    nlim = sum(r.limit_power_w) / len(r.limit_power_w)
+    rows = []
+    for i, f in enumerate(r.forecasts):
+        for j, h in enumerate(r.horizons):
+            pw = [v for v in r.mpc_power_w[i][j] if v == v]
+            rows.append([f"receding horizon, {f} forecast", f"{h:g}",
+                         f"{sum(pw) / len(pw):.4g}" if pw else "nan",
+                         _pct(r.mpc_fraction_mean[i][j]),
+                         f"{_pct(r.mpc_fraction_min[i][j])} .. "
+                         f"{_pct(r.mpc_fraction_max[i][j])}",
+                         _pct(r.mpc_limit_fraction_mean[i][j])])
+    names = {"tracker": "regular-wave tracker (track --irregular)",
+             "extremum": "half-turn rule at the extrema of q"}
+    for b, name in enumerate(r.baselines):
+        pw = [v for v in r.baseline_power_w[b] if v == v]
+        rows.append([names[name], "-", f"{sum(pw) / len(pw):.4g}" if pw else "nan",
+                     _pct(r.baseline_fraction_mean[b]),
+                     f"{_pct(r.baseline_fraction_min[b])} .. "
+                     f"{_pct(r.baseline_fraction_max[b])}",
+                     _pct(r.baseline_limit_fraction_mean[b])])
+    out = [head, f"non-causal optimum (sea) {nopt:.4g} W, limit {nlim:.4g} W (mean over the "
+                 "records); every run from the hanging rest over the whole record", "",
+           _table(rows, ["controller", "horizon (Tp)", "power (W)", "of optimum",
+                         "min .. max", "of limit"])]
+    if r.ar_leads:
+        out += ["", "AR forecast, normalized rms error of q against lead time:",
+                _table([[f"{ld:g}", f"{e:.3f}"] for ld, e in zip(r.ar_leads, r.ar_error)],
+                       ["lead (Tp)", "error"])]
+    out += ["", f"status: {r.status}: {r.message}"]
+    if a.save:
+        out.append(f"curve written to {a.save}")
+    if a.plot:
+        out.append(f"figure written to {a.plot}")
+    return "\n".join(out)
+
+
+COMMANDS = {"horizon": _cmd_horizon}

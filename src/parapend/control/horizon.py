@@ -1,0 +1,389 @@
+r"""The horizon curve: mean power of causal control against the forecast horizon.
+
+For a sea state and a pendulum (as :func:`parapend.irregular.sea` takes them), over
+``records`` seeded records (seeds ``seed .. seed + records - 1``), each one repeat
+``T_r`` long, run from the hanging rest:
+
+- the receding-horizon controller (:func:`parapend.control.mpc.mpc_run`) with each forecast
+  (:mod:`.forecast`: "perfect", the record's own future, and "ar", the autoregressive
+  predictor fitted on the past) at each horizon (in peak periods);
+- the causal baselines (:mod:`.baselines`: the regular-wave "tracker" and the half-turn
+  rule "extremum");
+
+and report each run's mean electrical power over the whole record (start-up from rest
+included) as a fraction of the record's non-causal optimum (``sea`` on the same record:
+the best periodic rotation knowing every wave) and of its ``gamma -> 0`` limit. Beside them,
+the autoregressive forecast's normalized rms prediction error against lead time on the same
+records.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from .. import limits
+from ..errors import ParameterError, check_int, check_range
+from ..results import _Result
+
+__all__ = ["HorizonResult", "horizon_curve", "plot_horizon", "horizon_dataset"]
+
+#: lead times (peak periods) of the reported AR prediction error
+AR_LEADS = (0.0, 0.05, 0.1, 0.25, 0.5, 1.0, 2.0)
+#: most records of one curve
+MAX_RECORDS = 20
+#: most horizons of one curve
+MAX_HORIZONS = 16
+
+
+@dataclass(frozen=True, eq=False)
+class HorizonResult(_Result):
+    """Mean power against horizon (fields = JSON keys of ``parapend horizon --json``).
+
+    Powers are non-dimensional (``m g l / t0``) and in watts (``*_w``). Indices: ``[f][h][r]``
+    for forecast ``forecasts[f]``, horizon ``horizons[h]`` (peak periods), record ``r``
+    (seed ``seeds[r]``); ``[b][r]`` for baseline ``baselines[b]``.
+
+    Attributes
+    ----------
+    mpc_power, baseline_power : nested lists of float
+        Mean electrical power of each run over the record (NaN: the run failed).
+    optimum_power, limit_power : list of float
+        Per record: the non-causal optimum of ``sea`` and the ``gamma -> 0`` limit.
+    mpc_fraction, baseline_fraction : nested lists of float
+        Power over the record's optimum.
+    mpc_fraction_mean, mpc_fraction_min, mpc_fraction_max : ``[f][h]`` over the records.
+    baseline_fraction_mean, baseline_fraction_min, baseline_fraction_max : ``[b]``.
+    mpc_limit_fraction_mean, baseline_limit_fraction_mean : the same over the limit.
+    mpc_status : nested list of str ``[f][h][r]``; the solver's status of each run.
+    ar_leads, ar_error : lead times (peak periods) and the AR forecast's normalized rms
+        error at each (over the records), when "ar" is among the forecasts.
+    """
+
+    horizons: list
+    forecasts: list
+    baselines: list
+    seeds: list
+    mpc_power: list
+    baseline_power: list
+    optimum_power: list
+    limit_power: list
+    mpc_fraction: list
+    baseline_fraction: list
+    mpc_fraction_mean: list
+    mpc_fraction_min: list
+    mpc_fraction_max: list
+    baseline_fraction_mean: list
+    baseline_fraction_min: list
+    baseline_fraction_max: list
+    mpc_limit_fraction_mean: list
+    baseline_limit_fraction_mean: list
+    mpc_status: list
+    baseline_status: list
+    ar_leads: list
+    ar_error: list
+    peak_period: float
+    update_interval: float
+    gamma: float
+    torque_limit: float | None
+    efficiency: float | None
+    record: dict
+    units: dict
+    success: bool
+    status: str
+    message: str
+    optimum_power_w: list = field(default_factory=list)
+    limit_power_w: list = field(default_factory=list)
+    mpc_power_w: list = field(default_factory=list)
+    baseline_power_w: list = field(default_factory=list)
+    convention: str = ("power positive when harvested; mean over the whole record from "
+                       "the hanging rest; fractions of the record's non-causal optimum "
+                       "(sea) and of its gamma -> 0 limit")
+
+
+def _names(value, allowed, what):
+    if isinstance(value, str):
+        items = [s.strip() for s in value.split(",") if s.strip()]
+        if items == ["none"]:
+            items = []
+    else:
+        items = list(value)
+    for s in items:
+        if s not in allowed:
+            raise ParameterError(f"{what}: expected names from {', '.join(allowed)} (comma "
+                                 f"separated, or none), got {s!r:.40}")
+    if len(set(items)) != len(items):
+        raise ParameterError(f"{what}: expected distinct names, got {','.join(items)}")
+    return items
+
+
+def _horizons(value):
+    if isinstance(value, str):
+        try:
+            hs = [float(s) for s in value.split(",") if s.strip()]
+        except ValueError:
+            raise ParameterError(f"horizons: expected a comma list of numbers, got "
+                                 f"{value!r:.60}") from None
+    else:
+        hs = [float(v) for v in np.atleast_1d(value)]
+    if not 1 <= len(hs) <= MAX_HORIZONS:
+        raise ParameterError(f"horizons: expected 1 to {MAX_HORIZONS} horizons, got {len(hs)}")
+    for h in hs:
+        check_range("horizons", h, 0.05, 20.0)
+    return hs
+
+
+def _stats(a):
+    a = np.asarray(a, dtype=float)
+    ok = np.isfinite(a)
+    if not ok.any():
+        return math.nan, math.nan, math.nan
+    return float(np.mean(a[ok])), float(np.min(a[ok])), float(np.max(a[ok]))
+
+
+def horizon_curve(*, hs: float = 2.0, tp: float = 8.0, spectrum: str = "jonswap",
+                  gamma_peak: float = 3.3, repeat_period=None, seed: int = 0,
+                  cutoff: float = 3.0, length: float = 1.0, mass: float = 10.0,
+                  inertia=None, gravity: float = 9.81, gamma=None, damping_coefficient=None,
+                  torque_limit=None, efficiency=None, horizons="0.25,0.5,1,2,4",
+                  forecasts="perfect,ar", baselines="tracker,extremum", records: int = 1,
+                  update_interval: float = 0.125, progress=None) -> HorizonResult:
+    """Mean power of causal control against the horizon (module docstring).
+
+    Parameters
+    ----------
+    hs, tp, spectrum, gamma_peak, repeat_period, seed, cutoff :
+        The sea state (:func:`parapend.seas.sea_record`; ``repeat_period`` in s, default
+        ``100 tp``); record ``r`` has the seed ``seed + r``.
+    length, mass, inertia, gravity, gamma, damping_coefficient :
+        The pendulum, as :func:`parapend.irregular.sea` (default ``gamma = 0.01``).
+    torque_limit : float or None
+        ``T_max`` (units ``m g l``) for every controller.
+    efficiency : float or None
+        PTO efficiency (generating and motoring) as :mod:`parapend.pto`, for every
+        controller; the optimum and the limit stay mechanical.
+    horizons : str or sequence of float
+        Horizons in peak periods (0.05 to 20).
+    forecasts, baselines : str or sequence of str
+        Subsets of ("perfect", "ar") and ("tracker", "extremum"); "none" for neither.
+    records : int
+        Seeded records, 1 to 20.
+    update_interval : float
+        MPC update interval in peak periods.
+    progress : callable or None
+        Called ``progress(done, total)`` after every run.
+    """
+    from ..irregular import sea
+    from ..seas import sea_record
+    from ..units import Units
+    from .baselines import BASELINES, extremum_baseline, tracker_baseline
+    from .forecast import FORECASTS, ARForecast, prediction_error
+
+    units = Units(length, mass, gravity, inertia)
+    if gamma is not None and damping_coefficient is not None:
+        raise ParameterError("gamma: give either gamma or damping-coefficient, not both")
+    if damping_coefficient is not None:
+        gamma = units.gamma(damping_coefficient)
+    gamma = check_range("gamma", 0.01 if gamma is None else gamma, 0.0, limits.MAX_GAMMA)
+    hz = _horizons(horizons)
+    fc = _names(forecasts, FORECASTS, "forecasts")
+    bl = _names(baselines, BASELINES, "baselines")
+    if not fc and not bl:
+        raise ParameterError("forecasts: expected at least one forecast or baseline, got none")
+    records = check_int("records", records, 1, MAX_RECORDS)
+    seed = check_int("seed", seed, 0, 2**63 - 1 - MAX_RECORDS)
+    upd = check_range("update-interval", update_interval, 1e-3, 1.0)
+    if torque_limit is not None:
+        torque_limit = check_range("torque-limit", torque_limit, 0.0, limits.MAX_TORQUE_LIMIT)
+        if torque_limit <= 0:
+            raise ParameterError(f"torque-limit: expected a number > 0, got {torque_limit!r}")
+    eff = None
+    if efficiency is not None:
+        from ..pto import efficiencies
+
+        eff = efficiencies(efficiency)
+    sea_kw = dict(hs=hs, tp=tp, spectrum=spectrum, gamma_peak=gamma_peak,
+                  repeat_period=repeat_period, cutoff=cutoff)
+    excs = [sea_record(units, seed=seed + r, **sea_kw) for r in range(records)]
+    tp_n = tp / units.time
+    wp = 2 * math.pi / tp_n
+    total = records * (1 + len(fc) * len(hz) + len(bl))
+    done = 0
+
+    def tick():
+        nonlocal done
+        done += 1
+        if progress is not None:
+            progress(done, total)
+
+    opt, lim = [], []
+    for r in range(records):
+        s = sea(seed=seed + r, length=length, mass=mass, inertia=inertia, gravity=gravity,
+                gamma=gamma, **sea_kw)
+        opt.append(s.power)
+        lim.append(s.limit_power)
+        tick()
+    mpc_p = [[[math.nan] * records for _ in hz] for _ in fc]
+    mpc_st = [[[""] * records for _ in hz] for _ in fc]
+    if fc:
+        from .mpc import mpc_run
+
+        for i, name in enumerate(fc):
+            for j, h in enumerate(hz):
+                for r, exc in enumerate(excs):
+                    fo = None if name == "perfect" else ARForecast(tp_n)
+                    res = mpc_run(exc.q, gamma=gamma, horizon=h * tp_n,
+                                  update_interval=upd * tp_n, dt=tp_n / 64,
+                                  torque_limit=torque_limit, efficiency=eff,
+                                  forecast=fo, t_end=exc.period, seed=seed + r)
+                    mpc_p[i][j][r] = (float(res.mean_electrical_power) if res.success
+                                      else math.nan)
+                    mpc_st[i][j][r] = str(res.status)
+                    tick()
+    base_p = [[math.nan] * records for _ in bl]
+    base_st = [[""] * records for _ in bl]
+    for b, name in enumerate(bl):
+        fn = tracker_baseline if name == "tracker" else extremum_baseline
+        for r, exc in enumerate(excs):
+            run = fn(exc.q, peak_omega=wp, gamma=gamma, t_end=exc.period,
+                     torque_limit=torque_limit, efficiency=efficiency)
+            base_p[b][r] = run.mean_power if run.success else math.nan
+            base_st[b][r] = run.status
+            tick()
+    leads, err = [], []
+    if "ar" in fc:
+        leads = list(AR_LEADS)
+        errs = [prediction_error(ARForecast(tp_n), exc.q, t_start=min(45 * tp_n,
+                                 0.5 * exc.period), t_end=exc.period, dt=tp_n / 64,
+                                 leads=tp_n * np.asarray(leads), origins=100)
+                for exc in excs]
+        err = [float(v) for v in np.mean(errs, axis=0)]
+    o = np.asarray(opt)
+    li = np.asarray(lim)
+    mf = (np.asarray(mpc_p) / o).tolist() if fc else []
+    bf = (np.asarray(base_p) / o).tolist() if bl else []
+    mst = [[_stats(np.asarray(mpc_p[i][j]) / o) for j in range(len(hz))]
+           for i in range(len(fc))]
+    bst = [_stats(np.asarray(base_p[b]) / o) for b in range(len(bl))]
+    nan_runs = int(np.sum(~np.isfinite(np.asarray(mpc_p)))) if fc else 0
+    nan_runs += int(np.sum(~np.isfinite(np.asarray(base_p)))) if bl else 0
+    ok = nan_runs == 0
+    msg = (f"{records} record(s) of {excs[0].period * units.time:g} s; "
+           + ("every run finished" if ok else f"{nan_runs} run(s) failed (NaN power)"))
+    rec = {k: v for k, v in excs[0].describe().items() if k not in ("omega", "seed")}
+    w = units.to_watts
+    return HorizonResult(
+        horizons=hz, forecasts=fc, baselines=bl, seeds=[seed + r for r in range(records)],
+        mpc_power=mpc_p, baseline_power=base_p, optimum_power=opt, limit_power=lim,
+        mpc_fraction=mf, baseline_fraction=bf,
+        mpc_fraction_mean=[[m[0] for m in row] for row in mst],
+        mpc_fraction_min=[[m[1] for m in row] for row in mst],
+        mpc_fraction_max=[[m[2] for m in row] for row in mst],
+        baseline_fraction_mean=[m[0] for m in bst],
+        baseline_fraction_min=[m[1] for m in bst],
+        baseline_fraction_max=[m[2] for m in bst],
+        mpc_limit_fraction_mean=[[_stats(np.asarray(mpc_p[i][j]) / li)[0]
+                                  for j in range(len(hz))] for i in range(len(fc))],
+        baseline_limit_fraction_mean=[_stats(np.asarray(base_p[b]) / li)[0]
+                                      for b in range(len(bl))],
+        mpc_status=mpc_st, baseline_status=base_st, ar_leads=leads, ar_error=err,
+        peak_period=tp_n, update_interval=upd, gamma=gamma, torque_limit=torque_limit,
+        efficiency=efficiency, record=rec, units=units.describe(), success=ok,
+        status="done" if ok else "failed_runs", message=msg,
+        optimum_power_w=[w(v) for v in opt], limit_power_w=[w(v) for v in lim],
+        mpc_power_w=[[[w(v) for v in col] for col in row] for row in mpc_p],
+        baseline_power_w=[[w(v) for v in row] for row in base_p])
+
+
+def horizon_dataset(r: HorizonResult):
+    """The result as an ``xarray.Dataset`` (dims ``forecast``, ``horizon``, ``baseline``,
+    ``record``) for NetCDF."""
+    import xarray as xr
+
+    nr = len(r.seeds)
+    coords = {"record": np.arange(nr), "horizon": np.asarray(r.horizons, dtype=float)}
+    data = {"seed": (("record",), np.asarray(r.seeds, dtype=np.int64)),
+            "optimum_power": (("record",), np.asarray(r.optimum_power)),
+            "limit_power": (("record",), np.asarray(r.limit_power)),
+            "optimum_power_w": (("record",), np.asarray(r.optimum_power_w)),
+            "limit_power_w": (("record",), np.asarray(r.limit_power_w))}
+    if r.forecasts:
+        coords["forecast"] = np.asarray(r.forecasts, dtype=str)
+        dims = ("forecast", "horizon", "record")
+        data["mpc_power"] = (dims, np.asarray(r.mpc_power, dtype=float))
+        data["mpc_power_w"] = (dims, np.asarray(r.mpc_power_w, dtype=float))
+        data["mpc_fraction"] = (dims, np.asarray(r.mpc_fraction, dtype=float))
+    if r.baselines:
+        coords["baseline"] = np.asarray(r.baselines, dtype=str)
+        data["baseline_power"] = (("baseline", "record"),
+                                  np.asarray(r.baseline_power, dtype=float))
+        data["baseline_power_w"] = (("baseline", "record"),
+                                    np.asarray(r.baseline_power_w, dtype=float))
+        data["baseline_fraction"] = (("baseline", "record"),
+                                     np.asarray(r.baseline_fraction, dtype=float))
+    if r.ar_leads:
+        coords["lead"] = np.asarray(r.ar_leads, dtype=float)
+        data["ar_error"] = (("lead",), np.asarray(r.ar_error, dtype=float))
+    ds = xr.Dataset(data, coords=coords)
+    ds["horizon"].attrs["units"] = "peak periods"
+    if "lead" in ds.coords:
+        ds["lead"].attrs["units"] = "peak periods"
+    ds.attrs.update({"gamma": r.gamma, "peak_period": r.peak_period,
+                     "update_interval_peak_periods": r.update_interval,
+                     "torque_limit": "none" if r.torque_limit is None else r.torque_limit,
+                     "efficiency": "none" if r.efficiency is None else r.efficiency,
+                     "convention": r.convention, "status": r.status,
+                     "power_unit_w": r.units["power_unit_w"],
+                     **{f"record_{k}": str(v) for k, v in r.record.items()}})
+    return ds
+
+
+def plot_horizon(r: HorizonResult, path=None):
+    """Fraction of the non-causal optimum against the horizon: each forecast's mean over
+    the records with its min-max band, the baselines as horizontal lines with theirs."""
+    import matplotlib
+
+    matplotlib.use("Agg", force=False)
+    import matplotlib.pyplot as plt
+
+    from ..plotting import _finish
+    from ..style import figure_style
+
+    hz = np.asarray(r.horizons, dtype=float)
+    with figure_style():
+        fig, ax = plt.subplots(figsize=(7.0, 4.6), layout="constrained")
+        for i, name in enumerate(r.forecasts):
+            mean = np.asarray(r.mpc_fraction_mean[i])
+            line, = ax.plot(hz, mean, "o-", lw=1.2, label=f"receding horizon, {name} forecast")
+            if len(r.seeds) > 1:
+                ax.fill_between(hz, r.mpc_fraction_min[i], r.mpc_fraction_max[i],
+                                color=line.get_color(), alpha=0.2, lw=0)
+        styles = {"tracker": "--", "extremum": ":"}
+        labels = {"tracker": "regular-wave tracker", "extremum": "half-turn rule at extrema"}
+        x = [hz.min() / 1.25, hz.max() * 1.25]
+        for b, name in enumerate(r.baselines):
+            line, = ax.plot(x, [r.baseline_fraction_mean[b]] * 2, styles[name], lw=1.2,
+                            color=f"C{len(r.forecasts) + b}", label=labels[name])
+            if len(r.seeds) > 1:
+                ax.fill_between(x, r.baseline_fraction_min[b], r.baseline_fraction_max[b],
+                                color=line.get_color(), alpha=0.12, lw=0)
+        ax.axhline(1.0, color="0.5", lw=0.8)
+        ax.axhline(0.0, color="0.7", lw=0.6)
+        ax.set_xscale("log")
+        ax.set_xlim(*x)
+        ax.set_xticks(hz if hz.size else [])
+        ax.set_xticklabels([f"{v:g}" for v in hz])
+        ax.minorticks_off()
+        ax.set_xlabel("horizon (peak periods)")
+        ax.set_ylabel("mean power / non-causal optimum (-)")
+        u = r.units
+        rec = r.record
+        ax.set_title(f"{rec.get('spectrum', '')} Hs = {rec.get('hs', '')} m, Tp = "
+                     f"{rec.get('tp', '')} s, {len(r.seeds)} record(s); l = "
+                     f"{u['length_m']:g} m, m = {u['mass_kg']:g} kg, $\\gamma$ = {r.gamma:g}",
+                     fontsize=9)
+        ax.legend(loc="lower left", bbox_to_anchor=(0.0, 1.08), ncol=2, frameon=False,
+                  borderaxespad=0.2)
+        return _finish(fig, path, layout=False)

@@ -1,0 +1,471 @@
+r"""Receding-horizon (model predictive) control of the pendulum in an irregular sea.
+
+Every ``update_interval`` the controller measures the state ``(theta, theta')``, takes the
+excitation ``q`` over the next ``horizon`` from a forecast, and solves the horizon problem on
+the full nonlinear Eq. 14,
+
+    maximize   sum_i e(-T_i (theta_{i+1} - theta_i)) + kappa E(x(t + H))
+    subject to theta'' + gamma theta' - (1 + q) sin(theta) = T,  |T| <= T_max,
+
+with the torque held over samples of ``dt`` (zero-order hold, as it is applied), the work
+``-T (theta_{i+1} - theta_i)`` of each RK4 step exact for the held torque, ``e`` the
+efficiency model of :mod:`parapend.pto` (``eta_g p`` generating, ``p / eta_m`` motoring) and
+the terminal value ``kappa E``, ``E = theta'^2 / 2 + cos(theta)`` (docs/control.md: the
+energy the pendulum keeps is worth ``kappa = eta_g`` of harvested energy, so the horizon
+does not end by draining it). It applies the first ``update_interval`` of the torque and
+repeats. The solver is L-BFGS-B with the bounds ``|T| <= T_max`` and the exact gradient by
+the discrete adjoint of the RK4 steps (:mod:`._mpc_kernel`), warm-started from the
+previous solution shifted by one update (its last torque repeated).
+
+From the hanging rest the horizon problem has a stationary point at ``T = 0`` (no work is
+done on a pendulum at rest, to first order), so the swing-up of :mod:`.swingup` (energy
+pumping) runs until the pendulum rotates forward above the top's energy, then the MPC takes
+over. The plant is the same Eq. 14 integrated by RK4 with ``plant_steps`` steps per torque
+sample, driven by the record's true ``q``.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..errors import ParameterError, check_int, check_range
+from ..results import _Result
+from .swingup import pump_torque, ready_to_catch
+
+__all__ = ["MPCResult", "horizon_problem", "mpc_run"]
+
+#: RK4 steps per torque sample in the horizon model
+MODEL_STEPS = 4
+#: RK4 steps per torque sample in the plant (a multiple of MODEL_STEPS)
+PLANT_STEPS = 16
+#: L-BFGS-B iterations per update (a warm-started solve needs far fewer)
+MAX_ITER = 200
+#: the swing-up hands over above the top's energy by this margin (as track)
+CATCH_MARGIN = 0.05
+
+
+@dataclass(frozen=True, eq=False)
+class MPCResult(_Result):
+    """One receding-horizon run (non-dimensional, pendulum units; theta from the upright).
+
+    Attributes
+    ----------
+    t : ndarray (n + 1,)
+        Sample times.
+    theta, theta_dot : ndarray (n + 1,)
+        Measured (plant) state at the sample times.
+    torque : ndarray (n,)
+        Torque held over each sample ``[t_k, t_k+1)``.
+    power_series : ndarray (n,)
+        Mean mechanical power of each sample, ``-T_k (theta_k+1 - theta_k) / dt`` (exact for
+        the held torque; positive = harvested).
+    electrical_series : ndarray (n,)
+        The same through the efficiency model (equal without one).
+    mean_power, mean_electrical_power : float
+        Means of the series over ``t >= average_from``.
+    solve_times : ndarray
+        Wall time (s) of each horizon solve.
+    iterations : ndarray
+        L-BFGS-B iterations of each solve.
+    catch_time : float or None
+        When the swing-up handed over to the MPC (None: never).
+    """
+
+    t: np.ndarray
+    theta: np.ndarray
+    theta_dot: np.ndarray
+    torque: np.ndarray
+    power_series: np.ndarray
+    electrical_series: np.ndarray
+    mean_power: float
+    mean_electrical_power: float
+    energy: float
+    solve_times: np.ndarray
+    iterations: np.ndarray
+    update_interval: float
+    horizon: float
+    dt: float
+    gamma: float
+    torque_limit: float | None
+    efficiency: tuple | None
+    terminal_weight: float
+    average_from: float
+    catch_time: float | None
+    solves: int
+    failed_solves: int
+    peak_torque: float
+    forecast: str
+    success: bool
+    status: str
+    message: str
+    convention: str = ("theta from the upright (hanging at rest is theta = pi); power "
+                       "positive when harvested, P = -<T theta'>; torque units m g l")
+    extra: dict = field(default_factory=dict)
+
+
+def _q_function(q_record):
+    """A vectorized ``q(t)`` from an excitation (``.q``), a callable or samples ``(t, q)``
+    (linear interpolation)."""
+    if hasattr(q_record, "q") and callable(q_record.q):
+        return q_record.q
+    if callable(q_record):
+        return lambda t: np.asarray(q_record(np.asarray(t, dtype=float)), dtype=float)
+    try:
+        ts, qs = (np.asarray(a, dtype=float) for a in q_record)
+    except (TypeError, ValueError):
+        raise ParameterError("q_record: expected an excitation, a callable q(t) or samples "
+                             "(t, q)") from None
+    if ts.ndim != 1 or ts.shape != qs.shape or ts.size < 2 or np.any(np.diff(ts) <= 0):
+        raise ParameterError("q_record: samples (t, q) must be two 1-D arrays of equal "
+                             "length >= 2 with t increasing")
+    return lambda t: np.interp(t, ts, qs)
+
+
+class HorizonProblem:
+    """The horizon problem of one update: ``n`` held torques of ``dt``, ``steps`` RK4 steps
+    each, from ``x0``, with ``q`` at the half-step nodes ``qn`` (``2 n steps + 1``)."""
+
+    def __init__(self, n, dt, steps, gamma, torque_limit=None, efficiency=None,
+                 kappa=None):
+        from . import _mpc_kernel as k
+
+        self.k = k
+        self.n, self.dt, self.steps, self.gamma = n, dt, steps, gamma
+        self.h = dt / steps
+        self.eta = (1.0, 1.0) if efficiency is None else tuple(efficiency)
+        self.kappa = self.eta[0] if kappa is None else float(kappa)
+        self.torque_limit = torque_limit
+        self.grad, self.th, self.v = k.work(n, steps)
+        self.evaluations = 0
+
+    def fun(self, u, x0, qn):
+        self.evaluations += 1
+        f = self.k.objective(u, x0[0], x0[1], qn, self.h, self.steps, self.gamma,
+                             self.eta[0], self.eta[1], self.kappa, self.grad, self.th,
+                             self.v)
+        return f, self.grad.copy()
+
+    def solve(self, x0, qn, u0, max_iter=MAX_ITER, tol=1e-10):
+        """L-BFGS-B from ``u0``; returns the scipy result (``x`` the torques)."""
+        from scipy.optimize import minimize
+
+        bounds = (None if self.torque_limit is None
+                  else [(-self.torque_limit, self.torque_limit)] * self.n)
+        if bounds is not None:
+            u0 = np.clip(u0, -self.torque_limit, self.torque_limit)
+        return minimize(self.fun, u0, args=(np.asarray(x0, float), qn), jac=True,
+                        method="L-BFGS-B", bounds=bounds,
+                        options={"maxiter": max_iter, "ftol": tol, "gtol": 1e-8,
+                                 "maxcor": 20})
+
+
+def horizon_problem(n, dt, *, gamma, steps=MODEL_STEPS, torque_limit=None, efficiency=None,
+                    terminal_weight=None) -> HorizonProblem:
+    """The horizon problem (for benchmarks and tests); see :class:`HorizonProblem`."""
+    return HorizonProblem(n, dt, steps, gamma, torque_limit, efficiency, terminal_weight)
+
+
+def _electrical(p, eta):
+    return np.where(p > 0, eta[0] * p, p / eta[1])
+
+
+def mpc_run(q_record, *, gamma, horizon, update_interval, dt, torque_limit=None,
+            efficiency=None, forecast=None, theta0=math.pi, theta_dot0=0.0, t_end=None,
+            warm=True, seed=0, terminal_weight=None, average_from=0.0,
+            model_steps=MODEL_STEPS, plant_steps=PLANT_STEPS, max_iter=MAX_ITER,
+            pump_level=1.0) -> MPCResult:
+    """Receding-horizon control of Eq. 14 driven by the record ``q_record``.
+
+    Parameters
+    ----------
+    q_record : Excitation, callable or (t, q) samples
+        The sea's ``q(t)`` (non-dimensional time, as :mod:`parapend.seas` records).
+    gamma : float
+        Viscous damping of Eq. 14.
+    horizon, update_interval, dt : float
+        Horizon ``H``, update interval and torque sample (non-dimensional time); ``H`` and
+        the update interval are rounded to whole samples (at least one).
+    torque_limit : float or None
+        ``T_max``: bounds of every held torque (also the swing-up's pump, at most
+        ``pump_level``).
+    efficiency : (eta_g, eta_m) or None
+        The efficiency model of :mod:`parapend.pto`, in the objective and the electrical
+        series.
+    forecast : None or object with ``predict(t_now, past_t, past_q, lead_times)``
+        None: perfect (the record's own future). Otherwise the predicted ``q`` at
+        ``t_now + lead_times``, given the measured ``q`` at the past sample times.
+    theta0, theta_dot0 : float
+        Initial state (default hanging at rest).
+    t_end : float
+        Length of the run (required for a callable or an excitation; samples: their end).
+    warm : bool
+        Warm-start each solve from the previous one shifted (else from zero torque).
+    seed : int
+        Seeds nothing random here (kept for the forecasts' interface).
+    terminal_weight : float or None
+        ``kappa`` of the terminal value ``kappa E``; None: ``eta_g`` (1 without an
+        efficiency); 0: no terminal value.
+    average_from : float
+        The means are over ``t >= average_from``.
+    """
+    from . import _mpc_kernel as k
+
+    gamma = check_range("gamma", gamma, 0.0, 1e3)
+    dt = check_range("dt", dt, 1e-4, 1e3)
+    if not horizon >= dt:
+        raise ParameterError(f"horizon: expected at least one sample dt = {dt:g}, got "
+                             f"{horizon!r}")
+    n = max(1, int(round(horizon / dt)))
+    m = max(1, min(n, int(round(update_interval / dt))))
+    model_steps = check_int("model_steps", model_steps, 1, 1024)
+    plant_steps = check_int("plant_steps", plant_steps, model_steps, 4096)
+    if plant_steps % model_steps:
+        raise ParameterError("plant_steps: expected a multiple of model_steps")
+    if torque_limit is not None:
+        torque_limit = check_range("torque-limit", torque_limit, 1e-9, 1e6)
+    qf = _q_function(q_record)
+    if t_end is None:
+        if isinstance(q_record, tuple) or isinstance(q_record, list):
+            t_end = float(np.asarray(q_record[0])[-1])
+        else:
+            raise ParameterError("t_end: expected the length of the run")
+    total = int(math.floor(t_end / dt + 1e-9))
+    if total < 1:
+        raise ParameterError(f"t_end: expected at least one sample dt = {dt:g}")
+    # q on the plant's half-step grid, over the run and one horizon beyond (perfect forecast)
+    hp = dt / plant_steps
+    nodes = 2 * (total + n) * plant_steps + 1
+    qp = np.empty(nodes)
+    chunk = 1 << 16
+    for a in range(0, nodes, chunk):
+        b = min(nodes, a + chunk)
+        qp[a:b] = qf(0.5 * hp * np.arange(a, b))
+    stride = plant_steps // model_steps
+    prob = HorizonProblem(n, dt, model_steps, gamma, torque_limit, efficiency,
+                          terminal_weight)
+    eta = prob.eta
+    lead = 0.5 * (dt / model_steps) * np.arange(2 * n * model_steps + 1)
+
+    th = np.empty(total + 1)
+    v = np.empty(total + 1)
+    u_all = np.zeros(total)
+    th[0], v[0] = float(theta0), float(theta_dot0)
+    tmp_t, tmp_v = np.empty(2), np.empty(2)
+    level = pump_level if torque_limit is None else min(torque_limit, pump_level)
+    caught = None
+    braking = False
+    plan = np.zeros(n)
+    solve_times, iters = [], []
+    failed = 0
+    status = "ok"
+    t_samples = dt * np.arange(total + 1)
+    q_samples = qp[::2 * plant_steps]
+    j = 0
+    while j < total:
+        x = (th[j], v[j])
+        if caught is None and ready_to_catch(x[0], x[1], CATCH_MARGIN):
+            caught = j
+        if caught is None:
+            tq, braking = pump_torque(x[0], x[1], level, CATCH_MARGIN, braking)
+            steps_now = 1
+            seg = np.array([tq])
+        else:
+            a = 2 * j * plant_steps
+            if forecast is None:
+                qn = qp[a:a + 2 * n * plant_steps + 1:stride]
+            else:
+                qn = np.asarray(forecast.predict(t_samples[j], t_samples[:j + 1],
+                                                 q_samples[:j + 1], lead), dtype=float)
+            if warm and solve_times:
+                u0 = np.concatenate((plan[m:], np.full(m, plan[-1])))
+            else:
+                u0 = np.zeros(n)
+            t0 = time.perf_counter()
+            res = prob.solve(x, qn, u0, max_iter=max_iter)
+            solve_times.append(time.perf_counter() - t0)
+            iters.append(int(res.nit))
+            if not np.all(np.isfinite(res.x)):
+                failed += 1
+                res_x = u0
+            else:
+                res_x = res.x
+                if res.status not in (0, 1):
+                    failed += 1
+            plan = np.asarray(res_x, float)
+            steps_now = min(m, total - j)
+            seg = plan[:steps_now]
+        a = 2 * j * plant_steps
+        qseg = qp[a:a + 2 * steps_now * plant_steps + 1]
+        ok = True
+        st, sv = np.empty(steps_now + 1), np.empty(steps_now + 1)
+        ok = k.simulate(seg, th[j], v[j], qseg, hp, plant_steps, gamma, st, sv)
+        u_all[j:j + steps_now] = seg
+        th[j + 1:j + steps_now + 1] = st[1:]
+        v[j + 1:j + steps_now + 1] = sv[1:]
+        if not ok:
+            status = "diverged"
+            total = j + steps_now
+            break
+        j += steps_now
+    del tmp_t, tmp_v
+    th, v, u_all = th[:total + 1], v[:total + 1], u_all[:total]
+    t = dt * np.arange(total + 1)
+    p = -u_all * np.diff(th) / dt
+    pe = _electrical(p, eta)
+    sel = t[:-1] >= average_from - 1e-9 * dt
+    mean_p = float(np.mean(p[sel])) if np.any(sel) else math.nan
+    mean_e = float(np.mean(pe[sel])) if np.any(sel) else math.nan
+    st_arr = np.asarray(solve_times)
+    if status == "ok" and not math.isfinite(mean_p):
+        status = "nonfinite"
+    success = status == "ok"
+    msg = {"ok": f"{len(solve_times)} horizon solves, {failed} ended abnormally",
+           "diverged": "the closed loop diverged (|theta'| > 1e6)",
+           "nonfinite": "non-finite power"}[status]
+    return MPCResult(
+        t=t, theta=th, theta_dot=v, torque=u_all, power_series=p, electrical_series=pe,
+        mean_power=mean_p, mean_electrical_power=mean_e,
+        energy=float(np.sum(p) * dt), solve_times=st_arr,
+        iterations=np.asarray(iters, dtype=int), update_interval=m * dt, horizon=n * dt,
+        dt=dt, gamma=gamma, torque_limit=torque_limit,
+        efficiency=None if efficiency is None else tuple(eta),
+        terminal_weight=prob.kappa, average_from=float(average_from),
+        catch_time=None if caught is None else float(caught * dt), solves=len(solve_times),
+        failed_solves=failed, peak_torque=float(np.max(np.abs(u_all))) if total else 0.0,
+        forecast="perfect" if forecast is None else type(forecast).__name__,
+        success=success, status=status, message=msg)
+
+
+# --- track --controller mpc ----------------------------------------------------------------
+#: MPC torque samples per peak (forcing) period in ``track``
+TRACK_SAMPLES = 64
+#: periods at the start of a ``track`` run left out of ``run_power`` (swing-up and catch)
+WARMUP_PERIODS = 10
+
+
+@dataclass(frozen=True, eq=False)
+class MPCTrackResult(_Result):
+    """``parapend track --controller mpc`` (fields = JSON keys).
+
+    Attributes
+    ----------
+    mean_power : float
+        Mean power over the last 10 periods (as ``track``), exact for the held torque.
+    run_power : float
+        Mean power from period 10 to the end (after the swing-up).
+    record_power : float or None
+        With ``irregular`` and at least 110 periods: the mean over the last full repeat of
+        the record (100 peak periods), the number comparable with ``parapend sea`` on the
+        same record.
+    horizon, update_interval : float
+        In peak (forcing) periods.
+    solve_time_median, solve_time_max : float
+        Wall time (s) of one horizon solve.
+    """
+
+    controller: str
+    mean_power: float
+    run_power: float
+    record_power: float | None
+    electrical_power: float
+    catch_period: float | None
+    peak_torque: float
+    horizon: float
+    update_interval: float
+    samples_per_period: int
+    forecast: str
+    terminal_weight: float
+    solves: int
+    failed_solves: int
+    solve_time_median: float
+    solve_time_max: float
+    iterations_median: float
+    success: bool
+    status: str
+    message: str
+    gamma: float
+    omega: float
+    torque_limit: float | None
+    periods: int
+    seed: int
+    irregular: bool
+    excitation: dict = field(default_factory=dict)
+    sea: dict | None = None
+    units: dict | None = None
+    mean_power_w: float | None = None
+    record_power_w: float | None = None
+    peak_torque_nm: float | None = None
+    torque_limit_nm: float | None = None
+    period_s: float | None = None
+    update_interval_s: float | None = None
+    convention: str = ("theta from the upright (hanging at rest is theta = pi); power "
+                       "positive when harvested, P = -<T theta'>; torque units m g l")
+    _run: object = field(default=None, repr=False)
+    _q: object = field(default=None, repr=False)
+
+
+def track_mpc(excitation, *, gamma, horizon=2.0, update_interval=0.125, forecast="perfect",
+              torque_limit=None, efficiency=None, periods=100, seed=0, irregular=False,
+              theta0=math.pi, theta_dot0=0.0, terminal_weight=None,
+              samples=TRACK_SAMPLES) -> MPCTrackResult:
+    """Receding-horizon control of the case ``excitation`` (or, with ``irregular``, of the
+    seeded sea record of :func:`parapend.control.track.design_sea` built from it, the same
+    record as ``track --irregular`` with the same seed); ``horizon`` and ``update_interval``
+    in forcing (peak) periods."""
+    from .track import SEA_WAVES, _on_grid, design_sea
+
+    horizon = check_range("horizon", horizon, 0.01, 20.0)
+    update_interval = check_range("update-interval", update_interval, 1.0 / samples, 20.0)
+    if update_interval > horizon:
+        raise ParameterError(f"update-interval: expected at most the horizon {horizon:g} "
+                             f"peak periods, got {update_interval:g}")
+    if forecast not in ("perfect", "ar"):
+        raise ParameterError(f"forecast: expected perfect or ar, got {forecast!r:.40}")
+    tp = excitation.period
+    omega = excitation.omega
+    sea_info = None
+    if irregular:
+        rng = np.random.default_rng(seed)
+        rms = math.sqrt(float(np.mean(excitation.q_uniform(1024) ** 2)))
+        sea, sea_info = design_sea(omega, rms, int(rng.integers(0, 2**63 - 1)))
+        qf = _on_grid(sea, SEA_WAVES * 2 * samples * PLANT_STEPS)
+    else:
+        qf = excitation.q
+    fo = None
+    if forecast == "ar":
+        try:
+            from .forecast import make_forecast
+        except ImportError:
+            raise ParameterError("forecast: 'ar' needs parapend.control.forecast, which this "
+                                 "installation lacks") from None
+        fo = make_forecast("ar", qf, tp)
+    dt = tp / samples
+    r = mpc_run(qf, gamma=gamma, horizon=horizon * tp, update_interval=update_interval * tp,
+                dt=dt, torque_limit=torque_limit, efficiency=efficiency, forecast=fo,
+                theta0=theta0, theta_dot0=theta_dot0, t_end=periods * tp, seed=seed,
+                terminal_weight=terminal_weight, average_from=WARMUP_PERIODS * tp)
+    p = r.power_series
+    last = min(p.size, 10 * samples)
+    mean_power = float(np.mean(p[-last:])) if p.size else math.nan
+    record_power = None
+    if irregular and p.size >= (SEA_WAVES + WARMUP_PERIODS) * samples:
+        record_power = float(np.mean(p[-SEA_WAVES * samples:]))
+    st = r.solve_times
+    return MPCTrackResult(
+        controller="mpc", mean_power=mean_power, run_power=r.mean_power,
+        record_power=record_power, electrical_power=r.mean_electrical_power,
+        catch_period=None if r.catch_time is None else r.catch_time / tp,
+        peak_torque=r.peak_torque, horizon=r.horizon / tp,
+        update_interval=r.update_interval / tp, samples_per_period=samples,
+        forecast=forecast, terminal_weight=r.terminal_weight, solves=r.solves,
+        failed_solves=r.failed_solves,
+        solve_time_median=float(np.median(st)) if st.size else 0.0,
+        solve_time_max=float(np.max(st)) if st.size else 0.0,
+        iterations_median=float(np.median(r.iterations)) if st.size else 0.0,
+        success=r.success, status=r.status, message=r.message, gamma=r.gamma, omega=omega,
+        torque_limit=torque_limit, periods=periods, seed=seed, irregular=bool(irregular),
+        excitation=excitation.describe(), sea=sea_info, _run=r, _q=qf)
