@@ -47,7 +47,7 @@ SUBSTEPS = 4
 
 @dataclass(frozen=True, eq=False)
 class BaselineRun:
-    """One baseline run: samples ``k = 0 .. K`` at ``t_k = k h`` (``torque[k]`` held on
+    """One baseline run: samples ``k = 0, ..., K`` at ``t_k = k h`` (``torque[k]`` held on
     ``[t_k, t_k + h)``), ``work[k]`` the electrical work of interval ``k`` (positive =
     harvested) and ``mean_power = sum(work) / t[-1]``."""
 

@@ -61,7 +61,7 @@ class PerfectForecast:
 
 
 def fit_ar(x, order: int, method: str = "ls") -> np.ndarray:
-    """Coefficients ``a_1 .. a_p`` of ``x_k = sum_i a_i x_{k-i} + e_k`` fitted to ``x``.
+    """Coefficients ``a_1, ..., a_p`` of ``x_k = sum_i a_i x_{k-i} + e_k`` fitted to ``x``.
 
     ``method``: "ls" (least squares on every complete lag vector in ``x``) or "yw"
     (Yule-Walker: the biased autocovariance, a Toeplitz solve; the model is stable).

@@ -36,7 +36,8 @@ from ..errors import ParameterError, check_int, check_range
 from ..results import _Result
 from .swingup import pump_torque, ready_to_catch
 
-__all__ = ["MPCResult", "horizon_problem", "mpc_run"]
+__all__ = ["HorizonProblem", "MPCResult", "MPCTrackResult", "horizon_problem", "mpc_run",
+           "track_mpc"]
 
 #: RK4 steps per torque sample in the horizon model
 MODEL_STEPS = 4
@@ -413,7 +414,7 @@ def track_mpc(excitation, *, gamma, horizon=2.0, update_interval=0.125, forecast
               theta0=math.pi, theta_dot0=0.0, terminal_weight=None,
               samples=TRACK_SAMPLES) -> MPCTrackResult:
     """Receding-horizon control of the case ``excitation`` (or, with ``irregular``, of the
-    seeded sea record of :func:`parapend.control.track.design_sea` built from it, the same
+    seeded sea record of ``parapend.control.track.design_sea`` built from it, the same
     record as ``track --irregular`` with the same seed); ``horizon`` and ``update_interval``
     in forcing (peak) periods."""
     from .track import SEA_WAVES, _on_grid, design_sea
