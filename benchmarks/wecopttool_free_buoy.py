@@ -28,7 +28,8 @@ cannot share an environment. This script runs in parapend's environment and
 The conventions match when both use ``x(t) = Re(X exp(+i w t))``: the comparison then agrees
 to round-off (the impedance route) or to the pseudo-spectral solver's tolerance.
 
-Run (the first line once; it installs WecOptTool and its pinned Capytaine into the venv)::
+Run (the first line once; it installs WecOptTool 3.3.0 and its pinned Capytaine into the
+venv)::
 
     python benchmarks/wecopttool_free_buoy.py --setup
     python benchmarks/wecopttool_free_buoy.py > benchmarks/wecopttool_free_buoy.out.txt
@@ -58,6 +59,10 @@ RADIUS, DRAFT, RHO, G = 0.5, 0.5, 1025.0, 9.81
 #: wave of the pseudo-spectral check is harmonic K_WAVE (3.5 rad/s, period 1.795 s, beside
 #: the default wave's 1.8 s and the heave resonance at 1.76 s).
 W1, NFREQ, K_WAVE = 0.35, 30, 10
+#: What --setup installs: the version whose functions this script calls (read_netcdf,
+#: change_bem_convention, add_linear_friction, check_radiation_damping,
+#: hydrodynamic_impedance, wave_excitation, WEC.from_bem, WEC.solve, WEC.post_process).
+WECOPTTOOL = "wecopttool==3.3.0"
 
 
 def default_venv() -> Path:
@@ -175,7 +180,7 @@ def _version(name):
 # -- the comparison ----------------------------------------------------------------------------
 def setup(venv: Path) -> None:
     subprocess.run([sys.executable, "-m", "venv", str(venv)], check=True)
-    subprocess.run([str(venv_python(venv)), "-m", "pip", "install", "wecopttool"], check=True)
+    subprocess.run([str(venv_python(venv)), "-m", "pip", "install", WECOPTTOOL], check=True)
 
 
 def compare(venv: Path, workdir: Path):
