@@ -44,6 +44,11 @@ def run(sphere_nc, tmp_path_factory):
             assert main(["power-matrix", "--device", "buoy", "--hydro", sphere_nc, *ARGS,
                          "--store", store, "--json"]) == 0
         outs.append(json.loads(buf.getvalue()))
+    buf = io.StringIO()
+    with contextlib.redirect_stdout(buf):  # the text report, from the finished store
+        assert main(["power-matrix", "--device", "buoy", "--hydro", sphere_nc, *ARGS,
+                     "--store", store]) == 0
+    outs.append(buf.getvalue())
     return outs
 
 
@@ -64,6 +69,7 @@ def _by_hand(sphere_nc, hs, tp, seed, waves=4.0):
 def test_a_bin_is_the_coupled_optimum_by_hand(run, sphere_nc):
     out = run[0]
     assert out["device"] == "buoy" and out["failed_solves"] == 0
+    assert out["width"] is None  # a dataset has no known width
     st = out["statistics"]
     p, bound, one_way = _by_hand(sphere_nc, 0.2, 3.0, 7)
     assert st["power"]["mean"][1][1] == pytest.approx(p, rel=1e-10)
@@ -84,7 +90,9 @@ def test_the_radiation_bound_is_never_exceeded(run):
 
 
 def test_the_store_resumes_to_the_same_numbers(run):
-    first, again = run
+    first, again, text = run
+    assert "power matrix, coupled buoy: 2 Hm0 x 2 tp bins" in text
+    assert "found finished 4" in text
     assert first["computed_bins"] == 4 and again["resumed_bins"] == 4
     assert again["computed_bins"] == 0
     assert again["statistics"] == first["statistics"]

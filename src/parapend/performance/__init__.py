@@ -184,7 +184,9 @@ def _buoy_spec(hm0, period, kind, tps, realizations, waves, seed, spectrum, gamm
                       mesh=None if mesh is None else os.path.abspath(mesh),
                       hydro=None if hydro is None else os.path.abspath(hydro),
                       damping_coefficient=float(pend.damping_coefficient))
-    spec = dataclasses.replace(spec, band=buoy_device.band(spec))
+    spec = dataclasses.replace(spec, band=buoy_device.band(spec),
+                               digest=buoy_device.file_digest(mesh if hydro is None
+                                                              else hydro))
     width = buoy_device.prepare(spec)
     return dataclasses.replace(spec, width=width)
 

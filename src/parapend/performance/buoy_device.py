@@ -18,7 +18,8 @@ import numpy as np
 from ..defaults import BUOY
 from ..errors import ParameterError, check_int
 
-__all__ = ["body_hydro", "check_buoy", "solve_buoy_bin", "wave_of"]
+__all__ = ["band", "body_hydro", "check_buoy", "file_digest", "prepare", "solve_buoy_bin",
+           "wave_of"]
 
 #: the per-process coefficients, keyed by the body's description in the spec
 _HYDRO: dict = {}
@@ -52,7 +53,22 @@ def _band(spec, j: int) -> tuple:
 
 
 def _key(spec) -> str:
-    return repr((spec.body, spec.radius, spec.draft, spec.mesh, spec.hydro, spec.band))
+    return repr((spec.body, spec.radius, spec.draft, spec.mesh, spec.hydro, spec.digest,
+                 spec.band))
+
+
+def file_digest(path) -> str | None:
+    """sha256 of a ``--mesh`` or ``--hydro`` file (None without one; a file that cannot be
+    read is left to the loader's own error)."""
+    if path is None:
+        return None
+    import hashlib
+
+    try:
+        with open(path, "rb") as fh:
+            return hashlib.sha256(fh.read()).hexdigest()
+    except OSError:
+        return None
 
 
 def body_hydro(spec):

@@ -40,8 +40,8 @@ STORE_NAMES = ("hm0", "te", "tp", "realization", "seed", "done", "status", *QUAN
 #: devices a matrix can be computed for
 DEVICES = ("prescribed-heave", "buoy")
 #: the spec's fields only the buoy uses (left out of a prescribed-heave spec's JSON)
-_BUOY_FIELDS = ("body", "radius", "draft", "mesh", "hydro", "damping_coefficient", "band",
-                "width")
+_BUOY_FIELDS = ("body", "radius", "draft", "mesh", "hydro", "digest", "damping_coefficient",
+                "band", "width")
 
 
 @dataclasses.dataclass(frozen=True)
@@ -75,6 +75,8 @@ class MatrixSpec:
     draft: float | None = None
     mesh: str | None = None
     hydro: str | None = None
+    digest: str | None = None  # sha256 of the --mesh or --hydro file (a changed file is
+    # another matrix: the store does not resume it)
     damping_coefficient: float | None = None
     band: tuple | None = None
     width: float | None = None
