@@ -752,9 +752,10 @@ def power_matrix(*, hs: str = "1:3:3", te=None, tp=None, realizations: int = 3,
                  waves: float = 50.0, seed: int = 0, spectrum: str = "jonswap",
                  gamma_peak: float = 3.3, cutoff: float = 3.0, response=None,
                  device: str = "prescribed-heave", horizon=None,
-                 length: float = SEA["length"], mass: float = SEA["mass"], inertia=None,
+                 length=None, mass=None, inertia=None,
                  gravity: float = SEA["gravity"], gamma=None, damping_coefficient=None,
-                 winding=1, harmonics=None, efficiency=None, torque_limit=None, depth=None,
+                 winding=1, harmonics=None, efficiency=None, torque_limit=None, body=None,
+                 radius=None, draft=None, mesh=None, hydro=None, depth=None,
                  density: float = 1025.0, width=None, scatter=None, timeseries=None,
                  rated_power=None, store=None, overwrite: bool = False, workers=None,
                  scheduler=None, netcdf=None, zarr=None, csv=None, command=None,
@@ -762,7 +763,9 @@ def power_matrix(*, hs: str = "1:3:3", te=None, tp=None, realizations: int = 3,
     """Power matrix over sea-state bins, capture width and annual energy (command
     ``power-matrix``; :func:`parapend.performance.power_matrix`, docs/performance.md).
     ``te`` default ``"6:10:3"`` when neither ``te`` nor ``tp`` is given. Fields are the JSON
-    keys; ``_dataset`` is the full Dataset (MHKiT's layout), ``_run`` the engine's run."""
+    keys; ``_dataset`` is the full Dataset (MHKiT's layout), ``_run`` the engine's run.
+    ``device="buoy"``: the coupled buoy (``body, radius, draft, mesh, hydro`` and the
+    pendulum in SI as ``buoy``; ``length``/``mass`` None: the device's default)."""
     from .performance import STATISTICS
     from .performance import power_matrix as _pm
 
@@ -775,7 +778,8 @@ def power_matrix(*, hs: str = "1:3:3", te=None, tp=None, realizations: int = 3,
         device=device, horizon=horizon, length=length, mass=mass, inertia=inertia,
         gravity=gravity, gamma=gamma, damping_coefficient=damping_coefficient,
         winding=winding, harmonics=harmonics, efficiency=efficiency,
-        torque_limit=torque_limit, depth=depth, density=density, width=width,
+        torque_limit=torque_limit, body=body, radius=radius, draft=draft, mesh=mesh,
+        hydro=hydro, depth=depth, density=density, width=width,
         scatter=scatter, timeseries=timeseries, rated_power=rated_power, store=store,
         overwrite=overwrite, workers=workers, scheduler=scheduler, netcdf=netcdf, zarr=zarr,
         csv=csv, command=command, progress=progress)
@@ -785,8 +789,8 @@ def power_matrix(*, hs: str = "1:3:3", te=None, tp=None, realizations: int = 3,
         return [[None if not math.isfinite(float(v)) else float(v) for v in row]
                 for row in ds[name].values]
 
-    quantities = [q for q in ("power", "limit_power", "uniform_power", "electrical_power")
-                  if q in ds]
+    quantities = [q for q in ("power", "limit_power", "uniform_power", "electrical_power",
+                              "radiation_bound_power", "one_way_power") if q in ds]
     stats = {q: {s: (ds[f"{q}_{s}"].values.astype(int).tolist() if s == "count"
                      else grid(f"{q}_{s}")) for s in STATISTICS} for q in quantities}
     codes = ds["status"].values
@@ -805,7 +809,9 @@ def power_matrix(*, hs: str = "1:3:3", te=None, tp=None, realizations: int = 3,
            "capture_width_ratio_matrix": (grid("capture_width_ratio_matrix")
                                           if "capture_width_ratio_matrix" in ds else None),
            "statistics": stats, "failed_solves": failed,
-           "depth": depth, "width": width, "annual_energy": annual,
+           "depth": depth, "width": (ds["capture_width_ratio_matrix"].attrs.get("width")
+                                     if "capture_width_ratio_matrix" in ds else None),
+           "annual_energy": annual,
            "annual_energy_mwh": None if annual is None else annual["power"]["mwh"],
            "capacity_factor": (None if annual is None
                                else annual["power"].get("capacity_factor")),

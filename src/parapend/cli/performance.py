@@ -6,7 +6,7 @@ from __future__ import annotations
 import shlex
 import sys
 
-from ..defaults import SEA
+from ..defaults import BUOY, SEA
 from . import _output
 from ._common import FIGURE_SUFFIXES, _check_output, _finite_float, _int, _run
 from .sweep import _NEGATIVE_VALUE, _EtaProgress
@@ -24,8 +24,9 @@ def add_parsers(sub) -> None:
         "power-matrix", help="power matrix over Hs x Te bins, capture width, annual energy",
         description="Mean, std, min, max and count of the power over seeded records in each "
                     "sea-state bin (the non-causal optimum, the gamma -> 0 limit, the uniform "
-                    "rotation), the wave energy flux and capture width of each bin, and the "
-                    "mean annual energy at a site (IEC TS 62600-100; MHKiT's layout). "
+                    "rotation; with --device buoy the coupled optimum, the radiation bound, "
+                    "the one-way answer), the wave energy flux and capture width of each "
+                    "bin, and the mean annual energy at a site (IEC TS 62600-100; MHKiT's layout). "
                     "Resumable with --store.")
     p._negative_number_matcher = _NEGATIVE_VALUE
     g = p.add_argument_group("bins (bin centres: " + _BINS + ")")
@@ -49,15 +50,16 @@ def add_parsers(sub) -> None:
                    help="heave response 'f,gain,phase' (default: the base follows the "
                         "surface)")
     g = p.add_argument_group("device")
-    g.add_argument("--device", choices=["prescribed-heave"], default="prescribed-heave",
-                   help="the prescribed-heave pendulum (the coupled buoy is not available "
-                        "yet)")
+    g.add_argument("--device", choices=["prescribed-heave", "buoy"],
+                   default="prescribed-heave",
+                   help="the prescribed-heave pendulum, or the coupled buoy (the body "
+                        "below, the pendulum in SI as parapend buoy)")
     g.add_argument("--horizon", type=_finite_float("horizon"), default=None,
                    help="causal controller's horizon, s (not available yet: refused)")
-    g.add_argument("--length", type=_finite_float("length"), default=SEA["length"],
-                   help="m (default 1)")
-    g.add_argument("--mass", type=_finite_float("mass"), default=SEA["mass"],
-                   help="kg (default 10)")
+    g.add_argument("--length", type=_finite_float("length"), default=None,
+                   help=f"m (default {SEA['length']:g}; buoy {BUOY['length']:g})")
+    g.add_argument("--mass", type=_finite_float("mass"), default=None,
+                   help=f"kg (default {SEA['mass']:g}; buoy {BUOY['mass']:g})")
     g.add_argument("--inertia", type=_finite_float("inertia"), default=None,
                    help="kg m^2 (default m l^2)")
     g.add_argument("--gravity", type=_finite_float("gravity"), default=SEA["gravity"],
@@ -65,20 +67,33 @@ def add_parsers(sub) -> None:
     g.add_argument("--gamma", type=_finite_float("gamma"), default=None,
                    help="viscous damping, non-dimensional (default 0.01)")
     g.add_argument("--damping-coefficient", type=_finite_float("damping-coefficient"),
-                   default=None, help="N m s/rad (instead of --gamma)")
+                   default=None, help="N m s/rad (instead of --gamma; buoy default "
+                                      f"{BUOY['damping_coefficient']:g})")
     g.add_argument("--winding", type=_winding, default=1, help="as sea (default 1)")
     g.add_argument("--harmonics", type=_int, default=None, help="as sea (default 16 per wave)")
     g.add_argument("--efficiency", type=_finite_float("efficiency"), default=None,
                    help="power take-off efficiency in (0, 1]: adds the electrical power")
     g.add_argument("--torque-limit", type=_finite_float("torque-limit"), default=None,
                    help="not supported over a sea record (refused)")
+    g = p.add_argument_group("the buoy's body (--device buoy; as parapend buoy)")
+    g.add_argument("--body", choices=["cylinder", "sphere"], default=None,
+                   help="a vertical cylinder or a floating sphere (default cylinder)")
+    g.add_argument("--radius", type=_finite_float("radius"), default=None,
+                   help=f"m (default {BUOY['radius']:g})")
+    g.add_argument("--draft", type=_finite_float("draft"), default=None,
+                   help=f"cylinder's draft, m (default {BUOY['draft']:g})")
+    g.add_argument("--mesh", metavar="FILE", default=None,
+                   help="a mesh file Capytaine reads, instead of --body")
+    g.add_argument("--hydro", metavar="FILE", default=None,
+                   help="a Capytaine NetCDF dataset, instead of --body (docs/buoy.md)")
     g = p.add_argument_group("resource and site")
     g.add_argument("--depth", type=_finite_float("depth"), default=None,
                    help="water depth, m (default deep water)")
     g.add_argument("--density", type=_finite_float("density"), default=1025.0,
                    help="water density, kg/m^3 (default 1025)")
     g.add_argument("--width", type=_finite_float("width"), default=None,
-                   help="characteristic width, m: adds the capture-width ratio")
+                   help="characteristic width, m: adds the capture-width ratio (buoy "
+                        "default: the body's diameter)")
     g.add_argument("--scatter", metavar="CSV", default=None,
                    help="scatter diagram 'hs,te,frequency' (shares summing to 1) or "
                         "'hs,te,count'; bin centres of the matrix")

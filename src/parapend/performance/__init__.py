@@ -74,16 +74,29 @@ def parse_bins(name: str, value) -> tuple:
 def matrix_spec(*, hs="1:3:3", te=None, tp=None, realizations: int = 3, waves: float = 50,
                 seed: int = 0, spectrum: str = "jonswap", gamma_peak: float = 3.3,
                 cutoff: float = 3.0, response=None, device: str = "prescribed-heave",
-                horizon=None, length: float = 1.0, mass: float = 10.0, inertia=None,
+                horizon=None, length=None, mass=None, inertia=None,
                 gravity: float = 9.81, gamma=None, damping_coefficient=None, winding=1,
-                harmonics=None, efficiency=None, torque_limit=None) -> MatrixSpec:
-    """Check everything a matrix's bins depend on (one line naming the parameter)."""
+                harmonics=None, efficiency=None, torque_limit=None, body=None, radius=None,
+                draft=None, mesh=None, hydro=None) -> MatrixSpec:
+    """Check everything a matrix's bins depend on (one line naming the parameter).
+    ``length``, ``mass``: None is the device's default (``parapend.defaults.SEA`` for the
+    prescribed-heave pendulum, ``BUOY`` for the buoy); ``body, radius, draft, mesh, hydro``
+    are the buoy's body as ``parapend buoy`` takes them."""
     from ..seas import _check_sea, check_response, read_response
     from ..units import Units
 
     if device not in DEVICES:
-        raise ParameterError(f"device: expected one of {', '.join(DEVICES)} (the coupled buoy "
-                             f"is not available yet), got {device!r:.60}")
+        raise ParameterError(f"device: expected one of {', '.join(DEVICES)}, got "
+                             f"{device!r:.60}")
+    if device != "buoy":
+        given = [n for n, v in (("body", body), ("radius", radius), ("draft", draft),
+                                ("mesh", mesh), ("hydro", hydro)) if v is not None]
+        if given:
+            raise ParameterError(f"{given[0]}: a body is only used with --device buoy")
+        from ..defaults import SEA
+
+        length = SEA["length"] if length is None else length
+        mass = SEA["mass"] if mass is None else mass
     if horizon is not None:
         raise ParameterError("horizon: the causal controller is not available yet; the matrix "
                              "gives the non-causal optimum, the limit and the uniform rotation")
@@ -113,6 +126,13 @@ def matrix_spec(*, hs="1:3:3", te=None, tp=None, realizations: int = 3, waves: f
                                  f"{limits.SEA_TP_RANGE[0]:g} to {limits.SEA_TP_RANGE[1]:g} s, "
                                  f"got {t:g} s" + (f" (Te {t * ratio:g} s)" if kind == "te"
                                                    else ""))
+    if device == "buoy":
+        return _buoy_spec(hm0, period, kind, tps, realizations, waves, seed, spectrum,
+                          gamma_peak, cutoff, response=response, length=length, mass=mass,
+                          inertia=inertia, gravity=gravity, gamma=gamma,
+                          damping_coefficient=damping_coefficient, winding=winding,
+                          harmonics=harmonics, efficiency=efficiency, body=body,
+                          radius=radius, draft=draft, mesh=mesh, hydro=hydro)
     units = Units(length, mass, gravity, inertia)
     if gamma is not None and damping_coefficient is not None:
         raise ParameterError("gamma: give either gamma or damping-coefficient, not both")
@@ -139,6 +159,36 @@ def matrix_spec(*, hs="1:3:3", te=None, tp=None, realizations: int = 3, waves: f
                       None if inertia is None else float(inertia), float(gravity),
                       float(gamma), winding, harmonics,
                       None if efficiency is None else float(efficiency), device)
+
+
+def _buoy_spec(hm0, period, kind, tps, realizations, waves, seed, spectrum, gamma_peak,
+               cutoff, *, body, radius, draft, mesh, hydro, **pendulum) -> MatrixSpec:
+    """The coupled buoy's spec: the pendulum and the body checked as ``parapend buoy`` checks
+    them, the BEM solved (or loaded) once over every bin's band, every bin checked to lie
+    in the data."""
+    import dataclasses
+    import os
+
+    from . import buoy_device
+
+    pend, winding, harmonics = buoy_device.check_buoy(**pendulum)
+    body = "cylinder" if body is None else body
+    if body not in ("cylinder", "sphere"):
+        raise ParameterError(f"body: expected cylinder or sphere, got {body!r:.40}")
+    spec = MatrixSpec(hm0, period, kind, tps, realizations, float(waves), seed, spectrum,
+                      float(gamma_peak), float(cutoff), None, float(pend.length),
+                      float(pend.mass), float(pend.inertia), 9.81, 0.0, winding, harmonics,
+                      None, "buoy", body=body,
+                      radius=None if radius is None else float(radius),
+                      draft=None if draft is None else float(draft),
+                      mesh=None if mesh is None else os.path.abspath(mesh),
+                      hydro=None if hydro is None else os.path.abspath(hydro),
+                      damping_coefficient=float(pend.damping_coefficient))
+    spec = dataclasses.replace(spec, band=buoy_device.band(spec),
+                               digest=buoy_device.file_digest(mesh if hydro is None
+                                                              else hydro))
+    width = buoy_device.prepare(spec)
+    return dataclasses.replace(spec, width=width)
 
 
 def _stats(x: np.ndarray, ok: np.ndarray) -> dict:
@@ -202,7 +252,8 @@ def matrix_dataset(raw, spec: MatrixSpec, *, depth=None, density: float = 1025.0
             "long_name": f"capture width P / J, {s} over the realizations", "units": "m"})
     if width is not None:
         ds["capture_width_ratio_matrix"] = (dims2, ds["power_mean"].values / j / width, {
-            "long_name": f"capture width ratio P / (J w), w = {width:g} m", "units": "1"})
+            "long_name": f"capture width ratio P / (J w), w = {width:g} m", "units": "1",
+            "width": width})
     ds = ds.assign_coords({
         "hm0_edges": ("hm0_edge", bin_edges(spec.hm0), {"long_name": "Hm0 bin edges (MHKiT)",
                                                          "units": "m"}),
@@ -236,9 +287,10 @@ def to_mhkit(da):
 def power_matrix(*, hs="1:3:3", te=None, tp=None, realizations: int = 3, waves: float = 50,
                  seed: int = 0, spectrum: str = "jonswap", gamma_peak: float = 3.3,
                  cutoff: float = 3.0, response=None, device: str = "prescribed-heave",
-                 horizon=None, length: float = 1.0, mass: float = 10.0, inertia=None,
+                 horizon=None, length=None, mass=None, inertia=None,
                  gravity: float = 9.81, gamma=None, damping_coefficient=None, winding=1,
-                 harmonics=None, efficiency=None, torque_limit=None, depth=None,
+                 harmonics=None, efficiency=None, torque_limit=None, body=None, radius=None,
+                 draft=None, mesh=None, hydro=None, depth=None,
                  density: float = 1025.0, width=None, scatter=None, timeseries=None,
                  rated_power=None, store=None, overwrite: bool = False, workers=None,
                  scheduler=None, netcdf=None, zarr=None, csv=None, command=None,
@@ -253,12 +305,15 @@ def power_matrix(*, hs="1:3:3", te=None, tp=None, realizations: int = 3, waves: 
                        response=response, device=device, horizon=horizon, length=length,
                        mass=mass, inertia=inertia, gravity=gravity, gamma=gamma,
                        damping_coefficient=damping_coefficient, winding=winding,
-                       harmonics=harmonics, efficiency=efficiency, torque_limit=torque_limit)
+                       harmonics=harmonics, efficiency=efficiency, torque_limit=torque_limit,
+                       body=body, radius=radius, draft=draft, mesh=mesh, hydro=hydro)
     if depth is not None:
         depth = check_positive("depth", depth)
     density = check_range("density", density, 500.0, 2000.0, why="kg/m^3")
     if width is not None:
         width = check_positive("width", width)
+    elif spec.device == "buoy":
+        width = spec.width  # the body's diameter (None for a mesh or a dataset)
     if rated_power is not None:
         rated_power = check_positive("rated-power", rated_power)
     if scatter is not None and timeseries is not None:

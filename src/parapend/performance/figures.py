@@ -161,7 +161,8 @@ def text_report(ds, out: dict, drawn: list) -> str:
 
     pk = _period(ds)
     hm0, per = ds["hm0"].values, ds[pk].values
-    lines = [f"power matrix, {out['device']} pendulum: {hm0.size} Hm0 x {per.size} {pk} bins, "
+    what = "coupled buoy" if out["device"] == "buoy" else f"{out['device']} pendulum"
+    lines = [f"power matrix, {what}: {hm0.size} Hm0 x {per.size} {pk} bins, "
              f"{out['realizations']} records of {out['waves']:g} peak periods each (seeds "
              f"{out['seeds'][0]}..{out['seeds'][-1]}); Te/Tp = {out['te_over_tp']:.6g}",
              f"computed now {out['computed_bins']} bins, found finished "
@@ -177,11 +178,12 @@ def text_report(ds, out: dict, drawn: list) -> str:
     a = out["annual_energy"]
     if a is not None:
         p = a["power"]
-        lines.append(f"mean annual energy (8766 h/yr): optimum {p['mwh']:.6g} MWh/yr, limit "
-                     f"{a['limit_power']['mwh']:.6g}, uniform rotation "
-                     f"{a['uniform_power']['mwh']:.6g}"
-                     + (f", electrical {a['electrical_power']['mwh']:.6g}"
-                        if "electrical_power" in a else ""))
+        names = (("limit_power", "limit"), ("uniform_power", "uniform rotation"),
+                 ("electrical_power", "electrical"),
+                 ("radiation_bound_power", "radiation bound"), ("one_way_power", "one-way"))
+        lines.append(f"mean annual energy (8766 h/yr): optimum {p['mwh']:.6g} MWh/yr"
+                     + "".join(f", {label} {a[q]['mwh']:.6g}" for q, label in names
+                               if q in a))
         if p.get("capacity_factor") is not None:
             lines.append(f"capacity factor {p['capacity_factor']:.4g}")
         if p["bins_without_power"]:

@@ -20,6 +20,10 @@ def electrical_power(result, efficiency: float) -> float:
 
 
 def solve_bin(spec, i: int, j: int, r: int) -> dict:
+    if spec.device == "buoy":
+        from .buoy_device import solve_buoy_bin
+
+        return solve_buoy_bin(spec, i, j, r)
     from ..irregular import sea
 
     res = sea(**spec.sea_kwargs(i, j, r))

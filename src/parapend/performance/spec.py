@@ -28,12 +28,20 @@ QUANTITIES = {
     "uniform_power": "best uniform rotation at the mean wave frequency (K_m turns per record)",
     "electrical_power": "electrical power of the optimum's motion through a power take-off "
                         "of the given efficiency (generating x eta, motoring / eta)",
+    # the coupled buoy (--device buoy)
+    "radiation_bound_power": "radiation bound sum_k |F_k a_k|^2 / (8 B_k): no mechanism "
+                             "inside the buoy absorbs more",
+    "one_way_power": "one-way optimum: the pendulum's reaction on the buoy left out (the "
+                     "pivot moves as the free buoy), its predicted power",
 }
 _TITLE = "parapend design map"
 #: every top-level name a power-matrix store holds (coordinates and variables)
 STORE_NAMES = ("hm0", "te", "tp", "realization", "seed", "done", "status", *QUANTITIES)
-#: devices a matrix can be computed for (the coupled buoy joins when it lands)
-DEVICES = ("prescribed-heave",)
+#: devices a matrix can be computed for
+DEVICES = ("prescribed-heave", "buoy")
+#: the spec's fields only the buoy uses (left out of a prescribed-heave spec's JSON)
+_BUOY_FIELDS = ("body", "radius", "draft", "mesh", "hydro", "digest", "damping_coefficient",
+                "band", "width")
 
 
 @dataclasses.dataclass(frozen=True)
@@ -60,6 +68,18 @@ class MatrixSpec:
     harmonics: int | None
     efficiency: float | None
     device: str = "prescribed-heave"
+    # the coupled buoy: the body as ``parapend buoy`` takes it, the pendulum's damping
+    # (N m s/rad), the BEM's frequency range (rad/s) covering every bin, the body's width
+    body: str | None = None
+    radius: float | None = None
+    draft: float | None = None
+    mesh: str | None = None
+    hydro: str | None = None
+    digest: str | None = None  # sha256 of the --mesh or --hydro file (a changed file is
+    # another matrix: the store does not resume it)
+    damping_coefficient: float | None = None
+    band: tuple | None = None
+    width: float | None = None
 
     kind = "power_matrix"
     pto = False
@@ -96,6 +116,8 @@ class MatrixSpec:
 
     @property
     def variables(self) -> tuple:
+        if self.device == "buoy":
+            return ("power", "radiation_bound_power", "one_way_power", "status")
         out = ["power", "limit_power", "uniform_power"]
         if self.efficiency is not None:
             out.append("electrical_power")
@@ -114,6 +136,9 @@ class MatrixSpec:
         d = dataclasses.asdict(self)
         d["kind"] = self.kind
         d["chunks"] = list(self.chunks)
+        if self.device != "buoy":
+            for k in _BUOY_FIELDS:
+                d.pop(k)
         return json.dumps(d, sort_keys=True)
 
     @classmethod
@@ -125,6 +150,8 @@ class MatrixSpec:
             d[k] = tuple(float(v) for v in d[k])
         if d["response"] is not None:
             d["response"] = tuple(tuple(float(v) for v in c) for c in d["response"])
+        if d.get("band") is not None:
+            d["band"] = tuple(float(v) for v in d["band"])
         return cls(**d)
 
     def coordinates(self) -> dict:

@@ -1,0 +1,167 @@
+"""The coupled buoy as a power-matrix device (``--device buoy``): the design checked as
+``parapend buoy`` checks it, the BEM solved once for every bin's band, and one bin's
+realization solved as ``parapend buoy --hs --tp`` solves a seeded record.
+
+The record of bin ``(i, j)``, realization ``r`` is the prescribed device's: ``Hs = hm0[i]``,
+``Tp = tp[j]`` (the same Te/Tp conversion), ``repeat_period = waves * Tp``, seed
+``seed + r``. Per realization the store keeps the coupled optimum's power, the radiation
+bound ``sum_k |F_k a_k|^2 / (8 B_k)`` and the one-way answer (the pendulum's reaction left
+out), all in W.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from ..defaults import BUOY
+from ..errors import ParameterError, check_int
+
+__all__ = ["band", "body_hydro", "check_buoy", "file_digest", "prepare", "solve_buoy_bin",
+           "wave_of"]
+
+#: the per-process coefficients, keyed by the body's description in the spec
+_HYDRO: dict = {}
+
+
+def _units(spec):
+    from ..units import Units
+
+    return Units(spec.length, spec.mass, 9.81, spec.inertia)
+
+
+def wave_of(spec, i: int, j: int, r: int):
+    """The Wave of bin ``(i, j)``, realization ``r`` (``parapend buoy``'s record builder on
+    the prescribed device's arguments) and its description."""
+    from ..buoy.api import _irregular_wave
+
+    tp = spec.tp[j]
+    return _irregular_wave(spec.hm0[i], tp, spec.spectrum, spec.gamma_peak, spec.waves * tp,
+                           int(spec.seeds[r]), spec.cutoff, None, 0.1, _units(spec))
+
+
+def _band(spec, j: int) -> tuple:
+    """The significant components' band (rad/s) of period bin ``j`` and the highest
+    component: as ``parapend buoy`` takes it from a record (amplitudes do not depend on
+    the seed or on Hs, only their scale and phases do)."""
+    wave, _ = wave_of(spec, 0, j, 0)
+    amps = np.abs(np.asarray(wave.amplitudes))
+    sig = np.nonzero(amps >= 1e-3 * amps.max())[0]
+    top = np.nonzero(amps)[0][-1]
+    return (wave.omega * (sig[0] + 1), wave.omega * (sig[-1] + 1), wave.omega * (top + 1))
+
+
+def _key(spec) -> str:
+    return repr((spec.body, spec.radius, spec.draft, spec.mesh, spec.hydro, spec.digest,
+                 spec.band))
+
+
+def file_digest(path) -> str | None:
+    """sha256 of a ``--mesh`` or ``--hydro`` file (None without one; a file that cannot be
+    read is left to the loader's own error)."""
+    if path is None:
+        return None
+    import hashlib
+
+    try:
+        with open(path, "rb") as fh:
+            return hashlib.sha256(fh.read()).hexdigest()
+    except OSError:
+        return None
+
+
+def body_hydro(spec):
+    """The body's coefficients over ``spec.band`` (BEM solved once, cached on disk; one
+    load per process) and the body's width (None for a mesh or a dataset)."""
+    key = _key(spec)
+    if key not in _HYDRO:
+        from ..buoy.api import _hydro
+
+        _HYDRO[key] = _hydro(spec.body, spec.radius, spec.draft, spec.mesh, spec.hydro,
+                             np.array(spec.band), 2)
+    return _HYDRO[key]
+
+
+def check_buoy(*, response, gamma, gravity, winding, harmonics, efficiency, mass, length,
+               inertia, damping_coefficient):
+    """The options the buoy device refuses or takes in its own sense; returns the checked
+    pendulum (``parapend buoy``'s checks) and ``(winding, harmonics)``."""
+    from ..buoy.api import _pendulum
+
+    if response is not None:
+        raise ParameterError("response: the buoy's heave is solved, not prescribed; drop "
+                             "--response with --device buoy")
+    if gamma is not None:
+        raise ParameterError("gamma: the buoy's pendulum takes its damping in SI; give "
+                             "--damping-coefficient (N m s/rad) with --device buoy")
+    if gravity != 9.81:
+        raise ParameterError(f"gravity: the buoy's hydrodynamics use g = 9.81 m/s^2, got "
+                             f"{gravity:g}; drop --gravity with --device buoy")
+    if efficiency is not None:
+        raise ParameterError("efficiency: not supported with --device buoy (the coupled "
+                             "optimum has an ideal power take-off); drop --efficiency")
+    if isinstance(winding, str):
+        raise ParameterError(f"winding: expected a positive integer with --device buoy (turns "
+                             f"per record), got {winding!r:.40}")
+    winding = check_int("winding", winding, 1, 64)
+    if harmonics is not None:
+        harmonics = check_int("harmonics", harmonics, 2, 4096)
+    pend = _pendulum(BUOY["mass"] if mass is None else mass,
+                     BUOY["length"] if length is None else length, inertia,
+                     BUOY["damping_coefficient"] if damping_coefficient is None
+                     else damping_coefficient)
+    return pend, winding, harmonics
+
+
+def prepare(spec):
+    """Solve (or load) the body over every bin's band, check each bin is covered and that
+    the pendulum floats; returns the body's width."""
+    h, width = body_hydro(spec)
+    pk = spec.period_kind
+    for j, per in enumerate(spec.period):
+        lo, hi, _ = _band(spec, j)
+        try:
+            h.check_covers(lo, hi, name="record")
+        except ParameterError as err:
+            raise ParameterError(f"{pk}: the record of the bin {per:g} s spans "
+                                 + str(err).split(": ", 1)[1]) from None
+    from ..buoy.api import _check_floats
+
+    _check_floats(h, pendulum(spec))
+    return width
+
+
+def band(spec) -> tuple:
+    """``(w_lo, w_hi)`` of every period bin together: the BEM's range (rad/s)."""
+    bands = [_band(spec, j) for j in range(len(spec.period))]
+    return (float(min(b[0] for b in bands)), float(max(b[2] for b in bands)))
+
+
+def pendulum(spec):
+    from ..buoy.coupled import Pendulum
+
+    return Pendulum(mass=spec.mass, length=spec.length, inertia=spec.inertia,
+                    damping_coefficient=spec.damping_coefficient)
+
+
+def solve_buoy_bin(spec, i: int, j: int, r: int) -> dict:
+    """The coupled optimum, the radiation bound and the one-way optimum of one record."""
+    from ..buoy.api import _solve
+    from ..maps.spec import _CODE
+
+    h, _ = body_hydro(spec)
+    wave, _ = wave_of(spec, i, j, r)
+    sol, ow, _ = _solve(h, pendulum(spec), wave, winding=spec.winding,
+                        harmonics=spec.harmonics, torque_limit=None, efficiency=None)
+    p = float(sol.power)
+    if p <= 0:
+        status = "no_power"
+    elif sol.success:
+        status = "converged"
+    else:
+        head = str(sol.status).split(";")[0].strip()
+        status = head if head in _CODE and head != "converged" else "other"
+    return {"power": p, "radiation_bound_power": float(sol.radiation_bound),
+            "one_way_power": float(ow.power) if math.isfinite(ow.power) else math.nan,
+            "status": status}
