@@ -158,10 +158,28 @@ class HorizonProblem:
                   else [(-self.torque_limit, self.torque_limit)] * self.n)
         if bounds is not None:
             u0 = np.clip(u0, -self.torque_limit, self.torque_limit)
-        return minimize(self.fun, u0, args=(np.asarray(x0, float), qn), jac=True,
-                        method="L-BFGS-B", bounds=bounds,
-                        options={"maxiter": max_iter, "ftol": tol, "gtol": 1e-8,
-                                 "maxcor": 20})
+        # One BLAS thread: L-BFGS-B's small vector operations go through BLAS, and a
+        # threaded BLAS on a loaded machine made every solve many times slower (the CLI
+        # limits BLAS at start; this covers calls from Python).
+        with _blas_controller().limit(limits=1, user_api="blas"):
+            return minimize(self.fun, u0, args=(np.asarray(x0, float), qn), jac=True,
+                            method="L-BFGS-B", bounds=bounds,
+                            options={"maxiter": max_iter, "ftol": tol, "gtol": 1e-8,
+                                     "maxcor": 20})
+
+
+_CONTROLLER = None
+
+
+def _blas_controller():
+    """A process-wide ``threadpoolctl.ThreadpoolController`` (inspecting the loaded
+    libraries once, not at every solve)."""
+    global _CONTROLLER
+    if _CONTROLLER is None:
+        from threadpoolctl import ThreadpoolController
+
+        _CONTROLLER = ThreadpoolController()
+    return _CONTROLLER
 
 
 def horizon_problem(n, dt, *, gamma, steps=MODEL_STEPS, torque_limit=None, efficiency=None,
