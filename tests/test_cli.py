@@ -190,3 +190,39 @@ def test_an_interrupt_a_library_turned_into_its_own_error_is_still_an_interrupt(
     monkeypatch.setattr(_entry, "_interrupted", False)  # no interrupt: the error is a bug
     with pytest.raises(RuntimeError, match="lowering"):
         main(["threshold"])
+
+
+def test_an_interrupt_a_callback_swallowed_is_still_an_interrupt(monkeypatch, capsys):
+    """SIGINT inside a callback whose exceptions CPython ignores (a weakref callback of the
+    import machinery) printed "Exception ignored in ... KeyboardInterrupt" with a traceback
+    and the command ran on: the console script keeps it silent and ends in the one
+    interrupted line, exit code 130, with the hook restored afterwards."""
+    import weakref
+
+    from parapend import _entry
+    from parapend import cli as cli_pkg
+
+    def ran_on(argv):
+        _entry._interrupted = True  # as the SIGINT handler does before it raises
+
+        class Held:
+            pass
+
+        def callback(_):
+            raise KeyboardInterrupt
+
+        held = Held()
+        ref = weakref.ref(held, callback)
+        del held  # the callback raises: CPython reports it as unraisable and goes on
+        assert ref() is None
+        print("status: converged")
+        return 0
+
+    monkeypatch.setattr(cli_pkg, "main", ran_on)
+    monkeypatch.setattr(_entry, "_interrupted", False)
+    monkeypatch.setattr(_entry, "_swallowed", False)
+    hook = sys.unraisablehook
+    assert _entry.main([]) == _entry.EXIT_INTERRUPTED
+    captured = capsys.readouterr()
+    assert captured.err == "parapend: interrupted\n"
+    assert sys.unraisablehook is hook
