@@ -157,10 +157,20 @@ def test_sweep_and_map_through_both(tmp_path, capsys):
         _same(cli[key], got[key], key)
     png = str(tmp_path / "m.png")
     cli = _cli_json(["map", "--store", store, "--plot", png, "--json"], capsys)
-    got = parapend.map(store=store, plot=png).to_dict()
+    mapped = parapend.map(store=store, plot=png)
+    got = mapped.to_dict()
     assert set(cli) <= set(got)
     for key in cli:
         _same(cli[key], got[key], key)
+    # the Dataset behind the record, public: the map's power over the swept grid
+    ds = mapped.to_dataset()
+    assert ds is mapped._dataset and ds.sizes["omega"] == 2 and ds.sizes["delta"] == 2
+
+
+def test_records_without_a_dataset_say_so(tmp_path):
+    rec = parapend.figure("1", plot=str(tmp_path / "f.png"))
+    with pytest.raises(AttributeError, match="figure result has no Dataset"):
+        rec.to_dataset()
 
 
 def test_figure_through_both(tmp_path, capsys):

@@ -255,7 +255,8 @@ class Record(_Result):
     commands whose result is not one of the dataclasses above: ``figure``, ``reproduce``,
     ``sweep``, ``map``, ``optimize --method all``). Fields read as attributes or with
     ``record["key"]``; ``to_dict`` gives the JSON object. Objects that are not JSON (a
-    figure, a Dataset) ride along as private attributes (``_figure``, ``_dataset``); the
+    figure, a Dataset) ride along as private attributes (``_figure``, ``_dataset``;
+    :meth:`to_dataset` returns the Dataset); the
     attributes of ``_source`` (the object the record describes, e.g. a simulated motion)
     read through.
     """
@@ -295,6 +296,20 @@ class Record(_Result):
     def fields(self) -> tuple:
         """The field names, which are the JSON keys."""
         return tuple(self._data)
+
+    def to_dataset(self):
+        """The full ``xarray.Dataset`` behind the record (``basins``, ``rotations``,
+        ``sweep``, ``map``, ``power-matrix``: what ``--save`` writes).
+
+        Raises
+        ------
+        AttributeError
+            For a command whose result carries no Dataset.
+        """
+        private = object.__getattribute__(self, "_private")
+        if private.get("dataset") is None:
+            raise AttributeError(f"{self._kind} result has no Dataset")
+        return private["dataset"]
 
     def to_dict(self) -> dict:
         return to_jsonable(self._data)
