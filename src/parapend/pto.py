@@ -52,6 +52,12 @@ def efficiencies(efficiency=None, efficiency_generating=None, efficiency_motorin
     return eg, em
 
 
+def _lossy(eff):
+    """``eff`` when it loses power, None when it is None or 1 both ways (lossless: the
+    problem without an efficiency, solved by the same method)."""
+    return None if eff is None or eff == (1.0, 1.0) else eff
+
+
 def _eta(name, value) -> float:
     x = check_finite(name, value)
     if not 0.0 < x <= 1.0:
@@ -191,7 +197,10 @@ def optimize_pto(*, torque_limit=None, efficiency=None, efficiency_generating=No
         raise ParameterError("method: a power take-off is optimized with method 'fourier'")
     n = check_int("harmonics", optimize_args.get("harmonics", 24), 1,
                   limits.MAX_PTO_HARMONICS)
-    lossless = tmax is None and r_cu == 0.0 and (eff is None or eff == (1.0, 1.0))
+    # an efficiency of 1 both ways is no efficiency: solved as the problem without one (the
+    # result still reports the efficiencies given)
+    eff_solve = _lossy(eff)
+    lossless = tmax is None and r_cu == 0.0 and eff_solve is None
     if ideal is None and not lossless:  # refuse before the ideal optimum's work
         check_pto_excitation(build_excitation(**{
             k: optimize_args[k] for k in ("excitation", "omega", "delta", "square_alpha",
@@ -219,12 +228,13 @@ def optimize_pto(*, torque_limit=None, efficiency=None, efficiency_generating=No
     check_pto_excitation(exc)
     cap = limits.MAX_PTO_INTERVALS if max_intervals is None else \
         check_int("max-intervals", max_intervals, 2, limits.MAX_PTO_INTERVALS)
-    if eff is None and tmax is not None:
+    if eff_solve is None and tmax is not None:
         sol, motion, extra = _time_domain(exc, gamma, ideal, tmax, r_cu, warm, cap=cap)
     else:
-        sol, motion, extra = _collocation(exc, gamma, ideal, tmax, r_cu, eff, warm, cap=cap)
+        sol, motion, extra = _collocation(exc, gamma, ideal, tmax, r_cu, eff_solve, warm,
+                                          cap=cap)
     coefficients = _coefficients(_projection(motion, exc, n))
-    prof = pto_profile(motion, exc, gamma, efficiency=eff)
+    prof = pto_profile(motion, exc, gamma, efficiency=eff_solve)
     pu = ideal.uniform_power
     status = sol.status
     bound = ideal.upper_bound
@@ -555,6 +565,7 @@ def _collocation(exc, gamma, ideal, tmax, copper_loss, eff, warm, rtol: float = 
     prev = last = coarse = None
     iters = 0
     change = float("nan")
+    refined = False
     while True:
         sol = solve_collocation(exc, gamma, k, start, efficiency=eff, torque_limit=tmax,
                                 copper_loss=copper_loss, winding=ideal.winding)
@@ -562,6 +573,13 @@ def _collocation(exc, gamma, ideal, tmax, copper_loss, eff, warm, rtol: float = 
         if sol.status != "converged" and last is None and start is not ideal.motion:
             # a warm start (continuation) that failed: from the ideal optimum instead
             start = ideal.motion
+            continue
+        if sol.status != "converged" and last is None and not refined and 2 * k <= cap:
+            # the ideal optimum with its torque clipped to the limit is off the dynamics;
+            # on a coarse mesh the interior point can stall there, at defects of 1e-2 and
+            # a power above any rotation's: try a finer mesh once, as _time_domain does
+            refined = True
+            k *= 2
             continue
         if sol.status != "converged":
             if last is not None:
@@ -673,7 +691,7 @@ def pto_curve(vary: str = "torque-limit", *, values=None, points: int = 12,
         if torque_limit is not None:
             raise ParameterError("torque-limit: it is the varied quantity; drop it")
         eff = efficiencies(efficiency, efficiency_generating, efficiency_motoring)
-        tmin = _smallest_limit(ideal) if eff is None else None
+        tmin = _smallest_limit(ideal) if _lossy(eff) is None else None
         if values is None:
             top = ideal.peak_torque
             # down to the smallest feasible limit; with a free rotation (smallest limit 0)
