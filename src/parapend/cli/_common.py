@@ -132,6 +132,24 @@ def add_pendulum_options(g, *, gamma_note: str = "") -> None:
                    default=None, help="viscous damping c, N m s/rad (instead of --gamma)")
 
 
+def add_body_options(g, *, body_default, body_help: str, hydro_help: str) -> None:
+    """The buoy's body of ``buoy`` and ``power-matrix --device buoy`` into the argument group
+    ``g``: ``--body --radius --draft --mesh --hydro`` (sizes default to ``defaults.BUOY``'s);
+    the default of ``--body`` and the help of ``--body`` and ``--hydro`` are the commands'
+    own."""
+    from ..defaults import BUOY
+
+    g.add_argument("--body", choices=["cylinder", "sphere"], default=body_default,
+                   help=body_help)
+    g.add_argument("--radius", type=_finite_float("radius"), default=None,
+                   help=f"m (default {BUOY['radius']:g})")
+    g.add_argument("--draft", type=_finite_float("draft"), default=None,
+                   help=f"cylinder's draft, m (default {BUOY['draft']:g})")
+    g.add_argument("--mesh", metavar="FILE", default=None,
+                   help="a mesh file Capytaine reads, instead of --body")
+    g.add_argument("--hydro", metavar="FILE", default=None, help=hydro_help)
+
+
 FIGURE_SUFFIXES = (".png", ".svg", ".pdf")
 
 
