@@ -34,6 +34,7 @@ from pathlib import Path
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
 
 import numpy as np  # noqa: E402
+from _timing import best_of  # noqa: E402  (benchmarks/_timing.py)
 from buoy_synthetic import toy_hydro  # noqa: E402  (the tests' toy heave coefficients)
 
 from parapend.buoy.coupled import (  # noqa: E402
@@ -77,16 +78,6 @@ def ipopt_run(solver, x0):
     r = solver(x0=x0)
     st = solver.stats()
     return -float(r["f"]), np.asarray(r["x"]).ravel(), st["return_status"], st["iter_count"]
-
-
-def best_of(fn, repeat):
-    fn()
-    ts = []
-    for _ in range(repeat):
-        t = time.perf_counter()
-        out = fn()
-        ts.append(time.perf_counter() - t)
-    return min(ts), out
 
 
 def main():

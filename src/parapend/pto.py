@@ -455,6 +455,15 @@ def intervals_for(exc) -> int:
                    max(64, 1 << int(math.ceil(math.log2(k))))))
 
 
+def _settled(prev, power, k, cap, rtol):
+    """``(done, change)`` of the doubling of the intervals after a converged solve on ``k``:
+    ``change`` is the move of the electrical power from the coarser mesh's ``prev`` (NaN
+    without one); done when it is within ``rtol`` (relative, absolute below 1) or the next
+    doubling would pass the cap."""
+    change = float("nan") if prev is None else abs(power - prev)
+    return 2 * k > cap or change <= rtol * max(1.0, abs(power)), change
+
+
 def _time_domain(exc, gamma, ideal, tmax, copper_loss, warm, rtol: float = 1e-6,
                  cap: int = limits.MAX_PTO_INTERVALS):
     """Torque-limited optimum on Hermite intervals, doubled until the power settles."""
@@ -497,11 +506,8 @@ def _time_domain(exc, gamma, ideal, tmax, copper_loss, warm, rtol: float = 1e-6,
         last = sol, k
         anchor = sol.anchor  # strictly inside the limit: the finer solve starts towards it
         motion = sol.motion
-        if prev is not None:
-            change = abs(sol.electrical_power - prev)
-            if change <= rtol * max(1.0, abs(sol.electrical_power)) or 2 * k > cap:
-                break
-        elif 2 * k > cap:
+        done, change = _settled(prev, sol.electrical_power, k, cap, rtol)
+        if done:
             break
         prev = sol.electrical_power
         start = motion
@@ -589,11 +595,8 @@ def _collocation(exc, gamma, ideal, tmax, copper_loss, eff, warm, rtol: float = 
         if last is not None:
             coarse = last[0]
         last = sol, k
-        if prev is not None:
-            change = abs(sol.electrical_power - prev)
-            if change <= rtol * max(1.0, abs(sol.electrical_power)) or 2 * k > cap:
-                break
-        elif 2 * k > cap:
+        done, change = _settled(prev, sol.electrical_power, k, cap, rtol)
+        if done:
             break
         prev = sol.electrical_power
         start = sol.motion

@@ -174,17 +174,21 @@ def _cmd_track(a) -> dict | str:
            f"Floquet multipliers, open loop: {_mult(r.open_loop_multipliers)}",
            f"closed loop: {_mult(r.closed_loop_multipliers)}"]
     if r.sea is not None:
-        sea = r.sea
-        out.append(f"irregular sea: JONSWAP peaked at omega {sea['peak_omega']:g}, Hs "
-                   f"{sea['hs']:.4g} (units g t0^2), rms of q {sea['rms_q']:.4g}, "
-                   f"{sea['components']} components, repeating every "
-                   f"{sea['repeat_periods']} peak periods, seed {sea['seed']}")
+        out.append(_sea_line(r.sea))
     out += _si_lines(r)
     if a.save:
         out.append(f"run written to {a.save}")
     if a.plot:
         out.append(f"figure written to {a.plot}")
     return "\n".join(out)
+
+
+def _sea_line(sea: dict) -> str:
+    """The irregular sea of a ``track --irregular`` run, in one line."""
+    return (f"irregular sea: JONSWAP peaked at omega {sea['peak_omega']:g}, Hs "
+            f"{sea['hs']:.4g} (units g t0^2), rms of q {sea['rms_q']:.4g}, "
+            f"{sea['components']} components, repeating every "
+            f"{sea['repeat_periods']} peak periods, seed {sea['seed']}")
 
 
 def _mpc_out(a, r) -> dict | str:
@@ -214,11 +218,7 @@ def _mpc_out(a, r) -> dict | str:
            f"max {1e3 * r.solve_time_max:.3g} ms, median {r.iterations_median:g} "
            "L-BFGS-B iterations"]
     if r.sea is not None:
-        sea = r.sea
-        out.append(f"irregular sea: JONSWAP peaked at omega {sea['peak_omega']:g}, Hs "
-                   f"{sea['hs']:.4g} (units g t0^2), rms of q {sea['rms_q']:.4g}, "
-                   f"{sea['components']} components, repeating every "
-                   f"{sea['repeat_periods']} peak periods, seed {sea['seed']}")
+        out.append(_sea_line(r.sea))
     if r.units is not None:
         u = r.units
         out.append(f"physical (l = {u['length_m']:g} m, m = {u['mass_kg']:g} kg): period "
