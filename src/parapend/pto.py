@@ -17,6 +17,11 @@ Two methods, both warm-started from the ideal optimum of :func:`parapend.optimiz
   :mod:`parapend.optimal.collocation`, Hermite-Simpson collocation with the torque as an
   unknown (the efficiency exact through two slacks per point) and a full-space primal-dual
   interior point on the banded KKT system; K from the excitation, checked by one doubling.
+
+Under a torque limit without a copper loss, where either fails or comes within 10 % of the
+bound ``T_max K omega`` of every monotone rotation, the constant brake
+(:mod:`parapend.optimal.brake`) is tried, and returned when it is at least as good. An
+efficiency of 1 both ways is no efficiency: the problem is solved as without one.
 """
 
 from __future__ import annotations
@@ -601,6 +606,18 @@ def _collocation(exc, gamma, ideal, tmax, copper_loss, eff, warm, rtol: float = 
         prev = sol.electrical_power
         start = sol.motion
         k *= 2
+    if tmax is not None and copper_loss == 0.0 and (
+            sol.status != "converged" or sol.power >= 0.9 * tmax * ideal.winding * exc.omega):
+        # as in _time_domain: where the interior point failed, or near the bound of every
+        # monotone rotation (P <= T_max K omega), the constant brake attains that bound if it
+        # exists; it only generates (theta' > 0), so its electrical power is eta_g P, the
+        # bound of every monotone rotation through the efficiency too
+        brake = _constant_brake(exc, gamma, tmax, sol.motion, iters, ideal.winding)
+        eg = 1.0 if eff is None else eff[0]
+        if brake is not None and (sol.status != "converged" or
+                                  eg * brake[0].power >= sol.electrical_power):
+            out, motion, extra = brake
+            return dataclasses.replace(out, electrical_power=eg * out.power), motion, extra
     status = sol.status
     if status == "converged" and not change <= rtol * max(1.0, abs(sol.electrical_power)):
         status = "unresolved"
