@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import json
 import math
 
 import numpy as np
@@ -258,7 +259,7 @@ def test_winding_two_by_both_time_domain_methods():
     assert a.peak_torque <= 3.0 * (1 + 1e-9) and b.peak_torque <= 3.0 * (1 + 1e-9)
 
 
-def test_lossless_efficiency_with_a_torque_limit_is_the_torque_limited_optimum():
+def test_lossless_efficiency_with_a_torque_limit_is_the_torque_limited_optimum(capsys):
     """Efficiency 1 both ways with a torque limit is the torque-limited problem: the same
     method and the same answer as without an efficiency (it went to the collocation, whose
     first mesh stalled off the dynamics at 1.7 times the unlimited optimum, "infeasible").
@@ -274,6 +275,11 @@ def test_lossless_efficiency_with_a_torque_limit_is_the_torque_limited_optimum()
     assert one.power == pytest.approx(limited.power, rel=1e-8)
     assert one.electrical_power == pytest.approx(limited.power, rel=1e-8)
     assert one.efficiency_generating == one.efficiency_motoring == 1.0
+    code, out, _ = _run(capsys, "optimize", "--length", "1", "--mass", "10", "--frequency",
+                        "0.9", "--amplitude", "0.09", "--damping-coefficient", "0.5",
+                        "--torque-limit-nm", "20", "--efficiency", "1", "--json")
+    assert code == 0
+    assert json.loads(out)["power_w"] == pytest.approx(limited.power_w, rel=1e-8)
     curve = parapend.pto_curve(vary="efficiency", torque_limit_nm=20.0, points=3, **args)
     assert list(curve["status"].values) == ["converged"] * 3
     assert float(curve["power_w"][0]) == pytest.approx(limited.power_w, rel=1e-8)
