@@ -26,27 +26,26 @@ Run: ``OPENBLAS_NUM_THREADS=1 python benchmarks/bench_buoy.py``.
 from __future__ import annotations
 
 import argparse
-import math
 import os
+import sys
 import time
+from pathlib import Path
 
-import numpy as np
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
 
-from parapend.buoy.coupled import CoupledProblem, Pendulum, Wave, free_excitation, scales
-from parapend.buoy.hydro import Hydro
-from parapend.buoy.optimum import _seeds, coupled_optimum
-from parapend.optimal.fourier import newton_maximize, search_fourier
+import numpy as np  # noqa: E402
+from _timing import best_of  # noqa: E402  (benchmarks/_timing.py)
+from buoy_synthetic import toy_hydro  # noqa: E402  (the tests' toy heave coefficients)
 
-
-def toy_hydro(radius=1.5, rho=1025.0, g=9.81, n=200, top=8.0) -> Hydro:
-    w = np.linspace(0.05, top, n)
-    c = rho * g * math.pi * radius**2
-    mass = rho * (2 / 3) * math.pi * radius**3 * 1.5
-    a = 0.5 * mass * np.ones_like(w)
-    b = 0.3 * mass * w**2 / (1 + (w / 2) ** 4) * np.exp(-0.1 * w)
-    f = np.sqrt(2 * rho * g**3 * b / w**3) * np.exp(-0.2j * w)
-    return Hydro(omega=w, added_mass=a, radiation_damping=b, excitation=f,
-                 hydrostatic_stiffness=c, mass=mass, rho=rho, g=g)
+from parapend.buoy.coupled import (  # noqa: E402
+    CoupledProblem,
+    Pendulum,
+    Wave,
+    free_excitation,
+    scales,
+)
+from parapend.buoy.optimum import _seeds, coupled_optimum  # noqa: E402
+from parapend.optimal.fourier import newton_maximize, search_fourier  # noqa: E402
 
 
 def casadi_problem(pr: CoupledProblem):
@@ -81,16 +80,6 @@ def ipopt_run(solver, x0):
     return -float(r["f"]), np.asarray(r["x"]).ravel(), st["return_status"], st["iter_count"]
 
 
-def best_of(fn, repeat):
-    fn()
-    ts = []
-    for _ in range(repeat):
-        t = time.perf_counter()
-        out = fn()
-        ts.append(time.perf_counter() - t)
-    return min(ts), out
-
-
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--repeat", type=int, default=5)
@@ -98,7 +87,7 @@ def main():
     ap.add_argument("--skip-irregular", action="store_true")
     a = ap.parse_args()
     load0 = os.getloadavg()[0]
-    hydro = toy_hydro()
+    hydro = toy_hydro(radius=1.5)
     pend = Pendulum(4000.0, 1.0, 4500.0, 40.0)
     wave = Wave.regular(1.5, 6.0)
     sc = scales(hydro, pend, wave)

@@ -33,12 +33,12 @@ from __future__ import annotations
 
 import argparse
 import sys
-import time
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
 
 import numpy as np  # noqa: E402
+from _timing import best_of  # noqa: E402  (benchmarks/_timing.py)
 
 import parapend  # noqa: E402
 from parapend.optimal.collocation import solve_collocation  # noqa: E402
@@ -63,16 +63,6 @@ def ours(gamma, kw, size, start="ideal"):
     if "torque_limit" in kw:
         return solve_hermite(exc, gamma, size, motion, **kw)
     return solve_collocation(exc, gamma, size, motion, **kw)
-
-
-def best_time(fn, repeat):
-    fn()
-    ts, out = [], None
-    for _ in range(repeat):
-        t = time.perf_counter()
-        out = fn()
-        ts.append(time.perf_counter() - t)
-    return min(ts), out
 
 
 def main():
@@ -100,7 +90,7 @@ def main():
         sizes = (32, 48, 64, 96, 128, 192, 256, 512) if "torque_limit" in kw else SIZES
         label = "K"
         for n in sizes:
-            t, s = best_time(lambda n=n, g=gamma, k=kw: ours(g, k, n, a.start), a.repeat)
+            t, s = best_of(lambda n=n, g=gamma, k=kw: ours(g, k, n, a.start), a.repeat)
             rows.append(("parapend", f"{label}={n}", t, s.electrical_power))
         for k in SIZES:
             ts = []

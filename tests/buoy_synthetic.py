@@ -1,9 +1,15 @@
-"""A synthetic, exactly causal heave dataset for the buoy tests (no BEM needed).
+"""Synthetic heave datasets for the buoy tests and benchmark (no BEM needed).
 
-The radiation force has the transfer function ``H(s) = k s / (s^2 + 2 zeta w0 s + w0^2)``
-(``s = i w``): ``B(w) = Re H(i w)``, ``A(w) = A_inf + Im H(i w) / w`` (Kramers-Kronig holds
-exactly), impulse response ``K(t) = k exp(-zeta w0 t) (cos(wd t) - zeta w0 / wd sin(wd t))``.
+:func:`synthetic`: an exactly causal dataset. The radiation force has the transfer
+function ``H(s) = k s / (s^2 + 2 zeta w0 s + w0^2)`` (``s = i w``): ``B(w) = Re H(i w)``,
+``A(w) = A_inf + Im H(i w) / w`` (Kramers-Kronig holds exactly), impulse response
+``K(t) = k exp(-zeta w0 t) (cos(wd t) - zeta w0 / wd sin(wd t))``.
+
+:func:`toy_hydro`: an analytic, passive set sized by a radius (tests/test_buoy_kernel.py,
+benchmarks/bench_buoy.py).
 """
+
+import math
 
 import numpy as np
 
@@ -39,3 +45,17 @@ def synthetic(n=400, w_max=60.0, w_min=0.05):
     a, b, f = exact(w)
     return Hydro(omega=w, added_mass=a, radiation_damping=b, excitation=f,
                  hydrostatic_stiffness=C, mass=M, description="synthetic")
+
+
+def toy_hydro(radius=1.0, rho=1025.0, g=9.81, n=200, top=8.0) -> Hydro:
+    """A passive heave model: constant A, B(w) >= 0 vanishing at 0, |F|^2 from B (the
+    Haskind relation of deep water), the stiffness and mass of a floating body of this
+    radius."""
+    w = np.linspace(0.05, top, n)
+    c = rho * g * math.pi * radius**2
+    mass = rho * (2 / 3) * math.pi * radius**3 * 1.5
+    a = 0.5 * mass * np.ones_like(w)
+    b = 0.3 * mass * w**2 / (1 + (w / 2) ** 4) * np.exp(-0.1 * w)
+    f = np.sqrt(2 * rho * g**3 * b / w**3) * np.exp(-0.2j * w)
+    return Hydro(omega=w, added_mass=a, radiation_damping=b, excitation=f,
+                 hydrostatic_stiffness=c, mass=mass, rho=rho, g=g)

@@ -10,28 +10,15 @@ import math
 
 import numpy as np
 import pytest
+from buoy_synthetic import toy_hydro
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 import parapend
 from parapend.buoy.coupled import CoupledProblem, Pendulum, Wave, free_excitation, scales
-from parapend.buoy.hydro import Hydro
 from parapend.buoy.optimum import BALANCE_TOL, coupled_limit, coupled_optimum
 from parapend.errors import ParameterError
 from parapend.optimal.fourier import FourierProblem
-
-
-def toy_hydro(radius=1.0, rho=1025.0, g=9.81, n=200, top=8.0) -> Hydro:
-    """A passive heave model: constant A, B(w) >= 0 vanishing at 0, |F|^2 from B."""
-    w = np.linspace(0.05, top, n)
-    c = rho * g * math.pi * radius**2
-    mass = rho * (2 / 3) * math.pi * radius**3 * 1.5
-    a = 0.5 * mass * np.ones_like(w)
-    b = 0.3 * mass * w**2 / (1 + (w / 2) ** 4) * np.exp(-0.1 * w)
-    f = np.sqrt(2 * rho * g**3 * b / w**3) * np.exp(-0.2j * w)
-    return Hydro(omega=w, added_mass=a, radiation_damping=b, excitation=f,
-                 hydrostatic_stiffness=c, mass=mass, rho=rho, g=g)
-
 
 HYDRO = toy_hydro()
 

@@ -352,6 +352,18 @@ def test_figures_pass_the_house_checks(tiny):
         plt.close(fig)
 
 
+def test_matrix_title_counts_records_in_the_singular_and_plural(tiny):
+    import matplotlib.pyplot as plt
+
+    from parapend.performance import figures
+
+    ds, _ = tiny
+    for n, words in ((2, "mean over 2 records of 4"), (1, "mean over 1 record of 4")):
+        fig = figures.plot_matrix(ds.isel(realization=slice(0, n)))
+        assert words in fig.axes[0].get_title(), fig.axes[0].get_title()
+        plt.close(fig)
+
+
 def test_electrical_power_at_efficiency_one_is_the_power():
     from parapend.performance.solve import electrical_power
 

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import json
 import math
 
 import numpy as np
@@ -245,13 +246,64 @@ def test_copper_loss_alone_and_with_a_slack_limit_agree():
 
 def test_winding_two_by_both_time_domain_methods():
     """K = 2 turns per forcing period under a torque limit: the Hermite interior point and
-    the collocation (efficiency 1: the same problem) are independent discretizations and
+    the collocation (lossless: the same problem) are independent discretizations and
     solvers, and they agree after refinement (at gamma = 0.01 with one harmonic a two-turn
     rotation costs power: status no_power, the smallest loss)."""
     a = pto.optimize_pto(gamma=0.01, torque_limit=3.0, winding=2)
-    b = pto.optimize_pto(gamma=0.01, torque_limit=3.0, efficiency=1.0, winding=2)
-    assert (a.method, b.method) == ("hermite", "collocation")
-    assert a.status == b.status == "no_power"
-    assert a.winding == b.winding == 2
+    ideal = parapend.optimize(gamma=0.01, winding=2)
+    b, _, extra = pto._collocation(ideal._excitation, 0.01, ideal, 3.0, 0.0, None, None)
+    assert (a.method, extra["method"]) == ("hermite", "collocation")
+    assert a.status == "no_power" and b.status == "converged" and b.electrical_power <= 0
+    assert a.winding == 2
     assert a.power == pytest.approx(b.power, abs=1e-6)
     assert a.peak_torque <= 3.0 * (1 + 1e-9) and b.peak_torque <= 3.0 * (1 + 1e-9)
+
+
+def test_lossless_efficiency_with_a_torque_limit_is_the_torque_limited_optimum(capsys):
+    """Efficiency 1 both ways with a torque limit is the torque-limited problem: the same
+    method and the same answer as without an efficiency (it went to the collocation, whose
+    first mesh stalled off the dynamics at 1.7 times the unlimited optimum, "infeasible").
+    Along the efficiency curve the electrical power does not fall as eta rises, and no
+    mechanical power exceeds the unlimited optimum."""
+    args = {"length": 1.0, "mass": 10.0, "frequency": 0.9, "amplitude": 0.09,
+            "damping_coefficient": 0.5}
+    unlimited = parapend.optimize(**args)
+    limited = parapend.optimize(torque_limit_nm=20.0, **args)
+    one = parapend.optimize(torque_limit_nm=20.0, efficiency=1.0, **args)
+    assert limited.status == one.status == "converged"
+    assert one.method == limited.method == "hermite"
+    assert one.power == pytest.approx(limited.power, rel=1e-8)
+    assert one.electrical_power == pytest.approx(limited.power, rel=1e-8)
+    assert one.efficiency_generating == one.efficiency_motoring == 1.0
+    code, out, _ = _run(capsys, "optimize", "--length", "1", "--mass", "10", "--frequency",
+                        "0.9", "--amplitude", "0.09", "--damping-coefficient", "0.5",
+                        "--torque-limit-nm", "20", "--efficiency", "1", "--json")
+    assert code == 0
+    assert json.loads(out)["power_w"] == pytest.approx(limited.power_w, rel=1e-8)
+    curve = parapend.pto_curve(vary="efficiency", torque_limit_nm=20.0, points=3, **args)
+    assert list(curve["status"].values) == ["converged"] * 3
+    assert float(curve["power_w"][0]) == pytest.approx(limited.power_w, rel=1e-8)
+    ele = curve["electrical_power"].values[::-1]  # eta rising
+    assert np.all(np.diff(ele) >= -1e-12)
+    assert np.all(curve["power"].values <= unlimited.power * (1 + 1e-9))
+    # the collocation agrees on the same problem (an independent discretization), from
+    # the first mesh that stalled: a finer mesh is tried before "infeasible"
+    b, _, _ = pto._collocation(unlimited._excitation, unlimited.gamma, unlimited,
+                               limited.torque_limit, 0.0, None, None)
+    assert b.status == "converged"
+    assert b.power == pytest.approx(limited.power, rel=1e-5)
+
+
+def test_efficiency_with_a_small_limit_is_the_constant_brake():
+    """Through an efficiency the collocation alone stalled at a 1 N m limit and reported
+    "infeasible", while 0.5 N m was feasible: the constant brake is tried as in the
+    Hermite path. Its power is the closed-form bound T_max omega of every monotone
+    rotation, and it only generates: electrical = eta_g P."""
+    args = {"length": 1.0, "mass": 10.0, "frequency": 0.9, "amplitude": 0.09,
+            "damping_coefficient": 0.5}
+    r = parapend.optimize(torque_limit_nm=1.0, efficiency=0.9, **args)
+    assert r.status == "converged" and r.method == "constant-brake"
+    assert r.power == pytest.approx(r.torque_limit * r.omega, rel=1e-9)
+    assert r.electrical_power == pytest.approx(0.9 * r.power, rel=1e-12)
+    assert r.motoring_energy == pytest.approx(0.0, abs=1e-12)
+    assert r.peak_torque <= r.torque_limit * (1 + 1e-9)

@@ -352,3 +352,19 @@ def test_sweep_function_is_not_shadowed_by_the_maps_package():
     from parapend.commands import sweep
 
     assert parapend.sweep is sweep and parapend.maps.sweep is not sweep
+
+
+def test_track_controller_defaults_are_in_defaults_and_its_table():
+    """``track``'s receding-horizon options take their defaults from ``defaults.TRACK``
+    (command line and function alike), and docs/defaults.md lists each."""
+    from pathlib import Path
+
+    from parapend.defaults import TRACK
+
+    params = inspect.signature(commands.track).parameters
+    table = (Path(__file__).resolve().parents[1] / "docs" / "defaults.md").read_text()
+    row = next(line for line in table.splitlines() if line.startswith("| controller of `track`"))
+    for name, value in TRACK.items():
+        assert params[name].default == value
+        assert f"`--{name.replace('_', '-')} {value:g}`" in row if isinstance(value, float) \
+            else f"`--{name} {value}`" in row

@@ -470,6 +470,9 @@ def rotations(*, gamma=GAMMA["rotations"], omega=DYNAMICS["omega"], p_max: float
 
 
 # --- track ---------------------------------------------------------------------------------
+from .defaults import TRACK  # noqa: E402
+
+
 def track(*, excitation=None, omega=OMEGA, delta=None, square_alpha=None, fourier=None,
           file=None, gamma=GAMMA["track"], harmonics: int = 24, torque_limit=None,
           torque_margin: float = 0.1, r_weight: float = 0.1, lock_tolerance: float = 0.1,
@@ -478,8 +481,9 @@ def track(*, excitation=None, omega=OMEGA, delta=None, square_alpha=None, fourie
           noise_theta: float = 0.0, noise_speed: float = 0.0, irregular: bool = False,
           length=None, mass=None, inertia=None, gravity=None, frequency=None,
           amplitude=None, damping_coefficient=None, torque_limit_nm=None, progress=None,
-          controller: str = "lqr", horizon: float = 2.0, update_interval: float = 0.125,
-          forecast: str = "perfect"):
+          controller: str = TRACK["controller"], horizon: float = TRACK["horizon"],
+          update_interval: float = TRACK["update_interval"],
+          forecast: str = TRACK["forecast"]):
     """Swing up from rest, catch and hold the optimal rotation (command ``track``): a
     :class:`~parapend.control.track.TrackResult` (``runs`` 1) or a
     :class:`~parapend.control.robustness.RobustnessResult` (more seeded runs). With

@@ -17,6 +17,11 @@ Two methods, both warm-started from the ideal optimum of :func:`parapend.optimiz
   :mod:`parapend.optimal.collocation`, Hermite-Simpson collocation with the torque as an
   unknown (the efficiency exact through two slacks per point) and a full-space primal-dual
   interior point on the banded KKT system; K from the excitation, checked by one doubling.
+
+Under a torque limit without a copper loss, where either fails or comes within 10 % of the
+bound ``T_max K omega`` of every monotone rotation, the constant brake
+(:mod:`parapend.optimal.brake`) is tried, and returned when it is at least as good. An
+efficiency of 1 both ways is no efficiency: the problem is solved as without one.
 """
 
 from __future__ import annotations
@@ -50,6 +55,12 @@ def efficiencies(efficiency=None, efficiency_generating=None, efficiency_motorin
     em = base if efficiency_motoring is None else _eta("efficiency-motoring",
                                                        efficiency_motoring)
     return eg, em
+
+
+def _lossy(eff):
+    """``eff`` when it loses power, None when it is None or 1 both ways (lossless: the
+    problem without an efficiency, solved by the same method)."""
+    return None if eff is None or eff == (1.0, 1.0) else eff
 
 
 def _eta(name, value) -> float:
@@ -191,7 +202,10 @@ def optimize_pto(*, torque_limit=None, efficiency=None, efficiency_generating=No
         raise ParameterError("method: a power take-off is optimized with method 'fourier'")
     n = check_int("harmonics", optimize_args.get("harmonics", 24), 1,
                   limits.MAX_PTO_HARMONICS)
-    lossless = tmax is None and r_cu == 0.0 and (eff is None or eff == (1.0, 1.0))
+    # an efficiency of 1 both ways is no efficiency: solved as the problem without one (the
+    # result still reports the efficiencies given)
+    eff_solve = _lossy(eff)
+    lossless = tmax is None and r_cu == 0.0 and eff_solve is None
     if ideal is None and not lossless:  # refuse before the ideal optimum's work
         check_pto_excitation(build_excitation(**{
             k: optimize_args[k] for k in ("excitation", "omega", "delta", "square_alpha",
@@ -219,12 +233,13 @@ def optimize_pto(*, torque_limit=None, efficiency=None, efficiency_generating=No
     check_pto_excitation(exc)
     cap = limits.MAX_PTO_INTERVALS if max_intervals is None else \
         check_int("max-intervals", max_intervals, 2, limits.MAX_PTO_INTERVALS)
-    if eff is None and tmax is not None:
+    if eff_solve is None and tmax is not None:
         sol, motion, extra = _time_domain(exc, gamma, ideal, tmax, r_cu, warm, cap=cap)
     else:
-        sol, motion, extra = _collocation(exc, gamma, ideal, tmax, r_cu, eff, warm, cap=cap)
+        sol, motion, extra = _collocation(exc, gamma, ideal, tmax, r_cu, eff_solve, warm,
+                                          cap=cap)
     coefficients = _coefficients(_projection(motion, exc, n))
-    prof = pto_profile(motion, exc, gamma, efficiency=eff)
+    prof = pto_profile(motion, exc, gamma, efficiency=eff_solve)
     pu = ideal.uniform_power
     status = sol.status
     bound = ideal.upper_bound
@@ -445,6 +460,15 @@ def intervals_for(exc) -> int:
                    max(64, 1 << int(math.ceil(math.log2(k))))))
 
 
+def _settled(prev, power, k, cap, rtol):
+    """``(done, change)`` of the doubling of the intervals after a converged solve on ``k``:
+    ``change`` is the move of the electrical power from the coarser mesh's ``prev`` (NaN
+    without one); done when it is within ``rtol`` (relative, absolute below 1) or the next
+    doubling would pass the cap."""
+    change = float("nan") if prev is None else abs(power - prev)
+    return 2 * k > cap or change <= rtol * max(1.0, abs(power)), change
+
+
 def _time_domain(exc, gamma, ideal, tmax, copper_loss, warm, rtol: float = 1e-6,
                  cap: int = limits.MAX_PTO_INTERVALS):
     """Torque-limited optimum on Hermite intervals, doubled until the power settles."""
@@ -487,11 +511,8 @@ def _time_domain(exc, gamma, ideal, tmax, copper_loss, warm, rtol: float = 1e-6,
         last = sol, k
         anchor = sol.anchor  # strictly inside the limit: the finer solve starts towards it
         motion = sol.motion
-        if prev is not None:
-            change = abs(sol.electrical_power - prev)
-            if change <= rtol * max(1.0, abs(sol.electrical_power)) or 2 * k > cap:
-                break
-        elif 2 * k > cap:
+        done, change = _settled(prev, sol.electrical_power, k, cap, rtol)
+        if done:
             break
         prev = sol.electrical_power
         start = motion
@@ -555,6 +576,7 @@ def _collocation(exc, gamma, ideal, tmax, copper_loss, eff, warm, rtol: float = 
     prev = last = coarse = None
     iters = 0
     change = float("nan")
+    refined = False
     while True:
         sol = solve_collocation(exc, gamma, k, start, efficiency=eff, torque_limit=tmax,
                                 copper_loss=copper_loss, winding=ideal.winding)
@@ -562,6 +584,13 @@ def _collocation(exc, gamma, ideal, tmax, copper_loss, eff, warm, rtol: float = 
         if sol.status != "converged" and last is None and start is not ideal.motion:
             # a warm start (continuation) that failed: from the ideal optimum instead
             start = ideal.motion
+            continue
+        if sol.status != "converged" and last is None and not refined and 2 * k <= cap:
+            # the ideal optimum with its torque clipped to the limit is off the dynamics;
+            # on a coarse mesh the interior point can stall there, at defects of 1e-2 and
+            # a power above any rotation's: try a finer mesh once, as _time_domain does
+            refined = True
+            k *= 2
             continue
         if sol.status != "converged":
             if last is not None:
@@ -571,15 +600,24 @@ def _collocation(exc, gamma, ideal, tmax, copper_loss, eff, warm, rtol: float = 
         if last is not None:
             coarse = last[0]
         last = sol, k
-        if prev is not None:
-            change = abs(sol.electrical_power - prev)
-            if change <= rtol * max(1.0, abs(sol.electrical_power)) or 2 * k > cap:
-                break
-        elif 2 * k > cap:
+        done, change = _settled(prev, sol.electrical_power, k, cap, rtol)
+        if done:
             break
         prev = sol.electrical_power
         start = sol.motion
         k *= 2
+    if tmax is not None and copper_loss == 0.0 and (
+            sol.status != "converged" or sol.power >= 0.9 * tmax * ideal.winding * exc.omega):
+        # as in _time_domain: where the interior point failed, or near the bound of every
+        # monotone rotation (P <= T_max K omega), the constant brake attains that bound if it
+        # exists; it only generates (theta' > 0), so its electrical power is eta_g P, the
+        # bound of every monotone rotation through the efficiency too
+        brake = _constant_brake(exc, gamma, tmax, sol.motion, iters, ideal.winding)
+        eg = 1.0 if eff is None else eff[0]
+        if brake is not None and (sol.status != "converged" or
+                                  eg * brake[0].power >= sol.electrical_power):
+            out, motion, extra = brake
+            return dataclasses.replace(out, electrical_power=eg * out.power), motion, extra
     status = sol.status
     if status == "converged" and not change <= rtol * max(1.0, abs(sol.electrical_power)):
         status = "unresolved"
@@ -673,7 +711,7 @@ def pto_curve(vary: str = "torque-limit", *, values=None, points: int = 12,
         if torque_limit is not None:
             raise ParameterError("torque-limit: it is the varied quantity; drop it")
         eff = efficiencies(efficiency, efficiency_generating, efficiency_motoring)
-        tmin = _smallest_limit(ideal) if eff is None else None
+        tmin = _smallest_limit(ideal) if _lossy(eff) is None else None
         if values is None:
             top = ideal.peak_torque
             # down to the smallest feasible limit; with a free rotation (smallest limit 0)

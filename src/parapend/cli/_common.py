@@ -87,6 +87,69 @@ def _excitation_kwargs(a) -> dict:
             "square_alpha": a.square_alpha, "fourier": a.fourier, "file": a.file}
 
 
+def add_sea_options(g, *, repeat_period: str = "the record repeats with it",
+                    seed: str = "seed of the random phases (default 0)",
+                    cutoff: str = "highest frequency, in units of the peak frequency, 1.5 "
+                                  "to 10 (default 3)") -> None:
+    """The sea state of ``sea`` and ``horizon`` into the argument group ``g``: ``--hs --tp
+    --spectrum --gamma-peak --repeat-period --seed --cutoff`` (the defaults are
+    :func:`parapend.seas` 's). ``repeat_period`` (what the record length is), ``seed`` and
+    ``cutoff`` are the commands' own help texts."""
+    from .. import limits
+
+    g.add_argument("--hs", type=_finite_float("hs"), default=None,
+                   help="significant wave height, m (default 2)")
+    g.add_argument("--tp", type=_finite_float("tp"), default=None,
+                   help="peak period, s (default 8)")
+    g.add_argument("--spectrum", choices=["jonswap", "pierson-moskowitz"], default="jonswap",
+                   help="spectrum shape (default jonswap)")
+    g.add_argument("--gamma-peak", type=_finite_float("gamma-peak"), default=3.3,
+                   help="JONSWAP peak enhancement in [1, 20] (default 3.3)")
+    g.add_argument("--repeat-period", type=_finite_float("repeat-period"), default=None,
+                   help=f"T_r, s: {repeat_period}; {limits.SEA_WAVES_RANGE[0]:g} "
+                        f"to {limits.SEA_WAVES_RANGE[1]:g} peak periods (default 100 Tp)")
+    g.add_argument("--seed", type=_int, default=None, help=seed)
+    g.add_argument("--cutoff", type=_finite_float("cutoff"), default=3.0, help=cutoff)
+
+
+def add_pendulum_options(g, *, gamma_note: str = "") -> None:
+    """The pendulum in SI units of ``sea`` and ``horizon`` into the argument group ``g``:
+    ``--length --mass --inertia --gravity --gamma --damping-coefficient`` (defaults
+    ``defaults.SEA``); ``gamma_note`` ends the help of ``--gamma``'s default."""
+    from ..defaults import SEA
+
+    g.add_argument("--length", type=_finite_float("length"), default=SEA["length"],
+                   help="pivot to centre of mass, m (default 1)")
+    g.add_argument("--mass", type=_finite_float("mass"), default=SEA["mass"],
+                   help="kg (default 10)")
+    g.add_argument("--inertia", type=_finite_float("inertia"), default=None,
+                   help="about the pivot, kg m^2 (default m l^2)")
+    g.add_argument("--gravity", type=_finite_float("gravity"), default=SEA["gravity"],
+                   help="m/s^2 (default 9.81)")
+    g.add_argument("--gamma", type=_finite_float("gamma"), default=None,
+                   help=f"viscous damping, non-dimensional (default 0.01{gamma_note})")
+    g.add_argument("--damping-coefficient", type=_finite_float("damping-coefficient"),
+                   default=None, help="viscous damping c, N m s/rad (instead of --gamma)")
+
+
+def add_body_options(g, *, body_default, body_help: str, hydro_help: str) -> None:
+    """The buoy's body of ``buoy`` and ``power-matrix --device buoy`` into the argument group
+    ``g``: ``--body --radius --draft --mesh --hydro`` (sizes default to ``defaults.BUOY``'s);
+    the default of ``--body`` and the help of ``--body`` and ``--hydro`` are the commands'
+    own."""
+    from ..defaults import BUOY
+
+    g.add_argument("--body", choices=["cylinder", "sphere"], default=body_default,
+                   help=body_help)
+    g.add_argument("--radius", type=_finite_float("radius"), default=None,
+                   help=f"m (default {BUOY['radius']:g})")
+    g.add_argument("--draft", type=_finite_float("draft"), default=None,
+                   help=f"cylinder's draft, m (default {BUOY['draft']:g})")
+    g.add_argument("--mesh", metavar="FILE", default=None,
+                   help="a mesh file Capytaine reads, instead of --body")
+    g.add_argument("--hydro", metavar="FILE", default=None, help=hydro_help)
+
+
 FIGURE_SUFFIXES = (".png", ".svg", ".pdf")
 
 

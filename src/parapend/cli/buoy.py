@@ -64,16 +64,13 @@ def add_parsers(sub) -> None:
                    default=BUOY["damping_coefficient"],
                    help=f"viscous c, N m s/rad (default {BUOY['damping_coefficient']:g})")
     g = p.add_argument_group("body (Capytaine; the BEM result is cached on disk)")
-    g.add_argument("--body", choices=["cylinder", "sphere"], default="cylinder",
-                   help="vertical cylinder or sphere floating at its centre (default cylinder)")
-    g.add_argument("--radius", type=_finite_float("radius"), default=None,
-                   help=f"m (default {BUOY['radius']:g})")
-    g.add_argument("--draft", type=_finite_float("draft"), default=None,
-                   help=f"cylinder's draft, m (default {BUOY['draft']:g})")
-    g.add_argument("--mesh", metavar="FILE", default=None,
-                   help="a mesh file Capytaine reads, instead of --body")
-    g.add_argument("--hydro", metavar="FILE", default=None,
-                   help="a Capytaine dataset (NetCDF), instead of solving (docs/buoy.md)")
+    from ._common import add_body_options
+
+    add_body_options(g, body_default="cylinder",
+                     body_help="vertical cylinder or sphere floating at its centre (default "
+                               "cylinder)",
+                     hydro_help="a Capytaine dataset (NetCDF), instead of solving "
+                                "(docs/buoy.md)")
     g = p.add_argument_group("motion and power take-off")
     g.add_argument("--winding", type=_int, default=1,
                    help="turns per wave (per record in an irregular sea) (default 1)")

@@ -70,18 +70,22 @@ def add_parsers(sub) -> None:
                    help="drive the plant with a seeded JONSWAP sea record (parapend.seas) "
                         "peaked at omega, with the rms of q, instead of q")
     g = p.add_argument_group("receding-horizon control (--controller mpc)")
-    g.add_argument("--controller", choices=("lqr", "mpc"), default="lqr",
+    from ..defaults import TRACK
+
+    g.add_argument("--controller", choices=("lqr", "mpc"), default=TRACK["controller"],
                    help="lqr: hold the regular-wave optimum (feedforward + periodic LQR); "
                         "mpc: receding-horizon control on the full model with a wave "
-                        "forecast (docs/control.md; default lqr)")
-    g.add_argument("--horizon", type=_finite_float("horizon"), default=2.0,
-                   help="MPC horizon in peak (forcing) periods, in [0.01, 20] (default 2)")
-    g.add_argument("--update-interval", type=_finite_float("update-interval"), default=0.125,
+                        f"forecast (docs/control.md; default {TRACK['controller']})")
+    g.add_argument("--horizon", type=_finite_float("horizon"), default=TRACK["horizon"],
+                   help="MPC horizon in peak (forcing) periods, in [0.01, 20] (default "
+                        f"{TRACK['horizon']:g})")
+    g.add_argument("--update-interval", type=_finite_float("update-interval"),
+                   default=TRACK["update_interval"],
                    help="MPC update interval in peak periods, at most the horizon "
-                        "(default 0.125)")
-    g.add_argument("--forecast", choices=("perfect", "ar"), default="perfect",
+                        f"(default {TRACK['update_interval']:g})")
+    g.add_argument("--forecast", choices=("perfect", "ar"), default=TRACK["forecast"],
                    help="MPC wave forecast: perfect (the record's own future) or ar "
-                        "(autoregressive, fitted on the past; default perfect)")
+                        f"(autoregressive, fitted on the past; default {TRACK['forecast']})")
     from .pto import add_unit_options
 
     add_unit_options(p, torque=True)
@@ -170,17 +174,21 @@ def _cmd_track(a) -> dict | str:
            f"Floquet multipliers, open loop: {_mult(r.open_loop_multipliers)}",
            f"closed loop: {_mult(r.closed_loop_multipliers)}"]
     if r.sea is not None:
-        sea = r.sea
-        out.append(f"irregular sea: JONSWAP peaked at omega {sea['peak_omega']:g}, Hs "
-                   f"{sea['hs']:.4g} (units g t0^2), rms of q {sea['rms_q']:.4g}, "
-                   f"{sea['components']} components, repeating every "
-                   f"{sea['repeat_periods']} peak periods, seed {sea['seed']}")
+        out.append(_sea_line(r.sea))
     out += _si_lines(r)
     if a.save:
         out.append(f"run written to {a.save}")
     if a.plot:
         out.append(f"figure written to {a.plot}")
     return "\n".join(out)
+
+
+def _sea_line(sea: dict) -> str:
+    """The irregular sea of a ``track --irregular`` run, in one line."""
+    return (f"irregular sea: JONSWAP peaked at omega {sea['peak_omega']:g}, Hs "
+            f"{sea['hs']:.4g} (units g t0^2), rms of q {sea['rms_q']:.4g}, "
+            f"{sea['components']} components, repeating every "
+            f"{sea['repeat_periods']} peak periods, seed {sea['seed']}")
 
 
 def _mpc_out(a, r) -> dict | str:
@@ -210,11 +218,7 @@ def _mpc_out(a, r) -> dict | str:
            f"max {1e3 * r.solve_time_max:.3g} ms, median {r.iterations_median:g} "
            "L-BFGS-B iterations"]
     if r.sea is not None:
-        sea = r.sea
-        out.append(f"irregular sea: JONSWAP peaked at omega {sea['peak_omega']:g}, Hs "
-                   f"{sea['hs']:.4g} (units g t0^2), rms of q {sea['rms_q']:.4g}, "
-                   f"{sea['components']} components, repeating every "
-                   f"{sea['repeat_periods']} peak periods, seed {sea['seed']}")
+        out.append(_sea_line(r.sea))
     if r.units is not None:
         u = r.units
         out.append(f"physical (l = {u['length_m']:g} m, m = {u['mass_kg']:g} kg): period "

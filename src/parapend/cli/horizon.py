@@ -3,10 +3,18 @@
 
 from __future__ import annotations
 
-from .. import limits
-from ..defaults import HORIZON, SEA
+from ..defaults import HORIZON
 from . import _output
-from ._common import FIGURE_SUFFIXES, _check_output, _finite_float, _int, _run, _table
+from ._common import (
+    FIGURE_SUFFIXES,
+    _check_output,
+    _finite_float,
+    _int,
+    _run,
+    _table,
+    add_pendulum_options,
+    add_sea_options,
+)
 
 
 def add_parsers(sub) -> None:
@@ -18,37 +26,14 @@ def add_parsers(sub) -> None:
                     "horizon, and of two causal baselines, as fractions of each record's "
                     "non-causal optimum (parapend sea) and of its limit (docs/control.md).")
     g = p.add_argument_group("sea state (IEC TS 62600-2 spectra)")
-    g.add_argument("--hs", type=_finite_float("hs"), default=None,
-                   help="significant wave height, m (default 2)")
-    g.add_argument("--tp", type=_finite_float("tp"), default=None,
-                   help="peak period, s (default 8)")
-    g.add_argument("--spectrum", choices=["jonswap", "pierson-moskowitz"], default="jonswap",
-                   help="spectrum shape (default jonswap)")
-    g.add_argument("--gamma-peak", type=_finite_float("gamma-peak"), default=3.3,
-                   help="JONSWAP peak enhancement in [1, 20] (default 3.3)")
-    g.add_argument("--repeat-period", type=_finite_float("repeat-period"), default=None,
-                   help=f"T_r, s: the length of each record; {limits.SEA_WAVES_RANGE[0]:g} "
-                        f"to {limits.SEA_WAVES_RANGE[1]:g} peak periods (default 100 Tp)")
-    g.add_argument("--seed", type=_int, default=None,
-                   help="seed of the first record's phases; record r has seed + r "
-                        "(default 0)")
-    g.add_argument("--cutoff", type=_finite_float("cutoff"), default=3.0,
-                   help="highest frequency, in units of the peak frequency (default 3)")
+    add_sea_options(g, repeat_period="the length of each record",
+                    seed="seed of the first record's phases; record r has seed + r "
+                         "(default 0)",
+                    cutoff="highest frequency, in units of the peak frequency (default 3)")
     g.add_argument("--records", type=_int, default=HORIZON["records"],
                    help="seeded records, 1 to 20 (default 1)")
     g = p.add_argument_group("pendulum (SI units) and power take-off")
-    g.add_argument("--length", type=_finite_float("length"), default=SEA["length"],
-                   help="pivot to centre of mass, m (default 1)")
-    g.add_argument("--mass", type=_finite_float("mass"), default=SEA["mass"],
-                   help="kg (default 10)")
-    g.add_argument("--inertia", type=_finite_float("inertia"), default=None,
-                   help="about the pivot, kg m^2 (default m l^2)")
-    g.add_argument("--gravity", type=_finite_float("gravity"), default=SEA["gravity"],
-                   help="m/s^2 (default 9.81)")
-    g.add_argument("--gamma", type=_finite_float("gamma"), default=None,
-                   help="viscous damping, non-dimensional (default 0.01)")
-    g.add_argument("--damping-coefficient", type=_finite_float("damping-coefficient"),
-                   default=None, help="viscous damping c, N m s/rad (instead of --gamma)")
+    add_pendulum_options(g)
     g.add_argument("--torque-limit", type=_finite_float("torque-limit"), default=None,
                    help="|T| <= T_max, units m g l, for every controller (default none)")
     g.add_argument("--efficiency", type=_finite_float("efficiency"), default=None,

@@ -8,7 +8,14 @@ import sys
 
 from ..defaults import BUOY, SEA
 from . import _output
-from ._common import FIGURE_SUFFIXES, _check_output, _finite_float, _int, _run
+from ._common import (
+    FIGURE_SUFFIXES,
+    _check_output,
+    _finite_float,
+    _int,
+    _run,
+    add_body_options,
+)
 from .sweep import _NEGATIVE_VALUE, _EtaProgress
 
 _BINS = "FROM:TO:N (N centres, ends included) or a comma list"
@@ -76,16 +83,9 @@ def add_parsers(sub) -> None:
     g.add_argument("--torque-limit", type=_finite_float("torque-limit"), default=None,
                    help="not supported over a sea record (refused)")
     g = p.add_argument_group("the buoy's body (--device buoy; as parapend buoy)")
-    g.add_argument("--body", choices=["cylinder", "sphere"], default=None,
-                   help="a vertical cylinder or a floating sphere (default cylinder)")
-    g.add_argument("--radius", type=_finite_float("radius"), default=None,
-                   help=f"m (default {BUOY['radius']:g})")
-    g.add_argument("--draft", type=_finite_float("draft"), default=None,
-                   help=f"cylinder's draft, m (default {BUOY['draft']:g})")
-    g.add_argument("--mesh", metavar="FILE", default=None,
-                   help="a mesh file Capytaine reads, instead of --body")
-    g.add_argument("--hydro", metavar="FILE", default=None,
-                   help="a Capytaine NetCDF dataset, instead of --body (docs/buoy.md)")
+    add_body_options(g, body_default=None,
+                     body_help="a vertical cylinder or a floating sphere (default cylinder)",
+                     hydro_help="a Capytaine NetCDF dataset, instead of --body (docs/buoy.md)")
     g = p.add_argument_group("resource and site")
     g.add_argument("--depth", type=_finite_float("depth"), default=None,
                    help="water depth, m (default deep water)")

@@ -153,10 +153,10 @@ def pto_lines(r) -> list[str]:
             out.append(f"torque impulse over the peak's arc (int |T| dt): "
                        f"{r.torque_impulse:.6g}, change from {r.intervals // 2} intervals "
                        f"{_change(r.torque_impulse_change)}")
-    if r.efficiency_generating == 1.0 and r.efficiency_motoring == 1.0 and \
-            r.method == "fourier":
+    if r.efficiency_generating == 1.0 and r.efficiency_motoring == 1.0:
         out.append("efficiency 1 both ways, no limit: lossless, the ideal problem (its "
-                   "Fourier optimum)")
+                   "Fourier optimum)" if r.method == "fourier" else
+                   "efficiency 1 both ways: lossless, solved as without an efficiency")
     elif r.efficiency_generating is not None:
         out.append(f"efficiency: generating {r.efficiency_generating:g}, motoring "
                    f"{r.efficiency_motoring:g}; electrical power {_fmt(r.electrical_power, 8)}"

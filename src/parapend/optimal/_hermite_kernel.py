@@ -44,6 +44,17 @@ def interval_vector(x, j, k, wrap):
 
 
 @nb.njit(cache=True)
+def _row(m, r, y):
+    """``sum_i m[r, i] y[i]`` over the four unknowns ``y`` of an interval: at one point, the
+    value that row ``r`` of a basis matrix ``m`` gives (theta, theta' or the torque's linear
+    part)."""
+    s = 0.0
+    for i in range(4):
+        s += m[r, i] * y[i]
+    return s
+
+
+@nb.njit(cache=True)
 def torques(x, k, wrap, b0, lin, q1):
     """``T`` at the points of rows ``b0, lin`` (shape (P, 4)) of every interval: (K, P)."""
     p = b0.shape[0]
@@ -51,12 +62,7 @@ def torques(x, k, wrap, b0, lin, q1):
     for j in range(k):
         y = interval_vector(x, j, k, wrap)
         for c in range(p):
-            th = 0.0
-            ln = 0.0
-            for i in range(4):
-                th += b0[c, i] * y[i]
-                ln += lin[c, i] * y[i]
-            out[j, c] = ln - q1[j, c] * math.sin(th)
+            out[j, c] = _row(lin, c, y) - q1[j, c] * math.sin(_row(b0, c, y))
     return out
 
 
@@ -69,14 +75,9 @@ def power_terms(x, k, wrap, b0g, b1g, ling, q1g, wg, gamma):
     for j in range(k):
         y = interval_vector(x, j, k, wrap)
         for g in range(b0g.shape[0]):
-            th = 0.0
-            thd = 0.0
-            ln = 0.0
-            for i in range(4):
-                th += b0g[g, i] * y[i]
-                thd += b1g[g, i] * y[i]
-                ln += ling[g, i] * y[i]
-            sn = math.sin(th)
+            thd = _row(b1g, g, y)
+            ln = _row(ling, g, y)
+            sn = math.sin(_row(b0g, g, y))
             tq = ln - q1g[j, g] * sn
             p += wg[g] * (q1g[j, g] * sn * thd - gamma * thd * thd)
             t2 += wg[g] * tq * tq
@@ -139,13 +140,9 @@ def newton(x, t, lam, mu, k, wrap, b0g, b1g, ling, q1g, wg, gamma, copper, b0c, 
         if mode != PHASE1:
             # minimize -sum w f, f = q1 sin(theta) theta' - gamma theta'^2 (+ r T^2 loss)
             for q in range(ng):
-                th = 0.0
-                thd = 0.0
-                ln = 0.0
-                for i in range(4):
-                    th += b0g[q, i] * y[i]
-                    thd += b1g[q, i] * y[i]
-                    ln += ling[q, i] * y[i]
+                th = _row(b0g, q, y)
+                thd = _row(b1g, q, y)
+                ln = _row(ling, q, y)
                 sn = math.sin(th)
                 cs = math.cos(th)
                 a = wg[q] * q1g[j, q]
@@ -172,11 +169,8 @@ def newton(x, t, lam, mu, k, wrap, b0g, b1g, ling, q1g, wg, gamma, copper, b0c, 
                             blk[i, m] += r2 * (jt[i] * jt[m] + ht * b0g[q, i] * b0g[q, m])
         if mode != NONE:
             for c in range(pc):
-                th = 0.0
-                ln = 0.0
-                for i in range(4):
-                    th += b0c[c, i] * y[i]
-                    ln += linc[c, i] * y[i]
+                th = _row(b0c, c, y)
+                ln = _row(linc, c, y)
                 sn = math.sin(th)
                 cs = math.cos(th)
                 tq = ln - q1c[j, c] * sn

@@ -135,6 +135,28 @@ def _put(ab, row, col, val):
 
 
 @nb.njit(cache=True)
+def _slack_point(i, w, p, a, b, xi, za, zb, mu, eg, em, slack, dpc, prim_inf, dual_inf, comp):
+    """The slacks ``p+ - p- = p`` of point ``i`` (weight ``w``, power ``p``) eliminated:
+    ``(lam, coef, rank, prim_inf, dual_inf, comp)`` with the multiplier ``lam`` of ``p`` in
+    the Lagrangian, ``coef`` (also into ``dpc[i]``) and ``rank`` of the rank-one term, and
+    the three errors updated; without slacks (efficiency 1 both ways) ``lam = w eta_g``."""
+    if not slack:
+        return w * eg, 0.0, 0.0, prim_inf, dual_inf, comp
+    sa_ = za[i] / a[i]
+    sb_ = zb[i] / b[i]
+    ra = -w * eg + xi[i] - mu / a[i]
+    rb = w / em - xi[i] - mu / b[i]
+    rxi = a[i] - b[i] - p
+    dd = 1.0 / sa_ + 1.0 / sb_
+    coef = (rxi - ra / sa_ + rb / sb_) / dd
+    dpc[i] = coef
+    prim_inf = max(prim_inf, abs(rxi))
+    dual_inf = max(dual_inf, abs(-w * eg + xi[i] - za[i]), abs(w / em - xi[i] - zb[i]))
+    comp = max(comp, abs(a[i] * za[i] - mu), abs(b[i] * zb[i] - mu))
+    return xi[i], coef, 1.0 / dd, prim_inf, dual_inf, comp
+
+
+@nb.njit(cache=True)
 def _kkt(th, v, u, a, b, xi, za, zb, y, al, be, q1n, q1m, h, gamma, wrap, pos, mu, eg, em,
          r, tmax, slack, ab, rhs, dpc, gp):
     """Assemble the condensed KKT matrix (band storage, without the regularization) and its
@@ -168,25 +190,8 @@ def _kkt(th, v, u, a, b, xi, za, zb, y, al, be, q1n, q1m, h, gamma, wrap, pos, m
         # midpoint point i = 2j + 1, weight 2
         im = 2 * j + 1
         w = 2.0
-        if slack:
-            lam = xi[im]
-            sa_ = za[im] / a[im]
-            sb_ = zb[im] / b[im]
-            ra = -w * eg + xi[im] - mu / a[im]
-            rb = w / em - xi[im] - mu / b[im]
-            rxi = a[im] - b[im] - pm
-            dd = 1.0 / sa_ + 1.0 / sb_
-            coef = (rxi - ra / sa_ + rb / sb_) / dd
-            rank = 1.0 / dd
-            dpc[im] = coef
-            prim_inf = max(prim_inf, abs(rxi))
-            dual_inf = max(dual_inf, abs(-w * eg + xi[im] - za[im]),
-                           abs(w / em - xi[im] - zb[im]))
-            comp = max(comp, abs(a[im] * za[im] - mu), abs(b[im] * zb[im] - mu))
-        else:
-            lam = w * eg
-            coef = 0.0
-            rank = 0.0
+        lam, coef, rank, prim_inf, dual_inf, comp = _slack_point(
+            im, w, pm, a, b, xi, za, zb, mu, eg, em, slack, dpc, prim_inf, dual_inf, comp)
         for c in range(6):
             gp[im, c] = g[6, c]
         # Hessian of the Lagrangian, local 6x6: y1 Hc1 + y2 Hc2 - lam Hpm + rank gp gp^T
@@ -233,25 +238,8 @@ def _kkt(th, v, u, a, b, xi, za, zb, y, al, be, q1n, q1m, h, gamma, wrap, pos, m
         gp[i, 0] = 0.0
         gp[i, 1] = -u[j]
         gp[i, 2] = -v[j]
-        if slack:
-            lam = xi[i]
-            sa_ = za[i] / a[i]
-            sb_ = zb[i] / b[i]
-            ra = -w * eg + xi[i] - mu / a[i]
-            rb = w / em - xi[i] - mu / b[i]
-            rxi = a[i] - b[i] - pn
-            dd = 1.0 / sa_ + 1.0 / sb_
-            coef = (rxi - ra / sa_ + rb / sb_) / dd
-            rank = 1.0 / dd
-            dpc[i] = coef
-            prim_inf = max(prim_inf, abs(rxi))
-            dual_inf = max(dual_inf, abs(-w * eg + xi[i] - za[i]),
-                           abs(w / em - xi[i] - zb[i]))
-            comp = max(comp, abs(a[i] * za[i] - mu), abs(b[i] * zb[i] - mu))
-        else:
-            lam = w * eg
-            coef = 0.0
-            rank = 0.0
+        lam, coef, rank, prim_inf, dual_inf, comp = _slack_point(
+            i, w, pn, a, b, xi, za, zb, mu, eg, em, slack, dpc, prim_inf, dual_inf, comp)
         # Hessian: -lam Hpn (Hpn[1,2] = -1) + rank gp gp^T + 2 r w e_u e_u^T + Sigma_u
         hvv = rank * u[j] * u[j]
         huu = rank * v[j] * v[j] + 2 * r * w

@@ -80,9 +80,14 @@ def plot_matrix(ds, path=None):
                                                                        ds.sizes["hm0"] + 2)))
         _table_image(ax, ds, ds["power_mean"].values, "viridis", ".3g",
                      "mean optimum power (W)", fig)
-        ax.set_title(f"power matrix: mean over {ds.sizes['realization']} records of "
+        ax.set_title(f"power matrix: mean over {_records(ds.sizes['realization'])} of "
                      f"{_waves(ds)} peak periods per bin", fontsize=9)
         return _finish(fig, path)
+
+
+def _records(n: int) -> str:
+    """``1 record``, ``3 records``."""
+    return f"{n} record" + ("" if n == 1 else "s")
 
 
 def _waves(ds) -> str:
@@ -163,8 +168,10 @@ def text_report(ds, out: dict, drawn: list) -> str:
     hm0, per = ds["hm0"].values, ds[pk].values
     what = "coupled buoy" if out["device"] == "buoy" else f"{out['device']} pendulum"
     lines = [f"power matrix, {what}: {hm0.size} Hm0 x {per.size} {pk} bins, "
-             f"{out['realizations']} records of {out['waves']:g} peak periods each (seeds "
-             f"{out['seeds'][0]}..{out['seeds'][-1]}); Te/Tp = {out['te_over_tp']:.6g}",
+             f"{_records(out['realizations'])} of {out['waves']:g} peak periods each ("
+             + (f"seed {out['seeds'][0]}" if len(out["seeds"]) == 1 else
+                f"seeds {out['seeds'][0]}..{out['seeds'][-1]}")
+             + f"); Te/Tp = {out['te_over_tp']:.6g}",
              f"computed now {out['computed_bins']} bins, found finished "
              f"{out['resumed_bins']}; {out['seconds']:.1f} s ({out['executor']})"
              + (f"; store {out['store']}" if out["store"] else ""), "",
