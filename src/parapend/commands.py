@@ -478,7 +478,7 @@ def track(*, excitation=None, omega=OMEGA, delta=None, square_alpha=None, fourie
           noise_theta: float = 0.0, noise_speed: float = 0.0, irregular: bool = False,
           length=None, mass=None, inertia=None, gravity=None, frequency=None,
           amplitude=None, damping_coefficient=None, torque_limit_nm=None, progress=None,
-          controller: str = "lqr", horizon: float = 2.0, update_interval: float = 0.125,
+          controller: str = "lqr", horizon: float = 2.0, update_interval: float = 0.03125,
           forecast: str = "perfect"):
     """Swing up from rest, catch and hold the optimal rotation (command ``track``): a
     :class:`~parapend.control.track.TrackResult` (``runs`` 1) or a
@@ -508,7 +508,7 @@ def track(*, excitation=None, omega=OMEGA, delta=None, square_alpha=None, fourie
                 frequency=frequency, amplitude=amplitude,
                 damping_coefficient=damping_coefficient, torque_limit_nm=torque_limit_nm),
             horizon=horizon, update_interval=update_interval, forecast=forecast)
-    if (horizon, update_interval, forecast) != (2.0, 0.125, "perfect"):
+    if (horizon, update_interval, forecast) != (2.0, 0.03125, "perfect"):
         raise ParameterError("horizon: --horizon, --update-interval and --forecast belong to "
                              "--controller mpc")
 

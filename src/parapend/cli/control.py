@@ -76,9 +76,9 @@ def add_parsers(sub) -> None:
                         "forecast (docs/control.md; default lqr)")
     g.add_argument("--horizon", type=_finite_float("horizon"), default=2.0,
                    help="MPC horizon in peak (forcing) periods, in [0.01, 20] (default 2)")
-    g.add_argument("--update-interval", type=_finite_float("update-interval"), default=0.125,
+    g.add_argument("--update-interval", type=_finite_float("update-interval"), default=0.03125,
                    help="MPC update interval in peak periods, at most the horizon "
-                        "(default 0.125)")
+                        "(default 0.03125)")
     g.add_argument("--forecast", choices=("perfect", "ar"), default="perfect",
                    help="MPC wave forecast: perfect (the record's own future) or ar "
                         "(autoregressive, fitted on the past; default perfect)")

@@ -512,7 +512,7 @@ class MPCTrackResult(_Result):
     _q: object = field(default=None, repr=False)
 
 
-def track_mpc(excitation, *, gamma, horizon=2.0, update_interval=0.125, forecast="perfect",
+def track_mpc(excitation, *, gamma, horizon=2.0, update_interval=0.03125, forecast="perfect",
               torque_limit=None, efficiency=None, periods=100, seed=0, irregular=False,
               theta0=math.pi, theta_dot0=0.0, terminal_weight=None,
               samples=TRACK_SAMPLES) -> MPCTrackResult:
