@@ -378,7 +378,8 @@ def mpc_run(q_record, *, gamma, horizon, update_interval, dt, torque_limit=None,
                 tqq = c_ + gamma * b_ - (1 + qq) * np.sin(a_)
                 pw = -tqq * b_
                 wpl = float(np.sum((pw[1:] + pw[:-1]) / 2) * (ss[1] - ss[0]))
-                print("DBG2", j, sol.value, sol.iterations, "planned W", wpl,
+                print("DBG2", j, sol.value, sol.iterations, "planned W", wpl, sol.status,
+                      0.5 * x[1] ** 2 + math.cos(x[0]),
                       "peakT", float(np.max(np.abs(tqq))))
             solve_times.append(time.perf_counter() - t0)
             iters.append(int(sol.iterations))
