@@ -125,8 +125,8 @@ def test_natural_end_condition_holds_at_the_unconstrained_optimum():
 
 def test_torque_limit_holds_on_the_plan_and_the_held_torques():
     """At the torque points the plan meets the limit; between them (dense evaluation) it
-    exceeds it by the interpolation's O(h^2) at most 2 %; the held torques the controller
-    applies never exceed it."""
+    exceeds it by the interpolation's O(h^2), at most 5 % at 16 intervals per period; the
+    held torques the controller applies never exceed it."""
     from parapend.control.mpc import horizon_problem
 
     exc = build_excitation(omega=1.8, delta=-0.3)
@@ -138,7 +138,7 @@ def test_torque_limit_holds_on_the_plan_and_the_held_torques():
     assert np.max(np.abs(res.x)) <= 0.5
     s = np.linspace(0.0, n * dt, 20001)
     dense = np.max(np.abs(res.plan.torque(s, exc.q(s))))
-    assert 0.5 * 0.999 < dense < 0.5 * 1.02
+    assert 0.5 * 0.999 < dense < 0.5 * 1.05
 
 
 def _read(path):
@@ -225,7 +225,7 @@ def test_terminal_value_keeps_the_energy_at_the_horizon_end():
         res = p.solve((0.3, 1.8), qn, np.zeros(n))
         assert res.success
         ends.append(res.plan.energy_end())
-    assert ends[1] > ends[0] + 0.5
+    assert ends[1] > ends[0] + 0.3
 
 
 def test_mpc_run_bad_input_is_a_parameter_error():
@@ -254,15 +254,14 @@ def test_cli_errors_are_one_line(args, word, capsys):
 def test_perfect_forecast_harvests_most_of_the_noncausal_optimum():
     """The README's sea state on a 10-wave record: after 4 peak periods of warm-up, the MPC
     with a perfect forecast of one peak period over a whole repeat against ``sea``'s
-    periodic optimum on the same record (docs/control.md)."""
+    periodic optimum on the same record (docs/control.md: 99.98 %)."""
     from parapend.irregular import sea
 
     s = sea(seed=0, repeat_period=80.0)
     exc = s.excitation
     tp = exc.period / 10
-    r = mpc_run(exc, gamma=0.01, horizon=tp, update_interval=tp / 8, dt=tp / 32,
+    r = mpc_run(exc, gamma=0.01, horizon=tp, update_interval=tp / 32, dt=tp / 64,
                 t_end=exc.period + 4 * tp, average_from=4 * tp)
     assert r.success and r.catch_time is not None
-    assert r.mean_power > 0
-    assert r.mean_power / s.power > 0.5
+    assert r.mean_power / s.power > 0.95
     assert r.mean_power < s.limit_power

@@ -214,11 +214,6 @@ def horizon_problem(n, dt, *, gamma, steps=MODEL_STEPS, torque_limit=None, effic
     return HorizonProblem(n, dt, steps, gamma, torque_limit, efficiency, terminal_weight)
 
 
-import os  # noqa: E402
-
-_DEBUG = bool(os.environ.get("MPCDEBUG"))
-
-
 def _electrical(p, eta):
     return np.where(p > 0, eta[0] * p, p / eta[1])
 
@@ -366,21 +361,8 @@ def mpc_run(q_record, *, gamma, horizon, update_interval, dt, torque_limit=None,
                 start = pr.start(th_o, v_o)
             else:
                 start = anchor
-            if plan is not None and _DEBUG:
-                tp_, vp_, _ = plan.evaluate(since * dt)
-                print("DBG", j, x[0] - float(tp_), x[1] - float(vp_), pr.value(start))
             t0 = time.perf_counter()
             sol = solve_plan(pr, start, anchor=anchor, maxiter=max_iter)
-            if _DEBUG:
-                ss = np.linspace(0, m * dt, 401)
-                a_, b_, c_ = sol.plan.evaluate(ss)
-                qq = qf(tj + ss)
-                tqq = c_ + gamma * b_ - (1 + qq) * np.sin(a_)
-                pw = -tqq * b_
-                wpl = float(np.sum((pw[1:] + pw[:-1]) / 2) * (ss[1] - ss[0]))
-                print("DBG2", j, sol.value, sol.iterations, "planned W", wpl, sol.status,
-                      0.5 * x[1] ** 2 + math.cos(x[0]),
-                      "peakT", float(np.max(np.abs(tqq))))
             solve_times.append(time.perf_counter() - t0)
             iters.append(int(sol.iterations))
             if not sol.success:
