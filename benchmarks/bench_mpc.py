@@ -1,24 +1,24 @@
 r"""Time one receding-horizon update: parapend's horizon solve against CasADi + IPOPT.
 
-The problem (:mod:`parapend.control.mpc`): the README's sea state (JONSWAP, Hs 2 m, Tp 8 s,
-seed 0, 100-wave record) on a 1 m, 10 kg point-mass pendulum, gamma = 0.01, horizon
-``--horizon`` peak periods of ``n`` held torques (``--samples`` per peak period), 4 RK4 steps
-per torque sample, the work of the held torque plus the terminal value ``E(x_N)``
-(kappa = 1), ``|T| <= --torque-limit``.
+The problem (:mod:`parapend.control.plan`): the README's sea state (JONSWAP, Hs 2 m, Tp 8 s,
+seed 0, 100-wave record) on a 1 m, 10 kg point-mass pendulum, gamma = 0.01, a horizon of
+``--horizon`` peak periods on ``K`` cubic Hermite intervals (``--intervals`` per peak
+period), the motion from the measured state, the torque by inverse dynamics, the objective
+``int (q sin(theta) theta' - gamma theta'^2) + E(t)`` (kappa = 1, lossless) by the 4-point
+Gauss rule, ``|T| <= --torque-limit`` at ``tau = 0, 1/2, 1`` of every interval.
 
-1. **parapend**: the numba kernel (objective and exact adjoint gradient,
-   :mod:`parapend.control._mpc_kernel`) under SciPy's L-BFGS-B with the bounds.
-2. **CasADi + IPOPT**: the same discrete problem written in CasADi (SX): the same RK4 steps
-   and held torques (single shooting), the same objective, the bounds on the torques;
-   IPOPT with CasADi's exact Hessian (``--hessian exact``) or its L-BFGS approximation.
-   IPOPT's solve only is timed (the graph and the solver are built once, outside).
+1. **parapend**: the banded Newton / primal-dual interior point of
+   :mod:`parapend.optimal.hermite` (:func:`parapend.control.plan.solve_plan`).
+2. **CasADi + IPOPT**: the same discrete problem written out in CasADi (SX, exact Hessian):
+   the same nodes, Gauss rule, torque points and bounds; the state and ``q`` are parameters,
+   so the graph and the solver are built once, outside the timing. IPOPT ``tol`` 1e-10.
 
-Both start from the same point at every update: the previous parapend solution shifted by
-one update interval (the warm start of ``mpc_run``); the state is advanced by parapend's
-plan. The first solve (from the swing-up hand-over, cold) is reported separately. "Equal
-accuracy": each solve's objective is compared, ``|f_casadi - f_parapend|`` relative to
-``|f|`` is printed (the median and the largest), with IPOPT's ``tol`` 1e-8 and L-BFGS-B's
-``ftol`` 1e-10. Ratio: CasADi's median time over parapend's.
+Both start every update from the same point: the previous parapend plan shifted by one
+update interval (the warm start of ``mpc_run``; the first update from the unforced motion).
+The states are those of a closed-loop run (``mpc_run``, perfect forecast) on the record.
+"Equal accuracy": both solve to convergence; the relative difference of the objectives is
+printed (median and largest over the updates where both converged). Ratio: IPOPT's median
+time over parapend's. The load average is printed (the machine may be shared).
 
 Run: ``OPENBLAS_NUM_THREADS=1 python benchmarks/bench_mpc.py``.
 """
@@ -28,135 +28,154 @@ from __future__ import annotations
 import argparse
 import math
 import os
-import subprocess
 import time
 
 import numpy as np
 
 
-def casadi_problem(n, steps, dt, gamma, kappa, tmax, hessian):
+def casadi_solver(k, h, gamma, tmax):
     import casadi as ca
 
-    u = ca.SX.sym("u", n)
-    p = ca.SX.sym("p", 2 + 2 * n * steps + 1)
-    th, v = p[0], p[1]
-    qn = p[2:]
-    h = dt / steps
-    f = 0
-    for j in range(n):
-        for s in range(steps):
-            i = j * steps + s
-            q0, qm, q1 = qn[2 * i], qn[2 * i + 1], qn[2 * i + 2]
+    from parapend.control.plan import _TAU_G
+    from parapend.optimal.hermite import TORQUE_TAU, _hermite_rows
 
-            def rhs(a, b, q, uj=u[j]):
-                return b, (1 + q) * ca.sin(a) - gamma * b + uj
-
-            k1 = rhs(th, v, q0)
-            k2 = rhs(th + h / 2 * k1[0], v + h / 2 * k1[1], qm)
-            k3 = rhs(th + h / 2 * k2[0], v + h / 2 * k2[1], qm)
-            k4 = rhs(th + h * k3[0], v + h * k3[1], q1)
-            th1 = th + h / 6 * (k1[0] + 2 * k2[0] + 2 * k3[0] + k4[0])
-            v1 = v + h / 6 * (k1[1] + 2 * k2[1] + 2 * k3[1] + k4[1])
-            f = f + u[j] * (th1 - th)
-            th, v = th1, v1
-    f = f - kappa * (0.5 * v * v + ca.cos(th))
-    opts = {"ipopt.print_level": 0, "print_time": 0, "ipopt.tol": 1e-8,
-            "ipopt.max_iter": 500}
-    if hessian != "exact":
-        opts["ipopt.hessian_approximation"] = "limited-memory"
-    solver = ca.nlpsol("s", "ipopt", {"x": u, "p": p, "f": f}, opts)
-    return solver, [-tmax] * n, [tmax] * n
+    z = ca.SX.sym("z", 2 * k)
+    par = ca.SX.sym("p", 2 + 4 * k + 3 * k)
+    th = [par[0]] + [z[2 * i] for i in range(k)]
+    v = [par[1]] + [z[2 * i + 1] for i in range(k)]
+    qg = par[2:2 + 4 * k]
+    qc = par[2 + 4 * k:]
+    rg, rc = _hermite_rows(_TAU_G, h), _hermite_rows(TORQUE_TAU, h)
+    w = np.polynomial.legendre.leggauss(4)[1] / 2 * h
+    obj, cons = 0, []
+    for j in range(k):
+        y = [th[j], v[j], th[j + 1], v[j + 1]]
+        for p in range(4):
+            a = sum(rg[0][p, i] * y[i] for i in range(4))
+            b = sum(rg[1][p, i] * y[i] for i in range(4))
+            obj += w[p] * (qg[4 * j + p] * ca.sin(a) * b - gamma * b * b)
+        for p in range(3):
+            a = sum(rc[0][p, i] * y[i] for i in range(4))
+            b = sum(rc[1][p, i] * y[i] for i in range(4))
+            c = sum(rc[2][p, i] * y[i] for i in range(4))
+            cons.append(c + gamma * b - (1 + qc[3 * j + p]) * ca.sin(a))
+    nlp = {"x": z, "p": par, "f": -obj, "g": ca.vertcat(*cons)}
+    return ca.nlpsol("s", "ipopt", nlp, {"ipopt.print_level": 0, "print_time": 0,
+                                         "ipopt.tol": 1e-10, "ipopt.max_iter": 3000,
+                                         "ipopt.sb": "yes"})
 
 
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--horizon", type=float, default=2.0, help="peak periods")
-    ap.add_argument("--samples", type=int, default=64, help="torque samples per peak period")
-    ap.add_argument("--update", type=float, default=0.125, help="update interval, peak periods")
-    ap.add_argument("--updates", type=int, default=12)
+    ap.add_argument("--intervals", type=int, default=32, help="Hermite intervals per Tp")
     ap.add_argument("--torque-limit", type=float, default=1.0)
-    ap.add_argument("--hessian", choices=("exact", "lbfgs"), default="exact")
+    ap.add_argument("--update", type=float, default=1 / 32, help="peak periods")
+    ap.add_argument("--updates", type=int, default=40)
+    ap.add_argument("--out", default=None, help="also write the table here")
     a = ap.parse_args()
 
-    from parapend.control import _mpc_kernel as k
-    from parapend.control.mpc import horizon_problem
-    from parapend.control.swingup import pump_torque, ready_to_catch
+    from parapend.control.mpc import mpc_run
+    from parapend.control.plan import PlanProblem, free_motion, gauss_leads, solve_plan
     from parapend.seas import sea_record
     from parapend.units import Units
 
     units = Units(1.0, 10.0)
     exc = sea_record(units, hs=2.0, tp=8.0, seed=0)
     tp = 8.0 / units.time
-    gamma, steps, kappa = 0.01, 4, 1.0
-    dt = tp / a.samples
-    n = int(round(a.horizon * a.samples))
-    m = int(round(a.update * a.samples))
-    lead = 0.5 * dt / steps * np.arange(2 * n * steps + 1)
-    prob = horizon_problem(n, dt, gamma=gamma, steps=steps, torque_limit=a.torque_limit,
-                           terminal_weight=kappa)
-    t_build = time.perf_counter()
-    solver, lb, ub = casadi_problem(n, steps, dt, gamma, kappa, a.torque_limit, a.hessian)
-    t_build = time.perf_counter() - t_build
-
-    # swing-up by the pump to the hand-over, as mpc_run
-    x = np.array([math.pi, 0.0])
-    t = 0.0
-    braking = False
-    st, sv = np.empty(2), np.empty(2)
-    while not ready_to_catch(x[0], x[1], 0.05):
-        tq, braking = pump_torque(x[0], x[1], min(1.0, a.torque_limit), 0.05, braking)
-        qn = exc.q(t + lead[:2 * steps + 1])
-        k.simulate(np.array([tq]), x[0], x[1], qn, dt / steps, steps, gamma, st, sv)
-        x = np.array([st[1], sv[1]])
-        t += dt
-    prob.solve(x, exc.q(t + lead), np.zeros(n))    # compile, untimed
-    u0 = np.zeros(n)
+    gamma, tmax = 0.01, a.torque_limit
+    k = int(round(a.horizon * a.intervals))
+    h = a.horizon * tp / k
+    dt = tp / 64
+    m = max(1, int(round(a.update * tp / dt)))
+    # the closed loop whose states the updates start from (from rest, 6 peak periods)
+    run = mpc_run(exc.q, gamma=gamma, horizon=a.horizon * tp, update_interval=m * dt, dt=dt,
+                  torque_limit=tmax, t_end=6 * tp)
+    j0 = int(round(run.catch_time / dt)) + 64  # one peak period after the hand-over
+    lg, lc = gauss_leads(k, h)
+    t0 = time.perf_counter()
+    solver = casadi_solver(k, h, gamma, tmax)
+    build = time.perf_counter() - t0
     rows = []
-    for i in range(a.updates):
-        qn = exc.q(t + lead)
-        t0 = time.perf_counter()
-        r = prob.solve(x, qn, u0)
-        tp_ = time.perf_counter() - t0
-        fp = float(r.fun)
-        t0 = time.perf_counter()
-        rc = solver(x0=u0, p=np.concatenate((x, qn)), lbx=lb, ubx=ub)
-        tc = time.perf_counter() - t0
-        fc = float(rc["f"])
-        stats = solver.stats()
-        rows.append((i, tp_, tc, fp, fc, int(r.nit), int(stats["iter_count"]),
-                     stats["return_status"]))
-        plan = r.x
-        qs = exc.q(t + lead[:2 * m * steps + 1])
-        ths, vs = np.empty(m + 1), np.empty(m + 1)
-        k.simulate(plan[:m], x[0], x[1], qs, dt / steps, steps, gamma, ths, vs)
-        x = np.array([ths[-1], vs[-1]])
-        t += m * dt
-        u0 = np.concatenate((plan[m:], np.full(m, plan[-1])))
+    plan = None
+    tn = h * np.arange(k + 1)
+    for u in range(a.updates):
+        j = j0 + u * m
+        tj = j * dt
+        x0 = (float(run.theta[j]), float(run.theta_dot[j]))
+        qg, qc = exc.q(tj + lg), exc.q(tj + lc)
+        pr = PlanProblem(x0, h, qg, qc, gamma, torque_limit=tmax)
+        fth, fv = free_motion(x0, h, k, gamma, exc.q(tj + 0.5 * h * np.arange(2 * k + 1)))
+        anchor = pr.start(fth, fv)
+        if plan is None:
+            start = anchor
+        else:
+            s = tn + m * dt
+            th_o, v_o, _ = plan.evaluate(s)
+            beyond = s > plan.horizon
+            th_o = np.where(beyond, plan.theta[-1] + plan.v[-1] * (s - plan.horizon), th_o)
+            v_o = np.where(beyond, plan.v[-1], v_o)
+            th_o = th_o + 2 * math.pi * round((x0[0] - th_o[0]) / (2 * math.pi))
+            start = pr.start(th_o, v_o)
+        # a start outside the limit is blended to the anchor by solve_plan: give IPOPT the
+        # same feasible start
+        from parapend.optimal.hermite import _blend_feasible
 
-    print(f"bench_mpc: README sea state (Hs 2 m, Tp 8 s, seed 0), 1 m 10 kg pendulum, "
-          f"gamma {gamma}, T_max {a.torque_limit:g}; horizon {a.horizon:g} Tp = {n} held "
-          f"torques x {steps} RK4 steps; update {a.update:g} Tp = "
-          f"{m * dt * units.time:.3g} s; IPOPT Hessian {a.hessian}; CasADi graph built in "
-          f"{t_build:.2f} s (not counted)")
-    print(f"{'update':>6} {'parapend s':>11} {'IPOPT s':>9} {'f parapend':>14} "
-          f"{'f IPOPT':>14} {'rel diff':>9} {'it':>4} {'it IP':>5}  status")
-    for i, tp_, tc, fp, fc, itp, itc, stc in rows:
-        print(f"{i:>6} {tp_:>11.4f} {tc:>9.4f} {fp:>14.8f} {fc:>14.8f} "
-              f"{abs(fc - fp) / max(abs(fp), 1e-12):>9.1e} {itp:>4} {itc:>5}  {stc}")
-    warm = rows[1:]
-    tpm = float(np.median([r[1] for r in warm]))
-    tcm = float(np.median([r[2] for r in warm]))
-    rd = [abs(r[4] - r[3]) / max(abs(r[3]), 1e-12) for r in warm]
-    better = sum(r[3] <= r[4] + 1e-9 * abs(r[3]) for r in warm)
-    print(f"warm-started updates: median parapend {1e3 * tpm:.2f} ms, IPOPT "
-          f"{1e3 * tcm:.1f} ms, ratio {tcm / tpm:.1f}; objective relative difference median "
-          f"{np.median(rd):.1e}, largest {max(rd):.1e}; parapend's objective as low or "
-          f"lower in {better} of {len(warm)}")
-    print(f"update interval {m * dt * units.time:.3g} s physical; parapend's median solve "
-          f"is {tpm / (m * dt * units.time):.2%} of it, its slowest "
-          f"{max(r[1] for r in rows) / (m * dt * units.time):.2%}")
-    print("uptime:", subprocess.run(["uptime"], capture_output=True, text=True).stdout.strip(),
-          "| cores:", os.cpu_count())
+        if np.max(pr.constraints(start)) >= 0:
+            start = _blend_feasible(pr, start, anchor)
+        t1 = time.perf_counter()
+        sol = solve_plan(pr, start, anchor=anchor)
+        tp_ = time.perf_counter() - t1
+        plan = sol.plan
+        par = np.concatenate((x0, qg.ravel(), qc.ravel()))
+        t1 = time.perf_counter()
+        r = solver(x0=start, p=par, lbg=-tmax, ubg=tmax)
+        tc = time.perf_counter() - t1
+        e0 = 0.5 * x0[1] ** 2 + math.cos(x0[0])
+        jc = -float(r["f"]) + e0
+        st = solver.stats()["return_status"]
+        rows.append((u, tp_, tc, sol.value, jc, sol.status, st, sol.iterations,
+                     solver.stats()["iter_count"]))
+    both = [r for r in rows if r[5] == "converged" and r[6] in (
+        "Solve_Succeeded", "Solved_To_Acceptable_Level")]
+    rel = np.array([abs(r[3] - r[4]) / max(1.0, abs(r[4])) for r in both])
+    same = rel < 1e-6
+    tpar = np.array([r[1] for r in rows])
+    tcas = np.array([r[2] for r in rows])
+    tps, tcs = tpar[[r[0] for r in both]], tcas[[r[0] for r in both]]
+    ts = m * dt * units.time
+    load = os.getloadavg()
+    lines = [
+        f"bench_mpc: README sea state (Hs 2 m, Tp 8 s, seed 0), 1 m 10 kg pendulum, gamma "
+        f"{gamma}, horizon {a.horizon:g} Tp = {k} Hermite intervals ({a.intervals}/Tp), "
+        f"|T| <= {tmax:g}, update every {a.update:g} Tp = {ts:.3g} s",
+        f"load average {load[0]:.2f} {load[1]:.2f} {load[2]:.2f} (2 cores); CasADi graph "
+        f"and IPOPT built in {build:.2f} s (not timed below)",
+        "",
+        f"{'solver':<22}{'median (ms)':>12}{'max (ms)':>10}{'iterations (median)':>22}",
+        f"{'parapend (banded IP)':<22}{1e3 * np.median(tpar):>12.2f}{1e3 * np.max(tpar):>10.2f}"
+        f"{np.median([r[7] for r in rows]):>22g}",
+        f"{'CasADi + IPOPT':<22}{1e3 * np.median(tcas):>12.2f}{1e3 * np.max(tcas):>10.2f}"
+        f"{np.median([r[8] for r in rows]):>22g}",
+        "",
+        f"{len(rows)} updates; both converged on {len(both)}; of those, the same optimum "
+        f"(|J_ipopt - J| / max(1, |J|) < 1e-6) on {int(np.sum(same))}: median difference "
+        f"{np.median(rel) if rel.size else math.nan:.2e}, largest "
+        f"{np.max(rel) if rel.size else math.nan:.2e}",
+        f"ratio of median times, IPOPT / parapend, over the updates at the same optimum: "
+        f"{np.median(tcs[same]) / np.median(tps[same]) if np.any(same) else math.nan:.1f}",
+        f"update interval {ts:.3g} s physical: parapend's median solve is "
+        f"{np.median(tpar) / ts:.2%} of it, its slowest {np.max(tpar) / ts:.2%}",
+    ]
+    diff = [r for r in both if abs(r[3] - r[4]) / max(1.0, abs(r[4])) >= 1e-6]
+    for r in diff:
+        lines.append(f"  update {r[0]}: different local optima, J = {r[3]:.8g} (parapend), "
+                     f"{r[4]:.8g} (IPOPT)")
+    text = "\n".join(lines)
+    print(text)
+    if a.out:
+        with open(a.out, "w") as f:
+            f.write(text + "\n")
 
 
 if __name__ == "__main__":

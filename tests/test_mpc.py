@@ -20,43 +20,125 @@ from parapend.control.mpc import horizon_problem, mpc_run
 GAMMA = 0.01
 
 
-def test_gradient_is_the_exact_derivative_of_the_horizon_objective():
-    """The adjoint gradient against central differences, with and without an efficiency
-    and a terminal value (the objective is smooth away from the efficiency's kink)."""
-    rng = np.random.default_rng(1)
-    n, dt = 24, 0.2
-    qn = 0.3 * np.sin(1.8 * 0.5 * dt / 4 * np.arange(2 * n * 4 + 1))
-    for eff, kappa in ((None, None), ((0.9, 0.8), 0.5), (None, 0.0)):
-        p = horizon_problem(n, dt, gamma=GAMMA, efficiency=eff, terminal_weight=kappa)
-        u = 0.5 * rng.normal(size=n)
-        x0 = (2.0, 1.3)
-        _, g = p.fun(u, x0, qn)
-        e = 1e-6
-        fd = [(p.fun(u + e * np.eye(n)[i], x0, qn)[0] - p.fun(u - e * np.eye(n)[i], x0, qn)[0])
-              / (2 * e) for i in range(n)]
-        np.testing.assert_allclose(g, fd, atol=1e-7)
+def _casadi_plan(pr, start):
+    """IPOPT (CasADi, exact Hessian) on the same discrete horizon problem as the
+    :class:`~parapend.control.plan.PlanProblem` ``pr``: the same Hermite nodes, Gauss rule,
+    torque points, smoothing and terminal value, written out independently. Returns ``J``."""
+    ca = pytest.importorskip("casadi")
+    from parapend.control.plan import _TAU_G
+    from parapend.optimal.hermite import TORQUE_TAU, _hermite_rows
+
+    k, h, g = pr.k, pr.h, pr.gamma
+    z = ca.SX.sym("z", 2 * k)
+    th = [pr.x0[0]] + [z[2 * i] for i in range(k)]
+    v = [pr.x0[1]] + [z[2 * i + 1] for i in range(k)]
+    rg, rc = _hermite_rows(_TAU_G, h), _hermite_rows(TORQUE_TAU, h)
+    obj, cons = 0, []
+
+    def at(rows, p, y):
+        return [sum(r[p, i] * y[i] for i in range(4)) for r in rows]
+
+    for j in range(k):
+        y = [th[j], v[j], th[j + 1], v[j + 1]]
+        for p in range(_TAU_G.size):
+            a, b, c = at(rg, p, y)
+            q = pr.q_g[j, p]
+            obj += pr.eta_g * pr.w[p] * (q * ca.sin(a) * b - g * b * b)
+            if pr.kink:
+                zz = (c + g * b - (1 + q) * ca.sin(a)) * b
+                obj -= pr.kink * pr.w[p] * (zz + ca.sqrt(zz * zz + pr.smoothing**2)) / 2
+        if pr.torque_limit is not None:
+            for p in range(TORQUE_TAU.size):
+                a, b, c = at(rc, p, y)
+                cons.append(c + g * b - (1 + pr.q_c[j, p]) * ca.sin(a))
+    obj += (pr.kappa - pr.eta_g) * (0.5 * v[-1] ** 2 + ca.cos(th[-1]))
+    nlp = {"x": z, "f": -obj}
+    kw = {}
+    if cons:
+        nlp["g"] = ca.vertcat(*cons)
+        kw = {"lbg": -pr.torque_limit, "ubg": pr.torque_limit}
+    solver = ca.nlpsol("s", "ipopt", nlp, {"ipopt.print_level": 0, "print_time": 0,
+                                           "ipopt.tol": 1e-10, "ipopt.sb": "yes"})
+    r = solver(x0=start, **kw)
+    # (the last: IPOPT's step below its precision, at the optimum; the values are compared)
+    assert solver.stats()["return_status"] in ("Solve_Succeeded", "Solved_To_Acceptable_Level",
+                                               "Search_Direction_Becomes_Too_Small")
+    e0 = 0.5 * pr.x0[1] ** 2 + math.cos(pr.x0[0])
+    return -float(r["f"]) + pr.eta_g * e0
 
 
-def test_objective_is_the_work_of_the_held_torque_plus_the_terminal_energy():
-    """f(u) = -(work) - kappa E_N, the work recomputed from an independent DOP853
-    integration of the held torques."""
-    n, dt, steps = 10, 0.25, 8
+def _plan_problem(k, horizon, **kw):
+    from parapend.control.plan import PlanProblem, free_motion, gauss_leads
+
     exc = build_excitation(omega=1.8, delta=-0.3)
-    t = 0.5 * dt / steps * np.arange(2 * n * steps + 1)
-    p = horizon_problem(n, dt, gamma=GAMMA, steps=steps, terminal_weight=1.0)
-    u = np.linspace(-0.5, 0.7, n)
-    f, _ = p.fun(u, (math.pi - 1.0, 0.5), exc.q(t))
-    y = np.array([math.pi - 1.0, 0.5])
-    work = 0.0
-    for j in range(n):
-        s = solve_ivp(lambda tt, z, uj=u[j]: [z[1], (1 + exc.q(tt)) * math.sin(z[0])
-                                              - GAMMA * z[1] + uj],
-                      (j * dt, (j + 1) * dt), y, method="DOP853", rtol=1e-12, atol=1e-12)
-        y1 = s.y[:, -1]
-        work += -u[j] * (y1[0] - y[0])
-        y = y1
-    energy = 0.5 * y[1] ** 2 + math.cos(y[0])
-    assert f == pytest.approx(-work - energy, abs=1e-8)
+    h = horizon / k
+    lg, lc = gauss_leads(k, h)
+    pr = PlanProblem((0.3, 1.8), h, exc.q(lg), exc.q(lc), GAMMA, **kw)
+    th, v = free_motion(pr.x0, h, k, GAMMA, exc.q(0.5 * h * np.arange(2 * k + 1)))
+    return pr, pr.start(th, v), exc
+
+
+@pytest.mark.parametrize("kw", [{}, {"torque_limit": 1.0}, {"efficiency": (0.9, 0.8)},
+                                {"terminal_weight": 0.0}])
+def test_horizon_optimum_equals_ipopt_on_the_same_discretization(kw):
+    """The banded Newton / interior point and IPOPT (an independent transcription of the
+    same discrete problem) reach the same optimum; the objective ``J`` equals the work of
+    the plan's torque (trapezoid on a fine grid) plus ``kappa E`` at the end."""
+    from parapend.control.plan import solve_plan
+
+    kw = dict(kw)
+    if "terminal_weight" in kw:
+        kw["kappa"] = kw.pop("terminal_weight")
+    pr, start, exc = _plan_problem(12, 0.75 * 2 * math.pi / 1.8, **kw)
+    sol = solve_plan(pr, start, anchor=start)
+    assert sol.success
+    # the same start; with the efficiency's (smoothed) kink the two may end in different
+    # local optima from it, so IPOPT starts from this optimum and must stay there
+    assert sol.value == pytest.approx(
+        _casadi_plan(pr, sol.x if "efficiency" in kw else start), rel=1e-8)
+    if "efficiency" not in kw:
+        # 30-point Gauss-Legendre on every interval (the torque jumps at the nodes)
+        x, w = np.polynomial.legendre.leggauss(30)
+        s = pr.h * (np.arange(pr.k)[:, None] + (x[None, :] + 1) / 2)
+        _, thd, _ = sol.plan.evaluate(s)
+        p = -sol.plan.torque(s, exc.q(s)) * thd
+        work = float(np.sum(p @ w) * pr.h / 2)
+        assert sol.value == pytest.approx(work + pr.kappa * sol.plan.energy_end(), rel=1e-4)
+
+
+def test_natural_end_condition_holds_at_the_unconstrained_optimum():
+    """Without a limit (kappa = 1, lossless) the optimum meets ``q sin(theta) = 2 gamma
+    theta'`` at the horizon's end, the closer the finer the intervals."""
+    from parapend.control.plan import solve_plan
+
+    res = []
+    for k in (8, 16, 32):
+        pr, start, exc = _plan_problem(k, 0.8 * 2 * math.pi / 1.8)
+        sol = solve_plan(pr, start)
+        assert sol.success
+        p = sol.plan
+        q_end = float(exc.q(pr.h * k))
+        assert abs(q_end * math.sin(p.theta[-1])) > 0.05  # the condition is not trivial
+        res.append(abs(q_end * math.sin(p.theta[-1]) - 2 * GAMMA * p.v[-1]))
+    assert res[2] < res[1] < res[0] and res[2] < 1e-4
+
+
+def test_torque_limit_holds_on_the_plan_and_the_held_torques():
+    """At the torque points the plan meets the limit; between them (dense evaluation) it
+    exceeds it by the interpolation's O(h^2), at most 5 % at 16 intervals per period; the
+    held torques the controller applies never exceed it."""
+    from parapend.control.mpc import horizon_problem
+
+    exc = build_excitation(omega=1.8, delta=-0.3)
+    n, dt = 32, exc.period / 32
+    qn = exc.q(0.5 * dt / 4 * np.arange(2 * n * 4 + 1))
+    p = horizon_problem(n, dt, gamma=GAMMA, torque_limit=0.5)
+    res = p.solve((0.3, 1.8), qn, np.zeros(n))
+    assert res.success and res.x.shape == (n,)
+    assert np.max(np.abs(res.x)) <= 0.5
+    s = np.linspace(0.0, n * dt, 20001)
+    dense = np.max(np.abs(res.plan.torque(s, exc.q(s))))
+    assert 0.5 * 0.999 < dense < 0.5 * 1.05
 
 
 def _read(path):
@@ -141,9 +223,9 @@ def test_terminal_value_keeps_the_energy_at_the_horizon_end():
     for kappa in (0.0, 1.0):
         p = horizon_problem(n, dt, gamma=GAMMA, terminal_weight=kappa, torque_limit=1.0)
         res = p.solve((0.3, 1.8), qn, np.zeros(n))
-        p.fun(res.x, (0.3, 1.8), qn)
-        ends.append(0.5 * p.v[-1] ** 2 + math.cos(p.th[-1]))
-    assert ends[1] > ends[0] + 0.5
+        assert res.success
+        ends.append(res.plan.energy_end())
+    assert ends[1] > ends[0] + 0.3
 
 
 def test_mpc_run_bad_input_is_a_parameter_error():
@@ -172,15 +254,14 @@ def test_cli_errors_are_one_line(args, word, capsys):
 def test_perfect_forecast_harvests_most_of_the_noncausal_optimum():
     """The README's sea state on a 10-wave record: after 4 peak periods of warm-up, the MPC
     with a perfect forecast of one peak period over a whole repeat against ``sea``'s
-    periodic optimum on the same record (docs/control.md)."""
+    periodic optimum on the same record (docs/control.md: 99.98 %)."""
     from parapend.irregular import sea
 
     s = sea(seed=0, repeat_period=80.0)
     exc = s.excitation
     tp = exc.period / 10
-    r = mpc_run(exc, gamma=0.01, horizon=tp, update_interval=tp / 8, dt=tp / 32,
+    r = mpc_run(exc, gamma=0.01, horizon=tp, update_interval=tp / 32, dt=tp / 64,
                 t_end=exc.period + 4 * tp, average_from=4 * tp)
     assert r.success and r.catch_time is not None
-    assert r.mean_power > 0
-    assert r.mean_power / s.power > 0.5
+    assert r.mean_power / s.power > 0.95
     assert r.mean_power < s.limit_power

@@ -512,7 +512,7 @@ def track(*, excitation=None, omega=OMEGA, delta=None, square_alpha=None, fourie
                 frequency=frequency, amplitude=amplitude,
                 damping_coefficient=damping_coefficient, torque_limit_nm=torque_limit_nm),
             horizon=horizon, update_interval=update_interval, forecast=forecast)
-    if (horizon, update_interval, forecast) != (2.0, 0.125, "perfect"):
+    if (horizon, update_interval, forecast) != (2.0, 0.03125, "perfect"):
         raise ParameterError("horizon: --horizon, --update-interval and --forecast belong to "
                              "--controller mpc")
 
@@ -860,7 +860,8 @@ def horizon(*, hs=None, tp=None, spectrum: str = "jonswap", gamma_peak: float = 
             gamma=None, damping_coefficient=None, torque_limit=None, efficiency=None,
             horizons: str = HORIZON["horizons"], forecasts: str = HORIZON["forecasts"],
             baselines: str = HORIZON["baselines"], records: int = HORIZON["records"],
-            update_interval: float = HORIZON["update_interval"], progress=None):
+            update_interval: float = HORIZON["update_interval"], progress=None,
+            warm_up: float = HORIZON["warm_up"]):
     """Mean power of causal control against the forecast horizon, as a fraction of the
     record's non-causal optimum and of its limit (command ``horizon``;
     :func:`parapend.control.horizon.horizon_curve`). The sea state and the pendulum as
@@ -875,4 +876,5 @@ def horizon(*, hs=None, tp=None, spectrum: str = "jonswap", gamma_peak: float = 
                          gamma=gamma, damping_coefficient=damping_coefficient,
                          torque_limit=torque_limit, efficiency=efficiency, horizons=horizons,
                          forecasts=forecasts, baselines=baselines, records=records,
-                         update_interval=update_interval, progress=progress)
+                         update_interval=update_interval, progress=progress,
+                         warm_up=warm_up)

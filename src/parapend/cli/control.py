@@ -216,7 +216,7 @@ def _mpc_out(a, r) -> dict | str:
            f"{_fmt(r.peak_torque, 5)}",
            f"{r.solves} horizon solves: median {1e3 * r.solve_time_median:.3g} ms, "
            f"max {1e3 * r.solve_time_max:.3g} ms, median {r.iterations_median:g} "
-           "L-BFGS-B iterations"]
+           "Newton iterations"]
     if r.sea is not None:
         out.append(_sea_line(r.sea))
     if r.units is not None:

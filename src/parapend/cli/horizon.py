@@ -53,6 +53,9 @@ def add_parsers(sub) -> None:
                    default=HORIZON["update_interval"],
                    help="receding-horizon update interval, peak periods (default "
                         f"{HORIZON['update_interval']:g})")
+    g.add_argument("--warm-up", type=_finite_float("warm-up"), default=HORIZON["warm_up"],
+                   help="peak periods of every receding-horizon run left out of its mean "
+                        "(the run is then this plus one repeat long; default 0)")
     p.add_argument("--plot", metavar="PNG", help="draw the fraction of the optimum against "
                                                   "the horizon")
     p.add_argument("--save", metavar="NC", help="write the curve and every run as NetCDF")
@@ -105,7 +108,9 @@ def _cmd_horizon(a) -> dict | str:
                      f"{_pct(r.baseline_fraction_max[b])}",
                      _pct(r.baseline_limit_fraction_mean[b])])
     out = [head, f"non-causal optimum (sea) {nopt:.4g} W, limit {nlim:.4g} W (mean over the "
-                 "records); every run from the hanging rest over the whole record", "",
+                 "records); every run from the hanging rest over the whole record"
+                 + (f" (receding horizon: after {r.warm_up:g} peak periods)" if r.warm_up
+                    else ""), "",
            _table(rows, ["controller", "horizon (Tp)", "power (W)", "of optimum",
                          "min .. max", "of limit"])]
     if r.ar_leads:

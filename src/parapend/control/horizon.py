@@ -94,6 +94,7 @@ class HorizonResult(_Result):
     success: bool
     status: str
     message: str
+    warm_up: float = 0.0
     optimum_power_w: list = field(default_factory=list)
     limit_power_w: list = field(default_factory=list)
     mpc_power_w: list = field(default_factory=list)
@@ -149,7 +150,8 @@ def horizon_curve(*, hs: float = 2.0, tp: float = 8.0, spectrum: str = "jonswap"
                   inertia=None, gravity: float = 9.81, gamma=None, damping_coefficient=None,
                   torque_limit=None, efficiency=None, horizons="0.25,0.5,1,2,4",
                   forecasts="perfect,ar", baselines="tracker,extremum", records: int = 1,
-                  update_interval: float = 0.125, progress=None) -> HorizonResult:
+                  update_interval: float = 0.03125, progress=None,
+                  warm_up: float = 0.0) -> HorizonResult:
     """Mean power of causal control against the horizon (module docstring).
 
     Parameters
@@ -174,6 +176,10 @@ def horizon_curve(*, hs: float = 2.0, tp: float = 8.0, spectrum: str = "jonswap"
         MPC update interval in peak periods.
     progress : callable or None
         Called ``progress(done, total)`` after every run.
+    warm_up : float
+        Peak periods of the receding-horizon runs left out of their mean (start-up from
+        rest); the run is then ``warm_up`` plus one whole repeat of the record long, so the
+        mean is over one repeat (the baselines still average the whole record from rest).
     """
     from ..irregular import sea
     from ..seas import sea_record
@@ -195,6 +201,7 @@ def horizon_curve(*, hs: float = 2.0, tp: float = 8.0, spectrum: str = "jonswap"
     records = check_int("records", records, 1, MAX_RECORDS)
     seed = check_int("seed", seed, 0, 2**63 - 1 - MAX_RECORDS)
     upd = check_range("update-interval", update_interval, 1e-3, 1.0)
+    warm_up = check_range("warm-up", warm_up, 0.0, 100.0)
     if torque_limit is not None:
         torque_limit = check_range("torque-limit", torque_limit, 0.0, limits.MAX_TORQUE_LIMIT)
         if torque_limit <= 0:
@@ -236,8 +243,9 @@ def horizon_curve(*, hs: float = 2.0, tp: float = 8.0, spectrum: str = "jonswap"
                     fo = None if name == "perfect" else ARForecast(tp_n)
                     res = mpc_run(exc.q, gamma=gamma, horizon=h * tp_n,
                                   update_interval=upd * tp_n, dt=tp_n / 64,
+                                  average_from=warm_up * tp_n,
                                   torque_limit=torque_limit, efficiency=eff,
-                                  forecast=fo, t_end=exc.period, seed=seed + r)
+                                  forecast=fo, t_end=exc.period + warm_up * tp_n, seed=seed + r)
                     mpc_p[i][j][r] = (float(res.mean_electrical_power) if res.success
                                       else math.nan)
                     mpc_st[i][j][r] = str(res.status)
@@ -291,7 +299,7 @@ def horizon_curve(*, hs: float = 2.0, tp: float = 8.0, spectrum: str = "jonswap"
         mpc_status=mpc_st, baseline_status=base_st, ar_leads=leads, ar_error=err,
         peak_period=tp_n, update_interval=upd, gamma=gamma, torque_limit=torque_limit,
         efficiency=efficiency, record=rec, units=units.describe(), success=ok,
-        status="done" if ok else "failed_runs", message=msg,
+        status="done" if ok else "failed_runs", message=msg, warm_up=warm_up,
         optimum_power_w=[w(v) for v in opt], limit_power_w=[w(v) for v in lim],
         mpc_power_w=[[[w(v) for v in col] for col in row] for row in mpc_p],
         baseline_power_w=[[w(v) for v in row] for row in base_p])
@@ -332,6 +340,7 @@ def horizon_dataset(r: HorizonResult):
         ds["lead"].attrs["units"] = "peak periods"
     ds.attrs.update({"gamma": r.gamma, "peak_period": r.peak_period,
                      "update_interval_peak_periods": r.update_interval,
+                     "warm_up_peak_periods": r.warm_up,
                      "torque_limit": "none" if r.torque_limit is None else r.torque_limit,
                      "efficiency": "none" if r.efficiency is None else r.efficiency,
                      "convention": r.convention, "status": r.status,

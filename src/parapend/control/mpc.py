@@ -2,26 +2,23 @@ r"""Receding-horizon (model predictive) control of the pendulum in an irregular 
 
 Every ``update_interval`` the controller measures the state ``(theta, theta')``, takes the
 excitation ``q`` over the next ``horizon`` from a forecast, and solves the horizon problem on
-the full nonlinear Eq. 14,
+the full nonlinear Eq. 14 with the motion as the unknown (:mod:`.plan`): a ``C^1`` cubic
+Hermite on ``K`` intervals from the measured state, free at the end, the torque defined by
+the motion (inverse dynamics), maximizing the electrical work plus the terminal value
+``kappa E(t + H)``, ``E = theta'^2 / 2 + cos(theta)`` (docs/control.md: the energy the
+pendulum keeps is worth ``kappa = eta_g`` of harvested energy), with ``|T| <= T_max``. The
+solver is the banded Newton / primal-dual interior point of :mod:`parapend.optimal.hermite`,
+warm-started from the previous plan shifted by one update.
 
-    maximize   sum_i e(-T_i (theta_{i+1} - theta_i)) + kappa E(x(t + H))
-    subject to theta'' + gamma theta' - (1 + q) sin(theta) = T,  |T| <= T_max,
+The plan is applied as held torque samples of ``dt`` (zero-order hold): each sample holds
+the plan's torque averaged over the sample (3-point Gauss rule; the plan's ``q`` is the
+forecast's), clipped to ``T_max``. The plant is Eq. 14 integrated by RK4 with
+``plant_steps`` steps per torque sample, driven by the record's true ``q``.
 
-with the torque held over samples of ``dt`` (zero-order hold, as it is applied), the work
-``-T (theta_{i+1} - theta_i)`` of each RK4 step exact for the held torque, ``e`` the
-efficiency model of :mod:`parapend.pto` (``eta_g p`` generating, ``p / eta_m`` motoring) and
-the terminal value ``kappa E``, ``E = theta'^2 / 2 + cos(theta)`` (docs/control.md: the
-energy the pendulum keeps is worth ``kappa = eta_g`` of harvested energy, so the horizon
-does not end by draining it). It applies the first ``update_interval`` of the torque and
-repeats. The solver is L-BFGS-B with the bounds ``|T| <= T_max`` and the exact gradient by
-the discrete adjoint of the RK4 steps (:mod:`._mpc_kernel`), warm-started from the
-previous solution shifted by one update (its last torque repeated).
-
-From the hanging rest the horizon problem has a stationary point at ``T = 0`` (no work is
-done on a pendulum at rest, to first order), so the swing-up of :mod:`.swingup` (energy
+From the hanging rest the horizon problem has a stationary point at the rest itself (no work
+is done on a pendulum at rest, to first order), so the swing-up of :mod:`.swingup` (energy
 pumping) runs until the pendulum rotates forward above the top's energy, then the MPC takes
-over. The plant is the same Eq. 14 integrated by RK4 with ``plant_steps`` steps per torque
-sample, driven by the record's true ``q``.
+over.
 """
 
 from __future__ import annotations
@@ -39,11 +36,16 @@ from .swingup import pump_torque, ready_to_catch
 __all__ = ["HorizonProblem", "MPCResult", "MPCTrackResult", "horizon_problem", "mpc_run",
            "track_mpc"]
 
-#: RK4 steps per torque sample in the horizon model
+#: q samples (RK4 steps) per torque sample in the ``qn`` of :class:`HorizonProblem`
 MODEL_STEPS = 4
-#: RK4 steps per torque sample in the plant (a multiple of MODEL_STEPS)
+#: RK4 steps per torque sample in the plant
 PLANT_STEPS = 16
-#: L-BFGS-B iterations per update (a warm-started solve needs far fewer)
+#: torque samples per Hermite interval of the plan (32 intervals per peak period in
+#: ``track`` and ``horizon``, 64 samples)
+INTERVAL_SAMPLES = 2
+#: natural frequency (pendulum units) of the tracking feedback between re-plans
+TRACKING = 1.0
+#: interior-point (Newton) iterations per horizon solve
 MAX_ITER = 200
 #: the swing-up hands over above the top's energy by this margin (as track)
 CATCH_MARGIN = 0.05
@@ -71,7 +73,7 @@ class MPCResult(_Result):
     solve_times : ndarray
         Wall time (s) of each horizon solve.
     iterations : ndarray
-        L-BFGS-B iterations of each solve.
+        Newton (interior-point) iterations of each solve.
     catch_time : float or None
         When the swing-up handed over to the MPC (None: never).
     """
@@ -126,60 +128,84 @@ def _q_function(q_record):
     return lambda t: np.interp(t, ts, qs)
 
 
+def _gauss3(dt):
+    """Offsets and weights of the 3-point Gauss rule on a sample ``[0, dt]`` (mean)."""
+    x, w = np.polynomial.legendre.leggauss(3)
+    return dt * (x + 1) / 2, w / 2
+
+
+def held_torques(plan, q_of_lead, m, dt, torque_limit=None):
+    """The first ``m`` held torques of a plan: its torque (Eq. 14 with the plan's ``q``)
+    averaged over each sample by the 3-point Gauss rule, clipped to the limit."""
+    off, w = _gauss3(dt)
+    s = (dt * np.arange(m))[:, None] + off[None, :]
+    u = plan.torque(s, q_of_lead(s)) @ w
+    if torque_limit is not None:
+        u = np.clip(u, -torque_limit, torque_limit)
+    return u
+
+
 class HorizonProblem:
-    """The horizon problem of one update: ``n`` held torques of ``dt``, ``steps`` RK4 steps
-    each, from ``x0``, with ``q`` at the half-step nodes ``qn`` (``2 n steps + 1``)."""
+    """The horizon problem of one update in the torque-sample interface: ``n`` held torques
+    of ``dt`` from ``x0`` with ``q`` at the half-step nodes ``qn`` (``2 n steps + 1``, spacing
+    ``dt / (2 steps)``).
+
+    :meth:`solve` poses the motion problem of :mod:`.plan` (``ceil(n / 2)`` Hermite
+    intervals over ``n dt``, ``q`` interpolated from ``qn`` by a cubic spline), starts it from
+    the motion of the held torques ``u0`` (RK4 through ``qn``), solves it, and returns the
+    plan's torque averaged over each sample (:func:`held_torques`).
+    """
 
     def __init__(self, n, dt, steps, gamma, torque_limit=None, efficiency=None,
                  kappa=None):
-        from . import _mpc_kernel as k
-
-        self.k = k
-        self.n, self.dt, self.steps, self.gamma = n, dt, steps, gamma
-        self.h = dt / steps
+        self.n, self.dt, self.steps, self.gamma = int(n), float(dt), int(steps), float(gamma)
         self.eta = (1.0, 1.0) if efficiency is None else tuple(efficiency)
+        self.efficiency = efficiency
         self.kappa = self.eta[0] if kappa is None else float(kappa)
         self.torque_limit = torque_limit
-        self.grad, self.th, self.v = k.work(n, steps)
-        self.evaluations = 0
+        self.k = max(1, -(-self.n // INTERVAL_SAMPLES))
+        self.h = self.n * self.dt / self.k
 
-    def fun(self, u, x0, qn):
-        self.evaluations += 1
-        f = self.k.objective(u, x0[0], x0[1], qn, self.h, self.steps, self.gamma,
-                             self.eta[0], self.eta[1], self.kappa, self.grad, self.th,
-                             self.v)
-        return f, self.grad.copy()
+    def problem(self, x0, q_of_lead):
+        """The :class:`~.plan.PlanProblem` from ``x0`` with ``q`` a callable of the lead."""
+        from .plan import PlanProblem, gauss_leads
+
+        lg, lc = gauss_leads(self.k, self.h)
+        return PlanProblem(x0, self.h, q_of_lead(lg), q_of_lead(lc), self.gamma,
+                           torque_limit=self.torque_limit, efficiency=self.efficiency,
+                           kappa=self.kappa)
 
     def solve(self, x0, qn, u0, max_iter=MAX_ITER, tol=1e-10):
-        """L-BFGS-B from ``u0``; returns the scipy result (``x`` the torques)."""
-        from scipy.optimize import minimize
+        """Solve from the motion of ``u0``; returns a ``scipy.optimize.OptimizeResult``:
+        ``x`` the ``n`` held torques, ``fun`` minus the plan's objective ``J``, ``success``,
+        ``status`` (the interior point's), ``nit``, ``plan`` (:class:`~.plan.HorizonPlan`)."""
+        from scipy.interpolate import CubicSpline
+        from scipy.optimize import OptimizeResult
 
-        bounds = (None if self.torque_limit is None
-                  else [(-self.torque_limit, self.torque_limit)] * self.n)
-        if bounds is not None:
-            u0 = np.clip(u0, -self.torque_limit, self.torque_limit)
-        # One BLAS thread: L-BFGS-B's small vector operations go through BLAS, and a
-        # threaded BLAS on a loaded machine made every solve many times slower (the CLI
-        # limits BLAS at start; this covers calls from Python).
-        with _blas_controller().limit(limits=1, user_api="blas"):
-            return minimize(self.fun, u0, args=(np.asarray(x0, float), qn), jac=True,
-                            method="L-BFGS-B", bounds=bounds,
-                            options={"maxiter": max_iter, "ftol": tol, "gtol": 1e-8,
-                                     "maxcor": 20})
+        from . import _mpc_kernel as km
+        from .plan import free_motion, solve_plan
 
-
-_CONTROLLER = None
-
-
-def _blas_controller():
-    """A process-wide ``threadpoolctl.ThreadpoolController`` (inspecting the loaded
-    libraries once, not at every solve)."""
-    global _CONTROLLER
-    if _CONTROLLER is None:
-        from threadpoolctl import ThreadpoolController
-
-        _CONTROLLER = ThreadpoolController()
-    return _CONTROLLER
+        qn = np.asarray(qn, dtype=float)
+        tq = 0.5 * self.dt / self.steps * np.arange(qn.size)
+        spline = CubicSpline(tq, qn)
+        pr = self.problem(x0, spline)
+        th = np.empty(self.n + 1)
+        v = np.empty(self.n + 1)
+        u0 = np.asarray(u0, dtype=float)
+        km.simulate(u0, float(x0[0]), float(x0[1]), qn, self.dt / self.steps, self.steps,
+                    self.gamma, th, v)
+        ts = self.dt * np.arange(self.n + 1)
+        tn = self.h * np.arange(self.k + 1)
+        start = pr.start(np.interp(tn, ts, th), np.interp(tn, ts, v))
+        anchor = None
+        if self.torque_limit is not None:
+            fth, fv = free_motion(x0, self.h, self.k, self.gamma,
+                                  spline(0.5 * self.h * np.arange(2 * self.k + 1)))
+            anchor = pr.start(fth, fv)
+        sol = solve_plan(pr, start, anchor=anchor, gap_tol=tol, maxiter=max_iter)
+        u = held_torques(sol.plan, spline, self.n, self.dt, self.torque_limit)
+        return OptimizeResult(x=u, fun=-sol.value, success=sol.success, status=sol.status,
+                              nit=sol.iterations, plan=sol.plan)
 
 
 def horizon_problem(n, dt, *, gamma, steps=MODEL_STEPS, torque_limit=None, efficiency=None,
@@ -195,8 +221,8 @@ def _electrical(p, eta):
 def mpc_run(q_record, *, gamma, horizon, update_interval, dt, torque_limit=None,
             efficiency=None, forecast=None, theta0=math.pi, theta_dot0=0.0, t_end=None,
             warm=True, seed=0, terminal_weight=None, average_from=0.0,
-            model_steps=MODEL_STEPS, plant_steps=PLANT_STEPS, max_iter=MAX_ITER,
-            pump_level=1.0) -> MPCResult:
+            interval_samples=INTERVAL_SAMPLES, plant_steps=PLANT_STEPS, max_iter=MAX_ITER,
+            pump_level=1.0, tracking=TRACKING) -> MPCResult:
     """Receding-horizon control of Eq. 14 driven by the record ``q_record``.
 
     Parameters
@@ -209,8 +235,8 @@ def mpc_run(q_record, *, gamma, horizon, update_interval, dt, torque_limit=None,
         Horizon ``H``, update interval and torque sample (non-dimensional time); ``H`` and
         the update interval are rounded to whole samples (at least one).
     torque_limit : float or None
-        ``T_max``: bounds of every held torque (also the swing-up's pump, at most
-        ``pump_level``).
+        ``T_max``: bound of the planned torque at the plan's torque points and of every held
+        torque (also the swing-up's pump, at most ``pump_level``).
     efficiency : (eta_g, eta_m) or None
         The efficiency model of :mod:`parapend.pto`, in the objective and the electrical
         series.
@@ -222,7 +248,8 @@ def mpc_run(q_record, *, gamma, horizon, update_interval, dt, torque_limit=None,
     t_end : float
         Length of the run (required for a callable or an excitation; samples: their end).
     warm : bool
-        Warm-start each solve from the previous one shifted (else from zero torque).
+        Warm-start each solve from the previous plan shifted (else from the unforced
+        motion).
     seed : int
         Seeds nothing random here (kept for the forecasts' interface).
     terminal_weight : float or None
@@ -230,8 +257,16 @@ def mpc_run(q_record, *, gamma, horizon, update_interval, dt, torque_limit=None,
         efficiency); 0: no terminal value.
     average_from : float
         The means are over ``t >= average_from``.
+    interval_samples : int
+        Torque samples per Hermite interval of the plan (``K = ceil(n / interval_samples)``
+        intervals over the horizon's ``n`` samples).
+    plant_steps : int
+        RK4 steps of the plant per torque sample.
+    max_iter : int
+        Newton iterations per horizon solve.
     """
     from . import _mpc_kernel as k
+    from .plan import PlanProblem, free_motion, gauss_leads, solve_plan
 
     gamma = check_range("gamma", gamma, 0.0, 1e3)
     dt = check_range("dt", dt, 1e-4, 1e3)
@@ -240,10 +275,8 @@ def mpc_run(q_record, *, gamma, horizon, update_interval, dt, torque_limit=None,
                              f"{horizon!r}")
     n = max(1, int(round(horizon / dt)))
     m = max(1, min(n, int(round(update_interval / dt))))
-    model_steps = check_int("model_steps", model_steps, 1, 1024)
-    plant_steps = check_int("plant_steps", plant_steps, model_steps, 4096)
-    if plant_steps % model_steps:
-        raise ParameterError("plant_steps: expected a multiple of model_steps")
+    interval_samples = check_int("interval_samples", interval_samples, 1, 1024)
+    plant_steps = check_int("plant_steps", plant_steps, 1, 4096)
     if torque_limit is not None:
         torque_limit = check_range("torque-limit", torque_limit, 1e-9, 1e6)
     qf = _q_function(q_record)
@@ -255,34 +288,42 @@ def mpc_run(q_record, *, gamma, horizon, update_interval, dt, torque_limit=None,
     total = int(math.floor(t_end / dt + 1e-9))
     if total < 1:
         raise ParameterError(f"t_end: expected at least one sample dt = {dt:g}")
-    # q on the plant's half-step grid, over the run and one horizon beyond (perfect forecast)
+    # q on the plant's half-step grid over the run
     hp = dt / plant_steps
-    nodes = 2 * (total + n) * plant_steps + 1
+    nodes = 2 * total * plant_steps + 1
     qp = np.empty(nodes)
     chunk = 1 << 16
     for a in range(0, nodes, chunk):
         b = min(nodes, a + chunk)
         qp[a:b] = qf(0.5 * hp * np.arange(a, b))
-    stride = plant_steps // model_steps
-    prob = HorizonProblem(n, dt, model_steps, gamma, torque_limit, efficiency,
-                          terminal_weight)
-    eta = prob.eta
-    lead = 0.5 * (dt / model_steps) * np.arange(2 * n * model_steps + 1)
+    eta = (1.0, 1.0) if efficiency is None else tuple(float(e) for e in efficiency)
+    kappa = eta[0] if terminal_weight is None else float(terminal_weight)
+    # the plan: K Hermite intervals of h over the horizon
+    kk = max(1, -(-n // interval_samples))
+    hh = n * dt / kk
+    lg, lc = gauss_leads(kk, hh)
+    off, w3 = _gauss3(dt)
+    smp = (dt * np.arange(m))[:, None] + off[None, :]
+    ls = smp.ravel()
+    lf = 0.5 * hh * np.arange(2 * kk + 1)
+    leads = np.concatenate((lg.ravel(), lc.ravel(), ls, lf))
+    cuts = np.cumsum([lg.size, lc.size, ls.size])
 
     th = np.empty(total + 1)
     v = np.empty(total + 1)
     u_all = np.zeros(total)
     th[0], v[0] = float(theta0), float(theta_dot0)
-    tmp_t, tmp_v = np.empty(2), np.empty(2)
     level = pump_level if torque_limit is None else min(torque_limit, pump_level)
     caught = None
     braking = False
-    plan = np.zeros(n)
+    plan = None
+    since = 0
     solve_times, iters = [], []
     failed = 0
     status = "ok"
     t_samples = dt * np.arange(total + 1)
     q_samples = qp[::2 * plant_steps]
+    tn = hh * np.arange(kk + 1)
     j = 0
     while j < total:
         x = (th[j], v[j])
@@ -292,34 +333,60 @@ def mpc_run(q_record, *, gamma, horizon, update_interval, dt, torque_limit=None,
             tq, braking = pump_torque(x[0], x[1], level, CATCH_MARGIN, braking)
             steps_now = 1
             seg = np.array([tq])
-        else:
-            a = 2 * j * plant_steps
+        elif plan is None or since >= m:
+            tj = t_samples[j]
             if forecast is None:
-                qn = qp[a:a + 2 * n * plant_steps + 1:stride]
+                qall = np.asarray(qf(tj + leads), dtype=float)
             else:
-                qn = np.asarray(forecast.predict(t_samples[j], t_samples[:j + 1],
-                                                 q_samples[:j + 1], lead), dtype=float)
-            if warm and solve_times:
-                u0 = np.concatenate((plan[m:], np.full(m, plan[-1])))
+                qall = np.asarray(forecast.predict(tj, t_samples[:j + 1], q_samples[:j + 1],
+                                                   leads), dtype=float)
+            qg, qc, qs, qfree = np.split(qall, cuts)
+            pr = PlanProblem(x, hh, qg.reshape(lg.shape), qc.reshape(lc.shape), gamma,
+                             torque_limit=torque_limit, efficiency=efficiency, kappa=kappa)
+            anchor = None
+            if torque_limit is not None or plan is None or not warm:
+                fth, fv = free_motion(x, hh, kk, gamma, qfree)
+                anchor = pr.start(fth, fv)
+            if warm and plan is not None:
+                # the previous plan shifted by the samples since it was made, continued at
+                # its end speed
+                s = tn + dt * since
+                th_o, v_o, _ = plan.evaluate(s)
+                beyond = s > plan.horizon
+                th_o = np.where(beyond, plan.theta[-1] + plan.v[-1] * (s - plan.horizon),
+                                th_o)
+                v_o = np.where(beyond, plan.v[-1], v_o)
+                # the plan's angle continued through the measured one (whole turns)
+                th_o = th_o + 2 * math.pi * round((x[0] - th_o[0]) / (2 * math.pi))
+                start = pr.start(th_o, v_o)
             else:
-                u0 = np.zeros(n)
+                start = anchor
             t0 = time.perf_counter()
-            res = prob.solve(x, qn, u0, max_iter=max_iter)
+            sol = solve_plan(pr, start, anchor=anchor, maxiter=max_iter)
             solve_times.append(time.perf_counter() - t0)
-            iters.append(int(res.nit))
-            if not np.all(np.isfinite(res.x)):
+            iters.append(int(sol.iterations))
+            if not sol.success:
                 failed += 1
-                res_x = u0
-            else:
-                res_x = res.x
-                if res.status not in (0, 1):
-                    failed += 1
-            plan = np.asarray(res_x, float)
-            steps_now = min(m, total - j)
-            seg = plan[:steps_now]
+            if np.all(np.isfinite(sol.x)):
+                plan = sol.plan
+            since = 0
+            u_open = plan.torque(smp, qs.reshape(m, -1)) @ w3  # the plan's sample means
+            q_mean = qs.reshape(m, -1) @ w3
+        if caught is not None:
+            # the plan's held torque plus the tracking feedback on the measured state
+            i = since
+            tp_, vp_, _ = plan.evaluate(i * dt)
+            e, ed = x[0] - float(tp_), x[1] - float(vp_)
+            tq = float(u_open[i])
+            if tracking:
+                tq += (gamma * ed - (1.0 + q_mean[i]) * (math.sin(x[0]) - math.sin(float(tp_)))
+                       - tracking**2 * e - 2.0 * tracking * ed)
+            if torque_limit is not None:
+                tq = min(max(tq, -torque_limit), torque_limit)
+            seg = np.array([tq])
+            steps_now = 1
         a = 2 * j * plant_steps
         qseg = qp[a:a + 2 * steps_now * plant_steps + 1]
-        ok = True
         st, sv = np.empty(steps_now + 1), np.empty(steps_now + 1)
         ok = k.simulate(seg, th[j], v[j], qseg, hp, plant_steps, gamma, st, sv)
         u_all[j:j + steps_now] = seg
@@ -330,7 +397,8 @@ def mpc_run(q_record, *, gamma, horizon, update_interval, dt, torque_limit=None,
             total = j + steps_now
             break
         j += steps_now
-    del tmp_t, tmp_v
+        if plan is not None:
+            since += steps_now
     th, v, u_all = th[:total + 1], v[:total + 1], u_all[:total]
     t = dt * np.arange(total + 1)
     p = -u_all * np.diff(th) / dt
@@ -342,7 +410,7 @@ def mpc_run(q_record, *, gamma, horizon, update_interval, dt, torque_limit=None,
     if status == "ok" and not math.isfinite(mean_p):
         status = "nonfinite"
     success = status == "ok"
-    msg = {"ok": f"{len(solve_times)} horizon solves, {failed} ended abnormally",
+    msg = {"ok": f"{len(solve_times)} horizon solves, {failed} not converged",
            "diverged": "the closed loop diverged (|theta'| > 1e6)",
            "nonfinite": "non-finite power"}[status]
     return MPCResult(
@@ -352,7 +420,7 @@ def mpc_run(q_record, *, gamma, horizon, update_interval, dt, torque_limit=None,
         iterations=np.asarray(iters, dtype=int), update_interval=m * dt, horizon=n * dt,
         dt=dt, gamma=gamma, torque_limit=torque_limit,
         efficiency=None if efficiency is None else tuple(eta),
-        terminal_weight=prob.kappa, average_from=float(average_from),
+        terminal_weight=kappa, average_from=float(average_from),
         catch_time=None if caught is None else float(caught * dt), solves=len(solve_times),
         failed_solves=failed, peak_torque=float(np.max(np.abs(u_all))) if total else 0.0,
         forecast="perfect" if forecast is None else type(forecast).__name__,
@@ -427,7 +495,7 @@ class MPCTrackResult(_Result):
     _q: object = field(default=None, repr=False)
 
 
-def track_mpc(excitation, *, gamma, horizon=2.0, update_interval=0.125, forecast="perfect",
+def track_mpc(excitation, *, gamma, horizon=2.0, update_interval=0.03125, forecast="perfect",
               torque_limit=None, efficiency=None, periods=100, seed=0, irregular=False,
               theta0=math.pi, theta_dot0=0.0, terminal_weight=None,
               samples=TRACK_SAMPLES) -> MPCTrackResult:

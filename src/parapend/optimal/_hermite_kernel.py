@@ -33,12 +33,14 @@ announce_compiles()  # log a first-use compile (parapend._jit)
 
 @nb.njit(cache=True)
 def interval_vector(x, j, k, wrap):
-    """``y`` of interval ``j`` (the last wraps to node 0 plus ``wrap`` turns)."""
-    jn = j + 1 if j + 1 < k else 0
+    """``y`` of interval ``j``: periodic (``x`` of ``K`` nodes), the last wraps to node 0
+    plus ``wrap`` turns; open (``x`` of ``K + 1`` nodes, the receding horizon of
+    :mod:`parapend.control.plan`), interval ``j`` ends at node ``j + 1``."""
+    jn = j + 1 if 2 * (j + 1) < x.size else 0
     y = np.empty(4)
     y[0] = x[2 * j]
     y[1] = x[2 * j + 1]
-    y[2] = x[2 * jn] + (wrap if j == k - 1 else 0.0)
+    y[2] = x[2 * jn] + (wrap if jn == 0 else 0.0)
     y[3] = x[2 * jn + 1]
     return y
 
@@ -119,7 +121,7 @@ def newton(x, t, lam, mu, k, wrap, b0g, b1g, ling, q1g, wg, gamma, copper, b0c, 
     folded order of ``gvar`` (the folded positions of every interval's four variables);
     fills ``jtc`` (K, 3, 4) with ``dT/dy`` at the constraint points for the step.
     """
-    n = 2 * k
+    n = x.size
     ab = np.zeros((6, n))
     g = np.zeros(n)
     border = np.zeros(n)
@@ -323,7 +325,7 @@ def interval_peaks(x, k, wrap, h, gamma, spec, omega, samples, floor, q1s):
 def jt_apply(w, k, jtc, mode, scale, gvar):
     """``J^T w`` for a vector ``w`` over the constraints: ``(x part in the folded order,
     t part)`` (the constraints' ``dT/dy`` from the last :func:`newton`)."""
-    gx = np.zeros(2 * k)
+    gx = np.zeros(np.max(gvar) + 1)
     gt = 0.0
     if mode == NONE:
         return gx, gt

@@ -344,6 +344,11 @@ class HermiteProblem:
         return _k.constraint_step(np.asarray(dx, dtype=float), 0.0 if dt is None else
                                   float(dt), self.k, self._jtc, self.mode, self._scale)
 
+    def jt_apply(self, w):
+        """``J^T w`` over the constraints at the point of the last :meth:`newton` call:
+        ``(x part in the folded order, t part)``."""
+        return _k.jt_apply(w, self.k, self._jtc, self.mode, self._scale, self._gvar)
+
     def barrier_count(self) -> int:
         """Number of barrier terms (the barrier's duality gap is this times ``mu``)."""
         if self.mode == _k.NONE:
@@ -442,13 +447,13 @@ def _predictor_corrector(pr, fac, rhs, border, rhs_t, d_tt, delta, s, lam, mu, m
     """
     if not lam.size:
         return None
-    ones = _k.jt_apply(1.0 / s, pr.k, pr._jtc, pr.mode, pr._scale, pr._gvar)
+    ones = pr.jt_apply(1.0 / s)
     rhs0, rhs_t0 = rhs + mu * ones[0], rhs_t + mu * ones[1]  # the right-hand side at mu = 0
     dx_a, dt_a = _solve(fac, rhs0, border, rhs_t0, d_tt, delta)
     ds_a = -pr.constraint_step(dx_a[pr.perm], dt_a)
     dlam_a = -lam - lam / s * ds_a
     target = (mu_new - ds_a * dlam_a) / s
-    jw = _k.jt_apply(target, pr.k, pr._jtc, pr.mode, pr._scale, pr._gvar)
+    jw = pr.jt_apply(target)
     dx_f, dt = _solve(fac, rhs0 - jw[0], border, rhs_t0 - jw[1], d_tt, delta)
     rhs_new, rhs_t_new = rhs0 - mu_new * ones[0], rhs_t0 - mu_new * ones[1]
     slope = -float(rhs_new @ dx_f) - (rhs_t_new * dt if border is not None else 0.0)
