@@ -161,13 +161,16 @@ def _stage_adjoint(z, th, om, fnet, tau, p, g0, g1, g2, g3):
 
 
 @nb.njit(cache=True)
-def plan_objective(u, y0, fnet, h, steps, p, tu, eta_g, eta_m, kappa, grad, ys):
+def plan_objective(u, y0, fnet, h, steps, p, tu, eta_g, eta_m, kappa, ref, total, grad, ys):
     """The coupled horizon problem: minus the harvested work of the held torques ``u tu``
     (N m) over ``steps`` RK4 steps each (through the efficiency weights), minus ``kappa``
     times the mechanical energy of buoy and pendulum at the end (``E`` of
-    :meth:`parapend.buoy.control._Plant.energy`), in units of ``tu = m g l``; the heave and the pendulum coupled, the memory force frozen in ``fnet``
-    (``F - mu`` at the half-step nodes). Exact gradient by the adjoint of the RK4 steps;
-    ``ys`` (``len(u) steps + 1`` x 4) the step states."""
+    :meth:`parapend.buoy.control._Plant.energy`), in units of ``tu = m g l``; the heave and
+    the pendulum coupled, the memory force frozen in ``fnet`` (``F - mu`` at the half-step
+    nodes); the buoy's energy counted from the end state ``ref = (z, z')`` of a reference
+    plan (a constant, for precision); ``total = 0``: the pendulum's energy
+    ``I theta'^2 / 2 + m g l cos(theta)`` alone. Exact gradient by the adjoint of the RK4
+    steps; ``ys`` (``len(u) steps + 1`` x 4) the step states."""
     n = u.size
     ml, inertia, g = p[2], p[3], p[5]
     ys[0, 0], ys[0, 1], ys[0, 2], ys[0, 3] = y0[0], y0[1], y0[2], y0[3]
@@ -206,12 +209,16 @@ def plan_objective(u, y0, fnet, h, steps, p, tu, eta_g, eta_m, kappa, grad, ys):
     mtot, cst = p[0], p[1]
     zm, zdm, thm, omm = ys[m, 0], ys[m, 1], ys[m, 2], ys[m, 3]
     sm, cm = math.sin(thm), math.cos(thm)
-    f -= kappa * (0.5 * mtot * zdm * zdm - ml * sm * zdm * omm + 0.5 * inertia * omm * omm
-                  + 0.5 * cst * zm * zm + ml * g * cm) / tu
-    lz = -kappa * cst * zm / tu
-    lzd = -kappa * (mtot * zdm - ml * sm * omm) / tu
-    lth = -kappa * (-ml * cm * zdm * omm - ml * g * sm) / tu
-    lom = -kappa * (-ml * sm * zdm + inertia * omm) / tu
+    # the buoy's part relative to the reference end state ``ref = (z, z')`` (a constant),
+    # as differences of squares: its dependence on u is O(m / M) of its size
+    zr, zdr = ref[0], ref[1]
+    f -= kappa * (total * (0.5 * mtot * (zdm - zdr) * (zdm + zdr) - ml * sm * zdm * omm
+                           + 0.5 * cst * (zm - zr) * (zm + zr))
+                  + 0.5 * inertia * omm * omm + ml * g * cm) / tu
+    lz = -kappa * total * cst * zm / tu
+    lzd = -kappa * total * (mtot * zdm - ml * sm * omm) / tu
+    lth = -kappa * (-total * ml * cm * zdm * omm - ml * g * sm) / tu
+    lom = -kappa * (-total * ml * sm * zdm + inertia * omm) / tu
     for j in range(n - 1, -1, -1):
         tau = u[j] * tu
         gj = 0.0

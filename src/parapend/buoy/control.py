@@ -11,17 +11,22 @@ torque with the pendulum's horizon problem (:class:`parapend.control.mpc.Horizon
 pendulum units: time ``t0 = sqrt(I / (m g l))``, torque ``m g l``, ``q = z'' / g``,
 ``gamma = c t0 / I``). Two controllers:
 
-- ``"coupled"``: the heave over the horizon is predicted by the coupled model itself, from
-  the measured state with the forecast force and the torque of the current plan; the
-  pendulum is planned on that ``q``, the heave predicted again under the new plan, and so on
-  ``iterations`` times (a fixed-point iteration plan <-> heave, with ``relaxation``
-  ``alpha``: ``q <- (1 - alpha) q + alpha q(plan)``). The first prediction uses the previous
-  plan shifted (the warm start), so the reaction of the pendulum is in the model from the
-  first solve on. The iteration's change of ``q`` and its residual after the last solve
-  are recorded.
-- ``"one-way"``: the pendulum MPC planning on the FREE buoy's heave (the periodic response
-  of the buoy without the pendulum to the record, as the one-way answer of ``parapend
-  buoy``), ignoring its reaction; one solve per update.
+- ``"coupled"``: the horizon problem on the coupled model itself: heave and pendulum
+  integrated together (the 2x2 mass matrix of :mod:`.timedomain`), maximizing the harvested
+  work plus ``kappa`` times the mechanical energy of buoy AND pendulum at the horizon's end
+  (docs/buoy.md: with the pendulum's energy alone the plan drains the buoy into the
+  pendulum's spin), solved by L-BFGS-B with the exact adjoint gradient
+  (:func:`._control_kernel.plan_objective`). The radiation memory force over the horizon
+  is predicted by the plant's model under the current plan and frozen in the solve; it is
+  predicted again under the new plan and the problem solved again, ``iterations`` times
+  (with ``relaxation`` ``alpha``: ``mu <- (1 - alpha) mu + alpha mu(plan)``). The change of
+  ``mu`` and its residual after the last solve are recorded.
+- ``"one-way"``: the pendulum MPC planning on the FREE buoy's heave (the buoy's response to
+  the record without the pendulum, from the same start, by the plant's own model), ignoring
+  its reaction; one solve per update.
+- ``"fixed-point"``: the pendulum MPC planning on the heave the coupled model predicts under
+  its current plan, predicted again under the new plan, ``iterations`` times (plan <->
+  heave); it does not converge for a heavy pendulum (docs/buoy.md).
 
 Both start from the hanging rest with the swing-up of :mod:`parapend.control.swingup` (the
 buoy in its free periodic motion, the sea already running), as the pendulum MPC does, and
@@ -48,6 +53,10 @@ MODEL_STEPS = 4
 PLANT_STEPS = 8
 #: the swing-up hands over above the top's energy by this margin (as the pendulum MPC)
 CATCH_MARGIN = 0.05
+#: without a torque limit, this many m g l bound the planned torque
+DEFAULT_LIMIT = 2.0
+#: a run whose pendulum turns more than this (rad) in one plant step is not resolved
+RESOLVED = 0.5
 CONTROLLERS = ("coupled", "fixed-point", "one-way")
 
 
@@ -105,7 +114,8 @@ class BuoyMPCResult(_Result):
     failed_solves: int
     solve_time_median_s: float
     solve_time_max_s: float
-    torque_limit_nm: float | None
+    torque_limit_nm: float
+    torque_limit_given: bool
     efficiency: tuple | None
     success: bool
     status: str
@@ -168,6 +178,15 @@ def record_force(hydro, wave):
         t = np.asarray(t, dtype=float)
         return np.real(np.exp(1j * np.multiply.outer(t, kk * wave.omega)) @ c)
     return force
+
+
+def force_nodes(hydro, wave, per_record, plant_steps, count):
+    """``F_exc`` (N) at the plant's half-step nodes ``t = j T_r / (2 per_record
+    plant_steps)``, ``j = 0..count - 1``."""
+    kk = np.arange(1, wave.amplitudes.size + 1)
+    _, _, fk = hydro.coefficients(kk * wave.omega)
+    return _periodic(fk * np.asarray(wave.amplitudes), wave.omega, 2 * math.pi / wave.omega,
+                     2 * per_record * plant_steps, count)
 
 
 def free_motion(hydro, wave):
@@ -246,20 +265,24 @@ class CoupledHorizon:
     and pendulum with the memory force frozen; L-BFGS-B with the exact gradient, as
     :class:`parapend.control.mpc.HorizonProblem`."""
 
-    def __init__(self, n, h, steps, p, tu, torque_limit=None, efficiency=None, kappa=None):
+    def __init__(self, n, h, steps, p, tu, torque_limit=None, efficiency=None, kappa=None,
+                 terminal="total"):
         self.n, self.h, self.steps, self.p, self.tu = n, h, steps, p, tu
+        self.total = 1.0 if terminal == "total" else 0.0
         self.eta = (1.0, 1.0) if efficiency is None else tuple(efficiency)
         self.kappa = self.eta[0] if kappa is None else float(kappa)
         self.torque_limit = torque_limit
         self.grad = np.empty(n)
         self.ys = np.empty((n * steps + 1, 4))
         self.offset = 0.0
+        self.ref = np.zeros(2)
 
     def fun(self, u, y0, fnet):
         from ._control_kernel import plan_objective
 
         f = plan_objective(np.asarray(u, float), y0, fnet, self.h, self.steps, self.p,
-                           self.tu, self.eta[0], self.eta[1], self.kappa, self.grad, self.ys)
+                           self.tu, self.eta[0], self.eta[1], self.kappa, self.ref,
+                           self.total, self.grad, self.ys)
         return f - self.offset, self.grad.copy()
 
     def solve(self, y0, fnet, u0, max_iter=200, tol=1e-10):
@@ -275,6 +298,9 @@ class CoupledHorizon:
         # is not diluted by the buoy's energy (a constant when the pendulum is light)
         y0 = np.asarray(y0, float)
         self.offset = 0.0
+        self.ref = np.zeros(2)
+        self.fun(u0, y0, fnet)
+        self.ref = self.ys[-1, :2].copy()
         self.offset = self.fun(u0, y0, fnet)[0]
         with _blas_controller().limit(limits=1, user_api="blas"):
             return minimize(self.fun, u0, args=(y0, fnet), jac=True,
@@ -364,7 +390,7 @@ def buoy_mpc(hydro, pendulum, wave, *, peak_period, horizon=2.0, update_interval
              controller="coupled", iterations=3, relaxation=1.0, samples=SAMPLES,
              warmup=4.0, repeats=1, torque_limit=None, efficiency=None, terminal_weight=None,
              model_steps=MODEL_STEPS, plant_steps=PLANT_STEPS, memory=None, a_inf=None,
-             max_iter=None, residual=True) -> BuoyMPCResult:
+             max_iter=None, residual=True, terminal="total") -> BuoyMPCResult:
     """Receding-horizon control of the pendulum inside the buoy in a periodic record.
 
     Parameters
@@ -390,7 +416,9 @@ def buoy_mpc(hydro, pendulum, wave, *, peak_period, horizon=2.0, update_interval
     repeats : int
         Repeats of the record in the averaging window.
     torque_limit : float or None
-        N m, on every held torque (and on the swing-up's pump).
+        N m, on every held torque (and on the swing-up's pump); None: ``DEFAULT_LIMIT``
+        (2) times ``m g l`` (without a bound the discrete horizon problem's optimum runs off
+        to torques and speeds its steps do not resolve).
     efficiency : float, (eta_g, eta_m) or None
         The efficiency model of :mod:`parapend.pto` in the horizon objective and the
         electrical power.
@@ -398,6 +426,10 @@ def buoy_mpc(hydro, pendulum, wave, *, peak_period, horizon=2.0, update_interval
         ``kappa`` of the horizon's terminal value (None: ``eta_g``).
     memory, a_inf : the plant's radiation memory (s) and infinite-frequency added mass (kg),
         as :func:`parapend.buoy.timedomain.simulate` (default: its defaults).
+    terminal : "total" or "pendulum"
+        ``coupled``: the terminal value counts the mechanical energy of buoy and pendulum
+        (default) or the pendulum's alone (``I theta'^2 / 2 + m g l cos(theta)``, the
+        pendulum MPC's; docs/buoy.md).
     residual : bool
         ``coupled``: also measure the fixed point's residual (one extra prediction per
         update, not timed).
@@ -405,6 +437,8 @@ def buoy_mpc(hydro, pendulum, wave, *, peak_period, horizon=2.0, update_interval
     from ..control.mpc import MAX_ITER, HorizonProblem, _electrical
     from ..control.swingup import pump_torque, ready_to_catch
 
+    if terminal not in ("total", "pendulum"):
+        raise ParameterError(f"terminal: expected total or pendulum, got {terminal!r:.40}")
     if controller not in CONTROLLERS:
         raise ParameterError(f"controller: expected coupled, fixed-point or one-way, got "
                              f"{controller!r:.40}")
@@ -427,6 +461,7 @@ def buoy_mpc(hydro, pendulum, wave, *, peak_period, horizon=2.0, update_interval
     if torque_limit is not None:
         torque_limit = check_range("torque-limit", torque_limit, 1e-9, 1e9, why="N m")
     eta = _efficiency(efficiency)
+    limit_given = torque_limit is not None
     if max_iter is None:
         max_iter = MAX_ITER
     if not pendulum.mass < hydro.mass:
@@ -436,6 +471,10 @@ def buoy_mpc(hydro, pendulum, wave, *, peak_period, horizon=2.0, update_interval
     g = float(hydro.g)
     t0 = math.sqrt(pendulum.inertia / (pendulum.mass * g * pendulum.length))
     tu = pendulum.mass * g * pendulum.length
+    if torque_limit is None:
+        # the horizon model's discrete optimum runs off to torques (and speeds) the steps
+        # do not resolve when nothing bounds them: a bound is part of the planning problem
+        torque_limit = DEFAULT_LIMIT * tu
     tr = 2 * math.pi / wave.omega
     per_record = max(1, int(round(tr / (tp / samples))))
     dt = tr / per_record
@@ -449,10 +488,7 @@ def buoy_mpc(hydro, pendulum, wave, *, peak_period, horizon=2.0, update_interval
 
     # the record on the plant's half-step nodes, over the run and one horizon beyond
     nodes = 2 * (total + n) * ps + 1
-    kk = np.arange(1, wave.amplitudes.size + 1)
-    _, _, fk = hydro.coefficients(kk * wave.omega)
-    fa = fk * np.asarray(wave.amplitudes)
-    fn = _periodic(fa, wave.omega, tr, 2 * per_record * ps, nodes)
+    fn = force_nodes(hydro, wave, per_record, ps, nodes)
     zk, wk = free_motion(hydro, wave)
     qw = _periodic(-(wk**2) * zk / g, wave.omega, tr, 2 * per_record * ps, nodes)
     z0 = float(np.real(np.sum(zk)))
@@ -462,9 +498,16 @@ def buoy_mpc(hydro, pendulum, wave, *, peak_period, horizon=2.0, update_interval
         return np.real(np.exp(1j * np.multiply.outer(t, wk)) @ (1j * wk * zk))
 
     plant = _Plant(hydro, pendulum, h, total * ps, memory, a_inf, z0, zd0, history)
+    if controller == "one-way":
+        # the free buoy's heave as the plant's model gives it (the pendulum hanging at rest
+        # exerts no reaction): what the pendulum MPC is told when the reaction is ignored
+        zfree = plant.predict(np.zeros(total + n), ps, fn)
+        if zfree is not None:
+            qw = zfree / g
     tl_nd = None if torque_limit is None else torque_limit / tu
     if controller == "coupled":
-        prob = CoupledHorizon(n, dt / ms, ms, plant.p, tu, tl_nd, eta, terminal_weight)
+        prob = CoupledHorizon(n, dt / ms, ms, plant.p, tu, tl_nd, eta, terminal_weight,
+                              terminal)
     else:
         prob = HorizonProblem(n, dt / t0, ms, pendulum.damping_coefficient * t0 /
                               pendulum.inertia, tl_nd, eta, terminal_weight)
@@ -552,6 +595,8 @@ def buoy_mpc(hydro, pendulum, wave, *, peak_period, horizon=2.0, update_interval
     resid = abs(mean_p + damping + stored - absorbed) / max(abs(absorbed), 1e-300)
     if status == "ok" and not math.isfinite(mean_p):
         status = "nonfinite"
+    if status == "ok" and float(np.max(np.abs(ys[:, 3]))) * h > RESOLVED:
+        status = "unresolved"
     st = np.asarray(times)
     fp = []
     if controller != "one-way" and iterations > 1 and changes:
@@ -560,7 +605,10 @@ def buoy_mpc(hydro, pendulum, wave, *, peak_period, horizon=2.0, update_interval
             fp.append(float(np.median(col)) if col else math.nan)
     msg = {"ok": f"{solves} horizon solves in {st.size} updates, {failed} ended abnormally",
            "diverged": "the closed loop diverged (|theta'| > 1e6 rad/s)",
-           "nonfinite": "non-finite power"}[status]
+           "nonfinite": "non-finite power",
+           "unresolved": (f"the pendulum turned more than {RESOLVED:g} rad in one plant step: "
+                          "the integration does not resolve the run; lower the torque "
+                          "limit")}[status]
     series = {"t": t, "theta": ys[:, 2], "theta_dot": ys[:, 3], "z": ys[:, 0],
               "z_dot": ys[:, 1], "torque": u_all, "power": p}
     zwin = ys[a0 * 1:, 0]
@@ -578,8 +626,8 @@ def buoy_mpc(hydro, pendulum, wave, *, peak_period, horizon=2.0, update_interval
         solves=solves, failed_solves=failed,
         solve_time_median_s=float(np.median(st)) if st.size else 0.0,
         solve_time_max_s=float(np.max(st)) if st.size else 0.0,
-        torque_limit_nm=torque_limit, efficiency=eta, success=status == "ok", status=status,
-        message=msg,
+        torque_limit_nm=torque_limit, torque_limit_given=limit_given, efficiency=eta,
+        success=status == "ok", status=status, message=msg,
         pendulum={"mass_kg": pendulum.mass, "length_m": pendulum.length,
                   "inertia_kg_m2": pendulum.inertia,
                   "damping_coefficient_nm_s_per_rad": pendulum.damping_coefficient},
