@@ -163,3 +163,17 @@ def test_bad_input(kw, name):
         bc.buoy_mpc(HYDRO, _pendulum(20.0), WAVE, **opts)
     with pytest.raises(ParameterError, match="mass"):
         bc.buoy_mpc(HYDRO, _pendulum(2000.0), WAVE, **OPTS)
+
+
+@pytest.mark.parametrize("argv, name", [
+    (["--controller", "mpc"], "controller"),                       # no irregular sea
+    (["--controller", "mpc", "--wave-period", "1.5"], "controller"),
+    (["--controller", "pid", "--hs", "0.5", "--tp", "2.5"], "controller"),
+    (["--controller", "mpc", "--hs", "0.5", "--tp", "2.5", "--plot", "figs"], "plot"),
+])
+def test_cli_bad_input_is_one_line(argv, name, capsys):
+    from parapend.cli import main
+
+    assert main(["buoy", *argv]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and name in err[0]

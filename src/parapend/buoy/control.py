@@ -122,6 +122,10 @@ class BuoyMPCResult(_Result):
     message: str
     pendulum: dict
     units: dict
+    optimum_power_w: float | None = None
+    optimum_fraction: float | None = None
+    optimum_winding: int | None = None
+    wave: dict | None = None
     convention: str = ("theta from the upright (hanging at rest is theta = pi), z up from "
                        "the static equilibrium; power positive when harvested, "
                        "P = -<tau theta'>")
@@ -387,7 +391,7 @@ def _plan_fixed_point(plant, prob, x0, q, u0, fseg, ps, stride, rounds, relaxati
 
 
 def buoy_mpc(hydro, pendulum, wave, *, peak_period, horizon=2.0, update_interval=0.125,
-             controller="coupled", iterations=3, relaxation=1.0, samples=SAMPLES,
+             controller="coupled", iterations=2, relaxation=1.0, samples=SAMPLES,
              warmup=4.0, repeats=1, torque_limit=None, efficiency=None, terminal_weight=None,
              model_steps=MODEL_STEPS, plant_steps=PLANT_STEPS, memory=None, a_inf=None,
              max_iter=None, residual=True, terminal="total") -> BuoyMPCResult:
@@ -634,3 +638,63 @@ def buoy_mpc(hydro, pendulum, wave, *, peak_period, horizon=2.0, update_interval
         units={"time_s": t0, "torque_nm": tu, "power_w": tu / t0, "a_inf_kg": plant.a_inf,
                "memory_s": plant.nk * h, "plant_step_s": h},
         _series=series, _plant=plant)
+
+
+def mpc_command(hydro, pendulum, wave, info, *, controller, horizon, update_interval, winding,
+                harmonics, torque_limit, efficiency, irregular, design):
+    """``parapend buoy --controller mpc|one-way-mpc``: the closed loop on the record (4 peak
+    periods of warm-up, then one repeat) beside the record's coupled non-causal optimum
+    (mechanical, without torque limit or efficiency, at ``winding`` turns per record)."""
+    import dataclasses
+
+    from .api import _solve
+
+    if design:
+        raise ParameterError("optimize-design: not with --controller mpc")
+    if not irregular or "tp" not in info:
+        raise ParameterError("controller: mpc runs in an irregular sea state: give --hs and "
+                             "--tp")
+    r = buoy_mpc(hydro, pendulum, wave, peak_period=float(info["tp"]), horizon=horizon,
+                 update_interval=update_interval,
+                 controller="coupled" if controller == "mpc" else "one-way",
+                 torque_limit=torque_limit, efficiency=efficiency)
+    sol, _, _ = _solve(hydro, pendulum, wave, winding=winding, harmonics=harmonics,
+                       torque_limit=None, efficiency=None, one_way=False)
+    opt = float(sol.power) if sol.success else None
+    frac = r.mean_power_w / opt if opt is not None and opt > 0 else None
+    return dataclasses.replace(r, optimum_power_w=opt, optimum_fraction=frac,
+                               optimum_winding=int(winding), wave=info)
+
+
+def mpc_text(r) -> list:
+    """The text report of :func:`mpc_command`'s result."""
+    def f(x, unit=""):
+        return "-" if x is None else f"{x:.6g}{unit}"
+    w = r.wave or {}
+    p = r.pendulum
+    out = [f"wave: irregular, {w.get('spectrum', '')}, Hs = {w.get('hs', math.nan):g} m, "
+           f"Tp = {w.get('tp', math.nan):g} s, seed {w.get('seed', '-')}, repeat period "
+           f"{w.get('repeat_period', math.nan):.6g} s",
+           f"pendulum: m = {p['mass_kg']:g} kg, l = {p['length_m']:g} m, I = "
+           f"{p['inertia_kg_m2']:.6g} kg m^2, c = {p['damping_coefficient_nm_s_per_rad']:g} "
+           "N m s/rad",
+           f"controller: {r.controller} receding horizon, horizon {r.horizon_s:.4g} s, update "
+           f"every {r.update_interval_s:.4g} s, torque held over {r.dt_s:.4g} s, limit "
+           f"{r.torque_limit_nm:.6g} N m" + ("" if r.torque_limit_given else
+                                            " (2 m g l, the default)"),
+           "",
+           f"mean power over the last repeat    {f(r.mean_power_w, ' W')}",
+           f"  electrical                       {f(r.electrical_power_w, ' W')}",
+           f"non-causal coupled optimum         {f(r.optimum_power_w, ' W')} (winding "
+           f"{r.optimum_winding})",
+           f"  fraction reached                 {f(r.optimum_fraction)}",
+           f"absorbed by the buoy               {f(r.absorbed_w, ' W')}",
+           f"  pendulum damping                 {f(r.damping_w, ' W')}",
+           f"  stored (change / time)           {f(r.stored_w, ' W')}",
+           f"  energy balance residual          {r.energy_balance_residual:.1e}",
+           f"heave amplitude (half range)       {f(r.heave_amplitude_m, ' m')}",
+           f"peak torque                        {f(r.peak_torque_nm, ' N m')}",
+           f"solve per update: median {r.solve_time_median_s:.3g} s, max "
+           f"{r.solve_time_max_s:.3g} s, against the update interval {r.update_interval_s:.4g} s",
+           f"status: {r.status}; {r.message}"]
+    return out
