@@ -644,7 +644,8 @@ def mpc_command(hydro, pendulum, wave, info, *, controller, horizon, update_inte
                 harmonics, torque_limit, efficiency, irregular, design):
     """``parapend buoy --controller mpc|one-way-mpc``: the closed loop on the record (4 peak
     periods of warm-up, then one repeat) beside the record's coupled non-causal optimum
-    (mechanical, without torque limit or efficiency, at ``winding`` turns per record)."""
+    (mechanical, without torque limit or efficiency, at ``winding`` turns per record);
+    ``optimum_fraction`` is the electrical power over it."""
     import dataclasses
 
     from .api import _solve
@@ -661,7 +662,8 @@ def mpc_command(hydro, pendulum, wave, info, *, controller, horizon, update_inte
     sol, _, _ = _solve(hydro, pendulum, wave, winding=winding, harmonics=harmonics,
                        torque_limit=None, efficiency=None, one_way=False)
     opt = float(sol.power) if sol.success else None
-    frac = r.mean_power_w / opt if opt is not None and opt > 0 else None
+    # with an efficiency the fraction includes the losses (as parapend horizon's)
+    frac = r.electrical_power_w / opt if opt is not None and opt > 0 else None
     return dataclasses.replace(r, optimum_power_w=opt, optimum_fraction=frac,
                                optimum_winding=int(winding), wave=info)
 
@@ -687,7 +689,7 @@ def mpc_text(r) -> list:
            f"  electrical                       {f(r.electrical_power_w, ' W')}",
            f"non-causal coupled optimum         {f(r.optimum_power_w, ' W')} (winding "
            f"{r.optimum_winding})",
-           f"  fraction reached                 {f(r.optimum_fraction)}",
+           f"  fraction reached (electrical)    {f(r.optimum_fraction)}",
            f"absorbed by the buoy               {f(r.absorbed_w, ' W')}",
            f"  pendulum damping                 {f(r.damping_w, ' W')}",
            f"  stored (change / time)           {f(r.stored_w, ' W')}",
