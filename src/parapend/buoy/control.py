@@ -263,6 +263,20 @@ class _Plant:
         return (zdd, mun) if memory_force else zdd
 
 
+_CONTROLLER = None
+
+
+def _blas_controller():
+    """A process-wide ``threadpoolctl.ThreadpoolController`` (one BLAS thread in the
+    solves, as :mod:`parapend.control.mpc`)."""
+    global _CONTROLLER
+    if _CONTROLLER is None:
+        from threadpoolctl import ThreadpoolController
+
+        _CONTROLLER = ThreadpoolController()
+    return _CONTROLLER
+
+
 class CoupledHorizon:
     """The coupled horizon problem of one update (:func:`._control_kernel.plan_objective`):
     ``n`` held torques (units ``m g l``) of ``steps`` RK4 steps of ``h`` on the coupled heave
@@ -291,8 +305,6 @@ class CoupledHorizon:
 
     def solve(self, y0, fnet, u0, max_iter=200, tol=1e-10):
         from scipy.optimize import minimize
-
-        from ..control.mpc import _blas_controller
 
         bounds = (None if self.torque_limit is None
                   else [(-self.torque_limit, self.torque_limit)] * self.n)
@@ -378,7 +390,8 @@ def _plan_fixed_point(plant, prob, x0, q, u0, fseg, ps, stride, rounds, relaxati
                 qn = zdd[::stride] / g
                 ch.append(_rel(qn, q))
                 q = (1 - relaxation) * q + relaxation * qn
-        res = prob.solve(x0, q, u, max_iter=max_iter)
+        # the pendulum's horizon problem through its documented call only
+        res = prob.solve(x0, q, u)
         u, bad = _check_solve(res, u)
         failed += bad
     res_fp = None
@@ -438,7 +451,8 @@ def buoy_mpc(hydro, pendulum, wave, *, peak_period, horizon=2.0, update_interval
         ``coupled``: also measure the fixed point's residual (one extra prediction per
         update, not timed).
     """
-    from ..control.mpc import MAX_ITER, HorizonProblem, _electrical
+    from ..control import mpc as _mpc
+    from ..control.mpc import HorizonProblem
     from ..control.swingup import pump_torque, ready_to_catch
 
     if terminal not in ("total", "pendulum"):
@@ -467,7 +481,7 @@ def buoy_mpc(hydro, pendulum, wave, *, peak_period, horizon=2.0, update_interval
     eta = _efficiency(efficiency)
     limit_given = torque_limit is not None
     if max_iter is None:
-        max_iter = MAX_ITER
+        max_iter = getattr(_mpc, "MAX_ITER", 200)
     if not pendulum.mass < hydro.mass:
         raise ParameterError(f"mass: the pendulum's {pendulum.mass:g} kg is not less than the "
                              f"floating mass {hydro.mass:.6g} kg")
@@ -584,7 +598,7 @@ def buoy_mpc(hydro, pendulum, wave, *, peak_period, horizon=2.0, update_interval
     ys, acc, energy, u_all = ys[:total + 1], acc[:total + 1], energy[:total + 1], u_all[:total]
     t = dt * np.arange(total + 1)
     p = -u_all * np.diff(ys[:, 2]) / dt
-    pe = p if eta is None else _electrical(p, eta)
+    pe = p if eta is None else np.where(p > 0, eta[0] * p, p / eta[1])
     a0 = max(0, total - repeats * per_record)
     span = (total - a0) * dt
     if span > 0:
