@@ -835,7 +835,8 @@ def buoy(*, wave_height=None, wave_period=None, hs=None, tp=None, spectrum="jons
          damping_coefficient=BUOY["damping_coefficient"], body="cylinder", radius=None,
          draft=None, mesh=None, hydro=None, winding=1, harmonics=None, torque_limit=None,
          efficiency=None, optimize_design=None, mass_bounds=None, length_bounds=None,
-         inertia_bounds=None, damping_coefficient_bounds=None):
+         inertia_bounds=None, damping_coefficient_bounds=None, controller="optimum",
+         horizon=1.0, update_interval=0.125):
     """The coupled optimum of a pendulum inside a floating buoy, in SI units (command
     ``buoy``; :func:`parapend.buoy.api.buoy`, parameters there): a
     :class:`~parapend.buoy.api.BuoyResult`, or a :class:`~parapend.buoy.api.BuoySweepResult`
@@ -852,7 +853,8 @@ def buoy(*, wave_height=None, wave_period=None, hs=None, tp=None, spectrum="jons
                  efficiency=efficiency, optimize_design=optimize_design,
                  mass_bounds=mass_bounds, length_bounds=length_bounds,
                  inertia_bounds=inertia_bounds,
-                 damping_coefficient_bounds=damping_coefficient_bounds)
+                 damping_coefficient_bounds=damping_coefficient_bounds,
+                 controller=controller, horizon=horizon, update_interval=update_interval)
 # --- horizon -------------------------------------------------------------------------------
 def horizon(*, hs=None, tp=None, spectrum: str = "jonswap", gamma_peak: float = 3.3,
             repeat_period=None, seed=None, cutoff: float = 3.0, length: float = SEA["length"],

@@ -428,7 +428,8 @@ def buoy(*, wave_height=None, wave_period=None, hs=None, tp=None, spectrum="jons
          damping_coefficient=BUOY["damping_coefficient"], body="cylinder", radius=None,
          draft=None, mesh=None, hydro=None, winding=1, harmonics=None, torque_limit=None,
          efficiency=None, optimize_design=None, mass_bounds=None, length_bounds=None,
-         inertia_bounds=None, damping_coefficient_bounds=None):
+         inertia_bounds=None, damping_coefficient_bounds=None, controller="optimum",
+         horizon=1.0, update_interval=0.125):
     """The coupled optimum of a pendulum inside a floating buoy (command ``buoy``).
 
     Parameters
@@ -453,13 +454,26 @@ def buoy(*, wave_height=None, wave_period=None, hs=None, tp=None, spectrum="jons
     optimize_design : comma list of pendulum parameters to choose (``"length,inertia"``)
         for the largest coupled power, each within ``<name>_bounds`` ``"LO:HI"``.
 
+    controller, horizon, update_interval : ``"optimum"`` (the non-causal coupled optimum),
+        or a causal receding-horizon controller run on the coupled time-domain plant in an
+        irregular sea (:mod:`.control`): ``"mpc"`` (planned on the coupled model) or
+        ``"one-way-mpc"`` (planned on the free buoy's heave); horizon and update interval in
+        peak periods.
+
     Returns
     -------
-    BuoyResult or BuoySweepResult
+    BuoyResult, BuoySweepResult or parapend.buoy.control.BuoyMPCResult
     """
     from .coupled import Wave
 
+    if controller not in ("optimum", "mpc", "one-way-mpc"):
+        raise ParameterError(f"controller: expected optimum, mpc or one-way-mpc, got "
+                             f"{controller!r:.40}")
     periods = parse_periods(wave_period)
+    if controller != "optimum" and (periods is not None or not any(
+            v is not None for v in (hs, tp, repeat_period, seed))):
+        raise ParameterError("controller: mpc runs in an irregular sea state: give --hs and "
+                             "--tp (and --repeat-period, --seed)")
     irregular = any(v is not None for v in (hs, tp, record, repeat_period, seed))
     if irregular:
         bad = [n for n, v in (("wave-height", wave_height), ("wave-period", wave_period))
@@ -520,6 +534,14 @@ def buoy(*, wave_height=None, wave_period=None, hs=None, tp=None, spectrum="jons
         info = {"kind": "regular", "height_m": height, "period_s": float(periods_all[0]),
                 "omega_rad_per_s": 2 * math.pi / float(periods_all[0])}
     _check_floats(h, pend)
+    if controller != "optimum":
+        from .control import mpc_command
+
+        return mpc_command(h, pend, wave, info, controller=controller, horizon=horizon,
+                           update_interval=update_interval, winding=winding,
+                           harmonics=harmonics, torque_limit=torque_limit,
+                           efficiency=efficiency, irregular=irregular,
+                           design=bool(variables))
     opts = {"winding": winding, "harmonics": harmonics, "torque_limit": torque_limit,
             "efficiency": efficiency}
     design = None

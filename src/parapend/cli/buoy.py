@@ -91,6 +91,15 @@ def add_parsers(sub) -> None:
                             + ("0:20" if name.startswith("damping") else
                                f"{BUOY['design_bounds'][name][0]:g} to "
                                f"{BUOY['design_bounds'][name][1]:g} x the design's") + ")")
+    g = p.add_argument_group("causal control (an irregular sea, the coupled time-domain plant)")
+    g.add_argument("--controller", choices=["optimum", "mpc", "one-way-mpc"], default="optimum",
+                   help="optimum: the non-causal coupled optimum (default); mpc: receding-"
+                        "horizon control planned on the coupled model; one-way-mpc: planned "
+                        "on the free buoy's heave")
+    g.add_argument("--horizon", type=_finite_float("horizon"), default=1.0,
+                   help="with mpc: forecast horizon, peak periods (default 1)")
+    g.add_argument("--update-interval", type=_finite_float("update-interval"), default=0.125,
+                   help="with mpc: re-planning interval, peak periods (default 0.125)")
     p.add_argument("--plot", metavar="DIR",
                    help="draw the figures (PNG and SVG) into this directory")
     p.add_argument("--save", metavar="NC", help="write the motion (or the sweep) as NetCDF")
@@ -135,7 +144,16 @@ def _figures(r, directory) -> list:
 def _cmd_buoy(a) -> dict | str:
     _check_dir(a.plot)
     _check_output(a.save, "--save", (".nc",))
+    if a.controller != "optimum" and a.plot:
+        raise ParameterError("plot: not drawn with --controller mpc (use --save)")
     r = _run(a)
+    if hasattr(r, "controller"):
+        from ..buoy.control import mpc_text
+
+        if a.save:
+            _output.write_dataset(r.to_dataset(), a.save)
+        return r.to_dict() if a.json else "\n".join(
+            mpc_text(r) + ([f"written: {a.save}"] if a.save else []))
     sweep = hasattr(r, "period_s")
     if not sweep and r.status == "no_power":
         raise ParameterError(f"damping-coefficient: {r.message}")

@@ -1,0 +1,716 @@
+r"""Receding-horizon control of the pendulum inside the floating buoy (docs/buoy.md).
+
+The PLANT is the coupled time-domain model of :mod:`.timedomain`: Cummins' equation with the
+radiation memory for the heave, the pendulum's reaction ``m l (cos theta)''`` loading it, and
+Eq. 1 for the pendulum, driven by the record's excitation force ``F_exc(t)`` and integrated
+by the same scheme (:mod:`._control_kernel`; ``plant_steps`` RK4 steps per torque sample).
+
+The CONTROLLER measures the pendulum's state and the buoy's (``z``, ``z'`` and the past
+``z'`` the memory needs), knows ``F_exc`` over the horizon (perfect forecast), and plans the
+torque with the pendulum's horizon problem (:class:`parapend.control.mpc.HorizonProblem`,
+pendulum units: time ``t0 = sqrt(I / (m g l))``, torque ``m g l``, ``q = z'' / g``,
+``gamma = c t0 / I``). Two controllers:
+
+- ``"coupled"``: the horizon problem on the coupled model itself: heave and pendulum
+  integrated together (the 2x2 mass matrix of :mod:`.timedomain`), maximizing the harvested
+  work plus ``kappa`` times the mechanical energy of buoy AND pendulum at the horizon's end
+  (docs/buoy.md: with the pendulum's energy alone the plan drains the buoy into the
+  pendulum's spin), solved by L-BFGS-B with the exact adjoint gradient
+  (:func:`._control_kernel.plan_objective`). The radiation memory force over the horizon
+  is predicted by the plant's model under the current plan and frozen in the solve; it is
+  predicted again under the new plan and the problem solved again, ``iterations`` times
+  (with ``relaxation`` ``alpha``: ``mu <- (1 - alpha) mu + alpha mu(plan)``). The change of
+  ``mu`` and its residual after the last solve are recorded.
+- ``"one-way"``: the pendulum MPC planning on the FREE buoy's heave (the buoy's response to
+  the record without the pendulum, from the same start, by the plant's own model), ignoring
+  its reaction; one solve per update.
+- ``"fixed-point"``: the pendulum MPC planning on the heave the coupled model predicts under
+  its current plan, predicted again under the new plan, ``iterations`` times (plan <->
+  heave); it does not converge for a heavy pendulum (docs/buoy.md).
+
+Both start from the hanging rest with the swing-up of :mod:`parapend.control.swingup` (the
+buoy in its free periodic motion, the sea already running), as the pendulum MPC does, and
+hand over to the horizon solves when the pendulum rotates forward above the top's energy.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..errors import ParameterError, check_int, check_range
+from ..results import _Result
+
+__all__ = ["BuoyMPCResult", "buoy_mpc", "record_force"]
+
+#: torque samples per peak period
+SAMPLES = 64
+#: RK4 steps per torque sample in the horizon model / in the plant (and the prediction)
+MODEL_STEPS = 4
+PLANT_STEPS = 8
+#: the swing-up hands over above the top's energy by this margin (as the pendulum MPC)
+CATCH_MARGIN = 0.05
+#: without a torque limit, this many m g l bound the planned torque
+DEFAULT_LIMIT = 2.0
+#: a run whose pendulum turns more than this (rad) in one plant step is not resolved
+RESOLVED = 0.5
+CONTROLLERS = ("coupled", "fixed-point", "one-way")
+
+
+@dataclass(frozen=True, eq=False)
+class BuoyMPCResult(_Result):
+    """One closed-loop run of the receding-horizon controller on the buoy (SI units).
+
+    Attributes
+    ----------
+    mean_power_w : float
+        Mean harvested (mechanical) power over the last ``repeats`` repeats of the record,
+        ``-<tau theta'>``, exact for the held torque: comparable with the record's periodic
+        optimum (``parapend.buoy`` with the same record).
+    electrical_power_w : float
+        The same through the efficiency model (equal without one).
+    absorbed_w, damping_w, stored_w : float
+        Over the same window: the mean power the buoy absorbs from the waves
+        ``<(F_exc - mu) z'>`` (excitation less radiation, ``mu`` the memory force), the
+        pendulum's damping ``c <theta'^2>``, and the change of the mechanical energy of buoy
+        and pendulum over the window divided by its length.
+    energy_balance_residual : float
+        ``|P + damping + stored - absorbed|`` over ``absorbed``: the plant's energy balance.
+    fixed_point_change : list
+        ``coupled``: median over the updates of the relative change of the predicted ``q``
+        at each iteration (``||q_k - q_{k-1}|| / ||q_k||``, k = 1..iterations - 1).
+    fixed_point_residual : float or None
+        ``coupled``: median over the updates of ``||q(plan) - q|| / ||q||`` for the applied
+        plan, the heave it makes against the heave it was planned on (one extra prediction
+        per update, outside the timed part).
+    solve_time_median_s, solve_time_max_s : float
+        Wall time of one update's planning (every solve and prediction), against
+        ``update_interval_s``.
+    """
+
+    controller: str
+    mean_power_w: float
+    electrical_power_w: float
+    absorbed_w: float
+    damping_w: float
+    stored_w: float
+    energy_balance_residual: float
+    peak_torque_nm: float
+    heave_amplitude_m: float
+    catch_time_s: float | None
+    horizon_s: float
+    update_interval_s: float
+    dt_s: float
+    average_from_s: float
+    t_end_s: float
+    iterations: int
+    relaxation: float
+    fixed_point_change: list
+    fixed_point_residual: float | None
+    solves: int
+    failed_solves: int
+    solve_time_median_s: float
+    solve_time_max_s: float
+    torque_limit_nm: float
+    torque_limit_given: bool
+    efficiency: tuple | None
+    success: bool
+    status: str
+    message: str
+    pendulum: dict
+    units: dict
+    optimum_power_w: float | None = None
+    optimum_fraction: float | None = None
+    optimum_winding: int | None = None
+    wave: dict | None = None
+    convention: str = ("theta from the upright (hanging at rest is theta = pi), z up from "
+                       "the static equilibrium; power positive when harvested, "
+                       "P = -<tau theta'>")
+    _series: dict = field(default=None, repr=False)
+    _plant: object = field(default=None, repr=False)
+
+    @property
+    def series(self) -> dict:
+        """``t`` (s, sample times), ``theta``, ``theta_dot``, ``z``, ``z_dot`` there,
+        ``torque`` (N m, held over ``[t_k, t_k+1)``) and ``power`` (W, each sample's mean)."""
+        return self._series
+
+    def to_dataset(self):
+        """The series as an ``xarray.Dataset`` (the torque's last value ``nan``: no interval)."""
+        import xarray as xr
+
+        from .api import _attr
+
+        s = self._series
+        tq = np.append(s["torque"], np.nan)
+        pw = np.append(s["power"], np.nan)
+        units = {"theta": "rad", "theta_dot": "rad/s", "z": "m", "z_dot": "m/s"}
+        ds = xr.Dataset({k: ("t", s[k], {"units": u}) for k, u in units.items()},
+                        coords={"t": ("t", s["t"], {"units": "s"})})
+        ds["torque"] = ("t", tq, {"units": "N m", "hold": "over [t, t + dt)"})
+        ds["power"] = ("t", pw, {"units": "W"})
+        for k, v in self.to_dict().items():
+            ds.attrs[k] = _attr(v)
+        return ds
+
+
+def _periodic(coefs, omega, period, points, count):
+    """``Re sum_k c_k exp(i k omega t)`` (k = 1..K) at ``t = j period / points``,
+    ``j = 0..count - 1`` (the periodic record tiled)."""
+    coefs = np.asarray(coefs, dtype=complex)
+    k = coefs.size
+    if k >= points // 2:
+        raise ParameterError("samples: too few samples per record for its components")
+    spec = np.zeros(points // 2 + 1, dtype=complex)
+    spec[1:k + 1] = coefs * (points / 2.0)
+    one = np.fft.irfft(spec, points)
+    reps = -(-count // points)
+    return np.tile(one, reps)[:count]
+
+
+def record_force(hydro, wave):
+    """The excitation force ``F_exc(t)`` (N) of a periodic wave at the buoy, as a vectorized
+    callable (``Re sum_k F(k w) a_k exp(i k w t)``)."""
+    kk = np.arange(1, wave.amplitudes.size + 1)
+    _, _, f = hydro.coefficients(kk * wave.omega)
+    c = f * np.asarray(wave.amplitudes)
+
+    def force(t):
+        t = np.asarray(t, dtype=float)
+        return np.real(np.exp(1j * np.multiply.outer(t, kk * wave.omega)) @ c)
+    return force
+
+
+def force_nodes(hydro, wave, per_record, plant_steps, count):
+    """``F_exc`` (N) at the plant's half-step nodes ``t = j T_r / (2 per_record
+    plant_steps)``, ``j = 0..count - 1``."""
+    kk = np.arange(1, wave.amplitudes.size + 1)
+    _, _, fk = hydro.coefficients(kk * wave.omega)
+    return _periodic(fk * np.asarray(wave.amplitudes), wave.omega, 2 * math.pi / wave.omega,
+                     2 * per_record * plant_steps, count)
+
+
+def free_motion(hydro, wave):
+    """The free buoy's periodic heave: ``(Z_k, k w)`` with ``Z_k = F a_k / D`` (m)."""
+    kk = np.arange(1, wave.amplitudes.size + 1)
+    w = kk * wave.omega
+    return hydro.free_response(w) * np.asarray(wave.amplitudes), w
+
+
+class _Plant:
+    """The coupled plant (and the controller's copy of it): state, velocity history, memory."""
+
+    def __init__(self, hydro, pendulum, h, total_steps, memory, a_inf, z0, zd0, history):
+        from . import timedomain as td
+
+        self.h = h
+        self.w, self.nk = td._memory_weights(hydro, h, memory)
+        self.a_inf = td._a_inf(hydro, a_inf, None, td.a_infinity(hydro))
+        m, ell = pendulum.mass, pendulum.length
+        self.g = float(hydro.g)
+        self.p = np.array([hydro.mass + self.a_inf, hydro.hydrostatic_stiffness, m * ell,
+                           pendulum.inertia, pendulum.damping_coefficient, self.g])
+        self.mgl = m * self.g * ell
+        nk = self.nk
+        self.vel = np.zeros(nk + total_steps + 1)
+        if history is not None:
+            self.vel[:nk] = np.asarray(history(-np.arange(nk, 0, -1) * h), dtype=float)
+        self.vel[nk] = zd0
+        mu0 = float(self.w @ self.vel[:nk + 1][::-1])
+        self.mus = np.array([mu0, mu0, mu0])
+        self.k0 = 0
+        self.y = np.array([z0, zd0, math.pi, 0.0])
+        self.acc = np.zeros(3)
+
+    def energy(self, y=None) -> float:
+        """Mechanical energy of buoy and pendulum (J), zero for both at rest, pendulum up."""
+        z, zd, th, om = self.y if y is None else y
+        mt, cst, ml, inertia = self.p[0], self.p[1], self.p[2], self.p[3]
+        return (0.5 * mt * zd * zd - ml * math.sin(th) * zd * om + 0.5 * inertia * om * om
+                + 0.5 * cst * z * z + ml * self.g * math.cos(th))
+
+    def step(self, u, steps, fn):
+        """Advance the plant over the held torques ``u`` (N m); True unless it diverged."""
+        from ._control_kernel import advance
+
+        n = u.size
+        ys = np.empty((n + 1, 4))
+        zdd = np.empty(2 * n * steps + 1)
+        ok = advance(self.y, self.vel, self.k0, self.mus, np.asarray(u, float), steps, fn,
+                     self.h, self.w, self.p, ys, zdd, self.acc, np.empty_like(zdd))
+        self.k0 += n * steps
+        return ok, ys
+
+    def predict(self, u, steps, fn, memory_force=False):
+        """The heave acceleration (m/s^2) at the half-step nodes under the held torques ``u``
+        from the current state, without changing the plant (and, with ``memory_force``, the
+        memory force there, N); None if it diverged."""
+        from ._control_kernel import advance
+
+        nk, n = self.nk, u.size
+        vel = np.empty(nk + 1 + n * steps)
+        vel[:nk + 1] = self.vel[self.k0:self.k0 + nk + 1]
+        ys = np.empty((n + 1, 4))
+        zdd = np.empty(2 * n * steps + 1)
+        mun = np.empty_like(zdd)
+        ok = advance(self.y.copy(), vel, 0, self.mus.copy(), np.asarray(u, float), steps, fn,
+                     self.h, self.w, self.p, ys, zdd, np.zeros(3), mun)
+        if not ok:
+            return None
+        return (zdd, mun) if memory_force else zdd
+
+
+_CONTROLLER = None
+
+
+def _blas_controller():
+    """A process-wide ``threadpoolctl.ThreadpoolController`` (one BLAS thread in the
+    solves, as :mod:`parapend.control.mpc`)."""
+    global _CONTROLLER
+    if _CONTROLLER is None:
+        from threadpoolctl import ThreadpoolController
+
+        _CONTROLLER = ThreadpoolController()
+    return _CONTROLLER
+
+
+class CoupledHorizon:
+    """The coupled horizon problem of one update (:func:`._control_kernel.plan_objective`):
+    ``n`` held torques (units ``m g l``) of ``steps`` RK4 steps of ``h`` on the coupled heave
+    and pendulum with the memory force frozen; L-BFGS-B with the exact gradient, as
+    :class:`parapend.control.mpc.HorizonProblem`."""
+
+    def __init__(self, n, h, steps, p, tu, torque_limit=None, efficiency=None, kappa=None,
+                 terminal="total"):
+        self.n, self.h, self.steps, self.p, self.tu = n, h, steps, p, tu
+        self.total = 1.0 if terminal == "total" else 0.0
+        self.eta = (1.0, 1.0) if efficiency is None else tuple(efficiency)
+        self.kappa = self.eta[0] if kappa is None else float(kappa)
+        self.torque_limit = torque_limit
+        self.grad = np.empty(n)
+        self.ys = np.empty((n * steps + 1, 4))
+        self.offset = 0.0
+        self.ref = np.zeros(2)
+
+    def fun(self, u, y0, fnet):
+        from ._control_kernel import plan_objective
+
+        f = plan_objective(np.asarray(u, float), y0, fnet, self.h, self.steps, self.p,
+                           self.tu, self.eta[0], self.eta[1], self.kappa, self.ref,
+                           self.total, self.grad, self.ys)
+        return f - self.offset, self.grad.copy()
+
+    def solve(self, y0, fnet, u0, max_iter=200, tol=1e-10):
+        from scipy.optimize import minimize
+
+        bounds = (None if self.torque_limit is None
+                  else [(-self.torque_limit, self.torque_limit)] * self.n)
+        if bounds is not None:
+            u0 = np.clip(u0, -self.torque_limit, self.torque_limit)
+        # the objective relative to the start's, so that L-BFGS-B's relative reduction test
+        # is not diluted by the buoy's energy (a constant when the pendulum is light)
+        y0 = np.asarray(y0, float)
+        self.offset = 0.0
+        self.ref = np.zeros(2)
+        self.fun(u0, y0, fnet)
+        self.ref = self.ys[-1, :2].copy()
+        self.offset = self.fun(u0, y0, fnet)[0]
+        with _blas_controller().limit(limits=1, user_api="blas"):
+            return minimize(self.fun, u0, args=(y0, fnet), jac=True,
+                            method="L-BFGS-B", bounds=bounds,
+                            options={"maxiter": max_iter, "ftol": tol, "gtol": 1e-8,
+                                     "maxcor": 20})
+
+
+def _efficiency(efficiency):
+    if efficiency is None:
+        return None
+    if isinstance(efficiency, (tuple, list)):
+        eg, em = efficiency
+    else:
+        eg = em = efficiency
+    eg = check_range("efficiency", eg, 0.0, 1.0, why="PTO efficiency")
+    em = check_range("efficiency", em, 0.0, 1.0, why="PTO efficiency")
+    if eg == 0 or em == 0:
+        raise ParameterError("efficiency: expected a value in (0, 1], got 0")
+    return (float(eg), float(em))
+
+
+def _check_solve(res, u):
+    x = np.asarray(res.x, dtype=float)
+    if not np.all(np.isfinite(x)):
+        return u, 1
+    bad = not getattr(res, "success", True) and getattr(res, "status", 0) not in (0, 1)
+    return x, int(bad)
+
+
+def _rel(a, b) -> float:
+    return float(np.linalg.norm(a - b) / max(np.linalg.norm(a), 1e-300))
+
+
+def _plan_coupled(plant, prob, u0, fseg, ps, stride, iterations, relaxation, max_iter,
+                  residual, tic):
+    """Plan on the coupled model: the memory force over the horizon predicted under the
+    current plan and frozen; re-predicted after each solve (``iterations`` solves)."""
+    tu = prob.tu
+    out = plant.predict(u0 * tu, ps, fseg, memory_force=True)
+    mu = out[1] if out is not None else np.full(fseg.size, plant.mus[0])
+    y0 = plant.y.copy()
+    u, ch, failed = u0, [], 0
+    for it in range(iterations):
+        if it:
+            out = plant.predict(u * tu, ps, fseg, memory_force=True)
+            if out is not None:
+                ch.append(_rel(out[1], mu))
+                mu = (1 - relaxation) * mu + relaxation * out[1]
+        res = prob.solve(y0, (fseg - mu)[::stride], u, max_iter=max_iter)
+        u, bad = _check_solve(res, u)
+        failed += bad
+    res_fp = None
+    if residual:
+        t1 = time.perf_counter()
+        out = plant.predict(u * tu, ps, fseg, memory_force=True)
+        if out is not None:
+            res_fp = (_rel(out[1], mu), time.perf_counter() - t1)
+    return u, ch, res_fp, iterations, failed
+
+
+def _plan_fixed_point(plant, prob, x0, q, u0, fseg, ps, stride, rounds, relaxation, max_iter,
+                      residual, g, tu):
+    """Plan the pendulum alone (:class:`parapend.control.mpc.HorizonProblem`) on the heave
+    ``q``; ``fixed-point``: the heave predicted again under the new plan, ``rounds`` times."""
+    u, ch, failed = u0, [], 0
+    for it in range(rounds):
+        if it:
+            zdd = plant.predict(u * tu, ps, fseg)
+            if zdd is not None:
+                qn = zdd[::stride] / g
+                ch.append(_rel(qn, q))
+                q = (1 - relaxation) * q + relaxation * qn
+        # the pendulum's horizon problem through its documented call only
+        res = prob.solve(x0, q, u)
+        u, bad = _check_solve(res, u)
+        failed += bad
+    res_fp = None
+    if residual:
+        t1 = time.perf_counter()
+        zdd = plant.predict(u * tu, ps, fseg)
+        if zdd is not None:
+            res_fp = (_rel(zdd[::stride] / g, q), time.perf_counter() - t1)
+    return u, ch, res_fp, rounds, failed
+
+
+def buoy_mpc(hydro, pendulum, wave, *, peak_period, horizon=2.0, update_interval=0.125,
+             controller="coupled", iterations=2, relaxation=1.0, samples=SAMPLES,
+             warmup=4.0, repeats=1, torque_limit=None, efficiency=None, terminal_weight=None,
+             model_steps=MODEL_STEPS, plant_steps=PLANT_STEPS, memory=None, a_inf=None,
+             max_iter=None, residual=True, terminal="total") -> BuoyMPCResult:
+    """Receding-horizon control of the pendulum inside the buoy in a periodic record.
+
+    Parameters
+    ----------
+    hydro : Hydro
+        The buoy's coefficients (its ``mass`` the floating mass, pendulum included).
+    pendulum : parapend.buoy.coupled.Pendulum
+    wave : parapend.buoy.coupled.Wave
+        The periodic record at the buoy (``parapend.buoy``'s ``_wave``).
+    peak_period : float
+        ``Tp`` (s): the unit of ``horizon``, ``update_interval``, ``warmup`` and of the torque
+        sample ``Tp / samples`` (rounded so that the record holds whole samples).
+    horizon, update_interval : float
+        In peak periods.
+    controller : "coupled" or "one-way"
+        The module docstring.
+    iterations : int
+        ``coupled``: solves per update (plan <-> heave), at least 1.
+    relaxation : float
+        ``alpha`` in (0, 1] of the fixed-point iteration.
+    warmup : float
+        Peak periods run before the averaging window (swing-up and catch).
+    repeats : int
+        Repeats of the record in the averaging window.
+    torque_limit : float or None
+        N m, on every held torque (and on the swing-up's pump); None: ``DEFAULT_LIMIT``
+        (2) times ``m g l`` (without a bound the discrete horizon problem's optimum runs off
+        to torques and speeds its steps do not resolve).
+    efficiency : float, (eta_g, eta_m) or None
+        The efficiency model of :mod:`parapend.pto` in the horizon objective and the
+        electrical power.
+    terminal_weight : float or None
+        ``kappa`` of the horizon's terminal value (None: ``eta_g``).
+    memory, a_inf : the plant's radiation memory (s) and infinite-frequency added mass (kg),
+        as :func:`parapend.buoy.timedomain.simulate` (default: its defaults).
+    terminal : "total" or "pendulum"
+        ``coupled``: the terminal value counts the mechanical energy of buoy and pendulum
+        (default) or the pendulum's alone (``I theta'^2 / 2 + m g l cos(theta)``, the
+        pendulum MPC's; docs/buoy.md).
+    residual : bool
+        ``coupled``: also measure the fixed point's residual (one extra prediction per
+        update, not timed).
+    """
+    from ..control import mpc as _mpc
+    from ..control.mpc import HorizonProblem
+    from ..control.swingup import pump_torque, ready_to_catch
+
+    if terminal not in ("total", "pendulum"):
+        raise ParameterError(f"terminal: expected total or pendulum, got {terminal!r:.40}")
+    if controller not in CONTROLLERS:
+        raise ParameterError(f"controller: expected coupled, fixed-point or one-way, got "
+                             f"{controller!r:.40}")
+    tp = check_range("tp", peak_period, 1e-3, 1e3)
+    samples = check_int("samples", samples, 8, 4096)
+    horizon = check_range("horizon", horizon, 1.0 / samples, 20.0, why="peak periods")
+    update_interval = check_range("update-interval", update_interval, 1.0 / samples, 20.0,
+                                  why="peak periods")
+    if update_interval > horizon:
+        raise ParameterError(f"update-interval: expected at most the horizon {horizon:g} peak "
+                             f"periods, got {update_interval:g}")
+    iterations = check_int("iterations", iterations, 1, 50)
+    relaxation = check_range("relaxation", relaxation, 1e-3, 1.0)
+    warmup = check_range("warmup", warmup, 0.0, 1e3, why="peak periods")
+    repeats = check_int("repeats", repeats, 1, 100)
+    model_steps = check_int("model_steps", model_steps, 1, 64)
+    plant_steps = check_int("plant_steps", plant_steps, model_steps, 1024)
+    if plant_steps % model_steps:
+        raise ParameterError("plant_steps: expected a multiple of model_steps")
+    if torque_limit is not None:
+        torque_limit = check_range("torque-limit", torque_limit, 1e-9, 1e9, why="N m")
+    eta = _efficiency(efficiency)
+    limit_given = torque_limit is not None
+    if max_iter is None:
+        max_iter = getattr(_mpc, "MAX_ITER", 200)
+    if not pendulum.mass < hydro.mass:
+        raise ParameterError(f"mass: the pendulum's {pendulum.mass:g} kg is not less than the "
+                             f"floating mass {hydro.mass:.6g} kg")
+
+    g = float(hydro.g)
+    t0 = math.sqrt(pendulum.inertia / (pendulum.mass * g * pendulum.length))
+    tu = pendulum.mass * g * pendulum.length
+    if torque_limit is None:
+        # the horizon model's discrete optimum runs off to torques (and speeds) the steps
+        # do not resolve when nothing bounds them: a bound is part of the planning problem
+        torque_limit = DEFAULT_LIMIT * tu
+    tr = 2 * math.pi / wave.omega
+    per_record = max(1, int(round(tr / (tp / samples))))
+    dt = tr / per_record
+    n = max(1, int(round(horizon * tp / dt)))
+    m = max(1, min(n, int(round(update_interval * tp / dt))))
+    warm_samples = int(round(warmup * tp / dt))
+    total = warm_samples + repeats * per_record
+    ps, ms = plant_steps, model_steps
+    stride = ps // ms
+    h = dt / ps
+
+    # the record on the plant's half-step nodes, over the run and one horizon beyond
+    nodes = 2 * (total + n) * ps + 1
+    fn = force_nodes(hydro, wave, per_record, ps, nodes)
+    zk, wk = free_motion(hydro, wave)
+    qw = _periodic(-(wk**2) * zk / g, wave.omega, tr, 2 * per_record * ps, nodes)
+    z0 = float(np.real(np.sum(zk)))
+    zd0 = float(np.real(np.sum(1j * wk * zk)))
+
+    def history(t):
+        return np.real(np.exp(1j * np.multiply.outer(t, wk)) @ (1j * wk * zk))
+
+    plant = _Plant(hydro, pendulum, h, total * ps, memory, a_inf, z0, zd0, history)
+    if controller == "one-way":
+        # the free buoy's heave as the plant's model gives it (the pendulum hanging at rest
+        # exerts no reaction): what the pendulum MPC is told when the reaction is ignored
+        zfree = plant.predict(np.zeros(total + n), ps, fn)
+        if zfree is not None:
+            qw = zfree / g
+    tl_nd = None if torque_limit is None else torque_limit / tu
+    if controller == "coupled":
+        prob = CoupledHorizon(n, dt / ms, ms, plant.p, tu, tl_nd, eta, terminal_weight,
+                              terminal)
+    else:
+        prob = HorizonProblem(n, dt / t0, ms, pendulum.damping_coefficient * t0 /
+                              pendulum.inertia, tl_nd, eta, terminal_weight)
+    level = 1.0 if tl_nd is None else min(tl_nd, 1.0)
+
+    ys = np.empty((total + 1, 4))
+    ys[0] = plant.y
+    acc = np.zeros((total + 1, 3))
+    energy = np.empty(total + 1)
+    energy[0] = plant.energy()
+    u_all = np.zeros(total)
+    caught, braking = None, False
+    plan = np.zeros(n)
+    times, changes, residuals = [], [], []
+    solves = failed = 0
+    status = "ok"
+    j = 0
+    while j < total:
+        th, om = plant.y[2], plant.y[3] * t0
+        if caught is None and ready_to_catch(th, om, CATCH_MARGIN):
+            caught = j
+        if caught is None:
+            tq, braking = pump_torque(th, om, level, CATCH_MARGIN, braking)
+            seg = np.array([tq])
+        else:
+            a = 2 * j * ps
+            fseg = fn[a:a + 2 * n * ps + 1]
+            u0 = (np.concatenate((plan[m:], np.full(m, plan[-1]))) if solves
+                  else np.zeros(n))
+            x0 = np.array([th, om])
+            tic = time.perf_counter()
+            if controller == "coupled":
+                u, ch, res_fp, nsolve, nfail = _plan_coupled(
+                    plant, prob, u0, fseg, ps, stride, iterations, relaxation, max_iter,
+                    residual, tic)
+            else:
+                if controller == "one-way":
+                    q = qw[a:a + 2 * n * ps + 1:stride]
+                    rounds = 1
+                else:
+                    zdd = plant.predict(u0 * tu, ps, fseg)
+                    q = (qw[a:a + 2 * n * ps + 1] if zdd is None else zdd)[::stride] / g
+                    rounds = iterations
+                u, ch, res_fp, nsolve, nfail = _plan_fixed_point(
+                    plant, prob, x0, q, u0, fseg, ps, stride, rounds, relaxation, max_iter,
+                    residual and controller == "fixed-point", g, tu)
+            times.append(time.perf_counter() - tic - (0.0 if res_fp is None else res_fp[1]))
+            solves += nsolve
+            failed += nfail
+            changes.append(ch)
+            if res_fp is not None:
+                residuals.append(res_fp[0])
+            plan = u
+            seg = plan[:min(m, total - j)]
+        for k, uk in enumerate(seg):
+            ok, yk = plant.step(np.array([uk * tu]), ps, fn[2 * (j + k) * ps:
+                                                          2 * (j + k + 1) * ps + 1])
+            ys[j + k + 1] = yk[1]
+            acc[j + k + 1] = plant.acc
+            energy[j + k + 1] = plant.energy()
+            u_all[j + k] = uk * tu
+            if not ok:
+                status = "diverged"
+                total = j + k + 1
+                break
+        if status != "ok":
+            break
+        j += seg.size
+
+    ys, acc, energy, u_all = ys[:total + 1], acc[:total + 1], energy[:total + 1], u_all[:total]
+    t = dt * np.arange(total + 1)
+    p = -u_all * np.diff(ys[:, 2]) / dt
+    pe = p if eta is None else np.where(p > 0, eta[0] * p, p / eta[1])
+    a0 = max(0, total - repeats * per_record)
+    span = (total - a0) * dt
+    if span > 0:
+        mean_p = float(np.mean(p[a0:]))
+        mean_e = float(np.mean(pe[a0:]))
+        d = (acc[-1] - acc[a0]) / span
+        stored = (energy[-1] - energy[a0]) / span
+    else:
+        mean_p = mean_e = stored = math.nan
+        d = np.full(3, math.nan)
+    absorbed, damping = float(d[0]), float(d[1])
+    resid = abs(mean_p + damping + stored - absorbed) / max(abs(absorbed), 1e-300)
+    if status == "ok" and not math.isfinite(mean_p):
+        status = "nonfinite"
+    if status == "ok" and float(np.max(np.abs(ys[:, 3]))) * h > RESOLVED:
+        status = "unresolved"
+    st = np.asarray(times)
+    fp = []
+    if controller != "one-way" and iterations > 1 and changes:
+        for k in range(iterations - 1):
+            col = [c[k] for c in changes if len(c) > k]
+            fp.append(float(np.median(col)) if col else math.nan)
+    msg = {"ok": f"{solves} horizon solves in {st.size} updates, {failed} ended abnormally",
+           "diverged": "the closed loop diverged (|theta'| > 1e6 rad/s)",
+           "nonfinite": "non-finite power",
+           "unresolved": (f"the pendulum turned more than {RESOLVED:g} rad in one plant step: "
+                          "the integration does not resolve the run; lower the torque "
+                          "limit")}[status]
+    series = {"t": t, "theta": ys[:, 2], "theta_dot": ys[:, 3], "z": ys[:, 0],
+              "z_dot": ys[:, 1], "torque": u_all, "power": p}
+    zwin = ys[a0 * 1:, 0]
+    return BuoyMPCResult(
+        controller=controller, mean_power_w=mean_p, electrical_power_w=mean_e,
+        absorbed_w=absorbed, damping_w=damping, stored_w=float(stored),
+        energy_balance_residual=float(resid),
+        peak_torque_nm=float(np.max(np.abs(u_all))) if total else 0.0,
+        heave_amplitude_m=0.5 * float(np.ptp(zwin)) if zwin.size else math.nan,
+        catch_time_s=None if caught is None else float(caught * dt), horizon_s=n * dt,
+        update_interval_s=m * dt, dt_s=dt, average_from_s=a0 * dt, t_end_s=total * dt,
+        iterations=iterations if controller != "one-way" else 1, relaxation=relaxation,
+        fixed_point_change=fp,
+        fixed_point_residual=float(np.median(residuals)) if residuals else None,
+        solves=solves, failed_solves=failed,
+        solve_time_median_s=float(np.median(st)) if st.size else 0.0,
+        solve_time_max_s=float(np.max(st)) if st.size else 0.0,
+        torque_limit_nm=torque_limit, torque_limit_given=limit_given, efficiency=eta,
+        success=status == "ok", status=status, message=msg,
+        pendulum={"mass_kg": pendulum.mass, "length_m": pendulum.length,
+                  "inertia_kg_m2": pendulum.inertia,
+                  "damping_coefficient_nm_s_per_rad": pendulum.damping_coefficient},
+        units={"time_s": t0, "torque_nm": tu, "power_w": tu / t0, "a_inf_kg": plant.a_inf,
+               "memory_s": plant.nk * h, "plant_step_s": h},
+        _series=series, _plant=plant)
+
+
+def mpc_command(hydro, pendulum, wave, info, *, controller, horizon, update_interval, winding,
+                harmonics, torque_limit, efficiency, irregular, design):
+    """``parapend buoy --controller mpc|one-way-mpc``: the closed loop on the record (4 peak
+    periods of warm-up, then one repeat) beside the record's coupled non-causal optimum
+    (mechanical, without torque limit or efficiency, at ``winding`` turns per record);
+    ``optimum_fraction`` is the electrical power over it."""
+    import dataclasses
+
+    from .api import _solve
+
+    if design:
+        raise ParameterError("optimize-design: not with --controller mpc")
+    if not irregular or "tp" not in info:
+        raise ParameterError("controller: mpc runs in an irregular sea state: give --hs and "
+                             "--tp")
+    r = buoy_mpc(hydro, pendulum, wave, peak_period=float(info["tp"]), horizon=horizon,
+                 update_interval=update_interval,
+                 controller="coupled" if controller == "mpc" else "one-way",
+                 torque_limit=torque_limit, efficiency=efficiency)
+    sol, _, _ = _solve(hydro, pendulum, wave, winding=winding, harmonics=harmonics,
+                       torque_limit=None, efficiency=None, one_way=False)
+    opt = float(sol.power) if sol.success else None
+    # with an efficiency the fraction includes the losses (as parapend horizon's)
+    frac = r.electrical_power_w / opt if opt is not None and opt > 0 else None
+    return dataclasses.replace(r, optimum_power_w=opt, optimum_fraction=frac,
+                               optimum_winding=int(winding), wave=info)
+
+
+def mpc_text(r) -> list:
+    """The text report of :func:`mpc_command`'s result."""
+    def f(x, unit=""):
+        return "-" if x is None else f"{x:.6g}{unit}"
+    w = r.wave or {}
+    p = r.pendulum
+    out = [f"wave: irregular, {w.get('spectrum', '')}, Hs = {w.get('hs', math.nan):g} m, "
+           f"Tp = {w.get('tp', math.nan):g} s, seed {w.get('seed', '-')}, repeat period "
+           f"{w.get('repeat_period', math.nan):.6g} s",
+           f"pendulum: m = {p['mass_kg']:g} kg, l = {p['length_m']:g} m, I = "
+           f"{p['inertia_kg_m2']:.6g} kg m^2, c = {p['damping_coefficient_nm_s_per_rad']:g} "
+           "N m s/rad",
+           f"controller: {r.controller} receding horizon, horizon {r.horizon_s:.4g} s, update "
+           f"every {r.update_interval_s:.4g} s, torque held over {r.dt_s:.4g} s, limit "
+           f"{r.torque_limit_nm:.6g} N m" + ("" if r.torque_limit_given else
+                                            " (2 m g l, the default)"),
+           "",
+           f"mean power over the last repeat    {f(r.mean_power_w, ' W')}",
+           f"  electrical                       {f(r.electrical_power_w, ' W')}",
+           f"non-causal coupled optimum         {f(r.optimum_power_w, ' W')} (winding "
+           f"{r.optimum_winding})",
+           f"  fraction reached (electrical)    {f(r.optimum_fraction)}",
+           f"absorbed by the buoy               {f(r.absorbed_w, ' W')}",
+           f"  pendulum damping                 {f(r.damping_w, ' W')}",
+           f"  stored (change / time)           {f(r.stored_w, ' W')}",
+           f"  energy balance residual          {r.energy_balance_residual:.1e}",
+           f"heave amplitude (half range)       {f(r.heave_amplitude_m, ' m')}",
+           f"peak torque                        {f(r.peak_torque_nm, ' N m')}",
+           f"solve per update: median {r.solve_time_median_s:.3g} s, max "
+           f"{r.solve_time_max_s:.3g} s, against the update interval {r.update_interval_s:.4g} s",
+           f"status: {r.status}; {r.message}"]
+    return out
