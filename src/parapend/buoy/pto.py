@@ -1,0 +1,347 @@
+r"""The power take-off of the pendulum inside a buoy: the electrical power's optimum.
+
+The generator converts the mechanical power ``p = -tau theta'`` with efficiency ``eta_g``
+while generating and charges ``1 / eta_m`` while motoring::
+
+    e(p) = eta_g p  (p > 0),   p / eta_m  (p < 0),   e(p) = a p + b |p|,
+    a = (eta_g + 1/eta_m) / 2,   b = (eta_g - 1/eta_m) / 2 <= 0.
+
+The torque is the inverse dynamics of the motion, ``tau = I theta'' + c theta' - m l (g +
+z'') sin(theta)``, with the heave acceleration ``z'' = z_w'' + L cos(theta)`` (``L`` the
+circulant operator of the pendulum's reaction on the buoy, harmonics ``-(kw)^4 m l / D_k``,
+every harmonic of the grid; ``L = 0`` one-way). The objective ``<e(p)>`` is not smooth at
+``p = 0``; it is maximized over the Fourier coefficients of ``theta`` with the kink smoothed,
+``|p| ~ sqrt(p^2 + s^2)`` (concave in ``p`` as ``b <= 0``, and below ``e`` by at most
+``|b| s``), by the safeguarded Newton method of :mod:`parapend.optimal.fourier` with the exact
+gradient and Hessian (below) and a continuation ``s -> 0``; every iterate's exact
+(unsmoothed) value decides which one is returned.
+
+Derivatives, with ``phi_i`` the basis of ``theta``, ``d1_i``, ``d2_i`` its derivatives in
+``s = w t``, ``q = z'' / g`` and everything non-dimensional (:mod:`.coupled`)::
+
+    dtau_i = Om^2 d2_i + gamma Om d1_i - (1 + q) cos(theta) phi_i + sin(theta) L(sin(theta) phi_i)
+    dp_i   = -(dtau_i theta' + tau Om d1_i)
+    H d    = <e'' dp[d] dp_i> + <e' d2p_i[d]>
+
+where ``d2p_i[d]`` needs ``L`` and its adjoint ``L^T`` (the conjugate multiplier) only: a
+Hessian-vector product is a few real FFTs of the grid (:meth:`ElectricalProblem.hessp`),
+the dense Hessian the same product applied to the identity.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from ..errors import ParameterError
+from ..optimal.fourier import HessianOperator
+
+__all__ = ["ElectricalProblem", "efficiency_pair", "electrical_power"]
+
+
+def efficiency_pair(efficiency) -> tuple[float, float] | None:
+    """``(eta_g, eta_m)`` from ``efficiency``: None, a number (both ways), a pair, or the
+    text ``"ETA_G[,ETA_M]"``; each in (0, 1]."""
+    if efficiency is None:
+        return None
+    vals = efficiency
+    if isinstance(efficiency, str):
+        parts = [s.strip() for s in efficiency.split(",")]
+        try:
+            vals = [float(s) for s in parts]
+        except ValueError:
+            raise ParameterError(f"efficiency: expected ETA_G or ETA_G,ETA_M (numbers in "
+                                 f"(0, 1]), got {efficiency!r:.40}") from None
+    elif isinstance(efficiency, (int, float, np.floating)) and not isinstance(efficiency, bool):
+        vals = [float(efficiency)]
+    else:
+        try:
+            vals = [float(v) for v in efficiency]
+        except (TypeError, ValueError):
+            raise ParameterError(f"efficiency: expected a number in (0, 1] or a pair "
+                                 f"(eta_g, eta_m), got {efficiency!r:.40}") from None
+    if len(vals) not in (1, 2):
+        raise ParameterError(f"efficiency: expected ETA_G or ETA_G,ETA_M, got "
+                             f"{len(vals)} values")
+    for v in vals:
+        if not (math.isfinite(v) and 0.0 < v <= 1.0):
+            raise ParameterError(f"efficiency: expected numbers in (0, 1] (the fraction of "
+                                 f"the power converted), got {v!r}")
+    return (vals[0], vals[-1])
+
+
+def electrical_power(p: np.ndarray, eta: tuple[float, float]) -> tuple[float, float, float]:
+    """``(<e(p)>, <p+>, <p->)`` of the periodic samples ``p``, the kink of ``e`` integrated
+    exactly on the piecewise-linear interpolant of the samples (``<p+> - <p-> = <p>``)."""
+    from .optimum import _abs_mean
+
+    p = np.asarray(p, dtype=float)
+    mean = float(np.mean(p))
+    absm = _abs_mean(p)[0]
+    pos, neg = 0.5 * (absm + mean), 0.5 * (absm - mean)
+    return eta[0] * pos - neg / eta[1], pos, neg
+
+
+class _Operator(HessianOperator):
+    """The electrical Hessian as an operator (for the matrix-free Newton-CG)."""
+
+    def __init__(self, problem, state, diagonal):
+        self.problem = problem
+        self.state = state
+        self.diagonal = diagonal
+        self.mostly_positive = False
+        self.gw = 0.0
+
+    def matvec(self, d):
+        return self.problem.hessp(self.state, d)
+
+    def dense(self):
+        return self.problem.hessp(self.state, np.eye(self.diagonal.size))
+
+
+class ElectricalProblem:
+    """``<e_s(p)>`` on the grid of a :class:`~parapend.buoy.coupled.CoupledProblem`, with
+    its exact gradient and Hessian (dense, or an operator with ``hessian="operator"``).
+
+    Parameters
+    ----------
+    base : CoupledProblem
+        Harmonics, grid, winding, damping and the free buoy's excitation.
+    gk : ndarray, complex
+        The multiplier of ``L`` on the ``m // 2 + 1`` real-FFT harmonics (``q = q_w + L
+        cos(theta)``; zeros one-way).
+    eta : (eta_g, eta_m)
+    width : float
+        The smoothing ``s`` of the kink (non-dimensional power); 0: the exact objective
+        (for :meth:`power` only: its derivatives are then those of the kink's one side).
+    """
+
+    def __init__(self, base, gk: np.ndarray, eta, width: float, hessian: str | None = None):
+        self.base = base
+        self.harmonics = base.harmonics
+        self.points = base.points
+        self.winding = base.winding
+        self.omega = base.omega
+        self.gamma = base.gamma
+        self.w = base.w  # the scale newton_maximize reads
+        self.hessian = base.hessian if hessian is None else hessian
+        self.gk = np.asarray(gk, dtype=complex)
+        self.qw = base.excitation.q_grid(base.points)
+        eg, em = eta
+        self.a = 0.5 * (eg + 1.0 / em)
+        self.b = 0.5 * (eg - 1.0 / em)
+        self.width = float(width)
+        m, n = self.points, self.harmonics
+        k = np.arange(m // 2 + 1, dtype=float)
+        self._k = k
+        self._kn = k[: n + 1]
+
+    # ---- synthesis and projection ----------------------------------------------------
+    def _spec(self, d):
+        """Real-FFT coefficients of ``Phi^T d`` (``d`` a vector or columns)."""
+        n, m = self.harmonics, self.points
+        d = np.asarray(d, dtype=float)
+        c = np.zeros(d.shape[1:] + (m // 2 + 1,), dtype=complex)
+        dt = np.moveaxis(d, 0, -1)
+        c[..., 0] = m * dt[..., 0]
+        c[..., 1:n + 1] = (0.5 * m) * (dt[..., n + 1:] - 1j * dt[..., 1:n + 1])
+        return c
+
+    def _synth(self, d):
+        """``phi``, ``d1``, ``d2`` of ``d`` on the grid (last axis the grid)."""
+        m = self.points
+        c = self._spec(d)
+        k = self._k
+        return (np.fft.irfft(c, m), np.fft.irfft(1j * k * c, m),
+                np.fft.irfft(-(k * k) * c, m))
+
+    def _project(self, a, b=None, c=None):
+        """``sum_t a phi_i + b d1_i + c d2_i`` for every basis function ``i`` (first axis)."""
+        n = self.harmonics
+        kn = self._kn
+        y = np.fft.rfft(a)[..., : n + 1]
+        if b is not None:
+            y = y - 1j * kn * np.fft.rfft(b)[..., : n + 1]
+        if c is not None:
+            y = y - kn * kn * np.fft.rfft(c)[..., : n + 1]
+        out = np.empty(y.shape[:-1] + (2 * n + 1,))
+        out[..., 0] = y[..., 0].real
+        out[..., 1:n + 1] = -y[..., 1:].imag
+        out[..., n + 1:] = y[..., 1:].real
+        return np.moveaxis(out, -1, 0)
+
+    def _l(self, f):
+        return np.fft.irfft(self.gk * np.fft.rfft(f, axis=-1), self.points, axis=-1)
+
+    def _lt(self, f):
+        return np.fft.irfft(np.conj(self.gk) * np.fft.rfft(f, axis=-1), self.points, axis=-1)
+
+    # ---- the motion, the torque, the power ---------------------------------------------
+    def state(self, x):
+        """Grid quantities at ``x``: theta and its derivatives, q, tau, p."""
+        om, gam = self.omega, self.gamma
+        ph, d1, d2 = self._synth(x)
+        th = self.winding * self.base.s + ph
+        ths = self.winding + d1
+        sn, cs = np.sin(th), np.cos(th)
+        q = self.qw + self._l(cs)
+        tau = om * om * d2 + gam * om * ths - (1.0 + q) * sn
+        thd = om * ths
+        p = -tau * thd
+        return {"sn": sn, "cs": cs, "q": q, "tau": tau, "thd": thd, "p": p}
+
+    def _e(self, p):
+        s = self.width
+        r = np.sqrt(p * p + s * s)
+        return self.a * p + self.b * r, self.a + self.b * p / r, self.b * s * s / r**3
+
+    def exact(self, x) -> float:
+        """The unsmoothed ``<e(p)>`` on the grid (the kink integrated on the piecewise-linear
+        interpolant)."""
+        p = self.state(x)["p"]
+        return float(self.a * np.mean(p) + self.b * _abs(p))
+
+    def mechanical(self, x) -> float:
+        """``<p>`` on the grid."""
+        return float(np.mean(self.state(x)["p"]))
+
+    def power(self, x) -> float:
+        """The smoothed objective ``<e_s(p)>``."""
+        return float(np.mean(self._e(self.state(x)["p"])[0]))
+
+    def _dtau_t(self, st, w):
+        """``sum_t w dtau_i`` (the transpose of the torque's Jacobian applied to ``w``)."""
+        om, gam = self.omega, self.gamma
+        sn, cs, q = st["sn"], st["cs"], st["q"]
+        return self._project(-(1.0 + q) * cs * w + sn * self._lt(sn * w), gam * om * w,
+                             om * om * w)
+
+    def _dtau(self, st, ph, d1, d2):
+        om, gam = self.omega, self.gamma
+        sn, cs, q = st["sn"], st["cs"], st["q"]
+        return om * om * d2 + gam * om * d1 - (1.0 + q) * cs * ph + sn * self._l(sn * ph)
+
+    def evaluate(self, x):
+        """``(E_s, gradient, Hessian)``; the Hessian dense or an operator."""
+        st = self.state(x)
+        e, e1, e2 = self._e(st["p"])
+        st["e1"], st["e2"] = e1, e2
+        m = self.points
+        om = self.omega
+        g = (self._dtau_t(st, -e1 * st["thd"]) + self._project(
+            np.zeros(m), -om * e1 * st["tau"])) / m
+        nx = 2 * self.harmonics + 1
+        if self.hessian == "operator":
+            # a diagonal for the preconditioner: <|e''|> times the size of dp_i^2, plus |a|
+            # times the mechanical curvature
+            kk = np.concatenate(([0.0], self._kn[1:], self._kn[1:]))
+            scale = 0.5 * float(np.mean(np.abs(e2) * st["thd"] ** 2)) * (
+                om * om * kk * kk + 1.0) ** 2
+            mech = float(np.mean(np.abs(self.qw))) + self.gamma * om * om * kk * kk
+            return float(np.mean(e)), g, _Operator(self, st, scale + abs(self.a) * mech)
+        h = self.hessp(st, np.eye(nx))
+        h = 0.5 * (h + h.T)
+        return float(np.mean(e)), g, h
+
+    def hessp(self, st, d):
+        """``H d`` (``d`` a vector, or columns: the result has the same shape)."""
+        om = self.omega
+        m = self.points
+        sn, cs, q, tau, thd = st["sn"], st["cs"], st["q"], st["tau"], st["thd"]
+        e1, e2 = st["e1"], st["e2"]
+        ph, d1, d2 = self._synth(d)
+        dtau = self._dtau(st, ph, d1, d2)
+        dp = -(dtau * thd + tau * om * d1)
+        w1 = e2 * dp
+        out = self._dtau_t(st, -w1 * thd) + self._project(np.zeros_like(w1), -om * w1 * tau)
+        bb = -e1 * thd
+        a_term = (bb * cs * self._l(sn * ph) + sn * self._lt(bb * cs * ph)
+                  + bb * (1.0 + q) * sn * ph + cs * ph * self._lt(bb * sn))
+        out = out + self._project(a_term, -om * e1 * dtau)
+        out = out + self._dtau_t(st, -om * e1 * d1)
+        return out / m
+
+
+def _abs(p) -> float:
+    from .optimum import _abs_mean
+
+    return _abs_mean(np.asarray(p, dtype=float))[0]
+
+
+#: smoothing widths of the continuation, relative to the largest |p| of the start
+WIDTHS = (1e-1, 3e-2, 1e-2, 3e-3, 1e-3, 3e-4, 1e-4, 3e-5, 1e-5, 1e-6)
+#: widths after a doubling of the harmonics (started from the coarser optimum)
+WIDTHS_REFINE = (1e-3, 1e-4, 1e-5, 1e-6)
+#: Newton iterations per width (at the small widths Newton creeps along the kinks)
+MAXITER = 200
+
+
+def maximize(problem: ElectricalProblem, x0: np.ndarray, widths=None):
+    """Continuation ``s -> 0`` from ``x0``: a trust-region Newton method at each width from
+    the last optimum (``trust-exact`` on the dense Hessian, ``trust-krylov`` on the
+    operator's products: the smoothed objective is not concave in the coefficients, and a
+    trust region follows its directions of positive curvature where a shifted Newton step
+    creeps).
+
+    Returns ``(x, exact, runs)``: the iterate with the largest exact (unsmoothed) ``<e(p)>``
+    on the grid, that value, and per width ``(s, exact, status, iterations)``.
+    """
+    from scipy.optimize import minimize
+
+    p0 = float(np.max(np.abs(problem.state(x0)["p"])))
+    widths = WIDTHS if widths is None else widths
+    x = np.array(x0, dtype=float)
+    best_x, best = x.copy(), problem.exact(x)
+    runs = []
+    gtol = 1e-9 * max(float(np.max(np.abs(problem.w))), 1e-300)
+    dense = problem.hessian != "operator"
+    for rel in widths:
+        problem.width = rel * p0
+        cache = {}
+
+        def ev(z, cache=cache):
+            key = z.tobytes()
+            if key not in cache:
+                cache.clear()
+                cache[key] = problem.evaluate(z)
+            return cache[key]
+
+        kw = ({"hess": lambda z: -ev(z)[2]} if dense else
+              {"hessp": lambda z, d: -ev(z)[2].matvec(d)})
+        r = minimize(lambda z: -ev(z)[0], x, jac=lambda z: -ev(z)[1],
+                     method="trust-exact" if dense else "trust-krylov",
+                     options={"gtol": gtol, "maxiter": MAXITER}, **kw)
+        ex = problem.exact(r.x)
+        status = {0: "converged", 1: "max_iterations"}.get(r.status, "stalled")
+        runs.append((rel * p0, ex, status, int(r.nit)))
+        if math.isfinite(ex) and ex >= best:
+            best, best_x = ex, np.array(r.x)
+        x = np.array(r.x)
+    return best_x, best, runs
+
+
+def ladder(make, x_ideal: np.ndarray, harmonics: int, start: int):
+    """The electrical optimum with ``harmonics`` terms by continuation in the harmonics:
+    the full width continuation with ``start`` terms from the ideal optimum cut to them,
+    then doubling (each from the last optimum, :data:`WIDTHS_REFINE`) up to ``harmonics``.
+
+    ``make(n)`` builds the :class:`ElectricalProblem` with ``n`` harmonics. Returns ``(x,
+    exact, coarse_exact, log)``: the optimum, its exact value on its grid, the value one
+    doubling before (None when ``start == harmonics``) and per stage ``(n, exact, runs)``.
+    """
+    from ..optimal.fourier import _pad
+
+    ns = [harmonics]
+    while ns[-1] // 2 >= start:
+        ns.append(ns[-1] // 2)
+    ns = ns[::-1]
+    x = _pad(x_ideal, ns[0])
+    log, coarse, ex = [], None, None
+    for i, n in enumerate(ns):
+        pr = make(n)
+        x = _pad(x, n)
+        coarse = ex
+        x, ex, runs = maximize(pr, x, WIDTHS if i == 0 else WIDTHS_REFINE)
+        log.append((n, ex, runs))
+    return x, ex, coarse, log
