@@ -53,8 +53,8 @@ HARMONICS_PER_TURN = 24
 HARMONICS_PER_WAVE = 16
 #: a torque-limited optimum may exceed the limit between its grid points by this fraction
 TORQUE_SLACK = 1e-3
-#: relative change of the electrical power between a fine grid and one twice as fine above
-#: which the electrical optimum is not a success
+#: change of the electrical power between a fine grid and one twice as fine, relative to
+#: ``<|p|>``, above which the electrical optimum is not a success
 ELECTRICAL_GRID_TOL = 1e-6
 #: relative change of the electrical optimum from N/2 to N harmonics above which the status
 #: says so
@@ -704,7 +704,7 @@ def coupled_optimum(hydro, pendulum: Pendulum, wave: Wave, *, winding: int = 1,
                    "electrical_refinement_change": e_change}
         parts.append(f"electrical optimum (efficiency {eta[0]:g} generating, {eta[1]:g} "
                      f"motoring): {elec['status']}, {elec['harmonics']} harmonics")
-        if e_chk > ELECTRICAL_GRID_TOL * max(abs(e_w), 1e-300):
+        if e_chk > ELECTRICAL_GRID_TOL * max(gen + mot, 1e-300):
             ok = False
             parts.append(f"electrical power on a finer grid differs by {e_chk:.2g} W")
         if e_change > ELECTRICAL_REFINE_TOL * max(abs(e_w), 1e-300):
