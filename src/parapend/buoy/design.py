@@ -106,7 +106,8 @@ def optimize_design(solve, pendulum, variables, bounds, *, check=None) -> Design
                 check(p)
             sol = solve(p)
             # with an efficiency the electrical optimum's electrical power
-            best = sol.power if sol.electrical_power is None else sol.electrical_power
+            elec = getattr(sol, "electrical_power", None)
+            best = sol.power if elec is None else elec
             val = float(best) if sol.success else -math.inf
             if not sol.success:
                 failed[0] += 1
