@@ -179,3 +179,21 @@ def test_cli_efficiency_json(capsys):
                      "--efficiency", "0.9"]) == 0
         text = capsys.readouterr().out
         assert "electrical power (maximized)" in text and "take-off losses" in text
+
+
+@pytest.mark.slow
+def test_default_design_with_efficiency():
+    """The numbers of docs/buoy.md (default design, --efficiency 0.9), with the invariants:
+    electrical <= eta_g x ideal, the ideal motion through the same take-off far below, and
+    the energy balance."""
+    r = parapend.buoy(efficiency=0.9)
+    assert r.success, r.status
+    assert r.electrical_power_w == pytest.approx(28.16, rel=2e-3)
+    assert r.power_w == pytest.approx(31.29, rel=2e-3)
+    assert r.ideal_power_w == pytest.approx(38.40, rel=2e-3)
+    assert r.electrical_power_w <= 0.9 * r.ideal_power_w
+    assert r.energy_balance_residual <= BALANCE_TOL
+    ideal = parapend.buoy()
+    p = ideal.samples(20000)["power"][:-1]
+    assert electrical_power(p, (0.9, 0.9))[0] == pytest.approx(-16.2, abs=0.2)
+    assert r.one_way_electrical_power_w == pytest.approx(177.7, rel=2e-3)
