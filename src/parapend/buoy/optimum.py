@@ -489,21 +489,28 @@ class _Torque:
         return tau, jac.T
 
 
-def _torque_limited(problem, x0, limit_nd, torque):
-    """Maximize P subject to ``|tau| <= limit`` on the grid (SLSQP, exact gradients)."""
-    from scipy.optimize import minimize
+def _limited(hydro, pendulum, wave, sc, exc, x_ideal, n, n2, k, regular, limit_nd, coupled):
+    """The torque-limited optimum (:func:`parapend.buoy.pto.torque_limited`) with ``n``
+    harmonics from the ideal optimum, then with ``n2`` from that; None when the ideal
+    optimum already keeps ``|tau| <= limit`` on the ``n2`` grid."""
+    from .pto import ElectricalProblem, torque_limited
 
-    def f(x):
-        p, g, _ = problem.evaluate(x)
-        return -p, -g
+    def make(nn):
+        hess = "dense" if regular and nn <= DENSE_MAX else "operator"
+        base = CoupledProblem(exc, sc.beta_nd, nn, sc.gamma, winding=k, hessian=hess)
+        return ElectricalProblem(base, _Torque(base, hydro, pendulum, wave, coupled).gk,
+                                 (1.0, 1.0), 0.0)
 
-    cons = [{"type": "ineq", "fun": lambda x: limit_nd - torque(x)[0],
-             "jac": lambda x: -torque(x)[1]},
-            {"type": "ineq", "fun": lambda x: limit_nd + torque(x)[0],
-             "jac": lambda x: torque(x)[1]}]
-    r = minimize(f, x0, jac=True, method="SLSQP", constraints=cons,
-                 options={"maxiter": 500, "ftol": 1e-13})
-    return r
+    pf = make(n2)
+    if float(np.max(np.abs(pf.state(_pad(x_ideal, n2))["tau"]))) <= limit_nd:
+        return None
+    pc = make(n)
+    xc, oc, _, out_c, in_c, st_c = torque_limited(pc, _pad(x_ideal, n), limit_nd)
+    xf, of, _, out_f, in_f, st_f = torque_limited(pf, _pad(xc, n2), limit_nd)
+    ok = st_c == "converged" and st_f == "converged"
+    return {"x": xf, "power": of, "change": abs(of - oc), "points": pf.points,
+            "status": "converged" if ok else "stalled", "outer": out_c + out_f,
+            "inner": in_c + in_f}
 
 
 def _electrical(hydro, pendulum, wave, sc, exc, x_ideal, n, k, regular, eta, coupled):
@@ -576,10 +583,11 @@ def coupled_optimum(hydro, pendulum: Pendulum, wave: Wave, *, winding: int = 1,
         N; None: 24 K (regular wave) or 16 per mean wave of the free heave (record), then
         checked by one refinement (the result is the ``2N`` optimum).
     torque_limit : float or None
-        ``|tau| <= torque_limit`` (N m), regular wave only: SLSQP with exact gradients of
-        ``P`` and of the torque on the grid, from the ideal optimum, at N and 2N; the peak
-        between grid points is checked (within ``TORQUE_SLACK``, else ``success`` is
-        False) and stated in ``status``.
+        ``|tau| <= torque_limit`` (N m), a regular wave or a record: an augmented
+        Lagrangian on the grid's torques (:func:`parapend.buoy.pto.torque_limited`: exact
+        gradient and Hessian, trust-region Newton), from the ideal optimum, at N and 2N;
+        the peak between grid points is checked (within ``TORQUE_SLACK``, else
+        ``success`` is False) and stated in ``status``.
     efficiency : float, (eta_g, eta_m), "ETA_G[,ETA_M]" or None
         Maximize the electrical power ``<e(p)>`` instead (:mod:`.pto`): a smoothed kink with
         a continuation to zero width and in the harmonics (N/4 to N), started from the ideal
@@ -648,25 +656,18 @@ def coupled_optimum(hydro, pendulum: Pendulum, wave: Wave, *, winding: int = 1,
                         sol.seed, elec["points"], False)
         n = elec["harmonics"]
     if torque_limit is not None:
-        if not regular:
-            raise ParameterError("torque-limit: supported with the buoy for a regular wave "
-                                 "only (not for a record); drop --torque-limit")
-        lim_t = torque_limit / sc.torque_unit
-        coarse = problem_n
-        tq_f = _Torque(fine, hydro, pendulum, wave, not one_way)
-        if float(np.max(np.abs(tq_f(_pad(sol.x, n2))[0]))) <= lim_t:
+        tl = _limited(hydro, pendulum, wave, sc, exc, sol.x, n, n2, k, regular,
+                      torque_limit / sc.torque_unit, not one_way)
+        if tl is None:
             tl_note = "torque limit inactive: the ideal optimum stays within it"
         else:
-            tq_c = _Torque(coarse, hydro, pendulum, wave, not one_way)
-            rc = _torque_limited(coarse, best.x, lim_t, tq_c)
-            rf = _torque_limited(fine, _pad(rc.x, n2), lim_t, tq_f)
-            change = abs(-rf.fun + rc.fun)
-            status = "converged" if (rf.success and rc.success) else "stalled"
-            sol = type(sol)(rf.x, -float(rf.fun), 0.0, int(rf.nit), status, best.seed,
-                            fine.points, False)
+            change = tl["change"]
+            sol = type(sol)(tl["x"], tl["power"], 0.0, tl["inner"], tl["status"], best.seed,
+                            tl["points"], False)
             n = n2
-            tl_note = (f"torque limit {torque_limit:g} N m active (SLSQP on the {fine.points}-"
-                       f"point grid: {rf.message})")
+            tl_note = (f"torque limit {torque_limit:g} N m active (augmented Lagrangian on "
+                       f"the {tl['points']}-point grid: {tl['status']}, {tl['outer']} "
+                       f"multiplier updates, {tl['inner']} Newton steps)")
     # fine grid: the power from the torque, the heave, the energy balance
     mf = max(4096, 4 * fine.points)
     p_w, Z, resid = _heave_and_balance(hydro, pendulum, wave, sol.x, k, mf, not one_way)

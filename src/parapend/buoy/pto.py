@@ -207,8 +207,42 @@ class ElectricalProblem:
         return float(np.mean(self.state(x)["p"]))
 
     def power(self, x) -> float:
-        """The smoothed objective ``<e_s(p)>``."""
-        return float(np.mean(self._e(self.state(x)["p"])[0]))
+        """The smoothed objective ``<e_s(p)>`` (less the torque penalty, if any)."""
+        st = self.state(x)
+        val = float(np.mean(self._e(st["p"])[0]))
+        if self.limit is not None:
+            val += float(np.mean(self._penalty(st["tau"])[0]))
+        return val
+
+    # ---- a torque limit by an augmented Lagrangian -------------------------------------
+    limit = None
+
+    def set_limit(self, limit: float, rho: float, lam_hi=None, lam_lo=None):
+        """Penalize ``|tau| > limit`` on the grid (PHR augmented Lagrangian, per point
+        ``tau - limit <= 0`` and ``-tau - limit <= 0`` with multipliers ``lam_hi``,
+        ``lam_lo`` and penalty ``rho``)."""
+        m = self.points
+        self.limit = float(limit)
+        self.rho = float(rho)
+        self.lam_hi = np.zeros(m) if lam_hi is None else lam_hi
+        self.lam_lo = np.zeros(m) if lam_lo is None else lam_lo
+
+    def _penalty(self, tau):
+        """``(phi, phi', phi'')`` per grid point, ``phi = -(max(0, lam + rho g)^2 - lam^2) /
+        (2 rho)`` summed over both constraints ``g = +-tau - limit``."""
+        r = self.rho
+        hi = np.maximum(0.0, self.lam_hi + r * (tau - self.limit))
+        lo = np.maximum(0.0, self.lam_lo + r * (-tau - self.limit))
+        phi = -(hi * hi - self.lam_hi**2 + lo * lo - self.lam_lo**2) / (2 * r)
+        return phi, -hi + lo, -r * ((hi > 0).astype(float) + (lo > 0))
+
+    def update_multipliers(self, x):
+        """``lam <- max(0, lam + rho g)``; returns the largest violation ``max |tau| -
+        limit`` on the grid."""
+        tau = self.state(x)["tau"]
+        self.lam_hi = np.maximum(0.0, self.lam_hi + self.rho * (tau - self.limit))
+        self.lam_lo = np.maximum(0.0, self.lam_lo + self.rho * (-tau - self.limit))
+        return float(np.max(np.abs(tau))) - self.limit
 
     def _dtau_t(self, st, w):
         """``sum_t w dtau_i`` (the transpose of the torque's Jacobian applied to ``w``)."""
@@ -229,8 +263,14 @@ class ElectricalProblem:
         st["e1"], st["e2"] = e1, e2
         m = self.points
         om = self.omega
-        g = (self._dtau_t(st, -e1 * st["thd"]) + self._project(
-            np.zeros(m), -om * e1 * st["tau"])) / m
+        val = float(np.mean(e))
+        wt = -e1 * st["thd"]
+        if self.limit is not None:
+            ph0, ph1, ph2 = self._penalty(st["tau"])
+            val += float(np.mean(ph0))
+            wt = wt + ph1
+            st["ph1"], st["ph2"] = ph1, ph2
+        g = (self._dtau_t(st, wt) + self._project(np.zeros(m), -om * e1 * st["tau"])) / m
         nx = 2 * self.harmonics + 1
         if self.hessian == "operator":
             # a diagonal for the preconditioner: <|e''|> times the size of dp_i^2, plus |a|
@@ -239,10 +279,13 @@ class ElectricalProblem:
             scale = 0.5 * float(np.mean(np.abs(e2) * st["thd"] ** 2)) * (
                 om * om * kk * kk + 1.0) ** 2
             mech = float(np.mean(np.abs(self.qw))) + self.gamma * om * om * kk * kk
-            return float(np.mean(e)), g, _Operator(self, st, scale + abs(self.a) * mech)
+            if self.limit is not None:
+                scale = scale + 0.5 * float(np.mean(np.abs(st["ph2"]))) * (
+                    om * om * kk * kk + 1.0) ** 2
+            return val, g, _Operator(self, st, scale + abs(self.a) * mech)
         h = self.hessp(st, np.eye(nx))
         h = 0.5 * (h + h.T)
-        return float(np.mean(e)), g, h
+        return val, g, h
 
     def hessp(self, st, d):
         """``H d`` (``d`` a vector, or columns: the result has the same shape)."""
@@ -256,6 +299,9 @@ class ElectricalProblem:
         w1 = e2 * dp
         out = self._dtau_t(st, -w1 * thd) + self._project(np.zeros_like(w1), -om * w1 * tau)
         bb = -e1 * thd
+        if self.limit is not None:
+            bb = bb + st["ph1"]
+            out = out + self._dtau_t(st, st["ph2"] * dtau)
         a_term = (bb * cs * self._l(sn * ph) + sn * self._lt(bb * cs * ph)
                   + bb * (1.0 + q) * sn * ph + cs * ph * self._lt(bb * sn))
         out = out + self._project(a_term, -om * e1 * dtau)
@@ -345,3 +391,61 @@ def ladder(make, x_ideal: np.ndarray, harmonics: int, start: int):
         x, ex, runs = maximize(pr, x, WIDTHS if i == 0 else WIDTHS_REFINE)
         log.append((n, ex, runs))
     return x, ex, coarse, log
+
+
+def torque_limited(problem: ElectricalProblem, x0: np.ndarray, limit: float, *,
+                   tol: float = 1e-7, max_outer: int = 40):
+    """Maximize the problem's objective subject to ``|tau| <= limit`` on its grid by an
+    augmented Lagrangian (PHR): each outer step a trust-region Newton solve of the
+    penalized objective (exact gradient and Hessian), then ``lam <- max(0, lam + rho g)``,
+    and ``rho`` times 10 when the violation fell by less than a factor 4.
+
+    Returns ``(x, objective, violation, outer, inner, status)``: ``violation`` the largest
+    ``max |tau| - limit`` on the grid at ``x``; status "converged" when it is at most
+    ``tol * limit`` and the last inner solve converged.
+    """
+    from scipy.optimize import minimize
+
+    x = np.array(x0, dtype=float)
+    st = problem.state(x)
+    scale = max(float(np.max(np.abs(problem.w))), 1e-300)
+    p0 = max(abs(float(np.mean(problem._e(st["p"])[0]))), 1e-3 * scale)
+    rho = 10.0 * p0 / limit**2
+    problem.set_limit(limit, rho)
+    gtol = 1e-10 * scale
+    dense = problem.hessian != "operator"
+    viol_prev = math.inf
+    inner = 0
+    status = "max_iterations"
+    viol = float(np.max(np.abs(st["tau"]))) - limit
+    outer = 0
+    while outer < max_outer:
+        outer += 1
+        cache = {}
+
+        def ev(z, cache=cache):
+            key = z.tobytes()
+            if key not in cache:
+                cache.clear()
+                cache[key] = problem.evaluate(z)
+            return cache[key]
+
+        kw = ({"hess": lambda z: -ev(z)[2]} if dense else
+              {"hessp": lambda z, d: -ev(z)[2].matvec(d)})
+        r = minimize(lambda z: -ev(z)[0], x, jac=lambda z: -ev(z)[1],
+                     method="trust-exact" if dense else "trust-krylov",
+                     options={"gtol": gtol, "maxiter": MAXITER}, **kw)
+        x = np.array(r.x)
+        inner += int(r.nit)
+        viol = problem.update_multipliers(x)
+        if viol <= tol * limit and r.status != 1:
+            status = "converged"
+            break
+        if viol > 0.25 * viol_prev:
+            problem.rho *= 10.0
+        viol_prev = viol
+    lam_hi, lam_lo, rho = problem.lam_hi, problem.lam_lo, problem.rho
+    problem.limit = None
+    obj = float(np.mean(problem._e(problem.state(x)["p"])[0]))
+    problem.set_limit(limit, rho, lam_hi, lam_lo)
+    return x, obj, viol, outer, inner, status
