@@ -197,3 +197,44 @@ def test_default_design_with_efficiency():
     p = ideal.samples(20000)["power"][:-1]
     assert electrical_power(p, (0.9, 0.9))[0] == pytest.approx(-16.2, abs=0.2)
     assert r.one_way_electrical_power_w == pytest.approx(177.7, rel=2e-3)
+
+
+def test_one_way_torque_limit_is_optimize_pto():
+    """The augmented Lagrangian one-way (the free buoy's heave) against the uncoupled
+    time-domain solver with the same limit (parapend.pto.optimize_pto: Hermite intervals
+    and an interior point, an independent method)."""
+    from parapend.buoy.optimum import TORQUE_SLACK
+
+    sc = scales(HYDRO, PEND, WAVE, coupled=False)
+    q1 = sc.q_spec[1]
+    ideal = coupled_optimum(HYDRO, PEND, WAVE, one_way=True, harmonics=12)
+    lim = 0.7 * ideal.peak_torque()
+    r = coupled_optimum(HYDRO, PEND, WAVE, one_way=True, harmonics=12, torque_limit=lim)
+    o = parapend.pto.optimize_pto(torque_limit=lim / sc.torque_unit, harmonics=24,
+                                  omega=sc.omega_nd, gamma=sc.gamma,
+                                  fourier=[(1, abs(q1), np.angle(q1) + np.pi / 2)])
+    assert r.success and o.success, (r.status, o.status)
+    assert "augmented Lagrangian" in r.status
+    assert r.power == pytest.approx(o.power * sc.power_unit, rel=1e-4)
+    assert r.power <= o.power * sc.power_unit * (1 + 1e-9)  # N harmonics: a lower bound
+    assert r.peak_torque() <= lim * (1 + TORQUE_SLACK)
+    assert r.energy_balance_residual <= BALANCE_TOL
+
+
+@pytest.mark.slow
+def test_torque_limit_on_an_irregular_record():
+    """A 5-wave record under a limit at 0.8 of the ideal peak: the power falls a little,
+    the peak holds between the grid points, the balance closes."""
+    from parapend.buoy.optimum import TORQUE_SLACK
+
+    h = toy_hydro(radius=2.0, top=6.0)
+    p = Pendulum(2000.0, 1.0, 2500.0, 50.0)
+    rec = Wave.from_spectrum(hs=2.0, tp=8.0, repeat_period=40.0, seed=0)
+    ideal = coupled_optimum(h, p, rec, winding=5)
+    lim = 0.8 * ideal.peak_torque()
+    r = coupled_optimum(h, p, rec, winding=5, torque_limit=lim)
+    assert r.success, r.status
+    assert r.power <= ideal.power
+    assert r.power >= 0.99 * ideal.power
+    assert r.peak_torque() <= lim * (1 + TORQUE_SLACK)
+    assert r.energy_balance_residual <= BALANCE_TOL

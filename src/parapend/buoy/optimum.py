@@ -696,7 +696,8 @@ def coupled_optimum(hydro, pendulum: Pendulum, wave: Wave, *, winding: int = 1,
     efields = {}
     if elec is not None:
         e_w, gen, mot, e_chk = _electrical_fine(hydro, pendulum, sol.x, k, wave.omega,
-                                                max(mf, 16384),
+                                                max(mf, 16384, 1 << int(math.ceil(
+                                                    math.log2(128 * (n + k))))),
                                                 Z, eta)
         e_change = abs(elec["exact"] - elec["coarse"]) * pu if elec["coarse"] is not None \
             else 0.0
