@@ -238,3 +238,15 @@ def test_torque_limit_on_an_irregular_record():
     assert r.power >= 0.99 * ideal.power
     assert r.peak_torque() <= lim * (1 + TORQUE_SLACK)
     assert r.energy_balance_residual <= BALANCE_TOL
+
+
+@pytest.mark.slow
+def test_default_design_with_a_torque_limit():
+    """The torque-limit table of docs/buoy.md (default design, 254.95 N m)."""
+    from parapend.buoy.optimum import TORQUE_SLACK
+
+    r = parapend.buoy(torque_limit=254.95)
+    assert r.success, r.status
+    assert r.power_w == pytest.approx(37.7476, rel=1e-5)
+    assert 254.9 <= r.peak_torque_nm <= 254.95 * (1 + TORQUE_SLACK)
+    assert r.energy_balance_residual <= BALANCE_TOL

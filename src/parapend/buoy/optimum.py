@@ -656,8 +656,8 @@ def coupled_optimum(hydro, pendulum: Pendulum, wave: Wave, *, winding: int = 1,
                         sol.seed, elec["points"], False)
         n = elec["harmonics"]
     if torque_limit is not None:
-        tl = _limited(hydro, pendulum, wave, sc, exc, sol.x, n, n2, k, regular,
-                      torque_limit / sc.torque_unit, not one_way)
+        tl = _limited(hydro, pendulum, wave, sc, exc, sol.x, problem_n.harmonics, n2, k,
+                      regular, torque_limit / sc.torque_unit, not one_way)
         if tl is None:
             tl_note = "torque limit inactive: the ideal optimum stays within it"
         else:
