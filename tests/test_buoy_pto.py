@@ -135,16 +135,30 @@ def test_bad_efficiency(value, match):
         efficiency_pair(value)
 
 
-def test_efficiency_with_torque_limit_is_refused():
-    with pytest.raises(ParameterError, match="not both"):
-        coupled_optimum(HYDRO, PEND, WAVE, efficiency=0.9, torque_limit=100.0)
+@pytest.mark.slow
+def test_one_way_efficiency_and_torque_limit_is_optimize_pto():
+    """Both at once, one-way, against the uncoupled collocation (exact kink, torque bound)."""
+    from parapend.buoy.optimum import TORQUE_SLACK
+
+    sc = scales(HYDRO, PEND, WAVE, coupled=False)
+    q1 = sc.q_spec[1]
+    free = coupled_optimum(HYDRO, PEND, WAVE, one_way=True, harmonics=12, efficiency=0.9)
+    lim = 0.8 * free.peak_torque()
+    r = coupled_optimum(HYDRO, PEND, WAVE, one_way=True, harmonics=24, efficiency=0.9,
+                        torque_limit=lim)
+    o = parapend.pto.optimize_pto(torque_limit=lim / sc.torque_unit, efficiency=0.9,
+                                  harmonics=24, omega=sc.omega_nd, gamma=sc.gamma,
+                                  fourier=[(1, abs(q1), np.angle(q1) + np.pi / 2)])
+    assert r.success and o.success, (r.status, o.status)
+    assert r.electrical_power == pytest.approx(o.electrical_power * sc.power_unit, rel=1e-4)
+    assert r.peak_torque() <= lim * (1 + TORQUE_SLACK)
 
 
 @pytest.mark.parametrize("argv, match", [
     (["--efficiency", "0"], "efficiency: expected numbers in (0, 1]"),
     (["--efficiency", "0.9,1.2"], "efficiency"),
     (["--efficiency", "high"], "efficiency: expected ETA_G"),
-    (["--efficiency", "0.9", "--torque-limit", "100"], "not both"),
+    (["--efficiency", "0.9", "--torque-limit", "-1"], "torque-limit"),
 ])
 def test_cli_bad_efficiency(argv, match, capsys, tmp_path):
     before = set(tmp_path.iterdir())

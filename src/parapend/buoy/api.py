@@ -481,7 +481,7 @@ def buoy(*, wave_height=None, wave_period=None, hs=None, tp=None, spectrum="jons
     torque_limit : N m.
     efficiency : of the power take-off: a number in (0, 1] (both ways), a pair ``(eta_g,
         eta_m)`` or the text ``"ETA_G,ETA_M"``: the motion maximizes the electrical power
-        (docs/buoy.md); not with ``torque_limit``.
+        (docs/buoy.md), within ``torque_limit`` if given.
     optimize_design : comma list of pendulum parameters to choose (``"length,inertia"``)
         for the largest coupled power, each within ``<name>_bounds`` ``"LO:HI"``.
 
@@ -512,9 +512,6 @@ def buoy(*, wave_height=None, wave_period=None, hs=None, tp=None, spectrum="jons
         efficiency = efficiency_pair(efficiency)
         if efficiency == (1.0, 1.0):
             efficiency = None  # lossless: the ideal problem
-        elif torque_limit is not None:
-            raise ParameterError("efficiency: with the buoy, a torque limit or an efficiency, "
-                                 "not both; drop --torque-limit or --efficiency")
     variables, bounds = _design_request(optimize_design, pend, mass_bounds=mass_bounds,
                                         length_bounds=length_bounds,
                                         inertia_bounds=inertia_bounds,

@@ -513,7 +513,8 @@ def _limited(hydro, pendulum, wave, sc, exc, x_ideal, n, n2, k, regular, limit_n
             "inner": in_c + in_f}
 
 
-def _electrical(hydro, pendulum, wave, sc, exc, x_ideal, n, k, regular, eta, coupled):
+def _electrical(hydro, pendulum, wave, sc, exc, x_ideal, n, k, regular, eta, coupled,
+                limit=None):
     """The electrical optimum with ``n`` harmonics (:func:`parapend.buoy.pto.ladder` from
     the ideal optimum ``x_ideal``): a dict of the motion, its exact electrical and
     mechanical power (non-dimensional, on its grid) and the status."""
@@ -526,7 +527,7 @@ def _electrical(hydro, pendulum, wave, sc, exc, x_ideal, n, k, regular, eta, cou
                                  0.0)
 
     start = max(2 * k, n // 4)
-    x, ex, coarse, log = ladder(make, x_ideal, n, start)
+    x, ex, coarse, log = ladder(make, x_ideal, n, start, limit)
     pr = make(n)
     last = [r[1] for r in log[-1][2] if math.isfinite(r[1])]
     settled = len(last) >= 2 and abs(last[-1] - last[-2]) <= ELECTRICAL_SETTLED * max(
@@ -591,8 +592,9 @@ def coupled_optimum(hydro, pendulum: Pendulum, wave: Wave, *, winding: int = 1,
     efficiency : float, (eta_g, eta_m), "ETA_G[,ETA_M]" or None
         Maximize the electrical power ``<e(p)>`` instead (:mod:`.pto`): a smoothed kink with
         a continuation to zero width and in the harmonics (N/4 to N), started from the ideal
-        optimum; its exact value on a fine grid is ``electrical_power``. Not with
-        ``torque_limit``. 1 both ways is the ideal problem (the ideal optimum is returned).
+        optimum; its exact value on a fine grid is ``electrical_power``. With
+        ``torque_limit`` every width is solved under the limit. 1 both ways is the ideal
+        problem (the ideal optimum is returned).
     starts : int or None
         At most this many seeds of the global search (None: all).
     one_way : bool
@@ -608,9 +610,6 @@ def coupled_optimum(hydro, pendulum: Pendulum, wave: Wave, *, winding: int = 1,
     from .pto import efficiency_pair
 
     eta = efficiency_pair(efficiency)
-    if eta is not None and torque_limit is not None and eta != (1.0, 1.0):
-        raise ParameterError("efficiency: with the buoy, a torque limit or an efficiency, not "
-                             "both; drop --torque-limit or --efficiency")
     _check_hydro(hydro, wave)
     regular = wave.amplitudes.size == 1
     sc = scales(hydro, pendulum, wave, coupled=not one_way)
@@ -649,13 +648,17 @@ def coupled_optimum(hydro, pendulum: Pendulum, wave: Wave, *, winding: int = 1,
     tl_note = None
     elec = None
     if eta is not None and eta != (1.0, 1.0):
+        lim_e = None if torque_limit is None else torque_limit / sc.torque_unit
         elec = _electrical(hydro, pendulum, wave, sc, exc, sol.x, n, k, regular, eta,
-                           not one_way)
+                           not one_way, lim_e)
         ideal_nd = sol.power
         sol = type(sol)(elec["x"], float("nan"), 0.0, elec["iterations"], elec["status"],
                         sol.seed, elec["points"], False)
         n = elec["harmonics"]
-    if torque_limit is not None:
+    if torque_limit is not None and elec is not None:
+        tl_note = (f"torque limit {torque_limit:g} N m imposed on the electrical optimum "
+                   "(augmented Lagrangian at every width)")
+    elif torque_limit is not None:
         tl = _limited(hydro, pendulum, wave, sc, exc, sol.x, problem_n.harmonics, n2, k,
                       regular, torque_limit / sc.torque_unit, not one_way)
         if tl is None:

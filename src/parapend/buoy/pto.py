@@ -323,12 +323,15 @@ WIDTHS_REFINE = (1e-3, 1e-4, 1e-5, 1e-6)
 MAXITER = 200
 
 
-def maximize(problem: ElectricalProblem, x0: np.ndarray, widths=None):
+def maximize(problem: ElectricalProblem, x0: np.ndarray, widths=None, limit=None):
     """Continuation ``s -> 0`` from ``x0``: a trust-region Newton method at each width from
     the last optimum (``trust-exact`` on the dense Hessian, ``trust-krylov`` on the
     operator's products: the smoothed objective is not concave in the coefficients, and a
     trust region follows its directions of positive curvature where a shifted Newton step
     creeps).
+
+    With ``limit`` each width is solved under ``|tau| <= limit`` on the grid
+    (:func:`torque_limited`), and only iterates within the limit count.
 
     Returns ``(x, exact, runs)``: the iterate with the largest exact (unsmoothed) ``<e(p)>``
     on the grid, that value, and per width ``(s, exact, status, iterations)``.
@@ -342,6 +345,17 @@ def maximize(problem: ElectricalProblem, x0: np.ndarray, widths=None):
     runs = []
     gtol = 1e-9 * max(float(np.max(np.abs(problem.w))), 1e-300)
     dense = problem.hessian != "operator"
+    if limit is not None:
+        best = -math.inf
+        for rel in widths:
+            problem.width = rel * p0
+            x, _, viol, _, inner, status = torque_limited(problem, x, limit)
+            ex = problem.exact(x)
+            runs.append((rel * p0, ex, status, inner))
+            if math.isfinite(ex) and ex >= best and viol <= LIMIT_TOL * limit:
+                best, best_x = ex, np.array(x)
+        problem.limit = None
+        return best_x, best, runs
     for rel in widths:
         problem.width = rel * p0
         cache = {}
@@ -367,7 +381,7 @@ def maximize(problem: ElectricalProblem, x0: np.ndarray, widths=None):
     return best_x, best, runs
 
 
-def ladder(make, x_ideal: np.ndarray, harmonics: int, start: int):
+def ladder(make, x_ideal: np.ndarray, harmonics: int, start: int, limit=None):
     """The electrical optimum with ``harmonics`` terms by continuation in the harmonics:
     the full width continuation with ``start`` terms from the ideal optimum cut to them,
     then doubling (each from the last optimum, :data:`WIDTHS_REFINE`) up to ``harmonics``.
@@ -388,13 +402,17 @@ def ladder(make, x_ideal: np.ndarray, harmonics: int, start: int):
         pr = make(n)
         x = _pad(x, n)
         coarse = ex
-        x, ex, runs = maximize(pr, x, WIDTHS if i == 0 else WIDTHS_REFINE)
+        x, ex, runs = maximize(pr, x, WIDTHS if i == 0 else WIDTHS_REFINE, limit)
         log.append((n, ex, runs))
     return x, ex, coarse, log
 
 
+#: the torque limit holds on the grid to this fraction of it
+LIMIT_TOL = 1e-7
+
+
 def torque_limited(problem: ElectricalProblem, x0: np.ndarray, limit: float, *,
-                   tol: float = 1e-7, max_outer: int = 40):
+                   tol: float = LIMIT_TOL, max_outer: int = 40):
     """Maximize the problem's objective subject to ``|tau| <= limit`` on its grid by an
     augmented Lagrangian (PHR): each outer step a trust-region Newton solve of the
     penalized objective (exact gradient and Hessian), then ``lam <- max(0, lam + rho g)``,
