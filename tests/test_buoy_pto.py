@@ -264,3 +264,21 @@ def test_default_design_with_a_torque_limit():
     assert r.power_w == pytest.approx(37.7476, rel=1e-5)
     assert 254.9 <= r.peak_torque_nm <= 254.95 * (1 + TORQUE_SLACK)
     assert r.energy_balance_residual <= BALANCE_TOL
+
+
+def test_no_electrical_power_is_no_power():
+    """A design whose best motion loses energy through the take-off: status no_power, the
+    message names the efficiency (the CLI's one line)."""
+    from test_buoy_kernel import HYDRO as HEAVY_BUOY
+
+    from parapend.buoy.api import _result, _solve
+
+    p = Pendulum(500.0, 1.0, 600.0, 60.0)
+    wave = Wave.regular(1.5, 6.0)
+    sol, _, notes = _solve(HEAVY_BUOY, p, wave, winding=1, harmonics=6, torque_limit=None,
+                           efficiency=(0.9, 0.8), one_way=False)
+    assert sol.power > 0 >= sol.electrical_power
+    r = _result(HEAVY_BUOY, None, p, wave, {"kind": "regular"}, sol, None,
+                torque_limit=None, efficiency=(0.9, 0.8), winding=1, notes=notes)
+    assert r.status == "no_power" and not r.success
+    assert r.message.startswith("no electrical power")

@@ -415,6 +415,7 @@ def _result(h, width, pendulum, wave, wave_info, sol, ow, *, torque_limit, effic
                      f"{float(np.max(h.omega)):.4g} rad/s: there A is held and B = F = 0")
     owp = None if ow is None else float(ow.power)
     ep = sol.electrical_power
+    harvest = p if ep is None else float(ep)  # what the design delivers
     eff = None if sol.efficiency is None else [float(v) for v in sol.efficiency]
     efields = {} if ep is None else {
         "electrical_power_w": float(ep), "pto_loss_w": p - float(ep),
@@ -431,9 +432,9 @@ def _result(h, width, pendulum, wave, wave_info, sol, ow, *, torque_limit, effic
         one_way_power_w=owp, one_way_ratio=owp / p if owp is not None and p > 0 else None,
         free_heave_amplitude_m=_half_range(free_heave(h, wave, t)),
         energy_balance_residual=float(sol.energy_balance_residual), harmonics=n,
-        winding=int(winding), success=bool(sol.success) and p > 0,
-        status=str(sol.status) if p > 0 else "no_power",
-        message=_message(sol, p, pendulum), wave=wave_info,
+        winding=int(winding), success=bool(sol.success) and harvest > 0,
+        status=str(sol.status) if harvest > 0 else "no_power",
+        message=_message(sol, p, pendulum, ep), wave=wave_info,
         pendulum={"mass_kg": pendulum.mass, "length_m": pendulum.length,
                   "inertia_kg_m2": pendulum.inertia,
                   "damping_coefficient_nm_s_per_rad": pendulum.damping_coefficient},
@@ -442,7 +443,11 @@ def _result(h, width, pendulum, wave, wave_info, sol, ow, *, torque_limit, effic
         **efields)
 
 
-def _message(sol, p, pendulum) -> str:
+def _message(sol, p, pendulum, electrical=None) -> str:
+    if electrical is not None and p > 0 >= electrical:
+        return (f"no electrical power: through this take-off every motion found costs more "
+                f"than it harvests (best electrical power {electrical:.3g} W, mechanical "
+                f"{p:.3g} W); raise the efficiency or lower the damping")
     if p > 0:
         return str(getattr(sol, "message", "") or sol.status)
     return (f"the pendulum cannot rotate with positive power in this wave (best P = {p:.3g} W): "

@@ -143,7 +143,8 @@ def _cmd_buoy(a) -> dict | str:
     r = _run(a)
     sweep = hasattr(r, "period_s")
     if not sweep and r.status == "no_power":
-        raise ParameterError(f"damping-coefficient: {r.message}")
+        name = "efficiency" if r.message.startswith("no electrical") else "damping-coefficient"
+        raise ParameterError(f"{name}: {r.message}")
     written = []
     if a.save:
         _output.write_dataset(r.to_dataset(), a.save)
