@@ -25,6 +25,13 @@ depends on ``u = cos(theta)`` only, and a rotation can approach any measurable
 ``u(t)`` in ``[-1, 1]`` (fast turns cost nothing without damping), so the supremum is the
 concave box-constrained quadratic programme over ``u``, solved on a fine grid; without the
 box its value is the radiation bound.
+
+A power take-off (:mod:`.pto`), from the ideal optimum: an efficiency makes the motion
+maximize the electrical power (a smoothed kink with a continuation in its width and in the
+harmonics, trust-region Newton on the exact derivatives; the result's electrical power is
+evaluated exactly on a fine grid); a torque limit is imposed at every grid point by an
+augmented Lagrangian with the same inner solver, at N and 2N, and the peak between the grid
+points is checked on the motion's dense evaluation. Both together: the limit at every width.
 """
 
 from __future__ import annotations

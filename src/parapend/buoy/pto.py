@@ -12,14 +12,19 @@ circulant operator of the pendulum's reaction on the buoy, harmonics ``-(kw)^4 m
 every harmonic of the grid; ``L = 0`` one-way). The objective ``<e(p)>`` is not smooth at
 ``p = 0``; it is maximized over the Fourier coefficients of ``theta`` with the kink smoothed,
 ``|p| ~ sqrt(p^2 + s^2)`` (concave in ``p`` as ``b <= 0``, and below ``e`` by at most
-``|b| s``), by the safeguarded Newton method of :mod:`parapend.optimal.fourier` with the exact
-gradient and Hessian (below) and a continuation ``s -> 0``; every iterate's exact
-(unsmoothed) value decides which one is returned.
+``|b| s``), by a trust-region Newton method (SciPy's ``trust-exact`` on the dense Hessian,
+``trust-krylov`` on Hessian-vector products) with the exact gradient and Hessian (below)
+and a continuation ``s -> 0`` (:func:`maximize`) and in the harmonics (:func:`ladder`);
+every iterate's exact (unsmoothed) value decides which one is returned.
+
+A torque limit ``|tau| <= T`` at the grid points is an augmented Lagrangian on the same
+objective (:func:`torque_limited`): the penalty's derivatives are those of ``tau`` again.
 
 Derivatives, with ``phi_i`` the basis of ``theta``, ``d1_i``, ``d2_i`` its derivatives in
 ``s = w t``, ``q = z'' / g`` and everything non-dimensional (:mod:`.coupled`)::
 
-    dtau_i = Om^2 d2_i + gamma Om d1_i - (1 + q) cos(theta) phi_i + sin(theta) L(sin(theta) phi_i)
+    dtau_i = Om^2 d2_i + gamma Om d1_i - (1 + q) cos(theta) phi_i
+             + sin(theta) L(sin(theta) phi_i)
     dp_i   = -(dtau_i theta' + tau Om d1_i)
     H d    = <e'' dp[d] dp_i> + <e' d2p_i[d]>
 
@@ -35,9 +40,9 @@ import math
 import numpy as np
 
 from ..errors import ParameterError
-from ..optimal.fourier import HessianOperator
 
-__all__ = ["ElectricalProblem", "efficiency_pair", "electrical_power"]
+__all__ = ["ElectricalProblem", "efficiency_pair", "electrical_power", "ladder", "maximize",
+           "torque_limited"]
 
 
 def efficiency_pair(efficiency) -> tuple[float, float] | None:
@@ -83,21 +88,19 @@ def electrical_power(p: np.ndarray, eta: tuple[float, float]) -> tuple[float, fl
     return eta[0] * pos - neg / eta[1], pos, neg
 
 
-class _Operator(HessianOperator):
-    """The electrical Hessian as an operator (for the matrix-free Newton-CG)."""
+class _Operator:
+    """The Hessian as an operator: ``matvec`` (for ``trust-krylov``) and ``dense`` (tests)."""
 
-    def __init__(self, problem, state, diagonal):
+    def __init__(self, problem, state, size):
         self.problem = problem
         self.state = state
-        self.diagonal = diagonal
-        self.mostly_positive = False
-        self.gw = 0.0
+        self.size = size
 
     def matvec(self, d):
         return self.problem.hessp(self.state, d)
 
     def dense(self):
-        return self.problem.hessp(self.state, np.eye(self.diagonal.size))
+        return self.problem.hessp(self.state, np.eye(self.size))
 
 
 class ElectricalProblem:
@@ -124,7 +127,7 @@ class ElectricalProblem:
         self.winding = base.winding
         self.omega = base.omega
         self.gamma = base.gamma
-        self.w = base.w  # the scale newton_maximize reads
+        self.w = base.w  # the excitation's scale (tolerances)
         self.hessian = base.hessian if hessian is None else hessian
         self.gk = np.asarray(gk, dtype=complex)
         self.qw = base.excitation.q_grid(base.points)
@@ -193,6 +196,9 @@ class ElectricalProblem:
 
     def _e(self, p):
         s = self.width
+        if s == 0.0 or self.b == 0.0:  # the kink itself (one-sided derivatives)
+            return (self.a * p + self.b * np.abs(p), self.a + self.b * np.sign(p),
+                    np.zeros_like(p))
         r = np.sqrt(p * p + s * s)
         return self.a * p + self.b * r, self.a + self.b * p / r, self.b * s * s / r**3
 
@@ -273,16 +279,7 @@ class ElectricalProblem:
         g = (self._dtau_t(st, wt) + self._project(np.zeros(m), -om * e1 * st["tau"])) / m
         nx = 2 * self.harmonics + 1
         if self.hessian == "operator":
-            # a diagonal for the preconditioner: <|e''|> times the size of dp_i^2, plus |a|
-            # times the mechanical curvature
-            kk = np.concatenate(([0.0], self._kn[1:], self._kn[1:]))
-            scale = 0.5 * float(np.mean(np.abs(e2) * st["thd"] ** 2)) * (
-                om * om * kk * kk + 1.0) ** 2
-            mech = float(np.mean(np.abs(self.qw))) + self.gamma * om * om * kk * kk
-            if self.limit is not None:
-                scale = scale + 0.5 * float(np.mean(np.abs(st["ph2"]))) * (
-                    om * om * kk * kk + 1.0) ** 2
-            return val, g, _Operator(self, st, scale + abs(self.a) * mech)
+            return val, g, _Operator(self, st, nx)
         h = self.hessp(st, np.eye(nx))
         h = 0.5 * (h + h.T)
         return val, g, h
