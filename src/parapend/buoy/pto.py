@@ -346,7 +346,7 @@ def maximize(problem: ElectricalProblem, x0: np.ndarray, widths=None, limit=None
         best = -math.inf
         for rel in widths:
             problem.width = rel * p0
-            x, _, viol, _, inner, status = torque_limited(problem, x, limit)
+            x, _, viol, _, inner, status = torque_limited(problem, x, limit, warm=True)
             ex = problem.exact(x)
             runs.append((rel * p0, ex, status, inner))
             if math.isfinite(ex) and ex >= best and viol <= LIMIT_TOL * limit:
@@ -409,7 +409,7 @@ LIMIT_TOL = 1e-7
 
 
 def torque_limited(problem: ElectricalProblem, x0: np.ndarray, limit: float, *,
-                   tol: float = LIMIT_TOL, max_outer: int = 40):
+                   tol: float = LIMIT_TOL, max_outer: int = 40, warm: bool = False):
     """Maximize the problem's objective subject to ``|tau| <= limit`` on its grid by an
     augmented Lagrangian (PHR): each outer step a trust-region Newton solve of the
     penalized objective (exact gradient and Hessian), then ``lam <- max(0, lam + rho g)``,
@@ -417,7 +417,8 @@ def torque_limited(problem: ElectricalProblem, x0: np.ndarray, limit: float, *,
 
     Returns ``(x, objective, violation, outer, inner, status)``: ``violation`` the largest
     ``max |tau| - limit`` on the grid at ``x``; status "converged" when it is at most
-    ``tol * limit`` and the last inner solve converged.
+    ``tol * limit`` and the last inner solve converged. ``warm``: keep the multipliers and
+    the penalty the problem holds for this limit (a continuation).
     """
     from scipy.optimize import minimize
 
@@ -425,8 +426,8 @@ def torque_limited(problem: ElectricalProblem, x0: np.ndarray, limit: float, *,
     st = problem.state(x)
     scale = max(float(np.max(np.abs(problem.w))), 1e-300)
     p0 = max(abs(float(np.mean(problem._e(st["p"])[0]))), 1e-3 * scale)
-    rho = 10.0 * p0 / limit**2
-    problem.set_limit(limit, rho)
+    if not (warm and problem.limit == limit):
+        problem.set_limit(limit, 10.0 * p0 / limit**2)
     gtol = 1e-10 * scale
     dense = problem.hessian != "operator"
     viol_prev = math.inf
