@@ -282,3 +282,39 @@ def test_no_electrical_power_is_no_power():
                 torque_limit=None, efficiency=(0.9, 0.8), winding=1, notes=notes)
     assert r.status == "no_power" and not r.success
     assert r.message.startswith("no electrical power")
+
+
+@pytest.mark.slow
+def test_no_power_design_agrees_with_optimize_pto():
+    """A design that cannot generate through an unequal take-off (0.69 generating, 0.96
+    motoring): the one-way electrical optimum is negative and equals optimize_pto's
+    (status no_power there)."""
+    p = Pendulum(44.4, 0.46, 1.5 * 44.4 * 0.46**2, 2.04)
+    wave = Wave.regular(0.2, 2.28)
+    r = coupled_optimum(HYDRO, p, wave, one_way=True, harmonics=12, efficiency=(0.69, 0.96))
+    sc = scales(HYDRO, p, wave, coupled=False)
+    q1 = sc.q_spec[1]
+    o = parapend.pto.optimize_pto(efficiency_generating=0.69, efficiency_motoring=0.96,
+                                  harmonics=24, omega=sc.omega_nd, gamma=sc.gamma,
+                                  fourier=[(1, abs(q1), np.angle(q1) + np.pi / 2)])
+    assert o.status == "no_power"
+    assert r.electrical_power < 0 < r.ideal_power
+    assert r.electrical_power == pytest.approx(o.electrical_power * sc.power_unit, rel=1e-4)
+
+
+@pytest.mark.slow
+def test_invariants_over_random_designs():
+    """Seeded random designs and take-offs: electrical <= eta_g x ideal, <= mechanical,
+    generated - motoring = mechanical, and the energy balance, success or not."""
+    rng = np.random.default_rng(5)
+    for _ in range(6):
+        m, length = rng.uniform(5, 150), rng.uniform(0.15, 0.5)
+        p = Pendulum(m, length, rng.uniform(1, 2) * m * length**2, rng.uniform(0.1, 3))
+        eta = (rng.uniform(0.6, 1), rng.uniform(0.6, 1))
+        r = coupled_optimum(HYDRO, p, Wave.regular(0.2, rng.uniform(1.5, 2.4)),
+                            harmonics=6, starts=4, efficiency=eta)
+        assert r.electrical_power <= eta[0] * r.ideal_power + 1e-9 * abs(r.ideal_power)
+        assert r.electrical_power <= r.power + 1e-12
+        assert r.generated_power - r.motoring_power == pytest.approx(r.power, rel=1e-9,
+                                                                     abs=1e-12)
+        assert r.energy_balance_residual <= BALANCE_TOL
