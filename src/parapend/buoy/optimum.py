@@ -31,7 +31,8 @@ maximize the electrical power (a smoothed kink with a continuation in its width 
 harmonics, trust-region Newton on the exact derivatives; the result's electrical power is
 evaluated exactly on a fine grid); a torque limit is imposed at every grid point by an
 augmented Lagrangian with the same inner solver, at N and 2N, and the peak between the grid
-points is checked on the motion's dense evaluation. Both together: the limit at every width.
+points is checked on the motion's dense evaluation. Both together: the limit at every width
+of the last two harmonic stages.
 """
 
 from __future__ import annotations
@@ -600,7 +601,8 @@ def coupled_optimum(hydro, pendulum: Pendulum, wave: Wave, *, winding: int = 1,
         Maximize the electrical power ``<e(p)>`` instead (:mod:`.pto`): a smoothed kink with
         a continuation to zero width and in the harmonics (N/4 to N), started from the ideal
         optimum; its exact value on a fine grid is ``electrical_power``. With
-        ``torque_limit`` every width is solved under the limit. 1 both ways is the ideal
+        ``torque_limit`` every width of the last two harmonic stages is solved under the
+        limit. 1 both ways is the ideal
         problem (the ideal optimum is returned).
     starts : int or None
         At most this many seeds of the global search (None: all).
@@ -664,7 +666,8 @@ def coupled_optimum(hydro, pendulum: Pendulum, wave: Wave, *, winding: int = 1,
         n = elec["harmonics"]
     if torque_limit is not None and elec is not None:
         tl_note = (f"torque limit {torque_limit:g} N m imposed on the electrical optimum "
-                   "(augmented Lagrangian at every width)")
+                   "(augmented Lagrangian at every width of the last two harmonic "
+                   "stages)")
     elif torque_limit is not None:
         tl = _limited(hydro, pendulum, wave, sc, exc, sol.x, problem_n.harmonics, n2, k,
                       regular, torque_limit / sc.torque_unit, not one_way)

@@ -383,7 +383,8 @@ def ladder(make, x_ideal: np.ndarray, harmonics: int, start: int, limit=None):
     the full width continuation with ``start`` terms from the ideal optimum cut to them,
     then doubling (each from the last optimum, :data:`WIDTHS_REFINE`) up to ``harmonics``.
 
-    ``make(n)`` builds the :class:`ElectricalProblem` with ``n`` harmonics. Returns ``(x,
+    ``limit``: ``|tau| <= limit`` on the grid in the last two stages. ``make(n)`` builds the
+    :class:`ElectricalProblem` with ``n`` harmonics. Returns ``(x,
     exact, coarse_exact, log)``: the optimum, its exact value on its grid, the value one
     doubling before (None when ``start == harmonics``) and per stage ``(n, exact, runs)``.
     """
@@ -399,7 +400,10 @@ def ladder(make, x_ideal: np.ndarray, harmonics: int, start: int, limit=None):
         pr = make(n)
         x = _pad(x, n)
         coarse = ex
-        x, ex, runs = maximize(pr, x, WIDTHS if i == 0 else WIDTHS_REFINE, limit)
+        # the limit in the last two stages (the refinement compares limited optima); the
+        # first stages only find the basin
+        lim = limit if i >= len(ns) - 2 else None
+        x, ex, runs = maximize(pr, x, WIDTHS if i == 0 else WIDTHS_REFINE, lim)
         log.append((n, ex, runs))
     return x, ex, coarse, log
 
