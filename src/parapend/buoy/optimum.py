@@ -602,8 +602,7 @@ def coupled_optimum(hydro, pendulum: Pendulum, wave: Wave, *, winding: int = 1,
         a continuation to zero width and in the harmonics (N/4 to N), started from the ideal
         optimum; its exact value on a fine grid is ``electrical_power``. With
         ``torque_limit`` every width of the last two harmonic stages is solved under the
-        limit. 1 both ways is the ideal
-        problem (the ideal optimum is returned).
+        limit. 1 both ways is the ideal problem (the ideal optimum is returned).
     starts : int or None
         At most this many seeds of the global search (None: all).
     one_way : bool
