@@ -264,8 +264,8 @@ def test_bad_input_with_a_dataset(sphere_nc, capsys, tmp_path):
                 "cannot rotate")
     assert err.startswith("parapend buoy: error: damping-coefficient")
     _fail(["--hydro", sphere_nc, "--radius", "1", *save], capsys, tmp_path, "radius")
-    # no take-off efficiency with the buoy yet: one line says so
-    _fail(["--hydro", sphere_nc, "--wave-period", str(PERIOD), *PEND, "--efficiency", "0.9",
+    # an efficiency outside (0, 1]: one line says so
+    _fail(["--hydro", sphere_nc, "--wave-period", str(PERIOD), *PEND, "--efficiency", "1.1",
            *save], capsys, tmp_path, "efficiency")
     # the design search needs a design variable for its bounds, and one wave period
     _fail(["--hydro", sphere_nc, "--wave-period", "1.1:1.5:3", "--optimize-design", "length",

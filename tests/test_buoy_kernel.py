@@ -162,8 +162,8 @@ def test_not_yet_supported_and_bad_input():
     wave = Wave.regular(1.5, 6.0)
     with pytest.raises(ParameterError, match="torque-limit: expected a positive"):
         coupled_optimum(HYDRO, p, wave, torque_limit=-1.0)
-    with pytest.raises(ParameterError, match="efficiency: not yet supported"):
-        coupled_optimum(HYDRO, p, wave, efficiency=0.9)
+    with pytest.raises(ParameterError, match="efficiency: expected numbers in"):
+        coupled_optimum(HYDRO, p, wave, efficiency=1.5)
     with pytest.raises(ParameterError, match="inertia"):
         Pendulum(500.0, 1.0, 400.0)
     with pytest.raises(ParameterError, match="mass"):

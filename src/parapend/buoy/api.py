@@ -65,6 +65,14 @@ class BuoyResult(_Result):
     wave, pendulum, body : what was solved (dicts of SI numbers and descriptions).
     design : the outer search of ``optimize_design`` (None without it).
     warnings : notes on the result (retained harmonics above the dataset's frequencies).
+    efficiency : ``[eta_g, eta_m]`` of the power take-off (None: ideal). With it the motion
+        maximizes the electrical power, and ``power_w`` is that motion's mechanical power.
+    electrical_power_w : ``<e(p)>``, ``e = eta_g p`` generating, ``p / eta_m`` motoring.
+    pto_loss_w : ``power_w - electrical_power_w``, the take-off's losses.
+    generated_power_w, motoring_power_w : ``<max(p, 0)>`` and ``<max(-p, 0)>``.
+    ideal_power_w : the ideal (lossless) coupled optimum; ``electrical_power_w <= eta_g
+        ideal_power_w``.
+    one_way_electrical_power_w : the one-way answer's electrical optimum.
     """
 
     power_w: float
@@ -89,9 +97,15 @@ class BuoyResult(_Result):
     pendulum: dict
     body: dict
     torque_limit_nm: float | None
-    efficiency: float | None
+    efficiency: list | None
     design: dict | None
     warnings: list
+    electrical_power_w: float | None = None
+    pto_loss_w: float | None = None
+    generated_power_w: float | None = None
+    motoring_power_w: float | None = None
+    ideal_power_w: float | None = None
+    one_way_electrical_power_w: float | None = None
     _solution: object = field(default=None, repr=False)
     _one_way: object = field(default=None, repr=False)
     _hydro: object = field(default=None, repr=False)
@@ -133,7 +147,8 @@ class BuoyResult(_Result):
 @dataclass(frozen=True, eq=False)
 class BuoySweepResult(_Result):
     """Power of one design against wave period (``wave_period="FROM:TO:N"``), regular waves
-    of one height: arrays over ``period_s``, each field named with its unit."""
+    of one height: arrays over ``period_s``, each field named with its unit
+    (``electrical_power_w`` with an efficiency, else None)."""
 
     period_s: np.ndarray
     power_w: np.ndarray
@@ -152,6 +167,7 @@ class BuoySweepResult(_Result):
     body: dict
     warnings: list
     _results: tuple = field(default=(), repr=False)
+    electrical_power_w: np.ndarray | None = None
 
     def to_dataset(self):
         """The sweep as an ``xarray.Dataset`` over ``period_s`` (what ``--save`` writes)."""
@@ -163,6 +179,9 @@ class BuoySweepResult(_Result):
         ds = xr.Dataset({k: ("period_s", np.asarray(getattr(self, k), dtype=float))
                          for k in names}, coords={"period_s": self.period_s})
         ds["status"] = ("period_s", np.asarray(self.status, dtype=str))
+        if self.electrical_power_w is not None:
+            ds["electrical_power_w"] = ("period_s", np.asarray(self.electrical_power_w,
+                                                               dtype=float))
         for k in ("success", "wave_height_m", "pendulum", "body", "warnings"):
             ds.attrs[k] = _attr(getattr(self, k))
         return ds
@@ -395,6 +414,16 @@ def _result(h, width, pendulum, wave, wave_info, sol, ow, *, torque_limit, effic
                      f"above) lie above the dataset's highest frequency "
                      f"{float(np.max(h.omega)):.4g} rad/s: there A is held and B = F = 0")
     owp = None if ow is None else float(ow.power)
+    ep = sol.electrical_power
+    harvest = p if ep is None else float(ep)  # what the design delivers
+    eff = None if sol.efficiency is None else [float(v) for v in sol.efficiency]
+    efields = {} if ep is None else {
+        "electrical_power_w": float(ep), "pto_loss_w": p - float(ep),
+        "generated_power_w": float(sol.generated_power),
+        "motoring_power_w": float(sol.motoring_power),
+        "ideal_power_w": float(sol.ideal_power),
+        "one_way_electrical_power_w": None if ow is None or ow.electrical_power is None
+        else float(ow.electrical_power)}
     return BuoyResult(
         power_w=p, heave_amplitude_m=_half_range(s["z"]), peak_torque_nm=float(sol.peak_torque()),
         radiation_bound_w=bound, bound_fraction=p / bound if bound > 0 else None,
@@ -403,17 +432,22 @@ def _result(h, width, pendulum, wave, wave_info, sol, ow, *, torque_limit, effic
         one_way_power_w=owp, one_way_ratio=owp / p if owp is not None and p > 0 else None,
         free_heave_amplitude_m=_half_range(free_heave(h, wave, t)),
         energy_balance_residual=float(sol.energy_balance_residual), harmonics=n,
-        winding=int(winding), success=bool(sol.success) and p > 0,
-        status=str(sol.status) if p > 0 else "no_power",
-        message=_message(sol, p, pendulum), wave=wave_info,
+        winding=int(winding), success=bool(sol.success) and harvest > 0,
+        status=str(sol.status) if harvest > 0 else "no_power",
+        message=_message(sol, p, pendulum, ep), wave=wave_info,
         pendulum={"mass_kg": pendulum.mass, "length_m": pendulum.length,
                   "inertia_kg_m2": pendulum.inertia,
                   "damping_coefficient_nm_s_per_rad": pendulum.damping_coefficient},
-        body=_body_info(h, width), torque_limit_nm=torque_limit, efficiency=efficiency,
-        design=design, warnings=notes, _solution=sol, _one_way=ow, _hydro=h, _wave=wave)
+        body=_body_info(h, width), torque_limit_nm=torque_limit, efficiency=eff,
+        design=design, warnings=notes, _solution=sol, _one_way=ow, _hydro=h, _wave=wave,
+        **efields)
 
 
-def _message(sol, p, pendulum) -> str:
+def _message(sol, p, pendulum, electrical=None) -> str:
+    if electrical is not None and p > 0 >= electrical:
+        return (f"no electrical power: through this take-off every motion found costs more "
+                f"than it harvests (best electrical power {electrical:.3g} W, mechanical "
+                f"{p:.3g} W); raise the efficiency or lower the damping")
     if p > 0:
         return str(getattr(sol, "message", "") or sol.status)
     return (f"the pendulum cannot rotate with positive power in this wave (best P = {p:.3g} W): "
@@ -450,7 +484,10 @@ def buoy(*, wave_height=None, wave_period=None, hs=None, tp=None, spectrum="jons
     hydro : a NetCDF dataset of a Capytaine run (docs/buoy.md: bring your own).
     winding : turns of the pendulum per wave (per record for an irregular sea).
     harmonics : N of the motion (default chosen from the problem and checked).
-    torque_limit : N m; efficiency : of the power take-off (as ``pto-curve``).
+    torque_limit : N m.
+    efficiency : of the power take-off: a number in (0, 1] (both ways), a pair ``(eta_g,
+        eta_m)`` or the text ``"ETA_G,ETA_M"``: the motion maximizes the electrical power
+        (docs/buoy.md), within ``torque_limit`` if given.
     optimize_design : comma list of pendulum parameters to choose (``"length,inertia"``)
         for the largest coupled power, each within ``<name>_bounds`` ``"LO:HI"``.
 
@@ -489,9 +526,11 @@ def buoy(*, wave_height=None, wave_period=None, hs=None, tp=None, spectrum="jons
     if torque_limit is not None:
         torque_limit = check_positive("torque-limit", torque_limit)
     if efficiency is not None:
-        efficiency = check_range("efficiency", efficiency, 0.0, 1.0, why="PTO efficiency")
-        if efficiency == 0:
-            raise ParameterError("efficiency: expected a value in (0, 1], got 0")
+        from .pto import efficiency_pair
+
+        efficiency = efficiency_pair(efficiency)
+        if efficiency == (1.0, 1.0):
+            efficiency = None  # lossless: the ideal problem
     variables, bounds = _design_request(optimize_design, pend, mass_bounds=mass_bounds,
                                         length_bounds=length_bounds,
                                         inertia_bounds=inertia_bounds,

@@ -105,7 +105,10 @@ def optimize_design(solve, pendulum, variables, bounds, *, check=None) -> Design
             if check is not None:
                 check(p)
             sol = solve(p)
-            val = float(sol.power) if sol.success else -math.inf
+            # with an efficiency the electrical optimum's electrical power
+            elec = getattr(sol, "electrical_power", None)
+            best = sol.power if elec is None else elec
+            val = float(best) if sol.success else -math.inf
             if not sol.success:
                 failed[0] += 1
         except ParameterError:
@@ -195,4 +198,5 @@ def period_sweep(hydro, width, pendulum, height, periods, *, winding=1, harmonic
         energy_balance_residual=col("energy_balance_residual"),
         status=[r.status for r in rows], success=all(r.success for r in rows),
         wave_height_m=height, pendulum=rows[0].pendulum, body=rows[0].body, warnings=notes,
-        _results=tuple(rows))
+        _results=tuple(rows),
+        electrical_power_w=None if efficiency is None else col("electrical_power_w"))

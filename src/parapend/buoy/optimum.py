@@ -25,6 +25,14 @@ depends on ``u = cos(theta)`` only, and a rotation can approach any measurable
 ``u(t)`` in ``[-1, 1]`` (fast turns cost nothing without damping), so the supremum is the
 concave box-constrained quadratic programme over ``u``, solved on a fine grid; without the
 box its value is the radiation bound.
+
+A power take-off (:mod:`.pto`), from the ideal optimum: an efficiency makes the motion
+maximize the electrical power (a smoothed kink with a continuation in its width and in the
+harmonics, trust-region Newton on the exact derivatives; the result's electrical power is
+evaluated exactly on a fine grid); a torque limit is imposed at every grid point by an
+augmented Lagrangian with the same inner solver, at N and 2N, and the peak between the grid
+points is checked on the motion's dense evaluation. Both together: the limit at every width
+of the last two harmonic stages.
 """
 
 from __future__ import annotations
@@ -53,6 +61,15 @@ HARMONICS_PER_TURN = 24
 HARMONICS_PER_WAVE = 16
 #: a torque-limited optimum may exceed the limit between its grid points by this fraction
 TORQUE_SLACK = 1e-3
+#: change of the electrical power between a fine grid and one twice as fine, relative to
+#: ``<|p|>``, above which the electrical optimum is not a success
+ELECTRICAL_GRID_TOL = 1e-6
+#: relative change of the electrical optimum from N/2 to N harmonics above which the status
+#: says so
+ELECTRICAL_REFINE_TOL = 1e-3
+#: relative change of the exact electrical power over the last two widths of the
+#: continuation below which it counts as converged
+ELECTRICAL_SETTLED = 1e-5
 #: dense Hessian for a regular wave up to this many harmonics, matrix-free Newton-CG above
 #: and for every record (the dense Newton from the swinging-back seeds took minutes at N = 192)
 DENSE_MAX = 96
@@ -95,6 +112,19 @@ class CoupledSolution:
         Change of ``limit`` under one refinement of its grid, W.
     free_heave : ndarray, complex
         The free buoy's ``Z_k = F_k a_k / D_k``, k = 0..K (m).
+    efficiency : (eta_g, eta_m) or None
+        With an efficiency the motion maximizes the electrical power and ``power`` is its
+        mechanical power; None: the ideal (mechanical) optimum.
+    electrical_power : float or None
+        ``<e(p)>``, ``e(p) = eta_g p`` generating, ``p / eta_m`` motoring, W (the kink
+        integrated exactly on a fine grid's piecewise-linear ``p``).
+    ideal_power : float or None
+        The ideal (lossless) optimum's mechanical power, W: a bound, as ``e(p) <= eta_g p``
+        gives ``electrical_power <= eta_g ideal_power``.
+    generated_power, motoring_power : float or None
+        ``<max(p, 0)>`` and ``<max(-p, 0)>``, W (their difference is ``power``).
+    electrical_refinement_change : float or None
+        Change of the electrical optimum from N/2 to N harmonics, W.
     """
 
     success: bool
@@ -116,6 +146,12 @@ class CoupledSolution:
     _full_heave: np.ndarray = field(default=None, repr=False)
     _pendulum: Pendulum = field(default=None, repr=False)
     _g: float = 9.81
+    efficiency: tuple | None = None
+    electrical_power: float | None = None
+    ideal_power: float | None = None
+    generated_power: float | None = None
+    motoring_power: float | None = None
+    electrical_refinement_change: float | None = None
 
     @property
     def period(self) -> float:
@@ -322,9 +358,6 @@ def _check_args(winding, harmonics, torque_limit, efficiency, starts):
             and torque_limit > 0):
         raise ParameterError(f"torque-limit: expected a positive torque in N m, got "
                              f"{torque_limit!r}")
-    if efficiency is not None:
-        raise ParameterError("efficiency: not yet supported with the buoy (the ideal coupled "
-                             "optimum only); drop --efficiency")
     k = check_int("winding", winding, 1, 4096)
     n = None if harmonics is None else check_int("harmonics", harmonics, 1, 8192)
     if n is not None and n < 2 * k:
@@ -464,21 +497,72 @@ class _Torque:
         return tau, jac.T
 
 
-def _torque_limited(problem, x0, limit_nd, torque):
-    """Maximize P subject to ``|tau| <= limit`` on the grid (SLSQP, exact gradients)."""
-    from scipy.optimize import minimize
+def _limited(hydro, pendulum, wave, sc, exc, x_ideal, n, n2, k, regular, limit_nd, coupled):
+    """The torque-limited optimum (:func:`parapend.buoy.pto.torque_limited`) with ``n``
+    harmonics from the ideal optimum, then with ``n2`` from that; None when the ideal
+    optimum already keeps ``|tau| <= limit`` on the ``n2`` grid."""
+    from .pto import ElectricalProblem, torque_limited
 
-    def f(x):
-        p, g, _ = problem.evaluate(x)
-        return -p, -g
+    def make(nn):
+        hess = "dense" if regular and nn <= DENSE_MAX else "operator"
+        base = CoupledProblem(exc, sc.beta_nd, nn, sc.gamma, winding=k, hessian=hess)
+        return ElectricalProblem(base, _Torque(base, hydro, pendulum, wave, coupled).gk,
+                                 (1.0, 1.0), 0.0)
 
-    cons = [{"type": "ineq", "fun": lambda x: limit_nd - torque(x)[0],
-             "jac": lambda x: -torque(x)[1]},
-            {"type": "ineq", "fun": lambda x: limit_nd + torque(x)[0],
-             "jac": lambda x: torque(x)[1]}]
-    r = minimize(f, x0, jac=True, method="SLSQP", constraints=cons,
-                 options={"maxiter": 500, "ftol": 1e-13})
-    return r
+    pf = make(n2)
+    if float(np.max(np.abs(pf.state(_pad(x_ideal, n2))["tau"]))) <= limit_nd:
+        return None
+    pc = make(n)
+    xc, oc, _, out_c, in_c, st_c = torque_limited(pc, _pad(x_ideal, n), limit_nd)
+    xf, of, _, out_f, in_f, st_f = torque_limited(pf, _pad(xc, n2), limit_nd)
+    ok = st_c == "converged" and st_f == "converged"
+    return {"x": xf, "power": of, "change": abs(of - oc), "points": pf.points,
+            "status": "converged" if ok else "stalled", "outer": out_c + out_f,
+            "inner": in_c + in_f}
+
+
+def _electrical(hydro, pendulum, wave, sc, exc, x_ideal, n, k, regular, eta, coupled,
+                limit=None):
+    """The electrical optimum with ``n`` harmonics (:func:`parapend.buoy.pto.ladder` from
+    the ideal optimum ``x_ideal``): a dict of the motion, its exact electrical and
+    mechanical power (non-dimensional, on its grid) and the status."""
+    from .pto import ElectricalProblem, ladder
+
+    def make(nn):
+        hess = "dense" if regular and nn <= DENSE_MAX else "operator"
+        base = CoupledProblem(exc, sc.beta_nd, nn, sc.gamma, winding=k, hessian=hess)
+        return ElectricalProblem(base, _Torque(base, hydro, pendulum, wave, coupled).gk, eta,
+                                 0.0)
+
+    start = max(2 * k, n // 4)
+    x, ex, coarse, log = ladder(make, x_ideal, n, start, limit)
+    pr = make(n)
+    last = [r[1] for r in log[-1][2] if math.isfinite(r[1])]
+    settled = len(last) >= 2 and abs(last[-1] - last[-2]) <= ELECTRICAL_SETTLED * max(
+        abs(ex), 1e-300)
+    return {"x": x, "exact": ex, "coarse": coarse, "mechanical": pr.mechanical(x),
+            "status": "converged" if settled and math.isfinite(ex) else "stalled",
+            "iterations": sum(r[3] for stage in log for r in stage[2]), "points": pr.points,
+            "harmonics": n, "log": log}
+
+
+def _electrical_fine(hydro, pendulum, x, winding, omega, m, heave, eta):
+    """``(<e(p)>, <p+>, <p->, change)`` in W on ``m`` points (the kink exact on the
+    piecewise-linear ``p``), ``change`` against ``m / 2`` points."""
+    from .pto import electrical_power
+
+    out = []
+    for mm in (m // 2, m):
+        th, ths, thss = _grid_motion(x, winding, mm)
+        zf = heave[: mm // 2]
+        c = np.zeros(mm // 2 + 1, dtype=complex)
+        c[: zf.size] = -((np.arange(zf.size) * omega) ** 2) * zf * (mm / 2.0)
+        zdd = np.fft.irfft(c, mm)
+        thd = omega * ths
+        tau = (pendulum.inertia * omega**2 * thss + pendulum.damping_coefficient * thd
+               - pendulum.mass * pendulum.length * (float(hydro.g) + zdd) * np.sin(th))
+        out.append(electrical_power(-tau * thd, eta))
+    return out[1][0], out[1][1], out[1][2], abs(out[1][0] - out[0][0])
 
 
 def _distinct_maxima(runs, pu):
@@ -508,12 +592,17 @@ def coupled_optimum(hydro, pendulum: Pendulum, wave: Wave, *, winding: int = 1,
         N; None: 24 K (regular wave) or 16 per mean wave of the free heave (record), then
         checked by one refinement (the result is the ``2N`` optimum).
     torque_limit : float or None
-        ``|tau| <= torque_limit`` (N m), regular wave only: SLSQP with exact gradients of
-        ``P`` and of the torque on the grid, from the ideal optimum, at N and 2N; the peak
-        between grid points is checked (within ``TORQUE_SLACK``, else ``success`` is
-        False) and stated in ``status``.
-    efficiency : None
-        Not yet supported with the buoy (ParameterError).
+        ``|tau| <= torque_limit`` (N m), a regular wave or a record: an augmented
+        Lagrangian on the grid's torques (:func:`parapend.buoy.pto.torque_limited`: exact
+        gradient and Hessian, trust-region Newton), from the ideal optimum, at N and 2N;
+        the peak between grid points is checked (within ``TORQUE_SLACK``, else
+        ``success`` is False) and stated in ``status``.
+    efficiency : float, (eta_g, eta_m), "ETA_G[,ETA_M]" or None
+        Maximize the electrical power ``<e(p)>`` instead (:mod:`.pto`): a smoothed kink with
+        a continuation to zero width and in the harmonics (N/4 to N), started from the ideal
+        optimum; its exact value on a fine grid is ``electrical_power``. With
+        ``torque_limit`` every width of the last two harmonic stages is solved under the
+        limit. 1 both ways is the ideal problem (the ideal optimum is returned).
     starts : int or None
         At most this many seeds of the global search (None: all).
     one_way : bool
@@ -526,6 +615,9 @@ def coupled_optimum(hydro, pendulum: Pendulum, wave: Wave, *, winding: int = 1,
     if not isinstance(wave, Wave):
         raise ParameterError("wave: expected a Wave (Wave.regular or Wave.from_record)")
     k, n, starts = _check_args(winding, harmonics, torque_limit, efficiency, starts)
+    from .pto import efficiency_pair
+
+    eta = efficiency_pair(efficiency)
     _check_hydro(hydro, wave)
     regular = wave.amplitudes.size == 1
     sc = scales(hydro, pendulum, wave, coupled=not one_way)
@@ -562,30 +654,41 @@ def coupled_optimum(hydro, pendulum: Pendulum, wave: Wave, *, winding: int = 1,
             best.power)):
         sol, n = ref, n2
     tl_note = None
-    if torque_limit is not None:
-        if not regular:
-            raise ParameterError("torque-limit: supported with the buoy for a regular wave "
-                                 "only (not for a record); drop --torque-limit")
-        lim_t = torque_limit / sc.torque_unit
-        coarse = problem_n
-        tq_f = _Torque(fine, hydro, pendulum, wave, not one_way)
-        if float(np.max(np.abs(tq_f(_pad(sol.x, n2))[0]))) <= lim_t:
+    elec = None
+    if eta is not None and eta != (1.0, 1.0):
+        lim_e = None if torque_limit is None else torque_limit / sc.torque_unit
+        elec = _electrical(hydro, pendulum, wave, sc, exc, sol.x, n, k, regular, eta,
+                           not one_way, lim_e)
+        ideal_nd = sol.power
+        sol = type(sol)(elec["x"], float("nan"), 0.0, elec["iterations"], elec["status"],
+                        sol.seed, elec["points"], False)
+        n = elec["harmonics"]
+    if torque_limit is not None and elec is not None:
+        tl_note = (f"torque limit {torque_limit:g} N m imposed on the electrical optimum "
+                   "(augmented Lagrangian at every width of the last two harmonic "
+                   "stages)")
+    elif torque_limit is not None:
+        tl = _limited(hydro, pendulum, wave, sc, exc, sol.x, problem_n.harmonics, n2, k,
+                      regular, torque_limit / sc.torque_unit, not one_way)
+        if tl is None:
             tl_note = "torque limit inactive: the ideal optimum stays within it"
         else:
-            tq_c = _Torque(coarse, hydro, pendulum, wave, not one_way)
-            rc = _torque_limited(coarse, best.x, lim_t, tq_c)
-            rf = _torque_limited(fine, _pad(rc.x, n2), lim_t, tq_f)
-            change = abs(-rf.fun + rc.fun)
-            status = "converged" if (rf.success and rc.success) else "stalled"
-            sol = type(sol)(rf.x, -float(rf.fun), 0.0, int(rf.nit), status, best.seed,
-                            fine.points, False)
+            change = tl["change"]
+            sol = type(sol)(tl["x"], tl["power"], 0.0, tl["inner"], tl["status"], best.seed,
+                            tl["points"], False)
             n = n2
-            tl_note = (f"torque limit {torque_limit:g} N m active (SLSQP on the {fine.points}-"
-                       f"point grid: {rf.message})")
+            tl_note = (f"torque limit {torque_limit:g} N m active (augmented Lagrangian on "
+                       f"the {tl['points']}-point grid: {tl['status']}, {tl['outer']} "
+                       f"multiplier updates, {tl['inner']} Newton steps)")
     # fine grid: the power from the torque, the heave, the energy balance
     mf = max(4096, 4 * fine.points)
     p_w, Z, resid = _heave_and_balance(hydro, pendulum, wave, sol.x, k, mf, not one_way)
-    alias = abs(p_w - sol.power * pu) / max(abs(p_w), float(np.max(np.abs(fine.w))) * pu)
+    if elec is not None:
+        # the electrical optimum's grid: its own mechanical power there
+        alias = abs(p_w - elec["mechanical"] * pu) / max(abs(p_w),
+                                                          float(np.max(np.abs(fine.w))) * pu)
+    else:
+        alias = abs(p_w - sol.power * pu) / max(abs(p_w), float(np.max(np.abs(fine.w))) * pu)
     ok = sol.status == "converged" and resid <= BALANCE_TOL and alias <= ALIAS_TOL
     parts = [f"{'one-way' if one_way else 'coupled'} optimum: {sol.status} (found by "
              f"{sol.seed})"]
@@ -602,7 +705,30 @@ def coupled_optimum(hydro, pendulum: Pendulum, wave: Wave, *, winding: int = 1,
     if pendulum.damping_coefficient == 0:
         parts.append("c = 0: the supremum (limit) is approached by switching motions and not "
                      "attained; this finite-N power is a lower bound of it")
-    if change > 1e-6 * max(abs(sol.power), 1e-300):
+    efields = {}
+    if elec is not None:
+        e_w, gen, mot, e_chk = _electrical_fine(hydro, pendulum, sol.x, k, wave.omega,
+                                                max(mf, 16384, 1 << int(math.ceil(
+                                                    math.log2(128 * (n + k))))),
+                                                Z, eta)
+        e_change = abs(elec["exact"] - elec["coarse"]) * pu if elec["coarse"] is not None \
+            else 0.0
+        efields = {"efficiency": eta, "electrical_power": e_w, "ideal_power": ideal_nd * pu,
+                   "generated_power": gen, "motoring_power": mot,
+                   "electrical_refinement_change": e_change}
+        parts.append(f"electrical optimum (efficiency {eta[0]:g} generating, {eta[1]:g} "
+                     f"motoring): {elec['status']}, {elec['harmonics']} harmonics")
+        if e_chk > ELECTRICAL_GRID_TOL * max(gen + mot, 1e-300):
+            ok = False
+            parts.append(f"electrical power on a finer grid differs by {e_chk:.2g} W")
+        if e_change > ELECTRICAL_REFINE_TOL * max(abs(e_w), 1e-300):
+            parts.append(f"refinement N/2 -> N changed the electrical power by "
+                         f"{e_change:.3g} W")
+        if e_w > eta[0] * ideal_nd * pu * (1 + 1e-9) + 1e-12 * abs(ideal_nd * pu):
+            ok = False
+            parts.append("electrical power above eta_g times the ideal optimum: not "
+                         "resolved")
+    if elec is None and change > 1e-6 * max(abs(sol.power), 1e-300):
         parts.append(f"refinement N -> 2N changed the power by {change * pu:.3g} W")
     evid = {"starts": len(runs), "converged": sum(r.status == "converged" for r in runs),
             "abandoned": sum(r.status == "abandoned" for r in runs), "rejected_aliased":
@@ -622,7 +748,7 @@ def coupled_optimum(hydro, pendulum: Pendulum, wave: Wave, *, winding: int = 1,
         limit=float(lim_nd * pu), evidence=evid, one_way=bool(one_way),
         refinement_change=float(change * pu), limit_change=float(lim_change * pu),
         free_heave=np.asarray(sc.free_heave), omega=wave.omega, winding=k,
-        _full_heave=zfull, _pendulum=pendulum, _g=float(hydro.g))
+        _full_heave=zfull, _pendulum=pendulum, _g=float(hydro.g), **efields)
     if torque_limit is not None:
         # the limit is imposed on the solve grid: check it between the points
         peak = res.peak_torque()

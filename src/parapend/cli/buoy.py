@@ -78,8 +78,10 @@ def add_parsers(sub) -> None:
                    help="N of the motion (default chosen from the problem and checked)")
     g.add_argument("--torque-limit", type=_finite_float("torque-limit"), default=None,
                    help="largest |torque|, N m")
-    g.add_argument("--efficiency", type=_finite_float("efficiency"), default=None,
-                   help="power take-off efficiency in (0, 1]")
+    g.add_argument("--efficiency", type=_text("efficiency"), default=None,
+                   metavar="ETA_G[,ETA_M]",
+                   help="power take-off efficiency in (0, 1], generating[,motoring]: the "
+                        "motion maximizes the electrical power")
     g = p.add_argument_group("design")
     g.add_argument("--optimize-design", metavar="NAMES", default=None,
                    help="choose these pendulum parameters for the most power: a comma list "
@@ -156,7 +158,8 @@ def _cmd_buoy(a) -> dict | str:
             mpc_text(r) + ([f"written: {a.save}"] if a.save else []))
     sweep = hasattr(r, "period_s")
     if not sweep and r.status == "no_power":
-        raise ParameterError(f"damping-coefficient: {r.message}")
+        name = "efficiency" if r.message.startswith("no electrical") else "damping-coefficient"
+        raise ParameterError(f"{name}: {r.message}")
     written = []
     if a.save:
         _output.write_dataset(r.to_dataset(), a.save)
@@ -206,6 +209,14 @@ def _text_result(r) -> list:
             ["free buoy: heave amplitude", _w(r.free_heave_amplitude_m), "m"]]
     if r.torque_limit_nm is not None:
         rows.insert(3, ["  torque limit", _w(r.torque_limit_nm), "N m"])
+    if r.electrical_power_w is not None:
+        rows[0][0] = "coupled optimum: mechanical power"
+        rows[1:1] = [["  electrical power (maximized)", _w(r.electrical_power_w), "W"],
+                     ["  take-off losses", _w(r.pto_loss_w), "W"],
+                     ["  generated / motoring", f"{r.generated_power_w:.6g} / "
+                      f"{r.motoring_power_w:.6g}", "W"],
+                     ["  ideal (lossless) optimum", _w(r.ideal_power_w), "W"]]
+        rows.append(["one-way: electrical power", _w(r.one_way_electrical_power_w), "W"])
     out = [wave, *_head(r), "", _table(rows, ["quantity", "value", "unit"]), ""]
     if r.design:
         d = r.design
@@ -224,9 +235,14 @@ def _sweep_text(r) -> list:
                                                 r.radiation_bound_w, r.limit_w,
                                                 r.bound_fraction, r.heave_amplitude_m,
                                                 r.status)]
+    head = ["T (s)", "power (W)", "one-way (W)", "bound (W)", "limit (W)", "fraction",
+            "heave (m)", "status"]
+    if r.electrical_power_w is not None:
+        for row, e in zip(rows, r.electrical_power_w):
+            row.insert(2, _fmt(e))
+        head[1:2] = ["mechanical (W)", "electrical (W)"]
     out = [f"regular waves, H = {r.wave_height_m:g} m", *_head(r), "",
-           _table(rows, ["T (s)", "power (W)", "one-way (W)", "bound (W)", "limit (W)",
-                         "fraction", "heave (m)", "status"])]
+           _table(rows, head)]
     out += [f"note: {n}" for n in r.warnings]
     return out
 
