@@ -204,6 +204,10 @@ class ARForecast:
     shrink : bool
         Multiply each lead's prediction by its out-of-sample skill gain
         (:func:`skill_gains`); False: the plain iterated AR prediction.
+    reach_periods : float or None
+        The forecast's reach in peak periods: the receding-horizon controller
+        (:func:`parapend.control.mpc.mpc_run`) plans over at most this long (``reach``).
+        None: no cap.
     """
 
     peak_period: float
@@ -211,6 +215,7 @@ class ARForecast:
     window: float = 40.0
     samples_per_period: int = 12
     shrink: bool = True
+    reach_periods: float | None = 0.5
     name: str = "ar"
 
     def __post_init__(self):
@@ -218,11 +223,18 @@ class ARForecast:
         check_int("order", self.order, 1, 256)
         check_range("window", self.window, 1.0, 400.0)
         check_int("samples-per-period", self.samples_per_period, 2, 256)
+        if self.reach_periods is not None:
+            check_range("reach", self.reach_periods, 0.01, 100.0)
         if self.window * self.samples_per_period < 6 * self.order:
             raise ParameterError(
                 f"window: expected at least {6 * self.order} samples "
                 f"(window x samples-per-period) for an AR({self.order}) fit, got "
                 f"{self.window * self.samples_per_period:g}")
+
+    @property
+    def reach(self):
+        """The reach in non-dimensional time (``reach_periods * peak_period``), or None."""
+        return None if self.reach_periods is None else self.reach_periods * self.peak_period
 
     @property
     def spacing(self) -> float:
