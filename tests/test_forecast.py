@@ -74,9 +74,9 @@ def test_white_noise_has_no_skill_and_the_forecast_is_zero_beyond_lead_zero():
 
 def test_skill_gains_are_out_of_sample():
     """A window whose first half is a predictable AR(2) oscillation and whose second half
-    is white noise: a model fitted on the first half has no skill on the second, so every
-    gain is 0, while the same oscillation throughout gives gains near 1. The gains depend
-    on the history alone (the past of the window)."""
+    is white noise: a model fitted on either half has no skill on the other, so every gain
+    is 0 (an in-sample fit on the first half would claim skill), while the same
+    oscillation throughout gives gains near 1, non-increasing with the lead."""
     osc = _ar_process([1.6, -0.8], 480, seed=2)
     noise = np.random.default_rng(3).standard_normal(240) * np.std(osc)
     mixed = np.concatenate((osc[:240], noise))
@@ -132,3 +132,25 @@ def test_prediction_error_of_zero_is_one():
     err = fc.prediction_error(Zero(), exc.q, t_start=2 * TP, t_end=exc.period,
                               dt=TP / 64, leads=TP * np.array([0.3, 1.0]), origins=20)
     assert np.allclose(err, 1.0, rtol=0, atol=1e-12)
+
+
+def test_the_controller_plans_no_further_than_the_forecast_reach():
+    """mpc_run caps its horizon at a forecast's ``reach`` (ARForecast: ``reach_periods``
+    peak periods); a forecast without one, or with None, keeps the horizon asked for."""
+    from parapend.control.mpc import mpc_run
+
+    class Calm:
+        def __init__(self, reach):
+            self.reach = reach
+
+        def predict(self, t_now, past_t, past_q, lead):
+            return np.zeros(np.size(lead))
+
+    dt = 0.5
+    kw = dict(gamma=0.01, horizon=20 * dt, update_interval=2 * dt, dt=dt, t_end=12 * dt,
+              theta0=0.0, theta_dot0=1.0)  # rotating: the controller runs from the start
+    q = lambda t: np.zeros(np.shape(t))  # noqa: E731
+    assert mpc_run(q, forecast=Calm(5 * dt), **kw).horizon == pytest.approx(5 * dt)
+    assert mpc_run(q, forecast=Calm(None), **kw).horizon == pytest.approx(20 * dt)
+    assert fc.ARForecast(TP).reach == pytest.approx(0.5 * TP)
+    assert fc.ARForecast(TP, reach_periods=None).reach is None

@@ -18,9 +18,9 @@ at the times ``past_t <= t_now``.
   is fitted by least squares on that window (every call: the sea may change), and its
   ``k``-step prediction (the model iterated ``k`` steps, :func:`kstep_matrix`) is
   multiplied by a gain ``g_k`` in [0, 1] estimated out of sample on the same window
-  (:func:`skill_gains`: a model fitted on the first half of the window predicts the second
-  half; ``g_k`` is the least-squares gain of those predictions, 0 from the first lead
-  where they improve on predicting 0 by less than ``MIN_SKILL``, and non-increasing). So
+  (:func:`skill_gains`: a model fitted on one half of the window predicts the other half;
+  ``g_k`` is the least-squares gain of those predictions, 0 from the first lead where
+  they improve on predicting 0 by less than ``MIN_SKILL = 0.1``, so non-increasing). So
   the forecast is the AR prediction where the past shows it has skill and decays to the
   mean 0 where it has none, instead of predicting waves that are not there. The predicted
   samples are joined to the past by a cubic spline through the last past samples and the
@@ -30,6 +30,8 @@ at the times ``past_t <= t_now``.
   stable by construction. On a window shorter than ``6 order`` samples the order is a
   sixth of the window (three samples per coefficient in each half), and below
   ``MIN_ORDER`` coefficients (3 peak periods at the defaults) the forecast is persistence.
+  The receding-horizon controller plans over at most the forecast's ``reach``
+  (``reach_periods = 0.5`` peak periods; docs/control.md measures why).
 
 The defaults (``samples_per_period = 12``, ``order = 24``, ``window = 40`` peak periods)
 come from the error scan of :func:`prediction_error` on the JONSWAP record of ``sea``
@@ -59,6 +61,8 @@ MIN_ORDER = 6
 
 #: smallest out-of-sample skill ``1 - sum (p - y)^2 / sum y^2`` of a lead kept in the forecast
 MIN_SKILL = 0.1
+#: score the skill on both halves of the window (False: the second half only)
+TWO_FOLDS = True
 
 #: forecasts by name (``--forecast``)
 FORECASTS = ("perfect", "ar")
@@ -155,30 +159,43 @@ def skill_gains(history, order: int, steps: int) -> np.ndarray:
     """Gain ``g_k`` in [0, 1] of the ``k``-step AR prediction (``k = 1 .. steps``),
     estimated out of sample on ``history`` (oldest first) alone.
 
-    An AR(``order``) model is fitted on the first half of ``history`` and predicts, from
-    every origin in the second half, each sample up to ``steps`` ahead that the history
-    holds. Per step: the least-squares gain ``g_k = sum(p y) / sum(p^2)`` of those
-    predictions ``p`` against the samples ``y``, clipped to [0, 1]; 0 where the predictions
-    are worse than predicting zero (``sum (p - y)^2 >= sum y^2``) or fewer than ``order``
-    origins reach that step; and made non-increasing in ``k`` (skill only falls with the
-    lead, so a chance correlation at a long lead does not bring the forecast back).
+    Two folds: an AR(``order``) model fitted on the first half of ``history`` predicts,
+    from every origin in the second half, each sample up to ``steps`` ahead that the history
+    holds; one fitted on the second half predicts the first half backward in time (a
+    stationary process has the same AR model forward and backward). Per step, over the
+    pooled predictions ``p`` and samples ``y``: the least-squares gain ``g_k = sum(p y) /
+    sum(p^2)``, clipped to [0, 1]; 0 from the first step where the predictions improve on
+    predicting zero by less than ``MIN_SKILL`` (``sum (p - y)^2 > (1 - MIN_SKILL) sum
+    y^2``) or fewer than ``order`` origins reach it. So the gains are non-increasing with
+    the lead, and a chance correlation at a long lead does not bring the forecast back.
     """
     x = np.asarray(history, dtype=float)
     n = x.size
     h = n // 2
-    g = np.zeros(int(steps))
+    steps = int(steps)
+    g = np.zeros(steps)
     if h < 2 * order + 1:
         return g
-    a = _fit_stable(x[:h], order)
-    c = kstep_matrix(a, steps)
-    lag = _lags(x, order)[h - order:]  # origins t = h - 1 .. n - 1
-    pred = lag @ c.T
-    for k in range(int(steps)):
-        m = lag.shape[0] - (k + 1)  # origins whose k+1-step target is in the history
-        if m < order:
+    folds = [(x[:h], x)]  # fitted on the first half, scored forward on the second
+    if TWO_FOLDS:
+        # and fitted on the second half, scored on the first half backward in time (a
+        # stationary process has the same AR model forward and backward)
+        folds.append((x[n - h:][::-1], x[::-1]))
+    pairs = []
+    for train, seq in folds:
+        a = _fit_stable(train, order)
+        lag = _lags(seq, order)[h - order:]  # origins t = h - 1 .. n - 1 of seq
+        pairs.append((lag @ kstep_matrix(a, steps).T, seq))
+    for k in range(steps):
+        pk, yk = [], []
+        for pred, seq in pairs:
+            m = pred.shape[0] - (k + 1)  # origins whose k+1-step target is in seq
+            if m >= order:
+                pk.append(pred[:m, k])
+                yk.append(seq[h + k: h + k + m])
+        if not pk:
             break
-        pk = pred[:m, k]
-        yk = x[h + k: h + k + m]
+        pk, yk = np.concatenate(pk), np.concatenate(yk)
         den = float(pk @ pk)
         if den <= 0.0 or float((pk - yk) @ (pk - yk)) >= (1.0 - MIN_SKILL) * float(yk @ yk):
             break
@@ -196,7 +213,7 @@ class ARForecast:
     peak_period : float
         ``Tp`` in non-dimensional time (``2 pi / omega_p``).
     order : int
-        ``p``, the number of AR coefficients.
+        ``p``, the number of AR coefficients (fewer on a short window, :meth:`order_for`).
     window : float
         Length of the fitting window, in peak periods.
     samples_per_period : int
