@@ -154,3 +154,19 @@ def test_the_controller_plans_no_further_than_the_forecast_reach():
     assert mpc_run(q, forecast=Calm(None), **kw).horizon == pytest.approx(20 * dt)
     assert fc.ARForecast(TP).reach == pytest.approx(0.5 * TP)
     assert fc.ARForecast(TP, reach_periods=None).reach is None
+
+
+@pytest.mark.slow
+def test_closed_loop_with_the_ar_forecast_is_positive_and_flat_beyond_its_reach():
+    """The README's sea state on a 20-wave record (seed 0): the receding-horizon controller
+    with the AR forecast extracts positive power at half a period and at two, and at two
+    it plans over the forecast's reach, so both runs are the same run."""
+    import parapend
+
+    r = parapend.horizon(repeat_period=160.0, horizons="0.5,2", forecasts="ar",
+                         baselines="none")
+    assert r.success
+    assert r.mpc_horizon_used == [[0.5, 0.5]]
+    p = np.asarray(r.mpc_power)[0, :, 0]
+    assert np.all(p > 0.2 * r.optimum_power[0])
+    assert p[0] == p[1]
