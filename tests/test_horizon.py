@@ -91,7 +91,7 @@ def test_ar_forecast_is_causal_and_persists_before_its_window_fills():
     assert np.array_equal(p1, p2)
     assert p1[0] == pytest.approx(q[k], abs=1e-12)
     early = f.predict(t[10], t[:11], q[:11], lead)  # too short a past: persistence
-    assert np.allclose(early, q[10] * np.exp(-lead / TP))
+    assert np.allclose(early, q[10] * np.exp(-lead / (fc.PERSISTENCE * TP)))
 
 
 @pytest.mark.parametrize("kw, match", [({"order": 0}, "order"), ({"window": 0.5}, "window"),

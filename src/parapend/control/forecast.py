@@ -29,7 +29,8 @@ at the times ``past_t <= t_now``.
   prediction that would grow without bound) is replaced by the Yule-Walker fit, which is
   stable by construction. On a window shorter than ``6 order`` samples the order is a
   sixth of the window (three samples per coefficient in each half), and below
-  ``MIN_ORDER`` coefficients (3 peak periods at the defaults) the forecast is persistence.
+  ``MIN_ORDER`` coefficients (3 peak periods at the defaults) the forecast is persistence
+  decaying over ``PERSISTENCE`` peak periods.
   The receding-horizon controller plans over at most the forecast's ``reach``
   (``reach_periods = 0.5`` peak periods; docs/control.md measures why).
 
@@ -58,6 +59,10 @@ __all__ = ["ARForecast", "PerfectForecast", "fit_ar", "kstep_matrix", "make_fore
 
 #: smallest AR order fitted (below it, on a short window, the forecast is persistence)
 MIN_ORDER = 6
+#: decay time of the persistence forecast (before the first fit), in peak periods: of 1,
+#: 1/4, 1/8, 1/16 and 1/32 on the README's records, the longest whose error is within 1 %
+#: of predicting 0 at every lead (1/8: 1.07 at a quarter period; 1: 1.53)
+PERSISTENCE = 1.0 / 16
 
 #: smallest out-of-sample skill ``1 - sum (p - y)^2 / sum y^2`` of a lead kept in the forecast
 MIN_SKILL = 0.1
@@ -287,7 +292,7 @@ class ARForecast:
     def predict(self, t_now, past_t, past_q, lead_times) -> np.ndarray:
         """``q`` at ``t_now + lead_times`` (leads >= 0) from the past samples alone. Before
         the window holds enough samples for a fit, the forecast is ``q(t_now)`` decaying
-        to the record's mean 0 over a peak period (a persistence forecast)."""
+        to the record's mean 0 over ``PERSISTENCE`` peak periods (a persistence forecast)."""
         from scipy.interpolate import CubicSpline
 
         lead = np.asarray(lead_times, dtype=float)
@@ -296,7 +301,7 @@ class ARForecast:
         a, hist = self.coefficients(t_now, past_t, past_q)
         q_now = float(hist[-1])
         if a is None:
-            return q_now * np.exp(-np.clip(lead, 0.0, None) / self.peak_period)
+            return q_now * np.exp(-np.clip(lead, 0.0, None) / (PERSISTENCE * self.peak_period))
         d = self.spacing
         steps = max(1, int(math.ceil(float(np.max(lead, initial=0.0)) / d - 1e-9)))
         pred = kstep_matrix(a, steps) @ hist[::-1][:a.size]
