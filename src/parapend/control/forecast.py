@@ -246,7 +246,7 @@ class ARForecast:
         check_range("window", self.window, 1.0, 400.0)
         check_int("samples-per-period", self.samples_per_period, 2, 256)
         if self.reach_periods is not None:
-            check_range("reach", self.reach_periods, 0.01, 100.0)
+            check_range("reach-periods", self.reach_periods, 0.01, 100.0)
         if self.window * self.samples_per_period < 6 * self.order:
             raise ParameterError(
                 f"window: expected at least {6 * self.order} samples "
@@ -330,8 +330,8 @@ def prediction_error(forecast, q, *, t_start: float, t_end: float, dt: float, le
     times ``t_i`` evenly spread over ``[t_start, t_end - max(leads)]`` the forecast sees the
     samples up to that time and predicts ``q`` at every lead ``L``. Returns, per lead,
     ``sqrt(sum_i (q_hat_i - q(t_i + L))^2 / sum_i q(t_i + L)^2)``: the rms error over the
-    rms of the predicted values, so that predicting 0 scores exactly 1 at every lead > 0 (1
-    at lead 0 too when ``q(t_i) = 0``; the forecasts here return the measured ``q`` there).
+    rms of the predicted values, so that predicting 0 scores exactly 1 at every lead > 0
+    (at lead 0 the forecasts here return the measured ``q``: error 0).
     """
     leads = np.asarray(leads, dtype=float)
     t_all = np.arange(0.0, t_end + dt / 2, dt)
