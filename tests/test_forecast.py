@@ -170,3 +170,12 @@ def test_closed_loop_with_the_ar_forecast_is_positive_and_flat_beyond_its_reach(
     p = np.asarray(r.mpc_power)[0, :, 0]
     assert np.all(p > 0.2 * r.optimum_power[0])
     assert p[0] == p[1]
+
+
+@pytest.mark.parametrize("kw, match", [({"reach_periods": 0.0}, "reach-periods"),
+                                       ({"order": 24, "window": 10}, "window")])
+def test_bad_options_are_one_line_errors(kw, match):
+    from parapend.errors import ParameterError
+
+    with pytest.raises(ParameterError, match=match):
+        fc.ARForecast(TP, **kw)
