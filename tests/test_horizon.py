@@ -91,7 +91,7 @@ def test_ar_forecast_is_causal_and_persists_before_its_window_fills():
     assert np.array_equal(p1, p2)
     assert p1[0] == pytest.approx(q[k], abs=1e-12)
     early = f.predict(t[10], t[:11], q[:11], lead)  # too short a past: persistence
-    assert np.allclose(early, q[10] * np.exp(-lead / TP))
+    assert np.allclose(early, q[10] * np.exp(-lead / (fc.PERSISTENCE * TP)))
 
 
 @pytest.mark.parametrize("kw, match", [({"order": 0}, "order"), ({"window": 0.5}, "window"),
@@ -208,6 +208,8 @@ def test_horizon_fractions_and_wiring_with_a_stub_controller(monkeypatch):
         seen.append((horizon, None if forecast is None else forecast.name))
         r = Res()
         r.mean_electrical_power = horizon / 1000.0
+        reach = getattr(forecast, "reach", None)  # as mpc_run: plans over at most the reach
+        r.horizon = horizon if reach is None else min(horizon, reach)
         return r
 
     monkeypatch.setattr(mpc, "mpc_run", stub)
@@ -216,6 +218,7 @@ def test_horizon_fractions_and_wiring_with_a_stub_controller(monkeypatch):
     assert r.mpc_fraction[1][1][0] == pytest.approx(2 * TP / 1000 / r.optimum_power[0],
                                                     rel=1e-12)
     assert r.ar_leads[0] == 0 and r.ar_error[0] < 1e-12
+    assert np.allclose(r.mpc_horizon_used, [[0.5, 2.0], [0.5, 2.0]], rtol=1e-12)
 
 
 @pytest.mark.parametrize("argv, match", [

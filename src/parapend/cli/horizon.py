@@ -92,7 +92,9 @@ def _cmd_horizon(a) -> dict | str:
     for i, f in enumerate(r.forecasts):
         for j, h in enumerate(r.horizons):
             pw = [v for v in r.mpc_power_w[i][j] if v == v]
-            rows.append([f"receding horizon, {f} forecast", f"{h:g}",
+            hu = r.mpc_horizon_used[i][j] if r.mpc_horizon_used else h
+            cell = f"{h:g}" if abs(hu - h) <= 1e-9 * h else f"{h:g} (plans {hu:.3g})"
+            rows.append([f"receding horizon, {f} forecast", cell,
                          f"{sum(pw) / len(pw):.4g}" if pw else "nan",
                          _pct(r.mpc_fraction_mean[i][j]),
                          f"{_pct(r.mpc_fraction_min[i][j])} .. "
@@ -114,7 +116,8 @@ def _cmd_horizon(a) -> dict | str:
            _table(rows, ["controller", "horizon (Tp)", "power (W)", "of optimum",
                          "min .. max", "of limit"])]
     if r.ar_leads:
-        out += ["", "AR forecast, normalized rms error of q against lead time:",
+        out += ["", "AR forecast, normalized rms error of q against lead time (1: the "
+                    "error of predicting 0):",
                 _table([[f"{ld:g}", f"{e:.3f}"] for ld, e in zip(r.ar_leads, r.ar_error)],
                        ["lead (Tp)", "error"])]
     out += ["", f"status: {r.status}: {r.message}"]

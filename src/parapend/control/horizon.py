@@ -59,7 +59,12 @@ class HorizonResult(_Result):
     mpc_limit_fraction_mean, baseline_limit_fraction_mean : the same over the limit.
     mpc_status : nested list of str ``[f][h][r]``; the solver's status of each run.
     ar_leads, ar_error : lead times (peak periods) and the AR forecast's normalized rms
-        error at each (over the records), when "ar" is among the forecasts.
+        error at each (over the records; 1 is the error of predicting 0), when "ar" is
+        among the forecasts.
+    mpc_horizon_used : nested list of float ``[f][h]``
+        The horizon the controller planned over (peak periods): the one asked for, or
+        the forecast's reach where that is shorter (an ``ARForecast`` given
+        ``reach_periods``).
     """
 
     horizons: list
@@ -99,6 +104,7 @@ class HorizonResult(_Result):
     limit_power_w: list = field(default_factory=list)
     mpc_power_w: list = field(default_factory=list)
     baseline_power_w: list = field(default_factory=list)
+    mpc_horizon_used: list = field(default_factory=list)
     convention: str = ("power positive when harvested; mean over the whole record from "
                        "the hanging rest; fractions of the record's non-causal optimum "
                        "(sea) and of its gamma -> 0 limit")
@@ -234,6 +240,7 @@ def horizon_curve(*, hs: float = 2.0, tp: float = 8.0, spectrum: str = "jonswap"
         tick()
     mpc_p = [[[math.nan] * records for _ in hz] for _ in fc]
     mpc_st = [[[""] * records for _ in hz] for _ in fc]
+    used = [[h for h in hz] for _ in fc]
     if fc:
         from .mpc import mpc_run
 
@@ -249,6 +256,7 @@ def horizon_curve(*, hs: float = 2.0, tp: float = 8.0, spectrum: str = "jonswap"
                     mpc_p[i][j][r] = (float(res.mean_electrical_power) if res.success
                                       else math.nan)
                     mpc_st[i][j][r] = str(res.status)
+                    used[i][j] = float(getattr(res, "horizon", h * tp_n)) / tp_n
                     tick()
     base_p = [[math.nan] * records for _ in bl]
     base_st = [[""] * records for _ in bl]
@@ -302,7 +310,8 @@ def horizon_curve(*, hs: float = 2.0, tp: float = 8.0, spectrum: str = "jonswap"
         status="done" if ok else "failed_runs", message=msg, warm_up=warm_up,
         optimum_power_w=[w(v) for v in opt], limit_power_w=[w(v) for v in lim],
         mpc_power_w=[[[w(v) for v in col] for col in row] for row in mpc_p],
-        baseline_power_w=[[w(v) for v in row] for row in base_p])
+        baseline_power_w=[[w(v) for v in row] for row in base_p],
+        mpc_horizon_used=used)
 
 
 def horizon_dataset(r: HorizonResult):
@@ -323,6 +332,9 @@ def horizon_dataset(r: HorizonResult):
         data["mpc_power"] = (dims, np.asarray(r.mpc_power, dtype=float))
         data["mpc_power_w"] = (dims, np.asarray(r.mpc_power_w, dtype=float))
         data["mpc_fraction"] = (dims, np.asarray(r.mpc_fraction, dtype=float))
+        if r.mpc_horizon_used:
+            data["mpc_horizon_used"] = (("forecast", "horizon"),
+                                        np.asarray(r.mpc_horizon_used, dtype=float))
     if r.baselines:
         coords["baseline"] = np.asarray(r.baselines, dtype=str)
         data["baseline_power"] = (("baseline", "record"),

@@ -242,7 +242,9 @@ def mpc_run(q_record, *, gamma, horizon, update_interval, dt, torque_limit=None,
         series.
     forecast : None or object with ``predict(t_now, past_t, past_q, lead_times)``
         None: perfect (the record's own future). Otherwise the predicted ``q`` at
-        ``t_now + lead_times``, given the measured ``q`` at the past sample times.
+        ``t_now + lead_times``, given the measured ``q`` at the past sample times. A
+        forecast with an attribute ``reach`` (not None; non-dimensional time) caps the
+        horizon at it.
     theta0, theta_dot0 : float
         Initial state (default hanging at rest).
     t_end : float
@@ -270,6 +272,11 @@ def mpc_run(q_record, *, gamma, horizon, update_interval, dt, torque_limit=None,
 
     gamma = check_range("gamma", gamma, 0.0, 1e3)
     dt = check_range("dt", dt, 1e-4, 1e3)
+    # forecast reach: a forecast with a finite ``reach`` (non-dimensional time, e.g.
+    # ARForecast) is not planned on beyond it; the result's ``horizon`` is the one used
+    reach = getattr(forecast, "reach", None)
+    if reach is not None and horizon > reach:
+        horizon = max(float(reach), dt)
     if not horizon >= dt:
         raise ParameterError(f"horizon: expected at least one sample dt = {dt:g}, got "
                              f"{horizon!r}")
