@@ -70,8 +70,8 @@ class BuoyResult(_Result):
     electrical_power_w : ``<e(p)>``, ``e = eta_g p`` generating, ``p / eta_m`` motoring.
     pto_loss_w : ``power_w - electrical_power_w``, the take-off's losses.
     generated_power_w, motoring_power_w : ``<max(p, 0)>`` and ``<max(-p, 0)>``.
-    ideal_power_w : the ideal (lossless) coupled optimum; ``electrical_power_w <= eta_g
-        ideal_power_w``.
+    ideal_power_w : the ideal (lossless) coupled optimum
+        ``electrical_power_w <= eta_g ideal_power_w``.
     one_way_electrical_power_w : the one-way answer's electrical optimum.
     """
 
@@ -485,21 +485,24 @@ def buoy(*, wave_height=None, wave_period=None, hs=None, tp=None, spectrum="jons
     winding : turns of the pendulum per wave (per record for an irregular sea).
     harmonics : N of the motion (default chosen from the problem and checked).
     torque_limit : N m.
-    efficiency : of the power take-off: a number in (0, 1] (both ways), a pair ``(eta_g,
-        eta_m)`` or the text ``"ETA_G,ETA_M"``: the motion maximizes the electrical power
+    efficiency : float, pair or str
+        Of the power take-off: a number in (0, 1] (both ways), a pair ``(eta_g, eta_m)``
+        or the text ``"ETA_G,ETA_M"``: the motion maximizes the electrical power
         (docs/buoy.md), within ``torque_limit`` if given.
     optimize_design : comma list of pendulum parameters to choose (``"length,inertia"``)
         for the largest coupled power, each within ``<name>_bounds`` ``"LO:HI"``.
 
     controller, horizon, update_interval : ``"optimum"`` (the non-causal coupled optimum),
         or a causal receding-horizon controller run on the coupled time-domain plant in an
-        irregular sea (:mod:`.control`): ``"mpc"`` (planned on the coupled model) or
+        irregular sea (:mod:`parapend.buoy.control`): ``"mpc"`` (planned on the coupled model) or
         ``"one-way-mpc"`` (planned on the free buoy's heave); horizon and update interval in
         peak periods.
 
     Returns
     -------
-    BuoyResult, BuoySweepResult or parapend.buoy.control.BuoyMPCResult
+    result : BuoyResult, BuoySweepResult or BuoyMPCResult
+        One design; a period sweep; a receding-horizon run (``controller``, the result of
+        :func:`parapend.buoy.control.buoy_mpc`).
     """
     from .coupled import Wave
 

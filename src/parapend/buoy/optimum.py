@@ -26,7 +26,7 @@ depends on ``u = cos(theta)`` only, and a rotation can approach any measurable
 concave box-constrained quadratic programme over ``u``, solved on a fine grid; without the
 box its value is the radiation bound.
 
-A power take-off (:mod:`.pto`), from the ideal optimum: an efficiency makes the motion
+A power take-off (:mod:`parapend.buoy.pto`), from the ideal optimum: an efficiency makes the motion
 maximize the electrical power (a smoothed kink with a continuation in its width and in the
 harmonics, trust-region Newton on the exact derivatives; the result's electrical power is
 evaluated exactly on a fine grid); a torque limit is imposed at every grid point by an
@@ -598,7 +598,7 @@ def coupled_optimum(hydro, pendulum: Pendulum, wave: Wave, *, winding: int = 1,
         the peak between grid points is checked (within ``TORQUE_SLACK``, else
         ``success`` is False) and stated in ``status``.
     efficiency : float, (eta_g, eta_m), "ETA_G[,ETA_M]" or None
-        Maximize the electrical power ``<e(p)>`` instead (:mod:`.pto`): a smoothed kink with
+        Maximize the electrical power ``<e(p)>`` instead (:mod:`parapend.buoy.pto`): a smoothed kink with
         a continuation to zero width and in the harmonics (N/4 to N), started from the ideal
         optimum; its exact value on a fine grid is ``electrical_power``. With
         ``torque_limit`` every width of the last two harmonic stages is solved under the

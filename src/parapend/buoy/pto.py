@@ -381,7 +381,7 @@ def maximize(problem: ElectricalProblem, x0: np.ndarray, widths=None, limit=None
 def ladder(make, x_ideal: np.ndarray, harmonics: int, start: int, limit=None):
     """The electrical optimum with ``harmonics`` terms by continuation in the harmonics:
     the full width continuation with ``start`` terms from the ideal optimum cut to them,
-    then doubling (each from the last optimum, :data:`WIDTHS_REFINE`) up to ``harmonics``.
+    then doubling (each from the last optimum, ``WIDTHS_REFINE``) up to ``harmonics``.
 
     ``limit``: ``|tau| <= limit`` on the grid in the last two stages. ``make(n)`` builds the
     :class:`ElectricalProblem` with ``n`` harmonics. Returns ``(x,

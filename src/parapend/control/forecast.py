@@ -134,8 +134,10 @@ def _iterate(a, history, steps: int) -> np.ndarray:
 
 
 def kstep_matrix(a, steps: int) -> np.ndarray:
-    """Rows ``c_k`` (``k = 1 .. steps``) with ``x_{t+k}`` predicted ``= c_k . (x_t, x_{t-1},
-    ..., x_{t-p+1})`` by iterating the AR model ``a``: the ``k``-step predictor as a linear
+    """The ``k``-step predictors of the AR model ``a`` as rows ``c_k`` (``k`` from 1 to ``steps``).
+
+    ``x_{t+k}`` is predicted as ``c_k`` times ``(x_t, x_{t-1}, ..., x_{t-p+1})`` by iterating
+    the model: the ``k``-step predictor as a linear
     map of the last ``p`` samples (the first row of the companion matrix to the power k)."""
     a = np.asarray(a, dtype=float)
     p = a.size
@@ -162,7 +164,7 @@ def _fit_stable(x, order: int) -> np.ndarray:
 
 
 def skill_gains(history, order: int, steps: int) -> np.ndarray:
-    """Gain ``g_k`` in [0, 1] of the ``k``-step AR prediction (``k = 1 .. steps``),
+    """Gain ``g_k`` in [0, 1] of the ``k``-step AR prediction (``k`` from 1 to ``steps``),
     estimated out of sample on ``history`` (oldest first) alone.
 
     Two folds: an AR(``order``) model fitted on the first half of ``history`` predicts,

@@ -2,7 +2,7 @@ r"""Receding-horizon (model predictive) control of the pendulum in an irregular 
 
 Every ``update_interval`` the controller measures the state ``(theta, theta')``, takes the
 excitation ``q`` over the next ``horizon`` from a forecast, and solves the horizon problem on
-the full nonlinear Eq. 14 with the motion as the unknown (:mod:`.plan`): a ``C^1`` cubic
+the full nonlinear Eq. 14 with the motion as the unknown (:mod:`parapend.control.plan`): a ``C^1`` cubic
 Hermite on ``K`` intervals from the measured state, free at the end, the torque defined by
 the motion (inverse dynamics), maximizing the electrical work plus the terminal value
 ``kappa E(t + H)``, ``E = theta'^2 / 2 + cos(theta)`` (docs/control.md: the energy the
@@ -150,10 +150,10 @@ class HorizonProblem:
     of ``dt`` from ``x0`` with ``q`` at the half-step nodes ``qn`` (``2 n steps + 1``, spacing
     ``dt / (2 steps)``).
 
-    :meth:`solve` poses the motion problem of :mod:`.plan` (``ceil(n / 2)`` Hermite
+    :meth:`solve` poses the motion problem of :mod:`parapend.control.plan` (``ceil(n / 2)`` Hermite
     intervals over ``n dt``, ``q`` interpolated from ``qn`` by a cubic spline), starts it from
     the motion of the held torques ``u0`` (RK4 through ``qn``), solves it, and returns the
-    plan's torque averaged over each sample (:func:`held_torques`).
+    plan's torque averaged over each sample (``held_torques``).
     """
 
     def __init__(self, n, dt, steps, gamma, torque_limit=None, efficiency=None,
@@ -167,7 +167,7 @@ class HorizonProblem:
         self.h = self.n * self.dt / self.k
 
     def problem(self, x0, q_of_lead):
-        """The :class:`~.plan.PlanProblem` from ``x0`` with ``q`` a callable of the lead."""
+        """The :class:`~parapend.control.plan.PlanProblem` from ``x0`` with ``q`` a callable of the lead."""
         from .plan import PlanProblem, gauss_leads
 
         lg, lc = gauss_leads(self.k, self.h)
@@ -178,7 +178,7 @@ class HorizonProblem:
     def solve(self, x0, qn, u0, max_iter=MAX_ITER, tol=1e-10):
         """Solve from the motion of ``u0``; returns a ``scipy.optimize.OptimizeResult``:
         ``x`` the ``n`` held torques, ``fun`` minus the plan's objective ``J``, ``success``,
-        ``status`` (the interior point's), ``nit``, ``plan`` (:class:`~.plan.HorizonPlan`)."""
+        ``status`` (the interior point's), ``nit``, ``plan`` (:class:`~parapend.control.plan.HorizonPlan`)."""
         from scipy.interpolate import CubicSpline
         from scipy.optimize import OptimizeResult
 

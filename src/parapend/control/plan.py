@@ -31,7 +31,7 @@ Newton matrix of the eliminated torque; the smoothing keeps it, and its bias on 
 most ``(1 / eta_m - eta_g) eps H / 2``.
 
 **Solver.** The primal-dual interior point of :mod:`parapend.optimal.hermite`
-(:func:`~parapend.optimal.hermite.interior_point`, its compiled kernels
+(``parapend.optimal.hermite.interior_point``, its compiled kernels
 :mod:`parapend.optimal._hermite_kernel` on the open chain of ``K + 1`` nodes) with the
 torque limit ``|T| <= T_max`` at ``tau = 0, 1/2, 1`` of every interval; without a limit it
 is Newton's method with the exact banded Hessian (bandwidth 3: the first node's two
@@ -107,7 +107,7 @@ class HorizonPlan:
 
 
 class PlanProblem:
-    """One horizon problem (the interface :func:`~parapend.optimal.hermite.interior_point`
+    """One horizon problem (the interface ``parapend.optimal.hermite.interior_point``
     uses); the variables ``x = (theta_1, v_1, ..., theta_K, v_K)``, node 0 fixed to ``x0``.
 
     Parameters
@@ -347,7 +347,7 @@ def solve_plan(problem: PlanProblem, x, *, anchor=None, gap_tol=1e-10, maxiter=2
     Without a torque limit: Newton (the interior point without barrier terms). With one: a
     start that violates the limit is blended towards ``anchor`` (variables strictly inside,
     e.g. the unforced motion) until strictly feasible, else elastic mode from it; with an
-    efficiency, the kink's smoothing is continued (:data:`KINK_SMOOTHING`).
+    efficiency, the kink's smoothing is continued (``KINK_SMOOTHING``).
     """
     pr = problem
     x = np.asarray(x, dtype=float)
