@@ -111,7 +111,8 @@ def test_saved_torque_reintegrated_by_simulate(one_way):
                       z0=z0, zdot0=zd0, history=hist, dt=h, memory=MEMORY,
                       a_inf=r.units["a_inf_kg"])
     # the same scheme summed in another order: they differ by round-off (1e-13), which the
-    # rotating pendulum amplifies (1e-12 rad at 5 s, 2e-8 rad at 7.5 s, 0.25 rad at 15 s); compared over 5 s
+    # rotating pendulum amplifies (1e-12 rad at 5 s, 2e-8 rad at 7.5 s, 0.25 rad at 15 s);
+    # compared over 5 s
     k = int(round(5.0 / r.dt_s))
     th = out["theta"][::ps][:k + 1]
     assert np.max(np.abs(th - s["theta"][:k + 1])) < 1e-8

@@ -598,9 +598,9 @@ def coupled_optimum(hydro, pendulum: Pendulum, wave: Wave, *, winding: int = 1,
         the peak between grid points is checked (within ``TORQUE_SLACK``, else
         ``success`` is False) and stated in ``status``.
     efficiency : float, (eta_g, eta_m), "ETA_G[,ETA_M]" or None
-        Maximize the electrical power ``<e(p)>`` instead (:mod:`parapend.buoy.pto`): a smoothed kink with
-        a continuation to zero width and in the harmonics (N/4 to N), started from the ideal
-        optimum; its exact value on a fine grid is ``electrical_power``. With
+        Maximize the electrical power ``<e(p)>`` instead (:mod:`parapend.buoy.pto`): a
+        smoothed kink with a continuation to zero width and in the harmonics (N/4 to N),
+        started from the ideal optimum; its exact value on a fine grid is ``electrical_power``. With
         ``torque_limit`` every width of the last two harmonic stages is solved under the
         limit. 1 both ways is the ideal problem (the ideal optimum is returned).
     starts : int or None

@@ -1,14 +1,14 @@
 r"""Receding-horizon (model predictive) control of the pendulum in an irregular sea.
 
 Every ``update_interval`` the controller measures the state ``(theta, theta')``, takes the
-excitation ``q`` over the next ``horizon`` from a forecast, and solves the horizon problem on
-the full nonlinear Eq. 14 with the motion as the unknown (:mod:`parapend.control.plan`): a ``C^1`` cubic
-Hermite on ``K`` intervals from the measured state, free at the end, the torque defined by
-the motion (inverse dynamics), maximizing the electrical work plus the terminal value
-``kappa E(t + H)``, ``E = theta'^2 / 2 + cos(theta)`` (docs/control.md: the energy the
-pendulum keeps is worth ``kappa = eta_g`` of harvested energy), with ``|T| <= T_max``. The
-solver is the banded Newton / primal-dual interior point of :mod:`parapend.optimal.hermite`,
-warm-started from the previous plan shifted by one update.
+excitation ``q`` over the next ``horizon`` from a forecast, and solves the horizon problem
+on the full nonlinear Eq. 14 with the motion as the unknown (:mod:`parapend.control.plan`):
+a ``C^1`` cubic Hermite on ``K`` intervals from the measured state, free at the end, the
+torque defined by the motion (inverse dynamics), maximizing the electrical work plus the
+terminal value ``kappa E(t + H)``, ``E = theta'^2 / 2 + cos(theta)`` (docs/control.md: the
+energy the pendulum keeps is worth ``kappa = eta_g`` of harvested energy), with ``|T| <=
+T_max``. The solver is the banded Newton / primal-dual interior point of
+:mod:`parapend.optimal.hermite`, warm-started from the previous plan shifted by one update.
 
 The plan is applied as held torque samples of ``dt`` (zero-order hold): each sample holds
 the plan's torque averaged over the sample (3-point Gauss rule; the plan's ``q`` is the
@@ -167,7 +167,8 @@ class HorizonProblem:
         self.h = self.n * self.dt / self.k
 
     def problem(self, x0, q_of_lead):
-        """The :class:`~parapend.control.plan.PlanProblem` from ``x0`` with ``q`` a callable of the lead."""
+        """The :class:`~parapend.control.plan.PlanProblem` from ``x0`` with ``q`` a callable
+        of the lead."""
         from .plan import PlanProblem, gauss_leads
 
         lg, lc = gauss_leads(self.k, self.h)
@@ -178,7 +179,8 @@ class HorizonProblem:
     def solve(self, x0, qn, u0, max_iter=MAX_ITER, tol=1e-10):
         """Solve from the motion of ``u0``; returns a ``scipy.optimize.OptimizeResult``:
         ``x`` the ``n`` held torques, ``fun`` minus the plan's objective ``J``, ``success``,
-        ``status`` (the interior point's), ``nit``, ``plan`` (:class:`~parapend.control.plan.HorizonPlan`)."""
+        ``status`` (the interior point's), ``nit``,
+        ``plan`` (:class:`~parapend.control.plan.HorizonPlan`)."""
         from scipy.interpolate import CubicSpline
         from scipy.optimize import OptimizeResult
 
