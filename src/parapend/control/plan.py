@@ -22,6 +22,11 @@ is ``2 gamma theta'' = q' sin(theta)`` with the natural end condition
 ``q sin(theta) = 2 gamma theta'`` at ``t + H``. The integrals are evaluated by the 4-point
 Gauss-Legendre rule on every interval.
 
+**Terminal value under a torque limit.** ``terminal="limited"`` replaces ``kappa E(t + H)``
+by ``kappa V(E)``, ``V`` the energy a torque ``T_max`` harvests braking the rotation against
+the damping (:meth:`PlanProblem.terminal_value`, docs/control.md); ``V -> E`` without a
+limit.
+
 **Efficiency.** The kink of ``max(z, 0)`` (``z = T theta'``, the power motored) is smoothed,
 ``(z + sqrt(z^2 + eps^2)) / 2`` (above the kink by at most ``eps / 2``), with continuation
 ``eps = 1e-2, 1e-3, 1e-4`` (each solve warm-started from the last). A slack per Gauss point
@@ -46,6 +51,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..errors import ParameterError
 from ..optimal import _hermite_kernel as _k
 from ..optimal.hermite import (
     GAUSS_POINTS,
@@ -146,7 +152,7 @@ class PlanProblem:
         self.kink = max(1.0 / em - eg, 0.0)
         self.kappa = eg if kappa is None else float(kappa)
         if terminal not in ("energy", "limited"):
-            raise ValueError(f"terminal: expected energy or limited, got {terminal!r:.40}")
+            raise ParameterError(f"terminal: expected energy or limited, got {terminal!r:.40}")
         self.terminal = terminal
         # the scale T_max / gamma of the limited terminal value (inf: kappa E)
         self._a = (float(torque_limit) / float(gamma)
