@@ -228,6 +228,59 @@ def test_terminal_value_keeps_the_energy_at_the_horizon_end():
     assert ends[1] > ends[0] + 0.3
 
 
+def test_limited_terminal_value_is_the_braking_harvest_and_reduces_to_kappa_e():
+    """``terminal="limited"``: ``V(E)`` is the work a torque ``T_max`` harvests braking a
+    rotation of top speed ``w = sqrt(2 (E + 1))`` against ``gamma`` (``w' = -gamma w -
+    T_max`` integrated by DOP853, harvest ``T_max w``); as ``T_max / gamma`` grows it tends
+    to ``E``, and without a limit the problem is the ``kappa E`` one."""
+    from parapend.control.plan import solve_plan
+
+    pr, start, _ = _plan_problem(12, 2.0, torque_limit=1.0, terminal="limited")
+    def stopped(t, y):
+        return y[0]
+
+    stopped.terminal = True
+    for e in (0.5, 3.0, 50.0):
+        w0 = math.sqrt(2 * (e + 1))
+        sol = solve_ivp(lambda t, y: [-GAMMA * y[0] - 1.0, 1.0 * y[0]], (0, 1e4), [w0, 0.0],
+                        method="DOP853", rtol=1e-12, atol=1e-12, events=stopped)
+        harvest = float(sol.y_events[0][0][1])
+        v, v1, v2 = pr.terminal_value(e)
+        assert v + 1.0 == pytest.approx(harvest, rel=1e-9)
+        assert 0 < v1 < 1 and v2 < 0 and v1 == pytest.approx(1 / (1 + GAMMA * w0), rel=1e-12)
+    big, _, _ = _plan_problem(12, 2.0, torque_limit=1e9, terminal="limited")
+    assert big.terminal_value(50.0)[0] == pytest.approx(50.0, rel=1e-6)
+    free, start, _ = _plan_problem(12, 2.0, terminal="limited")
+    lin, _, _ = _plan_problem(12, 2.0)
+    assert solve_plan(free, start).value == pytest.approx(solve_plan(lin, start).value,
+                                                          rel=1e-12)
+
+
+def test_limited_terminal_value_gradient_and_hessian_are_exact():
+    """The Newton matrix and gradient of the limited terminal value against central
+    differences of the objective (12 intervals, the terminal value active)."""
+    pr, start, _ = _plan_problem(12, 2.0, terminal="limited", torque_limit=1.0)
+    from parapend.optimal import _hermite_kernel as _k
+
+    pr.mode = _k.NONE  # the objective's terms only (no barrier)
+    x = start + 0.1 * np.random.default_rng(3).normal(size=start.size)
+    x[-1] += 3.0  # a fast rotation at the end
+    n = x.size
+
+    def rhs(y):
+        return pr.newton(y, None, np.zeros(0), 0.0)[1]
+
+    ab = pr.newton(x, None, np.zeros(0), 0.0)[0]
+    g = np.array([(pr.objective(x + 1e-6 * e) - pr.objective(x - 1e-6 * e)) / 2e-6
+                  for e in np.eye(n)])
+    assert np.max(np.abs(g + rhs(x))) < 1e-6
+    for i in range(n - 2, n):
+        e = np.eye(n)[i]
+        col = -(rhs(x + 1e-5 * e) - rhs(x - 1e-5 * e)) / 2e-5
+        for j in range(max(0, i - 3), i + 1):
+            assert ab[i - j, j] == pytest.approx(col[j], abs=1e-6)
+
+
 def test_mpc_run_bad_input_is_a_parameter_error():
     from parapend.errors import ParameterError
 
@@ -236,6 +289,9 @@ def test_mpc_run_bad_input_is_a_parameter_error():
         mpc_run(exc, gamma=GAMMA, horizon=0.01, update_interval=0.1, dt=0.1, t_end=10)
     with pytest.raises(ParameterError, match="t_end"):
         mpc_run(exc, gamma=GAMMA, horizon=1, update_interval=0.1, dt=0.1)
+    with pytest.raises(ParameterError, match="terminal"):
+        mpc_run(exc, gamma=GAMMA, horizon=1, update_interval=0.1, dt=0.1, t_end=1,
+                terminal="cubic")
 
 
 @pytest.mark.parametrize("args,word", [
@@ -265,3 +321,16 @@ def test_perfect_forecast_harvests_most_of_the_noncausal_optimum():
     assert r.success and r.catch_time is not None
     assert r.mean_power / s.power > 0.95
     assert r.mean_power < s.limit_power
+
+
+@pytest.mark.slow
+def test_torque_limited_mpc_harvests_in_the_paper_case():
+    """The paper case with ``T_max = 1`` on the irregular record of seed 0 (20 peak
+    periods): with a horizon of one peak period the mean power over the last 10 periods is
+    positive (docs/control.md: 0.133)."""
+    from parapend.control.mpc import track_mpc
+    from parapend.excitation import harmonic
+
+    r = track_mpc(harmonic(), gamma=0.01, torque_limit=1.0, irregular=True, periods=20,
+                  seed=0, horizon=1.0)
+    assert r.success and r.mean_power > 0.05

@@ -224,7 +224,7 @@ def mpc_run(q_record, *, gamma, horizon, update_interval, dt, torque_limit=None,
             efficiency=None, forecast=None, theta0=math.pi, theta_dot0=0.0, t_end=None,
             warm=True, seed=0, terminal_weight=None, average_from=0.0,
             interval_samples=INTERVAL_SAMPLES, plant_steps=PLANT_STEPS, max_iter=MAX_ITER,
-            pump_level=1.0, tracking=TRACKING) -> MPCResult:
+            pump_level=1.0, tracking=TRACKING, terminal="energy") -> MPCResult:
     """Receding-horizon control of Eq. 14 driven by the record ``q_record``.
 
     Parameters
@@ -268,6 +268,11 @@ def mpc_run(q_record, *, gamma, horizon, update_interval, dt, torque_limit=None,
         RK4 steps of the plant per torque sample.
     max_iter : int
         Newton iterations per horizon solve.
+    terminal : {"energy", "limited"}
+        The terminal value ``kappa V(E)``: ``V = E`` (default), or ``"limited"``, the energy a
+        torque ``T_max`` harvests braking the rotation against ``gamma``
+        (:meth:`~.plan.PlanProblem.terminal_value`; docs/control.md: it makes the
+        torque-limited runs worse).
     """
     from . import _mpc_kernel as k
     from .plan import PlanProblem, free_motion, gauss_leads, solve_plan
@@ -284,6 +289,8 @@ def mpc_run(q_record, *, gamma, horizon, update_interval, dt, torque_limit=None,
                              f"{horizon!r}")
     n = max(1, int(round(horizon / dt)))
     m = max(1, min(n, int(round(update_interval / dt))))
+    if terminal not in ("energy", "limited"):
+        raise ParameterError(f"terminal: expected energy or limited, got {terminal!r:.40}")
     interval_samples = check_int("interval_samples", interval_samples, 1, 1024)
     plant_steps = check_int("plant_steps", plant_steps, 1, 4096)
     if torque_limit is not None:
@@ -351,7 +358,8 @@ def mpc_run(q_record, *, gamma, horizon, update_interval, dt, torque_limit=None,
                                                    leads), dtype=float)
             qg, qc, qs, qfree = np.split(qall, cuts)
             pr = PlanProblem(x, hh, qg.reshape(lg.shape), qc.reshape(lc.shape), gamma,
-                             torque_limit=torque_limit, efficiency=efficiency, kappa=kappa)
+                             torque_limit=torque_limit, efficiency=efficiency, kappa=kappa,
+                             terminal=terminal)
             anchor = None
             if torque_limit is not None or plan is None or not warm:
                 fth, fv = free_motion(x, hh, kk, gamma, qfree)
@@ -507,7 +515,7 @@ class MPCTrackResult(_Result):
 def track_mpc(excitation, *, gamma, horizon=2.0, update_interval=0.03125, forecast="perfect",
               torque_limit=None, efficiency=None, periods=100, seed=0, irregular=False,
               theta0=math.pi, theta_dot0=0.0, terminal_weight=None,
-              samples=TRACK_SAMPLES) -> MPCTrackResult:
+              samples=TRACK_SAMPLES, terminal="energy") -> MPCTrackResult:
     """Receding-horizon control of the case ``excitation`` (or, with ``irregular``, of the
     seeded sea record of ``parapend.control.track.design_sea`` built from it, the same
     record as ``track --irregular`` with the same seed); ``horizon`` and ``update_interval``
@@ -543,7 +551,8 @@ def track_mpc(excitation, *, gamma, horizon=2.0, update_interval=0.03125, foreca
     r = mpc_run(qf, gamma=gamma, horizon=horizon * tp, update_interval=update_interval * tp,
                 dt=dt, torque_limit=torque_limit, efficiency=efficiency, forecast=fo,
                 theta0=theta0, theta_dot0=theta_dot0, t_end=periods * tp, seed=seed,
-                terminal_weight=terminal_weight, average_from=WARMUP_PERIODS * tp)
+                terminal_weight=terminal_weight, average_from=WARMUP_PERIODS * tp,
+                terminal=terminal)
     p = r.power_series
     last = min(p.size, 10 * samples)
     mean_power = float(np.mean(p[-last:])) if p.size else math.nan

@@ -22,6 +22,11 @@ is ``2 gamma theta'' = q' sin(theta)`` with the natural end condition
 ``q sin(theta) = 2 gamma theta'`` at ``t + H``. The integrals are evaluated by the 4-point
 Gauss-Legendre rule on every interval.
 
+**Terminal value under a torque limit.** ``terminal="limited"`` replaces ``kappa E(t + H)``
+by ``kappa V(E)``, ``V`` the energy a torque ``T_max`` harvests braking the rotation against
+the damping (:meth:`PlanProblem.terminal_value`, docs/control.md); ``V -> E`` without a
+limit.
+
 **Efficiency.** The kink of ``max(z, 0)`` (``z = T theta'``, the power motored) is smoothed,
 ``(z + sqrt(z^2 + eps^2)) / 2`` (above the kink by at most ``eps / 2``), with continuation
 ``eps = 1e-2, 1e-3, 1e-4`` (each solve warm-started from the last). A slack per Gauss point
@@ -46,6 +51,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..errors import ParameterError
 from ..optimal import _hermite_kernel as _k
 from ..optimal.hermite import (
     GAUSS_POINTS,
@@ -125,12 +131,14 @@ class PlanProblem:
         Terminal weight (None: ``eta_g``).
     elastic : float or None
         Elastic mode: ``|T| <= torque_limit + t``, ``t >= 0``, penalty ``elastic t``.
+    terminal : {"energy", "limited"}
+        The terminal value ``kappa V(E)`` (:meth:`terminal_value`).
     """
 
     phase1 = False
 
     def __init__(self, x0, h, q_g, q_c, gamma, *, torque_limit=None, efficiency=None,
-                 kappa=None, elastic=None, smoothing=KINK_SMOOTHING[-1]):
+                 kappa=None, elastic=None, smoothing=KINK_SMOOTHING[-1], terminal="energy"):
         self.x0 = np.asarray(x0, dtype=float).copy()
         self.q_g = np.ascontiguousarray(q_g, dtype=float)
         self.q_c = np.ascontiguousarray(q_c, dtype=float)
@@ -143,6 +151,13 @@ class PlanProblem:
         self.eta_g = eg
         self.kink = max(1.0 / em - eg, 0.0)
         self.kappa = eg if kappa is None else float(kappa)
+        if terminal not in ("energy", "limited"):
+            raise ParameterError(f"terminal: expected energy or limited, got {terminal!r:.40}")
+        self.terminal = terminal
+        # the scale T_max / gamma of the limited terminal value (inf: kappa E)
+        self._a = (float(torque_limit) / float(gamma)
+                   if terminal == "limited" and torque_limit is not None and gamma > 0
+                   else math.inf)
         self.smoothing = float(smoothing)
         xg, wg = np.polynomial.legendre.leggauss(GAUSS_POINTS)
         self.w = wg / 2 * self.h  # the integral over one interval
@@ -187,10 +202,26 @@ class PlanProblem:
     def _local(self, f):
         return np.stack([f[0:-2:2], f[1:-2:2], f[2::2], f[3::2]], axis=1)
 
+    def terminal_value(self, e):
+        """``V(E)``, ``V'(E)``, ``V''(E)`` of the terminal value ``kappa V(E)``: ``V = E`` (the
+        default), or with ``terminal="limited"`` the energy the limited torque extracts,
+        ``V = a w - a^2 log(1 + w / a) - 1``, ``w = sqrt(2 (E + 1))``, ``a = T_max / gamma``
+        (``V' = a / (a + w)``; ``V -> E`` as ``a -> inf``)."""
+        a = self._a
+        if not math.isfinite(a):
+            return e, 1.0, 0.0
+        w = math.sqrt(max(2.0 * (e + 1.0), 1e-12))
+        return (a * w - a * a * math.log1p(w / a) - 1.0, a / (a + w),
+                -a / ((a + w) ** 2 * w))
+
     def _extra(self, f):
         """``terminal + kink`` of the minimized objective at the full variables ``f``."""
-        d = self.kappa - self.eta_g
-        val = -d * (0.5 * f[-1] ** 2 + math.cos(f[-2])) if d else 0.0
+        e_end = 0.5 * f[-1] ** 2 + math.cos(f[-2])
+        if math.isfinite(self._a):
+            val = -(self.kappa * self.terminal_value(e_end)[0] - self.eta_g * e_end)
+        else:
+            d = self.kappa - self.eta_g
+            val = -d * e_end if d else 0.0
         if self.kink:
             y = self._local(f)
             th = y @ self.rows_g[0].T
@@ -203,13 +234,17 @@ class PlanProblem:
     def _extra_newton(self, f, ab, rhs):
         """Add the gradient (to ``rhs``, minus) and Hessian (to the band ``ab``, full
         order) of :meth:`_extra`."""
-        d = self.kappa - self.eta_g
-        if d:
-            th, v = f[-2], f[-1]
-            rhs[-2] -= d * math.sin(th)
+        th, v = f[-2], f[-1]
+        _, v1, v2 = self.terminal_value(0.5 * v * v + math.cos(th))
+        d = self.kappa * v1 - self.eta_g
+        c = self.kappa * v2
+        if d or c:
+            sn = math.sin(th)
+            rhs[-2] -= d * sn
             rhs[-1] += d * v
-            ab[0, -2] += d * math.cos(th)
-            ab[0, -1] -= d
+            ab[0, -2] += d * math.cos(th) - c * sn * sn
+            ab[0, -1] -= d + c * v * v
+            ab[1, -2] += c * sn * v
         if not self.kink:
             return
         b0, b1, _ = self.rows_g
@@ -360,7 +395,8 @@ def solve_plan(problem: PlanProblem, x, *, anchor=None, gap_tol=1e-10, maxiter=2
                 el = PlanProblem(pr.x0, pr.h, pr.q_g, pr.q_c, pr.gamma,
                                  torque_limit=pr.torque_limit * (1 - 1e-4),
                                  efficiency=pr.efficiency, kappa=pr.kappa,
-                                 elastic=100.0 * max(1.0, pr.h), smoothing=pr.smoothing)
+                                 elastic=100.0 * max(1.0, pr.h), smoothing=pr.smoothing,
+                                 terminal=pr.terminal)
                 sol = interior_point(el, x, maxiter=maxiter)
                 iters += sol.iterations
                 xb = sol.x
