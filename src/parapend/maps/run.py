@@ -110,9 +110,17 @@ class _LocalPool:
         self._boot.start()
 
     def _submit_first(self):
-        # the first submit starts every worker (in this thread, not the caller's)
+        # Start every worker here, not in the caller's thread: a submit that finds no idle
+        # worker spawns one, and a Ctrl-C (raised in the main thread only) landing inside
+        # that spawn left a child that the pool did not know of, so it was neither stopped
+        # nor waited for, and it printed a traceback once the parent had gone (its queues'
+        # semaphores unlinked). Each submit here spawns a worker until all have started.
+        ex = self.executor
         with contextlib.suppress(Exception):
-            self.executor.submit(_ready)
+            for _ in range(4 * self.workers):
+                ex.submit(_ready)
+                if len(getattr(ex, "_processes", None) or ()) >= self.workers:
+                    break
 
     def shutdown(self):
         if self.executor is not None:
