@@ -36,6 +36,7 @@ the dense Hessian the same product applied to the identity.
 from __future__ import annotations
 
 import math
+import warnings
 
 import numpy as np
 
@@ -452,9 +453,15 @@ def torque_limited(problem: ElectricalProblem, x0: np.ndarray, limit: float, *,
 
         kw = ({"hess": lambda z: -ev(z)[2]} if dense else
               {"hessp": lambda z, d: -ev(z)[2].matvec(d)})
-        r = minimize(lambda z: -ev(z)[0], x, jac=lambda z: -ev(z)[1],
-                     method="trust-exact" if dense else "trust-krylov",
-                     options={"gtol": gtol, "maxiter": MAXITER}, **kw)
+        # trlib (trust-krylov) can form 0 * inf in a step it then rejects: not an error
+        with np.errstate(invalid="ignore", over="ignore"), warnings.catch_warnings():
+            warnings.simplefilter("ignore", RuntimeWarning)
+            r = minimize(lambda z: -ev(z)[0], x, jac=lambda z: -ev(z)[1],
+                         method="trust-exact" if dense else "trust-krylov",
+                         options={"gtol": gtol, "maxiter": MAXITER}, **kw)
+        if not np.all(np.isfinite(r.x)):
+            status = "stalled"
+            break
         x = np.array(r.x)
         inner += int(r.nit)
         viol = problem.update_multipliers(x)
