@@ -241,6 +241,7 @@ def test_power_against_wave_period(sphere_nc, tmp_path, capsys):
     (["--mass", "-1"], "mass"),
     (["--mass", "20", "--length", "0.3", "--inertia", "1.0"], "inertia: expected at least"),
     (["--wave-period", "1:2"], "wave-period"),
+    (["--wave-period", "0.1"], "wave-period: the waves are too short for the body's mesh"),
     (["--optimize-design", "colour"], "optimize-design"),
     (["--length-bounds", "0.2:2"], "only used with --optimize-design"),
     (["--hs", "0.5", "--wave-height", "1"], "not both"),

@@ -342,6 +342,17 @@ def _hydro(body, radius, draft, mesh, hydro, omegas, harmonics):
     if hydro is not None:
         return hy.load(hydro), None
     omega = hy.frequencies_for(np.asarray(omegas, dtype=float), harmonics)
+    try:
+        return _solve_hydro(hy, body, radius, draft, mesh, omega)
+    except ParameterError as e:
+        # the user gave wave periods, not the BEM's frequencies
+        if str(e).startswith("omega: every frequency is too high"):
+            raise ParameterError("wave-period: the waves are too short for the body's mesh; "
+                                 + str(e).split(": ", 1)[1]) from None
+        raise
+
+
+def _solve_hydro(hy, body, radius, draft, mesh, omega):
     if mesh is not None:
         return hy.from_mesh(mesh, omega=omega), None
     if body not in ("cylinder", "sphere"):

@@ -452,8 +452,13 @@ DEFAULT_OMEGA = np.linspace(0.3, 12.0, 30)
 def _keep_resolvable(omega, h, g, depth):
     keep = _resolvable(omega, h, g, depth)
     if not np.any(keep):
+        # the shortest resolvable wave: wavelength 8 h, its period from the dispersion relation
+        k = 2 * math.pi / (8 * h)
+        period = 2 * math.pi / math.sqrt(g * k * (math.tanh(k * depth) if math.isfinite(depth)
+                                                  else 1.0))
         raise ParameterError(f"omega: every frequency is too high for a mesh of panel radius "
-                             f"{h:.3g} m")
+                             f"{h:.3g} m: it resolves waves longer than {8 * h:.3g} m, "
+                             f"periods above {period:.3g} s")
     # a contiguous lower part: the resolvable frequencies are those below a limit
     return omega[keep]
 
