@@ -16,6 +16,12 @@ more than :data:`ALIAS_TOL` (relative) is rejected (aliasing: on a coarse grid t
 can be driven to absurd values by large coefficients). The harmonics ``N`` are chosen from
 the problem and checked by one refinement (``2N`` polished from the ``N`` optimum).
 
+In a regular wave (odd harmonics only) the optimum ``theta(t)`` and its half-period image
+``theta(t + T/2) + pi`` (:func:`half_period_image`) have the same power exactly, and differ
+in their torque; a search returns either, as rounding falls. The result is the one with the
+smaller peak torque (peaks within :data:`IMAGE_TIE`: a fixed rule on the coefficients),
+before a take-off or a torque limit starts from it.
+
 Checks reported in every result: the energy balance
 ``P + c <theta'^2> = <F_exc z'> - sum_k 1/2 B_k (k w)^2 |Z_k|^2`` (the left side from the
 torque in the time domain on a fine grid, the right side from the heave harmonics), the
@@ -316,8 +322,10 @@ def _canonical_copy(hydro, pendulum, wave, x, winding, m, coupled):
     ``m`` points; peaks within :data:`IMAGE_TIE` (relative) of each other: the one whose first
     odd harmonic (``a_1, b_1, a_3, b_3, ...``) above 1e-6 rad is positive (even ``K`` and
     no such harmonic: ``a0`` modulo 2 pi below pi). Returns ``(x, peak, image_peak)``
-    (N m), the peaks None where the wave has even harmonics (no such symmetry)."""
-    if np.any(np.asarray(wave.amplitudes)[1::2] != 0):
+    (N m), the peaks None where the wave has even harmonics above 1e-12 of its largest
+    (no such symmetry)."""
+    a = np.abs(np.asarray(wave.amplitudes))
+    if a.size > 1 and float(np.max(a[1::2])) > 1e-12 * float(np.max(a)):
         return x, None, None
     y = half_period_image(x, winding)
     p0, _, _, t0 = _heave_and_balance(hydro, pendulum, wave, x, winding, m, coupled, True)
