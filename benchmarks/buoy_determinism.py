@@ -2,7 +2,8 @@
 
 Runs the default design's calls in fresh subprocesses, in different orders, with the BEM
 cache cold (a new ``PARAPEND_CACHE``) and warm, and with the body's mass changed by a few
-ulp (the last bits another BLAS kernel or another machine could change), and prints one
+ulp (the last bits another BLAS kernel or another machine could change), and under four
+OpenBLAS kernels (``OPENBLAS_CORETYPE``; one the processor lacks falls back), and prints one
 fingerprint per call: the power, the peak torque, a hash of the motion's coefficients, and
 for the ideal optimum its motion sent through a take-off of 0.9 both ways.
 
@@ -68,9 +69,11 @@ for c in sys.argv[1].split(","):
 '''
 
 
-def run(src: str, calls: str, cache: str) -> str:
+def run(src: str, calls: str, cache: str, coretype: str | None = None) -> str:
     env = dict(os.environ, PYTHONPATH=src, PARAPEND_CACHE=cache, OPENBLAS_NUM_THREADS="1",
                OMP_NUM_THREADS="1")
+    if coretype:
+        env["OPENBLAS_CORETYPE"] = coretype
     out = subprocess.run([sys.executable, "-c", CHILD, calls], env=env, capture_output=True,
                          text=True, check=False)
     return out.stdout + (out.stderr if out.returncode else "")
@@ -87,6 +90,9 @@ def main() -> None:
         for what, calls in plan:
             print(f"--- fresh process, {what}: {calls}", flush=True)
             print(run(args.src, calls, tmp), end="", flush=True)
+        for core in ("Prescott", "Sandybridge", "Haswell", "SkylakeX"):
+            print(f"--- fresh process, warm cache, OPENBLAS_CORETYPE={core}: I,L", flush=True)
+            print(run(args.src, "I,L", tmp, core), end="", flush=True)
 
 
 if __name__ == "__main__":
