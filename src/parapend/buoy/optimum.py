@@ -16,6 +16,12 @@ more than :data:`ALIAS_TOL` (relative) is rejected (aliasing: on a coarse grid t
 can be driven to absurd values by large coefficients). The harmonics ``N`` are chosen from
 the problem and checked by one refinement (``2N`` polished from the ``N`` optimum).
 
+In a regular wave (odd harmonics only) the optimum ``theta(t)`` and its half-period image
+``theta(t + T/2) + pi`` (:func:`half_period_image`) have the same power exactly, and differ
+in their torque; a search returns either, as rounding falls. The result is the one with the
+smaller peak torque (peaks within :data:`IMAGE_TIE`: a fixed rule on the coefficients),
+before a take-off or a torque limit starts from it.
+
 Checks reported in every result: the energy balance
 ``P + c <theta'^2> = <F_exc z'> - sum_k 1/2 B_k (k w)^2 |Z_k|^2`` (the left side from the
 torque in the time domain on a fine grid, the right side from the heave harmonics), the
@@ -49,7 +55,8 @@ from ..optimal.fourier import _pad, motion_distance, newton_maximize, search_fou
 from ..optimal.limit import limit as uncoupled_limit
 from .coupled import CoupledProblem, Pendulum, Wave, free_excitation, scales
 
-__all__ = ["CoupledSolution", "coupled_limit", "coupled_optimum", "radiation_bound"]
+__all__ = ["CoupledSolution", "coupled_limit", "coupled_optimum", "half_period_image",
+           "radiation_bound"]
 
 #: relative change of the optimum's power between its grid and one four times finer above
 #: which the optimum is rejected as aliased
@@ -70,6 +77,9 @@ ELECTRICAL_REFINE_TOL = 1e-3
 #: relative change of the exact electrical power over the last two widths of the
 #: continuation below which it counts as converged
 ELECTRICAL_SETTLED = 1e-5
+#: peak torques of an optimum and its half-period image closer than this (relative) do not
+#: decide between them (:func:`_canonical_copy`)
+IMAGE_TIE = 1e-6
 #: dense Hessian for a regular wave up to this many harmonics, matrix-free Newton-CG above
 #: and for every record (the dense Newton from the swinging-back seeds took minutes at N = 192)
 DENSE_MAX = 96
@@ -230,10 +240,11 @@ def _grid_motion(x: np.ndarray, winding: int, m: int):
 
 
 def _heave_and_balance(hydro, pendulum: Pendulum, wave: Wave, x: np.ndarray, winding: int,
-                       m: int, coupled: bool):
+                       m: int, coupled: bool, torque: bool = False):
     """Power from the torque in the time domain, the heave harmonics and the energy balance.
 
-    Returns ``(power_w, heave, residual)``: ``heave`` the ``Z_k``, k = 0..m/2 - 1.
+    Returns ``(power_w, heave, residual)``: ``heave`` the ``Z_k``, k = 0..m/2 - 1; with
+    ``torque``, ``(power_w, heave, residual, tau)``, ``tau`` (N m) on the ``m`` points.
     """
     w = wave.omega
     mass, l_, inertia = pendulum.mass, pendulum.length, pendulum.inertia
@@ -269,7 +280,71 @@ def _heave_and_balance(hydro, pendulum: Pendulum, wave: Wave, x: np.ndarray, win
         # the pendulum's own balance: P + c<theta'^2> = m l <z''' cos(theta)>
         rhs = mass * l_ * 0.5 * float(np.sum(((-1j * om**3) * Z * np.conj(ch)).real))
         scale = max(abs(p), diss, abs(rhs), 1e-300)
+    if torque:
+        return p, Z, abs(p + diss - rhs) / scale, tau
     return p, Z, abs(p + diss - rhs) / scale
+
+
+# ------------------------------------------------------------------------------------------
+def half_period_image(x: np.ndarray, winding: int) -> np.ndarray:
+    r"""The packed coefficients of ``theta(s + pi) + pi`` from those of ``theta(s)``.
+
+    ``theta(s) = K s + a0 + sum a_n sin(ns) + b_n cos(ns)``: the image has ``a_n`` and
+    ``b_n`` times ``(-1)^n`` and ``a0 + (K + 1) pi``, taken as ``a0`` for odd ``K`` (a whole
+    number of turns) and ``a0 + pi`` for even ``K``.
+
+    In a wave of odd harmonics only (a regular wave), ``q_w(s + pi) = -q_w(s)``. The image
+    ``theta~(s) = theta(s + pi) + pi`` has ``cos(theta~(s)) = -cos(theta(s + pi))``, so the
+    reaction's heave (linear in ``cos(theta)``) and the wave's both change sign:
+    ``z~(s) = -z(s + pi)``. The mean power ``P = -c <theta'^2> + m l <z'' theta' sin(theta)>``
+    (``I <theta'' theta'>`` and ``g <theta' sin(theta)>`` vanish: exact derivatives) is the
+    same for both, on every even grid (the shift by ``pi`` maps its points onto themselves),
+    and so is the heave amplitude. The torques are not:
+    ``tau~(s) = tau(s + pi) + 2 m l g sin(theta(s + pi))`` (gravity's part, which averages
+    to nothing in ``P``), nor is anything else that depends on more than the mean power:
+    the peak torque, the electrical power through a take-off, the torque-limited optimum
+    started from the motion.
+    """
+    x = np.asarray(x, dtype=float)
+    n = (x.size - 1) // 2
+    sign = (-1.0) ** np.arange(1, n + 1)
+    y = x.copy()
+    y[1:n + 1] *= sign
+    y[n + 1:] *= sign
+    if winding % 2 == 0:
+        y[0] += math.pi
+    return y
+
+
+def _canonical_copy(hydro, pendulum, wave, x, winding, m, coupled):
+    """Of the optimum ``x`` and its :func:`half_period_image` (the same power: which of the
+    two a search returns is decided by rounding), the one with the smaller peak torque on
+    ``m`` points; peaks within :data:`IMAGE_TIE` (relative) of each other: the one whose first
+    odd harmonic (``a_1, b_1, a_3, b_3, ...``) above 1e-6 rad is positive (even ``K`` and
+    no such harmonic: ``a0`` modulo 2 pi below pi). Returns ``(x, peak, image_peak)``
+    (N m), the peaks None where the wave has even harmonics above 1e-12 of its largest
+    (no such symmetry)."""
+    a = np.abs(np.asarray(wave.amplitudes))
+    if a.size > 1 and float(np.max(a[1::2])) > 1e-12 * float(np.max(a)):
+        return x, None, None
+    y = half_period_image(x, winding)
+    p0, _, _, t0 = _heave_and_balance(hydro, pendulum, wave, x, winding, m, coupled, True)
+    p1, _, _, t1 = _heave_and_balance(hydro, pendulum, wave, y, winding, m, coupled, True)
+    if not abs(p1 - p0) <= 1e-9 * max(abs(p0), abs(p1), 1e-300):
+        return x, None, None  # not the symmetry this relies on: keep the search's choice
+    a, b = float(np.max(np.abs(t0))), float(np.max(np.abs(t1)))
+    if abs(a - b) > IMAGE_TIE * max(a, b):
+        swap = b < a
+    else:
+        n = (x.size - 1) // 2
+        odd = np.column_stack((x[1:n + 1:2], x[n + 1::2])).ravel()
+        big = odd[np.abs(odd) > 1e-6]
+        if big.size:
+            swap = bool(big[0] < 0)
+        else:
+            swap = winding % 2 == 0 and abs(math.remainder(float(x[0]) - math.pi / 2,
+                                                            2 * math.pi)) >= math.pi / 2
+    return (y, b, a) if swap else (x, a, b)
 
 
 # ------------------------------------------------------------------------------------------
@@ -653,6 +728,11 @@ def coupled_optimum(hydro, pendulum: Pendulum, wave: Wave, *, winding: int = 1,
     if ref.status == "converged" and ref.power >= best.power - 1e-12 * max(1.0, abs(
             best.power)):
         sol, n = ref, n2
+    # a regular wave: the optimum and its half-period image tie in power; take one by rule
+    mf = max(4096, 4 * fine.points)
+    x_c, peak_c, peak_i = _canonical_copy(hydro, pendulum, wave, sol.x, k, mf, not one_way)
+    if x_c is not sol.x:
+        sol = replace(sol, x=x_c)
     tl_note = None
     elec = None
     if eta is not None and eta != (1.0, 1.0):
@@ -681,7 +761,6 @@ def coupled_optimum(hydro, pendulum: Pendulum, wave: Wave, *, winding: int = 1,
                        f"the {tl['points']}-point grid: {tl['status']}, {tl['outer']} "
                        f"multiplier updates, {tl['inner']} Newton steps)")
     # fine grid: the power from the torque, the heave, the energy balance
-    mf = max(4096, 4 * fine.points)
     p_w, Z, resid = _heave_and_balance(hydro, pendulum, wave, sol.x, k, mf, not one_way)
     if elec is not None:
         # the electrical optimum's grid: its own mechanical power there
@@ -733,7 +812,8 @@ def coupled_optimum(hydro, pendulum: Pendulum, wave: Wave, *, winding: int = 1,
     evid = {"starts": len(runs), "converged": sum(r.status == "converged" for r in runs),
             "abandoned": sum(r.status == "abandoned" for r in runs), "rejected_aliased":
             rejected, "maxima": _distinct_maxima(runs, pu), "found_by": sol.seed,
-            "one_way_power": ow.best.power * pu, "one_way_strategy": ow.evidence.strategy}
+            "one_way_power": ow.best.power * pu, "one_way_strategy": ow.evidence.strategy,
+            "ideal_peak_torque": peak_c, "image_peak_torque": peak_i}
     second = [d["power"] for d in evid["maxima"][1:]]
     evid["second_power"] = second[0] if second else None
     zfull = Z
