@@ -285,6 +285,30 @@ class ElectricalProblem:
         h = 0.5 * (h + h.T)
         return val, g, h
 
+    def diagonal(self, st) -> np.ndarray:
+        """An estimate of the Hessian's diagonal in the Fourier basis, the scaling that
+        preconditions ``trust-krylov``: the kink's term ``<e'' dp_i^2>`` alone, with the
+        reaction ``L`` left out and ``cos^2, sin^2`` by their mean 1/2. With ``dp_i = A
+        phi_i + B d1_i + C d2_i`` (``A = (1 + q) cos(theta) theta'``, ``B = -Om (gamma
+        theta' + tau)``, ``C = -Om^2 theta'``) harmonic ``k`` has ``<|e''| ((A - k^2 C)^2 +
+        k^2 B^2)> / 2``: its ``k^4`` growth is what the scaling takes out."""
+        om, gam = self.omega, self.gamma
+        thd = st["thd"]
+        e2 = np.abs(st["e2"])
+        a = (1.0 + st["q"]) * st["cs"] * thd
+        b = -om * (gam * thd + st["tau"])
+        c = -om * om * thd
+        k2 = self._kn[1:] ** 2
+
+        def mean(f):
+            return float(np.mean(e2 * f))
+
+        aa, ac, cc, bb = mean(a * a), mean(a * c), mean(c * c), mean(b * b)
+        dk = 0.5 * (aa - 2.0 * k2 * ac + k2 * k2 * cc + k2 * bb)
+        d = np.concatenate([[aa], dk, dk])
+        top = float(np.max(d))
+        return np.maximum(d, 1e-12 * top if top > 0 else 1.0)
+
     def hessp(self, st, d):
         """``H d`` (``d`` a vector, or columns: the result has the same shape)."""
         om = self.omega
@@ -365,18 +389,63 @@ def maximize(problem: ElectricalProblem, x0: np.ndarray, widths=None, limit=None
                 cache[key] = problem.evaluate(z)
             return cache[key]
 
-        kw = ({"hess": lambda z: -ev(z)[2]} if dense else
-              {"hessp": lambda z, d: -ev(z)[2].matvec(d)})
-        r = minimize(lambda z: -ev(z)[0], x, jac=lambda z: -ev(z)[1],
-                     method="trust-exact" if dense else "trust-krylov",
-                     options={"gtol": gtol, "maxiter": MAXITER}, **kw)
+        if dense:
+            r = minimize(lambda z: -ev(z)[0], x, jac=lambda z: -ev(z)[1],
+                         hess=lambda z: -ev(z)[2], method="trust-exact",
+                         options={"gtol": gtol, "maxiter": MAXITER})
+            status = {0: "converged", 1: "max_iterations"}.get(r.status, "stalled")
+            nit = int(r.nit)
+        else:
+            r, status, nit = _scaled_krylov(problem, ev, x, gtol)
         ex = problem.exact(r.x)
-        status = {0: "converged", 1: "max_iterations"}.get(r.status, "stalled")
-        runs.append((rel * p0, ex, status, int(r.nit)))
+        runs.append((rel * p0, ex, status, nit))
         if math.isfinite(ex) and ex >= best:
             best, best_x = ex, np.array(r.x)
         x = np.array(r.x)
     return best_x, best, runs
+
+
+#: restarts of a preconditioned trust-krylov solve that stalled short of the tolerance
+RESTARTS = 8
+
+
+def _scaled_krylov(problem, ev, x0, gtol):
+    """``trust-krylov`` on the coefficients scaled by the Hessian's estimated diagonal
+    (``x = D y``, ``D = diag^(-1/2)``, :meth:`ElectricalProblem.diagonal`: a Jacobi
+    preconditioner, which trlib does not take otherwise), restarted with a fresh scaling
+    when trlib stalls (a step that predicts no improvement) short of ``gtol`` on the
+    unscaled gradient's largest component. Returns ``(result, status, iterations)``."""
+    from scipy.optimize import minimize
+
+    x = np.array(x0, dtype=float)
+    nit = 0
+    status = "stalled"
+    r = None
+    for _ in range(RESTARTS):
+        d = 1.0 / np.sqrt(problem.diagonal(ev(x)[2].state))
+        with np.errstate(invalid="ignore", over="ignore"), warnings.catch_warnings():
+            warnings.simplefilter("ignore", RuntimeWarning)
+            r = minimize(lambda y: -ev(d * y)[0], x / d, jac=lambda y: -d * ev(d * y)[1],
+                         hessp=lambda y, v: -d * ev(d * y)[2].matvec(d * v),
+                         method="trust-krylov",
+                         options={"gtol": gtol * float(np.min(d)), "maxiter": MAXITER})
+        nit += int(r.nit)
+        xn = d * r.x
+        if not np.all(np.isfinite(xn)):
+            break
+        moved = ev(xn)[0] > ev(x)[0]
+        x = xn
+        g = float(np.max(np.abs(ev(x)[1])))
+        if g <= gtol:
+            status = "converged"
+            break
+        if r.status == 1:
+            status = "max_iterations"
+            break
+        if not moved and r.nit <= 1:
+            break
+    r.x = x
+    return r, status, nit
 
 
 def ladder(make, x_ideal: np.ndarray, harmonics: int, start: int, limit=None):
