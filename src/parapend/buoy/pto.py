@@ -407,6 +407,28 @@ def maximize(problem: ElectricalProblem, x0: np.ndarray, widths=None, limit=None
 
 #: restarts of a preconditioned trust-krylov solve that stalled short of the tolerance
 RESTARTS = 8
+#: iterations of the truncated-CG fallback per width
+FALLBACK_MAXITER = 50
+#: a width is settled when the smoothed value moved by at most PLATEAU_TOL (relative, the
+#: rounding of a mean over the grid) in PLATEAU trust-region iterations
+PLATEAU = 10
+PLATEAU_TOL = 1e-13
+_DEBUG = bool(__import__("os").environ.get("PP_DEBUG"))
+
+
+def _plateau():
+    """A SciPy callback that stops a minimization when its value has stopped moving at the
+    rounding level (no step can be verified), and the list it marks when it does."""
+    hist, halted = [], []
+
+    def settled(intermediate_result):
+        hist.append(float(intermediate_result.fun))
+        if len(hist) > PLATEAU and hist[-PLATEAU - 1] - hist[-1] <= PLATEAU_TOL * abs(
+                hist[-1]):
+            halted.append(True)
+            raise StopIteration
+
+    return settled, halted
 
 
 def _scaled_krylov(problem, ev, x0, gtol):
@@ -421,29 +443,46 @@ def _scaled_krylov(problem, ev, x0, gtol):
     nit = 0
     status = "stalled"
     r = None
+    method = "trust-krylov"
     for _ in range(RESTARTS):
         d = 1.0 / np.sqrt(problem.diagonal(ev(x)[2].state))
+        settled, halted = _plateau()
+
         with np.errstate(invalid="ignore", over="ignore"), warnings.catch_warnings():
             warnings.simplefilter("ignore", RuntimeWarning)
-            r = minimize(lambda y: -ev(d * y)[0], x / d, jac=lambda y: -d * ev(d * y)[1],
-                         hessp=lambda y, v: -d * ev(d * y)[2].matvec(d * v),
-                         method="trust-krylov",
-                         options={"gtol": gtol * float(np.min(d)), "maxiter": MAXITER})
+            r = minimize(lambda y, d=d: -ev(d * y)[0], x / d,
+                         jac=lambda y, d=d: -d * ev(d * y)[1],
+                         hessp=lambda y, v, d=d: -d * ev(d * y)[2].matvec(d * v),
+                         method=method, callback=settled,
+                         options={"gtol": gtol * float(np.min(d)),
+                                  "maxiter": MAXITER if method == "trust-krylov" else
+                                  FALLBACK_MAXITER})
         nit += int(r.nit)
         xn = d * r.x
         if not np.all(np.isfinite(xn)):
             break
-        moved = ev(xn)[0] > ev(x)[0]
-        x = xn
+        f0, f1 = ev(x)[0], ev(xn)[0]
+        moved = f1 > f0 + PLATEAU_TOL * abs(f1)
+        x = xn if f1 >= f0 else x
         g = float(np.max(np.abs(ev(x)[1])))
+        if _DEBUG:
+            print(f"        {method} st={r.status} nit={r.nit} |g|={g:.2e} gtol={gtol:.1e} "
+                  f"f={ev(x)[0]:.12g} moved={moved}", flush=True)
         if g <= gtol:
             status = "converged"
+            break
+        if halted:
+            status = "settled"
             break
         if r.status == 1:
             status = "max_iterations"
             break
-        if not moved and r.nit <= 1:
-            break
+        if not moved:
+            if method == "trust-ncg":
+                break
+            # trlib found no step that predicts an improvement (at the smallest widths):
+            # Steihaug's truncated CG from here
+            method = "trust-ncg"
     r.x = x
     return r, status, nit
 
