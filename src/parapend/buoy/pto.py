@@ -13,7 +13,8 @@ every harmonic of the grid; ``L = 0`` one-way). The objective ``<e(p)>`` is not 
 ``p = 0``; it is maximized over the Fourier coefficients of ``theta`` with the kink smoothed,
 ``|p| ~ sqrt(p^2 + s^2)`` (concave in ``p`` as ``b <= 0``, and below ``e`` by at most
 ``|b| s``), by a trust-region Newton method (SciPy's ``trust-exact`` on the dense Hessian,
-``trust-krylov`` on Hessian-vector products) with the exact gradient and Hessian (below)
+``trust-krylov`` on Hessian-vector products, the coefficients scaled by the Hessian's
+estimated diagonal, :meth:`ElectricalProblem.diagonal`) with the exact gradient and Hessian (below)
 and a continuation ``s -> 0`` (:func:`maximize`) and in the harmonics (:func:`ladder`);
 every iterate's exact (unsmoothed) value decides which one is returned.
 
@@ -421,7 +422,6 @@ FALLBACK_MAXITER = 50
 #: rounding of a mean over the grid) in PLATEAU trust-region iterations
 PLATEAU = 10
 PLATEAU_TOL = 1e-13
-_DEBUG = bool(__import__("os").environ.get("PP_DEBUG"))
 
 
 def _plateau():
@@ -473,9 +473,6 @@ def _scaled_krylov(problem, ev, x0, gtol):
         moved = f1 > f0 + PLATEAU_TOL * abs(f1)
         x = xn if f1 >= f0 else x
         g = float(np.max(np.abs(ev(x)[1])))
-        if _DEBUG:
-            print(f"        {method} st={r.status} nit={r.nit} |g|={g:.2e} gtol={gtol:.1e} "
-                  f"f={ev(x)[0]:.12g} moved={moved}", flush=True)
         if g <= gtol:
             status = "converged"
             break
