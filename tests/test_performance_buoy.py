@@ -101,7 +101,7 @@ def test_the_store_resumes_to_the_same_numbers(run):
 @pytest.mark.parametrize("extra, match", [
     (["--response", "x.csv"], "response:"),
     (["--gamma", "0.01"], "gamma:"),
-    (["--efficiency", "0.8"], "efficiency:"),
+    (["--efficiency", "1.2"], "efficiency:"),
     (["--winding", "auto"], "winding:"),
     (["--tp", "2.0,2.6"], "tp: the record of the bin 2 s spans"),
     (["--mass", "1000"], "mass:"),
@@ -139,3 +139,47 @@ def test_default_width_is_the_bodys_diameter(tmp_path, capsys, monkeypatch):
     assert out["width"] == 1.0
     cw = np.array(out["capture_width_matrix"])
     assert np.allclose(np.array(out["capture_width_ratio_matrix"]), cw / 1.0, rtol=1e-14)
+
+
+@pytest.fixture(scope="module")
+def run_eff(sphere_nc, tmp_path_factory):
+    """``--efficiency 0.9``: the JSON on a fresh store, then on the finished store."""
+    import contextlib
+    import io
+
+    store = str(tmp_path_factory.mktemp("pm") / "e.zarr")
+    args = list(ARGS)
+    args[1] = "0.4,0.6"  # higher seas than ARGS': at 0.1, 0.2 m the take-off loses
+    outs = []
+    for _ in range(2):
+        buf = io.StringIO()
+        with contextlib.redirect_stdout(buf):
+            assert main(["power-matrix", "--device", "buoy", "--hydro", sphere_nc, *args,
+                         "--efficiency", "0.9", "--store", store, "--json"]) == 0
+        outs.append(json.loads(buf.getvalue()))
+    return outs
+
+
+@pytest.mark.slow
+def test_a_bin_with_an_efficiency_is_parapend_buoy_by_hand(run_eff, sphere_nc):
+    """A bin's electrical power is ``parapend.buoy(..., efficiency=0.9)``'s on the same
+    record and dataset; the store resumes to the same numbers."""
+    import parapend
+
+    first, again = run_eff
+    assert first["failed_solves"] == 0 and again["resumed_bins"] == 4
+    assert again["statistics"] == first["statistics"]
+    st = first["statistics"]
+    r = parapend.buoy(hs=0.6, tp=3.0, repeat_period=4 * 3.0, seed=7, hydro=sphere_nc,
+                      efficiency=0.9, mass=PEND["mass"], length=PEND["length"],
+                      damping_coefficient=PEND["damping_coefficient"],
+                      harmonics=PEND["harmonics"])
+    assert st["electrical_power"]["mean"][1][1] == pytest.approx(r.electrical_power_w,
+                                                                 rel=1e-9)
+    # the mechanical power of that motion: the optimum is flat in the motion, so a motion
+    # within the solver's tolerance of the same electrical power moves it more
+    assert st["power"]["mean"][1][1] == pytest.approx(r.power_w, rel=1e-4)
+    # the take-off loses: electrical <= mechanical <= the radiation bound, in every bin
+    e, p = np.array(st["electrical_power"]["max"]), np.array(st["power"]["max"])
+    assert r.success and np.all(e > 0) and np.all(e <= p)
+    assert np.all(p <= np.array(st["radiation_bound_power"]["min"]))

@@ -13,7 +13,8 @@ every harmonic of the grid; ``L = 0`` one-way). The objective ``<e(p)>`` is not 
 ``p = 0``; it is maximized over the Fourier coefficients of ``theta`` with the kink smoothed,
 ``|p| ~ sqrt(p^2 + s^2)`` (concave in ``p`` as ``b <= 0``, and below ``e`` by at most
 ``|b| s``), by a trust-region Newton method (SciPy's ``trust-exact`` on the dense Hessian,
-``trust-krylov`` on Hessian-vector products) with the exact gradient and Hessian (below)
+``trust-krylov`` on Hessian-vector products, the coefficients scaled by the Hessian's
+estimated diagonal, :meth:`ElectricalProblem.diagonal`) with the exact gradient and Hessian (below)
 and a continuation ``s -> 0`` (:func:`maximize`) and in the harmonics (:func:`ladder`);
 every iterate's exact (unsmoothed) value decides which one is returned.
 
@@ -285,26 +286,58 @@ class ElectricalProblem:
         h = 0.5 * (h + h.T)
         return val, g, h
 
+    def diagonal(self, st) -> np.ndarray:
+        """An estimate of the Hessian's diagonal in the Fourier basis, the scaling that
+        preconditions ``trust-krylov``: the kink's term ``<e'' dp_i^2>`` alone, with the
+        reaction ``L`` left out and ``cos^2, sin^2`` by their mean 1/2. With ``dp_i = A
+        phi_i + B d1_i + C d2_i`` (``A = (1 + q) cos(theta) theta'``, ``B = -Om (gamma
+        theta' + tau)``, ``C = -Om^2 theta'``) harmonic ``k`` has ``<|e''| ((A - k^2 C)^2 +
+        k^2 B^2)> / 2``: its ``k^4`` growth is what the scaling takes out."""
+        om, gam = self.omega, self.gamma
+        thd = st["thd"]
+        e2 = np.abs(st["e2"])
+        a = (1.0 + st["q"]) * st["cs"] * thd
+        b = -om * (gam * thd + st["tau"])
+        c = -om * om * thd
+        k2 = self._kn[1:] ** 2
+
+        def mean(f):
+            return float(np.mean(e2 * f))
+
+        aa, ac, cc, bb = mean(a * a), mean(a * c), mean(c * c), mean(b * b)
+        dk = 0.5 * (aa - 2.0 * k2 * ac + k2 * k2 * cc + k2 * bb)
+        d = np.concatenate([[aa], dk, dk])
+        top = float(np.max(d))
+        return np.maximum(d, 1e-12 * top if top > 0 else 1.0)
+
     def hessp(self, st, d):
-        """``H d`` (``d`` a vector, or columns: the result has the same shape)."""
-        om = self.omega
+        """``H d`` (``d`` a vector, or columns: the result has the same shape).
+
+        Every term is a projection ``sum_t a phi_i + b d1_i + c d2_i`` (the torque's
+        transposed Jacobian is one too), so the terms are summed on the grid and projected
+        once, and ``L(sin(theta) phi)`` is shared by ``dtau`` and its second derivative:
+        the product costs 3 inverse FFTs, 3 forward ones and 3 pairs for ``L``."""
+        om, gam = self.omega, self.gamma
         m = self.points
         sn, cs, q, tau, thd = st["sn"], st["cs"], st["q"], st["tau"], st["thd"]
         e1, e2 = st["e1"], st["e2"]
         ph, d1, d2 = self._synth(d)
-        dtau = self._dtau(st, ph, d1, d2)
+        lsp = self._l(sn * ph)
+        dtau = om * om * d2 + gam * om * d1 - (1.0 + q) * cs * ph + sn * lsp
         dp = -(dtau * thd + tau * om * d1)
         w1 = e2 * dp
-        out = self._dtau_t(st, -w1 * thd) + self._project(np.zeros_like(w1), -om * w1 * tau)
         bb = -e1 * thd
+        # the weight on the torque's Jacobian (transposed)
+        wt = -w1 * thd - om * e1 * d1
         if self.limit is not None:
             bb = bb + st["ph1"]
-            out = out + self._dtau_t(st, st["ph2"] * dtau)
-        a_term = (bb * cs * self._l(sn * ph) + sn * self._lt(bb * cs * ph)
-                  + bb * (1.0 + q) * sn * ph + cs * ph * self._lt(bb * sn))
-        out = out + self._project(a_term, -om * e1 * dtau)
-        out = out + self._dtau_t(st, -om * e1 * d1)
-        return out / m
+            wt = wt + st["ph2"] * dtau
+        if "lt_bb_sn" not in st:
+            st["lt_bb_sn"] = self._lt(bb * sn)
+        a = (-(1.0 + q) * cs * wt + sn * self._lt(sn * wt + bb * cs * ph)
+             + bb * cs * lsp + bb * (1.0 + q) * sn * ph + cs * ph * st["lt_bb_sn"])
+        b = gam * om * wt - om * w1 * tau - om * e1 * dtau
+        return self._project(a, b, om * om * wt) / m
 
 
 def _abs(p) -> float:
@@ -365,18 +398,98 @@ def maximize(problem: ElectricalProblem, x0: np.ndarray, widths=None, limit=None
                 cache[key] = problem.evaluate(z)
             return cache[key]
 
-        kw = ({"hess": lambda z: -ev(z)[2]} if dense else
-              {"hessp": lambda z, d: -ev(z)[2].matvec(d)})
-        r = minimize(lambda z: -ev(z)[0], x, jac=lambda z: -ev(z)[1],
-                     method="trust-exact" if dense else "trust-krylov",
-                     options={"gtol": gtol, "maxiter": MAXITER}, **kw)
+        if dense:
+            r = minimize(lambda z: -ev(z)[0], x, jac=lambda z: -ev(z)[1],
+                         hess=lambda z: -ev(z)[2], method="trust-exact",
+                         options={"gtol": gtol, "maxiter": MAXITER})
+            status = {0: "converged", 1: "max_iterations"}.get(r.status, "stalled")
+            nit = int(r.nit)
+        else:
+            r, status, nit = _scaled_krylov(problem, ev, x, gtol)
         ex = problem.exact(r.x)
-        status = {0: "converged", 1: "max_iterations"}.get(r.status, "stalled")
-        runs.append((rel * p0, ex, status, int(r.nit)))
+        runs.append((rel * p0, ex, status, nit))
         if math.isfinite(ex) and ex >= best:
             best, best_x = ex, np.array(r.x)
         x = np.array(r.x)
     return best_x, best, runs
+
+
+#: restarts of a preconditioned trust-krylov solve that stalled short of the tolerance
+RESTARTS = 8
+#: iterations of the truncated-CG fallback per width
+FALLBACK_MAXITER = 50
+#: a width is settled when the smoothed value moved by at most PLATEAU_TOL (relative, the
+#: rounding of a mean over the grid) in PLATEAU trust-region iterations
+PLATEAU = 10
+PLATEAU_TOL = 1e-13
+
+
+def _plateau():
+    """A SciPy callback that stops a minimization when its value has stopped moving at the
+    rounding level (no step can be verified), and the list it marks when it does."""
+    hist, halted = [], []
+
+    def settled(intermediate_result):
+        hist.append(float(intermediate_result.fun))
+        if len(hist) > PLATEAU and hist[-PLATEAU - 1] - hist[-1] <= PLATEAU_TOL * abs(
+                hist[-1]):
+            halted.append(True)
+            raise StopIteration
+
+    return settled, halted
+
+
+def _scaled_krylov(problem, ev, x0, gtol):
+    """``trust-krylov`` on the coefficients scaled by the Hessian's estimated diagonal
+    (``x = D y``, ``D = diag^(-1/2)``, :meth:`ElectricalProblem.diagonal`: a Jacobi
+    preconditioner, which trlib does not take otherwise), restarted with a fresh scaling
+    when trlib stalls (a step that predicts no improvement) short of ``gtol`` on the
+    unscaled gradient's largest component. Returns ``(result, status, iterations)``."""
+    from scipy.optimize import minimize
+
+    x = np.array(x0, dtype=float)
+    nit = 0
+    status = "stalled"
+    r = None
+    method = "trust-krylov"
+    for _ in range(RESTARTS):
+        d = 1.0 / np.sqrt(problem.diagonal(ev(x)[2].state))
+        settled, halted = _plateau()
+
+        with np.errstate(invalid="ignore", over="ignore"), warnings.catch_warnings():
+            warnings.simplefilter("ignore", RuntimeWarning)
+            r = minimize(lambda y, d=d: -ev(d * y)[0], x / d,
+                         jac=lambda y, d=d: -d * ev(d * y)[1],
+                         hessp=lambda y, v, d=d: -d * ev(d * y)[2].matvec(d * v),
+                         method=method, callback=settled,
+                         options={"gtol": gtol * float(np.min(d)),
+                                  "maxiter": MAXITER if method == "trust-krylov" else
+                                  FALLBACK_MAXITER})
+        nit += int(r.nit)
+        xn = d * r.x
+        if not np.all(np.isfinite(xn)):
+            break
+        f0, f1 = ev(x)[0], ev(xn)[0]
+        moved = f1 > f0 + PLATEAU_TOL * abs(f1)
+        x = xn if f1 >= f0 else x
+        g = float(np.max(np.abs(ev(x)[1])))
+        if g <= gtol:
+            status = "converged"
+            break
+        if halted:
+            status = "settled"
+            break
+        if r.status == 1:
+            status = "max_iterations"
+            break
+        if not moved:
+            if method == "trust-ncg":
+                break
+            # trlib found no step that predicts an improvement (at the smallest widths):
+            # Steihaug's truncated CG from here
+            method = "trust-ncg"
+    r.x = x
+    return r, status, nit
 
 
 def ladder(make, x_ideal: np.ndarray, harmonics: int, start: int, limit=None):

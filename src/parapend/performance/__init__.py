@@ -171,14 +171,14 @@ def _buoy_spec(hm0, period, kind, tps, realizations, waves, seed, spectrum, gamm
 
     from . import buoy_device
 
-    pend, winding, harmonics = buoy_device.check_buoy(**pendulum)
+    pend, winding, harmonics, efficiency = buoy_device.check_buoy(**pendulum)
     body = "cylinder" if body is None else body
     if body not in ("cylinder", "sphere"):
         raise ParameterError(f"body: expected cylinder or sphere, got {body!r:.40}")
     spec = MatrixSpec(hm0, period, kind, tps, realizations, float(waves), seed, spectrum,
                       float(gamma_peak), float(cutoff), None, float(pend.length),
                       float(pend.mass), float(pend.inertia), 9.81, 0.0, winding, harmonics,
-                      None, "buoy", body=body,
+                      efficiency, "buoy", body=body,
                       radius=None if radius is None else float(radius),
                       draft=None if draft is None else float(draft),
                       mesh=None if mesh is None else os.path.abspath(mesh),

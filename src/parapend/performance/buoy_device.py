@@ -99,8 +99,11 @@ def check_buoy(*, response, gamma, gravity, winding, harmonics, efficiency, mass
         raise ParameterError(f"gravity: the buoy's hydrodynamics use g = 9.81 m/s^2, got "
                              f"{gravity:g}; drop --gravity with --device buoy")
     if efficiency is not None:
-        raise ParameterError("efficiency: not supported with --device buoy (the coupled "
-                             "optimum has an ideal power take-off); drop --efficiency")
+        from ..errors import check_range
+
+        efficiency = check_range("efficiency", efficiency, 0.0, 1.0)
+        if efficiency <= 0:
+            raise ParameterError(f"efficiency: expected a number in (0, 1], got {efficiency}")
     if isinstance(winding, str):
         raise ParameterError(f"winding: expected a positive integer with --device buoy (turns "
                              f"per record), got {winding!r:.40}")
@@ -111,7 +114,7 @@ def check_buoy(*, response, gamma, gravity, winding, harmonics, efficiency, mass
                      BUOY["length"] if length is None else length, inertia,
                      BUOY["damping_coefficient"] if damping_coefficient is None
                      else damping_coefficient)
-    return pend, winding, harmonics
+    return pend, winding, harmonics, None if efficiency is None else float(efficiency)
 
 
 def prepare(spec):
@@ -152,10 +155,21 @@ def solve_buoy_bin(spec, i: int, j: int, r: int) -> dict:
 
     h, _ = body_hydro(spec)
     wave, _ = wave_of(spec, i, j, r)
+    eta = spec.efficiency
     sol, ow, _ = _solve(h, pendulum(spec), wave, winding=spec.winding,
-                        harmonics=spec.harmonics, torque_limit=None, efficiency=None)
+                        harmonics=spec.harmonics, torque_limit=None,
+                        efficiency=None if eta is None or eta == 1.0 else eta)
     p = float(sol.power)
-    if p <= 0:
+    out = {}
+    if eta is not None:
+        # the electrical optimum (parapend buoy --efficiency); power is its motion's
+        # mechanical power; efficiency 1 is the ideal optimum itself
+        e = sol.electrical_power if sol.electrical_power is not None else p
+        out["electrical_power"] = float(e)
+        p_ok = e
+    else:
+        p_ok = p
+    if p_ok <= 0:
         status = "no_power"
     elif sol.success:
         status = "converged"
@@ -164,4 +178,4 @@ def solve_buoy_bin(spec, i: int, j: int, r: int) -> dict:
         status = head if head in _CODE and head != "converged" else "other"
     return {"power": p, "radiation_bound_power": float(sol.radiation_bound),
             "one_way_power": float(ow.power) if math.isfinite(ow.power) else math.nan,
-            "status": status}
+            **out, "status": status}

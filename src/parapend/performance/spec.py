@@ -117,7 +117,8 @@ class MatrixSpec:
     @property
     def variables(self) -> tuple:
         if self.device == "buoy":
-            return ("power", "radiation_bound_power", "one_way_power", "status")
+            e = ("electrical_power",) if self.efficiency is not None else ()
+            return ("power", "radiation_bound_power", "one_way_power", *e, "status")
         out = ["power", "limit_power", "uniform_power"]
         if self.efficiency is not None:
             out.append("electrical_power")
