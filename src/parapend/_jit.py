@@ -34,6 +34,7 @@ KERNELS = {
     "parapend.optimal.collocation": ("the efficiency solver's kernels", 10),
     "parapend.dynamics._kernel": ("the basin-map kernel", 15),
     "parapend.control._mpc_kernel": ("the receding-horizon controller's kernels", 10),
+    "parapend.control._plan_kernel": ("the receding-horizon controller's horizon solver", 10),
 }
 
 _lock = threading.Lock()
