@@ -162,6 +162,149 @@ def cho_solve(c, b):
 
 
 @nb.njit(cache=True)
+def newton(f, lam, mu, k, b0g, b1g, ling, qg, wk, gamma, b0c, linc, q1c, limit_on, scale,
+           ab, g, jtc):
+    """The Newton matrix (lower band ``ab``, bandwidth 3, full order: node 0 included) and
+    the barrier gradient ``g`` of the horizon problem without its extra terms: the open
+    chain's case of :func:`parapend.optimal._hermite_kernel.newton` (the kernel's ``q1g``
+    is ``q``, its weights ``wk``), the lower triangle of each interval's block only, the
+    Gauss point's Hessian ``h00 b0 b0' - h01 (b0 b1' + b1 b0') + h11 b1 b1'`` as
+    ``(h00 b0 - h01 b1) b0' + (h11 b1 - h01 b0) b1'``. Fills ``jtc`` (``dT/dy`` at the
+    torque points)."""
+    ab[:, :] = 0.0
+    g[:] = 0.0
+    ng = b0g.shape[0]
+    pc = b0c.shape[0]
+    nc = k * pc
+    y = np.empty(4)
+    p = np.empty(4)
+    r = np.empty(4)
+    for j in range(k):
+        o = 2 * j
+        for i in range(4):
+            y[i] = f[o + i]
+        for q in range(ng):
+            th = 0.0
+            thd = 0.0
+            for i in range(4):
+                th += b0g[q, i] * y[i]
+                thd += b1g[q, i] * y[i]
+            sn = math.sin(th)
+            cs = math.cos(th)
+            a = wk[q] * qg[j, q]
+            c0 = a * cs * thd
+            c1 = a * sn - 2.0 * gamma * wk[q] * thd
+            h00 = a * sn * thd
+            h01 = a * cs
+            h11 = 2.0 * gamma * wk[q]
+            for i in range(4):
+                g[o + i] -= c0 * b0g[q, i] + c1 * b1g[q, i]
+                p[i] = h00 * b0g[q, i] - h01 * b1g[q, i]
+                r[i] = h11 * b1g[q, i] - h01 * b0g[q, i]
+            for i in range(4):
+                for m in range(i + 1):
+                    ab[i - m, o + m] += p[i] * b0g[q, m] + r[i] * b1g[q, m]
+        if not limit_on:
+            continue
+        sc = scale[j]
+        for c in range(pc):
+            th = 0.0
+            ln = 0.0
+            for i in range(4):
+                th += b0c[c, i] * y[i]
+                ln += linc[c, i] * y[i]
+            sn = math.sin(th)
+            cs = math.cos(th)
+            tq = ln - q1c[j, c] * sn
+            for i in range(4):
+                jtc[j, c, i] = linc[c, i] - q1c[j, c] * cs * b0c[c, i]
+            sp = 1.0 - tq * sc
+            sm = 1.0 + tq * sc
+            lp = lam[j * pc + c]
+            lm = lam[nc + j * pc + c]
+            gc = sc * (mu / sp - mu / sm)
+            sig = (lp / sp + lm / sm) * sc * sc
+            hc = sc * (lp - lm) * q1c[j, c] * sn
+            for i in range(4):
+                g[o + i] += gc * jtc[j, c, i]
+                for m in range(i + 1):
+                    ab[i - m, o + m] += (sig * jtc[j, c, i] * jtc[j, c, m]
+                                         + hc * b0c[c, i] * b0c[c, m])
+
+
+@nb.njit(cache=True)
+def slack_step(dxf, k, jtc, scale, out):
+    """``ds = -J d`` (the slacks' linearized change along ``dxf``, full order) into ``out``
+    (:func:`parapend.optimal._hermite_kernel.constraint_step`, mode LIMIT)."""
+    pc = jtc.shape[1]
+    nc = k * pc
+    for j in range(k):
+        for c in range(pc):
+            d = 0.0
+            for i in range(4):
+                d += jtc[j, c, i] * dxf[2 * j + i]
+            out[j * pc + c] = -d * scale[j]
+            out[nc + j * pc + c] = d * scale[j]
+
+
+@nb.njit(cache=True)
+def jt_apply(w, k, jtc, scale, out):
+    """``J^T w`` into ``out`` (full order; :func:`parapend.optimal._hermite_kernel.jt_apply`,
+    mode LIMIT)."""
+    out[:] = 0.0
+    pc = jtc.shape[1]
+    nc = k * pc
+    for j in range(k):
+        for c in range(pc):
+            d = (w[j * pc + c] - w[nc + j * pc + c]) * scale[j]
+            for i in range(4):
+                out[2 * j + i] += d * jtc[j, c, i]
+
+
+@nb.njit(cache=True)
+def trial(f, dxf, alpha, s, floor, k, b0g, b1g, qg, wk, gamma, b0c, linc, q1c, limit_on,
+          scale, xn, sn):
+    """The trial point ``xn = f + alpha dxf`` and its slacks ``sn`` (into the buffers);
+    returns ``(ok, phi, log_sum)``: ``ok`` when every slack exceeds ``floor`` times its old
+    value, ``phi = -P`` (:func:`parapend.optimal._hermite_kernel.trial` without the
+    allocations, mode NONE or LIMIT)."""
+    for i in range(f.size):
+        xn[i] = f[i] + alpha * dxf[i]
+    pc = b0c.shape[0]
+    nc = k * pc
+    logs = 0.0
+    if limit_on:
+        for j in range(k):
+            o = 2 * j
+            for c in range(pc):
+                th = 0.0
+                ln = 0.0
+                for i in range(4):
+                    th += b0c[c, i] * xn[o + i]
+                    ln += linc[c, i] * xn[o + i]
+                tq = (ln - q1c[j, c] * math.sin(th)) * scale[j]
+                i1 = j * pc + c
+                i2 = nc + i1
+                sn[i1] = 1.0 - tq
+                sn[i2] = 1.0 + tq
+                if not (sn[i1] > floor * s[i1] and sn[i2] > floor * s[i2]):
+                    return False, 0.0, 0.0
+        for i in range(2 * nc):
+            logs += math.log(sn[i])
+    p = 0.0
+    for j in range(k):
+        o = 2 * j
+        for q in range(b0g.shape[0]):
+            th = 0.0
+            thd = 0.0
+            for i in range(4):
+                th += b0g[q, i] * xn[o + i]
+                thd += b1g[q, i] * xn[o + i]
+            p += wk[q] * (qg[j, q] * math.sin(th) * thd - gamma * thd * thd)
+    return True, -p, logs
+
+
+@nb.njit(cache=True)
 def _full(x0, x):
     f = np.empty(x.size + 2)
     f[0] = x0[0]
@@ -171,39 +314,52 @@ def _full(x0, x):
 
 
 @nb.njit(cache=True)
-def solve(x, x0, k, b0g, b1g, ling, qg, wk, gamma, b0c, linc, q1c, mode, scale, limit, gvar,
-          jtc, q1g, w, kappa, eta_g, a, kink, eps, gap_tol, maxiter, mu0):
+def solve(x, x0, k, b0g, b1g, ling, qg, wk, gamma, b0c, linc, q1c, limit_on, scale, q1g, w,
+          kappa, eta_g, a, kink, eps, gap_tol, maxiter, mu0):
     """The interior point of :func:`parapend.optimal.hermite.interior_point` on the horizon
-    problem (variables ``x``, node 0 fixed to ``x0``; ``mode`` NONE or LIMIT of
-    :mod:`parapend.optimal._hermite_kernel`; ``mu0`` NaN: the default start).
+    problem (variables ``x``, node 0 fixed to ``x0``; ``limit_on``: the torque limit
+    ``|T| scale_j <= 1``, else none; ``mu0`` NaN: the default start).
 
     Returns ``(x, status, iterations, mu)``, ``status`` an index into :data:`STATUS`.
     """
     n = x.size
+    nf = n + 2
+    pc = b0c.shape[0]
+    nb_ = 2 * k * pc if limit_on else 0
     f = _full(x0, x)
-    c = _k.constraints(f, 0.0, k, 0.0, b0c, linc, q1c, mode, scale, limit)
-    if c.size and np.max(c) >= 0:
-        return x.copy(), _INFEASIBLE, 0, math.nan
-    m = max(c.size, 1)
-    phi = (-_k.power_terms(f, k, 0.0, b0g, b1g, ling, qg, wk, gamma)[0]
-           + extra(f, k, b0g, b1g, ling, q1g, w, kappa, eta_g, a, kink, eps))
+    xn = np.empty(nf)
+    s = np.ones(nb_)
+    sn = np.empty(nb_)
+    dxf = np.zeros(nf)
+    ok, phi, logs = trial(f, dxf, 0.0, s, -math.inf, k, b0g, b1g, qg, wk, gamma, b0c, linc,
+                          q1c, limit_on, scale, xn, s)
+    for i in range(nb_):
+        if not s[i] > 0.0:
+            return x.copy(), _INFEASIBLE, 0, math.nan
+    m = max(nb_, 1)
+    phi += extra(f, k, b0g, b1g, ling, q1g, w, kappa, eta_g, a, kink, eps)
     mu = mu0 if not math.isnan(mu0) else 0.1 * max(abs(phi), 1e-3) / m
     mu_min = min(gap_tol / m, mu)
-    s = -c
     lam = mu / s
     status = _MAXIT
     delta_last = 0.0
     stagnant = 0
     it = 0
+    ab6 = np.empty((_BW + 1, nf))
+    g6 = np.empty(nf)
+    jtc = np.zeros((k, pc, 4))
     ab = np.empty((_BW + 1, n))
     fac = np.empty((_BW + 1, n))
-    dxf = np.zeros(n + 2)
+    ds = np.empty(nb_)
+    ones = np.empty(nf)
+    jw = np.empty(nf)
     floor = 0.1 * (1 - _FRACTION)
     for it in range(1, maxiter + 1):  # noqa: B007 (returned: the iteration count)
-        ab6, rhs6, _, _, _ = _k.newton(f, 0.0, lam, mu, k, 0.0, b0g, b1g, ling, qg, wk, gamma,
-                                       0.0, b0c, linc, q1c, mode, scale, limit, 0.0, gvar, jtc)
+        newton(f, lam, mu, k, b0g, b1g, ling, qg, wk, gamma, b0c, linc, q1c, limit_on, scale,
+               ab6, g6, jtc)
+        rhs6 = -g6
         extra_newton(f, ab6, rhs6, k, b0g, b1g, ling, q1g, w, kappa, eta_g, a, kink, eps)
-        ab[:, :] = ab6[:_BW + 1, 2:]
+        ab[:, :] = ab6[:, 2:]
         rhs = rhs6[2:].copy()
         delta = 0.0  # inertia correction (interior_point's rule)
         ok = False
@@ -230,43 +386,41 @@ def solve(x, x0, k, b0g, b1g, ling, qg, wk, gamma, b0c, linc, q1c, mode, scale, 
             mu_new = max(mu_min, min(_MU_FACTOR * mu, mu**_MU_POWER))
             stagnant = 0
             # Mehrotra's predictor-corrector (interior_point's _predictor_corrector)
-            pc = False
-            if lam.size:
-                ones = _k.jt_apply(1.0 / s, k, jtc, mode, scale, gvar)[0][2:]
-                rhs0 = rhs + mu * ones
-                dx_a = cho_solve(fac, rhs0)
-                dxf[2:] = dx_a
-                ds_a = -_k.constraint_step(dxf, 0.0, k, jtc, mode, scale)
-                dlam_a = -lam - lam / s * ds_a
-                tg = (mu_new - ds_a * dlam_a) / s
-                jw = _k.jt_apply(tg, k, jtc, mode, scale, gvar)[0][2:]
-                dx_c = cho_solve(fac, rhs0 - jw)
-                sl = -float((rhs0 - mu_new * ones) @ dx_c)
+            pc_ok = False
+            if nb_:
+                jt_apply(1.0 / s, k, jtc, scale, ones)
+                rhs0 = rhs + mu * ones[2:]
+                dxf[2:] = cho_solve(fac, rhs0)
+                slack_step(dxf, k, jtc, scale, ds)
+                dlam_a = -lam - lam / s * ds
+                tg = (mu_new - ds * dlam_a) / s
+                jt_apply(tg, k, jtc, scale, jw)
+                dx_c = cho_solve(fac, rhs0 - jw[2:])
+                sl = -float((rhs0 - mu_new * ones[2:]) @ dx_c)
                 if sl < 0:
-                    pc = True
+                    pc_ok = True
                     dx = dx_c
                     slope = sl
                     target = tg
             mu = mu_new
-            if not pc:
+            if not pc_ok:
                 continue
-        b0 = phi - mu * float(np.sum(np.log(s)))
+        b0 = phi
+        for i in range(nb_):
+            b0 -= mu * math.log(s[i])
         dxf[2:] = dx
-        ds = -_k.constraint_step(dxf, 0.0, k, jtc, mode, scale)
+        if nb_:
+            slack_step(dxf, k, jtc, scale, ds)
         alpha = _k.max_step(s, ds, _FRACTION)
         found = False
         bn = 0.0
-        xn = f
-        sn = s
         phin = 0.0
         for _ in range(50):
-            okt, bn, xn, _, sn, phin = _k.trial(f, dxf, alpha, 0.0, 0.0, s, mu, floor, k, 0.0,
-                                                b0g, b1g, ling, qg, wk, gamma, 0.0, b0c, linc,
-                                                q1c, mode, scale, limit, 0.0)
+            okt, phin, logs = trial(f, dxf, alpha, s, floor, k, b0g, b1g, qg, wk, gamma, b0c,
+                                    linc, q1c, limit_on, scale, xn, sn)
             if okt:
-                ex = extra(xn, k, b0g, b1g, ling, q1g, w, kappa, eta_g, a, kink, eps)
-                bn += ex
-                phin += ex
+                phin += extra(xn, k, b0g, b1g, ling, q1g, w, kappa, eta_g, a, kink, eps)
+                bn = phin - mu * logs
                 if (bn <= b0 + 1e-4 * alpha * min(slope, 0.0)
                         or abs(bn - b0) <= 1e-15 * (1 + abs(b0))):
                     found = True
@@ -275,9 +429,11 @@ def solve(x, x0, k, b0g, b1g, ling, qg, wk, gamma, b0c, linc, q1c, mode, scale, 
         if not found:
             status = _STALLED
             break
-        if lam.size:
+        if nb_:
             dlam = target - lam - lam / s * ds
             lam = np.maximum(lam + _k.max_step(lam, dlam, _FRACTION) * dlam, 1e-30)
         stagnant = stagnant + 1 if abs(bn - b0) <= 1e-14 * (1 + abs(b0)) else 0
-        f, s, phi = xn, sn, phin
+        f, xn = xn, f
+        s, sn = sn, s
+        phi = phin
     return f[2:].copy(), status, it, mu
