@@ -42,6 +42,8 @@ torque limit ``|T| <= T_max`` at ``tau = 0, 1/2, 1`` of every interval; without 
 is Newton's method with the exact banded Hessian (bandwidth 3: the first node's two
 variables removed), inertia correction and an Armijo line search. The smoothed kink and the
 terminal value are added to the kernel's objective, gradient and Newton matrix here.
+:meth:`PlanProblem.solve_compiled` runs the same iteration as one compiled call
+(:mod:`parapend.control._plan_kernel`, used by :func:`solve_plan` outside elastic mode).
 """
 
 from __future__ import annotations
