@@ -8,9 +8,10 @@ compiled call: the Newton matrix and the line-search trials of
 :mod:`parapend.optimal._hermite_kernel`, the terminal value and the smoothed kink of
 :meth:`PlanProblem._extra` / :meth:`PlanProblem._extra_newton`, and a banded Cholesky of
 lower bandwidth 3 (the open chain in natural order: interval ``j`` couples variables
-``2 j - 2 .. 2 j + 1``) in place of LAPACK's ``dpbtrf`` / ``dpbtrs``. In Python the loop
-around those kernels cost about two thirds of every iteration (the 4 ms median of the
-benchmark's 30 iterations at ``K = 64``); compiled, an iteration is a few microseconds.
+``2 j - 2 .. 2 j + 1``) in place of LAPACK's ``dpbtrf`` / ``dpbtrs``. The Python loop
+around those kernels takes about two thirds of a solve (benchmarks/bench_mpc.py, 30
+iterations at ``K = 64``: a median of 4.1 ms at load 0.9 with it, 1.75 ms at load 6.2 as
+one compiled call; docs/control.md).
 
 The iterates agree with the Python loop to rounding (the Cholesky sums in another order than
 LAPACK's); tests/test_plan_kernel.py compares the two.

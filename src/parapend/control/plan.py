@@ -334,13 +334,12 @@ class PlanProblem:
             raise ValueError("solve_compiled: elastic mode is solved by interior_point")
         from . import _plan_kernel as _pk
 
-        a = self._a if math.isfinite(self._a) else math.inf
         xs, st, it, mu = _pk.solve(
             np.ascontiguousarray(x, dtype=float), self.x0, self.k, self.rows_g[0],
             self.rows_g[1], self.lin_g, self.q_g, self.wk, self.gamma, self.rows_c[0],
             self.lin_c, self.q1_c, self.mode == _k.LIMIT, self._scale,
             np.ascontiguousarray(self.q1_g), self.w, self.kappa,
-            self.eta_g, a, self.kink, self.smoothing, float(gap_tol), int(maxiter),
+            self.eta_g, self._a, self.kink, self.smoothing, float(gap_tol), int(maxiter),
             math.nan if mu0 is None else float(mu0))
         return HermiteSolution(xs, None, _pk.STATUS[st], int(it), float(mu))
 
