@@ -306,6 +306,62 @@ def trial(f, dxf, alpha, s, floor, k, b0g, b1g, qg, wk, gamma, b0c, linc, q1c, l
 
 
 @nb.njit(cache=True)
+def _dot(a, b):
+    acc = 0.0
+    for i in range(a.size):
+        acc += a[i] * b[i]
+    return acc
+
+
+@nb.njit(cache=True)
+def _median_abs(v):
+    """The median of ``|v|`` (the inertia correction's scale)."""
+    return float(np.median(np.abs(v)))
+
+
+@nb.njit(cache=True)
+def _corrector(fac, rhs, s, lam, mu, mu_new, k, jtc, scale, ones, jw, dxf, ds):
+    """Mehrotra's predictor-corrector step (``_predictor_corrector`` of
+    :mod:`parapend.optimal.hermite`, mode LIMIT): ``(dx, slope, target)``; ``slope >= 0``
+    when it is not a descent step."""
+    nb_ = s.size
+    n = rhs.size
+    w = np.empty(nb_)
+    for i in range(nb_):
+        w[i] = 1.0 / s[i]
+    jt_apply(w, k, jtc, scale, ones)
+    rhs0 = np.empty(n)
+    for i in range(n):
+        rhs0[i] = rhs[i] + mu * ones[i + 2]
+    dxf[2:] = cho_solve(fac, rhs0)
+    slack_step(dxf, k, jtc, scale, ds)
+    tg = np.empty(nb_)
+    for i in range(nb_):
+        dlam_a = -lam[i] - lam[i] / s[i] * ds[i]
+        tg[i] = (mu_new - ds[i] * dlam_a) / s[i]
+    jt_apply(tg, k, jtc, scale, jw)
+    r = np.empty(n)
+    for i in range(n):
+        r[i] = rhs0[i] - jw[i + 2]
+    dx = cho_solve(fac, r)
+    sl = 0.0
+    for i in range(n):
+        sl -= (rhs0[i] - mu_new * ones[i + 2]) * dx[i]
+    return dx, sl, tg
+
+
+@nb.njit(cache=True)
+def _dual_step(lam, target, s, ds):
+    """The dual step towards ``target`` with the fraction to the boundary, in place."""
+    dlam = np.empty(lam.size)
+    for i in range(lam.size):
+        dlam[i] = target[i] - lam[i] - lam[i] / s[i] * ds[i]
+    a = _k.max_step(lam, dlam, _FRACTION)
+    for i in range(lam.size):
+        lam[i] = max(lam[i] + a * dlam[i], 1e-30)
+
+
+@nb.njit(cache=True)
 def _full(x0, x):
     f = np.empty(x.size + 2)
     f[0] = x0[0]
@@ -341,7 +397,9 @@ def solve(x, x0, k, b0g, b1g, ling, qg, wk, gamma, b0c, linc, q1c, limit_on, sca
     phi += extra(f, k, b0g, b1g, ling, q1g, w, kappa, eta_g, a, kink, eps)
     mu = mu0 if not math.isnan(mu0) else 0.1 * max(abs(phi), 1e-3) / m
     mu_min = min(gap_tol / m, mu)
-    lam = mu / s
+    lam = np.empty(nb_)
+    for i in range(nb_):
+        lam[i] = mu / s[i]
     status = _MAXIT
     delta_last = 0.0
     stagnant = 0
@@ -358,10 +416,13 @@ def solve(x, x0, k, b0g, b1g, ling, qg, wk, gamma, b0c, linc, q1c, limit_on, sca
     for it in range(1, maxiter + 1):  # noqa: B007 (returned: the iteration count)
         newton(f, lam, mu, k, b0g, b1g, ling, qg, wk, gamma, b0c, linc, q1c, limit_on, scale,
                ab6, g6, jtc)
-        rhs6 = -g6
-        extra_newton(f, ab6, rhs6, k, b0g, b1g, ling, q1g, w, kappa, eta_g, a, kink, eps)
-        ab[:, :] = ab6[:, 2:]
-        rhs = rhs6[2:].copy()
+        for i in range(nf):
+            g6[i] = -g6[i]  # the right-hand side
+        extra_newton(f, ab6, g6, k, b0g, b1g, ling, q1g, w, kappa, eta_g, a, kink, eps)
+        for r in range(_BW + 1):
+            for i in range(n):
+                ab[r, i] = ab6[r, i + 2]
+        rhs = g6[2:].copy()
         delta = 0.0  # inertia correction (interior_point's rule)
         ok = False
         for _ in range(30):
@@ -372,14 +433,16 @@ def solve(x, x0, k, b0g, b1g, ling, qg, wk, gamma, b0c, linc, q1c, limit_on, sca
                 delta = 8.0 * delta
             else:
                 delta = max(delta_last / 3.0,
-                            1e-8 * max(1e-6, float(np.median(np.abs(ab[0])))))
+                            1e-8 * max(1e-6, _median_abs(ab[0])))
         if not ok:
             status = _SINGULAR
             break
         delta_last = delta
         dx = cho_solve(fac, rhs)
-        slope = -float(rhs @ dx)
-        target = mu / s
+        slope = -_dot(rhs, dx)
+        target = np.empty(nb_)
+        for i in range(nb_):
+            target[i] = mu / s[i]
         if -slope <= max(2e-2 * m * mu, 1e-12 * (1.0 + abs(phi))) or stagnant >= 5:
             if mu <= mu_min * (1 + 1e-12):
                 status = _CONVERGED
@@ -389,15 +452,8 @@ def solve(x, x0, k, b0g, b1g, ling, qg, wk, gamma, b0c, linc, q1c, limit_on, sca
             # Mehrotra's predictor-corrector (interior_point's _predictor_corrector)
             pc_ok = False
             if nb_:
-                jt_apply(1.0 / s, k, jtc, scale, ones)
-                rhs0 = rhs + mu * ones[2:]
-                dxf[2:] = cho_solve(fac, rhs0)
-                slack_step(dxf, k, jtc, scale, ds)
-                dlam_a = -lam - lam / s * ds
-                tg = (mu_new - ds * dlam_a) / s
-                jt_apply(tg, k, jtc, scale, jw)
-                dx_c = cho_solve(fac, rhs0 - jw[2:])
-                sl = -float((rhs0 - mu_new * ones[2:]) @ dx_c)
+                dx_c, sl, tg = _corrector(fac, rhs, s, lam, mu, mu_new, k, jtc, scale, ones,
+                                          jw, dxf, ds)
                 if sl < 0:
                     pc_ok = True
                     dx = dx_c
@@ -431,8 +487,7 @@ def solve(x, x0, k, b0g, b1g, ling, qg, wk, gamma, b0c, linc, q1c, limit_on, sca
             status = _STALLED
             break
         if nb_:
-            dlam = target - lam - lam / s * ds
-            lam = np.maximum(lam + _k.max_step(lam, dlam, _FRACTION) * dlam, 1e-30)
+            _dual_step(lam, target, s, ds)
         stagnant = stagnant + 1 if abs(bn - b0) <= 1e-14 * (1 + abs(b0)) else 0
         f, xn = xn, f
         s, sn = sn, s
