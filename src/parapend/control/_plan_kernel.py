@@ -164,14 +164,15 @@ def cho_solve(c, b):
 
 @nb.njit(cache=True)
 def newton(f, lam, mu, k, b0g, b1g, ling, qg, wk, gamma, b0c, linc, q1c, limit_on, scale,
-           ab, g, jtc):
+           ab, g, jtc, sb, cb):
     """The Newton matrix (lower band ``ab``, bandwidth 3, full order: node 0 included) and
     the barrier gradient ``g`` of the horizon problem without its extra terms: the open
     chain's case of :func:`parapend.optimal._hermite_kernel.newton` (the kernel's ``q1g``
     is ``q``, its weights ``wk``), the lower triangle of each interval's block only, the
     Gauss point's Hessian ``h00 b0 b0' - h01 (b0 b1' + b1 b0') + h11 b1 b1'`` as
-    ``(h00 b0 - h01 b1) b0' + (h11 b1 - h01 b0) b1'``. Fills ``jtc`` (``dT/dy`` at the
-    torque points)."""
+    ``(h00 b0 - h01 b1) b0' + (h11 b1 - h01 b0) b1'``. ``sb, cb`` (K, 7): ``sin, cos`` of
+    the angle at the Gauss points and the torque points of every interval at ``f``
+    (:func:`trial`, :func:`cosines`). Fills ``jtc`` (``dT/dy`` at the torque points)."""
     ab[:, :] = 0.0
     g[:] = 0.0
     ng = b0g.shape[0]
@@ -185,13 +186,11 @@ def newton(f, lam, mu, k, b0g, b1g, ling, qg, wk, gamma, b0c, linc, q1c, limit_o
         for i in range(4):
             y[i] = f[o + i]
         for q in range(ng):
-            th = 0.0
             thd = 0.0
             for i in range(4):
-                th += b0g[q, i] * y[i]
                 thd += b1g[q, i] * y[i]
-            sn = math.sin(th)
-            cs = math.cos(th)
+            sn = sb[j, q]
+            cs = cb[j, q]
             a = wk[q] * qg[j, q]
             c0 = a * cs * thd
             c1 = a * sn - 2.0 * gamma * wk[q] * thd
@@ -209,13 +208,11 @@ def newton(f, lam, mu, k, b0g, b1g, ling, qg, wk, gamma, b0c, linc, q1c, limit_o
             continue
         sc = scale[j]
         for c in range(pc):
-            th = 0.0
             ln = 0.0
             for i in range(4):
-                th += b0c[c, i] * y[i]
                 ln += linc[c, i] * y[i]
-            sn = math.sin(th)
-            cs = math.cos(th)
+            sn = sb[j, ng + c]
+            cs = cb[j, ng + c]
             tq = ln - q1c[j, c] * sn
             for i in range(4):
                 jtc[j, c, i] = linc[c, i] - q1c[j, c] * cs * b0c[c, i]
@@ -264,11 +261,12 @@ def jt_apply(w, k, jtc, scale, out):
 
 @nb.njit(cache=True)
 def trial(f, dxf, alpha, s, floor, k, b0g, b1g, qg, wk, gamma, b0c, linc, q1c, limit_on,
-          scale, xn, sn):
+          scale, xn, sn, sb):
     """The trial point ``xn = f + alpha dxf`` and its slacks ``sn`` (into the buffers);
     returns ``(ok, phi, log_sum)``: ``ok`` when every slack exceeds ``floor`` times its old
     value, ``phi = -P`` (:func:`parapend.optimal._hermite_kernel.trial` without the
-    allocations, mode NONE or LIMIT)."""
+    allocations, mode NONE or LIMIT). The sines of the angle at the Gauss points and the
+    torque points go to ``sb`` (K, 7) for :func:`newton`."""
     for i in range(f.size):
         xn[i] = f[i] + alpha * dxf[i]
     pc = b0c.shape[0]
@@ -283,7 +281,9 @@ def trial(f, dxf, alpha, s, floor, k, b0g, b1g, qg, wk, gamma, b0c, linc, q1c, l
                 for i in range(4):
                     th += b0c[c, i] * xn[o + i]
                     ln += linc[c, i] * xn[o + i]
-                tq = (ln - q1c[j, c] * math.sin(th)) * scale[j]
+                sv = math.sin(th)
+                sb[j, b0g.shape[0] + c] = sv
+                tq = (ln - q1c[j, c] * sv) * scale[j]
                 i1 = j * pc + c
                 i2 = nc + i1
                 sn[i1] = 1.0 - tq
@@ -301,8 +301,30 @@ def trial(f, dxf, alpha, s, floor, k, b0g, b1g, qg, wk, gamma, b0c, linc, q1c, l
             for i in range(4):
                 th += b0g[q, i] * xn[o + i]
                 thd += b1g[q, i] * xn[o + i]
-            p += wk[q] * (qg[j, q] * math.sin(th) * thd - gamma * thd * thd)
+            sv = math.sin(th)
+            sb[j, q] = sv
+            p += wk[q] * (qg[j, q] * sv * thd - gamma * thd * thd)
     return True, -p, logs
+
+
+@nb.njit(cache=True)
+def cosines(f, k, b0g, b0c, limit_on, cb):
+    """``cos`` of the angle at the Gauss points and (with the limit) the torque points of
+    every interval into ``cb`` (K, 7), the angle summed as :func:`trial` sums it."""
+    ng = b0g.shape[0]
+    for j in range(k):
+        o = 2 * j
+        for q in range(ng):
+            th = 0.0
+            for i in range(4):
+                th += b0g[q, i] * f[o + i]
+            cb[j, q] = math.cos(th)
+        if limit_on:
+            for c in range(b0c.shape[0]):
+                th = 0.0
+                for i in range(4):
+                    th += b0c[c, i] * f[o + i]
+                cb[j, ng + c] = math.cos(th)
 
 
 @nb.njit(cache=True)
@@ -388,8 +410,13 @@ def solve(x, x0, k, b0g, b1g, ling, qg, wk, gamma, b0c, linc, q1c, limit_on, sca
     s = np.ones(nb_)
     sn = np.empty(nb_)
     dxf = np.zeros(nf)
+    npt = b0g.shape[0] + pc
+    sb = np.zeros((k, npt))  # sin and cos at the points of f, and sin at the trial point
+    cb = np.zeros((k, npt))
+    sbn = np.zeros((k, npt))
     ok, phi, logs = trial(f, dxf, 0.0, s, -math.inf, k, b0g, b1g, qg, wk, gamma, b0c, linc,
-                          q1c, limit_on, scale, xn, s)
+                          q1c, limit_on, scale, xn, s, sb)
+    cosines(f, k, b0g, b0c, limit_on, cb)
     for i in range(nb_):
         if not s[i] > 0.0:
             return x.copy(), _INFEASIBLE, 0, math.nan
@@ -415,7 +442,7 @@ def solve(x, x0, k, b0g, b1g, ling, qg, wk, gamma, b0c, linc, q1c, limit_on, sca
     floor = 0.1 * (1 - _FRACTION)
     for it in range(1, maxiter + 1):  # noqa: B007 (returned: the iteration count)
         newton(f, lam, mu, k, b0g, b1g, ling, qg, wk, gamma, b0c, linc, q1c, limit_on, scale,
-               ab6, g6, jtc)
+               ab6, g6, jtc, sb, cb)
         for i in range(nf):
             g6[i] = -g6[i]  # the right-hand side
         extra_newton(f, ab6, g6, k, b0g, b1g, ling, q1g, w, kappa, eta_g, a, kink, eps)
@@ -474,7 +501,7 @@ def solve(x, x0, k, b0g, b1g, ling, qg, wk, gamma, b0c, linc, q1c, limit_on, sca
         phin = 0.0
         for _ in range(50):
             okt, phin, logs = trial(f, dxf, alpha, s, floor, k, b0g, b1g, qg, wk, gamma, b0c,
-                                    linc, q1c, limit_on, scale, xn, sn)
+                                    linc, q1c, limit_on, scale, xn, sn, sbn)
             if okt:
                 phin += extra(xn, k, b0g, b1g, ling, q1g, w, kappa, eta_g, a, kink, eps)
                 bn = phin - mu * logs
@@ -491,5 +518,7 @@ def solve(x, x0, k, b0g, b1g, ling, qg, wk, gamma, b0c, linc, q1c, limit_on, sca
         stagnant = stagnant + 1 if abs(bn - b0) <= 1e-14 * (1 + abs(b0)) else 0
         f, xn = xn, f
         s, sn = sn, s
+        sb, sbn = sbn, sb
+        cosines(f, k, b0g, b0c, limit_on, cb)
         phi = phin
     return f[2:].copy(), status, it, mu
