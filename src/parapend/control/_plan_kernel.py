@@ -144,11 +144,16 @@ def cholesky(ab, delta, c):
 
 
 @nb.njit(cache=True)
-def cho_solve(c, b):
-    """Solve ``L L^T x = b`` from the band factor ``c`` of :func:`cholesky`."""
+def cho_solve(c, b, x):
+    """Solve ``L L^T x = b`` into ``x`` from the band factor ``c`` of :func:`cholesky`.
+
+    (Into an argument: an array returned to Python from a kernel that numba also compiled
+    as a callee of :func:`solve`, loaded from its disk cache, failed in
+    ``NRT_adapt_ndarray_to_python`` with numba 0.68.)"""
     p = c.shape[0] - 1
     n = c.shape[1]
-    x = b.copy()
+    for i in range(n):
+        x[i] = b[i]
     for i in range(n):
         s = x[i]
         for m in range(max(0, i - p), i):
@@ -355,7 +360,7 @@ def _corrector(fac, rhs, s, lam, mu, mu_new, k, jtc, scale, ones, jw, dxf, ds):
     rhs0 = np.empty(n)
     for i in range(n):
         rhs0[i] = rhs[i] + mu * ones[i + 2]
-    dxf[2:] = cho_solve(fac, rhs0)
+    cho_solve(fac, rhs0, dxf[2:])
     slack_step(dxf, k, jtc, scale, ds)
     tg = np.empty(nb_)
     for i in range(nb_):
@@ -365,7 +370,8 @@ def _corrector(fac, rhs, s, lam, mu, mu_new, k, jtc, scale, ones, jw, dxf, ds):
     r = np.empty(n)
     for i in range(n):
         r[i] = rhs0[i] - jw[i + 2]
-    dx = cho_solve(fac, r)
+    dx = np.empty(n)
+    cho_solve(fac, r, dx)
     sl = 0.0
     for i in range(n):
         sl -= (rhs0[i] - mu_new * ones[i + 2]) * dx[i]
@@ -465,7 +471,8 @@ def solve(x, x0, k, b0g, b1g, ling, qg, wk, gamma, b0c, linc, q1c, limit_on, sca
             status = _SINGULAR
             break
         delta_last = delta
-        dx = cho_solve(fac, rhs)
+        dx = np.empty(n)
+        cho_solve(fac, rhs, dx)
         slope = -_dot(rhs, dx)
         target = np.empty(nb_)
         for i in range(nb_):
