@@ -10,7 +10,7 @@ compiled call: the Newton matrix and the line-search trials of
 lower bandwidth 3 (the open chain in natural order: interval ``j`` couples variables
 ``2 j - 2 .. 2 j + 1``) in place of LAPACK's ``dpbtrf`` / ``dpbtrs``. The Python loop
 around those kernels takes about two thirds of a solve (benchmarks/bench_mpc.py, 30
-iterations at ``K = 64``: a median of 4.1 ms at load 0.9 with it, 1.55 ms at load 2.4 as
+iterations at ``K = 64``: a median of 4.1 ms at load 0.9 with it, 1.05 ms at load 2.8 as
 one compiled call; docs/control.md).
 
 The iterates agree with the Python loop to rounding (the Cholesky sums in another order than
