@@ -42,6 +42,8 @@ torque limit ``|T| <= T_max`` at ``tau = 0, 1/2, 1`` of every interval; without 
 is Newton's method with the exact banded Hessian (bandwidth 3: the first node's two
 variables removed), inertia correction and an Armijo line search. The smoothed kink and the
 terminal value are added to the kernel's objective, gradient and Newton matrix here.
+:meth:`PlanProblem.solve_compiled` runs the same iteration as one compiled call
+(:mod:`parapend.control._plan_kernel`, used by :func:`solve_plan` outside elastic mode).
 """
 
 from __future__ import annotations
@@ -56,6 +58,7 @@ from ..optimal import _hermite_kernel as _k
 from ..optimal.hermite import (
     GAUSS_POINTS,
     TORQUE_TAU,
+    HermiteSolution,
     _blend_feasible,
     _hermite_rows,
     interior_point,
@@ -324,6 +327,22 @@ class PlanProblem:
             phi += ex
         return ok, bn, xn[2:], tn, sn, phi
 
+    def solve_compiled(self, x, *, gap_tol=1e-10, maxiter=200, mu0=None) -> HermiteSolution:
+        """:func:`parapend.optimal.hermite.interior_point` on this problem as one compiled
+        call (:func:`parapend.control._plan_kernel.solve`; not in elastic mode)."""
+        if self.mode == _k.ELASTIC:
+            raise ValueError("solve_compiled: elastic mode is solved by interior_point")
+        from . import _plan_kernel as _pk
+
+        xs, st, it, mu = _pk.solve(
+            np.ascontiguousarray(x, dtype=float), self.x0, self.k, self.rows_g[0],
+            self.rows_g[1], self.lin_g, self.q_g, self.wk, self.gamma, self.rows_c[0],
+            self.lin_c, self.q1_c, self.mode == _k.LIMIT, self._scale,
+            np.ascontiguousarray(self.q1_g), self.w, self.kappa,
+            self.eta_g, self._a, self.kink, self.smoothing, float(gap_tol), int(maxiter),
+            math.nan if mu0 is None else float(mu0))
+        return HermiteSolution(xs, None, _pk.STATUS[st], int(it), float(mu))
+
     def newton(self, x, t, lam, mu):
         f = self.full(x)
         ab, rhs, border, rhs_t, d_tt = _k.newton(
@@ -410,7 +429,7 @@ def solve_plan(problem: PlanProblem, x, *, anchor=None, gap_tol=1e-10, maxiter=2
     sol = None
     for e in eps_seq:
         pr.smoothing = e
-        sol = interior_point(pr, x, gap_tol=gap_tol, maxiter=maxiter, mu0=mu0)
+        sol = pr.solve_compiled(x, gap_tol=gap_tol, maxiter=maxiter, mu0=mu0)
         iters += sol.iterations
         x = sol.x
     pr.smoothing = final
