@@ -141,7 +141,7 @@ class PlanProblem:
 
     def __init__(self, x0, h, q_g, q_c, gamma, *, torque_limit=None, efficiency=None,
                  kappa=None, elastic=None, smoothing=KINK_SMOOTHING[-1], terminal="energy",
-                 speed_limit=None, speed_weight=None):
+                 speed_limit=None, speed_weight=None, discount=None):
         self.x0 = np.asarray(x0, dtype=float).copy()
         self.q_g = np.ascontiguousarray(q_g, dtype=float)
         self.q_c = np.ascontiguousarray(q_c, dtype=float)
@@ -166,6 +166,12 @@ class PlanProblem:
         self.speed_weight = (SPEED_WEIGHT if speed_weight is None else float(speed_weight))
         xg, wg = np.polynomial.legendre.leggauss(GAUSS_POINTS)
         self.w = wg / 2 * self.h  # the integral over one interval
+        # discounting exp(-t / tau): the weights (d - 1) w of the correction and 1 - d(H)
+        self.discount = None if discount is None else float(discount)
+        if self.discount is not None:
+            tg = self.h * (np.arange(k)[:, None] + _TAU_G[None, :])
+            self._dw = (np.exp(-tg / self.discount) - 1.0) * self.w[None, :]
+            self._d_end = 1.0 - math.exp(-k * self.h / self.discount)
         self.wk = eg * self.w  # the kernel's objective weights (its q1g is q here)
         self.rows_g = _hermite_rows(_TAU_G, self.h)
         self.rows_c = _hermite_rows(TORQUE_TAU, self.h)
@@ -236,6 +242,12 @@ class PlanProblem:
             val += self.kink * float(np.sum((z + np.sqrt(z * z + e * e)) * 0.5 * self.w))
         if self.speed_limit is not None:
             val += self.speed_penalty(f)
+        if self.discount is not None:
+            y = self._local(f)
+            th = y @ self.rows_g[0].T
+            thd = y @ self.rows_g[1].T
+            z = (y @ self.lin_g.T - self.q1_g * np.sin(th)) * thd
+            val += float(np.sum(self._dw * z)) + self.kappa * self._d_end * e_end
         return val
 
     def speed_penalty(self, f):
@@ -267,6 +279,8 @@ class PlanProblem:
             ab[1, -2] += c * sn * v
         if self.speed_limit is not None:
             self._speed_newton(f, ab, rhs)
+        if self.discount is not None:
+            self._discount_newton(f, ab, rhs)
         if not self.kink:
             return
         b0, b1, _ = self.rows_g
@@ -286,6 +300,36 @@ class PlanProblem:
         grad = np.einsum("kg,kga->ka", f1, dz)
         hess = (np.einsum("kg,kga,kgb->kab", f2, dz, dz)
                 + np.einsum("kg,kga,gb->kab", f1, dt, b1)
+                + np.einsum("kg,ga,kgb->kab", f1, b1, dt)
+                + np.einsum("kg,ga,gb->kab", f1 * thd * self.q1_g * sn, b0, b0))
+        k = self.k
+        for a in range(4):
+            rhs[a:a + 2 * k:2] -= grad[:, a]
+            for b in range(a + 1):
+                ab[a - b, b:b + 2 * k:2] += hess[:, a, b]
+
+    def _discount_newton(self, f, ab, rhs):
+        """Gradient and Hessian of the discount's correction ``sum (d - 1) w z + kappa (1 -
+        d(H)) E(H)``, ``z = T theta'`` (the power motored)."""
+        th, v = f[-2], f[-1]
+        c = self.kappa * self._d_end
+        sn = math.sin(th)
+        rhs[-2] += c * sn
+        rhs[-1] -= c * v
+        ab[0, -2] -= c * math.cos(th)
+        ab[0, -1] += c
+        b0, b1, _ = self.rows_g
+        lin = self.lin_g
+        y = self._local(f)
+        th = y @ b0.T
+        thd = y @ b1.T
+        sn, cs = np.sin(th), np.cos(th)
+        tq = y @ lin.T - self.q1_g * sn
+        f1 = self._dw
+        dt = lin[None, :, :] - (self.q1_g * cs)[:, :, None] * b0[None, :, :]
+        dz = thd[:, :, None] * dt + tq[:, :, None] * b1[None, :, :]
+        grad = np.einsum("kg,kga->ka", f1, dz)
+        hess = (np.einsum("kg,kga,gb->kab", f1, dt, b1)
                 + np.einsum("kg,ga,kgb->kab", f1, b1, dt)
                 + np.einsum("kg,ga,gb->kab", f1 * thd * self.q1_g * sn, b0, b0))
         k = self.k
@@ -419,7 +463,7 @@ def solve_plan(problem: PlanProblem, x, *, anchor=None, gap_tol=1e-10, maxiter=2
                                  efficiency=pr.efficiency, kappa=pr.kappa,
                                  elastic=100.0 * max(1.0, pr.h), smoothing=pr.smoothing,
                                  terminal=pr.terminal, speed_limit=pr.speed_limit,
-                                 speed_weight=pr.speed_weight)
+                                 speed_weight=pr.speed_weight, discount=pr.discount)
                 sol = interior_point(el, x, maxiter=maxiter)
                 iters += sol.iterations
                 xb = sol.x
