@@ -225,7 +225,7 @@ def mpc_run(q_record, *, gamma, horizon, update_interval, dt, torque_limit=None,
             warm=True, seed=0, terminal_weight=None, average_from=0.0,
             interval_samples=INTERVAL_SAMPLES, plant_steps=PLANT_STEPS, max_iter=MAX_ITER,
             pump_level=1.0, tracking=TRACKING, terminal="energy", speed_limit=None,
-            speed_weight=None, discount=None) -> MPCResult:
+            speed_weight=None, discount=None, energy_limit=None) -> MPCResult:
     """Receding-horizon control of Eq. 14 driven by the record ``q_record``.
 
     Parameters
@@ -361,7 +361,8 @@ def mpc_run(q_record, *, gamma, horizon, update_interval, dt, torque_limit=None,
             pr = PlanProblem(x, hh, qg.reshape(lg.shape), qc.reshape(lc.shape), gamma,
                              torque_limit=torque_limit, efficiency=efficiency, kappa=kappa,
                              terminal=terminal, speed_limit=speed_limit,
-                             speed_weight=speed_weight, discount=discount)
+                             speed_weight=speed_weight, discount=discount,
+                             energy_limit=energy_limit)
             anchor = None
             if torque_limit is not None or plan is None or not warm:
                 fth, fv = free_motion(x, hh, kk, gamma, qfree)
@@ -518,7 +519,7 @@ def track_mpc(excitation, *, gamma, horizon=2.0, update_interval=0.03125, foreca
               torque_limit=None, efficiency=None, periods=100, seed=0, irregular=False,
               theta0=math.pi, theta_dot0=0.0, terminal_weight=None,
               samples=TRACK_SAMPLES, terminal="energy", speed_limit=None,
-              speed_weight=None, discount=None) -> MPCTrackResult:
+              speed_weight=None, discount=None, energy_limit=None) -> MPCTrackResult:
     """Receding-horizon control of the case ``excitation`` (or, with ``irregular``, of the
     seeded sea record of ``parapend.control.track.design_sea`` built from it, the same
     record as ``track --irregular`` with the same seed); ``horizon`` and ``update_interval``
@@ -556,7 +557,8 @@ def track_mpc(excitation, *, gamma, horizon=2.0, update_interval=0.03125, foreca
                 theta0=theta0, theta_dot0=theta_dot0, t_end=periods * tp, seed=seed,
                 terminal_weight=terminal_weight, average_from=WARMUP_PERIODS * tp,
                 terminal=terminal, speed_limit=speed_limit, speed_weight=speed_weight,
-                discount=None if discount is None else discount * tp)
+                discount=None if discount is None else discount * tp,
+                energy_limit=energy_limit)
     p = r.power_series
     last = min(p.size, 10 * samples)
     mean_power = float(np.mean(p[-last:])) if p.size else math.nan

@@ -141,7 +141,7 @@ class PlanProblem:
 
     def __init__(self, x0, h, q_g, q_c, gamma, *, torque_limit=None, efficiency=None,
                  kappa=None, elastic=None, smoothing=KINK_SMOOTHING[-1], terminal="energy",
-                 speed_limit=None, speed_weight=None, discount=None):
+                 speed_limit=None, speed_weight=None, discount=None, energy_limit=None):
         self.x0 = np.asarray(x0, dtype=float).copy()
         self.q_g = np.ascontiguousarray(q_g, dtype=float)
         self.q_c = np.ascontiguousarray(q_c, dtype=float)
@@ -163,6 +163,7 @@ class PlanProblem:
                    else math.inf)
         self.smoothing = float(smoothing)
         self.speed_limit = None if speed_limit is None else float(speed_limit)
+        self.energy_limit = None if energy_limit is None else float(energy_limit)
         self.speed_weight = (SPEED_WEIGHT if speed_weight is None else float(speed_weight))
         xg, wg = np.polynomial.legendre.leggauss(GAUSS_POINTS)
         self.w = wg / 2 * self.h  # the integral over one interval
@@ -242,6 +243,9 @@ class PlanProblem:
             val += self.kink * float(np.sum((z + np.sqrt(z * z + e * e)) * 0.5 * self.w))
         if self.speed_limit is not None:
             val += self.speed_penalty(f)
+        if self.energy_limit is not None:
+            r = np.maximum(0.5 * f[3::2] ** 2 + np.cos(f[2::2]) - self.energy_limit, 0.0)
+            val += 0.5 * self.speed_weight * self.h * float(np.sum(r * r))
         if self.discount is not None:
             y = self._local(f)
             th = y @ self.rows_g[0].T
@@ -279,6 +283,16 @@ class PlanProblem:
             ab[1, -2] += c * sn * v
         if self.speed_limit is not None:
             self._speed_newton(f, ab, rhs)
+        if self.energy_limit is not None:
+            th, v = f[2::2], f[3::2]
+            r = np.maximum(0.5 * v * v + np.cos(th) - self.energy_limit, 0.0)
+            c = self.speed_weight * self.h * (r > 0)
+            sn = np.sin(th)
+            rhs[2::2] -= c * r * -sn
+            rhs[3::2] -= c * r * v
+            ab[0, 2::2] += c * (sn * sn - r * np.cos(th))
+            ab[0, 3::2] += c * (v * v + r)
+            ab[1, 2::2] += c * (-sn * v)
         if self.discount is not None:
             self._discount_newton(f, ab, rhs)
         if not self.kink:
@@ -463,7 +477,8 @@ def solve_plan(problem: PlanProblem, x, *, anchor=None, gap_tol=1e-10, maxiter=2
                                  efficiency=pr.efficiency, kappa=pr.kappa,
                                  elastic=100.0 * max(1.0, pr.h), smoothing=pr.smoothing,
                                  terminal=pr.terminal, speed_limit=pr.speed_limit,
-                                 speed_weight=pr.speed_weight, discount=pr.discount)
+                                 speed_weight=pr.speed_weight, discount=pr.discount,
+                                 energy_limit=pr.energy_limit)
                 sol = interior_point(el, x, maxiter=maxiter)
                 iters += sol.iterations
                 xb = sol.x
