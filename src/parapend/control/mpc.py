@@ -225,7 +225,7 @@ def mpc_run(q_record, *, gamma, horizon, update_interval, dt, torque_limit=None,
             warm=True, seed=0, terminal_weight=None, average_from=0.0,
             interval_samples=INTERVAL_SAMPLES, plant_steps=PLANT_STEPS, max_iter=MAX_ITER,
             pump_level=1.0, tracking=TRACKING, terminal="energy", speed_limit=None,
-            speed_weight=None, discount=None, energy_limit=None) -> MPCResult:
+            speed_weight=None, discount=None, energy_limit=None, relative=None) -> MPCResult:
     """Receding-horizon control of Eq. 14 driven by the record ``q_record``.
 
     Parameters
@@ -290,7 +290,7 @@ def mpc_run(q_record, *, gamma, horizon, update_interval, dt, torque_limit=None,
                              f"{horizon!r}")
     n = max(1, int(round(horizon / dt)))
     m = max(1, min(n, int(round(update_interval / dt))))
-    if terminal not in ("energy", "limited"):
+    if terminal not in ("energy", "limited", "relative"):
         raise ParameterError(f"terminal: expected energy or limited, got {terminal!r:.40}")
     interval_samples = check_int("interval_samples", interval_samples, 1, 1024)
     plant_steps = check_int("plant_steps", plant_steps, 1, 4096)
@@ -362,7 +362,7 @@ def mpc_run(q_record, *, gamma, horizon, update_interval, dt, torque_limit=None,
                              torque_limit=torque_limit, efficiency=efficiency, kappa=kappa,
                              terminal=terminal, speed_limit=speed_limit,
                              speed_weight=speed_weight, discount=discount,
-                             energy_limit=energy_limit)
+                             energy_limit=energy_limit, relative=relative)
             anchor = None
             if torque_limit is not None or plan is None or not warm:
                 fth, fv = free_motion(x, hh, kk, gamma, qfree)
@@ -519,7 +519,8 @@ def track_mpc(excitation, *, gamma, horizon=2.0, update_interval=0.03125, foreca
               torque_limit=None, efficiency=None, periods=100, seed=0, irregular=False,
               theta0=math.pi, theta_dot0=0.0, terminal_weight=None,
               samples=TRACK_SAMPLES, terminal="energy", speed_limit=None,
-              speed_weight=None, discount=None, energy_limit=None) -> MPCTrackResult:
+              speed_weight=None, discount=None, energy_limit=None,
+              relative=None) -> MPCTrackResult:
     """Receding-horizon control of the case ``excitation`` (or, with ``irregular``, of the
     seeded sea record of ``parapend.control.track.design_sea`` built from it, the same
     record as ``track --irregular`` with the same seed); ``horizon`` and ``update_interval``
@@ -558,7 +559,7 @@ def track_mpc(excitation, *, gamma, horizon=2.0, update_interval=0.03125, foreca
                 terminal_weight=terminal_weight, average_from=WARMUP_PERIODS * tp,
                 terminal=terminal, speed_limit=speed_limit, speed_weight=speed_weight,
                 discount=None if discount is None else discount * tp,
-                energy_limit=energy_limit)
+                energy_limit=energy_limit, relative=relative)
     p = r.power_series
     last = min(p.size, 10 * samples)
     mean_power = float(np.mean(p[-last:])) if p.size else math.nan

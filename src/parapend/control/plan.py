@@ -141,7 +141,8 @@ class PlanProblem:
 
     def __init__(self, x0, h, q_g, q_c, gamma, *, torque_limit=None, efficiency=None,
                  kappa=None, elastic=None, smoothing=KINK_SMOOTHING[-1], terminal="energy",
-                 speed_limit=None, speed_weight=None, discount=None, energy_limit=None):
+                 speed_limit=None, speed_weight=None, discount=None, energy_limit=None,
+                 relative=None):
         self.x0 = np.asarray(x0, dtype=float).copy()
         self.q_g = np.ascontiguousarray(q_g, dtype=float)
         self.q_c = np.ascontiguousarray(q_c, dtype=float)
@@ -154,13 +155,16 @@ class PlanProblem:
         self.eta_g = eg
         self.kink = max(1.0 / em - eg, 0.0)
         self.kappa = eg if kappa is None else float(kappa)
-        if terminal not in ("energy", "limited"):
+        self.relative = relative
+        if terminal not in ("energy", "limited", "relative"):
             raise ParameterError(f"terminal: expected energy or limited, got {terminal!r:.40}")
         self.terminal = terminal
         # the scale T_max / gamma of the limited terminal value (inf: kappa E)
         self._a = (float(torque_limit) / float(gamma)
                    if terminal == "limited" and torque_limit is not None and gamma > 0
                    else math.inf)
+        if terminal == "relative" and relative is not None and torque_limit is not None:
+            self._a = -1.0
         self.smoothing = float(smoothing)
         self.speed_limit = None if speed_limit is None else float(speed_limit)
         self.energy_limit = None if energy_limit is None else float(energy_limit)
@@ -222,14 +226,39 @@ class PlanProblem:
         a = self._a
         if not math.isfinite(a):
             return e, 1.0, 0.0
+        if a < 0:
+            return self._relative_value(e)
         w = math.sqrt(max(2.0 * (e + 1.0), 1e-12))
         return (a * w - a * a * math.log1p(w / a) - 1.0, a / (a + w),
                 -a / ((a + w) ** 2 * w))
 
+    def _relative_value(self, e, eps=0.05):
+        """``h(E) = E + g(w)``, ``w = sqrt(2 (E + 1))``: the relative value of the
+        average-reward problem approximated by the time a torque ``T_max`` needs to bring the
+        rotation back into the band ``[w_lo, w_hi]`` (losing the mean power ``rho`` per unit
+        time) and the damping on the way down (``gamma (w^3 - w_hi^3) / (3 T_max)``)."""
+        w_lo, w_hi, rho = self.relative
+        tm, g = float(self.torque_limit), self.gamma
+        w = math.sqrt(max(2.0 * (e + 1.0), 1e-12))
+
+        def sp(x):
+            r = math.sqrt(x * x + eps * eps)
+            return (x + r) / 2, (1 + x / r) / 2, eps * eps / (2 * r**3)
+
+        a0, a1, a2 = sp(w - w_hi)
+        b0, b1, b2 = sp(w_lo - w)
+        p = (rho + g * w_hi**2) / tm + 2 * g * w_hi * a0 / tm + g * a0 * a0 / tm
+        dp = 2 * g * w_hi / tm + 2 * g * a0 / tm
+        gv = (-((rho + g * w_hi**2) / tm) * a0 - g * w_hi / tm * a0**2
+              - g / (3 * tm) * a0**3 - rho / tm * b0)
+        g1 = -p * a1 + rho / tm * b1
+        g2 = -dp * a1 * a1 - p * a2 - rho / tm * b2
+        return e + gv, 1.0 + g1 / w, g2 / w**2 - g1 / w**3
+
     def _extra(self, f):
         """``terminal + kink`` of the minimized objective at the full variables ``f``."""
         e_end = 0.5 * f[-1] ** 2 + math.cos(f[-2])
-        if math.isfinite(self._a):
+        if math.isfinite(self._a) and self._a != 0:
             val = -(self.kappa * self.terminal_value(e_end)[0] - self.eta_g * e_end)
         else:
             d = self.kappa - self.eta_g
@@ -478,7 +507,7 @@ def solve_plan(problem: PlanProblem, x, *, anchor=None, gap_tol=1e-10, maxiter=2
                                  elastic=100.0 * max(1.0, pr.h), smoothing=pr.smoothing,
                                  terminal=pr.terminal, speed_limit=pr.speed_limit,
                                  speed_weight=pr.speed_weight, discount=pr.discount,
-                                 energy_limit=pr.energy_limit)
+                                 energy_limit=pr.energy_limit, relative=pr.relative)
                 sol = interior_point(el, x, maxiter=maxiter)
                 iters += sol.iterations
                 xb = sol.x
