@@ -71,4 +71,5 @@ HORIZON = {"horizons": "0.25,0.5,1,2,4", "forecasts": "perfect,ar",
 #: ``track --controller``: the regular-wave controller by default; with ``mpc`` the horizon
 #: and the update interval (peak periods) and the wave forecast of the receding-horizon
 #: controller (docs/control.md)
-TRACK = {"controller": "lqr", "horizon": 2.0, "update_interval": 0.03125, "forecast": "perfect"}
+TRACK = {"controller": "lqr", "horizon": 2.0, "update_interval": 0.03125, "forecast": "perfect",
+         "speed_limit": None}

@@ -27,6 +27,13 @@ by ``kappa V(E)``, ``V`` the energy a torque ``T_max`` harvests braking the rota
 the damping (:meth:`PlanProblem.terminal_value`, docs/control.md); ``V -> E`` without a
 limit.
 
+**Rated speed.** ``speed_limit=w_max`` adds the exterior penalty ``rho / 2 h sum_k
+max(|v_k| - w_max, 0)^2`` over the free nodes (a generator's rated speed; docs/control.md:
+under a torque limit the long horizons' optima spin the pendulum up first, and the receding
+horizon applies only that). A penalty, not a constraint of the interior point: the measured
+state may lie above the bound (the swing-up's catch, a wave group), where a hard bound on
+the path would have no feasible plan.
+
 **Efficiency.** The kink of ``max(z, 0)`` (``z = T theta'``, the power motored) is smoothed,
 ``(z + sqrt(z^2 + eps^2)) / 2`` (above the kink by at most ``eps / 2``), with continuation
 ``eps = 1e-2, 1e-3, 1e-4`` (each solve warm-started from the last). A slack per Gauss point
@@ -135,14 +142,18 @@ class PlanProblem:
         Elastic mode: ``|T| <= torque_limit + t``, ``t >= 0``, penalty ``elastic t``.
     terminal : {"energy", "limited"}
         The terminal value ``kappa V(E)`` (:meth:`terminal_value`).
+    speed_limit : float or None
+        Rated speed ``w_max``: the penalty :meth:`speed_penalty` on the nodes' speeds above
+        it (None: none).
+    speed_weight : float or None
+        Its ``rho`` (None: :data:`SPEED_WEIGHT`).
     """
 
     phase1 = False
 
     def __init__(self, x0, h, q_g, q_c, gamma, *, torque_limit=None, efficiency=None,
                  kappa=None, elastic=None, smoothing=KINK_SMOOTHING[-1], terminal="energy",
-                 speed_limit=None, speed_weight=None, discount=None, energy_limit=None,
-                 relative=None):
+                 speed_limit=None, speed_weight=None):
         self.x0 = np.asarray(x0, dtype=float).copy()
         self.q_g = np.ascontiguousarray(q_g, dtype=float)
         self.q_c = np.ascontiguousarray(q_c, dtype=float)
@@ -155,28 +166,18 @@ class PlanProblem:
         self.eta_g = eg
         self.kink = max(1.0 / em - eg, 0.0)
         self.kappa = eg if kappa is None else float(kappa)
-        self.relative = relative
-        if terminal not in ("energy", "limited", "relative"):
+        if terminal not in ("energy", "limited"):
             raise ParameterError(f"terminal: expected energy or limited, got {terminal!r:.40}")
         self.terminal = terminal
         # the scale T_max / gamma of the limited terminal value (inf: kappa E)
         self._a = (float(torque_limit) / float(gamma)
                    if terminal == "limited" and torque_limit is not None and gamma > 0
                    else math.inf)
-        if terminal == "relative" and relative is not None and torque_limit is not None:
-            self._a = -1.0
         self.smoothing = float(smoothing)
         self.speed_limit = None if speed_limit is None else float(speed_limit)
-        self.energy_limit = None if energy_limit is None else float(energy_limit)
         self.speed_weight = (SPEED_WEIGHT if speed_weight is None else float(speed_weight))
         xg, wg = np.polynomial.legendre.leggauss(GAUSS_POINTS)
         self.w = wg / 2 * self.h  # the integral over one interval
-        # discounting exp(-t / tau): the weights (d - 1) w of the correction and 1 - d(H)
-        self.discount = None if discount is None else float(discount)
-        if self.discount is not None:
-            tg = self.h * (np.arange(k)[:, None] + _TAU_G[None, :])
-            self._dw = (np.exp(-tg / self.discount) - 1.0) * self.w[None, :]
-            self._d_end = 1.0 - math.exp(-k * self.h / self.discount)
         self.wk = eg * self.w  # the kernel's objective weights (its q1g is q here)
         self.rows_g = _hermite_rows(_TAU_G, self.h)
         self.rows_c = _hermite_rows(TORQUE_TAU, self.h)
@@ -226,39 +227,14 @@ class PlanProblem:
         a = self._a
         if not math.isfinite(a):
             return e, 1.0, 0.0
-        if a < 0:
-            return self._relative_value(e)
         w = math.sqrt(max(2.0 * (e + 1.0), 1e-12))
         return (a * w - a * a * math.log1p(w / a) - 1.0, a / (a + w),
                 -a / ((a + w) ** 2 * w))
 
-    def _relative_value(self, e, eps=0.05):
-        """``h(E) = E + g(w)``, ``w = sqrt(2 (E + 1))``: the relative value of the
-        average-reward problem approximated by the time a torque ``T_max`` needs to bring the
-        rotation back into the band ``[w_lo, w_hi]`` (losing the mean power ``rho`` per unit
-        time) and the damping on the way down (``gamma (w^3 - w_hi^3) / (3 T_max)``)."""
-        w_lo, w_hi, rho = self.relative
-        tm, g = float(self.torque_limit), self.gamma
-        w = math.sqrt(max(2.0 * (e + 1.0), 1e-12))
-
-        def sp(x):
-            r = math.sqrt(x * x + eps * eps)
-            return (x + r) / 2, (1 + x / r) / 2, eps * eps / (2 * r**3)
-
-        a0, a1, a2 = sp(w - w_hi)
-        b0, b1, b2 = sp(w_lo - w)
-        p = (rho + g * w_hi**2) / tm + 2 * g * w_hi * a0 / tm + g * a0 * a0 / tm
-        dp = 2 * g * w_hi / tm + 2 * g * a0 / tm
-        gv = (-((rho + g * w_hi**2) / tm) * a0 - g * w_hi / tm * a0**2
-              - g / (3 * tm) * a0**3 - rho / tm * b0)
-        g1 = -p * a1 + rho / tm * b1
-        g2 = -dp * a1 * a1 - p * a2 - rho / tm * b2
-        return e + gv, 1.0 + g1 / w, g2 / w**2 - g1 / w**3
-
     def _extra(self, f):
         """``terminal + kink`` of the minimized objective at the full variables ``f``."""
         e_end = 0.5 * f[-1] ** 2 + math.cos(f[-2])
-        if math.isfinite(self._a) and self._a != 0:
+        if math.isfinite(self._a):
             val = -(self.kappa * self.terminal_value(e_end)[0] - self.eta_g * e_end)
         else:
             d = self.kappa - self.eta_g
@@ -272,15 +248,6 @@ class PlanProblem:
             val += self.kink * float(np.sum((z + np.sqrt(z * z + e * e)) * 0.5 * self.w))
         if self.speed_limit is not None:
             val += self.speed_penalty(f)
-        if self.energy_limit is not None:
-            r = np.maximum(0.5 * f[3::2] ** 2 + np.cos(f[2::2]) - self.energy_limit, 0.0)
-            val += 0.5 * self.speed_weight * self.h * float(np.sum(r * r))
-        if self.discount is not None:
-            y = self._local(f)
-            th = y @ self.rows_g[0].T
-            thd = y @ self.rows_g[1].T
-            z = (y @ self.lin_g.T - self.q1_g * np.sin(th)) * thd
-            val += float(np.sum(self._dw * z)) + self.kappa * self._d_end * e_end
         return val
 
     def speed_penalty(self, f):
@@ -312,18 +279,6 @@ class PlanProblem:
             ab[1, -2] += c * sn * v
         if self.speed_limit is not None:
             self._speed_newton(f, ab, rhs)
-        if self.energy_limit is not None:
-            th, v = f[2::2], f[3::2]
-            r = np.maximum(0.5 * v * v + np.cos(th) - self.energy_limit, 0.0)
-            c = self.speed_weight * self.h * (r > 0)
-            sn = np.sin(th)
-            rhs[2::2] -= c * r * -sn
-            rhs[3::2] -= c * r * v
-            ab[0, 2::2] += c * (sn * sn - r * np.cos(th))
-            ab[0, 3::2] += c * (v * v + r)
-            ab[1, 2::2] += c * (-sn * v)
-        if self.discount is not None:
-            self._discount_newton(f, ab, rhs)
         if not self.kink:
             return
         b0, b1, _ = self.rows_g
@@ -343,36 +298,6 @@ class PlanProblem:
         grad = np.einsum("kg,kga->ka", f1, dz)
         hess = (np.einsum("kg,kga,kgb->kab", f2, dz, dz)
                 + np.einsum("kg,kga,gb->kab", f1, dt, b1)
-                + np.einsum("kg,ga,kgb->kab", f1, b1, dt)
-                + np.einsum("kg,ga,gb->kab", f1 * thd * self.q1_g * sn, b0, b0))
-        k = self.k
-        for a in range(4):
-            rhs[a:a + 2 * k:2] -= grad[:, a]
-            for b in range(a + 1):
-                ab[a - b, b:b + 2 * k:2] += hess[:, a, b]
-
-    def _discount_newton(self, f, ab, rhs):
-        """Gradient and Hessian of the discount's correction ``sum (d - 1) w z + kappa (1 -
-        d(H)) E(H)``, ``z = T theta'`` (the power motored)."""
-        th, v = f[-2], f[-1]
-        c = self.kappa * self._d_end
-        sn = math.sin(th)
-        rhs[-2] += c * sn
-        rhs[-1] -= c * v
-        ab[0, -2] -= c * math.cos(th)
-        ab[0, -1] += c
-        b0, b1, _ = self.rows_g
-        lin = self.lin_g
-        y = self._local(f)
-        th = y @ b0.T
-        thd = y @ b1.T
-        sn, cs = np.sin(th), np.cos(th)
-        tq = y @ lin.T - self.q1_g * sn
-        f1 = self._dw
-        dt = lin[None, :, :] - (self.q1_g * cs)[:, :, None] * b0[None, :, :]
-        dz = thd[:, :, None] * dt + tq[:, :, None] * b1[None, :, :]
-        grad = np.einsum("kg,kga->ka", f1, dz)
-        hess = (np.einsum("kg,kga,gb->kab", f1, dt, b1)
                 + np.einsum("kg,ga,kgb->kab", f1, b1, dt)
                 + np.einsum("kg,ga,gb->kab", f1 * thd * self.q1_g * sn, b0, b0))
         k = self.k
@@ -506,8 +431,7 @@ def solve_plan(problem: PlanProblem, x, *, anchor=None, gap_tol=1e-10, maxiter=2
                                  efficiency=pr.efficiency, kappa=pr.kappa,
                                  elastic=100.0 * max(1.0, pr.h), smoothing=pr.smoothing,
                                  terminal=pr.terminal, speed_limit=pr.speed_limit,
-                                 speed_weight=pr.speed_weight, discount=pr.discount,
-                                 energy_limit=pr.energy_limit, relative=pr.relative)
+                                 speed_weight=pr.speed_weight)
                 sol = interior_point(el, x, maxiter=maxiter)
                 iters += sol.iterations
                 xb = sol.x
