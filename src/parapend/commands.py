@@ -868,7 +868,7 @@ def horizon(*, hs=None, tp=None, spectrum: str = "jonswap", gamma_peak: float = 
             horizons: str = HORIZON["horizons"], forecasts: str = HORIZON["forecasts"],
             baselines: str = HORIZON["baselines"], records: int = HORIZON["records"],
             update_interval: float = HORIZON["update_interval"], progress=None,
-            warm_up: float = HORIZON["warm_up"]):
+            warm_up: float = HORIZON["warm_up"], speed_limit=HORIZON["speed_limit"]):
     """Mean power of causal control against the forecast horizon, as a fraction of the
     record's non-causal optimum and of its limit (command ``horizon``;
     :func:`parapend.control.horizon.horizon_curve`). The sea state and the pendulum as
@@ -884,4 +884,4 @@ def horizon(*, hs=None, tp=None, spectrum: str = "jonswap", gamma_peak: float = 
                          torque_limit=torque_limit, efficiency=efficiency, horizons=horizons,
                          forecasts=forecasts, baselines=baselines, records=records,
                          update_interval=update_interval, progress=progress,
-                         warm_up=warm_up)
+                         warm_up=warm_up, speed_limit=speed_limit)
