@@ -281,6 +281,58 @@ def test_limited_terminal_value_gradient_and_hessian_are_exact():
             assert ab[i - j, j] == pytest.approx(col[j], abs=1e-6)
 
 
+def test_speed_penalty_gradient_and_hessian_are_exact():
+    """The rated-speed penalty's gradient and Newton matrix against central differences of
+    the objective (12 intervals, every node above the bound)."""
+    pr, start, _ = _plan_problem(12, 2.0, torque_limit=1.0, speed_limit=1.5)
+    from parapend.optimal import _hermite_kernel as _k
+
+    pr.mode = _k.NONE  # the objective's terms only (no barrier)
+    x = start + 0.1 * np.random.default_rng(3).normal(size=start.size)
+    x[1::2] += 1.0
+    x[3] = -3.0  # one node above the bound backwards
+    n = x.size
+    f = pr.full(x)
+    assert np.all(np.abs(f[3::2]) > 1.5)
+    excess = np.abs(f[3::2]) - 1.5
+    assert pr.speed_penalty(f) == pytest.approx(50.0 * pr.h * np.sum(excess**2), rel=1e-12)
+
+    def rhs(y):
+        return pr.newton(y, None, np.zeros(0), 0.0)[1]
+
+    ab = pr.newton(x, None, np.zeros(0), 0.0)[0]
+    g = np.array([(pr.objective(x + 1e-6 * e) - pr.objective(x - 1e-6 * e)) / 2e-6
+                  for e in np.eye(n)])
+    assert np.max(np.abs(g + rhs(x))) < 1e-6
+    for i in range(n):
+        e = np.eye(n)[i]
+        col = -(rhs(x + 1e-5 * e) - rhs(x - 1e-5 * e)) / 2e-5
+        for j in range(max(0, i - 3), i + 1):
+            assert ab[i - j, j] == pytest.approx(col[j], abs=1e-6)
+
+
+def test_speed_limit_bounds_the_plan_and_is_inactive_below_it():
+    """A plan that speeds up beyond ``w_max`` without the bound stays within it (to the
+    penalty's ``O(1 / rho)``) with it; a bound above the free optimum's speeds changes
+    nothing."""
+    from parapend.control.plan import solve_plan
+
+    free, start, _ = _plan_problem(32, 2 * 2 * math.pi / 1.8, torque_limit=1.0)
+    s0 = solve_plan(free, start, anchor=start)
+    top = float(np.max(np.abs(s0.plan.v)))
+    w = 0.8 * top
+    bound, _, _ = _plan_problem(32, 2 * 2 * math.pi / 1.8, torque_limit=1.0, speed_limit=w)
+    s1 = solve_plan(bound, start, anchor=start)
+    assert s0.success and s1.success
+    assert np.max(np.abs(s1.plan.v)) < w + 0.1 * (top - w)
+    assert s1.value < s0.value
+    loose, _, _ = _plan_problem(32, 2 * 2 * math.pi / 1.8, torque_limit=1.0,
+                                speed_limit=1.01 * top)
+    assert loose.value(s0.x) == s0.value  # the penalty is zero there
+    s2 = solve_plan(loose, s0.x, anchor=start)
+    assert s2.value == pytest.approx(s0.value, rel=1e-9)
+
+
 def test_mpc_run_bad_input_is_a_parameter_error():
     from parapend.errors import ParameterError
 
@@ -292,6 +344,9 @@ def test_mpc_run_bad_input_is_a_parameter_error():
     with pytest.raises(ParameterError, match="terminal"):
         mpc_run(exc, gamma=GAMMA, horizon=1, update_interval=0.1, dt=0.1, t_end=1,
                 terminal="cubic")
+    with pytest.raises(ParameterError, match="speed-limit"):
+        mpc_run(exc, gamma=GAMMA, horizon=1, update_interval=0.1, dt=0.1, t_end=1,
+                speed_limit=-1.0)
 
 
 @pytest.mark.parametrize("args,word", [
@@ -299,7 +354,9 @@ def test_mpc_run_bad_input_is_a_parameter_error():
     (["--controller", "mpc", "--noise-theta", "0.1"], "noise-theta"),
     (["--horizon", "3"], "horizon"),
     (["--controller", "mpc", "--horizon", "1", "--update-interval", "2"], "update-interval"),
-    (["--controller", "mpc", "--plot", "x.png"], "plot")])
+    (["--controller", "mpc", "--plot", "x.png"], "plot"),
+    (["--speed-limit", "3"], "speed-limit"),
+    (["--controller", "mpc", "--speed-limit", "0"], "speed-limit")])
 def test_cli_errors_are_one_line(args, word, capsys):
     assert main(["track", *args]) == 2
     err = capsys.readouterr().err.strip()
@@ -334,3 +391,19 @@ def test_torque_limited_mpc_harvests_in_the_paper_case():
     r = track_mpc(harmonic(), gamma=0.01, torque_limit=1.0, irregular=True, periods=20,
                   seed=0, horizon=1.0)
     assert r.success and r.mean_power > 0.05
+
+
+@pytest.mark.slow
+def test_rated_speed_makes_the_long_torque_limited_horizon_harvest():
+    """The paper case with ``T_max = 1`` on the irregular record of seed 0 (20 peak
+    periods), horizon 2 peak periods: without a bound the pendulum spins up and the mean
+    power over the last 10 periods is negative (docs/control.md: -0.765); with the rated
+    speed 3.5 it is positive (0.158) and the speed stays within the bound."""
+    from parapend.control.mpc import track_mpc
+    from parapend.excitation import harmonic
+
+    r = track_mpc(harmonic(), gamma=0.01, torque_limit=1.0, irregular=True, periods=20,
+                  seed=0, horizon=2.0, speed_limit=3.5)
+    assert r.success and r.mean_power > 0.05 and r.speed_limit == 3.5
+    last = r._run.theta_dot[-10 * r.samples_per_period:]
+    assert np.max(np.abs(last)) < 3.5 * 1.05

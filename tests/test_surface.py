@@ -366,5 +366,10 @@ def test_track_controller_defaults_are_in_defaults_and_its_table():
     row = next(line for line in table.splitlines() if line.startswith("| controller of `track`"))
     for name, value in TRACK.items():
         assert params[name].default == value
-        assert f"`--{name.replace('_', '-')} {value:g}`" in row if isinstance(value, float) \
-            else f"`--{name} {value}`" in row
+        flag = name.replace("_", "-")
+        if value is None:
+            assert f"no `--{flag}`" in row
+        elif isinstance(value, float):
+            assert f"`--{flag} {value:g}`" in row
+        else:
+            assert f"`--{name} {value}`" in row

@@ -483,7 +483,7 @@ def track(*, excitation=None, omega=OMEGA, delta=None, square_alpha=None, fourie
           amplitude=None, damping_coefficient=None, torque_limit_nm=None, progress=None,
           controller: str = TRACK["controller"], horizon: float = TRACK["horizon"],
           update_interval: float = TRACK["update_interval"],
-          forecast: str = TRACK["forecast"]):
+          forecast: str = TRACK["forecast"], speed_limit=TRACK["speed_limit"]):
     """Swing up from rest, catch and hold the optimal rotation (command ``track``): a
     :class:`~parapend.control.track.TrackResult` (``runs`` 1) or a
     :class:`~parapend.control.robustness.RobustnessResult` (more seeded runs). With
@@ -494,7 +494,8 @@ def track(*, excitation=None, omega=OMEGA, delta=None, square_alpha=None, fourie
     (:func:`parapend.control.mpc.track_mpc`, an
     :class:`~parapend.control.mpc.MPCTrackResult`), with ``horizon`` and
     ``update_interval`` in forcing (peak) periods and the wave ``forecast`` ("perfect" or
-    "ar"); one run, no model error or noise."""
+    "ar") and the plans' rated ``speed_limit`` (none by default); one run, no model error
+    or noise."""
     from .control.robustness import track_runs
     from .control.track import track as _track
 
@@ -511,10 +512,13 @@ def track(*, excitation=None, omega=OMEGA, delta=None, square_alpha=None, fourie
                 length=length, mass=mass, inertia=inertia, gravity=gravity,
                 frequency=frequency, amplitude=amplitude,
                 damping_coefficient=damping_coefficient, torque_limit_nm=torque_limit_nm),
-            horizon=horizon, update_interval=update_interval, forecast=forecast)
+            horizon=horizon, update_interval=update_interval, forecast=forecast,
+            speed_limit=speed_limit)
     if (horizon, update_interval, forecast) != (2.0, 0.03125, "perfect"):
         raise ParameterError("horizon: --horizon, --update-interval and --forecast belong to "
                              "--controller mpc")
+    if speed_limit is not None:
+        raise ParameterError("speed-limit: --speed-limit belongs to --controller mpc")
 
     kw = {"gamma": gamma, "harmonics": harmonics,
           **_excitation(excitation, omega, delta, square_alpha, fourier, file)}
@@ -546,7 +550,7 @@ def track(*, excitation=None, omega=OMEGA, delta=None, square_alpha=None, fourie
 
 def _track_mpc(*, excitation, omega, delta, square_alpha, fourier, file, gamma, torque_limit,
                theta0, theta_dot0, periods, seed, runs, errors, irregular, units_kw, horizon,
-               update_interval, forecast):
+               update_interval, forecast, speed_limit=None):
     """``track --controller mpc`` (:func:`parapend.control.mpc.track_mpc`)."""
     from .api import build_excitation
     from .control.mpc import track_mpc
@@ -570,7 +574,8 @@ def _track_mpc(*, excitation, omega, delta, square_alpha, fourier, file, gamma, 
     exc = build_excitation(kw.pop("excitation", None), **kw)
     r = track_mpc(exc, gamma=gamma, horizon=horizon, update_interval=update_interval,
                   forecast=forecast, torque_limit=torque_limit, periods=periods, seed=seed,
-                  irregular=irregular, theta0=theta0, theta_dot0=theta_dot0)
+                  irregular=irregular, theta0=theta0, theta_dot0=theta_dot0,
+                  speed_limit=speed_limit)
     if units is None:
         return r
     tp = 2 * math.pi / r.omega
@@ -863,7 +868,7 @@ def horizon(*, hs=None, tp=None, spectrum: str = "jonswap", gamma_peak: float = 
             horizons: str = HORIZON["horizons"], forecasts: str = HORIZON["forecasts"],
             baselines: str = HORIZON["baselines"], records: int = HORIZON["records"],
             update_interval: float = HORIZON["update_interval"], progress=None,
-            warm_up: float = HORIZON["warm_up"]):
+            warm_up: float = HORIZON["warm_up"], speed_limit=HORIZON["speed_limit"]):
     """Mean power of causal control against the forecast horizon, as a fraction of the
     record's non-causal optimum and of its limit (command ``horizon``;
     :func:`parapend.control.horizon.horizon_curve`). The sea state and the pendulum as
@@ -879,4 +884,4 @@ def horizon(*, hs=None, tp=None, spectrum: str = "jonswap", gamma_peak: float = 
                          torque_limit=torque_limit, efficiency=efficiency, horizons=horizons,
                          forecasts=forecasts, baselines=baselines, records=records,
                          update_interval=update_interval, progress=progress,
-                         warm_up=warm_up)
+                         warm_up=warm_up, speed_limit=speed_limit)

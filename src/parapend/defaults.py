@@ -66,9 +66,10 @@ BUOY = {"wave_height": 0.2, "wave_period": 1.8, "hs": 0.5, "tp": 2.5,
 #: number of seeded records and the update interval of the receding-horizon controller
 HORIZON = {"horizons": "0.25,0.5,1,2,4", "forecasts": "perfect,ar",
            "baselines": "tracker,extremum", "records": 1, "update_interval": 0.03125,
-           "warm_up": 0.0}
+           "warm_up": 0.0, "speed_limit": None}
 
 #: ``track --controller``: the regular-wave controller by default; with ``mpc`` the horizon
 #: and the update interval (peak periods) and the wave forecast of the receding-horizon
 #: controller (docs/control.md)
-TRACK = {"controller": "lqr", "horizon": 2.0, "update_interval": 0.03125, "forecast": "perfect"}
+TRACK = {"controller": "lqr", "horizon": 2.0, "update_interval": 0.03125, "forecast": "perfect",
+         "speed_limit": None}

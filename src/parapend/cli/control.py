@@ -86,6 +86,11 @@ def add_parsers(sub) -> None:
     g.add_argument("--forecast", choices=("perfect", "ar"), default=TRACK["forecast"],
                    help="MPC wave forecast: perfect (the record's own future) or ar "
                         f"(autoregressive, fitted on the past; default {TRACK['forecast']})")
+    g.add_argument("--speed-limit", type=_finite_float("speed-limit"),
+                   default=TRACK["speed_limit"],
+                   help="MPC rated speed: the plans keep |theta'| below it (a penalty on the "
+                        "excess at the plan's nodes), in units of sqrt(g/l), > 0; default "
+                        "none (docs/control.md: with --torque-limit 1 and --horizon 2, 3.5)")
     from .pto import add_unit_options
 
     add_unit_options(p, torque=True)
@@ -207,7 +212,8 @@ def _mpc_out(a, r) -> dict | str:
            f"receding-horizon control, {r.forecast} forecast: horizon {r.horizon:g} "
            f"periods, update every {r.update_interval:g} periods, {r.samples_per_period} "
            f"torque samples per period; gamma = {r.gamma:g}, omega = {r.omega:g}, T_max = "
-           f"{_fmt(r.torque_limit)}",
+           f"{_fmt(r.torque_limit)}"
+           + (f", rated speed {r.speed_limit:g}" if r.speed_limit is not None else ""),
            f"mean power (last 10 periods) {_fmt(r.mean_power, 8)}; from period 10 to the "
            f"end {_fmt(r.run_power, 8)}"
            + (f"; over the last repeat of the record {_fmt(r.record_power, 8)}"

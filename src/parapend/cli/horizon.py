@@ -56,6 +56,10 @@ def add_parsers(sub) -> None:
     g.add_argument("--warm-up", type=_finite_float("warm-up"), default=HORIZON["warm_up"],
                    help="peak periods of every receding-horizon run left out of its mean "
                         "(the run is then this plus one repeat long; default 0)")
+    g.add_argument("--speed-limit", type=_finite_float("speed-limit"),
+                   default=HORIZON["speed_limit"],
+                   help="rated speed of the receding-horizon plans, in units of sqrt(g/l), "
+                        "> 0 (default none; docs/control.md)")
     p.add_argument("--plot", metavar="PNG", help="draw the fraction of the optimum against "
                                                   "the horizon")
     p.add_argument("--save", metavar="NC", help="write the curve and every run as NetCDF")
@@ -112,7 +116,9 @@ def _cmd_horizon(a) -> dict | str:
     out = [head, f"non-causal optimum (sea) {nopt:.4g} W, limit {nlim:.4g} W (mean over the "
                  "records); every run from the hanging rest over the whole record"
                  + (f" (receding horizon: after {r.warm_up:g} peak periods)" if r.warm_up
-                    else ""), "",
+                    else "")
+                 + (f"; rated speed {r.speed_limit:g}" if r.speed_limit is not None else ""),
+                 "",
            _table(rows, ["controller", "horizon (Tp)", "power (W)", "of optimum",
                          "min .. max", "of limit"])]
     if r.ar_leads:

@@ -100,6 +100,7 @@ class HorizonResult(_Result):
     status: str
     message: str
     warm_up: float = 0.0
+    speed_limit: float | None = None
     optimum_power_w: list = field(default_factory=list)
     limit_power_w: list = field(default_factory=list)
     mpc_power_w: list = field(default_factory=list)
@@ -157,7 +158,7 @@ def horizon_curve(*, hs: float = 2.0, tp: float = 8.0, spectrum: str = "jonswap"
                   torque_limit=None, efficiency=None, horizons="0.25,0.5,1,2,4",
                   forecasts="perfect,ar", baselines="tracker,extremum", records: int = 1,
                   update_interval: float = 0.03125, progress=None,
-                  warm_up: float = 0.0) -> HorizonResult:
+                  warm_up: float = 0.0, speed_limit=None) -> HorizonResult:
     """Mean power of causal control against the horizon (module docstring).
 
     Parameters
@@ -186,6 +187,9 @@ def horizon_curve(*, hs: float = 2.0, tp: float = 8.0, spectrum: str = "jonswap"
         Peak periods of the receding-horizon runs left out of their mean (start-up from
         rest); the run is then ``warm_up`` plus one whole repeat of the record long, so the
         mean is over one repeat (the baselines still average the whole record from rest).
+    speed_limit : float or None
+        Rated speed of the receding-horizon plans (units ``sqrt(g / l)``;
+        :func:`parapend.control.mpc.mpc_run`); None: none.
     """
     from ..irregular import sea
     from ..seas import sea_record
@@ -208,6 +212,8 @@ def horizon_curve(*, hs: float = 2.0, tp: float = 8.0, spectrum: str = "jonswap"
     seed = check_int("seed", seed, 0, 2**63 - 1 - MAX_RECORDS)
     upd = check_range("update-interval", update_interval, 1e-3, 1.0)
     warm_up = check_range("warm-up", warm_up, 0.0, 100.0)
+    if speed_limit is not None:
+        speed_limit = check_range("speed-limit", speed_limit, 1e-9, 1e6)
     if torque_limit is not None:
         torque_limit = check_range("torque-limit", torque_limit, 0.0, limits.MAX_TORQUE_LIMIT)
         if torque_limit <= 0:
@@ -252,7 +258,8 @@ def horizon_curve(*, hs: float = 2.0, tp: float = 8.0, spectrum: str = "jonswap"
                                   update_interval=upd * tp_n, dt=tp_n / 64,
                                   average_from=warm_up * tp_n,
                                   torque_limit=torque_limit, efficiency=eff,
-                                  forecast=fo, t_end=exc.period + warm_up * tp_n, seed=seed + r)
+                                  forecast=fo, t_end=exc.period + warm_up * tp_n, seed=seed + r,
+                                  speed_limit=speed_limit)
                     mpc_p[i][j][r] = (float(res.mean_electrical_power) if res.success
                                       else math.nan)
                     mpc_st[i][j][r] = str(res.status)
@@ -308,6 +315,7 @@ def horizon_curve(*, hs: float = 2.0, tp: float = 8.0, spectrum: str = "jonswap"
         peak_period=tp_n, update_interval=upd, gamma=gamma, torque_limit=torque_limit,
         efficiency=efficiency, record=rec, units=units.describe(), success=ok,
         status="done" if ok else "failed_runs", message=msg, warm_up=warm_up,
+        speed_limit=speed_limit,
         optimum_power_w=[w(v) for v in opt], limit_power_w=[w(v) for v in lim],
         mpc_power_w=[[[w(v) for v in col] for col in row] for row in mpc_p],
         baseline_power_w=[[w(v) for v in row] for row in base_p],
@@ -354,6 +362,7 @@ def horizon_dataset(r: HorizonResult):
                      "update_interval_peak_periods": r.update_interval,
                      "warm_up_peak_periods": r.warm_up,
                      "torque_limit": "none" if r.torque_limit is None else r.torque_limit,
+                     "speed_limit": "none" if r.speed_limit is None else r.speed_limit,
                      "efficiency": "none" if r.efficiency is None else r.efficiency,
                      "convention": r.convention, "status": r.status,
                      "power_unit_w": r.units["power_unit_w"],

@@ -105,6 +105,7 @@ class MPCResult(_Result):
     success: bool
     status: str
     message: str
+    speed_limit: float | None = None
     convention: str = ("theta from the upright (hanging at rest is theta = pi); power "
                        "positive when harvested, P = -<T theta'>; torque units m g l")
     extra: dict = field(default_factory=dict)
@@ -224,7 +225,8 @@ def mpc_run(q_record, *, gamma, horizon, update_interval, dt, torque_limit=None,
             efficiency=None, forecast=None, theta0=math.pi, theta_dot0=0.0, t_end=None,
             warm=True, seed=0, terminal_weight=None, average_from=0.0,
             interval_samples=INTERVAL_SAMPLES, plant_steps=PLANT_STEPS, max_iter=MAX_ITER,
-            pump_level=1.0, tracking=TRACKING, terminal="energy") -> MPCResult:
+            pump_level=1.0, tracking=TRACKING, terminal="energy", speed_limit=None,
+            speed_weight=None) -> MPCResult:
     """Receding-horizon control of Eq. 14 driven by the record ``q_record``.
 
     Parameters
@@ -273,6 +275,13 @@ def mpc_run(q_record, *, gamma, horizon, update_interval, dt, torque_limit=None,
         torque ``T_max`` harvests braking the rotation against ``gamma``
         (:meth:`~.plan.PlanProblem.terminal_value`; docs/control.md: it makes the
         torque-limited runs worse).
+    speed_limit : float or None
+        Rated speed ``w_max`` of the plans: the penalty ``rho / 2 h sum max(|theta'_k| -
+        w_max, 0)^2`` at the plan's nodes (:meth:`~.plan.PlanProblem.speed_penalty`);
+        None: no bound. docs/control.md: under a torque limit it stops the spin-up of the
+        long horizons.
+    speed_weight : float or None
+        ``rho`` of that penalty (None: :data:`~.plan.SPEED_WEIGHT`).
     """
     from . import _mpc_kernel as k
     from .plan import PlanProblem, free_motion, gauss_leads, solve_plan
@@ -295,6 +304,8 @@ def mpc_run(q_record, *, gamma, horizon, update_interval, dt, torque_limit=None,
     plant_steps = check_int("plant_steps", plant_steps, 1, 4096)
     if torque_limit is not None:
         torque_limit = check_range("torque-limit", torque_limit, 1e-9, 1e6)
+    if speed_limit is not None:
+        speed_limit = check_range("speed-limit", speed_limit, 1e-9, 1e6)
     qf = _q_function(q_record)
     if t_end is None:
         if isinstance(q_record, tuple) or isinstance(q_record, list):
@@ -359,7 +370,8 @@ def mpc_run(q_record, *, gamma, horizon, update_interval, dt, torque_limit=None,
             qg, qc, qs, qfree = np.split(qall, cuts)
             pr = PlanProblem(x, hh, qg.reshape(lg.shape), qc.reshape(lc.shape), gamma,
                              torque_limit=torque_limit, efficiency=efficiency, kappa=kappa,
-                             terminal=terminal)
+                             terminal=terminal, speed_limit=speed_limit,
+                             speed_weight=speed_weight)
             anchor = None
             if torque_limit is not None or plan is None or not warm:
                 fth, fv = free_motion(x, hh, kk, gamma, qfree)
@@ -441,7 +453,7 @@ def mpc_run(q_record, *, gamma, horizon, update_interval, dt, torque_limit=None,
         catch_time=None if caught is None else float(caught * dt), solves=len(solve_times),
         failed_solves=failed, peak_torque=float(np.max(np.abs(u_all))) if total else 0.0,
         forecast="perfect" if forecast is None else type(forecast).__name__,
-        success=success, status=status, message=msg)
+        success=success, status=status, message=msg, speed_limit=speed_limit)
 
 
 # --- track --controller mpc ----------------------------------------------------------------
@@ -497,6 +509,7 @@ class MPCTrackResult(_Result):
     periods: int
     seed: int
     irregular: bool
+    speed_limit: float | None = None
     excitation: dict = field(default_factory=dict)
     sea: dict | None = None
     units: dict | None = None
@@ -515,7 +528,8 @@ class MPCTrackResult(_Result):
 def track_mpc(excitation, *, gamma, horizon=2.0, update_interval=0.03125, forecast="perfect",
               torque_limit=None, efficiency=None, periods=100, seed=0, irregular=False,
               theta0=math.pi, theta_dot0=0.0, terminal_weight=None,
-              samples=TRACK_SAMPLES, terminal="energy") -> MPCTrackResult:
+              samples=TRACK_SAMPLES, terminal="energy", speed_limit=None,
+              speed_weight=None) -> MPCTrackResult:
     """Receding-horizon control of the case ``excitation`` (or, with ``irregular``, of the
     seeded sea record of ``parapend.control.track.design_sea`` built from it, the same
     record as ``track --irregular`` with the same seed); ``horizon`` and ``update_interval``
@@ -552,7 +566,7 @@ def track_mpc(excitation, *, gamma, horizon=2.0, update_interval=0.03125, foreca
                 dt=dt, torque_limit=torque_limit, efficiency=efficiency, forecast=fo,
                 theta0=theta0, theta_dot0=theta_dot0, t_end=periods * tp, seed=seed,
                 terminal_weight=terminal_weight, average_from=WARMUP_PERIODS * tp,
-                terminal=terminal)
+                terminal=terminal, speed_limit=speed_limit, speed_weight=speed_weight)
     p = r.power_series
     last = min(p.size, 10 * samples)
     mean_power = float(np.mean(p[-last:])) if p.size else math.nan
@@ -573,4 +587,4 @@ def track_mpc(excitation, *, gamma, horizon=2.0, update_interval=0.03125, foreca
         iterations_median=float(np.median(r.iterations)) if st.size else 0.0,
         success=r.success, status=r.status, message=r.message, gamma=r.gamma, omega=omega,
         torque_limit=torque_limit, periods=periods, seed=seed, irregular=bool(irregular),
-        excitation=excitation.describe(), sea=sea_info, _run=r, _q=qf)
+        speed_limit=r.speed_limit, excitation=excitation.describe(), sea=sea_info, _run=r, _q=qf)

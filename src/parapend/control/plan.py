@@ -27,6 +27,13 @@ by ``kappa V(E)``, ``V`` the energy a torque ``T_max`` harvests braking the rota
 the damping (:meth:`PlanProblem.terminal_value`, docs/control.md); ``V -> E`` without a
 limit.
 
+**Rated speed.** ``speed_limit=w_max`` adds the exterior penalty ``rho / 2 h sum_k
+max(|v_k| - w_max, 0)^2`` over the free nodes (a generator's rated speed; docs/control.md:
+under a torque limit the long horizons' optima spin the pendulum up first, and the receding
+horizon applies only that). A penalty, not a constraint of the interior point: the measured
+state may lie above the bound (the swing-up's catch, a wave group), where a hard bound on
+the path would have no feasible plan.
+
 **Efficiency.** The kink of ``max(z, 0)`` (``z = T theta'``, the power motored) is smoothed,
 ``(z + sqrt(z^2 + eps^2)) / 2`` (above the kink by at most ``eps / 2``), with continuation
 ``eps = 1e-2, 1e-3, 1e-4`` (each solve warm-started from the last). A slack per Gauss point
@@ -66,6 +73,8 @@ from ..optimal.hermite import (
 
 __all__ = ["HorizonPlan", "PlanProblem", "gauss_leads", "solve_plan"]
 
+#: weight ``rho`` of the rated-speed penalty ``rho / 2 h sum max(|v_k| - w_max, 0)^2``
+SPEED_WEIGHT = 100.0
 #: smoothing of the efficiency's kink, in turn (continuation)
 KINK_SMOOTHING = (1e-2, 1e-3, 1e-4)
 _TAU_G = (np.polynomial.legendre.leggauss(GAUSS_POINTS)[0] + 1) / 2
@@ -136,12 +145,18 @@ class PlanProblem:
         Elastic mode: ``|T| <= torque_limit + t``, ``t >= 0``, penalty ``elastic t``.
     terminal : {"energy", "limited"}
         The terminal value ``kappa V(E)`` (:meth:`terminal_value`).
+    speed_limit : float or None
+        Rated speed ``w_max``: the penalty :meth:`speed_penalty` on the nodes' speeds above
+        it (None: none).
+    speed_weight : float or None
+        Its ``rho`` (None: :data:`SPEED_WEIGHT`).
     """
 
     phase1 = False
 
     def __init__(self, x0, h, q_g, q_c, gamma, *, torque_limit=None, efficiency=None,
-                 kappa=None, elastic=None, smoothing=KINK_SMOOTHING[-1], terminal="energy"):
+                 kappa=None, elastic=None, smoothing=KINK_SMOOTHING[-1], terminal="energy",
+                 speed_limit=None, speed_weight=None):
         self.x0 = np.asarray(x0, dtype=float).copy()
         self.q_g = np.ascontiguousarray(q_g, dtype=float)
         self.q_c = np.ascontiguousarray(q_c, dtype=float)
@@ -162,6 +177,8 @@ class PlanProblem:
                    if terminal == "limited" and torque_limit is not None and gamma > 0
                    else math.inf)
         self.smoothing = float(smoothing)
+        self.speed_limit = None if speed_limit is None else float(speed_limit)
+        self.speed_weight = (SPEED_WEIGHT if speed_weight is None else float(speed_weight))
         xg, wg = np.polynomial.legendre.leggauss(GAUSS_POINTS)
         self.w = wg / 2 * self.h  # the integral over one interval
         self.wk = eg * self.w  # the kernel's objective weights (its q1g is q here)
@@ -232,7 +249,22 @@ class PlanProblem:
             z = (y @ self.lin_g.T - self.q1_g * np.sin(th)) * thd
             e = self.smoothing
             val += self.kink * float(np.sum((z + np.sqrt(z * z + e * e)) * 0.5 * self.w))
+        if self.speed_limit is not None:
+            val += self.speed_penalty(f)
         return val
+
+    def speed_penalty(self, f):
+        """The rated-speed penalty ``rho / 2 h sum_k max(|v_k| - w_max, 0)^2`` over the
+        free nodes ``k = 1..K`` of the full variables ``f``."""
+        r = np.maximum(np.abs(f[3::2]) - self.speed_limit, 0.0)
+        return 0.5 * self.speed_weight * self.h * float(np.sum(r * r))
+
+    def _speed_newton(self, f, ab, rhs):
+        v = f[3::2]
+        r = np.maximum(np.abs(v) - self.speed_limit, 0.0)
+        c = self.speed_weight * self.h
+        rhs[3::2] -= c * r * np.sign(v)
+        ab[0, 3::2] += c * (r > 0)
 
     def _extra_newton(self, f, ab, rhs):
         """Add the gradient (to ``rhs``, minus) and Hessian (to the band ``ab``, full
@@ -248,6 +280,8 @@ class PlanProblem:
             ab[0, -2] += d * math.cos(th) - c * sn * sn
             ab[0, -1] -= d + c * v * v
             ab[1, -2] += c * sn * v
+        if self.speed_limit is not None:
+            self._speed_newton(f, ab, rhs)
         if not self.kink:
             return
         b0, b1, _ = self.rows_g
@@ -415,7 +449,8 @@ def solve_plan(problem: PlanProblem, x, *, anchor=None, gap_tol=1e-10, maxiter=2
                                  torque_limit=pr.torque_limit * (1 - 1e-4),
                                  efficiency=pr.efficiency, kappa=pr.kappa,
                                  elastic=100.0 * max(1.0, pr.h), smoothing=pr.smoothing,
-                                 terminal=pr.terminal)
+                                 terminal=pr.terminal, speed_limit=pr.speed_limit,
+                                 speed_weight=pr.speed_weight)
                 sol = interior_point(el, x, maxiter=maxiter)
                 iters += sol.iterations
                 xb = sol.x
