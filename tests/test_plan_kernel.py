@@ -75,13 +75,17 @@ def test_banded_cholesky_refuses_an_indefinite_matrix():
     assert not pk.cholesky(ab, 0.0, np.empty_like(ab))
 
 
-@pytest.mark.parametrize("terminal", ["energy", "limited"])
-def test_extra_terms_match_numpy(terminal):
+@pytest.mark.parametrize("terminal, speed_limit", [("energy", None), ("limited", None),
+                                                    ("energy", 2.0)])
+def test_extra_terms_match_numpy(terminal, speed_limit):
     pr, x = _problem(torque_limit=1.5, efficiency=(0.9, 0.8), kappa=0.7, terminal=terminal,
-                     smoothing=1e-2)
+                     smoothing=1e-2, speed_limit=speed_limit)
     f = pr.full(x + 0.05 * np.sin(np.arange(x.size)))
+    if speed_limit is not None:  # some nodes above the rated speed, some below
+        v = np.abs(f[3::2])
+        assert np.any(v > speed_limit) and np.any(v < speed_limit)
     args = (pr.k, pr.rows_g[0], pr.rows_g[1], pr.lin_g, np.ascontiguousarray(pr.q1_g), pr.w,
-            pr.kappa, pr.eta_g, pr._a, pr.kink, pr.smoothing)
+            pr.kappa, pr.eta_g, pr._a, pr.kink, pr.smoothing, *pr._speed_args())
     assert math.isclose(pk.extra(f, *args), pr._extra(f), rel_tol=1e-12, abs_tol=1e-14)
     n = f.size
     ab, rhs = np.zeros((6, n)), np.zeros(n)
@@ -98,7 +102,8 @@ def test_extra_terms_match_numpy(terminal):
     {"torque_limit": 0.6},
     {"torque_limit": 0.6, "efficiency": (0.9, 0.85), "smoothing": 1e-2},
     {"torque_limit": 0.6, "kappa": 0.8, "terminal": "limited"},
-], ids=["free", "limit", "efficiency", "limited-terminal"])
+    {"torque_limit": 0.6, "speed_limit": 1.0},
+], ids=["free", "limit", "efficiency", "limited-terminal", "rated-speed"])
 def test_compiled_solve_matches_the_python_interior_point(kw):
     pr, x = _problem(**kw)
     ref = interior_point(pr, x, gap_tol=1e-10, maxiter=200)

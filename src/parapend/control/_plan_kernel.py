@@ -48,8 +48,9 @@ def terminal_value(e, a):
 
 
 @nb.njit(cache=True)
-def extra(f, k, b0, b1, lin, q1, w, kappa, eta_g, a, kink, eps):
-    """``terminal + kink`` of the minimized objective (:meth:`PlanProblem._extra`)."""
+def extra(f, k, b0, b1, lin, q1, w, kappa, eta_g, a, kink, eps, wmax, rho_h):
+    """``terminal + kink + rated-speed penalty`` of the minimized objective
+    (:meth:`PlanProblem._extra`; ``wmax = inf``: no rated speed, ``rho_h = rho h``)."""
     e_end = 0.5 * f[-1] ** 2 + math.cos(f[-2])
     if math.isfinite(a):
         val = -(kappa * terminal_value(e_end, a)[0] - eta_g * e_end)
@@ -65,11 +66,18 @@ def extra(f, k, b0, b1, lin, q1, w, kappa, eta_g, a, kink, eps):
                 z = (_k._row(lin, g, y) - q1[j, g] * math.sin(th)) * thd
                 acc += (z + math.sqrt(z * z + eps * eps)) * 0.5 * w[g]
         val += kink * acc
+    if math.isfinite(wmax):
+        acc = 0.0
+        for i in range(3, f.size, 2):
+            r = abs(f[i]) - wmax
+            if r > 0.0:
+                acc += r * r
+        val += 0.5 * rho_h * acc
     return val
 
 
 @nb.njit(cache=True)
-def extra_newton(f, ab, rhs, k, b0, b1, lin, q1, w, kappa, eta_g, a, kink, eps):
+def extra_newton(f, ab, rhs, k, b0, b1, lin, q1, w, kappa, eta_g, a, kink, eps, wmax, rho_h):
     """Add the gradient (to ``rhs``, minus) and Hessian (to the lower band ``ab``, full
     order) of :func:`extra` (:meth:`PlanProblem._extra_newton`)."""
     n = f.size
@@ -85,6 +93,12 @@ def extra_newton(f, ab, rhs, k, b0, b1, lin, q1, w, kappa, eta_g, a, kink, eps):
         ab[0, n - 2] += d * math.cos(th) - c * sn * sn
         ab[0, n - 1] -= d + c * v * v
         ab[1, n - 2] += c * sn * v
+    if math.isfinite(wmax):
+        for i in range(3, n, 2):
+            r = abs(f[i]) - wmax
+            if r > 0.0:
+                rhs[i] -= rho_h * r * (1.0 if f[i] > 0.0 else -1.0)
+                ab[0, i] += rho_h
     if kink == 0.0:
         return
     dt = np.empty(4)
@@ -400,7 +414,7 @@ def _full(x0, x):
 
 @nb.njit(cache=True)
 def solve(x, x0, k, b0g, b1g, ling, qg, wk, gamma, b0c, linc, q1c, limit_on, scale, q1g, w,
-          kappa, eta_g, a, kink, eps, gap_tol, maxiter, mu0):
+          kappa, eta_g, a, kink, eps, wmax, rho_h, gap_tol, maxiter, mu0):
     """The interior point of :func:`parapend.optimal.hermite.interior_point` on the horizon
     problem (variables ``x``, node 0 fixed to ``x0``; ``limit_on``: the torque limit
     ``|T| scale_j <= 1``, else none; ``mu0`` NaN: the default start).
@@ -427,7 +441,7 @@ def solve(x, x0, k, b0g, b1g, ling, qg, wk, gamma, b0c, linc, q1c, limit_on, sca
         if not s[i] > 0.0:
             return x.copy(), _INFEASIBLE, 0, math.nan
     m = max(nb_, 1)
-    phi += extra(f, k, b0g, b1g, ling, q1g, w, kappa, eta_g, a, kink, eps)
+    phi += extra(f, k, b0g, b1g, ling, q1g, w, kappa, eta_g, a, kink, eps, wmax, rho_h)
     mu = mu0 if not math.isnan(mu0) else 0.1 * max(abs(phi), 1e-3) / m
     mu_min = min(gap_tol / m, mu)
     lam = np.empty(nb_)
@@ -451,7 +465,8 @@ def solve(x, x0, k, b0g, b1g, ling, qg, wk, gamma, b0c, linc, q1c, limit_on, sca
                ab6, g6, jtc, sb, cb)
         for i in range(nf):
             g6[i] = -g6[i]  # the right-hand side
-        extra_newton(f, ab6, g6, k, b0g, b1g, ling, q1g, w, kappa, eta_g, a, kink, eps)
+        extra_newton(f, ab6, g6, k, b0g, b1g, ling, q1g, w, kappa, eta_g, a, kink, eps,
+                     wmax, rho_h)
         for r in range(_BW + 1):
             for i in range(n):
                 ab[r, i] = ab6[r, i + 2]
@@ -510,7 +525,8 @@ def solve(x, x0, k, b0g, b1g, ling, qg, wk, gamma, b0c, linc, q1c, limit_on, sca
             okt, phin, logs = trial(f, dxf, alpha, s, floor, k, b0g, b1g, qg, wk, gamma, b0c,
                                     linc, q1c, limit_on, scale, xn, sn, sbn)
             if okt:
-                phin += extra(xn, k, b0g, b1g, ling, q1g, w, kappa, eta_g, a, kink, eps)
+                phin += extra(xn, k, b0g, b1g, ling, q1g, w, kappa, eta_g, a, kink, eps,
+                              wmax, rho_h)
                 bn = phin - mu * logs
                 if (bn <= b0 + 1e-4 * alpha * min(slope, 0.0)
                         or abs(bn - b0) <= 1e-15 * (1 + abs(b0))):

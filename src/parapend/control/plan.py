@@ -259,6 +259,12 @@ class PlanProblem:
         r = np.maximum(np.abs(f[3::2]) - self.speed_limit, 0.0)
         return 0.5 * self.speed_weight * self.h * float(np.sum(r * r))
 
+    def _speed_args(self):
+        """``(w_max, rho h)`` of the compiled kernel (``w_max = inf``: no rated speed)."""
+        if self.speed_limit is None:
+            return math.inf, 0.0
+        return self.speed_limit, self.speed_weight * self.h
+
     def _speed_newton(self, f, ab, rhs):
         v = f[3::2]
         r = np.maximum(np.abs(v) - self.speed_limit, 0.0)
@@ -373,7 +379,8 @@ class PlanProblem:
             self.rows_g[1], self.lin_g, self.q_g, self.wk, self.gamma, self.rows_c[0],
             self.lin_c, self.q1_c, self.mode == _k.LIMIT, self._scale,
             np.ascontiguousarray(self.q1_g), self.w, self.kappa,
-            self.eta_g, self._a, self.kink, self.smoothing, float(gap_tol), int(maxiter),
+            self.eta_g, self._a, self.kink, self.smoothing, *self._speed_args(),
+            float(gap_tol), int(maxiter),
             math.nan if mu0 is None else float(mu0))
         return HermiteSolution(xs, None, _pk.STATUS[st], int(it), float(mu))
 
