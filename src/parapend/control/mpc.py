@@ -281,7 +281,7 @@ def mpc_run(q_record, *, gamma, horizon, update_interval, dt, torque_limit=None,
         None: no bound. docs/control.md: under a torque limit it stops the spin-up of the
         long horizons.
     speed_weight : float or None
-        ``rho`` of that penalty (None: :data:`~.plan.SPEED_WEIGHT`).
+        ``rho`` of that penalty (None: ``parapend.control.plan.SPEED_WEIGHT``, 100).
     """
     from . import _mpc_kernel as k
     from .plan import PlanProblem, free_motion, gauss_leads, solve_plan

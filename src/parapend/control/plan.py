@@ -149,7 +149,7 @@ class PlanProblem:
         Rated speed ``w_max``: the penalty :meth:`speed_penalty` on the nodes' speeds above
         it (None: none).
     speed_weight : float or None
-        Its ``rho`` (None: :data:`SPEED_WEIGHT`).
+        Its ``rho`` (None: ``SPEED_WEIGHT``, 100).
     """
 
     phase1 = False
@@ -368,8 +368,8 @@ class PlanProblem:
         return ok, bn, xn[2:], tn, sn, phi
 
     def solve_compiled(self, x, *, gap_tol=1e-10, maxiter=200, mu0=None) -> HermiteSolution:
-        """:func:`parapend.optimal.hermite.interior_point` on this problem as one compiled
-        call (:func:`parapend.control._plan_kernel.solve`; not in elastic mode)."""
+        """``parapend.optimal.hermite.interior_point`` on this problem as one compiled
+        call (``parapend.control._plan_kernel.solve``; not in elastic mode)."""
         if self.mode == _k.ELASTIC:
             raise ValueError("solve_compiled: elastic mode is solved by interior_point")
         from . import _plan_kernel as _pk
