@@ -395,3 +395,38 @@ def test_record_electrical_optimum_second_methods():
     assert mech == pytest.approx(r.power, rel=1e-9)
     assert e == pytest.approx(r.electrical_power, rel=1e-6)
     assert pos == pytest.approx(r.generated_power, rel=1e-6)
+
+
+class _StaleNumpy:
+    """numpy whose ``empty`` returns arrays holding ``fill`` (stale heap contents)."""
+
+    def __init__(self, fill):
+        self.fill = fill
+
+    def __getattr__(self, name):
+        return getattr(np, name)
+
+    def empty(self, shape, dtype=float, order="C"):
+        a = np.empty(shape, dtype=dtype, order=order)
+        a[...] = self.fill
+        return a
+
+
+def test_record_krylov_does_not_read_stale_workspace(monkeypatch):
+    """SciPy's trlib wrapper allocates trlib's workspace with ``np.empty`` and trlib reads
+    parts of it unwritten: the continuation on a record gives the same bits whatever that
+    memory held (here: zeros, 1e300, NaN, -3), as the solve allocates it zeroed.
+    (Without it: two different optima in the last 10 bits from these four fills.)"""
+    from scipy.optimize._trlib import _trlib
+
+    from parapend.buoy.pto import maximize
+
+    make, x0, _ = _record_problem(2, 32)
+    out = []
+    for fill in (0.0, 1e300, np.nan, -3.0):
+        monkeypatch.setattr(_trlib, "np", _StaleNumpy(fill))
+        x, ex, _ = maximize(make("operator"), x0, (1e-1, 3e-2, 1e-2))
+        out.append((x.tobytes(), ex))
+    monkeypatch.undo()
+    assert all(o == out[0] for o in out[1:])
+    assert np.isfinite(out[0][1])

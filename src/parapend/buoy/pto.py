@@ -36,6 +36,7 @@ the dense Hessian the same product applied to the identity.
 
 from __future__ import annotations
 
+import contextlib
 import math
 import warnings
 
@@ -414,6 +415,49 @@ def maximize(problem: ElectricalProblem, x0: np.ndarray, widths=None, limit=None
     return best_x, best, runs
 
 
+class _ZeroedNumpy:
+    """numpy with ``empty`` allocating zeros (:func:`_trlib_zeroed`)."""
+
+    def __getattr__(self, name):
+        return getattr(np, name)
+
+    @staticmethod
+    def empty(shape, dtype=float, order="C", **kw):
+        return np.zeros(shape, dtype=dtype, order=order, **kw)
+
+
+@contextlib.contextmanager
+def _trlib_zeroed():
+    """Run ``trust-krylov`` with its workspace allocated zeroed.
+
+    SciPy's trlib wrapper (``scipy.optimize._trlib``, ``TRLIBQuadraticSubproblem``)
+    allocates trlib's floating-point workspace ``fwork`` with ``np.empty``, and
+    ``trlib_krylov_prepare_memory`` sets only two slices of it; ``trlib_krylov_min`` reads
+    other entries before writing them on some subproblems, so its steps depended on stale
+    heap contents and a solve differed run to run in the last bits (then more, through the
+    continuation). The wrapper takes ``np.empty`` from its module's ``np``: that is made a
+    numpy whose ``empty`` is ``zeros`` for the duration (the allocation the workspace
+    would have with ``np.zeros``). Left alone when the wrapper has no such name.
+
+    Not covered: trlib's inverse iteration for the leftmost eigenvector (the hard case,
+    ``trlib_eigen_inverse``) seeds its start vector with ``time(NULL)``, so a solve that
+    reaches it can still differ in its last bits between runs started in different
+    seconds."""
+    try:
+        from scipy.optimize._trlib import _trlib as mod
+    except ImportError:  # pragma: no cover - another SciPy layout
+        mod = None
+    old = getattr(mod, "np", None)
+    if old is None:  # pragma: no cover - another SciPy layout
+        yield
+        return
+    mod.np = _ZeroedNumpy()
+    try:
+        yield
+    finally:
+        mod.np = old
+
+
 #: restarts of a preconditioned trust-krylov solve that stalled short of the tolerance
 RESTARTS = 8
 #: iterations of the truncated-CG fallback per width
@@ -456,7 +500,8 @@ def _scaled_krylov(problem, ev, x0, gtol):
         d = 1.0 / np.sqrt(problem.diagonal(ev(x)[2].state))
         settled, halted = _plateau()
 
-        with np.errstate(invalid="ignore", over="ignore"), warnings.catch_warnings():
+        with np.errstate(invalid="ignore", over="ignore"), warnings.catch_warnings(), \
+                _trlib_zeroed():
             warnings.simplefilter("ignore", RuntimeWarning)
             r = minimize(lambda y, d=d: -ev(d * y)[0], x / d,
                          jac=lambda y, d=d: -d * ev(d * y)[1],
@@ -567,7 +612,8 @@ def torque_limited(problem: ElectricalProblem, x0: np.ndarray, limit: float, *,
         kw = ({"hess": lambda z: -ev(z)[2]} if dense else
               {"hessp": lambda z, d: -ev(z)[2].matvec(d)})
         # trlib (trust-krylov) can form 0 * inf in a step it then rejects: not an error
-        with np.errstate(invalid="ignore", over="ignore"), warnings.catch_warnings():
+        with np.errstate(invalid="ignore", over="ignore"), warnings.catch_warnings(), \
+                _trlib_zeroed():
             warnings.simplefilter("ignore", RuntimeWarning)
             r = minimize(lambda z: -ev(z)[0], x, jac=lambda z: -ev(z)[1],
                          method="trust-exact" if dense else "trust-krylov",
