@@ -223,6 +223,7 @@ def test_basins_ctrl_c_one_line_exit_130():
     assert out == ""
 
 
+@pytest.mark.slow  # several seconds; the default run stays within its budget
 @pytest.mark.skipif(os.name != "posix", reason="SIGINT delivery to a child process")
 def test_basins_ctrl_c_during_first_compile_one_line_exit_130(tmp_path):
     """Ctrl-C while numba compiles the kernel (an empty cache: 10 to 35 s inside LLVM, where

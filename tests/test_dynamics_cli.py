@@ -43,6 +43,7 @@ def test_numba_kernel_labels_equal_numpy_engine():
     assert json.loads(a.attrs["stats"])["verified"] == 3
 
 
+@pytest.mark.slow  # several seconds; the default run stays within its budget
 def test_numba_kernel_without_capture_and_without_symmetry():
     kw = dict(n_phi=24, n_dphi=24, periods=300, capture_radius=0.0, symmetric=False)
     a = basin_map(*COEX, engine="numba", **kw)

@@ -487,6 +487,7 @@ def test_track_refuses_plants_it_cannot_sample(capsys):
         f"omega: expected omega >= {2 * math.pi * math.sqrt(1 + 1.9 * 0.3) / 256:.4g}")
 
 
+@pytest.mark.slow  # several seconds; the default run stays within its budget
 def test_track_divergence_is_a_status(monkeypatch):
     """The safety net behind the sampling rule: a run that blows up ends with a status."""
     from parapend.control.closedloop import Diverged, run_closed_loop
