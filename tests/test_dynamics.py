@@ -167,6 +167,7 @@ def test_coexistence_initial_conditions_dop853(name):
     assert classify(tr.phi, tr.dphi, tol=1e-6).name == name
 
 
+@pytest.mark.slow  # several seconds; the default run stays within its budget
 def test_coexistence_neighbourhoods_with_engine():
     """Every point of a 7 x 7 neighbourhood (half-width 0.03) of each recorded initial
     condition reaches the same attractor: the choices are not on basin boundaries."""

@@ -136,6 +136,7 @@ def _settles_on_rotation(orbit, gamma, p, omega):
     return bool(max(abs(c.phi[0] - orbit.phi0), abs(c.dphi[0] - orbit.dphi0)) < 1e-4)
 
 
+@pytest.mark.slow  # several seconds; the default run stays within its budget
 def test_floquet_stability_agrees_with_simulation_across_G_and_E():
     gamma, omega = 0.1, 1.4      # G = 0.515, E = 2.268 (docs/dynamics.md)
     r = rotation_boundaries_at(gamma, omega, p_max=2.5)

@@ -150,6 +150,7 @@ def test_harmonic_table_global_rows_are_the_optimum():
         assert p <= best + 1e-12 and (not g or p == pytest.approx(best, abs=1e-10))
 
 
+@pytest.mark.slow  # several seconds; the default run stays within its budget
 def test_bvp_peak_torque_from_its_own_mesh():
     """At gamma = 1e-16 the turns are boundary layers about 1e-5 wide: a fixed grid of 4096
     points misses them (it reported 2.63); the motion's own mesh does not."""
