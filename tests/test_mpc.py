@@ -256,15 +256,10 @@ def test_limited_terminal_value_is_the_braking_harvest_and_reduces_to_kappa_e():
                                                           rel=1e-12)
 
 
-def test_limited_terminal_value_gradient_and_hessian_are_exact():
-    """The Newton matrix and gradient of the limited terminal value against central
-    differences of the objective (12 intervals, the terminal value active)."""
-    pr, start, _ = _plan_problem(12, 2.0, terminal="limited", torque_limit=1.0)
-    from parapend.optimal import _hermite_kernel as _k
-
-    pr.mode = _k.NONE  # the objective's terms only (no barrier)
-    x = start + 0.1 * np.random.default_rng(3).normal(size=start.size)
-    x[-1] += 3.0  # a fast rotation at the end
+def _check_newton_against_differences(pr, x, columns):
+    """The gradient (minus the Newton right-hand side) against central differences of the
+    objective, and the Newton matrix's band in ``columns`` against differences of the
+    right-hand side."""
     n = x.size
 
     def rhs(y):
@@ -274,11 +269,23 @@ def test_limited_terminal_value_gradient_and_hessian_are_exact():
     g = np.array([(pr.objective(x + 1e-6 * e) - pr.objective(x - 1e-6 * e)) / 2e-6
                   for e in np.eye(n)])
     assert np.max(np.abs(g + rhs(x))) < 1e-6
-    for i in range(n - 2, n):
+    for i in columns:
         e = np.eye(n)[i]
         col = -(rhs(x + 1e-5 * e) - rhs(x - 1e-5 * e)) / 2e-5
         for j in range(max(0, i - 3), i + 1):
             assert ab[i - j, j] == pytest.approx(col[j], abs=1e-6)
+
+
+def test_limited_terminal_value_gradient_and_hessian_are_exact():
+    """The Newton matrix and gradient of the limited terminal value against central
+    differences of the objective (12 intervals, the terminal value active)."""
+    pr, start, _ = _plan_problem(12, 2.0, terminal="limited", torque_limit=1.0)
+    from parapend.optimal import _hermite_kernel as _k
+
+    pr.mode = _k.NONE  # the objective's terms only (no barrier)
+    x = start + 0.1 * np.random.default_rng(3).normal(size=start.size)
+    x[-1] += 3.0  # a fast rotation at the end
+    _check_newton_against_differences(pr, x, range(x.size - 2, x.size))
 
 
 def test_speed_penalty_gradient_and_hessian_are_exact():
@@ -297,18 +304,7 @@ def test_speed_penalty_gradient_and_hessian_are_exact():
     excess = np.abs(f[3::2]) - 1.5
     assert pr.speed_penalty(f) == pytest.approx(50.0 * pr.h * np.sum(excess**2), rel=1e-12)
 
-    def rhs(y):
-        return pr.newton(y, None, np.zeros(0), 0.0)[1]
-
-    ab = pr.newton(x, None, np.zeros(0), 0.0)[0]
-    g = np.array([(pr.objective(x + 1e-6 * e) - pr.objective(x - 1e-6 * e)) / 2e-6
-                  for e in np.eye(n)])
-    assert np.max(np.abs(g + rhs(x))) < 1e-6
-    for i in range(n):
-        e = np.eye(n)[i]
-        col = -(rhs(x + 1e-5 * e) - rhs(x - 1e-5 * e)) / 2e-5
-        for j in range(max(0, i - 3), i + 1):
-            assert ab[i - j, j] == pytest.approx(col[j], abs=1e-6)
+    _check_newton_against_differences(pr, x, range(n))
 
 
 def test_speed_limit_bounds_the_plan_and_is_inactive_below_it():
