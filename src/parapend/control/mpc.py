@@ -273,13 +273,12 @@ def mpc_run(q_record, *, gamma, horizon, update_interval, dt, torque_limit=None,
     terminal : {"energy", "limited"}
         The terminal value ``kappa V(E)``: ``V = E`` (default), or ``"limited"``, the energy a
         torque ``T_max`` harvests braking the rotation against ``gamma``
-        (:meth:`~.plan.PlanProblem.terminal_value`; docs/control.md: it makes the
-        torque-limited runs worse).
+        (:meth:`~.plan.PlanProblem.terminal_value`; docs/control.md: about the same power
+        as ``kappa E``).
     speed_limit : float or None
         Rated speed ``w_max`` of the plans: the penalty ``rho / 2 h sum max(|theta'_k| -
         w_max, 0)^2`` at the plan's nodes (:meth:`~.plan.PlanProblem.speed_penalty`);
-        None: no bound. docs/control.md: under a torque limit it stops the spin-up of the
-        long horizons.
+        None: no bound (a generator's rated speed; docs/control.md: it costs power).
     speed_weight : float or None
         ``rho`` of that penalty (None: ``parapend.control.plan.SPEED_WEIGHT``, 100).
     """
