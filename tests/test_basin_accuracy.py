@@ -205,6 +205,7 @@ def test_rotations_time_limit_is_a_status(capsys):
 
 
 # --- Ctrl-C ------------------------------------------------------------------------------
+@pytest.mark.slow
 @pytest.mark.skipif(os.name != "posix", reason="SIGINT delivery to a child process")
 def test_basins_ctrl_c_one_line_exit_130():
     """Ctrl-C while the compiled kernel runs: one line on stderr and exit code 130 (the

@@ -122,6 +122,6 @@ def test_solve_plan_reports_an_infeasible_start_of_the_compiled_path():
     bad = x + 5.0  # far outside the limit
     assert np.max(pr.constraints(bad)) >= 0
     assert pr.solve_compiled(bad).status == "infeasible_start"
-    # solve_plan blends such a start towards the anchor and converges
+    # solve_plan repairs such a start (elastic mode from it) and converges
     sol = solve_plan(pr, bad, anchor=x)
     assert sol.success and np.max(np.abs(pr.torque_points(sol.x))) <= 0.6

@@ -990,6 +990,7 @@ def test_bad_scheduler_address_is_one_line(tmp_path):
     assert list(tmp_path.iterdir()) == []
 
 
+@pytest.mark.slow
 @pytest.mark.skipif(sys.platform == "win32", reason="SIGINT")
 def test_silent_scheduler_is_one_line_and_ctrl_c_during_connect(tmp_path):
     """A server that accepts the connection but never answers (distributed would wait for

@@ -90,7 +90,7 @@ def add_parsers(sub) -> None:
                    default=TRACK["speed_limit"],
                    help="MPC rated speed: the plans keep |theta'| below it (a penalty on the "
                         "excess at the plan's nodes), in units of sqrt(g/l), > 0; default "
-                        "none (docs/control.md: with --torque-limit 1 and --horizon 2, 3.5)")
+                        "none (a generator's bound; it costs power, docs/control.md)")
     from .pto import add_unit_options
 
     add_unit_options(p, torque=True)

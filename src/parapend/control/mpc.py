@@ -273,13 +273,12 @@ def mpc_run(q_record, *, gamma, horizon, update_interval, dt, torque_limit=None,
     terminal : {"energy", "limited"}
         The terminal value ``kappa V(E)``: ``V = E`` (default), or ``"limited"``, the energy a
         torque ``T_max`` harvests braking the rotation against ``gamma``
-        (:meth:`~.plan.PlanProblem.terminal_value`; docs/control.md: it makes the
-        torque-limited runs worse).
+        (:meth:`~.plan.PlanProblem.terminal_value`; docs/control.md: about the same power
+        as ``kappa E``).
     speed_limit : float or None
         Rated speed ``w_max`` of the plans: the penalty ``rho / 2 h sum max(|theta'_k| -
         w_max, 0)^2`` at the plan's nodes (:meth:`~.plan.PlanProblem.speed_penalty`);
-        None: no bound. docs/control.md: under a torque limit it stops the spin-up of the
-        long horizons.
+        None: no bound (a generator's rated speed; docs/control.md: it costs power).
     speed_weight : float or None
         ``rho`` of that penalty (None: ``parapend.control.plan.SPEED_WEIGHT``, 100).
     """
@@ -378,13 +377,20 @@ def mpc_run(q_record, *, gamma, horizon, update_interval, dt, torque_limit=None,
                 anchor = pr.start(fth, fv)
             if warm and plan is not None:
                 # the previous plan shifted by the samples since it was made, continued at
-                # its end speed
+                # its end speed (with a torque limit: by the unforced motion)
                 s = tn + dt * since
                 th_o, v_o, _ = plan.evaluate(s)
-                beyond = s > plan.horizon
-                th_o = np.where(beyond, plan.theta[-1] + plan.v[-1] * (s - plan.horizon),
-                                th_o)
-                v_o = np.where(beyond, plan.v[-1], v_o)
+                beyond = s > plan.horizon * (1 + 1e-12)
+                if torque_limit is None:
+                    th_o = np.where(beyond, plan.theta[-1] + plan.v[-1] * (s - plan.horizon),
+                                    th_o)
+                    v_o = np.where(beyond, plan.v[-1], v_o)
+                elif np.any(beyond):
+                    # beyond the plan's end the unforced motion: strictly inside the limit
+                    i0 = max(int(np.argmax(beyond)) - 1, 0)
+                    fth, fv = free_motion((th_o[i0], v_o[i0]), hh, kk - i0, gamma,
+                                          qfree[2 * i0:])
+                    th_o[i0:], v_o[i0:] = fth, fv
                 # the plan's angle continued through the measured one (whole turns)
                 th_o = th_o + 2 * math.pi * round((x[0] - th_o[0]) / (2 * math.pi))
                 start = pr.start(th_o, v_o)

@@ -75,6 +75,8 @@ __all__ = ["HorizonPlan", "PlanProblem", "gauss_leads", "solve_plan"]
 
 #: weight ``rho`` of the rated-speed penalty ``rho / 2 h sum max(|v_k| - w_max, 0)^2``
 SPEED_WEIGHT = 100.0
+#: penalty ``M`` per unit length of the elastic mode that repairs a start outside the limit
+ELASTIC_WEIGHT = 100.0
 #: smoothing of the efficiency's kink, in turn (continuation)
 KINK_SMOOTHING = (1e-2, 1e-3, 1e-4)
 _TAU_G = (np.polynomial.legendre.leggauss(GAUSS_POINTS)[0] + 1) / 2
@@ -440,30 +442,35 @@ def solve_plan(problem: PlanProblem, x, *, anchor=None, gap_tol=1e-10, maxiter=2
     """The horizon optimum from the start ``x`` (variables).
 
     Without a torque limit: Newton (the interior point without barrier terms). With one: a
-    start that violates the limit is blended towards ``anchor`` (variables strictly inside,
-    e.g. the unforced motion) until strictly feasible, else elastic mode from it; with an
-    efficiency, the kink's smoothing is continued (``KINK_SMOOTHING``).
+    start that violates the limit is repaired where it lies: elastic mode from it (``|T| <=
+    T_max (1 - 1e-4) + t``, ``t >= 0``, penalty ``M t``), stopped as soon as ``t < 0.5e-4
+    T_max`` (then strictly inside); only if that fails, blended towards ``anchor``
+    (variables strictly inside, e.g. the unforced motion). A warm start (the previous plan
+    shifted) leaves the limit only in its first interval, by the measured state's departure
+    from the plan; the repair keeps it, where a blend towards the unforced motion would move
+    it far (docs/control.md). With an efficiency, the kink's smoothing is continued
+    (``KINK_SMOOTHING``).
     """
     pr = problem
     x = np.asarray(x, dtype=float)
     iters = 0
     if pr.mode == _k.LIMIT:
-        c = pr.constraints(x)
-        if np.max(c) >= 0:
-            xb = None if anchor is None else _blend_feasible(pr, x, np.asarray(anchor))
-            if xb is None:
-                el = PlanProblem(pr.x0, pr.h, pr.q_g, pr.q_c, pr.gamma,
-                                 torque_limit=pr.torque_limit * (1 - 1e-4),
-                                 efficiency=pr.efficiency, kappa=pr.kappa,
-                                 elastic=100.0 * max(1.0, pr.h), smoothing=pr.smoothing,
-                                 terminal=pr.terminal, speed_limit=pr.speed_limit,
-                                 speed_weight=pr.speed_weight)
-                sol = interior_point(el, x, maxiter=maxiter)
-                iters += sol.iterations
-                xb = sol.x
-                if np.max(pr.constraints(xb)) >= 0:
-                    return PlanSolution(xb, pr.plan(xb), pr.value(xb), "infeasible", iters,
-                                        False)
+        if np.max(pr.constraints(x)) >= 0:
+            el = PlanProblem(pr.x0, pr.h, pr.q_g, pr.q_c, pr.gamma,
+                             torque_limit=pr.torque_limit * (1 - 1e-4),
+                             efficiency=pr.efficiency, kappa=pr.kappa,
+                             elastic=ELASTIC_WEIGHT * max(1.0, pr.h), smoothing=pr.smoothing,
+                             terminal=pr.terminal, speed_limit=pr.speed_limit,
+                             speed_weight=pr.speed_weight)
+            sol = interior_point(el, x, maxiter=maxiter,
+                                 stop_below=0.5e-4 * pr.torque_limit)
+            iters += sol.iterations
+            xb = sol.x
+            if np.max(pr.constraints(xb)) >= 0:
+                xb = None if anchor is None else _blend_feasible(pr, x, np.asarray(anchor))
+                if xb is None:
+                    return PlanSolution(sol.x, pr.plan(sol.x), pr.value(sol.x), "infeasible",
+                                        iters, False)
             x = xb
     eps_seq = [e for e in KINK_SMOOTHING if e > pr.smoothing] + [pr.smoothing] \
         if pr.kink else [pr.smoothing]
