@@ -125,3 +125,17 @@ def test_solve_plan_reports_an_infeasible_start_of_the_compiled_path():
     # solve_plan repairs such a start (elastic mode from it) and converges
     sol = solve_plan(pr, bad, anchor=x)
     assert sol.success and np.max(np.abs(pr.torque_points(sol.x))) <= 0.6
+
+
+def test_the_kernel_iterates_with_interior_points_constants():
+    """The compiled solve repeats ``parapend.optimal.hermite.interior_point``'s iteration:
+    the same fraction to the boundary, barrier update and rounding test (a failed line
+    search at the final barrier parameter with a relative Newton decrement below
+    ``ROUNDING_DECREMENT`` is converged, not stalled). The kernel holds them as literals
+    (numba's cache keys on its own file), so they are compared here."""
+    from parapend.control import _plan_kernel as pk
+    from parapend.optimal import hermite
+
+    assert pk._FRACTION == hermite._FRACTION
+    assert (pk._MU_FACTOR, pk._MU_POWER) == (hermite._MU_FACTOR, hermite._MU_POWER)
+    assert pk.ROUNDING_DECREMENT == hermite.ROUNDING_DECREMENT

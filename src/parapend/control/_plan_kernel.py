@@ -34,6 +34,8 @@ STATUS = ("converged", "max_iterations", "stalled", "singular", "infeasible_star
 _CONVERGED, _MAXIT, _STALLED, _SINGULAR, _INFEASIBLE = 0, 1, 2, 3, 4
 _FRACTION = 0.995
 _MU_FACTOR, _MU_POWER = 0.2, 1.3  # as parapend.optimal.hermite
+# a literal, not an import: numba's cache of this file keys on this file only
+ROUNDING_DECREMENT = 1e-10  # as parapend.optimal.hermite
 _BW = 3  # lower bandwidth of the open chain's Newton matrix
 
 
@@ -534,7 +536,13 @@ def solve(x, x0, k, b0g, b1g, ling, qg, wk, gamma, b0c, linc, q1c, limit_on, sca
                     break
             alpha *= 0.5
         if not found:
-            status = _STALLED
+            # at the final barrier parameter, with a Newton decrement at the precision to
+            # which the barrier function can be compared, the point is the optimum to
+            # rounding (as interior_point)
+            if mu <= mu_min * (1 + 1e-12) and -slope <= ROUNDING_DECREMENT * (1.0 + abs(phi)):
+                status = _CONVERGED
+            else:
+                status = _STALLED
             break
         if nb_:
             _dual_step(lam, target, s, ds)

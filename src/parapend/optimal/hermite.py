@@ -70,6 +70,9 @@ _FRACTION = 0.995
 # barrier parameter update (IPOPT's rule with a milder superlinear power: fewer damped
 # steps after each decrease; measured over 42 limit/damping/K cases)
 _MU_FACTOR, _MU_POWER = 0.2, 1.3
+#: relative Newton decrement below which a failed line search at the final barrier
+#: parameter is the arithmetic's limit (status converged), not a stall
+ROUNDING_DECREMENT = 1e-10
 # tightening: a margin of _MARGIN tol on every interval within _NEAR of the limit
 _NEAR, _MARGIN = 1e-3, 50
 _BAND = 5  # lower bandwidth of the folded Newton matrix
@@ -546,7 +549,12 @@ def interior_point(problem: HermiteProblem, x, *, t=None, mu0: float | None = No
                 break
             alpha *= 0.5
         else:
-            status = "stalled"
+            # at the final barrier parameter, with a Newton decrement at the precision to
+            # which the barrier function can be compared, the point is the optimum to
+            # rounding; otherwise the line search failed
+            final = mu <= mu_min * (1 + 1e-12)
+            status = ("converged" if final and -slope <= ROUNDING_DECREMENT * (1.0 + abs(phi))
+                      else "stalled")
             break
         if t is None:
             tn = None
