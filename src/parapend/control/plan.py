@@ -28,11 +28,10 @@ the damping (:meth:`PlanProblem.terminal_value`, docs/control.md); ``V -> E`` wi
 limit.
 
 **Rated speed.** ``speed_limit=w_max`` adds the exterior penalty ``rho / 2 h sum_k
-max(|v_k| - w_max, 0)^2`` over the free nodes (a generator's rated speed; docs/control.md:
-under a torque limit the long horizons' optima spin the pendulum up first, and the receding
-horizon applies only that). A penalty, not a constraint of the interior point: the measured
-state may lie above the bound (the swing-up's catch, a wave group), where a hard bound on
-the path would have no feasible plan.
+max(|v_k| - w_max, 0)^2`` over the free nodes (a generator's rated speed, the machine's
+bound; docs/control.md: the controller harvests without it, and it costs power). A penalty,
+not a constraint of the interior point: the measured state may lie above the bound (the
+swing-up's catch, a wave group), where a hard bound on the path would have no feasible plan.
 
 **Efficiency.** The kink of ``max(z, 0)`` (``z = T theta'``, the power motored) is smoothed,
 ``(z + sqrt(z^2 + eps^2)) / 2`` (above the kink by at most ``eps / 2``), with continuation
