@@ -3,14 +3,14 @@ r"""Time the coupled buoy-pendulum optimum against CasADi + IPOPT on the same di
 Problem: a heavy pendulum inside a heaving buoy in a regular wave (an analytic, passive set
 of heave coefficients: constant added mass, ``B(w) >= 0``, an excitation force with a phase;
 the same arrays for both tools). The coupled objective in ``theta`` alone
-(:mod:`parapend.buoy.coupled`) with N harmonics on the same M-point grid, the same coupling
+(:mod:`parapend.hydro.coupled`) with N harmonics on the same M-point grid, the same coupling
 harmonics ``Kc`` and the same coefficients, is written once more in CasADi symbolics
 (``theta = K s + Phi x``, ``u = cos(theta)``, ``P = <q_w' u> - 2 sum beta_k |<u e^{-iks}>|^2
 - gamma <theta'^2>``) and maximized by IPOPT with its exact (AD) Hessian.
 
 1. **local**: one local solve from the same start (the one-way optimum): parapend's
    safeguarded Newton (:func:`parapend.optimal.fourier.newton_maximize` on
-   :class:`~parapend.buoy.coupled.CoupledProblem`) against IPOPT.
+   :class:`~parapend.hydro.coupled.CoupledProblem`) against IPOPT.
 2. **search**: every seed of parapend's global search polished by each tool (IPOPT from
    the same seeds), best power; and parapend's whole :func:`coupled_optimum` (one-way search,
    coupled search, refinement, fine-grid check, energy balance, c = 0 limit) for reference.
@@ -37,14 +37,14 @@ import numpy as np  # noqa: E402
 from _timing import best_of  # noqa: E402  (benchmarks/_timing.py)
 from buoy_synthetic import toy_hydro  # noqa: E402  (the tests' toy heave coefficients)
 
-from parapend.buoy.coupled import (  # noqa: E402
+from parapend.hydro.coupled import (  # noqa: E402
     CoupledProblem,
     Pendulum,
     Wave,
     free_excitation,
     scales,
 )
-from parapend.buoy.optimum import _seeds, coupled_optimum  # noqa: E402
+from parapend.hydro.optimum import _seeds, coupled_optimum  # noqa: E402
 from parapend.optimal.fourier import newton_maximize, search_fourier  # noqa: E402
 
 

@@ -27,8 +27,8 @@ CHILD = r'''
 import dataclasses, hashlib, sys
 import numpy as np
 import parapend
-from parapend.buoy.optimum import coupled_optimum
-from parapend.buoy.pto import electrical_power
+from parapend.hydro.optimum import coupled_optimum
+from parapend.hydro.pto import electrical_power
 
 
 def fp(a):
@@ -47,7 +47,7 @@ def through(sol):
 
 for c in sys.argv[1].split(","):
     if c == "H":
-        from parapend.buoy import hydro as hy
+        from parapend.hydro import bem as hy
         h = hy.cylinder(0.5, 0.5)
         print("H    hydro", fp(h.added_mass), fp(h.radiation_damping), fp(h.excitation),
               repr(h.hydrostatic_stiffness), repr(h.mass), flush=True)

@@ -4,13 +4,13 @@ WecOptTool (3.3) pins ``capytaine==2.3.1`` while parapend needs ``capytaine>=3``
 cannot share an environment. This script runs in parapend's environment and
 
 1. solves the BEM of the default buoy (the vertical cylinder of radius 0.5 m and draft 0.5 m,
-   meshed as :func:`parapend.buoy.hydro.cylinder` meshes it) with Capytaine, on a harmonic
+   meshed as :func:`parapend.hydro.bem.cylinder` meshes it) with Capytaine, on a harmonic
    grid ``omega_k = k w1`` (WecOptTool's pseudo-spectral solver needs one), with
    Froude-Krylov and diffraction forces, hydrostatic stiffness and the floating mass, and
    writes it the Capytaine way (``capytaine.io.xarray.save_dataset_as_netcdf``);
-2. reads that file back with :func:`parapend.buoy.hydro.load` (the ``--hydro`` path, which
+2. reads that file back with :func:`parapend.hydro.bem.load` (the ``--hydro`` path, which
    conjugates Capytaine's ``exp(-i w t)`` values) and computes the free heave response
-   ``Z/a = F / D`` (:meth:`~parapend.buoy.hydro.Hydro.free_response`) at every frequency;
+   ``Z/a = F / D`` (:meth:`~parapend.hydro.bem.Hydro.free_response`) at every frequency;
 3. runs this same file, with ``--wecopttool``, in a separate virtual environment that has
    WecOptTool: it reads the dataset with ``wot.read_netcdf``, changes the convention with
    ``wot.change_bem_convention``, adds zero friction and WecOptTool's damping floor as
@@ -81,7 +81,7 @@ def write_dataset(path: Path):
     import xarray as xr
     from capytaine.io.xarray import save_dataset_as_netcdf
 
-    from parapend.buoy.hydro import DEFAULT_OMEGA, _keep_resolvable, mesh_size
+    from parapend.hydro.bem import DEFAULT_OMEGA, _keep_resolvable, mesh_size
 
     cpt.set_logging("ERROR")
     omega = W1 * np.arange(1, NFREQ + 1)
@@ -112,7 +112,7 @@ def write_dataset(path: Path):
 
 
 def parapend_side(path: Path):
-    from parapend.buoy.hydro import load
+    from parapend.hydro.bem import load
 
     hydro = load(path)
     return hydro, hydro.free_response(hydro.omega)

@@ -13,7 +13,7 @@ import math
 
 import numpy as np
 
-from parapend.buoy.hydro import Hydro
+from parapend.hydro.bem import Hydro
 
 K, ZETA, W0, A_INF = 2000.0, 0.5, 2.5, 800.0
 C, M = 17769.0, 1358.5

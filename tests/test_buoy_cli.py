@@ -17,10 +17,11 @@ import numpy as np
 import pytest
 
 import parapend
-from parapend.buoy.api import energy_flux, group_velocity, parse_periods
-from parapend.buoy.design import optimize_design
 from parapend.cli import main
 from parapend.errors import ParameterError
+from parapend.hydro.api import parse_periods
+from parapend.hydro.design import optimize_design
+from parapend.hydro.waves import energy_flux, group_velocity
 
 # the small sphere's design: resonance near 1.3 s
 PERIOD = 1.3
@@ -107,16 +108,19 @@ def test_period_ranges():
             parse_periods(bad)
 
 
-def test_the_package_is_the_command():
+def test_the_command_is_a_plain_function_beside_its_subpackage():
+    """``parapend.buoy`` is commands.buoy, a function like every command, and stays so after
+    the subpackage that answers it (``parapend.hydro``) and its modules are imported."""
     import importlib
     import inspect
 
     from parapend import commands
 
-    importlib.import_module("parapend.buoy.api")
-    importlib.import_module("parapend.buoy.design")
-    assert callable(parapend.buoy) and parapend.buoy.api.buoy is not None
-    assert inspect.signature(parapend.buoy) == inspect.signature(commands.buoy)
+    importlib.import_module("parapend.hydro.bem")
+    importlib.import_module("parapend.hydro.api")
+    importlib.import_module("parapend.hydro.design")
+    assert parapend.buoy is commands.buoy and inspect.isfunction(parapend.buoy)
+    assert parapend.hydro.api.buoy is not None and inspect.ismodule(parapend.hydro)
     assert "buoy" in parapend._COMMANDS
 
 
@@ -211,7 +215,7 @@ def test_cli_json_plot_and_save(sphere_nc, tmp_path, capsys, solved):
     with xr.open_dataset(nc) as ds:
         assert set(ds.data_vars) >= {"theta", "z", "tau", "power", "z_free"}
         assert math.isclose(float(ds.attrs["power_w"]), solved.power_w, rel_tol=1e-12)
-    from parapend.buoy.figures import plot_motion
+    from parapend.hydro.figures import plot_motion
 
     assert not all_problems(plot_motion(solved), si=True)
     assert main(["buoy", "--hydro", sphere_nc, "--wave-period", str(PERIOD), *PEND]) == 0
@@ -223,7 +227,7 @@ def test_cli_json_plot_and_save(sphere_nc, tmp_path, capsys, solved):
 def test_power_against_wave_period(sphere_nc, tmp_path, capsys):
     from figure_checks import all_problems
 
-    from parapend.buoy.figures import plot_sweep
+    from parapend.hydro.figures import plot_sweep
 
     r = parapend.buoy(hydro=sphere_nc, wave_period="1.1:1.5:3", mass=20.0, length=0.3,
                       damping_coefficient=0.5, harmonics=8)

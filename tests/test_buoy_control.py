@@ -1,6 +1,6 @@
-"""Receding-horizon control of the pendulum inside the buoy (buoy/control.py), on the synthetic,
+"""Receding-horizon control of the pendulum inside the buoy (hydro/control.py), on the synthetic,
 exactly causal dataset of tests/buoy_synthetic.py (no BEM): the plant against the pendulum
-alone and against buoy/timedomain.simulate, its energy balance, the horizon problem's
+alone and against hydro/timedomain.simulate, its energy balance, the horizon problem's
 gradient, and the input checks."""
 
 import math
@@ -9,12 +9,12 @@ import numpy as np
 import pytest
 from buoy_synthetic import synthetic
 
-from parapend.buoy import control as bc
-from parapend.buoy import timedomain as td
-from parapend.buoy._control_kernel import plan_objective
-from parapend.buoy.coupled import Pendulum, Wave
 from parapend.control.mpc import mpc_run
 from parapend.errors import ParameterError
+from parapend.hydro import control as bc
+from parapend.hydro import timedomain as td
+from parapend.hydro._control_kernel import plan_objective
+from parapend.hydro.coupled import Pendulum, Wave
 
 HYDRO = synthetic()
 TR, TP = 10.0, 2.5
@@ -89,7 +89,7 @@ def test_the_plant_energy_balance_closes(one_way):
 
 
 def test_saved_torque_reintegrated_by_simulate(one_way):
-    # buoy/timedomain.simulate, given the saved torque held over each sample, the record's
+    # hydro/timedomain.simulate, given the saved torque held over each sample, the record's
     # force and the free buoy's past, reproduces the saved motion and power
     r = one_way
     s = r.series

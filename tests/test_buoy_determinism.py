@@ -1,5 +1,5 @@
 """The coupled optimum does not depend on rounding: a regular wave's ideal optimum and its
-half-period image ``theta(t + T/2) + pi`` tie in power (buoy/optimum.py,
+half-period image ``theta(t + T/2) + pi`` tie in power (hydro/optimum.py,
 ``half_period_image``), and the result is the one of the two with the smaller peak torque,
 whatever the last bits of the data or the calls made before.
 
@@ -18,8 +18,8 @@ import numpy as np
 import pytest
 from buoy_synthetic import toy_hydro
 
-from parapend.buoy.coupled import Pendulum, Wave
-from parapend.buoy.optimum import BALANCE_TOL, coupled_optimum
+from parapend.hydro.coupled import Pendulum, Wave
+from parapend.hydro.optimum import BALANCE_TOL, coupled_optimum
 from parapend.optimal.fourier import motion_distance
 
 # a buoy like the default design (M = 402 kg, resonance near 1.74 s) without BEM
@@ -30,7 +30,7 @@ ULP = 2.0**-52
 
 
 def test_half_period_image_has_the_same_power_and_another_torque():
-    from parapend.buoy.optimum import _heave_and_balance, half_period_image
+    from parapend.hydro.optimum import _heave_and_balance, half_period_image
 
     s = coupled_optimum(HYDRO, PEND, WAVE)
     x = np.asarray(s.theta_coefficients["x"])
@@ -54,7 +54,7 @@ def test_half_period_image_has_the_same_power_and_another_torque():
 
 
 def test_winding_two_image_turns_the_offset_by_pi():
-    from parapend.buoy.optimum import half_period_image
+    from parapend.hydro.optimum import half_period_image
 
     x = np.array([0.3, 0.1, 0.2, -0.4, 0.5])  # N = 2: a1, a2, b1, b2
     for k, a0 in ((1, 0.3), (2, 0.3 + math.pi), (3, 0.3)):

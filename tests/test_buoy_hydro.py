@@ -1,4 +1,4 @@
-"""Heave hydrodynamics (buoy/hydro.py): interpolation rules, datasets, cache, bad input
+"""Heave hydrodynamics (hydro/bem.py): interpolation rules, datasets, cache, bad input
 (fast, no BEM), and the BEM against closed forms (slow)."""
 
 import math
@@ -9,8 +9,8 @@ import pytest
 import xarray as xr
 from buoy_synthetic import C, M, synthetic
 
-from parapend.buoy import hydro as hy
 from parapend.errors import ParameterError
+from parapend.hydro import bem as hy
 
 RHO, G = 1025.0, 9.81
 

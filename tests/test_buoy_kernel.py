@@ -1,4 +1,4 @@
-"""The coupled buoy-pendulum kernel and optimum (parapend.buoy.coupled, parapend.buoy.optimum).
+"""The coupled buoy-pendulum kernel and optimum (parapend.hydro.coupled, parapend.hydro.optimum).
 
 Coefficients: an analytic, passive set (constant added mass, B(w) >= 0, an excitation force
 with a phase), built from arrays with exactly the fields of the ``Hydro`` interface.
@@ -15,9 +15,9 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 import parapend
-from parapend.buoy.coupled import CoupledProblem, Pendulum, Wave, free_excitation, scales
-from parapend.buoy.optimum import BALANCE_TOL, coupled_limit, coupled_optimum
 from parapend.errors import ParameterError
+from parapend.hydro.coupled import CoupledProblem, Pendulum, Wave, free_excitation, scales
+from parapend.hydro.optimum import BALANCE_TOL, coupled_limit, coupled_optimum
 from parapend.optimal.fourier import FourierProblem
 
 HYDRO = toy_hydro()
@@ -183,7 +183,7 @@ def test_wave_from_record_round_trip():
 def test_aliased_optimum_is_rejected():
     """On a grid too coarse for its coefficients a run's power does not survive the fine
     grid: it is marked aliased and not returned."""
-    from parapend.buoy.optimum import _polish
+    from parapend.hydro.optimum import _polish
 
     p = Pendulum(4000.0, 1.0, 4500.0, 0.0)
     sc = scales(HYDRO, p, Wave.regular(1.5, 6.0))
@@ -220,7 +220,7 @@ def test_irregular_record_twenty_waves():
 def test_torque_limit():
     """An active limit lowers the power a little and holds on the grid (between its points
     within TORQUE_SLACK); an inactive one changes nothing."""
-    from parapend.buoy.optimum import TORQUE_SLACK
+    from parapend.hydro.optimum import TORQUE_SLACK
 
     h = toy_hydro(radius=1.5)
     p = Pendulum(4000.0, 1.0, 4500.0, 40.0)
@@ -238,11 +238,11 @@ def test_torque_limit():
 
 @pytest.mark.slow
 def test_time_domain_reproduces_the_coupled_optimum():
-    """Cummins' equation (buoy/timedomain.py, which knows nothing of the harmonic balance)
+    """Cummins' equation (hydro/timedomain.py, which knows nothing of the harmonic balance)
     driven by the optimal torque, with a feedback on the optimal motion (zero on it), stays
-    on the periodic coupled motion and harvests its power. Runs where buoy/timedomain.py and
+    on the periodic coupled motion and harvests its power. Runs where hydro/timedomain.py and
     tests/buoy_synthetic.py are present (skipped otherwise)."""
-    td = pytest.importorskip("parapend.buoy.timedomain")
+    td = pytest.importorskip("parapend.hydro.timedomain")
     syn = pytest.importorskip("buoy_synthetic")
     h = syn.synthetic()
     p = Pendulum(200.0, 0.5, 60.0, 5.0)

@@ -1,5 +1,5 @@
 """The coupled optimum in the time domain: Cummins' equation coupled with the pendulum
-(:func:`parapend.buoy.timedomain.simulate`, which knows nothing of the harmonic balance),
+(:func:`parapend.hydro.timedomain.simulate`, which knows nothing of the harmonic balance),
 driven by the optimum's torque, reproduces the optimal periodic motion and its power.
 
 The torque is the optimum's ``tau*(t)`` plus a stiff tracking term ``k_p (theta* - theta) +
@@ -15,9 +15,9 @@ import math
 import numpy as np
 from buoy_synthetic import synthetic
 
-from parapend.buoy import timedomain as td
-from parapend.buoy.coupled import Pendulum, Wave
-from parapend.buoy.optimum import coupled_optimum
+from parapend.hydro import timedomain as td
+from parapend.hydro.coupled import Pendulum, Wave
+from parapend.hydro.optimum import coupled_optimum
 
 HYDRO = synthetic()
 

@@ -1,4 +1,4 @@
-"""The buoy's power take-off: the electrical optimum (parapend.buoy.pto, coupled_optimum with
+"""The buoy's power take-off: the electrical optimum (parapend.hydro.pto, coupled_optimum with
 an efficiency, ``parapend buoy --efficiency``).
 
 Independent sources: finite differences (derivatives), parapend.pto.optimize_pto (the
@@ -16,11 +16,11 @@ import pytest
 from test_buoy_kernel import toy_hydro
 
 import parapend
-from parapend.buoy.coupled import CoupledProblem, Pendulum, Wave, free_excitation, scales
-from parapend.buoy.optimum import BALANCE_TOL, _Torque, coupled_optimum
-from parapend.buoy.pto import ElectricalProblem, efficiency_pair, electrical_power
 from parapend.cli import main
 from parapend.errors import ParameterError
+from parapend.hydro.coupled import CoupledProblem, Pendulum, Wave, free_excitation, scales
+from parapend.hydro.optimum import BALANCE_TOL, _Torque, coupled_optimum
+from parapend.hydro.pto import ElectricalProblem, efficiency_pair, electrical_power
 
 # a buoy like the default design (M = 402 kg, resonance near 1.74 s) without BEM
 HYDRO = toy_hydro(radius=0.5, top=12.0)
@@ -138,7 +138,7 @@ def test_bad_efficiency(value, match):
 @pytest.mark.slow
 def test_one_way_efficiency_and_torque_limit_is_optimize_pto():
     """Both at once, one-way, against the uncoupled collocation (exact kink, torque bound)."""
-    from parapend.buoy.optimum import TORQUE_SLACK
+    from parapend.hydro.optimum import TORQUE_SLACK
 
     sc = scales(HYDRO, PEND, WAVE, coupled=False)
     q1 = sc.q_spec[1]
@@ -221,7 +221,7 @@ def test_one_way_torque_limit_is_optimize_pto():
     """The augmented Lagrangian one-way (the free buoy's heave) against the uncoupled
     time-domain solver with the same limit (parapend.pto.optimize_pto: Hermite intervals
     and an interior point, an independent method)."""
-    from parapend.buoy.optimum import TORQUE_SLACK
+    from parapend.hydro.optimum import TORQUE_SLACK
 
     sc = scales(HYDRO, PEND, WAVE, coupled=False)
     q1 = sc.q_spec[1]
@@ -243,7 +243,7 @@ def test_one_way_torque_limit_is_optimize_pto():
 def test_torque_limit_on_an_irregular_record():
     """A 5-wave record under a limit at 0.8 of the ideal peak: the power falls a little,
     the peak holds between the grid points, the balance closes."""
-    from parapend.buoy.optimum import TORQUE_SLACK
+    from parapend.hydro.optimum import TORQUE_SLACK
 
     h = toy_hydro(radius=2.0, top=6.0)
     p = Pendulum(2000.0, 1.0, 2500.0, 50.0)
@@ -261,7 +261,7 @@ def test_torque_limit_on_an_irregular_record():
 @pytest.mark.slow
 def test_default_design_with_a_torque_limit():
     """The torque-limit table of docs/buoy.md (default design, 254.95 N m)."""
-    from parapend.buoy.optimum import TORQUE_SLACK
+    from parapend.hydro.optimum import TORQUE_SLACK
 
     r = parapend.buoy(torque_limit=254.95)
     assert r.success, r.status
@@ -280,7 +280,7 @@ def test_no_electrical_power_is_no_power():
     message names the efficiency (the CLI's one line)."""
     from test_buoy_kernel import HYDRO as HEAVY_BUOY
 
-    from parapend.buoy.api import _result, _solve
+    from parapend.hydro.result import _result, _solve
 
     p = Pendulum(500.0, 1.0, 600.0, 60.0)
     wave = Wave.regular(1.5, 6.0)
@@ -356,7 +356,7 @@ def test_record_preconditioned_krylov_is_a_dense_local_maximum():
     trust-exact) confirms it: its Hessian is negative definite there and trust-exact from
     it gains nothing. (From the ideal optimum the two continuations can end on different
     local maxima of this non-concave problem: 0.00819 preconditioned, 0.00745 dense.)"""
-    from parapend.buoy.pto import maximize
+    from parapend.hydro.pto import maximize
 
     make, x0, _ = _record_problem(2, 32)
     widths = (1e-1, 3e-2, 1e-2, 3e-3, 1e-3)
@@ -419,7 +419,7 @@ def test_record_krylov_does_not_read_stale_workspace(monkeypatch):
     (Without it: two different optima in the last 10 bits from these four fills.)"""
     from scipy.optimize._trlib import _trlib
 
-    from parapend.buoy.pto import maximize
+    from parapend.hydro.pto import maximize
 
     make, x0, _ = _record_problem(2, 32)
     out = []

@@ -1,4 +1,4 @@
-"""Cummins' equation coupled with the pendulum (buoy/timedomain.py), on a synthetic, exactly
+"""Cummins' equation coupled with the pendulum (hydro/timedomain.py), on a synthetic, exactly
 causal dataset (tests/buoy_synthetic.py): no BEM, fast."""
 
 import math
@@ -7,8 +7,8 @@ import numpy as np
 import pytest
 from buoy_synthetic import A_INF, W0, ZETA, K, kernel, synthetic
 
-from parapend.buoy import timedomain as td
 from parapend.errors import ParameterError
+from parapend.hydro import timedomain as td
 
 HYDRO = synthetic()
 

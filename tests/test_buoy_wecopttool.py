@@ -3,7 +3,7 @@
 WecOptTool pins an older Capytaine than parapend needs, so it lives in its own virtual
 environment (``python benchmarks/wecopttool_free_buoy.py --setup``); without it the test is
 skipped. It runs ``benchmarks/wecopttool_free_buoy.py --json``: a BEM of the default
-cylinder written with ``save_dataset_as_netcdf``, read by :func:`parapend.buoy.hydro.load`
+cylinder written with ``save_dataset_as_netcdf``, read by :func:`parapend.hydro.bem.load`
 and by WecOptTool (``read_netcdf``, ``change_bem_convention``), the free response ``Z/a``
 of each compared (docs/buoy.md, "Bring your own dataset").
 """

@@ -10,10 +10,10 @@ import numpy as np
 import pytest
 from test_buoy_cli import _capytaine_dataset
 
-from parapend.buoy.coupled import Pendulum, Wave
-from parapend.buoy.hydro import load
-from parapend.buoy.optimum import coupled_optimum
 from parapend.cli import main
+from parapend.hydro.bem import load
+from parapend.hydro.coupled import Pendulum, Wave
+from parapend.hydro.optimum import coupled_optimum
 from parapend.performance.resource import te_over_tp
 from parapend.seas import sea_record
 from parapend.units import Units

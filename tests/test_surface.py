@@ -42,7 +42,7 @@ def test_every_command_has_its_function():
     for name in names:
         fn = getattr(parapend, name.replace("-", "_"))
         assert callable(fn), name
-        assert fn is getattr(commands, name.replace("-", "_")) or name in ("sweep", "buoy")
+        assert fn is getattr(commands, name.replace("-", "_")) or name == "sweep"
 
 
 @pytest.mark.parametrize("command", sorted(_subparsers()))

@@ -45,11 +45,11 @@ _EXPORTS = {
     "SeaResult": ".irregular",
     "HorizonResult": ".control.horizon",
 }
-# the pendulum inside a floating buoy: ``parapend.buoy`` is the subpackage, which is callable
-# (``parapend.buoy(...)`` is commands.buoy): a plain function of that name would be rebound to
-# the subpackage as soon as one of its modules is imported
+# the pendulum inside a floating buoy: ``parapend.buoy`` is the command's function, the
+# subpackage that answers it is ``parapend.hydro`` (docs/layout.md)
 _COMMANDS += ("buoy",)
-_EXPORTS.update({"BuoyResult": ".buoy.api", "BuoySweepResult": ".buoy.api"})
+_EXPORTS["buoy"] = ".commands"
+_EXPORTS.update({"BuoyResult": ".hydro.result", "BuoySweepResult": ".hydro.result"})
 
 # `map` is left out of the star import, which would hide the builtin: use parapend.map
 __all__ = sorted([*(k for k in _EXPORTS if k != "map"), "__version__"])

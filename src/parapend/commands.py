@@ -843,11 +843,11 @@ def buoy(*, wave_height=None, wave_period=None, hs=None, tp=None, spectrum="jons
          inertia_bounds=None, damping_coefficient_bounds=None, controller="optimum",
          horizon=1.0, update_interval=0.125):
     """The coupled optimum of a pendulum inside a floating buoy, in SI units (command
-    ``buoy``; :func:`parapend.buoy.api.buoy`, parameters there): a
-    :class:`~parapend.buoy.api.BuoyResult`, or a :class:`~parapend.buoy.api.BuoySweepResult`
+    ``buoy``; :func:`parapend.hydro.api.buoy`, parameters there): a
+    :class:`~parapend.hydro.result.BuoyResult`, or a :class:`~parapend.hydro.result.BuoySweepResult`
     for ``wave_period="FROM:TO:N"``. With no arguments: the embedded default design
     (:data:`parapend.defaults.BUOY`, docs/defaults.md)."""
-    from .buoy.api import buoy as _buoy
+    from .hydro.api import buoy as _buoy
 
     return _buoy(wave_height=wave_height, wave_period=wave_period, hs=hs, tp=tp,
                  spectrum=spectrum, gamma_peak=gamma_peak, repeat_period=repeat_period,

@@ -124,8 +124,8 @@ def _check_dir(path):
 
 
 def _figures(r, directory) -> list:
-    from ..buoy.figures import plot_motion, plot_sweep
     from ..fileio import output_error, save_figure
+    from ..hydro.figures import plot_motion, plot_sweep
 
     d = Path(directory)
     try:
@@ -150,7 +150,7 @@ def _cmd_buoy(a) -> dict | str:
         raise ParameterError("plot: not drawn with --controller mpc (use --save)")
     r = _run(a)
     if hasattr(r, "controller"):
-        from ..buoy.control import mpc_text
+        from ..hydro.control import mpc_text
 
         if a.save:
             _output.write_dataset(r.to_dataset(), a.save)

@@ -34,7 +34,7 @@ def _units(spec):
 def wave_of(spec, i: int, j: int, r: int):
     """The Wave of bin ``(i, j)``, realization ``r`` (``parapend buoy``'s record builder on
     the prescribed device's arguments) and its description."""
-    from ..buoy.api import _irregular_wave
+    from ..hydro.api import _irregular_wave
 
     tp = spec.tp[j]
     return _irregular_wave(spec.hm0[i], tp, spec.spectrum, spec.gamma_peak, spec.waves * tp,
@@ -76,7 +76,7 @@ def body_hydro(spec):
     load per process) and the body's width (None for a mesh or a dataset)."""
     key = _key(spec)
     if key not in _HYDRO:
-        from ..buoy.api import _hydro
+        from ..hydro.api import _hydro
 
         _HYDRO[key] = _hydro(spec.body, spec.radius, spec.draft, spec.mesh, spec.hydro,
                              np.array(spec.band), 2)
@@ -87,7 +87,7 @@ def check_buoy(*, response, gamma, gravity, winding, harmonics, efficiency, mass
                inertia, damping_coefficient):
     """The options the buoy device refuses or takes in its own sense; returns the checked
     pendulum (``parapend buoy``'s checks) and ``(winding, harmonics)``."""
-    from ..buoy.api import _pendulum
+    from ..hydro.api import _pendulum
 
     if response is not None:
         raise ParameterError("response: the buoy's heave is solved, not prescribed; drop "
@@ -129,7 +129,7 @@ def prepare(spec):
         except ParameterError as err:
             raise ParameterError(f"{pk}: the record of the bin {per:g} s spans "
                                  + str(err).split(": ", 1)[1]) from None
-    from ..buoy.api import _check_floats
+    from ..hydro.api import _check_floats
 
     _check_floats(h, pendulum(spec))
     return width
@@ -142,7 +142,7 @@ def band(spec) -> tuple:
 
 
 def pendulum(spec):
-    from ..buoy.coupled import Pendulum
+    from ..hydro.coupled import Pendulum
 
     return Pendulum(mass=spec.mass, length=spec.length, inertia=spec.inertia,
                     damping_coefficient=spec.damping_coefficient)
@@ -150,7 +150,7 @@ def pendulum(spec):
 
 def solve_buoy_bin(spec, i: int, j: int, r: int) -> dict:
     """The coupled optimum, the radiation bound and the one-way optimum of one record."""
-    from ..buoy.api import _solve
+    from ..hydro.result import _solve
     from ..maps.spec import _CODE
 
     h, _ = body_hydro(spec)

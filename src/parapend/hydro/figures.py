@@ -23,7 +23,7 @@ def _finish(fig, path):
 @figure_style()
 def plot_motion(result, path=None, points: int = 600):
     """theta, the buoy's heave and the generator torque over one period of the coupled
-    optimum (a :class:`~parapend.buoy.api.BuoyResult`), with the free buoy's heave."""
+    optimum (a :class:`~parapend.hydro.result.BuoyResult`), with the free buoy's heave."""
     import matplotlib.pyplot as plt
 
     s = result.samples(points)
@@ -54,7 +54,7 @@ def _w(p):
 
 @figure_style()
 def plot_sweep(sweep, path=None):
-    """Power against wave period (a :class:`~parapend.buoy.api.BuoySweepResult`): the
+    """Power against wave period (a :class:`~parapend.hydro.result.BuoySweepResult`): the
     coupled optimum, the one-way answer, the radiation bound and the coupled limit."""
     import matplotlib.pyplot as plt
 

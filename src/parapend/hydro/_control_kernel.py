@@ -165,7 +165,7 @@ def plan_objective(u, y0, fnet, h, steps, p, tu, eta_g, eta_m, kappa, ref, total
     """The coupled horizon problem: minus the harvested work of the held torques ``u tu``
     (N m) over ``steps`` RK4 steps each (through the efficiency weights), minus ``kappa``
     times the mechanical energy of buoy and pendulum at the end (``E`` of
-    :meth:`parapend.buoy.control._Plant.energy`), in units of ``tu = m g l``; the heave and
+    :meth:`parapend.hydro.control._Plant.energy`), in units of ``tu = m g l``; the heave and
     the pendulum coupled, the memory force frozen in ``fnet`` (``F - mu`` at the half-step
     nodes); the buoy's energy counted from the end state ``ref = (z, z')`` of a reference
     plan (a constant, for precision); ``total = 0``: the pendulum's energy

@@ -43,6 +43,7 @@ import numpy as np
 
 from ..errors import ParameterError, check_int, check_range
 from ..results import _Result
+from .result import _attr, _solve
 
 __all__ = ["BuoyMPCResult", "buoy_mpc", "record_force"]
 
@@ -141,8 +142,6 @@ class BuoyMPCResult(_Result):
     def to_dataset(self):
         """The series as an ``xarray.Dataset`` (the torque's last value ``nan``: no interval)."""
         import xarray as xr
-
-        from .api import _attr
 
         s = self._series
         tq = np.append(s["torque"], np.nan)
@@ -414,8 +413,8 @@ def buoy_mpc(hydro, pendulum, wave, *, peak_period, horizon=2.0, update_interval
     ----------
     hydro : Hydro
         The buoy's coefficients (its ``mass`` the floating mass, pendulum included).
-    pendulum : parapend.buoy.coupled.Pendulum
-    wave : parapend.buoy.coupled.Wave
+    pendulum : parapend.hydro.coupled.Pendulum
+    wave : parapend.hydro.coupled.Wave
         The periodic record at the buoy (``parapend.buoy``'s ``_wave``).
     peak_period : float
         ``Tp`` (s): the unit of ``horizon``, ``update_interval``, ``warmup`` and of the torque
@@ -442,7 +441,7 @@ def buoy_mpc(hydro, pendulum, wave, *, peak_period, horizon=2.0, update_interval
     terminal_weight : float or None
         ``kappa`` of the horizon's terminal value (None: ``eta_g``).
     memory, a_inf : the plant's radiation memory (s) and infinite-frequency added mass (kg),
-        as :func:`parapend.buoy.timedomain.simulate` (default: its defaults).
+        as :func:`parapend.hydro.timedomain.simulate` (default: its defaults).
     terminal : "total" or "pendulum"
         ``coupled``: the terminal value counts the mechanical energy of buoy and pendulum
         (default) or the pendulum's alone (``I theta'^2 / 2 + m g l cos(theta)``, the
@@ -661,8 +660,6 @@ def mpc_command(hydro, pendulum, wave, info, *, controller, horizon, update_inte
     (mechanical, without torque limit or efficiency, at ``winding`` turns per record);
     ``optimum_fraction`` is the electrical power over it."""
     import dataclasses
-
-    from .api import _solve
 
     if design:
         raise ParameterError("optimize-design: not with --controller mpc")

@@ -156,7 +156,7 @@ def model_impedance(hydro, w, *, dt, memory=None, a_inf=None, match_omega=None):
     ``D_td(w) = -w^2 (M + A_inf - Ks(w) / w) + i w Kc(w) + C`` with ``Kc``, ``Ks`` the
     cosine and sine sums of the discrete memory (the same weights as :func:`simulate`
     with these ``dt``, ``memory``, ``a_inf``, ``match_omega``). Its difference from
-    :meth:`parapend.buoy.hydro.Hydro.impedance` is the model error that is not the integrator's.
+    :meth:`parapend.hydro.bem.Hydro.impedance` is the model error that is not the integrator's.
     """
     w = np.asarray(w, dtype=float)
     weights, nk = _memory_weights(hydro, check_positive("dt", dt), memory)

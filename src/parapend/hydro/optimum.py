@@ -32,7 +32,7 @@ depends on ``u = cos(theta)`` only, and a rotation can approach any measurable
 concave box-constrained quadratic programme over ``u``, solved on a fine grid; without the
 box its value is the radiation bound.
 
-A power take-off (:mod:`parapend.buoy.pto`), from the ideal optimum: an efficiency makes the motion
+A power take-off (:mod:`parapend.hydro.pto`), from the ideal optimum: an efficiency makes the motion
 maximize the electrical power (a smoothed kink with a continuation in its width and in the
 harmonics, trust-region Newton on the exact derivatives; the result's electrical power is
 evaluated exactly on a fine grid); a torque limit is imposed at every grid point by an
@@ -54,6 +54,7 @@ from ..excitation import _evaluate
 from ..optimal.fourier import _pad, motion_distance, newton_maximize, search_fourier
 from ..optimal.limit import limit as uncoupled_limit
 from .coupled import CoupledProblem, Pendulum, Wave, free_excitation, scales
+from .pto import _abs_mean
 
 __all__ = ["CoupledSolution", "coupled_limit", "coupled_optimum", "half_period_image",
            "radiation_bound"]
@@ -348,21 +349,6 @@ def _canonical_copy(hydro, pendulum, wave, x, winding, m, coupled):
 
 
 # ------------------------------------------------------------------------------------------
-def _abs_mean(f: np.ndarray):
-    """``<|f|>`` of the piecewise-linear periodic interpolant of the samples ``f``, exactly,
-    and its gradient with respect to the samples (continuous: the dual below is C^1)."""
-    m = f.size
-    a, b = f, np.roll(f, -1)
-    aa, ab = np.abs(a), np.abs(b)
-    same = a * b >= 0
-    den = np.where(same, 1.0, aa + ab)
-    val = np.where(same, 0.5 * (aa + ab), (a * a + b * b) / (2 * den))
-    sa, sb = np.sign(a), np.sign(b)
-    ga = np.where(same, 0.5 * sa, (2 * a * den - (a * a + b * b) * sa) / (2 * den**2))
-    gb = np.where(same, 0.5 * sb, (2 * b * den - (a * a + b * b) * sb) / (2 * den**2))
-    return float(np.sum(val)) / m, (ga + np.roll(gb, 1)) / m
-
-
 def _dual(w: np.ndarray, beta: np.ndarray, lam0: np.ndarray | None = None):
     """Minimize the dual ``D(lam) = <|w - rho|> + sum |lam_k|^2 / (2 beta_k)``,
     ``rho = 2 Re sum lam_k e^{iks}``, over ``lam`` (2 Kc reals; L-BFGS).
@@ -573,7 +559,7 @@ class _Torque:
 
 
 def _limited(hydro, pendulum, wave, sc, exc, x_ideal, n, n2, k, regular, limit_nd, coupled):
-    """The torque-limited optimum (:func:`parapend.buoy.pto.torque_limited`) with ``n``
+    """The torque-limited optimum (:func:`parapend.hydro.pto.torque_limited`) with ``n``
     harmonics from the ideal optimum, then with ``n2`` from that; None when the ideal
     optimum already keeps ``|tau| <= limit`` on the ``n2`` grid."""
     from .pto import ElectricalProblem, torque_limited
@@ -598,7 +584,7 @@ def _limited(hydro, pendulum, wave, sc, exc, x_ideal, n, n2, k, regular, limit_n
 
 def _electrical(hydro, pendulum, wave, sc, exc, x_ideal, n, k, regular, eta, coupled,
                 limit=None):
-    """The electrical optimum with ``n`` harmonics (:func:`parapend.buoy.pto.ladder` from
+    """The electrical optimum with ``n`` harmonics (:func:`parapend.hydro.pto.ladder` from
     the ideal optimum ``x_ideal``): a dict of the motion, its exact electrical and
     mechanical power (non-dimensional, on its grid) and the status."""
     from .pto import ElectricalProblem, ladder
@@ -668,12 +654,12 @@ def coupled_optimum(hydro, pendulum: Pendulum, wave: Wave, *, winding: int = 1,
         checked by one refinement (the result is the ``2N`` optimum).
     torque_limit : float or None
         ``|tau| <= torque_limit`` (N m), a regular wave or a record: an augmented
-        Lagrangian on the grid's torques (:func:`parapend.buoy.pto.torque_limited`: exact
+        Lagrangian on the grid's torques (:func:`parapend.hydro.pto.torque_limited`: exact
         gradient and Hessian, trust-region Newton), from the ideal optimum, at N and 2N;
         the peak between grid points is checked (within ``TORQUE_SLACK``, else
         ``success`` is False) and stated in ``status``.
     efficiency : float, (eta_g, eta_m), "ETA_G[,ETA_M]" or None
-        Maximize the electrical power ``<e(p)>`` instead (:mod:`parapend.buoy.pto`): a
+        Maximize the electrical power ``<e(p)>`` instead (:mod:`parapend.hydro.pto`): a
         smoothed kink with a continuation to zero width and in the harmonics (N/4 to N),
         started from the ideal optimum; its exact value on a fine grid is ``electrical_power``. With
         ``torque_limit`` every width of the last two harmonic stages is solved under the

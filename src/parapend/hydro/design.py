@@ -19,6 +19,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..results import _Result
+from .result import BuoySweepResult, _result, _solve
 
 __all__ = ["DesignResult", "optimize_design", "period_sweep"]
 
@@ -51,7 +52,7 @@ class DesignResult(_Result):
 
     @property
     def pendulum(self):
-        """The best design as a :class:`~parapend.buoy.coupled.Pendulum`."""
+        """The best design as a :class:`~parapend.hydro.coupled.Pendulum`."""
         return self._pendulum
 
 
@@ -166,8 +167,7 @@ def _simplex(u0, step):
 def period_sweep(hydro, width, pendulum, height, periods, *, winding=1, harmonics=None,
                  torque_limit=None, efficiency=None):
     """Coupled and one-way optima of one design in regular waves of height ``height`` (m)
-    over ``periods`` (s): a :class:`~parapend.buoy.api.BuoySweepResult`."""
-    from .api import BuoySweepResult, _result, _solve
+    over ``periods`` (s): a :class:`~parapend.hydro.result.BuoySweepResult`."""
     from .coupled import Wave
 
     rows = []

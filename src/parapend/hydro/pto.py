@@ -79,11 +79,24 @@ def efficiency_pair(efficiency) -> tuple[float, float] | None:
     return (vals[0], vals[-1])
 
 
+def _abs_mean(f: np.ndarray):
+    """``<|f|>`` of the piecewise-linear periodic interpolant of the samples ``f``, exactly,
+    and its gradient with respect to the samples (continuous: the dual below is C^1)."""
+    m = f.size
+    a, b = f, np.roll(f, -1)
+    aa, ab = np.abs(a), np.abs(b)
+    same = a * b >= 0
+    den = np.where(same, 1.0, aa + ab)
+    val = np.where(same, 0.5 * (aa + ab), (a * a + b * b) / (2 * den))
+    sa, sb = np.sign(a), np.sign(b)
+    ga = np.where(same, 0.5 * sa, (2 * a * den - (a * a + b * b) * sa) / (2 * den**2))
+    gb = np.where(same, 0.5 * sb, (2 * b * den - (a * a + b * b) * sb) / (2 * den**2))
+    return float(np.sum(val)) / m, (ga + np.roll(gb, 1)) / m
+
+
 def electrical_power(p: np.ndarray, eta: tuple[float, float]) -> tuple[float, float, float]:
     """``(<e(p)>, <p+>, <p->)`` of the periodic samples ``p``, the kink of ``e`` integrated
     exactly on the piecewise-linear interpolant of the samples (``<p+> - <p-> = <p>``)."""
-    from .optimum import _abs_mean
-
     p = np.asarray(p, dtype=float)
     mean = float(np.mean(p))
     absm = _abs_mean(p)[0]
@@ -107,7 +120,7 @@ class _Operator:
 
 
 class ElectricalProblem:
-    """``<e_s(p)>`` on the grid of a :class:`~parapend.buoy.coupled.CoupledProblem`, with
+    """``<e_s(p)>`` on the grid of a :class:`~parapend.hydro.coupled.CoupledProblem`, with
     its exact gradient and Hessian (dense, or an operator with ``hessian="operator"``).
 
     Parameters
@@ -342,8 +355,6 @@ class ElectricalProblem:
 
 
 def _abs(p) -> float:
-    from .optimum import _abs_mean
-
     return _abs_mean(np.asarray(p, dtype=float))[0]
 
 

@@ -1,0 +1,296 @@
+"""The buoy's results and one wave's answer: :class:`BuoyResult` (one wave, or one periodic
+record), :class:`BuoySweepResult` (power against wave period), and how a result is made from
+the body's coefficients, the pendulum and the wave (:func:`_solve`: the coupled optimum and
+the one-way one; :func:`_result`: what a designer reads). :mod:`.api` (the command),
+:mod:`.design` (sweeps, the design search) and :mod:`.control` (receding-horizon control)
+all build their answers from here.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..results import _Result
+from .waves import energy_flux
+
+__all__ = ["BuoyResult", "BuoySweepResult", "free_heave"]
+
+
+@dataclass(frozen=True, eq=False)
+class BuoyResult(_Result):
+    """The coupled optimum of one design in one sea (field names = JSON keys of ``parapend
+    buoy``; SI units, named in each field).
+
+    Attributes
+    ----------
+    power_w : mean harvested power of the coupled optimum, ``P = -<tau theta'>``.
+    heave_amplitude_m : half the buoy's peak-to-peak heave over the period, coupled.
+    peak_torque_nm : largest ``|tau|`` of the optimal motion.
+    radiation_bound_w : ``sum_k |F_k a_k|^2 / (8 B_k)``: no mechanism inside the buoy absorbs
+        more (a heaving body radiates what it does not absorb).
+    bound_fraction : ``power_w / radiation_bound_w``.
+    limit_w : the coupled undamped supremum (``c = 0``: switching motions approach it).
+    capture_width_m : ``power_w / J``, ``J`` the wave's energy flux per metre of crest
+        (:func:`~parapend.hydro.waves.energy_flux`); capture_width_ratio : over the body's
+        width ``2 radius`` (None where the width is not known: a mesh file or a dataset).
+    energy_flux_w_per_m : ``J``.
+    one_way_power_w : the optimum when the pendulum's reaction is left out (the pivot moves
+        as the free buoy): what a one-way model predicts; one_way_ratio : ``one_way_power_w /
+        power_w``.
+    free_heave_amplitude_m : half the free buoy's peak-to-peak heave (no pendulum).
+    energy_balance_residual
+        The relative residual of the energy balance
+        ``P + c <theta'^2> = <F_exc z'> - sum_k B_k (k w)^2 |Z_k|^2 / 2`` (below 1e-9 when
+        the solve is right).
+    harmonics : N of the motion; winding : turns per wave (or per record).
+    success, status, message : the coupled solve's verdict; "no_power" when no rotation
+        harvests anything.
+    wave, pendulum, body : what was solved (dicts of SI numbers and descriptions).
+    design : the outer search of ``optimize_design`` (None without it).
+    warnings : notes on the result (retained harmonics above the dataset's frequencies).
+    efficiency : ``[eta_g, eta_m]`` of the power take-off (None: ideal). With it the motion
+        maximizes the electrical power, and ``power_w`` is that motion's mechanical power.
+    electrical_power_w : ``<e(p)>``, ``e = eta_g p`` generating, ``p / eta_m`` motoring.
+    pto_loss_w : ``power_w - electrical_power_w``, the take-off's losses.
+    generated_power_w, motoring_power_w : ``<max(p, 0)>`` and ``<max(-p, 0)>``.
+    ideal_power_w : the ideal (lossless) coupled optimum
+        ``electrical_power_w <= eta_g ideal_power_w``.
+    one_way_electrical_power_w : the one-way answer's electrical optimum.
+    """
+
+    power_w: float
+    heave_amplitude_m: float
+    peak_torque_nm: float
+    radiation_bound_w: float
+    bound_fraction: float | None
+    limit_w: float
+    capture_width_m: float
+    capture_width_ratio: float | None
+    energy_flux_w_per_m: float
+    one_way_power_w: float | None
+    one_way_ratio: float | None
+    free_heave_amplitude_m: float
+    energy_balance_residual: float
+    harmonics: int
+    winding: int
+    success: bool
+    status: str
+    message: str
+    wave: dict
+    pendulum: dict
+    body: dict
+    torque_limit_nm: float | None
+    efficiency: list | None
+    design: dict | None
+    warnings: list
+    electrical_power_w: float | None = None
+    pto_loss_w: float | None = None
+    generated_power_w: float | None = None
+    motoring_power_w: float | None = None
+    ideal_power_w: float | None = None
+    one_way_electrical_power_w: float | None = None
+    _solution: object = field(default=None, repr=False)
+    _one_way: object = field(default=None, repr=False)
+    _hydro: object = field(default=None, repr=False)
+    _wave: object = field(default=None, repr=False)
+
+    @property
+    def solution(self):
+        """The coupled optimum (:class:`parapend.hydro.optimum.CoupledSolution`)."""
+        return self._solution
+
+    def samples(self, points: int = 400) -> dict:
+        """One period on a uniform grid: ``t`` (s), ``theta`` (rad), ``theta_dot`` (rad/s),
+        ``z`` (m), ``z_dot`` (m/s), ``tau`` (N m), ``power`` (``-tau theta'``, W) of the
+        coupled optimum, and ``z_free`` (m), the free buoy's heave."""
+        period = 2 * math.pi / self._wave.omega
+        t = period * np.arange(points + 1) / points
+        s = dict(self._solution.sample(t))
+        out = {"t": t, **{k: np.asarray(s[k], dtype=float)
+                          for k in ("theta", "theta_dot", "z", "z_dot", "tau")}}
+        out["power"] = -out["tau"] * out["theta_dot"]
+        out["z_free"] = free_heave(self._hydro, self._wave, t)
+        return out
+
+    def to_dataset(self, points: int = 400):
+        """The motion over one period as an ``xarray.Dataset`` (variables in SI units, the
+        scalar fields as attributes): what ``--save`` writes."""
+        import xarray as xr
+
+        s = self.samples(points)
+        units = {"theta": "rad", "theta_dot": "rad/s", "z": "m", "z_dot": "m/s", "tau": "N m",
+                 "power": "W", "z_free": "m"}
+        ds = xr.Dataset({k: ("t", s[k], {"units": u}) for k, u in units.items()},
+                        coords={"t": ("t", s["t"], {"units": "s"})})
+        for k, v in self.to_dict().items():
+            ds.attrs[k] = _attr(v)
+        return ds
+
+
+@dataclass(frozen=True, eq=False)
+class BuoySweepResult(_Result):
+    """Power of one design against wave period (``wave_period="FROM:TO:N"``), regular waves
+    of one height: arrays over ``period_s``, each field named with its unit
+    (``electrical_power_w`` with an efficiency, else None)."""
+
+    period_s: np.ndarray
+    power_w: np.ndarray
+    one_way_power_w: np.ndarray
+    radiation_bound_w: np.ndarray
+    limit_w: np.ndarray
+    bound_fraction: np.ndarray
+    capture_width_m: np.ndarray
+    heave_amplitude_m: np.ndarray
+    free_heave_amplitude_m: np.ndarray
+    energy_balance_residual: np.ndarray
+    status: list
+    success: bool
+    wave_height_m: float
+    pendulum: dict
+    body: dict
+    warnings: list
+    _results: tuple = field(default=(), repr=False)
+    electrical_power_w: np.ndarray | None = None
+
+    def to_dataset(self):
+        """The sweep as an ``xarray.Dataset`` over ``period_s`` (what ``--save`` writes)."""
+        import xarray as xr
+
+        names = ("power_w", "one_way_power_w", "radiation_bound_w", "limit_w",
+                 "bound_fraction", "capture_width_m", "heave_amplitude_m",
+                 "free_heave_amplitude_m", "energy_balance_residual")
+        ds = xr.Dataset({k: ("period_s", np.asarray(getattr(self, k), dtype=float))
+                         for k in names}, coords={"period_s": self.period_s})
+        ds["status"] = ("period_s", np.asarray(self.status, dtype=str))
+        if self.electrical_power_w is not None:
+            ds["electrical_power_w"] = ("period_s", np.asarray(self.electrical_power_w,
+                                                               dtype=float))
+        for k in ("success", "wave_height_m", "pendulum", "body", "warnings"):
+            ds.attrs[k] = _attr(getattr(self, k))
+        return ds
+
+
+def _attr(v):
+    """A value NetCDF can hold as an attribute."""
+    import json
+
+    if isinstance(v, bool):
+        return int(v)
+    if v is None:
+        return ""
+    if isinstance(v, (dict, list, tuple)):
+        from ..results import to_jsonable
+
+        return json.dumps(to_jsonable(v))
+    return v
+
+
+def free_heave(hydro, wave, t) -> np.ndarray:
+    """The free buoy's heave (m) at times ``t`` (s): ``Re sum_k F a_k / D exp(i k w t)``."""
+    k = np.arange(1, len(wave.amplitudes) + 1)
+    zk = hydro.free_response(k * wave.omega) * np.asarray(wave.amplitudes)
+    ph = np.multiply.outer(np.asarray(t, dtype=float) * wave.omega, k)
+    return (np.exp(1j * ph) @ zk).real
+
+
+def _half_range(x) -> float:
+    x = np.asarray(x, dtype=float)
+    return 0.5 * float(np.max(x) - np.min(x))
+
+
+
+def _body_info(h, width) -> dict:
+    out = {"description": getattr(h, "description", ""), "mass_kg": float(h.mass),
+           "hydrostatic_stiffness_n_per_m": float(h.hydrostatic_stiffness),
+           "rho_kg_per_m3": float(h.rho), "water_depth_m": float(h.water_depth),
+           "frequencies": int(np.size(h.omega)),
+           "omega_range_rad_per_s": [float(np.min(h.omega)), float(np.max(h.omega))]}
+    if width is not None:
+        out["width_m"] = width
+    return out
+
+
+
+def _solve(h, pendulum, wave, *, winding, harmonics, torque_limit, efficiency, one_way=True):
+    """The coupled optimum, the one-way one (``one_way``), and the solver's warnings as
+    notes for the result (never as Python warnings)."""
+    import warnings
+
+    from .optimum import coupled_optimum
+
+    kw = {"winding": winding, "harmonics": harmonics}
+    if torque_limit is not None:
+        kw["torque_limit"] = torque_limit
+    if efficiency is not None:
+        kw["efficiency"] = efficiency
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        sol = coupled_optimum(h, pendulum, wave, **kw)
+        ow = coupled_optimum(h, pendulum, wave, one_way=True, **kw) if one_way else None
+    notes = list(dict.fromkeys(str(w.message) for w in caught))
+    return sol, ow, notes
+
+
+def _result(h, width, pendulum, wave, wave_info, sol, ow, *, torque_limit, efficiency,
+            winding, design=None, notes=()) -> BuoyResult:
+    period = 2 * math.pi / wave.omega
+    t = period * np.arange(801) / 800
+    s = sol.sample(t)
+    amps = np.asarray(wave.amplitudes)
+    flux = energy_flux(wave.omega, amps, h.rho, h.g, h.water_depth)
+    p = float(sol.power)
+    bound = float(sol.radiation_bound)
+    cw = p / flux if flux > 0 else math.nan
+    notes = list(notes)
+    n = int(sol.harmonics)
+    above = np.asarray(h.above_range(wave.omega * np.arange(1, n + 1)))
+    if above.any():
+        k = int(np.argmax(above)) + 1
+        notes.append(f"harmonics {k} to {n} of the motion ({k * wave.omega:.4g} rad/s and "
+                     f"above) lie above the dataset's highest frequency "
+                     f"{float(np.max(h.omega)):.4g} rad/s: there A is held and B = F = 0")
+    owp = None if ow is None else float(ow.power)
+    ep = sol.electrical_power
+    harvest = p if ep is None else float(ep)  # what the design delivers
+    eff = None if sol.efficiency is None else [float(v) for v in sol.efficiency]
+    efields = {} if ep is None else {
+        "electrical_power_w": float(ep), "pto_loss_w": p - float(ep),
+        "generated_power_w": float(sol.generated_power),
+        "motoring_power_w": float(sol.motoring_power),
+        "ideal_power_w": float(sol.ideal_power),
+        "one_way_electrical_power_w": None if ow is None or ow.electrical_power is None
+        else float(ow.electrical_power)}
+    return BuoyResult(
+        power_w=p, heave_amplitude_m=_half_range(s["z"]), peak_torque_nm=float(sol.peak_torque()),
+        radiation_bound_w=bound, bound_fraction=p / bound if bound > 0 else None,
+        limit_w=float(sol.limit), capture_width_m=cw,
+        capture_width_ratio=cw / width if width else None, energy_flux_w_per_m=flux,
+        one_way_power_w=owp, one_way_ratio=owp / p if owp is not None and p > 0 else None,
+        free_heave_amplitude_m=_half_range(free_heave(h, wave, t)),
+        energy_balance_residual=float(sol.energy_balance_residual), harmonics=n,
+        winding=int(winding), success=bool(sol.success) and harvest > 0,
+        status=str(sol.status) if harvest > 0 else "no_power",
+        message=_message(sol, p, pendulum, ep), wave=wave_info,
+        pendulum={"mass_kg": pendulum.mass, "length_m": pendulum.length,
+                  "inertia_kg_m2": pendulum.inertia,
+                  "damping_coefficient_nm_s_per_rad": pendulum.damping_coefficient},
+        body=_body_info(h, width), torque_limit_nm=torque_limit, efficiency=eff,
+        design=design, warnings=notes, _solution=sol, _one_way=ow, _hydro=h, _wave=wave,
+        **efields)
+
+
+def _message(sol, p, pendulum, electrical=None) -> str:
+    if electrical is not None and p > 0 >= electrical:
+        return (f"no electrical power: through this take-off every motion found costs more "
+                f"than it harvests (best electrical power {electrical:.3g} W, mechanical "
+                f"{p:.3g} W); raise the efficiency or lower the damping")
+    if p > 0:
+        return str(getattr(sol, "message", "") or sol.status)
+    return (f"the pendulum cannot rotate with positive power in this wave (best P = {p:.3g} W): "
+            f"its damping c = {pendulum.damping_coefficient:g} N m s/rad takes more than the "
+            "wave gives; lower the damping or raise the wave height")
+
+
