@@ -40,8 +40,10 @@ def test_save_and_plot(tmp_path, capsys):
                      "--save", str(csvp), "--plot", str(png))
     assert code == 0
     rows = list(csv.reader(csvp.read_text().splitlines()))
-    assert rows[0] == ["t", "tau", "theta", "theta_dot", "torque", "power"]
-    data = np.array(rows[1:], dtype=float)
+    assert rows[0] == ["time", "phase", "theta", "theta_dot", "torque", "power"]
+    assert rows[1] == ["sqrt(l/g)", "1", "rad", "rad sqrt(g/l)", "m g l",
+                       "m g l sqrt(g/l)"]  # non-dimensional: the units row
+    data = np.array(rows[2:], dtype=float)
     assert data.shape[1] == 6 and data[-1, 1] < 1.0
     # theta advances by one turn per period (Eq. 3) on the saved samples
     assert data[-1, 2] - data[0, 2] == pytest.approx(2 * np.pi, abs=0.1)

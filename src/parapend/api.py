@@ -554,7 +554,7 @@ def threshold(*, omega: float = 1.8, delta=None, harmonics=None, excitation=None
     if limit(exc).power <= 0:
         return ThresholdResult(0.0, 0.0, 0.0, 0, exc.omega, True, "converged",
                                "constant excitation: no power can be extracted", 0,
-                               excitation=exc.describe())
+                               excitation=exc.describe(), _excitation=exc)
     tol = check_range("tol", tol, 1e-15, 1e-3)
     _check_threshold_in_range(exc, gamma_u)
     if harmonics is not None:
@@ -587,7 +587,7 @@ def threshold(*, omega: float = 1.8, delta=None, harmonics=None, excitation=None
                else f"threshold iteration did not converge ({status})")
     res = ThresholdResult(g, gamma_u, p, n, exc.omega, success, status, msg, total,
                           mean_square_speed=kin, refinement_change=change,
-                          excitation=exc.describe())
+                          excitation=exc.describe(), _excitation=exc)
     if throw and not success:
         raise SolverError(f"threshold: {msg}")
     return res

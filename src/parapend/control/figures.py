@@ -105,3 +105,48 @@ def plot_track(result, path=None, zoom_periods: int = 3):
 
 def _num(x) -> str:
     return "none" if x is None else f"{x:.4g}"
+
+
+def plot_mpc_track(result, zoom_periods: float = 3.0):
+    """A receding-horizon run: ``theta - omega t``, the held torque with ``+-T_max``, the
+    excitation ``q`` and the cumulative harvested energy, against time in forcing periods
+    (the whole run on the left, the last ``zoom_periods`` on the right).
+
+    ``result`` is a ``track --controller mpc`` result (``run``, ``q``, ``omega``) or a bare
+    :class:`~parapend.control.mpc.MPCResult` (no ``q`` panel then)."""
+    from ..plotting import _finish, plt
+    from ..style import figure_style
+
+    run = getattr(result, "run", result)
+    omega = getattr(result, "omega", None) or 2 * math.pi / max(run.t[-1], 1e-12)
+    period = 2 * math.pi / omega
+    per = run.t / period
+    held = np.append(run.torque, run.torque[-1])
+    work = np.concatenate(([0.0], np.cumsum(run.power_series) * run.dt))
+    q = result.q(run.t) if hasattr(result, "q") and callable(result.q) else None
+    last = per >= per[-1] - zoom_periods - 1e-9
+    rows = 4 if q is not None else 3
+    with figure_style():
+        fig, axes = plt.subplots(rows, 2, figsize=(9.0, 2.2 * rows + 1), sharex="col",
+                                 layout="constrained")
+        for col, sel in ((0, slice(None)), (1, last)):
+            a = axes[:, col]
+            a[0].plot(per[sel], run.theta[sel] - omega * run.t[sel], lw=1.0, color="C0")
+            a[0].set_ylabel(r"$\theta - \omega t$ (rad)")
+            a[1].step(per[sel], held[sel], where="post", lw=0.9, color="C2")
+            if result.torque_limit is not None:
+                for s in (1, -1):
+                    a[1].axhline(s * result.torque_limit, color="k", ls="--", lw=0.7)
+            a[1].set_ylabel("torque $T$ ($mgl$)")
+            a[2].plot(per[sel], work[sel], lw=1.0, color="C1")
+            a[2].set_ylabel("energy $W$ ($mgl$)")
+            if q is not None:
+                a[3].plot(per[sel], q[sel], lw=0.8, color="C4")
+                a[3].set_ylabel("$q$ (base acc./g)")
+            a[-1].set_xlabel("time (forcing periods)")
+        axes[0, 0].set_title("whole run", fontsize=9)
+        axes[0, 1].set_title(f"last {zoom_periods:g} periods", fontsize=9)
+        fig.suptitle(f"receding-horizon control ({result.forecast} forecast): mean power "
+                     f"{result.mean_power:.5g} ($mgl/t_0$), {result.failed_solves} of "
+                     f"{result.solves} solves failed", fontsize=10)
+        return _finish(fig, None, layout=False)
