@@ -31,7 +31,8 @@ import json
 import os
 import sys
 
-from .. import __version__, _entry
+from .. import __version__
+from .._interrupt import interrupted as _interrupted
 from ..errors import ParameterError, SolverError
 from ..results import to_jsonable
 from . import buoy as _buoy_cmds
@@ -141,7 +142,7 @@ def main(argv=None) -> int:
         except Exception:
             # an interrupt that a library turned into its own error (numba while it compiles,
             # pybind11 while a module loads) is still an interrupt
-            if _entry.interrupted():
+            if _interrupted():
                 raise KeyboardInterrupt from None
             raise
     except OutputError as exc:  # before ParameterError, of which it is a subclass
