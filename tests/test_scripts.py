@@ -98,6 +98,38 @@ print(json.dumps({"executors": [a.executor, b.executor], "stores": [a.store, b.s
     assert out["same"] and out["finite"]
 
 
+@pytest.mark.slow
+def test_workers_that_could_not_start_are_reported_so(tmp_path):
+    """Where the caller's own forkserver pool started the server first (without parapend's
+    preload), the workers run the unguarded script again and fail to start: the error says
+    that, names the script and the guard, and does not call it a kill."""
+    text = f"""\
+import multiprocessing as mp
+import os
+if __name__ == "__main__":
+    p = mp.get_context("forkserver").Process(target=os.getpid)
+    p.start()
+    p.join()
+import parapend
+try:
+    parapend.sweep(**{SWEEP!r}, workers=2)
+except parapend.SolverError as err:
+    print(err)
+"""
+    work = tmp_path / "work"
+    work.mkdir()
+    script = tmp_path / "first.py"
+    script.write_text(text)
+    env = {**os.environ, "PYTHONPATH": SRC}
+    proc = subprocess.run([sys.executable, str(script)], cwd=work, env=env, text=True,
+                          capture_output=True, timeout=300)
+    msg = proc.stdout.strip().splitlines()[-1]
+    assert msg.startswith("the worker processes could not start (exit status 1"), msg
+    assert "'first.py'" in msg and 'if __name__ == "__main__":' in msg
+    assert "killed" not in msg and "memory" not in msg and "resume" not in msg
+    assert "bootstrapping phase" in proc.stderr  # the workers' own error, on stderr
+
+
 def _pool(codes, started):
     procs = [SimpleNamespace(exitcode=c) for c in codes]
     return SimpleNamespace(context=SimpleNamespace(started=procs), started=lambda: started)
