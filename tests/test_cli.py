@@ -179,17 +179,17 @@ def test_an_interrupt_a_library_turned_into_its_own_error_is_still_an_interrupt(
         monkeypatch, capsys):
     """numba, interrupted while it compiles, raises its own error: after SIGINT under the
     console script's handler any exception ends as the command's one interrupted line."""
-    from parapend import _entry
+    from parapend import _interrupt
     from parapend import cli as cli_pkg
 
     def compiling(a):
         raise RuntimeError("numba: lowering failed: KeyboardInterrupt")
 
     monkeypatch.setitem(cli_pkg.COMMANDS, "threshold", compiling)
-    monkeypatch.setattr(_entry, "_interrupted", True)
+    monkeypatch.setattr(_interrupt, "_interrupted", True)
     assert main(["threshold"]) == 130
     assert capsys.readouterr().err == "parapend threshold: interrupted\n"
-    monkeypatch.setattr(_entry, "_interrupted", False)  # no interrupt: the error is a bug
+    monkeypatch.setattr(_interrupt, "_interrupted", False)  # no interrupt: the error is a bug
     with pytest.raises(RuntimeError, match="lowering"):
         main(["threshold"])
 
@@ -201,11 +201,11 @@ def test_an_interrupt_a_callback_swallowed_is_still_an_interrupt(monkeypatch, ca
     interrupted line, exit code 130, with the hook restored afterwards."""
     import weakref
 
-    from parapend import _entry
+    from parapend import _entry, _interrupt
     from parapend import cli as cli_pkg
 
     def ran_on(argv):
-        _entry._interrupted = True  # as the SIGINT handler does before it raises
+        _interrupt._interrupted = True  # as the SIGINT handler does before it raises
 
         class Held:
             pass
@@ -221,8 +221,8 @@ def test_an_interrupt_a_callback_swallowed_is_still_an_interrupt(monkeypatch, ca
         return 0
 
     monkeypatch.setattr(cli_pkg, "main", ran_on)
-    monkeypatch.setattr(_entry, "_interrupted", False)
-    monkeypatch.setattr(_entry, "_swallowed", False)
+    monkeypatch.setattr(_interrupt, "_interrupted", False)
+    monkeypatch.setattr(_interrupt, "_swallowed", False)
     hook = sys.unraisablehook
     assert _entry.main([]) == _entry.EXIT_INTERRUPTED
     captured = capsys.readouterr()

@@ -674,14 +674,16 @@ def sea(*, hs=None, tp=None, spectrum: str = "jonswap", gamma_peak: float = 3.3,
 # --- sweep, map ----------------------------------------------------------------------------
 def sweep(*, omega="1.8", delta=None, gamma=GAMMA["sweep"], torque_limit=None,
           efficiency=None, excitation=None, square_alpha=None, fourier=None,
-          harmonics: int = 24, threshold: bool = False, store: str = "map.zarr",
+          harmonics: int = 24, threshold: bool = False, store=None,
           overwrite: bool = False, netcdf=None, workers=None, scheduler=None,
           block_points=None, command=None, progress=None, length=None, mass=None,
           inertia=None, gravity=None):
     """A resumable design map (command ``sweep``; :func:`parapend.maps.sweep`): axes as
     one value, ``"START:STOP:COUNT"`` or a comma list (or numbers). Fields are the JSON
     keys; ``_run`` is the :class:`~parapend.maps.SweepRun`, ``_dataset`` its Dataset.
-    ``netcdf`` also exports the finished map. The store is non-dimensional (one store
+    ``netcdf`` also exports the finished map. ``store`` None (the default here; the command
+    line's is ``map.zarr``) computes in memory and writes nothing. The store is
+    non-dimensional (one store
     serves every pendulum); with ``length`` and ``mass`` the largest power is also given in
     W (``largest_power_w``) and ``parapend.map`` draws it in SI with the same options."""
     import importlib
