@@ -12,8 +12,6 @@ from __future__ import annotations
 import ast
 from pathlib import Path
 
-import pytest
-
 SRC = Path(__file__).resolve().parents[1] / "src"
 PACKAGE = "parapend"
 
@@ -97,10 +95,6 @@ def cycles(edges: dict[str, set[str]]) -> list[list[str]]:
     return out
 
 
-def _in_buoy(module: str) -> bool:
-    return module == f"{PACKAGE}.buoy" or module.startswith(f"{PACKAGE}.buoy.")
-
-
 def test_the_graph_resolves_relative_imports_names_and_function_level_imports(tmp_path):
     """The reader itself, on a small package with one cycle through a function-level import:
     ``from . import b`` goes to the module ``pkg.b``, ``from .c import f`` to ``pkg.c``
@@ -123,17 +117,6 @@ def test_the_graph_resolves_relative_imports_names_and_function_level_imports(tm
 
 
 def test_no_import_cycle():
-    """No cycle in the import graph of parapend, outside the buoy subpackage."""
-    found = [c for c in cycles(import_graph(modules(SRC))) if not all(map(_in_buoy, c))]
-    assert not found, f"import cycles: {found}"
-
-
-# The buoy subpackage still has cycles (buoy.optimum <-> buoy.pto; buoy.api, buoy.control,
-# buoy.design): another developer is breaking them while renaming it to parapend.hydro.
-# This mark covers ONLY the cycles made of modules under parapend.buoy; the lead removes it
-# once that branch is merged (the test above then covers the renamed package too).
-@pytest.mark.xfail(strict=False, reason="the buoy subpackage's cycles are being broken on "
-                                        "another branch (the rename to parapend.hydro)")
-def test_no_import_cycle_in_the_buoy_subpackage():
-    found = [c for c in cycles(import_graph(modules(SRC))) if all(map(_in_buoy, c))]
+    """No cycle in the import graph of parapend (imports inside functions counted)."""
+    found = cycles(import_graph(modules(SRC)))
     assert not found, f"import cycles: {found}"

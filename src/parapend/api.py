@@ -676,15 +676,11 @@ def damping_sweep(*, omega: float = 1.8, delta=None, harmonics: int | None = Non
 
 
 def motion_samples(result, points: int = 1000) -> dict:
-    """One period of an optimum on ``points`` uniform times: t, tau, theta, theta_dot, torque.
+    """One period of an optimum on ``points`` uniform times: t, tau, theta, theta_dot, torque
+    (:meth:`parapend.results.OptimizeResult.samples` under the older names).
 
     ``torque`` is Eq. 14 solved for T with the result's damping.
     """
-    from .model import torque
-
-    npts = check_int("points", points, 2, 10**6)
-    exc = result._excitation
-    motion = result.motion
-    t = exc.period * np.arange(npts) / npts
-    return {"t": t, "tau": t / exc.period, "theta": motion.theta(t),
-            "theta_dot": motion.theta_dot(t), "torque": torque(motion, exc, result.gamma, t)}
+    s = result.samples(points)
+    return {"t": s["time"], "tau": s["phase"], "theta": s["theta"],
+            "theta_dot": s["theta_dot"], "torque": s["torque"]}

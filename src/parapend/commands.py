@@ -145,7 +145,9 @@ def optimize(*, excitation=None, omega=OMEGA, delta=None, square_alpha=None, fou
         if pto or units is not None:
             raise ParameterError("method: 'all' compares the ideal methods; the power "
                                  "take-off and unit options need fourier (or bvp for units)")
-        f = _ideal(method="fourier", **kw)
+        from .plotting import plot_optimum
+
+        f = dataclasses.replace(_ideal(method="fourier", **kw), _draw=plot_optimum)
         b = _ideal(method="bvp", **kw) if f.gamma >= limits.MIN_BVP_GAMMA else None
         return Record("optimize", {
             "uniform_power": f.uniform_power, "limit_power": f.limit_power, "gamma": f.gamma,
@@ -154,18 +156,21 @@ def optimize(*, excitation=None, omega=OMEGA, delta=None, square_alpha=None, fou
             draw=lambda rec: rec.fourier_result.plot(),
             series=lambda rec: rec.fourier_result._series())
     if pto:
-        from .pto import optimize_pto
+        from .pto import optimize_pto, plot_pto_profile
 
-        return optimize_pto(units=units, method=method, torque_limit=torque_limit,
-                            efficiency=efficiency, efficiency_generating=efficiency_generating,
-                            efficiency_motoring=efficiency_motoring, copper_loss=copper_loss,
-                            warm=warm, throw=throw, **kw)
+        r = optimize_pto(units=units, method=method, torque_limit=torque_limit,
+                         efficiency=efficiency, efficiency_generating=efficiency_generating,
+                         efficiency_motoring=efficiency_motoring, copper_loss=copper_loss,
+                         warm=warm, throw=throw, **kw)
+        return dataclasses.replace(r, _draw=plot_pto_profile)
+    from .plotting import plot_optimum
+
     r = _ideal(method=method, warm=warm, throw=throw, **kw)
     if units is not None:
         from .pto import physical_fields
 
         r = dataclasses.replace(r, **physical_fields(r, units))
-    return r
+    return dataclasses.replace(r, _draw=plot_optimum)
 
 
 def threshold(*, excitation=None, omega=OMEGA, delta=None, square_alpha=None, fourier=None,
@@ -187,7 +192,14 @@ def threshold(*, excitation=None, omega=OMEGA, delta=None, square_alpha=None, fo
             r, units=units.describe(),
             damping_threshold_coefficient=units.damping_coefficient(r.damping_threshold),
             uniform_threshold_coefficient=units.damping_coefficient(r.uniform_threshold))
-    return r
+    si = {} if units is None else {"length": units.length, "mass": units.mass,
+                                   "gravity": units.gravity, "inertia": units.inertia}
+
+    def draw(res):  # the damping sweep around gamma*, as damping-sweep draws it
+        return damping_sweep(excitation=res.excitation_function, points=21,
+                             gamma_max=max(1.25 * res.damping_threshold, 1e-3), **si).plot()
+
+    return dataclasses.replace(r, _draw=draw)
 
 
 def damping_sweep(*, excitation=None, omega=OMEGA, delta=None, square_alpha=None,

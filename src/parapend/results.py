@@ -546,6 +546,7 @@ class OptimizeResult(Result):
     convention: str = CONVENTION
     _motion: object = field(default=None, repr=False)
     _excitation: object = field(default=None, repr=False)
+    _draw: object = field(default=None, repr=False)
 
     command = "optimize"
     headline = ("power", "power_w", "electrical_power", "electrical_power_w", "peak_torque",
@@ -577,11 +578,14 @@ class OptimizeResult(Result):
         (Eq. 14 solved for T), ``power`` (``-T theta'``, positive when harvested) and, with
         an efficiency, ``electrical_power``. :meth:`to_dataset` gives them in SI when the
         pendulum was given in SI."""
-        from .api import motion_samples
+        from .errors import check_int
+        from .model import torque
 
-        s = motion_samples(self, points)
-        out = {"time": s["t"], "phase": s["tau"], "theta": s["theta"],
-               "theta_dot": s["theta_dot"], "torque": s["torque"]}
+        npts = check_int("points", points, 2, 10**6)
+        exc, motion = self._excitation, self._motion
+        t = exc.period * np.arange(npts) / npts
+        out = {"time": t, "phase": t / exc.period, "theta": motion.theta(t),
+               "theta_dot": motion.theta_dot(t), "torque": torque(motion, exc, self.gamma, t)}
         out["power"] = -out["torque"] * out["theta_dot"]
         if self.efficiency_generating is not None:
             p = out["power"]
@@ -593,13 +597,14 @@ class OptimizeResult(Result):
         return series(self.samples(), self.physical_units)
 
     def _figure(self):
-        if self.unconstrained_power is not None:
-            from .pto import plot_pto_profile as draw
-        else:
-            from .plotting import plot_optimum as draw
+        """The figure of the command (:func:`parapend.plotting.plot_optimum`, or
+        :func:`parapend.pto.plot_pto_profile` through a take-off), SI axes beside with
+        units; ``_draw`` is set by :func:`parapend.optimize`, which knows the figure."""
         from .units import si_figure
 
-        return si_figure(draw(self), self.physical_units)
+        if self._draw is None:
+            return super()._figure()
+        return si_figure(self._draw(self), self.physical_units)
 
 
 @dataclass(frozen=True, eq=False, repr=False)
@@ -632,6 +637,7 @@ class ThresholdResult(Result):
     uniform_threshold_coefficient: float | None = None
     convention: str = CONVENTION
     _excitation: object = field(default=None, repr=False)
+    _draw: object = field(default=None, repr=False)
 
     command = "threshold"
     headline = ("damping_threshold", "damping_threshold_coefficient", "uniform_threshold",
@@ -639,15 +645,16 @@ class ThresholdResult(Result):
 
     def _figure(self):
         """Power against damping up to beyond gamma* (the threshold marked), as
-        ``damping-sweep`` draws it for this excitation."""
-        from .commands import damping_sweep
+        ``damping-sweep`` draws it for this excitation (``_draw``, set by
+        :func:`parapend.threshold`)."""
+        if self._draw is None:
+            return super()._figure()
+        return self._draw(self)
 
-        u = self.physical_units
-        si = {} if u is None else {"length": u.length, "mass": u.mass, "gravity": u.gravity,
-                                   "inertia": u.inertia}
-        return damping_sweep(excitation=self._excitation, points=21,
-                             gamma_max=max(1.25 * self.damping_threshold, 1e-3),
-                             **si).plot()
+    @property
+    def excitation_function(self):
+        """The excitation ``q(t)`` (an :class:`~parapend.excitation.Excitation`)."""
+        return self._excitation
 
     @property
     def physical_units(self):
