@@ -196,7 +196,8 @@ def threshold(*, excitation=None, omega=OMEGA, delta=None, square_alpha=None, fo
                                    "gravity": units.gravity, "inertia": units.inertia}
 
     def draw(res):  # the damping sweep around gamma*, as damping-sweep draws it
-        return damping_sweep(excitation=res.excitation_function, points=21,
+        return damping_sweep(excitation=res.excitation_function, points=13,
+                             harmonics=res.harmonics or None,
                              gamma_max=max(1.25 * res.damping_threshold, 1e-3), **si).plot()
 
     return dataclasses.replace(r, _draw=draw)

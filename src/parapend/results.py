@@ -81,6 +81,11 @@ QUANTITIES = {
     "capture_width_ratio": ("1", "capture width over the body's width"),
     "one_way_ratio": ("1", "coupled over one-way power"),
     "energy_balance_residual": ("1", "relative residual of the energy balance"),
+    "damping_coefficient": ("N m s/rad", "viscous damping coefficient c"),
+    "damping_threshold_coefficient": ("N m s/rad",
+                                      "damping threshold as a coefficient c* = gamma* I / t0"),
+    "uniform_threshold_coefficient": ("N m s/rad", "uniform-rotation threshold as a "
+                                                   "damping coefficient"),
 }
 
 #: A field's unit from its name's suffix (longest first).

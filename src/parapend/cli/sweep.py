@@ -132,7 +132,7 @@ def _cmd_sweep(a) -> dict | str:
     if a.store is None:
         a.store = SWEEP_STORE
     rec = _run(a, command=_command_line(), progress=_EtaProgress("sweep"))
-    run, out = rec._run, rec.to_dict()
+    run, out = rec.run, rec.to_dict()
     counts, best = out["status_counts"], out["largest_power"]
     if a.json:
         return out
@@ -162,7 +162,7 @@ def _cmd_map(a) -> dict | str:
     _check_output(a.plot, "--plot", FIGURE_SUFFIXES)
     rec = _run(a)
     out = rec.to_dict()
-    xn, yn, title, label = out["x"], out["y"], out["fixed"], rec._label
+    xn, yn, title, label = out["x"], out["y"], out["fixed"], rec.label
     finite = out["min"] is not None
     if a.json:
         return out

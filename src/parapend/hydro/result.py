@@ -102,6 +102,17 @@ class BuoyResult(_Result):
         """The coupled optimum (:class:`parapend.hydro.optimum.CoupledSolution`)."""
         return self._solution
 
+    @property
+    def hydrodynamics(self):
+        """The body's hydrodynamic coefficients the optimum was solved with
+        (:class:`parapend.hydro.bem.Hydro`)."""
+        return self._hydro
+
+    @property
+    def incident_wave(self):
+        """The incident wave (regular or a periodic record) the optimum was solved for."""
+        return self._wave
+
     def samples(self, points: int = 400) -> dict:
         """One period on a uniform grid: ``t`` (s), ``theta`` (rad), ``theta_dot`` (rad/s),
         ``z`` (m), ``z_dot`` (m/s), ``tau`` (N m), ``power`` (``-tau theta'``, W) of the
