@@ -27,7 +27,9 @@ def plot_track(result, path=None, zoom_periods: int = 3):
     from ..plotting import _finish, plt
     from ..style import figure_style
 
-    run, tg = result._run, result._target
+    run, tg = result.run, result.target
+    units = result.physical_units  # torque in N m, energy in J, an SI title: SI given
+    kt = 1.0 if units is None else units.torque
     m = tg.samples
     per = run.t / tg.period
     k = np.arange(run.t.size)
@@ -61,11 +63,12 @@ def plot_track(result, path=None, zoom_periods: int = 3):
                        fontsize=9)
         a_zoom.set_title(f"last {zoom} period{'s' if zoom > 1 else ''} {key}", fontsize=9)
         for ax, sel in ((t_up, first), (t_zoom, last)):
-            ax.plot(per[sel], run.torque[sel], lw=1.0, color="C2", drawstyle="steps-post")
+            ax.plot(per[sel], kt * run.torque[sel], lw=1.0, color="C2",
+                    drawstyle="steps-post")
             if result.torque_limit is not None:
                 for s in (1, -1):
-                    ax.axhline(s * result.torque_limit, color="k", ls="--", lw=0.7)
-            ax.set_ylabel("torque $T$ ($mgl$)")
+                    ax.axhline(s * kt * result.torque_limit, color="k", ls="--", lw=0.7)
+            ax.set_ylabel("torque $T$ ($mgl$)" if units is None else "torque $T$ (N m)")
             ax.set_xlabel("time (forcing periods)")
         a_up.set_xlim(0, per[first][-1])
         a_zoom.set_xlim(per[last][0], per[-1])
@@ -83,21 +86,33 @@ def plot_track(result, path=None, zoom_periods: int = 3):
         a_err.set_xlabel("time (forcing periods)")
         a_err.legend(loc="best")
         ends = m * np.arange(n + 1)
-        a_w.plot(per[ends], w[ends], ".-", ms=3, color="C0", lw=1.0,
+        ke = 1.0 if units is None else units.energy
+        a_w.plot(per[ends], ke * w[ends], ".-", ms=3, color="C0", lw=1.0,
                  label="extracted energy $W$ at the end of each period")
         if locked:
             tl = int(result.lock_period)
-            a_w.plot(per[tl * m:], w[tl * m] + tg.power * (run.t[tl * m:] - run.t[tl * m]),
-                     "k:", lw=1, label=f"predicted $P = {tg.power:.5g}$ from the lock")
+            pred = (f"$P = {tg.power:.5g}$" if units is None
+                    else f"$P$ = {units.to_watts(tg.power):.4g} W")
+            a_w.plot(per[tl * m:], ke * (w[tl * m] + tg.power * (run.t[tl * m:]
+                                                               - run.t[tl * m])),
+                     "k:", lw=1, label=f"predicted {pred} from the lock")
             for a in (a_up, t_up, a_err, a_w):
                 a.axvline(tl, color="gray", lw=0.7)
         a_w.axhline(0, color="gray", lw=0.5)
-        a_w.set_ylabel("energy $W$ ($mgl$)")
+        a_w.set_ylabel("energy $W$ ($mgl$)" if units is None else "energy $W$ (J)")
         a_w.set_xlabel("time (forcing periods)")
         a_w.legend(loc="best")
         a_err.set_xlim(0, per[-1])
-        fig.suptitle(f"track: $\\gamma$ = {result.gamma:g}, $\\omega$ = {result.omega:g}, "
-                     f"$T_{{\\max}}$ = {_num(result.torque_limit)}; "
+        if units is None:
+            case = (f"$\\gamma$ = {result.gamma:g}, $\\omega$ = {result.omega:g}, "
+                    f"$T_{{\\max}}$ = {_num(result.torque_limit)}")
+        else:
+            from ..plotting import si_title
+
+            case = si_title(result, units) + ", $T_{\\max}$ = " + (
+                "none" if result.torque_limit is None
+                else f"{units.to_newton_metres(result.torque_limit):.4g} N m")
+        fig.suptitle(f"track: {case}; "
                      + (f"locked after {result.lock_period} periods" if locked
                         else "not locked"), fontsize=10)
         return _finish(fig, path, layout=False)
