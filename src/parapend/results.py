@@ -126,14 +126,18 @@ def annotate(ds, command: str):
 
 
 def _attr_value(v):
-    """A JSON value as a NetCDF attribute: numbers and strings as they are, the rest as JSON
-    text (NetCDF has no nested attributes; None is the text "null")."""
+    """A JSON value as a NetCDF attribute: numbers, strings and flat lists of numbers as they
+    are, the rest as JSON text (NetCDF has no nested attributes)."""
     import json
 
-    if isinstance(v, bool):
+    if isinstance(v, (bool, np.bool_)):
         return int(v)
-    if isinstance(v, (int, float, str)):
+    if isinstance(v, (int, float, str, np.integer, np.floating)):
         return v
+    if isinstance(v, (list, tuple, np.ndarray)):  # a flat list of numbers: a NetCDF array
+        a = np.asarray(v) if not isinstance(v, np.ndarray) else v
+        if a.ndim == 1 and a.size and a.dtype.kind in "biuf":
+            return a.astype(np.int64 if a.dtype.kind in "biu" else float)
     return json.dumps(to_jsonable(v))
 
 
