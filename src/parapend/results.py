@@ -479,6 +479,9 @@ class OptimizeResult(Result):
         mechanical powers when there is no efficiency or copper loss).
     uniform_pto_power_w, uniform_pto_electrical_power_w : float or None
         The same in watts, with physical units.
+    omega_rad_per_s, damping_coefficient : float or None
+        With physical units, the forcing's angular frequency in rad/s (``omega`` is in units
+        of ``sqrt(g/l)``) and the damping as a coefficient in N m s/rad (``gamma I / t0``).
     winding : int
         K, turns per forcing period, ``theta(t + 2 pi/omega) = theta(t) + 2 pi K`` (1: the
         paper's period-1 rotation); ``uniform_power`` is then the uniform rotation with K
@@ -551,6 +554,8 @@ class OptimizeResult(Result):
     gain_over_uniform_pto: float | None = None
     uniform_pto_power_w: float | None = None
     uniform_pto_electrical_power_w: float | None = None
+    omega_rad_per_s: float | None = None
+    damping_coefficient: float | None = None
     winding: int = 1
     convention: str = CONVENTION
     _motion: object = field(default=None, repr=False)
