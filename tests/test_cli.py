@@ -40,8 +40,10 @@ def test_save_and_plot(tmp_path, capsys):
                      "--save", str(csvp), "--plot", str(png))
     assert code == 0
     rows = list(csv.reader(csvp.read_text().splitlines()))
-    assert rows[0] == ["t", "tau", "theta", "theta_dot", "torque", "power"]
-    data = np.array(rows[1:], dtype=float)
+    assert rows[0] == ["time", "phase", "theta", "theta_dot", "torque", "power"]
+    assert rows[1] == ["sqrt(l/g)", "1", "rad", "rad sqrt(g/l)", "m g l",
+                       "m g l sqrt(g/l)"]  # non-dimensional: the units row
+    data = np.array(rows[2:], dtype=float)
     assert data.shape[1] == 6 and data[-1, 1] < 1.0
     # theta advances by one turn per period (Eq. 3) on the saved samples
     assert data[-1, 2] - data[0, 2] == pytest.approx(2 * np.pi, abs=0.1)
@@ -177,17 +179,17 @@ def test_an_interrupt_a_library_turned_into_its_own_error_is_still_an_interrupt(
         monkeypatch, capsys):
     """numba, interrupted while it compiles, raises its own error: after SIGINT under the
     console script's handler any exception ends as the command's one interrupted line."""
-    from parapend import _entry
+    from parapend import _interrupt
     from parapend import cli as cli_pkg
 
     def compiling(a):
         raise RuntimeError("numba: lowering failed: KeyboardInterrupt")
 
     monkeypatch.setitem(cli_pkg.COMMANDS, "threshold", compiling)
-    monkeypatch.setattr(_entry, "_interrupted", True)
+    monkeypatch.setattr(_interrupt, "_interrupted", True)
     assert main(["threshold"]) == 130
     assert capsys.readouterr().err == "parapend threshold: interrupted\n"
-    monkeypatch.setattr(_entry, "_interrupted", False)  # no interrupt: the error is a bug
+    monkeypatch.setattr(_interrupt, "_interrupted", False)  # no interrupt: the error is a bug
     with pytest.raises(RuntimeError, match="lowering"):
         main(["threshold"])
 
@@ -199,11 +201,11 @@ def test_an_interrupt_a_callback_swallowed_is_still_an_interrupt(monkeypatch, ca
     interrupted line, exit code 130, with the hook restored afterwards."""
     import weakref
 
-    from parapend import _entry
+    from parapend import _entry, _interrupt
     from parapend import cli as cli_pkg
 
     def ran_on(argv):
-        _entry._interrupted = True  # as the SIGINT handler does before it raises
+        _interrupt._interrupted = True  # as the SIGINT handler does before it raises
 
         class Held:
             pass
@@ -219,8 +221,8 @@ def test_an_interrupt_a_callback_swallowed_is_still_an_interrupt(monkeypatch, ca
         return 0
 
     monkeypatch.setattr(cli_pkg, "main", ran_on)
-    monkeypatch.setattr(_entry, "_interrupted", False)
-    monkeypatch.setattr(_entry, "_swallowed", False)
+    monkeypatch.setattr(_interrupt, "_interrupted", False)
+    monkeypatch.setattr(_interrupt, "_swallowed", False)
     hook = sys.unraisablehook
     assert _entry.main([]) == _entry.EXIT_INTERRUPTED
     captured = capsys.readouterr()

@@ -53,8 +53,10 @@ def paper_run(paper_opt, tmp_path_factory):
 def _read(path):
     with open(path) as f:
         rows = list(csv.reader(f))
-    assert rows[0] == ["t", "theta", "theta_dot", "torque", "q"]
-    return {k: np.array([float(r[i]) for r in rows[1:]]) for i, k in enumerate(rows[0])}
+    assert rows[0] == ["time", "theta", "theta_dot", "torque", "q"]
+    assert rows[1] == ["sqrt(l/g)", "rad", "rad sqrt(g/l)", "m g l", "1"]  # the units row
+    names = ["t", "theta", "theta_dot", "torque", "q"]
+    return {k: np.array([float(r[i]) for r in rows[2:]]) for i, k in enumerate(names)}
 
 
 def _reintegrate(s, q, gamma):
@@ -395,12 +397,13 @@ def test_irregular_runs_are_seeded_and_report_their_sea(limited):
     b = track(design=limited, periods=20, irregular=True, seed=5)
     c = track(design=limited, periods=20, irregular=True, seed=6)
     assert a.mean_power == b.mean_power and a.sea == b.sea
-    assert a.sea["seed"] != c.sea["seed"] and a.mean_power != c.mean_power
+    assert a.sea["record_seed"] != c.sea["record_seed"] and a.mean_power != c.mean_power
+    assert a.sea["seed"] == 5 and c.sea["seed"] == 6  # the seeds given, as given
     rms = math.sqrt(np.mean(limited.target.excitation.q_uniform(1024) ** 2))
     assert a.sea["rms_q"] == pytest.approx(rms, rel=1e-12)
     # the plant saw that sea: the saved q is the record's
-    sea, _ = design_sea(limited.target.omega, rms, a.sea["seed"])
-    assert np.max(np.abs(a._run.q - sea.q(a._run.t))) < 1e-12
+    sea, _ = design_sea(limited.target.omega, rms, a.sea["record_seed"])
+    assert np.max(np.abs(a.run.q - sea.q(a.run.t))) < 1e-12
     assert track(design=limited, periods=20).sea is None
 
 
@@ -415,7 +418,7 @@ def _cli(capsys, *args):
     (["--periods", "5"], "periods"), (["--torque-limit", "0"], "torque-limit"),
     (["--gamma-error", "2"], "gamma-error"), (["--noise-theta", "-1"], "noise-theta"),
     (["--runs", "100", "--periods", "1000"], "runs"),
-    (["--runs", "2", "--save", "x.csv"], "runs"), (["--torque-margin", "1"], "torque-margin"),
+    (["--torque-margin", "1"], "torque-margin"),
     (["--save", "x.txt"], "--save"), (["--lock-tolerance", "0"], "lock-tolerance")])
 def test_cli_refuses_bad_input_with_one_line(capsys, args, name):
     code, out, err = _cli(capsys, "track", *args)
@@ -469,6 +472,6 @@ def test_cli_states_the_irregular_sea(capsys):
                        "--periods", "20", "--irregular", "--seed", "2", "--json")
     sea = json.loads(js)["sea"]
     # the stated Hs is the one that gives the design rms (0.3 / sqrt 2) at omega = 1.8
-    _, info = design_sea(1.8, 0.3 / math.sqrt(2), sea["seed"])
+    _, info = design_sea(1.8, 0.3 / math.sqrt(2), sea["record_seed"])
     assert sea["hs"] == pytest.approx(info["hs"], rel=1e-12)
-    assert f"Hs {sea['hs']:.4g}" in line and f"seed {sea['seed']}" in line
+    assert f"Hs {sea['hs']:.4g}" in line and line.endswith("seed 2") and sea["seed"] == 2

@@ -119,8 +119,9 @@ def test_cli_simulate_final_motions(capsys, tmp_path):
         assert json.loads(out)["final"]["name"] == name
     with open(csv_path, newline="") as fh:
         rows = list(csv.reader(fh))
-    assert rows[0] == ["t", "phi", "dphi", "energy"]
-    assert len(rows) == 150 * 64 + 2
+    assert rows[0] == ["time", "phi", "phi_dot", "energy"]
+    assert rows[1] == ["sqrt(l/g)", "rad", "rad sqrt(g/l)", "m g l"]  # the units row
+    assert len(rows) == 150 * 64 + 3
     code, out, _ = _run(capsys, "simulate", "--periods", "120")
     assert code == 0 and "P2 oscillation" in out
 

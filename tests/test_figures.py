@@ -55,7 +55,8 @@ def _render(argv, tmp_path, monkeypatch, *, plot: str | None = "--plot", si: boo
     save = fileio.figure_bytes
 
     def checked(fig, *args, **kwargs):
-        problems = fc.all_problems(fig, unitless=UNITLESS, si=si)
+        with fileio._figure_rc():  # as it is written: in the style the file is drawn with
+            problems = fc.all_problems(fig, unitless=UNITLESS, si=si)
         legends = [t.get_text() for ax in fig.axes if ax.get_legend() is not None
                    for t in ax.get_legend().get_texts()]
         seen.append((problems, legends))

@@ -164,13 +164,15 @@ def test_sweep_and_map_through_both(tmp_path, capsys):
         _same(cli[key], got[key], key)
     # the Dataset behind the record, public: the map's power over the swept grid
     ds = mapped.to_dataset()
-    assert ds is mapped._dataset and ds.sizes["omega"] == 2 and ds.sizes["delta"] == 2
+    assert ds["power"].equals(mapped.dataset["power"]) and ds.sizes["omega"] == 2 \
+        and ds.sizes["delta"] == 2 and ds["power"].attrs["units"] == "m g l sqrt(g/l)"
 
 
-def test_records_without_a_dataset_say_so(tmp_path):
+def test_records_without_curves_give_their_scalars(tmp_path):
     rec = parapend.figure("1", plot=str(tmp_path / "f.png"))
-    with pytest.raises(AttributeError, match="figure result has no Dataset"):
-        rec.to_dataset()
+    ds = rec.to_dataset()
+    assert not ds.dims and ds.attrs["command"] == "figure"
+    assert rec.plot() is rec.matplotlib_figure
 
 
 def test_figure_through_both(tmp_path, capsys):

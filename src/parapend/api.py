@@ -554,7 +554,7 @@ def threshold(*, omega: float = 1.8, delta=None, harmonics=None, excitation=None
     if limit(exc).power <= 0:
         return ThresholdResult(0.0, 0.0, 0.0, 0, exc.omega, True, "converged",
                                "constant excitation: no power can be extracted", 0,
-                               excitation=exc.describe())
+                               excitation=exc.describe(), _excitation=exc)
     tol = check_range("tol", tol, 1e-15, 1e-3)
     _check_threshold_in_range(exc, gamma_u)
     if harmonics is not None:
@@ -587,7 +587,7 @@ def threshold(*, omega: float = 1.8, delta=None, harmonics=None, excitation=None
                else f"threshold iteration did not converge ({status})")
     res = ThresholdResult(g, gamma_u, p, n, exc.omega, success, status, msg, total,
                           mean_square_speed=kin, refinement_change=change,
-                          excitation=exc.describe())
+                          excitation=exc.describe(), _excitation=exc)
     if throw and not success:
         raise SolverError(f"threshold: {msg}")
     return res
@@ -676,15 +676,11 @@ def damping_sweep(*, omega: float = 1.8, delta=None, harmonics: int | None = Non
 
 
 def motion_samples(result, points: int = 1000) -> dict:
-    """One period of an optimum on ``points`` uniform times: t, tau, theta, theta_dot, torque.
+    """One period of an optimum on ``points`` uniform times: t, tau, theta, theta_dot, torque
+    (:meth:`parapend.results.OptimizeResult.samples` under the older names).
 
     ``torque`` is Eq. 14 solved for T with the result's damping.
     """
-    from .model import torque
-
-    npts = check_int("points", points, 2, 10**6)
-    exc = result._excitation
-    motion = result.motion
-    t = exc.period * np.arange(npts) / npts
-    return {"t": t, "tau": t / exc.period, "theta": motion.theta(t),
-            "theta_dot": motion.theta_dot(t), "torque": torque(motion, exc, result.gamma, t)}
+    s = result.samples(points)
+    return {"t": s["time"], "tau": s["phase"], "theta": s["theta"],
+            "theta_dot": s["theta_dot"], "torque": s["torque"]}

@@ -86,6 +86,19 @@ def _physical(kw: dict, *, length=None, mass=None, inertia=None, gravity=None,
     return units, kw, torque_limit
 
 
+def _table(command: str, ds, module: str, function: str):
+    """A table result (:class:`~parapend.results.Table`) drawn by
+    ``parapend.<module>.<function>``."""
+    import importlib
+
+    from .results import Table
+
+    def draw(data):
+        return getattr(importlib.import_module(f".{module}", __package__), function)(data)
+
+    return Table(command, ds, draw)
+
+
 def _units_attrs(ds, units) -> None:
     """The pendulum's scales as Dataset attributes (NetCDF takes no nested dict)."""
     ds.attrs.update(units.describe())
@@ -132,25 +145,32 @@ def optimize(*, excitation=None, omega=OMEGA, delta=None, square_alpha=None, fou
         if pto or units is not None:
             raise ParameterError("method: 'all' compares the ideal methods; the power "
                                  "take-off and unit options need fourier (or bvp for units)")
-        f = _ideal(method="fourier", **kw)
+        from .plotting import plot_optimum
+
+        f = dataclasses.replace(_ideal(method="fourier", **kw), _draw=plot_optimum)
         b = _ideal(method="bvp", **kw) if f.gamma >= limits.MIN_BVP_GAMMA else None
         return Record("optimize", {
             "uniform_power": f.uniform_power, "limit_power": f.limit_power, "gamma": f.gamma,
             "omega": f.omega, "excitation": f.excitation, "fourier": f.to_dict(),
-            "bvp": None if b is None else b.to_dict()}, fourier=f, bvp=b)
+            "bvp": None if b is None else b.to_dict()}, fourier_result=f, bvp_result=b,
+            draw=lambda rec: rec.fourier_result.plot(),
+            series=lambda rec: rec.fourier_result._series())
     if pto:
-        from .pto import optimize_pto
+        from .pto import optimize_pto, plot_pto_profile
 
-        return optimize_pto(units=units, method=method, torque_limit=torque_limit,
-                            efficiency=efficiency, efficiency_generating=efficiency_generating,
-                            efficiency_motoring=efficiency_motoring, copper_loss=copper_loss,
-                            warm=warm, throw=throw, **kw)
+        r = optimize_pto(units=units, method=method, torque_limit=torque_limit,
+                         efficiency=efficiency, efficiency_generating=efficiency_generating,
+                         efficiency_motoring=efficiency_motoring, copper_loss=copper_loss,
+                         warm=warm, throw=throw, **kw)
+        return dataclasses.replace(r, _draw=plot_pto_profile)
+    from .plotting import plot_optimum
+
     r = _ideal(method=method, warm=warm, throw=throw, **kw)
     if units is not None:
         from .pto import physical_fields
 
         r = dataclasses.replace(r, **physical_fields(r, units))
-    return r
+    return dataclasses.replace(r, _draw=plot_optimum)
 
 
 def threshold(*, excitation=None, omega=OMEGA, delta=None, square_alpha=None, fourier=None,
@@ -172,7 +192,15 @@ def threshold(*, excitation=None, omega=OMEGA, delta=None, square_alpha=None, fo
             r, units=units.describe(),
             damping_threshold_coefficient=units.damping_coefficient(r.damping_threshold),
             uniform_threshold_coefficient=units.damping_coefficient(r.uniform_threshold))
-    return r
+    si = {} if units is None else {"length": units.length, "mass": units.mass,
+                                   "gravity": units.gravity, "inertia": units.inertia}
+
+    def draw(res):  # the damping sweep around gamma*, as damping-sweep draws it
+        return damping_sweep(excitation=res.excitation_function, points=13,
+                             harmonics=res.harmonics or None,
+                             gamma_max=max(1.25 * res.damping_threshold, 1e-3), **si).plot()
+
+    return dataclasses.replace(r, _draw=draw)
 
 
 def damping_sweep(*, excitation=None, omega=OMEGA, delta=None, square_alpha=None,
@@ -200,7 +228,7 @@ def damping_sweep(*, excitation=None, omega=OMEGA, delta=None, square_alpha=None
         ds.attrs["damping_threshold_coefficient"] = units.damping_coefficient(
             ds.attrs["damping_threshold"])
         _units_attrs(ds, units)
-    return ds
+    return _table("damping-sweep", ds, "plotting", "plot_damping_sweep")
 
 
 def harmonics(*, excitation=None, omega=OMEGA, delta=None, square_alpha=None, fourier=None,
@@ -230,7 +258,7 @@ def harmonics(*, excitation=None, omega=OMEGA, delta=None, square_alpha=None, fo
         ds.attrs["uniform_power_w"] = units.to_watts(ds.attrs["uniform_power"])
         ds.attrs["limit_power_w"] = units.to_watts(ds.attrs["limit_power"])
         _units_attrs(ds, units)
-    return ds
+    return _table("harmonics", ds, "plotting", "plot_harmonic_table")
 
 
 # --- pto-curve -----------------------------------------------------------------------------
@@ -265,7 +293,7 @@ def pto_curve(*, vary: str = "torque-limit", excitation=None, omega=OMEGA, delta
         if vary == "torque-limit":
             ds["torque_limit_nm"] = ds["value"] * units.torque
         _units_attrs(ds, units)
-    return ds
+    return _table("pto-curve", ds, "pto", "plot_pto_curve")
 
 
 # --- figure, reproduce ---------------------------------------------------------------------
@@ -280,7 +308,8 @@ def figure(number: str, *, plot=None):
     path = f"fig{number}.png" if plot is None else plot
     fig, numbers = paper_figure(f"fig{number}")
     fileio.save_figure(fig, path)
-    return Record("figure", {"figure": number, "file": path, "numbers": numbers}, figure=fig)
+    return Record("figure", {"figure": number, "file": path, "numbers": numbers},
+                  matplotlib_figure=fig, draw=lambda rec: rec.matplotlib_figure)
 
 
 def reproduce(*, out: str = "parapend-report", progress=None):
@@ -288,9 +317,11 @@ def reproduce(*, out: str = "parapend-report", progress=None):
     (command ``reproduce``); the fields are those of ``results.json``."""
     from pathlib import Path
 
+    from .report import contact_sheet
     from .report import reproduce as _reproduce
 
-    return Record("reproduce", _reproduce(Path(out), progress=progress))
+    return Record("reproduce", _reproduce(Path(out), progress=progress),
+                  directory=Path(out), draw=lambda rec: contact_sheet(rec.directory))
 
 
 # --- simulate, basins, rotations (paper Eq. 1) ---------------------------------------------
@@ -334,7 +365,29 @@ def simulate(*, gamma=GAMMA["simulate"], p=DYNAMICS["p"], omega=DYNAMICS["omega"
                    forcing_frequency_hz=1.0 / units.to_seconds(period),
                    duration_s=units.to_seconds(float(m.t[-1] - m.t[0])),
                    final_energy_j=units.to_joules(float(m.energy[-1])))
-    return Record("simulate", out, source=m, units=units)
+    return Record("simulate", out, source=m, physical_units=units, draw=_draw_simulate,
+                  series=_simulate_series)
+
+
+def _draw_simulate(rec):
+    from .dynamics.figures import plot_motion
+    from .units import si_figure
+
+    return si_figure(plot_motion(rec.source), rec.physical_units)
+
+
+def _simulate_series(rec):
+    """The motion of Eq. 1 over time (SI time and energy with a pendulum's units)."""
+    from .results import series
+
+    m, u = rec.source, rec.physical_units
+    ds = series({"time": m.t, "phi": m.phi, "phi_dot": m.dphi}, u)
+    if u is None:
+        ds["energy"] = (ds["phi"].dims, m.energy)
+    else:
+        ds["energy_j"] = (ds["phi"].dims, m.energy * u.energy)
+    ds["phi"].attrs.update(units="rad", long_name="angle from the hanging position (Eq. 1)")
+    return ds
 
 
 def basins_json(ds) -> dict:
@@ -411,7 +464,19 @@ def basins(*, gamma=GAMMA["basins"], p=DYNAMICS["p"], omega=DYNAMICS["omega"],
                    phi_range=phi_range, periods=periods, steps_per_period=steps,
                    split_phases=split_phases, engine=engine, progress=progress,
                    accuracy_sample=sample, accuracy_seed=seed)
-    return Record("basins", basins_json(ds), dataset=ds)
+    return Record("basins", basins_json(ds), dataset=ds, draw=_draw_dataset("dynamics.figures",
+                                                                           "plot_basins"))
+
+
+def _draw_dataset(module: str, function: str, **kw):
+    """``draw(record)``: ``parapend.<module>.<function>(record.dataset, **kw)``."""
+    import importlib
+
+    def draw(rec):
+        return getattr(importlib.import_module(f".{module}", __package__), function)(
+            rec.dataset, **kw)
+
+    return draw
 
 
 def _omegas(omega):
@@ -458,10 +523,12 @@ def rotations(*, gamma=GAMMA["rotations"], omega=DYNAMICS["omega"], p_max: float
                         coords={"omega": oms},
                         attrs={"gamma": gamma, "p_max": float(p_max),
                                "convention": "paper Eq. 1 (p, omega)", "status": r.status})
-        return Record("rotations", r.to_dict(), source=r, dataset=ds)
+        return Record("rotations", r.to_dict(), source=r, dataset=ds,
+                      draw=_draw_dataset("dynamics.figures", "plot_rotation_boundaries"))
     ds = rotation_boundaries(gamma, oms, p_max=p_max, progress=progress,
                              time_limit=time_limit)
-    return Record("rotations", {
+    return Record("rotations", draw=_draw_dataset("dynamics.figures",
+                                                  "plot_rotation_boundaries"), data={
         "gamma": gamma, "p_max": p_max, "omega": [float(x) for x in ds["omega"].values],
         **{k: [None if math.isnan(x) else float(x) for x in ds[k].values]
            for k in ("p_J", "p_G", "p_E", "p_start", "p_reached")},
@@ -620,14 +687,16 @@ def sea(*, hs=None, tp=None, spectrum: str = "jonswap", gamma_peak: float = 3.3,
 # --- sweep, map ----------------------------------------------------------------------------
 def sweep(*, omega="1.8", delta=None, gamma=GAMMA["sweep"], torque_limit=None,
           efficiency=None, excitation=None, square_alpha=None, fourier=None,
-          harmonics: int = 24, threshold: bool = False, store: str = "map.zarr",
+          harmonics: int = 24, threshold: bool = False, store=None,
           overwrite: bool = False, netcdf=None, workers=None, scheduler=None,
           block_points=None, command=None, progress=None, length=None, mass=None,
           inertia=None, gravity=None):
     """A resumable design map (command ``sweep``; :func:`parapend.maps.sweep`): axes as
     one value, ``"START:STOP:COUNT"`` or a comma list (or numbers). Fields are the JSON
     keys; ``_run`` is the :class:`~parapend.maps.SweepRun`, ``_dataset`` its Dataset.
-    ``netcdf`` also exports the finished map. The store is non-dimensional (one store
+    ``netcdf`` also exports the finished map. ``store`` None (the default here; the command
+    line's is ``map.zarr``) computes in memory and writes nothing. The store is
+    non-dimensional (one store
     serves every pendulum); with ``length`` and ``mass`` the largest power is also given in
     W (``largest_power_w``) and ``parapend.map`` draws it in SI with the same options."""
     import importlib
@@ -677,7 +746,7 @@ def sweep(*, omega="1.8", delta=None, gamma=GAMMA["sweep"], torque_limit=None,
     if units is not None:
         out.update(units=units.describe(), largest_power_w=(
             None if best is None else units.to_watts(best["power"])))
-    return Record("sweep", out, run=run, dataset=ds)
+    return Record("sweep", out, run=run, dataset=ds, draw=_draw_dataset("maps", "plot_map"))
 
 
 #: a design map's quantities in SI: the Units attribute that scales each (None: a ratio)
@@ -753,7 +822,8 @@ def map(*, store: str = "map.zarr", variable: str = "power", x=None, y=None, at=
         out.update(units=units.describe(), unit_si=None if si is None else si[1],
                    min_si=None if k is None or out["min"] is None else out["min"] * k,
                    max_si=None if k is None or out["max"] is None else out["max"] * k)
-    return Record("map", out, dataset=ds, label=label)
+    return Record("map", out, dataset=ds, label=label,
+                  draw=lambda rec: sw.plot_map(rec.dataset, variable, xn, yn, fixed))
 
 
 # --- power-matrix ----------------------------------------------------------------------------
@@ -827,7 +897,8 @@ def power_matrix(*, hs: str = "1:3:3", te=None, tp=None, realizations: int = 3,
            "store": run.store, "computed_bins": run.computed_points // int(realizations),
            "resumed_bins": run.resumed_points // int(realizations), "seconds": seconds,
            "executor": run.executor, "netcdf": netcdf, "zarr": zarr, "csv": csv}
-    return Record("power-matrix", out, dataset=ds, run=run)
+    return Record("power-matrix", out, dataset=ds, run=run,
+                  draw=_draw_dataset("performance.figures", "plot_matrix"))
 # --- buoy ----------------------------------------------------------------------------------
 from .defaults import BUOY  # noqa: E402
 

@@ -44,7 +44,7 @@ SEA_PROPOSE = 4
 AUTO_FRACTIONS = (0.25, 0.5, 0.75, 1.0, 1.25, 1.5)
 
 
-@dataclass(frozen=True, eq=False)
+@dataclass(frozen=True, eq=False, repr=False)
 class SeaResult(_Result):
     """The best rotation over one sea record (field names = JSON keys of ``parapend sea``).
 
@@ -107,6 +107,31 @@ class SeaResult(_Result):
     @property
     def excitation(self):
         return self._excitation
+
+    @property
+    def physical_units(self):
+        """The pendulum's :class:`~parapend.units.Units`."""
+        return self._units
+
+    command = "sea"
+    headline = ("power_w", "limit_power_w", "uniform_power_w", "winding", "status")
+
+    def samples(self, points: int | None = None) -> dict:
+        """The record and the optimal motion over one repeat period (:func:`sea_samples`)."""
+        return sea_samples(self, points)
+
+    def _series(self):
+        import xarray as xr
+
+        s = sea_samples(self)
+        names = {"t": "time_s", "z": "heave_m", "q": "q", "theta": "theta",
+                 "theta_dot": "theta_dot_rad_per_s", "power": "power_w",
+                 "energy": "energy_j", "energy_uniform": "uniform_energy_j"}
+        return xr.Dataset({names[k]: ("time_s", v) for k, v in s.items() if k != "t"},
+                          coords={"time_s": s["t"]})
+
+    def _figure(self):
+        return plot_sea(self)
 
 
 def _solve(exc, k: int, gamma: float, n: int):

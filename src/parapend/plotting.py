@@ -51,14 +51,30 @@ def _tau(omega, t):
     return omega * np.asarray(t) / (2 * math.pi)
 
 
+def si_title(result, units) -> str:
+    """The pendulum and its forcing in SI, for a title: length, mass, base frequency (Hz),
+    and the damping coefficient (N m s/rad)."""
+    f = units.frequency(result.omega)
+    desc = f"$l$ = {units.length:g} m, $m$ = {units.mass:g} kg, $f$ = {f:.4g} Hz"
+    delta = (result.excitation or {}).get("delta")
+    if delta is not None and result.excitation.get("excitation") == "harmonic":
+        desc += f", $A$ = {abs(units.amplitude(delta, f)):.4g} m"
+    if result.gamma:
+        desc += f", $c$ = {units.damping_coefficient(result.gamma):.4g} N m s/rad"
+    return desc
+
+
 @figure_style()
 def plot_optimum(result, path=None, points: int = 2000):
     """theta(tau) and torque of an optimum, with the gamma -> 0 limit motion (cf. paper Fig. 4).
 
-    ``tau = omega t / 2 pi`` over one forcing period. Returns the figure (saved if ``path``).
+    ``tau = omega t / 2 pi`` over one forcing period. With the pendulum in SI
+    (``result.physical_units``) the powers are in W, the torque in N m and the title gives
+    the pendulum and its forcing in SI. Returns the figure (saved if ``path``).
     """
-    exc = result._excitation
+    exc = result.excitation_function
     motion = result.motion
+    units = result.physical_units
     om = exc.omega
     t = exc.period * np.arange(points + 1) / points
     tau = _tau(om, t)
@@ -66,27 +82,37 @@ def plot_optimum(result, path=None, points: int = 2000):
     lim = limit(exc, k)
     fig, (ax1, ax2) = plt.subplots(2, 1, figsize=(7, 6), sharex=True,
                                    gridspec_kw={"height_ratios": [3, 2]})
+
+    def p(x):  # a power as the legend shows it
+        return f"$P = {x:.5f}$" if units is None else f"$P$ = {units.to_watts(x):.4g} W"
+
     label = f"{result.method}, $N = {result.harmonics}$" if result.method == "fourier" \
         else result.method
-    ax1.plot(tau, motion.theta(t), lw=1.8, label=f"optimum ({label}): $P = {result.power:.5f}$")
-    ax1.plot(tau, lim.motion.theta(t), "k--", lw=1,
-             label=f"{LIMIT_LABEL}: $P = {lim.power:.5f}$")
+    ax1.plot(tau, motion.theta(t), lw=1.8, label=f"optimum ({label}): {p(result.power)}")
+    ax1.plot(tau, lim.motion.theta(t), "k--", lw=1, label=f"{LIMIT_LABEL}: {p(lim.power)}")
     from .power import uniform_power
 
     _, phi = uniform_power(exc, result.gamma, k)
     ax1.plot(tau, k * om * t + phi, ":", color="gray", lw=1,
-             label=f"best uniform rotation: $P = {result.uniform_power:.5f}$")
+             label=f"best uniform rotation: {p(result.uniform_power)}")
     ax1.set_ylabel(r"$\theta$ (rad, from upright)")
     if k == 1:
         ax1.set_yticks(np.pi * np.arange(0, 5))
         ax1.set_yticklabels([_pi_label(np.pi * j) for j in range(5)])
     ax1.legend(loc="upper left")
-    desc = ", ".join(f"{k}={v}" for k, v in result.excitation.items() if k != "terms")
     what = "period-1 rotation" if k == 1 else f"rotation, winding K = {k}"
-    ax1.set_title(f"Optimal {what} ({desc}, $\\gamma = {result.gamma:g}$)")
+    if units is None:
+        desc = ", ".join(f"{k}={v}" for k, v in result.excitation.items() if k != "terms")
+        ax1.set_title(f"Optimal {what} ({desc}, $\\gamma = {result.gamma:g}$)")
+    else:
+        ax1.set_title(f"Optimal {what} ({si_title(result, units)})", fontsize=10)
     tq = torque(motion, exc, result.gamma, t)
-    ax2.plot(tau, tq, color="C3", lw=1.2)
-    ax2.set_ylabel("torque $T$ ($mgl$)")
+    if units is None:
+        ax2.plot(tau, tq, color="C3", lw=1.2)
+        ax2.set_ylabel("torque $T$ ($mgl$)")
+    else:
+        ax2.plot(tau, tq * units.torque, color="C3", lw=1.2)
+        ax2.set_ylabel("torque $T$ (N m)")
     ax2.set_xlabel(TAU_LABEL)
     ax2.set_xlim(0, 1)
     return _finish(fig, path)

@@ -789,31 +789,43 @@ def plot_pto_profile(result, path=None, points: int = 2000):
     """
     from .plotting import TAU_LABEL, _finish, plt
 
-    exc = result._excitation
+    exc = result.excitation_function
     eff = None if result.efficiency_generating is None else (result.efficiency_generating,
                                                               result.efficiency_motoring)
     k = getattr(result.motion, "intervals", None)
     if k:  # a grid through every node: the vertices of a piecewise-linear torque drawn
         points = k * -(-points // k)
     prof = pto_profile(result.motion, exc, result.gamma, points=points, efficiency=eff)
+    units = result.physical_units  # SI axes, title and legend with the pendulum in SI
+    kt, kp = (1.0, 1.0) if units is None else (units.torque, units.power)
     tau = prof["tau"]
     fig, (ax1, ax2) = plt.subplots(2, 1, figsize=(7, 5.5), sharex=True)
-    ax1.plot(tau, prof["torque"], color="C3", lw=1.2)
+    ax1.plot(tau, kt * prof["torque"], color="C3", lw=1.2)
     if result.torque_limit is not None:
         for s in (1, -1):
-            ax1.axhline(s * result.torque_limit, color="k", ls="--", lw=0.8)
-    ax1.set_ylabel("torque $T$ ($mgl$)")
-    ax1.set_title(f"Power take-off: $P$ = {result.power:.5f}, peak $|T|$ = "
-                  f"{result.peak_torque:.4g}, $\\gamma$ = {result.gamma:g}", fontsize=9)
+            ax1.axhline(s * kt * result.torque_limit, color="k", ls="--", lw=0.8)
+    if units is None:
+        ax1.set_ylabel("torque $T$ ($mgl$)")
+        ax1.set_title(f"Power take-off: $P$ = {result.power:.5f}, peak $|T|$ = "
+                      f"{result.peak_torque:.4g}, $\\gamma$ = {result.gamma:g}", fontsize=9)
+    else:
+        from .plotting import si_title
+
+        ax1.set_ylabel("torque $T$ (N m)")
+        head = (f"$P$ = {units.to_watts(result.power):.4g} W"
+                + ("" if result.electrical_power is None else
+                   f" (electrical {units.to_watts(result.electrical_power):.4g} W)")
+                + f", peak $|T|$ = {units.to_newton_metres(result.peak_torque):.4g} N m")
+        ax1.set_title(f"Power take-off: {head}\n{si_title(result, units)}", fontsize=9)
     ax1.grid(alpha=0.3)
-    p = prof["power"]
+    p = kp * prof["power"]
     ax2.plot(tau, p, color="C0", lw=1.2, label=r"mechanical $p = -T\dot\theta$")
     if np.any(p < 0):  # a legend entry only for what is drawn
         ax2.fill_between(tau, p, 0, where=p < 0, color="C1", alpha=0.4,
                          label="motoring ($p < 0$)")
     if "electrical_power" in prof:
-        ax2.plot(tau, prof["electrical_power"], color="C2", lw=1, label="electrical")
-    ax2.set_ylabel(r"power $p$ ($mgl/t_0$)")
+        ax2.plot(tau, kp * prof["electrical_power"], color="C2", lw=1, label="electrical")
+    ax2.set_ylabel(r"power $p$ ($mgl/t_0$)" if units is None else "power $p$ (W)")
     ax2.set_xlabel(TAU_LABEL)
     ax2.grid(alpha=0.3)
     ax2.legend(fontsize=8, loc="best")

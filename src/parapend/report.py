@@ -509,3 +509,32 @@ def reproduce(out, progress=None) -> dict:
     if progress:
         progress(len(figs) + 2, len(figs) + 2, "report")
     return results
+
+
+def contact_sheet(out):
+    """One figure holding every figure of the report in ``out`` (its ``figures/*.png``,
+    in the report's order), each titled with its name: the ``plot()`` of a
+    ``reproduce`` result."""
+    import math as _math
+
+    import matplotlib.image as mpimg
+
+    from .plotting import plt
+    from .style import figure_style
+
+    figdir = Path(out) / "figures"
+    names = [key for key, *_ in _figures() if (figdir / f"{key}.png").exists()]
+    if not names:
+        raise OutputError(f"cannot read the figures of the report in {str(out)!r}")
+    cols = 4
+    rows = _math.ceil(len(names) / cols)
+    with figure_style():
+        fig, axes = plt.subplots(rows, cols, figsize=(3.2 * cols, 2.6 * rows))
+        for ax in axes.flat:
+            ax.axis("off")
+        for ax, key in zip(axes.flat, names):
+            ax.imshow(mpimg.imread(figdir / f"{key}.png"))
+            ax.set_title(key, fontsize=9)
+        fig.suptitle("parapend reproduce: the paper's figures recomputed")
+        fig.tight_layout()
+    return fig

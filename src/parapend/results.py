@@ -7,7 +7,9 @@ from dataclasses import dataclass, field, fields
 
 import numpy as np
 
-__all__ = ["CONVENTION", "OptimizeResult", "Record", "ThresholdResult", "to_jsonable"]
+__all__ = ["CONVENTION", "OptimizeResult", "Record", "Result", "Table", "ThresholdResult",
+           "annotate",
+           "quantity", "to_jsonable"]
 
 CONVENTION = ("theta from the upright; non-dimensional time (unit sqrt(l/g)); power positive "
               "when harvested, P = -<T theta'> (paper Eqs. 14-16; the paper's tables list -P "
@@ -32,16 +34,355 @@ def to_jsonable(value):
     return value
 
 
-class _Result:
-    """Mixin: ``to_dict`` over the public dataclass fields (private ``_`` fields skipped)."""
+#: Units and long names of the quantities that results hold, by field name. A field named
+#: with a unit suffix (``power_w``, ``peak_torque_nm``) takes the suffix's unit
+#: (:data:`SUFFIX_UNITS`); the non-dimensional quantities of the paper's model are in the
+#: pendulum's scales (time ``sqrt(l/g)``, torque and energy ``m g l``, power
+#: ``m g l sqrt(g/l)``, as the design maps write them); counts and ratios have units "1".
+_P, _T, _TIME, _RATE = "m g l sqrt(g/l)", "m g l", "sqrt(l/g)", "sqrt(g/l)"
+QUANTITIES = {
+    "power": (_P, "mean extracted power P = -<T theta'> (positive = harvested)"),
+    "uniform_power": (_P, "power of the best uniform rotation (Eq. 17)"),
+    "limit_power": (_P, "gamma -> 0 limit of the power (Eqs. 19/24/32)"),
+    "upper_bound": (_P, "upper bound of the power"),
+    "bound_gap": (_P, "upper bound minus power"),
+    "electrical_power": (_P, "mean electrical power"),
+    "mean_power": (_P, "mean harvested power"),
+    "run_power": (_P, "mean harvested power of the run"),
+    "record_power": (_P, "mean harvested power over a repeat of the record"),
+    "predicted_power": (_P, "power of the target motion"),
+    "power_at_threshold": (_P, "optimal power at the threshold"),
+    "peak_torque": (_T, "peak torque |T|"),
+    "tracked_peak_torque": (_T, "peak torque of the tracked optimum"),
+    "torque_limit": (_T, "torque limit"),
+    "gamma": (_RATE, "viscous damping gamma"),
+    "damping_threshold": (_RATE, "damping threshold gamma*"),
+    "uniform_threshold": (_RATE, "damping where the uniform rotation stops extracting"),
+    "omega": (_RATE, "forcing frequency omega"),
+    "delta": ("1", "base acceleration amplitude over g"),
+    "time": (_TIME, "time"),
+    "t": (_TIME, "time"),
+    "phase": ("1", "time as a fraction of the forcing period"),
+    "theta": ("rad", "pendulum angle from the upright"),
+    "phi": ("rad", "pendulum angle"),
+    "theta_dot": ("rad " + _RATE, "angular speed"),
+    "phi_dot": ("rad " + _RATE, "angular speed"),
+    "torque": (_T, "take-off torque on the pendulum"),
+    "energy": (_T, "energy"),
+    "q": ("1", "base acceleration over g"),
+    "harmonics": ("1", "number of Fourier harmonics N"),
+    "winding": ("1", "turns per forcing period K"),
+    "iterations": ("1", "solver iterations"),
+    "success": ("1", "the solver converged"),
+    "mean_square_speed": (_RATE + "^2", "mean square speed <theta'^2>"),
+    "efficiency_generating": ("1", "take-off efficiency while generating"),
+    "efficiency_motoring": ("1", "take-off efficiency while motoring"),
+    "bound_fraction": ("1", "power over the radiation bound"),
+    "capture_width_ratio": ("1", "capture width over the body's width"),
+    "one_way_ratio": ("1", "coupled over one-way power"),
+    "energy_balance_residual": ("1", "relative residual of the energy balance"),
+    "damping_coefficient": ("N m s/rad", "viscous damping coefficient c"),
+    "damping_threshold_coefficient": ("N m s/rad",
+                                      "damping threshold as a coefficient c* = gamma* I / t0"),
+    "uniform_threshold_coefficient": ("N m s/rad", "uniform-rotation threshold as a "
+                                                   "damping coefficient"),
+}
+
+#: A field's unit from its name's suffix (longest first).
+SUFFIX_UNITS = (("_w_per_m", "W/m"), ("_mwh_per_year", "MWh/yr"), ("_rad_per_s", "rad/s"),
+                ("_m_per_s", "m/s"), ("_kg_m2", "kg m2"), ("_per_year", "1/yr"),
+                ("_kwh", "kWh"), ("_mwh", "MWh"), ("_deg", "degree"), ("_hz", "Hz"),
+                ("_nm", "N m"), ("_w", "W"), ("_j", "J"), ("_m", "m"), ("_s", "s"),
+                ("_kg", "kg"), ("_n", "N"), ("_h", "h"))
+
+
+def quantity(name: str) -> tuple[str, str]:
+    """``(units, long_name)`` of a result field or Dataset variable named ``name``.
+
+    Names in :data:`QUANTITIES` first; then a unit suffix (:data:`SUFFIX_UNITS`:
+    ``power_w`` is "W", its long name "power"); anything else is a count or ratio ("1")."""
+    if name in QUANTITIES:
+        return QUANTITIES[name]
+    for suffix, unit in SUFFIX_UNITS:
+        if name.endswith(suffix) and len(name) > len(suffix):
+            base = name[: -len(suffix)]
+            return unit, QUANTITIES.get(base, ("", base.replace("_", " ")))[1]
+    return "1", name.replace("_", " ")
+
+
+def annotate(ds, command: str):
+    """``ds`` with ``units`` and ``long_name`` on every variable and coordinate (kept where
+    already set), and the command and parapend's version in its attributes."""
+    from . import __version__
+
+    for name in list(ds.variables):
+        attrs = ds[name].attrs
+        units, long_name = quantity(str(name))
+        attrs.setdefault("units", units)
+        attrs.setdefault("long_name", long_name)
+    ds.attrs["command"] = command
+    ds.attrs["parapend_version"] = __version__
+    return ds
+
+
+def _attr_value(v):
+    """A JSON value as a NetCDF attribute: numbers and strings as they are, the rest as JSON
+    text (NetCDF has no nested attributes; None is the text "null")."""
+    import json
+
+    if isinstance(v, bool):
+        return int(v)
+    if isinstance(v, (int, float, str)):
+        return v
+    return json.dumps(to_jsonable(v))
+
+
+def scalars_dataset(data: dict, series=None):
+    """The Dataset of a result: every numeric scalar of ``data`` (its JSON object) a 0-d
+    variable, every other field an attribute (nested values as JSON text), plus ``series``
+    (an ``xarray.Dataset`` of the result's curves, or None)."""
+    import xarray as xr
+
+    ds = xr.Dataset() if series is None else series.copy()
+    for k, v in data.items():
+        if k in ds.variables:
+            continue
+        if isinstance(v, (bool, int, float)):
+            dtype = bool if isinstance(v, bool) else np.int64 if isinstance(v, int) else float
+            ds[k] = ((), np.asarray(v, dtype=dtype))
+        elif v is not None:
+            ds.attrs[k] = _attr_value(v)
+    return ds
+
+
+def dataset_csv(ds) -> str:
+    """CSV text of a Dataset's table: the variables along its one dimension as columns (the
+    dimension's coordinate first), a header row of names, then a row of units, then the
+    values (``repr(float)``: they read back exactly). A Dataset without dimensions gives its
+    scalar variables as one row.
+
+    Raises
+    ------
+    ParameterError
+        The Dataset has more than one dimension (a CSV holds one table: save as .nc).
+    """
+    import csv
+    import io
+
+    from .errors import ParameterError
+
+    dims = list(ds.dims)
+    if len(dims) > 1:
+        raise ParameterError(f"path: a CSV file holds one table, and this result has the "
+                             f"dimensions {', '.join(map(str, dims))}; save it as .nc")
+    if dims:
+        dim = dims[0]
+        names = ([dim] if dim in ds.coords else []) + [
+            str(k) for k, v in ds.data_vars.items() if v.dims == (dim,)
+            and v.dtype.kind in "biuf"]
+    else:
+        names = [str(k) for k, v in ds.data_vars.items() if v.dtype.kind in "biuf"]
+    buf = io.StringIO()
+    w = csv.writer(buf, lineterminator="\n")
+    w.writerow(names)
+    w.writerow([ds[n].attrs.get("units", quantity(n)[0]) for n in names])
+    cols = [np.atleast_1d(np.asarray(ds[n].values, dtype=float)) for n in names]
+    for row in zip(*cols):
+        w.writerow([repr(float(v)) for v in row])
+    return buf.getvalue()
+
+
+#: How a non-dimensional series converts to SI: name -> (SI name, Units attribute, power of
+#: it to multiply by).
+_SI_SERIES = {"time": ("time_s", "time", 1), "t": ("time_s", "time", 1),
+              "theta_dot": ("theta_dot_rad_per_s", "time", -1),
+              "torque": ("torque_nm", "torque", 1), "power": ("power_w", "power", 1),
+              "electrical_power": ("electrical_power_w", "power", 1),
+              "energy": ("energy_j", "energy", 1)}
+
+
+def series(columns: dict, units=None, dim: str = "time"):
+    """A Dataset of equal-length ``columns`` over the coordinate ``columns[dim]``;
+    with ``units`` (:class:`~parapend.units.Units`) every non-dimensional time, speed,
+    torque, power and energy in SI under its SI name (``time_s``, ``theta_dot_rad_per_s``,
+    ``torque_nm``, ``power_w``, ``energy_j``; angles and ratios as they are)."""
+    import xarray as xr
+
+    cols = {}
+    for k, v in columns.items():
+        v = np.asarray(v, dtype=float)
+        if units is not None and k in _SI_SERIES:
+            name, scale, power = _SI_SERIES[k]
+            cols[name] = v * float(getattr(units, scale)) ** power
+            if k == dim:
+                dim = name
+        else:
+            cols[k] = v
+    return xr.Dataset({k: (dim, v) for k, v in cols.items() if k != dim},
+                      coords={dim: cols[dim]})
+
+
+#: File suffixes :meth:`Result.save` writes.
+SAVE_SUFFIXES = (".json", ".csv", ".nc", ".png", ".svg", ".pdf")
+
+
+class Result:
+    """The one result protocol of every public function (DESIGN.md section 4).
+
+    - ``to_dict()``: the command's ``--json`` object;
+    - ``to_dataset()``: an ``xarray.Dataset`` (every variable with ``units`` and
+      ``long_name``; the command and version in its attributes), the result's curves over
+      their coordinate and its scalars as 0-d variables;
+    - ``plot()``: the figure the command line draws (a matplotlib ``Figure``);
+    - ``save(path)``: by extension, ``.json`` (``to_dict``), ``.csv`` (the table of
+      ``to_dataset``, with a row of units), ``.nc`` (``to_dataset``), ``.png``/``.svg``/
+      ``.pdf`` (``plot``);
+    - a short repr with the headline numbers.
+
+    Subclasses set :attr:`command` and :attr:`headline` and override :meth:`_series`
+    (the curves, or None) and :meth:`_figure`.
+    """
+
+    #: the command whose result this is
+    command = ""
+    #: the fields the repr shows
+    headline: tuple = ("success", "status")
 
     def to_dict(self) -> dict:
         return {f.name: to_jsonable(getattr(self, f.name)) for f in fields(self)
                 if not f.name.startswith("_")}
 
+    def _series(self):
+        """The result's curves as a Dataset (None: scalars only)."""
+        return None
 
-@dataclass(frozen=True, eq=False)
-class OptimizeResult(_Result):
+    def to_dataset(self):
+        """The result as an ``xarray.Dataset``: its curves (:meth:`_series`) and its scalar
+        fields as 0-d variables, the other fields as attributes; every variable with
+        ``units`` and ``long_name``."""
+        return annotate(scalars_dataset(self.to_dict(), self._series()), self.command)
+
+    def _figure(self):
+        from .errors import ParameterError
+
+        raise ParameterError(f"plot: the {self.command} result has no figure")
+
+    def plot(self):
+        """The figure of the result, as the command line's ``--plot`` draws it (a matplotlib
+        ``Figure``; save it with :meth:`save` or ``fig.savefig``)."""
+        return self._figure()
+
+    def save(self, path):
+        """Write the result to ``path`` by its extension: ``.json``, ``.csv`` (with a units
+        row), ``.nc``, or a figure ``.png``/``.svg``/``.pdf``; atomically
+        (:mod:`parapend.fileio`). Returns the path."""
+        import json
+        from pathlib import Path
+
+        from . import fileio
+        from .errors import ParameterError
+
+        suffix = Path(str(path)).suffix.lower()
+        if suffix == ".json":
+            return fileio.write_text(path, json.dumps(self.to_dict(), indent=2) + "\n")
+        if suffix == ".csv":
+            return fileio.write_text(path, dataset_csv(self.to_dataset()))
+        if suffix == ".nc":
+            return fileio.write_dataset(self.to_dataset(), path)
+        if suffix.lstrip(".") in fileio.FIGURE_FORMATS:
+            return fileio.save_figure(self.plot(), path)
+        raise ParameterError(f"path: expected a file name ending in "
+                             f"{', '.join(SAVE_SUFFIXES)}, got {str(path)!r}")
+
+    def __repr__(self) -> str:
+        items = []
+        for name in self.headline:
+            v = getattr(self, name, None)
+            if v is None:
+                continue
+            items.append(f"{name}={v:.6g}" if isinstance(v, float) else f"{name}={v!r}")
+        return f"{type(self).__name__}({', '.join(items)})"
+
+
+_Result = Result  # the older name, used by the result types across the package
+
+
+class Table(Result):
+    """A result that is a table over one parameter (``damping_sweep``, ``harmonics``,
+    ``pto_curve``): the ``xarray.Dataset`` read through (``r["power"]``, ``r.attrs``,
+    ``r.sel(...)``), with the result protocol on top (``to_dict`` is the ``--json`` object:
+    the coordinate, every variable and every attribute).
+
+    Parameters
+    ----------
+    command : str
+        The command whose result this is.
+    dataset : xarray.Dataset
+        The table, one dimension.
+    draw : callable
+        ``draw(dataset)``: the command's figure.
+    """
+
+    __slots__ = ("_dataset", "_draw", "command")
+
+    def __init__(self, command: str, dataset, draw):
+        object.__setattr__(self, "command", command)
+        object.__setattr__(self, "_dataset", dataset)
+        object.__setattr__(self, "_draw", draw)
+
+    def __getattr__(self, name):
+        if name.startswith("__"):
+            raise AttributeError(name)
+        return getattr(object.__getattribute__(self, "_dataset"), name)
+
+    def __setattr__(self, name, value):
+        raise AttributeError(f"{self.command} result is frozen")
+
+    def __getitem__(self, key):
+        return self._dataset[key]
+
+    def __contains__(self, key) -> bool:
+        return key in self._dataset
+
+    def __iter__(self):
+        return iter(self._dataset)
+
+    def __len__(self) -> int:
+        return len(self._dataset)
+
+    def __dir__(self):
+        return sorted(set(dir(type(self))) | set(self._dataset.variables)
+                      | {"attrs", "coords", "data_vars", "dims", "sel", "isel"})
+
+    def to_dict(self) -> dict:
+        ds = self._dataset
+        out = {name: ds[name].values for name in ds.coords}
+        out.update({name: ds[name].values for name in ds.data_vars})
+        return to_jsonable({**out, **ds.attrs})
+
+    def to_dataset(self):
+        ds = self._dataset.copy()
+        ds.attrs = {k: _attr_value(v) for k, v in ds.attrs.items()}
+        return annotate(ds, self.command)
+
+    def _figure(self):
+        from .units import Units, si_figure
+
+        units = Units.from_description(self._dataset.attrs)
+        return si_figure(self._draw(self._dataset), units)
+
+    def __repr__(self) -> str:
+        ds = self._dataset
+        dim = next(iter(ds.dims), None)
+        head = "" if dim is None else (
+            f"{dim}: {ds.sizes[dim]} points from {float(ds[dim].values[0]):.6g} to "
+            f"{float(ds[dim].values[-1]):.6g}")
+        name = "".join(w.capitalize() for w in self.command.replace("-", "_").split("_"))
+        return f"{name}Result({head}; variables {', '.join(map(str, ds.data_vars))})"
+
+
+@dataclass(frozen=True, eq=False, repr=False)
+class OptimizeResult(Result):
     """Optimal period-1 rotation for one excitation and damping.
 
     Attributes
@@ -210,6 +551,11 @@ class OptimizeResult(_Result):
     convention: str = CONVENTION
     _motion: object = field(default=None, repr=False)
     _excitation: object = field(default=None, repr=False)
+    _draw: object = field(default=None, repr=False)
+
+    command = "optimize"
+    headline = ("power", "power_w", "electrical_power", "electrical_power_w", "peak_torque",
+                "peak_torque_nm", "status")
 
     @property
     def motion(self):
@@ -218,9 +564,56 @@ class OptimizeResult(_Result):
         :class:`~parapend.optimal.collocation.CollocationMotion` for "collocation"."""
         return self._motion
 
+    @property
+    def excitation_function(self):
+        """The excitation ``q(t)`` the optimum was solved for (an
+        :class:`~parapend.excitation.Excitation`; ``excitation`` is its description)."""
+        return self._excitation
 
-@dataclass(frozen=True, eq=False)
-class ThresholdResult(_Result):
+    @property
+    def physical_units(self):
+        """The pendulum's :class:`~parapend.units.Units` (None without length and mass)."""
+        from .units import Units
+
+        return Units.from_description(self.units)
+
+    def samples(self, points: int = 1000) -> dict:
+        """One forcing period of the optimum on ``points`` uniform times (non-dimensional
+        arrays): ``time``, ``phase`` (``t/T``), ``theta``, ``theta_dot``, ``torque``
+        (Eq. 14 solved for T), ``power`` (``-T theta'``, positive when harvested) and, with
+        an efficiency, ``electrical_power``. :meth:`to_dataset` gives them in SI when the
+        pendulum was given in SI."""
+        from .errors import check_int
+        from .model import torque
+
+        npts = check_int("points", points, 2, 10**6)
+        exc, motion = self._excitation, self._motion
+        t = exc.period * np.arange(npts) / npts
+        out = {"time": t, "phase": t / exc.period, "theta": motion.theta(t),
+               "theta_dot": motion.theta_dot(t), "torque": torque(motion, exc, self.gamma, t)}
+        out["power"] = -out["torque"] * out["theta_dot"]
+        if self.efficiency_generating is not None:
+            p = out["power"]
+            out["electrical_power"] = np.where(p > 0, p * self.efficiency_generating,
+                                               p / self.efficiency_motoring)
+        return out
+
+    def _series(self):
+        return series(self.samples(), self.physical_units)
+
+    def _figure(self):
+        """The figure of the command (:func:`parapend.plotting.plot_optimum`, or
+        :func:`parapend.pto.plot_pto_profile` through a take-off), SI axes beside with
+        units; ``_draw`` is set by :func:`parapend.optimize`, which knows the figure."""
+        from .units import si_figure
+
+        if self._draw is None:
+            return super()._figure()
+        return si_figure(self._draw(self), self.physical_units)
+
+
+@dataclass(frozen=True, eq=False, repr=False)
+class ThresholdResult(Result):
     """Damping ``gamma*`` beyond which no period-1 rotation extracts power.
 
     ``power_at_threshold`` is the optimal power at ``damping_threshold`` (zero to the
@@ -248,35 +641,84 @@ class ThresholdResult(_Result):
     damping_threshold_coefficient: float | None = None
     uniform_threshold_coefficient: float | None = None
     convention: str = CONVENTION
+    _excitation: object = field(default=None, repr=False)
+    _draw: object = field(default=None, repr=False)
+
+    command = "threshold"
+    headline = ("damping_threshold", "damping_threshold_coefficient", "uniform_threshold",
+                "status")
+
+    def _figure(self):
+        """Power against damping up to beyond gamma* (the threshold marked), as
+        ``damping-sweep`` draws it for this excitation (``_draw``, set by
+        :func:`parapend.threshold`)."""
+        if self._draw is None:
+            return super()._figure()
+        return self._draw(self)
+
+    @property
+    def excitation_function(self):
+        """The excitation ``q(t)`` (an :class:`~parapend.excitation.Excitation`)."""
+        return self._excitation
+
+    @property
+    def physical_units(self):
+        """The pendulum's :class:`~parapend.units.Units` (None without length and mass)."""
+        from .units import Units
+
+        return Units.from_description(self.units)
 
 
-class Record(_Result):
+class Record(Result):
     """A frozen result whose fields are the keys of a command's JSON object (for the
-    commands whose result is not one of the dataclasses above: ``figure``, ``reproduce``,
-    ``sweep``, ``map``, ``optimize --method all``). Fields read as attributes or with
-    ``record["key"]``; ``to_dict`` gives the JSON object. Objects that are not JSON (a
-    figure, a Dataset) ride along as private attributes (``_figure``, ``_dataset``;
-    :meth:`to_dataset` returns the Dataset); the
-    attributes of ``_source`` (the object the record describes, e.g. a simulated motion)
-    read through.
+    commands whose result is not a dataclass: ``figure``, ``reproduce``, ``simulate``,
+    ``basins``, ``rotations``, ``sweep``, ``map``, ``power-matrix``, ``optimize`` with
+    ``method="all"``). Fields read as attributes or with ``record["key"]``; ``to_dict``
+    gives the JSON object.
+
+    The objects behind the fields are public attributes too, named in ``objects``: the
+    Dataset (``dataset``; :meth:`to_dataset` annotates it), the motion a field describes
+    (``source``, whose attributes also read through), a sweep's ``run``, ... The figure is
+    :meth:`plot`.
+
+    Parameters
+    ----------
+    kind : str
+        The command.
+    data : dict
+        The JSON object.
+    draw : callable or None
+        ``draw(record)``: the command's figure (a matplotlib ``Figure``).
+    series : callable or None
+        ``series(record)``: the curves of the result as a Dataset (default: ``dataset``).
+    **objects
+        The objects behind the fields, by public name.
     """
 
-    __slots__ = ("_kind", "_data", "_private")
+    __slots__ = ("_kind", "_data", "_objects", "_draw", "_series_of")
 
-    def __init__(self, kind: str, data: dict, **private):
+    def __init__(self, kind: str, data: dict, *, draw=None, series=None, **objects):
         object.__setattr__(self, "_kind", kind)
         object.__setattr__(self, "_data", dict(data))
-        object.__setattr__(self, "_private", private)
+        object.__setattr__(self, "_objects", objects)
+        object.__setattr__(self, "_draw", draw)
+        object.__setattr__(self, "_series_of", series)
+
+    @property
+    def command(self) -> str:
+        return self._kind
 
     def __getattr__(self, name):
         data = object.__getattribute__(self, "_data")
         if name in data:
             return data[name]
-        private = object.__getattribute__(self, "_private")
-        if name.startswith("_") and name[1:] in private:
-            return private[name[1:]]
-        if "source" in private and not name.startswith("_"):
-            return getattr(private["source"], name)
+        objects = object.__getattribute__(self, "_objects")
+        if name in objects:
+            return objects[name]
+        if name.startswith("_") and name[1:] in objects:  # the older, private spelling
+            return objects[name[1:]]
+        if "source" in objects and not name.startswith("_"):
+            return getattr(objects["source"], name)
         raise AttributeError(f"{object.__getattribute__(self, '_kind')} result has no field "
                              f"{name!r}")
 
@@ -287,29 +729,44 @@ class Record(_Result):
         raise AttributeError(f"{self._kind} result is frozen")
 
     def __dir__(self):
-        return sorted(self._data)
+        return sorted(set(self._data) | set(self._objects)
+                      | {"to_dict", "to_dataset", "plot", "save", "fields"})
 
     def __repr__(self) -> str:
-        keys = ", ".join(self._data)
-        return f"{self._kind.capitalize()}Result({keys})"
+        items = []
+        for k, v in self._data.items():
+            if isinstance(v, (bool, int, float, str)) and len(items) < 6 \
+                    and not (isinstance(v, str) and len(v) > 40):
+                items.append(f"{k}={v:.6g}" if isinstance(v, float) else f"{k}={v!r}")
+        name = "".join(w.capitalize() for w in self._kind.replace("-", "_").split("_"))
+        return f"{name}Result({', '.join(items)})"
 
     def fields(self) -> tuple:
         """The field names, which are the JSON keys."""
         return tuple(self._data)
 
-    def to_dataset(self):
-        """The full ``xarray.Dataset`` behind the record (``basins``, ``rotations``,
-        ``sweep``, ``map``, ``power-matrix``: what ``--save`` writes).
+    def _series(self):
+        if self._series_of is not None:
+            return self._series_of(self)
+        return self._objects.get("dataset")
 
-        Raises
-        ------
-        AttributeError
-            For a command whose result carries no Dataset.
-        """
-        private = object.__getattribute__(self, "_private")
-        if private.get("dataset") is None:
-            raise AttributeError(f"{self._kind} result has no Dataset")
-        return private["dataset"]
+    def to_dataset(self):
+        """The result as an annotated ``xarray.Dataset``: the Dataset behind the record
+        (``basins``, ``rotations``, ``sweep``, ``map``, ``power-matrix``: what ``--save``
+        writes) or its curves, plus the scalar fields (0-d) and the others as attributes."""
+        series = self._series()
+        if series is not None and series.attrs:
+            data = {k: v for k, v in self.to_dict().items() if k not in series.attrs}
+            series = series.copy()
+            series.attrs = {k: _attr_value(v) for k, v in series.attrs.items()}
+        else:
+            data = self.to_dict()
+        return annotate(scalars_dataset(data, series), self._kind)
+
+    def _figure(self):
+        if self._draw is None:
+            return super()._figure()
+        return self._draw(self)
 
     def to_dict(self) -> dict:
         return to_jsonable(self._data)

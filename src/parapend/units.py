@@ -170,6 +170,15 @@ class Units:
     def to_seconds(self, t: float) -> float:
         return t * self.time
 
+    @classmethod
+    def from_description(cls, description: dict | None):
+        """The units of a result's ``units`` field (:meth:`describe`), or None."""
+        if not description or "length_m" not in description:
+            return None
+        return cls(length=description["length_m"], mass=description["mass_kg"],
+                   gravity=description["gravity_m_s2"],
+                   inertia=description["inertia_kg_m2"])
+
     def describe(self) -> dict:
         """The scales, for JSON output (SI units in the key names)."""
         return {"length_m": self.length, "mass_kg": self.mass, "gravity_m_s2": self.gravity,
@@ -221,6 +230,21 @@ def from_options(*, length=None, mass=None, gravity=None, inertia=None, frequenc
 #: axis-label words -> (quantity, SI unit, name of the Units scale)
 _SI_AXES = (("torque", "torque", "N m", "torque"), ("power", "power", "W", "power"),
             ("energy", "energy", "J", "energy"), ("damping", "damping c", "N m s/rad", "damping"))
+
+
+def si_figure(fig, units: Units | None):
+    """``fig`` with SI axes beside its non-dimensional ones (:func:`add_si_axes`) and its
+    layout redone; ``fig`` unchanged when ``units`` is None. Returns ``fig``."""
+    if units is None:
+        return fig
+    from .style import figure_style
+
+    with figure_style():
+        add_si_axes(fig, units)
+        engine = fig.get_layout_engine()
+        if engine is None or type(engine).__name__ == "TightLayoutEngine":
+            fig.tight_layout()  # (a constrained layout adapts by itself)
+    return fig
 
 
 def add_si_axes(fig, units: Units) -> None:

@@ -4,8 +4,15 @@ Each command parses its options, calls the function of the same name in
 :mod:`parapend.commands` (every option but ``--json``, ``--plot``, ``--save``) and formats
 its result.
 
-Every command has ``--help``, defaults to the paper's case (harmonic excitation,
-delta = -0.3, omega = 1.8), prints a plain-text table or, with ``--json``, one JSON object.
+Every command has ``--help`` and prints a plain-text table or, with ``--json``, one JSON
+object. The defaults (docs/defaults.md) are the question's natural case: the paper's
+(harmonic excitation, delta = -0.3, omega = 1.8) for optimize, threshold, damping-sweep,
+harmonics, pto-curve, track and sweep (figure and reproduce draw the paper's own cases);
+Eq. 1's coexistence case (gamma = 0.1, p = 0.8, omega = 2.1) for simulate, basins and
+rotations; a JONSWAP sea (Hs = 2 m, Tp = 8 s, seed 0) and a 1 m, 10 kg pendulum with gamma =
+0.01 for sea and horizon (horizons 0.25 to 4 peak periods); sea-state bins Hs 1:3:3 m,
+Te 6:10:3 s with that pendulum for power-matrix; and an embedded buoy design (a 0.5 m x
+0.5 m cylinder, an 80 kg, 0.3 m pendulum, a regular wave of 0.2 m and 1.8 s) for buoy.
 User errors print one line and exit with code 2; only this package prints.
 
 Exit codes: 0 success; 1 a file or standard output could not be written, or a solver
@@ -31,7 +38,8 @@ import json
 import os
 import sys
 
-from .. import __version__, _entry
+from .. import __version__
+from .._interrupt import interrupted as _interrupted
 from ..errors import ParameterError, SolverError
 from ..results import to_jsonable
 from . import buoy as _buoy_cmds
@@ -141,7 +149,7 @@ def main(argv=None) -> int:
         except Exception:
             # an interrupt that a library turned into its own error (numba while it compiles,
             # pybind11 while a module loads) is still an interrupt
-            if _entry.interrupted():
+            if _interrupted():
                 raise KeyboardInterrupt from None
             raise
     except OutputError as exc:  # before ParameterError, of which it is a subclass

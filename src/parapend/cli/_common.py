@@ -151,6 +151,10 @@ def add_body_options(g, *, body_default, body_help: str, hydro_help: str) -> Non
 
 
 FIGURE_SUFFIXES = (".png", ".svg", ".pdf")
+#: what ``--save`` writes by extension (:meth:`parapend.results.Result.save`): a result with
+#: one table, and one with several dimensions (no CSV)
+SAVE_TABLE = (".csv", ".nc", ".json")
+SAVE_GRID = (".nc", ".json")
 
 
 def _blocking_file(p: Path) -> Path | None:

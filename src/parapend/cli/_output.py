@@ -17,7 +17,9 @@ from pathlib import Path
 from .. import fileio
 from ..errors import OutputError
 
-__all__ = ["OutputError", "plot", "probe_dir", "save_figure", "write_dataset", "write_text"]
+__all__ = ["OutputError", "plot", "probe_dir", "save_figure", "save_plot", "save_result",
+           "write_dataset",
+           "write_text"]
 
 
 def probe_dir(directory, target=None) -> None:
@@ -68,21 +70,36 @@ def save_figure(fig, path) -> None:
 def plot(func, data, path, units=None) -> None:
     """Draw ``func(data, path)`` (a :mod:`parapend.plotting` function that saves to ``path``);
     with ``units`` (:class:`parapend.units.Units`), ``func(data, None)`` and SI axes beside
-    the non-dimensional ones (:func:`parapend.units.add_si_axes`) before saving."""
+    the non-dimensional ones (:func:`parapend.units.si_figure`) before saving."""
     try:
         if units is not None:
-            from ..style import figure_style
-            from ..units import add_si_axes
+            from ..units import si_figure
 
-            fig = func(data, None)
-            with figure_style():
-                add_si_axes(fig, units)
-                engine = fig.get_layout_engine()
-                if engine is None or type(engine).__name__ == "TightLayoutEngine":
-                    fig.tight_layout()  # (a constrained layout adapts by itself)
-            save_figure(fig, path)
+            save_figure(si_figure(func(data, None), units), path)
             return
         func(data, path)
+    except OutputError:
+        raise
+    except OSError as exc:
+        raise fileio.output_error(path, exc) from None
+
+
+def save_plot(result, path) -> None:
+    """Draw ``result.plot()`` (:meth:`parapend.results.Result.plot`) into ``path`` (PNG, SVG
+    or PDF by extension), atomically."""
+    try:
+        save_figure(result.plot(), path)
+    except OutputError:
+        raise
+    except OSError as exc:
+        raise fileio.output_error(path, exc) from None
+
+
+def save_result(result, path) -> None:
+    """Write ``result`` to ``path`` by its extension (:meth:`parapend.results.Result.save`);
+    an operating-system failure is an :class:`OutputError` naming the file."""
+    try:
+        result.save(path)
     except OutputError:
         raise
     except OSError as exc:

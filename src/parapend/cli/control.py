@@ -6,10 +6,10 @@ import math
 
 from .. import limits
 from ..defaults import GAMMA
-from ..errors import ParameterError
 from . import _output
 from ._common import (
     FIGURE_SUFFIXES,
+    SAVE_TABLE,
     _add_excitation,
     _check_output,
     _finite_float,
@@ -94,9 +94,10 @@ def add_parsers(sub) -> None:
     from .pto import add_unit_options
 
     add_unit_options(p, torque=True)
-    p.add_argument("--save", metavar="CSV",
-                   help="write the run: t,theta,theta_dot,torque,q, 256 samples per period "
-                        "(torque held on [t, t + h)); one run only")
+    p.add_argument("--save", metavar="FILE",
+                   help="write the run (time, theta, theta_dot, torque held on [t, t + h), "
+                        "q; in SI with --length and --mass) and the scalars: .csv (with a "
+                        "row of units), .nc or .json; with --runs, each run's power")
     p.add_argument("--plot", metavar="PNG",
                    help="draw theta, torque and cumulative energy (PNG, SVG or PDF); one run")
     p.add_argument("--json", action="store_true", help="print one JSON object")
@@ -121,12 +122,7 @@ def _si_lines(r) -> list[str]:
 
 def _cmd_track(a) -> dict | str:
     _check_output(a.plot, "--plot", FIGURE_SUFFIXES)
-    _check_output(a.save, "--save", (".csv",))
-    if a.controller == "mpc" and a.plot:
-        raise ParameterError("plot: not drawn for --controller mpc; use --save")
-    if a.runs != 1 and (a.save or a.plot):
-        raise ParameterError("runs: --save and --plot write one run; drop them or use "
-                             "--runs 1")
+    _check_output(a.save, "--save", SAVE_TABLE)
     r = _run(a, progress=_Progress("track")) if a.runs != 1 else _run(a)
     if getattr(r, "controller", None) == "mpc":
         return _mpc_out(a, r)
@@ -147,16 +143,10 @@ def _cmd_track(a) -> dict | str:
             f"{_fmt(r.power_min, 6)}, max {_fmt(r.power_max, 6)}); locked runs "
             f"{_fmt(r.locked_mean_power, 6)}; predicted {_fmt(r.predicted_power, 6)}",
             f"peak torque {_fmt(r.peak_torque, 5)}", *_si_lines(r)])
-    if r._run is not None and a.save:
-        run = r._run
-        _output.write_columns(a.save, {"t": run.t, "theta": run.theta,
-                                       "theta_dot": run.theta_dot, "torque": run.torque,
-                                       "q": run.q})
-    if r._run is not None and a.plot:
-        from ..control.figures import plot_track
-        from .pto import units_of
-
-        _output.plot(plot_track, r, a.plot, units=units_of(r))
+    if a.save:
+        _output.save_result(r, a.save)
+    if a.plot:
+        _output.save_plot(r, a.plot)
     if a.json:
         return r.to_dict()
     out = [f"{r.status}: {r.message}",
@@ -198,14 +188,10 @@ def _sea_line(sea: dict) -> str:
 
 def _mpc_out(a, r) -> dict | str:
     """Save, plot and print a ``--controller mpc`` run."""
-    import numpy as np
-
-    run = r._run
     if a.save:
-        tq = np.append(run.torque, np.nan)
-        _output.write_columns(a.save, {"t": run.t, "theta": run.theta,
-                                       "theta_dot": run.theta_dot, "torque": tq,
-                                       "q": r._q(run.t)})
+        _output.save_result(r, a.save)
+    if a.plot:
+        _output.save_plot(r, a.plot)
     if a.json:
         return r.to_dict()
     out = [f"{r.status}: {r.message}",
@@ -232,6 +218,8 @@ def _mpc_out(a, r) -> dict | str:
                    f"power {r.mean_power_w:.6g} W; peak torque {r.peak_torque_nm:.6g} N m")
     if a.save:
         out.append(f"run written to {a.save}")
+    if a.plot:
+        out.append(f"figure written to {a.plot}")
     return "\n".join(out)
 
 

@@ -17,6 +17,8 @@ from . import _output
 from . import pto as _pto
 from ._common import (
     FIGURE_SUFFIXES,
+    SAVE_GRID,
+    SAVE_TABLE,
     _check_output,
     _finite_float,
     _fmt,
@@ -107,7 +109,10 @@ def add_parsers(sub) -> None:
     _pto.add_unit_options(p, damping=False, excitation=False, adds="time in s, energy in J")
     p.add_argument("--plot", metavar="PNG",
                    help="draw the time history and phase portrait (PNG, SVG or PDF)")
-    p.add_argument("--save", metavar="CSV", help="write the time series: t,phi,dphi,energy")
+    p.add_argument("--save", metavar="FILE",
+                   help="write the time series (time, phi, phi_dot, energy; in SI with "
+                        "--length and --mass) and the scalars: .csv (with a row of units), "
+                        ".nc or .json")
     p.add_argument("--json", action="store_true", help="print one JSON object")
 
     p = sub.add_parser("basins", help="basins of attraction of Eq. 1 (Fig. 2 right)",
@@ -148,7 +153,7 @@ def add_parsers(sub) -> None:
     p.add_argument("--engine", choices=["numba", "numpy"], default="numba",
                    help="compiled kernel (default) or the vectorized NumPy engine")
     p.add_argument("--plot", metavar="PNG", help="draw the basin image (PNG, SVG or PDF)")
-    p.add_argument("--save", metavar="NC", help="write the basin Dataset as NetCDF (.nc)")
+    p.add_argument("--save", metavar="FILE", help="write the basin Dataset: .nc or .json")
     p.add_argument("--json", action="store_true", help="print one JSON object")
 
     p = sub.add_parser("rotations",
@@ -174,29 +179,26 @@ def add_parsers(sub) -> None:
                         f"p was followed (default {limits.ROT_TIME_LIMIT:g})")
     p.add_argument("--plot", metavar="PNG",
                    help="draw J, G, E and the stability regions (PNG, SVG or PDF)")
-    p.add_argument("--save", metavar="NC", help="write J, G, E against omega as NetCDF (.nc)")
+    p.add_argument("--save", metavar="FILE",
+                   help="write J, G, E against omega: .csv (with a row of units), .nc or "
+                        ".json")
     p.add_argument("--json", action="store_true", help="print one JSON object")
 
 
 # --- simulate ------------------------------------------------------------------------------
 def _cmd_simulate(a) -> dict | str:
     _check_output(a.plot, "--plot", FIGURE_SUFFIXES)
-    _check_output(a.save, "--save", (".csv",))
+    _check_output(a.save, "--save", SAVE_TABLE)
     from ._common import _Ticker
 
     with _Ticker("simulate"):
         rec = _run(a)
-    m = rec._source
-    units = rec._units
+    m = rec.source
+    units = rec.physical_units
     if a.save:
-        cols = {"t": m.t, "phi": m.phi, "dphi": m.dphi, "energy": m.energy}
-        if units is not None:
-            cols.update(t_s=m.t * units.time, energy_j=m.energy * units.energy)
-        _output.write_columns(a.save, cols)
+        _output.save_result(rec, a.save)
     if a.plot:
-        from ..dynamics.figures import plot_motion
-
-        _output.plot(lambda mm, path: plot_motion(mm, path=path), m, a.plot, units=units)
+        _output.save_plot(rec, a.plot)
     if a.json:
         return rec.to_dict()
     c = m.classification
@@ -293,20 +295,18 @@ class _PromptInterrupt:
 
 def _cmd_basins(a) -> dict | str:
     _check_output(a.plot, "--plot", FIGURE_SUFFIXES)
-    _check_output(a.save, "--save", (".nc",))
+    _check_output(a.save, "--save", SAVE_GRID)
     bar = _Progress("basins")
     with _PromptInterrupt("basins"):
         rec = _run(a, progress=bar)
     bar(1, 1)
-    ds = rec._dataset
+    ds = rec.dataset
     n = ds.sizes["phi"]
     periods, steps = ds.attrs["periods"], ds.attrs["steps_per_period"]
     if a.save:
-        _output.write_dataset(ds, a.save)
+        _output.save_result(rec, a.save)
     if a.plot:
-        from ..dynamics.figures import plot_basins
-
-        _output.plot(lambda d, path: plot_basins(d, path=path), ds, a.plot)
+        _output.save_plot(rec, a.plot)
     out = rec.to_dict()
     if a.json:
         return out
@@ -335,24 +335,22 @@ def _cmd_basins(a) -> dict | str:
 # --- rotations -----------------------------------------------------------------------------
 def _cmd_rotations(a) -> dict | str:
     _check_output(a.plot, "--plot", FIGURE_SUFFIXES)
-    _check_output(a.save, "--save", (".nc",))
+    _check_output(a.save, "--save", SAVE_TABLE)
     single = not isinstance(a.omega, tuple)
     if single:
         from ._common import _Ticker
 
         with _Ticker("rotations"):
             rec = _run(a)
-        r = rec._source
+        r = rec.source
     else:
         rec = _run(a, progress=_Progress("rotations"))
-    ds = rec._dataset
+    ds = rec.dataset
     oms = ds["omega"].values
     if a.save:
-        _output.write_dataset(ds, a.save)
+        _output.save_result(rec, a.save)
     if a.plot:
-        from ..dynamics.figures import plot_rotation_boundaries
-
-        _output.plot(lambda d, path: plot_rotation_boundaries(d, path=path), ds, a.plot)
+        _output.save_plot(rec, a.plot)
     if single:
         if a.json:
             return rec.to_dict()

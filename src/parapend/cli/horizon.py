@@ -62,7 +62,8 @@ def add_parsers(sub) -> None:
                         "> 0 (default none; docs/control.md)")
     p.add_argument("--plot", metavar="PNG", help="draw the fraction of the optimum against "
                                                   "the horizon")
-    p.add_argument("--save", metavar="NC", help="write the curve and every run as NetCDF")
+    p.add_argument("--save", metavar="FILE",
+                   help="write the curve and every run: .nc or .json")
     p.add_argument("--json", action="store_true", help="print one JSON object")
 
 
@@ -71,16 +72,15 @@ def _pct(x) -> str:
 
 
 def _cmd_horizon(a) -> dict | str:
-    from ..control.horizon import horizon_dataset, plot_horizon
-    from ._common import _Progress
+    from ._common import SAVE_GRID, _Progress
 
     _check_output(a.plot, "--plot", FIGURE_SUFFIXES)
-    _check_output(a.save, "--save", (".nc",))
+    _check_output(a.save, "--save", SAVE_GRID)
     r = _run(a, progress=None if a.json else _Progress("horizon"))
     if a.save:
-        _output.write_dataset(horizon_dataset(r), a.save)
+        _output.save_result(r, a.save)
     if a.plot:
-        _output.plot(plot_horizon, r, a.plot)
+        _output.save_plot(r, a.plot)
     if a.json:
         return r.to_dict()
     rec, u = r.record, r.units

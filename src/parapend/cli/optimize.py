@@ -6,15 +6,14 @@ import math
 
 from .. import limits
 from ..defaults import GAMMA
-from ..errors import ParameterError
 from ..results import CONVENTION
 from . import _output
 from . import pto as _pto
 from ._common import (
     FIGURE_SUFFIXES,
+    SAVE_TABLE,
     _add_excitation,
     _check_output,
-    _dataset_json,
     _describe,
     _finite_float,
     _fmt,
@@ -43,9 +42,11 @@ def add_parsers(sub) -> None:
                         "side by side (default fourier)")
     p.add_argument("--plot", metavar="PNG",
                    help="draw theta(tau) and torque (PNG, SVG or PDF)")
-    p.add_argument("--save", metavar="CSV",
-                   help="write one period of the motion: t,tau,theta,theta_dot,torque,power "
-                        "(p = -T theta'; and electrical_power with an efficiency)")
+    p.add_argument("--save", metavar="FILE",
+                   help="write one period of the motion (time, phase, theta, theta_dot, "
+                        "torque, power = -T theta', electrical_power with an efficiency; in "
+                        "SI with --length and --mass) and the result's scalars: .csv (with a "
+                        "row of units), .nc or .json")
     p.add_argument("--winding", type=_int, default=1,
                    help="K turns per forcing period, theta(t + 2 pi/omega) = theta(t) + 2 pi "
                         "K (default 1, the paper's period-1 rotation; K > 1: method fourier "
@@ -61,6 +62,10 @@ def add_parsers(sub) -> None:
     p.add_argument("--harmonics", type=_int, default=None,
                    help=f"fixed N, at most {limits.MAX_THRESHOLD_HARMONICS} (default: doubled "
                         "from 8 until gamma* converges)")
+    p.add_argument("--plot", metavar="PNG",
+                   help="draw power against damping up to beyond gamma* (PNG, SVG or PDF)")
+    p.add_argument("--save", metavar="FILE",
+                   help="write the result: .csv (with a row of units), .nc or .json")
     p.add_argument("--json", action="store_true", help="print one JSON object")
     _pto.add_unit_options(p, damping=False)
 
@@ -78,7 +83,8 @@ def add_parsers(sub) -> None:
                         f"{limits.MAX_SWEEP_WORK} (default 41)")
     p.add_argument("--plot", metavar="PNG",
                    help="draw power against damping (PNG, SVG or PDF)")
-    p.add_argument("--save", metavar="NC", help="write the sweep as a NetCDF file (.nc)")
+    p.add_argument("--save", metavar="FILE",
+                   help="write the sweep: .csv (with a row of units), .nc or .json")
     p.add_argument("--json", action="store_true", help="print one JSON object")
     _pto.add_unit_options(p, damping=False)
 
@@ -92,42 +98,21 @@ def add_parsers(sub) -> None:
     p.add_argument("--to", dest="n_to", type=_int, default=64,
                    help=f"largest N, at most {limits.MAX_TABLE_HARMONICS} (default 64)")
     p.add_argument("--plot", metavar="PNG", help="draw power against N (PNG, SVG or PDF)")
-    p.add_argument("--save", metavar="NC", help="write the table as a NetCDF file (.nc)")
+    p.add_argument("--save", metavar="FILE",
+                   help="write the table: .csv (with a row of units), .nc or .json")
     p.add_argument("--json", action="store_true", help="print one JSON object")
     _pto.add_unit_options(p)
 
 
 def _cmd_optimize(a) -> dict | str:
-    from ..api import motion_samples
-
     _check_output(a.plot, "--plot", FIGURE_SUFFIXES)
-    _check_output(a.save, "--save", (".csv",))
-    if a.method == "all" and (a.save or a.plot):
-        raise ParameterError("--method all: --save and --plot need a single method "
-                             "(fourier or bvp)")
+    _check_output(a.save, "--save", SAVE_TABLE)
     r = _run(a)
+    _plot_and_save(r, a)
     if a.method == "all":
         return _optimize_all(a, r)
     pto = r.unconstrained_power is not None
     units = None if r.units is None else _pto.units_of(r)
-    if a.save:
-        s = motion_samples(r)
-        cols = ["t", "tau", "theta", "theta_dot", "torque"]
-        s["power"] = -s["torque"] * s["theta_dot"]
-        cols.append("power")
-        if r.efficiency_generating is not None:
-            p = s["power"]
-            s["electrical_power"] = [x * r.efficiency_generating if x > 0
-                                     else x / r.efficiency_motoring for x in p]
-            cols.append("electrical_power")
-        _output.write_columns(a.save, {c: s[c] for c in cols})
-    if a.plot:
-        if pto:
-            from ..pto import plot_pto_profile as plot_fn
-        else:
-            from ..plotting import plot_optimum as plot_fn
-
-        _output.plot(plot_fn, r, a.plot, units=units)
     if a.json:
         return r.to_dict()
     name = (f"Fourier optimum, N = {r.harmonics} (Eq. 10)" if r.method == "fourier"
@@ -217,7 +202,7 @@ def _gain(p, pu) -> str:
 
 def _optimize_all(a, rec) -> dict | str:
     """Uniform, Fourier, BVP (gamma > 0 only) and limit for one case."""
-    f, b = rec._fourier, rec._bvp
+    f, b = rec.fourier_result, rec.bvp_result
     if a.json:
         return rec.to_dict()
     rows = [[f"best uniform rotation at gamma = {f.gamma:g} (Eq. 17)",
@@ -240,7 +225,7 @@ def _optimize_all(a, rec) -> dict | str:
     if b is not None:
         out += ["", f"Fourier - BVP: {f.power - b.power:+.3e}  (agree when N resolves the "
                     "boundary layers)"]
-    return "\n".join(out)
+    return "\n".join(out + _written(a))
 
 
 def _count(r) -> str:
@@ -253,7 +238,10 @@ def _count(r) -> str:
 
 
 def _cmd_threshold(a) -> dict | str:
+    _check_output(a.plot, "--plot", FIGURE_SUFFIXES)
+    _check_output(a.save, "--save", SAVE_TABLE)
     r = _run(a)
+    _plot_and_save(r, a)
     if a.json:
         return r.to_dict()
     si = []
@@ -270,7 +258,7 @@ def _cmd_threshold(a) -> dict | str:
         f"uniform-rotation threshold: {_fmt(r.uniform_threshold, 10)}  (|Q1| / 2 omega)",
         f"status: {r.status} (N = {r.harmonics}, {r.iterations} Newton steps in gamma; "
         f"change from N/2: {_fmt(r.refinement_change, 3)})",
-        *si])
+        *si, *_written(a)])
 
 
 def _si_table(ds, coord: str, cols) -> str:
@@ -280,23 +268,26 @@ def _si_table(ds, coord: str, cols) -> str:
     return "in SI units:\n" + _table(rows, [coord] + [h for _, h in cols])
 
 
-def _plot_and_save(ds, a, plotter: str) -> None:
-    """``--plot`` with ``parapend.plotting.<plotter>`` and ``--save`` of a Dataset."""
-    if a.plot:
-        from .. import plotting
+def _written(a) -> list[str]:
+    return ([f"result written to {a.save}"] if a.save else []) + (
+        [f"figure written to {a.plot}"] if a.plot else [])
 
-        _output.plot(getattr(plotting, plotter), ds, a.plot, units=_pto.units_of(ds))
+
+def _plot_and_save(r, a) -> None:
+    """``--plot`` and ``--save`` of a result (:mod:`parapend.results`)."""
+    if a.plot:
+        _output.save_plot(r, a.plot)
     if a.save:
-        _output.write_dataset(ds, a.save)
+        _output.save_result(r, a.save)
 
 
 def _cmd_damping_sweep(a) -> dict | str:
     _check_output(a.plot, "--plot", FIGURE_SUFFIXES)
-    _check_output(a.save, "--save", (".nc",))
+    _check_output(a.save, "--save", SAVE_TABLE)
     ds = _run(a, progress=_Progress("damping sweep"))
-    _plot_and_save(ds, a, "plot_damping_sweep")
+    _plot_and_save(ds, a)
     if a.json:
-        return _dataset_json(ds)
+        return ds.to_dict()
     rows = [[_fmt(g), _fmt(p), _fmt(u), f"{t:.4g}" + ("*" if g == 0 else ""), str(s)]
             for g, p, u, t, s in zip(
         ds["gamma"].values, ds["power"].values, ds["uniform_power"].values,
@@ -323,11 +314,11 @@ def _cmd_damping_sweep(a) -> dict | str:
 
 def _cmd_harmonics(a) -> dict | str:
     _check_output(a.plot, "--plot", FIGURE_SUFFIXES)
-    _check_output(a.save, "--save", (".nc",))
+    _check_output(a.save, "--save", SAVE_TABLE)
     ds = _run(a, progress=_Progress("harmonics"))
-    _plot_and_save(ds, a, "plot_harmonic_table")
+    _plot_and_save(ds, a)
     if a.json:
-        return _dataset_json(ds)
+        return ds.to_dict()
     rows = [[str(n), _fmt(p, 8), str(s), "global" if g else "continued"]
             for n, p, s, g in zip(ds["harmonics"].values, ds["power"].values,
                                   ds["status"].values, ds["global_search"].values)]

@@ -128,7 +128,7 @@ def _cmd_power_matrix(a) -> dict | str:
     argv = sys.argv[1:] if sys.argv and sys.argv[0] else []
     rec = _run(a, command="parapend " + " ".join(shlex.quote(x) for x in argv),
                progress=_EtaProgress("power-matrix"))
-    ds = rec._dataset
+    ds = rec.dataset
     drawn = []
     if a.plot:
         _output.plot(figures.plot_matrix, ds, f"{a.plot}-matrix.png")

@@ -9,9 +9,9 @@ from ..defaults import GAMMA
 from . import _output
 from ._common import (
     FIGURE_SUFFIXES,
+    SAVE_TABLE,
     _add_excitation,
     _check_output,
-    _dataset_json,
     _finite_float,
     _fmt,
     _int,
@@ -194,23 +194,22 @@ def add_parsers(sub) -> None:
     add_pto_options(p)
     add_unit_options(p)
     p.add_argument("--plot", metavar="PNG", help="draw the curve (PNG, SVG or PDF)")
-    p.add_argument("--save", metavar="NC", help="write the curve as a NetCDF file (.nc)")
+    p.add_argument("--save", metavar="FILE",
+                   help="write the curve: .csv (with a row of units), .nc or .json")
     p.add_argument("--json", action="store_true", help="print one JSON object")
 
 
 def _cmd_pto_curve(a) -> dict | str:
-    from ..pto import plot_pto_curve
-
     _check_output(a.plot, "--plot", FIGURE_SUFFIXES)
-    _check_output(a.save, "--save", (".nc",))
+    _check_output(a.save, "--save", SAVE_TABLE)
     ds = _run(a, progress=_Progress("pto-curve"))
     units = ds.attrs.get("power_unit_w")
     if a.plot:
-        _output.plot(plot_pto_curve, ds, a.plot, units=units_of(ds))
+        _output.save_plot(ds, a.plot)
     if a.save:
-        _output.write_dataset(ds, a.save)
+        _output.save_result(ds, a.save)
     if a.json:
-        return _dataset_json(ds)
+        return ds.to_dict()
     name = "T_max" if a.vary == "torque-limit" else "eta"
     rows = [[f"{v:.6g}", _fmt(p, 8), _fmt(e, 8), "-" if math.isnan(u) else _fmt(u, 8),
              f"{t:.5g}" + ("*" if c == 0 else ""), _fmt(m), str(s)]

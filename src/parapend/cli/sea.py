@@ -5,6 +5,7 @@ from __future__ import annotations
 from . import _output
 from ._common import (
     FIGURE_SUFFIXES,
+    SAVE_TABLE,
     _check_output,
     _finite_float,
     _fmt,
@@ -47,23 +48,21 @@ def add_parsers(sub) -> None:
     g.add_argument("--harmonics", type=_int, default=None,
                    help="N (default 16 per mean wave, then checked at 2N)")
     p.add_argument("--plot", metavar="PNG", help="draw the record, the motion and the energy")
-    p.add_argument("--save", metavar="CSV",
-                   help="write t,z,q,theta,theta_dot,power,energy over the record")
+    p.add_argument("--save", metavar="FILE",
+                   help="write the record and the motion over it (time_s, heave_m, q, theta, "
+                        "theta_dot_rad_per_s, power_w, energy_j, uniform_energy_j) and the "
+                        "result's scalars: .csv (with a row of units), .nc or .json")
     p.add_argument("--json", action="store_true", help="print one JSON object")
 
 
 def _cmd_sea(a) -> dict | str:
-    from ..irregular import plot_sea, sea_samples
-
     _check_output(a.plot, "--plot", FIGURE_SUFFIXES)
-    _check_output(a.save, "--save", (".csv",))
+    _check_output(a.save, "--save", SAVE_TABLE)
     r = _run(a)
     if a.save:
-        s = sea_samples(r)
-        cols = ["t", "z", "q", "theta", "theta_dot", "power", "energy"]
-        _output.write_columns(a.save, {c: s[c] for c in cols})
+        _output.save_result(r, a.save)
     if a.plot:
-        _output.plot(plot_sea, r, a.plot)
+        _output.save_plot(r, a.plot)
     if a.json:
         return r.to_dict()
     rec, u = r.record, r.units

@@ -77,7 +77,8 @@ def add_parsers(sub) -> None:
                    help=f"N of every solve, at most {limits.MAP_MAX_HARMONICS} (default 24)")
     p.add_argument("--threshold", action="store_true",
                    help="also compute gamma* at every (omega, delta): several solves each")
-    p.add_argument("--store", default="map.zarr",
+    # default None, as parapend.sweep's (which then writes nothing); _cmd_sweep names the file
+    p.add_argument("--store", default=None,
                    help="Zarr store (a directory; default map.zarr), resumed if it holds "
                         "this sweep")
     p.add_argument("--overwrite", action="store_true",
@@ -128,8 +129,10 @@ def _command_line() -> str:
 
 def _cmd_sweep(a) -> dict | str:
     _check_output(a.netcdf, "--netcdf", (".nc",))
+    if a.store is None:
+        a.store = SWEEP_STORE
     rec = _run(a, command=_command_line(), progress=_EtaProgress("sweep"))
-    run, out = rec._run, rec.to_dict()
+    run, out = rec.run, rec.to_dict()
     counts, best = out["status_counts"], out["largest_power"]
     if a.json:
         return out
@@ -159,7 +162,7 @@ def _cmd_map(a) -> dict | str:
     _check_output(a.plot, "--plot", FIGURE_SUFFIXES)
     rec = _run(a)
     out = rec.to_dict()
-    xn, yn, title, label = out["x"], out["y"], out["fixed"], rec._label
+    xn, yn, title, label = out["x"], out["y"], out["fixed"], rec.label
     finite = out["min"] is not None
     if a.json:
         return out
@@ -175,5 +178,9 @@ def _cmd_map(a) -> dict | str:
                  "computed (grey)")
     return "\n".join(lines)
 
+
+#: the store of ``parapend sweep`` without --store (the Python function's default is None:
+#: in memory, nothing written)
+SWEEP_STORE = "map.zarr"
 
 COMMANDS = {"sweep": _cmd_sweep, "map": _cmd_map}

@@ -32,7 +32,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..errors import ParameterError, check_range
-from .closedloop import Diverged, run_closed_loop
+from .closedloop import Diverged, held_torque_step, run_closed_loop
 
 __all__ = ["BaselineRun", "electrical_work", "extremum_baseline", "tracker_baseline",
            "BASELINES"]
@@ -217,18 +217,7 @@ def extremum_baseline(q, *, peak_omega: float, gamma: float, t_end: float,
             break
         base = 2 * SUBSTEPS * k
         for s in range(SUBSTEPS):
-            i = base + 2 * s
-            qa, qb, qc = qgl[i], qgl[i + 1], qgl[i + 2]
-            a1 = om
-            b1 = (1.0 + qa) * sin(th) - gamma * om + u
-            a2 = om + 0.5 * dt * b1
-            b2 = (1.0 + qb) * sin(th + 0.5 * dt * a1) - gamma * a2 + u
-            a3 = om + 0.5 * dt * b2
-            b3 = (1.0 + qb) * sin(th + 0.5 * dt * a2) - gamma * a3 + u
-            a4 = om + dt * b3
-            b4 = (1.0 + qc) * sin(th + dt * a3) - gamma * a4 + u
-            th += dt / 6.0 * (a1 + 2 * a2 + 2 * a3 + a4)
-            om += dt / 6.0 * (b1 + 2 * b2 + 2 * b3 + b4)
+            th, om = held_torque_step(th, om, u, qgl, base + 2 * s, dt, gamma)
         if not -1e12 < om < 1e12:
             return _failed("extremum", "diverged", f"|theta'| unbounded at sample {k}", {})
     t = h * np.arange(n + 1)

@@ -71,6 +71,27 @@ def wrap(x: float) -> float:
     return (x + math.pi) % (2 * math.pi) - math.pi
 
 
+def held_torque_step(th: float, om: float, u: float, qg, i: int, dt: float,
+                     gamma: float) -> tuple[float, float]:
+    """One classical Runge-Kutta step of length ``dt`` of Eq. 14 under the torque ``u`` held
+    constant (the sampled controller's zero-order hold): ``qg[i]``, ``qg[i + 1]`` and
+    ``qg[i + 2]`` are ``q`` at the step's start, middle and end, ``gamma`` the plant's
+    damping. Returns ``(theta, theta')`` at the step's end (floats, a plain Python loop's
+    arithmetic: the closed loops call it once a substep)."""
+    sin = math.sin
+    qa, qb, qc = qg[i], qg[i + 1], qg[i + 2]
+    a1 = om
+    b1 = (1.0 + qa) * sin(th) - gamma * om + u
+    a2 = om + 0.5 * dt * b1
+    b2 = (1.0 + qb) * sin(th + 0.5 * dt * a1) - gamma * a2 + u
+    a3 = om + 0.5 * dt * b2
+    b3 = (1.0 + qb) * sin(th + 0.5 * dt * a2) - gamma * a3 + u
+    a4 = om + dt * b3
+    b4 = (1.0 + qc) * sin(th + dt * a3) - gamma * a4 + u
+    return (th + dt / 6.0 * (a1 + 2 * a2 + 2 * a3 + a4),
+            om + dt / 6.0 * (b1 + 2 * b2 + 2 * b3 + b4))
+
+
 def run_closed_loop(target, gains, *, periods: int, torque_limit: float | None,
                     plant_q, plant_gamma: float, state0=(math.pi, 0.0),
                     noise=(0.0, 0.0), rng=None, pump_level: float = 1.0,
@@ -124,7 +145,6 @@ def run_closed_loop(target, gains, *, periods: int, torque_limit: float | None,
     out_t = [0.0] * (nk + 1)
     out_mode = [0] * (nk + 1)
     mode, braking, astray = (TRACK if start_tracking else PUMP), False, 0
-    sin = math.sin
     for k in range(nk + 1):
         out_th[k], out_om[k] = th, om
         y0, y1 = th + nz_th[k], om + nz_om[k]
@@ -152,18 +172,7 @@ def run_closed_loop(target, gains, *, periods: int, torque_limit: float | None,
             break
         base = 2 * substeps * k
         for s in range(substeps):
-            i = base + 2 * s
-            qa, qb, qc = qg[i], qg[i + 1], qg[i + 2]
-            a1 = om
-            b1 = (1.0 + qa) * sin(th) - gamma_p * om + u
-            a2 = om + 0.5 * dt * b1
-            b2 = (1.0 + qb) * sin(th + 0.5 * dt * a1) - gamma_p * a2 + u
-            a3 = om + 0.5 * dt * b2
-            b3 = (1.0 + qb) * sin(th + 0.5 * dt * a2) - gamma_p * a3 + u
-            a4 = om + dt * b3
-            b4 = (1.0 + qc) * sin(th + dt * a3) - gamma_p * a4 + u
-            th += dt / 6.0 * (a1 + 2 * a2 + 2 * a3 + a4)
-            om += dt / 6.0 * (b1 + 2 * b2 + 2 * b3 + b4)
+            th, om = held_torque_step(th, om, u, qg, base + 2 * s, dt, gamma_p)
             if not -DIVERGED_SPEED < om < DIVERGED_SPEED:  # also NaN
                 raise Diverged(k)
     t = h * np.arange(nk + 1)

@@ -27,7 +27,9 @@ def plot_track(result, path=None, zoom_periods: int = 3):
     from ..plotting import _finish, plt
     from ..style import figure_style
 
-    run, tg = result._run, result._target
+    run, tg = result.run, result.target
+    units = result.physical_units  # torque in N m, energy in J, an SI title: SI given
+    kt = 1.0 if units is None else units.torque
     m = tg.samples
     per = run.t / tg.period
     k = np.arange(run.t.size)
@@ -61,11 +63,12 @@ def plot_track(result, path=None, zoom_periods: int = 3):
                        fontsize=9)
         a_zoom.set_title(f"last {zoom} period{'s' if zoom > 1 else ''} {key}", fontsize=9)
         for ax, sel in ((t_up, first), (t_zoom, last)):
-            ax.plot(per[sel], run.torque[sel], lw=1.0, color="C2", drawstyle="steps-post")
+            ax.plot(per[sel], kt * run.torque[sel], lw=1.0, color="C2",
+                    drawstyle="steps-post")
             if result.torque_limit is not None:
                 for s in (1, -1):
-                    ax.axhline(s * result.torque_limit, color="k", ls="--", lw=0.7)
-            ax.set_ylabel("torque $T$ ($mgl$)")
+                    ax.axhline(s * kt * result.torque_limit, color="k", ls="--", lw=0.7)
+            ax.set_ylabel("torque $T$ ($mgl$)" if units is None else "torque $T$ (N m)")
             ax.set_xlabel("time (forcing periods)")
         a_up.set_xlim(0, per[first][-1])
         a_zoom.set_xlim(per[last][0], per[-1])
@@ -83,21 +86,33 @@ def plot_track(result, path=None, zoom_periods: int = 3):
         a_err.set_xlabel("time (forcing periods)")
         a_err.legend(loc="best")
         ends = m * np.arange(n + 1)
-        a_w.plot(per[ends], w[ends], ".-", ms=3, color="C0", lw=1.0,
+        ke = 1.0 if units is None else units.energy
+        a_w.plot(per[ends], ke * w[ends], ".-", ms=3, color="C0", lw=1.0,
                  label="extracted energy $W$ at the end of each period")
         if locked:
             tl = int(result.lock_period)
-            a_w.plot(per[tl * m:], w[tl * m] + tg.power * (run.t[tl * m:] - run.t[tl * m]),
-                     "k:", lw=1, label=f"predicted $P = {tg.power:.5g}$ from the lock")
+            pred = (f"$P = {tg.power:.5g}$" if units is None
+                    else f"$P$ = {units.to_watts(tg.power):.4g} W")
+            a_w.plot(per[tl * m:], ke * (w[tl * m] + tg.power * (run.t[tl * m:]
+                                                               - run.t[tl * m])),
+                     "k:", lw=1, label=f"predicted {pred} from the lock")
             for a in (a_up, t_up, a_err, a_w):
                 a.axvline(tl, color="gray", lw=0.7)
         a_w.axhline(0, color="gray", lw=0.5)
-        a_w.set_ylabel("energy $W$ ($mgl$)")
+        a_w.set_ylabel("energy $W$ ($mgl$)" if units is None else "energy $W$ (J)")
         a_w.set_xlabel("time (forcing periods)")
         a_w.legend(loc="best")
         a_err.set_xlim(0, per[-1])
-        fig.suptitle(f"track: $\\gamma$ = {result.gamma:g}, $\\omega$ = {result.omega:g}, "
-                     f"$T_{{\\max}}$ = {_num(result.torque_limit)}; "
+        if units is None:
+            case = (f"$\\gamma$ = {result.gamma:g}, $\\omega$ = {result.omega:g}, "
+                    f"$T_{{\\max}}$ = {_num(result.torque_limit)}")
+        else:
+            from ..plotting import si_title
+
+            case = si_title(result, units) + ", $T_{\\max}$ = " + (
+                "none" if result.torque_limit is None
+                else f"{units.to_newton_metres(result.torque_limit):.4g} N m")
+        fig.suptitle(f"track: {case}; "
                      + (f"locked after {result.lock_period} periods" if locked
                         else "not locked"), fontsize=10)
         return _finish(fig, path, layout=False)
@@ -105,3 +120,48 @@ def plot_track(result, path=None, zoom_periods: int = 3):
 
 def _num(x) -> str:
     return "none" if x is None else f"{x:.4g}"
+
+
+def plot_mpc_track(result, zoom_periods: float = 3.0):
+    """A receding-horizon run: ``theta - omega t``, the held torque with ``+-T_max``, the
+    excitation ``q`` and the cumulative harvested energy, against time in forcing periods
+    (the whole run on the left, the last ``zoom_periods`` on the right).
+
+    ``result`` is a ``track --controller mpc`` result (``run``, ``q``, ``omega``) or a bare
+    :class:`~parapend.control.mpc.MPCResult` (no ``q`` panel then)."""
+    from ..plotting import _finish, plt
+    from ..style import figure_style
+
+    run = getattr(result, "run", result)
+    omega = getattr(result, "omega", None) or 2 * math.pi / max(run.t[-1], 1e-12)
+    period = 2 * math.pi / omega
+    per = run.t / period
+    held = np.append(run.torque, run.torque[-1])
+    work = np.concatenate(([0.0], np.cumsum(run.power_series) * run.dt))
+    q = result.q(run.t) if hasattr(result, "q") and callable(result.q) else None
+    last = per >= per[-1] - zoom_periods - 1e-9
+    rows = 4 if q is not None else 3
+    with figure_style():
+        fig, axes = plt.subplots(rows, 2, figsize=(9.0, 2.2 * rows + 1), sharex="col",
+                                 layout="constrained")
+        for col, sel in ((0, slice(None)), (1, last)):
+            a = axes[:, col]
+            a[0].plot(per[sel], run.theta[sel] - omega * run.t[sel], lw=1.0, color="C0")
+            a[0].set_ylabel(r"$\theta - \omega t$ (rad)")
+            a[1].step(per[sel], held[sel], where="post", lw=0.9, color="C2")
+            if result.torque_limit is not None:
+                for s in (1, -1):
+                    a[1].axhline(s * result.torque_limit, color="k", ls="--", lw=0.7)
+            a[1].set_ylabel("torque $T$ ($mgl$)")
+            a[2].plot(per[sel], work[sel], lw=1.0, color="C1")
+            a[2].set_ylabel("energy $W$ ($mgl$)")
+            if q is not None:
+                a[3].plot(per[sel], q[sel], lw=0.8, color="C4")
+                a[3].set_ylabel("$q$ (base acc./g)")
+            a[-1].set_xlabel("time (forcing periods)")
+        axes[0, 0].set_title("whole run", fontsize=9)
+        axes[0, 1].set_title(f"last {zoom_periods:g} periods", fontsize=9)
+        fig.suptitle(f"receding-horizon control ({result.forecast} forecast): mean power "
+                     f"{result.mean_power:.5g} ($mgl/t_0$), {result.failed_solves} of "
+                     f"{result.solves} solves failed", fontsize=10)
+        return _finish(fig, None, layout=False)

@@ -38,7 +38,7 @@ MAX_RECORDS = 20
 MAX_HORIZONS = 16
 
 
-@dataclass(frozen=True, eq=False)
+@dataclass(frozen=True, eq=False, repr=False)
 class HorizonResult(_Result):
     """Mean power against horizon (fields = JSON keys of ``parapend horizon --json``).
 
@@ -109,6 +109,15 @@ class HorizonResult(_Result):
     convention: str = ("power positive when harvested; mean over the whole record from "
                        "the hanging rest; fractions of the record's non-causal optimum "
                        "(sea) and of its gamma -> 0 limit")
+
+    command = "horizon"
+    headline = ("horizons", "mpc_fraction_mean", "baseline_fraction_mean", "status")
+
+    def _series(self):
+        return horizon_dataset(self)
+
+    def _figure(self):
+        return plot_horizon(self)
 
 
 def _names(value, allowed, what):

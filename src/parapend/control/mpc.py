@@ -51,7 +51,7 @@ MAX_ITER = 200
 CATCH_MARGIN = 0.05
 
 
-@dataclass(frozen=True, eq=False)
+@dataclass(frozen=True, eq=False, repr=False)
 class MPCResult(_Result):
     """One receding-horizon run (non-dimensional, pendulum units; theta from the upright).
 
@@ -109,6 +109,27 @@ class MPCResult(_Result):
     convention: str = ("theta from the upright (hanging at rest is theta = pi); power "
                        "positive when harvested, P = -<T theta'>; torque units m g l")
     extra: dict = field(default_factory=dict)
+
+    command = "mpc"
+    headline = ("mean_power", "mean_electrical_power", "solves", "failed_solves", "status")
+
+    def to_dict(self) -> dict:
+        """The scalars (the series are in :meth:`to_dataset`)."""
+        return {k: v for k, v in super().to_dict().items() if not isinstance(v, list)}
+
+    def _series(self):
+        from ..results import series
+
+        pad = np.append  # sample k's torque and power hold over [t_k, t_k+1)
+        return series({"time": self.t, "theta": self.theta, "theta_dot": self.theta_dot,
+                       "torque": pad(self.torque, np.nan),
+                       "power": pad(self.power_series, np.nan),
+                       "electrical_power": pad(self.electrical_series, np.nan)})
+
+    def _figure(self):
+        from .figures import plot_mpc_track
+
+        return plot_mpc_track(self)
 
 
 def _q_function(q_record):
@@ -469,7 +490,7 @@ TRACK_SAMPLES = 64
 WARMUP_PERIODS = 10
 
 
-@dataclass(frozen=True, eq=False)
+@dataclass(frozen=True, eq=False, repr=False)
 class MPCTrackResult(_Result):
     """``parapend track --controller mpc`` (fields = JSON keys).
 
@@ -530,6 +551,42 @@ class MPCTrackResult(_Result):
     _run: object = field(default=None, repr=False)
     _q: object = field(default=None, repr=False)
 
+    command = "track"
+    headline = ("mean_power", "mean_power_w", "run_power", "record_power", "failed_solves",
+                "status")
+
+    @property
+    def run(self):
+        """The receding-horizon run (:class:`MPCResult`: ``t``, ``theta``, ``theta_dot``,
+        ``torque`` held over each sample, the power of each sample), non-dimensional."""
+        return self._run
+
+    def q(self, t):
+        """The plant's excitation ``q(t)`` (base acceleration over g) at times ``t``."""
+        return self._q(t)
+
+    @property
+    def physical_units(self):
+        """The pendulum's :class:`~parapend.units.Units` (None without length and mass)."""
+        from ..units import Units
+
+        return Units.from_description(self.units)
+
+    def _series(self):
+        from ..results import series
+
+        r = self._run
+        pad = np.append  # the torque and power of sample k hold over [t_k, t_k+1)
+        return series({"time": r.t, "theta": r.theta, "theta_dot": r.theta_dot,
+                       "torque": pad(r.torque, np.nan), "power": pad(r.power_series, np.nan),
+                       "q": self._q(r.t)}, self.physical_units)
+
+    def _figure(self):
+        from ..units import si_figure
+        from .figures import plot_mpc_track
+
+        return si_figure(plot_mpc_track(self), self.physical_units)
+
 
 def track_mpc(excitation, *, gamma, horizon=2.0, update_interval=0.03125, forecast="perfect",
               torque_limit=None, efficiency=None, periods=100, seed=0, irregular=False,
@@ -556,6 +613,8 @@ def track_mpc(excitation, *, gamma, horizon=2.0, update_interval=0.03125, foreca
         rng = np.random.default_rng(seed)
         rms = math.sqrt(float(np.mean(excitation.q_uniform(1024) ** 2)))
         sea, sea_info = design_sea(omega, rms, int(rng.integers(0, 2**63 - 1)))
+        # the seed the user gave; the record's phases come from the one it drew
+        sea_info = {**sea_info, "seed": seed, "record_seed": sea_info["seed"]}
         qf = _on_grid(sea, SEA_WAVES * 2 * samples * PLANT_STEPS)
     else:
         qf = excitation.q

@@ -23,7 +23,7 @@ from .track import AVERAGE_PERIODS, simulate_design
 __all__ = ["RobustnessResult", "track_runs"]
 
 
-@dataclass(frozen=True, eq=False)
+@dataclass(frozen=True, eq=False, repr=False)
 class RobustnessResult(_Result):
     """A seeded batch (fields = JSON keys of ``parapend track --runs N --json``).
 
@@ -72,6 +72,50 @@ class RobustnessResult(_Result):
     peak_torque_nm: float | None = None
     torque_limit_nm: float | None = None
     period_s: float | None = None
+
+    command = "track"
+    headline = ("runs", "fraction_locked", "mean_power", "mean_power_w", "predicted_power")
+
+    def _series(self):
+        import numpy as np
+        import xarray as xr
+
+        ds = xr.Dataset({"run_power": ("run", np.asarray(self.run_power, dtype=float)),
+                         "run_locked": ("run", np.asarray(self.run_locked, dtype=bool)),
+                         "run_gamma_error": ("run", np.asarray(self.run_gamma_error,
+                                                               dtype=float)),
+                         "run_delta_error": ("run", np.asarray(self.run_delta_error,
+                                                               dtype=float))},
+                        coords={"run": np.arange(len(self.run_power))})
+        ds["run_lock_period"] = ("run", np.asarray(
+            [np.nan if v is None else v for v in self.run_lock_period], dtype=float))
+        return ds
+
+    def _figure(self):
+        """Mean power of each run against its plant's damping error, locked runs filled."""
+        import numpy as np
+
+        from ..plotting import plt
+        from ..style import figure_style
+
+        p = np.asarray(self.run_power, dtype=float)
+        locked = np.asarray(self.run_locked, dtype=bool)
+        g = np.asarray(self.run_gamma_error, dtype=float)
+        with figure_style():
+            fig, ax = plt.subplots(figsize=(6.5, 4.2))
+            ax.plot(g[locked], p[locked], "o", color="C0", label="locked")
+            ax.plot(g[~locked], p[~locked], "o", mfc="none", color="C3", label="not locked")
+            ax.axhline(self.predicted_power, color="k", ls="--", lw=0.8,
+                       label=f"predicted {self.predicted_power:.4g}")
+            ax.set_xlabel(r"damping error of the plant, $\Delta\gamma$")
+            ax.set_ylabel(r"mean power, last 10 periods ($mgl/t_0$)")
+            ax.set_title(f"track: {self.runs} runs, {100 * self.fraction_locked:.3g} % "
+                         f"locked", fontsize=10)
+            ax.legend(loc="best")
+            fig.tight_layout()
+        from ..units import Units, si_figure
+
+        return si_figure(fig, Units.from_description(self.units))
 
 
 def track_runs(*, runs: int = 20, seed: int = 0, periods: int = 100, torque_limit=None,

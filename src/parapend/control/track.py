@@ -35,7 +35,7 @@ SAMPLES = 256
 AVERAGE_PERIODS = 10
 
 
-@dataclass(frozen=True, eq=False)
+@dataclass(frozen=True, eq=False, repr=False)
 class TrackResult(_Result):
     """One closed-loop run (fields = JSON keys of ``parapend track --json``).
 
@@ -123,6 +123,41 @@ class TrackResult(_Result):
     _run: object = field(default=None, repr=False)
     _target: object = field(default=None, repr=False)
     _lqr: object = field(default=None, repr=False)
+
+    command = "track"
+    headline = ("mean_power", "mean_power_w", "predicted_power", "locked", "lock_period",
+                "status")
+
+    @property
+    def run(self):
+        """The closed-loop run (:class:`~parapend.control.closedloop.ClosedLoopRun`: ``t``,
+        ``theta``, ``theta_dot``, ``torque``, ``q``, ``mode``), non-dimensional."""
+        return self._run
+
+    @property
+    def target(self):
+        """The target orbit (:class:`~parapend.control.target.Target`)."""
+        return self._target
+
+    @property
+    def physical_units(self):
+        """The pendulum's :class:`~parapend.units.Units` (None without length and mass)."""
+        from ..units import Units
+
+        return Units.from_description(self.units)
+
+    def _series(self):
+        from ..results import series
+
+        r = self._run
+        return series({"time": r.t, "theta": r.theta, "theta_dot": r.theta_dot,
+                       "torque": r.torque, "q": r.q}, self.physical_units)
+
+    def _figure(self):
+        from ..units import si_figure
+        from .figures import plot_track
+
+        return si_figure(plot_track(self), self.physical_units)
 
 
 def _multipliers(ev) -> list:
@@ -309,12 +344,15 @@ def simulate_design(d: Design, *, periods: int, seed: int = 0, gamma_error: floa
                     lock_tolerance: float = 0.1, state0=(math.pi, 0.0), rng=None):
     """One closed-loop run of a prepared design; returns ``(run, fields)``."""
     tg = d.target
+    given = rng is None  # the run's generator is the user's seed (not a batch's stream)
     rng = np.random.default_rng(seed) if rng is None else rng
     plant_gamma = tg.gamma * (1.0 + gamma_error)
     sea_info = None
     if irregular:
         rms = math.sqrt(float(np.mean(tg.excitation.q_uniform(1024) ** 2)))
         sea, sea_info = design_sea(tg.omega, rms, int(rng.integers(0, 2**63 - 1)))
+        if given:  # the seed the user gave; the record's phases come from the one it drew
+            sea_info = {**sea_info, "seed": seed, "record_seed": sea_info["seed"]}
         base_q = _on_grid(sea, SEA_WAVES * 8 * tg.samples)
     else:
         base_q = tg.excitation.q

@@ -43,7 +43,7 @@ import numpy as np
 
 from ..errors import ParameterError, check_int, check_range
 from ..results import _Result
-from .result import _attr, _solve
+from .result import _solve
 
 __all__ = ["BuoyMPCResult", "buoy_mpc", "record_force"]
 
@@ -61,7 +61,7 @@ RESOLVED = 0.5
 CONTROLLERS = ("coupled", "fixed-point", "one-way")
 
 
-@dataclass(frozen=True, eq=False)
+@dataclass(frozen=True, eq=False, repr=False)
 class BuoyMPCResult(_Result):
     """One closed-loop run of the receding-horizon controller on the buoy (SI units).
 
@@ -130,30 +130,54 @@ class BuoyMPCResult(_Result):
     convention: str = ("theta from the upright (hanging at rest is theta = pi), z up from "
                        "the static equilibrium; power positive when harvested, "
                        "P = -<tau theta'>")
-    _series: dict = field(default=None, repr=False)
+    _samples: dict = field(default=None, repr=False)
     _plant: object = field(default=None, repr=False)
+
+    command = "buoy"
+    headline = ("mean_power_w", "electrical_power_w", "stored_w", "failed_solves", "status")
 
     @property
     def series(self) -> dict:
         """``t`` (s, sample times), ``theta``, ``theta_dot``, ``z``, ``z_dot`` there,
         ``torque`` (N m, held over ``[t_k, t_k+1)``) and ``power`` (W, each sample's mean)."""
-        return self._series
+        return self._samples
 
-    def to_dataset(self):
-        """The series as an ``xarray.Dataset`` (the torque's last value ``nan``: no interval)."""
+    def _series(self):
+        """The series (SI; the torque's and power's last value ``nan``: no interval)."""
         import xarray as xr
 
-        s = self._series
-        tq = np.append(s["torque"], np.nan)
-        pw = np.append(s["power"], np.nan)
-        units = {"theta": "rad", "theta_dot": "rad/s", "z": "m", "z_dot": "m/s"}
-        ds = xr.Dataset({k: ("t", s[k], {"units": u}) for k, u in units.items()},
-                        coords={"t": ("t", s["t"], {"units": "s"})})
-        ds["torque"] = ("t", tq, {"units": "N m", "hold": "over [t, t + dt)"})
-        ds["power"] = ("t", pw, {"units": "W"})
-        for k, v in self.to_dict().items():
-            ds.attrs[k] = _attr(v)
+        s = self._samples
+        cols = {"theta": s["theta"], "theta_dot_rad_per_s": s["theta_dot"],
+                "heave_m": s["z"], "heave_speed_m_per_s": s["z_dot"],
+                "torque_nm": np.append(s["torque"], np.nan),
+                "power_w": np.append(s["power"], np.nan)}
+        ds = xr.Dataset({k: ("time_s", v) for k, v in cols.items()},
+                        coords={"time_s": s["t"]})
+        ds["torque_nm"].attrs["hold"] = "over [t, t + dt)"
         return ds
+
+    def _figure(self):
+        """Heave, held torque and harvested energy against time."""
+        from ..plotting import plt
+        from ..style import figure_style
+
+        s = self._samples
+        t = np.asarray(s["t"])
+        e = np.concatenate(([0.0], np.cumsum(np.asarray(s["power"]) * np.diff(t))))
+        with figure_style():
+            fig, ax = plt.subplots(3, 1, figsize=(7, 7), sharex=True)
+            ax[0].plot(t, s["z"], lw=1.0, color="C1")
+            ax[0].set_ylabel("heave z (m)")
+            ax[1].step(t, np.append(s["torque"], s["torque"][-1]), where="post", lw=0.8,
+                       color="C3")
+            ax[1].set_ylabel(r"torque $\tau$ (N m)")
+            ax[2].plot(t, e, lw=1.0, color="C0")
+            ax[2].set_ylabel("harvested energy (J)")
+            ax[2].set_xlabel("time t (s)")
+            ax[0].set_title(f"buoy, {self.controller}: mean power {self.mean_power_w:.4g} W "
+                            f"over the averaging window", fontsize=10)
+            fig.tight_layout()
+        return fig
 
 
 def _periodic(coefs, omega, period, points, count):
@@ -650,7 +674,7 @@ def buoy_mpc(hydro, pendulum, wave, *, peak_period, horizon=2.0, update_interval
                   "damping_coefficient_nm_s_per_rad": pendulum.damping_coefficient},
         units={"time_s": t0, "torque_nm": tu, "power_w": tu / t0, "a_inf_kg": plant.a_inf,
                "memory_s": plant.nk * h, "plant_step_s": h},
-        _series=series, _plant=plant)
+        _samples=series, _plant=plant)
 
 
 def mpc_command(hydro, pendulum, wave, info, *, controller, horizon, update_interval, winding,

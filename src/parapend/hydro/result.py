@@ -19,7 +19,7 @@ from .waves import energy_flux
 __all__ = ["BuoyResult", "BuoySweepResult", "free_heave"]
 
 
-@dataclass(frozen=True, eq=False)
+@dataclass(frozen=True, eq=False, repr=False)
 class BuoyResult(_Result):
     """The coupled optimum of one design in one sea (field names = JSON keys of ``parapend
     buoy``; SI units, named in each field).
@@ -114,6 +114,17 @@ class BuoyResult(_Result):
         """The coupled optimum (:class:`parapend.hydro.optimum.CoupledSolution`)."""
         return self._solution
 
+    @property
+    def hydrodynamics(self):
+        """The body's hydrodynamic coefficients the optimum was solved with
+        (:class:`parapend.hydro.bem.Hydro`)."""
+        return self._hydro
+
+    @property
+    def incident_wave(self):
+        """The incident wave (regular or a periodic record) the optimum was solved for."""
+        return self._wave
+
     def samples(self, points: int = 400) -> dict:
         """One period on a uniform grid: ``t`` (s), ``theta`` (rad), ``theta_dot`` (rad/s),
         ``z`` (m), ``z_dot`` (m/s), ``tau`` (N m), ``power`` (``-tau theta'``, W) of the
@@ -127,22 +138,28 @@ class BuoyResult(_Result):
         out["z_free"] = free_heave(self._hydro, self._wave, t)
         return out
 
-    def to_dataset(self, points: int = 400):
-        """The motion over one period as an ``xarray.Dataset`` (variables in SI units, the
-        scalar fields as attributes): what ``--save`` writes."""
+    command = "buoy"
+    headline = ("power_w", "electrical_power_w", "one_way_power_w", "radiation_bound_w",
+                "heave_amplitude_m", "status")
+
+    def _series(self):
+        """The motion over one period (SI): what ``--save`` writes beside the scalars."""
         import xarray as xr
 
-        s = self.samples(points)
-        units = {"theta": "rad", "theta_dot": "rad/s", "z": "m", "z_dot": "m/s", "tau": "N m",
-                 "power": "W", "z_free": "m"}
-        ds = xr.Dataset({k: ("t", s[k], {"units": u}) for k, u in units.items()},
-                        coords={"t": ("t", s["t"], {"units": "s"})})
-        for k, v in self.to_dict().items():
-            ds.attrs[k] = _attr(v)
-        return ds
+        s = self.samples()
+        names = {"theta": "theta", "theta_dot": "theta_dot_rad_per_s", "z": "heave_m",
+                 "z_dot": "heave_speed_m_per_s", "tau": "torque_nm", "power": "power_w",
+                 "z_free": "free_heave_m"}
+        return xr.Dataset({names[k]: ("time_s", s[k]) for k in names},
+                          coords={"time_s": s["t"]})
+
+    def _figure(self):
+        from .figures import plot_motion
+
+        return plot_motion(self)
 
 
-@dataclass(frozen=True, eq=False)
+@dataclass(frozen=True, eq=False, repr=False)
 class BuoySweepResult(_Result):
     """Power of one design against wave period (``wave_period="FROM:TO:N"``), regular waves
     of one height: arrays over ``period_s``, each field named with its unit
@@ -172,8 +189,11 @@ class BuoySweepResult(_Result):
     mesh_error_w: np.ndarray | None = None
     validity_warnings: list = field(default_factory=list)
 
-    def to_dataset(self):
-        """The sweep as an ``xarray.Dataset`` over ``period_s`` (what ``--save`` writes)."""
+    command = "buoy"
+    headline = ("period_s", "power_w", "success")
+
+    def _series(self):
+        """The sweep over ``period_s`` (what ``--save`` writes)."""
         import xarray as xr
 
         names = ("power_w", "one_way_power_w", "radiation_bound_w", "limit_w",
@@ -187,10 +207,21 @@ class BuoySweepResult(_Result):
                                                                dtype=float))
         if self.mesh_error_w is not None:
             ds["mesh_error_w"] = ("period_s", np.asarray(self.mesh_error_w, dtype=float))
-        for k in ("success", "wave_height_m", "pendulum", "body", "warnings",
-                  "validity_warnings"):
-            ds.attrs[k] = _attr(getattr(self, k))
         return ds
+
+    def to_dict(self) -> dict:
+        return super().to_dict()
+
+    def _figure(self):
+        from .figures import plot_sweep
+
+        return plot_sweep(self)
+
+    def __repr__(self) -> str:
+        p = np.asarray(self.period_s, dtype=float)
+        w = np.asarray(self.power_w, dtype=float)
+        return (f"BuoySweepResult(period_s: {p.size} periods from {p[0]:.6g} to {p[-1]:.6g}, "
+                f"largest power_w={np.nanmax(w):.6g}, success={self.success!r})")
 
 
 def _attr(v):

@@ -8,12 +8,14 @@ import contextlib
 import dataclasses
 import logging
 import os
+import sys
 import threading
 import time
 
 import numpy as np
 
 from ..errors import OutputError, ParameterError, SolverError, check_int
+from ._forkserver import WorkerContext
 from .compute import compute_block
 from .spec import sweep_spec
 from .store import (
@@ -80,28 +82,34 @@ def _worker_init(parent: int) -> None:
 
 
 class _LocalPool:
-    """The local worker processes (a ``forkserver`` pool), started in the background as soon
-    as the sweep's parameters are checked: the server's imports and the workers' start (about
-    a second) then overlap the preparation of the store instead of preceding the first block.
+    """The local worker processes (a ``forkserver`` pool of :class:`ParapendWorker`, which
+    never run the caller's main script: :mod:`parapend.maps._forkserver`), started in the
+    background as soon as the sweep's parameters are checked: the server's imports and the
+    workers' start (about a second) then overlap the preparation of the store instead of
+    preceding the first block.
     """
 
     def __init__(self, workers: int, start: bool = True):
         self.workers = workers
         self.executor = None
+        self.context = None
         self._boot = None
+        self._first: list = []
         if start:
             self.start()
 
     def start(self):
         """Start the processes in the background (once)."""
         import concurrent.futures as cf
-        import multiprocessing as mp
         import threading
 
         if self.executor is not None:
             return
-        ctx = mp.get_context("forkserver")
-        ctx.set_forkserver_preload(["parapend.maps", "parapend.api", "parapend.optimal.fourier",
+        ctx = self.context = WorkerContext()
+        # the first preload wraps the forkserver's `prepare`: its ParapendWorker children
+        # do not import the caller's main script (parapend.maps._forkserver)
+        ctx.set_forkserver_preload(["parapend.maps._forkserver", "parapend.maps",
+                                    "parapend.api", "parapend.optimal.fourier",
                                     "parapend.optimal.batch"])
         self.executor = cf.ProcessPoolExecutor(max_workers=self.workers, mp_context=ctx,
                                                initializer=_worker_init,
@@ -118,14 +126,62 @@ class _LocalPool:
         ex = self.executor
         with contextlib.suppress(Exception):
             for _ in range(4 * self.workers):
-                ex.submit(_ready)
+                self._first.append(ex.submit(_ready))
                 if len(getattr(ex, "_processes", None) or ()) >= self.workers:
                     break
+
+    def started(self) -> bool:
+        """Whether a worker has run a task (so the workers could start)."""
+        return any(f.done() and not f.cancelled() and f.exception() is None
+                   for f in self._first)
 
     def shutdown(self):
         if self.executor is not None:
             self._boot.join()
             self.executor.shutdown(wait=True, cancel_futures=True)
+
+
+def _forkserver_available() -> bool:
+    """Whether this platform has the ``forkserver`` start method (not on Windows)."""
+    import multiprocessing as mp
+
+    return "forkserver" in mp.get_all_start_methods()
+
+
+def worker_death(pool, store: bool) -> str:
+    """What ended the pool ``pool`` (shut down, so its processes' exit codes are known), in
+    words, for the error of a broken pool; ``store``: whether finished blocks were kept.
+
+    An exit status (a Python error in the worker, printed on stderr) is not a kill: only a
+    signal is reported as one, and only then is the run worth repeating as it stands."""
+    import signal
+
+    codes = [p.exitcode for p in (pool.context.started if pool.context else ())]
+    statuses = sorted({c for c in codes if c is not None and c > 0})
+    signals = [-c for c in codes if c is not None and c < 0]
+    resume = ("; the finished blocks are in the store: run the same command again to resume"
+              if store else "")
+    if statuses:
+        status = ", ".join(map(str, statuses))
+        if not pool.started():
+            main = getattr(sys.modules.get("__main__"), "__file__", None)
+            guard = (f"; if it is multiprocessing's 'bootstrapping phase' error, the "
+                     f"forkserver was started before parapend's (without its preload) and "
+                     f"the workers ran {os.path.basename(main)!r} again: put its top-level "
+                     f"work under if __name__ == \"__main__\":" if main else "")
+            return (f"the worker processes could not start (exit status {status}; their "
+                    f"error is printed above{guard})")
+        return f"a worker process failed (exit status {status}; its error is printed above)"
+    killed = [s for s in signals if s != signal.SIGTERM] or signals
+    if killed:
+        try:
+            name = signal.Signals(killed[0]).name
+        except ValueError:
+            name = f"signal {killed[0]}"
+        why = (" (the system's out-of-memory killer sends it, as does kill -9)"
+               if killed[0] == getattr(signal, "SIGKILL", None) else "")
+        return f"a worker process was killed by {name}{why}{resume}"
+    return "a worker process ended unexpectedly (its error, if any, is printed above)" + resume
 
 
 def _ready() -> None:
@@ -147,7 +203,7 @@ def _compile_kernels(spec) -> None:
         optimize_pto(efficiency=0.9, gamma=0.03, harmonics=4)
 
 
-def _run_local(spec, todo, pool, done_cb):
+def _run_local(spec, todo, pool, done_cb, store=False):
     import concurrent.futures as cf
 
     if pool is None or len(todo) <= 1:
@@ -158,15 +214,13 @@ def _run_local(spec, todo, pool, done_cb):
     pool._boot.join()
     ex = pool.executor
     try:
-        futs = {ex.submit(compute_block, spec, b): b for b in todo}
-        for f in cf.as_completed(futs):
-            try:
-                vals = f.result()
-            except cf.process.BrokenProcessPool:
-                raise SolverError("a worker process died (killed, or out of memory); the "
-                                  "finished blocks are in the store: run the same command "
-                                  "again to resume") from None
-            done_cb(futs[f], vals)
+        try:
+            futs = {ex.submit(compute_block, spec, b): b for b in todo}
+            for f in cf.as_completed(futs):
+                done_cb(futs[f], f.result())
+        except cf.process.BrokenProcessPool:
+            ex.shutdown(wait=True, cancel_futures=True)  # the exit codes are known after
+            raise SolverError(worker_death(pool, store)) from None
     except BaseException:
         # Ctrl-C or an error: the running blocks would not be written, so they are not
         # waited for (a block with a power take-off can take half a minute)
@@ -344,6 +398,10 @@ def run_spec(spec, store=None, *, workers: int | None = None, scheduler=None,
     resume = (store is not None and not overwrite
               and _store_spec(_check_store_path(store)) == spec.to_json())
     local = client is None and workers > 1 and spec.blocks > 1
+    if local and not _forkserver_available():
+        log.info("no forkserver start method on this platform: the blocks run in this "
+                 "process")
+        local = False
     if local and spec.pto and not resume:
         _compile_kernels(spec)
     pool = _LocalPool(workers, start=not resume) if local else None
@@ -431,13 +489,14 @@ def _sweep_store(spec, path, pool, client, overwrite, command, progress, t0, siz
             if progress is not None:
                 progress(counted[0], total)
 
-        how = _execute(spec, todo, pool, client, write) if todo else "nothing to do"
+        how = (_execute(spec, todo, pool, client, write, store=True) if todo
+               else "nothing to do")
     ds = open_sweep(path)
     return SweepRun(ds, str(path), total, spec.blocks, total - resumed, resumed,
                     time.monotonic() - t0, how, repaired)
 
 
-def _execute(spec, todo, pool, client, write) -> str:
+def _execute(spec, todo, pool, client, write, store=False) -> str:
     if client is not None:
         return _run_dask(spec, todo, client, write)
-    return _run_local(spec, todo, pool, write)
+    return _run_local(spec, todo, pool, write, store)

@@ -160,10 +160,47 @@ def plot_scatter(ds, path=None):
         return _finish(fig, path)
 
 
+#: SI prefixes of the text report, largest first
+_PREFIXES = ((1e9, "G"), (1e6, "M"), (1e3, "k"), (1.0, ""), (1e-3, "m"))
+
+
+def with_unit(value, unit: str, digits: int = 4, smallest: str = "m") -> str:
+    """``value`` (in ``unit``) to ``digits`` significant digits with the SI prefix that
+    puts it in [1, 1000): ``with_unit(41000.0, "Wh")`` is ``"41 kWh"``, ``with_unit(0.05,
+    "W")`` ``"50 mW"``. Prefixes below ``smallest`` ("m" or "") are not used; zero is
+    ``"0 unit"``, a value that is not finite ``"n/a"``. The prefix is chosen after the
+    rounding, so 999.96 W is ``"1 kW"``, never ``"1000 W"``."""
+    v = float(value)
+    if not np.isfinite(v):
+        return "n/a"
+    prefixes = _PREFIXES[:[p for _, p in _PREFIXES].index(smallest) + 1]
+    r = float(f"{v:.{digits}g}")
+    scale, prefix = prefixes[-1]
+    for s, p in prefixes:
+        if abs(r) >= s:
+            scale, prefix = s, p
+            break
+    if r == 0:
+        scale, prefix = 1.0, ""
+    return f"{float(f'{r / scale:.{digits}g}'):.{digits}g} {prefix}{unit}"
+
+
+def _right_table(rows, header) -> str:
+    """Plain-text table, every column right-aligned (values with their units)."""
+    widths = [max(len(r[i]) for r in [header, *rows]) for i in range(len(header))]
+    lines = ["  ".join(v.rjust(w) for v, w in zip(r, widths)) for r in [header, *rows]]
+    lines.insert(1, "  ".join("-" * w for w in widths))
+    return "\n".join(lines)
+
+
+def _per_year(wh: float) -> str:
+    """An annual energy in Wh as Wh, kWh, MWh or GWh per year, by magnitude."""
+    text = with_unit(wh, "Wh", smallest="")
+    return text if text == "n/a" else text + "/yr"
+
+
 def text_report(ds, out: dict, drawn: list) -> str:
     """The plain-text summary of ``parapend power-matrix``."""
-    from ..cli._common import _table
-
     pk = _period(ds)
     hm0, per = ds["hm0"].values, ds[pk].values
     what = "coupled buoy" if out["device"] == "buoy" else f"{out['device']} pendulum"
@@ -175,10 +212,10 @@ def text_report(ds, out: dict, drawn: list) -> str:
              f"computed now {out['computed_bins']} bins, found finished "
              f"{out['resumed_bins']}; {out['seconds']:.1f} s ({out['executor']})"
              + (f"; store {out['store']}" if out["store"] else ""), "",
-             "mean optimum power (W), rows Hm0 (m), columns " + pk + " (s):"]
-    rows = [[f"{h:g}", *(("n/a" if not np.isfinite(v) else f"{v:.4g}")
-                         for v in ds["power_mean"].values[i])] for i, h in enumerate(hm0)]
-    lines += [_table(rows, ["Hm0 \\ " + pk, *(f"{t:g}" for t in per)]), ""]
+             "mean optimum power, rows Hm0, columns " + pk + ":"]
+    rows = [[f"{h:g} m", *(with_unit(v, "W") for v in ds["power_mean"].values[i])]
+            for i, h in enumerate(hm0)]
+    lines += [_right_table(rows, ["Hm0 \\ " + pk, *(f"{t:g} s" for t in per)]), ""]
     if out["failed_solves"]:
         lines.append(f"{out['failed_solves']} solves did not converge (status in the store; "
                      "left out of the statistics: see the count)")
@@ -188,13 +225,14 @@ def text_report(ds, out: dict, drawn: list) -> str:
         names = (("limit_power", "limit"), ("uniform_power", "uniform rotation"),
                  ("electrical_power", "electrical"),
                  ("radiation_bound_power", "radiation bound"), ("one_way_power", "one-way"))
-        lines.append(f"mean annual energy (8766 h/yr): optimum {p['mwh']:.6g} MWh/yr"
-                     + "".join(f", {label} {a[q]['mwh']:.6g}" for q, label in names
+        lines.append(f"mean annual energy (8766 h/yr): optimum {_per_year(p['wh'])}"
+                     + "".join(f", {label} {_per_year(a[q]['wh'])}" for q, label in names
                                if q in a))
         if p.get("capacity_factor") is not None:
-            lines.append(f"capacity factor {p['capacity_factor']:.4g}")
+            lines.append(f"capacity factor {p['capacity_factor']:.4g} "
+                         f"({100 * p['capacity_factor']:.3g} % of the rated power's energy)")
         if p["bins_without_power"]:
-            miss = ", ".join(f"(Hm0 {b['hm0']:g}, {pk} {b[pk]:g})"
+            miss = ", ".join(f"(Hm0 {b['hm0']:g} m, {pk} {b[pk]:g} s)"
                              for b in p["bins_without_power"][:8])
             lines.append(f"bins of the site without power (left out of the sum): {miss}"
                          f"{' ...' if len(p['bins_without_power']) > 8 else ''}; "
