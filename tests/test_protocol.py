@@ -144,6 +144,12 @@ def test_si_results_are_si_in_every_file(tmp_path):
     assert float(ds["power_w"].values.mean()) == pytest.approx(r.power_w, rel=1e-6)
     assert u.power == pytest.approx(m * g * length / t0, rel=1e-14)
     assert ds["power_w"].attrs["units"] == "W" and ds["time_s"].attrs["units"] == "s"
+    # omega in rad/s beside the non-dimensional one, as a Capytaine or WecOptTool user reads it
+    assert r.omega_rad_per_s == pytest.approx(2 * math.pi * 0.9, rel=1e-14)
+    assert ds["omega_rad_per_s"].attrs["units"] == "rad/s"
+    c = parapend.optimize(harmonics=8, length=1.0, mass=10.0, frequency=0.9, amplitude=0.09,
+                          damping_coefficient=0.3)
+    assert c.damping_coefficient == pytest.approx(0.3, rel=1e-14)
     tr = parapend.track(periods=20, harmonics=8, length=1.0, mass=10.0)
     tds = tr.to_dataset()
     assert set(tds.dims) == {"time_s"} and tds["torque_nm"].attrs["units"] == "N m"

@@ -124,7 +124,9 @@ def physical_fields(result, units) -> dict:
            "uniform_power_w": units.to_watts(result.uniform_power),
            "limit_power_w": units.to_watts(result.limit_power),
            "peak_torque_nm": units.to_newton_metres(result.peak_torque),
-           "energy_per_cycle_j": units.to_joules(result.power * period)}
+           "energy_per_cycle_j": units.to_joules(result.power * period),
+           "omega_rad_per_s": result.omega / units.time,
+           "damping_coefficient": units.damping_coefficient(result.gamma)}
     if result.electrical_power is not None:
         out["electrical_power_w"] = units.to_watts(result.electrical_power)
     if result.motoring_energy is not None:

@@ -126,14 +126,18 @@ def annotate(ds, command: str):
 
 
 def _attr_value(v):
-    """A JSON value as a NetCDF attribute: numbers and strings as they are, the rest as JSON
-    text (NetCDF has no nested attributes; None is the text "null")."""
+    """A JSON value as a NetCDF attribute: numbers, strings and flat lists of numbers as they
+    are, the rest as JSON text (NetCDF has no nested attributes)."""
     import json
 
-    if isinstance(v, bool):
+    if isinstance(v, (bool, np.bool_)):
         return int(v)
-    if isinstance(v, (int, float, str)):
+    if isinstance(v, (int, float, str, np.integer, np.floating)):
         return v
+    if isinstance(v, (list, tuple, np.ndarray)):  # a flat list of numbers: a NetCDF array
+        a = np.asarray(v) if not isinstance(v, np.ndarray) else v
+        if a.ndim == 1 and a.size and a.dtype.kind in "biuf":
+            return a.astype(np.int64 if a.dtype.kind in "biu" else float)
     return json.dumps(to_jsonable(v))
 
 
@@ -475,6 +479,9 @@ class OptimizeResult(Result):
         mechanical powers when there is no efficiency or copper loss).
     uniform_pto_power_w, uniform_pto_electrical_power_w : float or None
         The same in watts, with physical units.
+    omega_rad_per_s, damping_coefficient : float or None
+        With physical units, the forcing's angular frequency in rad/s (``omega`` is in units
+        of ``sqrt(g/l)``) and the damping as a coefficient in N m s/rad (``gamma I / t0``).
     winding : int
         K, turns per forcing period, ``theta(t + 2 pi/omega) = theta(t) + 2 pi K`` (1: the
         paper's period-1 rotation); ``uniform_power`` is then the uniform rotation with K
@@ -547,6 +554,8 @@ class OptimizeResult(Result):
     gain_over_uniform_pto: float | None = None
     uniform_pto_power_w: float | None = None
     uniform_pto_electrical_power_w: float | None = None
+    omega_rad_per_s: float | None = None
+    damping_coefficient: float | None = None
     winding: int = 1
     convention: str = CONVENTION
     _motion: object = field(default=None, repr=False)

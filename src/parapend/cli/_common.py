@@ -157,6 +157,17 @@ SAVE_TABLE = (".csv", ".nc", ".json")
 SAVE_GRID = (".nc", ".json")
 
 
+def add_output_options(p, *, plot: str, save: str, table: bool = True) -> None:
+    """``--plot``, ``--save`` and ``--json``: how a command's result is drawn, written and
+    printed (:meth:`~parapend.results.Result.plot`, :meth:`~parapend.results.Result.save`,
+    :meth:`~parapend.results.Result.to_dict`). ``plot`` and ``save`` say what is drawn and
+    written; ``table`` is False for a result of several dimensions (no CSV)."""
+    p.add_argument("--plot", metavar="PNG", help=f"draw {plot} (PNG, SVG or PDF)")
+    kinds = ".csv (with a row of units), .nc or .json" if table else ".nc or .json"
+    p.add_argument("--save", metavar="FILE", help=f"write {save}: {kinds}")
+    p.add_argument("--json", action="store_true", help="print one JSON object")
+
+
 def _blocking_file(p: Path) -> Path | None:
     """The first ancestor of ``p`` (nearest the root) that exists but is not a directory."""
     for anc in reversed(p.parents):

@@ -26,6 +26,7 @@ from ._common import (
     _Progress,
     _run,
     _table,
+    add_output_options,
 )
 
 EQ1 = "paper Eq. 1: phi'' + gamma phi' + (1 + p cos(omega t)) sin(phi) = 0, phi from hanging"
@@ -107,13 +108,9 @@ def add_parsers(sub) -> None:
     p.add_argument("--points-per-period", type=_int, default=64,
                    help="output samples per forcing period, 2 to 1024 (default 64)")
     _pto.add_unit_options(p, damping=False, excitation=False, adds="time in s, energy in J")
-    p.add_argument("--plot", metavar="PNG",
-                   help="draw the time history and phase portrait (PNG, SVG or PDF)")
-    p.add_argument("--save", metavar="FILE",
-                   help="write the time series (time, phi, phi_dot, energy; in SI with "
-                        "--length and --mass) and the scalars: .csv (with a row of units), "
-                        ".nc or .json")
-    p.add_argument("--json", action="store_true", help="print one JSON object")
+    add_output_options(p, plot="the time history and phase portrait",
+                       save="the time series (time, phi, phi_dot, energy; in SI with --length "
+                            "and --mass) and the scalars")
 
     p = sub.add_parser("basins", help="basins of attraction of Eq. 1 (Fig. 2 right)",
                        description="Basins of attraction of paper Eq. 1 on an N x N grid of "
@@ -152,9 +149,7 @@ def add_parsers(sub) -> None:
                         "attractors of Fig. 2 right)")
     p.add_argument("--engine", choices=["numba", "numpy"], default="numba",
                    help="compiled kernel (default) or the vectorized NumPy engine")
-    p.add_argument("--plot", metavar="PNG", help="draw the basin image (PNG, SVG or PDF)")
-    p.add_argument("--save", metavar="FILE", help="write the basin Dataset: .nc or .json")
-    p.add_argument("--json", action="store_true", help="print one JSON object")
+    add_output_options(p, plot="the basin image", save="the basin Dataset", table=False)
 
     p = sub.add_parser("rotations",
                        help="existence and stability of the period-1 rotation (Fig. 2 left)",
@@ -177,12 +172,7 @@ def add_parsers(sub) -> None:
                    help=f"seconds of continuation, in (0, {limits.ROT_MAX_TIME_LIMIT:g}]; past "
                         "them the branches stop where they are and the output says how far "
                         f"p was followed (default {limits.ROT_TIME_LIMIT:g})")
-    p.add_argument("--plot", metavar="PNG",
-                   help="draw J, G, E and the stability regions (PNG, SVG or PDF)")
-    p.add_argument("--save", metavar="FILE",
-                   help="write J, G, E against omega: .csv (with a row of units), .nc or "
-                        ".json")
-    p.add_argument("--json", action="store_true", help="print one JSON object")
+    add_output_options(p, plot="J, G, E and the stability regions", save="J, G, E against omega")
 
 
 # --- simulate ------------------------------------------------------------------------------

@@ -21,6 +21,7 @@ from ._common import (
     _Progress,
     _run,
     _table,
+    add_output_options,
 )
 
 
@@ -40,18 +41,14 @@ def add_parsers(sub) -> None:
                    help="fourier: Eq. 10 with N harmonics; bvp: Euler-Lagrange BVP (Eqs. 13, "
                         "22, 27; needs gamma >= 1e-7); all: uniform, Fourier, BVP and limit "
                         "side by side (default fourier)")
-    p.add_argument("--plot", metavar="PNG",
-                   help="draw theta(tau) and torque (PNG, SVG or PDF)")
-    p.add_argument("--save", metavar="FILE",
-                   help="write one period of the motion (time, phase, theta, theta_dot, "
-                        "torque, power = -T theta', electrical_power with an efficiency; in "
-                        "SI with --length and --mass) and the result's scalars: .csv (with a "
-                        "row of units), .nc or .json")
+    add_output_options(p, plot="theta(tau) and the torque",
+                       save="one period of the motion (time, phase, theta, theta_dot, torque, "
+                            "power = -T theta', electrical_power with an efficiency; in SI with "
+                            "--length and --mass) and the result's scalars")
     p.add_argument("--winding", type=_int, default=1,
                    help="K turns per forcing period, theta(t + 2 pi/omega) = theta(t) + 2 pi "
                         "K (default 1, the paper's period-1 rotation; K > 1: method fourier "
                         "with N >= 2K, or bvp; docs/seas.md)")
-    p.add_argument("--json", action="store_true", help="print one JSON object")
     _pto.add_pto_options(p)
     _pto.add_unit_options(p)
 
@@ -62,11 +59,7 @@ def add_parsers(sub) -> None:
     p.add_argument("--harmonics", type=_int, default=None,
                    help=f"fixed N, at most {limits.MAX_THRESHOLD_HARMONICS} (default: doubled "
                         "from 8 until gamma* converges)")
-    p.add_argument("--plot", metavar="PNG",
-                   help="draw power against damping up to beyond gamma* (PNG, SVG or PDF)")
-    p.add_argument("--save", metavar="FILE",
-                   help="write the result: .csv (with a row of units), .nc or .json")
-    p.add_argument("--json", action="store_true", help="print one JSON object")
+    add_output_options(p, plot="power against damping up to beyond gamma*", save="the result")
     _pto.add_unit_options(p, damping=False)
 
     p = sub.add_parser("damping-sweep", help="optimal power against damping (paper Fig. 6)",
@@ -81,11 +74,7 @@ def add_parsers(sub) -> None:
     p.add_argument("--points", type=_int, default=41,
                    help=f"number of dampings, 2 to {limits.MAX_POINTS}, with points x N^2 <= "
                         f"{limits.MAX_SWEEP_WORK} (default 41)")
-    p.add_argument("--plot", metavar="PNG",
-                   help="draw power against damping (PNG, SVG or PDF)")
-    p.add_argument("--save", metavar="FILE",
-                   help="write the sweep: .csv (with a row of units), .nc or .json")
-    p.add_argument("--json", action="store_true", help="print one JSON object")
+    add_output_options(p, plot="power against damping", save="the sweep")
     _pto.add_unit_options(p, damping=False)
 
     p = sub.add_parser("harmonics", help="optimal power against the number of harmonics",
@@ -97,10 +86,7 @@ def add_parsers(sub) -> None:
     p.add_argument("--from", dest="n_from", type=_int, default=2, help="smallest N (default 2)")
     p.add_argument("--to", dest="n_to", type=_int, default=64,
                    help=f"largest N, at most {limits.MAX_TABLE_HARMONICS} (default 64)")
-    p.add_argument("--plot", metavar="PNG", help="draw power against N (PNG, SVG or PDF)")
-    p.add_argument("--save", metavar="FILE",
-                   help="write the table: .csv (with a row of units), .nc or .json")
-    p.add_argument("--json", action="store_true", help="print one JSON object")
+    add_output_options(p, plot="power against N", save="the table")
     _pto.add_unit_options(p)
 
 

@@ -18,6 +18,7 @@ from ._common import (
     _Progress,
     _run,
     _table,
+    add_output_options,
 )
 
 
@@ -193,10 +194,7 @@ def add_parsers(sub) -> None:
                    help=f"number of values, 2 to {limits.MAX_PTO_POINTS} (default 10)")
     add_pto_options(p)
     add_unit_options(p)
-    p.add_argument("--plot", metavar="PNG", help="draw the curve (PNG, SVG or PDF)")
-    p.add_argument("--save", metavar="FILE",
-                   help="write the curve: .csv (with a row of units), .nc or .json")
-    p.add_argument("--json", action="store_true", help="print one JSON object")
+    add_output_options(p, plot="the curve", save="the curve")
 
 
 def _cmd_pto_curve(a) -> dict | str:

@@ -12,6 +12,7 @@ from ._common import (
     _int,
     _run,
     _table,
+    add_output_options,
     add_pendulum_options,
     add_sea_options,
 )
@@ -47,12 +48,10 @@ def add_parsers(sub) -> None:
                         "'auto': K = 1 and fractions of the mean-wave-frequency K (default 1)")
     g.add_argument("--harmonics", type=_int, default=None,
                    help="N (default 16 per mean wave, then checked at 2N)")
-    p.add_argument("--plot", metavar="PNG", help="draw the record, the motion and the energy")
-    p.add_argument("--save", metavar="FILE",
-                   help="write the record and the motion over it (time_s, heave_m, q, theta, "
-                        "theta_dot_rad_per_s, power_w, energy_j, uniform_energy_j) and the "
-                        "result's scalars: .csv (with a row of units), .nc or .json")
-    p.add_argument("--json", action="store_true", help="print one JSON object")
+    add_output_options(p, plot="the record, the motion and the energy",
+                       save="the record and the motion over it (time_s, heave_m, q, theta, "
+                            "theta_dot_rad_per_s, power_w, energy_j, uniform_energy_j) and the "
+                            "result's scalars")
 
 
 def _cmd_sea(a) -> dict | str:

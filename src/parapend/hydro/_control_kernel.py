@@ -161,6 +161,40 @@ def _stage_adjoint(z, th, om, fnet, tau, p, g0, g1, g2, g3):
 
 
 @nb.njit(cache=True)
+def _stages(z, zd, th, om, f0, fm, tau, p, h):
+    """The first three RK4 stages of one step from ``(z, z', theta, theta')`` (the forcing
+    ``f0`` at its start, ``fm`` at its middle): each stage's derivatives (``_rhs_jac``) and
+    the states of stages 2 to 4, shared by the forward pass and the adjoint's recomputation."""
+    r1 = _rhs_jac(z, th, om, f0, tau, p)
+    z2 = z + 0.5 * h * zd
+    zd2 = zd + 0.5 * h * r1[0]
+    th2 = th + 0.5 * h * om
+    om2 = om + 0.5 * h * r1[1]
+    r2 = _rhs_jac(z2, th2, om2, fm, tau, p)
+    z3 = z + 0.5 * h * zd2
+    zd3 = zd + 0.5 * h * r2[0]
+    th3 = th + 0.5 * h * om2
+    om3 = om + 0.5 * h * r2[1]
+    r3 = _rhs_jac(z3, th3, om3, fm, tau, p)
+    z4 = z + h * zd3
+    zd4 = zd + h * r3[0]
+    th4 = th + h * om3
+    om4 = om + h * r3[1]
+    return r1, z2, zd2, th2, om2, r2, z3, zd3, th3, om3, r3, z4, zd4, th4, om4
+
+
+@nb.njit(cache=True)
+def _gather(a, k, c, gz, gzd, gth, gom, gt):
+    """One stage adjoint ``a`` added to the gradient sums, and ``c a`` to the previous stage's
+    adjoint ``k`` (in place); returns the sums."""
+    k[0] += c * a[0]
+    k[1] += c * a[1]
+    k[2] += c * a[2]
+    k[3] += c * a[3]
+    return gz + a[0], gzd + a[1], gth + a[2], gom + a[3], gt + a[4]
+
+
+@nb.njit(cache=True)
 def plan_objective(u, y0, fnet, h, steps, p, tu, eta_g, eta_m, kappa, ref, total, grad, ys):
     """The coupled horizon problem: minus the harvested work of the held torques ``u tu``
     (N m) over ``steps`` RK4 steps each (through the efficiency weights), minus ``kappa``
@@ -183,21 +217,8 @@ def plan_objective(u, y0, fnet, h, steps, p, tu, eta_g, eta_m, kappa, ref, total
             f0 = fnet[2 * i]
             fm = fnet[2 * i + 1]
             f1 = fnet[2 * i + 2]
-            r1 = _rhs_jac(z, th, om, f0, tau, p)
-            z2 = z + 0.5 * h * zd
-            zd2 = zd + 0.5 * h * r1[0]
-            th2 = th + 0.5 * h * om
-            om2 = om + 0.5 * h * r1[1]
-            r2 = _rhs_jac(z2, th2, om2, fm, tau, p)
-            z3 = z + 0.5 * h * zd2
-            zd3 = zd + 0.5 * h * r2[0]
-            th3 = th + 0.5 * h * om2
-            om3 = om + 0.5 * h * r2[1]
-            r3 = _rhs_jac(z3, th3, om3, fm, tau, p)
-            z4 = z + h * zd3
-            zd4 = zd + h * r3[0]
-            th4 = th + h * om3
-            om4 = om + h * r3[1]
+            (r1, z2, zd2, th2, om2, r2, z3, zd3, th3, om3, r3,
+             z4, zd4, th4, om4) = _stages(z, zd, th, om, f0, fm, tau, p, h)
             r4 = _rhs_jac(z4, th4, om4, f1, tau, p)
             ys[i + 1, 0] = z + h / 6.0 * (zd + 2.0 * zd2 + 2.0 * zd3 + zd4)
             ys[i + 1, 1] = zd + h / 6.0 * (r1[0] + 2.0 * r2[0] + 2.0 * r3[0] + r4[0])
@@ -234,20 +255,8 @@ def plan_objective(u, y0, fnet, h, steps, p, tu, eta_g, eta_m, kappa, ref, total
             fm = fnet[2 * i + 1]
             f1 = fnet[2 * i + 2]
             # recompute the stages
-            r1 = _rhs_jac(z, th, om, f0, tau, p)
-            z2 = z + 0.5 * h * zd
-            zd2 = zd + 0.5 * h * r1[0]
-            th2 = th + 0.5 * h * om
-            om2 = om + 0.5 * h * r1[1]
-            r2 = _rhs_jac(z2, th2, om2, fm, tau, p)
-            z3 = z + 0.5 * h * zd2
-            zd3 = zd + 0.5 * h * r2[0]
-            th3 = th + 0.5 * h * om2
-            om3 = om + 0.5 * h * r2[1]
-            r3 = _rhs_jac(z3, th3, om3, fm, tau, p)
-            z4 = z + h * zd3
-            th4 = th + h * om3
-            om4 = om + h * r3[1]
+            (r1, z2, zd2, th2, om2, r2, z3, zd3, th3, om3, r3,
+             z4, _, th4, om4) = _stages(z, zd, th, om, f0, fm, tau, p, h)
             # adjoints of the stage derivatives k1..k4
             c6 = h / 6.0
             c3 = h / 3.0
@@ -257,42 +266,16 @@ def plan_objective(u, y0, fnet, h, steps, p, tu, eta_g, eta_m, kappa, ref, total
             k1 = [c6 * lz, c6 * lzd, c6 * lth, c6 * lom]
             gz, gzd, gth, gom = lz, lzd, lth, lom
             gt = 0.0
+            # each stage's adjoint into the state's gradient, and back into the stage before
+            # (k3 += h a, k2 += h/2 a, k1 += h/2 a: the RK4 stage weights)
             a = _stage_adjoint(z4, th4, om4, f1, tau, p, k4[0], k4[1], k4[2], k4[3])
-            gz += a[0]
-            gzd += a[1]
-            gth += a[2]
-            gom += a[3]
-            gt += a[4]
-            k3[0] += h * a[0]
-            k3[1] += h * a[1]
-            k3[2] += h * a[2]
-            k3[3] += h * a[3]
+            gz, gzd, gth, gom, gt = _gather(a, k3, h, gz, gzd, gth, gom, gt)
             a = _stage_adjoint(z3, th3, om3, fm, tau, p, k3[0], k3[1], k3[2], k3[3])
-            gz += a[0]
-            gzd += a[1]
-            gth += a[2]
-            gom += a[3]
-            gt += a[4]
-            k2[0] += 0.5 * h * a[0]
-            k2[1] += 0.5 * h * a[1]
-            k2[2] += 0.5 * h * a[2]
-            k2[3] += 0.5 * h * a[3]
+            gz, gzd, gth, gom, gt = _gather(a, k2, 0.5 * h, gz, gzd, gth, gom, gt)
             a = _stage_adjoint(z2, th2, om2, fm, tau, p, k2[0], k2[1], k2[2], k2[3])
-            gz += a[0]
-            gzd += a[1]
-            gth += a[2]
-            gom += a[3]
-            gt += a[4]
-            k1[0] += 0.5 * h * a[0]
-            k1[1] += 0.5 * h * a[1]
-            k1[2] += 0.5 * h * a[2]
-            k1[3] += 0.5 * h * a[3]
+            gz, gzd, gth, gom, gt = _gather(a, k1, 0.5 * h, gz, gzd, gth, gom, gt)
             a = _stage_adjoint(z, th, om, f0, tau, p, k1[0], k1[1], k1[2], k1[3])
-            gz += a[0]
-            gzd += a[1]
-            gth += a[2]
-            gom += a[3]
-            gt += a[4]
+            gz, gzd, gth, gom, gt = gz + a[0], gzd + a[1], gth + a[2], gom + a[3], gt + a[4]
             lz, lzd, lom = gz, gzd, gom
             lth = gth - wgt * u[j]
             gj += gt * tu
