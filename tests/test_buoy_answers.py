@@ -132,6 +132,10 @@ def test_linear_theory_warnings(fake_bem, capsys):
     assert "bottom leaves the water" in text
     steep = 1.5 / (G * 1.8**2 / (2 * math.pi))
     assert f"{steep:.3g} exceeds the breaking limit" in text
+    # the motion relative to the wave, eta = H/2 cos(2 pi t / T), from the samples
+    rel = s["z"] - 0.75 * np.cos(2 * math.pi * s["t"] / 1.8)
+    assert f"relative to the wave reaches {rel.max():.3g} m" in text
+    assert f"the wave rises {-rel.min():.3g} m above" in text
     assert main(["buoy", "--wave-height", "1.5"]) == 0
     out = capsys.readouterr().out
     assert out.count("warning: linear theory") == len(big.validity_warnings) >= 4
@@ -168,8 +172,13 @@ def test_cli_takes_a_comma_list(fake_bem, capsys):
     rows = [ln.split() for ln in out.splitlines()
             if ln.strip().startswith(("1.8 ", "2.2 "))]
     assert [float(x[0]) for x in rows] == [1.8, 2.2]
-    for row, p in zip(rows, r.power_w):
+    for row, p, e in zip(rows, r.power_w, r.mesh_error_w):
         assert float(row[1]) == pytest.approx(p, rel=1e-5)
+        assert float(row[7]) == pytest.approx(e, rel=1e-5)  # the mesh err (W) column
+    # the single run prints the same estimate, the difference of the two meshes' answers
+    assert main(["buoy", "--wave-period", "1.8"]) == 0
+    line = next(ln for ln in capsys.readouterr().out.splitlines() if "mesh error" in ln)
+    assert float(line.split()[-2]) == pytest.approx(r.mesh_error_w[0], rel=1e-5)
 
 
 # --- a design on its bound --------------------------------------------------------------------
