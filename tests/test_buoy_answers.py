@@ -101,6 +101,14 @@ def test_the_mesh_error_is_the_answer_on_the_coarser_mesh(fake_bem):
     assert r.mesh_error_w == pytest.approx(abs(r.power_w - pc), rel=1e-9)
     assert r.mesh_error_w > 0
     assert r.mesh_error_relative == pytest.approx(r.mesh_error_w / r.power_w, rel=1e-14)
+    # the grid's estimate: the body's coefficients on every other frequency (the last kept)
+    w = fine.omega
+    half = _toy(np.append(w[::2], w[-1]) if (w.size - 1) % 2 else w[::2],
+                0.5 / bem.GEOMETRY_PANELS)
+    assert half.omega.size == (w.size + 2) // 2 and half.omega[-1] == w[-1]
+    ph = coupled_optimum(half, pend, Wave.regular(0.2, 1.8)).power
+    assert r.grid_error_w == pytest.approx(abs(r.power_w - ph), rel=1e-9)
+    assert r.grid_error_w > 0
 
 
 def test_a_mesh_file_or_a_dataset_has_no_second_mesh(fake_bem):
@@ -175,10 +183,15 @@ def test_cli_takes_a_comma_list(fake_bem, capsys):
     for row, p, e in zip(rows, r.power_w, r.mesh_error_w):
         assert float(row[1]) == pytest.approx(p, rel=1e-5)
         assert float(row[7]) == pytest.approx(e, rel=1e-5)  # the mesh err (W) column
+    for row, e in zip(rows, r.grid_error_w):
+        assert float(row[8]) == pytest.approx(e, rel=1e-5)  # the grid err (W) column
     # the single run prints the same estimate, the difference of the two meshes' answers
     assert main(["buoy", "--wave-period", "1.8"]) == 0
-    line = next(ln for ln in capsys.readouterr().out.splitlines() if "mesh error" in ln)
+    out = capsys.readouterr().out.splitlines()
+    line = next(ln for ln in out if "mesh error" in ln)
     assert float(line.split()[-2]) == pytest.approx(r.mesh_error_w[0], rel=1e-5)
+    line = next(ln for ln in out if "grid error" in ln)
+    assert float(line.split()[-2]) == pytest.approx(r.grid_error_w[0], rel=1e-5)
 
 
 # --- a design on its bound --------------------------------------------------------------------
@@ -263,4 +276,5 @@ def test_the_default_buoy_same_alone_and_in_sweeps():
         assert s.body == alone.body
     assert alone.body["description"].endswith("1026 panels")
     assert 1e-5 * alone.power_w < alone.mesh_error_w < 1e-2 * alone.power_w
+    assert 1e-5 * alone.power_w < alone.grid_error_w < 3e-2 * alone.power_w
     assert alone.validity_warnings == []

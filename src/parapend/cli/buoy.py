@@ -207,6 +207,9 @@ def _text_result(r) -> list:
             ["one-way (reaction left out): power", _w(r.one_way_power_w), "W"],
             ["  one-way / coupled", _w(r.one_way_ratio), "-"],
             ["free buoy: heave amplitude", _w(r.free_heave_amplitude_m), "m"]]
+    if r.grid_error_w is not None:
+        rows.insert(1, ["  grid error estimate |P - P(every other frequency)|",
+                        _w(r.grid_error_w), "W"])
     if r.mesh_error_w is not None:
         rows.insert(1, ["  mesh error estimate |P - P(coarser mesh)|", _w(r.mesh_error_w),
                         "W"])
@@ -250,10 +253,11 @@ def _sweep_text(r) -> list:
         for row, e in zip(rows, r.electrical_power_w):
             row.insert(2, _fmt(e))
         head[1:2] = ["mechanical (W)", "electrical (W)"]
-    if r.mesh_error_w is not None:
-        for row, e in zip(rows, r.mesh_error_w):
-            row.insert(-1, _fmt(e))
-        head.insert(-1, "mesh err (W)")
+    for name, label in (("mesh_error_w", "mesh err (W)"), ("grid_error_w", "grid err (W)")):
+        if getattr(r, name) is not None:
+            for row, e in zip(rows, getattr(r, name)):
+                row.insert(-1, _fmt(e))
+            head.insert(-1, label)
     out = [f"regular waves, H = {r.wave_height_m:g} m", *_head(r), "",
            _table(rows, head)]
     out += [f"note: {n}" for n in r.warnings]

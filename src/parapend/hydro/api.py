@@ -19,7 +19,7 @@ import numpy as np
 
 from ..defaults import BUOY
 from ..errors import ParameterError, check_int, check_nonnegative, check_positive, check_range
-from .result import _coarse_power, _result, _solve
+from .result import _error_powers, _result, _solve
 
 __all__ = ["buoy", "parse_periods"]
 
@@ -323,10 +323,10 @@ def buoy(*, wave_height=None, wave_period=None, hs=None, tp=None, spectrum="jons
                        variables, bounds, check=lambda p: _check_floats(h, p))
         pend, design = found.pendulum, found.to_dict()
     sol, ow, notes = _solve(h, pend, wave, **opts)
-    coarse_power = None if coarse is None else _coarse_power(coarse, pend, wave, **opts)
+    errors = _error_powers(h, coarse, pend, wave, **opts)
     return _result(h, width, pend, wave, info, sol, ow, torque_limit=torque_limit,
                    efficiency=efficiency, winding=winding, design=design, notes=notes,
-                   coarse_power=coarse_power, geometry=geometry)
+                   error_powers=errors, geometry=geometry)
 
 
 def _bounds(name, text, value):

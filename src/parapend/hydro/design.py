@@ -19,7 +19,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..results import _Result
-from .result import BuoySweepResult, _coarse_power, _result, _solve
+from .result import BuoySweepResult, _error_powers, _result, _solve
 
 __all__ = ["DesignResult", "optimize_design", "period_sweep"]
 
@@ -189,12 +189,12 @@ def period_sweep(hydro, width, pendulum, height, periods, *, winding=1, harmonic
         sol, ow, notes = _solve(hydro, pendulum, wave, winding=winding, harmonics=harmonics,
                                 torque_limit=torque_limit, efficiency=efficiency)
         info = {"kind": "regular", "height_m": height, "period_s": float(period)}
-        cp = None if coarse is None else _coarse_power(
-            coarse, pendulum, wave, winding=winding, harmonics=harmonics,
-            torque_limit=torque_limit, efficiency=efficiency)
+        errors = _error_powers(hydro, coarse, pendulum, wave, winding=winding,
+                               harmonics=harmonics, torque_limit=torque_limit,
+                               efficiency=efficiency)
         rows.append(_result(hydro, width, pendulum, wave, info, sol, ow,
                             torque_limit=torque_limit, efficiency=efficiency, winding=winding,
-                            notes=notes, coarse_power=cp, geometry=geometry))
+                            notes=notes, error_powers=errors, geometry=geometry))
 
     def col(name):
         return np.array([np.nan if getattr(r, name) is None else getattr(r, name)
@@ -217,5 +217,6 @@ def period_sweep(hydro, width, pendulum, height, periods, *, winding=1, harmonic
         _results=tuple(rows),
         electrical_power_w=None if efficiency is None else col("electrical_power_w"),
         mesh_error_w=None if coarse is None else col("mesh_error_w"),
+        grid_error_w=col("grid_error_w"),
         validity_warnings=[f"T = {r.wave['period_s']:g} s: {w}" for r in rows
                            for w in r.validity_warnings])

@@ -8,6 +8,7 @@ all build their answers from here.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from dataclasses import dataclass, field
 
@@ -64,6 +65,10 @@ class BuoyResult(_Result):
         larger, on the same frequencies (:func:`parapend.hydro.bem.body_frequencies`; None
         for a mesh file or a dataset, which have one mesh); mesh_error_relative : over
         ``power_w``.
+    grid_error_w : the same for the frequency grid: ``|P - P_h|``, ``P_h`` the optimum on
+        every other frequency of the grid (the last kept). Linear interpolation converges
+        like the spacing squared, so the answer's own interpolation error is about a third
+        of it.
     validity_warnings : where the answer lies outside linear theory's assumptions: the
         heave amplitude above the draft or the freeboard, the body's bottom out of the water
         or its top under it (the motion relative to the wave), a regular wave steeper than
@@ -103,6 +108,7 @@ class BuoyResult(_Result):
     one_way_electrical_power_w: float | None = None
     mesh_error_w: float | None = None
     mesh_error_relative: float | None = None
+    grid_error_w: float | None = None
     validity_warnings: list = field(default_factory=list)
     _solution: object = field(default=None, repr=False)
     _one_way: object = field(default=None, repr=False)
@@ -165,8 +171,8 @@ class BuoySweepResult(_Result):
     of one height: arrays over ``period_s``, each field named with its unit
     (``electrical_power_w`` with an efficiency, else None). Every period is solved on the
     same mesh and frequencies as alone (:class:`BuoyResult`: the same numbers);
-    ``mesh_error_w`` and ``validity_warnings`` are those of each period (the warnings
-    prefixed with the period)."""
+    ``mesh_error_w``, ``grid_error_w`` and ``validity_warnings`` are those of each period
+    (the warnings prefixed with the period)."""
 
     period_s: np.ndarray
     power_w: np.ndarray
@@ -188,6 +194,7 @@ class BuoySweepResult(_Result):
     electrical_power_w: np.ndarray | None = None
     mesh_error_w: np.ndarray | None = None
     validity_warnings: list = field(default_factory=list)
+    grid_error_w: np.ndarray | None = None
 
     command = "buoy"
     headline = ("period_s", "power_w", "success")
@@ -207,6 +214,8 @@ class BuoySweepResult(_Result):
                                                                dtype=float))
         if self.mesh_error_w is not None:
             ds["mesh_error_w"] = ("period_s", np.asarray(self.mesh_error_w, dtype=float))
+        if self.grid_error_w is not None:
+            ds["grid_error_w"] = ("period_s", np.asarray(self.grid_error_w, dtype=float))
         return ds
 
     def to_dict(self) -> dict:
@@ -287,9 +296,9 @@ def _solve(h, pendulum, wave, *, winding, harmonics, torque_limit, efficiency, o
     return sol, ow, notes
 
 
-def _coarse_power(coarse, pendulum, wave, *, winding, harmonics, torque_limit, efficiency):
-    """``power_w`` of the same problem on the coarse mesh ``coarse`` (its warnings dropped:
-    they are the fine answer's too)."""
+def _power_on(hydro, pendulum, wave, *, winding, harmonics, torque_limit, efficiency):
+    """``power_w`` of the same problem on other coefficients ``hydro`` (its warnings
+    dropped: they are the answer's own)."""
     import warnings
 
     from .optimum import coupled_optimum
@@ -301,8 +310,31 @@ def _coarse_power(coarse, pendulum, wave, *, winding, harmonics, torque_limit, e
         kw["efficiency"] = efficiency
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        sol = coupled_optimum(coarse, pendulum, wave, **kw)
+        sol = coupled_optimum(hydro, pendulum, wave, **kw)
     return float(sol.power)
+
+
+def _half_grid(h):
+    """The same coefficients on every other frequency of ``h``'s grid (the last kept); None
+    below 3 frequencies."""
+    n = np.size(h.omega)
+    if n < 3:
+        return None
+    i = np.arange(0, n, 2)
+    if i[-1] != n - 1:
+        i = np.append(i, n - 1)
+    return dataclasses.replace(h, omega=np.asarray(h.omega)[i],
+                               added_mass=np.asarray(h.added_mass)[i],
+                               radiation_damping=np.asarray(h.radiation_damping)[i],
+                               excitation=np.asarray(h.excitation)[i])
+
+
+def _error_powers(h, coarse, pendulum, wave, **opts):
+    """``(P_c, P_half)``: the same optimum on the coarse mesh ``coarse`` (None: none) and on
+    every other frequency of ``h`` (the error estimates' second answers)."""
+    pc = None if coarse is None else _power_on(coarse, pendulum, wave, **opts)
+    half = _half_grid(h)
+    return pc, None if half is None else _power_on(half, pendulum, wave, **opts)
 
 
 #: A regular wave steeper than this breaks (Michell's limit, H / lambda ~ 0.142).
@@ -342,7 +374,8 @@ def _validity(z, eta, wave, wave_info, h, geometry) -> list:
 
 
 def _result(h, width, pendulum, wave, wave_info, sol, ow, *, torque_limit, efficiency,
-            winding, design=None, notes=(), coarse_power=None, geometry=None) -> BuoyResult:
+            winding, design=None, notes=(), error_powers=(None, None),
+            geometry=None) -> BuoyResult:
     period = 2 * math.pi / wave.omega
     t = period * np.arange(801) / 800
     s = sol.sample(t)
@@ -360,7 +393,9 @@ def _result(h, width, pendulum, wave, wave_info, sol, ow, *, torque_limit, effic
                      f"above) lie above the dataset's highest frequency "
                      f"{float(np.max(h.omega)):.4g} rad/s: there A is held and B = F = 0")
     owp = None if ow is None else float(ow.power)
+    coarse_power, half_power = error_powers
     err = None if coarse_power is None else abs(p - float(coarse_power))
+    gerr = None if half_power is None else abs(p - float(half_power))
     eta = (np.exp(1j * np.multiply.outer(t * wave.omega, np.arange(1, amps.size + 1)))
            @ amps).real
     validity = _validity(s["z"], eta, wave, wave_info, h, geometry)
@@ -391,6 +426,7 @@ def _result(h, width, pendulum, wave, wave_info, sol, ow, *, torque_limit, effic
         body=_body_info(h, width, geometry), torque_limit_nm=torque_limit, efficiency=eff,
         design=design, warnings=notes, mesh_error_w=err,
         mesh_error_relative=err / p if err is not None and p > 0 else None,
+        grid_error_w=gerr,
         validity_warnings=validity, _solution=sol, _one_way=ow, _hydro=h, _wave=wave,
         **efields)
 
