@@ -32,8 +32,8 @@ def add_parsers(sub) -> None:
     g.add_argument("--wave-height", type=_finite_float("wave-height"), default=None,
                    help=f"H, m, crest to trough (default {BUOY['wave_height']:g})")
     g.add_argument("--wave-period", type=_text("wave-period"), default=None, metavar="T",
-                   help=f"s (default {BUOY['wave_period']:g}); FROM:TO:N for power against "
-                        "period")
+                   help=f"s (default {BUOY['wave_period']:g}); FROM:TO:N or a comma list "
+                        "T1,T2,... for power against period")
     g = p.add_argument_group("irregular sea (as 'parapend sea' takes it)")
     g.add_argument("--hs", type=_finite_float("hs"), default=None,
                    help=f"significant wave height, m (default {BUOY['hs']:g} with --tp)")
@@ -207,6 +207,12 @@ def _text_result(r) -> list:
             ["one-way (reaction left out): power", _w(r.one_way_power_w), "W"],
             ["  one-way / coupled", _w(r.one_way_ratio), "-"],
             ["free buoy: heave amplitude", _w(r.free_heave_amplitude_m), "m"]]
+    if r.grid_error_w is not None:
+        rows.insert(1, ["  grid error estimate |P - P(every other frequency)|",
+                        _w(r.grid_error_w), "W"])
+    if r.mesh_error_w is not None:
+        rows.insert(1, ["  mesh error estimate |P - P(coarser mesh)|", _w(r.mesh_error_w),
+                        "W"])
     if r.torque_limit_nm is not None:
         rows.insert(3, ["  torque limit", _w(r.torque_limit_nm), "N m"])
     if r.electrical_power_w is not None:
@@ -223,9 +229,15 @@ def _text_result(r) -> list:
         out.append(f"design: {', '.join(d['variables'])} chosen within "
                    + ", ".join(f"{k} [{lo:g}, {hi:g}]" for k, (lo, hi) in d["bounds"].items())
                    + f" ({d['method']}; {d['evaluations']} inner optima)")
+        for k, side in d.get("at_bound", {}).items():
+            lo, hi = d["bounds"][k]
+            out.append(f"design: {k} lies on its {side} bound {lo if side == 'lower' else hi:g}"
+                       f": the best design may lie beyond it (widen "
+                       f"--{k.replace('_', '-')}-bounds)")
     out.append(f"status: {r.status}; N = {r.harmonics}, winding {r.winding}; energy balance "
                f"residual {r.energy_balance_residual:.1e}")
     out += [f"note: {n}" for n in r.warnings]
+    out += [f"warning: {n}" for n in r.validity_warnings]
     return out
 
 
@@ -241,9 +253,15 @@ def _sweep_text(r) -> list:
         for row, e in zip(rows, r.electrical_power_w):
             row.insert(2, _fmt(e))
         head[1:2] = ["mechanical (W)", "electrical (W)"]
+    for name, label in (("mesh_error_w", "mesh err (W)"), ("grid_error_w", "grid err (W)")):
+        if getattr(r, name) is not None:
+            for row, e in zip(rows, getattr(r, name)):
+                row.insert(-1, _fmt(e))
+            head.insert(-1, label)
     out = [f"regular waves, H = {r.wave_height_m:g} m", *_head(r), "",
            _table(rows, head)]
     out += [f"note: {n}" for n in r.warnings]
+    out += [f"warning: {n}" for n in r.validity_warnings]
     return out
 
 

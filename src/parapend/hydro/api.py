@@ -19,7 +19,7 @@ import numpy as np
 
 from ..defaults import BUOY
 from ..errors import ParameterError, check_int, check_nonnegative, check_positive, check_range
-from .result import _result, _solve
+from .result import _error_powers, _result, _solve
 
 __all__ = ["buoy", "parse_periods"]
 
@@ -31,13 +31,20 @@ MAX_PERIODS = 200
 
 
 def parse_periods(text) -> np.ndarray | None:
-    """``"FROM:TO:N"`` -> N periods from FROM to TO (s); a plain number -> None."""
-    if not isinstance(text, str) or ":" not in text:
+    """``"FROM:TO:N"`` -> N periods from FROM to TO (s); a comma list ``"T1,T2,..."`` -> those
+    periods (s), in the order given; a plain number -> None."""
+    if not isinstance(text, str) or (":" not in text and "," not in text):
         return None
+    if ":" not in text:
+        parts = [s.strip() for s in text.split(",")]
+        if not 1 <= len(parts) <= MAX_PERIODS:
+            raise ParameterError(f"wave-period: expected at most {MAX_PERIODS} periods, got "
+                                 f"{len(parts)}")
+        return np.array([_period(s) for s in parts])
     parts = text.split(":")
     if len(parts) != 3:
-        raise ParameterError(f"wave-period: expected a period in s or FROM:TO:N, got "
-                             f"{text!r:.60}")
+        raise ParameterError(f"wave-period: expected a period in s, T1,T2,... or FROM:TO:N, "
+                             f"got {text!r:.60}")
     try:
         lo, hi = float(parts[0]), float(parts[1])
         n = int(parts[2])
@@ -57,8 +64,8 @@ def _period(value) -> float:
         try:
             value = float(value)
         except ValueError:
-            raise ParameterError(f"wave-period: expected a period in s or FROM:TO:N, got "
-                                 f"{value!r:.60}") from None
+            raise ParameterError(f"wave-period: expected a period in s, T1,T2,... or "
+                                 f"FROM:TO:N, got {value!r:.60}") from None
     return check_range("wave-period", value, 0.1, 100.0, why="wave period, s")
 
 
@@ -107,9 +114,9 @@ def _irregular_wave(hs, tp, spectrum, gamma_peak, repeat_period, seed, cutoff, r
     return wave, info
 
 
-def _hydro(body, radius, draft, mesh, hydro, omegas, harmonics):
-    """The body's coefficients over the frequencies the problem needs (the wave's
-    ``omegas`` up to ``harmonics`` times the highest, rad/s), and the body's width."""
+def _hydro(body, radius, draft, mesh, hydro):
+    """The body's coefficients on the body's own frequency grid (:func:`.bem.body_frequencies`:
+    one mesh and one grid per body, whatever the waves of the call), and its width."""
     from . import bem as hy
 
     given = [n for n, v in (("mesh", mesh), ("hydro", hydro)) if v is not None]
@@ -120,20 +127,16 @@ def _hydro(body, radius, draft, mesh, hydro, omegas, harmonics):
                              f"from --{given[0]}; drop it")
     if hydro is not None:
         return hy.load(hydro), None
-    omega = hy.frequencies_for(np.asarray(omegas, dtype=float), harmonics)
-    try:
-        return _solve_hydro(hy, body, radius, draft, mesh, omega)
-    except ParameterError as e:
-        # the user gave wave periods, not the BEM's frequencies
-        if str(e).startswith("omega: every frequency is too high"):
-            raise ParameterError("wave-period: the waves are too short for the body's mesh; "
-                                 + str(e).split(": ", 1)[1]) from None
-        raise
-
-
-def _solve_hydro(hy, body, radius, draft, mesh, omega):
     if mesh is not None:
-        return hy.from_mesh(mesh, omega=omega), None
+        return hy.from_mesh(mesh, omega="body"), None
+    r, d = _dimensions(body, radius, draft)
+    if body == "sphere":
+        return hy.sphere(r, omega="body"), 2 * r
+    return hy.cylinder(r, d, omega="body"), 2 * r
+
+
+def _dimensions(body, radius, draft):
+    """Radius and draft (m) of a parametric body (a sphere's draft is its radius)."""
     if body not in ("cylinder", "sphere"):
         raise ParameterError(f"body: expected cylinder or sphere, got {body!r:.40}")
     r = check_positive("radius", BUOY["radius"] if radius is None else radius)
@@ -141,9 +144,30 @@ def _solve_hydro(hy, body, radius, draft, mesh, omega):
         if draft is not None:
             raise ParameterError("draft: a sphere floats at its centre (draft = radius); "
                                  "drop --draft")
-        return hy.sphere(r, omega=omega), 2 * r
-    d = check_positive("draft", BUOY["draft"] if draft is None else draft)
-    return hy.cylinder(r, d, omega=omega), 2 * r
+        return r, r
+    return r, check_positive("draft", BUOY["draft"] if draft is None else draft)
+
+
+def _coarse_hydro(body, radius, draft, mesh, hydro):
+    """The same body on a mesh of panels :data:`.bem.COARSE` times larger, on the same
+    frequencies (the error estimate's second mesh); None for a mesh file or a dataset."""
+    if mesh is not None or hydro is not None:
+        return None
+    from . import bem as hy
+
+    r, d = _dimensions(body, radius, draft)
+    if body == "sphere":
+        return hy.sphere(r, omega="body", refine=1 / hy.COARSE)
+    return hy.cylinder(r, d, omega="body", refine=1 / hy.COARSE)
+
+
+def _geometry(body, radius, draft, mesh, hydro) -> dict | None:
+    """Draft and freeboard (m) of a parametric body (its mesh: a cylinder of length twice
+    the draft, a whole sphere, centred on the free surface); None otherwise."""
+    if mesh is not None or hydro is not None:
+        return None
+    r, d = _dimensions(body, radius, draft)
+    return {"draft_m": d, "freeboard_m": d}
 
 
 def _check_floats(h, pendulum):
@@ -241,7 +265,6 @@ def buoy(*, wave_height=None, wave_period=None, hs=None, tp=None, spectrum="jons
                          else wave_height, 1e-4, 30.0, why="regular wave height, m")
     if periods is not None and variables:
         raise ParameterError("optimize-design: one wave period at a time (drop FROM:TO:N)")
-    nb = BUOY["bem_harmonics"]
     if irregular:
         from ..units import Units
 
@@ -250,9 +273,7 @@ def buoy(*, wave_height=None, wave_period=None, hs=None, tp=None, spectrum="jons
                                                           pend.inertia))
         amps = np.abs(np.asarray(wave.amplitudes))
         sig = np.nonzero(amps >= 1e-3 * amps.max())[0]  # the components that matter
-        top = np.nonzero(amps)[0][-1]
-        h, width = _hydro(body, radius, draft, mesh, hydro,
-                          wave.omega * np.array([sig[0] + 1.0, top + 1.0]), 2)
+        h, width = _hydro(body, radius, draft, mesh, hydro)
         h.check_covers(wave.omega * (sig[0] + 1), wave.omega * (sig[-1] + 1),
                        name="tp" if record is None else "record")
     else:
@@ -261,20 +282,29 @@ def buoy(*, wave_height=None, wave_period=None, hs=None, tp=None, spectrum="jons
             periods_all = np.array([period])
         else:
             periods_all = np.array([_period(p) for p in periods])
-        h, width = _hydro(body, radius, draft, mesh, hydro, 2 * math.pi / periods_all, nb)
+        h, width = _hydro(body, radius, draft, mesh, hydro)
         w = 2 * math.pi / periods_all
+        top = float(np.max(h.omega))
+        if hydro is None and float(np.max(w)) > top * (1 + 1e-9):
+            raise ParameterError(f"wave-period: the waves are too short for the body's mesh; "
+                                 f"its frequencies cover periods from {2 * math.pi / top:.4g} "
+                                 f"s up, got {float(np.min(periods_all)):g} s")
         h.check_covers(float(np.min(w)), float(np.max(w)), name="wave-period")
-        if periods is not None:
-            _check_floats(h, pend)
-            from .design import period_sweep
+    _check_floats(h, pend)
+    # the body on a second, coarser mesh: the estimate of the discretization error
+    coarse = (_coarse_hydro(body, radius, draft, mesh, hydro) if controller == "optimum"
+              else None)
+    geometry = _geometry(body, radius, draft, mesh, hydro)
+    if not irregular and periods is not None:
+        from .design import period_sweep
 
-            return period_sweep(h, width, pend, height, periods_all, winding=winding,
-                                harmonics=harmonics, torque_limit=torque_limit,
-                                efficiency=efficiency)
+        return period_sweep(h, width, pend, height, periods_all, winding=winding,
+                            harmonics=harmonics, torque_limit=torque_limit,
+                            efficiency=efficiency, coarse=coarse, geometry=geometry)
+    if not irregular:
         wave = Wave.regular(height, float(periods_all[0]))
         info = {"kind": "regular", "height_m": height, "period_s": float(periods_all[0]),
                 "omega_rad_per_s": 2 * math.pi / float(periods_all[0])}
-    _check_floats(h, pend)
     if controller != "optimum":
         from .control import mpc_command
 
@@ -293,8 +323,10 @@ def buoy(*, wave_height=None, wave_period=None, hs=None, tp=None, spectrum="jons
                        variables, bounds, check=lambda p: _check_floats(h, p))
         pend, design = found.pendulum, found.to_dict()
     sol, ow, notes = _solve(h, pend, wave, **opts)
+    errors = _error_powers(h, coarse, pend, wave, **opts)
     return _result(h, width, pend, wave, info, sol, ow, torque_limit=torque_limit,
-                   efficiency=efficiency, winding=winding, design=design, notes=notes)
+                   efficiency=efficiency, winding=winding, design=design, notes=notes,
+                   error_powers=errors, geometry=geometry)
 
 
 def _bounds(name, text, value):

@@ -40,8 +40,8 @@ import numpy as np
 
 from ..errors import ParameterError, check_int, check_positive
 
-__all__ = ["Hydro", "cache_dir", "cylinder", "frequencies_for", "from_mesh", "load",
-           "mesh_size", "sphere"]
+__all__ = ["Hydro", "body_frequencies", "cache_dir", "cylinder", "frequencies_for",
+           "from_mesh", "load", "mesh_size", "sphere"]
 
 #: Bump when the cached content or the meshing rule changes (old entries are then ignored).
 CACHE_VERSION = 1
@@ -57,6 +57,19 @@ GEOMETRY_PANELS = 12
 #: The finest panel the automatic rule uses: ``scale / FINEST_PANELS``; frequencies whose
 #: wavelength that panel cannot resolve are left out of the BEM (they are then above range).
 FINEST_PANELS = 24
+
+#: The body's own frequency grid (``omega="body"``, :func:`body_frequencies`): so many
+#: frequencies, evenly spaced, from ``2 pi / LONGEST_PERIOD`` to the frequency whose
+#: wavelength is ``COARSE * 8`` panel radii of the body's mesh.
+BODY_FREQUENCIES = 48
+
+#: The longest wave period (s) the body's grid starts at (``parapend buoy`` takes 0.1 to 100 s).
+LONGEST_PERIOD = 100.0
+
+#: The panels of the error estimate's second mesh are this many times larger (panel radius):
+#: the grid ends where that mesh still has Capytaine's 8 panel radii per wavelength, so the
+#: body's own mesh has 12 there, more than :data:`PANELS_PER_WAVE`.
+COARSE = 1.5
 
 
 def _as_omega(w) -> np.ndarray:
@@ -279,6 +292,26 @@ def frequencies_for(omegas, harmonics=3, *, count=30, low=0.5):
     return np.linspace(low * w.min(), harmonics * w.max(), count)
 
 
+def body_frequencies(h, *, g=9.81, water_depth=math.inf) -> np.ndarray:
+    """The body's frequency grid (rad/s): one for every problem on the body, whichever wave
+    periods a call asks for, so that an answer does not depend on the call.
+
+    ``BODY_FREQUENCIES`` frequencies, evenly spaced, from ``2 pi / LONGEST_PERIOD`` to the
+    frequency whose wavelength is ``8 COARSE h`` (``h`` the panel radius of the body's mesh):
+    there the mesh of panels ``COARSE`` times larger (the error estimate's) still resolves
+    the wave, and this one has ``8 COARSE = 12`` panel radii per wavelength.
+    """
+    h = check_positive("h", h)
+    k = 2 * math.pi / (8 * COARSE * h * (1 + 1e-9))
+    top = math.sqrt(g * k * (math.tanh(k * water_depth) if math.isfinite(water_depth)
+                             else 1.0))
+    low = 2 * math.pi / LONGEST_PERIOD
+    if not top > low:
+        raise ParameterError(f"h: a panel radius of {h:.3g} m resolves no wave shorter than "
+                             f"{LONGEST_PERIOD:g} s")
+    return np.linspace(low, top, BODY_FREQUENCIES)
+
+
 def _wavenumber(w, g, depth):
     """Wavenumber (1/m) from the dispersion relation ``w^2 = g k tanh(k h)``."""
     k0 = w * w / g
@@ -471,10 +504,14 @@ def cylinder(radius, draft, *, omega=None, rho=1025.0, g=9.81, water_depth=math.
     ----------
     radius, draft : float
         Radius and draft (m), both > 0.
-    omega : array_like, optional
+    omega : array_like or "body", optional
         Angular frequencies (rad/s) for the BEM (default ``DEFAULT_OMEGA``; see
         :func:`frequencies_for`). Frequencies too high for the finest panel the meshing
-        rule allows are left out (the coefficients are then above range there).
+        rule allows are left out (the coefficients are then above range there). ``"body"``:
+        the mesh from the geometry alone (panel radius ``scale / GEOMETRY_PANELS``, ``scale``
+        the smaller of radius and draft, divided by ``refine``) and the body's own grid
+        (:func:`body_frequencies` of the panel radius ``scale / GEOMETRY_PANELS``, whatever
+        ``refine``), the same for every call.
     rho, g, water_depth : float
         Water density (kg/m^3), gravity (m/s^2), depth (m; ``inf`` deep water).
     cache : bool
@@ -489,9 +526,7 @@ def cylinder(radius, draft, *, omega=None, rho=1025.0, g=9.81, water_depth=math.
     radius = check_positive("radius", radius)
     draft = check_positive("draft", draft)
     rho, g, water_depth, refine = _common(rho, g, water_depth, refine)
-    omega = DEFAULT_OMEGA if omega is None else _omega_grid(omega)
-    h = mesh_size(min(radius, draft), omega[-1], g=g, water_depth=water_depth, refine=refine)
-    omega = _keep_resolvable(omega, h, g, water_depth)
+    h, omega = _mesh_and_grid(min(radius, draft), omega, g, water_depth, refine)
     if math.isfinite(water_depth) and draft >= water_depth:
         raise ParameterError(f"draft: expected less than the water depth {water_depth:g} m, "
                              f"got {draft!r}")
@@ -515,9 +550,7 @@ def sphere(radius, *, omega=None, rho=1025.0, g=9.81, water_depth=math.inf, cach
     """
     radius = check_positive("radius", radius)
     rho, g, water_depth, refine = _common(rho, g, water_depth, refine)
-    omega = DEFAULT_OMEGA if omega is None else _omega_grid(omega)
-    h = mesh_size(radius, omega[-1], g=g, water_depth=water_depth, refine=refine)
-    omega = _keep_resolvable(omega, h, g, water_depth)
+    h, omega = _mesh_and_grid(radius, omega, g, water_depth, refine)
     if math.isfinite(water_depth) and radius >= water_depth:
         raise ParameterError(f"radius: expected less than the water depth {water_depth:g} m, "
                              f"got {radius!r}")
@@ -531,6 +564,18 @@ def sphere(radius, *, omega=None, rho=1025.0, g=9.81, water_depth=math.inf, cach
     desc = f"sphere floating at its centre, radius {radius:g} m"
     return _solve(build, omega, rho=rho, g=g, water_depth=water_depth, description=desc,
                   cache=cache, key_parts=_params(body="sphere", **kw))
+
+
+def _mesh_and_grid(scale, omega, g, depth, refine):
+    """The panel radius and the frequencies of a parametric body of size ``scale``."""
+    if isinstance(omega, str) and omega == "body":
+        # the grid is the body's (from its geometry mesh), whatever ``refine``: a refined or
+        # a coarsened mesh of the same body answers on the same frequencies
+        h = scale / GEOMETRY_PANELS
+        return h / refine, body_frequencies(h, g=g, water_depth=depth)
+    omega = DEFAULT_OMEGA if omega is None else _omega_grid(omega)
+    h = mesh_size(scale, omega[-1], g=g, water_depth=depth, refine=refine)
+    return h, _keep_resolvable(omega, h, g, depth)
 
 
 def _common(rho, g, water_depth, refine):
@@ -573,10 +618,12 @@ def from_mesh(path, *, omega=None, rho=1025.0, g=9.81, water_depth=math.inf, cac
     may be the whole hull or only its wetted part; its immersed part must be closed up to
     the waterline: every edge used by one panel only must lie on ``z = 0``.
 
-    Parameters as :func:`cylinder`; the panel size is the file's.
+    Parameters as :func:`cylinder`; the panel size is the file's (``omega="body"``: the
+    body's grid, :func:`body_frequencies`, from the largest panel radius).
     """
     rho, g, water_depth, _ = _common(rho, g, water_depth, 1.0)
-    omega = DEFAULT_OMEGA if omega is None else _omega_grid(omega)
+    body_grid = isinstance(omega, str) and omega == "body"
+    omega = DEFAULT_OMEGA if omega is None or body_grid else _omega_grid(omega)
     p = Path(path)
     name = "mesh"
     if not p.is_file():
@@ -612,7 +659,8 @@ def from_mesh(path, *, omega=None, rho=1025.0, g=9.81, water_depth=math.inf, cac
                              "normals pointing outwards?)")
     radii = np.asarray(hull.faces_radiuses)
     h = float(radii.max())
-    omega = _keep_resolvable(omega, h, g, water_depth)
+    omega = (body_frequencies(h, g=g, water_depth=water_depth) if body_grid
+             else _keep_resolvable(omega, h, g, water_depth))
     desc = f"mesh {p.name}, immersed part"
     parts = b"file|" + str(file_format).encode() + b"|" + p.read_bytes()
     return _solve(lambda: (hull, hull), omega, rho=rho, g=g, water_depth=water_depth,

@@ -19,12 +19,15 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..results import _Result
-from .result import BuoySweepResult, _result, _solve
+from .result import BuoySweepResult, _error_powers, _result, _solve
 
 __all__ = ["DesignResult", "optimize_design", "period_sweep"]
 
 #: grid points per variable before the polish, by the number of variables
 GRID = {1: 7, 2: 5, 3: 3, 4: 3}
+
+#: a best value within this fraction of its box's width from a bound lies on the bound
+BOUND_TOL = 1e-3
 
 
 @dataclass(frozen=True, eq=False)
@@ -38,6 +41,9 @@ class DesignResult(_Result):
         ``m l^2``); power_w : the coupled optimum there.
     evaluations : inner optima solved; grid_best_w : the best on the grid before the polish.
     failed : inner solves that did not succeed (counted as no power).
+    at_bound : ``{name: "lower" | "upper"}`` for each variable whose best value lies on a
+        bound of its box (within 1e-3 of the box's width): the search stopped there, and
+        the best design may lie beyond it (widen the bounds).
     """
 
     variables: list
@@ -48,6 +54,7 @@ class DesignResult(_Result):
     evaluations: int
     failed: int
     method: str
+    at_bound: dict = dataclasses.field(default_factory=dict)
     _pendulum: object = dataclasses.field(default=None, repr=False)
 
     @property
@@ -145,13 +152,16 @@ def optimize_design(solve, pendulum, variables, bounds, *, check=None) -> Design
         cand = [np.asarray(r.x)]
         method = f"grid of {g}^{len(names)}, then Nelder-Mead within the bounds"
     best_u = max([u0, *cand], key=lambda u: power(u))
-    p = _physical(pendulum, names, lo + np.clip(best_u, 0, 1) * (hi - lo))
+    best_u = np.clip(best_u, 0, 1)
+    p = _physical(pendulum, names, lo + best_u * (hi - lo))
+    at_bound = {n: ("lower" if u <= BOUND_TOL else "upper") for n, u in zip(names, best_u)
+                if u <= BOUND_TOL or u >= 1 - BOUND_TOL}
     return DesignResult(
         variables=names, bounds={n: [float(a), float(b)] for n, a, b in zip(names, lo, hi)},
         best={"mass_kg": p.mass, "length_m": p.length, "inertia_kg_m2": p.inertia,
               "damping_coefficient_nm_s_per_rad": p.damping_coefficient},
         power_w=power(best_u), grid_best_w=grid_best, evaluations=len(cache),
-        failed=failed[0], method=method, _pendulum=p)
+        failed=failed[0], method=method, at_bound=at_bound, _pendulum=p)
 
 
 def _simplex(u0, step):
@@ -165,9 +175,12 @@ def _simplex(u0, step):
 
 
 def period_sweep(hydro, width, pendulum, height, periods, *, winding=1, harmonics=None,
-                 torque_limit=None, efficiency=None):
+                 torque_limit=None, efficiency=None, coarse=None, geometry=None):
     """Coupled and one-way optima of one design in regular waves of height ``height`` (m)
-    over ``periods`` (s): a :class:`~parapend.hydro.result.BuoySweepResult`."""
+    over ``periods`` (s): a :class:`~parapend.hydro.result.BuoySweepResult`. Each period is
+    solved as alone (the same body, mesh and frequencies); ``coarse`` (the body on the
+    error estimate's mesh, or None) gives ``mesh_error_w``, ``geometry`` (draft and
+    freeboard, or None) the validity checks."""
     from .coupled import Wave
 
     rows = []
@@ -176,9 +189,12 @@ def period_sweep(hydro, width, pendulum, height, periods, *, winding=1, harmonic
         sol, ow, notes = _solve(hydro, pendulum, wave, winding=winding, harmonics=harmonics,
                                 torque_limit=torque_limit, efficiency=efficiency)
         info = {"kind": "regular", "height_m": height, "period_s": float(period)}
+        errors = _error_powers(hydro, coarse, pendulum, wave, winding=winding,
+                               harmonics=harmonics, torque_limit=torque_limit,
+                               efficiency=efficiency)
         rows.append(_result(hydro, width, pendulum, wave, info, sol, ow,
                             torque_limit=torque_limit, efficiency=efficiency, winding=winding,
-                            notes=notes))
+                            notes=notes, error_powers=errors, geometry=geometry))
 
     def col(name):
         return np.array([np.nan if getattr(r, name) is None else getattr(r, name)
@@ -199,4 +215,8 @@ def period_sweep(hydro, width, pendulum, height, periods, *, winding=1, harmonic
         status=[r.status for r in rows], success=all(r.success for r in rows),
         wave_height_m=height, pendulum=rows[0].pendulum, body=rows[0].body, warnings=notes,
         _results=tuple(rows),
-        electrical_power_w=None if efficiency is None else col("electrical_power_w"))
+        electrical_power_w=None if efficiency is None else col("electrical_power_w"),
+        mesh_error_w=None if coarse is None else col("mesh_error_w"),
+        grid_error_w=col("grid_error_w"),
+        validity_warnings=[f"T = {r.wave['period_s']:g} s: {w}" for r in rows
+                           for w in r.validity_warnings])

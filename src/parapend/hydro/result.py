@@ -8,6 +8,7 @@ all build their answers from here.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from dataclasses import dataclass, field
 
@@ -59,6 +60,19 @@ class BuoyResult(_Result):
     ideal_power_w : the ideal (lossless) coupled optimum
         ``electrical_power_w <= eta_g ideal_power_w``.
     one_way_electrical_power_w : the one-way answer's electrical optimum.
+    mesh_error_w : the estimate of the discretization error of ``power_w``: ``|P - P_c|``,
+        ``P_c`` the same optimum on the same body meshed with panels ``COARSE = 1.5`` times
+        larger, on the same frequencies (:func:`parapend.hydro.bem.body_frequencies`; None
+        for a mesh file or a dataset, which have one mesh); mesh_error_relative : over
+        ``power_w``.
+    grid_error_w : the same for the frequency grid: ``|P - P_h|``, ``P_h`` the optimum on
+        every other frequency of the grid (the last kept). Linear interpolation converges
+        like the spacing squared, so the answer's own interpolation error is about a third
+        of it.
+    validity_warnings : where the answer lies outside linear theory's assumptions: the
+        heave amplitude above the draft or the freeboard, the body's bottom out of the water
+        or its top under it (the motion relative to the wave), a regular wave steeper than
+        the breaking limit ``H / lambda = 1/7`` (docs/buoy.md).
     """
 
     power_w: float
@@ -92,6 +106,10 @@ class BuoyResult(_Result):
     motoring_power_w: float | None = None
     ideal_power_w: float | None = None
     one_way_electrical_power_w: float | None = None
+    mesh_error_w: float | None = None
+    mesh_error_relative: float | None = None
+    grid_error_w: float | None = None
+    validity_warnings: list = field(default_factory=list)
     _solution: object = field(default=None, repr=False)
     _one_way: object = field(default=None, repr=False)
     _hydro: object = field(default=None, repr=False)
@@ -151,7 +169,10 @@ class BuoyResult(_Result):
 class BuoySweepResult(_Result):
     """Power of one design against wave period (``wave_period="FROM:TO:N"``), regular waves
     of one height: arrays over ``period_s``, each field named with its unit
-    (``electrical_power_w`` with an efficiency, else None)."""
+    (``electrical_power_w`` with an efficiency, else None). Every period is solved on the
+    same mesh and frequencies as alone (:class:`BuoyResult`: the same numbers);
+    ``mesh_error_w``, ``grid_error_w`` and ``validity_warnings`` are those of each period
+    (the warnings prefixed with the period)."""
 
     period_s: np.ndarray
     power_w: np.ndarray
@@ -171,6 +192,9 @@ class BuoySweepResult(_Result):
     warnings: list
     _results: tuple = field(default=(), repr=False)
     electrical_power_w: np.ndarray | None = None
+    mesh_error_w: np.ndarray | None = None
+    validity_warnings: list = field(default_factory=list)
+    grid_error_w: np.ndarray | None = None
 
     command = "buoy"
     headline = ("period_s", "power_w", "success")
@@ -188,6 +212,10 @@ class BuoySweepResult(_Result):
         if self.electrical_power_w is not None:
             ds["electrical_power_w"] = ("period_s", np.asarray(self.electrical_power_w,
                                                                dtype=float))
+        if self.mesh_error_w is not None:
+            ds["mesh_error_w"] = ("period_s", np.asarray(self.mesh_error_w, dtype=float))
+        if self.grid_error_w is not None:
+            ds["grid_error_w"] = ("period_s", np.asarray(self.grid_error_w, dtype=float))
         return ds
 
     def to_dict(self) -> dict:
@@ -234,7 +262,7 @@ def _half_range(x) -> float:
 
 
 
-def _body_info(h, width) -> dict:
+def _body_info(h, width, geometry=None) -> dict:
     out = {"description": getattr(h, "description", ""), "mass_kg": float(h.mass),
            "hydrostatic_stiffness_n_per_m": float(h.hydrostatic_stiffness),
            "rho_kg_per_m3": float(h.rho), "water_depth_m": float(h.water_depth),
@@ -242,6 +270,8 @@ def _body_info(h, width) -> dict:
            "omega_range_rad_per_s": [float(np.min(h.omega)), float(np.max(h.omega))]}
     if width is not None:
         out["width_m"] = width
+    if geometry is not None:
+        out.update(geometry)
     return out
 
 
@@ -266,8 +296,86 @@ def _solve(h, pendulum, wave, *, winding, harmonics, torque_limit, efficiency, o
     return sol, ow, notes
 
 
+def _power_on(hydro, pendulum, wave, *, winding, harmonics, torque_limit, efficiency):
+    """``power_w`` of the same problem on other coefficients ``hydro`` (its warnings
+    dropped: they are the answer's own)."""
+    import warnings
+
+    from .optimum import coupled_optimum
+
+    kw = {"winding": winding, "harmonics": harmonics}
+    if torque_limit is not None:
+        kw["torque_limit"] = torque_limit
+    if efficiency is not None:
+        kw["efficiency"] = efficiency
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        sol = coupled_optimum(hydro, pendulum, wave, **kw)
+    return float(sol.power)
+
+
+def _half_grid(h):
+    """The same coefficients on every other frequency of ``h``'s grid (the last kept); None
+    below 3 frequencies."""
+    n = np.size(h.omega)
+    if n < 3:
+        return None
+    i = np.arange(0, n, 2)
+    if i[-1] != n - 1:
+        i = np.append(i, n - 1)
+    return dataclasses.replace(h, omega=np.asarray(h.omega)[i],
+                               added_mass=np.asarray(h.added_mass)[i],
+                               radiation_damping=np.asarray(h.radiation_damping)[i],
+                               excitation=np.asarray(h.excitation)[i])
+
+
+def _error_powers(h, coarse, pendulum, wave, **opts):
+    """``(P_c, P_half)``: the same optimum on the coarse mesh ``coarse`` (None: none) and on
+    every other frequency of ``h`` (the error estimates' second answers)."""
+    pc = None if coarse is None else _power_on(coarse, pendulum, wave, **opts)
+    half = _half_grid(h)
+    return pc, None if half is None else _power_on(half, pendulum, wave, **opts)
+
+
+#: A regular wave steeper than this breaks (Michell's limit, H / lambda ~ 0.142).
+BREAKING_STEEPNESS = 1 / 7
+
+
+def _validity(z, eta, wave, wave_info, h, geometry) -> list:
+    """Where the motion ``z`` (m, one period's samples) in the wave ``eta`` (m, the same
+    times) leaves linear theory's assumptions (:class:`BuoyResult`'s ``validity_warnings``)."""
+    out = []
+    heave = _half_range(z)
+    rel = np.asarray(z) - np.asarray(eta)
+    if geometry is not None:
+        d, f = geometry["draft_m"], geometry["freeboard_m"]
+        for name, size in (("draft", d), ("freeboard", f)):
+            if heave > size:
+                out.append(f"linear theory: the heave amplitude {heave:.3g} m exceeds the "
+                           f"body's {name} {size:.3g} m; the answer is outside its validity")
+        if float(np.max(rel)) > d:
+            out.append(f"linear theory: the body's bottom leaves the water (the heave "
+                       f"relative to the wave reaches {float(np.max(rel)):.3g} m, the draft "
+                       f"is {d:.3g} m)")
+        if -float(np.min(rel)) > f:
+            out.append(f"linear theory: the body's top goes under water (the wave rises "
+                       f"{-float(np.min(rel)):.3g} m above the body's still waterline, the "
+                       f"freeboard is {f:.3g} m)")
+    if wave_info.get("kind") == "regular":
+        from .waves import wavenumber
+
+        k = wavenumber(wave.omega, h.water_depth, h.g)
+        height = 2 * float(np.max(np.abs(np.asarray(wave.amplitudes))))
+        steep = height * k / (2 * math.pi)
+        if steep > BREAKING_STEEPNESS:
+            out.append(f"linear theory: the wave's steepness H / lambda = {steep:.3g} exceeds "
+                       f"the breaking limit 1/7 (wavelength {2 * math.pi / k:.3g} m)")
+    return out
+
+
 def _result(h, width, pendulum, wave, wave_info, sol, ow, *, torque_limit, efficiency,
-            winding, design=None, notes=()) -> BuoyResult:
+            winding, design=None, notes=(), error_powers=(None, None),
+            geometry=None) -> BuoyResult:
     period = 2 * math.pi / wave.omega
     t = period * np.arange(801) / 800
     s = sol.sample(t)
@@ -285,6 +393,12 @@ def _result(h, width, pendulum, wave, wave_info, sol, ow, *, torque_limit, effic
                      f"above) lie above the dataset's highest frequency "
                      f"{float(np.max(h.omega)):.4g} rad/s: there A is held and B = F = 0")
     owp = None if ow is None else float(ow.power)
+    coarse_power, half_power = error_powers
+    err = None if coarse_power is None else abs(p - float(coarse_power))
+    gerr = None if half_power is None else abs(p - float(half_power))
+    eta = (np.exp(1j * np.multiply.outer(t * wave.omega, np.arange(1, amps.size + 1)))
+           @ amps).real
+    validity = _validity(s["z"], eta, wave, wave_info, h, geometry)
     ep = sol.electrical_power
     harvest = p if ep is None else float(ep)  # what the design delivers
     eff = None if sol.efficiency is None else [float(v) for v in sol.efficiency]
@@ -309,8 +423,11 @@ def _result(h, width, pendulum, wave, wave_info, sol, ow, *, torque_limit, effic
         pendulum={"mass_kg": pendulum.mass, "length_m": pendulum.length,
                   "inertia_kg_m2": pendulum.inertia,
                   "damping_coefficient_nm_s_per_rad": pendulum.damping_coefficient},
-        body=_body_info(h, width), torque_limit_nm=torque_limit, efficiency=eff,
-        design=design, warnings=notes, _solution=sol, _one_way=ow, _hydro=h, _wave=wave,
+        body=_body_info(h, width, geometry), torque_limit_nm=torque_limit, efficiency=eff,
+        design=design, warnings=notes, mesh_error_w=err,
+        mesh_error_relative=err / p if err is not None and p > 0 else None,
+        grid_error_w=gerr,
+        validity_warnings=validity, _solution=sol, _one_way=ow, _hydro=h, _wave=wave,
         **efields)
 
 

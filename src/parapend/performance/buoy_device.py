@@ -72,14 +72,14 @@ def file_digest(path) -> str | None:
 
 
 def body_hydro(spec):
-    """The body's coefficients over ``spec.band`` (BEM solved once, cached on disk; one
-    load per process) and the body's width (None for a mesh or a dataset)."""
+    """The body's coefficients on the body's own frequency grid, the same as ``parapend
+    buoy``'s (BEM solved once, cached on disk; one load per process), and the body's width
+    (None for a mesh or a dataset)."""
     key = _key(spec)
     if key not in _HYDRO:
         from ..hydro.api import _hydro
 
-        _HYDRO[key] = _hydro(spec.body, spec.radius, spec.draft, spec.mesh, spec.hydro,
-                             np.array(spec.band), 2)
+        _HYDRO[key] = _hydro(spec.body, spec.radius, spec.draft, spec.mesh, spec.hydro)
     return _HYDRO[key]
 
 
