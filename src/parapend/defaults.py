@@ -58,7 +58,7 @@ SEA = {"hs": 2.0, "tp": 8.0, "seed": 0, "length": 1.0, "mass": 10.0, "gravity": 
 #: without ``--<name>-bounds``, as factors of the design's value (damping: N m s/rad).
 BUOY = {"wave_height": 0.2, "wave_period": 1.8, "hs": 0.5, "tp": 2.5,
         "radius": 0.5, "draft": 0.5, "mass": 80.0, "length": 0.3, "inertia": None,
-        "damping_coefficient": 1.0, "bem_harmonics": 3,
+        "damping_coefficient": 1.0,
         "design_bounds": {"mass": (0.25, 4.0), "length": (0.25, 4.0), "inertia": (1.0, 4.0),
                           "damping_coefficient": (0.0, 20.0)}}
 
