@@ -917,7 +917,7 @@ def buoy(*, wave_height=None, wave_period=None, hs=None, tp=None, spectrum="jons
     ``buoy``; :func:`parapend.hydro.api.buoy`, parameters there): a
     :class:`~parapend.hydro.result.BuoyResult`, or a :class:`~parapend.hydro.result.BuoySweepResult`
     for ``wave_period="FROM:TO:N"``. With no arguments: the embedded default design
-    (:data:`parapend.defaults.BUOY`, docs/defaults.md)."""
+    (``parapend.defaults.BUOY``, docs/defaults.md)."""
     from .hydro.api import buoy as _buoy
 
     return _buoy(wave_height=wave_height, wave_period=wave_period, hs=hs, tp=tp,

@@ -117,7 +117,7 @@ class SeaResult(_Result):
     headline = ("power_w", "limit_power_w", "uniform_power_w", "winding", "status")
 
     def samples(self, points: int | None = None) -> dict:
-        """The record and the optimal motion over one repeat period (:func:`sea_samples`)."""
+        """The record and the optimal motion over one repeat period (``sea_samples``)."""
         return sea_samples(self, points)
 
     def _series(self):

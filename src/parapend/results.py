@@ -36,7 +36,7 @@ def to_jsonable(value):
 
 #: Units and long names of the quantities that results hold, by field name. A field named
 #: with a unit suffix (``power_w``, ``peak_torque_nm``) takes the suffix's unit
-#: (:data:`SUFFIX_UNITS`); the non-dimensional quantities of the paper's model are in the
+#: (``SUFFIX_UNITS``); the non-dimensional quantities of the paper's model are in the
 #: pendulum's scales (time ``sqrt(l/g)``, torque and energy ``m g l``, power
 #: ``m g l sqrt(g/l)``, as the design maps write them); counts and ratios have units "1".
 _P, _T, _TIME, _RATE = "m g l sqrt(g/l)", "m g l", "sqrt(l/g)", "sqrt(g/l)"
@@ -99,7 +99,7 @@ SUFFIX_UNITS = (("_w_per_m", "W/m"), ("_mwh_per_year", "MWh/yr"), ("_rad_per_s",
 def quantity(name: str) -> tuple[str, str]:
     """``(units, long_name)`` of a result field or Dataset variable named ``name``.
 
-    Names in :data:`QUANTITIES` first; then a unit suffix (:data:`SUFFIX_UNITS`:
+    Names in ``QUANTITIES`` first; then a unit suffix (``SUFFIX_UNITS``:
     ``power_w`` is "W", its long name "power"); anything else is a count or ratio ("1")."""
     if name in QUANTITIES:
         return QUANTITIES[name]
@@ -243,8 +243,8 @@ class Result:
       ``.pdf`` (``plot``);
     - a short repr with the headline numbers.
 
-    Subclasses set :attr:`command` and :attr:`headline` and override :meth:`_series`
-    (the curves, or None) and :meth:`_figure`.
+    Subclasses set :attr:`command` and :attr:`headline` and override ``_series()``
+    (the curves, or None) and ``_figure()``.
     """
 
     #: the command whose result this is
@@ -261,7 +261,7 @@ class Result:
         return None
 
     def to_dataset(self):
-        """The result as an ``xarray.Dataset``: its curves (:meth:`_series`) and its scalar
+        """The result as an ``xarray.Dataset``: its curves (``_series()``) and its scalar
         fields as 0-d variables, the other fields as attributes; every variable with
         ``units`` and ``long_name``."""
         return annotate(scalars_dataset(self.to_dict(), self._series()), self.command)
@@ -590,7 +590,7 @@ class OptimizeResult(Result):
         """One forcing period of the optimum on ``points`` uniform times (non-dimensional
         arrays): ``time``, ``phase`` (``t/T``), ``theta``, ``theta_dot``, ``torque``
         (Eq. 14 solved for T), ``power`` (``-T theta'``, positive when harvested) and, with
-        an efficiency, ``electrical_power``. :meth:`to_dataset` gives them in SI when the
+        an efficiency, ``electrical_power``. ``to_dataset()`` gives them in SI when the
         pendulum was given in SI."""
         from .errors import check_int
         from .model import torque
@@ -686,9 +686,9 @@ class Record(Result):
     gives the JSON object.
 
     The objects behind the fields are public attributes too, named in ``objects``: the
-    Dataset (``dataset``; :meth:`to_dataset` annotates it), the motion a field describes
+    Dataset (``dataset``; ``to_dataset()`` annotates it), the motion a field describes
     (``source``, whose attributes also read through), a sweep's ``run``, ... The figure is
-    :meth:`plot`.
+    ``plot()``.
 
     Parameters
     ----------

@@ -114,7 +114,7 @@ class MPCResult(_Result):
     headline = ("mean_power", "mean_electrical_power", "solves", "failed_solves", "status")
 
     def to_dict(self) -> dict:
-        """The scalars (the series are in :meth:`to_dataset`)."""
+        """The scalars (the series are in ``to_dataset()``)."""
         return {k: v for k, v in super().to_dict().items() if not isinstance(v, list)}
 
     def _series(self):

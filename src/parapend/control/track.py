@@ -130,13 +130,13 @@ class TrackResult(_Result):
 
     @property
     def run(self):
-        """The closed-loop run (:class:`~parapend.control.closedloop.ClosedLoopRun`: ``t``,
+        """The closed-loop run (``parapend.control.closedloop.ClosedLoopRun``: ``t``,
         ``theta``, ``theta_dot``, ``torque``, ``q``, ``mode``), non-dimensional."""
         return self._run
 
     @property
     def target(self):
-        """The target orbit (:class:`~parapend.control.target.Target`)."""
+        """The target orbit (``parapend.control.target.Target``)."""
         return self._target
 
     @property
