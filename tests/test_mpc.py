@@ -196,9 +196,21 @@ def test_saved_mpc_series_reintegrates_and_gives_the_reported_power(mpc_saved):
     assert np.max(np.abs(th1 - th[1:])) < 1e-8
     assert np.max(np.abs(om1 - om[1:])) < 1e-7
     p = -tq * (th1 - th[:-1]) / h
-    last = 10 * 64
-    assert np.mean(p[-last:]) == pytest.approx(r["mean_power"], abs=1e-8)
-    assert np.mean(p[10 * 64:]) == pytest.approx(r["run_power"], abs=1e-8)
+    # the account after the warm-up (10 periods), from the re-integrated run alone: the
+    # harvested energy, the change of the stored energy E = theta'^2/2 + cos(theta) (theta
+    # from the upright) and their sum per unit time, the headline
+    i0 = r["warm_up_periods"] * 64
+    assert i0 == 10 * 64
+    tau = t[-1] - t[i0]
+    w = float(np.sum(p[i0:]) * h)
+    e_end = 0.5 * om1[-1] ** 2 + np.cos(th1[-1])
+    de = e_end - (0.5 * om[i0] ** 2 + np.cos(th[i0]))
+    assert r["averaged_time"] == pytest.approx(tau, rel=1e-12)
+    assert r["harvested_energy"] == pytest.approx(w, abs=1e-7)
+    assert r["stored_energy_change"] == pytest.approx(de, abs=1e-7)
+    assert r["harvested_power"] == pytest.approx(w / tau, abs=1e-8)
+    assert r["mean_power"] == pytest.approx((w + de) / tau, abs=1e-8)
+    assert "run_power" not in r  # the windowed number that ignored storage is gone
     # the check can fail: a 10 % wrong damping is seen (on the last period)
     k = t0.size - 64
     bad = solve_ivp(lambda x, y: np.concatenate((y[64:], (1 + q(t0[k:] + x)) * np.sin(y[:64])
@@ -211,7 +223,7 @@ def test_saved_mpc_series_reintegrates_and_gives_the_reported_power(mpc_saved):
 def test_mpc_harvests_from_rest_in_the_irregular_sea(mpc_saved):
     _, r, _ = mpc_saved
     assert r["success"] and r["catch_period"] is not None
-    assert r["mean_power"] > 0 and r["run_power"] > 0
+    assert r["mean_power"] > 0 and r["harvested_power"] > 0
     assert r["peak_torque"] <= 1.0
     assert r["solves"] > 0 and r["controller"] == "mpc"
 
@@ -434,3 +446,24 @@ def test_torque_limited_long_horizon_harvests_and_honours_a_rated_speed():
     assert r.success and r.mean_power > 0.05 and r.speed_limit == 3.5
     last = r._run.theta_dot[-10 * r.samples_per_period:]
     assert np.max(np.abs(last)) < 3.5 * 1.05
+
+
+def test_undamped_unlimited_run_harvests_and_a_runaway_is_never_a_success():
+    """At gamma = 0 without a torque limit the horizon problem has no optimum (its supremum
+    is the gamma -> 0 limit's instant flips) and, unpriced, the plans spun the pendulum up
+    to |theta'| ~ 2e4 while the run said "ok". With the plans pricing the damping
+    ``PLAN_DAMPING`` the default run harvests, below the regular-wave optimum at gamma = 0
+    (0.3435) and above the best uniform rotation (0.27); without it the run stops as
+    "unresolved" (more than a turn per held torque sample), never a success."""
+    from parapend.control.mpc import mpc_run
+
+    exc = build_excitation(omega=1.8, delta=-0.3)
+    tp = exc.period
+    kw = dict(gamma=0.0, horizon=2 * tp, update_interval=tp / 32, dt=tp / 64)
+    bad = mpc_run(exc.q, t_end=6 * tp, plan_damping=0.0, **kw)
+    assert not bad.success and bad.status == "unresolved"
+    assert np.max(np.abs(bad.theta_dot)) * bad.dt > 2 * math.pi
+    good = mpc_run(exc.q, t_end=14 * tp, average_from=10 * tp, **kw)
+    assert good.success and good.plan_damping > 0
+    assert np.max(np.abs(good.theta_dot)) * good.dt < 2 * math.pi
+    assert 0.27 < good.mean_power < 0.3435
