@@ -27,6 +27,13 @@ by ``kappa V(E)``, ``V`` the energy a torque ``T_max`` harvests braking the rota
 the damping (:meth:`PlanProblem.terminal_value`, docs/control.md); ``V -> E`` without a
 limit.
 
+**Least priced damping.** ``plan_damping=c`` makes the objective price the damping
+``max(gamma, c) theta'^2`` while the torque keeps the model's ``gamma``. Without a torque
+limit and at ``gamma = 0`` the objective depends on the motion only through ``int q sin(theta)
+theta' dt``, whose supremum is the ``gamma -> 0`` limit's instant flips: the problem has no
+optimum and its Newton iterates drift to ever faster turns (the receding horizon of
+:mod:`.mpc` ran away to ``|theta'| ~ 2e4``); a small priced damping gives it one.
+
 **Rated speed.** ``speed_limit=w_max`` adds the exterior penalty ``rho / 2 h sum_k
 max(|v_k| - w_max, 0)^2`` over the free nodes (a generator's rated speed, the machine's
 bound; docs/control.md: the controller harvests without it, and it costs power). A penalty,
@@ -151,6 +158,8 @@ class PlanProblem:
         it (None: none).
     speed_weight : float or None
         Its ``rho`` (None: ``SPEED_WEIGHT``, 100).
+    plan_damping : float
+        Least damping the objective prices (module docstring); the torque keeps ``gamma``.
     """
 
     phase1 = False
@@ -393,8 +402,8 @@ class PlanProblem:
         ab, rhs, border, rhs_t, d_tt = _k.newton(
             f, 0.0 if t is None else float(t), np.asarray(lam, dtype=float), float(mu), self.k,
             0.0, self.rows_g[0], self.rows_g[1], self.lin_g, self.q_g, self.wk,
-            self.gamma_objective, 0.0, self.rows_c[0], self.lin_c, self.q1_c, self.mode, self._scale,
-            float(self.torque_limit or 0.0), float(self.elastic or 0.0), self._gvar,
+            self.gamma_objective, 0.0, self.rows_c[0], self.lin_c, self.q1_c, self.mode,
+            self._scale, float(self.torque_limit or 0.0), float(self.elastic or 0.0), self._gvar,
             self._jtc)
         self._extra_newton(f, ab, rhs)
         ab = np.ascontiguousarray(ab[:4, 2:])
