@@ -467,3 +467,50 @@ def test_undamped_unlimited_run_harvests_and_a_runaway_is_never_a_success():
     assert good.success and good.plan_damping > 0
     assert np.max(np.abs(good.theta_dot)) * good.dt < 2 * math.pi
     assert 0.27 < good.mean_power < 0.3435
+
+
+def test_timing_summary_reports_the_first_update_apart():
+    from parapend.control.mpc import timing_summary
+
+    t = timing_summary([5.0, 1.0, 3.0, 2.0], interval_s=2.5)
+    assert t["update_time_first"] == 5.0
+    assert t["update_time_median"] == 2.0 and t["update_time_max"] == 3.0
+    assert t["update_time_p99"] == pytest.approx(np.percentile([1.0, 3.0, 2.0], 99))
+    assert t["realtime_fits"] is False  # p99 2.98 > 2.5
+    assert timing_summary([5.0, 1.0], interval_s=2.5)["realtime_fits"] is True
+    assert timing_summary([5.0])["update_time_median"] is None
+
+
+def test_track_mpc_reports_timing_speed_penalty_exceedance_and_storage():
+    """The updates are timed (forecast + solve) with the first reported apart; the rated
+    speed is a penalty whose exceedance is reported, as counted from the run; the storage
+    correction is the run's own energy account."""
+    import dataclasses
+
+    from parapend.control.mpc import track_mpc
+
+    exc = build_excitation(omega=1.8, delta=-0.3)
+    r = track_mpc(exc, gamma=GAMMA, periods=12, speed_limit=3.0)
+    run = r.run
+    assert r.success and run.update_times.size == r.solves == run.forecast_times.size
+    assert r.update_time_first == run.update_times[0]
+    assert r.update_time_max == np.max(run.update_times[1:])
+    assert r.update_time_median == np.median(run.update_times[1:])
+    assert r.solve_time_median == np.median(run.solve_times[1:])
+    assert np.all(run.update_times >= run.solve_times)  # an update includes its solve
+    after = run.t >= run.catch_time - 1e-12
+    speed = np.abs(run.theta_dot[after])
+    assert r.speed_exceeded_fraction == pytest.approx(np.mean(speed > 3.0), abs=1e-15)
+    assert r.speed_peak == np.max(speed)
+    assert 0 < r.speed_exceeded_fraction < 1 and r.speed_peak > 3.0  # a penalty, exceeded
+    i0 = 10 * 64
+    w = np.sum(run.power_series[i0:]) * run.dt
+    e = 0.5 * run.theta_dot**2 + np.cos(run.theta)
+    assert r.harvested_energy == pytest.approx(w, rel=1e-12)
+    assert r.mean_power == pytest.approx((w + e[-1] - e[i0]) / (run.t[-1] - run.t[i0]),
+                                         rel=1e-12)
+    assert r.realtime_fits is None  # no device: no update interval in seconds
+    d = dataclasses.replace(r, update_interval_s=1e-12)
+    assert d.realtime_fits is False
+    d = dataclasses.replace(r, update_interval_s=1e6)
+    assert d.realtime_fits is True
