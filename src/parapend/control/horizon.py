@@ -235,7 +235,8 @@ def horizon_curve(*, hs: float = 2.0, tp: float = 8.0, spectrum: str = "jonswap"
         rest); the run is then ``warm_up`` plus one whole repeat of the record long, so the
         mean is over one repeat (the baselines still average the whole record from rest).
     speed_limit : float or None
-        Rated speed of the receding-horizon plans (units ``sqrt(g / l)``;
+        Rated-speed penalty of the receding-horizon plans, not a hard bound (its exceedance
+        is reported; units ``sqrt(g / l)``;
         :func:`parapend.control.mpc.mpc_run`); None: none.
     """
     from ..irregular import sea

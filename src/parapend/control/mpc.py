@@ -364,9 +364,11 @@ def mpc_run(q_record, *, gamma, horizon, update_interval, dt, torque_limit=None,
         (:meth:`~.plan.PlanProblem.terminal_value`; docs/control.md: about the same power
         as ``kappa E``).
     speed_limit : float or None
-        Rated speed ``w_max`` of the plans: the penalty ``rho / 2 h sum max(|theta'_k| -
-        w_max, 0)^2`` at the plan's nodes (:meth:`~.plan.PlanProblem.speed_penalty`);
-        None: no bound (a generator's rated speed; docs/control.md: it costs power).
+        Rated speed ``w_max`` priced in the plans: the penalty ``rho / 2 h sum
+        max(|theta'_k| - w_max, 0)^2`` at the plan's nodes
+        (:meth:`~.plan.PlanProblem.speed_penalty`), a penalty and not a hard bound: the
+        result reports the fraction of samples above it and the peak speed; None: none
+        (docs/control.md: it costs power).
     speed_weight : float or None
         ``rho`` of that penalty (None: ``parapend.control.plan.SPEED_WEIGHT``, 100).
     plan_damping : float or None
