@@ -418,8 +418,8 @@ def test_perfect_forecast_harvests_most_of_the_noncausal_optimum():
 @pytest.mark.slow
 def test_torque_limited_mpc_harvests_in_the_paper_case():
     """The paper case with ``T_max = 1`` on the irregular record of seed 0 (20 peak
-    periods): with a horizon of one peak period the mean power over the last 10 periods is
-    positive (docs/control.md: 0.133)."""
+    periods): with a horizon of one peak period the storage-corrected power after period 10
+    is positive."""
     from parapend.control.mpc import track_mpc
     from parapend.excitation import harmonic
 
@@ -431,21 +431,25 @@ def test_torque_limited_mpc_harvests_in_the_paper_case():
 @pytest.mark.slow
 def test_torque_limited_long_horizon_harvests_and_honours_a_rated_speed():
     """The paper case with ``T_max = 1`` on the irregular record of seed 0 (20 peak
-    periods), horizon 2 peak periods: the mean power over the last 10 periods is positive
-    (docs/control.md: 0.584; -0.765 when the warm start was blended towards the unforced
-    motion). With the rated speed 3.5 it stays positive and the speed within the bound
-    (the penalty's overshoot)."""
+    periods), horizon 2 peak periods: the energy harvested over periods 10 to 20 per unit
+    time (the former window) is 0.584 (-0.765 when the warm start was blended towards the
+    unforced motion), and with the stored energy's change counted 0.240 (docs/control.md).
+    With the rated-speed penalty 3.5 it stays positive and the speed exceeds the penalty's
+    bound on some samples, by at most 5 %, as reported."""
     from parapend.control.mpc import track_mpc
     from parapend.excitation import harmonic
 
     r = track_mpc(harmonic(), gamma=0.01, torque_limit=1.0, irregular=True, periods=20,
                   seed=0, horizon=2.0)
-    assert r.success and r.mean_power > 0.3 and r.failed_solves == 0
+    assert r.success and r.harvested_power > 0.3 and r.failed_solves == 0
+    assert 0.2 < r.mean_power < r.harvested_power  # the pendulum gave back stored energy
+    assert r.stored_energy_change < 0
     r = track_mpc(harmonic(), gamma=0.01, torque_limit=1.0, irregular=True, periods=20,
                   seed=0, horizon=2.0, speed_limit=3.5)
     assert r.success and r.mean_power > 0.05 and r.speed_limit == 3.5
     last = r._run.theta_dot[-10 * r.samples_per_period:]
     assert np.max(np.abs(last)) < 3.5 * 1.05
+    assert 0 < r.speed_exceeded_fraction < 0.5 and 3.5 < r.speed_peak < 3.5 * 1.05
 
 
 def test_undamped_unlimited_run_harvests_and_a_runaway_is_never_a_success():
