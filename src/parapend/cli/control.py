@@ -205,7 +205,7 @@ def _mpc_out(a, r) -> dict | str:
            f"mean power {_fmt(r.mean_power, 6)} = (harvested energy "
            f"{_fmt(r.harvested_energy, 6)} + change of stored energy "
            f"{_fmt(r.stored_energy_change, 6)}) / time {_fmt(r.averaged_time, 6)}, from "
-           f"period {r.warm_up_periods} to the end (m g l, units sqrt(l/g))",
+           f"period {r.warm_up_periods} to the end (energies in m g l, time in sqrt(l/g))",
            f"harvested alone {_fmt(r.harvested_power, 6)}; electrical "
            f"{_fmt(r.electrical_power, 6)}"
            + (f"; over the last repeat of the record {_fmt(r.record_power, 6)}"
