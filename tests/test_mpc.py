@@ -518,3 +518,25 @@ def test_track_mpc_reports_timing_speed_penalty_exceedance_and_storage():
     assert d.realtime_fits is False
     d = dataclasses.replace(r, update_interval_s=1e6)
     assert d.realtime_fits is True
+
+
+def test_energy_account_counts_the_stored_energy_at_eta_g():
+    """The account over ``t >= start`` on a made-up series: harvested energy, the stored
+    energy's change, the corrected powers (the stored energy at ``eta_g`` electrically)."""
+    from parapend.control.mpc import energy_account, stored_energy
+
+    t = 0.5 * np.arange(9)
+    theta = np.linspace(np.pi, 3.0 * np.pi, 9)
+    om = np.linspace(0.0, 2.0, 9)
+    p = np.arange(8, dtype=float) - 2.0
+    pe = np.where(p > 0, 0.9 * p, p / 0.8)
+    a = energy_account(t, theta, om, p, pe, start=1.0, eta_g=0.9)
+    w = 0.5 * np.sum(p[2:])
+    de = stored_energy(theta[-1], om[-1]) - stored_energy(theta[2], om[2])
+    assert a["averaged_time"] == 3.0 and a["harvested_energy"] == pytest.approx(w)
+    # E(end) = 2^2/2 + cos(3 pi) = 1, E(t = 1) = 0.5^2/2 + cos(3 pi/2) = 0.125
+    assert a["stored_energy_change"] == pytest.approx(0.875)
+    assert de == pytest.approx(a["stored_energy_change"])
+    assert a["mean_power"] == pytest.approx((w + de) / 3.0)
+    assert a["harvested_power"] == pytest.approx(w / 3.0)
+    assert a["mean_electrical_power"] == pytest.approx((0.5 * np.sum(pe[2:]) + 0.9 * de) / 3.0)
