@@ -65,7 +65,7 @@ def _light_pendulum_errors(ps):
     assert ok
     p = -ref.torque * tu * np.diff(ys[:, 2]) / dt
     return (np.max(np.abs(ys[:, 2] - ref.theta)), np.max(np.abs(ys[:, 3] * t0 - ref.theta_dot)),
-            abs(np.mean(p) - ref.mean_power * tu / t0) / (ref.mean_power * tu / t0))
+            abs(np.mean(p) - ref.harvested_power * tu / t0) / (ref.harvested_power * tu / t0))
 
 
 def test_light_pendulum_on_the_buoy_is_the_pendulum_on_the_free_heave():

@@ -183,10 +183,18 @@ def test_horizon_baselines_only_cli_json_save_plot(tmp_path, capsys):
     for r in range(2):
         run = bl.extremum_baseline(_record(seed=r, waves=6).q, peak_omega=2 * math.pi / TP,
                                    gamma=0.01, t_end=_record(seed=r, waves=6).period)
-        assert out["baseline_power"][0][r] == pytest.approx(run.mean_power, rel=1e-12)
-        assert out["baseline_fraction"][0][r] == pytest.approx(run.mean_power / opt[r],
+        # storage-corrected: the harvested energy plus the change of the stored energy
+        # E = theta'^2/2 + cos(theta) over the record, per unit time
+        de = (0.5 * run.theta_dot[-1] ** 2 + math.cos(run.theta[-1])
+              - 0.5 * run.theta_dot[0] ** 2 - math.cos(run.theta[0]))
+        corrected = (np.sum(run.work) + de) / run.t[-1]
+        assert out["baseline_harvested_power"][0][r] == pytest.approx(run.mean_power,
+                                                                       rel=1e-12)
+        assert out["baseline_stored_energy_change"][0][r] == pytest.approx(de, abs=1e-12)
+        assert out["baseline_power"][0][r] == pytest.approx(corrected, rel=1e-12)
+        assert out["baseline_fraction"][0][r] == pytest.approx(corrected / opt[r],
                                                                rel=1e-12)
-        assert run.mean_power < out["limit_power"][r]
+        assert corrected < out["limit_power"][r]
     ds = xr.open_dataset(nc)
     assert np.allclose(ds["baseline_power"].values, out["baseline_power"], rtol=1e-15)
     ds.close()
@@ -208,6 +216,10 @@ def test_horizon_fractions_and_wiring_with_a_stub_controller(monkeypatch):
         seen.append((horizon, None if forecast is None else forecast.name))
         r = Res()
         r.mean_electrical_power = horizon / 1000.0
+        r.harvested_electrical_power = horizon / 1000.0 - 1e-4
+        r.stored_energy_change = 0.5
+        r.failed_solves = 1
+        r.update_times = np.array([9.0, 1e-3, 2e-3, 3e-3])
         reach = getattr(forecast, "reach", None)  # as mpc_run: plans over at most the reach
         r.horizon = horizon if reach is None else min(horizon, reach)
         return r
@@ -219,6 +231,14 @@ def test_horizon_fractions_and_wiring_with_a_stub_controller(monkeypatch):
                                                     rel=1e-12)
     assert r.ar_leads[0] == 0 and r.ar_error[0] < 1e-12
     assert np.allclose(r.mpc_horizon_used, [[0.5, 2.0], [0.5, 2.0]], rtol=1e-12)
+    # the storage account and the timing of every run are passed through; the first update
+    # of the first record is reported apart, the others pooled
+    assert r.mpc_stored_energy_change[0][1] == [0.5]
+    assert r.mpc_harvested_power[0][1][0] == pytest.approx(2 * TP / 1000 - 1e-4)
+    assert r.mpc_failed_solves == [[[1], [1]], [[1], [1]]]
+    assert r.mpc_update_time_first[0][0] == 9.0 and r.mpc_update_time_max[0][0] == 3e-3
+    assert r.mpc_update_time_median[0][0] == 2e-3
+    assert r.update_interval_s == pytest.approx(0.03125 * 8.0) and r.realtime_fits is True
 
 
 @pytest.mark.parametrize("argv, match", [

@@ -88,9 +88,10 @@ def add_parsers(sub) -> None:
                         f"(autoregressive, fitted on the past; default {TRACK['forecast']})")
     g.add_argument("--speed-limit", type=_finite_float("speed-limit"),
                    default=TRACK["speed_limit"],
-                   help="MPC rated speed: the plans keep |theta'| below it (a penalty on the "
-                        "excess at the plan's nodes), in units of sqrt(g/l), > 0; default "
-                        "none (a generator's bound; it costs power, docs/control.md)")
+                   help="MPC rated-speed penalty: the plans pay rho/2 h sum max(|theta'_k| - "
+                        "w, 0)^2 at their nodes, a penalty and not a hard bound (the measured "
+                        "speed can exceed it; the run reports how often and how far), in "
+                        "units of sqrt(g/l), > 0; default none (docs/control.md)")
     from .pto import add_unit_options
 
     add_unit_options(p, torque=True)
@@ -199,23 +200,48 @@ def _mpc_out(a, r) -> dict | str:
            f"periods, update every {r.update_interval:g} periods, {r.samples_per_period} "
            f"torque samples per period; gamma = {r.gamma:g}, omega = {r.omega:g}, T_max = "
            f"{_fmt(r.torque_limit)}"
-           + (f", rated speed {r.speed_limit:g}" if r.speed_limit is not None else ""),
-           f"mean power (last 10 periods) {_fmt(r.mean_power, 8)}; from period 10 to the "
-           f"end {_fmt(r.run_power, 8)}"
-           + (f"; over the last repeat of the record {_fmt(r.record_power, 8)}"
+           + (f", rated-speed penalty {r.speed_limit:g}" if r.speed_limit is not None
+              else ""),
+           f"mean power {_fmt(r.mean_power, 6)} = (harvested energy "
+           f"{_fmt(r.harvested_energy, 6)} + change of stored energy "
+           f"{_fmt(r.stored_energy_change, 6)}) / time {_fmt(r.averaged_time, 6)}, from "
+           f"period {r.warm_up_periods} to the end (energies in m g l, time in sqrt(l/g))",
+           f"harvested alone {_fmt(r.harvested_power, 6)}; electrical "
+           f"{_fmt(r.electrical_power, 6)}"
+           + (f"; over the last repeat of the record {_fmt(r.record_power, 6)}"
               if r.record_power is not None else ""),
            f"swing-up handed over after {_fmt(r.catch_period, 4)} periods; peak torque "
-           f"{_fmt(r.peak_torque, 5)}",
-           f"{r.solves} horizon solves: median {1e3 * r.solve_time_median:.3g} ms, "
-           f"max {1e3 * r.solve_time_max:.3g} ms, median {r.iterations_median:g} "
-           "Newton iterations"]
+           f"{_fmt(r.peak_torque, 5)}"]
+    if r.speed_limit is not None and r.speed_exceeded_fraction is not None:
+        out.append(f"rated-speed penalty {r.speed_limit:g}: |theta'| above it on "
+                   f"{100 * r.speed_exceeded_fraction:.3g} % of the samples after the "
+                   f"hand-over, peak {r.speed_peak:.4g} "
+                   f"({100 * (r.speed_peak / r.speed_limit - 1):+.3g} %)")
+    if r.update_time_median is not None:
+        out.append(
+            f"{r.solves} updates (forecast + solve), after the first: median "
+            f"{1e3 * r.update_time_median:.3g} ms, p99 {1e3 * r.update_time_p99:.3g} ms, max "
+            f"{1e3 * r.update_time_max:.3g} ms (forecast {1e3 * r.forecast_time_median:.3g}, "
+            f"solve {1e3 * r.solve_time_median:.3g} ms median); the first "
+            f"{1e3 * r.update_time_first:.3g} ms (kernel load); median "
+            f"{r.iterations_median:g} Newton iterations; {r.failed_solves} not converged")
     if r.sea is not None:
         out.append(_sea_line(r.sea))
     if r.units is not None:
         u = r.units
         out.append(f"physical (l = {u['length_m']:g} m, m = {u['mass_kg']:g} kg): period "
-                   f"{r.period_s:.6g} s, update interval {r.update_interval_s:.4g} s; mean "
-                   f"power {r.mean_power_w:.6g} W; peak torque {r.peak_torque_nm:.6g} N m")
+                   f"{r.period_s:.6g} s; mean power {r.mean_power_w:.6g} W (harvested alone "
+                   f"{r.harvested_power_w:.6g} W, stored energy change "
+                   f"{r.stored_energy_change_j:.6g} J); peak torque {r.peak_torque_nm:.6g} "
+                   "N m")
+        if r.update_time_p99 is not None:
+            out.append(f"real time: update interval {1e3 * r.update_interval_s:.4g} ms; "
+                       f"p99 of an update {1e3 * r.update_time_p99:.3g} ms "
+                       + ("fits in it" if r.realtime_fits else "does NOT fit in it")
+                       + " (measured on one process, single-threaded kernels)")
+    elif r.update_time_p99 is not None:
+        out.append("real time: give --length and --mass to state the update interval in "
+                   "seconds and whether the updates fit in it")
     if a.save:
         out.append(f"run written to {a.save}")
     if a.plot:

@@ -58,8 +58,10 @@ def add_parsers(sub) -> None:
                         "(the run is then this plus one repeat long; default 0)")
     g.add_argument("--speed-limit", type=_finite_float("speed-limit"),
                    default=HORIZON["speed_limit"],
-                   help="rated speed of the receding-horizon plans, in units of sqrt(g/l), "
-                        "> 0 (default none; docs/control.md)")
+                   help="rated-speed penalty of the receding-horizon plans (a penalty on "
+                        "the plans' speeds above it, not a hard bound; the exceedance is "
+                        "reported), in units of sqrt(g/l), > 0 (default none; "
+                        "docs/control.md)")
     p.add_argument("--plot", metavar="PNG", help="draw the fraction of the optimum against "
                                                   "the horizon")
     p.add_argument("--save", metavar="FILE",
@@ -69,6 +71,11 @@ def add_parsers(sub) -> None:
 
 def _pct(x) -> str:
     return "nan" if x != x else f"{100 * x:.1f} %"
+
+
+def _mean(values) -> str:
+    v = [x for x in values if x is not None and x == x]
+    return f"{sum(v) / len(v):.4g}" if v else "nan"
 
 
 def _cmd_horizon(a) -> dict | str:
@@ -103,7 +110,9 @@ def _cmd_horizon(a) -> dict | str:
                          _pct(r.mpc_fraction_mean[i][j]),
                          f"{_pct(r.mpc_fraction_min[i][j])} .. "
                          f"{_pct(r.mpc_fraction_max[i][j])}",
-                         _pct(r.mpc_limit_fraction_mean[i][j])])
+                         _pct(r.mpc_limit_fraction_mean[i][j]),
+                         _mean(r.mpc_stored_energy_change_j[i][j])
+                         if r.mpc_stored_energy_change_j else "-"])
     names = {"tracker": "regular-wave tracker (track --irregular)",
              "extremum": "half-turn rule at the extrema of q"}
     for b, name in enumerate(r.baselines):
@@ -112,15 +121,44 @@ def _cmd_horizon(a) -> dict | str:
                      _pct(r.baseline_fraction_mean[b]),
                      f"{_pct(r.baseline_fraction_min[b])} .. "
                      f"{_pct(r.baseline_fraction_max[b])}",
-                     _pct(r.baseline_limit_fraction_mean[b])])
+                     _pct(r.baseline_limit_fraction_mean[b]),
+                     _mean(r.baseline_stored_energy_change_j[b])
+                     if r.baseline_stored_energy_change_j else "-"])
     out = [head, f"non-causal optimum (sea) {nopt:.4g} W, limit {nlim:.4g} W (mean over the "
-                 "records); every run from the hanging rest over the whole record"
+                 "records); power = (harvested energy + change of the stored energy, "
+                 "mean dE in the last column) / time; every run from the hanging rest over "
+                 "the whole record"
                  + (f" (receding horizon: after {r.warm_up:g} peak periods)" if r.warm_up
                     else "")
-                 + (f"; rated speed {r.speed_limit:g}" if r.speed_limit is not None else ""),
+                 + (f"; rated-speed penalty {r.speed_limit:g}" if r.speed_limit is not None
+                    else ""),
                  "",
            _table(rows, ["controller", "horizon (Tp)", "power (W)", "of optimum",
-                         "min .. max", "of limit"])]
+                         "min .. max", "of limit", "dE (J)"])]
+    if r.forecasts and r.mpc_update_time_p99:
+        trows = []
+        for i, f in enumerate(r.forecasts):
+            for j, h in enumerate(r.horizons):
+                fails = [v for v in r.mpc_failed_solves[i][j] if v is not None]
+                row = [f, f"{h:g}", f"{1e3 * r.mpc_update_time_median[i][j]:.3g}",
+                       f"{1e3 * r.mpc_update_time_p99[i][j]:.3g}",
+                       f"{1e3 * r.mpc_update_time_max[i][j]:.3g}",
+                       f"{1e3 * r.mpc_update_time_first[i][j]:.3g}", f"{sum(fails)}"]
+                if r.speed_limit is not None:
+                    xf = [v for v in r.mpc_speed_exceeded_fraction[i][j] if v is not None]
+                    xp = [v for v in r.mpc_speed_peak[i][j] if v is not None]
+                    row += [_pct(sum(xf) / len(xf)) if xf else "nan",
+                            f"{max(xp):.4g}" if xp else "nan"]
+                trows.append(row)
+        cols = ["forecast", "horizon (Tp)", "median (ms)", "p99 (ms)", "max (ms)",
+                "first (ms)", "failed solves"]
+        if r.speed_limit is not None:
+            cols += ["speed above the penalty's w", "peak |theta'|"]
+        out += ["", f"receding-horizon updates (forecast + solve) against the update interval "
+                    f"{1e3 * r.update_interval_s:.4g} ms: p99 "
+                    + ("fits" if r.realtime_fits else "does NOT fit")
+                    + " (one process; the first update, kernel load, apart)",
+                _table(trows, cols)]
     if r.ar_leads:
         out += ["", "AR forecast, normalized rms error of q against lead time (1: the "
                     "error of predicting 0):",

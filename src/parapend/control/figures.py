@@ -138,6 +138,8 @@ def plot_mpc_track(result, zoom_periods: float = 3.0):
     per = run.t / period
     held = np.append(run.torque, run.torque[-1])
     work = np.concatenate(([0.0], np.cumsum(run.power_series) * run.dt))
+    e = 0.5 * run.theta_dot**2 + np.cos(run.theta)  # stored energy, theta from the upright
+    stored = work + e - e[0]
     q = result.q(run.t) if hasattr(result, "q") and callable(result.q) else None
     last = per >= per[-1] - zoom_periods - 1e-9
     rows = 4 if q is not None else 3
@@ -153,15 +155,19 @@ def plot_mpc_track(result, zoom_periods: float = 3.0):
                 for s in (1, -1):
                     a[1].axhline(s * result.torque_limit, color="k", ls="--", lw=0.7)
             a[1].set_ylabel("torque $T$ ($mgl$)")
-            a[2].plot(per[sel], work[sel], lw=1.0, color="C1")
-            a[2].set_ylabel("energy $W$ ($mgl$)")
+            a[2].plot(per[sel], work[sel], lw=1.0, color="C1", label="harvested $W$")
+            a[2].plot(per[sel], stored[sel], lw=0.9, color="C3", ls="--",
+                      label=r"$W + E - E_0$ (stored counted)")
+            a[2].set_ylabel("energy ($mgl$)")
             if q is not None:
                 a[3].plot(per[sel], q[sel], lw=0.8, color="C4")
                 a[3].set_ylabel("$q$ (base acc./g)")
             a[-1].set_xlabel("time (forcing periods)")
+        axes[2, 0].legend(fontsize=7, loc="best")
         axes[0, 0].set_title("whole run", fontsize=9)
         axes[0, 1].set_title(f"last {zoom_periods:g} periods", fontsize=9)
         fig.suptitle(f"receding-horizon control ({result.forecast} forecast): mean power "
-                     f"{result.mean_power:.5g} ($mgl/t_0$), {result.failed_solves} of "
+                     f"{result.mean_power:.5g} ($mgl/t_0$, stored energy counted), "
+                     f"{result.failed_solves} of "
                      f"{result.solves} solves failed", fontsize=10)
         return _finish(fig, None, layout=False)

@@ -11,7 +11,10 @@ For a sea state and a pendulum (as :func:`parapend.irregular.sea` takes them), o
   rule "extremum");
 
 and report each run's mean electrical power over the whole record (start-up from rest
-included) as a fraction of the record's non-causal optimum (``sea`` on the same record:
+included; with ``warm_up``, over one whole repeat after it), storage-corrected: the
+harvested energy plus the change of the pendulum's stored energy ``E = theta'^2 / 2 +
+cos(theta)`` (at ``eta_g``) per unit time, the change reported beside it, as a fraction of
+the record's non-causal optimum (``sea`` on the same record:
 the best periodic rotation knowing every wave) and of its ``gamma -> 0`` limit. Beside them,
 the autoregressive forecast's normalized rms prediction error against lead time on the same
 records.
@@ -49,7 +52,25 @@ class HorizonResult(_Result):
     Attributes
     ----------
     mpc_power, baseline_power : nested lists of float
-        Mean electrical power of each run over the record (NaN: the run failed).
+        Mean electrical power of each run over the record (NaN: the run failed),
+        storage-corrected: ``(W_e + eta_g dE) / time``.
+    mpc_harvested_power, baseline_harvested_power : nested lists of float
+        The harvested electrical energy alone per unit time (no storage correction).
+    mpc_stored_energy_change, baseline_stored_energy_change : nested lists of float
+        ``dE = E(end) - E(start)`` of each run (units ``m g l``; ``*_j``: joules).
+    mpc_update_time_first, mpc_update_time_median, mpc_update_time_p99, mpc_update_time_max :
+        ``[f][h]``: wall time (s) of one receding-horizon update (forecast + solve), the
+        first update of the first record apart (kernel load), the others pooled over the
+        records.
+    update_interval_s : float
+        The update interval in seconds for this pendulum; ``realtime_fits``: whether every
+        ``mpc_update_time_p99`` fits in it (measured on one process).
+    mpc_failed_solves : nested list of int ``[f][h][r]``
+        Horizon solves that did not converge (the last iterate applied, or the previous
+        plan where that was not finite).
+    mpc_speed_exceeded_fraction, mpc_speed_peak : nested lists ``[f][h][r]``
+        With ``speed_limit`` (a penalty, not a hard bound): the fraction of samples after
+        the hand-over with ``|theta'|`` above it and the largest ``|theta'|``.
     optimum_power, limit_power : list of float
         Per record: the non-causal optimum of ``sea`` and the ``gamma -> 0`` limit.
     mpc_fraction, baseline_fraction : nested lists of float
@@ -106,8 +127,25 @@ class HorizonResult(_Result):
     mpc_power_w: list = field(default_factory=list)
     baseline_power_w: list = field(default_factory=list)
     mpc_horizon_used: list = field(default_factory=list)
-    convention: str = ("power positive when harvested; mean over the whole record from "
-                       "the hanging rest; fractions of the record's non-causal optimum "
+    mpc_harvested_power: list = field(default_factory=list)
+    mpc_stored_energy_change: list = field(default_factory=list)
+    mpc_stored_energy_change_j: list = field(default_factory=list)
+    baseline_harvested_power: list = field(default_factory=list)
+    baseline_stored_energy_change: list = field(default_factory=list)
+    baseline_stored_energy_change_j: list = field(default_factory=list)
+    mpc_update_time_first: list = field(default_factory=list)
+    mpc_update_time_median: list = field(default_factory=list)
+    mpc_update_time_p99: list = field(default_factory=list)
+    mpc_update_time_max: list = field(default_factory=list)
+    update_interval_s: float | None = None
+    realtime_fits: bool | None = None
+    mpc_failed_solves: list = field(default_factory=list)
+    mpc_speed_exceeded_fraction: list = field(default_factory=list)
+    mpc_speed_peak: list = field(default_factory=list)
+    convention: str = ("power positive when harvested; (harvested energy + change of the "
+                       "stored energy theta'^2/2 + cos(theta), at eta_g) per unit time over "
+                       "the whole record from the hanging rest (receding horizon: one "
+                       "repeat after warm_up); fractions of the record's non-causal optimum "
                        "(sea) and of its gamma -> 0 limit")
 
     command = "horizon"
@@ -197,7 +235,8 @@ def horizon_curve(*, hs: float = 2.0, tp: float = 8.0, spectrum: str = "jonswap"
         rest); the run is then ``warm_up`` plus one whole repeat of the record long, so the
         mean is over one repeat (the baselines still average the whole record from rest).
     speed_limit : float or None
-        Rated speed of the receding-horizon plans (units ``sqrt(g / l)``;
+        Rated-speed penalty of the receding-horizon plans, not a hard bound (its exceedance
+        is reported; units ``sqrt(g / l)``;
         :func:`parapend.control.mpc.mpc_run`); None: none.
     """
     from ..irregular import sea
@@ -205,6 +244,7 @@ def horizon_curve(*, hs: float = 2.0, tp: float = 8.0, spectrum: str = "jonswap"
     from ..units import Units
     from .baselines import BASELINES, extremum_baseline, tracker_baseline
     from .forecast import FORECASTS, ARForecast, prediction_error
+    from .mpc import stored_energy
 
     units = Units(length, mass, gravity, inertia)
     if gamma is not None and damping_coefficient is not None:
@@ -255,6 +295,10 @@ def horizon_curve(*, hs: float = 2.0, tp: float = 8.0, spectrum: str = "jonswap"
         tick()
     mpc_p = [[[math.nan] * records for _ in hz] for _ in fc]
     mpc_st = [[[""] * records for _ in hz] for _ in fc]
+    mpc_w, mpc_de, mpc_fail, mpc_xf, mpc_xp = ([[[math.nan] * records for _ in hz]
+                                                for _ in fc] for _ in range(5))
+    times = [[[] for _ in hz] for _ in fc]
+    first = [[math.nan for _ in hz] for _ in fc]
     used = [[h for h in hz] for _ in fc]
     if fc:
         from .mpc import mpc_run
@@ -272,16 +316,38 @@ def horizon_curve(*, hs: float = 2.0, tp: float = 8.0, spectrum: str = "jonswap"
                     mpc_p[i][j][r] = (float(res.mean_electrical_power) if res.success
                                       else math.nan)
                     mpc_st[i][j][r] = str(res.status)
+                    if res.success:
+                        mpc_w[i][j][r] = float(getattr(res, "harvested_electrical_power",
+                                                       math.nan))
+                        mpc_de[i][j][r] = float(getattr(res, "stored_energy_change", math.nan))
+                    mpc_fail[i][j][r] = int(getattr(res, "failed_solves", 0))
+                    mpc_xf[i][j][r] = getattr(res, "speed_exceeded_fraction", None)
+                    mpc_xp[i][j][r] = getattr(res, "speed_peak", None)
+                    ut = np.asarray(getattr(res, "update_times", ()), dtype=float)
+                    if ut.size:
+                        if r == 0:
+                            first[i][j] = float(ut[0])
+                        times[i][j].append(ut[1:] if r == 0 else ut)
                     used[i][j] = float(getattr(res, "horizon", h * tp_n)) / tp_n
                     tick()
     base_p = [[math.nan] * records for _ in bl]
     base_st = [[""] * records for _ in bl]
+    base_w = [[math.nan] * records for _ in bl]
+    base_de = [[math.nan] * records for _ in bl]
+    eta_g = 1.0 if eff is None else float(eff[0])
     for b, name in enumerate(bl):
         fn = tracker_baseline if name == "tracker" else extremum_baseline
         for r, exc in enumerate(excs):
             run = fn(exc.q, peak_omega=wp, gamma=gamma, t_end=exc.period,
                      torque_limit=torque_limit, efficiency=efficiency)
-            base_p[b][r] = run.mean_power if run.success else math.nan
+            if run.success:
+                # the stored energy's change over the record, counted at eta_g
+                de = float(stored_energy(run.theta[-1], run.theta_dot[-1])
+                           - stored_energy(run.theta[0], run.theta_dot[0]))
+                span = float(run.t[-1] - run.t[0])
+                base_w[b][r] = float(run.mean_power)
+                base_de[b][r] = de
+                base_p[b][r] = float(run.mean_power) + eta_g * de / span
             base_st[b][r] = run.status
             tick()
     leads, err = [], []
@@ -306,6 +372,25 @@ def horizon_curve(*, hs: float = 2.0, tp: float = 8.0, spectrum: str = "jonswap"
            + ("every run finished" if ok else f"{nan_runs} run(s) failed (NaN power)"))
     rec = {k: v for k, v in excs[0].describe().items() if k not in ("omega", "seed")}
     w = units.to_watts
+
+    def pct(i, j, f):
+        a = np.concatenate(times[i][j]) if times[i][j] else np.zeros(0)
+        return float(f(a)) if a.size else math.nan
+
+    t_med = [[pct(i, j, np.median) for j in range(len(hz))] for i in range(len(fc))]
+    t_p99 = [[pct(i, j, lambda a: np.percentile(a, 99)) for j in range(len(hz))]
+             for i in range(len(fc))]
+    t_max = [[pct(i, j, np.max) for j in range(len(hz))] for i in range(len(fc))]
+    upd_s = upd * tp
+    fits = None
+    if fc and np.all(np.isfinite(t_p99)):
+        fits = bool(np.max(t_p99) <= upd_s)
+    joules = units.to_joules
+
+    def opt_list(a):
+        return [[[None if v is None or (isinstance(v, float) and math.isnan(v)) else v
+                  for v in col] for col in row] for row in a]
+
     return HorizonResult(
         horizons=hz, forecasts=fc, baselines=bl, seeds=[seed + r for r in range(records)],
         mpc_power=mpc_p, baseline_power=base_p, optimum_power=opt, limit_power=lim,
@@ -328,7 +413,17 @@ def horizon_curve(*, hs: float = 2.0, tp: float = 8.0, spectrum: str = "jonswap"
         optimum_power_w=[w(v) for v in opt], limit_power_w=[w(v) for v in lim],
         mpc_power_w=[[[w(v) for v in col] for col in row] for row in mpc_p],
         baseline_power_w=[[w(v) for v in row] for row in base_p],
-        mpc_horizon_used=used)
+        mpc_horizon_used=used, mpc_harvested_power=mpc_w, mpc_stored_energy_change=mpc_de,
+        mpc_stored_energy_change_j=[[[joules(v) for v in col] for col in row]
+                                    for row in mpc_de],
+        baseline_harvested_power=base_w, baseline_stored_energy_change=base_de,
+        baseline_stored_energy_change_j=[[joules(v) for v in row] for row in base_de],
+        mpc_update_time_first=first, mpc_update_time_median=t_med,
+        mpc_update_time_p99=t_p99, mpc_update_time_max=t_max, update_interval_s=upd_s,
+        realtime_fits=fits,
+        mpc_failed_solves=[[[int(v) if v == v else None for v in col] for col in row]
+                           for row in mpc_fail],
+        mpc_speed_exceeded_fraction=opt_list(mpc_xf), mpc_speed_peak=opt_list(mpc_xp))
 
 
 def horizon_dataset(r: HorizonResult):
@@ -352,6 +447,19 @@ def horizon_dataset(r: HorizonResult):
         if r.mpc_horizon_used:
             data["mpc_horizon_used"] = (("forecast", "horizon"),
                                         np.asarray(r.mpc_horizon_used, dtype=float))
+        for name in ("mpc_harvested_power", "mpc_stored_energy_change",
+                     "mpc_stored_energy_change_j"):
+            if getattr(r, name):
+                data[name] = (dims, np.asarray(getattr(r, name), dtype=float))
+        if r.mpc_failed_solves:
+            data["mpc_failed_solves"] = (dims, np.asarray(
+                [[[-1 if v is None else v for v in c] for c in row]
+                 for row in r.mpc_failed_solves], dtype=np.int64))
+        for name in ("first", "median", "p99", "max"):
+            v = getattr(r, f"mpc_update_time_{name}")
+            if v:
+                data[f"mpc_update_time_{name}"] = (("forecast", "horizon"),
+                                                   np.asarray(v, dtype=float))
     if r.baselines:
         coords["baseline"] = np.asarray(r.baselines, dtype=str)
         data["baseline_power"] = (("baseline", "record"),
@@ -360,16 +468,43 @@ def horizon_dataset(r: HorizonResult):
                                     np.asarray(r.baseline_power_w, dtype=float))
         data["baseline_fraction"] = (("baseline", "record"),
                                      np.asarray(r.baseline_fraction, dtype=float))
+        for name in ("baseline_harvested_power", "baseline_stored_energy_change",
+                     "baseline_stored_energy_change_j"):
+            if getattr(r, name):
+                data[name] = (("baseline", "record"),
+                              np.asarray(getattr(r, name), dtype=float))
     if r.ar_leads:
         coords["lead"] = np.asarray(r.ar_leads, dtype=float)
         data["ar_error"] = (("lead",), np.asarray(r.ar_error, dtype=float))
     ds = xr.Dataset(data, coords=coords)
+    p_unit = "m g l sqrt(g/l)"
+    described = {
+        "mpc_power": (p_unit, "storage-corrected mean electrical power"),
+        "baseline_power": (p_unit, "storage-corrected mean electrical power"),
+        "mpc_power_w": ("W", "storage-corrected mean electrical power"),
+        "baseline_power_w": ("W", "storage-corrected mean electrical power"),
+        "mpc_harvested_power": (p_unit, "harvested electrical energy / time"),
+        "baseline_harvested_power": (p_unit, "harvested electrical energy / time"),
+        "mpc_stored_energy_change": ("m g l", "change of the stored energy"),
+        "baseline_stored_energy_change": ("m g l", "change of the stored energy"),
+        "mpc_stored_energy_change_j": ("J", "change of the stored energy"),
+        "baseline_stored_energy_change_j": ("J", "change of the stored energy"),
+        "mpc_failed_solves": ("1", "horizon solves not converged (-1: no run)"),
+        **{f"mpc_update_time_{k}": ("s", f"wall time of an update (forecast + solve), {k}")
+           for k in ("first", "median", "p99", "max")}}
+    for name, (unit, long_name) in described.items():
+        if name in ds.variables:
+            ds[name].attrs.update(units=unit, long_name=long_name)
     ds["horizon"].attrs["units"] = "peak periods"
     if "lead" in ds.coords:
         ds["lead"].attrs["units"] = "peak periods"
     ds.attrs.update({"gamma": r.gamma, "peak_period": r.peak_period,
                      "update_interval_peak_periods": r.update_interval,
                      "warm_up_peak_periods": r.warm_up,
+                     "update_interval_s": ("none" if r.update_interval_s is None
+                                           else r.update_interval_s),
+                     "realtime_fits": ("unknown" if r.realtime_fits is None
+                                       else int(r.realtime_fits)),
                      "torque_limit": "none" if r.torque_limit is None else r.torque_limit,
                      "speed_limit": "none" if r.speed_limit is None else r.speed_limit,
                      "efficiency": "none" if r.efficiency is None else r.efficiency,

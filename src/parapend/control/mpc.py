@@ -49,6 +49,11 @@ TRACKING = 1.0
 MAX_ITER = 200
 #: the swing-up hands over above the top's energy by this margin (as track)
 CATCH_MARGIN = 0.05
+#: a run stops as "unresolved" when ``|theta'| dt`` exceeds this (rad per held sample)
+RESOLVED_TURN = 2 * math.pi
+#: least damping the plans price (docs/control.md: at gamma = 0 without a torque limit the
+#: horizon problem has no optimum; its supremum is the gamma -> 0 limit's instant flips)
+PLAN_DAMPING = 3e-3
 
 
 @dataclass(frozen=True, eq=False, repr=False)
@@ -69,9 +74,24 @@ class MPCResult(_Result):
     electrical_series : ndarray (n,)
         The same through the efficiency model (equal without one).
     mean_power, mean_electrical_power : float
-        Means of the series over ``t >= average_from``.
-    solve_times : ndarray
-        Wall time (s) of each horizon solve.
+        Over ``t >= average_from``: the harvested energy plus the change of the stored
+        energy, per unit time (:func:`energy_account`; electrically the stored energy counts
+        at ``eta_g``).
+    harvested_power, harvested_electrical_power : float
+        The harvested energy alone per unit time over ``t >= average_from`` (the means of
+        the series; a storage swing moves them).
+    harvested_energy, stored_energy_change, averaged_time : float
+        ``W``, ``E(end) - E(average_from)`` (``E = theta'^2 / 2 + cos(theta)``) and the time
+        they are over.
+    solve_times, forecast_times, update_times : ndarray
+        Wall time (s) of each horizon solve, of each forecast, and of each whole update
+        (forecast, problem, warm start, solve, held torques).
+    failed_kept_previous : int
+        Failed solves whose iterate was not finite, after which the previous plan went on
+        (the others applied their last iterate).
+    speed_exceeded_fraction, speed_peak : float or None
+        With ``speed_limit``: the fraction of samples after the hand-over with ``|theta'|``
+        above it, and the largest ``|theta'|`` there (the limit is a penalty).
     iterations : ndarray
         Newton (interior-point) iterations of each solve.
     catch_time : float or None
@@ -106,6 +126,17 @@ class MPCResult(_Result):
     status: str
     message: str
     speed_limit: float | None = None
+    harvested_power: float = math.nan
+    harvested_electrical_power: float = math.nan
+    harvested_energy: float = math.nan
+    stored_energy_change: float = math.nan
+    averaged_time: float = 0.0
+    forecast_times: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    update_times: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    failed_kept_previous: int = 0
+    speed_exceeded_fraction: float | None = None
+    speed_peak: float | None = None
+    plan_damping: float = 0.0
     convention: str = ("theta from the upright (hanging at rest is theta = pi); power "
                        "positive when harvested, P = -<T theta'>; torque units m g l")
     extra: dict = field(default_factory=dict)
@@ -242,12 +273,48 @@ def _electrical(p, eta):
     return np.where(p > 0, eta[0] * p, p / eta[1])
 
 
+def stored_energy(theta, theta_dot):
+    """The pendulum's mechanical energy ``E = theta'^2 / 2 + cos(theta)`` (units ``m g l``;
+    theta from the upright: ``E = -1`` hanging at rest, ``1`` at rest on top), the energy of
+    Eq. 14's balance ``dE/dt = q sin(theta) theta' - gamma theta'^2 + T theta'``."""
+    return 0.5 * np.asarray(theta_dot, dtype=float) ** 2 + np.cos(theta)
+
+
+def energy_account(t, theta, theta_dot, p, pe, start, eta_g=1.0):
+    """The energy account of a sampled run over ``t >= start``: the harvested energy
+    ``W = sum p_k dt`` (``p_k`` the power of held sample ``k``, exact), the change of the
+    stored energy ``dE = E(end) - E(start)`` (:func:`stored_energy`), the time ``tau``, and
+    the powers ``harvested_power = W / tau`` and ``mean_power = (W + dE) / tau`` (the energy
+    still in the pendulum counted as harvested, energy drawn from it as not); electrically
+    ``(W_e + eta_g dE) / tau`` (stored energy is harvested at ``eta_g``). A dict."""
+    t = np.asarray(t, dtype=float)
+    if t.size < 2:
+        nan = math.nan
+        return {"harvested_energy": nan, "stored_energy_change": nan, "averaged_time": 0.0,
+                "harvested_power": nan, "harvested_electrical_power": nan,
+                "mean_power": nan, "mean_electrical_power": nan}
+    dt = t[1] - t[0]
+    i0 = int(np.searchsorted(t, start - 1e-9 * dt))
+    i0 = min(i0, t.size - 1)
+    tau = float(t[-1] - t[i0])
+    w = float(np.sum(p[i0:]) * dt)
+    we = float(np.sum(pe[i0:]) * dt)
+    e = stored_energy(theta[[i0, -1]], theta_dot[[i0, -1]])
+    de = float(e[1] - e[0])
+    ok = tau > 0
+    return {"harvested_energy": w, "stored_energy_change": de, "averaged_time": tau,
+            "harvested_power": w / tau if ok else math.nan,
+            "harvested_electrical_power": we / tau if ok else math.nan,
+            "mean_power": (w + de) / tau if ok else math.nan,
+            "mean_electrical_power": (we + eta_g * de) / tau if ok else math.nan}
+
+
 def mpc_run(q_record, *, gamma, horizon, update_interval, dt, torque_limit=None,
             efficiency=None, forecast=None, theta0=math.pi, theta_dot0=0.0, t_end=None,
             warm=True, seed=0, terminal_weight=None, average_from=0.0,
             interval_samples=INTERVAL_SAMPLES, plant_steps=PLANT_STEPS, max_iter=MAX_ITER,
             pump_level=1.0, tracking=TRACKING, terminal="energy", speed_limit=None,
-            speed_weight=None) -> MPCResult:
+            speed_weight=None, plan_damping=None) -> MPCResult:
     """Receding-horizon control of Eq. 14 driven by the record ``q_record``.
 
     Parameters
@@ -297,11 +364,20 @@ def mpc_run(q_record, *, gamma, horizon, update_interval, dt, torque_limit=None,
         (:meth:`~.plan.PlanProblem.terminal_value`; docs/control.md: about the same power
         as ``kappa E``).
     speed_limit : float or None
-        Rated speed ``w_max`` of the plans: the penalty ``rho / 2 h sum max(|theta'_k| -
-        w_max, 0)^2`` at the plan's nodes (:meth:`~.plan.PlanProblem.speed_penalty`);
-        None: no bound (a generator's rated speed; docs/control.md: it costs power).
+        Rated speed ``w_max`` priced in the plans: the penalty ``rho / 2 h sum
+        max(|theta'_k| - w_max, 0)^2`` at the plan's nodes
+        (:meth:`~.plan.PlanProblem.speed_penalty`), a penalty and not a hard bound: the
+        result reports the fraction of samples above it and the peak speed; None: none
+        (docs/control.md: it costs power).
     speed_weight : float or None
         ``rho`` of that penalty (None: ``parapend.control.plan.SPEED_WEIGHT``, 100).
+    plan_damping : float or None
+        Least damping the plans' objective prices, ``max(gamma, plan_damping)`` (the torque
+        keeps ``gamma``); None: ``PLAN_DAMPING``. At ``gamma = 0`` without it the horizon
+        problem has no optimum (docs/control.md) and the plans spin the pendulum up.
+
+    A run whose speed exceeds a turn per held torque sample stops with the status
+    "unresolved" (``success`` False).
     """
     from . import _mpc_kernel as k
     from .plan import PlanProblem, free_motion, gauss_leads, solve_plan
@@ -326,6 +402,8 @@ def mpc_run(q_record, *, gamma, horizon, update_interval, dt, torque_limit=None,
         torque_limit = check_range("torque-limit", torque_limit, 1e-9, 1e6)
     if speed_limit is not None:
         speed_limit = check_range("speed-limit", speed_limit, 1e-9, 1e6)
+    plan_damping = PLAN_DAMPING if plan_damping is None else check_range(
+        "plan-damping", plan_damping, 0.0, 1e3)
     qf = _q_function(q_record)
     if t_end is None:
         if isinstance(q_record, tuple) or isinstance(q_record, list):
@@ -365,8 +443,12 @@ def mpc_run(q_record, *, gamma, horizon, update_interval, dt, torque_limit=None,
     braking = False
     plan = None
     since = 0
-    solve_times, iters = [], []
+    solve_times, forecast_times, update_times, iters = [], [], [], []
     failed = 0
+    kept = 0  # failed solves whose iterate was not finite: the previous plan continued
+    # a held torque over a whole turn resolves nothing (and the plant's RK4 steps then
+    # exceed 2 pi / plant_steps rad): the run stops as unresolved
+    max_speed = RESOLVED_TURN / dt
     status = "ok"
     t_samples = dt * np.arange(total + 1)
     q_samples = qp[::2 * plant_steps]
@@ -382,16 +464,18 @@ def mpc_run(q_record, *, gamma, horizon, update_interval, dt, torque_limit=None,
             seg = np.array([tq])
         elif plan is None or since >= m:
             tj = t_samples[j]
+            tu = time.perf_counter()
             if forecast is None:
                 qall = np.asarray(qf(tj + leads), dtype=float)
             else:
                 qall = np.asarray(forecast.predict(tj, t_samples[:j + 1], q_samples[:j + 1],
                                                    leads), dtype=float)
+            forecast_times.append(time.perf_counter() - tu)
             qg, qc, qs, qfree = np.split(qall, cuts)
             pr = PlanProblem(x, hh, qg.reshape(lg.shape), qc.reshape(lc.shape), gamma,
                              torque_limit=torque_limit, efficiency=efficiency, kappa=kappa,
                              terminal=terminal, speed_limit=speed_limit,
-                             speed_weight=speed_weight)
+                             speed_weight=speed_weight, plan_damping=plan_damping)
             anchor = None
             if torque_limit is not None or plan is None or not warm:
                 fth, fv = free_motion(x, hh, kk, gamma, qfree)
@@ -425,9 +509,12 @@ def mpc_run(q_record, *, gamma, horizon, update_interval, dt, torque_limit=None,
                 failed += 1
             if np.all(np.isfinite(sol.x)):
                 plan = sol.plan
+            else:
+                kept += 1
             since = 0
             u_open = plan.torque(smp, qs.reshape(m, -1)) @ w3  # the plan's sample means
             q_mean = qs.reshape(m, -1) @ w3
+            update_times.append(time.perf_counter() - tu)
         if caught is not None:
             # the plan's held torque plus the tracking feedback on the measured state
             i = since
@@ -452,6 +539,10 @@ def mpc_run(q_record, *, gamma, horizon, update_interval, dt, torque_limit=None,
             status = "diverged"
             total = j + steps_now
             break
+        if not np.max(np.abs(sv)) <= max_speed:
+            status = "unresolved"
+            total = j + steps_now
+            break
         j += steps_now
         if plan is not None:
             since += steps_now
@@ -459,19 +550,39 @@ def mpc_run(q_record, *, gamma, horizon, update_interval, dt, torque_limit=None,
     t = dt * np.arange(total + 1)
     p = -u_all * np.diff(th) / dt
     pe = _electrical(p, eta)
-    sel = t[:-1] >= average_from - 1e-9 * dt
-    mean_p = float(np.mean(p[sel])) if np.any(sel) else math.nan
-    mean_e = float(np.mean(pe[sel])) if np.any(sel) else math.nan
+    acc = energy_account(t, th, v, p, pe, average_from, eta[0])
+    mean_p, mean_e = acc["mean_power"], acc["mean_electrical_power"]
     st_arr = np.asarray(solve_times)
     if status == "ok" and not math.isfinite(mean_p):
         status = "nonfinite"
     success = status == "ok"
-    msg = {"ok": f"{len(solve_times)} horizon solves, {failed} not converged",
+    done = (f"{len(solve_times)} horizon solves, {failed} not converged"
+            + (f" (applied: the last iterate of {failed - kept}, the previous plan "
+               f"continued for {kept})" if failed else ""))
+    msg = {"ok": done,
            "diverged": "the closed loop diverged (|theta'| > 1e6)",
+           "unresolved": (f"stopped at t = {t[-1]:.4g}: |theta'| reached "
+                          f"{float(np.max(np.abs(v))):.4g}, more than a turn per held torque "
+                          f"sample (dt = {dt:.4g}); the sampled loop does not resolve the "
+                          f"motion, its numbers mean nothing; {done}"),
            "nonfinite": "non-finite power"}[status]
+    after = t >= (caught if caught is not None else total + 1) * dt - 1e-9 * dt
+    speed = np.abs(v[after])
+    exceed = peak = None
+    if speed_limit is not None and speed.size:
+        exceed = float(np.mean(speed > speed_limit))
+        peak = float(np.max(speed))
     return MPCResult(
         t=t, theta=th, theta_dot=v, torque=u_all, power_series=p, electrical_series=pe,
         mean_power=mean_p, mean_electrical_power=mean_e,
+        harvested_power=acc["harvested_power"],
+        harvested_electrical_power=acc["harvested_electrical_power"],
+        harvested_energy=acc["harvested_energy"],
+        stored_energy_change=acc["stored_energy_change"],
+        averaged_time=acc["averaged_time"],
+        forecast_times=np.asarray(forecast_times), update_times=np.asarray(update_times),
+        failed_kept_previous=kept, speed_exceeded_fraction=exceed, speed_peak=peak,
+        plan_damping=plan_damping,
         energy=float(np.sum(p) * dt), solve_times=st_arr,
         iterations=np.asarray(iters, dtype=int), update_interval=m * dt, horizon=n * dt,
         dt=dt, gamma=gamma, torque_limit=torque_limit,
@@ -486,33 +597,79 @@ def mpc_run(q_record, *, gamma, horizon, update_interval, dt, torque_limit=None,
 # --- track --controller mpc ----------------------------------------------------------------
 #: MPC torque samples per peak (forcing) period in ``track``
 TRACK_SAMPLES = 64
-#: periods at the start of a ``track`` run left out of ``run_power`` (swing-up and catch)
+#: periods at the start of a ``track`` run left out of its powers (swing-up and catch)
 WARMUP_PERIODS = 10
+
+
+def timing_summary(update_times, interval_s=None) -> dict:
+    """Wall times (s) of the updates: the first apart (it loads or compiles the kernels),
+    the median, 99th percentile and largest of the others; with the update interval in
+    seconds, whether the 99th percentile fits in it (``realtime_fits``)."""
+    ut = np.asarray(update_times, dtype=float)
+    rest = ut[1:]
+    out = {"update_time_first": float(ut[0]) if ut.size else None,
+           "update_time_median": float(np.median(rest)) if rest.size else None,
+           "update_time_p99": float(np.percentile(rest, 99)) if rest.size else None,
+           "update_time_max": float(np.max(rest)) if rest.size else None}
+    out["realtime_fits"] = (None if interval_s is None or out["update_time_p99"] is None
+                            else bool(out["update_time_p99"] <= interval_s))
+    return out
 
 
 @dataclass(frozen=True, eq=False, repr=False)
 class MPCTrackResult(_Result):
     """``parapend track --controller mpc`` (fields = JSON keys).
 
+    Powers are over the run after the stated start-up (``warm_up_periods``, swing-up and
+    catch): ``t`` from ``warm_up_periods`` forcing (peak) periods to the end.
+
     Attributes
     ----------
     mean_power : float
-        Mean power over the last 10 periods (as ``track``), exact for the held torque.
-    run_power : float
-        Mean power from period 10 to the end (after the swing-up).
+        The headline: (harvested energy + change of the stored energy) / time after the
+        start-up (:func:`energy_account`), the energy left in the pendulum counted as
+        harvested and energy drawn from it as not; exact for the held torque.
+    harvested_power : float
+        The harvested energy alone over the same time (a storage swing moves it).
+    harvested_energy, stored_energy_change, averaged_time : float
+        ``W``, ``E(end) - E(start)`` (``E = theta'^2 / 2 + cos(theta)``, units ``m g l``)
+        and the time, non-dimensional.
+    electrical_power : float
+        ``mean_power`` through the efficiency model (stored energy at ``eta_g``).
     record_power : float or None
-        With ``irregular`` and at least 110 periods: the mean over the last full repeat of
-        the record (100 peak periods), the number comparable with ``parapend sea`` on the
-        same record.
+        With ``irregular`` and at least ``warm_up_periods + 100`` periods: the same
+        storage-corrected power over the last whole repeat of the record (100 peak
+        periods), the number comparable with ``parapend sea`` on the same record.
     horizon, update_interval : float
         In peak (forcing) periods.
-    solve_time_median, solve_time_max : float
-        Wall time (s) of one horizon solve.
+    update_time_first : float
+        Wall time (s) of the first update (forecast + solve; it loads or compiles the
+        kernels), reported apart.
+    update_time_median, update_time_p99, update_time_max : float
+        Wall time (s) of one update (forecast, problem, warm start, solve, held torques)
+        over the updates after the first, on this process (the kernels are single-threaded).
+    forecast_time_median, solve_time_median : float
+        Their forecast and solve parts (median, after the first).
+    realtime_fits : bool or None
+        Whether ``update_time_p99`` fits in the update interval in seconds (with a device:
+        ``length`` and ``mass``; None without).
+    failed_solves, failed_kept_previous : int
+        Solves that did not converge; of them, those whose iterate was not finite, after
+        which the previous plan went on (the others applied their last iterate).
+    speed_limit : float or None
+        The plans' rated-speed penalty (not a hard bound).
+    speed_exceeded_fraction, speed_peak : float or None
+        With it: the fraction of samples after the hand-over with ``|theta'|`` above it,
+        and the largest ``|theta'|`` there.
     """
 
     controller: str
     mean_power: float
-    run_power: float
+    harvested_power: float
+    harvested_energy: float
+    stored_energy_change: float
+    averaged_time: float
+    warm_up_periods: int
     record_power: float | None
     electrical_power: float
     catch_period: float | None
@@ -522,10 +679,16 @@ class MPCTrackResult(_Result):
     samples_per_period: int
     forecast: str
     terminal_weight: float
+    plan_damping: float
     solves: int
     failed_solves: int
-    solve_time_median: float
-    solve_time_max: float
+    failed_kept_previous: int
+    update_time_first: float | None
+    update_time_median: float | None
+    update_time_p99: float | None
+    update_time_max: float | None
+    forecast_time_median: float | None
+    solve_time_median: float | None
     iterations_median: float
     success: bool
     status: str
@@ -537,23 +700,44 @@ class MPCTrackResult(_Result):
     seed: int
     irregular: bool
     speed_limit: float | None = None
+    speed_exceeded_fraction: float | None = None
+    speed_peak: float | None = None
     excitation: dict = field(default_factory=dict)
     sea: dict | None = None
     units: dict | None = None
     mean_power_w: float | None = None
+    harvested_power_w: float | None = None
+    stored_energy_change_j: float | None = None
     record_power_w: float | None = None
     peak_torque_nm: float | None = None
     torque_limit_nm: float | None = None
     period_s: float | None = None
     update_interval_s: float | None = None
+    realtime_fits: bool | None = None
     convention: str = ("theta from the upright (hanging at rest is theta = pi); power "
-                       "positive when harvested, P = -<T theta'>; torque units m g l")
+                       "positive when harvested, P = -<T theta'>; torque units m g l; "
+                       "mean_power = (harvested energy + change of stored energy) / time "
+                       "after warm_up_periods")
     _run: object = field(default=None, repr=False)
     _q: object = field(default=None, repr=False)
 
     command = "track"
-    headline = ("mean_power", "mean_power_w", "run_power", "record_power", "failed_solves",
-                "status")
+    headline = ("mean_power", "mean_power_w", "harvested_power", "stored_energy_change",
+                "record_power", "failed_solves", "status")
+
+    def __post_init__(self):
+        # with a device (``units``, added by dataclasses.replace) the SI fields and whether
+        # the updates fit in its update interval in seconds
+        if self.update_interval_s is not None and self.update_time_p99 is not None:
+            object.__setattr__(self, "realtime_fits",
+                               bool(self.update_time_p99 <= self.update_interval_s))
+        if self.units is not None:
+            from ..units import Units
+
+            u = Units.from_description(self.units)
+            object.__setattr__(self, "harvested_power_w", u.to_watts(self.harvested_power))
+            object.__setattr__(self, "stored_energy_change_j",
+                               u.to_joules(self.stored_energy_change))
 
     @property
     def run(self):
@@ -571,6 +755,38 @@ class MPCTrackResult(_Result):
         from ..units import Units
 
         return Units.from_description(self.units)
+
+    def to_dataset(self):
+        from ..results import annotate, scalars_dataset
+
+        ds = scalars_dataset(self.to_dict(), self._series())
+        p = "m g l sqrt(g/l)"
+        names = {
+            "mean_power": (p, "(harvested energy + change of stored energy) / time after "
+                              "the warm-up"),
+            "harvested_power": (p, "harvested energy / time after the warm-up"),
+            "harvested_energy": ("m g l", "harvested energy after the warm-up"),
+            "stored_energy_change": ("m g l", "change of the stored energy after the "
+                                              "warm-up"),
+            "averaged_time": ("sqrt(l/g)", "time the powers are over"),
+            "record_power": (p, "storage-corrected power over the last repeat"),
+            "electrical_power": (p, "storage-corrected electrical power"),
+            "mean_power_w": ("W", "(harvested energy + change of stored energy) / time"),
+            "harvested_power_w": ("W", "harvested energy / time"),
+            "stored_energy_change_j": ("J", "change of the stored energy"),
+            "speed_peak": ("rad sqrt(g/l)", "largest |theta'| after the hand-over"),
+            "speed_limit": ("rad sqrt(g/l)", "rated-speed penalty of the plans"),
+            "stored_energy": ("m g l", "stored energy theta'^2/2 + cos(theta)"),
+        }
+        for k in [k for k in ds.variables if str(k).startswith(("update_time",
+                                                                   "forecast_time",
+                                                                   "solve_time"))]:
+            names[str(k)] = ("s", str(k).replace("_", " ") + " (wall clock)")
+        for k, (unit, long_name) in names.items():
+            if k in ds.variables:
+                ds[k].attrs.setdefault("units", unit)
+                ds[k].attrs.setdefault("long_name", long_name)
+        return annotate(ds, self.command)
 
     def _series(self):
         from ..results import series
@@ -592,11 +808,12 @@ def track_mpc(excitation, *, gamma, horizon=2.0, update_interval=0.03125, foreca
               torque_limit=None, efficiency=None, periods=100, seed=0, irregular=False,
               theta0=math.pi, theta_dot0=0.0, terminal_weight=None,
               samples=TRACK_SAMPLES, terminal="energy", speed_limit=None,
-              speed_weight=None) -> MPCTrackResult:
+              speed_weight=None, plan_damping=None) -> MPCTrackResult:
     """Receding-horizon control of the case ``excitation`` (or, with ``irregular``, of the
     seeded sea record of ``parapend.control.track.design_sea`` built from it, the same
     record as ``track --irregular`` with the same seed); ``horizon`` and ``update_interval``
-    in forcing (peak) periods."""
+    in forcing (peak) periods. The powers are over the run after ``WARMUP_PERIODS``
+    (:class:`MPCTrackResult`)."""
     from .track import SEA_WAVES, _on_grid, design_sea
 
     horizon = check_range("horizon", horizon, 0.01, 20.0)
@@ -631,25 +848,36 @@ def track_mpc(excitation, *, gamma, horizon=2.0, update_interval=0.03125, foreca
                 dt=dt, torque_limit=torque_limit, efficiency=efficiency, forecast=fo,
                 theta0=theta0, theta_dot0=theta_dot0, t_end=periods * tp, seed=seed,
                 terminal_weight=terminal_weight, average_from=WARMUP_PERIODS * tp,
-                terminal=terminal, speed_limit=speed_limit, speed_weight=speed_weight)
-    p = r.power_series
-    last = min(p.size, 10 * samples)
-    mean_power = float(np.mean(p[-last:])) if p.size else math.nan
+                terminal=terminal, speed_limit=speed_limit, speed_weight=speed_weight,
+                plan_damping=plan_damping)
     record_power = None
-    if irregular and p.size >= (SEA_WAVES + WARMUP_PERIODS) * samples:
-        record_power = float(np.mean(p[-SEA_WAVES * samples:]))
-    st = r.solve_times
+    n_rec = SEA_WAVES * samples
+    if irregular and r.power_series.size >= (SEA_WAVES + WARMUP_PERIODS) * samples:
+        eg = 1.0 if r.efficiency is None else r.efficiency[0]
+        record_power = energy_account(r.t, r.theta, r.theta_dot, r.power_series,
+                                      r.electrical_series, r.t[-1 - n_rec], eg)["mean_power"]
+    tm = timing_summary(r.update_times)
+    rest = slice(1, None)
     return MPCTrackResult(
-        controller="mpc", mean_power=mean_power, run_power=r.mean_power,
+        controller="mpc", mean_power=r.mean_power, harvested_power=r.harvested_power,
+        harvested_energy=r.harvested_energy, stored_energy_change=r.stored_energy_change,
+        averaged_time=r.averaged_time, warm_up_periods=WARMUP_PERIODS,
         record_power=record_power, electrical_power=r.mean_electrical_power,
         catch_period=None if r.catch_time is None else r.catch_time / tp,
         peak_torque=r.peak_torque, horizon=r.horizon / tp,
         update_interval=r.update_interval / tp, samples_per_period=samples,
-        forecast=forecast, terminal_weight=r.terminal_weight, solves=r.solves,
-        failed_solves=r.failed_solves,
-        solve_time_median=float(np.median(st)) if st.size else 0.0,
-        solve_time_max=float(np.max(st)) if st.size else 0.0,
-        iterations_median=float(np.median(r.iterations)) if st.size else 0.0,
+        forecast=forecast, terminal_weight=r.terminal_weight, plan_damping=r.plan_damping,
+        solves=r.solves, failed_solves=r.failed_solves,
+        failed_kept_previous=r.failed_kept_previous,
+        update_time_first=tm["update_time_first"], update_time_median=tm["update_time_median"],
+        update_time_p99=tm["update_time_p99"], update_time_max=tm["update_time_max"],
+        forecast_time_median=(float(np.median(r.forecast_times[rest]))
+                              if r.forecast_times.size > 1 else None),
+        solve_time_median=(float(np.median(r.solve_times[rest]))
+                           if r.solve_times.size > 1 else None),
+        iterations_median=float(np.median(r.iterations)) if r.iterations.size else 0.0,
         success=r.success, status=r.status, message=r.message, gamma=r.gamma, omega=omega,
         torque_limit=torque_limit, periods=periods, seed=seed, irregular=bool(irregular),
-        speed_limit=r.speed_limit, excitation=excitation.describe(), sea=sea_info, _run=r, _q=qf)
+        speed_limit=r.speed_limit, speed_exceeded_fraction=r.speed_exceeded_fraction,
+        speed_peak=r.speed_peak, excitation=excitation.describe(), sea=sea_info, _run=r,
+        _q=qf)

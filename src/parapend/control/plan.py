@@ -27,6 +27,13 @@ by ``kappa V(E)``, ``V`` the energy a torque ``T_max`` harvests braking the rota
 the damping (:meth:`PlanProblem.terminal_value`, docs/control.md); ``V -> E`` without a
 limit.
 
+**Least priced damping.** ``plan_damping=c`` makes the objective price the damping
+``max(gamma, c) theta'^2`` while the torque keeps the model's ``gamma``. Without a torque
+limit and at ``gamma = 0`` the objective depends on the motion only through ``int q sin(theta)
+theta' dt``, whose supremum is the ``gamma -> 0`` limit's instant flips: the problem has no
+optimum and its Newton iterates drift to ever faster turns (the receding horizon of
+:mod:`.mpc` ran away to ``|theta'| ~ 2e4``); a small priced damping gives it one.
+
 **Rated speed.** ``speed_limit=w_max`` adds the exterior penalty ``rho / 2 h sum_k
 max(|v_k| - w_max, 0)^2`` over the free nodes (a generator's rated speed, the machine's
 bound; docs/control.md: the controller harvests without it, and it costs power). A penalty,
@@ -151,19 +158,24 @@ class PlanProblem:
         it (None: none).
     speed_weight : float or None
         Its ``rho`` (None: ``SPEED_WEIGHT``, 100).
+    plan_damping : float
+        Least damping the objective prices (module docstring); the torque keeps ``gamma``.
     """
 
     phase1 = False
 
     def __init__(self, x0, h, q_g, q_c, gamma, *, torque_limit=None, efficiency=None,
                  kappa=None, elastic=None, smoothing=KINK_SMOOTHING[-1], terminal="energy",
-                 speed_limit=None, speed_weight=None):
+                 speed_limit=None, speed_weight=None, plan_damping=0.0):
         self.x0 = np.asarray(x0, dtype=float).copy()
         self.q_g = np.ascontiguousarray(q_g, dtype=float)
         self.q_c = np.ascontiguousarray(q_c, dtype=float)
         self.k = k = self.q_g.shape[0]
         self.h = float(h)
         self.gamma = float(gamma)
+        self.plan_damping = float(plan_damping)
+        # the damping the objective prices (the torque keeps the model's gamma)
+        self.gamma_objective = max(self.gamma, self.plan_damping)
         eg, em = (1.0, 1.0) if efficiency is None else (float(efficiency[0]),
                                                         float(efficiency[1]))
         self.efficiency = efficiency
@@ -341,7 +353,7 @@ class PlanProblem:
 
     def _kernel_power(self, f):
         return _k.power_terms(f, self.k, 0.0, self.rows_g[0], self.rows_g[1], self.lin_g,
-                              self.q_g, self.wk, self.gamma)[0]
+                              self.q_g, self.wk, self.gamma_objective)[0]
 
     def objective(self, x, mu: float = 0.0, t=None) -> float:
         """The minimized ``-(J - eta_g E(t))`` (plus ``elastic t`` in elastic mode)."""
@@ -360,8 +372,8 @@ class PlanProblem:
             self.full(x), np.concatenate((np.zeros(2), dx)), float(alpha),
             0.0 if t is None else float(t), 0.0 if dt is None else float(dt), s, float(mu),
             float(floor), self.k, 0.0, self.rows_g[0], self.rows_g[1], self.lin_g, self.q_g,
-            self.wk, self.gamma, 0.0, self.rows_c[0], self.lin_c, self.q1_c, self.mode,
-            self._scale, float(self.torque_limit or 0.0), float(self.elastic or 0.0))
+            self.wk, self.gamma_objective, 0.0, self.rows_c[0], self.lin_c, self.q1_c,
+            self.mode, self._scale, float(self.torque_limit or 0.0), float(self.elastic or 0.0))
         if ok:
             ex = self._extra(xn)
             bn += ex
@@ -377,7 +389,7 @@ class PlanProblem:
 
         xs, st, it, mu = _pk.solve(
             np.ascontiguousarray(x, dtype=float), self.x0, self.k, self.rows_g[0],
-            self.rows_g[1], self.lin_g, self.q_g, self.wk, self.gamma, self.rows_c[0],
+            self.rows_g[1], self.lin_g, self.q_g, self.wk, self.gamma_objective, self.rows_c[0],
             self.lin_c, self.q1_c, self.mode == _k.LIMIT, self._scale,
             np.ascontiguousarray(self.q1_g), self.w, self.kappa,
             self.eta_g, self._a, self.kink, self.smoothing, *self._speed_args(),
@@ -389,9 +401,9 @@ class PlanProblem:
         f = self.full(x)
         ab, rhs, border, rhs_t, d_tt = _k.newton(
             f, 0.0 if t is None else float(t), np.asarray(lam, dtype=float), float(mu), self.k,
-            0.0, self.rows_g[0], self.rows_g[1], self.lin_g, self.q_g, self.wk, self.gamma,
-            0.0, self.rows_c[0], self.lin_c, self.q1_c, self.mode, self._scale,
-            float(self.torque_limit or 0.0), float(self.elastic or 0.0), self._gvar,
+            0.0, self.rows_g[0], self.rows_g[1], self.lin_g, self.q_g, self.wk,
+            self.gamma_objective, 0.0, self.rows_c[0], self.lin_c, self.q1_c, self.mode,
+            self._scale, float(self.torque_limit or 0.0), float(self.elastic or 0.0), self._gvar,
             self._jtc)
         self._extra_newton(f, ab, rhs)
         ab = np.ascontiguousarray(ab[:4, 2:])
@@ -460,7 +472,7 @@ def solve_plan(problem: PlanProblem, x, *, anchor=None, gap_tol=1e-10, maxiter=2
                              efficiency=pr.efficiency, kappa=pr.kappa,
                              elastic=ELASTIC_WEIGHT * max(1.0, pr.h), smoothing=pr.smoothing,
                              terminal=pr.terminal, speed_limit=pr.speed_limit,
-                             speed_weight=pr.speed_weight)
+                             speed_weight=pr.speed_weight, plan_damping=pr.plan_damping)
             sol = interior_point(el, x, maxiter=maxiter,
                                  stop_below=0.5e-4 * pr.torque_limit)
             iters += sol.iterations
