@@ -49,7 +49,7 @@ QUANTITIES = {
     "electrical_power": (_P, "mean electrical power"),
     "mean_power": (_P, "mean harvested power"),
     "run_power": (_P, "mean harvested power of the run"),
-    "record_power": (_P, "mean harvested power over a repeat of the record"),
+    "record_power": (_P, "storage-corrected power over the last repeat of the record"),
     "predicted_power": (_P, "power of the target motion"),
     "power_at_threshold": (_P, "optimal power at the threshold"),
     "peak_torque": (_T, "peak torque |T|"),
@@ -86,7 +86,17 @@ QUANTITIES = {
                                       "damping threshold as a coefficient c* = gamma* I / t0"),
     "uniform_threshold_coefficient": ("N m s/rad", "uniform-rotation threshold as a "
                                                    "damping coefficient"),
+    # the causal controller's energy account (track --controller mpc, horizon)
+    "harvested_power": (_P, "harvested energy / time after the warm-up"),
+    "harvested_energy": (_T, "harvested energy after the warm-up"),
+    "stored_energy_change": (_T, "change of the stored energy theta'^2/2 + cos(theta) after "
+                                 "the warm-up"),
+    "stored_energy": (_T, "stored energy theta'^2/2 + cos(theta)"),
+    "averaged_time": (_TIME, "time the powers are averaged over"),
+    "speed_peak": ("rad " + _RATE, "largest |theta'| after the hand-over"),
+    "speed_limit": ("rad " + _RATE, "rated-speed penalty of the plans"),
 }
+
 
 #: A field's unit from its name's suffix (longest first).
 SUFFIX_UNITS = (("_w_per_m", "W/m"), ("_mwh_per_year", "MWh/yr"), ("_rad_per_s", "rad/s"),
@@ -103,6 +113,8 @@ def quantity(name: str) -> tuple[str, str]:
     ``power_w`` is "W", its long name "power"); anything else is a count or ratio ("1")."""
     if name in QUANTITIES:
         return QUANTITIES[name]
+    if name.startswith(("update_time", "forecast_time", "solve_time")):
+        return "s", name.replace("_", " ") + " (wall clock)"
     for suffix, unit in SUFFIX_UNITS:
         if name.endswith(suffix) and len(name) > len(suffix):
             base = name[: -len(suffix)]

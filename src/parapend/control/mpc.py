@@ -756,38 +756,6 @@ class MPCTrackResult(_Result):
 
         return Units.from_description(self.units)
 
-    def to_dataset(self):
-        from ..results import annotate, scalars_dataset
-
-        ds = scalars_dataset(self.to_dict(), self._series())
-        p = "m g l sqrt(g/l)"
-        names = {
-            "mean_power": (p, "(harvested energy + change of stored energy) / time after "
-                              "the warm-up"),
-            "harvested_power": (p, "harvested energy / time after the warm-up"),
-            "harvested_energy": ("m g l", "harvested energy after the warm-up"),
-            "stored_energy_change": ("m g l", "change of the stored energy after the "
-                                              "warm-up"),
-            "averaged_time": ("sqrt(l/g)", "time the powers are over"),
-            "record_power": (p, "storage-corrected power over the last repeat"),
-            "electrical_power": (p, "storage-corrected electrical power"),
-            "mean_power_w": ("W", "(harvested energy + change of stored energy) / time"),
-            "harvested_power_w": ("W", "harvested energy / time"),
-            "stored_energy_change_j": ("J", "change of the stored energy"),
-            "speed_peak": ("rad sqrt(g/l)", "largest |theta'| after the hand-over"),
-            "speed_limit": ("rad sqrt(g/l)", "rated-speed penalty of the plans"),
-            "stored_energy": ("m g l", "stored energy theta'^2/2 + cos(theta)"),
-        }
-        for k in [k for k in ds.variables if str(k).startswith(("update_time",
-                                                                   "forecast_time",
-                                                                   "solve_time"))]:
-            names[str(k)] = ("s", str(k).replace("_", " ") + " (wall clock)")
-        for k, (unit, long_name) in names.items():
-            if k in ds.variables:
-                ds[k].attrs.setdefault("units", unit)
-                ds[k].attrs.setdefault("long_name", long_name)
-        return annotate(ds, self.command)
-
     def _series(self):
         from ..results import series
 
