@@ -176,3 +176,15 @@ def test_nothing_a_user_or_the_cli_needs_is_behind_an_underscore():
             if _PRIVATE.search(line) and "_negative_number_matcher" not in line:
                 found.append(f"{f.relative_to(ROOT)}:{i}: {line.strip()}")
     assert not found, "\n".join(found)
+
+
+def test_every_torque_limit_has_its_si_form():
+    """horizon takes the limit in N m as well as in m g l: the same runs (m g l = 98.1 N m for
+    the default 1 m, 10 kg pendulum at g = 9.81), and not both at once."""
+    kw = dict(repeat_period=48.0, forecasts="none", baselines="extremum", records=1)
+    a = parapend.horizon(torque_limit=1.0, **kw)
+    b = parapend.horizon(torque_limit_nm=10.0 * 9.81 * 1.0, **kw)
+    assert b.torque_limit == pytest.approx(1.0, rel=1e-14)
+    np.testing.assert_allclose(b.baseline_power, a.baseline_power, rtol=1e-9)
+    with pytest.raises(parapend.ParameterError, match="torque-limit-nm: give either"):
+        parapend.horizon(torque_limit=1.0, torque_limit_nm=5.0, **kw)

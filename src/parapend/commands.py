@@ -935,7 +935,8 @@ def buoy(*, wave_height=None, wave_period=None, hs=None, tp=None, spectrum="jons
 def horizon(*, hs=None, tp=None, spectrum: str = "jonswap", gamma_peak: float = 3.3,
             repeat_period=None, seed=None, cutoff: float = 3.0, length: float = SEA["length"],
             mass: float = SEA["mass"], inertia=None, gravity: float = SEA["gravity"],
-            gamma=None, damping_coefficient=None, torque_limit=None, efficiency=None,
+            gamma=None, damping_coefficient=None, torque_limit=None, torque_limit_nm=None,
+            efficiency=None,
             horizons: str = HORIZON["horizons"], forecasts: str = HORIZON["forecasts"],
             baselines: str = HORIZON["baselines"], records: int = HORIZON["records"],
             update_interval: float = HORIZON["update_interval"], progress=None,
@@ -943,8 +944,18 @@ def horizon(*, hs=None, tp=None, spectrum: str = "jonswap", gamma_peak: float = 
     """Mean power of causal control against the forecast horizon, as a fraction of the
     record's non-causal optimum and of its limit (command ``horizon``;
     :func:`parapend.control.horizon.horizon_curve`). The sea state and the pendulum as
-    ``sea`` (default 2 m, 8 s, seed 0; ``gamma`` 0.01); ``records`` seeded records."""
+    ``sea`` (default 2 m, 8 s, seed 0; ``gamma`` 0.01); ``records`` seeded records. The
+    torque limit in units of ``m g l`` (``torque_limit``) or in N m (``torque_limit_nm``)."""
     from .control.horizon import horizon_curve
+
+    if torque_limit_nm is not None:
+        from .units import Units
+
+        if torque_limit is not None:
+            raise ParameterError("torque-limit-nm: give either --torque-limit or "
+                                 "--torque-limit-nm, not both")
+        torque_limit = Units(length=length, mass=mass, gravity=gravity,
+                             inertia=inertia).from_newton_metres(torque_limit_nm)
 
     return horizon_curve(hs=SEA["hs"] if hs is None else hs,
                          tp=SEA["tp"] if tp is None else tp, spectrum=spectrum,

@@ -36,6 +36,8 @@ def add_parsers(sub) -> None:
     add_pendulum_options(g)
     g.add_argument("--torque-limit", type=_finite_float("torque-limit"), default=None,
                    help="|T| <= T_max, units m g l, for every controller (default none)")
+    g.add_argument("--torque-limit-nm", type=_finite_float("torque-limit-nm"), default=None,
+                   help="the torque limit in N m (instead of --torque-limit)")
     g.add_argument("--efficiency", type=_finite_float("efficiency"), default=None,
                    help="PTO efficiency in (0, 1], generating and motoring (default none: "
                         "lossless)")
