@@ -25,8 +25,34 @@ from .spec import DEVICES, QUANTITIES, MatrixSpec
 __all__ = ["HOURS_PER_YEAR", "STATISTICS", "MatrixSpec", "matrix_dataset", "matrix_spec",
            "parse_bins", "power_matrix", "to_mhkit"]
 
+#: the lowest power take-off efficiency a matrix takes: below it the motoring power p / eta
+#: of a record overflows (a subnormal eta gave NaN bins); 1e-6 is far below any machine
+MIN_EFFICIENCY = 1e-6
+
+
+def check_efficiency(value) -> float:
+    """A power take-off efficiency in ``[MIN_EFFICIENCY, 1]`` (one line naming it)."""
+    return check_range("efficiency", value, MIN_EFFICIENCY, 1.0,
+                       why="fraction of the power converted")
+
+
 #: the statistics of each bin over its realizations (IEC TS 62600-100; std with ddof 0)
 STATISTICS = ("mean", "std", "min", "max", "count")
+
+
+#: depth-limited breaking: Hm0 / depth above this (the breaker index of a solitary wave,
+#: 0.78) is a sea state that cannot exist; the flux of linear theory there is meaningless
+BREAKING = 0.78
+
+
+def check_depth(value) -> float:
+    """A water depth in m: positive and at least 1e-3 m (below, the dispersion relation's
+    wave numbers leave the floating-point range: 5e-324 gave a NaN flux); the check
+    against the waves' height is :func:`power_matrix`'s."""
+    x = check_positive("depth", value)
+    if x < 1e-3:
+        raise ParameterError(f"depth: expected a water depth of at least 0.001 m, got {x:g}")
+    return x
 
 
 def parse_bins(name: str, value) -> tuple:
@@ -117,9 +143,9 @@ def matrix_spec(*, hs="1:3:3", te=None, tp=None, realizations: int = 3, waves: f
                         why="record length in peak periods")
     seed = check_int("seed", seed, 0, 2**62)
     for h in (hm0[0], hm0[-1]):
-        if h > limits.SEA_MAX_HS:
-            raise ParameterError(f"hs: expected bin centres up to {limits.SEA_MAX_HS:g} m, "
-                                 f"got {h:g}")
+        if not limits.SEA_MIN_HS <= h <= limits.SEA_MAX_HS:
+            raise ParameterError(f"hs: expected bin centres from {limits.SEA_MIN_HS:g} to "
+                                 f"{limits.SEA_MAX_HS:g} m, got {h:g}")
     for t in (tps[0], tps[-1]):
         if not limits.SEA_TP_RANGE[0] <= t <= limits.SEA_TP_RANGE[1]:
             raise ParameterError(f"{kind}: expected peak periods from "
@@ -140,9 +166,7 @@ def matrix_spec(*, hs="1:3:3", te=None, tp=None, realizations: int = 3, waves: f
         gamma = units.gamma(damping_coefficient)
     gamma = check_range("gamma", 0.01 if gamma is None else gamma, 0.0, limits.MAX_GAMMA)
     if efficiency is not None:
-        efficiency = check_range("efficiency", efficiency, 0.0, 1.0)
-        if efficiency <= 0:
-            raise ParameterError(f"efficiency: expected a number in (0, 1], got {efficiency}")
+        efficiency = check_efficiency(efficiency)
     if response is not None:
         rf, rg, rp = (read_response(response) if isinstance(response, str)
                       else check_response(*response))
@@ -299,7 +323,40 @@ def power_matrix(*, hs="1:3:3", te=None, tp=None, realizations: int = 3, waves: 
     text and docs/performance.md. Returns ``(dataset, annual, run)``."""
     from ..maps.run import run_spec
     from .annual import bin_series, read_scatter, read_series
+    from .check import check_bins, check_size, workers_for
 
+    # everything checked before any bin runs (and, for the buoy, before its BEM): the plain
+    # options, the output paths, the bins' sizes, every bin's record, the site's file
+    if depth is not None:
+        depth = check_depth(depth)
+    density = check_range("density", density, 500.0, 2000.0, why="kg/m^3")
+    if device == "buoy":
+        # the body is solved at 1025 kg/m^3 in deep water (parapend buoy): a flux at another
+        # density or depth would not be the body's sea (capture widths off by their ratio)
+        if density != 1025.0:
+            raise ParameterError(f"density: the buoy's body is solved at 1025 kg/m^3, got "
+                                 f"{density:g}; drop --density with --device buoy")
+        if depth is not None:
+            raise ParameterError(f"depth: the buoy's body is solved in deep water, got "
+                                 f"{depth:g} m; drop --depth with --device buoy")
+    if width is not None:
+        width = check_positive("width", width)
+    if rated_power is not None:
+        rated_power = check_positive("rated-power", rated_power)
+    if scatter is not None and timeseries is not None:
+        raise ParameterError("scatter, timeseries: give the site as one of them")
+    if rated_power is not None and scatter is None and timeseries is None:
+        raise ParameterError("rated-power: the capacity factor needs a site: give --scatter "
+                             "or --timeseries")
+    from .. import fileio
+
+    for path, flag, sfx in ((netcdf, "netcdf", ".nc"), (csv, "csv", ".csv")):
+        if path is not None:
+            fileio.check_target(path, flag, (sfx,))
+    if zarr is not None:
+        _check_zarr(zarr)
+    if workers is not None:
+        workers = check_int("workers", workers, 1, 256)
     spec = matrix_spec(hs=hs, te=te, tp=tp, realizations=realizations, waves=waves, seed=seed,
                        spectrum=spectrum, gamma_peak=gamma_peak, cutoff=cutoff,
                        response=response, device=device, horizon=horizon, length=length,
@@ -307,17 +364,17 @@ def power_matrix(*, hs="1:3:3", te=None, tp=None, realizations: int = 3, waves: 
                        damping_coefficient=damping_coefficient, winding=winding,
                        harmonics=harmonics, efficiency=efficiency, torque_limit=torque_limit,
                        body=body, radius=radius, draft=draft, mesh=mesh, hydro=hydro)
-    if depth is not None:
-        depth = check_positive("depth", depth)
-    density = check_range("density", density, 500.0, 2000.0, why="kg/m^3")
-    if width is not None:
-        width = check_positive("width", width)
-    elif spec.device == "buoy":
+    if depth is not None and depth < spec.hm0[-1] / BREAKING:
+        raise ParameterError(f"depth: expected at least Hm0 / {BREAKING:g} = "
+                             f"{spec.hm0[-1] / BREAKING:.4g} m for the largest Hm0 bin "
+                             f"({spec.hm0[-1]:g} m: waves that high break in shallower "
+                             f"water), got {depth:g} m")
+    if width is None and spec.device == "buoy":
         width = spec.width  # the body's diameter (None for a mesh or a dataset)
-    if rated_power is not None:
-        rated_power = check_positive("rated-power", rated_power)
-    if scatter is not None and timeseries is not None:
-        raise ParameterError("scatter, timeseries: give the site as one of them")
+    check_size(spec, workers, scheduler)
+    if scheduler is None:
+        workers = workers_for(spec, workers)
+    check_bins(spec)
     frequency, outside = None, None
     pk = spec.period_kind
     if scatter is not None:
@@ -327,21 +384,12 @@ def power_matrix(*, hs="1:3:3", te=None, tp=None, realizations: int = 3, waves: 
         counts, out = bin_series(hs_t, per_t, bin_edges(spec.hm0), bin_edges(spec.period))
         frequency = counts / hs_t.size
         outside = {"sea_states": out, "frequency": out / hs_t.size} if out else None
-    if rated_power is not None and frequency is None:
-        raise ParameterError("rated-power: the capacity factor needs a site: give --scatter "
-                             "or --timeseries")
-    for path, flag, sfx in ((netcdf, "netcdf", ".nc"), (csv, "csv", ".csv")):
-        if path is not None and not str(path).endswith(sfx):
-            raise ParameterError(f"{flag}: expected a file name ending in {sfx}, got "
-                                 f"{str(path)!r:.60}")
     t0 = time.monotonic()
     run = run_spec(spec, store, workers=workers, scheduler=scheduler, overwrite=overwrite,
                    command=command, progress=progress)
     ds, annual = matrix_dataset(run.dataset, spec, depth=depth, density=density, width=width,
                                 frequency=frequency, outside=outside, rated_power=rated_power)
     seconds = time.monotonic() - t0
-    from .. import fileio
-
     if netcdf is not None:
         fileio.write_dataset(ds, netcdf)
     if zarr is not None:
@@ -355,9 +403,30 @@ def power_matrix(*, hs="1:3:3", te=None, tp=None, realizations: int = 3, waves: 
 _EXPORT = "parapend power matrix dataset"
 
 
+def _check_zarr(path):
+    """The ``--zarr`` destination, checked before the work: a directory that can be created
+    beside, and only an earlier export of a power matrix replaced (never a ``--store``,
+    whose raw results it would destroy, nor any other directory or file)."""
+    import json
+    from pathlib import Path
+
+    from .. import fileio
+
+    path = fileio.check_target(path, "zarr", directory=True)
+    if path.exists() or path.is_symlink():
+        try:
+            attrs = json.loads((path / "zarr.json").read_text())["attributes"]
+            ours = attrs.get("export") == _EXPORT
+        except (OSError, ValueError, KeyError, TypeError):
+            ours = False
+        if not ours or path.is_symlink():
+            raise ParameterError(f"zarr: {str(path)!r} exists and is not an export of a power "
+                                 "matrix (parapend replaces only those); choose another name")
+    return Path(path)
+
+
 def _write_zarr(ds, path) -> None:
     """The full Dataset as a Zarr 3 store written beside, then moved in (atomic rename)."""
-    import json
     import os
     import shutil
     import tempfile
@@ -365,18 +434,7 @@ def _write_zarr(ds, path) -> None:
 
     from ..errors import OutputError
 
-    path = Path(path)
-    if path.exists():
-        # only an earlier export of a power matrix is replaced (never a --store, whose raw
-        # results it would destroy, nor any other directory)
-        try:
-            attrs = json.loads((path / "zarr.json").read_text())["attributes"]
-            ours = attrs.get("export") == _EXPORT
-        except (OSError, ValueError, KeyError, TypeError):
-            ours = False
-        if not ours:
-            raise ParameterError(f"zarr: {str(path)!r} exists and is not an export of a power "
-                                 "matrix (parapend replaces only those); choose another name")
+    path = _check_zarr(path)
     tmp = Path(tempfile.mkdtemp(prefix=".parapend-", dir=path.parent if str(path.parent)
                                 else "."))
     try:

@@ -99,11 +99,9 @@ def check_buoy(*, response, gamma, gravity, winding, harmonics, efficiency, mass
         raise ParameterError(f"gravity: the buoy's hydrodynamics use g = 9.81 m/s^2, got "
                              f"{gravity:g}; drop --gravity with --device buoy")
     if efficiency is not None:
-        from ..errors import check_range
+        from . import check_efficiency
 
-        efficiency = check_range("efficiency", efficiency, 0.0, 1.0)
-        if efficiency <= 0:
-            raise ParameterError(f"efficiency: expected a number in (0, 1], got {efficiency}")
+        efficiency = check_efficiency(efficiency)
     if isinstance(winding, str):
         raise ParameterError(f"winding: expected a positive integer with --device buoy (turns "
                              f"per record), got {winding!r:.40}")
@@ -114,6 +112,11 @@ def check_buoy(*, response, gamma, gravity, winding, harmonics, efficiency, mass
                      BUOY["length"] if length is None else length, inertia,
                      BUOY["damping_coefficient"] if damping_coefficient is None
                      else damping_coefficient)
+    # the damping's non-dimensional gamma = c t0 / I is what the solver takes (at most
+    # MAX_GAMMA): checked here, not in every bin (1e300 N m s/rad failed each bin alone)
+    from ..units import Units
+
+    Units(pend.length, pend.mass, 9.81, pend.inertia).gamma(pend.damping_coefficient)
     return pend, winding, harmonics, None if efficiency is None else float(efficiency)
 
 

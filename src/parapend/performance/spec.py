@@ -229,6 +229,14 @@ class MatrixSpec:
                                 "parapend.performance adds the statistics (docs/performance.md)"}
         return xr.Dataset(data, coords=coords, attrs=attrs), enc
 
+    def finished(self, vals: dict) -> np.ndarray:
+        """The points of a computed block the store marks finished: every realization but
+        those whose solve raised (status "error"), so a rerun retries them rather than
+        keeping the failure for good."""
+        from ..maps.spec import _CODE
+
+        return np.asarray(vals["status"]) != _CODE["error"]
+
     # -- one block ---------------------------------------------------------------------------
     def compute_block(self, block: int) -> dict:
         from ..maps.spec import _CODE
