@@ -20,7 +20,7 @@ from .. import limits
 from ..errors import ParameterError, check_int, check_positive, check_range
 from .annual import HOURS_PER_YEAR
 from .resource import bin_edges, energy_flux, record_spectrum, te_over_tp
-from .spec import DEVICES, QUANTITIES, MatrixSpec
+from .spec import DEVICES, QUANTITIES, MatrixSpec, repeat_period
 
 __all__ = ["HOURS_PER_YEAR", "STATISTICS", "MatrixSpec", "matrix_dataset", "matrix_spec",
            "parse_bins", "power_matrix", "to_mhkit"]
@@ -257,7 +257,7 @@ def matrix_dataset(raw, spec: MatrixSpec, *, depth=None, density: float = 1025.0
     te_rec = np.empty_like(j)
     for a, h in enumerate(spec.hm0):
         for b, tp in enumerate(spec.tp):
-            f, s = record_spectrum(h, tp, spec.waves * tp, spectrum=spec.spectrum,
+            f, s = record_spectrum(h, tp, repeat_period(spec.waves, tp), spectrum=spec.spectrum,
                                    gamma_peak=spec.gamma_peak, cutoff=spec.cutoff)
             j[a, b] = energy_flux(f, s, depth=depth, density=density, gravity=spec.gravity)
             te_rec[a, b] = float(np.sum(s / f) / np.sum(s))

@@ -35,9 +35,10 @@ def wave_of(spec, i: int, j: int, r: int):
     """The Wave of bin ``(i, j)``, realization ``r`` (``parapend buoy``'s record builder on
     the prescribed device's arguments) and its description."""
     from ..hydro.api import _irregular_wave
+    from .spec import repeat_period
 
     tp = spec.tp[j]
-    return _irregular_wave(spec.hm0[i], tp, spec.spectrum, spec.gamma_peak, spec.waves * tp,
+    return _irregular_wave(spec.hm0[i], tp, spec.spectrum, spec.gamma_peak, repeat_period(spec.waves, tp),
                            int(spec.seeds[r]), spec.cutoff, None, 0.1, _units(spec))
 
 
