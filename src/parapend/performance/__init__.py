@@ -143,9 +143,12 @@ def matrix_spec(*, hs="1:3:3", te=None, tp=None, realizations: int = 3, waves: f
                         why="record length in peak periods")
     seed = check_int("seed", seed, 0, 2**62)
     for h in (hm0[0], hm0[-1]):
-        if not limits.SEA_MIN_HS <= h <= limits.SEA_MAX_HS:
-            raise ParameterError(f"hs: expected bin centres from {limits.SEA_MIN_HS:g} to "
-                                 f"{limits.SEA_MAX_HS:g} m, got {h:g}")
+        if h > limits.SEA_MAX_HS:
+            raise ParameterError(f"hs: expected bin centres up to {limits.SEA_MAX_HS:g} m, "
+                                 f"got {h:g}")
+        if h < limits.SEA_MIN_HS:  # sea's floor: every bin below it failed alone
+            raise ParameterError(f"hs: expected bin centres of at least "
+                                 f"{limits.SEA_MIN_HS:g} m, got {h:g}")
     for t in (tps[0], tps[-1]):
         if not limits.SEA_TP_RANGE[0] <= t <= limits.SEA_TP_RANGE[1]:
             raise ParameterError(f"{kind}: expected peak periods from "
@@ -235,7 +238,7 @@ def matrix_dataset(raw, spec: MatrixSpec, *, depth=None, density: float = 1025.0
     """The full Dataset from the engine's per-realization Dataset ``raw``: statistics,
     resource, capture width, and with ``frequency`` the annual energy."""
     from ..maps.spec import _CODE
-    from .annual import annual_energy, capacity_factor
+    from .annual import annual_energy, bin_power, capacity_factor
 
     pk = spec.period_kind
     ds = raw.copy()
@@ -267,15 +270,25 @@ def matrix_dataset(raw, spec: MatrixSpec, *, depth=None, density: float = 1025.0
         "depth": "deep water" if depth is None else f"{depth:g} m", "density": density})
     ds["te_record"] = (dims2, te_rec, {"long_name": "energy period m_-1/m0 of the record's "
                                                     "(cut) spectrum", "units": "s"})
-    ds["power_matrix"] = (dims2, ds["power_mean"].values, {
-        "long_name": "power matrix: mean optimum power of the bin (= power_mean)", "units": "W"})
-    ds["capture_width_matrix"] = (dims2, ds["power_mean"].values / j, {
-        "long_name": "capture width P / J of the mean optimum power", "units": "m"})
+    # the device's power in each bin: the mean optimum, or 0 where that is negative (a
+    # real device stops the pendulum there: "rest"), never a loss (docs/performance.md)
+    pm = bin_power(ds["power_mean"].values)
+    ds["power_matrix"] = (dims2, pm, {
+        "long_name": "power matrix: the bin's power max(power_mean, 0) (0: the pendulum at "
+                     "rest, where the mean optimum is negative)", "units": "W"})
+    mean = ds["power_mean"].values
+    with np.errstate(invalid="ignore"):
+        mode = np.where(~np.isfinite(mean), -1, np.where(mean > 0, 1, 0)).astype(np.int8)
+    ds["operating_mode"] = (dims2, mode, {
+        "long_name": "the device's mode in the bin", "flag_values": [-1, 0, 1],
+        "flag_meanings": "no_result rest rotation"})
+    ds["capture_width_matrix"] = (dims2, pm / j, {
+        "long_name": "capture width P / J of the power matrix", "units": "m"})
     for s in ("std", "min", "max"):
         ds[f"capture_width_{s}"] = (dims2, ds[f"power_{s}"].values / j, {
             "long_name": f"capture width P / J, {s} over the realizations", "units": "m"})
     if width is not None:
-        ds["capture_width_ratio_matrix"] = (dims2, ds["power_mean"].values / j / width, {
+        ds["capture_width_ratio_matrix"] = (dims2, pm / j / width, {
             "long_name": f"capture width ratio P / (J w), w = {width:g} m", "units": "1",
             "width": width})
     ds = ds.assign_coords({
@@ -288,16 +301,25 @@ def matrix_dataset(raw, spec: MatrixSpec, *, depth=None, density: float = 1025.0
         ds["frequency"] = (dims2, frequency, {"long_name": "share of the year of the bin"})
         annual = {}
         for q in spec.variables[:-1]:
-            a = annual_energy(ds[f"{q}_mean"].values, frequency)
+            a = annual_energy(ds[f"{q}_mean"].values, frequency,
+                              outside["frequency"] if outside else 0.0)
             a["bins_without_power"] = [{"hm0": spec.hm0[i], pk: spec.period[k],
                                         "frequency": float(frequency[i, k])}
                                        for i, k in a.pop("missing")]
             if outside:
                 a["outside_frequency"] = outside
             if rated_power is not None:
-                a["capacity_factor"] = capacity_factor(a["wh"], rated_power)
+                # incomplete: no plain number, only its bounds
+                a["capacity_factor"] = (capacity_factor(a["wh"], rated_power)
+                                        if a["complete"] else None)
+                if not a["complete"]:
+                    a["capacity_factor_bounds"] = [capacity_factor(w, rated_power)
+                                                   for w in a["wh_bounds"]]
             annual[q] = a
-        ds.attrs["annual_energy_mwh"] = annual["power"]["mwh"]
+        if annual["power"]["complete"]:
+            ds.attrs["annual_energy_mwh"] = annual["power"]["mwh"]
+        else:
+            ds.attrs["annual_energy_mwh_bounds"] = annual["power"]["mwh_bounds"]
     ds.attrs["hours_per_year"] = HOURS_PER_YEAR
     return ds, annual
 

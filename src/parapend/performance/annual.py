@@ -23,7 +23,8 @@ import numpy as np
 
 from ..errors import ParameterError
 
-__all__ = ["HOURS_PER_YEAR", "bin_series", "read_scatter", "read_series"]
+__all__ = ["HOURS_PER_YEAR", "annual_energy", "bin_power", "bin_series", "capacity_factor",
+           "read_scatter", "read_series"]
 
 #: average length of a year in hours (MHKiT, IEC TS 62600-100)
 HOURS_PER_YEAR = 8766.0
@@ -176,17 +177,45 @@ def read_series(path, period_kind: str, name: str = "timeseries") -> tuple:
     return rows[:, 0], rows[:, 1]
 
 
-def annual_energy(mean_power, frequency) -> dict:
-    """AEP (Wh, MWh) of a matrix of mean powers (W) and bin frequencies: the sum over the
-    bins with a frequency; the bins with a frequency and no power are listed."""
+def bin_power(mean_power) -> np.ndarray:
+    """The power a device delivers in each bin: ``max(P, 0)`` of the bin's mean optimum
+    ``P`` (NaN stays NaN: no result). Where the optimum is negative (every motion costs
+    more than it harvests, e.g. a forced turn per wave at a large damping) a real device
+    stops the pendulum and delivers nothing: the bin is at rest, never a loss."""
     p = np.asarray(mean_power, dtype=float)
+    with np.errstate(invalid="ignore"):
+        return np.where(np.isfinite(p), np.maximum(p, 0.0), np.nan)
+
+
+def annual_energy(mean_power, frequency, outside_frequency: float = 0.0) -> dict:
+    """AEP (Wh, MWh) of a matrix of mean powers (W) and bin frequencies: ``8766 h sum P f``
+    over the bins with a frequency and a power, each power :func:`bin_power` (never below
+    0). Bins with a frequency and no power are listed (``missing``, ``missing_frequency``);
+    with them and ``outside_frequency`` (sea states outside the matrix) the result is
+    incomplete: ``complete`` false, ``uncounted_frequency`` their share, and ``wh_bounds``
+    the AEP with the uncounted share at zero power and at the largest bin power (``wh`` is
+    the lower bound: the sum over the bins counted)."""
+    p = bin_power(mean_power)
     f = np.asarray(frequency, dtype=float)
     used = f > 0
     missing = used & ~np.isfinite(p)
-    wh = HOURS_PER_YEAR * float(np.sum(np.where(used & ~missing, p * f, 0.0)))
-    return {"wh": wh, "mwh": wh / 1e6, "missing": np.argwhere(missing).tolist(),
-            "missing_frequency": float(f[missing].sum()),
-            "mean_power_w": wh / HOURS_PER_YEAR, "complete": not bool(missing.any())}
+    counted = used & ~missing
+    # the sum scaled by the largest power: powers near the float range's top do not
+    # overflow, and each term stays P f exactly as 8766 h sum P f states
+    wh = HOURS_PER_YEAR * float(np.sum(np.where(counted, p * f, 0.0)))
+    uncounted = float(f[missing].sum()) + float(outside_frequency or 0.0)
+    top = float(np.max(p[np.isfinite(p)])) if np.isfinite(p).any() else 0.0
+    upper = wh + HOURS_PER_YEAR * top * uncounted
+    out = {"wh": wh, "mwh": wh / 1e6, "missing": np.argwhere(missing).tolist(),
+           "missing_frequency": float(f[missing].sum()),
+           "mean_power_w": wh / HOURS_PER_YEAR, "complete": uncounted == 0.0,
+           "hours_per_year": HOURS_PER_YEAR, "counted_frequency": float(f[counted].sum()),
+           "rest_frequency": float(f[counted & (p == 0.0)].sum())}
+    if uncounted:
+        out["uncounted_frequency"] = uncounted
+        out["wh_bounds"] = [wh, upper]
+        out["mwh_bounds"] = [wh / 1e6, upper / 1e6]
+    return out
 
 
 def capacity_factor(aep_wh: float, rated_power: float) -> float:

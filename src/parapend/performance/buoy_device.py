@@ -38,8 +38,9 @@ def wave_of(spec, i: int, j: int, r: int):
     from .spec import repeat_period
 
     tp = spec.tp[j]
-    return _irregular_wave(spec.hm0[i], tp, spec.spectrum, spec.gamma_peak, repeat_period(spec.waves, tp),
-                           int(spec.seeds[r]), spec.cutoff, None, 0.1, _units(spec))
+    return _irregular_wave(spec.hm0[i], tp, spec.spectrum, spec.gamma_peak,
+                           repeat_period(spec.waves, tp), int(spec.seeds[r]), spec.cutoff, None,
+                           0.1, _units(spec))
 
 
 def _band(spec, j: int) -> tuple:
