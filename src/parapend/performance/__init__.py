@@ -12,6 +12,7 @@ energy (:mod:`.annual`); :mod:`.figures` draws the three figures.
 from __future__ import annotations
 
 import math
+import os
 import time
 
 import numpy as np
@@ -19,22 +20,11 @@ import numpy as np
 from .. import limits
 from ..errors import ParameterError, check_int, check_positive, check_range
 from .annual import HOURS_PER_YEAR
-from .resource import bin_edges, energy_flux, record_spectrum, te_over_tp
-from .spec import DEVICES, QUANTITIES, MatrixSpec, repeat_period
+from .resource import bin_edges, energy_flux, record_spectrum, repeat_period, te_over_tp
+from .spec import DEVICES, QUANTITIES, MatrixSpec
 
 __all__ = ["HOURS_PER_YEAR", "STATISTICS", "MatrixSpec", "matrix_dataset", "matrix_spec",
            "parse_bins", "power_matrix", "to_mhkit"]
-
-#: the lowest power take-off efficiency a matrix takes: below it the motoring power p / eta
-#: of a record overflows (a subnormal eta gave NaN bins); 1e-6 is far below any machine
-MIN_EFFICIENCY = 1e-6
-
-
-def check_efficiency(value) -> float:
-    """A power take-off efficiency in ``[MIN_EFFICIENCY, 1]`` (one line naming it)."""
-    return check_range("efficiency", value, MIN_EFFICIENCY, 1.0,
-                       why="fraction of the power converted")
-
 
 #: the statistics of each bin over its realizations (IEC TS 62600-100; std with ddof 0)
 STATISTICS = ("mean", "std", "min", "max", "count")
@@ -111,7 +101,7 @@ def matrix_spec(*, hs="1:3:3", te=None, tp=None, realizations: int = 3, waves: f
     from ..seas import _check_sea, check_response, read_response
     from ..units import Units
 
-    if device not in DEVICES:
+    if not isinstance(device, str) or device not in DEVICES:
         raise ParameterError(f"device: expected one of {', '.join(DEVICES)}, got "
                              f"{device!r:.60}")
     if device != "buoy":
@@ -169,10 +159,19 @@ def matrix_spec(*, hs="1:3:3", te=None, tp=None, realizations: int = 3, waves: f
         gamma = units.gamma(damping_coefficient)
     gamma = check_range("gamma", 0.01 if gamma is None else gamma, 0.0, limits.MAX_GAMMA)
     if efficiency is not None:
+        from .check import check_efficiency
+
         efficiency = check_efficiency(efficiency)
     if response is not None:
-        rf, rg, rp = (read_response(response) if isinstance(response, str)
-                      else check_response(*response))
+        if isinstance(response, (str, os.PathLike)):
+            rf, rg, rp = read_response(response)
+        else:
+            try:
+                rf, rg, rp = response
+            except (TypeError, ValueError):
+                raise ParameterError("response: expected a CSV path or three arrays (f, gain, "
+                                     "phase)") from None
+            rf, rg, rp = check_response(rf, rg, rp)
         response = tuple(tuple(float(v) for v in c) for c in (rf, rg, rp))
     if harmonics is not None:
         harmonics = check_int("harmonics", harmonics, 1, limits.SEA_MAX_HARMONICS // 2)
@@ -352,6 +351,9 @@ def power_matrix(*, hs="1:3:3", te=None, tp=None, realizations: int = 3, waves: 
     if depth is not None:
         depth = check_depth(depth)
     density = check_range("density", density, 500.0, 2000.0, why="kg/m^3")
+    if not isinstance(device, str) or device not in DEVICES:
+        raise ParameterError(f"device: expected one of {', '.join(DEVICES)}, got "
+                             f"{device!r:.60}")
     if device == "buoy":
         # the body is solved at 1025 kg/m^3 in deep water (parapend buoy): a flux at another
         # density or depth would not be the body's sea (capture widths off by their ratio)

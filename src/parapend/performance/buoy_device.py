@@ -35,7 +35,7 @@ def wave_of(spec, i: int, j: int, r: int):
     """The Wave of bin ``(i, j)``, realization ``r`` (``parapend buoy``'s record builder on
     the prescribed device's arguments) and its description."""
     from ..hydro.api import _irregular_wave
-    from .spec import repeat_period
+    from .resource import repeat_period
 
     tp = spec.tp[j]
     return _irregular_wave(spec.hm0[i], tp, spec.spectrum, spec.gamma_peak,
@@ -101,7 +101,7 @@ def check_buoy(*, response, gamma, gravity, winding, harmonics, efficiency, mass
         raise ParameterError(f"gravity: the buoy's hydrodynamics use g = 9.81 m/s^2, got "
                              f"{gravity:g}; drop --gravity with --device buoy")
     if efficiency is not None:
-        from . import check_efficiency
+        from .check import check_efficiency
 
         efficiency = check_efficiency(efficiency)
     if isinstance(winding, str):

@@ -13,10 +13,10 @@ from __future__ import annotations
 import math
 import os
 
-from ..errors import ParameterError
+from ..errors import ParameterError, check_range
 
-__all__ = ["MAX_BINS", "MAX_SOLVES", "WORKER_BYTES", "check_bins", "check_size",
-           "memory_available", "workers_for"]
+__all__ = ["MAX_BINS", "MAX_SOLVES", "MIN_EFFICIENCY", "WORKER_BYTES", "check_bins",
+           "check_efficiency", "check_size", "memory_available", "workers_for"]
 
 #: most bins of one matrix (Hm0 x period): the store holds a chunk per bin and variable, and
 #: the engine a task per bin (10 000 bins: about 0.3 GB and 10 s of bookkeeping)
@@ -33,6 +33,17 @@ _SOLVE_BYTES = 128
 WORKER_BYTES = 300 << 20
 
 
+#: the lowest power take-off efficiency a matrix takes: below it the motoring power p / eta
+#: of a record overflows (a subnormal eta gave NaN bins); 1e-6 is far below any machine
+MIN_EFFICIENCY = 1e-6
+
+
+def check_efficiency(value) -> float:
+    """A power take-off efficiency in ``[MIN_EFFICIENCY, 1]`` (one line naming it)."""
+    return check_range("efficiency", value, MIN_EFFICIENCY, 1.0,
+                       why="fraction of the power converted")
+
+
 def _where(spec, i: int, j: int, r: int | None = None) -> str:
     pk = spec.period_kind
     return (f"the bin Hm0 {spec.hm0[i]:g} m, {pk} {spec.period[j]:g} s"
@@ -40,16 +51,18 @@ def _where(spec, i: int, j: int, r: int | None = None) -> str:
 
 
 def _units(spec):
+    """The pendulum's units (the buoy's at g = 9.81, as its spec holds)."""
     from ..units import Units
 
-    return Units(spec.length, spec.mass, spec.gravity, spec.inertia)
+    return Units(spec.length, spec.mass, 9.81 if spec.device == "buoy" else spec.gravity,
+                 spec.inertia)
 
 
 def _record(spec, units, i: int, j: int, r: int):
     """The excitation of bin ``(i, j)``, realization ``r``, as ``sea`` builds it; its
     ParameterError reworded to name the bin and the options that set it."""
     from ..seas import sea_record
-    from .spec import repeat_period
+    from .resource import repeat_period
 
     tp = spec.tp[j]
     response = (None if spec.response is None else tuple(spec.response))
@@ -76,11 +89,7 @@ def check_bins(spec) -> None:
     from .. import limits
     from ..irregular import AUTO_FRACTIONS, HARMONICS_PER_WAVE
 
-    units = _units(spec) if spec.device != "buoy" else None
-    if units is None:
-        from .buoy_device import _units as buoy_units
-
-        units = buoy_units(spec)
+    units = _units(spec)
     cap = limits.MAX_AMPLITUDE * (1.0 + 1e-12)
     top = len(spec.hm0) - 1
     for j in range(len(spec.period)):

@@ -44,18 +44,6 @@ _BUOY_FIELDS = ("body", "radius", "draft", "mesh", "hydro", "digest", "damping_c
                 "band", "width")
 
 
-def repeat_period(waves: float, tp: float) -> float:
-    """``waves * tp`` (s), one ulp lower where the product's rounding would put the record
-    above ``parapend sea``'s longest (``waves = 400`` at some Tp read back as 400.0000001
-    peak periods and every bin was refused)."""
-    from .. import limits
-
-    rp = waves * tp
-    while rp / tp > limits.SEA_WAVES_RANGE[1]:
-        rp = math.nextafter(rp, 0.0)
-    return rp
-
-
 @dataclasses.dataclass(frozen=True)
 class MatrixSpec:
     """The bins and everything a bin's solve depends on (its identity in the store)."""
@@ -174,9 +162,11 @@ class MatrixSpec:
 
     def sea_kwargs(self, i: int, j: int, r: int) -> dict:
         """The arguments of :func:`parapend.irregular.sea` for bin (i, j), realization r."""
+        from .resource import repeat_period as _repeat
+
         tp = self.tp[j]
         kw = {"hs": self.hm0[i], "tp": tp, "spectrum": self.spectrum,
-              "repeat_period": repeat_period(self.waves, tp), "seed": int(self.seeds[r]),
+              "repeat_period": _repeat(self.waves, tp), "seed": int(self.seeds[r]),
               "cutoff": self.cutoff, "length": self.length, "mass": self.mass,
               "inertia": self.inertia, "gravity": self.gravity, "gamma": self.gamma,
               "winding": self.winding, "harmonics": self.harmonics}
