@@ -13,6 +13,7 @@ from __future__ import annotations
 import json
 import math
 import os
+import re
 from pathlib import Path
 
 import numpy as np
@@ -381,3 +382,38 @@ def test_the_zarr_export_is_checked_before_and_written_after(tmp_path, monkeypat
     capsys.readouterr()
     assert main(_argv(["--zarr", str(store)])) == 2
     assert "zarr: " in capsys.readouterr().err
+
+
+def test_long_work_is_announced_before_it_starts(caplog, no_solve):
+    """300 solves of 50-wave records on 2 processes: about 3 s each, 8 minutes."""
+    import logging
+
+    with caplog.at_level(logging.INFO, logger="parapend.performance"), \
+            pytest.raises(AssertionError, match="the engine ran"):
+        parapend.power_matrix(hs="0.5:5:10", te="4:13:10", workers=2)
+    (msg,) = [r.getMessage() for r in caplog.records if r.name == "parapend.performance"]
+    assert msg.startswith("power matrix: 100 bins x 3 realizations = 300 solves of 50-wave "
+                          "records on 2 processes: roughly 8 minutes")
+
+
+def test_the_buoys_flux_is_of_the_water_its_body_was_solved_in(monkeypatch):
+    """A --hydro dataset's own rho and depth make the flux (it was 1025 kg/m^3 in deep
+    water whatever the dataset said); a g other than the pendulum's, or a rho no water has,
+    is refused."""
+    from types import SimpleNamespace
+
+    from parapend.performance import buoy_device
+
+    spec = SimpleNamespace(hydro="body.nc")
+    for (rho, g, depth), want in (((1000.0, 9.81, math.inf), (1000.0, None)),
+                                  ((1025.0, 9.81, 30.0), (1025.0, 30.0))):
+        h = SimpleNamespace(rho=rho, g=g, water_depth=depth)
+        monkeypatch.setattr(buoy_device, "body_hydro", lambda s, h=h: (h, None))
+        assert buoy_device.water_of(spec) == want
+    for (rho, g), needle in (((1e-300, 9.81), "rho = 1e-300 kg/m^3"),
+                             ((1025.0, 9.80665), "g = 9.80665 m/s^2")):
+        h = SimpleNamespace(rho=rho, g=g, water_depth=math.inf)
+        monkeypatch.setattr(buoy_device, "body_hydro", lambda s, h=h: (h, None))
+        with pytest.raises(ParameterError,
+                           match=f"hydro: the dataset of body.nc .*{re.escape(needle)}"):
+            buoy_device.water_of(spec)

@@ -3,6 +3,8 @@ energy (docs/performance.md). A thin shell over :mod:`parapend.performance`."""
 
 from __future__ import annotations
 
+import contextlib
+import logging
 import shlex
 import sys
 
@@ -119,6 +121,34 @@ def add_parsers(sub) -> None:
                    help="print one JSON object (annual energy, matrix, statistics)")
 
 
+class _Announce(logging.Handler):
+    """Prints the library's estimate of long work (``parapend.performance``'s INFO records)
+    on stderr, one line, before the work starts; standard output stays the report."""
+
+    def emit(self, record: logging.LogRecord) -> None:
+        stream = sys.stderr or sys.__stderr__
+        try:
+            stream.write(f"parapend: {record.getMessage()}\n")
+            stream.flush()
+        except (OSError, ValueError, AttributeError):
+            pass
+
+
+@contextlib.contextmanager
+def _announce():
+    logger = logging.getLogger("parapend.performance")
+    handler = _Announce(logging.INFO)
+    level = logger.level
+    logger.addHandler(handler)
+    if logger.getEffectiveLevel() > logging.INFO:
+        logger.setLevel(logging.INFO)
+    try:
+        yield
+    finally:
+        logger.removeHandler(handler)
+        logger.setLevel(level)
+
+
 def _cmd_power_matrix(a) -> dict | str:
     from ..performance import figures
 
@@ -126,8 +156,9 @@ def _cmd_power_matrix(a) -> dict | str:
         for s in ("matrix", "capture-width", "scatter"):
             _check_output(f"{a.plot}-{s}.png", "--plot", FIGURE_SUFFIXES)
     argv = sys.argv[1:] if sys.argv and sys.argv[0] else []
-    rec = _run(a, command="parapend " + " ".join(shlex.quote(x) for x in argv),
-               progress=_EtaProgress("power-matrix"))
+    with _announce():
+        rec = _run(a, command="parapend " + " ".join(shlex.quote(x) for x in argv),
+                   progress=_EtaProgress("power-matrix"))
     ds = rec._dataset
     drawn = []
     if a.plot:

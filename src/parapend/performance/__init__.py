@@ -11,6 +11,7 @@ energy (:mod:`.annual`); :mod:`.figures` draws the three figures.
 
 from __future__ import annotations
 
+import logging
 import math
 import os
 import time
@@ -25,6 +26,8 @@ from .spec import DEVICES, QUANTITIES, MatrixSpec
 
 __all__ = ["HOURS_PER_YEAR", "STATISTICS", "MatrixSpec", "matrix_dataset", "matrix_spec",
            "parse_bins", "power_matrix", "to_mhkit"]
+
+log = logging.getLogger(__name__)
 
 #: the statistics of each bin over its realizations (IEC TS 62600-100; std with ddof 0)
 STATISTICS = ("mean", "std", "min", "max", "count")
@@ -323,6 +326,17 @@ def matrix_dataset(raw, spec: MatrixSpec, *, depth=None, density: float = 1025.0
     return ds, annual
 
 
+#: work estimated above this many seconds is announced before it starts
+_ANNOUNCE_SECONDS = 120.0
+
+
+def _duration(seconds: float) -> str:
+    for unit, size in (("days", 86400.0), ("hours", 3600.0), ("minutes", 60.0)):
+        if seconds >= 2 * size:
+            return f"{seconds / size:.0f} {unit}"
+    return f"{seconds:.0f} s"
+
+
 def to_mhkit(da):
     """A matrix variable with MHKiT's dimension names (``x_centers``, ``y_centers``), for
     ``mhkit.wave.performance`` (e.g. ``mean_annual_energy_production_matrix``)."""
@@ -393,9 +407,22 @@ def power_matrix(*, hs="1:3:3", te=None, tp=None, realizations: int = 3, waves: 
                              f"{spec.hm0[-1] / BREAKING:.4g} m for the largest Hm0 bin "
                              f"({spec.hm0[-1]:g} m: waves that high break in shallower "
                              f"water), got {depth:g} m")
-    if width is None and spec.device == "buoy":
-        width = spec.width  # the body's diameter (None for a mesh or a dataset)
-    check_size(spec, workers, scheduler)
+    if spec.device == "buoy":
+        from .buoy_device import water_of
+
+        # the flux of the water the body was solved in (a --hydro dataset's own rho and
+        # depth), never another: the capture widths would be off by the ratio
+        density, depth = water_of(spec)
+        if width is None:
+            width = spec.width  # the body's diameter (None for a mesh or a dataset)
+    est = check_size(spec, workers, scheduler)
+    if est["seconds"] is not None and est["seconds"] > _ANNOUNCE_SECONDS:
+        log.info("power matrix: %d bins x %d realizations = %d solves of %g-wave records on "
+                 "%s: roughly %s (about 3 s a 50-wave solve; the progress bar gives the rate)",
+                 est["bins"], spec.realizations, est["solves"], spec.waves,
+                 f"{est['processes']} processes" if est["processes"] else "the cluster",
+                 _duration(est["seconds"]) if est["processes"] else
+                 _duration(est["seconds"] * 1.0) + " of one core")
     if scheduler is None:
         workers = workers_for(spec, workers)
     check_bins(spec)

@@ -140,6 +140,23 @@ def prepare(spec):
     return width
 
 
+def water_of(spec) -> tuple:
+    """``(density, depth)`` of the water the body was solved in (``depth`` None: deep), for
+    the waves' energy flux: a ``--hydro`` dataset's own ``rho`` and depth, 1025 kg/m^3 in
+    deep water for a body solved here. A dataset's ``g`` must be the pendulum's 9.81 m/s^2
+    and its ``rho`` a water's (a rho of 1e-300 gave a capture width of 5.6e302 m)."""
+    h, _ = body_hydro(spec)
+    rho, g, depth = float(h.rho), float(h.g), float(h.water_depth)
+    where = f" of {spec.hydro}" if spec.hydro is not None else ""
+    if not abs(g - 9.81) <= 1e-9 * 9.81:
+        raise ParameterError(f"hydro: the dataset{where} is solved at g = {g:g} m/s^2; the "
+                             "buoy's pendulum and waves use 9.81: solve it at g = 9.81")
+    if not 500.0 <= rho <= 2000.0:
+        raise ParameterError(f"hydro: the dataset{where} has rho = {rho:g} kg/m^3; expected "
+                             "a water's density, 500 to 2000 kg/m^3")
+    return rho, (None if math.isinf(depth) else depth)
+
+
 def band(spec) -> tuple:
     """``(w_lo, w_hi)`` of every period bin together: the BEM's range (rad/s)."""
     bands = [_band(spec, j) for j in range(len(spec.period))]
