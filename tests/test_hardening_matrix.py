@@ -179,6 +179,9 @@ def test_memory_estimate_names_the_workers_that_fit():
         check_size(spec, workers=256, available=2 << 30)
     est = check_size(spec, workers=6, available=2 << 30)
     assert est["processes"] == 6 and est["bins"] == 100 and est["memory_bytes"] <= 2 << 30
+    # the default is not refused: it starts as many processes as the memory holds
+    est = check_size(spec, workers=None, available=2 << 30)
+    assert est["processes"] == min(6, os.cpu_count() or 1)
     assert MAX_BINS == 10_000
 
 
@@ -344,8 +347,8 @@ def test_a_large_damping_rests_every_bin_and_the_aep_is_zero(tmp_path, capsys):
     """--gamma 2: every bin's optimum is a forced turn per wave (negative); the device rests,
     so the AEP is 0 Wh (it printed -1478 Wh/yr), complete."""
     (tmp_path / "s.csv").write_text("hs,te,frequency\n1,6,0.5\n2,7,0.5\n")
-    assert main(_argv(["--gamma", "2", "--scatter", str(tmp_path / "s.csv"),
-                       "--json"])) == 0
+    assert main(_argv(["--gamma", "2", "--scatter", str(tmp_path / "s.csv")])
+                + ["--json"]) == 0
     out = json.loads(capsys.readouterr().out)
     means = np.array(out["statistics"]["power"]["mean"], dtype=float)
     assert np.all(means < 0)
@@ -359,7 +362,7 @@ def test_the_old_failing_inputs_neighbours_give_a_result(capsys):
     """One decade inside the refusals the command runs and every bin converges or rests:
     Hm0 at sea's floor, g = 0.01."""
     for extra in (["--hs", "1e-6,2e-6"], ["--gravity", "1e-2"]):
-        assert main(_argv(extra + ["--json"])) == 0
+        assert main(_argv(extra) + ["--json"]) == 0
         out = json.loads(capsys.readouterr().out)
         assert out["failed_solves"] == 0
         assert all(m in ("rotation", "rest") for row in out["operating_mode"] for m in row)

@@ -358,7 +358,7 @@ def power_matrix(*, hs="1:3:3", te=None, tp=None, realizations: int = 3, waves: 
     text and docs/performance.md. Returns ``(dataset, annual, run)``."""
     from ..maps.run import run_spec
     from .annual import bin_series, read_scatter, read_series
-    from .check import check_bins, check_size, workers_for
+    from .check import check_bins, check_size
 
     # everything checked before any bin runs (and, for the buoy, before its BEM): the plain
     # options, the output paths, the bins' sizes, every bin's record, the site's file
@@ -424,7 +424,7 @@ def power_matrix(*, hs="1:3:3", te=None, tp=None, realizations: int = 3, waves: 
                  _duration(est["seconds"]) if est["processes"] else
                  _duration(est["seconds"] * 1.0) + " of one core")
     if scheduler is None:
-        workers = workers_for(spec, workers)
+        workers = est["processes"]
     check_bins(spec)
     frequency, outside = None, None
     pk = spec.period_kind

@@ -141,7 +141,9 @@ def check_size(spec, workers=None, scheduler=None, available=None) -> dict:
     """The size of the matrix before anything is allocated or started: refuses in one line
     (naming the option and the largest value that fits) more than :data:`MAX_BINS` bins,
     more than :data:`MAX_SOLVES` solves, or what needs more memory than is available
-    (``available`` bytes; default :func:`memory_available`). Returns the estimate."""
+    (``available`` bytes; default :func:`memory_available`). Returns the estimate, with
+    ``processes`` the local processes to start: ``min(workers, bins)``, and by default
+    (``workers`` None) at most as many as the memory holds."""
     nh, npk, r = len(spec.hm0), len(spec.period), spec.realizations
     pk = spec.period_kind
     bins = nh * npk
@@ -157,10 +159,13 @@ def check_size(spec, workers=None, scheduler=None, available=None) -> dict:
             f"{bins} bins x {r} = {solves}; with {bins} bins, --realizations may be at "
             f"most {MAX_SOLVES // bins}")
     procs = 0 if scheduler is not None else workers_for(spec, workers)
-    need = bins * _BIN_BYTES + solves * _SOLVE_BYTES + procs * WORKER_BYTES
+    base = bins * _BIN_BYTES + solves * _SOLVE_BYTES
     have = memory_available() if available is None else available
+    fit = None if have is None else max(0, (have - base) // WORKER_BYTES)
+    if workers is None and fit is not None and procs > max(1, fit):
+        procs = max(1, int(fit))  # the default: as many processes as the memory holds
+    need = base + procs * WORKER_BYTES
     if have is not None and need > have:
-        fit = max(0, (have - bins * _BIN_BYTES - solves * _SOLVE_BYTES) // WORKER_BYTES)
         if fit >= 1 and procs > fit:
             raise ParameterError(
                 f"workers: {procs} processes need about {procs * WORKER_BYTES / 2**30:.3g} GB "
