@@ -420,3 +420,18 @@ def test_the_buoys_flux_is_of_the_water_its_body_was_solved_in(monkeypatch):
         with pytest.raises(ParameterError,
                            match=f"hydro: the dataset of body.nc .*{re.escape(needle)}"):
             buoy_device.water_of(spec)
+
+
+@pytest.mark.parametrize("opt", ["--hydro", "--mesh"])
+def test_a_device_or_fifo_as_the_buoys_file_is_refused_unread(opt, tmp_path, capsys,
+                                                               no_solve):
+    """/dev/zero (or a link to it) was read whole for the store's digest: memory without
+    end; a FIFO blocked for ever."""
+    os.mkfifo(tmp_path / "fifo")
+    (tmp_path / "zero.nc").symlink_to("/dev/zero")
+    for path, kind in ((tmp_path / "fifo", "a FIFO"), (tmp_path / "zero.nc", "a device"),
+                       ("/dev/zero", "a device"), (tmp_path, "a directory")):
+        assert main(_argv(["--device", "buoy", opt, str(path)])) == 2
+        err = capsys.readouterr().err
+        assert len(err.strip().splitlines()) == 1, err
+        assert f"{opt[2:]}: expected a regular file, got {kind}" in err, err

@@ -202,8 +202,12 @@ def _buoy_spec(hm0, period, kind, tps, realizations, waves, seed, spectrum, gamm
 
     pend, winding, harmonics, efficiency = buoy_device.check_buoy(**pendulum)
     body = "cylinder" if body is None else body
-    if body not in ("cylinder", "sphere"):
+    if not isinstance(body, str) or body not in ("cylinder", "sphere"):
         raise ParameterError(f"body: expected cylinder or sphere, got {body!r:.40}")
+    radius = None if radius is None else check_positive("radius", radius)
+    draft = None if draft is None else check_positive("draft", draft)
+    mesh = None if mesh is None else buoy_device.check_file(mesh, "mesh")
+    hydro = None if hydro is None else buoy_device.check_file(hydro, "hydro")
     spec = MatrixSpec(hm0, period, kind, tps, realizations, float(waves), seed, spectrum,
                       float(gamma_peak), float(cutoff), None, float(pend.length),
                       float(pend.mass), float(pend.inertia), 9.81, 0.0, winding, harmonics,

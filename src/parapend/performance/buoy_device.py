@@ -18,8 +18,8 @@ import numpy as np
 from ..defaults import BUOY
 from ..errors import ParameterError, check_int
 
-__all__ = ["band", "body_hydro", "check_buoy", "file_digest", "prepare", "solve_buoy_bin",
-           "wave_of"]
+__all__ = ["band", "body_hydro", "check_buoy", "check_file", "file_digest", "prepare",
+           "solve_buoy_bin", "water_of", "wave_of"]
 
 #: the per-process coefficients, keyed by the body's description in the spec
 _HYDRO: dict = {}
@@ -59,18 +59,45 @@ def _key(spec) -> str:
                  spec.band))
 
 
+def check_file(path, name: str) -> str:
+    """A ``--mesh`` or ``--hydro`` path: a name of a regular file, absolute. A FIFO would
+    block its reader for ever and ``/dev/zero`` (or a link to it) never ends: both are
+    refused here, before the digest or the loader reads a byte."""
+    import os
+    import stat
+
+    if not isinstance(path, (str, os.PathLike)) or not str(path).strip():
+        raise ParameterError(f"{name}: expected a file name, got {path!r:.60}")
+    try:
+        st = os.stat(path)
+    except OSError as exc:
+        raise ParameterError(f"{name}: cannot read {str(path)!r}: "
+                             f"{exc.strerror or exc}") from None
+    if not stat.S_ISREG(st.st_mode):
+        kind = ("a directory" if stat.S_ISDIR(st.st_mode) else
+                "a FIFO (named pipe)" if stat.S_ISFIFO(st.st_mode) else
+                "a device" if stat.S_ISCHR(st.st_mode) or stat.S_ISBLK(st.st_mode) else
+                "not a regular file")
+        raise ParameterError(f"{name}: expected a regular file, got {kind}: {str(path)!r}")
+    return os.path.abspath(path)
+
+
 def file_digest(path) -> str | None:
     """sha256 of a ``--mesh`` or ``--hydro`` file (None without one; a file that cannot be
-    read is left to the loader's own error)."""
+    read is left to the loader's own error), read in blocks of 1 MiB (a 3 GB file was read
+    whole into memory)."""
     if path is None:
         return None
     import hashlib
 
+    h = hashlib.sha256()
     try:
         with open(path, "rb") as fh:
-            return hashlib.sha256(fh.read()).hexdigest()
+            for block in iter(lambda: fh.read(1 << 20), b""):
+                h.update(block)
     except OSError:
         return None
+    return h.hexdigest()
 
 
 def body_hydro(spec):
