@@ -399,6 +399,13 @@ def power_matrix(*, hs="1:3:3", te=None, tp=None, realizations: int = 3, waves: 
         _check_zarr(zarr)
     if workers is not None:
         workers = check_int("workers", workers, 1, 256)
+    # the site's file: its kind and size now (a FIFO or a device refused unread), before a
+    # buoy's BEM; its rows once the bins are known
+    from .annual import _read_rows
+
+    for path, name in ((scatter, "scatter"), (timeseries, "timeseries")):
+        if path is not None:
+            _read_rows(path, name, "of sea states")
     spec = matrix_spec(hs=hs, te=te, tp=tp, realizations=realizations, waves=waves, seed=seed,
                        spectrum=spectrum, gamma_peak=gamma_peak, cutoff=cutoff,
                        response=response, device=device, horizon=horizon, length=length,
