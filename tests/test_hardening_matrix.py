@@ -332,8 +332,10 @@ def test_the_command_reports_rest_bins_and_an_incomplete_aep(tmp_path, monkeypat
     assert a["uncounted_frequency"] == 0.25 and not a["complete"]
     # the JSON's AEP is 8766 h sum P f over the bins it counted
     pm = np.array(out["power_matrix"])
-    freq = np.array([[0.25, 0.25], [0.0, 0.25]])
+    freq = np.array(out["frequency"])
+    assert np.array_equal(freq, [[0.25, 0.25], [0.0, 0.25]])
     assert a["wh"] == pytest.approx(8766.0 * float(np.sum(pm * freq)), rel=1e-15)
+    assert a["counted_frequency"] == float(freq.sum())
     assert main(argv) == 0
     text = capsys.readouterr().out
     assert "optimum 10.96 kWh/yr to 19.72 kWh/yr" in text  # 1.25 W and 2.25 W

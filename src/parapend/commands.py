@@ -891,6 +891,7 @@ def power_matrix(*, hs: str = "1:3:3", te=None, tp=None, realizations: int = 3,
                                      if "capture_width_ratio_matrix" in ds else None),
            "operating_mode": [[{1: "rotation", 0: "rest"}.get(int(v)) for v in row]
                               for row in ds["operating_mode"].values],
+           "frequency": grid("frequency") if "frequency" in ds else None,
            "annual_energy": annual, "hours_per_year": float(ds.attrs["hours_per_year"]),
            # an incomplete AEP is no plain number: its bounds (annual_energy.power)
            "annual_energy_complete": None if annual is None else annual["power"]["complete"],
