@@ -427,13 +427,6 @@ def power_matrix(*, hs="1:3:3", te=None, tp=None, realizations: int = 3, waves: 
         if width is None:
             width = spec.width  # the body's diameter (None for a mesh or a dataset)
     est = check_size(spec, workers, scheduler)
-    if est["seconds"] is not None and est["seconds"] > _ANNOUNCE_SECONDS:
-        log.info("power matrix: %d bins x %d realizations = %d solves of %g-wave records on "
-                 "%s: roughly %s (about 3 s a 50-wave solve; the progress bar gives the rate)",
-                 est["bins"], spec.realizations, est["solves"], spec.waves,
-                 f"{est['processes']} processes" if est["processes"] else "the cluster",
-                 _duration(est["seconds"]) if est["processes"] else
-                 _duration(est["seconds"] * 1.0) + " of one core")
     if scheduler is None:
         workers = est["processes"]
     check_bins(spec)
@@ -446,6 +439,13 @@ def power_matrix(*, hs="1:3:3", te=None, tp=None, realizations: int = 3, waves: 
         counts, out = bin_series(hs_t, per_t, bin_edges(spec.hm0), bin_edges(spec.period))
         frequency = counts / hs_t.size
         outside = {"sea_states": out, "frequency": out / hs_t.size} if out else None
+    # announced once nothing is left to refuse
+    if est["seconds"] is not None and est["seconds"] > _ANNOUNCE_SECONDS:
+        log.info("power matrix: %d bins x %d realizations = %d solves of %g-wave records on "
+                 "%s: roughly %s (about 3 s a 50-wave solve; the progress bar gives the rate)",
+                 est["bins"], spec.realizations, est["solves"], spec.waves,
+                 f"{est['processes']} processes" if est["processes"] else "the cluster",
+                 _duration(est["seconds"]) + ("" if est["processes"] else " of one core"))
     t0 = time.monotonic()
     run = run_spec(spec, store, workers=workers, scheduler=scheduler, overwrite=overwrite,
                    command=command, progress=progress)
