@@ -77,6 +77,9 @@ CASES = [
     (["--harmonics", "1"], "harmonics: expected at least 2 K = 2"),
     (["--gravity", "1e-3"], "hs, cutoff, gravity: the bin Hm0 1 m, te 6 s"),
     (["--gravity", "1e-4"], "gravity: expected a number in [0.001, 1000]"),
+    # long work refused by a bin: the refusal alone, no estimate line before it
+    (["--hs", "0.5:5:100", "--te", "4:13:100", "--gravity", "1e-3"],
+     "hs, cutoff, gravity: the bin Hm0 0.5 m, te 4 s"),
     (["--device", "buoy", "--damping-coefficient", "1e300"], "damping-coefficient:"),
     (["--device", "buoy", "--damping-coefficient", "1e30"], "damping-coefficient:"),
     # silent wrong numbers
