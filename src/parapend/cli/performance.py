@@ -3,8 +3,8 @@ energy (docs/performance.md). A thin shell over :mod:`parapend.performance`."""
 
 from __future__ import annotations
 
-import contextlib
 import logging
+import os
 import shlex
 import sys
 
@@ -123,9 +123,16 @@ def add_parsers(sub) -> None:
 
 class _Announce(logging.Handler):
     """Prints the library's estimate of long work (``parapend.performance``'s INFO records)
-    on stderr, one line, before the work starts; standard output stays the report."""
+    on stderr, one line, before the work starts; standard output stays the report. Only
+    the process that installed it prints (as :mod:`._notice`)."""
+
+    def __init__(self):
+        super().__init__(logging.INFO)
+        self.pid = os.getpid()
 
     def emit(self, record: logging.LogRecord) -> None:
+        if os.getpid() != self.pid:
+            return
         stream = sys.stderr or sys.__stderr__
         try:
             stream.write(f"parapend: {record.getMessage()}\n")
@@ -134,31 +141,26 @@ class _Announce(logging.Handler):
             pass
 
 
-@contextlib.contextmanager
-def _announce():
+def _announce() -> None:
+    """Print the estimate of long work of this process on stderr (idempotent)."""
     logger = logging.getLogger("parapend.performance")
-    handler = _Announce(logging.INFO)
-    level = logger.level
-    logger.addHandler(handler)
+    if not any(isinstance(h, _Announce) for h in logger.handlers):
+        logger.addHandler(_Announce())
     if logger.getEffectiveLevel() > logging.INFO:
         logger.setLevel(logging.INFO)
-    try:
-        yield
-    finally:
-        logger.removeHandler(handler)
-        logger.setLevel(level)
 
 
 def _cmd_power_matrix(a) -> dict | str:
     from ..performance import figures
 
+    _announce()
+
     if a.plot:
         for s in ("matrix", "capture-width", "scatter"):
             _check_output(f"{a.plot}-{s}.png", "--plot", FIGURE_SUFFIXES)
     argv = sys.argv[1:] if sys.argv and sys.argv[0] else []
-    with _announce():
-        rec = _run(a, command="parapend " + " ".join(shlex.quote(x) for x in argv),
-                   progress=_EtaProgress("power-matrix"))
+    rec = _run(a, command="parapend " + " ".join(shlex.quote(x) for x in argv),
+               progress=_EtaProgress("power-matrix"))
     ds = rec._dataset
     drawn = []
     if a.plot:
