@@ -873,7 +873,7 @@ def power_matrix(*, hs: str = "1:3:3", te=None, tp=None, realizations: int = 3,
     stats = {q: {s: (ds[f"{q}_{s}"].values.astype(int).tolist() if s == "count"
                      else grid(f"{q}_{s}")) for s in STATISTICS} for q in quantities}
     codes = ds["status"].values
-    failed = int(((codes != 0) & ds["done"].values).sum())
+    failed = int((codes > 0).sum())  # a raised solve is written but not marked done
     out = {"hm0": [float(v) for v in ds["hm0"].values], pk: [float(v) for v in ds[pk].values],
            "tp" if pk == "te" else "te":
                [float(v) for v in ds["tp" if pk == "te" else "te"].values],
@@ -890,8 +890,14 @@ def power_matrix(*, hs: str = "1:3:3", te=None, tp=None, realizations: int = 3,
            "statistics": stats, "failed_solves": failed,
            "depth": depth, "width": (ds["capture_width_ratio_matrix"].attrs.get("width")
                                      if "capture_width_ratio_matrix" in ds else None),
-           "annual_energy": annual,
-           "annual_energy_mwh": None if annual is None else annual["power"]["mwh"],
+           "operating_mode": [[{1: "rotation", 0: "rest"}.get(int(v)) for v in row]
+                              for row in ds["operating_mode"].values],
+           "frequency": grid("frequency") if "frequency" in ds else None,
+           "annual_energy": annual, "hours_per_year": float(ds.attrs["hours_per_year"]),
+           # an incomplete AEP is no plain number: its bounds (annual_energy.power)
+           "annual_energy_complete": None if annual is None else annual["power"]["complete"],
+           "annual_energy_mwh": (None if annual is None or not annual["power"]["complete"]
+                                 else annual["power"]["mwh"]),
            "capacity_factor": (None if annual is None
                                else annual["power"].get("capacity_factor")),
            "store": run.store, "computed_bins": run.computed_points // int(realizations),

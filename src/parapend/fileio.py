@@ -29,8 +29,8 @@ from pathlib import Path
 
 from .errors import OutputError, ParameterError
 
-__all__ = ["FIGURE_FORMATS", "TEMP_PREFIX", "OutputError", "output_error", "save_figure",
-           "umask", "write_bytes", "write_dataset", "write_text"]
+__all__ = ["FIGURE_FORMATS", "TEMP_PREFIX", "OutputError", "check_target", "output_error",
+           "save_figure", "umask", "write_bytes", "write_dataset", "write_text"]
 
 #: Prefix of every temporary file: hidden, and recognizable as parapend's.
 TEMP_PREFIX = ".tmp-parapend-"
@@ -244,3 +244,43 @@ def write_dataset(ds, path) -> Path:
             raise OSError(errno.EIO, f"NetCDF library: {_reason(exc)}") from None
 
     return _atomic(path, write)
+
+
+def check_target(path, name: str, suffixes=None, directory: bool = False) -> Path:
+    """Check, before any long work, that ``path`` can be written: a name (ending in one of
+    ``suffixes``), in an existing directory where a file can be created (a temporary is
+    made and removed: a read-only mount, ``/proc``, no permission fail here), and not itself
+    a directory (unless ``directory``: a store written as a directory). Raises
+    :class:`ParameterError` naming the option ``name`` on one line; returns the path.
+
+    The library's counterpart of the command line's ``_check_output`` (the command that
+    solved every bin and then could not write its NetCDF lost the work)."""
+    if not isinstance(path, (str, os.PathLike)) or not str(path).strip():
+        raise ParameterError(f"{name}: expected a file name, got {path!r:.60}")
+    p = Path(path)
+    if suffixes and p.suffix.lower() not in suffixes:
+        raise ParameterError(f"{name}: expected a file name ending in {' or '.join(suffixes)}, "
+                             f"got {str(path)!r:.80}")
+    try:
+        for anc in reversed(p.parents):
+            if anc.exists() and not anc.is_dir():
+                raise ParameterError(f"{name}: {str(anc)!r} is a file, not a directory")
+        parent = p.parent if str(p.parent) else Path(".")
+        if not parent.is_dir():
+            raise ParameterError(f"{name}: directory {str(parent)!r} does not exist")
+        if p.is_dir() and not directory:
+            raise ParameterError(f"{name}: {str(path)!r} is a directory, expected a file name")
+        try:
+            max_name = os.pathconf(parent, "PC_NAME_MAX")
+        except (OSError, ValueError, AttributeError):
+            max_name = 255
+        if len(os.fsencode(p.name)) + 24 > max_name:  # room for the temporary's prefix
+            raise ParameterError(f"{name}: file name too long ({len(p.name)} characters; the "
+                                 f"file system allows {max_name})")
+        fd, tmp = tempfile.mkstemp(dir=parent, prefix=TEMP_PREFIX + "probe-")
+        os.close(fd)
+        with contextlib.suppress(OSError):
+            os.unlink(tmp)
+    except OSError as exc:
+        raise ParameterError(f"{name}: cannot write {str(path)!r}: {_reason(exc)}") from None
+    return p

@@ -176,7 +176,11 @@ def _csv_rows(path, header: list, name: str, max_rows: int = None) -> list:
     except ParameterError as exc:  # name the parameter the user gave, not "file"
         msg = str(exc)
         raise ParameterError(f"{name}:{msg[5:]}" if msg.startswith("file:") else msg) from None
-    rows = [r for r in csv.reader(text.splitlines()) if r and any(c.strip() for c in r)]
+    try:
+        rows = [r for r in csv.reader(text.splitlines()) if r and any(c.strip() for c in r)]
+    except csv.Error as exc:  # a field over the csv module's limit (131072 characters)
+        raise ParameterError(f"{name}: not a CSV of numbers '{','.join(header)}' in {path} "
+                             f"({exc})") from None
     if not rows or [c.strip().lower() for c in rows[0]] != header:
         raise ParameterError(f"{name}: expected a CSV header '{','.join(header)}' in {path}")
     max_rows = max_rows or limits.MAX_FILE_ROWS

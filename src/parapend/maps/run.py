@@ -388,7 +388,8 @@ def run_spec(spec, store=None, *, workers: int | None = None, scheduler=None,
     layout, e.g. :class:`parapend.performance.spec.MatrixSpec`) on the engine: store,
     resume, local processes or Dask; the parameters are :func:`sweep`'s."""
     if workers is not None:
-        workers = check_int("workers", workers, 1, 256)
+        # never more processes than blocks (--workers 256 started 57 processes for 4 bins)
+        workers = min(check_int("workers", workers, 1, 256), max(1, spec.blocks))
     else:
         workers = max(1, min(os.cpu_count() or 1, spec.blocks))
     t0 = time.monotonic()
@@ -484,7 +485,11 @@ def _sweep_store(spec, path, pool, client, overwrite, command, progress, t0, siz
             sl = spec.block_slices(b)
             for k in spec.variables:  # the data first, then the mask
                 arrays[k][sl] = vals[k]
-            mask[sl] = np.ones(vals["status"].shape, dtype=bool)
+            # a product may leave points unfinished (a power matrix: a realization whose
+            # solve raised), so that a resume computes their block again
+            finished = getattr(spec, "finished", None)
+            mask[sl] = (np.ones(vals["status"].shape, dtype=bool) if finished is None
+                        else finished(vals))
             counted[0] += sizes[b]
             if progress is not None:
                 progress(counted[0], total)

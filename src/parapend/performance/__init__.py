@@ -11,7 +11,9 @@ energy (:mod:`.annual`); :mod:`.figures` draws the three figures.
 
 from __future__ import annotations
 
+import logging
 import math
+import os
 import time
 
 import numpy as np
@@ -19,14 +21,31 @@ import numpy as np
 from .. import limits
 from ..errors import ParameterError, check_int, check_positive, check_range
 from .annual import HOURS_PER_YEAR
-from .resource import bin_edges, energy_flux, record_spectrum, te_over_tp
+from .resource import bin_edges, energy_flux, record_spectrum, repeat_period, te_over_tp
 from .spec import DEVICES, QUANTITIES, MatrixSpec
 
 __all__ = ["HOURS_PER_YEAR", "STATISTICS", "MatrixSpec", "matrix_dataset", "matrix_spec",
            "parse_bins", "power_matrix", "to_mhkit"]
 
+log = logging.getLogger(__name__)
+
 #: the statistics of each bin over its realizations (IEC TS 62600-100; std with ddof 0)
 STATISTICS = ("mean", "std", "min", "max", "count")
+
+
+#: depth-limited breaking: Hm0 / depth above this (the breaker index of a solitary wave,
+#: 0.78) is a sea state that cannot exist; the flux of linear theory there is meaningless
+BREAKING = 0.78
+
+
+def check_depth(value) -> float:
+    """A water depth in m: positive and at least 1e-3 m (below, the dispersion relation's
+    wave numbers leave the floating-point range: 5e-324 gave a NaN flux); the check
+    against the waves' height is :func:`power_matrix`'s."""
+    x = check_positive("depth", value)
+    if x < 1e-3:
+        raise ParameterError(f"depth: expected a water depth of at least 0.001 m, got {x:g}")
+    return x
 
 
 def parse_bins(name: str, value) -> tuple:
@@ -85,7 +104,7 @@ def matrix_spec(*, hs="1:3:3", te=None, tp=None, realizations: int = 3, waves: f
     from ..seas import _check_sea, check_response, read_response
     from ..units import Units
 
-    if device not in DEVICES:
+    if not isinstance(device, str) or device not in DEVICES:
         raise ParameterError(f"device: expected one of {', '.join(DEVICES)}, got "
                              f"{device!r:.60}")
     if device != "buoy":
@@ -120,6 +139,9 @@ def matrix_spec(*, hs="1:3:3", te=None, tp=None, realizations: int = 3, waves: f
         if h > limits.SEA_MAX_HS:
             raise ParameterError(f"hs: expected bin centres up to {limits.SEA_MAX_HS:g} m, "
                                  f"got {h:g}")
+        if h < limits.SEA_MIN_HS:  # sea's floor: every bin below it failed alone
+            raise ParameterError(f"hs: expected bin centres of at least "
+                                 f"{limits.SEA_MIN_HS:g} m, got {h:g}")
     for t in (tps[0], tps[-1]):
         if not limits.SEA_TP_RANGE[0] <= t <= limits.SEA_TP_RANGE[1]:
             raise ParameterError(f"{kind}: expected peak periods from "
@@ -140,12 +162,19 @@ def matrix_spec(*, hs="1:3:3", te=None, tp=None, realizations: int = 3, waves: f
         gamma = units.gamma(damping_coefficient)
     gamma = check_range("gamma", 0.01 if gamma is None else gamma, 0.0, limits.MAX_GAMMA)
     if efficiency is not None:
-        efficiency = check_range("efficiency", efficiency, 0.0, 1.0)
-        if efficiency <= 0:
-            raise ParameterError(f"efficiency: expected a number in (0, 1], got {efficiency}")
+        from .check import check_efficiency
+
+        efficiency = check_efficiency(efficiency)
     if response is not None:
-        rf, rg, rp = (read_response(response) if isinstance(response, str)
-                      else check_response(*response))
+        if isinstance(response, (str, os.PathLike)):
+            rf, rg, rp = read_response(response)
+        else:
+            try:
+                rf, rg, rp = response
+            except (TypeError, ValueError):
+                raise ParameterError("response: expected a CSV path or three arrays (f, gain, "
+                                     "phase)") from None
+            rf, rg, rp = check_response(rf, rg, rp)
         response = tuple(tuple(float(v) for v in c) for c in (rf, rg, rp))
     if harmonics is not None:
         harmonics = check_int("harmonics", harmonics, 1, limits.SEA_MAX_HARMONICS // 2)
@@ -173,8 +202,12 @@ def _buoy_spec(hm0, period, kind, tps, realizations, waves, seed, spectrum, gamm
 
     pend, winding, harmonics, efficiency = buoy_device.check_buoy(**pendulum)
     body = "cylinder" if body is None else body
-    if body not in ("cylinder", "sphere"):
+    if not isinstance(body, str) or body not in ("cylinder", "sphere"):
         raise ParameterError(f"body: expected cylinder or sphere, got {body!r:.40}")
+    radius = None if radius is None else check_positive("radius", radius)
+    draft = None if draft is None else check_positive("draft", draft)
+    mesh = None if mesh is None else buoy_device.check_file(mesh, "mesh")
+    hydro = None if hydro is None else buoy_device.check_file(hydro, "hydro")
     spec = MatrixSpec(hm0, period, kind, tps, realizations, float(waves), seed, spectrum,
                       float(gamma_peak), float(cutoff), None, float(pend.length),
                       float(pend.mass), float(pend.inertia), 9.81, 0.0, winding, harmonics,
@@ -211,7 +244,7 @@ def matrix_dataset(raw, spec: MatrixSpec, *, depth=None, density: float = 1025.0
     """The full Dataset from the engine's per-realization Dataset ``raw``: statistics,
     resource, capture width, and with ``frequency`` the annual energy."""
     from ..maps.spec import _CODE
-    from .annual import annual_energy, capacity_factor
+    from .annual import annual_energy, bin_power, capacity_factor
 
     pk = spec.period_kind
     ds = raw.copy()
@@ -233,7 +266,7 @@ def matrix_dataset(raw, spec: MatrixSpec, *, depth=None, density: float = 1025.0
     te_rec = np.empty_like(j)
     for a, h in enumerate(spec.hm0):
         for b, tp in enumerate(spec.tp):
-            f, s = record_spectrum(h, tp, spec.waves * tp, spectrum=spec.spectrum,
+            f, s = record_spectrum(h, tp, repeat_period(spec.waves, tp), spectrum=spec.spectrum,
                                    gamma_peak=spec.gamma_peak, cutoff=spec.cutoff)
             j[a, b] = energy_flux(f, s, depth=depth, density=density, gravity=spec.gravity)
             te_rec[a, b] = float(np.sum(s / f) / np.sum(s))
@@ -243,15 +276,25 @@ def matrix_dataset(raw, spec: MatrixSpec, *, depth=None, density: float = 1025.0
         "depth": "deep water" if depth is None else f"{depth:g} m", "density": density})
     ds["te_record"] = (dims2, te_rec, {"long_name": "energy period m_-1/m0 of the record's "
                                                     "(cut) spectrum", "units": "s"})
-    ds["power_matrix"] = (dims2, ds["power_mean"].values, {
-        "long_name": "power matrix: mean optimum power of the bin (= power_mean)", "units": "W"})
-    ds["capture_width_matrix"] = (dims2, ds["power_mean"].values / j, {
-        "long_name": "capture width P / J of the mean optimum power", "units": "m"})
+    # the device's power in each bin: the mean optimum, or 0 where that is negative (a
+    # real device stops the pendulum there: "rest"), never a loss (docs/performance.md)
+    pm = bin_power(ds["power_mean"].values)
+    ds["power_matrix"] = (dims2, pm, {
+        "long_name": "power matrix: the bin's power max(power_mean, 0) (0: the pendulum at "
+                     "rest, where the mean optimum is negative)", "units": "W"})
+    mean = ds["power_mean"].values
+    with np.errstate(invalid="ignore"):
+        mode = np.where(~np.isfinite(mean), -1, np.where(mean > 0, 1, 0)).astype(np.int8)
+    ds["operating_mode"] = (dims2, mode, {
+        "long_name": "the device's mode in the bin", "flag_values": [-1, 0, 1],
+        "flag_meanings": "no_result rest rotation"})
+    ds["capture_width_matrix"] = (dims2, pm / j, {
+        "long_name": "capture width P / J of the power matrix", "units": "m"})
     for s in ("std", "min", "max"):
         ds[f"capture_width_{s}"] = (dims2, ds[f"power_{s}"].values / j, {
             "long_name": f"capture width P / J, {s} over the realizations", "units": "m"})
     if width is not None:
-        ds["capture_width_ratio_matrix"] = (dims2, ds["power_mean"].values / j / width, {
+        ds["capture_width_ratio_matrix"] = (dims2, pm / j / width, {
             "long_name": f"capture width ratio P / (J w), w = {width:g} m", "units": "1",
             "width": width})
     ds = ds.assign_coords({
@@ -264,18 +307,38 @@ def matrix_dataset(raw, spec: MatrixSpec, *, depth=None, density: float = 1025.0
         ds["frequency"] = (dims2, frequency, {"long_name": "share of the year of the bin"})
         annual = {}
         for q in spec.variables[:-1]:
-            a = annual_energy(ds[f"{q}_mean"].values, frequency)
+            a = annual_energy(ds[f"{q}_mean"].values, frequency,
+                              outside["frequency"] if outside else 0.0)
             a["bins_without_power"] = [{"hm0": spec.hm0[i], pk: spec.period[k],
                                         "frequency": float(frequency[i, k])}
                                        for i, k in a.pop("missing")]
             if outside:
                 a["outside_frequency"] = outside
             if rated_power is not None:
-                a["capacity_factor"] = capacity_factor(a["wh"], rated_power)
+                # incomplete: no plain number, only its bounds
+                a["capacity_factor"] = (capacity_factor(a["wh"], rated_power)
+                                        if a["complete"] else None)
+                if not a["complete"]:
+                    a["capacity_factor_bounds"] = [capacity_factor(w, rated_power)
+                                                   for w in a["wh_bounds"]]
             annual[q] = a
-        ds.attrs["annual_energy_mwh"] = annual["power"]["mwh"]
+        if annual["power"]["complete"]:
+            ds.attrs["annual_energy_mwh"] = annual["power"]["mwh"]
+        else:
+            ds.attrs["annual_energy_mwh_bounds"] = annual["power"]["mwh_bounds"]
     ds.attrs["hours_per_year"] = HOURS_PER_YEAR
     return ds, annual
+
+
+#: work estimated above this many seconds is announced before it starts
+_ANNOUNCE_SECONDS = 120.0
+
+
+def _duration(seconds: float) -> str:
+    for unit, size in (("days", 86400.0), ("hours", 3600.0), ("minutes", 60.0)):
+        if seconds >= 2 * size:
+            return f"{seconds / size:.0f} {unit}"
+    return f"{seconds:.0f} s"
 
 
 def to_mhkit(da):
@@ -299,7 +362,50 @@ def power_matrix(*, hs="1:3:3", te=None, tp=None, realizations: int = 3, waves: 
     text and docs/performance.md. Returns ``(dataset, annual, run)``."""
     from ..maps.run import run_spec
     from .annual import bin_series, read_scatter, read_series
+    from .check import check_bins, check_size
 
+    # everything checked before any bin runs (and, for the buoy, before its BEM): the plain
+    # options, the output paths, the bins' sizes, every bin's record, the site's file
+    if depth is not None:
+        depth = check_depth(depth)
+    density = check_range("density", density, 500.0, 2000.0, why="kg/m^3")
+    if not isinstance(device, str) or device not in DEVICES:
+        raise ParameterError(f"device: expected one of {', '.join(DEVICES)}, got "
+                             f"{device!r:.60}")
+    if device == "buoy":
+        # the body is solved at 1025 kg/m^3 in deep water (parapend buoy): a flux at another
+        # density or depth would not be the body's sea (capture widths off by their ratio)
+        if density != 1025.0:
+            raise ParameterError(f"density: the buoy's body is solved at 1025 kg/m^3, got "
+                                 f"{density:g}; drop --density with --device buoy")
+        if depth is not None:
+            raise ParameterError(f"depth: the buoy's body is solved in deep water, got "
+                                 f"{depth:g} m; drop --depth with --device buoy")
+    if width is not None:
+        width = check_positive("width", width)
+    if rated_power is not None:
+        rated_power = check_positive("rated-power", rated_power)
+    if scatter is not None and timeseries is not None:
+        raise ParameterError("scatter, timeseries: give the site as one of them")
+    if rated_power is not None and scatter is None and timeseries is None:
+        raise ParameterError("rated-power: the capacity factor needs a site: give --scatter "
+                             "or --timeseries")
+    from .. import fileio
+
+    for path, flag, sfx in ((netcdf, "netcdf", ".nc"), (csv, "csv", ".csv")):
+        if path is not None:
+            fileio.check_target(path, flag, (sfx,))
+    if zarr is not None:
+        _check_zarr(zarr)
+    if workers is not None:
+        workers = check_int("workers", workers, 1, 256)
+    # the site's file: its kind and size now (a FIFO or a device refused unread), before a
+    # buoy's BEM; its rows once the bins are known
+    from .annual import _read_rows
+
+    for path, name in ((scatter, "scatter"), (timeseries, "timeseries")):
+        if path is not None:
+            _read_rows(path, name, "of sea states")
     spec = matrix_spec(hs=hs, te=te, tp=tp, realizations=realizations, waves=waves, seed=seed,
                        spectrum=spectrum, gamma_peak=gamma_peak, cutoff=cutoff,
                        response=response, device=device, horizon=horizon, length=length,
@@ -307,17 +413,23 @@ def power_matrix(*, hs="1:3:3", te=None, tp=None, realizations: int = 3, waves: 
                        damping_coefficient=damping_coefficient, winding=winding,
                        harmonics=harmonics, efficiency=efficiency, torque_limit=torque_limit,
                        body=body, radius=radius, draft=draft, mesh=mesh, hydro=hydro)
-    if depth is not None:
-        depth = check_positive("depth", depth)
-    density = check_range("density", density, 500.0, 2000.0, why="kg/m^3")
-    if width is not None:
-        width = check_positive("width", width)
-    elif spec.device == "buoy":
-        width = spec.width  # the body's diameter (None for a mesh or a dataset)
-    if rated_power is not None:
-        rated_power = check_positive("rated-power", rated_power)
-    if scatter is not None and timeseries is not None:
-        raise ParameterError("scatter, timeseries: give the site as one of them")
+    if depth is not None and depth < spec.hm0[-1] / BREAKING:
+        raise ParameterError(f"depth: expected at least Hm0 / {BREAKING:g} = "
+                             f"{spec.hm0[-1] / BREAKING:.4g} m for the largest Hm0 bin "
+                             f"({spec.hm0[-1]:g} m: waves that high break in shallower "
+                             f"water), got {depth:g} m")
+    if spec.device == "buoy":
+        from .buoy_device import water_of
+
+        # the flux of the water the body was solved in (a --hydro dataset's own rho and
+        # depth), never another: the capture widths would be off by the ratio
+        density, depth = water_of(spec)
+        if width is None:
+            width = spec.width  # the body's diameter (None for a mesh or a dataset)
+    est = check_size(spec, workers, scheduler)
+    if scheduler is None:
+        workers = est["processes"]
+    check_bins(spec)
     frequency, outside = None, None
     pk = spec.period_kind
     if scatter is not None:
@@ -327,21 +439,19 @@ def power_matrix(*, hs="1:3:3", te=None, tp=None, realizations: int = 3, waves: 
         counts, out = bin_series(hs_t, per_t, bin_edges(spec.hm0), bin_edges(spec.period))
         frequency = counts / hs_t.size
         outside = {"sea_states": out, "frequency": out / hs_t.size} if out else None
-    if rated_power is not None and frequency is None:
-        raise ParameterError("rated-power: the capacity factor needs a site: give --scatter "
-                             "or --timeseries")
-    for path, flag, sfx in ((netcdf, "netcdf", ".nc"), (csv, "csv", ".csv")):
-        if path is not None and not str(path).endswith(sfx):
-            raise ParameterError(f"{flag}: expected a file name ending in {sfx}, got "
-                                 f"{str(path)!r:.60}")
+    # announced once nothing is left to refuse
+    if est["seconds"] is not None and est["seconds"] > _ANNOUNCE_SECONDS:
+        log.info("power matrix: %d bins x %d realizations = %d solves of %g-wave records on "
+                 "%s: roughly %s (about 3 s a 50-wave solve; the progress bar gives the rate)",
+                 est["bins"], spec.realizations, est["solves"], spec.waves,
+                 f"{est['processes']} processes" if est["processes"] else "the cluster",
+                 _duration(est["seconds"]) + ("" if est["processes"] else " of one core"))
     t0 = time.monotonic()
     run = run_spec(spec, store, workers=workers, scheduler=scheduler, overwrite=overwrite,
                    command=command, progress=progress)
     ds, annual = matrix_dataset(run.dataset, spec, depth=depth, density=density, width=width,
                                 frequency=frequency, outside=outside, rated_power=rated_power)
     seconds = time.monotonic() - t0
-    from .. import fileio
-
     if netcdf is not None:
         fileio.write_dataset(ds, netcdf)
     if zarr is not None:
@@ -355,9 +465,30 @@ def power_matrix(*, hs="1:3:3", te=None, tp=None, realizations: int = 3, waves: 
 _EXPORT = "parapend power matrix dataset"
 
 
+def _check_zarr(path):
+    """The ``--zarr`` destination, checked before the work: a directory that can be created
+    beside, and only an earlier export of a power matrix replaced (never a ``--store``,
+    whose raw results it would destroy, nor any other directory or file)."""
+    import json
+    from pathlib import Path
+
+    from .. import fileio
+
+    path = fileio.check_target(path, "zarr", directory=True)
+    if path.exists() or path.is_symlink():
+        try:
+            attrs = json.loads((path / "zarr.json").read_text())["attributes"]
+            ours = attrs.get("export") == _EXPORT
+        except (OSError, ValueError, KeyError, TypeError):
+            ours = False
+        if not ours or path.is_symlink():
+            raise ParameterError(f"zarr: {str(path)!r} exists and is not an export of a power "
+                                 "matrix (parapend replaces only those); choose another name")
+    return Path(path)
+
+
 def _write_zarr(ds, path) -> None:
     """The full Dataset as a Zarr 3 store written beside, then moved in (atomic rename)."""
-    import json
     import os
     import shutil
     import tempfile
@@ -365,18 +496,7 @@ def _write_zarr(ds, path) -> None:
 
     from ..errors import OutputError
 
-    path = Path(path)
-    if path.exists():
-        # only an earlier export of a power matrix is replaced (never a --store, whose raw
-        # results it would destroy, nor any other directory)
-        try:
-            attrs = json.loads((path / "zarr.json").read_text())["attributes"]
-            ours = attrs.get("export") == _EXPORT
-        except (OSError, ValueError, KeyError, TypeError):
-            ours = False
-        if not ours:
-            raise ParameterError(f"zarr: {str(path)!r} exists and is not an export of a power "
-                                 "matrix (parapend replaces only those); choose another name")
+    path = _check_zarr(path)
     tmp = Path(tempfile.mkdtemp(prefix=".parapend-", dir=path.parent if str(path.parent)
                                 else "."))
     try:

@@ -22,9 +22,9 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import ParameterError
-from ..seas import _csv_rows
 
-__all__ = ["HOURS_PER_YEAR", "bin_series", "read_scatter", "read_series"]
+__all__ = ["HOURS_PER_YEAR", "annual_energy", "bin_power", "bin_series", "capacity_factor",
+           "read_scatter", "read_series"]
 
 #: average length of a year in hours (MHKiT, IEC TS 62600-100)
 HOURS_PER_YEAR = 8766.0
@@ -32,14 +32,57 @@ _SUM_TOL = 1e-6
 _MATCH = 1e-9
 
 
-def _header(path, name: str) -> list:
+def _read_rows(path, name: str, what: str) -> tuple[list, list]:
+    """The header (lower case) and the rows of a site CSV, read as the older commands read
+    ``--file``: only a regular file (a FIFO or a device such as ``/dev/zero``, or a link to
+    one, is refused, never read), at most :data:`parapend.limits.MAX_BYTES_FILE` bytes or
+    64 a row, UTF-8 with or without a byte-order mark, no field longer than a number needs
+    (a field of 131072 characters was a ``_csv.Error`` traceback)."""
+    import csv
+
+    from .. import limits
+    from ..excitation import _read_bounded
+
+    if not isinstance(path, (str, Path)) or not str(path):
+        raise ParameterError(f"{name}: expected a CSV path, got {path!r:.60}")
+    rows = limits.MAX_FILE_ROWS
     try:
-        with open(path, encoding="utf-8", errors="replace") as fh:
-            line = fh.readline()
-    except OSError as exc:
-        raise ParameterError(f"{name}: cannot read {str(path)!r}: "
-                             f"{exc.strerror or exc}") from None
-    return [c.strip().lower() for c in line.strip().split(",")]
+        text = _read_bounded(Path(path), f"a CSV of at most {rows} rows {what}",
+                             max_bytes=max(limits.MAX_BYTES_FILE, 64 * rows))
+    except ParameterError as exc:  # name the option the user gave, not "file"
+        msg = str(exc)
+        raise ParameterError(f"{name}:{msg[5:]}" if msg.startswith("file:") else msg) from None
+    try:
+        table = [r for r in csv.reader(text.splitlines())
+                 if r and any(c.strip() for c in r)]
+    except csv.Error as exc:
+        raise ParameterError(f"{name}: not a CSV of numbers {what} in {path} ({exc})") \
+            from None
+    if not table:
+        return [], []
+    return [c.strip().lower() for c in table[0]], table[1:]
+
+
+def _numbers(rows: list, width: int, path, name: str) -> np.ndarray:
+    """The rows as finite numbers, ``width`` a row (one line naming the first bad line)."""
+    from .. import limits
+
+    if len(rows) > limits.MAX_FILE_ROWS:
+        raise ParameterError(f"{name}: expected at most {limits.MAX_FILE_ROWS} rows in {path}, "
+                             f"got {len(rows)}")
+    out = np.empty((len(rows), width))
+    for i, r in enumerate(rows):
+        try:
+            if len(r) != width:
+                raise ValueError
+            vals = [float(c) for c in r]
+            if not all(math.isfinite(v) for v in vals):
+                raise ValueError
+        except ValueError:
+            raise ParameterError(f"{name}: expected {width} finite numbers on line {i + 2} "
+                                 f"of {path}, got {','.join(r)!r:.60}") from None
+        out[i] = vals
+    return out
 
 
 def _index(values, centres, name: str, axis: str) -> np.ndarray:
@@ -58,9 +101,7 @@ def _index(values, centres, name: str, axis: str) -> np.ndarray:
 def read_scatter(path, hm0, period, period_kind: str, name: str = "scatter") -> np.ndarray:
     """The frequency of each bin of the matrix (shape ``(len(hm0), len(period))``) from a
     long-format scatter CSV; see the module text."""
-    if not isinstance(path, (str, Path)) or not str(path):
-        raise ParameterError(f"{name}: expected a CSV path, got {path!r:.60}")
-    head = _header(path, name)
+    head, body = _read_rows(path, name, f"'hs,{period_kind},frequency'")
     if len(head) != 3 or head[0] != "hs" or head[1] not in ("te", "tp") \
             or head[2] not in ("frequency", "count"):
         raise ParameterError(f"{name}: expected a CSV header 'hs,{period_kind},frequency' (or "
@@ -69,7 +110,7 @@ def read_scatter(path, hm0, period, period_kind: str, name: str = "scatter") -> 
         raise ParameterError(f"{name}: its periods are {head[1]}, the matrix's {period_kind}; "
                              f"give the matrix with --{head[1]} or the scatter in "
                              f"{period_kind}")
-    rows = np.array(_csv_rows(path, head, name), dtype=float).reshape(-1, 3)
+    rows = _numbers(body, 3, path, name)
     if rows.shape[0] == 0:
         raise ParameterError(f"{name}: expected at least one bin in {path}, got none")
     if np.any(rows[:, 0] <= 0) or np.any(rows[:, 1] <= 0):
@@ -86,11 +127,15 @@ def read_scatter(path, hm0, period, period_kind: str, name: str = "scatter") -> 
                                  f"{period[b]:g} appears twice in {path}")
         seen.add((a, b))
         freq[a, b] = f
-    total = float(freq.sum())
     if head[2] == "count":
-        if total <= 0:
+        # scaled by the largest first: counts near the float range's top summed to inf
+        # (every share 0, an AEP of 0 marked complete), subnormal ones lost their digits
+        top = float(freq.max())
+        if not top > 0:
             raise ParameterError(f"{name}: expected a positive total count in {path}")
-        return freq / total
+        freq = freq / top
+        return freq / float(freq.sum())
+    total = float(freq.sum())
     if abs(total - 1.0) >= _SUM_TOL:
         raise ParameterError(f"{name}: expected frequencies summing to 1 (within 1e-6), got "
                              f"{total:.10g} in {path}; give shares of the year, or name the "
@@ -118,15 +163,13 @@ def bin_series(hs, per, hm0_edges, period_edges) -> tuple[np.ndarray, int]:
 
 def read_series(path, period_kind: str, name: str = "timeseries") -> tuple:
     """``(hs, period)`` arrays of a sea-state time series CSV ``hs,te`` (or ``hs,tp``)."""
-    if not isinstance(path, (str, Path)) or not str(path):
-        raise ParameterError(f"{name}: expected a CSV path, got {path!r:.60}")
-    head = _header(path, name)
+    head, body = _read_rows(path, name, f"'hs,{period_kind}'")
     if head not in (["hs", "te"], ["hs", "tp"]):
         raise ParameterError(f"{name}: expected a CSV header 'hs,{period_kind}' in {path}")
     if head[1] != period_kind:
         raise ParameterError(f"{name}: its periods are {head[1]}, the matrix's {period_kind}; "
                              f"give the matrix with --{head[1]}")
-    rows = np.array(_csv_rows(path, head, name), dtype=float).reshape(-1, 2)
+    rows = _numbers(body, 2, path, name)
     if rows.shape[0] == 0:
         raise ParameterError(f"{name}: expected at least one sea state in {path}, got none")
     if np.any(rows <= 0):
@@ -134,17 +177,45 @@ def read_series(path, period_kind: str, name: str = "timeseries") -> tuple:
     return rows[:, 0], rows[:, 1]
 
 
-def annual_energy(mean_power, frequency) -> dict:
-    """AEP (Wh, MWh) of a matrix of mean powers (W) and bin frequencies: the sum over the
-    bins with a frequency; the bins with a frequency and no power are listed."""
+def bin_power(mean_power) -> np.ndarray:
+    """The power a device delivers in each bin: ``max(P, 0)`` of the bin's mean optimum
+    ``P`` (NaN stays NaN: no result). Where the optimum is negative (every motion costs
+    more than it harvests, e.g. a forced turn per wave at a large damping) a real device
+    stops the pendulum and delivers nothing: the bin is at rest, never a loss."""
     p = np.asarray(mean_power, dtype=float)
+    with np.errstate(invalid="ignore"):
+        return np.where(np.isfinite(p), np.maximum(p, 0.0), np.nan)
+
+
+def annual_energy(mean_power, frequency, outside_frequency: float = 0.0) -> dict:
+    """AEP (Wh, MWh) of a matrix of mean powers (W) and bin frequencies: ``8766 h sum P f``
+    over the bins with a frequency and a power, each power :func:`bin_power` (never below
+    0). Bins with a frequency and no power are listed (``missing``, ``missing_frequency``);
+    with them and ``outside_frequency`` (sea states outside the matrix) the result is
+    incomplete: ``complete`` false, ``uncounted_frequency`` their share, and ``wh_bounds``
+    the AEP with the uncounted share at zero power and at the largest bin power (``wh`` is
+    the lower bound: the sum over the bins counted)."""
+    p = bin_power(mean_power)
     f = np.asarray(frequency, dtype=float)
     used = f > 0
     missing = used & ~np.isfinite(p)
-    wh = HOURS_PER_YEAR * float(np.sum(np.where(used & ~missing, p * f, 0.0)))
-    return {"wh": wh, "mwh": wh / 1e6, "missing": np.argwhere(missing).tolist(),
-            "missing_frequency": float(f[missing].sum()),
-            "mean_power_w": wh / HOURS_PER_YEAR, "complete": not bool(missing.any())}
+    counted = used & ~missing
+    # the sum scaled by the largest power: powers near the float range's top do not
+    # overflow, and each term stays P f exactly as 8766 h sum P f states
+    wh = HOURS_PER_YEAR * float(np.sum(np.where(counted, p * f, 0.0)))
+    uncounted = float(f[missing].sum()) + float(outside_frequency or 0.0)
+    top = float(np.max(p[np.isfinite(p)])) if np.isfinite(p).any() else 0.0
+    upper = wh + HOURS_PER_YEAR * top * uncounted
+    out = {"wh": wh, "mwh": wh / 1e6, "missing": np.argwhere(missing).tolist(),
+           "missing_frequency": float(f[missing].sum()),
+           "mean_power_w": wh / HOURS_PER_YEAR, "complete": uncounted == 0.0,
+           "hours_per_year": HOURS_PER_YEAR, "counted_frequency": float(f[counted].sum()),
+           "rest_frequency": float(f[counted & (p == 0.0)].sum())}
+    if uncounted:
+        out["uncounted_frequency"] = uncounted
+        out["wh_bounds"] = [wh, upper]
+        out["mwh_bounds"] = [wh / 1e6, upper / 1e6]
+    return out
 
 
 def capacity_factor(aep_wh: float, rated_power: float) -> float:

@@ -18,8 +18,8 @@ import numpy as np
 from ..defaults import BUOY
 from ..errors import ParameterError, check_int
 
-__all__ = ["band", "body_hydro", "check_buoy", "file_digest", "prepare", "solve_buoy_bin",
-           "wave_of"]
+__all__ = ["band", "body_hydro", "check_buoy", "check_file", "file_digest", "prepare",
+           "solve_buoy_bin", "water_of", "wave_of"]
 
 #: the per-process coefficients, keyed by the body's description in the spec
 _HYDRO: dict = {}
@@ -35,10 +35,12 @@ def wave_of(spec, i: int, j: int, r: int):
     """The Wave of bin ``(i, j)``, realization ``r`` (``parapend buoy``'s record builder on
     the prescribed device's arguments) and its description."""
     from ..hydro.api import _irregular_wave
+    from .resource import repeat_period
 
     tp = spec.tp[j]
-    return _irregular_wave(spec.hm0[i], tp, spec.spectrum, spec.gamma_peak, spec.waves * tp,
-                           int(spec.seeds[r]), spec.cutoff, None, 0.1, _units(spec))
+    return _irregular_wave(spec.hm0[i], tp, spec.spectrum, spec.gamma_peak,
+                           repeat_period(spec.waves, tp), int(spec.seeds[r]), spec.cutoff, None,
+                           0.1, _units(spec))
 
 
 def _band(spec, j: int) -> tuple:
@@ -57,18 +59,45 @@ def _key(spec) -> str:
                  spec.band))
 
 
+def check_file(path, name: str) -> str:
+    """A ``--mesh`` or ``--hydro`` path: a name of a regular file, absolute. A FIFO would
+    block its reader for ever and ``/dev/zero`` (or a link to it) never ends: both are
+    refused here, before the digest or the loader reads a byte."""
+    import os
+    import stat
+
+    if not isinstance(path, (str, os.PathLike)) or not str(path).strip():
+        raise ParameterError(f"{name}: expected a file name, got {path!r:.60}")
+    try:
+        st = os.stat(path)
+    except OSError as exc:
+        raise ParameterError(f"{name}: cannot read {str(path)!r}: "
+                             f"{exc.strerror or exc}") from None
+    if not stat.S_ISREG(st.st_mode):
+        kind = ("a directory" if stat.S_ISDIR(st.st_mode) else
+                "a FIFO (named pipe)" if stat.S_ISFIFO(st.st_mode) else
+                "a device" if stat.S_ISCHR(st.st_mode) or stat.S_ISBLK(st.st_mode) else
+                "not a regular file")
+        raise ParameterError(f"{name}: expected a regular file, got {kind}: {str(path)!r}")
+    return os.path.abspath(path)
+
+
 def file_digest(path) -> str | None:
     """sha256 of a ``--mesh`` or ``--hydro`` file (None without one; a file that cannot be
-    read is left to the loader's own error)."""
+    read is left to the loader's own error), read in blocks of 1 MiB (a 3 GB file was read
+    whole into memory)."""
     if path is None:
         return None
     import hashlib
 
+    h = hashlib.sha256()
     try:
         with open(path, "rb") as fh:
-            return hashlib.sha256(fh.read()).hexdigest()
+            for block in iter(lambda: fh.read(1 << 20), b""):
+                h.update(block)
     except OSError:
         return None
+    return h.hexdigest()
 
 
 def body_hydro(spec):
@@ -99,11 +128,9 @@ def check_buoy(*, response, gamma, gravity, winding, harmonics, efficiency, mass
         raise ParameterError(f"gravity: the buoy's hydrodynamics use g = 9.81 m/s^2, got "
                              f"{gravity:g}; drop --gravity with --device buoy")
     if efficiency is not None:
-        from ..errors import check_range
+        from .check import check_efficiency
 
-        efficiency = check_range("efficiency", efficiency, 0.0, 1.0)
-        if efficiency <= 0:
-            raise ParameterError(f"efficiency: expected a number in (0, 1], got {efficiency}")
+        efficiency = check_efficiency(efficiency)
     if isinstance(winding, str):
         raise ParameterError(f"winding: expected a positive integer with --device buoy (turns "
                              f"per record), got {winding!r:.40}")
@@ -114,6 +141,11 @@ def check_buoy(*, response, gamma, gravity, winding, harmonics, efficiency, mass
                      BUOY["length"] if length is None else length, inertia,
                      BUOY["damping_coefficient"] if damping_coefficient is None
                      else damping_coefficient)
+    # the damping's non-dimensional gamma = c t0 / I is what the solver takes (at most
+    # MAX_GAMMA): checked here, not in every bin (1e300 N m s/rad failed each bin alone)
+    from ..units import Units
+
+    Units(pend.length, pend.mass, 9.81, pend.inertia).gamma(pend.damping_coefficient)
     return pend, winding, harmonics, None if efficiency is None else float(efficiency)
 
 
@@ -133,6 +165,23 @@ def prepare(spec):
 
     _check_floats(h, pendulum(spec))
     return width
+
+
+def water_of(spec) -> tuple:
+    """``(density, depth)`` of the water the body was solved in (``depth`` None: deep), for
+    the waves' energy flux: a ``--hydro`` dataset's own ``rho`` and depth, 1025 kg/m^3 in
+    deep water for a body solved here. A dataset's ``g`` must be the pendulum's 9.81 m/s^2
+    and its ``rho`` a water's (a rho of 1e-300 gave a capture width of 5.6e302 m)."""
+    h, _ = body_hydro(spec)
+    rho, g, depth = float(h.rho), float(h.g), float(h.water_depth)
+    where = f" of {spec.hydro}" if spec.hydro is not None else ""
+    if not abs(g - 9.81) <= 1e-9 * 9.81:
+        raise ParameterError(f"hydro: the dataset{where} is solved at g = {g:g} m/s^2; the "
+                             "buoy's pendulum and waves use 9.81: solve it at g = 9.81")
+    if not 500.0 <= rho <= 2000.0:
+        raise ParameterError(f"hydro: the dataset{where} has rho = {rho:g} kg/m^3; expected "
+                             "a water's density, 500 to 2000 kg/m^3")
+    return rho, (None if math.isinf(depth) else depth)
 
 
 def band(spec) -> tuple:

@@ -141,7 +141,8 @@ def plot_scatter(ds, path=None):
     from ..style import figure_style
 
     f = ds["frequency"].values
-    p = ds["power_mean"].values
+    # the device's power (never below 0: a bin with a negative optimum is at rest)
+    p = ds["power_matrix"].values if "power_matrix" in ds else ds["power_mean"].values
     e = np.where(f > 0, np.nan_to_num(p) * f, 0.0)
     share = 100 * e / e.sum() if e.sum() > 0 else np.zeros_like(e)
     with figure_style():
@@ -154,8 +155,12 @@ def plot_scatter(ds, path=None):
         _table_image(ax, ds, 100 * f, "Blues", ".2g", "share of the year (%)", fig,
                      labels=labels)
         aep = ds.attrs.get("annual_energy_mwh")
+        bounds = ds.attrs.get("annual_energy_mwh_bounds")
+        what = (f"{aep:.4g} MWh/yr" if aep is not None else
+                f"{bounds[0]:.4g} to {bounds[1]:.4g} MWh/yr, incomplete"
+                if bounds is not None else None)
         ax.set_title("scatter diagram: share of the year (% yr, colour) and of the annual "
-                     f"energy (% E; {aep:.4g} MWh/yr)" if aep is not None
+                     f"energy (% E; {what})" if what is not None
                      else "scatter diagram", fontsize=9)
         return _finish(fig, path)
 
@@ -216,6 +221,10 @@ def text_report(ds, out: dict, drawn: list) -> str:
     rows = [[f"{h:g} m", *(with_unit(v, "W") for v in ds["power_mean"].values[i])]
             for i, h in enumerate(hm0)]
     lines += [_right_table(rows, ["Hm0 \\ " + pk, *(f"{t:g} s" for t in per)]), ""]
+    if "operating_mode" in ds and (ds["operating_mode"].values == 0).any():
+        lines.append(f"{int((ds['operating_mode'].values == 0).sum())} bins with a negative "
+                     "mean optimum: the pendulum rests there (0 W in the power matrix and "
+                     "the annual energy)")
     if out["failed_solves"]:
         lines.append(f"{out['failed_solves']} solves did not converge (status in the store; "
                      "left out of the statistics: see the count)")
@@ -225,12 +234,27 @@ def text_report(ds, out: dict, drawn: list) -> str:
         names = (("limit_power", "limit"), ("uniform_power", "uniform rotation"),
                  ("electrical_power", "electrical"),
                  ("radiation_bound_power", "radiation bound"), ("one_way_power", "one-way"))
-        lines.append(f"mean annual energy (8766 h/yr): optimum {_per_year(p['wh'])}"
-                     + "".join(f", {label} {_per_year(a[q]['wh'])}" for q, label in names
-                               if q in a))
+        def aep(e):
+            # an incomplete AEP is never one plain number: its bounds
+            if e.get("complete", True) or "wh_bounds" not in e:
+                return _per_year(e["wh"])
+            lo, hi = e["wh_bounds"]
+            return f"{_per_year(lo)} to {_per_year(hi)}"
+
+        lines.append(f"mean annual energy (8766 h/yr): optimum {aep(p)}"
+                     + "".join(f", {label} {aep(a[q])}" for q, label in names if q in a))
+        if not p.get("complete", True) and "uncounted_frequency" in p:
+            lines.append(f"incomplete: {p['uncounted_frequency']:.4g} of the year has no "
+                         "power (the bounds count it at 0 and at the largest bin's power)")
         if p.get("capacity_factor") is not None:
             lines.append(f"capacity factor {p['capacity_factor']:.4g} "
                          f"({100 * p['capacity_factor']:.3g} % of the rated power's energy)")
+        elif p.get("capacity_factor_bounds"):
+            lo, hi = p["capacity_factor_bounds"]
+            lines.append(f"capacity factor {lo:.4g} to {hi:.4g} (incomplete)")
+        if p.get("rest_frequency"):
+            lines.append(f"{p['rest_frequency']:.4g} of the year in bins where the optimum is "
+                         "negative: the pendulum at rest there, counted at 0 W")
         if p["bins_without_power"]:
             miss = ", ".join(f"(Hm0 {b['hm0']:g} m, {pk} {b[pk]:g} s)"
                              for b in p["bins_without_power"][:8])
@@ -240,7 +264,7 @@ def text_report(ds, out: dict, drawn: list) -> str:
         if p.get("outside_frequency"):
             o = p["outside_frequency"]
             lines.append(f"{o['sea_states']} sea states ({o['frequency']:.4g} of the year) "
-                         "lie outside the matrix's bins and contribute nothing")
+                         "lie outside the matrix's bins (not counted: see the bounds)")
     for key in ("netcdf", "zarr", "csv"):
         if out[key]:
             lines.append(f"{key} written to {out[key]}")

@@ -24,9 +24,11 @@ import math
 
 import numpy as np
 
+from .. import limits
 from ..seas import jonswap, pierson_moskowitz
 
-__all__ = ["bin_edges", "energy_flux", "record_spectrum", "te_over_tp", "wave_number"]
+__all__ = ["bin_edges", "energy_flux", "record_spectrum", "repeat_period", "te_over_tp",
+           "wave_number"]
 
 #: water density (kg/m^3), MHKiT's default
 DENSITY = 1025.0
@@ -108,3 +110,13 @@ def bin_edges(centres) -> np.ndarray:
     c = np.asarray(centres, dtype=float)
     mids = [float(np.mean([c[i], c[i + 1]])) for i in range(c.size - 1)]
     return np.array([0.0, *mids, float(c[-1] + np.diff(c[-2:])[0] / 2)])
+
+
+def repeat_period(waves: float, tp: float) -> float:
+    """``waves * tp`` (s), one ulp lower where the product's rounding would put the record
+    above ``parapend sea``'s longest (``waves = 400`` at some Tp read back as 400.0000001
+    peak periods and every bin was refused)."""
+    rp = waves * tp
+    while rp / tp > limits.SEA_WAVES_RANGE[1]:
+        rp = math.nextafter(rp, 0.0)
+    return rp

@@ -162,9 +162,11 @@ class MatrixSpec:
 
     def sea_kwargs(self, i: int, j: int, r: int) -> dict:
         """The arguments of :func:`parapend.irregular.sea` for bin (i, j), realization r."""
+        from .resource import repeat_period as _repeat
+
         tp = self.tp[j]
         kw = {"hs": self.hm0[i], "tp": tp, "spectrum": self.spectrum,
-              "repeat_period": self.waves * tp, "seed": int(self.seeds[r]),
+              "repeat_period": _repeat(self.waves, tp), "seed": int(self.seeds[r]),
               "cutoff": self.cutoff, "length": self.length, "mass": self.mass,
               "inertia": self.inertia, "gravity": self.gravity, "gamma": self.gamma,
               "winding": self.winding, "harmonics": self.harmonics}
@@ -228,6 +230,14 @@ class MatrixSpec:
                  "conventions": "powers in W, positive = harvested; per realization; "
                                 "parapend.performance adds the statistics (docs/performance.md)"}
         return xr.Dataset(data, coords=coords, attrs=attrs), enc
+
+    def finished(self, vals: dict) -> np.ndarray:
+        """The points of a computed block the store marks finished: every realization but
+        those whose solve raised (status "error"), so a rerun retries them rather than
+        keeping the failure for good."""
+        from ..maps.spec import _CODE
+
+        return np.asarray(vals["status"]) != _CODE["error"]
 
     # -- one block ---------------------------------------------------------------------------
     def compute_block(self, block: int) -> dict:

@@ -1,0 +1,181 @@
+"""What a power matrix is asked, checked before any bin runs: every bin's record and
+resolution (:func:`check_bins`), and the size of the whole (:func:`check_size`: bins,
+solves, memory and worker processes), each refused in one line naming the option.
+
+A bin whose inputs ``parapend sea`` (or ``parapend buoy``) would refuse used to be solved
+anyway: every realization failed with a warning, the matrix came back empty with exit 0,
+and a store marked those bins finished for good. Here the record of every bin is built (a
+millisecond each) and checked as the solver checks it, before the first solve.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+
+from ..errors import ParameterError, check_range
+
+__all__ = ["MAX_BINS", "MAX_SOLVES", "MIN_EFFICIENCY", "WORKER_BYTES", "check_bins",
+           "check_efficiency", "check_size", "memory_available", "workers_for"]
+
+#: most bins of one matrix (Hm0 x period): the store holds a chunk per bin and variable, and
+#: the engine a task per bin (10 000 bins: about 0.3 GB and 10 s of bookkeeping)
+MAX_BINS = 10_000
+#: most solves (bins x realizations) of one matrix: a solve of a 50-wave record takes
+#: seconds, so a million of them is days of a large cluster
+MAX_SOLVES = 1_000_000
+#: bookkeeping per bin (the engine's task and the lazy store's chunks: measured 12 kB)
+_BIN_BYTES = 16 << 10
+#: per solve (realization): the stored quantities, their statistics and the report
+_SOLVE_BYTES = 128
+#: memory of one worker process: Python, NumPy, SciPy and numba's kernels loaded (about
+#: 200 MB measured) and one solve's arrays
+WORKER_BYTES = 300 << 20
+
+
+#: the lowest power take-off efficiency a matrix takes: below it the motoring power p / eta
+#: of a record overflows (a subnormal eta gave NaN bins); 1e-6 is far below any machine
+MIN_EFFICIENCY = 1e-6
+
+
+def check_efficiency(value) -> float:
+    """A power take-off efficiency in ``[MIN_EFFICIENCY, 1]`` (one line naming it)."""
+    return check_range("efficiency", value, MIN_EFFICIENCY, 1.0,
+                       why="fraction of the power converted")
+
+
+def _where(spec, i: int, j: int, r: int | None = None) -> str:
+    pk = spec.period_kind
+    return (f"the bin Hm0 {spec.hm0[i]:g} m, {pk} {spec.period[j]:g} s"
+            + ("" if r is None else f" (realization {r}, seed {int(spec.seeds[r])})"))
+
+
+def _units(spec):
+    """The pendulum's units (the buoy's at g = 9.81, as its spec holds)."""
+    from ..units import Units
+
+    return Units(spec.length, spec.mass, 9.81 if spec.device == "buoy" else spec.gravity,
+                 spec.inertia)
+
+
+def _record(spec, units, i: int, j: int, r: int):
+    """The excitation of bin ``(i, j)``, realization ``r``, as ``sea`` builds it; its
+    ParameterError reworded to name the bin and the options that set it."""
+    from ..seas import sea_record
+    from .resource import repeat_period
+
+    tp = spec.tp[j]
+    response = (None if spec.response is None else tuple(spec.response))
+    try:
+        return sea_record(units, hs=spec.hm0[i], tp=tp, spectrum=spec.spectrum,
+                          gamma_peak=spec.gamma_peak, repeat_period=repeat_period(spec.waves, tp),
+                          seed=int(spec.seeds[r]), cutoff=spec.cutoff, response=response)
+    except ParameterError as err:
+        head, _, rest = str(err).partition(": ")
+        if head == "sea":  # the record's q: set by hs, the cutoff and gravity
+            head = "hs, cutoff, gravity" if spec.device != "buoy" else "hs, cutoff"
+        raise ParameterError(f"{head}: {_where(spec, i, j, r)}: {rest}") from None
+
+
+def check_bins(spec) -> None:
+    """Every bin's record (each realization) and resolution, as the solver checks them;
+    raises :class:`~parapend.errors.ParameterError` naming the option and the bin.
+
+    A record scales with Hm0 (q is proportional to it), and the record's other checks do
+    not depend on it: so the smallest and the largest Hm0 bin of each period bin stand for
+    the rest (the smallest harmonic's floor, the cap on ``max |q(t)|``). The realizations
+    differ only in their phases: the same amplitudes, so only the cap can differ, and it is
+    checked on each of them only where the bound ``2 sum |q_k|`` (any phases) exceeds it."""
+    from .. import limits
+    from ..irregular import AUTO_FRACTIONS, HARMONICS_PER_WAVE
+
+    units = _units(spec)
+    cap = limits.MAX_AMPLITUDE * (1.0 + 1e-12)
+    top = len(spec.hm0) - 1
+    for j in range(len(spec.period)):
+        for i in sorted({0, top}):
+            exc = _record(spec, units, i, j, 0)
+            if (i == top and spec.realizations > 1
+                    and 2.0 * float(abs(exc.spectrum[1:]).sum()) > cap):
+                for r in range(1, spec.realizations):
+                    _record(spec, units, i, j, r)
+            if spec.device == "buoy" or i:
+                continue
+            # the resolution (seed- and Hs-independent): sea's rule
+            km = max(1, int(round(exc.mean_frequency_harmonic)))
+            if isinstance(spec.winding, str):
+                ks = sorted({1} | {max(1, int(round(f * km))) for f in AUTO_FRACTIONS})
+            else:
+                ks = [int(spec.winding)]
+            n = (spec.harmonics if spec.harmonics is not None
+                 else min(HARMONICS_PER_WAVE * max(km, max(ks)),
+                          limits.SEA_MAX_HARMONICS // 2))
+            if n < 2 * max(ks):
+                raise ParameterError(
+                    f"harmonics: expected at least 2 K = {2 * max(ks)} (K = {max(ks)} turns "
+                    f"per record{', winding auto' if isinstance(spec.winding, str) else ''}) "
+                    f"for {_where(spec, i, j)}, got {n}")
+
+
+def memory_available() -> int | None:
+    """Bytes of memory available to new work (``MemAvailable`` of /proc/meminfo), or None
+    where it cannot be read."""
+    try:
+        with open("/proc/meminfo", encoding="ascii") as fh:
+            for line in fh:
+                if line.startswith("MemAvailable:"):
+                    return int(line.split()[1]) * 1024
+    except (OSError, ValueError, IndexError):
+        pass
+    return None
+
+
+def workers_for(spec, workers) -> int:
+    """The local processes a matrix starts: ``min(workers, bins)`` (default: the CPUs)."""
+    if workers is None:
+        workers = os.cpu_count() or 1
+    return max(1, min(int(workers), spec.blocks))
+
+
+def check_size(spec, workers=None, scheduler=None, available=None) -> dict:
+    """The size of the matrix before anything is allocated or started: refuses in one line
+    (naming the option and the largest value that fits) more than :data:`MAX_BINS` bins,
+    more than :data:`MAX_SOLVES` solves, or what needs more memory than is available
+    (``available`` bytes; default :func:`memory_available`). Returns the estimate, with
+    ``processes`` the local processes to start: ``min(workers, bins)``, and by default
+    (``workers`` None) at most as many as the memory holds."""
+    nh, npk, r = len(spec.hm0), len(spec.period), spec.realizations
+    pk = spec.period_kind
+    bins = nh * npk
+    if bins > MAX_BINS:
+        big, small, nb, ns = (("hs", pk, nh, npk) if nh >= npk else (pk, "hs", npk, nh))
+        raise ParameterError(
+            f"{big}: at most {MAX_BINS} bins in all, got {nh} Hm0 x {npk} {pk} = {bins}; "
+            f"with {ns} {small} bins, --{big} may have at most {MAX_BINS // ns} bins")
+    solves = bins * r
+    if solves > MAX_SOLVES:
+        raise ParameterError(
+            f"realizations: at most {MAX_SOLVES} solves (bins x realizations) in all, got "
+            f"{bins} bins x {r} = {solves}; with {bins} bins, --realizations may be at "
+            f"most {MAX_SOLVES // bins}")
+    procs = 0 if scheduler is not None else workers_for(spec, workers)
+    base = bins * _BIN_BYTES + solves * _SOLVE_BYTES
+    have = memory_available() if available is None else available
+    fit = None if have is None else max(0, (have - base) // WORKER_BYTES)
+    if workers is None and fit is not None and procs > max(1, fit):
+        procs = max(1, int(fit))  # the default: as many processes as the memory holds
+    need = base + procs * WORKER_BYTES
+    if have is not None and need > have:
+        if fit >= 1 and procs > fit:
+            raise ParameterError(
+                f"workers: {procs} processes need about {procs * WORKER_BYTES / 2**30:.3g} GB "
+                f"({WORKER_BYTES >> 20} MB each), {have / 2**30:.3g} GB is available; "
+                f"--workers may be at most {fit}")
+        raise ParameterError(
+            f"hs, {pk}, realizations: the matrix needs about {need / 2**30:.3g} GB, "
+            f"{have / 2**30:.3g} GB is available; give fewer bins or realizations")
+    # a rough time: a 50-wave record solves in about 3 s on one core, a 400-wave one in
+    # about 9 s (measured on the shared 2-core machine): as the square root of the length
+    seconds = solves * 3.0 * math.sqrt(max(1.0, spec.waves / 50.0)) / max(1, procs or 1)
+    return {"bins": bins, "solves": solves, "processes": procs, "memory_bytes": need,
+            "seconds": seconds if math.isfinite(seconds) else None}
