@@ -583,7 +583,8 @@ LIMIT_TOL = 1e-7
 
 
 def torque_limited(problem: ElectricalProblem, x0: np.ndarray, limit: float, *,
-                   tol: float = LIMIT_TOL, max_outer: int = 40, warm: bool = False):
+                   tol: float = LIMIT_TOL, max_outer: int = 40, warm: bool = False,
+                   max_inner: int | None = None):
     """Maximize the problem's objective subject to ``|tau| <= limit`` on its grid by an
     augmented Lagrangian (PHR): each outer step a trust-region Newton solve of the
     penalized objective (exact gradient and Hessian), then ``lam <- max(0, lam + rho g)``,
@@ -592,7 +593,8 @@ def torque_limited(problem: ElectricalProblem, x0: np.ndarray, limit: float, *,
     Returns ``(x, objective, violation, outer, inner, status)``: ``violation`` the largest
     ``max |tau| - limit`` on the grid at ``x``; status "converged" when it is at most
     ``tol * limit`` and the last inner solve converged. ``warm``: keep the multipliers and
-    the penalty the problem holds for this limit (a continuation).
+    the penalty the problem holds for this limit (a continuation). ``max_inner``: at most
+    so many inner iterations in all (then status "max_iterations"): each costs O(N^3).
     """
     from scipy.optimize import minimize
 
@@ -610,6 +612,8 @@ def torque_limited(problem: ElectricalProblem, x0: np.ndarray, limit: float, *,
     viol = float(np.max(np.abs(st["tau"]))) - limit
     outer = 0
     while outer < max_outer:
+        if max_inner is not None and inner >= max_inner:
+            break
         outer += 1
         cache = {}
 
@@ -628,7 +632,8 @@ def torque_limited(problem: ElectricalProblem, x0: np.ndarray, limit: float, *,
             warnings.simplefilter("ignore", RuntimeWarning)
             r = minimize(lambda z: -ev(z)[0], x, jac=lambda z: -ev(z)[1],
                          method="trust-exact" if dense else "trust-krylov",
-                         options={"gtol": gtol, "maxiter": MAXITER}, **kw)
+                         options={"gtol": gtol, "maxiter": MAXITER if max_inner is None
+                                  else max(1, min(MAXITER, max_inner - inner))}, **kw)
         if not np.all(np.isfinite(r.x)):
             status = "stalled"
             break
