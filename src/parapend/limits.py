@@ -170,3 +170,29 @@ SEA_MAX_RECORD_ROWS = 1 << 17
 SEA_MAX_RESAMPLED = 1 << 20
 #: harmonics N of the motion over one record (operator Newton: memory O(N), time O(N log N))
 SEA_MAX_HARMONICS = 16384
+
+# --- the floating buoy (parapend buoy, docs/buoy.md) ---------------------------------------
+#: radius and draft of a parametric body, m (1e-300 and 1e300 overflowed Capytaine's panel
+#: counts: "Maximum allowed size exceeded")
+BUOY_SIZE_RANGE = (1e-2, 1e3)
+#: influence coefficients of one BEM frequency of a parametric (rotation-symmetric) body:
+#: panels x panels of one slice. The default cylinder (1026 panels, 19 a slice, about 2e4)
+#: took 12 s for its 48 frequencies under load, radius 2 m beside a 0.5 m draft (9416
+#: panels, 4e5) 142 s: the cap keeps a body's BEM near a minute
+BUOY_MAX_BEM_WORK = 1.5e5
+#: panels of the immersed part of a mesh file (no symmetry: a dense panels x panels solve
+#: per frequency; 20 000 panels reached 2.8 GB)
+BUOY_MAX_MESH_PANELS = 1500
+#: bytes of a mesh file or of a hydrodynamics dataset (a sparse 3 GB file was read whole)
+BUOY_MAX_FILE_BYTES = 64 << 20
+#: smallest efficiency of the power take-off, each way (1e-300 and 5e-324 gave infinite
+#: motoring costs and NaN; below 1 % the take-off is not a generator)
+BUOY_MIN_EFFICIENCY = 1e-2
+#: relative asymmetry of A and B (between DOFs) a dataset may have before it is refused;
+#: below it they are symmetrised (with a warning where above round-off)
+BUOY_SYMMETRY_TOL = 1e-2
+#: negative heave radiation damping a dataset may hold at a frequency, as a fraction of its
+#: largest B, before it is refused (at most this much: the frequencies are dropped, named)
+BUOY_NEGATIVE_DAMPING_TOL = 1e-2
+#: radians a chosen wave direction may differ from one in the dataset
+BUOY_DIRECTION_TOL = 1e-6

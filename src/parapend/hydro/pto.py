@@ -38,10 +38,13 @@ from __future__ import annotations
 
 import contextlib
 import math
+import numbers
 import warnings
+from decimal import Decimal
 
 import numpy as np
 
+from .. import limits
 from ..errors import ParameterError
 
 __all__ = ["ElectricalProblem", "efficiency_pair", "electrical_power", "ladder", "maximize",
@@ -61,7 +64,7 @@ def efficiency_pair(efficiency) -> tuple[float, float] | None:
         except ValueError:
             raise ParameterError(f"efficiency: expected ETA_G or ETA_G,ETA_M (numbers in "
                                  f"(0, 1]), got {efficiency!r:.40}") from None
-    elif isinstance(efficiency, (int, float, np.floating)) and not isinstance(efficiency, bool):
+    elif isinstance(efficiency, (numbers.Real, Decimal)) and not isinstance(efficiency, bool):
         vals = [float(efficiency)]
     else:
         try:
@@ -72,10 +75,11 @@ def efficiency_pair(efficiency) -> tuple[float, float] | None:
     if len(vals) not in (1, 2):
         raise ParameterError(f"efficiency: expected ETA_G or ETA_G,ETA_M, got "
                              f"{len(vals)} values")
+    lo = limits.BUOY_MIN_EFFICIENCY
     for v in vals:
-        if not (math.isfinite(v) and 0.0 < v <= 1.0):
-            raise ParameterError(f"efficiency: expected numbers in (0, 1] (the fraction of "
-                                 f"the power converted), got {v!r}")
+        if not (math.isfinite(v) and lo <= v <= 1.0):
+            raise ParameterError(f"efficiency: expected numbers in [{lo:g}, 1] (the fraction "
+                                 f"of the power converted), got {v!r}")
     return (vals[0], vals[-1])
 
 

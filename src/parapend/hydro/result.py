@@ -384,7 +384,7 @@ def _result(h, width, pendulum, wave, wave_info, sol, ow, *, torque_limit, effic
     p = float(sol.power)
     bound = float(sol.radiation_bound)
     cw = p / flux if flux > 0 else math.nan
-    notes = list(notes)
+    notes = list(getattr(h, "notes", ())) + list(notes)
     n = int(sol.harmonics)
     above = np.asarray(h.above_range(wave.omega * np.arange(1, n + 1)))
     if above.any():
