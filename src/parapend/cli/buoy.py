@@ -163,6 +163,9 @@ def _cmd_buoy(a) -> dict | str:
             mpc_text(r) + ([f"written: {a.save}"] if a.save else []))
     sweep = hasattr(r, "period_s")
     if not sweep and r.status == "no_power":
+        head = r.message.split(":", 1)[0]
+        if head in ("wave", "torque-limit"):
+            raise ParameterError(r.message)
         name = "efficiency" if r.message.startswith("no electrical") else "damping-coefficient"
         raise ParameterError(f"{name}: {r.message}")
     written = []

@@ -951,6 +951,12 @@ def _from_dataset(ds, *, c=None, mass=None, description="", path="the dataset",
                              f"got {c!r}")
     if not (math.isfinite(mass) and mass > 0):
         raise ParameterError(f"hydro: {path}: expected a heave mass > 0, got {mass!r}")
+    if check and np.any(mass + a <= 0):
+        i = int(np.argmin(a))
+        raise ParameterError(f"hydro: {path}: added_mass makes the heaving mass M + A <= 0 at "
+                             f"{int(np.sum(mass + a <= 0))} of {w.size} frequencies (A = "
+                             f"{a[i]:.4g} kg at {w[i]:.4g} rad/s, M = {mass:.4g} kg): not a "
+                             "floating body's")
     rho = _scalar(ds, "rho", 1025.0)
     g = _scalar(ds, "g", 9.81)
     depth = _scalar(ds, "water_depth", math.inf)

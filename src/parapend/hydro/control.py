@@ -638,6 +638,9 @@ def buoy_mpc(hydro, pendulum, wave, *, peak_period, horizon=2.0, update_interval
         status = "nonfinite"
     if status == "ok" and float(np.max(np.abs(ys[:, 3]))) * h > RESOLVED:
         status = "unresolved"
+    if status == "ok" and solves and 2 * failed > solves:
+        # a run whose plans mostly failed is not a success, whatever its power
+        status = "solves_failed"
     st = np.asarray(times)
     fp = []
     if controller != "one-way" and iterations > 1 and changes:
@@ -647,6 +650,8 @@ def buoy_mpc(hydro, pendulum, wave, *, peak_period, horizon=2.0, update_interval
     msg = {"ok": f"{solves} horizon solves in {st.size} updates, {failed} ended abnormally",
            "diverged": "the closed loop diverged (|theta'| > 1e6 rad/s)",
            "nonfinite": "non-finite power",
+           "solves_failed": (f"{failed} of {solves} horizon solves ended abnormally: the "
+                             "controller did not plan this run"),
            "unresolved": (f"the pendulum turned more than {RESOLVED:g} rad in one plant step: "
                           "the integration does not resolve the run; lower the torque "
                           "limit")}[status]

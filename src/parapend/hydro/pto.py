@@ -78,8 +78,8 @@ def efficiency_pair(efficiency) -> tuple[float, float] | None:
     lo = limits.BUOY_MIN_EFFICIENCY
     for v in vals:
         if not (math.isfinite(v) and lo <= v <= 1.0):
-            raise ParameterError(f"efficiency: expected numbers in [{lo:g}, 1] (the fraction "
-                                 f"of the power converted), got {v!r}")
+            raise ParameterError(f"efficiency: expected numbers in (0, 1], at least {lo:g} "
+                                 f"(the fraction of the power converted), got {v!r}")
     return (vals[0], vals[-1])
 
 
