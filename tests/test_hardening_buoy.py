@@ -228,3 +228,16 @@ def test_low_torque_limit_blames_the_limit():
 
     msg = _message(None, -1.0, _P(), bound=10.0, torque_limit=1e-3)
     assert msg.startswith("torque-limit:")
+
+
+@pytest.mark.parametrize("args, names", [
+    (["--harmonics", "4096"], ["harmonics"]),
+    (["--harmonics", "4096", "--efficiency", "0.9"], ["harmonics"]),
+    (["--harmonics", "1024"], ["harmonics"]),
+    (["--harmonics", "48", "--torque-limit", "10"], ["harmonics"]),
+    (["--winding", "64"], ["winding"]),
+    (["--winding", "2", "--efficiency", "0.9"], ["winding"]),
+])
+def test_sizes_refused_before_work(capsys, args, names):
+    err = _refused(capsys, *args, names=names)
+    assert "at most" in err

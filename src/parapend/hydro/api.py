@@ -192,6 +192,28 @@ def _check_bem_size(radius, draft):
                          f"--{big} at most {a:.3g} m")
 
 
+def _check_harmonics(harmonics, winding, pto):
+    """Refuse a regular wave's motion of more harmonics than finish in about two minutes
+    (:data:`parapend.limits.BUOY_MAX_HARMONICS`, ``BUOY_MAX_PTO_HARMONICS`` with a power
+    take-off), naming the option that set them."""
+    from .optimum import HARMONICS_PER_TURN
+
+    cap = limits.BUOY_MAX_PTO_HARMONICS if pto else limits.BUOY_MAX_HARMONICS
+    why = "with --efficiency or --torque-limit, " if pto else ""
+    if harmonics is not None:
+        if harmonics > cap:
+            raise ParameterError(f"harmonics: expected at most {cap} ({why}the most that "
+                                 f"finish in about two minutes), got {harmonics}")
+        return
+    n = HARMONICS_PER_TURN * winding
+    if n > cap:
+        raise ParameterError(f"winding: {winding} turns need {n} harmonics ("
+                             f"{HARMONICS_PER_TURN} per turn), more than the {cap} that "
+                             f"finish in about two minutes ({why or 'regular wave, '}"
+                             f"at most {max(1, cap // HARMONICS_PER_TURN)} turns); or give "
+                             f"--harmonics, at least 2 per turn")
+
+
 def _coarse_hydro(body, radius, draft, mesh, hydro):
     """The same body on a mesh of panels :data:`.bem.COARSE` times larger, on the same
     frequencies (the error estimate's second mesh); None for a mesh file or a dataset."""
@@ -336,6 +358,8 @@ def buoy(*, wave_height=None, wave_period=None, hs=None, tp=None, spectrum=None,
         efficiency = efficiency_pair(efficiency)
         if efficiency == (1.0, 1.0):
             efficiency = None  # lossless: the ideal problem
+    if not irregular:
+        _check_harmonics(harmonics, winding, torque_limit is not None or efficiency is not None)
     variables, bounds = _design_request(optimize_design, pend, mass_bounds=mass_bounds,
                                         length_bounds=length_bounds,
                                         inertia_bounds=inertia_bounds,
