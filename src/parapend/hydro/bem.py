@@ -795,8 +795,9 @@ def _dof_matrix(da, path, name):
 def _physics(w, a_full, b_full, b, path):
     """Check the radiation coefficients as physics: the matrices over the DOFs symmetric
     within :data:`parapend.limits.BUOY_SYMMETRY_TOL`, the damping positive semidefinite
-    at each frequency (heave's ``B >= 0``). Returns the mask of the frequencies kept and the
-    notes; refuses (one line) data whose damping is negative beyond round-off at more than a
+    at each frequency (heave's ``B >= 0``; where it is negative by less than the tolerance,
+    BEM noise, it is set to 0 by :class:`Hydro`, and named in a note). Returns the mask of
+    the frequencies kept and the notes; refuses (one line) data whose damping is negative beyond round-off at more than a
     few frequencies, or nowhere positive."""
     from .. import limits
 
@@ -832,15 +833,13 @@ def _physics(w, a_full, b_full, b, path):
                              f"{low[i]:.3g} N s/m at {w[i]:.4g} rad/s, beyond "
                              f"{limits.BUOY_NEGATIVE_DAMPING_TOL:g} of its largest): a passive "
                              "body's damping is positive semidefinite")
-    keep = ~slight
+    keep = np.ones(w.size, dtype=bool)
     if np.any(slight):
-        if np.sum(keep) < 2:
-            raise ParameterError(f"hydro: {path}: radiation_damping is negative at "
-                                 f"{int(np.sum(slight))} of {w.size} frequencies")
         named = ", ".join(f"{x:.4g}" for x in w[slight][:8]) + (
             ", ..." if np.sum(slight) > 8 else "")
-        notes.append(f"hydro: dropped {int(np.sum(slight))} frequencies whose radiation "
-                     f"damping is slightly negative (BEM noise): {named} rad/s")
+        notes.append(f"hydro: radiation damping slightly negative (BEM noise, at most "
+                     f"{limits.BUOY_NEGATIVE_DAMPING_TOL:g} of its largest) set to 0 at "
+                     f"{int(np.sum(slight))} frequencies: {named} rad/s")
     return keep, notes
 
 
@@ -981,9 +980,9 @@ def load(path, *, wave_direction=None) -> Hydro:
     The data are checked as physics: numbers of numeric type, finite; ``added_mass`` and
     ``radiation_damping`` symmetric over the degrees of freedom within
     :data:`parapend.limits.BUOY_SYMMETRY_TOL` (symmetrised, with a note); the damping
-    positive semidefinite at each frequency (frequencies where it is negative by less than
-    :data:`parapend.limits.BUOY_NEGATIVE_DAMPING_TOL` of its largest are dropped, named in
-    a note; more is refused). ``wave_direction`` (rad, default 0) chooses one of the
+    positive semidefinite at each frequency (where it is negative by less than
+    :data:`parapend.limits.BUOY_NEGATIVE_DAMPING_TOL` of its largest, BEM noise, it is set
+    to 0 and the frequencies are named in a note; more is refused). ``wave_direction`` (rad, default 0) chooses one of the
     dataset's wave directions.
 
     Raises
