@@ -241,3 +241,9 @@ def test_low_torque_limit_blames_the_limit():
 def test_sizes_refused_before_work(capsys, args, names):
     err = _refused(capsys, *args, names=names)
     assert "at most" in err
+
+
+def test_long_mpc_record_refused_before_work(capsys):
+    err = _refused(capsys, "--hs", "2", "--tp", "5", "--repeat-period", "1000", "--controller",
+                   "mpc", names=["repeat-period"])
+    assert "at most" in err

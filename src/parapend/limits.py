@@ -204,3 +204,8 @@ BUOY_MAX_HARMONICS = 512
 #: with an efficiency and 57 s with a 1 N m torque limit; 48, 64 and 128 with an efficiency
 #: over 2 minutes
 BUOY_MAX_PTO_HARMONICS = 24
+#: a receding-horizon run of the buoy (--controller mpc): updates x horizon samples x solves
+#: per update. The default run (100 peak periods, horizon 1, update 1/8: 832 x 64 x 2 =
+#: 1.06e5) took 87 s under load; the cap keeps a run near two minutes (about 130 peak
+#: periods of record at the default horizon; a 1000 s record at Tp 5 s is refused)
+BUOY_MAX_MPC_WORK = 1.4e5
