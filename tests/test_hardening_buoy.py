@@ -247,3 +247,15 @@ def test_long_mpc_record_refused_before_work(capsys):
     err = _refused(capsys, "--hs", "2", "--tp", "5", "--repeat-period", "1000", "--controller",
                    "mpc", names=["repeat-period"])
     assert "at most" in err
+
+
+@pytest.mark.parametrize("args, names", [
+    (["--hs", "2", "--tp", "8", "--repeat-period", "1000", "--winding", "64", "--efficiency",
+      "0.9"], ["repeat-period", "winding"]),
+    (["--hs", "2", "--tp", "8", "--repeat-period", "256", "--efficiency", "0.9"],
+     ["repeat-period"]),
+    (["--hs", "2", "--tp", "8", "--repeat-period", "40", "--efficiency", "0.9", "--harmonics",
+      "512"], ["harmonics"]),
+])
+def test_record_with_take_off_refused_before_work(capsys, args, names):
+    assert "at most" in _refused(capsys, *args, names=names)

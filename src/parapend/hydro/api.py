@@ -214,6 +214,34 @@ def _check_harmonics(harmonics, winding, pto):
                              f"--harmonics, at least 2 per turn")
 
 
+def _check_record_harmonics(h, wave, harmonics, winding, record):
+    """Refuse a power take-off over an irregular record whose motion needs more harmonics
+    than finish in about two minutes (:data:`parapend.limits.BUOY_MAX_PTO_RECORD_HARMONICS`;
+    the default is :func:`.optimum._default_harmonics`'s), naming the option."""
+    from .optimum import HARMONICS_PER_WAVE
+
+    cap = limits.BUOY_MAX_PTO_RECORD_HARMONICS
+    if harmonics is not None:
+        if harmonics > cap:
+            raise ParameterError(f"harmonics: expected at most {cap} over a record with "
+                                 f"--efficiency or --torque-limit (the most that finish in "
+                                 f"about two minutes), got {harmonics}")
+        return
+    kk = np.arange(1, np.asarray(wave.amplitudes).size + 1)
+    _, _, f = h.coefficients(kk * wave.omega)
+    e = np.abs(f * np.asarray(wave.amplitudes) / h.impedance(kk * wave.omega)) ** 2
+    km = max(1, int(round(float(np.sum(kk * e) / np.sum(e))))) if np.sum(e) > 0 else 1
+    n = min(HARMONICS_PER_WAVE * max(km, winding), 8192)
+    if n > cap:
+        name = "winding" if winding >= km else ("record" if record is not None
+                                                 else "repeat-period")
+        raise ParameterError(f"{name}: with --efficiency or --torque-limit this record needs "
+                             f"{n} harmonics ({HARMONICS_PER_WAVE} per wave, {max(km, winding)} "
+                             f"waves or turns), more than the {cap} that finish in about two "
+                             f"minutes; use a record of at most {cap // HARMONICS_PER_WAVE} "
+                             "waves and turns, or give --harmonics")
+
+
 def _coarse_hydro(body, radius, draft, mesh, hydro):
     """The same body on a mesh of panels :data:`.bem.COARSE` times larger, on the same
     frequencies (the error estimate's second mesh); None for a mesh file or a dataset."""
@@ -379,6 +407,8 @@ def buoy(*, wave_height=None, wave_period=None, hs=None, tp=None, spectrum=None,
         h, width = _hydro(body, radius, draft, mesh, hydro, wave_direction)
         h.check_covers(wave.omega * (sig[0] + 1), wave.omega * (sig[-1] + 1),
                        name="tp" if record is None else "record")
+        if torque_limit is not None or efficiency is not None:
+            _check_record_harmonics(h, wave, harmonics, winding, record)
     else:
         if periods is None:
             period = _period(BUOY["wave_period"] if wave_period is None else wave_period)
