@@ -72,9 +72,8 @@ def _period(value) -> float:
 
 # --- the pieces -----------------------------------------------------------------------------
 def _pendulum(mass, length, inertia, damping_coefficient):
-    from .coupled import Pendulum
-
     from ..units import Units
+    from .coupled import Pendulum
 
     mass = check_positive("mass", mass)
     length = check_positive("length", length)

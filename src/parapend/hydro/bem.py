@@ -797,8 +797,8 @@ def _physics(w, a_full, b_full, b, path):
     within :data:`parapend.limits.BUOY_SYMMETRY_TOL`, the damping positive semidefinite
     at each frequency (heave's ``B >= 0``; where it is negative by less than the tolerance,
     BEM noise, it is set to 0 by :class:`Hydro`, and named in a note). Returns the mask of
-    the frequencies kept and the notes; refuses (one line) data whose damping is negative beyond round-off at more than a
-    few frequencies, or nowhere positive."""
+    the frequencies kept and the notes; refuses (one line) data whose damping is negative
+    beyond the tolerance, or nowhere positive."""
     from .. import limits
 
     notes = []
@@ -982,8 +982,8 @@ def load(path, *, wave_direction=None) -> Hydro:
     :data:`parapend.limits.BUOY_SYMMETRY_TOL` (symmetrised, with a note); the damping
     positive semidefinite at each frequency (where it is negative by less than
     :data:`parapend.limits.BUOY_NEGATIVE_DAMPING_TOL` of its largest, BEM noise, it is set
-    to 0 and the frequencies are named in a note; more is refused). ``wave_direction`` (rad, default 0) chooses one of the
-    dataset's wave directions.
+    to 0 and the frequencies are named in a note; more is refused). ``wave_direction`` (rad,
+    default 0) chooses one of the dataset's wave directions.
 
     Raises
     ------

@@ -401,6 +401,12 @@ def _result(h, width, pendulum, wave, wave_info, sol, ow, *, torque_limit, effic
     validity = _validity(s["z"], eta, wave, wave_info, h, geometry)
     ep = sol.electrical_power
     harvest = p if ep is None else float(ep)  # what the design delivers
+    # a heaving body absorbs at most the radiation bound: a power above it (beyond the
+    # discretization's 0.1 %) is an impossible number, never a success
+    impossible = harvest > 0 and not p <= bound * (1 + 1e-3)
+    if impossible:
+        notes.append(f"the power {p:.6g} W exceeds the radiation bound {bound:.6g} W: the "
+                     "hydrodynamic data or the solve are wrong; not a success")
     eff = None if sol.efficiency is None else [float(v) for v in sol.efficiency]
     efields = {} if ep is None else {
         "electrical_power_w": float(ep), "pto_loss_w": p - float(ep),
@@ -417,8 +423,9 @@ def _result(h, width, pendulum, wave, wave_info, sol, ow, *, torque_limit, effic
         one_way_power_w=owp, one_way_ratio=owp / p if owp is not None and p > 0 else None,
         free_heave_amplitude_m=_half_range(free_heave(h, wave, t)),
         energy_balance_residual=float(sol.energy_balance_residual), harmonics=n,
-        winding=int(winding), success=bool(sol.success) and harvest > 0,
-        status=str(sol.status) if harvest > 0 else "no_power",
+        winding=int(winding), success=bool(sol.success) and harvest > 0 and not impossible,
+        status=("above_bound" if impossible else str(sol.status)) if harvest > 0
+        else "no_power",
         message=_message(sol, p, pendulum, ep, bound=bound, torque_limit=torque_limit),
         wave=wave_info,
         pendulum={"mass_kg": pendulum.mass, "length_m": pendulum.length,
