@@ -259,3 +259,16 @@ def test_long_mpc_record_refused_before_work(capsys):
 ])
 def test_record_with_take_off_refused_before_work(capsys, args, names):
     assert "at most" in _refused(capsys, *args, names=names)
+
+
+@pytest.mark.slow  # about 7 s: meshing and reading 6400 panels
+def test_mesh_of_too_many_panels_refused_before_the_bem(tmp_path):
+    import capytaine as cpt
+
+    from tests.test_buoy_hydro import _gdf
+
+    # 2 x 40 x 40 = 3200 panels below the waterline, more than the cap (limits.py)
+    mesh = cpt.mesh_vertical_cylinder(length=1.0, radius=0.5, center=(0, 0, 0),
+                                      resolution=(20, 80, 40))
+    with pytest.raises(ParameterError, match=r"^mesh: .* immersed panels; .* at most 1500"):
+        bem.from_mesh(_gdf(tmp_path / "fine.gdf", mesh), omega="body")
