@@ -272,3 +272,14 @@ def test_mesh_of_too_many_panels_refused_before_the_bem(tmp_path):
                                       resolution=(20, 80, 40))
     with pytest.raises(ParameterError, match=r"^mesh: .* immersed panels; .* at most 1500"):
         bem.from_mesh(_gdf(tmp_path / "fine.gdf", mesh), omega="body")
+
+
+@pytest.mark.parametrize("kw, name", [
+    (dict(hydro=42), "hydro"), (dict(mass="x"), "mass"), (dict(horizon=2), "horizon"),
+    (dict(efficiency=[0.9, "a"]), "efficiency"), (dict(torque_limit="1"), "torque-limit"),
+    (dict(radius=[1]), "radius"), (dict(efficiency=Decimal("0.9"), harmonics=100),
+                                   "harmonics"),
+])
+def test_api_raises_parameter_error(kw, name):
+    with pytest.raises(ParameterError, match=f"^{name}:"):
+        parapend.buoy(**kw)

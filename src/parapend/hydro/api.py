@@ -369,8 +369,7 @@ def buoy(*, wave_height=None, wave_period=None, hs=None, tp=None, spectrum=None,
             raise ParameterError(f"{bad[0]}: a regular wave or an irregular sea (--hs, --tp, "
                                  "--record), not both")
     pend = _pendulum(mass, length, inertia, damping_coefficient)
-    if winding is not None:
-        winding = check_int("winding", winding, 1, 64)
+    winding = 1 if winding is None else check_int("winding", winding, 1, 64)
     if harmonics is not None:
         harmonics = check_int("harmonics", harmonics, 2, 4096)
     if torque_limit is not None:
