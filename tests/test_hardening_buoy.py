@@ -283,3 +283,15 @@ def test_mesh_of_too_many_panels_refused_before_the_bem(tmp_path):
 def test_api_raises_parameter_error(kw, name):
     with pytest.raises(ParameterError, match=f"^{name}:"):
         parapend.buoy(**kw)
+
+
+def test_out_of_memory_names_options_of_buoy(monkeypatch, capsys):
+    import parapend.cli.buoy as cb
+
+    def boom(a):
+        raise MemoryError
+
+    monkeypatch.setattr(cb, "_run", boom)
+    assert main(["buoy"]) == 1
+    err = capsys.readouterr().err.strip()
+    assert "out of memory" in err and "--points" not in err and "\n" not in err

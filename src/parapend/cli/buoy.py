@@ -153,7 +153,14 @@ def _cmd_buoy(a) -> dict | str:
     _check_output(a.save, "--save", (".nc",))
     if a.controller != "optimum" and a.plot:
         raise ParameterError("plot: not drawn with --controller mpc (use --save)")
-    r = _run(a)
+    try:
+        r = _run(a)
+    except MemoryError:
+        # the generic message names --points, which this command has not
+        from ..errors import SolverError
+
+        raise SolverError("out of memory; use smaller --harmonics or --winding, a shorter "
+                          "record (--repeat-period, --record), or a smaller --mesh") from None
     if hasattr(r, "controller"):
         from ..hydro.control import mpc_text
 
