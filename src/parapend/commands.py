@@ -911,14 +911,14 @@ from .defaults import BUOY  # noqa: E402
 __all__ += ["buoy"]
 
 
-def buoy(*, wave_height=None, wave_period=None, hs=None, tp=None, spectrum="jonswap",
-         gamma_peak=3.3, repeat_period=None, seed=None, cutoff=3.0, record=None, taper=0.1,
+def buoy(*, wave_height=None, wave_period=None, hs=None, tp=None, spectrum=None,
+         gamma_peak=None, repeat_period=None, seed=None, cutoff=None, record=None, taper=None,
          mass=BUOY["mass"], length=BUOY["length"], inertia=BUOY["inertia"],
-         damping_coefficient=BUOY["damping_coefficient"], body="cylinder", radius=None,
+         damping_coefficient=BUOY["damping_coefficient"], body=None, radius=None,
          draft=None, mesh=None, hydro=None, winding=1, harmonics=None, torque_limit=None,
          efficiency=None, optimize_design=None, mass_bounds=None, length_bounds=None,
          inertia_bounds=None, damping_coefficient_bounds=None, controller="optimum",
-         horizon=1.0, update_interval=0.125):
+         horizon=None, update_interval=None, wave_direction=None):
     """The coupled optimum of a pendulum inside a floating buoy, in SI units (command
     ``buoy``; :func:`parapend.hydro.api.buoy`, parameters there): a
     :class:`~parapend.hydro.result.BuoyResult`, or a :class:`~parapend.hydro.result.BuoySweepResult`
@@ -936,7 +936,8 @@ def buoy(*, wave_height=None, wave_period=None, hs=None, tp=None, spectrum="jons
                  mass_bounds=mass_bounds, length_bounds=length_bounds,
                  inertia_bounds=inertia_bounds,
                  damping_coefficient_bounds=damping_coefficient_bounds,
-                 controller=controller, horizon=horizon, update_interval=update_interval)
+                 controller=controller, horizon=horizon, update_interval=update_interval,
+                 wave_direction=wave_direction)
 # --- horizon -------------------------------------------------------------------------------
 def horizon(*, hs=None, tp=None, spectrum: str = "jonswap", gamma_peak: float = 3.3,
             repeat_period=None, seed=None, cutoff: float = 3.0, length: float = SEA["length"],

@@ -170,3 +170,47 @@ SEA_MAX_RECORD_ROWS = 1 << 17
 SEA_MAX_RESAMPLED = 1 << 20
 #: harmonics N of the motion over one record (operator Newton: memory O(N), time O(N log N))
 SEA_MAX_HARMONICS = 16384
+
+# --- the floating buoy (parapend buoy, docs/buoy.md) ---------------------------------------
+#: radius and draft of a parametric body, m (1e-300 and 1e300 overflowed Capytaine's panel
+#: counts: "Maximum allowed size exceeded")
+BUOY_SIZE_RANGE = (1e-2, 1e3)
+#: influence coefficients of one BEM frequency of a parametric (rotation-symmetric) body:
+#: panels x panels of one slice. The default cylinder (1026 panels, 19 a slice, about 2e4)
+#: took 12 s for its 48 frequencies under load, radius 2 m beside a 0.5 m draft (9416
+#: panels, 4e5) 142 s: the cap keeps a body's BEM near a minute
+BUOY_MAX_BEM_WORK = 1.5e5
+#: panels of the immersed part of a mesh file (no symmetry: a dense panels x panels solve
+#: per frequency; 20 000 panels reached 2.8 GB)
+BUOY_MAX_MESH_PANELS = 1500
+#: bytes of a mesh file or of a hydrodynamics dataset (a sparse 3 GB file was read whole)
+BUOY_MAX_FILE_BYTES = 64 << 20
+#: smallest efficiency of the power take-off, each way (1e-300 and 5e-324 gave infinite
+#: motoring costs and NaN; below 1 % the take-off is not a generator)
+BUOY_MIN_EFFICIENCY = 1e-2
+#: relative asymmetry of A and B (between DOFs) a dataset may have before it is refused;
+#: below it they are symmetrised (with a warning where above round-off)
+BUOY_SYMMETRY_TOL = 1e-2
+#: negative heave radiation damping a dataset may hold at a frequency, as a fraction of its
+#: largest B, before it is refused (at most this much: the frequencies are dropped, named)
+BUOY_NEGATIVE_DAMPING_TOL = 1e-2
+#: radians a chosen wave direction may differ from one in the dataset
+BUOY_DIRECTION_TOL = 1e-6
+#: harmonics of the buoy's motion in a regular wave (--harmonics, or the default 24 per turn
+#: x winding; the solve refines to twice as many): 512 took 18 s, 1024 over 2 minutes (the
+#: solve and its two error estimates)
+BUOY_MAX_HARMONICS = 512
+#: the same with a power take-off (--efficiency, --torque-limit): the default 24 took 25 s
+#: with an efficiency and 57 s with a 1 N m torque limit; 48, 64 and 128 with an efficiency
+#: over 2 minutes
+BUOY_MAX_PTO_HARMONICS = 24
+#: a receding-horizon run of the buoy (--controller mpc): updates x horizon samples x solves
+#: per update. The default run (100 peak periods, horizon 1, update 1/8: 832 x 64 x 2 =
+#: 1.06e5) took 87 s under load; the cap keeps a run near two minutes (about 130 peak
+#: periods of record at the default horizon; a 1000 s record at Tp 5 s is refused)
+BUOY_MAX_MPC_WORK = 1.4e5
+#: harmonics of the buoy's motion over an irregular record with a power take-off (given, or
+#: the default 16 x max(the free heave's mean harmonic, winding)): 192 (--hs 2 --tp 8
+#: --repeat-period 40 --efficiency 0.9) took 14 s of CPU, 512 (--repeat-period 256) over
+#: 2 minutes and 1.3 GB, 800 (--repeat-period 160 --winding 20) 163 s of CPU
+BUOY_MAX_PTO_RECORD_HARMONICS = 256

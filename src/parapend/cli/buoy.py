@@ -39,19 +39,19 @@ def add_parsers(sub) -> None:
                    help=f"significant wave height, m (default {BUOY['hs']:g} with --tp)")
     g.add_argument("--tp", type=_finite_float("tp"), default=None,
                    help=f"peak period, s (default {BUOY['tp']:g} with --hs)")
-    g.add_argument("--spectrum", choices=["jonswap", "pierson-moskowitz"], default="jonswap",
+    g.add_argument("--spectrum", choices=["jonswap", "pierson-moskowitz"], default=None,
                    help="spectrum shape (default jonswap)")
-    g.add_argument("--gamma-peak", type=_finite_float("gamma-peak"), default=3.3,
+    g.add_argument("--gamma-peak", type=_finite_float("gamma-peak"), default=None,
                    help="JONSWAP peak enhancement in [1, 20] (default 3.3)")
     g.add_argument("--repeat-period", type=_finite_float("repeat-period"), default=None,
                    help="T_r, s: the record repeats with it (default 100 Tp)")
     g.add_argument("--seed", type=_int, default=None, help="seed of the random phases "
                                                            "(default 0)")
-    g.add_argument("--cutoff", type=_finite_float("cutoff"), default=3.0,
+    g.add_argument("--cutoff", type=_finite_float("cutoff"), default=None,
                    help="highest frequency, in units of the peak frequency (default 3)")
     g.add_argument("--record", metavar="CSV", default=None,
                    help="measured surface elevation at the body, CSV 't,z' (s, m)")
-    g.add_argument("--taper", type=_finite_float("taper"), default=0.1,
+    g.add_argument("--taper", type=_finite_float("taper"), default=None,
                    help="with --record: fraction under the Tukey taper (default 0.1)")
     g = p.add_argument_group("pendulum (SI units)")
     g.add_argument("--mass", type=_finite_float("mass"), default=BUOY["mass"],
@@ -71,6 +71,10 @@ def add_parsers(sub) -> None:
                                "cylinder)",
                      hydro_help="a Capytaine dataset (NetCDF), instead of solving "
                                 "(docs/buoy.md)")
+    p.set_defaults(body=None)  # so that --body given beside --hydro or --mesh is refused
+    g.add_argument("--wave-direction", type=_finite_float("wave-direction"), default=None,
+                   metavar="RAD", help="with --hydro: the dataset's wave direction to use, rad "
+                                       "(default 0, waves travelling along +x)")
     g = p.add_argument_group("motion and power take-off")
     g.add_argument("--winding", type=_int, default=1,
                    help="turns per wave (per record in an irregular sea) (default 1)")
@@ -98,9 +102,10 @@ def add_parsers(sub) -> None:
                    help="optimum: the non-causal coupled optimum (default); mpc: receding-"
                         "horizon control planned on the coupled model; one-way-mpc: planned "
                         "on the free buoy's heave")
-    g.add_argument("--horizon", type=_finite_float("horizon"), default=1.0,
+    g.add_argument("--horizon", type=_finite_float("horizon"), default=None,
                    help="with mpc: forecast horizon, peak periods (default 1)")
-    g.add_argument("--update-interval", type=_finite_float("update-interval"), default=0.125,
+    g.add_argument("--update-interval", type=_finite_float("update-interval"),
+                   default=None,
                    help="with mpc: re-planning interval, peak periods (default 0.125)")
     p.add_argument("--plot", metavar="DIR",
                    help="draw the figures (PNG and SVG) into this directory")
@@ -148,7 +153,14 @@ def _cmd_buoy(a) -> dict | str:
     _check_output(a.save, "--save", (".nc",))
     if a.controller != "optimum" and a.plot:
         raise ParameterError("plot: not drawn with --controller mpc (use --save)")
-    r = _run(a)
+    try:
+        r = _run(a)
+    except MemoryError:
+        # the generic message names --points, which this command has not
+        from ..errors import SolverError
+
+        raise SolverError("out of memory; use smaller --harmonics or --winding, a shorter "
+                          "record (--repeat-period, --record), or a smaller --mesh") from None
     if hasattr(r, "controller"):
         from ..hydro.control import mpc_text
 
@@ -158,6 +170,9 @@ def _cmd_buoy(a) -> dict | str:
             mpc_text(r) + ([f"written: {a.save}"] if a.save else []))
     sweep = hasattr(r, "period_s")
     if not sweep and r.status == "no_power":
+        head = r.message.split(":", 1)[0]
+        if head in ("wave", "torque-limit"):
+            raise ParameterError(r.message)
         name = "efficiency" if r.message.startswith("no electrical") else "damping-coefficient"
         raise ParameterError(f"{name}: {r.message}")
     written = []

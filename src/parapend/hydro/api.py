@@ -17,6 +17,7 @@ import math
 
 import numpy as np
 
+from .. import limits
 from ..defaults import BUOY
 from ..errors import ParameterError, check_int, check_nonnegative, check_positive, check_range
 from .result import _error_powers, _result, _solve
@@ -71,10 +72,13 @@ def _period(value) -> float:
 
 # --- the pieces -----------------------------------------------------------------------------
 def _pendulum(mass, length, inertia, damping_coefficient):
+    from ..units import Units
     from .coupled import Pendulum
 
     mass = check_positive("mass", mass)
     length = check_positive("length", length)
+    # the ranges of the units (limits.UNIT_*): each message names the option given
+    Units(length, mass, 9.81, None)
     ml2 = mass * length * length
     if inertia is None:
         inertia = ml2
@@ -84,6 +88,7 @@ def _pendulum(mass, length, inertia, damping_coefficient):
                              f"inertia about the pivot of a mass {mass:g} kg at {length:g} m), "
                              f"got {inertia:g}")
     c = check_nonnegative("damping-coefficient", damping_coefficient)
+    Units(length, mass, 9.81, inertia).gamma(c)
     return Pendulum(mass=mass, length=length, inertia=inertia, damping_coefficient=c)
 
 
@@ -114,7 +119,7 @@ def _irregular_wave(hs, tp, spectrum, gamma_peak, repeat_period, seed, cutoff, r
     return wave, info
 
 
-def _hydro(body, radius, draft, mesh, hydro):
+def _hydro(body, radius, draft, mesh, hydro, wave_direction=None):
     """The body's coefficients on the body's own frequency grid (:func:`.bem.body_frequencies`:
     one mesh and one grid per body, whatever the waves of the call), and its width."""
     from . import bem as hy
@@ -122,11 +127,15 @@ def _hydro(body, radius, draft, mesh, hydro):
     given = [n for n, v in (("mesh", mesh), ("hydro", hydro)) if v is not None]
     if len(given) > 1:
         raise ParameterError("hydro: give either --mesh or --hydro, not both")
+    if given and body not in (None, "cylinder"):
+        raise ParameterError(f"body: the body comes from --{given[0]}; drop --body")
+    if body is None:
+        body = "cylinder"
     if given and (radius is not None or draft is not None):
         raise ParameterError(f"{'radius' if radius is not None else 'draft'}: the body comes "
                              f"from --{given[0]}; drop it")
     if hydro is not None:
-        return hy.load(hydro), None
+        return hy.load(hydro, wave_direction=wave_direction), None
     if mesh is not None:
         return hy.from_mesh(mesh, omega="body"), None
     r, d = _dimensions(body, radius, draft)
@@ -137,15 +146,99 @@ def _hydro(body, radius, draft, mesh, hydro):
 
 def _dimensions(body, radius, draft):
     """Radius and draft (m) of a parametric body (a sphere's draft is its radius)."""
+    body = "cylinder" if body is None else body
     if body not in ("cylinder", "sphere"):
         raise ParameterError(f"body: expected cylinder or sphere, got {body!r:.40}")
-    r = check_positive("radius", BUOY["radius"] if radius is None else radius)
+    lo, hi = limits.BUOY_SIZE_RANGE
+    r = check_range("radius", BUOY["radius"] if radius is None else radius, lo, hi, why="m")
     if body == "sphere":
         if draft is not None:
             raise ParameterError("draft: a sphere floats at its centre (draft = radius); "
                                  "drop --draft")
         return r, r
-    return r, check_positive("draft", BUOY["draft"] if draft is None else draft)
+    d = check_range("draft", BUOY["draft"] if draft is None else draft, lo, hi, why="m")
+    _check_bem_size(r, d)
+    return r, d
+
+
+def _check_bem_size(radius, draft):
+    """Refuse a cylinder whose BEM would not finish in about a minute: the panels of its
+    mesh (Capytaine's own count for the panel radius :func:`.bem.cylinder` uses) times the
+    panels of one slice, against :data:`parapend.limits.BUOY_MAX_BEM_WORK`."""
+    from .bem import GEOMETRY_PANELS
+
+    def work(r, d):
+        hh = math.sqrt(2) * min(r, d) / GEOMETRY_PANELS
+        nr, nth, nz = math.ceil(r / hh), 2 * math.ceil(math.pi * r / hh), math.ceil(2 * d / hh)
+        piece = nr + math.ceil(nz / 2)
+        return piece * nth * piece
+
+    cap = limits.BUOY_MAX_BEM_WORK
+    if work(radius, draft) <= cap:
+        return
+    # the largest value of the larger dimension that fits, the other held
+    big = "radius" if radius >= draft else "draft"
+    small = min(radius, draft)
+    a, b = small, max(radius, draft)
+    for _ in range(60):
+        mid = math.sqrt(a * b)
+        w = work(mid, small) if big == "radius" else work(small, mid)
+        a, b = (mid, b) if w <= cap else (a, mid)
+    raise ParameterError(f"{big}: a cylinder of radius {radius:g} m and draft {draft:g} m "
+                         f"needs a BEM of about {work(radius, draft):.3g} influence "
+                         f"coefficients per frequency, more than the {cap:.3g} that finish in "
+                         f"about a minute (the panels follow the smaller dimension); use "
+                         f"--{big} at most {a:.3g} m")
+
+
+def _check_harmonics(harmonics, winding, pto):
+    """Refuse a regular wave's motion of more harmonics than finish in about two minutes
+    (:data:`parapend.limits.BUOY_MAX_HARMONICS`, ``BUOY_MAX_PTO_HARMONICS`` with a power
+    take-off), naming the option that set them."""
+    from .optimum import HARMONICS_PER_TURN
+
+    cap = limits.BUOY_MAX_PTO_HARMONICS if pto else limits.BUOY_MAX_HARMONICS
+    why = "with --efficiency or --torque-limit, " if pto else ""
+    if harmonics is not None:
+        if harmonics > cap:
+            raise ParameterError(f"harmonics: expected at most {cap} ({why}the most that "
+                                 f"finish in about two minutes), got {harmonics}")
+        return
+    n = HARMONICS_PER_TURN * winding
+    if n > cap:
+        raise ParameterError(f"winding: {winding} turns need {n} harmonics ("
+                             f"{HARMONICS_PER_TURN} per turn), more than the {cap} that "
+                             f"finish in about two minutes ({why or 'regular wave, '}"
+                             f"at most {max(1, cap // HARMONICS_PER_TURN)} turns); or give "
+                             f"--harmonics, at least 2 per turn")
+
+
+def _check_record_harmonics(h, wave, harmonics, winding, record):
+    """Refuse a power take-off over an irregular record whose motion needs more harmonics
+    than finish in about two minutes (:data:`parapend.limits.BUOY_MAX_PTO_RECORD_HARMONICS`;
+    the default is :func:`.optimum._default_harmonics`'s), naming the option."""
+    from .optimum import HARMONICS_PER_WAVE
+
+    cap = limits.BUOY_MAX_PTO_RECORD_HARMONICS
+    if harmonics is not None:
+        if harmonics > cap:
+            raise ParameterError(f"harmonics: expected at most {cap} over a record with "
+                                 f"--efficiency or --torque-limit (the most that finish in "
+                                 f"about two minutes), got {harmonics}")
+        return
+    kk = np.arange(1, np.asarray(wave.amplitudes).size + 1)
+    _, _, f = h.coefficients(kk * wave.omega)
+    e = np.abs(f * np.asarray(wave.amplitudes) / h.impedance(kk * wave.omega)) ** 2
+    km = max(1, int(round(float(np.sum(kk * e) / np.sum(e))))) if np.sum(e) > 0 else 1
+    n = min(HARMONICS_PER_WAVE * max(km, winding), 8192)
+    if n > cap:
+        name = "winding" if winding >= km else ("record" if record is not None
+                                                 else "repeat-period")
+        raise ParameterError(f"{name}: with --efficiency or --torque-limit this record needs "
+                             f"{n} harmonics ({HARMONICS_PER_WAVE} per wave, {max(km, winding)} "
+                             f"waves or turns), more than the {cap} that finish in about two "
+                             f"minutes; use a record of at most {cap // HARMONICS_PER_WAVE} "
+                             "waves and turns, or give --harmonics")
 
 
 def _coarse_hydro(body, radius, draft, mesh, hydro):
@@ -154,6 +247,8 @@ def _coarse_hydro(body, radius, draft, mesh, hydro):
     if mesh is not None or hydro is not None:
         return None
     from . import bem as hy
+
+    body = body or "cylinder"
 
     r, d = _dimensions(body, radius, draft)
     if body == "sphere":
@@ -166,7 +261,7 @@ def _geometry(body, radius, draft, mesh, hydro) -> dict | None:
     the draft, a whole sphere, centred on the free surface); None otherwise."""
     if mesh is not None or hydro is not None:
         return None
-    r, d = _dimensions(body, radius, draft)
+    r, d = _dimensions(body or "cylinder", radius, draft)
     return {"draft_m": d, "freeboard_m": d}
 
 
@@ -179,14 +274,14 @@ def _check_floats(h, pendulum):
 
 
 # --- the command ------------------------------------------------------------------------------
-def buoy(*, wave_height=None, wave_period=None, hs=None, tp=None, spectrum="jonswap",
-         gamma_peak=3.3, repeat_period=None, seed=None, cutoff=3.0, record=None, taper=0.1,
+def buoy(*, wave_height=None, wave_period=None, hs=None, tp=None, spectrum=None,
+         gamma_peak=None, repeat_period=None, seed=None, cutoff=None, record=None, taper=None,
          mass=BUOY["mass"], length=BUOY["length"], inertia=BUOY["inertia"],
-         damping_coefficient=BUOY["damping_coefficient"], body="cylinder", radius=None,
+         damping_coefficient=BUOY["damping_coefficient"], body=None, radius=None,
          draft=None, mesh=None, hydro=None, winding=1, harmonics=None, torque_limit=None,
          efficiency=None, optimize_design=None, mass_bounds=None, length_bounds=None,
          inertia_bounds=None, damping_coefficient_bounds=None, controller="optimum",
-         horizon=1.0, update_interval=0.125):
+         horizon=None, update_interval=None, wave_direction=None):
     """The coupled optimum of a pendulum inside a floating buoy (command ``buoy``).
 
     Parameters
@@ -238,6 +333,35 @@ def buoy(*, wave_height=None, wave_period=None, hs=None, tp=None, spectrum="jons
         raise ParameterError("controller: mpc runs in an irregular sea state: give --hs and "
                              "--tp (and --repeat-period, --seed)")
     irregular = any(v is not None for v in (hs, tp, record, repeat_period, seed))
+    # options that would be accepted and ignored: refused with what they need
+    if controller == "optimum":
+        for name, v in (("horizon", horizon), ("update-interval", update_interval)):
+            if v is not None:
+                raise ParameterError(f"{name}: needs --controller mpc (or one-way-mpc)")
+    horizon = 1.0 if horizon is None else horizon
+    update_interval = 0.125 if update_interval is None else update_interval
+    sea_opts = (("spectrum", spectrum), ("gamma-peak", gamma_peak), ("cutoff", cutoff),
+                ("taper", taper))
+    for name, v in sea_opts:
+        if v is None:
+            continue
+        if not irregular:
+            raise ParameterError(f"{name}: an irregular sea's option; needs --hs and --tp "
+                                 f"(or --record)")
+        if name == "taper" and record is None:
+            raise ParameterError("taper: needs --record")
+        if name in ("spectrum", "gamma-peak") and record is not None:
+            raise ParameterError(f"{name}: not used with --record; drop it")
+    spectrum = "jonswap" if spectrum is None else spectrum
+    gamma_peak = 3.3 if gamma_peak is None else gamma_peak
+    cutoff = 3.0 if cutoff is None else cutoff
+    taper = 0.1 if taper is None else taper
+    if wave_direction is not None:
+        wave_direction = check_range("wave-direction", wave_direction, 0.0, 2 * math.pi,
+                                     absolute=True, why="rad")
+        if hydro is None:
+            raise ParameterError("wave-direction: needs --hydro (a dataset with several "
+                                 "wave directions)")
     if irregular:
         bad = [n for n, v in (("wave-height", wave_height), ("wave-period", wave_period))
                if v is not None]
@@ -245,18 +369,23 @@ def buoy(*, wave_height=None, wave_period=None, hs=None, tp=None, spectrum="jons
             raise ParameterError(f"{bad[0]}: a regular wave or an irregular sea (--hs, --tp, "
                                  "--record), not both")
     pend = _pendulum(mass, length, inertia, damping_coefficient)
-    if winding is not None:
-        winding = check_int("winding", winding, 1, 64)
+    winding = 1 if winding is None else check_int("winding", winding, 1, 64)
     if harmonics is not None:
         harmonics = check_int("harmonics", harmonics, 2, 4096)
     if torque_limit is not None:
-        torque_limit = check_positive("torque-limit", torque_limit)
+        mgl = pend.mass * 9.81 * pend.length
+        lo, hi = limits.MIN_TORQUE_LIMIT * mgl, limits.MAX_TORQUE_LIMIT * mgl
+        torque_limit = check_range("torque-limit", torque_limit, lo, hi,
+                                   why=f"N m: {limits.MIN_TORQUE_LIMIT:g} to "
+                                       f"{limits.MAX_TORQUE_LIMIT:g} x m g l")
     if efficiency is not None:
         from .pto import efficiency_pair
 
         efficiency = efficiency_pair(efficiency)
         if efficiency == (1.0, 1.0):
             efficiency = None  # lossless: the ideal problem
+    if not irregular:
+        _check_harmonics(harmonics, winding, torque_limit is not None or efficiency is not None)
     variables, bounds = _design_request(optimize_design, pend, mass_bounds=mass_bounds,
                                         length_bounds=length_bounds,
                                         inertia_bounds=inertia_bounds,
@@ -273,16 +402,18 @@ def buoy(*, wave_height=None, wave_period=None, hs=None, tp=None, spectrum="jons
                                                           pend.inertia))
         amps = np.abs(np.asarray(wave.amplitudes))
         sig = np.nonzero(amps >= 1e-3 * amps.max())[0]  # the components that matter
-        h, width = _hydro(body, radius, draft, mesh, hydro)
+        h, width = _hydro(body, radius, draft, mesh, hydro, wave_direction)
         h.check_covers(wave.omega * (sig[0] + 1), wave.omega * (sig[-1] + 1),
                        name="tp" if record is None else "record")
+        if torque_limit is not None or efficiency is not None:
+            _check_record_harmonics(h, wave, harmonics, winding, record)
     else:
         if periods is None:
             period = _period(BUOY["wave_period"] if wave_period is None else wave_period)
             periods_all = np.array([period])
         else:
             periods_all = np.array([_period(p) for p in periods])
-        h, width = _hydro(body, radius, draft, mesh, hydro)
+        h, width = _hydro(body, radius, draft, mesh, hydro, wave_direction)
         w = 2 * math.pi / periods_all
         top = float(np.max(h.omega))
         if hydro is None and float(np.max(w)) > top * (1 + 1e-9):

@@ -111,6 +111,9 @@ class Hydro:
     g: float = 9.81
     water_depth: float = math.inf
     description: str = ""
+    #: what reading the data changed (symmetrised matrices, dropped frequencies): the
+    #: result's warnings
+    notes: tuple = ()
 
     def __post_init__(self):
         w = np.array(self.omega, dtype=float).ravel()
@@ -624,10 +627,11 @@ def from_mesh(path, *, omega=None, rho=1025.0, g=9.81, water_depth=math.inf, cac
     rho, g, water_depth, _ = _common(rho, g, water_depth, 1.0)
     body_grid = isinstance(omega, str) and omega == "body"
     omega = DEFAULT_OMEGA if omega is None or body_grid else _omega_grid(omega)
+    from .. import limits
+
     p = Path(path)
     name = "mesh"
-    if not p.is_file():
-        raise ParameterError(f"{name}: cannot read {str(p)!r}: no such file")
+    _regular_file(p, name, "a mesh file")
     cpt = _quiet_capytaine()
     try:
         raw = cpt.load_mesh(p, file_format)
@@ -644,6 +648,11 @@ def from_mesh(path, *, omega=None, rho=1025.0, g=9.81, water_depth=math.inf, cac
     if hull is None or hull.nb_faces == 0:
         raise ParameterError(f"{name}: {str(p)!r} has no immersed part (no panel below z = 0; "
                              "the mesh must be in its floating position)")
+    cap = limits.BUOY_MAX_MESH_PANELS
+    if hull.nb_faces > cap:
+        raise ParameterError(f"{name}: {str(p)!r} has {hull.nb_faces} immersed panels; the BEM "
+                             f"(a dense panels x panels solve per frequency) takes at most "
+                             f"{cap} in about a minute and 2 GB: coarsen the mesh")
     size = float(np.ptp(np.asarray(hull.vertices), axis=0).max())
     tol = 1e-6 * size
     bad = [e for e in _open_edges(hull, tol)
@@ -667,6 +676,39 @@ def from_mesh(path, *, omega=None, rho=1025.0, g=9.81, water_depth=math.inf, cac
                   description=desc, cache=cache, key_parts=parts)
 
 
+def _regular_file(p: Path, name: str, what: str) -> None:
+    """Refuse ``p`` unless it is a regular file of at most
+    :data:`parapend.limits.BUOY_MAX_FILE_BYTES` (a directory, FIFO or device is named; a FIFO
+    is opened without blocking, as :func:`parapend.excitation._read_bounded` does)."""
+    import stat
+
+    from .. import limits
+
+    shown = repr(str(p))
+    if p.is_dir():
+        raise ParameterError(f"{name}: expected {what}, got the directory {shown}")
+    try:
+        fd = os.open(p, os.O_RDONLY | getattr(os, "O_NONBLOCK", 0) | getattr(os, "O_NOCTTY", 0))
+    except FileNotFoundError:
+        raise ParameterError(f"{name}: cannot read {shown}: no such file") from None
+    except OSError as exc:
+        raise ParameterError(f"{name}: cannot read {shown}: {exc.strerror or exc}") from None
+    try:
+        st = os.fstat(fd)
+    finally:
+        os.close(fd)
+    if not stat.S_ISREG(st.st_mode):
+        kind = ("a FIFO (named pipe)" if stat.S_ISFIFO(st.st_mode) else
+                "a character device" if stat.S_ISCHR(st.st_mode) else
+                "a block device" if stat.S_ISBLK(st.st_mode) else
+                "a socket" if stat.S_ISSOCK(st.st_mode) else "not a regular file")
+        raise ParameterError(f"{name}: expected {what}, got {kind}: {shown} (save it to a "
+                             "file first)")
+    cap = limits.BUOY_MAX_FILE_BYTES
+    if st.st_size > cap:
+        raise ParameterError(f"{name}: {shown} is larger than {cap >> 20} MiB; expected {what}")
+
+
 def _plain(mesh):
     """``mesh`` as a plain Capytaine Mesh (symmetric meshes merged)."""
     if hasattr(mesh, "merged") and type(mesh).__name__ != "Mesh":
@@ -686,16 +728,123 @@ def _pick(da, dim, label, name, path):
     return da.isel({dim: labels.index(label)})
 
 
+def _numeric(values, name, path, kind="f"):
+    """``values`` as a float (``kind="f"``) or complex array; refuse a variable that is not
+    numeric (a string, an object array) or not finite, in one line."""
+    v = np.asarray(values)
+    if v.dtype.kind not in "iufcb" or v.dtype.kind == "b":
+        raise ParameterError(f"hydro: {path}: {name} is not numeric (type {v.dtype}); "
+                             "expected numbers")
+    if kind == "f" and v.dtype.kind == "c":
+        if np.any(v.imag != 0):
+            raise ParameterError(f"hydro: {path}: {name} is complex; expected real numbers")
+        v = v.real
+    v = v.astype(complex if kind == "c" else float)
+    if not np.all(np.isfinite(v)):
+        raise ParameterError(f"hydro: {path}: {name} holds NaN or infinite values")
+    return v
+
+
 def _scalar(ds, name, default):
     if name in ds.coords or name in ds.variables:
         v = np.asarray(ds[name].values).ravel()
         if v.size != 1:
             raise ParameterError(f"hydro: expected one value of {name}, got {v.size}")
+        if v.dtype.kind not in "iuf":
+            raise ParameterError(f"hydro: {name} is not a number (type {v.dtype})")
         return float(v[0])
     return default
 
 
-def _from_dataset(ds, *, c=None, mass=None, description="", path="the dataset"):
+def _direction(fx, wave_direction, path):
+    """``fx`` at the chosen wave direction (rad; default 0, the waves travelling along
+    +x): one of the dataset's directions, else refused naming them."""
+    from .. import limits
+
+    if "wave_direction" not in fx.dims and "wave_direction" not in fx.coords:
+        return fx
+    dirs = np.atleast_1d(_numeric(fx["wave_direction"].values, "wave_direction", path))
+    want = 0.0 if wave_direction is None else float(wave_direction)
+    gap = np.abs(np.angle(np.exp(1j * (dirs - want))))
+    i = int(np.argmin(gap))
+    if gap[i] > limits.BUOY_DIRECTION_TOL:
+        have = ", ".join(f"{d:g}" for d in dirs[:8]) + (", ..." if dirs.size > 8 else "")
+        raise ParameterError(f"wave-direction: {path} has no wave direction {want:g} rad; "
+                             f"choose one of {have} (rad) with --wave-direction")
+    return fx.isel(wave_direction=i) if "wave_direction" in fx.dims else fx
+
+
+def _dof_matrix(da, path, name):
+    """``da`` (omega, radiating_dof, influenced_dof) as an array (n, d, d), or None when it
+    has one DOF or lacks the dimensions."""
+    if not ("radiating_dof" in da.dims and "influenced_dof" in da.dims):
+        return None
+    rad = [str(v) for v in da["radiating_dof"].values]
+    inf = [str(v) for v in da["influenced_dof"].values]
+    common = [d for d in rad if d in inf]
+    if len(common) < 2:
+        return None
+    sub = da.sel(radiating_dof=common, influenced_dof=common)
+    extra = [d for d in sub.dims if d not in ("omega", "radiating_dof", "influenced_dof")]
+    for d in extra:
+        sub = sub.isel({d: 0})
+    return _numeric(sub.transpose("omega", "radiating_dof", "influenced_dof").values,
+                    name, path)
+
+
+def _physics(w, a_full, b_full, b, path):
+    """Check the radiation coefficients as physics: the matrices over the DOFs symmetric
+    within :data:`parapend.limits.BUOY_SYMMETRY_TOL`, the damping positive semidefinite
+    at each frequency (heave's ``B >= 0``; where it is negative by less than the tolerance,
+    BEM noise, it is set to 0 by :class:`Hydro`, and named in a note). Returns the mask of
+    the frequencies kept and the notes; refuses (one line) data whose damping is negative
+    beyond the tolerance, or nowhere positive."""
+    from .. import limits
+
+    notes = []
+    tol = limits.BUOY_SYMMETRY_TOL
+    eig_b = None
+    for name, m in (("added_mass", a_full), ("radiation_damping", b_full)):
+        if m is None:
+            continue
+        scale = max(float(np.max(np.abs(m))), 1e-300)
+        asym = float(np.max(np.abs(m - np.swapaxes(m, 1, 2)))) / scale
+        if asym > tol:
+            raise ParameterError(f"hydro: {path}: {name} is not symmetric over the degrees of "
+                                 f"freedom (relative asymmetry {asym:.2g}, more than {tol:g}): "
+                                 "not a body's radiation coefficients")
+        if asym > 1e-9:
+            notes.append(f"hydro: {name} symmetrised over the degrees of freedom (relative "
+                         f"asymmetry {asym:.2g})")
+        if name == "radiation_damping":
+            eig_b = np.linalg.eigvalsh(0.5 * (m + np.swapaxes(m, 1, 2))).min(axis=1)
+    top = float(np.max(b))
+    if not top > 0:
+        raise ParameterError(f"hydro: {path}: radiation_damping in heave is nowhere positive "
+                             f"(largest {top:.3g} N s/m): a floating body radiates, B > 0 "
+                             "(negated data, or another sign convention?)")
+    low = b if eig_b is None else np.minimum(b, eig_b)
+    bad = low < -limits.BUOY_NEGATIVE_DAMPING_TOL * top
+    slight = (low < 0) & ~bad
+    if np.any(bad):
+        i = int(np.argmin(low))
+        raise ParameterError(f"hydro: {path}: radiation_damping is negative at "
+                             f"{int(np.sum(bad))} of {w.size} frequencies (down to "
+                             f"{low[i]:.3g} N s/m at {w[i]:.4g} rad/s, beyond "
+                             f"{limits.BUOY_NEGATIVE_DAMPING_TOL:g} of its largest): a passive "
+                             "body's damping is positive semidefinite")
+    keep = np.ones(w.size, dtype=bool)
+    if np.any(slight):
+        named = ", ".join(f"{x:.4g}" for x in w[slight][:8]) + (
+            ", ..." if np.sum(slight) > 8 else "")
+        notes.append(f"hydro: radiation damping slightly negative (BEM noise, at most "
+                     f"{limits.BUOY_NEGATIVE_DAMPING_TOL:g} of its largest) set to 0 at "
+                     f"{int(np.sum(slight))} frequencies: {named} rad/s")
+    return keep, notes
+
+
+def _from_dataset(ds, *, c=None, mass=None, description="", path="the dataset",
+                  check=False, wave_direction=None):
     """A :class:`Hydro` from a Capytaine dataset (complex values merged, ``exp(-i w t)``)."""
     from capytaine.io.xarray import merge_complex_values
 
@@ -734,7 +883,11 @@ def _from_dataset(ds, *, c=None, mass=None, description="", path="the dataset"):
     b = _pick(_pick(ds["radiation_damping"], "radiating_dof", "Heave", "radiation_damping",
                     path), "influenced_dof", "Heave", "radiation_damping", path)
     fx = _pick(fx, "influenced_dof", "Heave", "excitation_force", path)
-    if "wave_direction" in fx.dims:
+    if check:
+        fx = _direction(fx, wave_direction, path)
+        a_full = _dof_matrix(ds["added_mass"], path, "added_mass")
+        b_full = _dof_matrix(ds["radiation_damping"], path, "radiation_damping")
+    elif "wave_direction" in fx.dims:
         dirs = np.asarray(fx["wave_direction"].values, dtype=float)
         fx = fx.isel(wave_direction=int(np.argmin(np.abs(np.angle(np.exp(1j * dirs))))))
     for extra in [d for d in a.dims if d != omega_name]:
@@ -743,10 +896,22 @@ def _from_dataset(ds, *, c=None, mass=None, description="", path="the dataset"):
         b = b.isel({extra: 0})
     for extra in [d for d in fx.dims if d != omega_name]:
         fx = fx.isel({extra: 0})
-    w = np.asarray(ds[omega_name].values, dtype=float)
-    a = np.asarray(a.transpose(omega_name).values, dtype=float)
-    b = np.asarray(b.transpose(omega_name).values, dtype=float)
-    f = np.conj(np.asarray(fx.transpose(omega_name).values, dtype=complex))
+    if check:
+        w = np.asarray(ds[omega_name].values)
+        if w.dtype.kind not in "iuf":
+            raise ParameterError(f"hydro: {path}: omega is not numeric (type {w.dtype})")
+        w = w.astype(float)
+        if np.any(np.isnan(w)) or np.any(w < 0):
+            raise ParameterError(f"hydro: {path}: expected frequencies omega >= 0 (rad/s), "
+                                 "got NaN or a negative one")
+        a = _numeric(a.transpose(omega_name).values, "added_mass", path)
+        b = _numeric(b.transpose(omega_name).values, "radiation_damping", path)
+        f = np.conj(_numeric(fx.transpose(omega_name).values, "excitation_force", path, "c"))
+    else:
+        w = np.asarray(ds[omega_name].values, dtype=float)
+        a = np.asarray(a.transpose(omega_name).values, dtype=float)
+        b = np.asarray(b.transpose(omega_name).values, dtype=float)
+        f = np.conj(np.asarray(fx.transpose(omega_name).values, dtype=complex))
     finite = np.isfinite(w) & (w > 0)  # omega = 0 or inf rows carry no excitation
     order = np.argsort(w[finite])
     w, a, b, f = (x[finite][order] for x in (w, a, b, f))
@@ -754,6 +919,11 @@ def _from_dataset(ds, *, c=None, mass=None, description="", path="the dataset"):
         raise ParameterError(f"hydro: {path} has no finite frequency > 0")
     if np.any(np.diff(w) <= 0):
         raise ParameterError(f"hydro: {path} repeats a frequency")
+    notes = []
+    if check:
+        a_full, b_full = ((None if m is None else m[finite][order]) for m in (a_full, b_full))
+        keep, notes = _physics(w, a_full, b_full, b, path)
+        w, a, b, f = (x[keep] for x in (w, a, b, f))
     if c is None:
         if "hydrostatic_stiffness" not in ds:
             raise ParameterError(f"hydro: {path} has no hydrostatics: hydrostatic_stiffness is "
@@ -761,14 +931,17 @@ def _from_dataset(ds, *, c=None, mass=None, description="", path="the dataset"):
         cs = _pick(_pick(ds["hydrostatic_stiffness"], "radiating_dof", "Heave",
                          "hydrostatic_stiffness", path), "influenced_dof", "Heave",
                    "hydrostatic_stiffness", path)
-        c = float(np.asarray(cs.values).ravel()[0])
+        c = float(_numeric(np.asarray(cs.values).ravel()[:1], "hydrostatic_stiffness",
+                           path)[0])
     if mass is None:
         if "inertia_matrix" in ds:
             ms = _pick(_pick(ds["inertia_matrix"], "radiating_dof", "Heave", "inertia_matrix",
                              path), "influenced_dof", "Heave", "inertia_matrix", path)
-            mass = float(np.asarray(ms.values).ravel()[0])
+            mass = float(_numeric(np.asarray(ms.values).ravel()[:1], "inertia_matrix",
+                                  path)[0])
         elif "disp_mass" in ds:
-            mass = float(np.asarray(ds["disp_mass"].values).ravel()[0])
+            mass = float(_numeric(np.asarray(ds["disp_mass"].values).ravel()[:1], "disp_mass",
+                                  path)[0])
         else:
             raise ParameterError(f"hydro: {path} has no hydrostatics: the mass is missing "
                                  "(expected inertia_matrix or disp_mass)")
@@ -777,16 +950,24 @@ def _from_dataset(ds, *, c=None, mass=None, description="", path="the dataset"):
                              f"got {c!r}")
     if not (math.isfinite(mass) and mass > 0):
         raise ParameterError(f"hydro: {path}: expected a heave mass > 0, got {mass!r}")
+    if check and np.any(mass + a <= 0):
+        i = int(np.argmin(a))
+        raise ParameterError(f"hydro: {path}: added_mass makes the heaving mass M + A <= 0 at "
+                             f"{int(np.sum(mass + a <= 0))} of {w.size} frequencies (A = "
+                             f"{a[i]:.4g} kg at {w[i]:.4g} rad/s, M = {mass:.4g} kg): not a "
+                             "floating body's")
     rho = _scalar(ds, "rho", 1025.0)
     g = _scalar(ds, "g", 9.81)
     depth = _scalar(ds, "water_depth", math.inf)
     return Hydro(omega=w, added_mass=a, radiation_damping=b, excitation=f,
                  hydrostatic_stiffness=c, mass=mass, rho=rho, g=g, water_depth=depth,
-                 description=description or str(ds.attrs.get("description", "")))
+                 description=description or str(ds.attrs.get("description", "")),
+                 notes=tuple(notes))
 
 
-def load(path) -> Hydro:
-    """Read heave coefficients from a NetCDF dataset written by Capytaine.
+def load(path, *, wave_direction=None) -> Hydro:
+    """Read heave coefficients from a NetCDF dataset written by Capytaine, or take them
+    from the :class:`xarray.Dataset` itself (a Capytaine user's ``fill_dataset`` result).
 
     Either ``capytaine.io.xarray.save_dataset_as_netcdf(path, ds)`` or
     ``separate_complex_values(ds).to_netcdf(path)``: complex values split along a
@@ -796,6 +977,14 @@ def load(path) -> Hydro:
     ``hydrostatic_stiffness`` and the mass (``inertia_matrix`` or ``disp_mass``).
     Rows at ``omega = 0`` or ``inf`` are ignored.
 
+    The data are checked as physics: numbers of numeric type, finite; ``added_mass`` and
+    ``radiation_damping`` symmetric over the degrees of freedom within
+    :data:`parapend.limits.BUOY_SYMMETRY_TOL` (symmetrised, with a note); the damping
+    positive semidefinite at each frequency (where it is negative by less than
+    :data:`parapend.limits.BUOY_NEGATIVE_DAMPING_TOL` of its largest, BEM noise, it is set
+    to 0 and the frequencies are named in a note; more is refused). ``wave_direction`` (rad,
+    default 0) chooses one of the dataset's wave directions.
+
     Raises
     ------
     ParameterError
@@ -803,10 +992,16 @@ def load(path) -> Hydro:
     """
     import xarray as xr
 
+    if isinstance(path, xr.Dataset):
+        return _from_dataset(path, description=str(path.attrs.get("description", ""))
+                             or "an xarray dataset", path="the dataset", check=True,
+                             wave_direction=wave_direction)
+    if not isinstance(path, (str, os.PathLike)) or not str(path):
+        raise ParameterError(f"hydro: expected a NetCDF path or an xarray.Dataset, got "
+                             f"{type(path).__name__}")
     p = Path(path)
     shown = repr(str(p))
-    if not p.is_file():
-        raise ParameterError(f"hydro: cannot read {shown}: no such file")
+    _regular_file(p, "hydro", "a NetCDF dataset")
     try:
         ds = xr.load_dataset(p)
     except Exception as exc:  # noqa: BLE001 - xarray's engines raise many types
@@ -814,5 +1009,6 @@ def load(path) -> Hydro:
         raise ParameterError(f"hydro: cannot read {shown} as a NetCDF dataset: {reason}") \
             from None
     desc = str(ds.attrs.get("description", "")) or f"dataset {p.name}"
-    return _from_dataset(ds, description=desc, path=shown)
+    return _from_dataset(ds, description=desc, path=shown, check=True,
+                         wave_direction=wave_direction)
 

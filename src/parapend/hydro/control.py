@@ -207,6 +207,25 @@ def record_force(hydro, wave):
     return force
 
 
+def _check_work(total, n, m, iterations, warm, repeats, dt):
+    """Refuse, before any work, a run whose horizon solves (updates x horizon samples x
+    solves per update) exceed :data:`parapend.limits.BUOY_MAX_MPC_WORK`, naming the longest
+    record that fits."""
+    from .. import limits
+
+    cap = limits.BUOY_MAX_MPC_WORK
+    work = math.ceil(total / m) * n * iterations
+    if work <= cap:
+        return
+    most = (cap / (n * iterations) * m - warm) / repeats * dt
+    fits = (f"use --repeat-period at most {most:.4g} s (or --record that long), or a shorter "
+            "--horizon or a longer --update-interval" if most > 0 else
+            "use a shorter --horizon or a longer --update-interval")
+    raise ParameterError(f"repeat-period: a receding-horizon run of {math.ceil(total / m)} "
+                         f"updates x {n} horizon samples x {iterations} solves is more than "
+                         f"finishes in about two minutes ({cap:.3g}); {fits}")
+
+
 def force_nodes(hydro, wave, per_record, plant_steps, count):
     """``F_exc`` (N) at the plant's half-step nodes ``t = j T_r / (2 per_record
     plant_steps)``, ``j = 0..count - 1``."""
@@ -523,6 +542,8 @@ def buoy_mpc(hydro, pendulum, wave, *, peak_period, horizon=2.0, update_interval
     m = max(1, min(n, int(round(update_interval * tp / dt))))
     warm_samples = int(round(warmup * tp / dt))
     total = warm_samples + repeats * per_record
+    _check_work(total, n, m, iterations if controller != "one-way" else 1, warm_samples,
+                repeats, dt)
     ps, ms = plant_steps, model_steps
     stride = ps // ms
     h = dt / ps
@@ -638,6 +659,9 @@ def buoy_mpc(hydro, pendulum, wave, *, peak_period, horizon=2.0, update_interval
         status = "nonfinite"
     if status == "ok" and float(np.max(np.abs(ys[:, 3]))) * h > RESOLVED:
         status = "unresolved"
+    if status == "ok" and solves and 2 * failed > solves:
+        # a run whose plans mostly failed is not a success, whatever its power
+        status = "solves_failed"
     st = np.asarray(times)
     fp = []
     if controller != "one-way" and iterations > 1 and changes:
@@ -647,6 +671,8 @@ def buoy_mpc(hydro, pendulum, wave, *, peak_period, horizon=2.0, update_interval
     msg = {"ok": f"{solves} horizon solves in {st.size} updates, {failed} ended abnormally",
            "diverged": "the closed loop diverged (|theta'| > 1e6 rad/s)",
            "nonfinite": "non-finite power",
+           "solves_failed": (f"{failed} of {solves} horizon solves ended abnormally: the "
+                             "controller did not plan this run"),
            "unresolved": (f"the pendulum turned more than {RESOLVED:g} rad in one plant step: "
                           "the integration does not resolve the run; lower the torque "
                           "limit")}[status]

@@ -85,6 +85,12 @@ IMAGE_TIE = 1e-6
 #: and for every record (the dense Newton from the swinging-back seeds took minutes at N = 192)
 DENSE_MAX = 96
 
+#: inner (trust-region Newton) iterations of each stage of the torque-limited optimum: on
+#: the fine grid an iteration costs tens of ms and a tight limit (1 N m at the default design)
+#: ran 200 per outer step for 40 outer steps, minutes; past the budget the status is
+#: "stalled" (the answer is then marked unconverged, not waited for)
+LIMITED_MAX_INNER = 300
+
 
 @dataclass(frozen=True, eq=False)
 class CoupledSolution:
@@ -574,8 +580,10 @@ def _limited(hydro, pendulum, wave, sc, exc, x_ideal, n, n2, k, regular, limit_n
     if float(np.max(np.abs(pf.state(_pad(x_ideal, n2))["tau"]))) <= limit_nd:
         return None
     pc = make(n)
-    xc, oc, _, out_c, in_c, st_c = torque_limited(pc, _pad(x_ideal, n), limit_nd)
-    xf, of, _, out_f, in_f, st_f = torque_limited(pf, _pad(xc, n2), limit_nd)
+    xc, oc, _, out_c, in_c, st_c = torque_limited(pc, _pad(x_ideal, n), limit_nd,
+                                                  max_inner=LIMITED_MAX_INNER)
+    xf, of, _, out_f, in_f, st_f = torque_limited(pf, _pad(xc, n2), limit_nd,
+                                                  max_inner=LIMITED_MAX_INNER)
     ok = st_c == "converged" and st_f == "converged"
     return {"x": xf, "power": of, "change": abs(of - oc), "points": pf.points,
             "status": "converged" if ok else "stalled", "outer": out_c + out_f,

@@ -38,10 +38,13 @@ from __future__ import annotations
 
 import contextlib
 import math
+import numbers
 import warnings
+from decimal import Decimal
 
 import numpy as np
 
+from .. import limits
 from ..errors import ParameterError
 
 __all__ = ["ElectricalProblem", "efficiency_pair", "electrical_power", "ladder", "maximize",
@@ -61,7 +64,7 @@ def efficiency_pair(efficiency) -> tuple[float, float] | None:
         except ValueError:
             raise ParameterError(f"efficiency: expected ETA_G or ETA_G,ETA_M (numbers in "
                                  f"(0, 1]), got {efficiency!r:.40}") from None
-    elif isinstance(efficiency, (int, float, np.floating)) and not isinstance(efficiency, bool):
+    elif isinstance(efficiency, (numbers.Real, Decimal)) and not isinstance(efficiency, bool):
         vals = [float(efficiency)]
     else:
         try:
@@ -72,10 +75,11 @@ def efficiency_pair(efficiency) -> tuple[float, float] | None:
     if len(vals) not in (1, 2):
         raise ParameterError(f"efficiency: expected ETA_G or ETA_G,ETA_M, got "
                              f"{len(vals)} values")
+    lo = limits.BUOY_MIN_EFFICIENCY
     for v in vals:
-        if not (math.isfinite(v) and 0.0 < v <= 1.0):
-            raise ParameterError(f"efficiency: expected numbers in (0, 1] (the fraction of "
-                                 f"the power converted), got {v!r}")
+        if not (math.isfinite(v) and lo <= v <= 1.0):
+            raise ParameterError(f"efficiency: expected numbers in (0, 1], at least {lo:g} "
+                                 f"(the fraction of the power converted), got {v!r}")
     return (vals[0], vals[-1])
 
 
@@ -583,7 +587,8 @@ LIMIT_TOL = 1e-7
 
 
 def torque_limited(problem: ElectricalProblem, x0: np.ndarray, limit: float, *,
-                   tol: float = LIMIT_TOL, max_outer: int = 40, warm: bool = False):
+                   tol: float = LIMIT_TOL, max_outer: int = 40, warm: bool = False,
+                   max_inner: int | None = None):
     """Maximize the problem's objective subject to ``|tau| <= limit`` on its grid by an
     augmented Lagrangian (PHR): each outer step a trust-region Newton solve of the
     penalized objective (exact gradient and Hessian), then ``lam <- max(0, lam + rho g)``,
@@ -592,7 +597,8 @@ def torque_limited(problem: ElectricalProblem, x0: np.ndarray, limit: float, *,
     Returns ``(x, objective, violation, outer, inner, status)``: ``violation`` the largest
     ``max |tau| - limit`` on the grid at ``x``; status "converged" when it is at most
     ``tol * limit`` and the last inner solve converged. ``warm``: keep the multipliers and
-    the penalty the problem holds for this limit (a continuation).
+    the penalty the problem holds for this limit (a continuation). ``max_inner``: at most
+    so many inner iterations in all (then status "max_iterations"): each costs O(N^3).
     """
     from scipy.optimize import minimize
 
@@ -610,6 +616,8 @@ def torque_limited(problem: ElectricalProblem, x0: np.ndarray, limit: float, *,
     viol = float(np.max(np.abs(st["tau"]))) - limit
     outer = 0
     while outer < max_outer:
+        if max_inner is not None and inner >= max_inner:
+            break
         outer += 1
         cache = {}
 
@@ -628,7 +636,8 @@ def torque_limited(problem: ElectricalProblem, x0: np.ndarray, limit: float, *,
             warnings.simplefilter("ignore", RuntimeWarning)
             r = minimize(lambda z: -ev(z)[0], x, jac=lambda z: -ev(z)[1],
                          method="trust-exact" if dense else "trust-krylov",
-                         options={"gtol": gtol, "maxiter": MAXITER}, **kw)
+                         options={"gtol": gtol, "maxiter": MAXITER if max_inner is None
+                                  else max(1, min(MAXITER, max_inner - inner))}, **kw)
         if not np.all(np.isfinite(r.x)):
             status = "stalled"
             break

@@ -384,7 +384,7 @@ def _result(h, width, pendulum, wave, wave_info, sol, ow, *, torque_limit, effic
     p = float(sol.power)
     bound = float(sol.radiation_bound)
     cw = p / flux if flux > 0 else math.nan
-    notes = list(notes)
+    notes = list(getattr(h, "notes", ())) + list(notes)
     n = int(sol.harmonics)
     above = np.asarray(h.above_range(wave.omega * np.arange(1, n + 1)))
     if above.any():
@@ -401,6 +401,12 @@ def _result(h, width, pendulum, wave, wave_info, sol, ow, *, torque_limit, effic
     validity = _validity(s["z"], eta, wave, wave_info, h, geometry)
     ep = sol.electrical_power
     harvest = p if ep is None else float(ep)  # what the design delivers
+    # a heaving body absorbs at most the radiation bound: a power above it (beyond the
+    # discretization's 0.1 %) is an impossible number, never a success
+    impossible = harvest > 0 and not p <= bound * (1 + 1e-3)
+    if impossible:
+        notes.append(f"the power {p:.6g} W exceeds the radiation bound {bound:.6g} W: the "
+                     "hydrodynamic data or the solve are wrong; not a success")
     eff = None if sol.efficiency is None else [float(v) for v in sol.efficiency]
     efields = {} if ep is None else {
         "electrical_power_w": float(ep), "pto_loss_w": p - float(ep),
@@ -417,9 +423,11 @@ def _result(h, width, pendulum, wave, wave_info, sol, ow, *, torque_limit, effic
         one_way_power_w=owp, one_way_ratio=owp / p if owp is not None and p > 0 else None,
         free_heave_amplitude_m=_half_range(free_heave(h, wave, t)),
         energy_balance_residual=float(sol.energy_balance_residual), harmonics=n,
-        winding=int(winding), success=bool(sol.success) and harvest > 0,
-        status=str(sol.status) if harvest > 0 else "no_power",
-        message=_message(sol, p, pendulum, ep), wave=wave_info,
+        winding=int(winding), success=bool(sol.success) and harvest > 0 and not impossible,
+        status=("above_bound" if impossible else str(sol.status)) if harvest > 0
+        else "no_power",
+        message=_message(sol, p, pendulum, ep, bound=bound, torque_limit=torque_limit),
+        wave=wave_info,
         pendulum={"mass_kg": pendulum.mass, "length_m": pendulum.length,
                   "inertia_kg_m2": pendulum.inertia,
                   "damping_coefficient_nm_s_per_rad": pendulum.damping_coefficient},
@@ -431,7 +439,19 @@ def _result(h, width, pendulum, wave, wave_info, sol, ow, *, torque_limit, effic
         **efields)
 
 
-def _message(sol, p, pendulum, electrical=None) -> str:
+def _message(sol, p, pendulum, electrical=None, *, bound=None, torque_limit=None) -> str:
+    """The solve's message; where no power is harvested, its cause, beginning with the
+    option to change (the CLI names it): no force on the body, a torque limit too low to
+    turn the pendulum over, losses, or the pendulum's damping."""
+    if not p > 0 and bound is not None and not bound > 0:
+        return ("wave: the wave gives the body nothing to absorb (radiation bound 0 W: no "
+                "excitation force or no radiation damping at its frequencies); check the "
+                "hydrodynamic data and the wave period")
+    mgl = pendulum.mass * 9.81 * pendulum.length
+    if not p > 0 and torque_limit is not None and torque_limit < mgl:
+        return (f"torque-limit: the pendulum cannot rotate with positive power within a torque "
+                f"limit of {torque_limit:.3g} N m (best P = {p:.3g} W; m g l = {mgl:.3g} N m "
+                "holds it against gravity); raise the limit")
     if electrical is not None and p > 0 >= electrical:
         return (f"no electrical power: through this take-off every motion found costs more "
                 f"than it harvests (best electrical power {electrical:.3g} W, mechanical "

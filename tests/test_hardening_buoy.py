@@ -1,0 +1,297 @@
+"""Issue 33 (hardening 3), the buoy: every bad input ends in one line naming the option
+(exit 2; ``ParameterError`` from Python), datasets are checked as physics, and the sizes
+that ran for minutes or past 2 GB are refused before any work."""
+
+from __future__ import annotations
+
+import os
+from decimal import Decimal
+
+import numpy as np
+import pytest
+
+import parapend
+from parapend.cli import main
+from parapend.errors import ParameterError
+from parapend.hydro import bem
+from tests.buoy_synthetic import toy_hydro
+
+
+def _refused(capsys, *args, names):
+    code = main(["buoy", *args])
+    err = capsys.readouterr().err.strip()
+    assert code == 2, err
+    assert "\n" not in err and "Traceback" not in err
+    assert any(f"error: {n}:" in err for n in names), err
+    return err
+
+
+@pytest.mark.parametrize("args, names", [
+    (["--torque-limit", "5e-324"], ["torque-limit"]),
+    (["--torque-limit", "1e-300"], ["torque-limit"]),
+    (["--torque-limit", "1e-6"], ["torque-limit"]),
+    (["--radius", "5e-324"], ["radius"]),
+    (["--radius", "1e-300"], ["radius"]),
+    (["--radius", "1e300"], ["radius"]),
+    (["--draft", "5e-324"], ["draft"]),
+    (["--draft", "1e-300"], ["draft"]),
+    (["--draft", "1e300"], ["draft"]),
+    (["--draft", "100"], ["draft"]),
+    (["--draft", "1000"], ["draft"]),
+    (["--radius", "100"], ["radius"]),
+    (["--radius", "1000"], ["radius"]),
+    (["--efficiency", "5e-324"], ["efficiency"]),
+    (["--efficiency", "0.9,1e-310"], ["efficiency"]),
+    (["--efficiency", "1e-300"], ["efficiency"]),
+    (["--mass", "5e-324"], ["mass"]),
+    (["--mass", "1e-300"], ["mass"]),
+    (["--length", "1e300"], ["length"]),
+    (["--length", "5e-324"], ["length"]),
+    (["--horizon", "2"], ["horizon"]),
+    (["--update-interval", "0.2"], ["update-interval"]),
+    (["--taper", "0.2"], ["taper"]),
+    (["--spectrum", "jonswap"], ["spectrum"]),
+    (["--gamma-peak", "2"], ["gamma-peak"]),
+    (["--cutoff", "2"], ["cutoff"]),
+    (["--wave-direction", "1"], ["wave-direction"]),
+    (["--hydro", "/dev/zero"], ["hydro"]),
+    (["--hydro", "/"], ["hydro"]),
+    (["--mesh", "/dev/zero"], ["mesh"]),
+    (["--mesh", "/"], ["mesh"]),
+])
+def test_refused_in_one_line(capsys, args, names):
+    _refused(capsys, *args, names=names)
+
+
+def test_messages_name_the_option_given(capsys):
+    assert "inertia" not in _refused(capsys, "--mass", "5e-324", names=["mass"])
+    assert "gamma:" not in _refused(capsys, "--mass", "1e-300", names=["mass"])
+    err = _refused(capsys, "--draft", "100", names=["draft"])
+    assert "NaN" not in err and "at most" in err
+
+
+def test_fifo_refused_without_blocking(tmp_path, capsys):
+    fifo = tmp_path / "pipe.nc"
+    os.mkfifo(fifo)
+    assert "FIFO" in _refused(capsys, "--hydro", str(fifo), names=["hydro"])
+    assert "FIFO" in _refused(capsys, "--mesh", str(fifo), names=["mesh"])
+
+
+def test_sparse_file_refused_before_reading(tmp_path, capsys):
+    big = tmp_path / "big.stl"
+    with open(big, "wb") as fh:
+        fh.truncate(3 << 30)
+    assert "MiB" in _refused(capsys, "--mesh", str(big), names=["mesh"])
+
+
+def test_body_with_hydro_refused(tmp_path, capsys):
+    path = tmp_path / "toy.nc"
+    path.write_bytes(b"x")
+    _refused(capsys, "--body", "sphere", "--hydro", str(path), names=["body"])
+    with pytest.raises(ParameterError, match="^body:"):
+        parapend.buoy(body="sphere", hydro=toy_hydro().to_dataset())
+
+
+# --- datasets as physics -------------------------------------------------------------------
+def _ds(**change):
+    ds = toy_hydro(radius=1.0).to_dataset()
+    for k, v in change.items():
+        ds[k] = v(ds[k])
+    return ds
+
+
+def test_dataset_accepted_as_xarray():
+    r = parapend.buoy(hydro=_ds(), damping_coefficient=0.0)
+    assert r.status.startswith("coupled optimum: converged")
+    assert 0 < r.power_w <= r.radiation_bound_w * (1 + 1e-9)
+
+
+@pytest.mark.parametrize("change, match", [
+    (lambda b: -b, "nowhere positive"),
+    (lambda b: 0 * b, "nowhere positive"),
+])
+def test_negated_or_zero_damping_refused(change, match):
+    with pytest.raises(ParameterError, match=f"^hydro: .*{match}"):
+        parapend.buoy(hydro=_ds(radiation_damping=change))
+
+
+def test_damping_negative_beyond_noise_refused():
+    def dip(b):
+        b = b.copy()
+        b[10] = -0.5 * float(b.max())
+        return b
+    with pytest.raises(ParameterError, match="^hydro: .*negative at 1 of"):
+        bem.load(_ds(radiation_damping=dip))
+
+
+def test_slightly_negative_damping_zeroed_and_named():
+    ds = _ds()
+    w = ds["omega"].values
+    b = ds["radiation_damping"].values.copy()
+    b[0] = -1e-6 * b.max()  # the lowest frequency: B -> 0 there, noise
+    ds["radiation_damping"] = (ds["radiation_damping"].dims, b)
+    h = bem.load(ds)
+    assert h.omega.size == w.size and h.radiation_damping[0] == 0.0
+    assert any("set to 0 at 1 frequencies" in n and f"{w[0]:.4g}" in n for n in h.notes)
+
+
+def test_string_mass_refused():
+    ds = _ds()
+    ds["inertia_matrix"] = ds["inertia_matrix"].astype(str)
+    with pytest.raises(ParameterError, match="^hydro: .*inertia_matrix is not numeric"):
+        bem.load(ds)
+
+
+def _multi(directions=(0.0, np.pi / 2), dofs=("Heave", "Pitch"), asym=0.0):
+    """A two-DOF, two-direction dataset whose heave part is the toy's."""
+    import xarray as xr
+
+    h = toy_hydro(radius=1.0)
+    n = h.omega.size
+    a = np.zeros((n, 2, 2))
+    b = np.zeros((n, 2, 2))
+    a[:, 0, 0], b[:, 0, 0] = h.added_mass, h.radiation_damping
+    a[:, 1, 1], b[:, 1, 1] = 2 * h.added_mass, 2 * h.radiation_damping
+    a[:, 0, 1] = a[:, 1, 0] = 0.1 * h.added_mass
+    b[:, 0, 1] = b[:, 1, 0] = 0.1 * h.radiation_damping
+    a[:, 0, 1] *= 1 + asym
+    f = np.zeros((n, len(directions), 2), complex)
+    for j, _ in enumerate(directions):
+        f[:, j, 0] = np.conj(h.excitation) * (1 + j)
+    return xr.Dataset(
+        {"added_mass": (("omega", "radiating_dof", "influenced_dof"), a),
+         "radiation_damping": (("omega", "radiating_dof", "influenced_dof"), b),
+         "excitation_force": (("omega", "wave_direction", "influenced_dof"), f),
+         "hydrostatic_stiffness": (("influenced_dof", "radiating_dof"),
+                                   [[h.hydrostatic_stiffness, 0], [0, 1.0]]),
+         "inertia_matrix": (("influenced_dof", "radiating_dof"), [[h.mass, 0], [0, 1.0]])},
+        coords={"omega": h.omega, "radiating_dof": list(dofs), "influenced_dof": list(dofs),
+                "wave_direction": list(directions), "rho": 1025.0, "g": 9.81,
+                "water_depth": np.inf})
+
+
+def test_wave_direction_chosen():
+    h0 = toy_hydro(radius=1.0)
+    h = bem.load(_multi())
+    np.testing.assert_allclose(h.excitation, h0.excitation, rtol=1e-12)
+    h2 = bem.load(_multi(), wave_direction=np.pi / 2)
+    np.testing.assert_allclose(h2.excitation, 2 * h0.excitation, rtol=1e-12)
+    with pytest.raises(ParameterError, match="^wave-direction: .*choose one of"):
+        bem.load(_multi(), wave_direction=1.0)
+
+
+def test_asymmetry_symmetrised_or_refused():
+    h = bem.load(_multi(asym=1e-4))
+    assert any("symmetrised" in n for n in h.notes)
+    r = parapend.buoy(hydro=_multi(asym=1e-4))
+    assert any("symmetrised" in n for n in r.warnings)
+    with pytest.raises(ParameterError, match="^hydro: .*not symmetric"):
+        bem.load(_multi(asym=0.5))
+
+
+def test_hydro_of_wrong_type_refused():
+    with pytest.raises(ParameterError, match="^hydro:"):
+        bem.load(42)
+
+
+@pytest.mark.parametrize("value", [Decimal("0.9"), np.float32(0.9), 0.9])
+def test_decimal_efficiency_accepted(value):
+    from parapend.hydro.pto import efficiency_pair
+
+    assert efficiency_pair(value) == pytest.approx((0.9, 0.9))
+
+
+def test_negative_heaving_mass_refused():
+    ds = _ds()
+    m = float(ds["inertia_matrix"].values.ravel()[0])
+    ds["added_mass"] = ds["added_mass"] * 0 - 2 * m
+    with pytest.raises(ParameterError, match=r"^hydro: .*M \+ A <= 0"):
+        bem.load(ds)
+
+
+def test_zero_excitation_blames_the_wave_not_the_damping(capsys, tmp_path):
+    ds = _ds(excitation_force=lambda f: 0 * f)
+    path = tmp_path / "calm.nc"
+    from capytaine.io.xarray import save_dataset_as_netcdf
+
+    save_dataset_as_netcdf(path, ds)
+    err = _refused(capsys, "--hydro", str(path), "--damping-coefficient", "0",
+                   names=["wave"])
+    assert "damping" not in err.split(":")[0]
+
+
+def test_low_torque_limit_blames_the_limit():
+    from parapend.hydro.result import _message
+
+    class _P:
+        mass, length, damping_coefficient = 80.0, 0.3, 1.0
+
+    msg = _message(None, -1.0, _P(), bound=10.0, torque_limit=1e-3)
+    assert msg.startswith("torque-limit:")
+
+
+@pytest.mark.parametrize("args, names", [
+    (["--harmonics", "4096"], ["harmonics"]),
+    (["--harmonics", "4096", "--efficiency", "0.9"], ["harmonics"]),
+    (["--harmonics", "1024"], ["harmonics"]),
+    (["--harmonics", "48", "--torque-limit", "10"], ["harmonics"]),
+    (["--winding", "64"], ["winding"]),
+    (["--winding", "2", "--efficiency", "0.9"], ["winding"]),
+])
+def test_sizes_refused_before_work(capsys, args, names):
+    err = _refused(capsys, *args, names=names)
+    assert "at most" in err
+
+
+def test_long_mpc_record_refused_before_work(capsys):
+    err = _refused(capsys, "--hs", "2", "--tp", "5", "--repeat-period", "1000", "--controller",
+                   "mpc", names=["repeat-period"])
+    assert "at most" in err
+
+
+@pytest.mark.parametrize("args, names", [
+    (["--hs", "2", "--tp", "8", "--repeat-period", "1000", "--winding", "64", "--efficiency",
+      "0.9"], ["repeat-period", "winding"]),
+    (["--hs", "2", "--tp", "8", "--repeat-period", "256", "--efficiency", "0.9"],
+     ["repeat-period"]),
+    (["--hs", "2", "--tp", "8", "--repeat-period", "40", "--efficiency", "0.9", "--harmonics",
+      "512"], ["harmonics"]),
+])
+def test_record_with_take_off_refused_before_work(capsys, args, names):
+    assert "at most" in _refused(capsys, *args, names=names)
+
+
+@pytest.mark.slow  # about 7 s: meshing and reading 6400 panels
+def test_mesh_of_too_many_panels_refused_before_the_bem(tmp_path):
+    import capytaine as cpt
+
+    from tests.test_buoy_hydro import _gdf
+
+    # 2 x 40 x 40 = 3200 panels below the waterline, more than the cap (limits.py)
+    mesh = cpt.mesh_vertical_cylinder(length=1.0, radius=0.5, center=(0, 0, 0),
+                                      resolution=(20, 80, 40))
+    with pytest.raises(ParameterError, match=r"^mesh: .* immersed panels; .* at most 1500"):
+        bem.from_mesh(_gdf(tmp_path / "fine.gdf", mesh), omega="body")
+
+
+@pytest.mark.parametrize("kw, name", [
+    (dict(hydro=42), "hydro"), (dict(mass="x"), "mass"), (dict(horizon=2), "horizon"),
+    (dict(efficiency=[0.9, "a"]), "efficiency"), (dict(torque_limit="1"), "torque-limit"),
+    (dict(radius=[1]), "radius"), (dict(efficiency=Decimal("0.9"), harmonics=100),
+                                   "harmonics"),
+])
+def test_api_raises_parameter_error(kw, name):
+    with pytest.raises(ParameterError, match=f"^{name}:"):
+        parapend.buoy(**kw)
+
+
+def test_out_of_memory_names_options_of_buoy(monkeypatch, capsys):
+    import parapend.cli.buoy as cb
+
+    def boom(a):
+        raise MemoryError
+
+    monkeypatch.setattr(cb, "_run", boom)
+    assert main(["buoy"]) == 1
+    err = capsys.readouterr().err.strip()
+    assert "out of memory" in err and "--points" not in err and "\n" not in err
