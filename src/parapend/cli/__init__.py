@@ -105,6 +105,15 @@ def _err(line: str) -> None:
         pass
 
 
+def _quiet_after_interrupt() -> None:
+    """After the one interrupted line, nothing more: work the interrupt cut short in other
+    threads (a store's asynchronous writes, whose directory may be gone) must not report
+    "Future exception was never retrieved" through asyncio's logger as the process ends."""
+    import logging
+
+    logging.getLogger("asyncio").setLevel(logging.CRITICAL + 1)
+
+
 def _silence_stdout() -> None:
     """Point fd 1 at /dev/null so the interpreter's final flush cannot fail again."""
     try:
@@ -170,6 +179,7 @@ def main(argv=None) -> int:
         return EXIT_FAILURE
     except KeyboardInterrupt:
         _err(f"{name}: interrupted")
+        _quiet_after_interrupt()
         return 130
     if closed:
         _err(f"{name}: error: standard output is closed; the result was not printed")
