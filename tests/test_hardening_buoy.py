@@ -209,6 +209,7 @@ def test_negative_heaving_mass_refused():
         bem.load(ds)
 
 
+@pytest.mark.slow  # a real solve of the default body: about 9 s
 def test_zero_excitation_blames_the_wave_not_the_damping(capsys, tmp_path):
     ds = _ds(excitation_force=lambda f: 0 * f)
     path = tmp_path / "calm.nc"
