@@ -144,9 +144,9 @@ class HorizonResult(_Result):
     mpc_speed_peak: list = field(default_factory=list)
     convention: str = ("power positive when harvested; (harvested energy + change of the "
                        "stored energy theta'^2/2 + cos(theta), at eta_g) per unit time over "
-                       "the whole record from the hanging rest (receding horizon: one "
-                       "repeat after warm_up); fractions of the record's non-causal optimum "
-                       "(sea) and of its gamma -> 0 limit")
+                       "the whole record from the hanging rest, the receding horizon's over "
+                       "one repeat after warm_up; fractions of the record's non-causal "
+                       "optimum from sea and of its gamma -> 0 limit")
 
     command = "horizon"
     headline = ("horizons", "mpc_fraction_mean", "baseline_fraction_mean", "status")

@@ -75,7 +75,7 @@ class MPCResult(_Result):
         The same through the efficiency model (equal without one).
     mean_power, mean_electrical_power : float
         Over ``t >= average_from``: the harvested energy plus the change of the stored
-        energy, per unit time (:func:`energy_account`; electrically the stored energy counts
+        energy, per unit time (``energy_account``; electrically the stored energy counts
         at ``eta_g``).
     harvested_power, harvested_electrical_power : float
         The harvested energy alone per unit time over ``t >= average_from`` (the means of
@@ -627,7 +627,7 @@ class MPCTrackResult(_Result):
     ----------
     mean_power : float
         The headline: (harvested energy + change of the stored energy) / time after the
-        start-up (:func:`energy_account`), the energy left in the pendulum counted as
+        start-up (``energy_account``), the energy left in the pendulum counted as
         harvested and energy drawn from it as not; exact for the held torque.
     harvested_power : float
         The harvested energy alone over the same time (a storage swing moves it).

@@ -288,8 +288,9 @@ def buoy(*, wave_height=None, wave_period=None, hs=None, tp=None, spectrum=None,
     ----------
     wave_height, wave_period : float
         A regular wave: height ``H`` (m, crest to trough) and period (s); ``wave_period``
-        as ``"FROM:TO:N"`` gives power against period (:class:`BuoySweepResult`). Default
-        the embedded design's wave (``parapend.defaults.BUOY``).
+        as ``"FROM:TO:N"`` gives power against period
+        (:class:`~parapend.hydro.result.BuoySweepResult`). Default the embedded design's
+        wave (``parapend.defaults.BUOY``).
     hs, tp, spectrum, gamma_peak, repeat_period, seed, cutoff : an irregular sea state, as
         ``parapend.sea`` takes it (a periodic record of ``repeat_period`` s, default 100 tp).
     record, taper : a measured surface-elevation record at the body, CSV ``t,z`` (s, m),

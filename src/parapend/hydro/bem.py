@@ -794,7 +794,7 @@ def _dof_matrix(da, path, name):
 
 def _physics(w, a_full, b_full, b, path):
     """Check the radiation coefficients as physics: the matrices over the DOFs symmetric
-    within :data:`parapend.limits.BUOY_SYMMETRY_TOL`, the damping positive semidefinite
+    within ``parapend.limits.BUOY_SYMMETRY_TOL``, the damping positive semidefinite
     at each frequency (heave's ``B >= 0``; where it is negative by less than the tolerance,
     BEM noise, it is set to 0 by :class:`Hydro`, and named in a note). Returns the mask of
     the frequencies kept and the notes; refuses (one line) data whose damping is negative
@@ -979,9 +979,9 @@ def load(path, *, wave_direction=None) -> Hydro:
 
     The data are checked as physics: numbers of numeric type, finite; ``added_mass`` and
     ``radiation_damping`` symmetric over the degrees of freedom within
-    :data:`parapend.limits.BUOY_SYMMETRY_TOL` (symmetrised, with a note); the damping
+    ``parapend.limits.BUOY_SYMMETRY_TOL`` (symmetrised, with a note); the damping
     positive semidefinite at each frequency (where it is negative by less than
-    :data:`parapend.limits.BUOY_NEGATIVE_DAMPING_TOL` of its largest, BEM noise, it is set
+    ``parapend.limits.BUOY_NEGATIVE_DAMPING_TOL`` of its largest, BEM noise, it is set
     to 0 and the frequencies are named in a note; more is refused). ``wave_direction`` (rad,
     default 0) chooses one of the dataset's wave directions.
 
