@@ -40,7 +40,8 @@ def test_save_and_plot(tmp_path, capsys):
                      "--save", str(csvp), "--plot", str(png))
     assert code == 0
     rows = list(csv.reader(csvp.read_text().splitlines()))
-    assert rows[0] == ["time", "phase", "theta", "theta_dot", "torque", "power"]
+    assert rows[0] == ["time", "phase", "theta", "theta_dot", "torque",
+                       "instantaneous_power"]
     assert rows[1] == ["sqrt(l/g)", "1", "rad", "rad sqrt(g/l)", "m g l",
                        "m g l sqrt(g/l)"]  # non-dimensional: the units row
     data = np.array(rows[2:], dtype=float)

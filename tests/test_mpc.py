@@ -144,7 +144,7 @@ def test_torque_limit_holds_on_the_plan_and_the_held_torques():
 def _read(path):
     with open(path) as f:
         rows = list(csv.reader(f))
-    assert rows[0] == ["time", "theta", "theta_dot", "torque", "power", "q"]
+    assert rows[0] == ["time", "theta", "theta_dot", "torque", "sample_power", "q"]
     assert rows[1] == ["sqrt(l/g)", "rad", "rad sqrt(g/l)", "m g l", "m g l sqrt(g/l)",
                        "1"]  # the units row
     names = ["t", "theta", "theta_dot", "torque", "power", "q"]

@@ -87,7 +87,11 @@ def _check(result, tmp: Path):
                 np.testing.assert_array_equal(back[name].values, var.values, err_msg=name)
                 assert back[name].attrs["units"] == var.attrs["units"]
     # CSV: one table (names, then units, then the values), where the result has one
-    if len(ds.dims) <= 1:
+    numeric = any(v.dtype.kind in "biuf" for v in ds.data_vars.values())
+    if not numeric:
+        with pytest.raises(parapend.ParameterError, match="path: this result holds no numbers"):
+            result.save(tmp / "r.csv")
+    elif len(ds.dims) <= 1:
         result.save(tmp / "r.csv")
         rows = list(csv.reader((tmp / "r.csv").read_text().splitlines()))
         names, units = rows[0], rows[1]
@@ -131,19 +135,24 @@ def test_si_results_are_si_in_every_file(tmp_path):
     s = r.samples()
     ds = r.to_dataset()
     assert set(ds.dims) == {"time_s"}
-    assert {"torque_nm", "power_w", "theta_dot_rad_per_s"} <= set(ds.data_vars)
+    assert {"torque_nm", "instantaneous_power_w", "theta_dot_rad_per_s"} <= set(ds.data_vars)
+    # the headline mean and the curve have a name each: power_w (0-d), instantaneous_power_w
+    assert ds["power_w"].ndim == 0 and float(ds["power_w"]) == r.power_w
     assert "torque" not in ds.data_vars and "time" not in ds.coords
     g, length, m = 9.81, 1.0, 10.0
     t0 = math.sqrt(length / g)
     np.testing.assert_allclose(ds["time_s"].values, s["time"] * t0, rtol=1e-14)
     np.testing.assert_allclose(ds["torque_nm"].values, s["torque"] * m * g * length,
                                rtol=1e-14)
-    np.testing.assert_allclose(ds["power_w"].values, s["power"] * m * g * length / t0,
+    np.testing.assert_allclose(ds["instantaneous_power_w"].values,
+                               s["instantaneous_power"] * m * g * length / t0,
                                rtol=1e-14)
     # the mean of the saved power is the headline power in watts (one period, uniform grid)
-    assert float(ds["power_w"].values.mean()) == pytest.approx(r.power_w, rel=1e-6)
+    assert float(ds["instantaneous_power_w"].values.mean()) == pytest.approx(r.power_w,
+                                                                             rel=1e-6)
     assert u.power == pytest.approx(m * g * length / t0, rel=1e-14)
-    assert ds["power_w"].attrs["units"] == "W" and ds["time_s"].attrs["units"] == "s"
+    assert ds["instantaneous_power_w"].attrs["units"] == "W"
+    assert ds["time_s"].attrs["units"] == "s"
     # omega in rad/s beside the non-dimensional one, as a Capytaine or WecOptTool user reads it
     assert r.omega_rad_per_s == pytest.approx(2 * math.pi * 0.9, rel=1e-14)
     assert ds["omega_rad_per_s"].attrs["units"] == "rad/s"

@@ -188,7 +188,8 @@ def test_cli_pto_save(capsys, tmp_path):
                         "--save", str(f))
     assert code == 0 and "electrical power" in out
     head = f.read_text().splitlines()[0]
-    assert head == "time,phase,theta,theta_dot,torque,power,electrical_power"
+    assert head == ("time,phase,theta,theta_dot,torque,instantaneous_power,"
+                    "instantaneous_electrical_power")
 
 
 @pytest.mark.parametrize("args,name", [

@@ -485,8 +485,8 @@ def test_sea_cli_json_text_and_errors(tmp_path, capsys):
     out = capsys.readouterr().out
     assert code == 0 and "optimum, winding K = 1" in out and (tmp_path / "s.png").exists()
     header, units = (tmp_path / "s.csv").read_text().splitlines()[:2]
-    assert header == ("time_s,heave_m,q,theta,theta_dot_rad_per_s,power_w,energy_j,"
-                      "uniform_energy_j")
+    assert header == ("time_s,heave_m,q,theta,theta_dot_rad_per_s,instantaneous_power_w,"
+                      "energy_j,uniform_energy_j")
     assert units == "s,m,1,rad,rad/s,W,J,J"
     for argv, msg in ((["--hs", "-2"], "hs: expected"),
                       (["--winding", "x"], "expected an integer"),

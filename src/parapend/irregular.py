@@ -125,7 +125,7 @@ class SeaResult(_Result):
 
         s = sea_samples(self)
         names = {"t": "time_s", "z": "heave_m", "q": "q", "theta": "theta",
-                 "theta_dot": "theta_dot_rad_per_s", "power": "power_w",
+                 "theta_dot": "theta_dot_rad_per_s", "power": "instantaneous_power_w",
                  "energy": "energy_j", "energy_uniform": "uniform_energy_j"}
         return xr.Dataset({names[k]: ("time_s", v) for k, v in s.items() if k != "t"},
                           coords={"time_s": s["t"]})

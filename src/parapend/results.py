@@ -47,6 +47,10 @@ QUANTITIES = {
     "upper_bound": (_P, "upper bound of the power"),
     "bound_gap": (_P, "upper bound minus power"),
     "electrical_power": (_P, "mean electrical power"),
+    "instantaneous_power": (_P, "instantaneous power -T theta' (positive = harvested)"),
+    "instantaneous_electrical_power": (_P, "instantaneous electrical power"),
+    "sample_power": (_P, "mean power -T (theta_k+1 - theta_k) / dt of the held sample"),
+    "sample_electrical_power": (_P, "electrical power of the held sample"),
     "mean_power": (_P, "mean harvested power"),
     "run_power": (_P, "mean harvested power of the run"),
     "record_power": (_P, "storage-corrected power over the last repeat of the record"),
@@ -198,6 +202,9 @@ def dataset_csv(ds) -> str:
             and v.dtype.kind in "biuf"]
     else:
         names = [str(k) for k, v in ds.data_vars.items() if v.dtype.kind in "biuf"]
+    if not names:
+        raise ParameterError("path: this result holds no numbers for a CSV table; save it as "
+                             ".json or .nc")
     buf = io.StringIO()
     w = csv.writer(buf, lineterminator="\n")
     w.writerow(names)
@@ -212,8 +219,11 @@ def dataset_csv(ds) -> str:
 #: it to multiply by).
 _SI_SERIES = {"time": ("time_s", "time", 1), "t": ("time_s", "time", 1),
               "theta_dot": ("theta_dot_rad_per_s", "time", -1),
-              "torque": ("torque_nm", "torque", 1), "power": ("power_w", "power", 1),
-              "electrical_power": ("electrical_power_w", "power", 1),
+              "torque": ("torque_nm", "torque", 1),
+              "instantaneous_power": ("instantaneous_power_w", "power", 1),
+              "instantaneous_electrical_power": ("instantaneous_electrical_power_w", "power", 1),
+              "sample_power": ("sample_power_w", "power", 1),
+              "sample_electrical_power": ("sample_electrical_power_w", "power", 1),
               "energy": ("energy_j", "energy", 1)}
 
 
@@ -601,8 +611,9 @@ class OptimizeResult(Result):
     def samples(self, points: int = 1000) -> dict:
         """One forcing period of the optimum on ``points`` uniform times (non-dimensional
         arrays): ``time``, ``phase`` (``t/T``), ``theta``, ``theta_dot``, ``torque``
-        (Eq. 14 solved for T), ``power`` (``-T theta'``, positive when harvested) and, with
-        an efficiency, ``electrical_power``. ``to_dataset()`` gives them in SI when the
+        (Eq. 14 solved for T), ``instantaneous_power`` (``-T theta'``, positive when
+        harvested; its mean is ``power``) and, with an efficiency,
+        ``instantaneous_electrical_power``. ``to_dataset()`` gives them in SI when the
         pendulum was given in SI."""
         from .errors import check_int
         from .model import torque
@@ -612,11 +623,11 @@ class OptimizeResult(Result):
         t = exc.period * np.arange(npts) / npts
         out = {"time": t, "phase": t / exc.period, "theta": motion.theta(t),
                "theta_dot": motion.theta_dot(t), "torque": torque(motion, exc, self.gamma, t)}
-        out["power"] = -out["torque"] * out["theta_dot"]
+        out["instantaneous_power"] = -out["torque"] * out["theta_dot"]
         if self.efficiency_generating is not None:
-            p = out["power"]
-            out["electrical_power"] = np.where(p > 0, p * self.efficiency_generating,
-                                               p / self.efficiency_motoring)
+            p = out["instantaneous_power"]
+            out["instantaneous_electrical_power"] = np.where(
+                p > 0, p * self.efficiency_generating, p / self.efficiency_motoring)
         return out
 
     def _series(self):

@@ -43,8 +43,9 @@ def add_parsers(sub) -> None:
                         "side by side (default fourier)")
     add_output_options(p, plot="theta(tau) and the torque",
                        save="one period of the motion (time, phase, theta, theta_dot, torque, "
-                            "power = -T theta', electrical_power with an efficiency; in SI with "
-                            "--length and --mass) and the result's scalars")
+                            "instantaneous_power = -T theta', instantaneous_electrical_power "
+                            "with an efficiency; in SI with --length and --mass) and the "
+                            "result's scalars")
     p.add_argument("--winding", type=_int, default=1,
                    help="K turns per forcing period, theta(t + 2 pi/omega) = theta(t) + 2 pi "
                         "K (default 1, the paper's period-1 rotation; K > 1: method fourier "

@@ -50,7 +50,8 @@ def add_parsers(sub) -> None:
                    help="N (default 16 per mean wave, then checked at 2N)")
     add_output_options(p, plot="the record, the motion and the energy",
                        save="the record and the motion over it (time_s, heave_m, q, theta, "
-                            "theta_dot_rad_per_s, power_w, energy_j, uniform_energy_j) and the "
+                            "theta_dot_rad_per_s, instantaneous_power_w, energy_j, "
+                            "uniform_energy_j) and the "
                             "result's scalars")
 
 

@@ -154,8 +154,8 @@ class MPCResult(_Result):
         pad = np.append  # sample k's torque and power hold over [t_k, t_k+1)
         return series({"time": self.t, "theta": self.theta, "theta_dot": self.theta_dot,
                        "torque": pad(self.torque, np.nan),
-                       "power": pad(self.power_series, np.nan),
-                       "electrical_power": pad(self.electrical_series, np.nan)})
+                       "sample_power": pad(self.power_series, np.nan),
+                       "sample_electrical_power": pad(self.electrical_series, np.nan)})
 
     def _figure(self):
         from .figures import plot_mpc_track
@@ -762,7 +762,7 @@ class MPCTrackResult(_Result):
         r = self._run
         pad = np.append  # the torque and power of sample k hold over [t_k, t_k+1)
         return series({"time": r.t, "theta": r.theta, "theta_dot": r.theta_dot,
-                       "torque": pad(r.torque, np.nan), "power": pad(r.power_series, np.nan),
+                       "torque": pad(r.torque, np.nan), "sample_power": pad(r.power_series, np.nan),
                        "q": self._q(r.t)}, self.physical_units)
 
     def _figure(self):

@@ -150,7 +150,7 @@ class BuoyMPCResult(_Result):
         cols = {"theta": s["theta"], "theta_dot_rad_per_s": s["theta_dot"],
                 "heave_m": s["z"], "heave_speed_m_per_s": s["z_dot"],
                 "torque_nm": np.append(s["torque"], np.nan),
-                "power_w": np.append(s["power"], np.nan)}
+                "sample_power_w": np.append(s["power"], np.nan)}
         ds = xr.Dataset({k: ("time_s", v) for k, v in cols.items()},
                         coords={"time_s": s["t"]})
         ds["torque_nm"].attrs["hold"] = "over [t, t + dt)"

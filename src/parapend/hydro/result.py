@@ -154,8 +154,8 @@ class BuoyResult(_Result):
 
         s = self.samples()
         names = {"theta": "theta", "theta_dot": "theta_dot_rad_per_s", "z": "heave_m",
-                 "z_dot": "heave_speed_m_per_s", "tau": "torque_nm", "power": "power_w",
-                 "z_free": "free_heave_m"}
+                 "z_dot": "heave_speed_m_per_s", "tau": "torque_nm",
+                 "power": "instantaneous_power_w", "z_free": "free_heave_m"}
         return xr.Dataset({names[k]: ("time_s", s[k]) for k in names},
                           coords={"time_s": s["t"]})
 
