@@ -169,6 +169,7 @@ def test_cli_bad_efficiency(argv, match, capsys, tmp_path):
     assert set(tmp_path.iterdir()) == before
 
 
+@pytest.mark.slow
 def test_cli_efficiency_json(capsys):
     import tempfile
     from pathlib import Path

@@ -157,6 +157,7 @@ def test_paper_case_epsilon_1e_6_value():
 @settings(max_examples=25, derandomize=True, database=None, deadline=None,
           suppress_health_check=[HealthCheck.too_slow])
 @given(terms=fourier_terms, omega=omegas)
+@pytest.mark.slow
 def test_random_excitation_epsilon_1e_6(terms, omega):
     exc = _excitation(terms, omega)
     fine = solve_bvp_optimum(exc, 5e-7)

@@ -179,6 +179,7 @@ def test_coexistence_neighbourhoods_with_engine():
         assert {r.legend[int(c)] for c in np.unique(r.labels)} == {name}
 
 
+@pytest.mark.slow
 def test_fig2_case_attractors_and_stable_rotation():
     """Paper Fig. 2 right (p = 0.5, omega = 1.8; gamma = 0.1): a stable period-1 rotation
     (both directions) coexists with a period-2 oscillation; nothing else from 4000 random
@@ -286,6 +287,7 @@ def test_period_one_rotation_by_shooting(case):
     assert mirror.dphi0 == pytest.approx(-orb.dphi0, abs=1e-9)
 
 
+@pytest.mark.slow
 def test_period_two_oscillation_by_shooting_matches_engine():
     gamma, p, omega = COEX
     r = find_attractors(0.5, 0.0, gamma, p, omega)

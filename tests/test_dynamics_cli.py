@@ -29,6 +29,7 @@ def _run(capsys, *args):
 
 
 # --- the compiled kernel ---------------------------------------------------------------
+@pytest.mark.slow
 def test_numba_kernel_labels_equal_numpy_engine():
     # 48 x 25 points integrated (> 1024: the pilot and capture are used by both engines)
     kw = dict(n_phi=48, n_dphi=48, periods=300)
@@ -95,6 +96,7 @@ def test_cli_basins_coexistence_equals_library(capsys, tmp_path):
         np.testing.assert_array_equal(back["attractor"].values, ds["attractor"].values)
 
 
+@pytest.mark.slow
 def test_cli_rotations_equal_rotation_boundaries(capsys):
     code, out, _ = _run(capsys, "rotations", "--gamma", "0.1", "--omega", "2.1", "--json")
     assert code == 0
@@ -106,6 +108,7 @@ def test_cli_rotations_equal_rotation_boundaries(capsys):
     assert js["p_J"][0] < 0.8 < js["p_G"][0]     # the rotation at p = 0.8 is stable
 
 
+@pytest.mark.slow
 def test_cli_simulate_final_motions(capsys, tmp_path):
     csv_path = tmp_path / "m.csv"
     for dphi0, name in (("0", "P2 oscillation"), ("2.5", "P1 rotation (+)"),

@@ -225,6 +225,7 @@ def test_pto_refuses_an_excitation_its_mesh_cannot_follow(tmp_path, capsys):
     assert "resample the record" in capsys.readouterr().err
 
 
+@pytest.mark.slow
 def test_pto_curve_work_is_bounded(tmp_path, capsys):
     f = _noisy(tmp_path / "noisy.csv", 2048)  # 1024 harmonics: 1024 intervals per solve
     assert main(["pto-curve", "--file", f]) == 2

@@ -90,6 +90,7 @@ def test_figure_slow(argv, tmp_path, monkeypatch):
 
 
 @pytest.mark.parametrize("argv", [a for _, a in SI], ids=[n for n, _ in SI])
+@pytest.mark.slow
 def test_figure_si_units(argv, tmp_path, monkeypatch):
     _assert_clean(_render(argv, tmp_path, monkeypatch, si=True), argv)
 

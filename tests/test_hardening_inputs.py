@@ -377,6 +377,7 @@ def test_file_interpolant_is_capped_not_only_its_samples(tmp_path, capsys):
     assert parapend.excitation.max_abs_q(exc) == pytest.approx(1000, rel=1e-12)
 
 
+@pytest.mark.slow
 def test_max_abs_q_against_dense_evaluation():
     from parapend.excitation import max_abs_q
 

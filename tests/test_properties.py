@@ -64,6 +64,7 @@ def test_bounds_and_monotonicity_many(exc, gamma):
 
 
 @given(excitations)
+@pytest.mark.slow
 def test_threshold_is_where_power_vanishes(exc):
     _threshold_is_where_power_vanishes(exc)
 

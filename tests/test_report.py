@@ -29,6 +29,7 @@ def report_dir(tmp_path_factory):
     return out
 
 
+@pytest.mark.slow
 def test_files_written(report_dir):
     figs = {p.name for p in (report_dir / "figures").iterdir()}
     for key in ("fig1", "fig2a", "fig2b", "fig4", "fig5", "fig6", "fig7", "fig8", "fig9",
@@ -40,6 +41,7 @@ def test_files_written(report_dir):
     assert (report_dir / "report.html").read_text().count("data:image/png;base64,") == 10
 
 
+@pytest.mark.slow
 def test_key_numbers(report_dir):
     r = json.loads((report_dir / "results.json").read_text())
     t1 = {row["quantity"]: row for row in r["tables"]["table1"]}
@@ -102,6 +104,7 @@ def test_deterministic(report_dir, tmp_path):
 
 
 @pytest.mark.parametrize("key", ["fig8", "fig10"])
+@pytest.mark.slow
 def test_figures_reproducible_across_runs(report_dir, tmp_path, key):
     """A figure recomputed in this process is byte-identical to the report's (SVG and PNG),
     and its numbers to those in results.json."""
@@ -150,6 +153,7 @@ class _Page(HTMLParser):
             self._cell += data
 
 
+@pytest.mark.slow
 def test_report_header_contents_and_columns(report_dir):
     import matplotlib
     import numpy
@@ -180,6 +184,7 @@ def test_report_header_contents_and_columns(report_dir):
     assert len(widths) == 10 and all(300 < w < 1200 for w in widths)
 
 
+@pytest.mark.slow
 def test_figure_pngs_are_200_dpi(report_dir):
     from PIL import Image
 
@@ -316,6 +321,7 @@ def test_reproduce_refuses_what_it_must_not_replace(tmp_path, monkeypatch):
     assert _hidden(tmp_path) == []
 
 
+@pytest.mark.slow
 def test_sigkill_during_reproduce_keeps_the_old_report(report_dir, tmp_path):
     """kill -9 in the middle of a real run over an older report: the report is untouched and
     complete; what the killed run left is hidden and removed by the next run."""
@@ -355,6 +361,7 @@ def _chromium():
     return None
 
 
+@pytest.mark.slow
 def test_report_renders_in_headless_chromium(report_dir, tmp_path):
     """Load report.html in Debian's Chromium and check every image decoded with a size.
 

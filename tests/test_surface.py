@@ -175,6 +175,7 @@ def test_records_without_curves_give_their_scalars(tmp_path):
     assert rec.plot() is rec.matplotlib_figure
 
 
+@pytest.mark.slow
 def test_figure_through_both(tmp_path, capsys):
     png = str(tmp_path / "f.png")
     cli = _cli_json(["figure", "1", "--plot", png, "--json"], capsys)
@@ -253,6 +254,7 @@ def test_uniform_rotation_through_an_efficiency_matches_quadrature():
     assert math.isclose(u1["power"], 1.8 * 0.3 / 2 - 0.03 * 1.8**2, rel_tol=1e-9)
 
 
+@pytest.mark.slow
 def test_uniform_rotation_under_a_torque_limit():
     from parapend.excitation import harmonic
     from parapend.pto import uniform_under_pto

@@ -1029,6 +1029,7 @@ def test_silent_scheduler_is_one_line_and_ctrl_c_during_connect(tmp_path):
 
 
 @pytest.mark.skipif(sys.platform == "win32", reason="SIGINT")
+@pytest.mark.slow
 def test_ctrl_c_during_a_scheduler_sweep_is_one_line(cluster, tmp_path):
     """Ctrl-C while the blocks run on a Dask cluster: one line, exit 130, no traceback; the
     blocks written are sound."""
