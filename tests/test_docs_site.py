@@ -51,6 +51,7 @@ def _page(tmp_path: Path, body: str, name: str = "page.html") -> Path:
     return page
 
 
+@pytest.mark.slow
 def test_good_page_passes_broken_image_and_overflow_fail(checker, tmp_path, capsys):
     """One Chromium run per page (each takes seconds): a good page, a broken image, a page
     wider than the window; the exit status and one line per problem."""

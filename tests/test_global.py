@@ -75,6 +75,7 @@ FAST_CASES = [
 
 @pytest.mark.parametrize("terms,omega", FAST_CASES)
 @pytest.mark.parametrize("gamma", [0.0, 0.01, 0.05])
+@pytest.mark.slow
 def test_optimum_is_the_best_known_on_many_extrema(terms, omega, gamma):
     exc = parapend.fourier(terms, omega=omega)
     assert exc.extrema.t.size >= 6

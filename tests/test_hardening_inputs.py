@@ -157,6 +157,7 @@ def test_full_disk_one_line(tmp_path):
     assert [p.name for p in tmp_path.iterdir()] == []  # no temporary left behind
 
 
+@pytest.mark.slow
 def test_stdout_full_or_closed():
     with open("/dev/full", "w") as full:
         r = cli("optimize", "--harmonics", "4", stdout=full)

@@ -314,6 +314,7 @@ def _multistart(exc, n, gamma, k, starts, seed):
 
 @pytest.mark.parametrize("winding, starts", [(10, 40), pytest.param(9, 120,
                                                                     marks=pytest.mark.slow)])
+@pytest.mark.slow
 def test_winding_optimum_agrees_with_independent_multistart_and_converges_in_n(winding,
                                                                                 starts):
     exc = fourier([(8, 0.1, 0.0), (9, 0.12, 1.0), (10, 0.08, 2.0), (11, 0.1, 3.0),

@@ -960,6 +960,7 @@ def _blocks_done(store):
 
 
 @pytest.mark.skipif(sys.platform == "win32", reason="SIGINT")
+@pytest.mark.slow
 def test_ctrl_c_with_local_processes_is_one_line(tmp_path):
     """Ctrl-C while two local processes compute blocks with a power take-off (up to half a
     minute each): one line and exit code 130 at once, the running blocks are not waited
