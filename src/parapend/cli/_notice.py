@@ -36,9 +36,11 @@ class _Notice(logging.Handler):
             pass
 
 
-def install() -> None:
-    """Print the compile notices of this process on stderr (idempotent)."""
-    logger = logging.getLogger(_LOGGER)
+def install(name: str = _LOGGER) -> None:
+    """Print the INFO records of logger ``name`` of this process on stderr, one line each
+    (idempotent): the compile notices, and the estimate of long work a command announces
+    (``parapend.performance``)."""
+    logger = logging.getLogger(name)
     if not any(isinstance(h, _Notice) for h in logger.handlers):
         logger.addHandler(_Notice())
     if logger.level == logging.NOTSET or logger.level > logging.INFO:

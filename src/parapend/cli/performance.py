@@ -3,8 +3,6 @@ energy (docs/performance.md). A thin shell over :mod:`parapend.performance`."""
 
 from __future__ import annotations
 
-import logging
-import os
 import shlex
 import sys
 
@@ -121,39 +119,11 @@ def add_parsers(sub) -> None:
                    help="print one JSON object (annual energy, matrix, statistics)")
 
 
-class _Announce(logging.Handler):
-    """Prints the library's estimate of long work (``parapend.performance``'s INFO records)
-    on stderr, one line, before the work starts; standard output stays the report. Only
-    the process that installed it prints (as :mod:`._notice`)."""
-
-    def __init__(self):
-        super().__init__(logging.INFO)
-        self.pid = os.getpid()
-
-    def emit(self, record: logging.LogRecord) -> None:
-        if os.getpid() != self.pid:
-            return
-        stream = sys.stderr or sys.__stderr__
-        try:
-            stream.write(f"parapend: {record.getMessage()}\n")
-            stream.flush()
-        except (OSError, ValueError, AttributeError):
-            pass
-
-
-def _announce() -> None:
-    """Print the estimate of long work of this process on stderr (idempotent)."""
-    logger = logging.getLogger("parapend.performance")
-    if not any(isinstance(h, _Announce) for h in logger.handlers):
-        logger.addHandler(_Announce())
-    if logger.getEffectiveLevel() > logging.INFO:
-        logger.setLevel(logging.INFO)
-
-
 def _cmd_power_matrix(a) -> dict | str:
     from ..performance import figures
+    from ._notice import install
 
-    _announce()
+    install("parapend.performance")  # the library's estimate of long work, on stderr
 
     if a.plot:
         for s in ("matrix", "capture-width", "scatter"):
