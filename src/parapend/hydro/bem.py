@@ -904,9 +904,14 @@ def _from_dataset(ds, *, c=None, mass=None, description="", path="the dataset",
         if np.any(np.isnan(w)) or np.any(w < 0):
             raise ParameterError(f"hydro: {path}: expected frequencies omega >= 0 (rad/s), "
                                  "got NaN or a negative one")
-        a = _numeric(a.transpose(omega_name).values, "added_mass", path)
-        b = _numeric(b.transpose(omega_name).values, "radiation_damping", path)
-        f = np.conj(_numeric(fx.transpose(omega_name).values, "excitation_force", path, "c"))
+        # rows at omega = 0 or inf are dropped below; Capytaine leaves their excitation NaN
+        rows = np.isfinite(w) & (w > 0)
+        a, b, fx = (x.transpose(omega_name).values for x in (a, b, fx))
+        for x, name in ((a, "added_mass"), (b, "radiation_damping"), (fx, "excitation_force")):
+            _numeric(x[rows], name, path, "c" if name == "excitation_force" else "f")
+        a = np.asarray(a.real if a.dtype.kind == "c" else a, dtype=float)
+        b = np.asarray(b.real if b.dtype.kind == "c" else b, dtype=float)
+        f = np.conj(np.asarray(fx, dtype=complex))
     else:
         w = np.asarray(ds[omega_name].values, dtype=float)
         a = np.asarray(a.transpose(omega_name).values, dtype=float)
