@@ -1,0 +1,374 @@
+r"""A pendulum in a hull that surges, heaves and pitches: the objective in ``phi`` alone.
+
+Model (SI; docs/hull.md, issue 30). Hull DOFs ``xi = (x, z, beta)`` about the rotation
+centre O; the pivot at ``(d_p, h_p)`` from O moves by ``p = G xi``,
+``G = [[1, 0, h_p], [0, 1, -d_p]]``; ``phi`` is the pendulum's absolute angle from the
+upward vertical (centre of mass at ``p + l (sin phi, cos phi)``), ``theta = phi - beta``
+the generator's angle, ``phi(t + T) = phi(t) + 2 pi K``::
+
+    (P)  I phi'' + c (phi' - beta') - m l [(g + p_z'') sin phi - p_x'' cos phi] = tau
+    (H)  (M_h + A) xi'' + B xi' + C xi = F a - G^T f + e_beta (-tau + c (phi' - beta'))
+         f = m (p'' + l ((sin phi)'', (cos phi)'')),     P = -<tau (phi' - beta')>
+
+Discretization (the issue's, shared with the independent IPOPT reference of
+tests/hull_reference.py): ``phi = K s + x_0 + sum_n x_n sin(ns) + x_{N+n} cos(ns)``
+(``s = w t``), the hull's harmonics ``k = 0..Nh``, (H) projected on them with the grid's
+DFT (M points), the means on the grid. Given ``phi``, (H) is linear in ``xi`` but with
+coefficients that vary with ``phi`` (the pivot's acceleration times ``sin phi``, ``cos phi``
+in the reaction torque), so the hull's harmonics are solved together:
+
+    S(phi) y = b(phi),   S = Z - m l Pi_beta [sin(phi) Q_z - cos(phi) Q_x]
+
+``y`` the real hull unknowns, ``Z`` block diagonal (``Z_k = -(k w)^2 (M_h + A_k + m G^T G)
++ i k w B_k + C'``, ``C' = C - m g h_p e_beta e_beta^T``), ``Q`` the pivot's acceleration
+on the grid. The power ``P(phi) = P(phi, y(phi))`` is maximized over ``x`` alone (reduced
+space): its gradient by the adjoint ``S^T lambda = dP/dy``, its Hessian exactly, by the
+sensitivity ``T = S^{-1} g_x`` (one LU, ``2N + 1`` solves):
+
+    H = L_xx + L_xy T + T^T L_yx + T^T L_yy T
+
+with ``L`` the Lagrangian, whose dependence on ``x`` and ``y`` is a sum over grid points of
+a function of ``(phi, phi', phi'', p_x'', p_z'', beta')`` (:func:`_pointwise`): every
+block is a weighted Gram matrix of the grid maps. With the hull fixed at its free response
+(``coupled=False``) the same code gives the one-way problem (``T = 0``, no adjoint).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+from scipy.linalg import lu_factor, lu_solve
+
+from ..errors import ParameterError
+
+__all__ = ["HullCase", "HullProblem", "hull_points"]
+
+#: grid variables of the pointwise functions, in this order
+_VARS = ("phi", "phi1", "phi2", "qx", "qz", "b1")
+
+
+def hull_points(harmonics: int, hull_harmonics: int, winding: int, wave_harmonics: int) -> int:
+    """A power of two with 8 points per harmonic of the motion and of the wave, and 4 per
+    harmonic of the products ``sin(phi) xi''`` that the hull's projection reads."""
+    need = max(64, 8 * (harmonics + winding), 8 * (wave_harmonics + 1),
+               4 * (hull_harmonics + harmonics + winding))
+    return 1 << int(math.ceil(math.log2(need)))
+
+
+@dataclass(frozen=True, eq=False)
+class HullCase:
+    """The discretized hull problem's data (SI).
+
+    ``A``, ``B`` (Nh+1, 3, 3) and ``F`` (Nh+1, 3) at ``k w``, k = 0..Nh (``F`` complex per
+    metre of wave amplitude, ``exp(+i w t)``); ``C`` the hull's hydrostatic stiffness (the
+    whole floating mass at O; the pendulum's weight at the pivot is added here); ``Mh`` the
+    hull's mass matrix without the pendulum; ``pivot = (d_p, h_p)``; ``amplitudes`` the
+    wave's ``a_k``, k = 1..Kw.
+    """
+
+    omega: float
+    amplitudes: np.ndarray
+    winding: int
+    harmonics: int
+    hull_harmonics: int
+    points: int
+    A: np.ndarray = field(repr=False)
+    B: np.ndarray = field(repr=False)
+    F: np.ndarray = field(repr=False)
+    C: np.ndarray = field(repr=False)
+    Mh: np.ndarray = field(repr=False)
+    m: float = 1.0
+    l: float = 1.0  # noqa: E741  (the pendulum's length, as in the paper)
+    I: float = 1.0  # noqa: E741
+    c: float = 0.0
+    g: float = 9.81
+    pivot: tuple = (0.0, 0.0)
+
+    def __post_init__(self):
+        nh = int(self.hull_harmonics)
+        for name, shape in (("A", (nh + 1, 3, 3)), ("B", (nh + 1, 3, 3)), ("F", (nh + 1, 3))):
+            if np.shape(getattr(self, name)) != shape:
+                raise ParameterError(f"hull: {name}: expected shape {shape}, got "
+                                     f"{np.shape(getattr(self, name))}")
+        if self.points < 2 * (nh + self.harmonics + self.winding) + 2:
+            raise ParameterError("hull: too few grid points for the harmonics")
+
+    @property
+    def G(self) -> np.ndarray:
+        d, h = self.pivot
+        return np.array([[1.0, 0.0, h], [0.0, 1.0, -d]])
+
+    def stiffness(self) -> np.ndarray:
+        """``C'``: the hull's stiffness with the pendulum's weight at the pivot."""
+        c = 0.5 * (np.asarray(self.C, dtype=float) + np.asarray(self.C, dtype=float).T)
+        c[2, 2] -= self.m * self.g * self.pivot[1]
+        return c
+
+    def impedance(self, k: int) -> np.ndarray:
+        """``Z_k`` (3 x 3 complex): the hull with the pendulum's mass lumped at the pivot."""
+        wk = k * self.omega
+        sym = (lambda a: 0.5 * (a + a.T))
+        mass = np.asarray(self.Mh, float) + sym(np.asarray(self.A[k], float)) \
+            + self.m * self.G.T @ self.G
+        return -wk**2 * mass + 1j * wk * sym(np.asarray(self.B[k], float)) + self.stiffness()
+
+    def wave_force(self) -> np.ndarray:
+        """``F(k w) a_k`` (Nh+1, 3), 0 at k = 0 and above the wave's harmonics."""
+        out = np.zeros((self.hull_harmonics + 1, 3), dtype=complex)
+        a = np.asarray(self.amplitudes, dtype=complex)
+        top = min(a.size, self.hull_harmonics)
+        out[1:top + 1] = np.asarray(self.F, dtype=complex)[1:top + 1] * a[:top, None]
+        return out
+
+
+class HullProblem:
+    """Power, exact gradient and Hessian of the hull problem in the ``phi`` coefficients.
+
+    ``coupled=False``: the hull moves as if the pendulum were not there (its free response,
+    the pendulum's mass lumped at the pivot): the one-way problem.
+    """
+
+    def __init__(self, case: HullCase, coupled: bool = True):
+        self.case = case
+        self.coupled = coupled
+        n, nh, m = case.harmonics, case.hull_harmonics, case.points
+        w, kw = case.omega, case.winding
+        self.harmonics, self.points, self.winding, self.omega = n, m, kw, w
+        s = 2 * math.pi * np.arange(m) / m
+        self.s = s
+        # phi's maps: phi = K s + P0 x, phi' = w K + P1 x, phi'' = P2 x
+        kn = np.arange(1, n + 1)
+        sn, cn = np.sin(np.outer(s, kn)), np.cos(np.outer(s, kn))
+        self.P0 = np.hstack((np.ones((m, 1)), sn, cn))
+        self.P1 = w * np.hstack((np.zeros((m, 1)), kn * cn, -kn * sn))
+        self.P2 = -w**2 * np.hstack((np.zeros((m, 1)), kn**2 * sn, kn**2 * cn))
+        # the hull's unknowns y: Xi_0 on the DOFs with stiffness, then (Re, Im) Xi_k
+        cp = case.stiffness()
+        self.static = [d for d in range(3) if cp[d, d] > 0]
+        j0 = len(self.static)
+        ny = j0 + 6 * nh
+        self.ny = ny
+        kh = np.arange(1, nh + 1)
+        ch, sh = np.cos(np.outer(s, kh)), np.sin(np.outer(s, kh))
+        # E[d]: y -> xi_d on the grid; E1, E2 its derivatives; Pi[d]: grid -> y rows
+        E = np.zeros((3, m, ny))
+        E1 = np.zeros((3, m, ny))
+        E2 = np.zeros((3, m, ny))
+        Pi = np.zeros((3, ny, m))
+        for i, d in enumerate(self.static):
+            E[d, :, i] = 1.0
+            Pi[d, i, :] = 1.0 / m
+        for d in range(3):
+            re = j0 + 6 * (kh - 1) + d
+            im = re + 3
+            E[d][:, re], E[d][:, im] = ch, -sh
+            E1[d][:, re], E1[d][:, im] = -w * kh * sh, -w * kh * ch
+            E2[d][:, re], E2[d][:, im] = -(w * kh) ** 2 * ch, (w * kh) ** 2 * sh
+            Pi[d][re, :] = (2.0 / m) * ch.T
+            Pi[d][im, :] = -(2.0 / m) * sh.T
+        self.E, self.E1, self.E2, self.Pi = E, E1, E2, Pi
+        dp, hp = case.pivot
+        self.Qx = E2[0] + hp * E2[2]
+        self.Qz = E2[1] - dp * E2[2]
+        # Z (real form) and the wave's force
+        Z = np.zeros((ny, ny))
+        Z[:j0, :j0] = cp[np.ix_(self.static, self.static)]
+        fa = case.wave_force()
+        rhs = np.zeros(ny)
+        for k in kh:
+            zk = case.impedance(int(k))
+            o = j0 + 6 * (k - 1)
+            Z[o:o + 3, o:o + 3] = zk.real
+            Z[o:o + 3, o + 3:o + 6] = -zk.imag
+            Z[o + 3:o + 6, o:o + 3] = zk.imag
+            Z[o + 3:o + 6, o + 3:o + 6] = zk.real
+            rhs[o:o + 3] = fa[k].real
+            rhs[o + 3:o + 6] = fa[k].imag
+        self.Z, self.fa_real = Z, rhs
+        self.y_free = np.linalg.solve(Z, rhs)
+        # a power scale for the solvers' tolerances (W): m g l w
+        self.w = np.array([case.m * case.g * case.l * w])
+
+    # --------------------------------------------------------------------------------------
+    def phi(self, x):
+        """``(phi, phi', phi'')`` on the grid."""
+        kw, w = self.winding, self.omega
+        return (kw * self.s + self.P0 @ x, w * kw + self.P1 @ x, self.P2 @ x)
+
+    def _rho(self, ph, y):
+        """The pendulum's reaction on the hull on the grid, ``r`` (3, M), and the
+        pointwise derivatives of its three rows in ``(phi, phi', phi'')``."""
+        cs = self.case
+        ml = cs.m * cs.l
+        dp, hp = cs.pivot
+        f, f1, f2 = ph
+        sn, co = np.sin(f), np.cos(f)
+        qx, qz = self.Qx @ y, self.Qz @ y
+        rx = -ml * (co * f2 - sn * f1**2)
+        rz = ml * (sn * f2 + co * f1**2)
+        wgt = (cs.g + qz) * sn - qx * co
+        rb = hp * rx - dp * rz - cs.I * f2 + ml * wgt
+        dx = (rz, 2 * ml * sn * f1, -ml * co)
+        dz = (-rx, 2 * ml * co * f1, ml * sn)
+        wphi = (cs.g + qz) * co + qx * sn
+        db = (hp * dx[0] - dp * dz[0] + ml * wphi, hp * dx[1] - dp * dz[1],
+              hp * dx[2] - dp * dz[2] - cs.I)
+        return np.array((rx, rz, rb)), (dx, dz, db)
+
+    def solve_hull(self, x):
+        """The hull's unknowns ``y`` at ``phi(x)``, and the factorized ``S`` (None when
+        not coupled)."""
+        if not self.coupled:
+            return self.y_free, None
+        ph = self.phi(x)
+        r, _ = self._rho(ph, np.zeros(self.ny))
+        s_mat = self._s_matrix(ph[0])
+        b = self.fa_real + sum(self.Pi[d] @ r[d] for d in range(3))
+        lu = lu_factor(s_mat, check_finite=False)
+        return lu_solve(lu, b, check_finite=False), lu
+
+    def _s_matrix(self, f):
+        ml = self.case.m * self.case.l
+        sn, co = np.sin(f), np.cos(f)
+        return self.Z - ml * (self.Pi[2] @ (sn[:, None] * self.Qz - co[:, None] * self.Qx))
+
+    def grid_state(self, x, y=None):
+        """Everything on the grid at ``x``: phi and its derivatives, the hull's ``y``, the
+        pivot's acceleration, the pitch rate, the torque and the power."""
+        if y is None:
+            y, _ = self.solve_hull(x)
+        cs = self.case
+        f, f1, f2 = self.phi(x)
+        qx, qz = self.Qx @ y, self.Qz @ y
+        b1 = self.E1[2] @ y
+        v = f1 - b1
+        tau = cs.I * f2 + cs.c * v - cs.m * cs.l * ((cs.g + qz) * np.sin(f) - qx * np.cos(f))
+        return {"phi": f, "phi1": f1, "phi2": f2, "qx": qx, "qz": qz, "b1": b1, "y": y,
+                "tau": tau, "relative_speed": v, "power": -float(np.mean(tau * v))}
+
+    def power(self, x) -> float:
+        return self.grid_state(x)["power"]
+
+    # --------------------------------------------------------------------------------------
+    def _pointwise(self, st, mu):
+        """Value-free first and second derivatives of the Lagrangian's pointwise part
+        ``-tau v / M + sum_d mu_d rho_d`` in ``_VARS`` (the constraint's weights ``mu``
+        (3, M), zero for the one-way problem). Returns ``(d1, d2)``: dicts of arrays."""
+        cs = self.case
+        ml, mm = cs.m * cs.l, self.points
+        dp, hp = cs.pivot
+        f, f1, f2 = st["phi"], st["phi1"], st["phi2"]
+        qx, qz, b1 = st["qx"], st["qz"], st["b1"]
+        sn, co = np.sin(f), np.cos(f)
+        v = f1 - b1
+        e = mu[2]
+        a = mu[0] + hp * e
+        b = mu[1] - dp * e
+        kap = e + v / mm
+        wgt = (cs.g + qz) * sn - qx * co
+        wph = (cs.g + qz) * co + qx * sn
+        X = a * sn + b * co
+        Y = b * sn - a * co
+        d1 = {
+            "phi": ml * kap * wph + ml * (f2 * X - f1**2 * Y),
+            "phi1": ml * wgt / mm + 2 * ml * f1 * X - cs.I * f2 / mm - 2 * cs.c * v / mm,
+            "phi2": ml * Y - cs.I * kap,
+            "qx": -ml * kap * co,
+            "qz": ml * kap * sn,
+            "b1": -ml * wgt / mm + cs.I * f2 / mm + 2 * cs.c * v / mm,
+        }
+        d2 = {
+            ("phi", "phi"): -ml * kap * wgt + ml * (-f2 * Y - f1**2 * X),
+            ("phi", "phi1"): ml * wph / mm - 2 * ml * f1 * Y,
+            ("phi", "phi2"): ml * X,
+            ("phi", "qx"): ml * kap * sn,
+            ("phi", "qz"): ml * kap * co,
+            ("phi", "b1"): -ml * wph / mm,
+            ("phi1", "phi1"): 2 * ml * X - 2 * cs.c / mm,
+            ("phi1", "phi2"): -cs.I / mm + 0 * f,
+            ("phi1", "qx"): -ml * co / mm,
+            ("phi1", "qz"): ml * sn / mm,
+            ("phi1", "b1"): 2 * cs.c / mm + 0 * f,
+            ("phi2", "b1"): cs.I / mm + 0 * f,
+            ("qx", "b1"): ml * co / mm,
+            ("qz", "b1"): -ml * sn / mm,
+            ("b1", "b1"): -2 * cs.c / mm + 0 * f,
+        }
+        return d1, d2
+
+    def _maps(self):
+        """The linear maps of ``_VARS`` from x (first three) and y (last three)."""
+        return {"phi": self.P0, "phi1": self.P1, "phi2": self.P2, "qx": self.Qx,
+                "qz": self.Qz, "b1": self.E1[2]}
+
+    def evaluate(self, x):
+        """``(P, gradient, Hessian)`` of the (reduced) power in ``x``."""
+        x = np.asarray(x, dtype=float)
+        y, lu = self.solve_hull(x)
+        st = self.grid_state(x, y)
+        maps = self._maps()
+        xv, yv = ("phi", "phi1", "phi2"), ("qx", "qz", "b1")
+        zero = np.zeros((3, self.points))
+        d1, _ = self._pointwise(st, zero)
+        if lu is not None:
+            gy = sum(maps[k].T @ d1[k] for k in yv)
+            lam = lu_solve(lu, gy, trans=1, check_finite=False)
+            mu = np.array([self.Pi[d].T @ lam for d in range(3)])
+        else:
+            mu = zero
+        d1, d2 = self._pointwise(st, mu)
+        grad = sum(maps[k].T @ d1[k] for k in xv)
+
+        def block(rows, cols):
+            out = 0.0
+            for (u, v), wgt in d2.items():
+                if u in rows and v in cols:
+                    out = out + maps[u].T @ (wgt[:, None] * maps[v])
+                if u != v and v in rows and u in cols:
+                    out = out + maps[v].T @ (wgt[:, None] * maps[u])
+            return out
+
+        hxx = block(xv, xv)
+        if lu is None:
+            return st["power"], grad, hxx
+        _, dr = self._rho(self.phi(x), y)
+        gx = sum(self.Pi[d] @ sum(dr[d][i][:, None] * maps[xv[i]] for i in range(3))
+                 for d in range(3))
+        t = lu_solve(lu, gx, check_finite=False)
+        hxy = block(xv, yv)
+        hyy = block(yv, yv)
+        ht = hxy @ t
+        h = hxx + ht + ht.T + t.T @ (hyy @ t)
+        return st["power"], grad, 0.5 * (h + h.T)
+
+    # --------------------------------------------------------------------------------------
+    def harmonics_of(self, y) -> np.ndarray:
+        """The hull's complex harmonics ``Xi_k`` (Nh+1, 3) from ``y``."""
+        nh, j0 = self.case.hull_harmonics, len(self.static)
+        xi = np.zeros((nh + 1, 3), dtype=complex)
+        for i, d in enumerate(self.static):
+            xi[0, d] = y[i]
+        body = y[j0:].reshape(nh, 2, 3)
+        xi[1:] = body[:, 0, :] + 1j * body[:, 1, :]
+        return xi
+
+    def balance(self, x, y=None) -> tuple[float, float, float]:
+        """``(P, hull side, residual)`` of the energy balance
+        ``P + c <(phi' - beta')^2> = sum_k Re((F a)_k^H U_k) / 2 - U_k^H B_k U_k / 2``, the
+        residual relative to the larger of the wave's and the radiated power."""
+        st = self.grid_state(x, y)
+        xi = self.harmonics_of(st["y"])
+        cs = self.case
+        fa = cs.wave_force()
+        absorbed = radiated = 0.0
+        for k in range(1, cs.hull_harmonics + 1):
+            u = 1j * k * cs.omega * xi[k]
+            bk = 0.5 * (cs.B[k] + cs.B[k].T)
+            absorbed += 0.5 * float(np.real(np.vdot(fa[k], u)))
+            radiated += 0.5 * float(np.real(np.vdot(u, bk @ u)))
+        lhs = st["power"] + cs.c * float(np.mean(st["relative_speed"] ** 2))
+        hull = absorbed - radiated
+        scale = max(abs(absorbed), abs(radiated), abs(lhs), 1e-300)
+        return st["power"], hull, abs(lhs - hull) / scale
