@@ -7,7 +7,7 @@ import numpy as np
 
 from ..style import figure_style
 
-__all__ = ["plot_motion", "plot_sweep"]
+__all__ = ["plot_hull", "plot_motion", "plot_sweep"]
 
 
 def _finish(fig, path):
@@ -81,4 +81,34 @@ def plot_sweep(sweep, path=None):
     ax2.set_xlabel("wave period T (s)")
     ax2.legend(loc="best", fontsize="small")
     ax2.set_xlim(t[0], t[-1])
+    return _finish(fig, path)
+
+
+@figure_style()
+def plot_hull(result, path=None, points: int = 600):
+    """The best mode of a pendulum in a surging, heaving, pitching hull over one period (a
+    :class:`~parapend.hydro.hull_result.HullResult`): the pendulum's angle, the hull's
+    motion, the generator torque."""
+    import matplotlib.pyplot as plt
+
+    s = result.samples(points)
+    t = s["t"]
+    fig, (ax1, ax2, ax3) = plt.subplots(3, 1, figsize=(7, 7.5), sharex=True)
+    ax1.plot(t, np.degrees(s["phi"]), lw=1.6, color="C0")
+    ax1.set_ylabel(r"$\varphi$ (deg, from upright)")
+    w = result.wave
+    what = (f"H = {w['height_m']:g} m, T = {w['period_s']:g} s" if w.get("kind") == "regular"
+            else "irregular record")
+    ax1.set_title(f"{result.mode.capitalize()} ({what}): P = {result.power_w:.4g} W, "
+                  f"one-way {_w(result.one_way_power_w)}")
+    ax2.plot(t, s["xi"][0], lw=1.4, color="C1", label="surge (m)")
+    ax2.plot(t, s["xi"][1], lw=1.4, color="C2", label="heave (m)")
+    ax2.plot(t, np.degrees(s["xi"][2]), lw=1.4, color="C4", label="pitch (deg)")
+    ax2.set_ylabel("hull motion")
+    ax2.legend(loc="best", fontsize="small")
+    ax3.plot(t, s["tau"], lw=1.4, color="C3")
+    ax3.axhline(0.0, color="k", lw=0.5)
+    ax3.set_ylabel(r"torque $\tau$ (N m)")
+    ax3.set_xlabel("time t (s)")
+    ax3.set_xlim(t[0], t[-1])
     return _finish(fig, path)

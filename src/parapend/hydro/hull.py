@@ -109,7 +109,8 @@ class HullCase:
     def impedance(self, k: int) -> np.ndarray:
         """``Z_k`` (3 x 3 complex): the hull with the pendulum's mass lumped at the pivot."""
         wk = k * self.omega
-        sym = (lambda a: 0.5 * (a + a.T))
+        def sym(a):
+            return (0.5 * (a + a.T))
         mass = np.asarray(self.Mh, float) + sym(np.asarray(self.A[k], float)) \
             + self.m * self.G.T @ self.G
         return -wk**2 * mass + 1j * wk * sym(np.asarray(self.B[k], float)) + self.stiffness()
