@@ -1,0 +1,128 @@
+"""The hull kernel (parapend.hydro.hull): its exact derivatives against finite differences,
+the energy balance at its optima, the one-way limit, the heave-only reduction."""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+
+import numpy as np
+import pytest
+from hull_synthetic import case
+
+from parapend.hydro.hull import HullProblem
+from parapend.hydro.hull_optimum import GTOL, hull_search, radiation_bound
+from parapend.optimal.fourier import newton_maximize
+
+
+def _x(n, winding, seed):
+    x = 0.3 * np.random.default_rng(seed).standard_normal(2 * n + 1)
+    x[0] += math.pi if winding == 0 else 0.0
+    return x
+
+
+@pytest.mark.parametrize("winding", [0, 1, 2])
+@pytest.mark.parametrize("coupled", [False, True])
+def test_gradient_and_hessian_are_the_derivatives(winding, coupled):
+    """Central differences of P (step 1e-5: truncation ~1e-10, rounding ~1e-11 relative)
+    agree with the exact gradient and Hessian to 1e-6 of their size."""
+    cs = case(winding=winding, harmonics=5)
+    pr = HullProblem(cs, coupled=coupled)
+    x = _x(cs.harmonics, winding, winding)
+    _, g, h = pr.evaluate(x)
+    eps = 1e-5
+    eye = np.eye(x.size)
+    gfd = np.array([(pr.power(x + eps * e) - pr.power(x - eps * e)) / (2 * eps) for e in eye])
+    hfd = np.array([(pr.evaluate(x + eps * e)[1] - pr.evaluate(x - eps * e)[1]) / (2 * eps)
+                    for e in eye])
+    assert np.max(np.abs(g - gfd)) <= 1e-6 * np.max(np.abs(g))
+    assert np.max(np.abs(h - hfd)) <= 1e-6 * np.max(np.abs(h))
+    assert np.allclose(h, h.T, rtol=0, atol=1e-12 * np.max(np.abs(h)))
+
+
+def test_hull_equations_hold_at_the_solved_motion():
+    """The solved hull harmonics satisfy (H) harmonic by harmonic, rebuilt here from the
+    grid's torque and pivot acceleration (not from the kernel's matrices)."""
+    cs = case(winding=1, harmonics=6)
+    pr = HullProblem(cs)
+    x = _x(cs.harmonics, 1, 3)
+    st = pr.grid_state(x)
+    xi = pr.harmonics_of(st["y"])
+    ml, hp, dp = cs.m * cs.l, cs.pivot[1], cs.pivot[0]
+    f, f1, f2 = st["phi"], st["phi1"], st["phi2"]
+    sin2 = np.cos(f) * f2 - np.sin(f) * f1**2
+    cos2 = -np.sin(f) * f2 - np.cos(f) * f1**2
+    # the pivot force on the pendulum without m p'' (moved into Z) and the reaction torque
+    fx, fz = ml * sin2, ml * cos2
+    torque = -st["tau"] + cs.c * st["relative_speed"]
+    r = np.array([-fx, -fz, -(hp * fx - dp * fz) + torque])
+    fa = cs.wave_force()
+    for k in range(1, cs.hull_harmonics + 1):
+        rk = 2 * np.mean(r * np.exp(-1j * k * pr.s), axis=1)
+        # Z_k without the pendulum's lumped mass, and the m p'' it moves
+        lhs = cs.impedance(k) @ xi[k]
+        assert np.allclose(lhs, fa[k] + rk, rtol=0, atol=1e-9 * np.max(np.abs(fa[1])))
+    assert xi[0, 0] == 0.0  # the mean surge
+
+
+@pytest.mark.parametrize("winding", [0, 1])
+def test_energy_balance_at_the_optimum(winding):
+    cs = case(winding=winding, harmonics=12)
+    sol = hull_search(lambda s: dataclasses.replace(
+        case(winding=winding, harmonics=12 * s, hull_harmonics=(12 + max(1, winding)) * s)))
+    assert sol.success, sol.status
+    assert sol.energy_balance_residual < 1e-9
+    assert sol.refinement_change <= 1e-7 * abs(sol.power)
+    assert sol.power > 0
+    bound, _ = radiation_bound(sol.case)
+    assert 0 < sol.power <= bound
+    assert cs.harmonics == 12
+
+
+def test_light_pendulum_tends_to_the_one_way_answer():
+    """m, I, c -> 0 together: the pendulum's reaction vanishes, the coupled power over
+    m g l tends to the one-way power over m g l (difference O(m))."""
+    gaps = []
+    for scale in (1e-2, 1e-4):
+        cs = case(winding=1, harmonics=8, m=2000.0 * scale, c=50.0 * scale)
+        one = HullProblem(cs, coupled=False)
+        r1 = newton_maximize(one, np.zeros(17), "0", gtol=GTOL)
+        co = HullProblem(cs)
+        r2 = newton_maximize(co, r1.x, "1", gtol=GTOL)
+        gaps.append(abs(r2.power - r1.power) / abs(r1.power))
+    assert gaps[1] < 1e-3 and gaps[1] < 0.05 * gaps[0]
+
+
+def test_heave_only_hull_equals_the_heave_kernel():
+    """With surge and pitch locked out (no coupling in A, B, F, C, inert in M) and the pivot
+    at O, the hull problem is the heaving buoy: its optimum equals
+    parapend.hydro.optimum.coupled_optimum's on the same heave data."""
+    import hull_synthetic as hs
+
+    from parapend.hydro.bem import Hydro
+    from parapend.hydro.coupled import Pendulum, Wave
+    from parapend.hydro.optimum import coupled_optimum
+
+    w0 = 2 * math.pi / 5
+    n, nh = 16, 18
+    cs = case(winding=1, harmonics=n, hull_harmonics=nh, pivot=(0.0, 0.0), c=50.0)
+    a, b, f = cs.A.copy(), cs.B.copy(), cs.F.copy()
+    for arr in (a, b):
+        arr[:, 0, :] = arr[:, :, 0] = arr[:, 2, :] = arr[:, :, 2] = 0.0
+    f[:, 0] = f[:, 2] = 0.0
+    big = 1e12
+    cs = dataclasses.replace(cs, A=a, B=b, F=f, C=np.diag([0.0, hs.stiffness()[1, 1], big]),
+                             Mh=np.diag([big, hs.MASS - cs.m, big]))
+    pr = HullProblem(cs)
+    one = HullProblem(cs, coupled=False)
+    r0 = newton_maximize(one, np.zeros(2 * n + 1), "0", gtol=GTOL)
+    r = newton_maximize(pr, r0.x, "1", gtol=GTOL)
+    wg = w0 * np.arange(1, nh + 1)  # the harmonics themselves: no interpolation
+    aa, bb, ff = hs.coefficients(wg)
+    hyd = Hydro(omega=wg, added_mass=aa[:, 1, 1], radiation_damping=bb[:, 1, 1],
+                excitation=ff[:, 1], hydrostatic_stiffness=hs.stiffness()[1, 1], mass=hs.MASS)
+    ref = coupled_optimum(hyd, Pendulum(cs.m, cs.l, cs.I, cs.c), Wave.regular(1.0, 5.0),
+                          winding=1, harmonics=n)
+    assert ref.success
+    # measured 3e-10: the locked DOFs' 1e12 mass and stiffness leave a 1e-10 coupling
+    assert r.power == pytest.approx(ref.power, rel=1e-8)
