@@ -8,7 +8,7 @@ named for it.
 
 from __future__ import annotations
 
-__all__ = ["Default", "given", "OMEGA", "DELTA", "GAMMA", "DYNAMICS", "SEA", "BUOY"]
+__all__ = ["Default", "given", "OMEGA", "DELTA", "GAMMA", "DYNAMICS", "SEA", "BUOY", "HULL"]
 
 
 class Default(float):
@@ -57,10 +57,19 @@ SEA = {"hs": 2.0, "tp": 8.0, "seed": 0, "length": 1.0, "mass": 10.0, "gravity": 
 #: changes the answer. SI units; ``design_bounds`` are the ranges ``--optimize-design`` searches
 #: without ``--<name>-bounds``, as factors of the design's value (damping: N m s/rad).
 BUOY = {"wave_height": 0.2, "wave_period": 1.8, "hs": 0.5, "tp": 2.5,
-        "radius": 0.5, "draft": 0.5, "mass": 80.0, "length": 0.3, "inertia": None,
-        "damping_coefficient": 1.0,
+        "radius": 0.5, "draft": 0.5, "mass": Default(80.0), "length": Default(0.3),
+        "inertia": None, "damping_coefficient": Default(1.0),
         "design_bounds": {"mass": (0.25, 4.0), "length": (0.25, 4.0), "inertia": (1.0, 4.0),
                           "damping_coefficient": (0.0, 20.0)}}
+
+#: ``buoy --dofs surge,heave,pitch``: the embedded hull design (docs/hull.md): a 10 m x 4 m
+#: x 1 m box barge, a 2 t pendulum of 1 m on a pivot 0.5 m above the waterline at midship,
+#: in a 1 m, 6 s regular wave (or a sea state of Hs 1 m, Tp 6 s in a record of 8 peak
+#: periods); the pendulum's options given to ``buoy`` replace these
+HULL = {"wave_height": 1.0, "wave_period": 6.0, "hs": 1.0, "tp": 6.0, "repeat_periods": 8,
+        "barge_length": 10.0, "barge_beam": 4.0, "barge_draft": 1.0,
+        "mass": 2000.0, "length": 1.0, "inertia": None, "damping_coefficient": 50.0,
+        "pivot_height": 0.5, "pivot_offset": 0.0}
 
 #: ``horizon``: the horizons (peak periods), forecasts and baselines of the curve, the
 #: number of seeded records and the update interval of the receding-horizon controller

@@ -214,3 +214,11 @@ BUOY_MAX_MPC_WORK = 1.4e5
 #: --repeat-period 40 --efficiency 0.9) took 14 s of CPU, 512 (--repeat-period 256) over
 #: 2 minutes and 1.3 GB, 800 (--repeat-period 160 --winding 20) 163 s of CPU
 BUOY_MAX_PTO_RECORD_HARMONICS = 256
+
+#: ``buoy --dofs surge,heave,pitch``: at most this many harmonics of the pendulum's motion
+#: (the hull's harmonics follow; a Newton step costs O(N^2 (N + M)) with dense matrices:
+#: about 0.3 s at 192 on one core) - a record of at most 16 waves
+HULL_MAX_HARMONICS = 192
+#: the harmonics' refinement (doubling until the power settles) stops here
+HULL_MAX_REFINED_HARMONICS = 384
+

@@ -278,10 +278,12 @@ def buoy(*, wave_height=None, wave_period=None, hs=None, tp=None, spectrum=None,
          gamma_peak=None, repeat_period=None, seed=None, cutoff=None, record=None, taper=None,
          mass=BUOY["mass"], length=BUOY["length"], inertia=BUOY["inertia"],
          damping_coefficient=BUOY["damping_coefficient"], body=None, radius=None,
-         draft=None, mesh=None, hydro=None, winding=1, harmonics=None, torque_limit=None,
+         draft=None, mesh=None, hydro=None, winding=None, harmonics=None, torque_limit=None,
          efficiency=None, optimize_design=None, mass_bounds=None, length_bounds=None,
          inertia_bounds=None, damping_coefficient_bounds=None, controller="optimum",
-         horizon=None, update_interval=None, wave_direction=None):
+         horizon=None, update_interval=None, wave_direction=None, dofs="heave",
+         pivot_height=None, pivot_offset=None, hull_pitch_inertia=None, barge_length=None,
+         barge_beam=None, barge_draft=None):
     """The coupled optimum of a pendulum inside a floating buoy (command ``buoy``).
 
     Parameters
@@ -301,7 +303,7 @@ def buoy(*, wave_height=None, wave_period=None, hs=None, tp=None, spectrum=None,
         (radius; floats at its centre), meshed and solved by Capytaine, cached on disk.
     mesh : a mesh file Capytaine reads (the body floats as meshed, z = 0 the free surface).
     hydro : a NetCDF dataset of a Capytaine run (docs/buoy.md: bring your own).
-    winding : turns of the pendulum per wave (per record for an irregular sea).
+    winding : turns of the pendulum per wave (per record for an irregular sea); default 1.
     harmonics : N of the motion (default chosen from the problem and checked).
     torque_limit : N m.
     efficiency : float, pair or str
@@ -317,14 +319,36 @@ def buoy(*, wave_height=None, wave_period=None, hs=None, tp=None, spectrum=None,
         ``"one-way-mpc"`` (planned on the free buoy's heave); horizon and update interval in
         peak periods.
 
+    dofs : ``"heave"`` (default: the heaving buoy) or ``"surge,heave,pitch"``: a hull that
+        surges, heaves and pitches, with a pendulum that rotates or swings (docs/hull.md;
+        :mod:`parapend.hydro.hull_api`). Then ``body`` is ``"barge"`` (default; its
+        ``barge_length``, ``barge_beam``, ``barge_draft``, m), ``"cylinder"`` or
+        ``"sphere"``, or ``mesh``/``hydro`` with these DOFs; ``pivot_height`` and
+        ``pivot_offset`` place the pivot from the rotation centre (the waterplane centre of
+        a built-in hull), m; ``hull_pitch_inertia`` (kg m^2, about it; default the
+        dataset's, else a homogeneous immersed hull); ``winding`` None reports rotation
+        (one turn per wave) and swinging (``winding=0``) side by side. Options not given
+        take the embedded hull design's values (``parapend.defaults.HULL``).
+
     Returns
     -------
-    result : BuoyResult, BuoySweepResult or BuoyMPCResult
+    result : BuoyResult, BuoySweepResult or BuoyMPCResult (HullResult, HullSweepResult
+        with ``dofs="surge,heave,pitch"``)
         One design; a period sweep; a receding-horizon run (``controller``, the result of
         :func:`parapend.hydro.control.buoy_mpc`).
     """
     from .coupled import Wave
+    from .hull_api import hull_buoy, parse_dofs
 
+    opts = dict(locals())
+    if parse_dofs(dofs) != ("heave",):
+        return hull_buoy(**{k: v for k, v in opts.items() if k not in (
+            "dofs", "Wave", "hull_buoy", "parse_dofs")})
+    for name in ("pivot_height", "pivot_offset", "hull_pitch_inertia", "barge_length",
+                 "barge_beam", "barge_draft"):
+        if opts[name] is not None:
+            raise ParameterError(f"{name.replace('_', '-')}: a hull's option; needs --dofs "
+                                 "surge,heave,pitch")
     if controller not in ("optimum", "mpc", "one-way-mpc"):
         raise ParameterError(f"controller: expected optimum, mpc or one-way-mpc, got "
                              f"{controller!r:.40}")

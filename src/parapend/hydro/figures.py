@@ -7,7 +7,7 @@ import numpy as np
 
 from ..style import figure_style
 
-__all__ = ["plot_hull", "plot_motion", "plot_sweep"]
+__all__ = ["plot_hull", "plot_hull_sweep", "plot_motion", "plot_sweep"]
 
 
 def _finish(fig, path):
@@ -111,4 +111,39 @@ def plot_hull(result, path=None, points: int = 600):
     ax3.set_ylabel(r"torque $\tau$ (N m)")
     ax3.set_xlabel("time t (s)")
     ax3.set_xlim(t[0], t[-1])
+    return _finish(fig, path)
+
+
+@figure_style()
+def plot_hull_sweep(sweep, path=None):
+    """Rotation against swinging over wave period (a
+    :class:`~parapend.hydro.hull_result.HullSweepResult`): each mode's optimum, the one-way
+    answer and the radiation bound; the hull's heave and pitch."""
+    import matplotlib.pyplot as plt
+
+    t = np.asarray(sweep.period_s)
+    fig, (ax1, ax2) = plt.subplots(2, 1, figsize=(7, 6.5), sharex=True,
+                                   gridspec_kw={"height_ratios": [3, 2]})
+
+    def pos(y):  # a log axis: no power is drawn as a gap
+        y = np.asarray(y, dtype=float)
+        return np.where(y > 0, y, np.nan)
+
+    ax1.plot(t, pos(sweep.radiation_bound_w), "k-", lw=1.0, label="radiation bound")
+    ax1.plot(t, pos(sweep.rotation_power_w), "-", color="C0", lw=1.8, marker="o", ms=3,
+             label="rotation (one turn per wave)")
+    ax1.plot(t, pos(sweep.swinging_power_w), "-", color="C3", lw=1.8, marker="s", ms=3,
+             label="swinging")
+    ax1.plot(t, pos(sweep.one_way_power_w), "--", color="C2", lw=1.2,
+             label="one-way, best mode (reaction left out)")
+    ax1.set_yscale("log")
+    ax1.set_ylabel("power (W)")
+    ax1.legend(loc="best", fontsize="small")
+    ax1.set_title(f"Rotate or swing: power against wave period, H = {sweep.wave_height_m:g} m")
+    ax2.plot(t, sweep.heave_amplitude_m, "-", color="C1", lw=1.6, label="heave (m)")
+    ax2.plot(t, sweep.pitch_amplitude_deg, "-", color="C4", lw=1.6, label="pitch (deg)")
+    ax2.set_ylabel("hull amplitude, best mode")
+    ax2.set_xlabel("wave period T (s)")
+    ax2.legend(loc="best", fontsize="small")
+    ax2.set_xlim(t[0], t[-1])
     return _finish(fig, path)

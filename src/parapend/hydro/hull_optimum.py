@@ -31,6 +31,8 @@ GTOL = 1e-10
 #: the harmonics are doubled until the power changes by at most this (relative), up to
 #: MAX_SCALE times the default
 REFINE_TOL = 1e-7
+#: a change above this (relative) at the most harmonics allowed is not an answer
+UNRESOLVED = 1e-3
 MAX_SCALE = 8
 #: singular values of B_k below this fraction of the largest are cut in the bound's
 #: pseudo-inverse (B's surge-pitch block is near singular: both radiate the same waves)
@@ -41,8 +43,7 @@ def make_case(hull, pendulum, wave, *, winding, harmonics=None, hull_harmonics=N
               pivot=(0.0, 0.0), pitch_inertia=None) -> HullCase:
     """The discretized problem: the hull's coefficients at ``k w`` (k = 0..Nh), its mass
     matrix without the pendulum, the wave's amplitudes."""
-    n = harmonics or HARMONICS_PER_TURN * max(1, winding) * max(1, wave.amplitudes.size // 8
-                                                                  + 1)
+    n = harmonics or HARMONICS_PER_TURN * max(1, winding, waves_in(wave))
     nh = hull_harmonics or n + max(1, winding)
     w = wave.omega
     kk = np.arange(nh + 1) * w
@@ -55,6 +56,14 @@ def make_case(hull, pendulum, wave, *, winding, harmonics=None, hull_harmonics=N
                     C=np.asarray(hull.hydrostatic_stiffness, float), Mh=mh, m=pendulum.mass,
                     l=pendulum.length, I=pendulum.inertia, c=pendulum.damping_coefficient,
                     g=float(hull.g), pivot=tuple(float(v) for v in pivot))
+
+
+def waves_in(wave) -> int:
+    """The wave's mean harmonic (energy-weighted): 1 for a regular wave, about the number
+    of waves in a record."""
+    a = np.abs(np.asarray(wave.amplitudes)) ** 2
+    k = np.arange(1, a.size + 1)
+    return max(1, int(round(float(np.sum(k * a) / np.sum(a)))))
 
 
 def _starts(n: int, winding: int) -> list[tuple[str, np.ndarray]]:
@@ -165,7 +174,10 @@ def _refine(sol: HullSolution, make, x) -> HullSolution:
     scale, power, case = 1, sol.power, sol.case
     status, ok = sol.status, sol.success
     change = math.inf
-    while scale < MAX_SCALE:
+    from ..limits import HULL_MAX_REFINED_HARMONICS
+
+    while scale < MAX_SCALE and 2 * scale * sol.case.harmonics <= max(
+            HULL_MAX_REFINED_HARMONICS, 2 * sol.case.harmonics):
         scale *= 2
         case = make(scale)
         pr = HullProblem(case)
@@ -176,11 +188,10 @@ def _refine(sol: HullSolution, make, x) -> HullSolution:
         x, power = r.x, float(r.power)
         if change <= REFINE_TOL * max(abs(power), 1e-300):
             break
-    else:
-        if change > REFINE_TOL * max(abs(power), 1e-300):
-            status = (f"not resolved: {case.harmonics} harmonics still change the power by "
-                      f"{change:.3g} W")
-            ok = False
+    if change > UNRESOLVED * max(abs(power), 1e-300):
+        status = (f"not resolved: {case.harmonics} harmonics still change the power by "
+                  f"{change:.3g} W")
+        ok = False
     pr = HullProblem(case)
     _, _, resid = pr.balance(x)
     one = HullProblem(case, coupled=False)

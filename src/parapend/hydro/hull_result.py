@@ -17,7 +17,7 @@ from .hull import HullProblem
 from .hull_optimum import BOUND_RCOND, hull_search, make_case, radiation_bound
 from .waves import energy_flux
 
-__all__ = ["HullResult", "MotionAt", "hull_answer"]
+__all__ = ["HullResult", "HullSweepResult", "MotionAt", "hull_answer"]
 
 #: pitch beyond which linear hull theory is stretched (deg)
 PITCH_VALIDITY_DEG = 15.0
@@ -301,3 +301,82 @@ def hull_answer(hull, pendulum, wave, *, pivot, windings=(1, 0), pitch_inertia=N
         body=dict(geometry or {}, description=getattr(hull, "description", "")),
         pivot={"pivot_offset_m": cs.pivot[0], "pivot_height_m": cs.pivot[1]},
         warnings=warnings, validity_warnings=validity, _motion=mot)
+
+
+@dataclass(frozen=True, eq=False, repr=False)
+class HullSweepResult(Result):
+    """Rotation against swinging over wave periods (regular waves of one height): arrays
+    over ``period_s``; ``mode`` the best per period; each :class:`HullResult` in
+    ``results``."""
+
+    period_s: np.ndarray
+    power_w: np.ndarray
+    rotation_power_w: np.ndarray
+    swinging_power_w: np.ndarray
+    one_way_power_w: np.ndarray
+    radiation_bound_w: np.ndarray
+    heave_amplitude_m: np.ndarray
+    pitch_amplitude_deg: np.ndarray
+    energy_balance_residual: np.ndarray
+    mode: list
+    status: list
+    success: bool
+    wave_height_m: float
+    pendulum: dict
+    body: dict
+    pivot: dict
+    warnings: list
+    _results: tuple = field(default=(), repr=False)
+
+    command = "buoy"
+    headline = ("period_s", "power_w", "success")
+
+    @property
+    def results(self) -> tuple:
+        """Each period's :class:`HullResult`."""
+        return self._results
+
+    @classmethod
+    def from_results(cls, periods, results, height) -> HullSweepResult:
+        def arr(name):
+            return np.array([np.nan if getattr(r, name) is None else getattr(r, name)
+                             for r in results], dtype=float)
+
+        def mode_power(r, mode):
+            return next((m["power_w"] for m in r.modes if m["mode"] == mode), np.nan)
+
+        warn = [f"T = {t:g} s: {w}" for t, r in zip(periods, results)
+                for w in list(r.warnings) + list(r.validity_warnings)]
+        return cls(period_s=np.asarray(periods, dtype=float), power_w=arr("power_w"),
+                   rotation_power_w=np.array([mode_power(r, "rotation") for r in results]),
+                   swinging_power_w=np.array([mode_power(r, "swinging") for r in results]),
+                   one_way_power_w=arr("one_way_power_w"),
+                   radiation_bound_w=arr("radiation_bound_w"),
+                   heave_amplitude_m=arr("heave_amplitude_m"),
+                   pitch_amplitude_deg=arr("pitch_amplitude_deg"),
+                   energy_balance_residual=arr("energy_balance_residual"),
+                   mode=[r.mode for r in results], status=[r.status for r in results],
+                   success=all(r.success for r in results), wave_height_m=float(height),
+                   pendulum=results[0].pendulum, body=results[0].body,
+                   pivot=results[0].pivot, warnings=warn, _results=tuple(results))
+
+    def _series(self):
+        import xarray as xr
+
+        names = ("power_w", "rotation_power_w", "swinging_power_w", "one_way_power_w",
+                 "radiation_bound_w", "heave_amplitude_m", "pitch_amplitude_deg",
+                 "energy_balance_residual")
+        ds = xr.Dataset({k: ("period_s", np.asarray(getattr(self, k), dtype=float))
+                         for k in names}, coords={"period_s": self.period_s})
+        ds["mode"] = ("period_s", np.asarray(self.mode, dtype=str))
+        return ds
+
+    def _figure(self):
+        from .figures import plot_hull_sweep
+
+        return plot_hull_sweep(self)
+
+    def __repr__(self) -> str:
+        p = np.asarray(self.period_s, dtype=float)
+        return (f"HullSweepResult(period_s: {p.size} periods from {p[0]:.6g} to {p[-1]:.6g}, "
+                f"largest power_w={np.nanmax(self.power_w):.6g}, success={self.success!r})")
