@@ -915,10 +915,12 @@ def buoy(*, wave_height=None, wave_period=None, hs=None, tp=None, spectrum=None,
          gamma_peak=None, repeat_period=None, seed=None, cutoff=None, record=None, taper=None,
          mass=BUOY["mass"], length=BUOY["length"], inertia=BUOY["inertia"],
          damping_coefficient=BUOY["damping_coefficient"], body=None, radius=None,
-         draft=None, mesh=None, hydro=None, winding=1, harmonics=None, torque_limit=None,
+         draft=None, mesh=None, hydro=None, winding=None, harmonics=None, torque_limit=None,
          efficiency=None, optimize_design=None, mass_bounds=None, length_bounds=None,
          inertia_bounds=None, damping_coefficient_bounds=None, controller="optimum",
-         horizon=None, update_interval=None, wave_direction=None):
+         horizon=None, update_interval=None, wave_direction=None, dofs="heave",
+         pivot_height=None, pivot_offset=None, hull_pitch_inertia=None, barge_length=None,
+         barge_beam=None, barge_draft=None):
     """The coupled optimum of a pendulum inside a floating buoy, in SI units (command
     ``buoy``; :func:`parapend.hydro.api.buoy`, parameters there): a
     :class:`~parapend.hydro.result.BuoyResult`, or a :class:`~parapend.hydro.result.BuoySweepResult`
@@ -937,7 +939,9 @@ def buoy(*, wave_height=None, wave_period=None, hs=None, tp=None, spectrum=None,
                  inertia_bounds=inertia_bounds,
                  damping_coefficient_bounds=damping_coefficient_bounds,
                  controller=controller, horizon=horizon, update_interval=update_interval,
-                 wave_direction=wave_direction)
+                 wave_direction=wave_direction, dofs=dofs, pivot_height=pivot_height,
+                 pivot_offset=pivot_offset, hull_pitch_inertia=hull_pitch_inertia,
+                 barge_length=barge_length, barge_beam=barge_beam, barge_draft=barge_draft)
 # --- horizon -------------------------------------------------------------------------------
 def horizon(*, hs=None, tp=None, spectrum: str = "jonswap", gamma_peak: float = 3.3,
             repeat_period=None, seed=None, cutoff: float = 3.0, length: float = SEA["length"],

@@ -132,14 +132,15 @@ def add_pendulum_options(g, *, gamma_note: str = "") -> None:
                    default=None, help="viscous damping c, N m s/rad (instead of --gamma)")
 
 
-def add_body_options(g, *, body_default, body_help: str, hydro_help: str) -> None:
+def add_body_options(g, *, body_default, body_help: str, hydro_help: str,
+                     bodies=("cylinder", "sphere")) -> None:
     """The buoy's body of ``buoy`` and ``power-matrix --device buoy`` into the argument group
     ``g``: ``--body --radius --draft --mesh --hydro`` (sizes default to ``defaults.BUOY``'s);
     the default of ``--body`` and the help of ``--body`` and ``--hydro`` are the commands'
     own."""
     from ..defaults import BUOY
 
-    g.add_argument("--body", choices=["cylinder", "sphere"], default=body_default,
+    g.add_argument("--body", choices=list(bodies), default=body_default,
                    help=body_help)
     g.add_argument("--radius", type=_finite_float("radius"), default=None,
                    help=f"m (default {BUOY['radius']:g})")

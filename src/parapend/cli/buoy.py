@@ -66,18 +66,42 @@ def add_parsers(sub) -> None:
     g = p.add_argument_group("body (Capytaine; the BEM result is cached on disk)")
     from ._common import add_body_options
 
-    add_body_options(g, body_default="cylinder",
+    add_body_options(g, body_default="cylinder", bodies=("cylinder", "sphere", "barge"),
                      body_help="vertical cylinder or sphere floating at its centre (default "
-                               "cylinder)",
+                               "cylinder); with --dofs surge,heave,pitch also a box barge "
+                               "(the default there)",
                      hydro_help="a Capytaine dataset (NetCDF), instead of solving "
                                 "(docs/buoy.md)")
     p.set_defaults(body=None)  # so that --body given beside --hydro or --mesh is refused
     g.add_argument("--wave-direction", type=_finite_float("wave-direction"), default=None,
                    metavar="RAD", help="with --hydro: the dataset's wave direction to use, rad "
                                        "(default 0, waves travelling along +x)")
+    from ..defaults import HULL
+
+    g = p.add_argument_group("hull: surge, heave and pitch (docs/hull.md)")
+    g.add_argument("--dofs", default="heave", metavar="DOFS",
+                   help="the hull's degrees of freedom: heave (default, the heaving buoy) "
+                        "or surge,heave,pitch (a hull that pitches; the pendulum rotates or "
+                        "swings)")
+    g.add_argument("--pivot-height", type=_finite_float("pivot-height"), default=None,
+                   help=f"the pivot above the hull's rotation centre (its waterplane "
+                        f"centre), m (default {HULL['pivot_height']:g})")
+    g.add_argument("--pivot-offset", type=_finite_float("pivot-offset"), default=None,
+                   help=f"the pivot ahead of it, along the waves' travel, m (default "
+                        f"{HULL['pivot_offset']:g})")
+    g.add_argument("--hull-pitch-inertia", type=_finite_float("hull-pitch-inertia"),
+                   default=None, help="the hull's pitch inertia about the rotation centre, "
+                                      "without the pendulum, kg m^2 (default: the dataset's, "
+                                      "else a homogeneous immersed hull's)")
+    for name, key in (("length", "barge_length"), ("beam", "barge_beam"),
+                      ("draft", "barge_draft")):
+        g.add_argument(f"--barge-{name}", type=_finite_float(f"barge-{name}"), default=None,
+                       help=f"the box barge's {name}, m (default {HULL[key]:g})")
     g = p.add_argument_group("motion and power take-off")
-    g.add_argument("--winding", type=_int, default=1,
-                   help="turns per wave (per record in an irregular sea) (default 1)")
+    g.add_argument("--winding", type=_int, default=None,
+                   help="turns per wave (per record in an irregular sea) (default 1; with "
+                        "--dofs surge,heave,pitch: rotation (1) and swinging (0) side by "
+                        "side)")
     g.add_argument("--harmonics", type=_int, default=None,
                    help="N of the motion (default chosen from the problem and checked)")
     g.add_argument("--torque-limit", type=_finite_float("torque-limit"), default=None,
@@ -168,6 +192,8 @@ def _cmd_buoy(a) -> dict | str:
             _output.write_dataset(r.to_dataset(), a.save)
         return r.to_dict() if a.json else "\n".join(
             mpc_text(r) + ([f"written: {a.save}"] if a.save else []))
+    if hasattr(r, "dofs") or hasattr(r, "rotation_power_w"):
+        return _hull_output(r, a)
     sweep = hasattr(r, "period_s")
     if not sweep and r.status == "no_power":
         head = r.message.split(":", 1)[0]
@@ -278,6 +304,89 @@ def _sweep_text(r) -> list:
     out += [f"note: {n}" for n in r.warnings]
     out += [f"warning: {n}" for n in r.validity_warnings]
     return out
+
+
+def _hull_output(r, a):
+    """Text, JSON, NetCDF and figures of a hull result (``--dofs surge,heave,pitch``)."""
+    written = []
+    if a.save:
+        _output.write_dataset(r.to_dataset(), a.save)
+        written.append(a.save)
+    if a.plot:
+        from ..fileio import output_error, save_figure
+
+        d = Path(a.plot)
+        try:
+            d.mkdir(exist_ok=True)
+        except OSError as exc:
+            raise output_error(a.plot, exc) from None
+        fig = r.plot()
+        name = "hull_power" if hasattr(r, "period_s") else "hull_motion"
+        for ext in ("png", "svg"):
+            save_figure(fig, d / f"{name}.{ext}", close=ext == "svg")
+            written.append(str(d / f"{name}.{ext}"))
+    if a.json:
+        return r.to_dict()
+    out = _hull_sweep_text(r) if hasattr(r, "period_s") else _hull_text(r)
+    return "\n".join(out + [f"written: {w}" for w in written])
+
+
+def _hull_head(r) -> list:
+    p, b, v = r.pendulum, r.body, r.pivot
+    return [f"hull: {b['description']} (surge, heave, pitch)",
+            f"pendulum: m = {p['mass_kg']:g} kg, l = {p['length_m']:g} m, I = "
+            f"{p['inertia_kg_m2']:.6g} kg m^2, c = {p['damping_coefficient']:g} N m s/rad; "
+            f"pivot {v['pivot_height_m']:g} m above and {v['pivot_offset_m']:g} m ahead of "
+            "the rotation centre"]
+
+
+def _hull_text(r) -> list:
+    w = r.wave
+    wave = (f"wave: regular, H = {w['height_m']:g} m, T = {w['period_s']:g} s"
+            if w.get("kind") == "regular" else
+            f"wave: irregular record, repeat period {w['repeat_period']:.6g} s")
+    modes = [[m["mode"], _w(m["power_w"]), _w(m.get("one_way_power_w")),
+              _w(m.get("mean_angle_deg")), _w(m.get("swing_amplitude_deg")),
+              _w(m.get("peak_torque_nm")), str(m.get("distinct_maxima", "-")),
+              m["status"]] for m in r.modes]
+    rows = [["best mode", r.mode, "-"],
+            ["power", _w(r.power_w), "W"],
+            ["  discretization error (half the harmonics)", _w(r.refinement_change_w), "W"],
+            ["one-way (reaction left out)", _w(r.one_way_power_w), "W"],
+            ["radiation bound (F a)^H B^+ (F a) / 8", _w(r.radiation_bound_w), "W"],
+            ["  fraction reached", _w(r.bound_fraction), "-"],
+            ["capture width P / J", _w(r.capture_width_m), "m"],
+            ["surge amplitude / phase", f"{r.surge_amplitude_m:.4g} / "
+             f"{_w(r.surge_phase_deg)}", "m / deg"],
+            ["heave amplitude / phase", f"{r.heave_amplitude_m:.4g} / "
+             f"{_w(r.heave_phase_deg)}", "m / deg"],
+            ["pitch amplitude / phase", f"{r.pitch_amplitude_deg:.4g} / "
+             f"{_w(r.pitch_phase_deg)}", "deg / deg"],
+            ["mean heel", f"{r.mean_heel_deg:.4g}", "deg"],
+            ["peak torque", _w(r.peak_torque_nm), "N m"],
+            ["peak bearing load", _w(r.peak_pivot_force_n), "N"]]
+    out = [wave, *_hull_head(r), "",
+           _table(modes, ["mode", "power (W)", "one-way (W)", "mean angle (deg)",
+                          "swing (deg)", "peak torque (N m)", "maxima", "status"]), "",
+           _table(rows, ["quantity", "value", "unit"]), "",
+           f"status: {r.status}; N = {r.harmonics}, hull harmonics {r.hull_harmonics}; "
+           f"energy balance residual {_w(r.energy_balance_residual)}"]
+    out += [f"note: {n}" for n in r.warnings]
+    out += [f"warning: {n}" for n in r.validity_warnings]
+    return out
+
+
+def _hull_sweep_text(r) -> list:
+    rows = [[f"{t:g}", _fmt(p), _fmt(rp), _fmt(sp), m, _fmt(o), _fmt(b), _fmt(z), _fmt(pi)]
+            for t, p, rp, sp, m, o, b, z, pi in zip(
+                r.period_s, r.power_w, r.rotation_power_w, r.swinging_power_w, r.mode,
+                r.one_way_power_w, r.radiation_bound_w, r.heave_amplitude_m,
+                r.pitch_amplitude_deg)]
+    head = ["T (s)", "power (W)", "rotation (W)", "swinging (W)", "best", "one-way (W)",
+            "bound (W)", "heave (m)", "pitch (deg)"]
+    out = [f"regular waves, H = {r.wave_height_m:g} m", *_hull_head(r), "",
+           _table(rows, head), "", f"success: {r.success}"]
+    return out + [f"note: {n}" for n in r.warnings]
 
 
 COMMANDS = {"buoy": _cmd_buoy}

@@ -147,6 +147,9 @@ def _hydro(body, radius, draft, mesh, hydro, wave_direction=None):
 def _dimensions(body, radius, draft):
     """Radius and draft (m) of a parametric body (a sphere's draft is its radius)."""
     body = "cylinder" if body is None else body
+    if body == "barge":
+        raise ParameterError("body: the barge is a hull that pitches: give --dofs "
+                             "surge,heave,pitch")
     if body not in ("cylinder", "sphere"):
         raise ParameterError(f"body: expected cylinder or sphere, got {body!r:.40}")
     lo, hi = limits.BUOY_SIZE_RANGE
