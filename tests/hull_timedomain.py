@@ -31,7 +31,7 @@ carries the quadrature's ``+ dt^2 K(0) / 12`` (Euler-Maclaurin: the odd integran
 harmonics is reported (``model_error``) and the model's own coefficients are returned
 (``model_coefficients``), so that :func:`harmonic_response` can separate the model's error from
 the integrator's. The continuous Kramers-Kronig estimates of ``A_inf`` at every data frequency
-(:func:`a_infinity_estimates`) are returned for information.
+(:func:`a_infinity_estimates`) are there for comparison.
 
 Integrator
 ----------
@@ -333,8 +333,7 @@ def replay(*, omega_data, A, B, F, C, Mh, m, l, I, c, g, pivot, wave_omega, ampl
         as in the spec, and every DOF's linear drift removed first); ``power`` (W), the
         mean of ``-tau (phi' - beta')`` over the last period; ``surge_drift`` (m/s), the mean
         surge velocity; ``periodicity``, ``max |xi'(last period) - xi'(period before)| /
-        max |xi'|``; ``dt``, ``memory`` (s), ``a_inf`` (3, 3), ``a_inf_kk`` (the continuous
-        Kramers-Kronig estimates, :func:`a_infinity_estimates`), ``model_coefficients``
+        max |xi'|``; ``dt``, ``memory`` (s), ``a_inf`` (3, 3), ``model_coefficients``
         (``w -> (A_td, B_td, F)``, the discrete model's own hydrodynamics) and
         ``model_error`` (the largest ``|A_td - A| w^2 + |B_td - B| w`` relative to
         ``|Z(w)|`` over the returned harmonics inside the data).
@@ -417,14 +416,15 @@ def replay(*, omega_data, A, B, F, C, Mh, m, l, I, c, g, pivot, wave_omega, ampl
     acc[0] = np.linalg.solve(mt[0], force[0])
     wflat = wts[nk:0:-1].transpose(1, 0, 2).reshape(3, 3 * nk)
     w0 = wts[0]
+    # C' px + w_0 pv with the predictors px = x + dt v + dt^2/4 a, pv = v + dt/2 a
+    qmat = np.hstack([cp, dt * cp + w0, 0.25 * dt * dt * cp + 0.5 * dt * w0])
     for n in range(nsteps):
+        xn, vn, an = x[n], vel[nk + n], acc[n]
         hist = wflat @ vel[n + 1:n + 1 + nk].ravel()
-        px = x[n] + dt * vel[nk + n] + 0.25 * dt * dt * acc[n]
-        pv = vel[nk + n] + 0.5 * dt * acc[n]
-        a_new = sinv[n + 1] @ (force[n + 1] - hist - cp @ px - w0 @ pv)
+        a_new = sinv[n + 1] @ (force[n + 1] - hist - qmat @ np.concatenate((xn, vn, an)))
         acc[n + 1] = a_new
-        vel[nk + n + 1] = pv + 0.5 * dt * a_new
-        x[n + 1] = px + 0.25 * dt * dt * a_new
+        vel[nk + n + 1] = vn + (0.5 * dt) * (an + a_new)
+        x[n + 1] = xn + dt * vn + (0.25 * dt * dt) * (an + a_new)
     v = vel[nk:]
 
     last = slice(nsteps - spp, nsteps)
@@ -445,7 +445,6 @@ def replay(*, omega_data, A, B, F, C, Mh, m, l, I, c, g, pivot, wave_omega, ampl
             "Xi": xi_k, "power": float(-np.mean(tau * rel)), "surge_drift": float(drift[0]),
             "periodicity": float(np.max(np.abs(v[last] - v[prev])) / vscale),
             "dt": dt, "memory": nk * dt, "a_inf": a_inf,
-            "a_inf_kk": a_infinity_estimates(om, A, B),
             "model_coefficients": model_coefficients, "model_error": err}
 
 

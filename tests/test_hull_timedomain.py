@@ -17,6 +17,7 @@ import numpy as np
 import pytest
 from hull_timedomain import (
     A_INF,
+    a_infinity_estimates,
     harmonic_response,
     interpolator,
     kernel,
@@ -69,10 +70,12 @@ def _sensitivity(k, hull=HULL, w=W):
     return float(np.linalg.norm(np.linalg.solve(z(x), x * (z(x + h) - z(x - h)) / (2 * h)), 2))
 
 
-def _compare(phi, amps, spp, periods=30, hull=HULL, w=W):
+def _compare(phi, amps, spp, periods=18, ramp=6, hull=HULL, w=W):
+    # 18 periods with a 6-period ramp: the transients have decayed to 1e-8 of the harmonics;
+    # what is left is the surge's drift, 4e-4 of its velocity (1/ramp^4), removed as a trend
     wave = {"wave_omega": w, "amplitudes": amps}
     fd = harmonic_response(**hull, **wave, phi=phi)
-    td = replay(**hull, **wave, phi=phi, periods=periods, steps_per_period=spp)
+    td = replay(**hull, **wave, phi=phi, periods=periods, ramp_periods=ramp, steps_per_period=spp)
     fm = harmonic_response(**hull, **wave, phi=phi, coefficients=td["model_coefficients"])
     return fd, td, fm
 
@@ -105,8 +108,10 @@ def test_kernel_is_the_cosine_transform_of_the_data():
     t = np.linspace(0.0, 20.0, 201)
     err = np.max(np.abs(kernel(om, HULL["B"], t) - synthetic_kernel(t)), axis=0)
     v = np.linspace(1e-4, om[-1], 5001)
-    coef = interpolator(om, HULL["A"], HULL["B"], HULL["F"], HULL["C"])
-    below = np.abs(np.array([coef(x)[1] for x in v]) - synthetic_exact(v)[1])
+    bsym = 0.5 * (HULL["B"] + np.swapaxes(HULL["B"], 1, 2))
+    b_lin = np.stack([np.interp(v, np.r_[0.0, om], np.r_[0.0, bsym[:, i, j]])
+                      for i in range(3) for j in range(3)], axis=1).reshape(-1, 3, 3)
+    below = np.abs(b_lin - synthetic_exact(v)[1])
     u = np.geomspace(om[-1], 1e5, 20001)
     above = np.abs(synthetic_exact(u)[1])
     # B ~ 1/w^2 beyond 1e5 rad/s: its integral there is B(1e5) 1e5
@@ -133,7 +138,8 @@ def test_the_models_damping_is_the_datas_and_its_added_mass_matches_at_the_funda
     # shift and the quadrature's dt^2 K(0) / 12 are what it absorbs)
     assert np.max(np.abs(td["a_inf"] - A_INF)) < 1e-3 * np.max(np.abs(A_INF))
     # the continuous Kramers-Kronig estimates agree to the same order
-    est = td["a_inf_kk"][HULL["omega_data"][:-1] < 10.0]
+    est = a_infinity_estimates(HULL["omega_data"], HULL["A"], HULL["B"])
+    est = est[HULL["omega_data"][:-1] < 10.0]
     assert np.max(np.abs(est - A_INF)) < 3e-3 * np.max(np.abs(A_INF))
 
 
@@ -164,8 +170,8 @@ def test_held_pendulum_heels_the_hull_in_both_domains():
     ref = np.linalg.solve(cp[1:, 1:], rhs)
     fd = harmonic_response(**HULL, wave_omega=W, amplitudes=[0.0], phi=held)
     assert np.max(np.abs(fd["Xi"][0, 1:] - ref)) < 1e-12 * np.max(np.abs(ref))
-    td = replay(**HULL, wave_omega=W, amplitudes=[0.0], phi=held, periods=30,
-                steps_per_period=100)
+    td = replay(**HULL, wave_omega=W, amplitudes=[0.0], phi=held, periods=18,
+                ramp_periods=6, steps_per_period=100)
     assert np.max(np.abs(td["Xi"][0, 1:] - ref)) < 1e-6 * np.max(np.abs(ref))
     assert abs(td["power"]) < 1e-9
 
@@ -279,11 +285,11 @@ def test_replay_on_a_capytaine_box_barge(box_barge):
     for phi in (lambda t: (math.pi + 0.5 * np.sin(w * t + 1.6), 0.5 * w * np.cos(w * t + 1.6),
                            -0.5 * w * w * np.sin(w * t + 1.6)),
                 phi_fourier([4.7, 0.3, 0.0], 1, w)):
-        fd, t1, fm1 = _compare(phi, [0.5], 100, periods=40, hull=box_barge, w=w)
+        fd, t1, fm1 = _compare(phi, [0.5], 100, periods=40, ramp=10, hull=box_barge, w=w)
         assert abs(fd["energy_residual"]) < 1e-9 * fd["energy_scale"]
         assert t1["periodicity"] < 1e-5
         _assert_agree(fd, t1, fm1, hull=box_barge, w=w)
-        _, t2, fm2 = _compare(phi, [0.5], 200, periods=40, hull=box_barge, w=w)
+        _, t2, fm2 = _compare(phi, [0.5], 200, periods=40, ramp=10, hull=box_barge, w=w)
         e1 = np.max(np.abs(t1["Xi"][1:4] - fm1["Xi"][1:4]))
         e2 = np.max(np.abs(t2["Xi"][1:4] - fm2["Xi"][1:4]))
         assert 3.5 < e1 / e2 < 4.5
