@@ -5,7 +5,6 @@ from __future__ import annotations
 import math
 
 from .. import limits
-from ..defaults import GAMMA
 from . import _output
 from ._common import (
     FIGURE_SUFFIXES,
@@ -26,17 +25,17 @@ def add_pto_options(p, torque_limit: bool = True) -> None:
     """``--torque-limit``, ``--efficiency``, ``--efficiency-generating/-motoring``."""
     g = p.add_argument_group("power take-off")
     if torque_limit:
-        g.add_argument("--torque-limit", type=_finite_float("torque-limit"), default=None,
+        g.add_argument("--torque-limit", type=_finite_float("torque-limit"),
                        help="|T(t)| <= this, units m g l (> 0)")
         g.add_argument("--torque-limit-nm", type=_finite_float("torque-limit-nm"),
-                       default=None, help="the torque limit in N m (needs --length, --mass)")
-    g.add_argument("--efficiency", type=_finite_float("efficiency"), default=None,
+                       help="the torque limit in N m (needs --length, --mass)")
+    g.add_argument("--efficiency", type=_finite_float("efficiency"),
                    help="generator and motor efficiency in (0, 1]: electrical power eta p "
                         "when harvesting (p = -T theta' > 0), p / eta when motoring")
     g.add_argument("--efficiency-generating", type=_finite_float("efficiency-generating"),
-                   default=None, help="eta_g in (0, 1] (overrides --efficiency)")
+                   help="eta_g in (0, 1] (overrides --efficiency)")
     g.add_argument("--efficiency-motoring", type=_finite_float("efficiency-motoring"),
-                   default=None, help="eta_m in (0, 1] (overrides --efficiency)")
+                   help="eta_m in (0, 1] (overrides --efficiency)")
 
 
 def add_unit_options(p, damping: bool = True, torque: bool = False,
@@ -47,25 +46,25 @@ def add_unit_options(p, damping: bool = True, torque: bool = False,
     with ``torque``, for commands that have no other take-off options; ``--frequency`` and
     ``--amplitude`` only with ``excitation``: a design map's axes stay non-dimensional)."""
     g = p.add_argument_group(f"physical units (docs/units.md); {adds}")
-    g.add_argument("--length", type=_finite_float("length"), default=None,
+    g.add_argument("--length", type=_finite_float("length"),
                    help="pivot to centre of mass, m")
-    g.add_argument("--mass", type=_finite_float("mass"), default=None, help="kg")
-    g.add_argument("--inertia", type=_finite_float("inertia"), default=None,
+    g.add_argument("--mass", type=_finite_float("mass"), help="kg")
+    g.add_argument("--inertia", type=_finite_float("inertia"),
                    help="moment of inertia about the pivot, kg m^2 (default m l^2)")
-    g.add_argument("--gravity", type=_finite_float("gravity"), default=None,
+    g.add_argument("--gravity", type=_finite_float("gravity"),
                    help="m/s^2 (default 9.81)")
     if excitation:
-        g.add_argument("--frequency", type=_finite_float("frequency"), default=None,
+        g.add_argument("--frequency", type=_finite_float("frequency"),
                        help="base heave frequency, Hz (sets omega = 2 pi f sqrt(l/g))")
-        g.add_argument("--amplitude", type=_finite_float("amplitude"), default=None,
+        g.add_argument("--amplitude", type=_finite_float("amplitude"),
                        help="base heave displacement amplitude A, m (sets delta = "
                             "-A (2 pi f)^2/g)")
     if damping:
         g.add_argument("--damping-coefficient", type=_finite_float("damping-coefficient"),
-                       default=None, help="viscous damping c, N m s/rad (sets gamma)")
+                       help="viscous damping c, N m s/rad (sets gamma)")
     if torque:
         g.add_argument("--torque-limit-nm", type=_finite_float("torque-limit-nm"),
-                       default=None, help="the torque limit in N m (needs --length, --mass)")
+                       help="the torque limit in N m (needs --length, --mass)")
 
 
 def units_of(r):
@@ -184,13 +183,13 @@ def add_parsers(sub) -> None:
                                    "torque down to the smallest feasible limit, by "
                                    "continuation) or against the efficiency.")
     _add_excitation(p)
-    p.add_argument("--vary", choices=["torque-limit", "efficiency"], default="torque-limit",
+    p.add_argument("--vary", choices=["torque-limit", "efficiency"],
                    help="the varied parameter (default torque-limit)")
-    p.add_argument("--gamma", type=_finite_float("gamma"), default=GAMMA["pto-curve"],
+    p.add_argument("--gamma", type=_finite_float("gamma"),
                    help="viscous damping gamma in [0, 1e3] (default 0.03; docs/defaults.md)")
-    p.add_argument("--harmonics", type=_int, default=24,
+    p.add_argument("--harmonics", type=_int,
                    help=f"N, at most {limits.MAX_PTO_HARMONICS} (default 24)")
-    p.add_argument("--points", type=_int, default=10,
+    p.add_argument("--points", type=_int,
                    help=f"number of values, 2 to {limits.MAX_PTO_POINTS} (default 10)")
     add_pto_options(p)
     add_unit_options(p)
