@@ -120,10 +120,13 @@ def optimize(*, excitation=None, omega=OMEGA, delta=None, square_alpha=None, fou
 
     Ideal (:func:`parapend.api.optimize`: Fourier Eq. 10 or the BVP of Eq. 22), or through
     a power take-off (:func:`parapend.pto.optimize_pto`) when a torque limit, an efficiency
-    or a copper loss is given. With ``length`` and ``mass`` (and optionally ``frequency``,
-    ``amplitude``, ``damping_coefficient``, ``gravity``, ``inertia``, ``torque_limit_nm``:
-    docs/units.md) the result adds watts, N m and joules. ``method="all"`` compares the
-    uniform rotation, Fourier, BVP and limit (a :class:`~parapend.results.Record`).
+    or a copper loss is given; through a lossy one (an efficiency or a copper loss)
+    ``power`` and ``power_w`` are the electrical power and ``mechanical_power``,
+    ``mechanical_power_w`` the mechanical one. With ``length`` and ``mass`` (and optionally
+    ``frequency``, ``amplitude``, ``damping_coefficient``, ``gravity``, ``inertia``,
+    ``torque_limit_nm``: docs/units.md) the result adds watts, N m and joules.
+    ``method="all"`` compares the uniform rotation, Fourier, BVP and limit (a
+    :class:`~parapend.results.Record`).
     Beyond the command's options: ``copper_loss`` (a winding loss ``r T^2``, a take-off),
     ``warm`` (a packed start) and ``throw`` (raise SolverError when not converged).
 
@@ -161,12 +164,14 @@ def optimize(*, excitation=None, omega=OMEGA, delta=None, square_alpha=None, fou
             draw=lambda rec: rec.fourier_result.plot(),
             series=lambda rec: rec.fourier_result._series())
     if pto:
-        from .pto import optimize_pto, plot_pto_profile
+        from .pto import electrical_headline, optimize_pto, plot_pto_profile
 
         r = optimize_pto(units=units, method=method, torque_limit=torque_limit,
                          efficiency=efficiency, efficiency_generating=efficiency_generating,
                          efficiency_motoring=efficiency_motoring, copper_loss=copper_loss,
                          warm=warm, throw=throw, **kw)
+        if r.efficiency_generating is not None or copper_loss != 0.0:
+            r = electrical_headline(r)  # lossy: power is the electrical power
         return dataclasses.replace(r, _draw=plot_pto_profile)
     from .plotting import plot_optimum
 
@@ -276,7 +281,9 @@ def pto_curve(*, vary: str = "torque-limit", excitation=None, omega=OMEGA, delta
     """Optimal power against the torque limit or the efficiency (command ``pto-curve``): a
     Dataset over ``value`` (:func:`parapend.pto.pto_curve`); with ``length`` and ``mass``
     it adds ``power_w``, ``electrical_power_w``, ``peak_torque_nm`` and, when the torque
-    limit varies, ``torque_limit_nm``."""
+    limit varies, ``torque_limit_nm``. With an efficiency (given, or varied) ``power`` and
+    ``power_w`` are the electrical power and ``mechanical_power``, ``mechanical_power_w``
+    the mechanical one."""
     from .pto import pto_curve as _curve
 
     kw = {"gamma": gamma, "harmonics": harmonics,
@@ -298,6 +305,11 @@ def pto_curve(*, vary: str = "torque-limit", excitation=None, omega=OMEGA, delta
         if vary == "torque-limit":
             ds["torque_limit_nm"] = ds["value"] * units.torque
         _units_attrs(ds, units)
+    if vary == "efficiency" or any(v is not None for v in (
+            efficiency, efficiency_generating, efficiency_motoring)):
+        from .pto import electrical_curve
+
+        electrical_curve(ds)  # lossy: power is the electrical power
     return _table("pto-curve", ds, "pto", "plot_pto_curve")
 
 

@@ -86,11 +86,12 @@ def physical_lines(r, units) -> list[str]:
     out = [f"physical (l = {units.length:g} m, m = {units.mass:g} kg, g = {units.gravity:g} "
            f"m/s^2; power unit {units.power:.6g} W, torque unit {units.torque:.6g} N m, time "
            f"unit {units.time:.6g} s): base {units.frequency(r.omega):.6g} Hz",
-           f"  power {r.power_w:.6g} W ({r.energy_per_cycle_j:.6g} J per cycle), uniform "
+           (f"  power {r.power_w:.6g} W" if r.mechanical_power_w is None else
+            f"  power (electrical) {r.power_w:.6g} W, mechanical power "
+            f"{r.mechanical_power_w:.6g} W")
+           + f" ({r.energy_per_cycle_j:.6g} J per cycle), uniform "
            f"{r.uniform_power_w:.6g} W, limit {r.limit_power_w:.6g} W, peak torque "
            f"{r.peak_torque_nm:.6g} N m"]
-    if r.electrical_power_w is not None and r.efficiency_generating is not None:
-        out.append(f"  electrical power {r.electrical_power_w:.6g} W")
     if r.motoring_energy_j is not None:
         out.append(f"  motoring energy {r.motoring_energy_j:.6g} J per cycle")
     if r.uniform_pto_power_w is not None:
@@ -105,7 +106,7 @@ def like_for_like_rows(r, name: str) -> list[list[str]]:
     uniform rotation through the same take-off, the optimum, the limit; "vs uniform"
     compares the optimum with the uniform rotation through the same take-off, electrical
     with electrical (mechanical without an efficiency or copper loss)."""
-    elec = r.efficiency_generating is not None or r.electrical_power != r.power
+    elec = r.mechanical_power is not None  # a lossy take-off: power is the electrical power
     what = "electrical" if elec else "mechanical"
     if r.uniform_pto_feasible:
         uni = [f"best uniform rotation, same take-off ({what})",
@@ -116,7 +117,7 @@ def like_for_like_rows(r, name: str) -> list[list[str]]:
         uni = ["best uniform rotation, same take-off", "infeasible",
                "no phase within the torque limit"]
         gain = "- (uniform infeasible)"
-    mine = r.electrical_power if elec else r.power
+    mine = r.power
     return [["best uniform rotation, ideal (Eq. 17)", _fmt(r.uniform_power), ""],
             uni,
             [f"{name} ({what})", _fmt(mine), gain],
@@ -208,9 +209,10 @@ def _cmd_pto_curve(a) -> dict | str:
     if a.json:
         return ds.to_dict()
     name = "T_max" if a.vary == "torque-limit" else "eta"
+    mech = ds["mechanical_power" if "mechanical_power" in ds else "power"]
     rows = [[f"{v:.6g}", _fmt(p, 8), _fmt(e, 8), "-" if math.isnan(u) else _fmt(u, 8),
              f"{t:.5g}" + ("*" if c == 0 else ""), _fmt(m), str(s)]
-            for v, p, e, u, t, m, s, c in zip(ds["value"].values, ds["power"].values,
+            for v, p, e, u, t, m, s, c in zip(ds["value"].values, mech.values,
                                               ds["electrical_power"].values,
                                               ds["uniform_pto_electrical_power"].values,
                                               ds["peak_torque"].values,
@@ -220,7 +222,8 @@ def _cmd_pto_curve(a) -> dict | str:
     head = [name, "mech. P", "electrical", "uniform, same", "peak |T|", "motoring E",
             "status"]
     if units is not None:
-        for r, w in zip(rows, ds["power_w"].values):
+        mech_w = ds["mechanical_power_w" if "mechanical_power_w" in ds else "power_w"]
+        for r, w in zip(rows, mech_w.values):
             r.insert(2, f"{w:.5g}")
         head.insert(2, "P (W)")
     out = [_table(rows, head), "",
