@@ -6,7 +6,8 @@ changing a default in the signature changes the command line's, for every option
 command; the parser that ``main`` uses (the defaults read when the command is parsed)
 gives the same values as the one built with every default read at once; and ``sea``,
 ``buoy`` and ``horizon`` are the implementing functions themselves, not wrappers that
-restate their signatures.
+restate their signatures. The defaults the help texts state (77 options) agree with the
+signatures.
 """
 
 from __future__ import annotations
@@ -115,3 +116,46 @@ def test_sea_refuses_a_sea_state_beside_a_record(tmp_path):
     f.write_text("t,z\n" + "".join(f"{0.5 * i},0\n" for i in range(64)))
     with pytest.raises(parapend.ParameterError, match="hs, seed: not used with --record"):
         parapend.sea(record=str(f), hs=2.0, seed=0)
+
+
+def _stated(text):
+    """The value a help text states as its default, ``(default X)`` or ``(default X;``, as
+    a float, a tuple of floats (``-3:3``) or the text; None where it states none."""
+    import re
+
+    m = re.search(r"\(default ([^;()]+)[;)]", text)
+    if m is None:
+        return None
+    tok = m.group(1).strip()
+    try:
+        return float(tok)
+    except ValueError:
+        pass
+    try:
+        return tuple(float(x) for x in tok.split(":"))
+    except ValueError:
+        return tok
+
+
+@pytest.mark.parametrize("command", COMMANDS)
+def test_a_default_stated_in_the_help_is_the_signature_default(command):
+    """Where an option's help states its default as a number or a word and the signature's
+    default is a value (not None, resolved inside the function), the two agree: the help
+    text is the one copy left beside the signature, and this keeps it from drifting."""
+    params = inspect.signature(_function(command)).parameters
+    checked = 0
+    for action in _parameter_options(_subparsers()[command], command):
+        want = params[action.dest].default
+        stated = _stated(action.help or "")
+        if stated is None or want is None or isinstance(want, bool):
+            continue
+        if isinstance(stated, float) and isinstance(want, (int, float)):
+            assert stated == want, (command, action.dest, stated, want)
+        elif isinstance(stated, tuple) and isinstance(want, tuple):
+            assert stated == want, (command, action.dest, stated, want)
+        elif isinstance(stated, str) and isinstance(want, str):
+            assert stated == want, (command, action.dest, stated, want)
+        else:
+            continue
+        checked += 1
+    assert checked or command in ("figure", "reproduce", "buoy"), command
