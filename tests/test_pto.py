@@ -299,12 +299,15 @@ def test_efficiency_with_a_small_limit_is_the_constant_brake():
     """Through an efficiency the collocation alone stalled at a 1 N m limit and reported
     "infeasible", while 0.5 N m was feasible: the constant brake is tried as in the
     Hermite path. Its power is the closed-form bound T_max omega of every monotone
-    rotation, and it only generates: electrical = eta_g P."""
+    rotation, and it only generates: electrical = eta_g P (``power`` is the electrical
+    power through an efficiency, ``mechanical_power`` the mechanical one)."""
     args = {"length": 1.0, "mass": 10.0, "frequency": 0.9, "amplitude": 0.09,
             "damping_coefficient": 0.5}
     r = parapend.optimize(torque_limit_nm=1.0, efficiency=0.9, **args)
     assert r.status == "converged" and r.method == "constant-brake"
-    assert r.power == pytest.approx(r.torque_limit * r.omega, rel=1e-9)
-    assert r.electrical_power == pytest.approx(0.9 * r.power, rel=1e-12)
+    assert r.mechanical_power == pytest.approx(r.torque_limit * r.omega, rel=1e-9)
+    assert r.power == r.electrical_power == pytest.approx(0.9 * r.mechanical_power,
+                                                          rel=1e-12)
+    assert r.power_w == pytest.approx(0.9 * r.mechanical_power_w, rel=1e-12)
     assert r.motoring_energy == pytest.approx(0.0, abs=1e-12)
     assert r.peak_torque <= r.torque_limit * (1 + 1e-9)

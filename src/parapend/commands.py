@@ -16,10 +16,16 @@ frozen result whose fields are the keys of the command's ``--json`` object:
   fields are the JSON keys; the objects behind it (the Dataset, the motion, the figure) are
   its private attributes ``_dataset``, ``_source``, ``_figure``.
 
-The command line is a thin shell over these functions: each command parses its options,
-calls the function and formats the result. Options that only choose how the result is
-presented are not parameters: they are :data:`PRESENTATION`. Progress bars are the
-``progress`` parameter (a callable ``progress(done, total)``) where a command has one.
+Each parameter is declared once: in the signature (and the docstring's Parameters) of the
+function that answers the command. ``sea``, ``buoy`` and ``horizon`` are that function itself
+(:data:`IMPLEMENTED`: :func:`parapend.irregular.sea`, :func:`parapend.hydro.api.buoy`,
+:func:`parapend.control.horizon.horizon_curve`); the others here convert units, check or
+shape the result around the modules that answer them. The command line is a thin shell over
+these functions: each command parses its options, whose defaults it reads from the
+function's signature (:meth:`parapend.cli._common._Parser.declare_defaults`), calls the
+function and formats the result. Options that only choose how the result is presented are
+not parameters: they are :data:`PRESENTATION`. Progress bars are the ``progress`` parameter
+(a callable ``progress(done, total)``) where a command has one.
 """
 
 from __future__ import annotations
@@ -28,14 +34,13 @@ import dataclasses
 import math
 
 from . import limits
-from .defaults import DELTA, DYNAMICS, GAMMA, HORIZON, OMEGA, SEA, given  # noqa: F401
+from .defaults import DELTA, DYNAMICS, GAMMA, OMEGA, SEA, given  # noqa: F401
 from .errors import OutputError, ParameterError, check_int, check_range
 from .results import Record
 
 __all__ = ["PRESENTATION", "basins", "damping_sweep", "figure", "harmonics", "map",
-           "optimize", "pto_curve", "reproduce", "rotations", "sea", "simulate", "sweep",
-           "threshold", "track",
-           "power_matrix", "horizon"]
+           "optimize", "pto_curve", "reproduce", "rotations", "simulate", "sweep",
+           "threshold", "track", "power_matrix"]
 
 #: command-line options that are not parameters of the functions: how to show or where to
 #: write a result (``figure`` and ``map`` keep ``plot``: the figure file is their product)
@@ -115,10 +120,13 @@ def optimize(*, excitation=None, omega=OMEGA, delta=None, square_alpha=None, fou
 
     Ideal (:func:`parapend.api.optimize`: Fourier Eq. 10 or the BVP of Eq. 22), or through
     a power take-off (:func:`parapend.pto.optimize_pto`) when a torque limit, an efficiency
-    or a copper loss is given. With ``length`` and ``mass`` (and optionally ``frequency``,
-    ``amplitude``, ``damping_coefficient``, ``gravity``, ``inertia``, ``torque_limit_nm``:
-    docs/units.md) the result adds watts, N m and joules. ``method="all"`` compares the
-    uniform rotation, Fourier, BVP and limit (a :class:`~parapend.results.Record`).
+    or a copper loss is given; through a lossy one (an efficiency or a copper loss)
+    ``power`` and ``power_w`` are the electrical power and ``mechanical_power``,
+    ``mechanical_power_w`` the mechanical one. With ``length`` and ``mass`` (and optionally
+    ``frequency``, ``amplitude``, ``damping_coefficient``, ``gravity``, ``inertia``,
+    ``torque_limit_nm``: docs/units.md) the result adds watts, N m and joules.
+    ``method="all"`` compares the uniform rotation, Fourier, BVP and limit (a
+    :class:`~parapend.results.Record`).
     Beyond the command's options: ``copper_loss`` (a winding loss ``r T^2``, a take-off),
     ``warm`` (a packed start) and ``throw`` (raise SolverError when not converged).
 
@@ -156,12 +164,14 @@ def optimize(*, excitation=None, omega=OMEGA, delta=None, square_alpha=None, fou
             draw=lambda rec: rec.fourier_result.plot(),
             series=lambda rec: rec.fourier_result._series())
     if pto:
-        from .pto import optimize_pto, plot_pto_profile
+        from .pto import electrical_headline, optimize_pto, plot_pto_profile
 
         r = optimize_pto(units=units, method=method, torque_limit=torque_limit,
                          efficiency=efficiency, efficiency_generating=efficiency_generating,
                          efficiency_motoring=efficiency_motoring, copper_loss=copper_loss,
                          warm=warm, throw=throw, **kw)
+        if r.efficiency_generating is not None or copper_loss != 0.0:
+            r = electrical_headline(r)  # lossy: power is the electrical power
         return dataclasses.replace(r, _draw=plot_pto_profile)
     from .plotting import plot_optimum
 
@@ -271,7 +281,9 @@ def pto_curve(*, vary: str = "torque-limit", excitation=None, omega=OMEGA, delta
     """Optimal power against the torque limit or the efficiency (command ``pto-curve``): a
     Dataset over ``value`` (:func:`parapend.pto.pto_curve`); with ``length`` and ``mass``
     it adds ``power_w``, ``electrical_power_w``, ``peak_torque_nm`` and, when the torque
-    limit varies, ``torque_limit_nm``."""
+    limit varies, ``torque_limit_nm``. With an efficiency (given, or varied) ``power`` and
+    ``power_w`` are the electrical power and ``mechanical_power``, ``mechanical_power_w``
+    the mechanical one."""
     from .pto import pto_curve as _curve
 
     kw = {"gamma": gamma, "harmonics": harmonics,
@@ -293,6 +305,11 @@ def pto_curve(*, vary: str = "torque-limit", excitation=None, omega=OMEGA, delta
         if vary == "torque-limit":
             ds["torque_limit_nm"] = ds["value"] * units.torque
         _units_attrs(ds, units)
+    if vary == "efficiency" or any(v is not None for v in (
+            efficiency, efficiency_generating, efficiency_motoring)):
+        from .pto import electrical_curve
+
+        electrical_curve(ds)  # lossy: power is the electrical power
     return _table("pto-curve", ds, "pto", "plot_pto_curve")
 
 
@@ -656,34 +673,6 @@ def _track_mpc(*, excitation, omega, delta, square_alpha, fourier, file, gamma, 
         * r.update_interval)
 
 
-# --- sea -----------------------------------------------------------------------------------
-def sea(*, hs=None, tp=None, spectrum: str = "jonswap", gamma_peak: float = 3.3,
-        repeat_period=None, seed=None, cutoff: float = 3.0, response=None, record=None,
-        taper: float = 0.1, length: float = SEA["length"], mass: float = SEA["mass"],
-        inertia=None, gravity: float = SEA["gravity"], gamma=None, damping_coefficient=None,
-        winding=1, harmonics=None):
-    """The best rotation over an irregular sea record, in watts (command ``sea``;
-    :func:`parapend.irregular.sea`). A sea state (``hs``, ``tp``, ... default 2 m, 8 s,
-    seed 0) or a measured ``record``, not both; ``gamma`` default 0.01."""
-    from .irregular import sea as _sea
-
-    if record is not None:
-        bad = [n for n, v in (("hs", hs), ("tp", tp), ("seed", seed),
-                              ("repeat-period", repeat_period), ("response", response))
-               if v is not None]
-        if bad:
-            raise ParameterError(f"{', '.join(bad)}: not used with --record; drop it")
-        kw = {"record": record, "taper": taper}
-    else:
-        kw = {"hs": SEA["hs"] if hs is None else hs, "tp": SEA["tp"] if tp is None else tp,
-              "spectrum": spectrum, "gamma_peak": gamma_peak,
-              "repeat_period": repeat_period, "seed": SEA["seed"] if seed is None else seed,
-              "response": response}
-    return _sea(cutoff=cutoff, length=length, mass=mass, inertia=inertia, gravity=gravity,
-                gamma=gamma, damping_coefficient=damping_coefficient, winding=winding,
-                harmonics=harmonics, **kw)
-
-
 # --- sweep, map ----------------------------------------------------------------------------
 def sweep(*, omega="1.8", delta=None, gamma=GAMMA["sweep"], torque_limit=None,
           efficiency=None, excitation=None, square_alpha=None, fourier=None,
@@ -905,76 +894,24 @@ def power_matrix(*, hs: str = "1:3:3", te=None, tp=None, realizations: int = 3,
            "executor": run.executor, "netcdf": netcdf, "zarr": zarr, "csv": csv}
     return Record("power-matrix", out, dataset=ds, run=run,
                   draw=_draw_dataset("performance.figures", "plot_matrix"))
-# --- buoy ----------------------------------------------------------------------------------
-from .defaults import BUOY  # noqa: E402
-
-__all__ += ["buoy"]
 
 
-def buoy(*, wave_height=None, wave_period=None, hs=None, tp=None, spectrum=None,
-         gamma_peak=None, repeat_period=None, seed=None, cutoff=None, record=None, taper=None,
-         mass=BUOY["mass"], length=BUOY["length"], inertia=BUOY["inertia"],
-         damping_coefficient=BUOY["damping_coefficient"], body=None, radius=None,
-         draft=None, mesh=None, hydro=None, winding=None, harmonics=None, torque_limit=None,
-         efficiency=None, optimize_design=None, mass_bounds=None, length_bounds=None,
-         inertia_bounds=None, damping_coefficient_bounds=None, controller="optimum",
-         horizon=None, update_interval=None, wave_direction=None, dofs="heave",
-         pivot_height=None, pivot_offset=None, hull_pitch_inertia=None, barge_length=None,
-         barge_beam=None, barge_draft=None):
-    """The coupled optimum of a pendulum inside a floating buoy, in SI units (command
-    ``buoy``; :func:`parapend.hydro.api.buoy`, parameters there): a
-    :class:`~parapend.hydro.result.BuoyResult`, or a :class:`~parapend.hydro.result.BuoySweepResult`
-    for ``wave_period="FROM:TO:N"``. With no arguments: the embedded default design
-    (``parapend.defaults.BUOY``, docs/defaults.md)."""
-    from .hydro.api import buoy as _buoy
+# --- sea, buoy, horizon: the implementation is the command's function ----------------------
+#: commands whose function is the implementation itself, imported on first use (its
+#: signature and docstring are the command's parameters, declared once): name -> (module,
+#: function)
+IMPLEMENTED = {"sea": (".irregular", "sea"), "buoy": (".hydro.api", "buoy"),
+               "horizon": (".control.horizon", "horizon_curve")}
+__all__ += list(IMPLEMENTED)
 
-    return _buoy(wave_height=wave_height, wave_period=wave_period, hs=hs, tp=tp,
-                 spectrum=spectrum, gamma_peak=gamma_peak, repeat_period=repeat_period,
-                 seed=seed, cutoff=cutoff, record=record, taper=taper, mass=mass,
-                 length=length, inertia=inertia, damping_coefficient=damping_coefficient,
-                 body=body, radius=radius, draft=draft, mesh=mesh, hydro=hydro,
-                 winding=winding, harmonics=harmonics, torque_limit=torque_limit,
-                 efficiency=efficiency, optimize_design=optimize_design,
-                 mass_bounds=mass_bounds, length_bounds=length_bounds,
-                 inertia_bounds=inertia_bounds,
-                 damping_coefficient_bounds=damping_coefficient_bounds,
-                 controller=controller, horizon=horizon, update_interval=update_interval,
-                 wave_direction=wave_direction, dofs=dofs, pivot_height=pivot_height,
-                 pivot_offset=pivot_offset, hull_pitch_inertia=hull_pitch_inertia,
-                 barge_length=barge_length, barge_beam=barge_beam, barge_draft=barge_draft)
-# --- horizon -------------------------------------------------------------------------------
-def horizon(*, hs=None, tp=None, spectrum: str = "jonswap", gamma_peak: float = 3.3,
-            repeat_period=None, seed=None, cutoff: float = 3.0, length: float = SEA["length"],
-            mass: float = SEA["mass"], inertia=None, gravity: float = SEA["gravity"],
-            gamma=None, damping_coefficient=None, torque_limit=None, torque_limit_nm=None,
-            efficiency=None,
-            horizons: str = HORIZON["horizons"], forecasts: str = HORIZON["forecasts"],
-            baselines: str = HORIZON["baselines"], records: int = HORIZON["records"],
-            update_interval: float = HORIZON["update_interval"], progress=None,
-            warm_up: float = HORIZON["warm_up"], speed_limit=HORIZON["speed_limit"]):
-    """Mean power of causal control against the forecast horizon, as a fraction of the
-    record's non-causal optimum and of its limit (command ``horizon``;
-    :func:`parapend.control.horizon.horizon_curve`). The sea state and the pendulum as
-    ``sea`` (default 2 m, 8 s, seed 0; ``gamma`` 0.01); ``records`` seeded records. The
-    torque limit in units of ``m g l`` (``torque_limit``) or in N m (``torque_limit_nm``)."""
-    from .control.horizon import horizon_curve
 
-    if torque_limit_nm is not None:
-        from .units import Units
+def __getattr__(name: str):
+    """``sea``, ``buoy``, ``horizon``: the implementing function (:data:`IMPLEMENTED`)."""
+    where = IMPLEMENTED.get(name)
+    if where is None:
+        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+    import importlib
 
-        if torque_limit is not None:
-            raise ParameterError("torque-limit-nm: give either --torque-limit or "
-                                 "--torque-limit-nm, not both")
-        torque_limit = Units(length=length, mass=mass, gravity=gravity,
-                             inertia=inertia).from_newton_metres(torque_limit_nm)
-
-    return horizon_curve(hs=SEA["hs"] if hs is None else hs,
-                         tp=SEA["tp"] if tp is None else tp, spectrum=spectrum,
-                         gamma_peak=gamma_peak, repeat_period=repeat_period,
-                         seed=SEA["seed"] if seed is None else seed, cutoff=cutoff,
-                         length=length, mass=mass, inertia=inertia, gravity=gravity,
-                         gamma=gamma, damping_coefficient=damping_coefficient,
-                         torque_limit=torque_limit, efficiency=efficiency, horizons=horizons,
-                         forecasts=forecasts, baselines=baselines, records=records,
-                         update_interval=update_interval, progress=progress,
-                         warm_up=warm_up, speed_limit=speed_limit)
+    fn = getattr(importlib.import_module(where[0], __package__), where[1])
+    globals()[name] = fn
+    return fn

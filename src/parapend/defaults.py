@@ -1,9 +1,9 @@
 """The defaults of every command, in one place (docs/defaults.md gives the reasons).
 
-The command line's parsers and the Python functions of :mod:`parapend.commands` both read
-their defaults from here, and ``tests/test_surface.py`` checks that every option's default
-on the command line equals the function's. A number that stands for the paper's case is
-named for it.
+The signatures of the commands' functions (:mod:`parapend.commands`) read their defaults
+from here, and the command line's parsers read theirs from those signatures
+(``tests/test_declared_once.py``). A number that stands for the paper's case is named for
+it.
 """
 
 from __future__ import annotations

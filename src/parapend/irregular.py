@@ -26,13 +26,14 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from . import limits
+from .defaults import SEA
 from .errors import ParameterError, SolverError, check_int, check_range
 from .optimal.fourier import FourierProblem, _pad, newton_maximize, search_fourier
 from .optimal.limit import limit
 from .power import uniform_power
 from .results import _Result
 from .trajectory import FourierMotion
-from .units import STANDARD_GRAVITY, Units
+from .units import Units
 
 __all__ = ["SeaResult", "sea"]
 
@@ -138,23 +139,26 @@ def _solve(exc, k: int, gamma: float, n: int):
     return search_fourier(exc, n, gamma, winding=k, hessian="operator", propose=SEA_PROPOSE)
 
 
-def sea(*, hs: float = 2.0, tp: float = 8.0, spectrum: str = "jonswap",
-        gamma_peak: float = 3.3, repeat_period: float | None = None, seed: int = 0,
+def sea(*, hs: float | None = None, tp: float | None = None, spectrum: str = "jonswap",
+        gamma_peak: float = 3.3, repeat_period: float | None = None, seed: int | None = None,
         cutoff: float = 3.0, response=None, record=None, taper: float = 0.1,
-        length: float = 1.0, mass: float = 10.0, inertia: float | None = None,
-        gravity: float = STANDARD_GRAVITY, gamma: float | None = None,
+        length: float = SEA["length"], mass: float = SEA["mass"], inertia: float | None = None,
+        gravity: float = SEA["gravity"], gamma: float | None = None,
         damping_coefficient: float | None = None, winding=1, harmonics: int | None = None,
         throw: bool = False) -> SeaResult:
-    """The best rotation of a pendulum over a record of irregular sea.
+    """The best rotation of a pendulum over a record of irregular sea, in watts (command
+    ``sea``: ``parapend.sea`` is this function).
 
     Parameters
     ----------
     hs, tp, spectrum, gamma_peak, repeat_period, seed, cutoff, response :
         The sea state and record (:func:`parapend.seas.sea_record`; ``repeat_period`` in s,
-        default ``100 tp``).
+        default ``100 tp``); ``hs``, ``tp``, ``seed`` None: 2 m, 8 s, 0
+        (``parapend.defaults.SEA``).
     record : path or None
         A measured heave record, CSV ``t,z`` (s, m), instead of a sea state
-        (:func:`parapend.seas.measured_record`, with ``taper`` and ``cutoff``).
+        (:func:`parapend.seas.measured_record`, with ``taper`` and ``cutoff``); then
+        ``hs``, ``tp``, ``seed``, ``repeat_period`` and ``response`` are refused.
     length, mass, inertia, gravity : the pendulum (m, kg, kg m^2, m/s^2).
     gamma, damping_coefficient : viscous damping, non-dimensional or N m s/rad (one of
         them; default ``gamma = 0.01``).
@@ -175,17 +179,17 @@ def sea(*, hs: float = 2.0, tp: float = 8.0, spectrum: str = "jonswap",
         gamma = units.gamma(damping_coefficient)
     gamma = check_range("gamma", 0.01 if gamma is None else gamma, 0.0, limits.MAX_GAMMA)
     if record is not None:
-        given = [n for n, v, d in (("hs", hs, 2.0), ("tp", tp, 8.0), ("seed", seed, 0),
-                                   ("repeat-period", repeat_period, None),
-                                   ("response", response, None))
-                 if v != d]
-        if given:
-            raise ParameterError(f"{', '.join(given)}: not used with a measured record; drop "
-                                 "it or drop --record")
+        bad = [n for n, v in (("hs", hs), ("tp", tp), ("seed", seed),
+                              ("repeat-period", repeat_period), ("response", response))
+               if v is not None]
+        if bad:
+            raise ParameterError(f"{', '.join(bad)}: not used with --record; drop it")
         exc = measured_record(units, record, taper=taper, cutoff=cutoff)
     else:
-        exc = sea_record(units, hs=hs, tp=tp, spectrum=spectrum, gamma_peak=gamma_peak,
-                         repeat_period=repeat_period, seed=seed, cutoff=cutoff,
+        exc = sea_record(units, hs=SEA["hs"] if hs is None else hs,
+                         tp=SEA["tp"] if tp is None else tp, spectrum=spectrum,
+                         gamma_peak=gamma_peak, repeat_period=repeat_period,
+                         seed=SEA["seed"] if seed is None else seed, cutoff=cutoff,
                          response=response)
     km = max(1, int(round(exc.mean_frequency_harmonic)))
     if isinstance(winding, str):

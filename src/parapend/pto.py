@@ -783,6 +783,28 @@ def pto_curve(vary: str = "torque-limit", *, values=None, points: int = 12,
 
 
 @figure_style()
+def electrical_headline(result):
+    """An optimum through a lossy take-off as the user reads it: ``power`` and ``power_w``
+    the electrical power (what the take-off delivers, the headline of the text), the
+    mechanical one as ``mechanical_power`` and ``mechanical_power_w`` (issue 32)."""
+    return dataclasses.replace(result, power=result.electrical_power,
+                               power_w=result.electrical_power_w,
+                               mechanical_power=result.power,
+                               mechanical_power_w=result.power_w)
+
+
+def electrical_curve(ds) -> None:
+    """A ``pto_curve`` Dataset through a lossy take-off, in place: ``power`` and ``power_w``
+    the electrical power, the mechanical one as ``mechanical_power`` and
+    ``mechanical_power_w`` (as :func:`electrical_headline`)."""
+    for suffix in ("", "_w"):
+        if f"power{suffix}" in ds:
+            ds[f"mechanical_power{suffix}"] = ds[f"power{suffix}"]
+            ds[f"power{suffix}"] = ds[f"electrical_power{suffix}"].copy()
+            ds[f"power{suffix}"].attrs["long_name"] = (
+                "mean electrical power (the take-off's output)")
+
+
 def plot_pto_profile(result, path=None, points: int = 2000):
     """Torque ``T(t)`` and instantaneous power ``p = -T theta'`` of an optimum over one period.
 
@@ -808,15 +830,17 @@ def plot_pto_profile(result, path=None, points: int = 2000):
             ax1.axhline(s * kt * result.torque_limit, color="k", ls="--", lw=0.8)
     if units is None:
         ax1.set_ylabel("torque $T$ ($mgl$)")
-        ax1.set_title(f"Power take-off: $P$ = {result.power:.5f}, peak $|T|$ = "
+        mech = ("" if result.mechanical_power is None else
+                f" (mechanical {result.mechanical_power:.5f})")
+        ax1.set_title(f"Power take-off: $P$ = {result.power:.5f}{mech}, peak $|T|$ = "
                       f"{result.peak_torque:.4g}, $\\gamma$ = {result.gamma:g}", fontsize=9)
     else:
         from .plotting import si_title
 
         ax1.set_ylabel("torque $T$ (N m)")
         head = (f"$P$ = {units.to_watts(result.power):.4g} W"
-                + ("" if result.electrical_power is None else
-                   f" (electrical {units.to_watts(result.electrical_power):.4g} W)")
+                + ("" if result.mechanical_power is None else
+                   f" (mechanical {units.to_watts(result.mechanical_power):.4g} W)")
                 + f", peak $|T|$ = {units.to_newton_metres(result.peak_torque):.4g} N m")
         ax1.set_title(f"Power take-off: {head}\n{si_title(result, units)}", fontsize=9)
     ax1.grid(alpha=0.3)
@@ -843,14 +867,15 @@ def plot_pto_curve(ds, path=None):
     fig, ax = plt.subplots(figsize=(7, 4.2))
     ok = np.isin(ds["status"].values, ["converged", "no_power"])
     v = ds["value"].values
-    mech, elec = ds["power"].values, ds["electrical_power"].values
+    mp = ds["mechanical_power" if "mechanical_power" in ds else "power"]
+    mech, elec = mp.values, ds["electrical_power"].values
     lossless = np.allclose(mech[ok], elec[ok], rtol=1e-12, atol=1e-14)
     ax.plot(v[ok], mech[ok], "o-",
             label="mechanical = electrical $P$ (lossless)" if lossless else "mechanical $P$")
     if not lossless:  # a curve of its own only where it differs
         ax.plot(v[ok], elec[ok], "s--", label="electrical")
     if not ok.all():
-        ax.plot(v[~ok], ds["power"].values[~ok], "x", color="C3", ms=8,
+        ax.plot(v[~ok], mech[~ok], "x", color="C3", ms=8,
                 label="not converged (status)")
     ax.axhline(ds.attrs["unconstrained_power"], color="k", ls=":", lw=1,
                label="ideal optimum")

@@ -47,6 +47,8 @@ QUANTITIES = {
     "upper_bound": (_P, "upper bound of the power"),
     "bound_gap": (_P, "upper bound minus power"),
     "electrical_power": (_P, "mean electrical power"),
+    "mechanical_power": (_P, "mean mechanical power -<T theta'> of a lossy take-off (its "
+                             "power is the electrical one)"),
     "instantaneous_power": (_P, "instantaneous power -T theta' (positive = harvested)"),
     "instantaneous_electrical_power": (_P, "instantaneous electrical power"),
     "sample_power": (_P, "mean power -T (theta_k+1 - theta_k) / dt of the held sample"),
@@ -455,9 +457,15 @@ class OptimizeResult(Result):
     torque_limit, efficiency_generating, efficiency_motoring : float or None
         The power take-off (:func:`parapend.pto.optimize_pto`): ``|T| <= torque_limit``
         (m g l), electrical power ``eta_g p`` generating, ``p / eta_m`` motoring; None when
-        not set. ``power`` stays the mechanical ``P = -<T theta'>`` of the PTO optimum.
+        not set.
     electrical_power : float or None
         Mean electrical power of the motion, unsmoothed efficiency model.
+    mechanical_power, mechanical_power_w : float or None
+        Through a lossy take-off (an efficiency or a copper loss: ``parapend.optimize``),
+        ``power`` and ``power_w`` are the electrical power, the headline, and these the
+        mechanical ``P = -<T theta'>`` of the optimum (its ``upper_bound``, ``bound_gap``,
+        ``gain_over_uniform`` and ``energy_per_cycle_j`` are mechanical); None otherwise,
+        where ``power`` is the mechanical power.
     unconstrained_power : float or None
         The ideal (lossless, unlimited) optimum the PTO solve started from.
     peak_power, motoring_energy, harvested_energy : float or None
@@ -549,6 +557,7 @@ class OptimizeResult(Result):
     efficiency_generating: float | None = None
     efficiency_motoring: float | None = None
     electrical_power: float | None = None
+    mechanical_power: float | None = None
     unconstrained_power: float | None = None
     peak_power: float | None = None
     motoring_energy: float | None = None
@@ -566,6 +575,7 @@ class OptimizeResult(Result):
     limit_power_w: float | None = None
     peak_torque_nm: float | None = None
     electrical_power_w: float | None = None
+    mechanical_power_w: float | None = None
     energy_per_cycle_j: float | None = None
     motoring_energy_j: float | None = None
     uniform_pto_feasible: bool | None = None

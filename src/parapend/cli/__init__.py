@@ -34,6 +34,7 @@ Modules: :mod:`._common` (parser helpers, number parsing, tables, progress),
 
 from __future__ import annotations
 
+import functools
 import json
 import os
 import sys
@@ -66,8 +67,18 @@ COMMANDS = {**_optimize_cmds.COMMANDS, **_paper_cmds.COMMANDS, **_pto_cmds.COMMA
             **_performance_cmds.COMMANDS, **_buoy_cmds.COMMANDS, **_horizon_cmds.COMMANDS}
 
 
-def build_parser():
-    """The ``parapend`` argument parser with every subcommand."""
+def _function(command: str):
+    """The function of ``command`` (:mod:`parapend.commands`)."""
+    from .. import commands
+
+    return getattr(commands, command.replace("-", "_"))
+
+
+def build_parser(*, declare: bool = True):
+    """The ``parapend`` argument parser with every subcommand. Each command's options take
+    their defaults from its function's signature: now (``declare``), or when the command is
+    parsed (:meth:`._common._Parser.declare_defaults`; :func:`main` imports only the
+    function of the command it runs)."""
     parser = _Parser(prog="parapend", description=(
         "Optimal energy extraction from period-1 rotations of a parametrically excited "
         "pendulum: theta'' + gamma theta' - (1 + q(t)) sin(theta) = T(t). Power P = -<T "
@@ -85,6 +96,10 @@ def build_parser():
     _performance_cmds.add_parsers(sub)
     _buoy_cmds.add_parsers(sub)
     _horizon_cmds.add_parsers(sub)
+    for name, p in sub.choices.items():
+        p.declared_by = functools.partial(_function, name)
+        if declare:
+            p.declare_defaults()
     return parser
 
 
@@ -143,7 +158,7 @@ def main(argv=None) -> int:
         _silence_stdout()
     _one_blas_thread()
     _compile_notice()  # a first-use compile of the numba kernels: one line on stderr
-    parser = build_parser()
+    parser = build_parser(declare=False)
     try:
         a = parser.parse_args(argv)
     except SystemExit as exc:  # --help, --version (0) or a usage error (2, one line printed)

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import inspect
 import math
 import os
 import re
@@ -25,14 +26,41 @@ _NEGATIVE_NUMBER = re.compile(r"^-(\d+\.?\d*|\.\d+)([eE][-+]?\d+)?$|^-(inf|infin
 
 class _Parser(argparse.ArgumentParser):
     """ArgumentParser whose errors are one line (no usage dump) with exit code 2, and which
-    reads ``-1e-3`` as a negative number (``--delta -1e-3``)."""
+    reads ``-1e-3`` as a negative number (``--delta -1e-3``).
+
+    A command's parser takes its options' defaults from the signature of the command's
+    function (``declared_by``, a callable returning it): the default of an option is declared
+    once, where the function declares its parameter (:meth:`declare_defaults`)."""
 
     def __init__(self, *args, **kwargs):
         super().__init__(*args, **kwargs)
         self._negative_number_matcher = _NEGATIVE_NUMBER
+        self.declared_by = None
+        self.declared = False
 
     def error(self, message):
         self.exit(EXIT_USAGE, f"{self.prog}: error: {message}\n")
+
+    def declare_defaults(self) -> None:
+        """Set the default of every option that is a parameter of the command's function to
+        the parameter's default (once; the function is imported here, so the command line
+        imports only the function of the command it runs)."""
+        if self.declared_by is None or self.declared:
+            return
+        self.declared = True
+        params = inspect.signature(self.declared_by()).parameters
+        for action in self._actions:
+            param = params.get(action.dest)
+            if (not action.option_strings or param is None
+                    or param.default is inspect.Parameter.empty):
+                continue
+            # argparse appends to the default of an "append" option: a fresh list of it
+            action.default = (list(param.default) if isinstance(action, argparse._AppendAction)
+                              else param.default)
+
+    def parse_known_args(self, args=None, namespace=None):
+        self.declare_defaults()
+        return super().parse_known_args(args, namespace)
 
 
 def _finite_float(name):
@@ -62,17 +90,17 @@ def _int(text):
 
 def _add_excitation(p):
     g = p.add_argument_group("excitation q(t) (base acceleration over g)")
-    g.add_argument("--excitation", default=None,
+    g.add_argument("--excitation",
                    choices=["harmonic", "two-harmonic", "square", "fourier", "file"],
                    help="harmonic: delta sin(omega t); two-harmonic: Eq. 23; square: Eq. 26; "
                         "fourier: --fourier terms; file: --file CSV (default: file if --file "
                         "is given, fourier if --fourier is given, else harmonic)")
-    g.add_argument("--omega", type=_finite_float("omega"), default=OMEGA,
+    g.add_argument("--omega", type=_finite_float("omega"),
                    help="forcing frequency in [1e-3, 1e3], units sqrt(g/l) (default 1.8)")
-    g.add_argument("--delta", type=_finite_float("delta"), default=None,
+    g.add_argument("--delta", type=_finite_float("delta"),
                    help="amplitude of harmonic, two-harmonic, square, |delta| <= 1e3 "
                         "(default -0.3)")
-    g.add_argument("--square-alpha", type=_finite_float("square-alpha"), default=None,
+    g.add_argument("--square-alpha", type=_finite_float("square-alpha"),
                    help="tanh smoothing width alpha of Eq. 26, square only (default 0.001)")
     g.add_argument("--fourier", metavar="TERMS",
                    help="'k:amp:phase,...' for q = sum amp sin(k omega t + phase), integer "
@@ -97,58 +125,56 @@ def add_sea_options(g, *, repeat_period: str = "the record repeats with it",
     ``cutoff`` are the commands' own help texts."""
     from .. import limits
 
-    g.add_argument("--hs", type=_finite_float("hs"), default=None,
+    g.add_argument("--hs", type=_finite_float("hs"),
                    help="significant wave height, m (default 2)")
-    g.add_argument("--tp", type=_finite_float("tp"), default=None,
+    g.add_argument("--tp", type=_finite_float("tp"),
                    help="peak period, s (default 8)")
-    g.add_argument("--spectrum", choices=["jonswap", "pierson-moskowitz"], default="jonswap",
+    g.add_argument("--spectrum", choices=["jonswap", "pierson-moskowitz"],
                    help="spectrum shape (default jonswap)")
-    g.add_argument("--gamma-peak", type=_finite_float("gamma-peak"), default=3.3,
+    g.add_argument("--gamma-peak", type=_finite_float("gamma-peak"),
                    help="JONSWAP peak enhancement in [1, 20] (default 3.3)")
-    g.add_argument("--repeat-period", type=_finite_float("repeat-period"), default=None,
+    g.add_argument("--repeat-period", type=_finite_float("repeat-period"),
                    help=f"T_r, s: {repeat_period}; {limits.SEA_WAVES_RANGE[0]:g} "
                         f"to {limits.SEA_WAVES_RANGE[1]:g} peak periods (default 100 Tp)")
-    g.add_argument("--seed", type=_int, default=None, help=seed)
-    g.add_argument("--cutoff", type=_finite_float("cutoff"), default=3.0, help=cutoff)
+    g.add_argument("--seed", type=_int, help=seed)
+    g.add_argument("--cutoff", type=_finite_float("cutoff"), help=cutoff)
 
 
 def add_pendulum_options(g, *, gamma_note: str = "") -> None:
     """The pendulum in SI units of ``sea`` and ``horizon`` into the argument group ``g``:
     ``--length --mass --inertia --gravity --gamma --damping-coefficient`` (defaults
     ``defaults.SEA``); ``gamma_note`` ends the help of ``--gamma``'s default."""
-    from ..defaults import SEA
 
-    g.add_argument("--length", type=_finite_float("length"), default=SEA["length"],
+    g.add_argument("--length", type=_finite_float("length"),
                    help="pivot to centre of mass, m (default 1)")
-    g.add_argument("--mass", type=_finite_float("mass"), default=SEA["mass"],
+    g.add_argument("--mass", type=_finite_float("mass"),
                    help="kg (default 10)")
-    g.add_argument("--inertia", type=_finite_float("inertia"), default=None,
+    g.add_argument("--inertia", type=_finite_float("inertia"),
                    help="about the pivot, kg m^2 (default m l^2)")
-    g.add_argument("--gravity", type=_finite_float("gravity"), default=SEA["gravity"],
+    g.add_argument("--gravity", type=_finite_float("gravity"),
                    help="m/s^2 (default 9.81)")
-    g.add_argument("--gamma", type=_finite_float("gamma"), default=None,
+    g.add_argument("--gamma", type=_finite_float("gamma"),
                    help=f"viscous damping, non-dimensional (default 0.01{gamma_note})")
     g.add_argument("--damping-coefficient", type=_finite_float("damping-coefficient"),
-                   default=None, help="viscous damping c, N m s/rad (instead of --gamma)")
+                   help="viscous damping c, N m s/rad (instead of --gamma)")
 
 
-def add_body_options(g, *, body_default, body_help: str, hydro_help: str,
+def add_body_options(g, *, body_help: str, hydro_help: str,
                      bodies=("cylinder", "sphere")) -> None:
     """The buoy's body of ``buoy`` and ``power-matrix --device buoy`` into the argument group
     ``g``: ``--body --radius --draft --mesh --hydro`` (sizes default to ``defaults.BUOY``'s);
-    the default of ``--body`` and the help of ``--body`` and ``--hydro`` are the commands'
-    own."""
+    the help of ``--body`` and ``--hydro`` are the commands' own."""
     from ..defaults import BUOY
 
-    g.add_argument("--body", choices=list(bodies), default=body_default,
+    g.add_argument("--body", choices=list(bodies),
                    help=body_help)
-    g.add_argument("--radius", type=_finite_float("radius"), default=None,
+    g.add_argument("--radius", type=_finite_float("radius"),
                    help=f"m (default {BUOY['radius']:g})")
-    g.add_argument("--draft", type=_finite_float("draft"), default=None,
+    g.add_argument("--draft", type=_finite_float("draft"),
                    help=f"cylinder's draft, m (default {BUOY['draft']:g})")
-    g.add_argument("--mesh", metavar="FILE", default=None,
+    g.add_argument("--mesh", metavar="FILE",
                    help="a mesh file Capytaine reads, instead of --body")
-    g.add_argument("--hydro", metavar="FILE", default=None, help=hydro_help)
+    g.add_argument("--hydro", metavar="FILE", help=hydro_help)
 
 
 FIGURE_SUFFIXES = (".png", ".svg", ".pdf")

@@ -29,89 +29,88 @@ def add_parsers(sub) -> None:
                     "units. With no options: the embedded default design (docs/buoy.md, "
                     "docs/defaults.md).")
     g = p.add_argument_group("regular wave")
-    g.add_argument("--wave-height", type=_finite_float("wave-height"), default=None,
+    g.add_argument("--wave-height", type=_finite_float("wave-height"),
                    help=f"H, m, crest to trough (default {BUOY['wave_height']:g})")
-    g.add_argument("--wave-period", type=_text("wave-period"), default=None, metavar="T",
+    g.add_argument("--wave-period", type=_text("wave-period"), metavar="T",
                    help=f"s (default {BUOY['wave_period']:g}); FROM:TO:N or a comma list "
                         "T1,T2,... for power against period")
     g = p.add_argument_group("irregular sea (as 'parapend sea' takes it)")
-    g.add_argument("--hs", type=_finite_float("hs"), default=None,
+    g.add_argument("--hs", type=_finite_float("hs"),
                    help=f"significant wave height, m (default {BUOY['hs']:g} with --tp)")
-    g.add_argument("--tp", type=_finite_float("tp"), default=None,
+    g.add_argument("--tp", type=_finite_float("tp"),
                    help=f"peak period, s (default {BUOY['tp']:g} with --hs)")
-    g.add_argument("--spectrum", choices=["jonswap", "pierson-moskowitz"], default=None,
+    g.add_argument("--spectrum", choices=["jonswap", "pierson-moskowitz"],
                    help="spectrum shape (default jonswap)")
-    g.add_argument("--gamma-peak", type=_finite_float("gamma-peak"), default=None,
+    g.add_argument("--gamma-peak", type=_finite_float("gamma-peak"),
                    help="JONSWAP peak enhancement in [1, 20] (default 3.3)")
-    g.add_argument("--repeat-period", type=_finite_float("repeat-period"), default=None,
+    g.add_argument("--repeat-period", type=_finite_float("repeat-period"),
                    help="T_r, s: the record repeats with it (default 100 Tp)")
-    g.add_argument("--seed", type=_int, default=None, help="seed of the random phases "
-                                                           "(default 0)")
-    g.add_argument("--cutoff", type=_finite_float("cutoff"), default=None,
+    g.add_argument("--seed", type=_int, help="seed of the random phases "
+                                             "(default 0)")
+    g.add_argument("--cutoff", type=_finite_float("cutoff"),
                    help="highest frequency, in units of the peak frequency (default 3)")
-    g.add_argument("--record", metavar="CSV", default=None,
+    g.add_argument("--record", metavar="CSV",
                    help="measured surface elevation at the body, CSV 't,z' (s, m)")
-    g.add_argument("--taper", type=_finite_float("taper"), default=None,
+    g.add_argument("--taper", type=_finite_float("taper"),
                    help="with --record: fraction under the Tukey taper (default 0.1)")
     g = p.add_argument_group("pendulum (SI units)")
-    g.add_argument("--mass", type=_finite_float("mass"), default=BUOY["mass"],
+    g.add_argument("--mass", type=_finite_float("mass"),
                    help=f"m, kg (default {BUOY['mass']:g})")
-    g.add_argument("--length", type=_finite_float("length"), default=BUOY["length"],
+    g.add_argument("--length", type=_finite_float("length"),
                    help=f"pivot to centre of mass l, m (default {BUOY['length']:g})")
-    g.add_argument("--inertia", type=_finite_float("inertia"), default=BUOY["inertia"],
+    g.add_argument("--inertia", type=_finite_float("inertia"),
                    help="about the pivot, kg m^2, at least m l^2 (default m l^2)")
     g.add_argument("--damping-coefficient", type=_finite_float("damping-coefficient"),
-                   default=BUOY["damping_coefficient"],
                    help=f"viscous c, N m s/rad (default {BUOY['damping_coefficient']:g})")
     g = p.add_argument_group("body (Capytaine; the BEM result is cached on disk)")
     from ._common import add_body_options
 
-    add_body_options(g, body_default="cylinder", bodies=("cylinder", "sphere", "barge"),
+    add_body_options(g, bodies=("cylinder", "sphere", "barge"),
                      body_help="vertical cylinder or sphere floating at its centre (default "
                                "cylinder); with --dofs surge,heave,pitch also a box barge "
                                "(the default there)",
                      hydro_help="a Capytaine dataset (NetCDF), instead of solving "
                                 "(docs/buoy.md)")
     p.set_defaults(body=None)  # so that --body given beside --hydro or --mesh is refused
-    g.add_argument("--wave-direction", type=_finite_float("wave-direction"), default=None,
+    g.add_argument("--wave-direction", type=_finite_float("wave-direction"),
                    metavar="RAD", help="with --hydro: the dataset's wave direction to use, rad "
                                        "(default 0, waves travelling along +x)")
     from ..defaults import HULL
 
     g = p.add_argument_group("hull: surge, heave and pitch (docs/hull.md)")
-    g.add_argument("--dofs", default="heave", metavar="DOFS",
+    g.add_argument("--dofs", metavar="DOFS",
                    help="the hull's degrees of freedom: heave (default, the heaving buoy) "
                         "or surge,heave,pitch (a hull that pitches; the pendulum rotates or "
                         "swings)")
-    g.add_argument("--pivot-height", type=_finite_float("pivot-height"), default=None,
+    g.add_argument("--pivot-height", type=_finite_float("pivot-height"),
                    help=f"the pivot above the hull's rotation centre (its waterplane "
                         f"centre), m (default {HULL['pivot_height']:g})")
-    g.add_argument("--pivot-offset", type=_finite_float("pivot-offset"), default=None,
+    g.add_argument("--pivot-offset", type=_finite_float("pivot-offset"),
                    help=f"the pivot ahead of it, along the waves' travel, m (default "
                         f"{HULL['pivot_offset']:g})")
     g.add_argument("--hull-pitch-inertia", type=_finite_float("hull-pitch-inertia"),
-                   default=None, help="the hull's pitch inertia about the rotation centre, "
+                   help="the hull's pitch inertia about the rotation centre, "
                                       "without the pendulum, kg m^2 (default: the dataset's, "
                                       "else a homogeneous immersed hull's)")
     for name, key in (("length", "barge_length"), ("beam", "barge_beam"),
                       ("draft", "barge_draft")):
-        g.add_argument(f"--barge-{name}", type=_finite_float(f"barge-{name}"), default=None,
+        g.add_argument(f"--barge-{name}", type=_finite_float(f"barge-{name}"),
                        help=f"the box barge's {name}, m (default {HULL[key]:g})")
     g = p.add_argument_group("motion and power take-off")
-    g.add_argument("--winding", type=_int, default=None,
+    g.add_argument("--winding", type=_int,
                    help="turns per wave (per record in an irregular sea) (default 1; with "
                         "--dofs surge,heave,pitch: rotation (1) and swinging (0) side by "
                         "side)")
-    g.add_argument("--harmonics", type=_int, default=None,
+    g.add_argument("--harmonics", type=_int,
                    help="N of the motion (default chosen from the problem and checked)")
-    g.add_argument("--torque-limit", type=_finite_float("torque-limit"), default=None,
+    g.add_argument("--torque-limit", type=_finite_float("torque-limit"),
                    help="largest |torque|, N m")
-    g.add_argument("--efficiency", type=_text("efficiency"), default=None,
+    g.add_argument("--efficiency", type=_text("efficiency"),
                    metavar="ETA_G[,ETA_M]",
                    help="power take-off efficiency in (0, 1], generating[,motoring]: the "
                         "motion maximizes the electrical power")
     g = p.add_argument_group("design")
-    g.add_argument("--optimize-design", metavar="NAMES", default=None,
+    g.add_argument("--optimize-design", metavar="NAMES",
                    help="choose these pendulum parameters for the most power: a comma list "
                         "of mass, length, inertia, damping-coefficient")
     for name, what in (("mass", "kg"), ("length", "m"), ("inertia", "kg m^2"),
@@ -122,14 +121,13 @@ def add_parsers(sub) -> None:
                                f"{BUOY['design_bounds'][name][0]:g} to "
                                f"{BUOY['design_bounds'][name][1]:g} x the design's") + ")")
     g = p.add_argument_group("causal control (an irregular sea, the coupled time-domain plant)")
-    g.add_argument("--controller", choices=["optimum", "mpc", "one-way-mpc"], default="optimum",
+    g.add_argument("--controller", choices=["optimum", "mpc", "one-way-mpc"],
                    help="optimum: the non-causal coupled optimum (default); mpc: receding-"
                         "horizon control planned on the coupled model; one-way-mpc: planned "
                         "on the free buoy's heave")
-    g.add_argument("--horizon", type=_finite_float("horizon"), default=None,
+    g.add_argument("--horizon", type=_finite_float("horizon"),
                    help="with mpc: forecast horizon, peak periods (default 1)")
     g.add_argument("--update-interval", type=_finite_float("update-interval"),
-                   default=None,
                    help="with mpc: re-planning interval, peak periods (default 0.125)")
     p.add_argument("--plot", metavar="DIR",
                    help="draw the figures (PNG and SVG) into this directory")

@@ -2,10 +2,7 @@
 
 from __future__ import annotations
 
-import math
-
 from .. import limits
-from ..defaults import GAMMA
 from . import _output
 from ._common import (
     FIGURE_SUFFIXES,
@@ -30,41 +27,41 @@ def add_parsers(sub) -> None:
                     "the torque-limited optimum at (1 - --torque-margin) T_max is tracked. "
                     "theta is measured from the upright (hanging at rest is pi).")
     _add_excitation(p)
-    p.add_argument("--gamma", type=_finite_float("gamma"), default=GAMMA["track"],
+    p.add_argument("--gamma", type=_finite_float("gamma"),
                    help="viscous damping gamma in [0, 1e3] (default 0; docs/defaults.md)")
-    p.add_argument("--harmonics", type=_int, default=24,
+    p.add_argument("--harmonics", type=_int,
                    help=f"N of the optimum, at most {limits.MAX_PTO_HARMONICS} with a torque "
                         "limit (default 24)")
     g = p.add_argument_group("power take-off and controller")
-    g.add_argument("--torque-limit", type=_finite_float("torque-limit"), default=None,
+    g.add_argument("--torque-limit", type=_finite_float("torque-limit"),
                    help="|T(t)| <= this, units m g l (> 0; default: no limit)")
-    g.add_argument("--torque-margin", type=_finite_float("torque-margin"), default=0.1,
+    g.add_argument("--torque-margin", type=_finite_float("torque-margin"),
                    help="fraction of the torque limit kept for feedback, in [0, 0.9] "
                         "(default 0.1)")
-    g.add_argument("--r-weight", type=_finite_float("r-weight"), default=0.1,
+    g.add_argument("--r-weight", type=_finite_float("r-weight"),
                    help="LQR torque weight R (Q = identity), in [1e-6, 1e6] (default 0.1)")
-    g.add_argument("--lock-tolerance", type=_finite_float("lock-tolerance"), default=0.1,
+    g.add_argument("--lock-tolerance", type=_finite_float("lock-tolerance"),
                    help="largest angle error (rad) of a locked period (default 0.1)")
-    g.add_argument("--theta0", type=_finite_float("theta0"), default=math.pi,
+    g.add_argument("--theta0", type=_finite_float("theta0"),
                    help="initial angle from the upright (default pi: hanging)")
-    g.add_argument("--theta-dot0", type=_finite_float("theta-dot0"), default=0.0,
+    g.add_argument("--theta-dot0", type=_finite_float("theta-dot0"),
                    help="initial angular speed (default 0)")
     g = p.add_argument_group("run and robustness (seeded)")
-    g.add_argument("--periods", type=_int, default=100,
+    g.add_argument("--periods", type=_int,
                    help=f"forcing periods simulated, 20 to {limits.MAX_TRACK_PERIODS} "
                         "(default 100)")
-    g.add_argument("--seed", type=_int, default=0, help="seed of noise and irregular q")
-    g.add_argument("--runs", type=_int, default=1,
+    g.add_argument("--seed", type=_int, help="seed of noise and irregular q")
+    g.add_argument("--runs", type=_int,
                    help="seeded runs; with more than one, each run draws its model errors "
                         f"uniformly within +-the given ones (runs x periods <= "
                         f"{limits.MAX_TRACK_WORK}; default 1)")
-    g.add_argument("--gamma-error", type=_finite_float("gamma-error"), default=0.0,
+    g.add_argument("--gamma-error", type=_finite_float("gamma-error"),
                    help="relative error of the plant's damping, in [-0.9, 0.9]")
-    g.add_argument("--delta-error", type=_finite_float("delta-error"), default=0.0,
+    g.add_argument("--delta-error", type=_finite_float("delta-error"),
                    help="relative error of the plant's excitation amplitude, in [-0.9, 0.9]")
-    g.add_argument("--noise-theta", type=_finite_float("noise-theta"), default=0.0,
+    g.add_argument("--noise-theta", type=_finite_float("noise-theta"),
                    help="std of the measurement noise on theta, rad, in [0, 1]")
-    g.add_argument("--noise-speed", type=_finite_float("noise-speed"), default=0.0,
+    g.add_argument("--noise-speed", type=_finite_float("noise-speed"),
                    help="std of the measurement noise on theta', in [0, 10]")
     g.add_argument("--irregular", action="store_true",
                    help="drive the plant with a seeded JONSWAP sea record (parapend.seas) "
@@ -72,22 +69,20 @@ def add_parsers(sub) -> None:
     g = p.add_argument_group("receding-horizon control (--controller mpc)")
     from ..defaults import TRACK
 
-    g.add_argument("--controller", choices=("lqr", "mpc"), default=TRACK["controller"],
+    g.add_argument("--controller", choices=("lqr", "mpc"),
                    help="lqr: hold the regular-wave optimum (feedforward + periodic LQR); "
                         "mpc: receding-horizon control on the full model with a wave "
                         f"forecast (docs/control.md; default {TRACK['controller']})")
-    g.add_argument("--horizon", type=_finite_float("horizon"), default=TRACK["horizon"],
+    g.add_argument("--horizon", type=_finite_float("horizon"),
                    help="MPC horizon in peak (forcing) periods, in [0.01, 20] (default "
                         f"{TRACK['horizon']:g})")
     g.add_argument("--update-interval", type=_finite_float("update-interval"),
-                   default=TRACK["update_interval"],
                    help="MPC update interval in peak periods, at most the horizon "
                         f"(default {TRACK['update_interval']:g})")
-    g.add_argument("--forecast", choices=("perfect", "ar"), default=TRACK["forecast"],
+    g.add_argument("--forecast", choices=("perfect", "ar"),
                    help="MPC wave forecast: perfect (the record's own future) or ar "
                         f"(autoregressive, fitted on the past; default {TRACK['forecast']})")
     g.add_argument("--speed-limit", type=_finite_float("speed-limit"),
-                   default=TRACK["speed_limit"],
                    help="MPC rated-speed penalty: the plans pay rho/2 h sum max(|theta'_k| - "
                         "w, 0)^2 at their nodes, a penalty and not a hard bound (the measured "
                         "speed can exceed it; the run reports how often and how far), in "

@@ -12,7 +12,6 @@ import re
 
 from .. import limits
 from ..commands import basins_json  # noqa: F401  (its former home)
-from ..defaults import DYNAMICS
 from . import _output
 from . import pto as _pto
 from ._common import (
@@ -76,13 +75,13 @@ def _omega_arg(text):
 
 def _add_model(p, omega=True):
     g = p.add_argument_group("Eq. 1 parameters (defaults: the paper's coexistence case)")
-    g.add_argument("--gamma", type=_finite_float("gamma"), default=DYNAMICS["gamma"],
+    g.add_argument("--gamma", type=_finite_float("gamma"),
                    help=f"damping gamma in [0, {limits.DYN_MAX_GAMMA:g}] (default 0.1)")
-    g.add_argument("--p", type=_finite_float("p"), default=DYNAMICS["p"],
+    g.add_argument("--p", type=_finite_float("p"),
                    help=f"excitation strength p, |p| <= {limits.DYN_MAX_P:g} (default 0.8)")
     if omega:
         lo, hi = limits.DYN_OMEGA_RANGE
-        g.add_argument("--omega", type=_finite_float("omega"), default=DYNAMICS["omega"],
+        g.add_argument("--omega", type=_finite_float("omega"),
                        help=f"forcing frequency in [{lo:g}, {hi:g}], units sqrt(g/l) "
                             "(default 2.1)")
 
@@ -96,16 +95,16 @@ def add_parsers(sub) -> None:
                                    "Poincare section t = m 2 pi/omega.")
     p._negative_number_matcher = _RANGE_OR_NUMBER
     _add_model(p)
-    p.add_argument("--phi0", type=_finite_float("phi0"), default=0.5,
+    p.add_argument("--phi0", type=_finite_float("phi0"),
                    help=f"initial angle from the hanging position, rad, |phi0| <= "
                         f"{limits.SIM_MAX_PHI0:g} (default 0.5)")
-    p.add_argument("--dphi0", type=_finite_float("dphi0"), default=0.0,
+    p.add_argument("--dphi0", type=_finite_float("dphi0"),
                    help=f"initial angular rate, |dphi0| <= {limits.SIM_MAX_DPHI0:g} (default 0)")
-    p.add_argument("--periods", type=_int, default=200,
+    p.add_argument("--periods", type=_int,
                    help=f"forcing periods, 1 to {limits.SIM_MAX_PERIODS}, with periods x 2 pi/"
                         f"omega x (sqrt(1 + |p|) + |dphi0|) <= {limits.SIM_MAX_WORK:g} "
                         "(default 200)")
-    p.add_argument("--points-per-period", type=_int, default=64,
+    p.add_argument("--points-per-period", type=_int,
                    help="output samples per forcing period, 2 to 1024 (default 64)")
     _pto.add_unit_options(p, damping=False, excitation=False, adds="time in s, energy in J")
     add_output_options(p, plot="the time history and phase portrait",
@@ -122,32 +121,32 @@ def add_parsers(sub) -> None:
                                    "labels that change is given with a 95 %% interval.")
     p._negative_number_matcher = _RANGE_OR_NUMBER
     _add_model(p)
-    p.add_argument("--resolution", type=_int, default=200,
+    p.add_argument("--resolution", type=_int,
                    help=f"grid points per axis N, 2 to {limits.BASIN_MAX_RESOLUTION} "
                         "(default 200)")
-    p.add_argument("--phi-range", type=_numbers("phi-range", 2), default=None,
+    p.add_argument("--phi-range", type=_numbers("phi-range", 2),
                    metavar="LOW:HIGH",
                    help="initial phi range, ends included (default the circle [-pi, pi))")
-    p.add_argument("--dphi-range", type=_numbers("dphi-range", 2), default=(-3.0, 3.0),
+    p.add_argument("--dphi-range", type=_numbers("dphi-range", 2),
                    metavar="LOW:HIGH", help="initial dphi range, ends included (default -3:3)")
-    p.add_argument("--periods", type=_int, default=300,
+    p.add_argument("--periods", type=_int,
                    help=f"period budget per point, 1 to {limits.BASIN_MAX_PERIODS}, with "
                         f"integrated points x periods <= {limits.BASIN_MAX_WORK:g} (half "
                         "the grid on the default symmetric grid; default 300)")
     lo_s, hi_s = limits.BASIN_STEPS_RANGE
-    p.add_argument("--steps-per-period", type=_int, default=128,
+    p.add_argument("--steps-per-period", type=_int,
                    help=f"RK4 steps per forcing period, {lo_s} to {hi_s}; the work bound "
                         "counts periods x steps/128 (default 128)")
     lo_a, hi_a = limits.BASIN_ACCURACY_RANGE
-    p.add_argument("--accuracy-sample", type=_int, default=1000,
+    p.add_argument("--accuracy-sample", type=_int,
                    help=f"points re-run to estimate the uncertain labels, {lo_a} to {hi_a} "
                         "(at most the integrated points; default 1000)")
-    p.add_argument("--accuracy-seed", type=_int, default=0,
+    p.add_argument("--accuracy-seed", type=_int,
                    help="seed of the accuracy sample (default 0)")
     p.add_argument("--split-phases", action="store_true",
                    help="one basin per phase of a period-k attractor (the paper's four "
                         "attractors of Fig. 2 right)")
-    p.add_argument("--engine", choices=["numba", "numpy"], default="numba",
+    p.add_argument("--engine", choices=["numba", "numpy"],
                    help="compiled kernel (default) or the vectorized NumPy engine")
     add_output_options(p, plot="the basin image", save="the basin Dataset", table=False)
 
@@ -158,17 +157,17 @@ def add_parsers(sub) -> None:
                                    "Eq. 1 by continuation in p with Floquet multipliers: "
                                    "for one omega, or for FROM:TO:N the (omega, p) map.")
     p._negative_number_matcher = _RANGE_OR_NUMBER
-    p.add_argument("--gamma", type=_finite_float("gamma"), default=DYNAMICS["gamma"],
+    p.add_argument("--gamma", type=_finite_float("gamma"),
                    help=f"damping gamma in [0, {limits.DYN_MAX_GAMMA:g}] (default 0.1)")
     lo, hi = limits.ROT_OMEGA_RANGE
-    p.add_argument("--omega", type=_omega_arg, default=DYNAMICS["omega"], metavar="W|FROM:TO:N",
+    p.add_argument("--omega", type=_omega_arg, metavar="W|FROM:TO:N",
                    help=f"one frequency, or N (1 to {limits.ROT_MAX_OMEGAS}) from FROM to TO, "
                         f"each in [{lo:g}, {hi:g}] (default 2.1)")
-    p.add_argument("--p-max", type=_finite_float("p-max"), default=3.0,
+    p.add_argument("--p-max", type=_finite_float("p-max"),
                    help=f"largest p followed, in (0, {limits.ROT_MAX_P:g}] (default 3, the "
                         "paper's range)")
     p.add_argument("--time-limit", type=_finite_float("time-limit"),
-                   default=limits.ROT_TIME_LIMIT, metavar="S",
+                   metavar="S",
                    help=f"seconds of continuation, in (0, {limits.ROT_MAX_TIME_LIMIT:g}]; past "
                         "them the branches stop where they are and the output says how far "
                         f"p was followed (default {limits.ROT_TIME_LIMIT:g})")

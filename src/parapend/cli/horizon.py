@@ -30,42 +30,40 @@ def add_parsers(sub) -> None:
                     seed="seed of the first record's phases; record r has seed + r "
                          "(default 0)",
                     cutoff="highest frequency, in units of the peak frequency (default 3)")
-    g.add_argument("--records", type=_int, default=HORIZON["records"],
+    g.add_argument("--records", type=_int,
                    help="seeded records, 1 to 20 (default 1)")
     g = p.add_argument_group("pendulum (SI units) and power take-off")
     add_pendulum_options(g)
-    g.add_argument("--torque-limit", type=_finite_float("torque-limit"), default=None,
+    g.add_argument("--torque-limit", type=_finite_float("torque-limit"),
                    help="|T| <= T_max, units m g l, for every controller (default none)")
-    g.add_argument("--torque-limit-nm", type=_finite_float("torque-limit-nm"), default=None,
+    g.add_argument("--torque-limit-nm", type=_finite_float("torque-limit-nm"),
                    help="the torque limit in N m (instead of --torque-limit)")
-    g.add_argument("--efficiency", type=_finite_float("efficiency"), default=None,
+    g.add_argument("--efficiency", type=_finite_float("efficiency"),
                    help="PTO efficiency in (0, 1], generating and motoring (default none: "
                         "lossless)")
     g = p.add_argument_group("controllers")
-    g.add_argument("--horizons", default=HORIZON["horizons"],
+    g.add_argument("--horizons",
                    help="horizons in peak periods, comma separated (default "
                         f"{HORIZON['horizons']})")
-    g.add_argument("--forecasts", default=HORIZON["forecasts"],
+    g.add_argument("--forecasts",
                    help="forecasts of the receding-horizon controller: perfect, ar, or none "
                         f"(default {HORIZON['forecasts']})")
-    g.add_argument("--baselines", default=HORIZON["baselines"],
+    g.add_argument("--baselines",
                    help="causal baselines: tracker, extremum, or none (default "
                         f"{HORIZON['baselines']})")
     g.add_argument("--update-interval", type=_finite_float("update-interval"),
-                   default=HORIZON["update_interval"],
                    help="receding-horizon update interval, peak periods (default "
                         f"{HORIZON['update_interval']:g})")
-    g.add_argument("--warm-up", type=_finite_float("warm-up"), default=HORIZON["warm_up"],
+    g.add_argument("--warm-up", type=_finite_float("warm-up"),
                    help="peak periods of every receding-horizon run left out of its mean "
                         "(the run is then this plus one repeat long; default 0)")
     g.add_argument("--speed-limit", type=_finite_float("speed-limit"),
-                   default=HORIZON["speed_limit"],
                    help="rated-speed penalty of the receding-horizon plans (a penalty on "
                         "the plans' speeds above it, not a hard bound; the exceedance is "
                         "reported), in units of sqrt(g/l), > 0 (default none; "
                         "docs/control.md)")
     p.add_argument("--plot", metavar="PNG", help="draw the fraction of the optimum against "
-                                                  "the horizon")
+                                                 "the horizon")
     p.add_argument("--save", metavar="FILE",
                    help="write the curve and every run: .nc or .json")
     p.add_argument("--json", action="store_true", help="print one JSON object")

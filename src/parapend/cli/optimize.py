@@ -5,7 +5,6 @@ from __future__ import annotations
 import math
 
 from .. import limits
-from ..defaults import GAMMA
 from ..results import CONVENTION
 from . import _output
 from . import pto as _pto
@@ -33,11 +32,11 @@ def add_parsers(sub) -> None:
                                    "22, 27), beside the best uniform rotation (Eq. 17) and the "
                                    "gamma -> 0 limit (Eqs. 19, 24, 32 generalized).")
     _add_excitation(p)
-    p.add_argument("--gamma", type=_finite_float("gamma"), default=GAMMA["optimize"],
+    p.add_argument("--gamma", type=_finite_float("gamma"),
                    help="viscous damping gamma in [0, 1e3] (default 0; docs/defaults.md)")
-    p.add_argument("--harmonics", type=_int, default=24,
+    p.add_argument("--harmonics", type=_int,
                    help=f"number N of harmonics, at most {limits.MAX_HARMONICS} (default 24)")
-    p.add_argument("--method", choices=["fourier", "bvp", "all"], default="fourier",
+    p.add_argument("--method", choices=["fourier", "bvp", "all"],
                    help="fourier: Eq. 10 with N harmonics; bvp: Euler-Lagrange BVP (Eqs. 13, "
                         "22, 27; needs gamma >= 1e-7); all: uniform, Fourier, BVP and limit "
                         "side by side (default fourier)")
@@ -46,7 +45,7 @@ def add_parsers(sub) -> None:
                             "instantaneous_power = -T theta', instantaneous_electrical_power "
                             "with an efficiency; in SI with --length and --mass) and the "
                             "result's scalars")
-    p.add_argument("--winding", type=_int, default=1,
+    p.add_argument("--winding", type=_int,
                    help="K turns per forcing period, theta(t + 2 pi/omega) = theta(t) + 2 pi "
                         "K (default 1, the paper's period-1 rotation; K > 1: method fourier "
                         "with N >= 2K, or bvp; docs/seas.md)")
@@ -57,7 +56,7 @@ def add_parsers(sub) -> None:
                        description="Damping threshold gamma* where the optimal power "
                                    "vanishes (paper Fig. 6: 0.0856 at delta=-0.3, omega=1.8).")
     _add_excitation(p)
-    p.add_argument("--harmonics", type=_int, default=None,
+    p.add_argument("--harmonics", type=_int,
                    help=f"fixed N, at most {limits.MAX_THRESHOLD_HARMONICS} (default: doubled "
                         "from 8 until gamma* converges)")
     add_output_options(p, plot="power against damping up to beyond gamma*", save="the result")
@@ -67,12 +66,12 @@ def add_parsers(sub) -> None:
                        description="Optimal and uniform power against damping gamma, from 0 "
                                    "to 1.25 gamma* by default (paper Fig. 6).")
     _add_excitation(p)
-    p.add_argument("--harmonics", type=_int, default=None,
+    p.add_argument("--harmonics", type=_int,
                    help=f"N, at most {limits.MAX_SWEEP_HARMONICS} (default 32, or the "
                         "excitation's band when higher)")
-    p.add_argument("--gamma-max", type=_finite_float("gamma-max"), default=None,
+    p.add_argument("--gamma-max", type=_finite_float("gamma-max"),
                    help="largest damping (default 1.25 gamma*)")
-    p.add_argument("--points", type=_int, default=41,
+    p.add_argument("--points", type=_int,
                    help=f"number of dampings, 2 to {limits.MAX_POINTS}, with points x N^2 <= "
                         f"{limits.MAX_SWEEP_WORK} (default 41)")
     add_output_options(p, plot="power against damping", save="the sweep")
@@ -82,10 +81,10 @@ def add_parsers(sub) -> None:
                        description="Fourier optimum for N = FROM..TO by continuation in N "
                                    "(nondecreasing in N), beside the uniform and limit powers.")
     _add_excitation(p)
-    p.add_argument("--gamma", type=_finite_float("gamma"), default=GAMMA["harmonics"],
+    p.add_argument("--gamma", type=_finite_float("gamma"),
                    help="viscous damping gamma in [0, 1e3] (default 0; docs/defaults.md)")
-    p.add_argument("--from", dest="n_from", type=_int, default=2, help="smallest N (default 2)")
-    p.add_argument("--to", dest="n_to", type=_int, default=64,
+    p.add_argument("--from", dest="n_from", type=_int, help="smallest N (default 2)")
+    p.add_argument("--to", dest="n_to", type=_int,
                    help=f"largest N, at most {limits.MAX_TABLE_HARMONICS} (default 64)")
     add_output_options(p, plot="power against N", save="the table")
     _pto.add_unit_options(p)

@@ -27,7 +27,7 @@ def add_parsers(sub) -> None:
                                    "solutions).")
     p.add_argument("number", choices=["1", "2a", "2b", "4", "5", "6", "7", "8", "9", "10"],
                    help="figure number in the paper")
-    p.add_argument("--plot", metavar="PNG", default=None,
+    p.add_argument("--plot", metavar="PNG",
                    help="output file, PNG, SVG or PDF (default: figN.png in the current "
                         "directory, e.g. fig5.png)")
     p.add_argument("--json", action="store_true", help="print the figure's numbers as JSON")
@@ -36,7 +36,7 @@ def add_parsers(sub) -> None:
                        description="Recompute every table and figure of the paper, compare each "
                                    "number with the paper's and write DIR/report.html, "
                                    "DIR/figures/, DIR/tables/ and DIR/results.json.")
-    p.add_argument("--out", default="parapend-report", metavar="DIR",
+    p.add_argument("--out", metavar="DIR",
                    help="output directory (default: parapend-report)")
     p.add_argument("--json", action="store_true", help="print results.json to stdout")
 

@@ -37,77 +37,75 @@ def add_parsers(sub) -> None:
                     "Resumable with --store.")
     p._negative_number_matcher = _NEGATIVE_VALUE
     g = p.add_argument_group("bins (bin centres: " + _BINS + ")")
-    g.add_argument("--hs", default="1:3:3", help="significant wave height Hm0, m (default "
-                                                 "1:3:3)")
-    g.add_argument("--te", default=None, help="energy period, s (default 6:10:3)")
-    g.add_argument("--tp", default=None, help="peak period, s, instead of --te (Te = "
-                                              "(Te/Tp of the spectrum) Tp)")
-    g.add_argument("--realizations", type=_int, default=3,
+    g.add_argument("--hs", help="significant wave height Hm0, m (default "
+                                "1:3:3)")
+    g.add_argument("--te", help="energy period, s (default 6:10:3)")
+    g.add_argument("--tp", help="peak period, s, instead of --te (Te = "
+                                "(Te/Tp of the spectrum) Tp)")
+    g.add_argument("--realizations", type=_int,
                    help="seeded records per bin (default 3)")
-    g.add_argument("--waves", type=_finite_float("waves"), default=50.0,
+    g.add_argument("--waves", type=_finite_float("waves"),
                    help="record length in peak periods, 2 to 400 (default 50)")
-    g.add_argument("--seed", type=_int, default=0,
+    g.add_argument("--seed", type=_int,
                    help="seed of realization 0; realization r has seed + r (default 0)")
-    g.add_argument("--spectrum", choices=["jonswap", "pierson-moskowitz"], default="jonswap")
-    g.add_argument("--gamma-peak", type=_finite_float("gamma-peak"), default=3.3,
+    g.add_argument("--spectrum", choices=["jonswap", "pierson-moskowitz"])
+    g.add_argument("--gamma-peak", type=_finite_float("gamma-peak"),
                    help="JONSWAP peak enhancement (default 3.3)")
-    g.add_argument("--cutoff", type=_finite_float("cutoff"), default=3.0,
+    g.add_argument("--cutoff", type=_finite_float("cutoff"),
                    help="highest frequency in units of the peak frequency (default 3)")
-    g.add_argument("--response", metavar="CSV", default=None,
+    g.add_argument("--response", metavar="CSV",
                    help="heave response 'f,gain,phase' (default: the base follows the "
                         "surface)")
     g = p.add_argument_group("device")
     g.add_argument("--device", choices=["prescribed-heave", "buoy"],
-                   default="prescribed-heave",
                    help="the prescribed-heave pendulum, or the coupled buoy (the body "
                         "below, the pendulum in SI as parapend buoy)")
-    g.add_argument("--horizon", type=_finite_float("horizon"), default=None,
+    g.add_argument("--horizon", type=_finite_float("horizon"),
                    help="causal controller's horizon, s (not available yet: refused)")
-    g.add_argument("--length", type=_finite_float("length"), default=None,
+    g.add_argument("--length", type=_finite_float("length"),
                    help=f"m (default {SEA['length']:g}; buoy {BUOY['length']:g})")
-    g.add_argument("--mass", type=_finite_float("mass"), default=None,
+    g.add_argument("--mass", type=_finite_float("mass"),
                    help=f"kg (default {SEA['mass']:g}; buoy {BUOY['mass']:g})")
-    g.add_argument("--inertia", type=_finite_float("inertia"), default=None,
+    g.add_argument("--inertia", type=_finite_float("inertia"),
                    help="kg m^2 (default m l^2)")
-    g.add_argument("--gravity", type=_finite_float("gravity"), default=SEA["gravity"],
+    g.add_argument("--gravity", type=_finite_float("gravity"),
                    help="m/s^2 (default 9.81; also the waves')")
-    g.add_argument("--gamma", type=_finite_float("gamma"), default=None,
+    g.add_argument("--gamma", type=_finite_float("gamma"),
                    help="viscous damping, non-dimensional (default 0.01)")
     g.add_argument("--damping-coefficient", type=_finite_float("damping-coefficient"),
-                   default=None, help="N m s/rad (instead of --gamma; buoy default "
+                   help="N m s/rad (instead of --gamma; buoy default "
                                       f"{BUOY['damping_coefficient']:g})")
-    g.add_argument("--winding", type=_winding, default=1, help="as sea (default 1)")
-    g.add_argument("--harmonics", type=_int, default=None, help="as sea (default 16 per wave)")
-    g.add_argument("--efficiency", type=_finite_float("efficiency"), default=None,
+    g.add_argument("--winding", type=_winding, help="as sea (default 1)")
+    g.add_argument("--harmonics", type=_int, help="as sea (default 16 per wave)")
+    g.add_argument("--efficiency", type=_finite_float("efficiency"),
                    help="power take-off efficiency in (0, 1]: adds the electrical power")
-    g.add_argument("--torque-limit", type=_finite_float("torque-limit"), default=None,
+    g.add_argument("--torque-limit", type=_finite_float("torque-limit"),
                    help="not supported over a sea record (refused)")
     g = p.add_argument_group("the buoy's body (--device buoy; as parapend buoy)")
-    add_body_options(g, body_default=None,
-                     body_help="a vertical cylinder or a floating sphere (default cylinder)",
+    add_body_options(g, body_help="a vertical cylinder or a floating sphere (default cylinder)",
                      hydro_help="a Capytaine NetCDF dataset, instead of --body (docs/buoy.md)")
     g = p.add_argument_group("resource and site")
-    g.add_argument("--depth", type=_finite_float("depth"), default=None,
+    g.add_argument("--depth", type=_finite_float("depth"),
                    help="water depth, m (default deep water)")
-    g.add_argument("--density", type=_finite_float("density"), default=1025.0,
+    g.add_argument("--density", type=_finite_float("density"),
                    help="water density, kg/m^3 (default 1025)")
-    g.add_argument("--width", type=_finite_float("width"), default=None,
+    g.add_argument("--width", type=_finite_float("width"),
                    help="characteristic width, m: adds the capture-width ratio (buoy "
                         "default: the body's diameter)")
-    g.add_argument("--scatter", metavar="CSV", default=None,
+    g.add_argument("--scatter", metavar="CSV",
                    help="scatter diagram 'hs,te,frequency' (shares summing to 1) or "
                         "'hs,te,count'; bin centres of the matrix")
-    g.add_argument("--timeseries", metavar="CSV", default=None,
+    g.add_argument("--timeseries", metavar="CSV",
                    help="sea states 'hs,te', one a row, binned with the matrix's edges")
-    g.add_argument("--rated-power", type=_finite_float("rated-power"), default=None,
+    g.add_argument("--rated-power", type=_finite_float("rated-power"),
                    help="W: adds the capacity factor")
     g = p.add_argument_group("engine and output")
-    g.add_argument("--store", default=None,
+    g.add_argument("--store",
                    help="Zarr store of the per-realization results, resumed if it holds this "
                         "matrix (default: in memory)")
     g.add_argument("--overwrite", action="store_true",
                    help="replace a store that holds another matrix")
-    g.add_argument("--workers", type=_int, default=None, help="local processes (default all)")
+    g.add_argument("--workers", type=_int, help="local processes (default all)")
     g.add_argument("--scheduler", metavar="ADDRESS", help="Dask scheduler tcp://host:8786")
     g.add_argument("--netcdf", metavar="FILE.nc", help="the full Dataset as NetCDF")
     g.add_argument("--zarr", metavar="DIR", help="the full Dataset as a Zarr store")

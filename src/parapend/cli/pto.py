@@ -5,7 +5,6 @@ from __future__ import annotations
 import math
 
 from .. import limits
-from ..defaults import GAMMA
 from . import _output
 from ._common import (
     FIGURE_SUFFIXES,
@@ -26,17 +25,17 @@ def add_pto_options(p, torque_limit: bool = True) -> None:
     """``--torque-limit``, ``--efficiency``, ``--efficiency-generating/-motoring``."""
     g = p.add_argument_group("power take-off")
     if torque_limit:
-        g.add_argument("--torque-limit", type=_finite_float("torque-limit"), default=None,
+        g.add_argument("--torque-limit", type=_finite_float("torque-limit"),
                        help="|T(t)| <= this, units m g l (> 0)")
         g.add_argument("--torque-limit-nm", type=_finite_float("torque-limit-nm"),
-                       default=None, help="the torque limit in N m (needs --length, --mass)")
-    g.add_argument("--efficiency", type=_finite_float("efficiency"), default=None,
+                       help="the torque limit in N m (needs --length, --mass)")
+    g.add_argument("--efficiency", type=_finite_float("efficiency"),
                    help="generator and motor efficiency in (0, 1]: electrical power eta p "
                         "when harvesting (p = -T theta' > 0), p / eta when motoring")
     g.add_argument("--efficiency-generating", type=_finite_float("efficiency-generating"),
-                   default=None, help="eta_g in (0, 1] (overrides --efficiency)")
+                   help="eta_g in (0, 1] (overrides --efficiency)")
     g.add_argument("--efficiency-motoring", type=_finite_float("efficiency-motoring"),
-                   default=None, help="eta_m in (0, 1] (overrides --efficiency)")
+                   help="eta_m in (0, 1] (overrides --efficiency)")
 
 
 def add_unit_options(p, damping: bool = True, torque: bool = False,
@@ -47,25 +46,25 @@ def add_unit_options(p, damping: bool = True, torque: bool = False,
     with ``torque``, for commands that have no other take-off options; ``--frequency`` and
     ``--amplitude`` only with ``excitation``: a design map's axes stay non-dimensional)."""
     g = p.add_argument_group(f"physical units (docs/units.md); {adds}")
-    g.add_argument("--length", type=_finite_float("length"), default=None,
+    g.add_argument("--length", type=_finite_float("length"),
                    help="pivot to centre of mass, m")
-    g.add_argument("--mass", type=_finite_float("mass"), default=None, help="kg")
-    g.add_argument("--inertia", type=_finite_float("inertia"), default=None,
+    g.add_argument("--mass", type=_finite_float("mass"), help="kg")
+    g.add_argument("--inertia", type=_finite_float("inertia"),
                    help="moment of inertia about the pivot, kg m^2 (default m l^2)")
-    g.add_argument("--gravity", type=_finite_float("gravity"), default=None,
+    g.add_argument("--gravity", type=_finite_float("gravity"),
                    help="m/s^2 (default 9.81)")
     if excitation:
-        g.add_argument("--frequency", type=_finite_float("frequency"), default=None,
+        g.add_argument("--frequency", type=_finite_float("frequency"),
                        help="base heave frequency, Hz (sets omega = 2 pi f sqrt(l/g))")
-        g.add_argument("--amplitude", type=_finite_float("amplitude"), default=None,
+        g.add_argument("--amplitude", type=_finite_float("amplitude"),
                        help="base heave displacement amplitude A, m (sets delta = "
                             "-A (2 pi f)^2/g)")
     if damping:
         g.add_argument("--damping-coefficient", type=_finite_float("damping-coefficient"),
-                       default=None, help="viscous damping c, N m s/rad (sets gamma)")
+                       help="viscous damping c, N m s/rad (sets gamma)")
     if torque:
         g.add_argument("--torque-limit-nm", type=_finite_float("torque-limit-nm"),
-                       default=None, help="the torque limit in N m (needs --length, --mass)")
+                       help="the torque limit in N m (needs --length, --mass)")
 
 
 def units_of(r):
@@ -87,11 +86,12 @@ def physical_lines(r, units) -> list[str]:
     out = [f"physical (l = {units.length:g} m, m = {units.mass:g} kg, g = {units.gravity:g} "
            f"m/s^2; power unit {units.power:.6g} W, torque unit {units.torque:.6g} N m, time "
            f"unit {units.time:.6g} s): base {units.frequency(r.omega):.6g} Hz",
-           f"  power {r.power_w:.6g} W ({r.energy_per_cycle_j:.6g} J per cycle), uniform "
+           (f"  power {r.power_w:.6g} W" if r.mechanical_power_w is None else
+            f"  power (electrical) {r.power_w:.6g} W, mechanical power "
+            f"{r.mechanical_power_w:.6g} W")
+           + f" ({r.energy_per_cycle_j:.6g} J per cycle), uniform "
            f"{r.uniform_power_w:.6g} W, limit {r.limit_power_w:.6g} W, peak torque "
            f"{r.peak_torque_nm:.6g} N m"]
-    if r.electrical_power_w is not None and r.efficiency_generating is not None:
-        out.append(f"  electrical power {r.electrical_power_w:.6g} W")
     if r.motoring_energy_j is not None:
         out.append(f"  motoring energy {r.motoring_energy_j:.6g} J per cycle")
     if r.uniform_pto_power_w is not None:
@@ -106,7 +106,7 @@ def like_for_like_rows(r, name: str) -> list[list[str]]:
     uniform rotation through the same take-off, the optimum, the limit; "vs uniform"
     compares the optimum with the uniform rotation through the same take-off, electrical
     with electrical (mechanical without an efficiency or copper loss)."""
-    elec = r.efficiency_generating is not None or r.electrical_power != r.power
+    elec = r.mechanical_power is not None  # a lossy take-off: power is the electrical power
     what = "electrical" if elec else "mechanical"
     if r.uniform_pto_feasible:
         uni = [f"best uniform rotation, same take-off ({what})",
@@ -117,7 +117,7 @@ def like_for_like_rows(r, name: str) -> list[list[str]]:
         uni = ["best uniform rotation, same take-off", "infeasible",
                "no phase within the torque limit"]
         gain = "- (uniform infeasible)"
-    mine = r.electrical_power if elec else r.power
+    mine = r.power
     return [["best uniform rotation, ideal (Eq. 17)", _fmt(r.uniform_power), ""],
             uni,
             [f"{name} ({what})", _fmt(mine), gain],
@@ -184,13 +184,13 @@ def add_parsers(sub) -> None:
                                    "torque down to the smallest feasible limit, by "
                                    "continuation) or against the efficiency.")
     _add_excitation(p)
-    p.add_argument("--vary", choices=["torque-limit", "efficiency"], default="torque-limit",
+    p.add_argument("--vary", choices=["torque-limit", "efficiency"],
                    help="the varied parameter (default torque-limit)")
-    p.add_argument("--gamma", type=_finite_float("gamma"), default=GAMMA["pto-curve"],
+    p.add_argument("--gamma", type=_finite_float("gamma"),
                    help="viscous damping gamma in [0, 1e3] (default 0.03; docs/defaults.md)")
-    p.add_argument("--harmonics", type=_int, default=24,
+    p.add_argument("--harmonics", type=_int,
                    help=f"N, at most {limits.MAX_PTO_HARMONICS} (default 24)")
-    p.add_argument("--points", type=_int, default=10,
+    p.add_argument("--points", type=_int,
                    help=f"number of values, 2 to {limits.MAX_PTO_POINTS} (default 10)")
     add_pto_options(p)
     add_unit_options(p)
@@ -209,9 +209,10 @@ def _cmd_pto_curve(a) -> dict | str:
     if a.json:
         return ds.to_dict()
     name = "T_max" if a.vary == "torque-limit" else "eta"
+    mech = ds["mechanical_power" if "mechanical_power" in ds else "power"]
     rows = [[f"{v:.6g}", _fmt(p, 8), _fmt(e, 8), "-" if math.isnan(u) else _fmt(u, 8),
              f"{t:.5g}" + ("*" if c == 0 else ""), _fmt(m), str(s)]
-            for v, p, e, u, t, m, s, c in zip(ds["value"].values, ds["power"].values,
+            for v, p, e, u, t, m, s, c in zip(ds["value"].values, mech.values,
                                               ds["electrical_power"].values,
                                               ds["uniform_pto_electrical_power"].values,
                                               ds["peak_torque"].values,
@@ -221,7 +222,8 @@ def _cmd_pto_curve(a) -> dict | str:
     head = [name, "mech. P", "electrical", "uniform, same", "peak |T|", "motoring E",
             "status"]
     if units is not None:
-        for r, w in zip(rows, ds["power_w"].values):
+        mech_w = ds["mechanical_power_w" if "mechanical_power_w" in ds else "power_w"]
+        for r, w in zip(rows, mech_w.values):
             r.insert(2, f"{w:.5g}")
         head.insert(2, "P (W)")
     out = [_table(rows, head), "",

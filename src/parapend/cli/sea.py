@@ -32,21 +32,21 @@ def add_parsers(sub) -> None:
                                    "(docs/seas.md).")
     g = p.add_argument_group("sea state (IEC TS 62600-2 spectra) or a measured record")
     add_sea_options(g)
-    g.add_argument("--response", metavar="CSV", default=None,
+    g.add_argument("--response", metavar="CSV",
                    help="heave response of the buoy, CSV 'f,gain,phase' (Hz, m/m, rad); "
                         "default: the base follows the surface (a small buoy)")
-    g.add_argument("--record", metavar="CSV", default=None,
+    g.add_argument("--record", metavar="CSV",
                    help="measured heave record, CSV 't,z' (s, m), instead of a sea state")
-    g.add_argument("--taper", type=_finite_float("taper"), default=0.1,
+    g.add_argument("--taper", type=_finite_float("taper"),
                    help="with --record: fraction of the record under the Tukey taper that "
                         "makes it periodic (default 0.1)")
     g = p.add_argument_group("pendulum (SI units)")
     add_pendulum_options(g, gamma_note="; docs/defaults.md")
     g = p.add_argument_group("motion")
-    g.add_argument("--winding", type=_winding, default=1,
+    g.add_argument("--winding", type=_winding,
                    help="K turns over the record, theta(t + T_r) = theta(t) + 2 pi K, or "
                         "'auto': K = 1 and fractions of the mean-wave-frequency K (default 1)")
-    g.add_argument("--harmonics", type=_int, default=None,
+    g.add_argument("--harmonics", type=_int,
                    help="N (default 16 per mean wave, then checked at 2N)")
     add_output_options(p, plot="the record, the motion and the energy",
                        save="the record and the motion over it (time_s, heave_m, q, theta, "

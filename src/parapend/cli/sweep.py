@@ -11,7 +11,6 @@ import sys
 import time
 
 from .. import limits
-from ..defaults import GAMMA
 from . import pto as _pto
 from ._common import (
     FIGURE_SUFFIXES,
@@ -58,39 +57,39 @@ def add_parsers(sub) -> None:
                     "the same command again after an interruption to resume it.")
     p._negative_number_matcher = _NEGATIVE_VALUE
     g = p.add_argument_group("axes (" + _AXIS_HELP + ")")
-    g.add_argument("--omega", default="1.8", help="forcing frequency (default 1.8)")
-    g.add_argument("--delta", default=None, help="excitation amplitude (default -0.3)")
-    g.add_argument("--gamma", default=GAMMA["sweep"], help="viscous damping (default 0)")
-    g.add_argument("--torque-limit", default=None,
+    g.add_argument("--omega", help="forcing frequency (default 1.8)")
+    g.add_argument("--delta", help="excitation amplitude (default -0.3)")
+    g.add_argument("--gamma", help="viscous damping (default 0)")
+    g.add_argument("--torque-limit",
                    help="T_max of the power take-off, units m g l (each point then solves "
                         "the power take-off problem: 0.2 to 2 s a point)")
-    g.add_argument("--efficiency", default=None,
+    g.add_argument("--efficiency",
                    help="efficiency of the power take-off in (0, 1] (as --torque-limit)")
     e = p.add_argument_group("excitation q(t)")
-    e.add_argument("--excitation", default=None,
+    e.add_argument("--excitation",
                    choices=["harmonic", "two-harmonic", "square", "fourier"],
                    help="default harmonic (fourier with --fourier)")
-    e.add_argument("--square-alpha", type=_finite_float("square-alpha"), default=None,
+    e.add_argument("--square-alpha", type=_finite_float("square-alpha"),
                    help="tanh width of Eq. 26, square only")
     e.add_argument("--fourier", metavar="TERMS", help="'k:amp:phase,...' (omega axis only)")
-    p.add_argument("--harmonics", type=_int, default=24,
+    p.add_argument("--harmonics", type=_int,
                    help=f"N of every solve, at most {limits.MAP_MAX_HARMONICS} (default 24)")
     p.add_argument("--threshold", action="store_true",
                    help="also compute gamma* at every (omega, delta): several solves each")
     # default None, as parapend.sweep's (which then writes nothing); _cmd_sweep names the file
-    p.add_argument("--store", default=None,
+    p.add_argument("--store",
                    help="Zarr store (a directory; default map.zarr), resumed if it holds "
                         "this sweep")
     p.add_argument("--overwrite", action="store_true",
                    help="replace a store that holds a different sweep (a parapend store "
                         "only: no other directory is ever deleted)")
     p.add_argument("--netcdf", metavar="FILE.nc", help="also export the finished map to NetCDF")
-    p.add_argument("--workers", type=_int, default=None,
+    p.add_argument("--workers", type=_int,
                    help="local processes (default: all CPUs)")
     p.add_argument("--scheduler", metavar="ADDRESS",
                    help="run on an existing Dask distributed cluster (tcp://host:8786); "
                         "needs the 'distributed' package")
-    p.add_argument("--block-points", type=_int, default=None,
+    p.add_argument("--block-points", type=_int,
                    help="points per block, one chunk of the store (default 512, 8 with a "
                         "power take-off)")
     _pto.add_unit_options(p, damping=False, excitation=False)
@@ -102,21 +101,21 @@ def add_parsers(sub) -> None:
                                    "with contour lines, failed points crossed and the "
                                    "paper's case marked.")
     m._negative_number_matcher = _NEGATIVE_VALUE
-    m.add_argument("--store", default="map.zarr",
+    m.add_argument("--store",
                    help="a sweep store (Zarr directory) or its NetCDF export")
     from ..maps import MAP_QUANTITIES
 
-    m.add_argument("--variable", default="power", choices=MAP_QUANTITIES,
+    m.add_argument("--variable", choices=MAP_QUANTITIES,
                    help="gain = power / uniform_power - 1 in percent (default power)")
     axes = ["omega", "delta", "gamma", "torque-limit", "efficiency"]
-    m.add_argument("--x", default=None, choices=axes, help="horizontal axis (default: the "
-                                                           "first swept)")
-    m.add_argument("--y", default=None, choices=axes, help="vertical axis (default: the "
-                                                           "second swept)")
-    m.add_argument("--at", action="append", default=[], metavar="AXIS=VALUE",
+    m.add_argument("--x", choices=axes, help="horizontal axis (default: the "
+                                             "first swept)")
+    m.add_argument("--y", choices=axes, help="vertical axis (default: the "
+                                             "second swept)")
+    m.add_argument("--at", action="append", metavar="AXIS=VALUE",
                    help="value of a further axis (nearest; default its first value); "
                         "repeatable")
-    m.add_argument("--plot", metavar="PNG", default="map.png",
+    m.add_argument("--plot", metavar="PNG",
                    help="figure file, PNG, SVG or PDF (default map.png)")
     _pto.add_unit_options(m, damping=False, excitation=False)
     m.add_argument("--json", action="store_true", help="print one JSON object")

@@ -28,6 +28,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .. import limits
+from ..defaults import HORIZON, SEA
 from ..errors import ParameterError, check_int, check_range
 from ..results import _Result
 
@@ -198,25 +199,32 @@ def _stats(a):
     return float(np.mean(a[ok])), float(np.min(a[ok])), float(np.max(a[ok]))
 
 
-def horizon_curve(*, hs: float = 2.0, tp: float = 8.0, spectrum: str = "jonswap",
-                  gamma_peak: float = 3.3, repeat_period=None, seed: int = 0,
-                  cutoff: float = 3.0, length: float = 1.0, mass: float = 10.0,
-                  inertia=None, gravity: float = 9.81, gamma=None, damping_coefficient=None,
-                  torque_limit=None, efficiency=None, horizons="0.25,0.5,1,2,4",
-                  forecasts="perfect,ar", baselines="tracker,extremum", records: int = 1,
-                  update_interval: float = 0.03125, progress=None,
-                  warm_up: float = 0.0, speed_limit=None) -> HorizonResult:
-    """Mean power of causal control against the horizon (module docstring).
+def horizon_curve(*, hs=None, tp=None, spectrum: str = "jonswap", gamma_peak: float = 3.3,
+                  repeat_period=None, seed=None, cutoff: float = 3.0,
+                  length: float = SEA["length"], mass: float = SEA["mass"], inertia=None,
+                  gravity: float = SEA["gravity"], gamma=None, damping_coefficient=None,
+                  torque_limit=None, torque_limit_nm=None, efficiency=None,
+                  horizons=HORIZON["horizons"], forecasts=HORIZON["forecasts"],
+                  baselines=HORIZON["baselines"], records: int = HORIZON["records"],
+                  update_interval: float = HORIZON["update_interval"], progress=None,
+                  warm_up: float = HORIZON["warm_up"],
+                  speed_limit=HORIZON["speed_limit"]) -> HorizonResult:
+    """Mean power of causal control against the horizon, as a fraction of the record's
+    non-causal optimum and of its limit (command ``horizon``: ``parapend.horizon`` is this
+    function; module docstring).
 
     Parameters
     ----------
     hs, tp, spectrum, gamma_peak, repeat_period, seed, cutoff :
         The sea state (:func:`parapend.seas.sea_record`; ``repeat_period`` in s, default
-        ``100 tp``); record ``r`` has the seed ``seed + r``.
+        ``100 tp``); record ``r`` has the seed ``seed + r``. ``hs``, ``tp``, ``seed`` None:
+        2 m, 8 s, 0 (``parapend.defaults.SEA``).
     length, mass, inertia, gravity, gamma, damping_coefficient :
         The pendulum, as :func:`parapend.irregular.sea` (default ``gamma = 0.01``).
     torque_limit : float or None
         ``T_max`` (units ``m g l``) for every controller.
+    torque_limit_nm : float or None
+        The torque limit in N m instead (not both).
     efficiency : float or None
         PTO efficiency (generating and motoring) as :mod:`parapend.pto`, for every
         controller; the optimum and the limit stay mechanical.
@@ -247,6 +255,14 @@ def horizon_curve(*, hs: float = 2.0, tp: float = 8.0, spectrum: str = "jonswap"
     from .mpc import stored_energy
 
     units = Units(length, mass, gravity, inertia)
+    hs = SEA["hs"] if hs is None else hs
+    tp = SEA["tp"] if tp is None else tp
+    seed = SEA["seed"] if seed is None else seed
+    if torque_limit_nm is not None:
+        if torque_limit is not None:
+            raise ParameterError("torque-limit-nm: give either --torque-limit or "
+                                 "--torque-limit-nm, not both")
+        torque_limit = units.from_newton_metres(torque_limit_nm)
     if gamma is not None and damping_coefficient is not None:
         raise ParameterError("gamma: give either gamma or damping-coefficient, not both")
     if damping_coefficient is not None:
