@@ -185,11 +185,13 @@ def test_cli_efficiency_json(capsys):
         out = json.loads(capsys.readouterr().out)
         assert out["efficiency"] == [0.9, 0.8]
         assert out["success"], out["status"]
-        assert out["pto_loss_w"] == pytest.approx(out["power_w"] - out["electrical_power_w"],
+        assert out["power_w"] == out["electrical_power_w"]  # the headline: electrical
+        assert out["pto_loss_w"] == pytest.approx(out["mechanical_power_w"]
+                                                  - out["electrical_power_w"],
                                                   rel=1e-12)
         assert 0 < out["electrical_power_w"] <= 0.9 * out["ideal_power_w"]
         assert out["generated_power_w"] - out["motoring_power_w"] == pytest.approx(
-            out["power_w"], rel=1e-9)
+            out["mechanical_power_w"], rel=1e-9)
 
 
 @pytest.mark.slow
@@ -204,7 +206,8 @@ def test_default_design_with_efficiency():
     text = "\n".join(_text_result(r))
     assert "electrical power (maximized)" in text and "take-off losses" in text
     assert r.electrical_power_w == pytest.approx(28.10, rel=2e-3)
-    assert r.power_w == pytest.approx(31.23, rel=2e-3)
+    assert r.mechanical_power_w == pytest.approx(31.23, rel=2e-3)
+    assert r.power_w == r.electrical_power_w
     assert r.ideal_power_w == pytest.approx(38.35, rel=2e-3)
     assert r.electrical_power_w <= 0.9 * r.ideal_power_w
     assert r.energy_balance_residual <= BALANCE_TOL

@@ -255,8 +255,8 @@ def _text_result(r) -> list:
     if r.torque_limit_nm is not None:
         rows.insert(3, ["  torque limit", _w(r.torque_limit_nm), "N m"])
     if r.electrical_power_w is not None:
-        rows[0][0] = "coupled optimum: mechanical power"
-        rows[1:1] = [["  electrical power (maximized)", _w(r.electrical_power_w), "W"],
+        rows[0][0] = "coupled optimum: electrical power (maximized)"
+        rows[1:1] = [["  mechanical power", _w(r.mechanical_power_w), "W"],
                      ["  take-off losses", _w(r.pto_loss_w), "W"],
                      ["  generated / motoring", f"{r.generated_power_w:.6g} / "
                       f"{r.motoring_power_w:.6g}", "W"],
@@ -288,10 +288,10 @@ def _sweep_text(r) -> list:
                                                 r.status)]
     head = ["T (s)", "power (W)", "one-way (W)", "bound (W)", "limit (W)", "fraction",
             "heave (m)", "status"]
-    if r.electrical_power_w is not None:
-        for row, e in zip(rows, r.electrical_power_w):
+    if r.mechanical_power_w is not None:
+        for row, e in zip(rows, r.mechanical_power_w):
             row.insert(2, _fmt(e))
-        head[1:2] = ["mechanical (W)", "electrical (W)"]
+        head[1:2] = ["electrical (W)", "mechanical (W)"]
     for name, label in (("mesh_error_w", "mesh err (W)"), ("grid_error_w", "grid err (W)")):
         if getattr(r, name) is not None:
             for row, e in zip(rows, getattr(r, name)):

@@ -216,6 +216,7 @@ def period_sweep(hydro, width, pendulum, height, periods, *, winding=1, harmonic
         wave_height_m=height, pendulum=rows[0].pendulum, body=rows[0].body, warnings=notes,
         _results=tuple(rows),
         electrical_power_w=None if efficiency is None else col("electrical_power_w"),
+        mechanical_power_w=None if efficiency is None else col("mechanical_power_w"),
         mesh_error_w=None if coarse is None else col("mesh_error_w"),
         grid_error_w=col("grid_error_w"),
         validity_warnings=[f"T = {r.wave['period_s']:g} s: {w}" for r in rows

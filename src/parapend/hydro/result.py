@@ -53,9 +53,14 @@ class BuoyResult(_Result):
     design : the outer search of ``optimize_design`` (None without it).
     warnings : notes on the result (retained harmonics above the dataset's frequencies).
     efficiency : ``[eta_g, eta_m]`` of the power take-off (None: ideal). With it the motion
-        maximizes the electrical power, and ``power_w`` is that motion's mechanical power.
-    electrical_power_w : ``<e(p)>``, ``e = eta_g p`` generating, ``p / eta_m`` motoring.
-    pto_loss_w : ``power_w - electrical_power_w``, the take-off's losses.
+        maximizes the electrical power, ``power_w`` is that electrical power (the headline:
+        what the design delivers) and ``mechanical_power_w`` the same motion's mechanical
+        power ``-<tau theta'>`` (what the bound fraction, the capture width and the energy
+        balance are of).
+    mechanical_power_w : see ``efficiency`` (None without one).
+    electrical_power_w : ``<e(p)>``, ``e = eta_g p`` generating, ``p / eta_m`` motoring
+        (equal to ``power_w`` with an efficiency).
+    pto_loss_w : ``mechanical_power_w - electrical_power_w``, the take-off's losses.
     generated_power_w, motoring_power_w : ``<max(p, 0)>`` and ``<max(-p, 0)>``.
     ideal_power_w : the ideal (lossless) coupled optimum
         ``electrical_power_w <= eta_g ideal_power_w``.
@@ -101,6 +106,7 @@ class BuoyResult(_Result):
     design: dict | None
     warnings: list
     electrical_power_w: float | None = None
+    mechanical_power_w: float | None = None
     pto_loss_w: float | None = None
     generated_power_w: float | None = None
     motoring_power_w: float | None = None
@@ -192,6 +198,7 @@ class BuoySweepResult(_Result):
     warnings: list
     _results: tuple = field(default=(), repr=False)
     electrical_power_w: np.ndarray | None = None
+    mechanical_power_w: np.ndarray | None = None
     mesh_error_w: np.ndarray | None = None
     validity_warnings: list = field(default_factory=list)
     grid_error_w: np.ndarray | None = None
@@ -209,9 +216,9 @@ class BuoySweepResult(_Result):
         ds = xr.Dataset({k: ("period_s", np.asarray(getattr(self, k), dtype=float))
                          for k in names}, coords={"period_s": self.period_s})
         ds["status"] = ("period_s", np.asarray(self.status, dtype=str))
-        if self.electrical_power_w is not None:
-            ds["electrical_power_w"] = ("period_s", np.asarray(self.electrical_power_w,
-                                                               dtype=float))
+        for name in ("electrical_power_w", "mechanical_power_w"):
+            if getattr(self, name) is not None:
+                ds[name] = ("period_s", np.asarray(getattr(self, name), dtype=float))
         if self.mesh_error_w is not None:
             ds["mesh_error_w"] = ("period_s", np.asarray(self.mesh_error_w, dtype=float))
         if self.grid_error_w is not None:
@@ -409,14 +416,14 @@ def _result(h, width, pendulum, wave, wave_info, sol, ow, *, torque_limit, effic
                      "hydrodynamic data or the solve are wrong; not a success")
     eff = None if sol.efficiency is None else [float(v) for v in sol.efficiency]
     efields = {} if ep is None else {
-        "electrical_power_w": float(ep), "pto_loss_w": p - float(ep),
+        "electrical_power_w": float(ep), "mechanical_power_w": p, "pto_loss_w": p - float(ep),
         "generated_power_w": float(sol.generated_power),
         "motoring_power_w": float(sol.motoring_power),
         "ideal_power_w": float(sol.ideal_power),
         "one_way_electrical_power_w": None if ow is None or ow.electrical_power is None
         else float(ow.electrical_power)}
     return BuoyResult(
-        power_w=p, heave_amplitude_m=_half_range(s["z"]), peak_torque_nm=float(sol.peak_torque()),
+        power_w=harvest, heave_amplitude_m=_half_range(s["z"]), peak_torque_nm=float(sol.peak_torque()),
         radiation_bound_w=bound, bound_fraction=p / bound if bound > 0 else None,
         limit_w=float(sol.limit), capture_width_m=cw,
         capture_width_ratio=cw / width if width else None, energy_flux_w_per_m=flux,
