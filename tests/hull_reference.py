@@ -38,7 +38,7 @@ class _Grid:
     """Constant matrices of the spec's discretization and the problem's data."""
 
     def __init__(self, *, omega, amplitudes, winding, harmonics, hull_harmonics, points,
-                 A, B, F, C, Mh, m, l, I, c, g, pivot):
+                 A, B, F, C, Mh, m, l, I, c, g, pivot):  # noqa: E741 (the spec's names)
         w = float(omega)
         n, nh, mm, kk = int(harmonics), int(hull_harmonics), int(points), int(winding)
         if not (w > 0 and math.isfinite(w)):
@@ -312,7 +312,7 @@ def _build(gr: _Grid, tol: float, max_iter: int, graph: str = "MX", one_way: boo
 
 
 def hull_reference(*, omega, amplitudes, winding, harmonics, hull_harmonics, points, A, B, F,
-                   C, Mh, m, l, I, c, g, pivot, x0=None, starts=8, seed=0, tol=1e-12,
+                   C, Mh, m, l, I, c, g, pivot, x0=None, starts=8, seed=0, tol=1e-12,  # noqa: E741
                    max_iter=1000, one_way=False, graph="MX") -> dict:
     """Maximize the spec's power over the pendulum's and the hull's harmonics (IPOPT).
 
@@ -436,7 +436,7 @@ def box_coefficients(w):
 
 
 def box_case(*, winding, harmonics, hull_harmonics=6, points=None, period=6.0, height=1.0,
-             m=2000.0, l=1.0, I=2500.0, c=500.0, pivot=(0.0, 1.0), g=9.81) -> dict:
+             m=2000.0, l=1.0, I=2500.0, c=500.0, pivot=(0.0, 1.0), g=9.81) -> dict:  # noqa: E741
     """Keyword arguments of :func:`hull_reference` for the synthetic box in a regular wave
     (``points`` default: the power of two at or above ``8 (N + Nh + K)``)."""
     w = 2 * math.pi / period
