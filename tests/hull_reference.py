@@ -29,6 +29,9 @@ import time
 import numpy as np
 
 STATUS_OK = "Solve_Succeeded"
+ACCEPT = 1e-8  # a converged start's power re-evaluated by NumPy (hull solved again), relative
+ALIAS_FACTOR = 8  # the power re-evaluated on ALIAS_FACTOR * M points (same N, Nh) ...
+ALIAS_TOL = 1e-6  # ... must agree to this (relative), else the start climbed into aliasing
 RCOND = 1e-10  # the radiation bound's pseudo-inverse cut (relative to B_k's largest eigenvalue)
 
 
@@ -313,7 +316,8 @@ def _build(gr: _Grid, tol: float, max_iter: int, graph: str = "MX", one_way: boo
 
 def hull_reference(*, omega, amplitudes, winding, harmonics, hull_harmonics, points, A, B, F,
                    C, Mh, m, l, I, c, g, pivot, x0=None, starts=8, seed=0, tol=1e-12,  # noqa: E741
-                   max_iter=1000, one_way=False, graph="MX") -> dict:
+                   max_iter=1000, one_way=False, graph="MX",
+                   coefficient_bound=2 * math.pi) -> dict:
     """Maximize the spec's power over the pendulum's and the hull's harmonics (IPOPT).
 
     Parameters
@@ -348,13 +352,21 @@ def hull_reference(*, omega, amplitudes, winding, harmonics, hull_harmonics, poi
     one_way : bool
         Hold the hull at its free response ``Z_k^{-1} Fa_k`` (the pendulum's reaction left
         out) and maximize over the pendulum alone: the one-way optimum.
+    coefficient_bound : float or None
+        Simple bounds ``|x_n| <= coefficient_bound`` (n >= 1; not the mean ``x_0``), rad:
+        they keep IPOPT out of the aliased region where the grid's power is unbounded (see
+        below); a start ending on a bound does not count as converged. None: no bounds.
     graph : "MX" or "SX"
         CasADi's graph of the NLP (MX: matrix operations, builds in a fraction of a second;
         SX: scalar graph, builds in seconds, and solves somewhat slower here).
 
-    A start counts as converged when IPOPT returns ``Solve_Succeeded`` and the NumPy
-    re-evaluation (hull solved again from (H)) agrees with IPOPT's power to ``1e-8``
-    relative.
+    A start counts as converged when IPOPT returns ``Solve_Succeeded``, the NumPy
+    re-evaluation (hull solved again from (H)) agrees with IPOPT's power to ``ACCEPT``
+    relative, and the power on ``ALIAS_FACTOR * M`` points agrees to ``ALIAS_TOL``: on the
+    M-point grid the power is unbounded (a phi with large coefficients has harmonics of
+    ``sin(phi)`` far above M/2, and the grid's mean of them is aliasing), and some starts
+    climb there (seen at K = 1..3 on the heave-only case: 1e8 to 1e9 W "optima", energy
+    balance broken, IPOPT ending at its iteration limit or "acceptable").
 
     Returns
     -------
@@ -364,7 +376,8 @@ def hull_reference(*, omega, amplitudes, winding, harmonics, hull_harmonics, poi
     ``powers`` (every start's power, status and seconds), ``power_check``
     (:func:`hull_power`-style NumPy re-evaluation at the optimum, the hull from (H) solved
     again; one-way: held), ``radiation_bound`` (W, pseudo-inverse of ``B_k`` with the cut
-    ``RCOND`` relative to its largest eigenvalue), ``points``.
+    ``RCOND`` relative to its largest eigenvalue), ``points``, ``alias_change`` (relative
+    change of the best's power on ``ALIAS_FACTOR * M`` points).
     """
     gr = _Grid(omega=omega, amplitudes=amplitudes, winding=winding, harmonics=harmonics,
                hull_harmonics=hull_harmonics, points=points, A=A, B=B, F=F, C=C, Mh=Mh, m=m,
@@ -379,6 +392,12 @@ def hull_reference(*, omega, amplitudes, winding, harmonics, hull_harmonics, poi
     else:
         seeds = _starts(gr, starts, seed)
 
+    ub = np.full(nx + gr.ny, np.inf)
+    if coefficient_bound is not None:
+        ub[1:nx] = float(coefficient_bound)
+        for xs in seeds:  # the starts inside the bounds
+            np.clip(xs[1:], -0.999 * ub[1:nx], 0.999 * ub[1:nx], out=xs[1:])
+
     def hull(x):
         return gr.one_way_y() if one_way else gr.solve_hull(x)
 
@@ -387,15 +406,26 @@ def hull_reference(*, omega, amplitudes, winding, harmonics, hull_harmonics, poi
     for xs in seeds:
         ys = hull(xs)
         t = time.perf_counter()
-        sol = solver(x0=np.concatenate((xs, ys)), lbg=zero, ubg=zero)
+        sol = solver(x0=np.concatenate((xs, ys)), lbg=zero, ubg=zero, lbx=-ub, ubx=ub)
         total += time.perf_counter() - t
         st = solver.stats()["return_status"]
         z = np.asarray(sol["x"]).ravel()
         runs.append((float(pfun(z[:nx], z[nx:])), st, z, time.perf_counter() - t))
 
+    fine = _Grid(omega=omega, amplitudes=amplitudes, winding=winding, harmonics=harmonics,
+                 hull_harmonics=hull_harmonics, points=ALIAS_FACTOR * gr.M, A=A, B=B, F=F, C=C,
+                 Mh=Mh, m=m, l=l, I=I, c=c, g=g, pivot=pivot)
+
+    def fine_power(x):
+        return fine.power_np(x, fine.one_way_y() if one_way else fine.solve_hull(x))[0]
+
     def ok(r):
-        chk = gr.power_np(r[2][:nx], hull(r[2][:nx]))[0]
-        return r[1] == STATUS_OK and abs(chk - r[0]) <= 1e-8 * max(abs(chk), 1e-300)
+        if r[1] != STATUS_OK or np.any(np.abs(r[2][1:nx]) >= (1 - 1e-6) * ub[1:nx]):
+            return False
+        x, tol_p = r[2][:nx], ACCEPT * max(abs(r[0]), 1e-300)
+        if abs(gr.power_np(x, hull(x))[0] - r[0]) > tol_p:
+            return False
+        return one_way or abs(fine_power(x) - r[0]) <= ALIAS_TOL * max(abs(r[0]), 1e-300)
 
     conv = [r for r in runs if ok(r)]
     best = max(conv if conv else runs, key=lambda r: r[0])
@@ -406,7 +436,8 @@ def hull_reference(*, omega, amplitudes, winding, harmonics, hull_harmonics, poi
             "energy_balance_residual": gr.balance(x, y), "starts_converged": len(conv),
             "powers": [(r[0], r[1], r[3]) for r in runs],
             "power_check": gr.power_np(x, hull(x))[0], "radiation_bound": gr.bound(),
-            "points": gr.M}
+            "points": gr.M,
+            "alias_change": abs(fine_power(x) - p) / max(abs(p), 1e-300)}
 
 
 # ------------------------------------------------------------------------------------------

@@ -101,10 +101,10 @@ def test_reference_optimum_balances_and_stays_below_the_bound(winding):
                if st == "Solve_Succeeded")
 
 
-def _heave_case(nh=10, inert=1e12):
+def _heave_case(winding=1, height=1.5, nh=10, inert=1e12):
     hyd = toy_hydro()
     pen = Pendulum(500.0, 1.0, 600.0, 20.0)
-    wave = Wave.regular(1.5, 6.0)
+    wave = Wave.regular(height, 6.0)
     w = wave.omega
     a, b, f = hyd.coefficients(w * np.arange(nh + 1))
     A = np.zeros((nh + 1, 3, 3))
@@ -113,21 +113,23 @@ def _heave_case(nh=10, inert=1e12):
     A[:, 1, 1], B[:, 1, 1], F[:, 1] = a, b, f
     # surge and pitch inert: huge mass, inertia and pitch stiffness, no coupling; the heave
     # mass of the hull without the pendulum is the buoy's displaced mass less m
-    kw = dict(omega=w, amplitudes=wave.amplitudes, winding=1, hull_harmonics=nh, points=256,
+    kw = dict(omega=w, amplitudes=wave.amplitudes, winding=winding, hull_harmonics=nh,
+              points=256,
               A=A, B=B, F=F, C=np.diag([0.0, hyd.hydrostatic_stiffness, inert]),
               Mh=np.diag([inert, hyd.mass - pen.mass, inert]), m=pen.mass, l=pen.length,
               I=pen.inertia, c=pen.damping_coefficient, g=hyd.g, pivot=(0.0, 0.0))
     return hyd, pen, wave, kw
 
 
-def test_heave_only_limit_equals_parapends_heave_optimum():
+@pytest.mark.parametrize(("winding", "height"), [(1, 1.5), (2, 3.0)])
+def test_heave_only_limit_equals_parapends_heave_optimum(winding, height):
     """Surge and pitch inert, pivot at O: the reference's optimum and its point value at
     parapend's heave-only coupled optimum both equal that optimum's power (1e-6). The
     toy dataset stops at 8 rad/s (B = 0 above: the heave kernel counts 7 harmonics of the
     coupling), below the 10 hull harmonics here; the heave kernel's theta is this phi
     (from the upward vertical, the same pendulum equation)."""
-    hyd, pen, wave, kw = _heave_case()
-    sol = coupled_optimum(hyd, pen, wave, winding=1, harmonics=4)
+    hyd, pen, wave, kw = _heave_case(winding, height)
+    sol = coupled_optimum(hyd, pen, wave, winding=winding, harmonics=2 * winding + 2)
     assert sol.success
     xk = np.asarray(sol.theta_coefficients["x"], dtype=float)
     n = (xk.size - 1) // 2
@@ -142,12 +144,13 @@ def test_heave_only_limit_equals_parapends_heave_optimum():
 
 
 @pytest.mark.slow
-def test_heave_only_limit_global_search():
-    """As above with the reference's own starts (one of them runs to a spurious
-    'acceptable' point where the inert rows' scaled residual hides a large force: the
-    NumPy re-evaluation rejects it)."""
-    hyd, pen, wave, kw = _heave_case()
-    sol = coupled_optimum(hyd, pen, wave, winding=1, harmonics=4)
+@pytest.mark.parametrize(("winding", "height"), [(1, 1.5), (2, 3.0)])
+def test_heave_only_limit_global_search(winding, height):
+    """As above with the reference's own starts (at K = 2, H = 3 m they find a second
+    maximum, 155 W; without the coefficient bounds most starts climb into aliasing, 1e8
+    to 1e9 W 'optima' of the grid's power)."""
+    hyd, pen, wave, kw = _heave_case(winding, height)
+    sol = coupled_optimum(hyd, pen, wave, winding=winding, harmonics=2 * winding + 2)
     n = (len(sol.theta_coefficients["x"]) - 1) // 2
     r = hull_reference(harmonics=n, starts=8, **kw)
     assert r["success"] and r["starts_converged"] >= 4
