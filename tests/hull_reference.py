@@ -12,8 +12,11 @@ equality constraints (each row divided by its largest coefficient), and the powe
     tau = I phi'' + c (phi' - beta') - m l [ (g + p_z'') sin(phi) - p_x'' cos(phi) ]
 
 is maximized on the M-point grid, with exact first and second derivatives from CasADi's
-automatic differentiation (SX graphs of the grid's sine/cosine matrices and elementwise
-``sin``/``cos`` of ``phi``).
+automatic differentiation (MX graphs of the grid's sine/cosine matrices and elementwise
+``sin``/``cos`` of ``phi``; SX on request). The harmonics ``x_n`` (n >= 1) are bounded by
+2 pi by default: on the grid the power is unbounded (aliasing), and IPOPT went there from
+some starts. Every converged start is re-checked by NumPy (the hull solved again, and the
+power on an 8 times finer grid).
 
 :func:`hull_power` is the same ``P`` at given ``x`` with the hull solved from (H) by one
 real linear solve in NumPy (no optimization): a point check of any kernel's answer.
