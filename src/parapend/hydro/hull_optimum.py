@@ -19,10 +19,12 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..errors import ParameterError
 from ..optimal.fourier import DISTINCT_RMS, _pad, motion_distance, newton_maximize
 from .hull import HullCase, HullProblem, hull_points
 
-__all__ = ["HullSolution", "hull_search", "make_case", "HARMONICS_PER_TURN"]
+__all__ = ["HARMONICS_PER_TURN", "HullSolution", "aliased", "hull_search", "make_case",
+           "radiation_bound", "waves_in"]
 
 #: harmonics of phi per turn (K >= 1) or per wave (K = 0) by default
 HARMONICS_PER_TURN = 12
@@ -34,6 +36,9 @@ REFINE_TOL = 1e-7
 #: a change above this (relative) at the most harmonics allowed is not an answer
 UNRESOLVED = 1e-3
 MAX_SCALE = 8
+#: relative change of the power at a maximum on a grid four times finer above which the
+#: maximum is rejected as aliased (the grid's mean of an unresolved motion)
+ALIAS_TOL = 1e-8
 #: singular values of B_k below this fraction of the largest are cut in the bound's
 #: pseudo-inverse (B's surge-pitch block is near singular: both radiate the same waves)
 BOUND_RCOND = 1e-8
@@ -49,6 +54,15 @@ def make_case(hull, pendulum, wave, *, winding, harmonics=None, hull_harmonics=N
     kk = np.arange(nh + 1) * w
     a, b, f = hull.coefficients(kk)
     mh = hull.mass_matrix(pendulum.mass, pitch_inertia)
+    c = np.asarray(hull.hydrostatic_stiffness, float)
+    c55 = float(c[2, 2]) - pendulum.mass * float(hull.g) * float(pivot[1])
+    if not c55 > 0:
+        top = float(c[2, 2]) / (pendulum.mass * float(hull.g))
+        raise ParameterError(
+            f"pivot-height: with the pendulum's {pendulum.mass:g} kg at {pivot[1]:g} m the "
+            f"hull is unstable in pitch (C55 = {float(c[2, 2]):.4g} - m g h_p = {c55:.4g} "
+            f"N m/rad <= 0); lower the pivot (below {top:.4g} m) "
+            "or the pendulum's mass")
     return HullCase(omega=w, amplitudes=wave.amplitudes, winding=int(winding), harmonics=n,
                     hull_harmonics=nh, points=hull_points(n, nh, winding,
                                                           wave.amplitudes.size),
@@ -108,12 +122,24 @@ class HullSolution:
         return HullProblem(self.case)
 
 
+def aliased(problem: HullProblem, x) -> bool:
+    """True when the power at ``x`` on a grid four times finer differs by more than
+    ``ALIAS_TOL`` (relative): the grid's mean has become aliasing (large coefficients push
+    the harmonics of ``sin(phi)`` past the grid's Nyquist frequency), not a power."""
+    fine = HullProblem(dataclasses.replace(problem.case, points=4 * problem.case.points),
+                       coupled=problem.coupled)
+    p, pf = problem.power(x), fine.power(x)
+    return not abs(p - pf) <= ALIAS_TOL * max(abs(pf), float(problem.w[0]))
+
+
 def _search(problem: HullProblem, seeds, gtol: float):
     runs = []
     best = None
     for name, x0 in seeds:
         r = newton_maximize(problem, x0, name, gtol=gtol, maxiter=200,
                             abandon_below=(best.power if best is not None else -math.inf))
+        if r.status == "converged" and aliased(problem, r.x):
+            r = dataclasses.replace(r, status="aliased")
         runs.append(r)
         if math.isfinite(r.power) and r.status == "converged" and (
                 best is None or r.power > best.power):

@@ -423,7 +423,8 @@ def _result(h, width, pendulum, wave, wave_info, sol, ow, *, torque_limit, effic
         "one_way_electrical_power_w": None if ow is None or ow.electrical_power is None
         else float(ow.electrical_power)}
     return BuoyResult(
-        power_w=harvest, heave_amplitude_m=_half_range(s["z"]), peak_torque_nm=float(sol.peak_torque()),
+        power_w=harvest, heave_amplitude_m=_half_range(s["z"]),
+        peak_torque_nm=float(sol.peak_torque()),
         radiation_bound_w=bound, bound_fraction=p / bound if bound > 0 else None,
         limit_w=float(sol.limit), capture_width_m=cw,
         capture_width_ratio=cw / width if width else None, energy_flux_w_per_m=flux,
