@@ -42,6 +42,7 @@ import numpy as np
 from scipy.linalg import lu_factor, lu_solve
 
 from ..errors import ParameterError
+from ._trig import GramPlan, TrigColumns, spectra
 
 __all__ = ["HullCase", "HullProblem", "hull_points"]
 
@@ -170,9 +171,11 @@ class HullProblem:
             Pi[d][re, :] = (2.0 / m) * ch.T
             Pi[d][im, :] = -(2.0 / m) * sh.T
         self.E, self.E1, self.E2, self.Pi = E, E1, E2, Pi
+        self.Pi_all = np.concatenate(list(Pi), axis=1)  # (ny, 3M): the three rows at once
         dp, hp = case.pivot
         self.Qx = E2[0] + hp * E2[2]
         self.Qz = E2[1] - dp * E2[2]
+        self._trig_maps(kn, kh, j0)
         # Z (real form) and the wave's force
         Z = np.zeros((ny, ny))
         Z[:j0, :j0] = cp[np.ix_(self.static, self.static)]
@@ -191,6 +194,54 @@ class HullProblem:
         self.y_free = np.linalg.solve(Z, rhs)
         # a power scale for the solvers' tolerances (W): m g l w
         self.w = np.array([case.m * case.g * case.l * w])
+
+    def _trig_maps(self, kn, kh, j0):
+        """The maps as trigonometric columns (:mod:`._trig`): the Gram matrices of the
+        Hessian, the sensitivity and the hull matrix from one FFT of each weight."""
+        n, w, m = self.harmonics, self.omega, self.points
+        z1, o1 = np.zeros(1), np.ones(1)
+        fx = np.concatenate(([0], kn, kn))
+        kx = np.concatenate(([0], np.ones(n), np.zeros(n)))
+        cols = {"phi": TrigColumns(fx, kx, np.concatenate((o1, np.ones(2 * n)))),
+                "phi1": TrigColumns(fx, 1 - kx, np.concatenate((z1, w * kn, -w * kn))),
+                "phi2": TrigColumns(fx, kx, np.concatenate((z1, -w**2 * kn**2,
+                                                            -w**2 * kn**2)))}
+        ny = self.ny
+        freq = np.zeros(ny, dtype=np.int64)
+        dof = np.zeros(ny, dtype=np.int64)
+        part = np.zeros(ny, dtype=np.int64)  # 0 static, 1 real, 2 imaginary
+        for i, d in enumerate(self.static):
+            dof[i] = d
+        for d in range(3):
+            re = j0 + 6 * (kh - 1) + d
+            freq[re], freq[re + 3] = kh, kh
+            dof[re], dof[re + 3] = d, d
+            part[re], part[re + 3] = 1, 2
+        wk = w * freq
+        # xi_d'' columns: Re: -(w k)^2 cos, Im: (w k)^2 sin; xi_d': Re: -w k sin, Im: -w k cos
+        k2 = np.where(part == 1, 0, np.where(part == 2, 1, 0))
+        s2 = np.where(part == 1, -wk**2, np.where(part == 2, wk**2, 0.0))
+        k1 = np.where(part == 1, 1, 0)
+        s1 = np.where(part == 0, 0.0, -wk)
+        dp, hp = self.case.pivot
+        on = {d: (dof == d).astype(float) for d in range(3)}
+        cols["qx"] = TrigColumns(freq, k2, s2 * (on[0] + hp * on[2]))
+        cols["qz"] = TrigColumns(freq, k2, s2 * (on[1] - dp * on[2]))
+        cols["b1"] = TrigColumns(freq, k1, s1 * on[2])
+        # the projection's rows (2/M cos, -2/M sin; 1/M for the static ones) as columns
+        kp = np.where(part == 2, 1, 0)
+        sp = np.where(part == 0, 1.0 / m, np.where(part == 1, 2.0 / m, -2.0 / m))
+        self._cols = cols
+        self._pi_cols = [TrigColumns(freq, kp, sp * on[d]) for d in range(3)]
+        self._plans = {}
+        self._last = None
+
+    def _plan(self, a: str, b: str) -> GramPlan:
+        key = (a, b)
+        if key not in self._plans:
+            ca = self._pi_cols[int(a[2:])] if a.startswith("pi") else self._cols[a]
+            self._plans[key] = GramPlan(ca, self._cols[b], self.points)
+        return self._plans[key]
 
     # --------------------------------------------------------------------------------------
     def phi(self, x):
@@ -220,20 +271,32 @@ class HullProblem:
 
     def solve_hull(self, x):
         """The hull's unknowns ``y`` at ``phi(x)``, and the factorized ``S`` (None when
-        not coupled)."""
+        not coupled). The last point's answer is kept: the line search's power and the
+        next Newton step's evaluation share it."""
+        x = np.asarray(x, dtype=float)
+        key = x.tobytes()
+        if self._last is not None and self._last[0] == key:
+            return self._last[1], self._last[2]
         if not self.coupled:
-            return self.y_free, None
-        ph = self.phi(x)
-        r, _ = self._rho(ph, np.zeros(self.ny))
-        s_mat = self._s_matrix(ph[0])
-        b = self.fa_real + sum(self.Pi[d] @ r[d] for d in range(3))
-        lu = lu_factor(s_mat, check_finite=False)
-        return lu_solve(lu, b, check_finite=False), lu
-
-    def _s_matrix(self, f):
-        ml = self.case.m * self.case.l
-        sn, co = np.sin(f), np.cos(f)
-        return self.Z - ml * (self.Pi[2] @ (sn[:, None] * self.Qz - co[:, None] * self.Qx))
+            y, lu = self.y_free, None
+        else:
+            ph = self.phi(x)
+            cs = self.case
+            ml = cs.m * cs.l
+            dp, hp = cs.pivot
+            f, f1, f2 = ph
+            sn, co = np.sin(f), np.cos(f)
+            rx = -ml * (co * f2 - sn * f1**2)
+            rz = ml * (sn * f2 + co * f1**2)
+            rb = hp * rx - dp * rz - cs.I * f2 + ml * cs.g * sn
+            v = spectra([sn, co])
+            s_mat = self.Z - ml * (self._plan("pi2", "qz")(v[0])
+                                   - self._plan("pi2", "qx")(v[1]))
+            b = self.fa_real + self.Pi_all @ np.concatenate((rx, rz, rb))
+            lu = lu_factor(s_mat, check_finite=False)
+            y = lu_solve(lu, b, check_finite=False)
+        self._last = (key, y, lu)
+        return y, lu
 
     def grid_state(self, x, y=None):
         """Everything on the grid at ``x``: phi and its derivatives, the hull's ``y``, the
@@ -299,6 +362,18 @@ class HullProblem:
         }
         return d1, d2
 
+    def _objective_gy(self, st):
+        """``dP/dy`` of the power at fixed phi (the adjoint's right side): the pointwise
+        derivatives of ``-tau v / M`` in ``(p_x'', p_z'', beta')`` mapped to ``y``."""
+        cs = self.case
+        ml, mm = cs.m * cs.l, self.points
+        f = st["phi"]
+        sn, co = np.sin(f), np.cos(f)
+        v = st["relative_speed"]
+        wgt = (cs.g + st["qz"]) * sn - st["qx"] * co
+        return (self.Qx.T @ (-ml * v * co) + self.Qz.T @ (ml * v * sn)
+                + self.E1[2].T @ (-ml * wgt + cs.I * st["phi2"] + 2 * cs.c * v)) / mm
+
     def _maps(self):
         """The linear maps of ``_VARS`` from x (first three) and y (last three)."""
         return {"phi": self.P0, "phi1": self.P1, "phi2": self.P2, "qx": self.Qx,
@@ -310,36 +385,42 @@ class HullProblem:
         y, lu = self.solve_hull(x)
         st = self.grid_state(x, y)
         maps = self._maps()
-        xv, yv = ("phi", "phi1", "phi2"), ("qx", "qz", "b1")
+        xv = ("phi", "phi1", "phi2")
         zero = np.zeros((3, self.points))
-        d1, _ = self._pointwise(st, zero)
         if lu is not None:
-            gy = sum(maps[k].T @ d1[k] for k in yv)
+            gy = self._objective_gy(st)
             lam = lu_solve(lu, gy, trans=1, check_finite=False)
             mu = np.array([self.Pi[d].T @ lam for d in range(3)])
         else:
             mu = zero
         d1, d2 = self._pointwise(st, mu)
         grad = sum(maps[k].T @ d1[k] for k in xv)
-
-        def block(rows, cols):
-            out = 0.0
-            for (u, v), wgt in d2.items():
-                if u in rows and v in cols:
-                    out = out + maps[u].T @ (wgt[:, None] * maps[v])
-                if u != v and v in rows and u in cols:
-                    out = out + maps[v].T @ (wgt[:, None] * maps[u])
-            return out
-
-        hxx = block(xv, xv)
+        # the Hessian of L in (x, y) as Gram matrices of the grid maps (one FFT per weight),
+        # then the reduced Hessian [I; T]^T (Hessian of L) [I; T]
+        pairs = [(u, v, wgt) for (u, v), wgt in d2.items()
+                 if lu is not None or (u in xv and v in xv)]
+        if lu is not None:
+            _, dr = self._rho(self.phi(x), y)
+            sens = [(f"pi{d}", xv[i], dr[d][i]) for d in range(3) for i in range(3)]
+        else:
+            sens = []
+        v = spectra([p[2] for p in pairs] + [p[2] for p in sens])
+        n = x.size
+        hxx = np.zeros((n, n))
+        hxy = np.zeros((n, self.ny))
+        hyy = np.zeros((self.ny, self.ny))
+        for (u, w_, _), vk in zip(pairs, v):
+            g = self._plan(u, w_)(vk)
+            if u in xv and w_ in xv:
+                hxx += g if u == w_ else g + g.T
+            elif u in xv:
+                hxy += g
+            else:
+                hyy += g if u == w_ else g + g.T
         if lu is None:
-            return st["power"], grad, hxx
-        _, dr = self._rho(self.phi(x), y)
-        gx = sum(self.Pi[d] @ sum(dr[d][i][:, None] * maps[xv[i]] for i in range(3))
-                 for d in range(3))
+            return st["power"], grad, 0.5 * (hxx + hxx.T)
+        gx = sum(self._plan(a, b)(vk) for (a, b, _), vk in zip(sens, v[len(pairs):]))
         t = lu_solve(lu, gx, check_finite=False)
-        hxy = block(xv, yv)
-        hyy = block(yv, yv)
         ht = hxy @ t
         h = hxx + ht + ht.T + t.T @ (hyy @ t)
         return st["power"], grad, 0.5 * (h + h.T)

@@ -1,0 +1,62 @@
+"""Weighted Gram matrices of trigonometric columns from one FFT of the weight.
+
+A map whose columns are ``f_i(s) = scale_i cos(freq_i s)`` or ``scale_i sin(freq_i s)``
+on the uniform grid ``s_j = 2 pi j / M`` (the pendulum's motion and its derivatives, the
+hull's harmonics and the Galerkin projection are all such maps) has
+``sum_j w_j f_i(s_j) g_l(s_j)`` read off the DFT ``W`` of ``w`` by the product formulas
+(``cos a cos b = (cos(a-b) + cos(a+b)) / 2`` and so on): two gathers per entry instead of
+``M`` multiply-adds, exact on the grid (indices taken modulo ``M``: the grid's own
+aliasing). :class:`parapend.hydro.hull.HullProblem` assembles its Hessian, its sensitivity
+and its hull matrix this way.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+__all__ = ["TrigColumns", "GramPlan"]
+
+
+class TrigColumns:
+    """Columns ``scale_i * (cos if kind_i == 0 else sin)(freq_i s)``."""
+
+    def __init__(self, freq, kind, scale):
+        self.freq = np.asarray(freq, dtype=np.int64)
+        self.kind = np.asarray(kind, dtype=np.int64)
+        self.scale = np.asarray(scale, dtype=float)
+
+    def __len__(self) -> int:
+        return self.freq.size
+
+    def matrix(self, m: int) -> np.ndarray:
+        """The (M, n) matrix of the columns on the grid."""
+        s = 2 * np.pi * np.arange(m) / m
+        arg = np.outer(s, self.freq)
+        return np.where(self.kind == 0, np.cos(arg), np.sin(arg)) * self.scale
+
+
+class GramPlan:
+    """``G(w) = sum_j w_j a_i(s_j) b_l(s_j)`` for two :class:`TrigColumns`, as
+    ``G = c1 * V[i1] + c2 * V[i2]`` with ``V = [Re W, Im W]``, ``W = fft(w)``."""
+
+    def __init__(self, a: TrigColumns, b: TrigColumns, m: int):
+        fa, fb = a.freq[:, None], b.freq[None, :]
+        minus, plus = (fa - fb) % m, (fa + fb) % m
+        ka, kb = a.kind[:, None], b.kind[None, :]
+        half = 0.5 * np.outer(a.scale, b.scale)
+        cos_part = ka == kb  # cos cos, sin sin: the real parts (C_k = Re W_k)
+        # C_{a-b} +- C_{a+b} (cos cos: +, sin sin: -); S_{a+b} +- S_{a-b} with S_k = -Im W_k
+        # (sin cos: S_P + S_D; cos sin: S_P - S_D)
+        self.i1 = np.where(cos_part, minus, m + minus)
+        self.i2 = np.where(cos_part, plus, m + plus)
+        self.c1 = np.where(cos_part, half, np.where(ka == 1, -half, half))
+        self.c2 = np.where(cos_part, np.where(ka == 0, half, -half), -half)
+
+    def __call__(self, v: np.ndarray) -> np.ndarray:
+        return self.c1 * v[self.i1] + self.c2 * v[self.i2]
+
+
+def spectra(weights) -> np.ndarray:
+    """``[Re W, Im W]`` (K, 2M) of the K weights (K, M)."""
+    w = np.fft.fft(np.asarray(weights, dtype=float), axis=-1)
+    return np.concatenate((w.real, w.imag), axis=-1)
