@@ -479,8 +479,9 @@ def _mesh_pitch_inertia(hull, rho):
 
 def _box_meshes(length, beam, draft, h, omega_max):
     """The barge's wetted surface (reflection-symmetric, an even number of panels of radius
-    at most ``h`` along x and y), the same as a plain mesh, and its lid below the waterline
-    (Capytaine's lowest lid position for ``omega_max``) against irregular frequencies."""
+    at most ``h`` along x and y), the same as a plain mesh, and its lid (Capytaine's lowest
+    lid position for ``omega_max``, the waterplane where no irregular frequency lies below
+    ``omega_max``) against irregular frequencies."""
     cpt = bem._quiet_capytaine()
     side = math.sqrt(2) * h
     res = (2 * math.ceil(length / (2 * side)), 2 * math.ceil(beam / (2 * side)),
@@ -488,7 +489,9 @@ def _box_meshes(length, beam, draft, h, omega_max):
     mesh = cpt.mesh_parallelepiped(size=(length, beam, draft), center=(0.0, 0.0, -draft / 2),
                                    resolution=res, missing_sides={"top"},
                                    reflection_symmetry=True)
-    lid = mesh.generate_lid(z=mesh.lowest_lid_position(omega_max=float(omega_max)))
+    with np.errstate(invalid="ignore"):  # NaN: no irregular frequency below omega_max
+        z = float(mesh.lowest_lid_position(omega_max=float(omega_max)))
+    lid = mesh.generate_lid(z=min(z, 0.0) if math.isfinite(z) else 0.0)
     return mesh, bem._plain(mesh), lid
 
 
