@@ -287,3 +287,51 @@ def test_cylinder_heave_entries_are_bem_cylinder(tmp_path):
     again = hd.cylinder_hull(2.0, 1.0, omega=w, refine=0.5)
     assert np.array_equal(again.added_mass, h3.added_mass)
     assert again.pitch_inertia == h3.pitch_inertia and again.notes == h3.notes
+
+
+@pytest.mark.slow
+def test_barge_from_a_mesh_file_and_its_dataset(tmp_path, coarse_barge):
+    from capytaine.io.xarray import save_dataset_as_netcdf
+    from test_buoy_hydro import _gdf
+
+    h_panel = bem.mesh_size(min(L, B), OMEGA[-1]) / 0.5
+    _, hull, _ = hd._box_meshes(L, B, D, h_panel, OMEGA[-1])
+    path = _gdf(tmp_path / "barge.gdf", hull)
+    w = OMEGA[1:3]
+    h3 = hd.hull_from_mesh(path, omega=w)
+    h1 = bem.from_mesh(path, omega=w)
+    # the heave entries are the heave-only BEM's on the same panels (no lid in either)
+    hv = h3.heave()
+    assert np.allclose(hv.added_mass, h1.added_mass, rtol=1e-9)
+    assert np.allclose(hv.radiation_damping, h1.radiation_damping, rtol=1e-9)
+    assert np.allclose(hv.excitation, h1.excitation, rtol=1e-9)
+    assert hv.mass == pytest.approx(h1.mass, rel=1e-12)
+    # the same hydrostatics as the built-in barge; the pitch inertia of the panels' box
+    assert np.allclose(h3.hydrostatic_stiffness, coarse_barge.hydrostatic_stiffness,
+                       rtol=1e-9, atol=1e-9 * coarse_barge.hydrostatic_stiffness.max())
+    dx = _dx(h_panel)
+    assert h3.pitch_inertia == pytest.approx(h3.mass * (L * L / 12 - dx * dx / 12 + D * D / 3),
+                                             rel=1e-12)
+    # the built-in barge's real data through NetCDF and back
+    save_dataset_as_netcdf(tmp_path / "barge.nc", coarse_barge.to_dataset())
+    back = hd.load_hull(tmp_path / "barge.nc")
+    for name in ("omega", "added_mass", "radiation_damping", "excitation",
+                 "hydrostatic_stiffness"):
+        assert np.allclose(getattr(back, name), getattr(coarse_barge, name), rtol=1e-14,
+                           atol=1e-14 * np.abs(getattr(coarse_barge, name)).max()), name
+    assert back.pitch_inertia == coarse_barge.pitch_inertia
+
+
+@pytest.mark.slow
+def test_a_sphere_above_its_centre_is_stable():
+    r, d = 2.0, 1.0
+    h = hd.sphere_hull(r, draft=d, omega=[0.5, 1.0], refine=0.5)
+    v = math.pi * d * d * (3 * r - d) / 3
+    c = h.hydrostatic_stiffness
+    # panels: volume and waterplane to the mesh's error (about 1 %)
+    assert h.mass == pytest.approx(RHO * v, rel=0.02)
+    assert c[1, 1] == pytest.approx(RHO * G * math.pi * (r * r - (r - d) ** 2), rel=0.02)
+    # the metacentre is the sphere's centre: C55 = rho g V (r - d)
+    assert c[2, 2] == pytest.approx(RHO * G * v * (r - d), rel=0.05)
+    _, ix, iz = hd._cap_integrals(r, d)
+    assert h.pitch_inertia == RHO * (ix + iz)
