@@ -889,6 +889,37 @@ def _by_omega(ds, path):
     return ds
 
 
+def _excitation(ds, path):
+    """The excitation force of a Capytaine dataset: ``excitation_force``, else the sum of
+    ``diffraction_force`` and ``Froude_Krylov_force``; refused (one line) without."""
+    if "excitation_force" in ds:
+        return ds["excitation_force"]
+    if "diffraction_force" in ds and "Froude_Krylov_force" in ds:
+        return ds["diffraction_force"] + ds["Froude_Krylov_force"]
+    raise ParameterError(f"hydro: {path} has no excitation_force (nor diffraction_force "
+                         "and Froude_Krylov_force)")
+
+
+def _read_netcdf(path):
+    """``(dataset, shown name, Path)`` of the NetCDF file ``path``, refused in one line
+    when it is not a regular, readable NetCDF file."""
+    import xarray as xr
+
+    if not isinstance(path, (str, os.PathLike)) or not str(path):
+        raise ParameterError(f"hydro: expected a NetCDF path or an xarray.Dataset, got "
+                             f"{type(path).__name__}")
+    p = Path(path)
+    shown = repr(str(p))
+    _regular_file(p, "hydro", "a NetCDF dataset")
+    try:
+        ds = xr.load_dataset(p)
+    except Exception as exc:  # noqa: BLE001 - xarray's engines raise many types
+        reason = " ".join(str(exc).split())[:120] or type(exc).__name__
+        raise ParameterError(f"hydro: cannot read {shown} as a NetCDF dataset: {reason}") \
+            from None
+    return ds, shown, p
+
+
 def _from_dataset(ds, *, c=None, mass=None, description="", path="the dataset",
                   check=False, wave_direction=None):
     """A :class:`Hydro` from a Capytaine dataset (complex values merged, ``exp(-i w t)``)."""
@@ -904,13 +935,7 @@ def _from_dataset(ds, *, c=None, mass=None, description="", path="the dataset",
         if var not in ds:
             raise ParameterError(f"hydro: {path} has no {var} (a radiation problem in heave "
                                  "is needed)")
-    if "excitation_force" in ds:
-        fx = ds["excitation_force"]
-    elif "diffraction_force" in ds and "Froude_Krylov_force" in ds:
-        fx = ds["diffraction_force"] + ds["Froude_Krylov_force"]
-    else:
-        raise ParameterError(f"hydro: {path} has no excitation_force (nor diffraction_force "
-                             "and Froude_Krylov_force)")
+    fx = _excitation(ds, path)
     a = _pick(_pick(ds["added_mass"], "radiating_dof", "Heave", "added_mass", path),
               "influenced_dof", "Heave", "added_mass", path)
     b = _pick(_pick(ds["radiation_damping"], "radiating_dof", "Heave", "radiation_damping",
@@ -1034,18 +1059,7 @@ def load(path, *, wave_direction=None) -> Hydro:
         return _from_dataset(path, description=str(path.attrs.get("description", ""))
                              or "an xarray dataset", path="the dataset", check=True,
                              wave_direction=wave_direction)
-    if not isinstance(path, (str, os.PathLike)) or not str(path):
-        raise ParameterError(f"hydro: expected a NetCDF path or an xarray.Dataset, got "
-                             f"{type(path).__name__}")
-    p = Path(path)
-    shown = repr(str(p))
-    _regular_file(p, "hydro", "a NetCDF dataset")
-    try:
-        ds = xr.load_dataset(p)
-    except Exception as exc:  # noqa: BLE001 - xarray's engines raise many types
-        reason = " ".join(str(exc).split())[:120] or type(exc).__name__
-        raise ParameterError(f"hydro: cannot read {shown} as a NetCDF dataset: {reason}") \
-            from None
+    ds, shown, p = _read_netcdf(path)
     desc = str(ds.attrs.get("description", "")) or f"dataset {p.name}"
     return _from_dataset(ds, description=desc, path=shown, check=True,
                          wave_direction=wave_direction)

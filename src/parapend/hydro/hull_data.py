@@ -275,14 +275,7 @@ def _hull_from_dataset(ds, *, c=None, mass=None, pitch_inertia=None, description
         if var not in ds:
             raise ParameterError(f"hydro: {path} has no {var} (radiation problems in surge, "
                                  "heave and pitch are needed)")
-    if "excitation_force" in ds:
-        fx = ds["excitation_force"]
-    elif "diffraction_force" in ds and "Froude_Krylov_force" in ds:
-        fx = ds["diffraction_force"] + ds["Froude_Krylov_force"]
-    else:
-        raise ParameterError(f"hydro: {path} has no excitation_force (nor diffraction_force "
-                             "and Froude_Krylov_force)")
-    fx = bem._direction(fx, wave_direction, path)
+    fx = bem._direction(bem._excitation(ds, path), wave_direction, path)
     pair = ("radiating_dof", "influenced_dof")
     w = np.asarray(ds["omega"].values)
     if w.dtype.kind not in "iuf":
@@ -375,20 +368,7 @@ def load_hull(path, *, wave_direction=None) -> HullHydro:
         return _hull_from_dataset(path, path="the dataset", wave_direction=wave_direction,
                                   description=str(path.attrs.get("description", ""))
                                   or "an xarray dataset")
-    from pathlib import Path
-
-    if not isinstance(path, (str, Path)) or not str(path):
-        raise ParameterError(f"hydro: expected a NetCDF path or an xarray.Dataset, got "
-                             f"{type(path).__name__}")
-    p = Path(path)
-    shown = repr(str(p))
-    bem._regular_file(p, "hydro", "a NetCDF dataset")
-    try:
-        ds = xr.load_dataset(p)
-    except Exception as exc:  # noqa: BLE001 - xarray's engines raise many types
-        reason = " ".join(str(exc).split())[:120] or type(exc).__name__
-        raise ParameterError(f"hydro: cannot read {shown} as a NetCDF dataset: {reason}") \
-            from None
+    ds, shown, p = bem._read_netcdf(path)
     return _hull_from_dataset(ds, path=shown, wave_direction=wave_direction,
                               description=str(ds.attrs.get("description", ""))
                               or f"dataset {p.name}")
@@ -492,7 +472,7 @@ def _box_meshes(length, beam, draft, h, omega_max):
     with np.errstate(invalid="ignore"):  # NaN: no irregular frequency below omega_max
         z = float(mesh.lowest_lid_position(omega_max=float(omega_max)))
     lid = mesh.generate_lid(z=min(z, 0.0) if math.isfinite(z) else 0.0)
-    return mesh, bem._plain(mesh), lid
+    return mesh, bem._plain(mesh), (lid if lid.nb_faces else None)
 
 
 def barge(length=10.0, beam=4.0, draft=1.0, *, omega=None, rho=1025.0, g=9.81,
