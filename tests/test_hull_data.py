@@ -335,3 +335,41 @@ def test_a_sphere_above_its_centre_is_stable():
     assert c[2, 2] == pytest.approx(RHO * G * v * (r - d), rel=0.05)
     _, ix, iz = hd._cap_integrals(r, d)
     assert h.pitch_inertia == RHO * (ix + iz)
+
+
+@pytest.mark.slow
+def test_load_a_six_dof_dataset_capytaine_wrote(tmp_path):
+    # a user's own run: six DOFs, two directions, omega = inf (NaN excitation), the
+    # hydrostatics and inertia Capytaine computes, saved the standard way
+    import capytaine as cpt
+    from capytaine.io.xarray import save_dataset_as_netcdf
+
+    mesh = cpt.mesh_vertical_cylinder(length=1.0, radius=0.8, center=(0, 0, 0),
+                                      resolution=(3, 12, 4)).immersed_part()
+    body = cpt.FloatingBody(mesh=mesh, dofs=cpt.rigid_body_dofs(rotation_center=(0, 0, 0)),
+                            center_of_mass=(0, 0, -0.2))
+    body.inertia_matrix = body.compute_rigid_body_inertia(rho=RHO)
+    body.hydrostatic_stiffness = body.compute_hydrostatic_stiffness(rho=RHO, g=G)
+    test = xr.Dataset(coords={"omega": [1.0, 2.0, 3.0, np.inf], "wave_direction": [0.0, 1.0],
+                              "radiating_dof": list(body.dofs), "water_depth": [np.inf],
+                              "rho": [RHO], "g": [G]})
+    ds = cpt.BEMSolver().fill_dataset(test, body, progress_bar=False)
+    save_dataset_as_netcdf(tmp_path / "user.nc", ds)
+    h = hd.load_hull(tmp_path / "user.nc")
+    w = [1.0, 2.0, 3.0]
+    assert np.array_equal(h.omega, w)
+    dofs = list(hd.DOFS)
+    sub = ds.sel(radiating_dof=dofs, influenced_dof=dofs, omega=w)
+    a = sub["added_mass"].transpose("omega", "radiating_dof", "influenced_dof").values
+    assert np.allclose(h.added_mass, 0.5 * (a + np.swapaxes(a, 1, 2)), rtol=1e-12)
+    f = ds["excitation_force"].sel(influenced_dof=dofs, wave_direction=0.0, omega=w).values
+    assert np.allclose(h.excitation, np.conj(f), rtol=1e-12)
+    c = body.hydrostatic_stiffness.sel(influenced_dof=dofs, radiating_dof=dofs).values
+    assert np.allclose(h.hydrostatic_stiffness, c, rtol=1e-12)
+    m = body.inertia_matrix.sel(influenced_dof=dofs, radiating_dof=dofs).values
+    assert h.mass == pytest.approx(m[1, 1], rel=1e-12)
+    assert h.pitch_inertia == pytest.approx(m[2, 2], rel=1e-12)
+    # the other direction on request
+    f1 = ds["excitation_force"].sel(influenced_dof=dofs, wave_direction=1.0, omega=w).values
+    assert np.allclose(hd.load_hull(tmp_path / "user.nc", wave_direction=1.0).excitation,
+                       np.conj(f1), rtol=1e-12)
