@@ -225,12 +225,14 @@ def test_barge_hydrostatics_and_conventions(coarse_barge):
     assert np.array_equal(h.added_mass, np.swapaxes(h.added_mass, 1, 2))
     assert np.array_equal(h.radiation_damping, np.swapaxes(h.radiation_damping, 1, 2))
     assert np.all(np.linalg.eigvalsh(h.radiation_damping) >= -1e-9 * h.radiation_damping.max())
-    # long-wave limits of the excitation, which fix the conjugation and the pitch sign: a
-    # long wave exp(i (w t - k x)) acts as a slope -i k (tilting the water by -i k per metre
-    # of amplitude: the pitch restoring moment C55 + g A_15, the surge one g (rho V + A_11)
-    # as a horizontal acceleration i g k, G. I. Taylor) and a lift (C[:, 1]); so
-    # F_pitch -> +i k (C55 + g A_15), F_surge -> +i k g (rho V + A_11), F_heave -> C33,
-    # to O(k L)^2 and O(k D) (here 3e-4)
+    # long-wave limits of the excitation, which fix the conjugation and the pitch sign. The
+    # wave exp(i (w t - k x)) has the slope -i k per metre of amplitude: a quarter period
+    # after its crest passes O the water is higher at +x, which turns +x up, a negative
+    # pitch; so F_pitch -> +i k (C55 + g A_15) (the tilted water's restoring moment, with
+    # the added mass's share of the horizontal acceleration). Under the crest the water
+    # moves towards +x and accelerates a quarter period earlier: F_surge -> +i k g
+    # (rho V + A_11) (G. I. Taylor's long-wave force). A long wave lifts: F_heave -> C33.
+    # All to O(k L)^2 and O(k D) (here 3e-4).
     k = OMEGA[0] ** 2 / G
     f, a = h.excitation[0], h.added_mass[0]
     assert f[2].imag / (k * (c[2, 2] + G * a[0, 2])) == pytest.approx(1.0, abs=2e-3)
