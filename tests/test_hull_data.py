@@ -375,3 +375,18 @@ def test_load_a_six_dof_dataset_capytaine_wrote(tmp_path):
     f1 = ds["excitation_force"].sel(influenced_dof=dofs, wave_direction=1.0, omega=w).values
     assert np.allclose(hd.load_hull(tmp_path / "user.nc", wave_direction=1.0).excitation,
                        np.conj(f1), rtol=1e-12)
+
+
+def test_own_bem_frequencies_with_indefinite_damping_left_out():
+    # the BEM run here: asymmetry noted (not refused), a frequency whose damping is
+    # indefinite beyond noise left out; a dataset read from a file is refused instead
+    h = synthetic()
+    ds = h.to_dataset().copy(deep=True)
+    ds["radiation_damping"][3, 0, 2] = ds["radiation_damping"][3, 2, 0] = 1e5
+    ds["added_mass"][:, 0, 2] *= 1.05
+    g = hd._hull_from_dataset(ds, c=h.hydrostatic_stiffness, mass=h.mass, own=True,
+                              path="the BEM")
+    assert np.array_equal(g.omega, h.omega[:3])
+    assert any("4 rad/s: left out" in n for n in g.notes)
+    assert any("added_mass of the BEM symmetrised" in n for n in g.notes)
+    _bad(ds, "radiation_damping is negative at 1 of 4")

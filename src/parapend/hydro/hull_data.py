@@ -307,6 +307,20 @@ def _hull_from_dataset(ds, *, c=None, mass=None, pitch_inertia=None, description
             notes.append(f"hydro: {name} of the BEM symmetrised (relative asymmetry "
                          f"{asym:.2g}, a measure of its discretisation error)")
         a, b = (0.5 * (m + np.swapaxes(m, 1, 2)) for m in (a, b))
+        # where the damping is indefinite beyond BEM noise, the mesh does not resolve the
+        # problem (near the grid's top, where the wave is 12 panel radii long): left out, as
+        # bem leaves out the frequencies its mesh cannot resolve (they are then above range
+        # or interpolated over)
+        from .. import limits
+
+        low = np.linalg.eigvalsh(b).min(axis=1)
+        # bem._physics's threshold: a fraction of the largest heave damping
+        bad = low < -limits.BUOY_NEGATIVE_DAMPING_TOL * float(np.max(b[:, 1, 1]))
+        if np.any(bad) and not np.all(bad):
+            named = ", ".join(f"{x:.4g}" for x in w[bad])
+            notes.append(f"hydro: the BEM's radiation damping is not positive semidefinite "
+                         f"(discretisation error) at {named} rad/s: left out")
+            w, a, b, f = (x[~bad] for x in (w, a, b, f))
     notes += bem._physics(w, a, b, b[:, 1, 1], path)[1]
     if c is None:
         if "hydrostatic_stiffness" not in ds:
@@ -459,9 +473,9 @@ def _mesh_pitch_inertia(hull, rho):
 
 def _box_meshes(length, beam, draft, h, omega_max):
     """The barge's wetted surface (reflection-symmetric, an even number of panels of radius
-    at most ``h`` along x and y), the same as a plain mesh, and its lid (Capytaine's lowest
-    lid position for ``omega_max``, the waterplane where no irregular frequency lies below
-    ``omega_max``) against irregular frequencies."""
+    at most ``h`` along x and y), the same as a plain mesh, and its lid against irregular
+    frequencies: panels of radius at most ``h`` at Capytaine's lowest lid position for
+    ``omega_max`` (the waterplane where no irregular frequency lies below ``omega_max``)."""
     cpt = bem._quiet_capytaine()
     side = math.sqrt(2) * h
     res = (2 * math.ceil(length / (2 * side)), 2 * math.ceil(beam / (2 * side)),
@@ -471,7 +485,9 @@ def _box_meshes(length, beam, draft, h, omega_max):
                                    reflection_symmetry=True)
     with np.errstate(invalid="ignore"):  # NaN: no irregular frequency below omega_max
         z = float(mesh.lowest_lid_position(omega_max=float(omega_max)))
-    lid = mesh.generate_lid(z=min(z, 0.0) if math.isfinite(z) else 0.0)
+    # the lid's panels as the hull's: Capytaine's default (finer, not aligned with the
+    # hull's) gave the default barge a heave damping of -6e5 N s/m at 5.5 rad/s
+    lid = mesh.generate_lid(z=min(z, 0.0) if math.isfinite(z) else 0.0, faces_max_radius=h)
     return mesh, bem._plain(mesh), (lid if lid.nb_faces else None)
 
 
@@ -520,7 +536,7 @@ def barge(length=10.0, beam=4.0, draft=1.0, *, omega=None, rho=1025.0, g=9.81,
     return _solve_hull(lambda: _box_meshes(length, beam, draft, h, omega[-1]), omega,
                        rho=rho, g=g, water_depth=water_depth, description=desc, cache=cache,
                        key_parts=bem._params(body="barge", size=(length, beam, draft), h=h,
-                                           method="direct", lid=True),
+                                           method="direct", lid="faces_max_radius=h"),
                        pitch_inertia=mass * (length**2 / 12 + draft**2 / 3), method="direct")
 
 
