@@ -255,6 +255,38 @@ def _dof_block(da, dims, path, name, kind="f"):
     return np.asarray(da.transpose(*[d for d in keep if d in da.dims]).values)
 
 
+def _resolved(w, a, b, f):
+    """Our own BEM's answer at the frequencies its mesh resolves, symmetrised, and notes.
+
+    Where the damping is indefinite beyond noise (``bem._physics``'s threshold: a fraction
+    ``BUOY_NEGATIVE_DAMPING_TOL`` of the largest heave damping) or asymmetric beyond
+    ``BUOY_SYMMETRY_TOL`` of its largest entry, the mesh does not resolve the problem (a
+    spike of an irregular frequency the lid misses, or the grid's top, where the wave is
+    12 panel radii long): those frequencies are left out, as bem leaves out the ones its mesh
+    cannot resolve (they are then interpolated over, or above range). The asymmetry left is
+    a measure of the discretisation error, noted.
+    """
+    from .. import limits
+
+    asym = np.max(np.abs(b - np.swapaxes(b, 1, 2)), axis=(1, 2)) / float(np.max(np.abs(b)))
+    b_sym = 0.5 * (b + np.swapaxes(b, 1, 2))
+    low = np.linalg.eigvalsh(b_sym).min(axis=1)
+    bad = ((low < -limits.BUOY_NEGATIVE_DAMPING_TOL * float(np.max(b[:, 1, 1])))
+           | (asym > limits.BUOY_SYMMETRY_TOL))
+    notes = []
+    if np.any(bad) and not np.all(bad):
+        named = ", ".join(f"{x:.4g}" for x in w[bad])
+        notes.append(f"hydro: the BEM's radiation damping is indefinite or asymmetric "
+                     f"(discretisation error) at {named} rad/s: left out")
+        w, a, b, f = (x[~bad] for x in (w, a, b, f))
+    for name, m in (("added_mass", a), ("radiation_damping", b)):
+        rel = float(np.max(np.abs(m - np.swapaxes(m, 1, 2)))) / float(np.max(np.abs(m)))
+        notes.append(f"hydro: {name} of the BEM symmetrised (relative asymmetry {rel:.2g}, "
+                     "a measure of its discretisation error)")
+    a, b = (0.5 * (m + np.swapaxes(m, 1, 2)) for m in (a, b))
+    return w, a, b, f, notes
+
+
 def _hull_from_dataset(ds, *, c=None, mass=None, pitch_inertia=None, description="",
                        path="the dataset", wave_direction=None, own=False) -> HullHydro:
     """A :class:`HullHydro` from a Capytaine dataset (``exp(-i w t)``), checked as physics
@@ -302,25 +334,7 @@ def _hull_from_dataset(ds, *, c=None, mass=None, pitch_inertia=None, description
         raise ParameterError(f"hydro: {path} repeats a frequency")
     notes = []
     if own:
-        for name, m in (("added_mass", a), ("radiation_damping", b)):
-            asym = float(np.max(np.abs(m - np.swapaxes(m, 1, 2)))) / float(np.max(np.abs(m)))
-            notes.append(f"hydro: {name} of the BEM symmetrised (relative asymmetry "
-                         f"{asym:.2g}, a measure of its discretisation error)")
-        a, b = (0.5 * (m + np.swapaxes(m, 1, 2)) for m in (a, b))
-        # where the damping is indefinite beyond BEM noise, the mesh does not resolve the
-        # problem (near the grid's top, where the wave is 12 panel radii long): left out, as
-        # bem leaves out the frequencies its mesh cannot resolve (they are then above range
-        # or interpolated over)
-        from .. import limits
-
-        low = np.linalg.eigvalsh(b).min(axis=1)
-        # bem._physics's threshold: a fraction of the largest heave damping
-        bad = low < -limits.BUOY_NEGATIVE_DAMPING_TOL * float(np.max(b[:, 1, 1]))
-        if np.any(bad) and not np.all(bad):
-            named = ", ".join(f"{x:.4g}" for x in w[bad])
-            notes.append(f"hydro: the BEM's radiation damping is not positive semidefinite "
-                         f"(discretisation error) at {named} rad/s: left out")
-            w, a, b, f = (x[~bad] for x in (w, a, b, f))
+        w, a, b, f, notes = _resolved(w, a, b, f)
     notes += bem._physics(w, a, b, b[:, 1, 1], path)[1]
     if c is None:
         if "hydrostatic_stiffness" not in ds:
@@ -509,8 +523,12 @@ def barge(length=10.0, beam=4.0, draft=1.0, *, omega=None, rho=1025.0, g=9.81,
         The box (m), all > 0; pitch-stable: ``length > sqrt(6) draft``.
     omega, rho, g, water_depth, cache, refine
         As :func:`parapend.hydro.bem.cylinder`, with the scale of the mesh rule the smaller of
-        length and beam (default 10 x 4 x 1 m: panel radius 1/3 m, ``omega="body"`` 48
-        frequencies from 0.063 to 3.9 rad/s).
+        length and beam (the default 10 x 4 x 1 m with ``omega="body"``: panel radius 1/3 m,
+        412 panels and a lid of 120, 48 frequencies from 0.063 to 3.9 rad/s of which the
+        42 up to 3.43 rad/s are resolved and kept; with ``omega=None``: 1412 panels, 13 of
+        ``DEFAULT_OMEGA``'s frequencies, 0.3 to 5.5 rad/s). Frequencies where the BEM's
+        damping is indefinite or asymmetric beyond the dataset checks' tolerances are left
+        out, with a note (:func:`_resolved`).
 
     Returns
     -------
