@@ -43,6 +43,10 @@ __all__ = ["DOFS", "HullHydro", "barge", "cylinder_hull", "hull_from_mesh", "loa
 #: The degrees of freedom, in the order of every array (Capytaine's names).
 DOFS = ("Surge", "Heave", "Pitch")
 
+#: Bump when the hull's cached content or its BEM's rules (mesh, lid, frequencies left out)
+#: change (with :data:`parapend.hydro.bem.CACHE_VERSION`, in every key).
+HULL_CACHE_VERSION = 1
+
 
 def _interp_columns(x, xp, fp, right=None):
     """``np.interp`` of every column of ``fp`` (n, k) at ``x`` (m,): an array (m, k)."""
@@ -432,7 +436,8 @@ def _solve_hull(build, omega, *, rho, g, water_depth, description, cache, key_pa
     Capytaine's BEM formulation (default its own, as :mod:`~parapend.hydro.bem`).
     """
     omega = np.asarray(omega, dtype=float)
-    key = bem._cache_key(b"hull|surge,heave,pitch|" + key_parts, omega, rho, g, water_depth)
+    key = bem._cache_key(f"hull{HULL_CACHE_VERSION}|surge,heave,pitch|".encode() + key_parts,
+                         omega, rho, g, water_depth)
     if cache:
         hit = _cached(key)
         if hit is not None:
