@@ -237,27 +237,33 @@ class Hydro:
         Write it with ``capytaine.io.xarray.save_dataset_as_netcdf``; :func:`load` reads it
         back.
         """
-        import xarray as xr
+        return _dataset(self.omega, self.added_mass[:, None, None],
+                        self.radiation_damping[:, None, None], self.excitation[:, None],
+                        ["Heave"], [[self.hydrostatic_stiffness]], [[self.mass]],
+                        rho=self.rho, g=self.g, water_depth=self.water_depth,
+                        description=self.description)
 
-        dof = ["Heave"]
-        ds = xr.Dataset(
-            {
-                "added_mass": (("omega", "radiating_dof", "influenced_dof"),
-                               self.added_mass[:, None, None]),
-                "radiation_damping": (("omega", "radiating_dof", "influenced_dof"),
-                                      self.radiation_damping[:, None, None]),
-                "excitation_force": (("omega", "wave_direction", "influenced_dof"),
-                                     np.conj(self.excitation)[:, None, None]),
-                "hydrostatic_stiffness": (("influenced_dof", "radiating_dof"),
-                                          [[self.hydrostatic_stiffness]]),
-                "inertia_matrix": (("influenced_dof", "radiating_dof"), [[self.mass]]),
-            },
-            coords={"omega": self.omega, "radiating_dof": dof, "influenced_dof": dof,
-                    "wave_direction": [0.0], "rho": self.rho, "g": self.g,
-                    "water_depth": self.water_depth},
-            attrs={"description": self.description},
-        )
-        return ds
+
+def _dataset(omega, a, b, f, dofs, c, inertia, *, rho, g, water_depth, description):
+    """A Capytaine-style :class:`xarray.Dataset` (``exp(-i w t)``, wave direction 0) of the
+    coefficients ``a``, ``b`` (n, d, d) and ``f`` (n, d, convention ``exp(+i w t)``) over the
+    DOFs ``dofs``; ``c`` and ``inertia`` (d, d); ``inertia`` None: no ``inertia_matrix``."""
+    import xarray as xr
+
+    mat = ("influenced_dof", "radiating_dof")
+    data = {
+        "added_mass": (("omega", "radiating_dof", "influenced_dof"), np.asarray(a)),
+        "radiation_damping": (("omega", "radiating_dof", "influenced_dof"), np.asarray(b)),
+        "excitation_force": (("omega", "wave_direction", "influenced_dof"),
+                             np.conj(np.asarray(f))[:, None, :]),
+        "hydrostatic_stiffness": (mat, np.asarray(c)),
+    }
+    if inertia is not None:
+        data["inertia_matrix"] = (mat, np.asarray(inertia))
+    return xr.Dataset(data, coords={"omega": omega, "radiating_dof": list(dofs),
+                                    "influenced_dof": list(dofs), "wave_direction": [0.0],
+                                    "rho": rho, "g": g, "water_depth": water_depth},
+                      attrs={"description": description})
 
 
 # -- frequencies ---------------------------------------------------------------------------
@@ -372,27 +378,34 @@ def _cache_key(parts: bytes, omega, rho, g, depth) -> str:
 
 def _cache_read(key: str) -> Hydro | None:
     """The cached :class:`Hydro` for ``key``, or None (missing, unreadable or corrupt)."""
-    path = cache_dir() / f"{key}.npz"
+    got = _cache_load(key)
+    if got is None:
+        return None
+    z, meta = got
     try:
-        with np.load(path, allow_pickle=False) as z:
-            if str(z["key"]) != key:
-                return None
-            meta = json.loads(str(z["meta"]))
-            body = _array_digest(z)
-            if body != str(z["digest"]):
-                return None
-            return Hydro(omega=z["omega"], added_mass=z["added_mass"],
-                         radiation_damping=z["radiation_damping"],
-                         excitation=z["excitation"],
-                         hydrostatic_stiffness=float(meta["C"]), mass=float(meta["M"]),
-                         rho=float(meta["rho"]), g=float(meta["g"]),
-                         water_depth=float(meta["depth"]),
-                         description=str(meta["description"]))
+        return Hydro(omega=z["omega"], added_mass=z["added_mass"],
+                     radiation_damping=z["radiation_damping"], excitation=z["excitation"],
+                     hydrostatic_stiffness=float(meta["C"]), mass=float(meta["M"]),
+                     rho=float(meta["rho"]), g=float(meta["g"]),
+                     water_depth=float(meta["depth"]), description=str(meta["description"]))
     except Exception:  # noqa: BLE001 - any failure means: recompute, never trust it
         return None
 
 
 _ARRAYS = ("omega", "added_mass", "radiation_damping", "excitation")
+
+
+def _cache_load(key: str):
+    """``(arrays, meta)`` stored under ``key`` (arrays: a dict of :data:`_ARRAYS`; meta: the
+    decoded JSON), or None when missing, unreadable or corrupt (digest or key mismatch)."""
+    path = cache_dir() / f"{key}.npz"
+    try:
+        with np.load(path, allow_pickle=False) as z:
+            if str(z["key"]) != key or _array_digest(z) != str(z["digest"]):
+                return None
+            return {name: np.array(z[name]) for name in _ARRAYS}, json.loads(str(z["meta"]))
+    except Exception:  # noqa: BLE001 - any failure means: recompute, never trust it
+        return None
 
 
 def _array_digest(arrays) -> str:
@@ -405,13 +418,19 @@ def _array_digest(arrays) -> str:
 
 def _cache_write(key: str, hydro: Hydro) -> None:
     """Store ``hydro`` under ``key`` atomically; a cache that cannot be written is skipped."""
+    _cache_store(key, {name: getattr(hydro, name) for name in _ARRAYS},
+                 {"C": hydro.hydrostatic_stiffness, "M": hydro.mass, "rho": hydro.rho,
+                  "g": hydro.g, "depth": repr(hydro.water_depth),
+                  "description": hydro.description})
+
+
+def _cache_store(key: str, arrays: dict, meta: dict) -> None:
+    """Store the :data:`_ARRAYS` in ``arrays`` and the JSON ``meta`` under ``key``,
+    atomically; a cache that cannot be written is skipped."""
     from ..fileio import write_bytes
 
-    meta = json.dumps({"C": hydro.hydrostatic_stiffness, "M": hydro.mass, "rho": hydro.rho,
-                       "g": hydro.g, "depth": repr(hydro.water_depth),
-                       "description": hydro.description})
-    arrays = {name: np.asarray(getattr(hydro, name)) for name in _ARRAYS}
-    arrays["meta"] = np.array(meta)
+    arrays = {name: np.asarray(arrays[name]) for name in _ARRAYS}
+    arrays["meta"] = np.array(json.dumps(meta))
     arrays["digest"] = np.array(_array_digest(arrays))
     arrays["key"] = np.array(key)
     buf = io.BytesIO()
@@ -625,6 +644,14 @@ def from_mesh(path, *, omega=None, rho=1025.0, g=9.81, water_depth=math.inf, cac
     body's grid, :func:`body_frequencies`, from the largest panel radius).
     """
     rho, g, water_depth, _ = _common(rho, g, water_depth, 1.0)
+    hull, omega, desc, parts = _mesh_file(path, omega, g, water_depth, file_format)
+    return _solve(lambda: (hull, hull), omega, rho=rho, g=g, water_depth=water_depth,
+                  description=desc, cache=cache, key_parts=parts)
+
+
+def _mesh_file(path, omega, g, water_depth, file_format):
+    """The checked immersed part of the mesh in the file ``path``, the frequencies of its
+    BEM, its description and the bytes keying its cache (see :func:`from_mesh`)."""
     body_grid = isinstance(omega, str) and omega == "body"
     omega = DEFAULT_OMEGA if omega is None or body_grid else _omega_grid(omega)
     from .. import limits
@@ -672,8 +699,7 @@ def from_mesh(path, *, omega=None, rho=1025.0, g=9.81, water_depth=math.inf, cac
              else _keep_resolvable(omega, h, g, water_depth))
     desc = f"mesh {p.name}, immersed part"
     parts = b"file|" + str(file_format).encode() + b"|" + p.read_bytes()
-    return _solve(lambda: (hull, hull), omega, rho=rho, g=g, water_depth=water_depth,
-                  description=desc, cache=cache, key_parts=parts)
+    return hull, omega, desc, parts
 
 
 def _regular_file(p: Path, name: str, what: str) -> None:
@@ -843,14 +869,13 @@ def _physics(w, a_full, b_full, b, path):
     return keep, notes
 
 
-def _from_dataset(ds, *, c=None, mass=None, description="", path="the dataset",
-                  check=False, wave_direction=None):
-    """A :class:`Hydro` from a Capytaine dataset (complex values merged, ``exp(-i w t)``)."""
+def _by_omega(ds, path):
+    """``ds`` with complex values merged and indexed by ``omega`` (from ``period`` or
+    ``freq`` where it has no ``omega`` dimension)."""
     from capytaine.io.xarray import merge_complex_values
 
     if "complex" in ds.dims:
         ds = merge_complex_values(ds)
-    omega_name = "omega"
     if "omega" not in ds.dims:
         # a dataset indexed by period or frequency only (assemble_dataset(omega=False))
         if "period" in ds.dims:
@@ -861,6 +886,45 @@ def _from_dataset(ds, *, c=None, mass=None, description="", path="the dataset",
             ds = ds.swap_dims(freq="omega")
         else:
             raise ParameterError(f"hydro: {path} has no omega (nor period, freq) coordinate")
+    return ds
+
+
+def _excitation(ds, path):
+    """The excitation force of a Capytaine dataset: ``excitation_force``, else the sum of
+    ``diffraction_force`` and ``Froude_Krylov_force``; refused (one line) without."""
+    if "excitation_force" in ds:
+        return ds["excitation_force"]
+    if "diffraction_force" in ds and "Froude_Krylov_force" in ds:
+        return ds["diffraction_force"] + ds["Froude_Krylov_force"]
+    raise ParameterError(f"hydro: {path} has no excitation_force (nor diffraction_force "
+                         "and Froude_Krylov_force)")
+
+
+def _read_netcdf(path):
+    """``(dataset, shown name, Path)`` of the NetCDF file ``path``, refused in one line
+    when it is not a regular, readable NetCDF file."""
+    import xarray as xr
+
+    if not isinstance(path, (str, os.PathLike)) or not str(path):
+        raise ParameterError(f"hydro: expected a NetCDF path or an xarray.Dataset, got "
+                             f"{type(path).__name__}")
+    p = Path(path)
+    shown = repr(str(p))
+    _regular_file(p, "hydro", "a NetCDF dataset")
+    try:
+        ds = xr.load_dataset(p)
+    except Exception as exc:  # noqa: BLE001 - xarray's engines raise many types
+        reason = " ".join(str(exc).split())[:120] or type(exc).__name__
+        raise ParameterError(f"hydro: cannot read {shown} as a NetCDF dataset: {reason}") \
+            from None
+    return ds, shown, p
+
+
+def _from_dataset(ds, *, c=None, mass=None, description="", path="the dataset",
+                  check=False, wave_direction=None):
+    """A :class:`Hydro` from a Capytaine dataset (complex values merged, ``exp(-i w t)``)."""
+    ds = _by_omega(ds, path)
+    omega_name = "omega"
     for dim in ("radiating_dof", "influenced_dof"):
         if dim in ds.coords:
             labels = [str(v) for v in ds[dim].values]
@@ -871,13 +935,7 @@ def _from_dataset(ds, *, c=None, mass=None, description="", path="the dataset",
         if var not in ds:
             raise ParameterError(f"hydro: {path} has no {var} (a radiation problem in heave "
                                  "is needed)")
-    if "excitation_force" in ds:
-        fx = ds["excitation_force"]
-    elif "diffraction_force" in ds and "Froude_Krylov_force" in ds:
-        fx = ds["diffraction_force"] + ds["Froude_Krylov_force"]
-    else:
-        raise ParameterError(f"hydro: {path} has no excitation_force (nor diffraction_force "
-                             "and Froude_Krylov_force)")
+    fx = _excitation(ds, path)
     a = _pick(_pick(ds["added_mass"], "radiating_dof", "Heave", "added_mass", path),
               "influenced_dof", "Heave", "added_mass", path)
     b = _pick(_pick(ds["radiation_damping"], "radiating_dof", "Heave", "radiation_damping",
@@ -1001,18 +1059,7 @@ def load(path, *, wave_direction=None) -> Hydro:
         return _from_dataset(path, description=str(path.attrs.get("description", ""))
                              or "an xarray dataset", path="the dataset", check=True,
                              wave_direction=wave_direction)
-    if not isinstance(path, (str, os.PathLike)) or not str(path):
-        raise ParameterError(f"hydro: expected a NetCDF path or an xarray.Dataset, got "
-                             f"{type(path).__name__}")
-    p = Path(path)
-    shown = repr(str(p))
-    _regular_file(p, "hydro", "a NetCDF dataset")
-    try:
-        ds = xr.load_dataset(p)
-    except Exception as exc:  # noqa: BLE001 - xarray's engines raise many types
-        reason = " ".join(str(exc).split())[:120] or type(exc).__name__
-        raise ParameterError(f"hydro: cannot read {shown} as a NetCDF dataset: {reason}") \
-            from None
+    ds, shown, p = _read_netcdf(path)
     desc = str(ds.attrs.get("description", "")) or f"dataset {p.name}"
     return _from_dataset(ds, description=desc, path=shown, check=True,
                          wave_direction=wave_direction)
