@@ -33,7 +33,7 @@ def coefficients(w):
     b[:, 0, 2] = b[:, 2, 0] = 0.03 * MASS * bb
     f = np.stack((0.5j * RHO * G * BEAM * DRAFT * w,
                   RHO * G * L * BEAM * np.exp(-0.3 * w) + 0j,
-                  -0.3j * RHO * G * BEAM * L**2 * w / (1 + w)), axis=1)
+                  0.3j * RHO * G * BEAM * L**2 * w / (1 + w)), axis=1)
     return a, b, f
 
 

@@ -8,9 +8,9 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-
 from hull_reference import box_case, hull_power, hull_reference
 from hull_timedomain import interpolator, synthetic_hull
+
 from parapend.hydro.hull import HullCase, HullProblem
 from parapend.hydro.hull_optimum import hull_search, radiation_bound
 

@@ -70,7 +70,8 @@ def _pendulum(opts):
 
 
 def _hull(opts):
-    """The hull's coefficients, the geometry a check can use (or None) and its name."""
+    """How to build the hull's coefficients (a callable: the BEM runs when it is called,
+    after the checks) and the geometry a check can use (or None)."""
     from . import hull_data as hd
 
     body, mesh, hydro = opts.get("body"), opts.get("mesh"), opts.get("hydro")
@@ -85,8 +86,9 @@ def _hull(opts):
             raise ParameterError(f"{bad[0].replace('_', '-')}: the hull comes from "
                                  f"--{given_src[0]}; drop it")
         if hydro is not None:
-            return hd.load_hull(hydro, wave_direction=opts.get("wave_direction")), None
-        return hd.hull_from_mesh(mesh), None
+            return (lambda: hd.load_hull(hydro, wave_direction=opts.get("wave_direction")),
+                    None)
+        return (lambda: hd.hull_from_mesh(mesh)), None
     if opts.get("wave_direction") is not None:
         raise ParameterError("wave-direction: needs --hydro (a dataset with several wave "
                              "directions)")
@@ -100,19 +102,43 @@ def _hull(opts):
         length = check_range("barge-length", _value(opts, "barge_length"), lo, hi, why="m")
         beam = check_range("barge-beam", _value(opts, "barge_beam"), lo, hi, why="m")
         draft = check_range("barge-draft", _value(opts, "barge_draft"), lo, hi, why="m")
-        h = hd.barge(length, beam, draft)
-        return h, {"draft_m": draft, "freeboard_m": draft, "half_length_m": length / 2,
+        def build():
+            try:
+                return hd.barge(length, beam, draft, omega="body")
+            except ParameterError as exc:  # the builder's own names for the barge's options
+                msg = str(exc)
+                for name in ("length", "beam", "draft"):
+                    if msg.startswith(f"{name}:"):
+                        raise ParameterError(f"barge-{msg}") from None
+                raise
+        return build, {"draft_m": draft, "freeboard_m": draft, "half_length_m": length / 2,
                    "half_beam_m": beam / 2, "body": "barge", "length_m": length,
                    "beam_m": beam}
     for k, v in barge_opts.items():
         if v is not None:
             raise ParameterError(f"{k.replace('_', '-')}: only with --body barge; drop it")
-    from .api import _dimensions
+    from ..defaults import BUOY
 
-    r, d = _dimensions(body, opts.get("radius"), opts.get("draft"))
-    h = hd.sphere_hull(r) if body == "sphere" else hd.cylinder_hull(r, d)
-    return h, {"draft_m": d, "freeboard_m": d, "half_length_m": r, "half_beam_m": r,
-               "body": body, "radius_m": r}
+    if body not in ("cylinder", "sphere"):
+        raise ParameterError(f"body: expected barge, cylinder or sphere, got {body!r:.40}")
+    r = check_range("radius", BUOY["radius"] if opts.get("radius") is None
+                    else opts["radius"], lo, hi, why="m")
+    if body == "sphere":
+        # a sphere floating at its centre has no pitch stiffness about its waterplane
+        # centre: a hull that pitches floats higher (default: half its radius immersed)
+        d = check_range("draft", 0.5 * r if opts.get("draft") is None else opts["draft"],
+                        lo, hi, why="m")
+        top = 2 * r - d
+        def build():
+            return (hd.sphere_hull(r, draft=d, omega="body"))
+    else:
+        d = check_range("draft", BUOY["draft"] if opts.get("draft") is None
+                        else opts["draft"], lo, hi, why="m")
+        top = d  # its mesh: a cylinder of length twice the draft
+        def build():
+            return (hd.cylinder_hull(r, d, omega="body"))
+    return build, {"draft_m": d, "freeboard_m": top, "half_length_m": r, "half_beam_m": r,
+                   "body": body, "radius_m": r}
 
 
 def _pivot(opts, geometry):
@@ -143,12 +169,13 @@ def hull_buoy(**opts):
 
     _refuse_unsupported(opts)
     pend = _pendulum(opts)
-    hull, geometry = _hull(opts)
+    build, geometry = _hull(opts)
+    pivot = _pivot(opts, geometry)  # before the BEM: a pivot outside the hull is refused
+    hull = build()
     if not pend.mass < hull.mass:
         raise ParameterError(f"mass: the pendulum's {pend.mass:g} kg is not less than the "
                              f"floating mass {hull.mass:.6g} kg (rho x displaced volume, "
                              "which includes the pendulum)")
-    pivot = _pivot(opts, geometry)
     inertia = opts.get("hull_pitch_inertia")
     if inertia is not None:
         inertia = check_range("hull-pitch-inertia", inertia, 1e-6, 1e12, why="kg m^2")
