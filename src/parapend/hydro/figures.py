@@ -52,36 +52,51 @@ def _w(p):
     return "-" if p is None else f"{p:.4g} W"
 
 
-@figure_style()
-def plot_sweep(sweep, path=None):
-    """Power against wave period (a :class:`~parapend.hydro.result.BuoySweepResult`): the
-    coupled optimum, the one-way answer, the radiation bound and the coupled limit."""
+def _pos(y):
+    """A log axis draws no power as a gap."""
+    y = np.asarray(y, dtype=float)
+    return np.where(y > 0, y, np.nan)
+
+
+def _power_against_period(t, powers, title, amplitudes, amp_label, path):
+    """Two panels over wave period ``t``: powers on a log axis (``(values, style, kwargs)``
+    per curve) and amplitudes below (the same)."""
     import matplotlib.pyplot as plt
 
-    t = np.asarray(sweep.period_s)
     fig, (ax1, ax2) = plt.subplots(2, 1, figsize=(7, 6.5), sharex=True,
                                    gridspec_kw={"height_ratios": [3, 2]})
-    def pos(y):  # a log axis: no power is drawn as a gap
-        y = np.asarray(y, dtype=float)
-        return np.where(y > 0, y, np.nan)
-
-    ax1.plot(t, pos(sweep.radiation_bound_w), "k-", lw=1.0, label="radiation bound")
-    ax1.plot(t, pos(sweep.limit_w), "k:", lw=1.2, label="coupled limit (c = 0)")
-    ax1.plot(t, pos(sweep.one_way_power_w), "--", color="C2", lw=1.4, marker="s", ms=3,
-             label="one-way (reaction left out)")
-    ax1.plot(t, pos(sweep.power_w), "-", color="C0", lw=1.8, marker="o", ms=3,
-             label="coupled optimum")
+    for values, style, kw in powers:
+        ax1.plot(t, _pos(values), style, **kw)
     ax1.set_yscale("log")
     ax1.set_ylabel("power (W)")
     ax1.legend(loc="best", fontsize="small")
-    ax1.set_title(f"Power against wave period, H = {sweep.wave_height_m:g} m")
-    ax2.plot(t, sweep.heave_amplitude_m, "-", color="C1", lw=1.6, label="coupled")
-    ax2.plot(t, sweep.free_heave_amplitude_m, "--", color="gray", lw=1.0, label="free buoy")
-    ax2.set_ylabel("heave amplitude (m)")
+    ax1.set_title(title)
+    for values, style, kw in amplitudes:
+        ax2.plot(t, values, style, **kw)
+    ax2.set_ylabel(amp_label)
     ax2.set_xlabel("wave period T (s)")
     ax2.legend(loc="best", fontsize="small")
     ax2.set_xlim(t[0], t[-1])
     return _finish(fig, path)
+
+
+@figure_style()
+def plot_sweep(sweep, path=None):
+    """Power against wave period (a :class:`~parapend.hydro.result.BuoySweepResult`): the
+    coupled optimum, the one-way answer, the radiation bound and the coupled limit."""
+    return _power_against_period(
+        np.asarray(sweep.period_s),
+        [(sweep.radiation_bound_w, "k-", {"lw": 1.0, "label": "radiation bound"}),
+         (sweep.limit_w, "k:", {"lw": 1.2, "label": "coupled limit (c = 0)"}),
+         (sweep.one_way_power_w, "--", {"color": "C2", "lw": 1.4, "marker": "s", "ms": 3,
+                                        "label": "one-way (reaction left out)"}),
+         (sweep.power_w, "-", {"color": "C0", "lw": 1.8, "marker": "o", "ms": 3,
+                               "label": "coupled optimum"})],
+        f"Power against wave period, H = {sweep.wave_height_m:g} m",
+        [(sweep.heave_amplitude_m, "-", {"color": "C1", "lw": 1.6, "label": "coupled"}),
+         (sweep.free_heave_amplitude_m, "--", {"color": "gray", "lw": 1.0,
+                                               "label": "free buoy"})],
+        "heave amplitude (m)", path)
 
 
 @figure_style()
@@ -119,31 +134,17 @@ def plot_hull_sweep(sweep, path=None):
     """Rotation against swinging over wave period (a
     :class:`~parapend.hydro.hull_result.HullSweepResult`): each mode's optimum, the one-way
     answer and the radiation bound; the hull's heave and pitch."""
-    import matplotlib.pyplot as plt
-
-    t = np.asarray(sweep.period_s)
-    fig, (ax1, ax2) = plt.subplots(2, 1, figsize=(7, 6.5), sharex=True,
-                                   gridspec_kw={"height_ratios": [3, 2]})
-
-    def pos(y):  # a log axis: no power is drawn as a gap
-        y = np.asarray(y, dtype=float)
-        return np.where(y > 0, y, np.nan)
-
-    ax1.plot(t, pos(sweep.radiation_bound_w), "k-", lw=1.0, label="radiation bound")
-    ax1.plot(t, pos(sweep.rotation_power_w), "-", color="C0", lw=1.8, marker="o", ms=3,
-             label="rotation (one turn per wave)")
-    ax1.plot(t, pos(sweep.swinging_power_w), "-", color="C3", lw=1.8, marker="s", ms=3,
-             label="swinging")
-    ax1.plot(t, pos(sweep.one_way_power_w), "--", color="C2", lw=1.2,
-             label="one-way, best mode (reaction left out)")
-    ax1.set_yscale("log")
-    ax1.set_ylabel("power (W)")
-    ax1.legend(loc="best", fontsize="small")
-    ax1.set_title(f"Rotate or swing: power against wave period, H = {sweep.wave_height_m:g} m")
-    ax2.plot(t, sweep.heave_amplitude_m, "-", color="C1", lw=1.6, label="heave (m)")
-    ax2.plot(t, sweep.pitch_amplitude_deg, "-", color="C4", lw=1.6, label="pitch (deg)")
-    ax2.set_ylabel("hull amplitude, best mode")
-    ax2.set_xlabel("wave period T (s)")
-    ax2.legend(loc="best", fontsize="small")
-    ax2.set_xlim(t[0], t[-1])
-    return _finish(fig, path)
+    return _power_against_period(
+        np.asarray(sweep.period_s),
+        [(sweep.radiation_bound_w, "k-", {"lw": 1.0, "label": "radiation bound"}),
+         (sweep.rotation_power_w, "-", {"color": "C0", "lw": 1.8, "marker": "o", "ms": 3,
+                                        "label": "rotation (one turn per wave)"}),
+         (sweep.swinging_power_w, "-", {"color": "C3", "lw": 1.8, "marker": "s", "ms": 3,
+                                        "label": "swinging"}),
+         (sweep.one_way_power_w, "--", {"color": "C2", "lw": 1.2,
+                                        "label": "one-way, best mode (reaction left out)"})],
+        f"Rotate or swing: power against wave period, H = {sweep.wave_height_m:g} m",
+        [(sweep.heave_amplitude_m, "-", {"color": "C1", "lw": 1.6, "label": "heave (m)"}),
+         (sweep.pitch_amplitude_deg, "-", {"color": "C4", "lw": 1.6,
+                                           "label": "pitch (deg)"})],
+        "hull amplitude, best mode", path)
