@@ -153,3 +153,22 @@ def test_pivot_outside_the_barge_refused_before_the_bem(capsys):
     assert main(["buoy", "--dofs", "surge,heave,pitch", "--pivot-offset", "6"]) == 2
     err = capsys.readouterr().err.strip()
     assert len(err.splitlines()) == 1 and "error: pivot-offset:" in err, err
+
+
+@pytest.mark.slow
+def test_short_irregular_record(dataset):
+    """A 4-wave record (Hs 1 m, Tp 5 s, repeating after 20 s): rotation turns once per
+    wave on average (the winding over the record), the balance closes, the power lies
+    below the radiation bound and the harmonics were refined until it settled."""
+    import parapend
+
+    r = parapend.buoy(dofs="surge,heave,pitch", hydro=dataset, hs=1.0, tp=5.0,
+                      repeat_period=20.0, mass=4000.0, length=1.0, inertia=5000.0,
+                      damping_coefficient=50.0, pivot_height=1.5, pivot_offset=1.0)
+    assert r.success, r.status
+    modes = {m["mode"]: m for m in r.modes}
+    assert modes["rotation"]["winding"] >= 3 and modes["swinging"]["winding"] == 0
+    assert r.energy_balance_residual < 1e-9
+    assert 0 < r.power_w <= r.radiation_bound_w
+    assert r.refinement_change_w <= 1e-3 * r.power_w
+    assert r.surge_phase_deg is None  # phases are of a regular wave's first harmonic

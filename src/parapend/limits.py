@@ -216,9 +216,9 @@ BUOY_MAX_MPC_WORK = 1.4e5
 BUOY_MAX_PTO_RECORD_HARMONICS = 256
 
 #: ``buoy --dofs surge,heave,pitch``: at most this many harmonics of the pendulum's motion
-#: (the hull's harmonics follow; a Newton step costs O(N^2 (N + M)) with dense matrices:
-#: about 0.3 s at 192 on one core) - a record of at most 16 waves
-HULL_MAX_HARMONICS = 192
+#: (the hull's harmonics follow; a Newton step costs O(N^3) with dense matrices, the
+#: refinement doubles N up to HULL_MAX_REFINED_HARMONICS): a record of at most 10 waves
+HULL_MAX_HARMONICS = 128
 #: the harmonics' refinement (doubling until the power settles) stops here
-HULL_MAX_REFINED_HARMONICS = 384
+HULL_MAX_REFINED_HARMONICS = 256
 
