@@ -39,7 +39,7 @@ import math
 from dataclasses import dataclass, field
 
 import numpy as np
-from scipy.linalg import lu_factor, lu_solve
+from scipy.linalg.lapack import dgetrf, dgetrs
 
 from ..errors import ParameterError
 from ._trig import GramPlan, TrigColumns, spectra
@@ -48,6 +48,20 @@ __all__ = ["HullCase", "HullProblem", "hull_points"]
 
 #: grid variables of the pointwise functions, in this order
 _VARS = ("phi", "phi1", "phi2", "qx", "qz", "b1")
+
+
+def _lu(a):
+    """LU factors of ``a`` (LAPACK getrf, called directly: for these small systems the
+    wrappers' checks cost more than the work)."""
+    lu, piv, info = dgetrf(a)
+    if info != 0:
+        raise np.linalg.LinAlgError("the hull's equations are singular at this motion")
+    return lu, piv
+
+
+def _solve(lu, b, trans=0):
+    x, info = dgetrs(lu[0], lu[1], b, trans=trans)
+    return x
 
 
 def hull_points(harmonics: int, hull_harmonics: int, winding: int, wave_harmonics: int) -> int:
@@ -235,6 +249,7 @@ class HullProblem:
         self._pi_cols = [TrigColumns(freq, kp, sp * on[d]) for d in range(3)]
         self._plans = {}
         self._last = None
+        self._last_phi = None
 
     def _plan(self, a: str, b: str) -> GramPlan:
         key = (a, b)
@@ -245,9 +260,14 @@ class HullProblem:
 
     # --------------------------------------------------------------------------------------
     def phi(self, x):
-        """``(phi, phi', phi'')`` on the grid."""
-        kw, w = self.winding, self.omega
-        return (kw * self.s + self.P0 @ x, w * kw + self.P1 @ x, self.P2 @ x)
+        """``(phi, phi', phi'')`` on the grid (the last point's kept)."""
+        x = np.asarray(x, dtype=float)
+        key = x.tobytes()
+        if self._last_phi is None or self._last_phi[0] != key:
+            kw, w = self.winding, self.omega
+            self._last_phi = (key, (kw * self.s + self.P0 @ x, w * kw + self.P1 @ x,
+                                    self.P2 @ x))
+        return self._last_phi[1]
 
     def _rho(self, ph, y):
         """The pendulum's reaction on the hull on the grid, ``r`` (3, M), and the
@@ -293,8 +313,8 @@ class HullProblem:
             s_mat = self.Z - ml * (self._plan("pi2", "qz")(v[0])
                                    - self._plan("pi2", "qx")(v[1]))
             b = self.fa_real + self.Pi_all @ np.concatenate((rx, rz, rb))
-            lu = lu_factor(s_mat, check_finite=False)
-            y = lu_solve(lu, b, check_finite=False)
+            lu = _lu(s_mat)
+            y = _solve(lu, b)
         self._last = (key, y, lu)
         return y, lu
 
@@ -389,7 +409,7 @@ class HullProblem:
         zero = np.zeros((3, self.points))
         if lu is not None:
             gy = self._objective_gy(st)
-            lam = lu_solve(lu, gy, trans=1, check_finite=False)
+            lam = _solve(lu, gy, trans=1)
             mu = np.array([self.Pi[d].T @ lam for d in range(3)])
         else:
             mu = zero
@@ -420,7 +440,7 @@ class HullProblem:
         if lu is None:
             return st["power"], grad, 0.5 * (hxx + hxx.T)
         gx = sum(self._plan(a, b)(vk) for (a, b, _), vk in zip(sens, v[len(pairs):]))
-        t = lu_solve(lu, gx, check_finite=False)
+        t = _solve(lu, gx)
         ht = hxy @ t
         h = hxx + ht + ht.T + t.T @ (hyy @ t)
         return st["power"], grad, 0.5 * (h + h.T)
