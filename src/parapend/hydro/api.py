@@ -20,6 +20,7 @@ import numpy as np
 from .. import limits
 from ..defaults import BUOY
 from ..errors import ParameterError, check_int, check_nonnegative, check_positive, check_range
+from .inputs import _irregular_wave, _pendulum, _period, parse_periods
 from .result import _error_powers, _result, _solve
 
 __all__ = ["buoy", "parse_periods"]
@@ -27,96 +28,6 @@ __all__ = ["buoy", "parse_periods"]
 #: pendulum parameters ``--optimize-design`` may vary
 DESIGN_VARIABLES = ("mass", "length", "inertia", "damping_coefficient")
 
-#: at most this many periods in a sweep
-MAX_PERIODS = 200
-
-
-def parse_periods(text) -> np.ndarray | None:
-    """``"FROM:TO:N"`` -> N periods from FROM to TO (s); a comma list ``"T1,T2,..."`` -> those
-    periods (s), in the order given; a plain number -> None."""
-    if not isinstance(text, str) or (":" not in text and "," not in text):
-        return None
-    if ":" not in text:
-        parts = [s.strip() for s in text.split(",")]
-        if not 1 <= len(parts) <= MAX_PERIODS:
-            raise ParameterError(f"wave-period: expected at most {MAX_PERIODS} periods, got "
-                                 f"{len(parts)}")
-        return np.array([_period(s) for s in parts])
-    parts = text.split(":")
-    if len(parts) != 3:
-        raise ParameterError(f"wave-period: expected a period in s, T1,T2,... or FROM:TO:N, "
-                             f"got {text!r:.60}")
-    try:
-        lo, hi = float(parts[0]), float(parts[1])
-        n = int(parts[2])
-    except ValueError:
-        raise ParameterError(f"wave-period: expected FROM:TO:N (two periods in s, a count), "
-                             f"got {text!r:.60}") from None
-    lo = check_positive("wave-period", lo)
-    hi = check_positive("wave-period", hi)
-    n = check_int("wave-period", n, 2, MAX_PERIODS)
-    if not hi > lo:
-        raise ParameterError(f"wave-period: expected FROM < TO, got {text!r:.60}")
-    return np.linspace(lo, hi, n)
-
-
-def _period(value) -> float:
-    if isinstance(value, str):
-        try:
-            value = float(value)
-        except ValueError:
-            raise ParameterError(f"wave-period: expected a period in s, T1,T2,... or "
-                                 f"FROM:TO:N, got {value!r:.60}") from None
-    return check_range("wave-period", value, 0.1, 100.0, why="wave period, s")
-
-
-# --- the pieces -----------------------------------------------------------------------------
-def _pendulum(mass, length, inertia, damping_coefficient):
-    from ..units import Units
-    from .coupled import Pendulum
-
-    mass = check_positive("mass", mass)
-    length = check_positive("length", length)
-    # the ranges of the units (limits.UNIT_*): each message names the option given
-    Units(length, mass, 9.81, None)
-    ml2 = mass * length * length
-    if inertia is None:
-        inertia = ml2
-    inertia = check_positive("inertia", inertia)
-    if inertia < ml2 * (1 - 1e-12):
-        raise ParameterError(f"inertia: expected at least m l^2 = {ml2:.6g} kg m^2 (the "
-                             f"inertia about the pivot of a mass {mass:g} kg at {length:g} m), "
-                             f"got {inertia:g}")
-    c = check_nonnegative("damping-coefficient", damping_coefficient)
-    Units(length, mass, 9.81, inertia).gamma(c)
-    return Pendulum(mass=mass, length=length, inertia=inertia, damping_coefficient=c)
-
-
-def _irregular_wave(hs, tp, spectrum, gamma_peak, repeat_period, seed, cutoff, record, taper,
-                    units):
-    """The Wave of a periodic irregular record (``sea``'s parsing and checks) and its
-    description."""
-    from ..seas import measured_record, sea_record
-    from .coupled import Wave
-
-    if record is not None:
-        bad = [n for n, v in (("hs", hs), ("tp", tp), ("seed", seed),
-                              ("repeat-period", repeat_period)) if v is not None]
-        if bad:
-            raise ParameterError(f"{', '.join(bad)}: not used with --record; drop it")
-        exc = measured_record(units, record, taper=taper, cutoff=cutoff)
-    else:
-        exc = sea_record(units, hs=BUOY["hs"] if hs is None else hs,
-                         tp=BUOY["tp"] if tp is None else tp, spectrum=spectrum,
-                         gamma_peak=gamma_peak, repeat_period=repeat_period,
-                         seed=0 if seed is None else seed, cutoff=cutoff)
-    info = dict(exc.info)
-    info.pop("response", None)
-    tr = float(info["repeat_period"])
-    # the record's own components (an FFT of samples would add round-off at every harmonic)
-    wave = Wave(2 * math.pi / tr, np.asarray(exc.heave[1:], dtype=complex))
-    info = {"kind": "irregular", **info}
-    return wave, info
 
 
 def _hydro(body, radius, draft, mesh, hydro, wave_direction=None):

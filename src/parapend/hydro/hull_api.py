@@ -63,7 +63,7 @@ def _value(opts, name):
 
 
 def _pendulum(opts):
-    from .api import _pendulum as build
+    from .inputs import _pendulum as build
 
     return build(_value(opts, "mass"), _value(opts, "length"), _value(opts, "inertia"),
                  _value(opts, "damping_coefficient"))
@@ -163,9 +163,9 @@ def _pivot(opts, geometry):
 def hull_buoy(**opts):
     """The optimum of a pendulum in a surging, heaving, pitching hull (see
     :func:`parapend.buoy`, ``dofs="surge,heave,pitch"``)."""
-    from .api import _irregular_wave, _period, parse_periods
     from .coupled import Wave
     from .hull_result import hull_answer
+    from .inputs import _irregular_wave, _period, parse_periods
 
     _refuse_unsupported(opts)
     pend = _pendulum(opts)
