@@ -177,6 +177,7 @@ def test_simulate_api_bounds_the_rate():
 
 
 # --- rotations above p = 3 ----------------------------------------------------------------
+@pytest.mark.slow
 def test_rotation_E_above_three_at_omega_2_1():
     """E (stability regained) at omega = 2.1 lies at p = 3.289 (independent audit); there
     one Floquet multiplier of the rotation is -1."""

@@ -60,6 +60,7 @@ def fake_bem(monkeypatch):
 
 
 # --- one mesh and one grid per body ---------------------------------------------------------------
+@pytest.mark.slow
 def test_one_mesh_and_one_grid_whatever_the_periods(fake_bem):
     """The 1.8 s answer alone, inside FROM:TO:N, inside a comma list and inside a sweep that
     contains 1.8 s: the same to 1e-9, as every call asks for the same two meshes (the body's

@@ -21,6 +21,9 @@ import pytest
 import parapend
 from parapend.cli import main
 
+#: about 12 s in all (the lossy optimum's fixture): the slow set
+pytestmark = pytest.mark.slow
+
 PENDULUM = {"length": 1.0, "mass": 10.0}
 
 

@@ -78,7 +78,13 @@ def _assert_clean(seen, argv):
     assert not problems, f"parapend {' '.join(argv)}:\n  " + "\n  ".join(problems)
 
 
-@pytest.mark.parametrize("argv", [a for _, a in FAST], ids=[n for n, _ in FAST])
+#: the figures that take 3 to 4 s each run in the slow set (the default run's 5 minutes)
+SLOW_FIGURES = ("figure 1", "figure 4", "figure 6", "track")
+
+
+@pytest.mark.parametrize("argv", [pytest.param(a, marks=pytest.mark.slow)
+                                  if n in SLOW_FIGURES else a for n, a in FAST],
+                         ids=[n for n, _ in FAST])
 def test_figure(argv, tmp_path, monkeypatch):
     _assert_clean(_render(argv, tmp_path, monkeypatch), argv)
 
@@ -110,6 +116,7 @@ SI_BESIDE = [
 ]
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("argv", [a for _, a in SI_BESIDE], ids=[n for n, _ in SI_BESIDE])
 def test_physical_options_give_si_axes(argv, tmp_path, monkeypatch):
     from parapend import fileio

@@ -149,6 +149,7 @@ def test_reproduce_out_below_a_file(tmp_path, capsys):
     assert "is a file" in err and "afile" in err
 
 
+@pytest.mark.slow
 def test_full_disk_one_line(tmp_path):
     r = cli("optimize", "--harmonics", "4", "--save", str(tmp_path / "m.csv"),
             limit_fsize=1000)

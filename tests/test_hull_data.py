@@ -173,6 +173,7 @@ def test_unstable_hulls_refused_before_any_bem():
         hd.barge(beam=-1.0)
 
 
+@pytest.mark.slow
 def test_immersed_inertia_closed_forms():
     # hemisphere: V = 2 pi R^3 / 3, integral of x^2 = integral of z^2 = V R^2 / 5
     v, ix, iz = hd._cap_integrals(2.0, 2.0)

@@ -387,6 +387,7 @@ def _files(store: Path) -> dict:
             for p in sorted(store.rglob("*")) if p.is_file()}
 
 
+@pytest.mark.slow
 def test_dask_local_cluster_writes_the_same_store(tmp_path):
     distributed = pytest.importorskip("distributed")
     ref = tmp_path / "ref.zarr"

@@ -240,6 +240,7 @@ def test_reproduce_replaces_an_old_report_whole(tmp_path, monkeypatch):
     assert {stat.S_IMODE(p.stat().st_mode) for p in out.rglob("*")} == {0o755, 0o644}
 
 
+@pytest.mark.slow
 def test_reproduce_is_deterministic_fast(tmp_path, monkeypatch):
     _fake_paper(monkeypatch)
     reproduce(tmp_path / "a")

@@ -168,6 +168,7 @@ def test_sweep_and_map_through_both(tmp_path, capsys):
         and ds.sizes["delta"] == 2 and ds["power"].attrs["units"] == "m g l sqrt(g/l)"
 
 
+@pytest.mark.slow
 def test_records_without_curves_give_their_scalars(tmp_path):
     rec = parapend.figure("1", plot=str(tmp_path / "f.png"))
     ds = rec.to_dataset()

@@ -227,6 +227,7 @@ def test_resume_after_partial_store(reference, tmp_path):
     assert _files(store) == _files(ref_store)
 
 
+@pytest.mark.slow
 @pytest.mark.skipif(sys.platform == "win32", reason="kill -9")
 def test_kill_9_then_resume_equals_uninterrupted(reference, tmp_path):
     ref_store, _ = reference

@@ -29,7 +29,6 @@ __all__ = ["buoy", "parse_periods"]
 DESIGN_VARIABLES = ("mass", "length", "inertia", "damping_coefficient")
 
 
-
 def _hydro(body, radius, draft, mesh, hydro, wave_direction=None):
     """The body's coefficients on the body's own frequency grid (:func:`.bem.body_frequencies`:
     one mesh and one grid per body, whatever the waves of the call), and its width."""
