@@ -55,6 +55,10 @@ SLOW = {
     "power-matrix": lambda tmp: parapend.power_matrix(hs="1,2", tp="6,7", realizations=1,
                                                       waves=10, workers=1),
     "figure": lambda tmp: parapend.figure("1", plot=str(tmp / "f.png")),
+    # the hull (the barge's BEM, cached after the first): one wave, and a sweep
+    "hull": lambda tmp: parapend.buoy(dofs="surge,heave,pitch", harmonics=8),
+    "hull-sweep": lambda tmp: parapend.buoy(dofs="surge,heave,pitch", harmonics=8,
+                                            wave_period="5,7", winding=1),
 }
 
 
