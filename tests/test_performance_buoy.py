@@ -178,7 +178,7 @@ def test_a_bin_with_an_efficiency_is_parapend_buoy_by_hand(run_eff, sphere_nc):
                                                                  rel=1e-9)
     # the mechanical power of that motion: the optimum is flat in the motion, so a motion
     # within the solver's tolerance of the same electrical power moves it more
-    assert st["power"]["mean"][1][1] == pytest.approx(r.power_w, rel=1e-4)
+    assert st["power"]["mean"][1][1] == pytest.approx(r.mechanical_power_w, rel=1e-4)
     # the take-off loses: electrical <= mechanical <= the radiation bound, in every bin
     e, p = np.array(st["electrical_power"]["max"]), np.array(st["power"]["max"])
     assert r.success and np.all(e > 0) and np.all(e <= p)
