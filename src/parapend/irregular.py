@@ -164,7 +164,7 @@ def sea(*, hs: float | None = None, tp: float | None = None, spectrum: str = "jo
         them; default ``gamma = 0.01``).
     winding : int or "auto"
         K, turns per record (default 1); "auto" solves K = 1 and ``K_m`` times
-        :data:`AUTO_FRACTIONS` and keeps the best.
+        ``AUTO_FRACTIONS`` and keeps the best.
     harmonics : int or None
         N; None: ``16 max(K, K_m)``.
     throw : bool

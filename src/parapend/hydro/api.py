@@ -234,7 +234,7 @@ def buoy(*, wave_height=None, wave_period=None, hs=None, tp=None, spectrum=None,
 
     dofs : ``"heave"`` (default: the heaving buoy) or ``"surge,heave,pitch"``: a hull that
         surges, heaves and pitches, with a pendulum that rotates or swings (docs/hull.md;
-        :mod:`parapend.hydro.hull_api`). Then ``body`` is ``"barge"`` (default; its
+        ``parapend.hydro.hull_api``). Then ``body`` is ``"barge"`` (default; its
         ``barge_length``, ``barge_beam``, ``barge_draft``, m), ``"cylinder"`` or
         ``"sphere"``, or ``mesh``/``hydro`` with these DOFs; ``pivot_height`` and
         ``pivot_offset`` place the pivot from the rotation centre (the waterplane centre of

@@ -188,7 +188,7 @@ class HullHydro:
         """``M_h = diag(rho V - m, rho V - m, I_h)`` (kg, kg, kg m^2): the hull without the
         pendulum of mass ``m`` (it floats at its draft: hull and pendulum weigh ``rho V``).
 
-        ``I_h`` is ``pitch_inertia`` (kg m^2, about O), else :attr:`pitch_inertia`, else
+        ``I_h`` is ``pitch_inertia`` (kg m^2, about O), else the ``pitch_inertia`` field, else
         refused (:class:`~parapend.errors.ParameterError` naming ``hull-pitch-inertia``).
         """
         from ..errors import check_nonnegative
@@ -533,7 +533,7 @@ def barge(length=10.0, beam=4.0, draft=1.0, *, omega=None, rho=1025.0, g=9.81,
         42 up to 3.43 rad/s are resolved and kept; with ``omega=None``: 1412 panels, 13 of
         ``DEFAULT_OMEGA``'s frequencies, 0.3 to 5.5 rad/s). Frequencies where the BEM's
         damping is indefinite or asymmetric beyond the dataset checks' tolerances are left
-        out, with a note (:func:`_resolved`).
+        out, with a note (``_resolved``).
 
     Returns
     -------
@@ -624,7 +624,7 @@ def sphere_hull(radius, *, draft=None, omega=None, rho=1025.0, g=9.81, water_dep
     ``C55 = rho g V (radius - draft)`` (the metacentre is the sphere's centre), 0 at the
     centre, where it is refused. The mesh rule's scale is the smaller of radius and draft.
     ``pitch_inertia = rho * integral of (x^2 + z^2) dV`` over the immersed cap, about O
-    (for a hemisphere ``2/5 M R^2``), exactly by :func:`_cap_integrals`.
+    (for a hemisphere ``2/5 M R^2``), exactly by ``_cap_integrals``.
     Other parameters as :func:`cylinder_hull`.
     """
     radius = check_positive("radius", radius)

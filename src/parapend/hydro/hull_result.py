@@ -96,9 +96,9 @@ class HullResult(Result):
     radiation_bound_w : ``sum_k (F a)_k^H B_k^+ (F a)_k / 8``, singular values of ``B_k``
         below ``bound_rcond`` of the largest cut (``bound_cut`` of them); bound_fraction.
     surge_amplitude_m, heave_amplitude_m, pitch_amplitude_deg : half the peak-to-peak hull
-        motion; ``*_phase_deg`` the phase of its first harmonic against the wave's
-        elevation at O (regular waves); mean_heel_deg : the mean pitch (the mean generator
-        torque heels the hull).
+        motion; surge_phase_deg, heave_phase_deg, pitch_phase_deg: the phase of its first
+        harmonic against the wave's elevation at O (regular waves); mean_heel_deg : the mean
+        pitch (the mean generator torque heels the hull).
     mean_angle_deg : the pendulum's mean absolute angle from the upward vertical (180:
         hanging); swing_amplitude_deg : half its peak-to-peak swing (swinging only).
     peak_torque_nm, peak_pivot_force_n : largest ``|tau|`` and bearing load over the motion
