@@ -91,8 +91,10 @@ class HullResult(Result):
         status, the search's evidence).
     one_way_power_w : the best mode's optimum with the hull moving as if the pendulum were
         not there; one_way_ratio : ``one_way_power_w / power_w``.
-    energy_balance_residual : relative residual of ``P + c <(phi' - beta')^2> = sum_k
-        Re((F a)_k^H U_k) / 2 - U_k^H B_k U_k / 2`` (below 1e-9 when the solve is right).
+    energy_balance_residual
+        The relative residual of the energy balance ``P + c <(phi' - beta')^2> =
+        sum_k Re((F a)_k^H U_k) / 2 - U_k^H B_k U_k / 2`` (below 1e-9 when the solve is
+        right).
     radiation_bound_w : ``sum_k (F a)_k^H B_k^+ (F a)_k / 8``, singular values of ``B_k``
         below ``bound_rcond`` of the largest cut (``bound_cut`` of them); bound_fraction.
     surge_amplitude_m, heave_amplitude_m, pitch_amplitude_deg : half the peak-to-peak hull
