@@ -40,11 +40,16 @@ def plot_motion(result, path=None, points: int = 600):
     ax2.plot(t, s["z_free"], "--", lw=1.0, color="gray", label="free buoy")
     ax2.set_ylabel("heave z (m)")
     ax2.legend(loc="best", fontsize="small")
-    ax3.plot(t, s["tau"], lw=1.4, color="C3")
-    ax3.axhline(0.0, color="k", lw=0.5)
-    ax3.set_ylabel(r"torque $\tau$ (N m)")
-    ax3.set_xlabel("time t (s)")
-    ax3.set_xlim(t[0], t[-1])
+    return _torque_panel(fig, ax3, t, s["tau"], path)
+
+
+def _torque_panel(fig, ax, t, tau, path):
+    """The generator torque over the period, the bottom panel of the motion figures."""
+    ax.plot(t, tau, lw=1.4, color="C3")
+    ax.axhline(0.0, color="k", lw=0.5)
+    ax.set_ylabel(r"torque $\tau$ (N m)")
+    ax.set_xlabel("time t (s)")
+    ax.set_xlim(t[0], t[-1])
     return _finish(fig, path)
 
 
@@ -121,12 +126,7 @@ def plot_hull(result, path=None, points: int = 600):
     ax2.plot(t, np.degrees(s["xi"][2]), lw=1.4, color="C4", label="pitch (deg)")
     ax2.set_ylabel("hull motion")
     ax2.legend(loc="best", fontsize="small")
-    ax3.plot(t, s["tau"], lw=1.4, color="C3")
-    ax3.axhline(0.0, color="k", lw=0.5)
-    ax3.set_ylabel(r"torque $\tau$ (N m)")
-    ax3.set_xlabel("time t (s)")
-    ax3.set_xlim(t[0], t[-1])
-    return _finish(fig, path)
+    return _torque_panel(fig, ax3, t, s["tau"], path)
 
 
 @figure_style()

@@ -168,23 +168,20 @@ class HullProblem:
         self.ny = ny
         kh = np.arange(1, nh + 1)
         ch, sh = np.cos(np.outer(s, kh)), np.sin(np.outer(s, kh))
-        # E[d]: y -> xi_d on the grid; E1, E2 its derivatives; Pi[d]: grid -> y rows
-        E = np.zeros((3, m, ny))
+        # E1[d], E2[d]: y -> xi_d', xi_d'' on the grid; Pi[d]: grid -> y rows
         E1 = np.zeros((3, m, ny))
         E2 = np.zeros((3, m, ny))
         Pi = np.zeros((3, ny, m))
         for i, d in enumerate(self.static):
-            E[d, :, i] = 1.0
             Pi[d, i, :] = 1.0 / m
         for d in range(3):
             re = j0 + 6 * (kh - 1) + d
             im = re + 3
-            E[d][:, re], E[d][:, im] = ch, -sh
             E1[d][:, re], E1[d][:, im] = -w * kh * sh, -w * kh * ch
             E2[d][:, re], E2[d][:, im] = -(w * kh) ** 2 * ch, (w * kh) ** 2 * sh
             Pi[d][re, :] = (2.0 / m) * ch.T
             Pi[d][im, :] = -(2.0 / m) * sh.T
-        self.E, self.E1, self.E2, self.Pi = E, E1, E2, Pi
+        self.E1, self.Pi = E1, Pi
         self.Pi_all = np.concatenate(list(Pi), axis=1)  # (ny, 3M): the three rows at once
         dp, hp = case.pivot
         self.Qx = E2[0] + hp * E2[2]

@@ -117,10 +117,6 @@ class HullSolution:
     energy_balance_residual: float
     refinement_change: float | None = None
 
-    @property
-    def problem(self) -> HullProblem:
-        return HullProblem(self.case)
-
 
 def aliased(problem: HullProblem, x) -> bool:
     """True when the power at ``x`` on a grid four times finer differs by more than
