@@ -43,6 +43,7 @@ from scipy.linalg.lapack import dgetrf, dgetrs
 
 from ..errors import ParameterError
 from ._trig import GramPlan, TrigColumns, spectra
+from .pto import PTOObjective, _abs
 
 __all__ = ["HullCase", "HullProblem", "hull_points"]
 
@@ -139,16 +140,29 @@ class HullCase:
         return out
 
 
-class HullProblem:
+class HullProblem(PTOObjective):
     """Power, exact gradient and Hessian of the hull problem in the ``phi`` coefficients.
 
     ``coupled=False``: the hull moves as if the pendulum were not there (its free response,
     the pendulum's mass lumped at the pivot): the one-way problem.
+
+    A real power take-off (:class:`~parapend.hydro.pto.PTOObjective`): ``eta = (eta_g,
+    eta_m)`` makes the objective the electrical power ``<e(p)>`` of the generator's
+    mechanical power ``p = -tau (phi' - beta')`` (its kink smoothed by ``width``),
+    ``copper_loss`` ``r`` (W per (N m)^2) subtracts the winding loss ``r <tau^2>`` (holding
+    an angle then costs power), and :meth:`set_limit` penalizes ``|tau|`` above a torque
+    limit on the grid; :func:`parapend.hydro.pto.maximize` drives the continuation. Without
+    them the objective is the mechanical power.
     """
 
-    def __init__(self, case: HullCase, coupled: bool = True):
+    hessian = None  # dense (the drivers of :mod:`.pto` read it)
+
+    def __init__(self, case: HullCase, coupled: bool = True, eta=None,
+                 copper_loss: float = 0.0):
         self.case = case
         self.coupled = coupled
+        self.set_efficiency(eta)
+        self.copper_loss = float(copper_loss)
         n, nh, m = case.harmonics, case.hull_harmonics, case.points
         w, kw = case.omega, case.winding
         self.harmonics, self.points, self.winding, self.omega = n, m, kw, w
@@ -329,67 +343,140 @@ class HullProblem:
         return {"phi": f, "phi1": f1, "phi2": f2, "qx": qx, "qz": qz, "b1": b1, "y": y,
                 "tau": tau, "relative_speed": v, "power": -float(np.mean(tau * v))}
 
-    def power(self, x) -> float:
+    @property
+    def lossless(self) -> bool:
+        """The objective is the mechanical power (no efficiency, loss or limit)."""
+        return self.b == 0.0 and self.a == 1.0 and self.copper_loss == 0.0 and \
+            self.limit is None
+
+    def state(self, x) -> dict:
+        """The grid state with the generator's mechanical power ``p = -tau v`` per point."""
+        st = self.grid_state(x)
+        st["p"] = -st["tau"] * st["relative_speed"]
+        return st
+
+    def mechanical(self, x) -> float:
+        """``<p>``: the mechanical power on the grid."""
         return self.grid_state(x)["power"]
 
+    def exact(self, x) -> float:
+        """The objective unsmoothed and without the limit's penalty: ``a <p> + b <|p|> - r
+        <tau^2>`` (the kink integrated on the piecewise-linear interpolant of ``p``)."""
+        st = self.state(x)
+        p = st["p"]
+        val = self.a * float(np.mean(p))
+        if self.b != 0.0:
+            val += self.b * _abs(p)
+        if self.copper_loss:
+            val -= self.copper_loss * float(np.mean(st["tau"] ** 2))
+        return val
+
+    def power(self, x) -> float:
+        """The objective the solvers climb: the mechanical power, or the smoothed electrical
+        power less the copper loss and the limit's penalty."""
+        if self.lossless:
+            return self.grid_state(x)["power"]
+        return float(np.mean(self._objective(self.state(x))[0]))
+
+    def _objective(self, st):
+        """The objective's pointwise value ``f(tau, v)`` and its derivatives ``(f, f_tau,
+        f_v, f_tt, f_tv, f_vv)`` (None: zero) on the grid."""
+        tau, v = st["tau"], st["relative_speed"]
+        p = -tau * v
+        if self.b == 0.0:
+            a = self.a
+            f, ft, fv, ftt, ftv, fvv = a * p, -a * v, -a * tau, None, -a, None
+        else:
+            e, e1, e2 = self._e(p)
+            f, ft, fv = e, -e1 * v, -e1 * tau
+            ftt, ftv, fvv = e2 * v * v, e2 * tau * v - e1, e2 * tau * tau
+        r = self.copper_loss
+        if r:
+            f = f - r * tau * tau
+            ft = ft - 2 * r * tau
+            ftt = -2 * r if ftt is None else ftt - 2 * r
+        if self.limit is not None:
+            q0, q1, q2 = self._penalty(tau)
+            f, ft = f + q0, ft + q1
+            ftt = q2 if ftt is None else ftt + q2
+        return f, ft, fv, ftt, ftv, fvv
+
     # --------------------------------------------------------------------------------------
-    def _pointwise(self, st, mu):
-        """Value-free first and second derivatives of the Lagrangian's pointwise part
-        ``-tau v / M + sum_d mu_d rho_d`` in ``_VARS`` (the constraint's weights ``mu``
-        (3, M), zero for the one-way problem). Returns ``(d1, d2)``: dicts of arrays."""
+    def _tau_derivatives(self, st):
+        """``dtau`` and ``d2tau`` in ``_VARS`` (pointwise), and ``dv`` (``v = phi' - b1``)."""
         cs = self.case
-        ml, mm = cs.m * cs.l, self.points
+        ml = cs.m * cs.l
+        f = st["phi"]
+        sn, co = np.sin(f), np.cos(f)
+        wgt = (cs.g + st["qz"]) * sn - st["qx"] * co
+        wph = (cs.g + st["qz"]) * co + st["qx"] * sn
+        dtau = {"phi": -ml * wph, "phi1": cs.c, "phi2": cs.I, "qx": ml * co, "qz": -ml * sn,
+                "b1": -cs.c}
+        d2tau = {("phi", "phi"): ml * wgt, ("phi", "qx"): -ml * sn, ("phi", "qz"): -ml * co}
+        return dtau, d2tau, {"phi1": 1.0, "b1": -1.0}
+
+    def _objective_derivatives(self, st):
+        """The first and second derivatives of the objective's mean ``<f(tau, v)>`` in
+        ``_VARS`` (chain rule through :meth:`_tau_derivatives`): dicts of arrays."""
+        mm = self.points
+        _, ft, fv, ftt, ftv, fvv = self._objective(st)
+        dtau, d2tau, dv = self._tau_derivatives(st)
+        d1 = {u: (ft * dtau[u] + (fv * dv[u] if u in dv else 0.0)) / mm for u in _VARS}
+        zero = np.zeros(mm)
+        d2 = {}
+        for i, u in enumerate(_VARS):
+            for w in _VARS[i:]:
+                h = ft * d2tau[(u, w)] if (u, w) in d2tau else zero
+                if ftt is not None:
+                    h = h + ftt * (dtau[u] * dtau[w])
+                cross = (dtau[u] * dv.get(w, 0.0)) + (dv.get(u, 0.0) * dtau[w])
+                if np.any(cross):
+                    h = h + ftv * cross
+                if fvv is not None and u in dv and w in dv:
+                    h = h + fvv * (dv[u] * dv[w])
+                if np.any(h):
+                    d2[(u, w)] = (h + zero) / mm
+        return d1, d2
+
+    def _pointwise(self, st, mu, obj=None):
+        """First and second derivatives of the Lagrangian's pointwise part ``<f(tau, v)> +
+        sum_d mu_d rho_d`` in ``_VARS`` (the constraint's weights ``mu`` (3, M), zero for
+        the one-way problem). Returns ``(d1, d2)``: dicts of arrays."""
+        cs = self.case
+        ml = cs.m * cs.l
         dp, hp = cs.pivot
         f, f1, f2 = st["phi"], st["phi1"], st["phi2"]
-        qx, qz, b1 = st["qx"], st["qz"], st["b1"]
+        qx, qz = st["qx"], st["qz"]
         sn, co = np.sin(f), np.cos(f)
-        v = f1 - b1
         e = mu[2]
         a = mu[0] + hp * e
         b = mu[1] - dp * e
-        kap = e + v / mm
         wgt = (cs.g + qz) * sn - qx * co
         wph = (cs.g + qz) * co + qx * sn
         X = a * sn + b * co
         Y = b * sn - a * co
-        d1 = {
-            "phi": ml * kap * wph + ml * (f2 * X - f1**2 * Y),
-            "phi1": ml * wgt / mm + 2 * ml * f1 * X - cs.I * f2 / mm - 2 * cs.c * v / mm,
-            "phi2": ml * Y - cs.I * kap,
-            "qx": -ml * kap * co,
-            "qz": ml * kap * sn,
-            "b1": -ml * wgt / mm + cs.I * f2 / mm + 2 * cs.c * v / mm,
-        }
-        d2 = {
-            ("phi", "phi"): -ml * kap * wgt + ml * (-f2 * Y - f1**2 * X),
-            ("phi", "phi1"): ml * wph / mm - 2 * ml * f1 * Y,
-            ("phi", "phi2"): ml * X,
-            ("phi", "qx"): ml * kap * sn,
-            ("phi", "qz"): ml * kap * co,
-            ("phi", "b1"): -ml * wph / mm,
-            ("phi1", "phi1"): 2 * ml * X - 2 * cs.c / mm,
-            ("phi1", "phi2"): -cs.I / mm + 0 * f,
-            ("phi1", "qx"): -ml * co / mm,
-            ("phi1", "qz"): ml * sn / mm,
-            ("phi1", "b1"): 2 * cs.c / mm + 0 * f,
-            ("phi2", "b1"): cs.I / mm + 0 * f,
-            ("qx", "b1"): ml * co / mm,
-            ("qz", "b1"): -ml * sn / mm,
-            ("b1", "b1"): -2 * cs.c / mm + 0 * f,
-        }
+        d1, d2 = self._objective_derivatives(st) if obj is None else obj
+        d1, d2 = dict(d1), dict(d2)
+        if not np.any(mu):
+            return d1, d2
+        con1 = {"phi": ml * e * wph + ml * (f2 * X - f1**2 * Y), "phi1": 2 * ml * f1 * X,
+                "phi2": ml * Y - cs.I * e, "qx": -ml * e * co, "qz": ml * e * sn}
+        con2 = {("phi", "phi"): -ml * e * wgt + ml * (-f2 * Y - f1**2 * X),
+                ("phi", "phi1"): -2 * ml * f1 * Y, ("phi", "phi2"): ml * X,
+                ("phi", "qx"): ml * e * sn, ("phi", "qz"): ml * e * co,
+                ("phi1", "phi1"): 2 * ml * X}
+        for k, v in con1.items():
+            d1[k] = d1[k] + v
+        for k, v in con2.items():
+            d2[k] = d2[k] + v if k in d2 else v
         return d1, d2
 
-    def _objective_gy(self, st):
-        """``dP/dy`` of the power at fixed phi (the adjoint's right side): the pointwise
-        derivatives of ``-tau v / M`` in ``(p_x'', p_z'', beta')`` mapped to ``y``."""
-        cs = self.case
-        ml, mm = cs.m * cs.l, self.points
-        f = st["phi"]
-        sn, co = np.sin(f), np.cos(f)
-        v = st["relative_speed"]
-        wgt = (cs.g + st["qz"]) * sn - st["qx"] * co
-        return (self.Qx.T @ (-ml * v * co) + self.Qz.T @ (ml * v * sn)
-                + self.E1[2].T @ (-ml * wgt + cs.I * st["phi2"] + 2 * cs.c * v)) / mm
+    def _objective_gy(self, st, d1=None):
+        """``d<f>/dy`` at fixed phi (the adjoint's right side): the objective's pointwise
+        derivatives in ``(p_x'', p_z'', beta')`` mapped to ``y``."""
+        if d1 is None:
+            d1 = self._objective_derivatives(st)[0]
+        return self.Qx.T @ d1["qx"] + self.Qz.T @ d1["qz"] + self.E1[2].T @ d1["b1"]
 
     def _maps(self):
         """The linear maps of ``_VARS`` from x (first three) and y (last three)."""
@@ -404,13 +491,14 @@ class HullProblem:
         maps = self._maps()
         xv = ("phi", "phi1", "phi2")
         zero = np.zeros((3, self.points))
+        obj = self._objective_derivatives(st)
         if lu is not None:
-            gy = self._objective_gy(st)
+            gy = self._objective_gy(st, obj[0])
             lam = _solve(lu, gy, trans=1)
             mu = np.array([self.Pi[d].T @ lam for d in range(3)])
         else:
             mu = zero
-        d1, d2 = self._pointwise(st, mu)
+        d1, d2 = self._pointwise(st, mu, obj)
         grad = sum(maps[k].T @ d1[k] for k in xv)
         # the Hessian of L in (x, y) as Gram matrices of the grid maps (one FFT per weight),
         # then the reduced Hessian [I; T]^T (Hessian of L) [I; T]
@@ -434,13 +522,14 @@ class HullProblem:
                 hxy += g
             else:
                 hyy += g if u == w_ else g + g.T
+        val = st["power"] if self.lossless else float(np.mean(self._objective(st)[0]))
         if lu is None:
-            return st["power"], grad, 0.5 * (hxx + hxx.T)
+            return val, grad, 0.5 * (hxx + hxx.T)
         gx = sum(self._plan(a, b)(vk) for (a, b, _), vk in zip(sens, v[len(pairs):]))
         t = _solve(lu, gx)
         ht = hxy @ t
         h = hxx + ht + ht.T + t.T @ (hyy @ t)
-        return st["power"], grad, 0.5 * (h + h.T)
+        return val, grad, 0.5 * (h + h.T)
 
     # --------------------------------------------------------------------------------------
     def harmonics_of(self, y) -> np.ndarray:
