@@ -18,12 +18,13 @@ __all__ = ["MAP_QUANTITIES", "map_data", "plot_map"]
 
 #: What ``parapend map`` can draw: a variable of the store, or ``gain`` (over uniform).
 MAP_QUANTITIES = ("power", "gain", "damping_threshold", "uniform_power", "limit_power",
-                  "electrical_power", "branch_gap")
+                  "electrical_power", "mechanical_power", "branch_gap")
 _PAPER = {"omega": 1.8, "delta": -0.3, "gamma": 0.0}
 _SHORT = {"power": "optimal power P", "gain": "gain over the best uniform rotation",
           "damping_threshold": "damping threshold gamma*",
           "uniform_power": "power of the best uniform rotation",
           "limit_power": "limit power (gamma -> 0)", "electrical_power": "electrical power",
+          "mechanical_power": "mechanical power of the electrical optimum",
           "branch_gap": "continued branch above the global search"}
 _LABELS = {"omega": r"$\omega$", "delta": r"$\delta$", "gamma": r"$\gamma$",
            "torque_limit": r"$T_{max}$", "efficiency": r"$\eta$"}
@@ -45,7 +46,11 @@ def map_data(ds, quantity: str = "power", x: str | None = None, y: str | None = 
     if quantity not in MAP_QUANTITIES:
         raise ParameterError(f"variable: expected one of {', '.join(MAP_QUANTITIES)}, got "
                              f"{quantity!r:.40}")
-    need = "power" if quantity == "gain" else quantity
+    # with an efficiency, power is the electrical power (the headline) and the gain stays the
+    # mechanical power's over the (ideal) uniform rotation's, as before
+    lossy = "mechanical_power" in ds
+    top = "mechanical_power" if lossy else "power"
+    need = top if quantity == "gain" else quantity
     if need not in ds:
         raise ParameterError(f"variable: {quantity!r} is not in this store (threshold maps "
                              "need a sweep with --threshold)")
@@ -76,10 +81,12 @@ def map_data(ds, quantity: str = "power", x: str | None = None, y: str | None = 
     if quantity == "gain":  # as optimize's gain_over_uniform: none where uniform <= 0
         pu = sub["uniform_power"].values
         with np.errstate(divide="ignore", invalid="ignore"):
-            z = np.where(pu > 0, 100.0 * (sub["power"].values / pu - 1.0), np.nan)
+            z = np.where(pu > 0, 100.0 * (sub[top].values / pu - 1.0), np.nan)
     else:
         z = np.array(sub[quantity].values, dtype=float)
-    label = _SHORT[quantity]
+    label = ("optimal electrical power" if quantity == "power" and lossy else
+             "gain of the mechanical power over the best uniform rotation"
+             if quantity == "gain" and lossy else _SHORT[quantity])
     units = "%" if quantity == "gain" else VARIABLES[quantity][1]
     label = f"{label} ({units})" if units else label
     if quantity == "damping_threshold":
@@ -239,7 +246,7 @@ def plot_map(ds, quantity: str = "power", x=None, y=None, at=None, path=None, sc
         paper = (px is not None and py is not None and xs.min() <= px <= xs.max()
                  and ys.min() <= py <= ys.max())
         # the power's zero contour is drawn black (where gamma crosses gamma*), not white
-        zero = (quantity in ("power", "electrical_power") and finite.any()
+        zero = (quantity in ("power", "electrical_power", "mechanical_power") and finite.any()
                 and np.nanmin(z) < 0 < np.nanmax(z))
         levels = [v for v in nice if lo < v < hi and not (zero and v == 0)]
         avoid = [(px, py)] if paper else []
