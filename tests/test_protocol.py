@@ -46,6 +46,9 @@ FAST = {
     "horizon": lambda tmp: parapend.horizon(repeat_period=48.0, forecasts="none",
                                             baselines="extremum", records=1),
     "sweep-map": _sweep,
+    # the sweep's own result: one axis (a curve, not a heat map), in SI
+    "sweep": lambda tmp: parapend.sweep(omega="1.7,1.8", harmonics=4, workers=1, length=1.0,
+                                        mass=10.0),
 }
 SLOW = {
     "rotations": lambda tmp: parapend.rotations(),

@@ -178,6 +178,12 @@ def test_efficiency_axis_headline_is_the_electrical_power(tmp_path, capsys):
     assert math.isclose(rec.largest_power_w, units.to_watts(best["power"]), rel_tol=1e-14)
     assert math.isclose(rec.largest_power_mechanical_w,
                         units.to_watts(best["mechanical_power"]), rel_tol=1e-14)
+    # its figure (one axis: the curves) names the electrical power, with SI scales beside
+    fig = rec.plot()
+    legend = [t.get_text() for t in fig.axes[0].get_legend().get_texts()]
+    assert legend[:3] == ["limit (gamma -> 0)", "optimum, electrical power",
+                          "mechanical power of the electrical optimum"]
+    assert any(c.get_ylabel() == "power (W)" for c in fig.axes[0].child_axes)
     # the command line, resuming the store: the same headline, named
     argv = ["sweep", "--omega", "1.8", "--gamma", "0.05", "--efficiency", "0.8,1",
             "--harmonics", "4", "--workers", "1", "--store", str(store)]

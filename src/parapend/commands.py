@@ -727,7 +727,8 @@ def _sweep_result(sweep, arguments):
             None if best is None else units.to_watts(best["power"])))
         if best is not None and "mechanical_power" in best:
             out["largest_power_mechanical_w"] = units.to_watts(best["mechanical_power"])
-    return Record("sweep", out, run=run, dataset=ds, draw=_draw_dataset("maps", "plot_map"))
+    return Record("sweep", out, run=run, dataset=ds,
+                  draw=lambda rec: sw.plot_sweep(rec.dataset, units=rec.run.units))
 
 
 #: a design map's quantities in SI: the Units attribute that scales each (None: a ratio)

@@ -11,7 +11,7 @@ import numpy as np
 from ..errors import ParameterError
 from .spec import _AXIS_ATTRS, _CODE, _SUCCESS, AXES, VARIABLES
 
-__all__ = ["MAP_QUANTITIES", "map_data", "plot_map"]
+__all__ = ["MAP_QUANTITIES", "map_data", "plot_map", "plot_sweep"]
 
 
 # -- heat maps -----------------------------------------------------------------------------
@@ -274,6 +274,73 @@ def plot_map(ds, quantity: str = "power", x=None, y=None, at=None, path=None, sc
         ax.grid(False)
         if title:
             ax.set_title(title)
+    if path is not None:
+        save_figure(fig, path)
+    return fig
+
+
+#: the curves of a map with one swept axis, in the order drawn: name -> (legend, style)
+_CURVES = {"limit_power": ("limit (gamma -> 0)", ":"), "power": ("optimum", "-"),
+           "mechanical_power": ("mechanical power of the electrical optimum", "-."),
+           "uniform_power": ("best uniform rotation", "--")}
+
+
+def plot_sweep(ds, path=None, units=None):
+    """The figure of a sweep's result (``parapend.sweep(...).plot()``): the heat map of the
+    power over the first two swept axes (:func:`plot_map`), or, over one swept axis, the
+    power, the uniform rotation's and the limit against it (with an efficiency ``power`` is
+    the electrical power and the mechanical one is drawn too), failed points crossed.
+    ``units`` (a :class:`parapend.units.Units`, the pendulum the sweep was given): SI scales
+    beside the non-dimensional ones, as ``parapend map`` draws them."""
+    from ..fileio import save_figure
+    from ..style import figure_style
+
+    dims = [d for d in AXES if d in ds.dims]
+    if len(dims) >= 2:
+        if units is None:
+            return plot_map(ds, "power", path=path)
+        from ..units import add_si_axes
+
+        fig = plot_map(ds, "power", scale=(float(units.power), "W"))
+        with figure_style():
+            add_si_axes(fig, units)
+        if path is not None:
+            save_figure(fig, path)
+        return fig
+    from ..style import use_agg
+
+    use_agg()
+    import matplotlib.pyplot as plt
+
+    x = dims[0]
+    xs = ds[x].values
+    done = ds["done"].values
+    ok = done & np.isin(ds["status"].values, [_CODE[s] for s in _SUCCESS])
+    lossy = "mechanical_power" in ds
+    with figure_style():
+        fig, ax = plt.subplots(figsize=(6.4, 4.2), layout="constrained")
+        for name, (legend, style) in _CURVES.items():
+            if name not in ds:
+                continue
+            mask = ok if name in ("power", "mechanical_power") else done
+            y = np.where(mask, ds[name].values, np.nan)
+            if name == "power" and lossy:
+                legend = "optimum, electrical power"
+            ax.plot(xs, y, style, lw=1.2, label=legend)
+        failed = done & ~ok
+        if failed.any():
+            ax.plot(xs[failed], np.zeros(int(failed.sum())), "x", color="red", ms=5,
+                    label="failed (see status)")
+        ax.set_xlabel(_axis_label(x))
+        ax.set_ylabel(f"mean power ({VARIABLES['power'][1]})")
+        fixed = {a: float(ds[a]) for a in AXES if a in ds.coords and ds[a].ndim == 0}
+        if fixed:
+            ax.set_title(", ".join(f"{k} = {v:.4g}" for k, v in fixed.items()))
+        ax.legend(frameon=False, fontsize=8)
+    if units is not None:
+        from ..units import si_figure
+
+        si_figure(fig, units)
     if path is not None:
         save_figure(fig, path)
     return fig
