@@ -19,6 +19,10 @@ from ._common import (
 from .sweep import _NEGATIVE_VALUE, _EtaProgress
 
 _BINS = "FROM:TO:N (N centres, ends included) or a comma list"
+#: the out-of-memory line: only options this command has
+OUT_OF_MEMORY = ("out of memory; use fewer --hs or --te/--tp bins, fewer --realizations, "
+                 "shorter records (--waves), fewer --harmonics or --workers; with --store "
+                 "the finished bins are kept: run the same command again to resume")
 
 
 def _winding(text):
@@ -127,8 +131,14 @@ def _cmd_power_matrix(a) -> dict | str:
         for s in ("matrix", "capture-width", "scatter"):
             _check_output(f"{a.plot}-{s}.png", "--plot", FIGURE_SUFFIXES)
     argv = sys.argv[1:] if sys.argv and sys.argv[0] else []
-    rec = _run(a, command="parapend " + " ".join(shlex.quote(x) for x in argv),
-               progress=_EtaProgress("power-matrix"))
+    try:
+        rec = _run(a, command="parapend " + " ".join(shlex.quote(x) for x in argv),
+                   progress=_EtaProgress("power-matrix"))
+    except MemoryError:
+        # the generic message names --points, which this command has not
+        from ..errors import SolverError
+
+        raise SolverError(OUT_OF_MEMORY) from None
     ds = rec.dataset
     drawn = []
     if a.plot:
