@@ -82,7 +82,8 @@ def add_parsers(sub) -> None:
     g.add_argument("--winding", type=_winding, help="as sea (default 1)")
     g.add_argument("--harmonics", type=_int, help="as sea (default 16 per wave)")
     g.add_argument("--efficiency", type=_finite_float("efficiency"),
-                   help="power take-off efficiency in (0, 1]: adds the electrical power")
+                   help="power take-off efficiency in [1e-6, 1]: the power reported is "
+                        "the electrical one, the mechanical beside it")
     g.add_argument("--torque-limit", type=_finite_float("torque-limit"),
                    help="not supported over a sea record (refused)")
     g = p.add_argument_group("the buoy's body (--device buoy; as parapend buoy)")
@@ -90,9 +91,11 @@ def add_parsers(sub) -> None:
                      hydro_help="a Capytaine NetCDF dataset, instead of --body (docs/buoy.md)")
     g = p.add_argument_group("resource and site")
     g.add_argument("--depth", type=_finite_float("depth"),
-                   help="water depth, m (default deep water)")
+                   help="water depth, m (default deep water; with --device buoy also "
+                        "the body's BEM)")
     g.add_argument("--density", type=_finite_float("density"),
-                   help="water density, kg/m^3 (default 1025)")
+                   help="water density, kg/m^3 (default 1025; with --device buoy also "
+                        "the body's)")
     g.add_argument("--width", type=_finite_float("width"),
                    help="characteristic width, m: adds the capture-width ratio (buoy "
                         "default: the body's diameter)")
