@@ -118,9 +118,11 @@ def body_hydro(spec):
 
 def _body_in_water(spec):
     """The body of ``spec`` solved in the matrix's water (``water_density``, ``water_depth``;
-    ``parapend buoy`` solves it at 1025 kg/m^3 in deep water): the same checks, mesh and
-    frequency grid as :func:`parapend.hydro.api._hydro`, another ``rho`` and depth. The
-    BEM refuses a draft (a sphere's radius) not less than the depth in one line."""
+    ``parapend buoy`` solves it at 1025 kg/m^3 in deep water): the same checks and mesh as
+    :func:`parapend.hydro.api._hydro`, another ``rho`` and depth; in deep water its
+    frequency grid too, at a finite depth :func:`_finite_grid` (a ``--mesh``: 48
+    frequencies over the bins' band). The BEM refuses a draft (a sphere's radius) not less
+    than the depth in one line."""
     from ..hydro import bem as hy
     from ..hydro.api import _dimensions
 
@@ -214,9 +216,10 @@ def prepare(spec):
 
 def water_of(spec) -> tuple:
     """``(density, depth)`` of the water the body was solved in (``depth`` None: deep), for
-    the waves' energy flux: a ``--hydro`` dataset's own ``rho`` and depth, 1025 kg/m^3 in
-    deep water for a body solved here. A dataset's ``g`` must be the pendulum's 9.81 m/s^2
-    and its ``rho`` a water's (a rho of 1e-300 gave a capture width of 5.6e302 m)."""
+    the waves' energy flux: a ``--hydro`` dataset's own ``rho`` and depth, the matrix's
+    (``spec.water_density``, ``spec.water_depth``) for a body solved here. A dataset's
+    ``g`` must be the pendulum's 9.81 m/s^2 and its ``rho`` a water's (a rho of 1e-300
+    gave a capture width of 5.6e302 m)."""
     h, _ = body_hydro(spec)
     rho, g, depth = float(h.rho), float(h.g), float(h.water_depth)
     where = f" of {spec.hydro}" if spec.hydro is not None else ""
