@@ -239,6 +239,15 @@ def test_the_buoys_body_is_solved_in_the_matrixs_water(monkeypatch):
     grid = seen["omega"]
     assert np.array_equal(grid, full[full.size - grid.size:])  # the body's own points
     assert grid[0] > full[0]
+    # deeper than two wavelengths of the grid's lowest frequency is deep water (Capytaine's
+    # finite-depth coefficients were NaN at 1e300 m): the body's deep-water problem
+    for depth in (1e4, 1e300):
+        seen.clear()
+        with pytest.raises(ParameterError, match="stop: seen"):
+            parapend.power_matrix(device="buoy", hs="0.5,1", tp="2.5,3", realizations=1,
+                                  waves=4, density=1000.0, depth=depth)
+        assert seen["water_depth"] == math.inf and seen["omega"] == "body"
+        assert seen["rho"] == 1000.0
 
 
 def test_a_hydro_datasets_water_is_used_and_contradictions_refused(monkeypatch, tmp_path):

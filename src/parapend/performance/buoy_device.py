@@ -121,13 +121,21 @@ def _body_in_water(spec):
     ``parapend buoy`` solves it at 1025 kg/m^3 in deep water): the same checks and mesh as
     :func:`parapend.hydro.api._hydro`, another ``rho`` and depth; in deep water its
     frequency grid too, at a finite depth :func:`_finite_grid` (a ``--mesh``: 48
-    frequencies over the bins' band). The BEM refuses a draft (a sphere's radius) not less
-    than the depth in one line."""
+    frequencies over the bins' band); deeper than ``DEEP_RATIO`` wavelengths of its lowest
+    frequency, in deep water (the flux then too). The BEM refuses a draft (a sphere's
+    radius) not less than the depth in one line."""
     from ..hydro import bem as hy
     from ..hydro.api import _dimensions
+    from .resource import DEEP_RATIO
 
     depth = math.inf if spec.water_depth is None else spec.water_depth
-    water = {"rho": spec.water_density, "water_depth": depth}
+
+    def deep(omega):
+        # deeper than DEEP_RATIO wavelengths at the lowest frequency (the flux's rule):
+        # deep water to about exp(-4 pi DEEP_RATIO) ~ 1e-11; Capytaine's finite-depth Green
+        # function gave NaN coefficients at 1e300 m
+        return depth >= DEEP_RATIO * 2 * math.pi * 9.81 / float(omega[0]) ** 2
+
     if spec.mesh is not None:
         for name in ("radius", "draft"):
             if getattr(spec, name) is not None:
@@ -138,10 +146,16 @@ def _body_in_water(spec):
         if math.isfinite(depth):  # the band's grid (the file's mesh kept), see _finite_grid
             lo, hi = spec.band
             omega = np.linspace(0.9 * lo, 1.05 * hi, hy.BODY_FREQUENCIES)
-        return hy.from_mesh(spec.mesh, omega=omega, **water), None
+            if deep(omega):
+                omega, depth = "body", math.inf
+        return hy.from_mesh(spec.mesh, omega=omega, rho=spec.water_density,
+                            water_depth=depth), None
     r, d = _dimensions(spec.body, spec.radius, spec.draft)
     scale = r if spec.body == "sphere" else min(r, d)
     omega = "body" if not math.isfinite(depth) else _finite_grid(spec, scale, depth)
+    if not isinstance(omega, str) and deep(omega):
+        omega, depth = "body", math.inf
+    water = {"rho": spec.water_density, "water_depth": depth}
     if spec.body == "sphere":
         return hy.sphere(r, omega=omega, **water), 2 * r
     return hy.cylinder(r, d, omega=omega, **water), 2 * r
