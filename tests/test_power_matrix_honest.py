@@ -305,3 +305,18 @@ def test_the_buoys_bound_and_flux_scale_with_the_waters_density():
     np.testing.assert_allclose(b["radiation_bound_power_mean"].values,
                                ratio * a["radiation_bound_power_mean"].values, rtol=1e-6)
     assert (b["status"].values == 0).all() and (a["status"].values == 0).all()
+
+
+@pytest.mark.slow
+def test_a_deep_finite_depth_is_the_deep_water_answer():
+    """A second method: at 50 m (under two wavelengths of the BEM's lowest frequency, so
+    Capytaine's finite-depth Green function) the coupled power, the radiation bound and the
+    flux of Tp 2.6-3 s waves (wavelengths 10-14 m, k h above 20) are deep water's (the
+    infinite-depth Green function) to the BEM's discretization, 1e-3."""
+    kw = {"device": "buoy", "hs": "0.1,0.2", "tp": "2.6,3.0", "realizations": 1,
+          "waves": 4, "workers": 1}
+    a = parapend.power_matrix(**kw).to_dataset()
+    b = parapend.power_matrix(**kw, depth=50.0).to_dataset()
+    for name in ("power_mean", "radiation_bound_power_mean", "wave_energy_flux_matrix"):
+        np.testing.assert_allclose(b[name].values, a[name].values, rtol=1e-3)
+    assert (b["status"].values == 0).all()
