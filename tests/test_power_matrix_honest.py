@@ -200,13 +200,14 @@ def test_the_prescribed_devices_electrical_bin_is_sea_through_the_take_off():
 # -- out of memory ---------------------------------------------------------------------------
 
 def test_out_of_memory_names_this_commands_options(monkeypatch, capsys):
-    import parapend.performance as perf
+    import parapend.maps.run as mr
 
-    def boom(**kw):
+    def boom(*a, **kw):
         raise MemoryError
 
-    monkeypatch.setattr(perf, "power_matrix", boom)
-    assert main(["power-matrix", "--hs", "1,2", "--te", "6,7"]) == 1
+    monkeypatch.setattr(mr, "run_spec", boom)  # the engine, as the command calls it
+    assert main(["power-matrix", "--hs", "1,2", "--te", "6,7", "--realizations", "1",
+                 "--waves", "3", "--workers", "1"]) == 1
     err = capsys.readouterr().err
     assert len(err.strip().splitlines()) == 1, err
     assert "out of memory" in err and "--realizations" in err and "--waves" in err
