@@ -838,12 +838,13 @@ def _power_matrix_result(power_matrix, arguments):
         return [[None if not math.isfinite(float(v)) else float(v) for v in row]
                 for row in ds[name].values]
 
-    quantities = [q for q in ("power", "limit_power", "uniform_power", "electrical_power",
-                              "radiation_bound_power", "one_way_power") if q in ds]
+    quantities = [q for q in ("power", "mechanical_power", "limit_power", "uniform_power",
+                              "electrical_power", "radiation_bound_power", "one_way_power")
+                  if q in ds]
     stats = {q: {s: (ds[f"{q}_{s}"].values.astype(int).tolist() if s == "count"
                      else grid(f"{q}_{s}")) for s in STATISTICS} for q in quantities}
     codes = ds["status"].values
-    failed = int((codes > 0).sum())  # a raised solve is written but not marked done
+    failed = int((codes > 1).sum())  # 0, 1: converged, no_power (a raised solve: not done)
     out = {"hm0": [float(v) for v in ds["hm0"].values], pk: [float(v) for v in ds[pk].values],
            "tp" if pk == "te" else "te":
                [float(v) for v in ds["tp" if pk == "te" else "te"].values],

@@ -34,7 +34,7 @@ _POWER_UNITS = "m g l sqrt(g/l)"
 #: fill value, "not computed". "error": the point raised (logged), "other": a status this
 #: version does not know.
 STATUSES = ("converged", "no_power", "stalled", "max_iterations", "nonfinite", "infeasible",
-            "unresolved", "error", "other")
+            "unresolved", "error", "other", "above_bound")
 _CODE = {s: i for i, s in enumerate(STATUSES)}
 NOT_COMPUTED = -1
 _SUCCESS = ("converged", "no_power")
