@@ -115,17 +115,20 @@ def test_torque_limit_against_ipopt(name):
 def test_efficiency_against_ipopt(name):
     """Efficiency 0.9 generating, 0.85 motoring. The two codes integrate the kink of
     ``e(p)`` differently on the grid (ours on the piecewise-linear interpolant, IPOPT's
-    split the grid's mean), so each is checked in its own measure: ours is not below IPOPT's
-    motion in ours, IPOPT's not below ours in its; the two optima agree to 1e-3 (measured
-    3e-6 and 1e-4), and neither exceeds eta_g times the ideal optimum."""
+    split the grid's mean): ours is not below IPOPT's motion in our measure, the two optima
+    and the two measures of our motion agree to 1e-3 (measured 3e-6 to 5e-4), and it does
+    not exceed eta_g times the ideal optimum."""
     eta = (0.9, 0.85)
     kw, cs, sol = _ours(name, {"efficiency": eta})
     ref = hull_reference_pto(x0=sol.x, pto={"efficiency": eta}, **kw)
     pr = HullPTO(efficiency=eta).problem(cs)
     assert sol.power >= pr.exact(ref["x"]) - 1e-9 * abs(sol.power)
+    # (IPOPT's own answer is not always at its measure's maximum: its interior point on
+    # the split of the power ends at an acceptable level, at times below our motion in its
+    # measure, so only ours is held to being a maximum)
     p = pr.state(sol.x)["p"]
     ours_in_theirs = float(np.mean(np.where(p > 0, eta[0] * p, p / eta[1])))
-    assert ref["objective"] >= ours_in_theirs - 1e-9 * abs(sol.power)
+    assert ours_in_theirs == pytest.approx(sol.power, rel=1e-3)
     assert sol.power == pytest.approx(ref["objective"], rel=1e-3)
     ideal = hull_search(lambda s: cs, refine=False)
     assert sol.power <= eta[0] * ideal.power

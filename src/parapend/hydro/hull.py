@@ -49,6 +49,12 @@ __all__ = ["HullCase", "HullProblem", "hull_points"]
 
 #: grid variables of the pointwise functions, in this order
 _VARS = ("phi", "phi1", "phi2", "qx", "qz", "b1")
+#: the pairs of them on which the objective's second derivative can be non-zero: every
+#: pair with a ``tau_tau`` term (an efficiency, a copper loss, a limit); else those of
+#: ``tau``'s own second derivative and those that hold ``v = phi' - b1``
+_PAIRS = {"all": [(u, w) for i, u in enumerate(_VARS) for w in _VARS[i:]]}
+_PAIRS["lossless"] = [(u, w) for u, w in _PAIRS["all"] if (u, w) in (
+    ("phi", "phi"), ("phi", "qx"), ("phi", "qz")) or {u, w} & {"phi1", "b1"}]
 
 
 def _lu(a):
@@ -417,31 +423,33 @@ class HullProblem(PTOObjective):
 
     def _objective_derivatives(self, st):
         """The first and second derivatives of the objective's mean ``<f(tau, v)>`` in
-        ``_VARS`` (chain rule through :meth:`_tau_derivatives`): dicts of arrays."""
+        ``_VARS`` (chain rule through :meth:`_tau_derivatives`): dicts of arrays, the
+        second only on the pairs that can be non-zero (:data:`_PAIRS`)."""
         mm = self.points
         _, ft, fv, ftt, ftv, fvv = self._objective(st)
         dtau, d2tau, dv = self._tau_derivatives(st)
-        d1 = {u: (ft * dtau[u] + (fv * dv[u] if u in dv else 0.0)) / mm for u in _VARS}
         zero = np.zeros(mm)
+        d1 = {u: (ft * dtau[u] + (fv * dv[u] if u in dv else 0.0) + zero) / mm
+              for u in _VARS}
         d2 = {}
-        for i, u in enumerate(_VARS):
-            for w in _VARS[i:]:
-                h = ft * d2tau[(u, w)] if (u, w) in d2tau else zero
-                if ftt is not None:
-                    h = h + ftt * (dtau[u] * dtau[w])
-                cross = (dtau[u] * dv.get(w, 0.0)) + (dv.get(u, 0.0) * dtau[w])
-                if np.any(cross):
-                    h = h + ftv * cross
-                if fvv is not None and u in dv and w in dv:
-                    h = h + fvv * (dv[u] * dv[w])
-                if np.any(h):
-                    d2[(u, w)] = (h + zero) / mm
+        for u, w in _PAIRS["all" if ftt is not None else "lossless"]:
+            h = ft * d2tau[(u, w)] if (u, w) in d2tau else zero
+            if u in dv or w in dv:
+                h = h + ftv * (dtau[u] * dv.get(w, 0.0) + dv.get(u, 0.0) * dtau[w])
+            if ftt is not None:
+                h = h + ftt * (dtau[u] * dtau[w])
+            if fvv is not None and u in dv and w in dv:
+                h = h + fvv * (dv[u] * dv[w])
+            d2[(u, w)] = (h + zero) / mm
         return d1, d2
 
     def _pointwise(self, st, mu, obj=None):
         """First and second derivatives of the Lagrangian's pointwise part ``<f(tau, v)> +
         sum_d mu_d rho_d`` in ``_VARS`` (the constraint's weights ``mu`` (3, M), zero for
-        the one-way problem). Returns ``(d1, d2)``: dicts of arrays."""
+        the one-way problem: None). Returns ``(d1, d2)``: dicts of arrays."""
+        d1, d2 = self._objective_derivatives(st) if obj is None else obj
+        if mu is None:
+            return d1, d2
         cs = self.case
         ml = cs.m * cs.l
         dp, hp = cs.pivot
@@ -455,10 +463,7 @@ class HullProblem(PTOObjective):
         wph = (cs.g + qz) * co + qx * sn
         X = a * sn + b * co
         Y = b * sn - a * co
-        d1, d2 = self._objective_derivatives(st) if obj is None else obj
         d1, d2 = dict(d1), dict(d2)
-        if not np.any(mu):
-            return d1, d2
         con1 = {"phi": ml * e * wph + ml * (f2 * X - f1**2 * Y), "phi1": 2 * ml * f1 * X,
                 "phi2": ml * Y - cs.I * e, "qx": -ml * e * co, "qz": ml * e * sn}
         con2 = {("phi", "phi"): -ml * e * wgt + ml * (-f2 * Y - f1**2 * X),
@@ -490,14 +495,12 @@ class HullProblem(PTOObjective):
         st = self.grid_state(x, y)
         maps = self._maps()
         xv = ("phi", "phi1", "phi2")
-        zero = np.zeros((3, self.points))
         obj = self._objective_derivatives(st)
+        mu = None
         if lu is not None:
             gy = self._objective_gy(st, obj[0])
             lam = _solve(lu, gy, trans=1)
             mu = np.array([self.Pi[d].T @ lam for d in range(3)])
-        else:
-            mu = zero
         d1, d2 = self._pointwise(st, mu, obj)
         grad = sum(maps[k].T @ d1[k] for k in xv)
         # the Hessian of L in (x, y) as Gram matrices of the grid maps (one FFT per weight),

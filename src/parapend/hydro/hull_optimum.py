@@ -250,6 +250,8 @@ def _refine(sol: HullSolution, make, x) -> HullSolution:
             xr, pr_power, st = r.x, r.power, r.status
         if st != "converged":
             status, ok = f"refinement to {case.harmonics} harmonics: {st}", False
+        elif pto.active:  # the answer is the finest stage's, and so is its status
+            status, ok = "converged", True
         change = abs(pr_power - power)
         x, power = xr, float(pr_power)
         if change <= (PTO_REFINE_TOL if pto.active else REFINE_TOL) * max(abs(power),
@@ -279,10 +281,11 @@ def _refine(sol: HullSolution, make, x) -> HullSolution:
 
 #: distinct ideal maxima that start the PTO's optimum
 PTO_STARTS = 4
-#: relative change of the exact objective over the continuation's last two widths below
-#: which it counts as settled (the kink's last widths move it by the grid's resolution of
-#: the kink; the refinement states the error)
-PTO_SETTLED = 1e-4
+#: change of the exact objective over the continuation's last two widths, relative to the
+#: larger of it and the pendulum's power scale ``m g l w``, below which it counts as settled
+#: (the kink's last widths move it by the grid's resolution of the kink; the refinement
+#: states the error)
+PTO_SETTLED = 1e-5
 #: with a PTO the harmonics are doubled until the objective changes by at most this
 #: (relative): the kink of the electrical power and the limit's active arcs make the
 #: convergence algebraic, not spectral
@@ -336,7 +339,8 @@ def _pto_maximize(pr: HullProblem, x, pto: HullPTO, first: bool):
     if not math.isfinite(ex):
         return x, ex, "no motion within the torque limit", its
     if pto.smoothed:
-        ok = len(last) >= 2 and abs(last[-1] - last[-2]) <= PTO_SETTLED * max(abs(ex), 1e-300)
+        scale = max(abs(ex), float(pr.w[0]))  # the power, or m g l w near zero
+        ok = len(last) >= 2 and abs(last[-1] - last[-2]) <= PTO_SETTLED * scale
     else:
         ok = log[-1][2] == "converged"
     return x, ex, "converged" if ok else f"stalled ({log[-1][2]})", its
@@ -361,8 +365,9 @@ def _pto_stage(case, make, pto: HullPTO, runs, best_one, refine: bool) -> HullSo
         if status == "converged" and aliased(pr, x):
             status = "aliased"
         tried.append((ex, status))
-        if math.isfinite(ex) and (best is None or (status == "converged", ex) >
-                                  (best[2] == "converged", best[1])):
+        # every iterate is a motion whose power is evaluated exactly: the largest wins, and
+        # its status says whether its continuation settled
+        if math.isfinite(ex) and (best is None or ex > best[1]):
             best = (x, ex, status, name)
     one_pr = pto.problem(case, coupled=False)
     one = None
@@ -388,7 +393,7 @@ def _pto_stage(case, make, pto: HullPTO, runs, best_one, refine: bool) -> HullSo
                        runs=len(tried) + 1, iterations=its,
                        energy_balance_residual=float(HullProblem(case).balance(x)[2]),
                        mechanical_power=float(pr.mechanical(x)), pto=pto)
-    if refine and ok:
+    if refine:  # a stalled continuation may settle with more harmonics: the status says
         sol = _refine(sol, make, x)
     return sol
 
