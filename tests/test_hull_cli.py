@@ -122,7 +122,10 @@ def test_result_protocol(dataset, tmp_path):
     (["--winding", "-1"], "winding"),
     (["--mass", "1e9"], "mass"),
     (["--dofs", "surge,pitch"], "dofs"),
-    (["--efficiency", "0.9"], "efficiency"),
+    (["--efficiency", "1.5"], "efficiency"),
+    (["--torque-limit", "-1"], "torque-limit"),
+    (["--copper-loss", "-1"], "copper-loss"),
+    (["--optimize-design", "mass"], "optimize-design"),
     (["--controller", "mpc"], "controller"),
     (["--pivot-height", "40", "--mass", "40000"], "pivot-height"),  # unstable in pitch
 ])
