@@ -42,7 +42,7 @@ import numpy as np
 from scipy.linalg.lapack import dgetrf, dgetrs
 
 from ..errors import ParameterError
-from ._trig import GramPlan, TrigColumns, spectra
+from ._trig import FusedGram, GramPlan, TrigColumns, spectra
 from .pto import PTOObjective, _abs
 
 __all__ = ["HullCase", "HullProblem", "hull_points"]
@@ -265,6 +265,7 @@ class HullProblem(PTOObjective):
         self._cols = cols
         self._pi_cols = [TrigColumns(freq, kp, sp * on[d]) for d in range(3)]
         self._plans = {}
+        self._fused_plans = {}
         self._last = None
         self._last_phi = None
 
@@ -274,6 +275,27 @@ class HullProblem(PTOObjective):
             ca = self._pi_cols[int(a[2:])] if a.startswith("pi") else self._cols[a]
             self._plans[key] = GramPlan(ca, self._cols[b], self.points)
         return self._plans[key]
+
+    def _fused(self, keys: tuple, coupled: bool) -> dict:
+        """The Hessian's blocks ``xx``, ``xy``, ``yy`` and the sensitivity's right side
+        ``sens`` as :class:`FusedGram` s over the weights in the order :meth:`evaluate`
+        stacks them (the pairs ``keys``, then the nine sensitivity weights)."""
+        ck = (keys, coupled)
+        if ck not in self._fused_plans:
+            xv = ("phi", "phi1", "phi2")
+            blocks = {"xx": [], "xy": [], "yy": [], "sens": []}
+            for k, (u, w) in enumerate(keys):
+                plan = self._plan(u, w)
+                blk = "xx" if w in xv else ("xy" if u in xv else "yy")
+                blocks[blk].append((plan, k, False))
+                if u != w and blk != "xy":
+                    blocks[blk].append((plan, k, True))
+            if coupled:
+                for j, (d, i) in enumerate((d, i) for d in range(3) for i in range(3)):
+                    blocks["sens"].append((self._plan(f"pi{d}", xv[i]), len(keys) + j, False))
+            self._fused_plans[ck] = {b: FusedGram(t, self.points) for b, t in blocks.items()
+                                     if t}
+        return self._fused_plans[ck]
 
     # --------------------------------------------------------------------------------------
     def phi(self, x):
@@ -513,22 +535,12 @@ class HullProblem(PTOObjective):
         else:
             sens = []
         v = spectra([p[2] for p in pairs] + [p[2] for p in sens])
-        n = x.size
-        hxx = np.zeros((n, n))
-        hxy = np.zeros((n, self.ny))
-        hyy = np.zeros((self.ny, self.ny))
-        for (u, w_, _), vk in zip(pairs, v):
-            g = self._plan(u, w_)(vk)
-            if u in xv and w_ in xv:
-                hxx += g if u == w_ else g + g.T
-            elif u in xv:
-                hxy += g
-            else:
-                hyy += g if u == w_ else g + g.T
+        fused = self._fused(tuple((u, w_) for u, w_, _ in pairs), bool(sens))
+        hxx = fused["xx"](v)
         val = st["power"] if self.lossless else float(np.mean(self._objective(st)[0]))
         if lu is None:
             return val, grad, 0.5 * (hxx + hxx.T)
-        gx = sum(self._plan(a, b)(vk) for (a, b, _), vk in zip(sens, v[len(pairs):]))
+        hxy, hyy, gx = fused["xy"](v), fused["yy"](v), fused["sens"](v)
         t = _solve(lu, gx)
         ht = hxy @ t
         h = hxx + ht + ht.T + t.T @ (hyy @ t)

@@ -393,8 +393,8 @@ class HullSweepResult(Result):
     def _series(self):
         import xarray as xr
 
-        names = ("power_w", "mechanical_power_w", "rotation_power_w", "swinging_power_w", "one_way_power_w",
-                 "radiation_bound_w", "heave_amplitude_m", "pitch_amplitude_deg",
+        names = ("power_w", "mechanical_power_w", "rotation_power_w", "swinging_power_w",
+                 "one_way_power_w", "radiation_bound_w", "heave_amplitude_m", "pitch_amplitude_deg",
                  "energy_balance_residual")
         ds = xr.Dataset({k: ("period_s", np.asarray(getattr(self, k), dtype=float))
                          for k in names}, coords={"period_s": self.period_s})
