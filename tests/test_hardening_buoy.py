@@ -296,3 +296,49 @@ def test_out_of_memory_names_options_of_buoy(monkeypatch, capsys):
     assert main(["buoy"]) == 1
     err = capsys.readouterr().err.strip()
     assert "out of memory" in err and "--points" not in err and "\n" not in err
+
+
+def test_small_torque_limit_is_the_constant_brake():
+    """A limit far below the ideal peak torque (1 N m against 279 N m; ``buoy
+    --torque-limit 1`` stalled for minutes at 3.434 W): the rotation under ``T = -T_max``,
+    whose torque on a dense grid is ``-T_max`` at every instant and which never turns back,
+    so its power is the bound ``T_max K omega`` of every such rotation (closed form; the
+    power itself is computed from the motion's torque on the fine grid)."""
+    import math
+
+    from parapend.hydro.coupled import Pendulum, Wave
+    from parapend.hydro.optimum import (
+        BALANCE_TOL,
+        _grid_motion,
+        _heave_and_balance,
+        coupled_optimum,
+    )
+
+    h = toy_hydro(radius=0.5)
+    p = Pendulum(80.0, 0.3, 7.2, 1.0)
+    wave = Wave.regular(0.2, 1.8)
+    lim = 1.0
+    r = coupled_optimum(h, p, wave, torque_limit=lim)
+    assert r.success and "constant brake" in r.status, r.status
+    # the closed form: the brake extracts T_max <theta'> = T_max K omega exactly
+    assert r.power == pytest.approx(lim * 2 * math.pi / 1.8, rel=1e-9)
+    assert r.power < coupled_optimum(h, p, wave).power
+    x = r.theta_coefficients["x"]
+    m = 8192
+    _, _, _, tau = _heave_and_balance(h, p, wave, x, 1, m, True, torque=True)
+    assert np.max(np.abs(tau + lim)) <= 1e-6 * lim
+    assert np.min(_grid_motion(x, 1, m)[1]) > 0
+    assert r.energy_balance_residual <= BALANCE_TOL
+
+
+@pytest.mark.slow  # the default body's BEM and four solves: about 10 s
+def test_torque_limit_one_newton_metre_takes_seconds(capsys):
+    """``buoy --torque-limit 1`` at the defaults: the constant brake, converged, its power
+    ``2 pi / 1.8`` W (T_max K omega)."""
+    import json
+    import math
+
+    assert main(["buoy", "--torque-limit", "1", "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert out["success"], out["status"]
+    assert out["power_w"] == pytest.approx(2 * math.pi / 1.8, rel=1e-9)
