@@ -58,6 +58,7 @@ def _refused(capsys, *args, names):
     (["--hydro", "/"], ["hydro"]),
     (["--mesh", "/dev/zero"], ["mesh"]),
     (["--mesh", "/"], ["mesh"]),
+    (["--wave-period", "1.2:3:200", "--harmonics", "40960"], ["harmonics"]),
 ])
 def test_refused_in_one_line(capsys, args, names):
     _refused(capsys, *args, names=names)
@@ -238,10 +239,39 @@ def test_low_torque_limit_blames_the_limit():
     (["--harmonics", "48", "--torque-limit", "10"], ["harmonics"]),
     (["--winding", "64"], ["winding"]),
     (["--winding", "2", "--efficiency", "0.9"], ["winding"]),
+    (["--wave-period", "1.2:3:200", "--harmonics", "4096"], ["harmonics"]),
+    (["--wave-period", "1.2:3:200", "--harmonics", "512"], ["wave-period"]),
+    (["--wave-period", "1.2:3:200", "--harmonics", "409"], ["wave-period"]),
+    (["--wave-period", "1.2:3:200"], ["wave-period"]),
+    (["--wave-period", "1.2:3:4", "--efficiency", "0.9"], ["wave-period"]),
+    (["--wave-period", "1.2:3:4", "--torque-limit", "100"], ["wave-period"]),
+    (["--wave-period", "1.2:3:4", "--harmonics", "512"], ["wave-period"]),
 ])
 def test_sizes_refused_before_work(capsys, args, names):
     err = _refused(capsys, *args, names=names)
     assert "at most" in err
+
+
+def test_sweep_estimate():
+    """The sweep's estimate: the periods times one period's time, within
+    BUOY_MAX_SWEEP_SECONDS; the message names the most periods that fit, and that many
+    pass."""
+    import re
+
+    from parapend.hydro.api import _check_sweep
+
+    for harmonics, pto in ((None, False), (128, False), (512, False), (None, True)):
+        with pytest.raises(ParameterError, match=r"^wave-period: 200 periods") as got:
+            _check_sweep(200, harmonics, 1, pto)
+        assert "\n" not in str(got.value)
+        most = re.search(r"at most (\d+) periods", str(got.value))
+        if most is None:  # one period at a time
+            assert "one period at a time" in str(got.value)
+            continue
+        _check_sweep(int(most.group(1)), harmonics, 1, pto)
+        with pytest.raises(ParameterError):
+            _check_sweep(int(most.group(1)) + 1, harmonics, 1, pto)
+    _check_sweep(10, None, 1, False)  # docs/buoy.md's 1.2:3:10
 
 
 def test_long_mpc_record_refused_before_work(capsys):
@@ -280,6 +310,11 @@ def test_mesh_of_too_many_panels_refused_before_the_bem(tmp_path):
     (dict(efficiency=[0.9, "a"]), "efficiency"), (dict(torque_limit="1"), "torque-limit"),
     (dict(radius=[1]), "radius"), (dict(efficiency=Decimal("0.9"), harmonics=100),
                                    "harmonics"),
+    # a bare ValueError or TypeError before
+    (dict(body=np.array([1.0, 2.0])), "body"), (dict(controller=np.array([1.0])), "controller"),
+    (dict(dofs=1.0), "dofs"), (dict(optimize_design=0), "optimize-design"),
+    (dict(mesh=1.0), "mesh"), (dict(mesh=["a.gdf"]), "mesh"),
+    (dict(wave_period="1.2:3:200", harmonics=512), "wave-period"),
 ])
 def test_api_raises_parameter_error(kw, name):
     with pytest.raises(ParameterError, match=f"^{name}:"):

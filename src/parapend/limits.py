@@ -204,6 +204,17 @@ BUOY_MAX_HARMONICS = 512
 #: with an efficiency and 57 s with a 1 N m torque limit; 48, 64 and 128 with an efficiency
 #: over 2 minutes
 BUOY_MAX_PTO_HARMONICS = 24
+#: a sweep over wave periods (--wave-period FROM:TO:N or T1,T2,...) solves each period as
+#: alone: the periods times one period's estimated time must stay within this many seconds
+#: (200 periods at 512 harmonics, about 2 hours, ran on unbounded)
+BUOY_MAX_SWEEP_SECONDS = 120.0
+#: one period's time (s; the solve and its error estimates, two shared cores under load),
+#: ``a + b (N / 512)^2`` at N harmonics: 4 periods took 1.5 s each at the default 24, 2.7 s
+#: at 128 and 34 s at 512
+BUOY_PERIOD_SECONDS = (1.2, 33.0)
+#: one period's time (s) with a power take-off (--efficiency, --torque-limit; at most 24
+#: harmonics): 4 periods with --efficiency 0.9 or --torque-limit 100 ran past 150 s
+BUOY_PTO_PERIOD_SECONDS = 40.0
 #: a receding-horizon run of the buoy (--controller mpc): updates x horizon samples x solves
 #: per update. The default run (100 peak periods, horizon 1, update 1/8: 832 x 64 x 2 =
 #: 1.06e5) took 87 s under load; the cap keeps a run near two minutes (about 130 peak

@@ -14,6 +14,7 @@ response); this module checks the input and builds the wave, the body and the pe
 from __future__ import annotations
 
 import math
+import os
 
 import numpy as np
 
@@ -52,6 +53,25 @@ def _hydro(body, radius, draft, mesh, hydro, wave_direction=None):
     if body == "sphere":
         return hy.sphere(r, omega="body"), 2 * r
     return hy.cylinder(r, d, omega="body"), 2 * r
+
+
+def _check_kinds(**opts):
+    """Refuse, in one line naming the option, a value of the wrong kind where a name, a list
+    of names or a path is expected (a number for ``dofs``, ``optimize_design`` or ``mesh``
+    raised a bare TypeError)."""
+    for name, v in opts.items():
+        if v is None:
+            continue
+        if name == "mesh":
+            ok = isinstance(v, (str, os.PathLike))
+            want = "a path (str or os.PathLike)"
+        else:
+            ok = isinstance(v, str) or (isinstance(v, (list, tuple))
+                                        and all(isinstance(x, str) for x in v))
+            want = "a comma list of names (str) or a list of them"
+        if not ok:
+            raise ParameterError(f"{name.replace('_', '-')}: expected {want}, got "
+                                 f"{type(v).__name__}")
 
 
 def _dimensions(body, radius, draft):
@@ -124,6 +144,32 @@ def _check_harmonics(harmonics, winding, pto):
                              f"finish in about two minutes ({why or 'regular wave, '}"
                              f"at most {max(1, cap // HARMONICS_PER_TURN)} turns); or give "
                              f"--harmonics, at least 2 per turn")
+
+
+def _check_sweep(count, harmonics, winding, pto):
+    """Refuse a sweep over ``count`` wave periods whose estimated time (the periods times one
+    period's, :data:`parapend.limits.BUOY_PERIOD_SECONDS` or ``BUOY_PTO_PERIOD_SECONDS``)
+    exceeds :data:`parapend.limits.BUOY_MAX_SWEEP_SECONDS`, naming ``--wave-period`` and the
+    most periods that fit."""
+    from .optimum import HARMONICS_PER_TURN
+
+    n = harmonics if harmonics is not None else HARMONICS_PER_TURN * winding
+    if pto:
+        each = limits.BUOY_PTO_PERIOD_SECONDS
+    else:
+        a, b = limits.BUOY_PERIOD_SECONDS
+        each = a + b * (n / 512) ** 2
+    cap = limits.BUOY_MAX_SWEEP_SECONDS
+    if count * each <= cap:
+        return
+    most = int(cap // each)
+    what = "with --efficiency or --torque-limit" if pto else f"of {n} harmonics"
+    fix = (f"give at most {most} periods" if most >= 2 else "solve one period at a time")
+    if harmonics is not None and not pto:
+        fix += " or fewer --harmonics"
+    raise ParameterError(f"wave-period: {count} periods {what} need about {count * each:.0f} "
+                         f"s ({each:.3g} s each), more than the {cap:g} s a sweep may take; "
+                         f"{fix}")
 
 
 def _check_record_harmonics(h, wave, harmonics, winding, record):
@@ -254,6 +300,7 @@ def buoy(*, wave_height=None, wave_period=None, hs=None, tp=None, spectrum=None,
     from .hull_api import hull_buoy, parse_dofs
 
     opts = dict(locals())
+    _check_kinds(dofs=dofs, optimize_design=optimize_design, mesh=mesh)
     if parse_dofs(dofs) != ("heave",):
         return hull_buoy(**{k: v for k, v in opts.items() if k not in (
             "dofs", "Wave", "hull_buoy", "parse_dofs")})
@@ -262,6 +309,9 @@ def buoy(*, wave_height=None, wave_period=None, hs=None, tp=None, spectrum=None,
         if opts[name] is not None:
             raise ParameterError(f"{name.replace('_', '-')}: a hull's option; needs --dofs "
                                  "surge,heave,pitch")
+    for name, v in (("body", body), ("controller", controller), ("spectrum", spectrum)):
+        if v is not None and not isinstance(v, str):
+            raise ParameterError(f"{name}: expected a name (str), got {type(v).__name__}")
     if controller not in ("optimum", "mpc", "one-way-mpc"):
         raise ParameterError(f"controller: expected optimum, mpc or one-way-mpc, got "
                              f"{controller!r:.40}")
@@ -323,7 +373,10 @@ def buoy(*, wave_height=None, wave_period=None, hs=None, tp=None, spectrum=None,
         if efficiency == (1.0, 1.0):
             efficiency = None  # lossless: the ideal problem
     if not irregular:
-        _check_harmonics(harmonics, winding, torque_limit is not None or efficiency is not None)
+        pto = torque_limit is not None or efficiency is not None
+        _check_harmonics(harmonics, winding, pto)
+        if periods is not None:
+            _check_sweep(periods.size, harmonics, winding, pto)
     variables, bounds = _design_request(optimize_design, pend, mass_bounds=mass_bounds,
                                         length_bounds=length_bounds,
                                         inertia_bounds=inertia_bounds,
