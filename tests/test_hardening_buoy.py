@@ -377,3 +377,31 @@ def test_torque_limit_one_newton_metre_takes_seconds(capsys):
     out = json.loads(capsys.readouterr().out)
     assert out["success"], out["status"]
     assert out["power_w"] == pytest.approx(2 * math.pi / 1.8, rel=1e-9)
+
+
+@pytest.mark.parametrize("change, match", [
+    (lambda d: d.assign_coords(rho=1e-300), "expected rho in"),
+    (lambda d: d.assign_coords(rho=1e300), "expected rho in"),
+    (lambda d: d.assign_coords(rho=1e-3), "expected rho in"),
+    (lambda d: d.assign_coords(g=1e-300), "expected g in"),
+    (lambda d: d.assign_coords(water_depth=1e-300), "water_depth"),
+    (lambda d: d.assign_coords(water_depth=1e-3), "water_depth"),
+    (lambda d: d.assign(excitation_force=d["excitation_force"] * 1e300), "excitation_force "
+                                                                           "reaches"),
+    (lambda d: d.assign(radiation_damping=d["radiation_damping"] * 1e300), "radiation_damping "
+                                                                            "reaches"),
+    (lambda d: d.assign(inertia_matrix=d["inertia_matrix"] * 1e300), "mass reaches"),
+])
+def test_dataset_scales_out_of_reach_refused(change, match):
+    """A dataset's rho of 1e-300 gave a capture width of -1e302 m, a depth of 1e-300 one of
+    -5e148 m, a g of 1e-300 blamed ``gamma``, an excitation of 1e300 N/m an infinite
+    radiation bound: each is refused in one line naming the dataset's variable."""
+    with pytest.raises(ParameterError, match=f"^hydro: .*{match}") as got:
+        bem.load(change(_ds()))
+    assert "\n" not in str(got.value)
+
+
+def test_dataset_scales_in_reach_accepted():
+    d = _ds().assign_coords(rho=1000.0, g=9.8, water_depth=0.5)
+    h = bem.load(d)
+    assert (h.rho, h.g, h.water_depth) == (1000.0, 9.8, 0.5)

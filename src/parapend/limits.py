@@ -194,6 +194,14 @@ BUOY_SYMMETRY_TOL = 1e-2
 #: negative heave radiation damping a dataset may hold at a frequency, as a fraction of its
 #: largest B, before it is refused (at most this much: the frequencies are dropped, named)
 BUOY_NEGATIVE_DAMPING_TOL = 1e-2
+#: a dataset's water density (kg/m^3; power-matrix --density's range), and its smallest
+#: water depth (m): a rho of 1e-300 gave a capture width of -1e302 m, a depth of 1e-300 one
+#: of -5e148 m (the energy flux vanishes), a g of 1e-300 blamed a gamma
+BUOY_RHO_RANGE = (500.0, 2000.0)
+BUOY_MIN_DEPTH = 1e-2
+#: the largest magnitude of a dataset's coefficient (A, B, F, C, M in SI units): the powers
+#: square them (an excitation of 1e300 N/m gave an infinite radiation bound)
+BUOY_MAX_COEFFICIENT = 1e100
 #: radians a chosen wave direction may differ from one in the dataset
 BUOY_DIRECTION_TOL = 1e-6
 #: harmonics of the buoy's motion in a regular wave (--harmonics, or the default 24 per turn

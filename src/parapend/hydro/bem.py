@@ -782,6 +782,30 @@ def _scalar(ds, name, default):
     return default
 
 
+def _check_scales(path, rho, g, depth, values):
+    """Refuse (one line) a dataset whose water, gravity or coefficients are out of physical
+    reach: ``rho`` in :data:`parapend.limits.BUOY_RHO_RANGE`, ``g`` in
+    ``UNIT_GRAVITY_RANGE``, a depth of at least ``BUOY_MIN_DEPTH`` (or infinite), every
+    coefficient at most ``BUOY_MAX_COEFFICIENT`` in magnitude."""
+    from .. import limits
+
+    checks = (("rho", rho, limits.BUOY_RHO_RANGE, "kg/m^3"),
+              ("g", g, limits.UNIT_GRAVITY_RANGE, "m/s^2"))
+    for name, v, (lo, hi), unit in checks:
+        if not lo <= v <= hi:
+            raise ParameterError(f"hydro: {path}: expected {name} in [{lo:g}, {hi:g}] "
+                                 f"{unit}, got {v:g}")
+    if not (depth >= limits.BUOY_MIN_DEPTH):
+        raise ParameterError(f"hydro: {path}: expected a water_depth of at least "
+                             f"{limits.BUOY_MIN_DEPTH:g} m (or inf, deep water), got {depth:g}")
+    cap = limits.BUOY_MAX_COEFFICIENT
+    for name, v in values.items():
+        top = float(np.max(np.abs(np.asarray(v))))
+        if top > cap:
+            raise ParameterError(f"hydro: {path}: {name} reaches {top:.3g} in magnitude, "
+                                 f"more than {cap:g} (SI units; the powers square it)")
+
+
 def _direction(fx, wave_direction, path):
     """``fx`` at the chosen wave direction (rad; default 0, the waves travelling along
     +x): one of the dataset's directions, else refused naming them."""
@@ -1022,6 +1046,10 @@ def _from_dataset(ds, *, c=None, mass=None, description="", path="the dataset",
     rho = _scalar(ds, "rho", 1025.0)
     g = _scalar(ds, "g", 9.81)
     depth = _scalar(ds, "water_depth", math.inf)
+    if check:
+        _check_scales(path, rho, g, depth, {"added_mass": a, "radiation_damping": b,
+                                            "excitation_force": f,
+                                            "hydrostatic_stiffness": c, "mass": mass})
     return Hydro(omega=w, added_mass=a, radiation_damping=b, excitation=f,
                  hydrostatic_stiffness=c, mass=mass, rho=rho, g=g, water_depth=depth,
                  description=description or str(ds.attrs.get("description", "")),
