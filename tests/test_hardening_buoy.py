@@ -405,3 +405,41 @@ def test_dataset_scales_in_reach_accepted():
     d = _ds().assign_coords(rho=1000.0, g=9.8, water_depth=0.5)
     h = bem.load(d)
     assert (h.rho, h.g, h.water_depth) == (1000.0, 9.8, 0.5)
+
+
+@pytest.mark.parametrize("args", [
+    ["--optimize-design", "mass,length", "--efficiency", "0.9"],
+    ["--optimize-design", "mass,length,inertia,damping-coefficient", "--torque-limit", "100"],
+])
+def test_design_search_refused_before_work(capsys, args):
+    """A design search whose solves cannot finish in about ten minutes (four variables with
+    an efficiency: about 40 minutes) is refused before any solve, naming what fits."""
+    assert "at most 1 of them" in _refused(capsys, *args, names=["optimize-design"])
+
+
+@pytest.mark.parametrize("names", [["length"], ["mass", "length", "inertia",
+                                                 "damping_coefficient"]])
+def test_design_search_reports_progress(names):
+    """The search calls ``progress(done, total)`` after each solve, never past its estimate
+    (design_solves, what buoy checks), and ends at ``(total, total)``."""
+    from types import SimpleNamespace
+
+    from parapend.hydro.coupled import Pendulum
+    from parapend.hydro.design import design_solves, optimize_design
+
+    def solve(p):  # a smooth power with one maximum inside the box
+        power = 10 - (p.length - 0.4) ** 2 - (p.mass - 90) ** 2 / 1e3
+        return SimpleNamespace(power=power, success=True, electrical_power=None)
+
+    calls = []
+    pend = Pendulum(80.0, 0.3, 7.2, 1.0)
+    bounds = {"mass": (40.0, 160.0), "length": (0.1, 0.8), "inertia": (7.2, 20.0),
+              "damping_coefficient": (0.0, 5.0)}
+    found = optimize_design(solve, pend, names, {n: bounds[n] for n in names},
+                            progress=lambda d, t: calls.append((d, t)))
+    total = design_solves(len(names))
+    assert calls[-1] == (total, total)
+    assert all(t == total and 0 <= d <= total for d, t in calls)
+    assert [d for d, _ in calls] == sorted(d for d, _ in calls)
+    assert found.evaluations <= total
+    assert found.best["length_m"] == pytest.approx(0.4, abs=1e-2)

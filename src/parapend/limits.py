@@ -223,6 +223,14 @@ BUOY_PERIOD_SECONDS = (1.2, 33.0)
 #: one period's time (s) with a power take-off (--efficiency, --torque-limit; at most 24
 #: harmonics): 4 periods with --efficiency 0.9 or --torque-limit 100 ran past 150 s
 BUOY_PTO_PERIOD_SECONDS = 40.0
+#: --optimize-design: the estimated time of the search (its solves times one solve's) must
+#: stay within this many seconds; it shows a progress bar on a terminal (four variables ran
+#: silently past 150 s, one with --efficiency past 150 s)
+BUOY_MAX_DESIGN_SECONDS = 600.0
+#: one inner solve of the design search (s; the coupled optimum alone, two shared cores
+#: under load): without and with a power take-off (241 solves of four variables took over
+#: 150 s; about 25 of one variable with --efficiency 0.9 over 150 s)
+BUOY_DESIGN_SOLVE_SECONDS = (0.7, 10.0)
 #: a receding-horizon run of the buoy (--controller mpc): updates x horizon samples x solves
 #: per update. The default run (100 peak periods, horizon 1, update 1/8: 832 x 64 x 2 =
 #: 1.06e5) took 87 s under load; the cap keeps a run near two minutes (about 130 peak

@@ -172,6 +172,26 @@ def _check_sweep(count, harmonics, winding, pto):
                          f"{fix}")
 
 
+def _check_design(count, pto):
+    """Refuse a design search whose estimated time (its solves, :func:`.design.design_solves`,
+    times one solve's, :data:`parapend.limits.BUOY_DESIGN_SOLVE_SECONDS`) exceeds
+    :data:`parapend.limits.BUOY_MAX_DESIGN_SECONDS`, naming the most variables that fit."""
+    from .design import design_solves
+
+    each = limits.BUOY_DESIGN_SOLVE_SECONDS[1 if pto else 0]
+    cap = limits.BUOY_MAX_DESIGN_SECONDS
+    if design_solves(count) * each <= cap:
+        return
+    fits = [k for k in range(1, count) if design_solves(k) * each <= cap]
+    what = " with --efficiency or --torque-limit" if pto else ""
+    fix = (f"choose at most {fits[-1]} of them" if fits else
+           "drop --efficiency and --torque-limit from the search")
+    raise ParameterError(f"optimize-design: {count} variables{what} need up to "
+                         f"{design_solves(count)} solves of about {each:g} s "
+                         f"({design_solves(count) * each:.0f} s), more than the {cap:g} s a "
+                         f"design search may take; {fix}")
+
+
 def _check_record_harmonics(h, wave, harmonics, winding, record):
     """Refuse a power take-off over an irregular record whose motion needs more harmonics
     than finish in about two minutes (:data:`parapend.limits.BUOY_MAX_PTO_RECORD_HARMONICS`;
@@ -242,7 +262,7 @@ def buoy(*, wave_height=None, wave_period=None, hs=None, tp=None, spectrum=None,
          inertia_bounds=None, damping_coefficient_bounds=None, controller="optimum",
          horizon=None, update_interval=None, wave_direction=None, dofs="heave",
          pivot_height=None, pivot_offset=None, hull_pitch_inertia=None, barge_length=None,
-         barge_beam=None, barge_draft=None):
+         barge_beam=None, barge_draft=None, progress=None):
     """The coupled optimum of a pendulum inside a floating buoy (command ``buoy``).
 
     Parameters
@@ -288,6 +308,9 @@ def buoy(*, wave_height=None, wave_period=None, hs=None, tp=None, spectrum=None,
         dataset's, else a homogeneous immersed hull); ``winding`` None reports rotation
         (one turn per wave) and swinging (``winding=0``) side by side. Options not given
         take the embedded hull design's values (``parapend.defaults.HULL``).
+    progress : callable or None
+        With ``optimize_design``: called ``progress(done, total)`` after every inner solve
+        of the search (the command line draws it as a bar on a terminal).
 
     Returns
     -------
@@ -303,7 +326,7 @@ def buoy(*, wave_height=None, wave_period=None, hs=None, tp=None, spectrum=None,
     _check_kinds(dofs=dofs, optimize_design=optimize_design, mesh=mesh)
     if parse_dofs(dofs) != ("heave",):
         return hull_buoy(**{k: v for k, v in opts.items() if k not in (
-            "dofs", "Wave", "hull_buoy", "parse_dofs")})
+            "dofs", "Wave", "hull_buoy", "parse_dofs", "progress")})
     for name in ("pivot_height", "pivot_offset", "hull_pitch_inertia", "barge_length",
                  "barge_beam", "barge_draft"):
         if opts[name] is not None:
@@ -385,6 +408,8 @@ def buoy(*, wave_height=None, wave_period=None, hs=None, tp=None, spectrum=None,
                          else wave_height, 1e-4, 30.0, why="regular wave height, m")
     if periods is not None and variables:
         raise ParameterError("optimize-design: one wave period at a time (drop FROM:TO:N)")
+    if variables:
+        _check_design(len(variables), torque_limit is not None or efficiency is not None)
     if irregular:
         from ..units import Units
 
@@ -442,7 +467,8 @@ def buoy(*, wave_height=None, wave_period=None, hs=None, tp=None, spectrum=None,
         from .design import optimize_design as _outer
 
         found = _outer(lambda p: _solve(h, p, wave, one_way=False, **opts)[0], pend,
-                       variables, bounds, check=lambda p: _check_floats(h, p))
+                       variables, bounds, check=lambda p: _check_floats(h, p),
+                       progress=progress)
         pend, design = found.pendulum, found.to_dict()
     sol, ow, notes = _solve(h, pend, wave, **opts)
     errors = _error_powers(h, coarse, pend, wave, **opts)
