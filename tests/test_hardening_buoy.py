@@ -443,3 +443,31 @@ def test_design_search_reports_progress(names):
     assert [d for d, _ in calls] == sorted(d for d, _ in calls)
     assert found.evaluations <= total
     assert found.best["length_m"] == pytest.approx(0.4, abs=1e-2)
+
+
+def test_large_gdf_mesh_refused_before_capytaine_reads_it(tmp_path, monkeypatch):
+    """A GDF mesh whose panels wholly below the waterline exceed the cap is refused from its
+    own numbers (Capytaine's reader took 25 s for 40 000 panels): Capytaine is not called."""
+    from parapend import limits
+
+    n = limits.BUOY_MAX_MESH_PANELS + 1
+    quad = np.array([[0, 0, -1], [1, 0, -1], [1, 1, -1], [0, 1, -1]], dtype=float)
+    rows = "\n".join(" ".join(f"{x:g}" for x in v) for _ in range(n) for v in quad)
+    path = tmp_path / "many.gdf"
+    path.write_text(f"test\n1.0 9.81\n0 0\n{n}\n{rows}\n")
+
+    def unread(*a, **k):
+        raise AssertionError("Capytaine read the mesh")
+
+    monkeypatch.setattr(bem, "_quiet_capytaine", unread)
+    with pytest.raises(ParameterError, match=rf"^mesh: .* at least {n} immersed panels; .* "
+                                             rf"at most {n - 1}") as got:
+        bem.from_mesh(path, omega="body")
+    assert "\n" not in str(got.value)
+    # panels above the waterline do not count; a count the numbers contradict is left to
+    # Capytaine
+    for text in (f"test\n1.0 9.81\n0 0\n{n}\n{rows.replace('-1', '1')}\n",
+                 f"test\n1.0 9.81\n0 0\n{n + 5}\n{rows}\n"):
+        path.write_text(text)
+        with pytest.raises(AssertionError, match="Capytaine read"):
+            bem.from_mesh(path, omega="body")
