@@ -180,6 +180,11 @@ class _Grid:
 
     def power_np(self, x, y):
         """``(P, c <(phi' - beta')^2>)`` on the grid."""
+        tau, rel = self.torque_np(x, y)
+        return -float(np.mean(tau * rel)), self.c * float(np.mean(rel * rel))
+
+    def torque_np(self, x, y):
+        """``(tau, phi' - beta')`` on the grid."""
         ph, d1, d2 = self.phi_grid(x)
         sp, cp = np.sin(ph), np.cos(ph)
         bd = self.E1[2] @ y
@@ -188,7 +193,7 @@ class _Grid:
         rel = d1 - bd
         tau = (self.I * d2 + self.c * rel
                - self.m * self.l * ((self.g + pz2) * sp - px2 * cp))
-        return -float(np.mean(tau * rel)), self.c * float(np.mean(rel * rel))
+        return tau, rel
 
     def balance(self, x, y):
         """Relative residual of ``P + c<(phi'-beta')^2> = sum_k [Re(Fa^H U)/2 - U^H B U/2]``
@@ -274,13 +279,24 @@ def _starts(gr: _Grid, starts: int, seed: int):
     return out
 
 
-def _build(gr: _Grid, tol: float, max_iter: int, graph: str = "MX", one_way: bool = False):
+def _build(gr: _Grid, tol: float, max_iter: int, graph: str = "MX", one_way: bool = False,
+           pto: dict | None = None):
+    """The NLP. ``pto``: ``torque_limit`` (``-T <= tau_j <= T`` at every grid point, as
+    constraints), ``copper_loss`` (``- r <tau^2>`` in the objective) and ``efficiency``
+    ``(eta_g, eta_m)``: the power split into non-negative parts, ``p_j = p+_j - p-_j`` as
+    constraints, objective ``<eta_g p+ - p- / eta_m>`` (exact and smooth: at an optimum one
+    part of each pair is zero, as ``eta_g < 1 / eta_m``). The variables are then ``(x, y,
+    p+, p-)``."""
     import casadi as ca
 
+    pto = pto or {}
     n, ny = 2 * gr.n + 1, gr.ny
     sym = getattr(ca, graph).sym
     xs = sym("x", n)
     ys = sym("y", ny)
+    eta = pto.get("efficiency")
+    pp = sym("pp", gr.M) if eta is not None else None
+    pm = sym("pm", gr.M) if eta is not None else None
     def DM(a):  # constant matrices as sparse: the zeros stay out of the graphs
         a = np.asarray(a, dtype=float)
         if a.ndim == 1:
@@ -310,17 +326,32 @@ def _build(gr: _Grid, tol: float, max_iter: int, graph: str = "MX", one_way: boo
     tau = gr.I * d2 + gr.c * rel - ml * ((gr.g + pz2) * sp - px2 * cp)
     power = -ca.sum1(tau * rel) / gr.M
     pscale = max(ml * gr.g * gr.w, 1e-300)
-    nlp = {"x": ca.vertcat(xs, ys), "f": -power / pscale, "g": cons}
+    objective = power
+    variables = [xs, ys]
+    if eta is not None:
+        objective = (eta[0] * ca.sum1(pp) - ca.sum1(pm) / eta[1]) / gr.M
+        cons = ca.vertcat(cons, (pp - pm + tau * rel) / pscale)
+        variables += [pp, pm]
+    if pto.get("copper_loss"):
+        objective = objective - pto["copper_loss"] * ca.sum1(tau * tau) / gr.M
+    if pto.get("torque_limit") is not None:
+        cons = ca.vertcat(cons, tau / pto["torque_limit"])
+    nlp = {"x": ca.vertcat(*variables), "f": -objective / pscale, "g": cons}
     opts = {"print_time": False, "ipopt": {"print_level": 0, "sb": "yes", "tol": tol,
                                            "max_iter": max_iter}}
+    if pto.get("torque_limit") is not None or eta is not None:
+        # inequalities: start from the given point, not pushed far into the interior
+        opts["ipopt"].update({"mu_init": 1e-6, "bound_push": 1e-9, "bound_frac": 1e-9,
+                              "warm_start_init_point": "yes"})
     solver = ca.nlpsol("hull", "ipopt", nlp, opts)
-    return solver, ca.Function("power", [xs, ys], [power])
+    return solver, ca.Function("power", [xs, ys], [power]), ca.Function(
+        "objective", variables, [objective])
 
 
 def hull_reference(*, omega, amplitudes, winding, harmonics, hull_harmonics, points, A, B, F,
                    C, Mh, m, l, I, c, g, pivot, x0=None, starts=8, seed=0, tol=1e-12,  # noqa: E741
                    max_iter=1000, one_way=False, graph="MX",
-                   coefficient_bound=2 * math.pi) -> dict:
+                   coefficient_bound=2 * math.pi, pto=None) -> dict:
     """Maximize the spec's power over the pendulum's and the hull's harmonics (IPOPT).
 
     Parameters
@@ -385,7 +416,7 @@ def hull_reference(*, omega, amplitudes, winding, harmonics, hull_harmonics, poi
     gr = _Grid(omega=omega, amplitudes=amplitudes, winding=winding, harmonics=harmonics,
                hull_harmonics=hull_harmonics, points=points, A=A, B=B, F=F, C=C, Mh=Mh, m=m,
                l=l, I=I, c=c, g=g, pivot=pivot)
-    solver, pfun = _build(gr, tol, max_iter, graph, one_way)
+    solver, pfun, _ = _build(gr, tol, max_iter, graph, one_way)
     nx = 2 * gr.n + 1
     zero = np.zeros(gr.ny)
     if x0 is not None:
@@ -482,3 +513,39 @@ def box_case(*, winding, harmonics, hull_harmonics=6, points=None, period=6.0, h
                 hull_harmonics=hull_harmonics, points=points, A=A, B=B, F=F,
                 C=np.diag([0.0, c33, 3.15e6]), Mh=np.diag([41000.0 - m, 41000.0 - m, 3.45e5]),
                 m=m, l=l, I=I, c=c, g=g, pivot=pivot)
+
+
+def hull_reference_pto(*, x0, pto, tol=1e-10, max_iter=3000, **case) -> dict:
+    """The optimum of the hull problem through a real power take-off (``pto``: see
+    :func:`_build`) by IPOPT from ``x0`` (the hull from (H) there, the power's parts from
+    its sign). Returns ``objective`` (W: the electrical power, the grid's mean of
+    ``eta_g p+ - p- / eta_m``, less the copper loss), ``power`` (mechanical), ``x``,
+    ``tau`` (the grid's torque), ``status``."""
+    import casadi as ca
+
+    gr = _Grid(**case)
+    solver, pfun, ofun = _build(gr, tol, max_iter, "MX", False, pto)
+    nx = 2 * gr.n + 1
+    x0 = np.asarray(x0, dtype=float)
+    y0 = gr.solve_hull(x0)
+    tau0, rel0 = gr.torque_np(x0, y0)
+    p = -tau0 * rel0
+    z0 = [x0, y0]
+    nc = gr.ny
+    lbx = [np.full(nx + gr.ny, -np.inf)]
+    if pto.get("efficiency") is not None:
+        z0 += [np.maximum(p, 0), np.maximum(-p, 0)]
+        lbx.append(np.zeros(2 * gr.M))
+        nc += gr.M
+    lbg, ubg = np.zeros(nc), np.zeros(nc)
+    if pto.get("torque_limit") is not None:
+        lbg = np.concatenate((lbg, -np.ones(gr.M)))
+        ubg = np.concatenate((ubg, np.ones(gr.M)))
+    sol = solver(x0=np.concatenate(z0), lbg=lbg, ubg=ubg, lbx=np.concatenate(lbx))
+    z = np.asarray(sol["x"]).ravel()
+    x, y = z[:nx], z[nx:nx + gr.ny]
+    parts = [x, y] + ([z[nx + gr.ny:nx + gr.ny + gr.M], z[nx + gr.ny + gr.M:]]
+                      if pto.get("efficiency") is not None else [])
+    tau, rel = gr.torque_np(x, y)
+    return {"objective": float(ofun(*parts)), "power": float(pfun(x, y)), "x": x,
+            "tau": tau, "p": -tau * rel, "status": solver.stats()["return_status"]}

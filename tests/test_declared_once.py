@@ -6,8 +6,10 @@ changing a default in the signature changes the command line's, for every option
 command; the parser that ``main`` uses (the defaults read when the command is parsed)
 gives the same values as the one built with every default read at once; and ``sea``,
 ``buoy`` and ``horizon`` are the implementing functions themselves, not wrappers that
-restate their signatures. The defaults the help texts state (77 options) agree with the
-signatures.
+restate their signatures; ``sweep`` and ``power-matrix`` take the signatures of the
+implementations (:func:`parapend.maps.sweep`, :func:`parapend.performance.power_matrix`) and
+shape their answers, restating nothing. The defaults the help texts state (77 options) agree
+with the signatures.
 """
 
 from __future__ import annotations
@@ -45,11 +47,18 @@ def _parameter_options(parser, command):
 
 @pytest.mark.parametrize("command", COMMANDS)
 def test_the_option_default_is_the_signature_default(command, monkeypatch):
-    """Give every keyword parameter a new default (a marker no parser could hold of its own):
-    every option's default follows, so the parser keeps no default of its own."""
-    fn = _function(command)
+    """Give every parameter a new default (a marker no parser could hold of its own), in the
+    function that declares it (the implementation's, for ``sweep`` and ``power-matrix``):
+    every option's default follows, so neither the parser nor a forwarding function keeps a
+    default of its own."""
+    fn = inspect.unwrap(_function(command))
     marks = {name: ("declared once", command, name) for name in fn.__kwdefaults__}
     monkeypatch.setattr(fn, "__kwdefaults__", {**fn.__kwdefaults__, **marks})
+    if fn.__defaults__:  # positional parameters with defaults (the sweep's store)
+        code = fn.__code__
+        names = code.co_varnames[:code.co_argcount][-len(fn.__defaults__):]
+        marks.update({name: ("declared once", command, name) for name in names})
+        monkeypatch.setattr(fn, "__defaults__", tuple(marks[name] for name in names))
     options = _parameter_options(_subparsers()[command], command)
     assert options, command
     for action in options:
@@ -93,6 +102,59 @@ def test_the_implementation_is_the_public_function(name, module, function):
     impl = getattr(importlib.import_module(module), function)
     assert getattr(parapend, name) is impl is getattr(commands, name)
     assert "Parameters" in impl.__doc__
+
+
+@pytest.mark.parametrize("name, module, function", [
+    ("sweep", "parapend.maps.run", "sweep"),
+    ("power_matrix", "parapend.performance", "power_matrix")])
+def test_a_forwarding_command_has_the_implementation_s_signature(name, module, function):
+    """``parapend.sweep`` and ``parapend.power_matrix`` shape the answer of the function that
+    answers the command into the command's result, and take its parameters as they are: the
+    signature is the implementation's (no second copy in ``commands.py``), and every argument
+    reaches the implementation unchanged."""
+    import importlib
+
+    impl = getattr(importlib.import_module(module), function)
+    fn = getattr(parapend, name)
+    assert fn is getattr(commands, name) and fn is not impl
+    assert inspect.unwrap(fn) is impl
+    assert inspect.signature(fn) == inspect.signature(impl)
+    import re
+
+    assert f"def {name}(" not in inspect.getsource(commands)
+    shape = commands.FORWARDED[name][2]
+    assert fn.__doc__ == shape.__doc__ and "Returns" in fn.__doc__
+    # no parameter list restated in a call either (``omega=omega, ...``)
+    passed = set(re.findall(r"\b(\w+)=\1\b", inspect.getsource(shape)))
+    assert not passed & set(inspect.signature(impl).parameters), passed
+
+
+def test_the_forwarded_arguments_reach_the_implementation(monkeypatch):
+    """Every argument of ``parapend.sweep`` is handed to :func:`parapend.maps.sweep` as given
+    (defaults applied from its signature), positional ``store`` included; an unknown one is
+    refused as the implementation refuses it."""
+    import parapend.maps.run as mr
+
+    seen = {}
+
+    class Stop(Exception):
+        pass
+
+    def fake(*args, **kwargs):
+        seen.update(args=args, kwargs=kwargs)
+        raise Stop
+
+    fake.__signature__ = inspect.signature(mr.sweep)
+    monkeypatch.setattr(commands, "sweep", commands._forward("sweep", fake,
+                                                              commands._sweep_result))
+    with pytest.raises(Stop):
+        commands.sweep("m.zarr", omega="1:2:3", efficiency=0.9)
+    defaults = {k: p.default for k, p in inspect.signature(mr.sweep).parameters.items()}
+    assert seen["args"] == ("m.zarr",)
+    assert seen["kwargs"] == {**{k: v for k, v in defaults.items() if k != "store"},
+                              "omega": "1:2:3", "efficiency": 0.9}
+    with pytest.raises(TypeError, match="not_an_option"):
+        parapend.sweep(not_an_option=1)
 
 
 def test_horizon_takes_its_controller_options_by_keyword():

@@ -324,7 +324,7 @@ def test_api_raises_parameter_error(kw, name):
 def test_out_of_memory_names_options_of_buoy(monkeypatch, capsys):
     import parapend.cli.buoy as cb
 
-    def boom(a):
+    def boom(a, **kw):
         raise MemoryError
 
     monkeypatch.setattr(cb, "_run", boom)

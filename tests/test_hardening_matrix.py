@@ -89,8 +89,15 @@ CASES = [
     (["--depth", "1"], "depth: expected at least Hm0 / 0.78 = 2.564 m"),
     (["--efficiency", "5e-324"], "efficiency: expected a number in [1e-06, 1]"),
     (["--efficiency", "1e-7"], "efficiency: expected a number in [1e-06, 1]"),
-    (["--device", "buoy", "--density", "1000"], "density: the buoy's body is solved at 1025"),
-    (["--device", "buoy", "--depth", "50"], "depth: the buoy's body is solved in deep water"),
+    # the buoy's body is solved in the matrix's water: a depth it does not float in, a
+    # density no water has, waves that break, all before its BEM
+    (["--device", "buoy", "--depth", "0.3", "--hs", "0.1,0.2"],
+     "draft: expected less than the water depth 0.3 m, got 0.5"),
+    (["--device", "buoy", "--body", "sphere", "--depth", "0.45", "--hs", "0.1,0.2"],
+     "radius: expected less than the water depth 0.45 m, got 0.5"),
+    (["--device", "buoy", "--depth", "1"], "depth: expected at least Hm0 / 0.78 = 2.564 m"),
+    (["--device", "buoy", "--depth", "5e-324"], "depth: expected a water depth of at least"),
+    (["--device", "buoy", "--density", "1e-300"], "density: expected a number in [500, 2000]"),
     # absurd sizes
     (["--hs", "0.5:5:1000", "--te", "4:13:1000"],
      "hs: at most 10000 bins in all, got 1000 Hm0 x 1000 te = 1000000; with 1000 te bins, "

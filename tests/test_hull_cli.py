@@ -122,7 +122,10 @@ def test_result_protocol(dataset, tmp_path):
     (["--winding", "-1"], "winding"),
     (["--mass", "1e9"], "mass"),
     (["--dofs", "surge,pitch"], "dofs"),
-    (["--efficiency", "0.9"], "efficiency"),
+    (["--efficiency", "1.5"], "efficiency"),
+    (["--torque-limit", "-1"], "torque-limit"),
+    (["--copper-loss", "-1"], "copper-loss"),
+    (["--optimize-design", "mass"], "optimize-design"),
     (["--controller", "mpc"], "controller"),
     (["--pivot-height", "40", "--mass", "40000"], "pivot-height"),  # unstable in pitch
 ])
@@ -172,3 +175,22 @@ def test_short_irregular_record(dataset):
     assert 0 < r.power_w <= r.radiation_bound_w
     assert r.refinement_change_w <= 1e-3 * r.power_w
     assert r.surge_phase_deg is None  # phases are of a regular wave's first harmonic
+
+
+@pytest.mark.slow
+def test_torque_limit_and_efficiency_on_the_hull(dataset, capsys):
+    """``--torque-limit`` and ``--efficiency`` with the hull: the swinging optimum's peak
+    torque (located between samples) within the limit, the electrical headline below the
+    mechanical power and below eta_g times the ideal answer, the energy balance closed."""
+    base = ["buoy", "--dofs", "surge,heave,pitch", "--hydro", dataset, *PEND,
+            "--wave-height", "1", "--wave-period", repr(PERIOD), "--winding", "0", "--json"]
+    ideal = _json(capsys, base)
+    limit = 0.5 * ideal["peak_torque_nm"]
+    out = _json(capsys, base + ["--torque-limit", repr(limit), "--efficiency", "0.9"])
+    assert out["success"], out["status"]
+    assert out["torque_limit_nm"] == limit and out["efficiency"] == [0.9, 0.9]
+    assert out["peak_torque_nm"] <= limit * (1 + 1e-3)
+    assert 0 < out["power_w"] <= out["mechanical_power_w"]
+    assert out["power_w"] <= 0.9 * ideal["power_w"]
+    assert out["energy_balance_residual"] < 1e-9
+    assert out["refinement_change_w"] is not None

@@ -176,10 +176,15 @@ def test_a_bin_with_an_efficiency_is_parapend_buoy_by_hand(run_eff, sphere_nc):
                       harmonics=PEND["harmonics"])
     assert st["electrical_power"]["mean"][1][1] == pytest.approx(r.electrical_power_w,
                                                                  rel=1e-9)
+    # the headline is the electrical power, as buoy's power_w (issue 32's rule)
+    assert st["power"] == st["electrical_power"]
+    assert st["power"]["mean"][1][1] == pytest.approx(r.power_w, rel=1e-9)
+    assert first["power_matrix"][1][1] == pytest.approx(r.power_w, rel=1e-9)
     # the mechanical power of that motion: the optimum is flat in the motion, so a motion
     # within the solver's tolerance of the same electrical power moves it more
-    assert st["power"]["mean"][1][1] == pytest.approx(r.mechanical_power_w, rel=1e-4)
+    assert st["mechanical_power"]["mean"][1][1] == pytest.approx(r.mechanical_power_w,
+                                                                 rel=1e-4)
     # the take-off loses: electrical <= mechanical <= the radiation bound, in every bin
-    e, p = np.array(st["electrical_power"]["max"]), np.array(st["power"]["max"])
+    e, p = np.array(st["electrical_power"]["max"]), np.array(st["mechanical_power"]["max"])
     assert r.success and np.all(e > 0) and np.all(e <= p)
     assert np.all(p <= np.array(st["radiation_bound_power"]["min"]))

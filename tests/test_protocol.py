@@ -46,10 +46,15 @@ FAST = {
     "horizon": lambda tmp: parapend.horizon(repeat_period=48.0, forecasts="none",
                                             baselines="extremum", records=1),
     "sweep-map": _sweep,
+    # the sweep's own result: one axis (a curve, not a heat map), in SI
+    "sweep": lambda tmp: parapend.sweep(omega="1.7,1.8", harmonics=4, workers=1, length=1.0,
+                                        mass=10.0),
 }
 SLOW = {
     "rotations": lambda tmp: parapend.rotations(),
     "buoy": lambda tmp: parapend.buoy(harmonics=8),
+    "buoy-sweep": lambda tmp: parapend.buoy(wave_period="1.8,2.2", harmonics=8),
+    "buoy-mpc": lambda tmp: parapend.buoy(controller="mpc", harmonics=8, repeat_period=20.0),
     "track-mpc": lambda tmp: parapend.track(periods=20, controller="mpc", torque_limit=1.0,
                                             gamma=0.01, length=1.0, mass=10.0),
     "power-matrix": lambda tmp: parapend.power_matrix(hs="1,2", tp="6,7", realizations=1,

@@ -147,6 +147,57 @@ def test_torque_limit_axis_equals_optimize_pto():
     _check_pto(ds, 4)
 
 
+def test_efficiency_axis_headline_is_the_electrical_power(tmp_path, capsys):
+    """With an efficiency the map's ``power`` is the electrical power of the electrically
+    optimal motion and ``mechanical_power`` that motion's mechanical power (issue 32: the
+    rule of ``optimize``, ``pto-curve`` and ``buoy``), each equal to the same point through
+    ``parapend.optimize(..., efficiency=...)``, an independent call (at efficiency 1 the
+    three are the ideal optimum); the JSON and the text headline name the electrical power
+    and give the mechanical one beside it. An efficiency map is another sweep than the same
+    axes in an earlier version's store (there ``power`` was the mechanical power)."""
+    store = tmp_path / "m.zarr"
+    grid = {"omega": 1.8, "gamma": 0.05, "efficiency": "0.8,1", "harmonics": 4}
+    rec = parapend.sweep(store=str(store), **grid, workers=1, length=1.0, mass=10.0)
+    ds = rec.dataset
+    assert "branch_gap" not in ds and ds["power"].attrs["units"] == "m g l sqrt(g/l)"
+    assert "electrical" in ds["power"].attrs["long_name"]
+    for eta in (0.8, 1.0):
+        r = parapend.optimize(omega=1.8, gamma=0.05, efficiency=eta, harmonics=4)
+        v = ds.sel(efficiency=eta)
+        assert sw.STATUSES[int(v["status"])] == r.status == "converged"
+        assert abs(float(v["power"]) - r.power) <= 1e-9
+        assert abs(float(v["mechanical_power"]) - r.mechanical_power) <= 1e-9
+        assert float(v["electrical_power"]) == float(v["power"])
+    p, m = ds["power"].values, ds["mechanical_power"].values
+    assert p[0] < m[0] and p[1] == m[1]  # losses at 0.8, none at 1
+    best = rec.largest_power
+    k = int(np.argmax(p))
+    assert best == {"power": float(p[k]), "mechanical_power": float(m[k]),
+                    "efficiency": float(ds["efficiency"][k])}
+    units = parapend.units.Units(1.0, 10.0, 9.81)
+    assert math.isclose(rec.largest_power_w, units.to_watts(best["power"]), rel_tol=1e-14)
+    assert math.isclose(rec.largest_power_mechanical_w,
+                        units.to_watts(best["mechanical_power"]), rel_tol=1e-14)
+    # its figure (one axis: the curves) names the electrical power, with SI scales beside
+    fig = rec.plot()
+    legend = [t.get_text() for t in fig.axes[0].get_legend().get_texts()]
+    assert legend[:3] == ["limit (gamma -> 0)", "optimum, electrical power",
+                          "mechanical power of the electrical optimum"]
+    assert any(c.get_ylabel() == "power (W)" for c in fig.axes[0].child_axes)
+    # the command line, resuming the store: the same headline, named
+    argv = ["sweep", "--omega", "1.8", "--gamma", "0.05", "--efficiency", "0.8,1",
+            "--harmonics", "4", "--workers", "1", "--store", str(store)]
+    assert main(argv) == 0
+    text = capsys.readouterr().out
+    assert (f"largest electrical power {best['power']:.8f} at efficiency = "
+            f"{best['efficiency']:.6g} (mechanical {best['mechanical_power']:.8f})") in text
+    assert main([*argv, "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert out["resumed_points"] == 2 and out["largest_power"] == best
+    ident = json.loads(sw.sweep_spec(**grid).to_json())
+    assert ident.pop("power") == "electrical"  # the earlier identity had no such key
+
+
 @pytest.mark.slow
 def test_infeasible_torque_limit_is_recorded():
     """A torque limit too small at a damping above gamma*: status infeasible (a few

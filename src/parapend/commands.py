@@ -12,15 +12,18 @@ frozen result whose fields are the keys of the command's ``--json`` object:
   ``harmonics``, ``pto_curve``): the JSON keys are its coordinate, data variables and
   attributes;
 - otherwise a :class:`parapend.results.Record` (``figure``, ``reproduce``, ``simulate``,
-  ``basins``, ``rotations``, ``sweep``, ``map``, ``optimize`` with ``method="all"``): its
-  fields are the JSON keys; the objects behind it (the Dataset, the motion, the figure) are
-  its private attributes ``_dataset``, ``_source``, ``_figure``.
+  ``basins``, ``rotations``, ``sweep``, ``map``, ``power_matrix``, ``optimize`` with
+  ``method="all"``): its fields are the JSON keys; the objects behind it (the Dataset, the
+  motion, a sweep's run) are its public attributes ``dataset``, ``source``, ``run``.
 
 Each parameter is declared once: in the signature (and the docstring's Parameters) of the
 function that answers the command. ``sea``, ``buoy`` and ``horizon`` are that function itself
 (:data:`IMPLEMENTED`: :func:`parapend.irregular.sea`, :func:`parapend.hydro.api.buoy`,
-:func:`parapend.control.horizon.horizon_curve`); the others here convert units, check or
-shape the result around the modules that answer them. The command line is a thin shell over
+:func:`parapend.control.horizon.horizon_curve`); ``sweep`` and ``power_matrix`` take the
+signature of theirs as it is and shape its answer into the command's result
+(:data:`FORWARDED`: :func:`parapend.maps.sweep`, :func:`parapend.performance.power_matrix`);
+the others here convert units, check or shape the result around the modules that answer
+them. The command line is a thin shell over
 these functions: each command parses its options, whose defaults it reads from the
 function's signature (:meth:`parapend.cli._common._Parser.declare_defaults`), calls the
 function and formats the result. Options that only choose how the result is presented are
@@ -39,8 +42,8 @@ from .errors import OutputError, ParameterError, check_int, check_range
 from .results import Record
 
 __all__ = ["PRESENTATION", "basins", "damping_sweep", "figure", "harmonics", "map",
-           "optimize", "pto_curve", "reproduce", "rotations", "simulate", "sweep",
-           "threshold", "track", "power_matrix"]
+           "optimize", "pto_curve", "reproduce", "rotations", "simulate", "threshold",
+           "track"]
 
 #: command-line options that are not parameters of the functions: how to show or where to
 #: write a result (``figure`` and ``map`` keep ``plot``: the figure file is their product)
@@ -674,45 +677,30 @@ def _track_mpc(*, excitation, omega, delta, square_alpha, fourier, file, gamma, 
 
 
 # --- sweep, map ----------------------------------------------------------------------------
-def sweep(*, omega="1.8", delta=None, gamma=GAMMA["sweep"], torque_limit=None,
-          efficiency=None, excitation=None, square_alpha=None, fourier=None,
-          harmonics: int = 24, threshold: bool = False, store=None,
-          overwrite: bool = False, netcdf=None, workers=None, scheduler=None,
-          block_points=None, command=None, progress=None, length=None, mass=None,
-          inertia=None, gravity=None):
-    """A resumable design map (command ``sweep``; :func:`parapend.maps.sweep`): axes as
-    one value, ``"START:STOP:COUNT"`` or a comma list (or numbers). Fields are the JSON
-    keys; ``_run`` is the :class:`~parapend.maps.SweepRun`, ``_dataset`` its Dataset.
-    ``netcdf`` also exports the finished map. ``store`` None (the default here; the command
-    line's is ``map.zarr``) computes in memory and writes nothing. The store is
-    non-dimensional (one store
-    serves every pendulum); with ``length`` and ``mass`` the largest power is also given in
-    W (``largest_power_w``) and ``parapend.map`` draws it in SI with the same options."""
+def _sweep_result(sweep, arguments):
+    """A resumable design map (command ``sweep``): :func:`parapend.maps.sweep` (its
+    parameters, declared there: axes as one value, ``"START:STOP:COUNT"`` or a comma list,
+    or numbers), as a :class:`~parapend.results.Record` whose fields are the JSON keys;
+    ``run`` is the :class:`~parapend.maps.SweepRun`, ``dataset`` its Dataset. ``store``
+    None (the default here; the command line's is ``map.zarr``) computes in memory and
+    writes nothing; ``netcdf`` also exports the finished map. The store is non-dimensional
+    (one store serves every pendulum); with ``length`` and ``mass`` the largest power is
+    also given in W (``largest_power_w``) and ``parapend.map`` draws it in SI with the same
+    options. With an efficiency ``power`` is the electrical power (the headline, as
+    ``optimize``): ``largest_power`` is the point of the largest electrical power, with that
+    point's ``mechanical_power``.
+
+    Returns
+    -------
+    Record
+    """
     import importlib
 
     import numpy as np
 
     sw = importlib.import_module(".maps", __package__)
-    units, _, _ = _physical({}, length=length, mass=mass, inertia=inertia, gravity=gravity)
-    if scheduler is not None and workers is not None:
-        raise ParameterError("workers: the processes are the cluster's with --scheduler; "
-                             "drop --workers")
-    if scheduler is not None:
-        try:
-            import distributed  # noqa: F401
-        except ImportError:
-            raise ParameterError("scheduler: needs the 'distributed' package (python -m pip "
-                                 "install distributed)") from None
-    run = sw.sweep(store, omega=omega, delta=delta, gamma=gamma, torque_limit=torque_limit,
-                   efficiency=efficiency, harmonics=harmonics, excitation=excitation,
-                   square_alpha=square_alpha, fourier=fourier, threshold=threshold,
-                   workers=workers, scheduler=scheduler, overwrite=overwrite,
-                   command=command, progress=progress, block_points=block_points)
-    ds = run.dataset
-    if netcdf:
-        from . import fileio
-
-        fileio.write_dataset(ds, netcdf)
+    run = sweep(*arguments.args, **arguments.kwargs)
+    ds, units = run.dataset, run.units
     codes = ds["status"].values[ds["done"].values]
     counts = {s: int(np.sum(codes == i)) for i, s in enumerate(sw.STATUSES)
               if np.any(codes == i)}
@@ -721,8 +709,10 @@ def sweep(*, omega="1.8", delta=None, gamma=GAMMA["sweep"], torque_limit=None,
     best = None
     if ok.any():
         k = np.unravel_index(np.nanargmax(np.where(ok, p, -np.inf)), p.shape)
-        best = {"power": float(p[k]), **{d: float(ds[d].values[i])
-                                          for d, i in zip(ds["power"].dims, k)}}
+        best = {"power": float(p[k])}
+        if "mechanical_power" in ds:
+            best["mechanical_power"] = float(ds["mechanical_power"].values[k])
+        best.update({d: float(ds[d].values[i]) for d, i in zip(ds["power"].dims, k)})
     out = {
         "store": run.store, "dims": {d: int(ds.sizes[d]) for d in ds["power"].dims},
         "points": run.points, "blocks": run.blocks, "computed_points": run.computed_points,
@@ -731,17 +721,21 @@ def sweep(*, omega="1.8", delta=None, gamma=GAMMA["sweep"], torque_limit=None,
         "largest_power": best,
         "largest_branch_gap": (float(np.nanmax(ds["branch_gap"].values))
                                if "branch_gap" in ds and ok.any() else None),
-        "netcdf": netcdf}
+        "netcdf": run.netcdf}
     if units is not None:
         out.update(units=units.describe(), largest_power_w=(
             None if best is None else units.to_watts(best["power"])))
-    return Record("sweep", out, run=run, dataset=ds, draw=_draw_dataset("maps", "plot_map"))
+        if best is not None and "mechanical_power" in best:
+            out["largest_power_mechanical_w"] = units.to_watts(best["mechanical_power"])
+    return Record("sweep", out, run=run, dataset=ds,
+                  draw=lambda rec: sw.plot_sweep(rec.dataset, units=rec.run.units))
 
 
 #: a design map's quantities in SI: the Units attribute that scales each (None: a ratio)
 MAP_SI = {"power": ("power", "W"), "uniform_power": ("power", "W"),
           "limit_power": ("power", "W"), "electrical_power": ("power", "W"),
-          "branch_gap": ("power", "W"), "damping_threshold": ("damping", "N m s/rad"),
+          "mechanical_power": ("power", "W"), "branch_gap": ("power", "W"),
+          "damping_threshold": ("damping", "N m s/rad"),
           "gain": None}
 
 
@@ -816,53 +810,41 @@ def map(*, store: str = "map.zarr", variable: str = "power", x=None, y=None, at=
 
 
 # --- power-matrix ----------------------------------------------------------------------------
-def power_matrix(*, hs: str = "1:3:3", te=None, tp=None, realizations: int = 3,
-                 waves: float = 50.0, seed: int = 0, spectrum: str = "jonswap",
-                 gamma_peak: float = 3.3, cutoff: float = 3.0, response=None,
-                 device: str = "prescribed-heave", horizon=None,
-                 length=None, mass=None, inertia=None,
-                 gravity: float = SEA["gravity"], gamma=None, damping_coefficient=None,
-                 winding=1, harmonics=None, efficiency=None, torque_limit=None, body=None,
-                 radius=None, draft=None, mesh=None, hydro=None, depth=None,
-                 density: float = 1025.0, width=None, scatter=None, timeseries=None,
-                 rated_power=None, store=None, overwrite: bool = False, workers=None,
-                 scheduler=None, netcdf=None, zarr=None, csv=None, command=None,
-                 progress=None):
+def _power_matrix_result(power_matrix, arguments):
     """Power matrix over sea-state bins, capture width and annual energy (command
-    ``power-matrix``; :func:`parapend.performance.power_matrix`, docs/performance.md).
-    ``te`` default ``"6:10:3"`` when neither ``te`` nor ``tp`` is given. Fields are the JSON
-    keys; ``_dataset`` is the full Dataset (MHKiT's layout), ``_run`` the engine's run.
+    ``power-matrix``): :func:`parapend.performance.power_matrix` (its parameters, declared
+    there; docs/performance.md) as a :class:`~parapend.results.Record` whose fields are the
+    JSON keys. ``te`` default ``"6:10:3"`` when neither ``te`` nor ``tp`` is given;
+    ``dataset`` is the full Dataset (MHKiT's layout), ``run`` the engine's run.
     ``device="buoy"``: the coupled buoy (``body, radius, draft, mesh, hydro`` and the
-    pendulum in SI as ``buoy``; ``length``/``mass`` None: the device's default)."""
-    from .performance import STATISTICS
-    from .performance import power_matrix as _pm
+    pendulum in SI as ``buoy``; ``length``/``mass`` None: the device's default).
 
-    if scheduler is not None and workers is not None:
+    Returns
+    -------
+    Record
+    """
+    from .performance import STATISTICS
+
+    a = arguments.arguments
+    if a["scheduler"] is not None and a["workers"] is not None:
         raise ParameterError("workers: the processes are the cluster's with --scheduler; "
                              "drop --workers")
-    ds, annual, run, seconds = _pm(
-        hs=hs, te=te, tp=tp, realizations=realizations, waves=waves, seed=seed,
-        spectrum=spectrum, gamma_peak=gamma_peak, cutoff=cutoff, response=response,
-        device=device, horizon=horizon, length=length, mass=mass, inertia=inertia,
-        gravity=gravity, gamma=gamma, damping_coefficient=damping_coefficient,
-        winding=winding, harmonics=harmonics, efficiency=efficiency,
-        torque_limit=torque_limit, body=body, radius=radius, draft=draft, mesh=mesh,
-        hydro=hydro, depth=depth, density=density, width=width,
-        scatter=scatter, timeseries=timeseries, rated_power=rated_power, store=store,
-        overwrite=overwrite, workers=workers, scheduler=scheduler, netcdf=netcdf, zarr=zarr,
-        csv=csv, command=command, progress=progress)
+    ds, annual, run, seconds = power_matrix(*arguments.args, **arguments.kwargs)
+    waves, device, depth = a["waves"], a["device"], a["depth"]
+    netcdf, zarr, csv = a["netcdf"], a["zarr"], a["csv"]
     pk = "tp" if "tp" in ds.dims else "te"
 
     def grid(name):
         return [[None if not math.isfinite(float(v)) else float(v) for v in row]
                 for row in ds[name].values]
 
-    quantities = [q for q in ("power", "limit_power", "uniform_power", "electrical_power",
-                              "radiation_bound_power", "one_way_power") if q in ds]
+    quantities = [q for q in ("power", "mechanical_power", "limit_power", "uniform_power",
+                              "electrical_power", "radiation_bound_power", "one_way_power")
+                  if q in ds]
     stats = {q: {s: (ds[f"{q}_{s}"].values.astype(int).tolist() if s == "count"
                      else grid(f"{q}_{s}")) for s in STATISTICS} for q in quantities}
     codes = ds["status"].values
-    failed = int((codes > 0).sum())  # a raised solve is written but not marked done
+    failed = int((codes > 1).sum())  # 0, 1: converged, no_power (a raised solve: not done)
     out = {"hm0": [float(v) for v in ds["hm0"].values], pk: [float(v) for v in ds[pk].values],
            "tp" if pk == "te" else "te":
                [float(v) for v in ds["tp" if pk == "te" else "te"].values],
@@ -889,29 +871,63 @@ def power_matrix(*, hs: str = "1:3:3", te=None, tp=None, realizations: int = 3,
                                  else annual["power"]["mwh"]),
            "capacity_factor": (None if annual is None
                                else annual["power"].get("capacity_factor")),
-           "store": run.store, "computed_bins": run.computed_points // int(realizations),
-           "resumed_bins": run.resumed_points // int(realizations), "seconds": seconds,
+           "store": run.store, "computed_bins": run.computed_points // int(a["realizations"]),
+           "resumed_bins": run.resumed_points // int(a["realizations"]), "seconds": seconds,
            "executor": run.executor, "netcdf": netcdf, "zarr": zarr, "csv": csv}
     return Record("power-matrix", out, dataset=ds, run=run,
                   draw=_draw_dataset("performance.figures", "plot_matrix"))
 
 
-# --- sea, buoy, horizon: the implementation is the command's function ----------------------
+# --- sea, buoy, horizon: the implementation is the command's function; sweep, power-matrix:
+# --- the implementation's signature ---------------------------------------------------------
 #: commands whose function is the implementation itself, imported on first use (its
 #: signature and docstring are the command's parameters, declared once): name -> (module,
 #: function)
 IMPLEMENTED = {"sea": (".irregular", "sea"), "buoy": (".hydro.api", "buoy"),
                "horizon": (".control.horizon", "horizon_curve")}
-__all__ += list(IMPLEMENTED)
+#: commands whose parameters are declared once, in the signature (and the docstring's
+#: Parameters) of the implementing function, whose answer the command's function shapes into
+#: the command's result: name -> (module, function, shape). The command's function takes
+#: every argument as the implementation does and hands it on unchanged; its signature is
+#: the implementation's, read live (``__wrapped__``: :func:`inspect.signature` follows it),
+#: so the command line's defaults are the implementation's.
+FORWARDED = {"sweep": (".maps.run", "sweep", _sweep_result),
+             "power_matrix": (".performance", "power_matrix", _power_matrix_result)}
+__all__ += [*IMPLEMENTED, *FORWARDED]
+
+
+def _forward(name: str, impl, shape):
+    """The command's function ``name``: ``shape(impl, arguments)`` with the call's arguments
+    bound to ``impl``'s signature (its defaults applied), under ``impl``'s signature and
+    ``shape``'s docstring (:data:`FORWARDED`)."""
+    import inspect
+
+    def command(*args, **kwargs):
+        arguments = inspect.signature(impl).bind(*args, **kwargs)
+        arguments.apply_defaults()
+        return shape(impl, arguments)
+
+    command.__wrapped__ = impl
+    command.__name__ = command.__qualname__ = name
+    command.__module__ = __name__
+    command.__doc__ = shape.__doc__
+    return command
 
 
 def __getattr__(name: str):
-    """``sea``, ``buoy``, ``horizon``: the implementing function (:data:`IMPLEMENTED`)."""
-    where = IMPLEMENTED.get(name)
-    if where is None:
-        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+    """``sea``, ``buoy``, ``horizon``: the implementing function (:data:`IMPLEMENTED`);
+    ``sweep``, ``power_matrix``: the implementation's parameters, the command's result
+    (:data:`FORWARDED`)."""
     import importlib
 
-    fn = getattr(importlib.import_module(where[0], __package__), where[1])
+    if name in FORWARDED:
+        module, function, shape = FORWARDED[name]
+        fn = _forward(name, getattr(importlib.import_module(module, __package__), function),
+                      shape)
+    elif name in IMPLEMENTED:
+        module, function = IMPLEMENTED[name]
+        fn = getattr(importlib.import_module(module, __package__), function)
+    else:
+        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
     globals()[name] = fn
     return fn

@@ -109,6 +109,9 @@ def add_parsers(sub) -> None:
                    metavar="ETA_G[,ETA_M]",
                    help="power take-off efficiency in (0, 1], generating[,motoring]: the "
                         "motion maximizes the electrical power")
+    g.add_argument("--copper-loss", type=_finite_float("copper-loss"),
+                   help="the generator's winding loss r tau^2 subtracted from the power, r "
+                        "in W/(N m)^2 (with --dofs surge,heave,pitch)")
     g = p.add_argument_group("design")
     g.add_argument("--optimize-design", metavar="NAMES",
                    help="choose these pendulum parameters for the most power: a comma list "
@@ -349,7 +352,8 @@ def _hull_text(r) -> list:
               _w(m.get("peak_torque_nm")), str(m.get("distinct_maxima", "-")),
               m["status"]] for m in r.modes]
     rows = [["best mode", r.mode, "-"],
-            ["power", _w(r.power_w), "W"],
+            ["power" if r.efficiency is None and not r.copper_loss else "electrical power",
+             _w(r.power_w), "W"],
             ["  discretization error (half the harmonics)", _w(r.refinement_change_w), "W"],
             ["one-way (reaction left out)", _w(r.one_way_power_w), "W"],
             ["radiation bound (F a)^H B^+ (F a) / 8", _w(r.radiation_bound_w), "W"],
@@ -364,6 +368,14 @@ def _hull_text(r) -> list:
             ["mean heel", f"{r.mean_heel_deg:.4g}", "deg"],
             ["peak torque", _w(r.peak_torque_nm), "N m"],
             ["peak bearing load", _w(r.peak_pivot_force_n), "N"]]
+    if r.efficiency is not None or r.copper_loss:
+        pto = [f"efficiency {r.efficiency[0]:g} generating, {r.efficiency[1]:g} motoring"
+               if r.efficiency is not None else None,
+               f"copper loss {r.copper_loss:g} W/(N m)^2" if r.copper_loss else None]
+        rows.insert(3, ["  mechanical power (" + ", ".join(x for x in pto if x) + ")",
+                        _w(r.mechanical_power_w), "W"])
+    if r.torque_limit_nm is not None:
+        rows.insert(3, ["  torque limit", _w(r.torque_limit_nm), "N m"])
     out = [wave, *_hull_head(r), "",
            _table(modes, ["mode", "power (W)", "one-way (W)", "mean angle (deg)",
                           "swing (deg)", "peak torque (N m)", "maxima", "status"]), "",

@@ -19,6 +19,10 @@ from ._common import (
 from .sweep import _NEGATIVE_VALUE, _EtaProgress
 
 _BINS = "FROM:TO:N (N centres, ends included) or a comma list"
+#: the out-of-memory line: only options this command has
+OUT_OF_MEMORY = ("out of memory; use fewer --hs or --te/--tp bins, fewer --realizations, "
+                 "shorter records (--waves), fewer --harmonics or --workers; with --store "
+                 "the finished bins are kept: run the same command again to resume")
 
 
 def _winding(text):
@@ -78,7 +82,8 @@ def add_parsers(sub) -> None:
     g.add_argument("--winding", type=_winding, help="as sea (default 1)")
     g.add_argument("--harmonics", type=_int, help="as sea (default 16 per wave)")
     g.add_argument("--efficiency", type=_finite_float("efficiency"),
-                   help="power take-off efficiency in (0, 1]: adds the electrical power")
+                   help="power take-off efficiency in [1e-6, 1]: the power reported is "
+                        "the electrical one, the mechanical beside it")
     g.add_argument("--torque-limit", type=_finite_float("torque-limit"),
                    help="not supported over a sea record (refused)")
     g = p.add_argument_group("the buoy's body (--device buoy; as parapend buoy)")
@@ -86,9 +91,11 @@ def add_parsers(sub) -> None:
                      hydro_help="a Capytaine NetCDF dataset, instead of --body (docs/buoy.md)")
     g = p.add_argument_group("resource and site")
     g.add_argument("--depth", type=_finite_float("depth"),
-                   help="water depth, m (default deep water)")
+                   help="water depth, m (default deep water; with --device buoy also "
+                        "the body's BEM)")
     g.add_argument("--density", type=_finite_float("density"),
-                   help="water density, kg/m^3 (default 1025)")
+                   help="water density, kg/m^3 (default 1025; with --device buoy also "
+                        "the body's)")
     g.add_argument("--width", type=_finite_float("width"),
                    help="characteristic width, m: adds the capture-width ratio (buoy "
                         "default: the body's diameter)")
@@ -127,8 +134,14 @@ def _cmd_power_matrix(a) -> dict | str:
         for s in ("matrix", "capture-width", "scatter"):
             _check_output(f"{a.plot}-{s}.png", "--plot", FIGURE_SUFFIXES)
     argv = sys.argv[1:] if sys.argv and sys.argv[0] else []
-    rec = _run(a, command="parapend " + " ".join(shlex.quote(x) for x in argv),
-               progress=_EtaProgress("power-matrix"))
+    try:
+        rec = _run(a, command="parapend " + " ".join(shlex.quote(x) for x in argv),
+                   progress=_EtaProgress("power-matrix"))
+    except MemoryError:
+        # the generic message names --points, which this command has not
+        from ..errors import SolverError
+
+        raise SolverError(OUT_OF_MEMORY) from None
     ds = rec.dataset
     drawn = []
     if a.plot:

@@ -144,10 +144,17 @@ def _cmd_sweep(a) -> dict | str:
                 if run.repaired_points else ""),
              "status: " + ", ".join(f"{s} {n}" for s, n in counts.items())]
     if best is not None:
-        where = ", ".join(f"{k} = {v:.6g}" for k, v in best.items() if k != "power")
+        where = ", ".join(f"{k} = {v:.6g}" for k, v in best.items()
+                          if k not in ("power", "mechanical_power"))
         watts = (f" ({out['largest_power_w']:.6g} W)" if out.get("largest_power_w") is not None
                  else "")
-        lines.append(f"largest power {_fmt(best['power'], 8)}{watts} at {where}")
+        if "mechanical_power" in best:  # an efficiency: the headline is the electrical power
+            mech = out.get("largest_power_mechanical_w")
+            lines.append(f"largest electrical power {_fmt(best['power'], 8)}{watts} at {where} "
+                         f"(mechanical {_fmt(best['mechanical_power'], 8)}"
+                         + (f", {mech:.6g} W)" if mech is not None else ")"))
+        else:
+            lines.append(f"largest power {_fmt(best['power'], 8)}{watts} at {where}")
     if out["largest_branch_gap"]:
         lines.append(f"continuation found a higher branch than the global search, by up to "
                      f"{out['largest_branch_gap']:.3g} (variable branch_gap)")

@@ -14,7 +14,7 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["TrigColumns", "GramPlan"]
+__all__ = ["FusedGram", "GramPlan", "TrigColumns"]
 
 
 class TrigColumns:
@@ -54,6 +54,26 @@ class GramPlan:
 
     def __call__(self, v: np.ndarray) -> np.ndarray:
         return self.c1 * v[self.i1] + self.c2 * v[self.i2]
+
+
+class FusedGram:
+    """A sum of Gram matrices ``sum_p G_p(w_{k_p})`` (each :class:`GramPlan` ``p`` on the
+    weight ``k_p``, transposed where asked) in one gather from the stacked spectra: the
+    per-plan calls' overhead, not their arithmetic, is what it saves."""
+
+    def __init__(self, terms, m: int):
+        """``terms``: ``(plan, k, transposed)`` of one shape (after the transposition)."""
+        idx, coef = [], []
+        for plan, k, tr in terms:
+            for i, c in ((plan.i1, plan.c1), (plan.i2, plan.c2)):
+                idx.append((i.T if tr else i) + 2 * m * k)
+                coef.append(c.T if tr else c)
+        self.idx = np.stack(idx)
+        self.coef = np.stack(coef)
+
+    def __call__(self, v: np.ndarray) -> np.ndarray:
+        """``v`` the stacked spectra (K, 2M) of :func:`spectra`."""
+        return np.einsum("pij,pij->ij", self.coef, v.ravel()[self.idx])
 
 
 def spectra(weights) -> np.ndarray:

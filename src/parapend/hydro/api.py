@@ -262,7 +262,7 @@ def buoy(*, wave_height=None, wave_period=None, hs=None, tp=None, spectrum=None,
          inertia_bounds=None, damping_coefficient_bounds=None, controller="optimum",
          horizon=None, update_interval=None, wave_direction=None, dofs="heave",
          pivot_height=None, pivot_offset=None, hull_pitch_inertia=None, barge_length=None,
-         barge_beam=None, barge_draft=None, progress=None):
+         barge_beam=None, barge_draft=None, copper_loss=None, progress=None):
     """The coupled optimum of a pendulum inside a floating buoy (command ``buoy``).
 
     Parameters
@@ -308,6 +308,8 @@ def buoy(*, wave_height=None, wave_period=None, hs=None, tp=None, spectrum=None,
         dataset's, else a homogeneous immersed hull); ``winding`` None reports rotation
         (one turn per wave) and swinging (``winding=0``) side by side. Options not given
         take the embedded hull design's values (``parapend.defaults.HULL``).
+        ``copper_loss`` ``r`` (W per (N m)^2; hull only) subtracts the winding loss ``r
+        tau^2`` from the power: holding an angle then costs what it costs a generator.
     progress : callable or None
         With ``optimize_design``: called ``progress(done, total)`` after every inner solve
         of the search (the command line draws it as a bar on a terminal).
@@ -328,7 +330,7 @@ def buoy(*, wave_height=None, wave_period=None, hs=None, tp=None, spectrum=None,
         return hull_buoy(**{k: v for k, v in opts.items() if k not in (
             "dofs", "Wave", "hull_buoy", "parse_dofs", "progress")})
     for name in ("pivot_height", "pivot_offset", "hull_pitch_inertia", "barge_length",
-                 "barge_beam", "barge_draft"):
+                 "barge_beam", "barge_draft", "copper_loss"):
         if opts[name] is not None:
             raise ParameterError(f"{name.replace('_', '-')}: a hull's option; needs --dofs "
                                  "surge,heave,pitch")

@@ -42,12 +42,19 @@ import numpy as np
 from scipy.linalg.lapack import dgetrf, dgetrs
 
 from ..errors import ParameterError
-from ._trig import GramPlan, TrigColumns, spectra
+from ._trig import FusedGram, GramPlan, TrigColumns, spectra
+from .pto import PTOObjective, _abs
 
 __all__ = ["HullCase", "HullProblem", "hull_points"]
 
 #: grid variables of the pointwise functions, in this order
 _VARS = ("phi", "phi1", "phi2", "qx", "qz", "b1")
+#: the pairs of them on which the objective's second derivative can be non-zero: every
+#: pair with a ``tau_tau`` term (an efficiency, a copper loss, a limit); else those of
+#: ``tau``'s own second derivative and those that hold ``v = phi' - b1``
+_PAIRS = {"all": [(u, w) for i, u in enumerate(_VARS) for w in _VARS[i:]]}
+_PAIRS["lossless"] = [(u, w) for u, w in _PAIRS["all"] if (u, w) in (
+    ("phi", "phi"), ("phi", "qx"), ("phi", "qz")) or {u, w} & {"phi1", "b1"}]
 
 
 def _lu(a):
@@ -139,16 +146,29 @@ class HullCase:
         return out
 
 
-class HullProblem:
+class HullProblem(PTOObjective):
     """Power, exact gradient and Hessian of the hull problem in the ``phi`` coefficients.
 
     ``coupled=False``: the hull moves as if the pendulum were not there (its free response,
     the pendulum's mass lumped at the pivot): the one-way problem.
+
+    A real power take-off (:class:`~parapend.hydro.pto.PTOObjective`): ``eta = (eta_g,
+    eta_m)`` makes the objective the electrical power ``<e(p)>`` of the generator's
+    mechanical power ``p = -tau (phi' - beta')`` (its kink smoothed by ``width``),
+    ``copper_loss`` ``r`` (W per (N m)^2) subtracts the winding loss ``r <tau^2>`` (holding
+    an angle then costs power), and :meth:`set_limit` penalizes ``|tau|`` above a torque
+    limit on the grid; :func:`parapend.hydro.pto.maximize` drives the continuation. Without
+    them the objective is the mechanical power.
     """
 
-    def __init__(self, case: HullCase, coupled: bool = True):
+    hessian = None  # dense (the drivers of :mod:`.pto` read it)
+
+    def __init__(self, case: HullCase, coupled: bool = True, eta=None,
+                 copper_loss: float = 0.0):
         self.case = case
         self.coupled = coupled
+        self.set_efficiency(eta)
+        self.copper_loss = float(copper_loss)
         n, nh, m = case.harmonics, case.hull_harmonics, case.points
         w, kw = case.omega, case.winding
         self.harmonics, self.points, self.winding, self.omega = n, m, kw, w
@@ -245,6 +265,7 @@ class HullProblem:
         self._cols = cols
         self._pi_cols = [TrigColumns(freq, kp, sp * on[d]) for d in range(3)]
         self._plans = {}
+        self._fused_plans = {}
         self._last = None
         self._last_phi = None
 
@@ -254,6 +275,27 @@ class HullProblem:
             ca = self._pi_cols[int(a[2:])] if a.startswith("pi") else self._cols[a]
             self._plans[key] = GramPlan(ca, self._cols[b], self.points)
         return self._plans[key]
+
+    def _fused(self, keys: tuple, coupled: bool) -> dict:
+        """The Hessian's blocks ``xx``, ``xy``, ``yy`` and the sensitivity's right side
+        ``sens`` as :class:`FusedGram` s over the weights in the order :meth:`evaluate`
+        stacks them (the pairs ``keys``, then the nine sensitivity weights)."""
+        ck = (keys, coupled)
+        if ck not in self._fused_plans:
+            xv = ("phi", "phi1", "phi2")
+            blocks = {"xx": [], "xy": [], "yy": [], "sens": []}
+            for k, (u, w) in enumerate(keys):
+                plan = self._plan(u, w)
+                blk = "xx" if w in xv else ("xy" if u in xv else "yy")
+                blocks[blk].append((plan, k, False))
+                if u != w and blk != "xy":
+                    blocks[blk].append((plan, k, True))
+            if coupled:
+                for j, (d, i) in enumerate((d, i) for d in range(3) for i in range(3)):
+                    blocks["sens"].append((self._plan(f"pi{d}", xv[i]), len(keys) + j, False))
+            self._fused_plans[ck] = {b: FusedGram(t, self.points) for b, t in blocks.items()
+                                     if t}
+        return self._fused_plans[ck]
 
     # --------------------------------------------------------------------------------------
     def phi(self, x):
@@ -329,67 +371,139 @@ class HullProblem:
         return {"phi": f, "phi1": f1, "phi2": f2, "qx": qx, "qz": qz, "b1": b1, "y": y,
                 "tau": tau, "relative_speed": v, "power": -float(np.mean(tau * v))}
 
-    def power(self, x) -> float:
+    @property
+    def lossless(self) -> bool:
+        """The objective is the mechanical power (no efficiency, loss or limit)."""
+        return self.b == 0.0 and self.a == 1.0 and self.copper_loss == 0.0 and \
+            self.limit is None
+
+    def state(self, x) -> dict:
+        """The grid state with the generator's mechanical power ``p = -tau v`` per point."""
+        st = self.grid_state(x)
+        st["p"] = -st["tau"] * st["relative_speed"]
+        return st
+
+    def mechanical(self, x) -> float:
+        """``<p>``: the mechanical power on the grid."""
         return self.grid_state(x)["power"]
 
+    def exact(self, x) -> float:
+        """The objective unsmoothed and without the limit's penalty: ``a <p> + b <|p|> - r
+        <tau^2>`` (the kink integrated on the piecewise-linear interpolant of ``p``)."""
+        st = self.state(x)
+        p = st["p"]
+        val = self.a * float(np.mean(p))
+        if self.b != 0.0:
+            val += self.b * _abs(p)
+        if self.copper_loss:
+            val -= self.copper_loss * float(np.mean(st["tau"] ** 2))
+        return val
+
+    def power(self, x) -> float:
+        """The objective the solvers climb: the mechanical power, or the smoothed electrical
+        power less the copper loss and the limit's penalty."""
+        if self.lossless:
+            return self.grid_state(x)["power"]
+        return float(np.mean(self._objective(self.state(x))[0]))
+
+    def _objective(self, st):
+        """The objective's pointwise value ``f(tau, v)`` and its derivatives ``(f, f_tau,
+        f_v, f_tt, f_tv, f_vv)`` (None: zero) on the grid."""
+        tau, v = st["tau"], st["relative_speed"]
+        p = -tau * v
+        if self.b == 0.0:
+            a = self.a
+            f, ft, fv, ftt, ftv, fvv = a * p, -a * v, -a * tau, None, -a, None
+        else:
+            e, e1, e2 = self._e(p)
+            f, ft, fv = e, -e1 * v, -e1 * tau
+            ftt, ftv, fvv = e2 * v * v, e2 * tau * v - e1, e2 * tau * tau
+        r = self.copper_loss
+        if r:
+            f = f - r * tau * tau
+            ft = ft - 2 * r * tau
+            ftt = -2 * r if ftt is None else ftt - 2 * r
+        if self.limit is not None:
+            q0, q1, q2 = self._penalty(tau)
+            f, ft = f + q0, ft + q1
+            ftt = q2 if ftt is None else ftt + q2
+        return f, ft, fv, ftt, ftv, fvv
+
     # --------------------------------------------------------------------------------------
-    def _pointwise(self, st, mu):
-        """Value-free first and second derivatives of the Lagrangian's pointwise part
-        ``-tau v / M + sum_d mu_d rho_d`` in ``_VARS`` (the constraint's weights ``mu``
-        (3, M), zero for the one-way problem). Returns ``(d1, d2)``: dicts of arrays."""
+    def _tau_derivatives(self, st):
+        """``dtau`` and ``d2tau`` in ``_VARS`` (pointwise), and ``dv`` (``v = phi' - b1``)."""
         cs = self.case
-        ml, mm = cs.m * cs.l, self.points
+        ml = cs.m * cs.l
+        f = st["phi"]
+        sn, co = np.sin(f), np.cos(f)
+        wgt = (cs.g + st["qz"]) * sn - st["qx"] * co
+        wph = (cs.g + st["qz"]) * co + st["qx"] * sn
+        dtau = {"phi": -ml * wph, "phi1": cs.c, "phi2": cs.I, "qx": ml * co, "qz": -ml * sn,
+                "b1": -cs.c}
+        d2tau = {("phi", "phi"): ml * wgt, ("phi", "qx"): -ml * sn, ("phi", "qz"): -ml * co}
+        return dtau, d2tau, {"phi1": 1.0, "b1": -1.0}
+
+    def _objective_derivatives(self, st):
+        """The first and second derivatives of the objective's mean ``<f(tau, v)>`` in
+        ``_VARS`` (chain rule through :meth:`_tau_derivatives`): dicts of arrays, the
+        second only on the pairs that can be non-zero (:data:`_PAIRS`)."""
+        mm = self.points
+        _, ft, fv, ftt, ftv, fvv = self._objective(st)
+        dtau, d2tau, dv = self._tau_derivatives(st)
+        zero = np.zeros(mm)
+        d1 = {u: (ft * dtau[u] + (fv * dv[u] if u in dv else 0.0) + zero) / mm
+              for u in _VARS}
+        d2 = {}
+        for u, w in _PAIRS["all" if ftt is not None else "lossless"]:
+            h = ft * d2tau[(u, w)] if (u, w) in d2tau else zero
+            if u in dv or w in dv:
+                h = h + ftv * (dtau[u] * dv.get(w, 0.0) + dv.get(u, 0.0) * dtau[w])
+            if ftt is not None:
+                h = h + ftt * (dtau[u] * dtau[w])
+            if fvv is not None and u in dv and w in dv:
+                h = h + fvv * (dv[u] * dv[w])
+            d2[(u, w)] = (h + zero) / mm
+        return d1, d2
+
+    def _pointwise(self, st, mu, obj=None):
+        """First and second derivatives of the Lagrangian's pointwise part ``<f(tau, v)> +
+        sum_d mu_d rho_d`` in ``_VARS`` (the constraint's weights ``mu`` (3, M), zero for
+        the one-way problem: None). Returns ``(d1, d2)``: dicts of arrays."""
+        d1, d2 = self._objective_derivatives(st) if obj is None else obj
+        if mu is None:
+            return d1, d2
+        cs = self.case
+        ml = cs.m * cs.l
         dp, hp = cs.pivot
         f, f1, f2 = st["phi"], st["phi1"], st["phi2"]
-        qx, qz, b1 = st["qx"], st["qz"], st["b1"]
+        qx, qz = st["qx"], st["qz"]
         sn, co = np.sin(f), np.cos(f)
-        v = f1 - b1
         e = mu[2]
         a = mu[0] + hp * e
         b = mu[1] - dp * e
-        kap = e + v / mm
         wgt = (cs.g + qz) * sn - qx * co
         wph = (cs.g + qz) * co + qx * sn
         X = a * sn + b * co
         Y = b * sn - a * co
-        d1 = {
-            "phi": ml * kap * wph + ml * (f2 * X - f1**2 * Y),
-            "phi1": ml * wgt / mm + 2 * ml * f1 * X - cs.I * f2 / mm - 2 * cs.c * v / mm,
-            "phi2": ml * Y - cs.I * kap,
-            "qx": -ml * kap * co,
-            "qz": ml * kap * sn,
-            "b1": -ml * wgt / mm + cs.I * f2 / mm + 2 * cs.c * v / mm,
-        }
-        d2 = {
-            ("phi", "phi"): -ml * kap * wgt + ml * (-f2 * Y - f1**2 * X),
-            ("phi", "phi1"): ml * wph / mm - 2 * ml * f1 * Y,
-            ("phi", "phi2"): ml * X,
-            ("phi", "qx"): ml * kap * sn,
-            ("phi", "qz"): ml * kap * co,
-            ("phi", "b1"): -ml * wph / mm,
-            ("phi1", "phi1"): 2 * ml * X - 2 * cs.c / mm,
-            ("phi1", "phi2"): -cs.I / mm + 0 * f,
-            ("phi1", "qx"): -ml * co / mm,
-            ("phi1", "qz"): ml * sn / mm,
-            ("phi1", "b1"): 2 * cs.c / mm + 0 * f,
-            ("phi2", "b1"): cs.I / mm + 0 * f,
-            ("qx", "b1"): ml * co / mm,
-            ("qz", "b1"): -ml * sn / mm,
-            ("b1", "b1"): -2 * cs.c / mm + 0 * f,
-        }
+        d1, d2 = dict(d1), dict(d2)
+        con1 = {"phi": ml * e * wph + ml * (f2 * X - f1**2 * Y), "phi1": 2 * ml * f1 * X,
+                "phi2": ml * Y - cs.I * e, "qx": -ml * e * co, "qz": ml * e * sn}
+        con2 = {("phi", "phi"): -ml * e * wgt + ml * (-f2 * Y - f1**2 * X),
+                ("phi", "phi1"): -2 * ml * f1 * Y, ("phi", "phi2"): ml * X,
+                ("phi", "qx"): ml * e * sn, ("phi", "qz"): ml * e * co,
+                ("phi1", "phi1"): 2 * ml * X}
+        for k, v in con1.items():
+            d1[k] = d1[k] + v
+        for k, v in con2.items():
+            d2[k] = d2[k] + v if k in d2 else v
         return d1, d2
 
-    def _objective_gy(self, st):
-        """``dP/dy`` of the power at fixed phi (the adjoint's right side): the pointwise
-        derivatives of ``-tau v / M`` in ``(p_x'', p_z'', beta')`` mapped to ``y``."""
-        cs = self.case
-        ml, mm = cs.m * cs.l, self.points
-        f = st["phi"]
-        sn, co = np.sin(f), np.cos(f)
-        v = st["relative_speed"]
-        wgt = (cs.g + st["qz"]) * sn - st["qx"] * co
-        return (self.Qx.T @ (-ml * v * co) + self.Qz.T @ (ml * v * sn)
-                + self.E1[2].T @ (-ml * wgt + cs.I * st["phi2"] + 2 * cs.c * v)) / mm
+    def _objective_gy(self, st, d1=None):
+        """``d<f>/dy`` at fixed phi (the adjoint's right side): the objective's pointwise
+        derivatives in ``(p_x'', p_z'', beta')`` mapped to ``y``."""
+        if d1 is None:
+            d1 = self._objective_derivatives(st)[0]
+        return self.Qx.T @ d1["qx"] + self.Qz.T @ d1["qz"] + self.E1[2].T @ d1["b1"]
 
     def _maps(self):
         """The linear maps of ``_VARS`` from x (first three) and y (last three)."""
@@ -403,14 +517,13 @@ class HullProblem:
         st = self.grid_state(x, y)
         maps = self._maps()
         xv = ("phi", "phi1", "phi2")
-        zero = np.zeros((3, self.points))
+        obj = self._objective_derivatives(st)
+        mu = None
         if lu is not None:
-            gy = self._objective_gy(st)
+            gy = self._objective_gy(st, obj[0])
             lam = _solve(lu, gy, trans=1)
             mu = np.array([self.Pi[d].T @ lam for d in range(3)])
-        else:
-            mu = zero
-        d1, d2 = self._pointwise(st, mu)
+        d1, d2 = self._pointwise(st, mu, obj)
         grad = sum(maps[k].T @ d1[k] for k in xv)
         # the Hessian of L in (x, y) as Gram matrices of the grid maps (one FFT per weight),
         # then the reduced Hessian [I; T]^T (Hessian of L) [I; T]
@@ -422,25 +535,16 @@ class HullProblem:
         else:
             sens = []
         v = spectra([p[2] for p in pairs] + [p[2] for p in sens])
-        n = x.size
-        hxx = np.zeros((n, n))
-        hxy = np.zeros((n, self.ny))
-        hyy = np.zeros((self.ny, self.ny))
-        for (u, w_, _), vk in zip(pairs, v):
-            g = self._plan(u, w_)(vk)
-            if u in xv and w_ in xv:
-                hxx += g if u == w_ else g + g.T
-            elif u in xv:
-                hxy += g
-            else:
-                hyy += g if u == w_ else g + g.T
+        fused = self._fused(tuple((u, w_) for u, w_, _ in pairs), bool(sens))
+        hxx = fused["xx"](v)
+        val = st["power"] if self.lossless else float(np.mean(self._objective(st)[0]))
         if lu is None:
-            return st["power"], grad, 0.5 * (hxx + hxx.T)
-        gx = sum(self._plan(a, b)(vk) for (a, b, _), vk in zip(sens, v[len(pairs):]))
+            return val, grad, 0.5 * (hxx + hxx.T)
+        hxy, hyy, gx = fused["xy"](v), fused["yy"](v), fused["sens"](v)
         t = _solve(lu, gx)
         ht = hxy @ t
         h = hxx + ht + ht.T + t.T @ (hyy @ t)
-        return st["power"], grad, 0.5 * (h + h.T)
+        return val, grad, 0.5 * (h + h.T)
 
     # --------------------------------------------------------------------------------------
     def harmonics_of(self, y) -> np.ndarray:

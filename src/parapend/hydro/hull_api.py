@@ -41,18 +41,32 @@ def parse_dofs(text) -> tuple:
 
 def _refuse_unsupported(opts: dict) -> None:
     """The heave-only command's options this problem does not take (yet): one line each."""
-    later = {"torque_limit": "torque-limit", "efficiency": "efficiency",
-             "optimize_design": "optimize-design", "mass_bounds": "mass-bounds",
+    later = {"optimize_design": "optimize-design", "mass_bounds": "mass-bounds",
              "length_bounds": "length-bounds", "inertia_bounds": "inertia-bounds",
              "damping_coefficient_bounds": "damping-coefficient-bounds",
              "horizon": "horizon", "update_interval": "update-interval"}
     for key, name in later.items():
         if opts.get(key) is not None:
-            raise ParameterError(f"{name}: not available with --dofs surge,heave,pitch yet "
-                                 "(the hull's optimum is ideal and unconstrained); drop it")
+            raise ParameterError(f"{name}: not available with --dofs surge,heave,pitch yet; "
+                                 "drop it")
     if opts.get("controller") not in (None, "optimum"):
         raise ParameterError("controller: the causal controllers run on the heaving buoy "
                              "only; drop --controller with --dofs surge,heave,pitch")
+
+
+def _pto(opts):
+    """The power take-off (:class:`.hull_optimum.HullPTO`) from ``torque_limit`` (N m),
+    ``efficiency`` and ``copper_loss`` (W per (N m)^2)."""
+    from .hull_optimum import HullPTO
+    from .pto import efficiency_pair
+
+    eta = efficiency_pair(opts.get("efficiency"))
+    limit = opts.get("torque_limit")
+    if limit is not None:
+        limit = check_range("torque-limit", limit, 1e-6, 1e12, why="N m")
+    r = opts.get("copper_loss")
+    r = 0.0 if r is None else check_range("copper-loss", r, 0.0, 1e6, why="W/(N m)^2")
+    return HullPTO(efficiency=eta, copper_loss=r, torque_limit=limit)
 
 
 def _value(opts, name):
@@ -168,6 +182,7 @@ def hull_buoy(**opts):
     from .inputs import _irregular_wave, _period, parse_periods
 
     _refuse_unsupported(opts)
+    pto = _pto(opts)
     pend = _pendulum(opts)
     build, geometry = _hull(opts)
     pivot = _pivot(opts, geometry)  # before the BEM: a pivot outside the hull is refused
@@ -205,7 +220,7 @@ def hull_buoy(**opts):
         hull.check_covers(wave.omega * (sig[0] + 1), wave.omega * (sig[-1] + 1), name="tp")
         return hull_answer(hull, pend, wave, pivot=pivot, windings=windings,
                            pitch_inertia=inertia, harmonics=harmonics, wave_info=info,
-                           geometry=geometry)
+                           geometry=geometry, pto=pto)
     height = check_range("wave-height", _value(opts, "wave_height"), 1e-4, 30.0,
                          why="regular wave height, m")
     periods = parse_periods(opts.get("wave_period"))
@@ -219,7 +234,7 @@ def hull_buoy(**opts):
         info = {"kind": "regular", "height_m": height, "period_s": float(t)}
         results.append(hull_answer(hull, pend, wave, pivot=pivot, windings=windings,
                                    pitch_inertia=inertia, harmonics=harmonics,
-                                   wave_info=info, geometry=geometry))
+                                   wave_info=info, geometry=geometry, pto=pto))
     if parse_periods(opts.get("wave_period")) is None:
         return results[0]
     from .hull_result import HullSweepResult

@@ -23,7 +23,7 @@ from ..errors import ParameterError
 from ..optimal.fourier import DISTINCT_RMS, _pad, motion_distance, newton_maximize
 from .hull import HullCase, HullProblem, hull_points
 
-__all__ = ["HARMONICS_PER_TURN", "HullSolution", "aliased", "hull_search", "make_case",
+__all__ = ["HARMONICS_PER_TURN", "HullPTO", "HullSolution", "aliased", "hull_search", "make_case",
            "radiation_bound", "waves_in"]
 
 #: harmonics of phi per turn (K >= 1) or per wave (K = 0) by default
@@ -99,6 +99,31 @@ def _starts(n: int, winding: int) -> list[tuple[str, np.ndarray]]:
     return out
 
 
+@dataclass(frozen=True)
+class HullPTO:
+    """The power take-off of the hull problem (SI): ``efficiency`` ``(eta_g, eta_m)`` or
+    None, ``copper_loss`` ``r`` of the winding loss ``r tau^2`` (W per (N m)^2), and
+    ``torque_limit`` (N m) or None. Inactive (all absent): the ideal, lossless PTO."""
+
+    efficiency: tuple | None = None
+    copper_loss: float = 0.0
+    torque_limit: float | None = None
+
+    @property
+    def active(self) -> bool:
+        return (self.efficiency is not None and tuple(self.efficiency) != (1.0, 1.0)) or \
+            self.copper_loss > 0 or self.torque_limit is not None
+
+    @property
+    def smoothed(self) -> bool:
+        """The objective has the efficiency's kink (a continuation in its smoothing)."""
+        return self.efficiency is not None and self.efficiency[0] * self.efficiency[1] != 1
+
+    def problem(self, case: HullCase, coupled: bool = True) -> HullProblem:
+        return HullProblem(case, coupled=coupled, eta=self.efficiency if self.smoothed
+                           else None, copper_loss=self.copper_loss)
+
+
 @dataclass(frozen=True, eq=False)
 class HullSolution:
     """One winding's optimum on one discretization (SI)."""
@@ -116,6 +141,9 @@ class HullSolution:
     iterations: int
     energy_balance_residual: float
     refinement_change: float | None = None
+    #: the mechanical power ``<-tau (phi' - beta')>`` (= ``power`` for an ideal PTO)
+    mechanical_power: float | None = None
+    pto: HullPTO = HullPTO()
 
 
 def aliased(problem: HullProblem, x) -> bool:
@@ -124,7 +152,9 @@ def aliased(problem: HullProblem, x) -> bool:
     the harmonics of ``sin(phi)`` past the grid's Nyquist frequency), not a power."""
     fine = HullProblem(dataclasses.replace(problem.case, points=4 * problem.case.points),
                        coupled=problem.coupled)
-    p, pf = problem.power(x), fine.power(x)
+    # the mechanical power, a smooth function of the motion, also under a PTO (whose
+    # kink the finer grid integrates differently: that is the refinement's business)
+    p, pf = problem.mechanical(x), fine.mechanical(x)
     return not abs(p - pf) <= ALIAS_TOL * max(abs(pf), float(problem.w[0]))
 
 
@@ -153,11 +183,12 @@ def _distinct(runs, best) -> int:
     return max(1, len(seen)) if best is not None else 0
 
 
-def hull_search(make, *, refine: bool = True) -> HullSolution:
+def hull_search(make, *, refine: bool = True, pto: HullPTO | None = None) -> HullSolution:
     """The best coupled maximum over the starts, with the one-way answer beside it.
 
     ``make(scale)`` returns the :class:`HullCase` with ``scale`` times the default
-    harmonics (1, and 2 for the refinement)."""
+    harmonics (1, and 2 for the refinement). With an active ``pto`` the ideal search's
+    distinct maxima start the PTO's optimum (:func:`_pto_stage`)."""
     case = make(1)
     n, kw = case.harmonics, case.winding
     one = HullProblem(case, coupled=False)
@@ -176,6 +207,8 @@ def hull_search(make, *, refine: bool = True) -> HullSolution:
         status, ok = f"no start converged (best: {best.status})", False
     else:
         status, ok = "converged", True
+    if pto is not None and pto.active:
+        return _pto_stage(case, make, pto, runs, best_one, refine)
     _, _, resid = coupled.balance(best.x)
     sol = HullSolution(case=case, x=best.x, power=float(coupled.power(best.x)),
                        one_way_power=float(best_one.power) if best_one else math.nan,
@@ -198,30 +231,171 @@ def _refine(sol: HullSolution, make, x) -> HullSolution:
     change = math.inf
     from ..limits import HULL_MAX_REFINED_HARMONICS
 
-    while scale < MAX_SCALE and 2 * scale * sol.case.harmonics <= max(
+    pto = sol.pto
+    x1, p1 = sol.one_way_x, sol.one_way_power
+    top = PTO_MAX_SCALE if pto.active else MAX_SCALE
+    while scale < top and 2 * scale * sol.case.harmonics <= max(
             HULL_MAX_REFINED_HARMONICS, 2 * sol.case.harmonics):
         scale *= 2
         case = make(scale)
-        pr = HullProblem(case)
-        r = newton_maximize(pr, _pad(x, case.harmonics), "refined", gtol=GTOL)
-        if r.status != "converged":
-            status, ok = f"refinement to {case.harmonics} harmonics: {r.status}", False
-        change = abs(r.power - power)
-        x, power = r.x, float(r.power)
-        if change <= REFINE_TOL * max(abs(power), 1e-300):
+        if pto.active:
+            pr = pto.problem(case)
+            xr, pr_power, st, _ = _pto_maximize(pr, _pad(x, case.harmonics), pto, False)
+            # the one-way answer follows, doubling by doubling
+            x1, p1, _, _ = _pto_maximize(pto.problem(case, coupled=False),
+                                         _pad(x1, case.harmonics), pto, False)
+        else:
+            pr = HullProblem(case)
+            r = newton_maximize(pr, _pad(x, case.harmonics), "refined", gtol=GTOL)
+            xr, pr_power, st = r.x, r.power, r.status
+        if st != "converged":
+            status, ok = f"refinement to {case.harmonics} harmonics: {st}", False
+        elif pto.active:  # the answer is the finest stage's, and so is its status
+            status, ok = "converged", True
+        change = abs(pr_power - power)
+        x, power = xr, float(pr_power)
+        if change <= (PTO_REFINE_TOL if pto.active else REFINE_TOL) * max(abs(power),
+                                                                          1e-300):
             break
     if change > UNRESOLVED * max(abs(power), 1e-300):
-        status = (f"not resolved: {case.harmonics} harmonics still change the power by "
-                  f"{change:.3g} W")
-        ok = False
+        if pto.active:  # algebraic convergence (the kink, the limit's corners): stated
+            status = (f"{status}; the last doubling to {case.harmonics} harmonics changed "
+                      f"the power by {change:.3g} W")
+        else:
+            status = (f"not resolved: {case.harmonics} harmonics still change the power by "
+                      f"{change:.3g} W")
+            ok = False
     pr = HullProblem(case)
     _, _, resid = pr.balance(x)
-    one = HullProblem(case, coupled=False)
-    r1 = newton_maximize(one, _pad(sol.one_way_x, case.harmonics), "one-way", gtol=GTOL)
+    if pto.active:
+        mech = float(pr.mechanical(x))
+    else:
+        r1 = newton_maximize(HullProblem(case, coupled=False),
+                             _pad(sol.one_way_x, case.harmonics), "one-way", gtol=GTOL)
+        x1, p1, mech = r1.x, r1.power, None
     return dataclasses.replace(sol, case=case, x=x, power=power, status=status, success=ok,
                                refinement_change=float(change),
                                energy_balance_residual=float(resid),
-                               one_way_power=float(r1.power), one_way_x=r1.x)
+                               one_way_power=float(p1), one_way_x=x1, mechanical_power=mech)
+
+
+#: distinct ideal maxima that start the PTO's optimum
+PTO_STARTS = 4
+#: change of the exact objective over the continuation's last two widths, relative to the
+#: larger of it and the pendulum's power scale ``m g l w``, below which it counts as settled
+#: (the kink's last widths move it by the grid's resolution of the kink; the refinement
+#: states the error)
+PTO_SETTLED = 1e-5
+#: with a PTO the harmonics are doubled until the objective changes by at most this
+#: (relative): the kink of the electrical power and the limit's active arcs make the
+#: convergence algebraic, not spectral
+PTO_REFINE_TOL = 1e-4
+#: ... up to this many times the default harmonics (each doubling of a torque-limited solve
+#: costs about four times the one before); a larger last change is stated in the status
+PTO_MAX_SCALE = 4
+
+
+def _free_motion(case: HullCase, winding: int, coupled: bool = True):
+    """The motion of least mean squared torque (``max -<tau^2>`` from the pendulum hanging,
+    or from each quarter-turn phase of the turn): the free pendulum's periodic motion where
+    one exists. It satisfies any torque limit it meets and costs no copper loss, so it
+    starts the PTO's optimum where the ideal maxima, with their large torques, are far from
+    what the limit or the loss allows."""
+    from .pto import maximize
+
+    pr = HullProblem(case, coupled=coupled, copper_loss=1.0)
+    pr.a = 0.0  # the objective is -<tau^2> alone
+    out = []
+    for name, x0 in _starts(case.harmonics, winding)[:: 6 if winding == 0 else 2]:
+        if winding == 0:
+            x0 = np.zeros_like(x0)
+            x0[0] = math.pi
+            name = "hanging"
+        x, ex, _ = maximize(pr, x0, (1.0,))
+        if math.isfinite(ex):
+            out.append((f"least-torque:{name}", x))
+        if winding == 0:
+            break
+    return out
+
+
+#: Newton iterations per width of a torque-limited solve from one start: from an ideal
+#: maximum far above the limit the augmented Lagrangian crawls (thousands of iterations,
+#: tens of seconds), while the least-torque start reaches the same optimum in a few hundred
+PTO_MAX_INNER = 400
+
+
+def _pto_maximize(pr: HullProblem, x, pto: HullPTO, first: bool):
+    """The PTO's optimum from ``x``: the smoothing continuation (an efficiency) under the
+    torque limit (:func:`parapend.hydro.pto.maximize`). Returns ``(x, exact, status,
+    iterations)``."""
+    from .pto import WIDTHS, WIDTHS_REFINE, maximize
+
+    widths = (WIDTHS if first else WIDTHS_REFINE) if pto.smoothed else (1.0,)
+    x, ex, log = maximize(pr, np.asarray(x, dtype=float), widths, pto.torque_limit,
+                          max_inner=PTO_MAX_INNER)
+    its = sum(r[3] for r in log)
+    last = [r[1] for r in log if math.isfinite(r[1])]
+    if not math.isfinite(ex):
+        return x, ex, "no motion within the torque limit", its
+    if pto.smoothed:
+        scale = max(abs(ex), float(pr.w[0]))  # the power, or m g l w near zero
+        ok = len(last) >= 2 and abs(last[-1] - last[-2]) <= PTO_SETTLED * scale
+    else:
+        ok = log[-1][2] == "converged"
+    return x, ex, "converged" if ok else f"stalled ({log[-1][2]})", its
+
+
+def _pto_stage(case, make, pto: HullPTO, runs, best_one, refine: bool) -> HullSolution:
+    """The PTO's optimum (efficiency, copper loss, torque limit) from the ideal search's
+    distinct converged maxima (at most ``PTO_STARTS``, best first), then its refinement."""
+    seeds = []
+    for r in sorted((r for r in runs if math.isfinite(r.power) and r.status in (
+            "converged", "max_iterations", "stalled")), key=lambda r: -r.power):
+        if all(motion_distance(r.x, s[1]) > 1e3 * DISTINCT_RMS for s in seeds):
+            seeds.append((r.seed, r.x))
+        if len(seeds) == PTO_STARTS:
+            break
+    seeds += _free_motion(case, case.winding)
+    pr = pto.problem(case)
+    best, tried, its = None, [], 0
+    for name, x0 in seeds:
+        x, ex, status, it = _pto_maximize(pr, x0, pto, True)
+        its += it
+        if status == "converged" and aliased(pr, x):
+            status = "aliased"
+        tried.append((ex, status))
+        # every iterate is a motion whose power is evaluated exactly: the largest wins, and
+        # its status says whether its continuation settled
+        if math.isfinite(ex) and (best is None or ex > best[1]):
+            best = (x, ex, status, name)
+    one_pr = pto.problem(case, coupled=False)
+    one = None
+    for x1 in ([best_one.x] if best_one is not None else []) + [
+            x for _, x in _free_motion(case, case.winding, coupled=False)]:
+        r = _pto_maximize(one_pr, x1, pto, True)
+        its += r[3]
+        if one is None or (math.isfinite(r[1]) and not r[1] <= one[1]):
+            one = r
+    if best is None:
+        x = seeds[0][1] if seeds else np.zeros(2 * case.harmonics + 1)
+        return HullSolution(case=case, x=x, power=math.nan, one_way_power=math.nan,
+                            one_way_x=x, status="no motion found for this power take-off",
+                            success=False, found_by="", distinct_maxima=0, runs=len(tried),
+                            iterations=its, energy_balance_residual=math.nan, pto=pto)
+    x, ex, status, name = best
+    ok = status == "converged"
+    distinct = len({round(e, 9) for e, st in tried if st == "converged"})
+    sol = HullSolution(case=case, x=x, power=float(ex),
+                       one_way_power=float(one[1]) if one else math.nan,
+                       one_way_x=one[0] if one else x, status=status, success=ok,
+                       found_by=name, distinct_maxima=max(distinct, 1),
+                       runs=len(tried) + 1, iterations=its,
+                       energy_balance_residual=float(HullProblem(case).balance(x)[2]),
+                       mechanical_power=float(pr.mechanical(x)), pto=pto)
+    if refine:  # a stalled continuation may settle with more harmonics: the status says
+        sol = _refine(sol, make, x)
+    return sol
 
 
 def radiation_bound(case: HullCase) -> tuple[float, int]:

@@ -14,7 +14,8 @@ from scipy.optimize import minimize_scalar
 
 from ..results import Result
 from .hull import HullProblem
-from .hull_optimum import BOUND_RCOND, hull_search, make_case, radiation_bound
+from .hull_optimum import BOUND_RCOND, HullPTO, hull_search, make_case, radiation_bound
+from .optimum import TORQUE_SLACK
 from .waves import energy_flux
 
 __all__ = ["HullResult", "HullSweepResult", "MotionAt", "hull_answer"]
@@ -84,7 +85,13 @@ class HullResult(Result):
 
     Attributes
     ----------
-    power_w : the best mode's mean power ``P = -<tau (phi' - beta')>``.
+    power_w : the best mode's mean power: the mechanical ``P = -<tau (phi' - beta')>``
+        with an ideal power take-off; with ``efficiency`` (``[eta_g, eta_m]``) the
+        electrical ``<e(p)>`` (``eta_g p`` generating, ``p / eta_m`` motoring, ``p`` the
+        instantaneous mechanical power), less ``copper_loss`` times ``<tau^2>``.
+    mechanical_power_w : the mechanical power ``P`` of that motion (= power_w ideal).
+    torque_limit_nm : ``|tau|`` held below it on the solve grid (its peak between the grid
+        points checked, ``TORQUE_SLACK``).
     mode : ``"rotation"``, ``"swinging"`` or ``"rest"`` (the pendulum held: 0 W) - the
         best; ``winding`` its turns per wave (0: swinging).
     modes : each mode's answer side by side (power, one-way power, mean angle, peak torque,
@@ -110,6 +117,10 @@ class HullResult(Result):
     """
 
     power_w: float
+    mechanical_power_w: float
+    efficiency: list | None
+    copper_loss: float
+    torque_limit_nm: float | None
     mode: str
     winding: int
     modes: list
@@ -196,21 +207,31 @@ def _mode(sol) -> dict:
     mot = MotionAt(pr, sol.x, y)
     period = 2 * math.pi / sol.case.omega
     pk = peak(lambda t: np.abs(mot(t)["tau"]), period)
+    status, ok = sol.status, sol.success
+    limit = sol.pto.torque_limit
+    if limit is not None and math.isfinite(sol.power) and pk > limit * (1 + 1e-12):
+        # the limit is imposed on the solve grid: checked between its points
+        over = pk / limit - 1
+        ok = ok and over <= TORQUE_SLACK
+        status += (f"; between the grid points the peak torque is {pk:.6g} N m "
+                   f"({over:.1e} above the limit)")
     s = mot(period * np.arange(PEAK_POINTS) / PEAK_POINTS)
     k = sol.case.winding
     swing = None if k else 0.5 * _deg(np.max(s["phi"]) - np.min(s["phi"]))
     mean = _deg(math.remainder(float(np.mean(s["phi"])) - math.pi, 2 * math.pi) + math.pi)
     return {"mode": "swinging" if k == 0 else "rotation", "winding": k,
-            "power_w": sol.power, "one_way_power_w": sol.one_way_power,
+            "power_w": sol.power, "mechanical_power_w": (
+                sol.power if sol.mechanical_power is None else sol.mechanical_power),
+            "one_way_power_w": sol.one_way_power,
             "energy_balance_residual": sol.energy_balance_residual,
             "refinement_change_w": sol.refinement_change, "harmonics": sol.case.harmonics,
             "mean_angle_deg": mean if k == 0 else None, "swing_amplitude_deg": swing,
             "peak_torque_nm": pk, "distinct_maxima": sol.distinct_maxima,
-            "found_by": sol.found_by, "starts": sol.runs, "success": sol.success,
-            "status": sol.status, "_solution": sol, "_motion": mot}
+            "found_by": sol.found_by, "starts": sol.runs, "success": ok,
+            "status": status, "_solution": sol, "_motion": mot}
 
 
-def _solve_mode(hull, pendulum, wave, k, harmonics, pivot, pitch_inertia) -> dict:
+def _solve_mode(hull, pendulum, wave, k, harmonics, pivot, pitch_inertia, pto) -> dict:
     def make(scale):
         base = make_case(hull, pendulum, wave, winding=k, harmonics=harmonics, pivot=pivot,
                          pitch_inertia=pitch_inertia)
@@ -219,13 +240,15 @@ def _solve_mode(hull, pendulum, wave, k, harmonics, pivot, pitch_inertia) -> dic
         return make_case(hull, pendulum, wave, winding=k, harmonics=scale * base.harmonics,
                          hull_harmonics=scale * base.hull_harmonics, pivot=pivot,
                          pitch_inertia=pitch_inertia)
-    return _mode(hull_search(make))
+    return _mode(hull_search(make, pto=pto))
 
 
 def hull_answer(hull, pendulum, wave, *, pivot, windings=(1, 0), pitch_inertia=None,
-                harmonics=None, wave_info=None, geometry=None, notes=()) -> HullResult:
+                harmonics=None, wave_info=None, geometry=None, notes=(),
+                pto: HullPTO | None = None) -> HullResult:
     """Solve each winding of ``windings`` (0: swinging), put them beside rest, and build
-    the result from the best."""
+    the result from the best; ``pto`` the power take-off (None: ideal)."""
+    pto = pto or HullPTO()
     from threadpoolctl import threadpool_limits
 
     modes = []
@@ -233,11 +256,11 @@ def hull_answer(hull, pendulum, wave, *, pivot, windings=(1, 0), pitch_inertia=N
     with threadpool_limits(1, user_api="blas"):
         for k in windings:
             modes.append(_solve_mode(hull, pendulum, wave, k, harmonics, pivot,
-                                     pitch_inertia))
+                                     pitch_inertia, pto))
     ok_modes = [m for m in modes if m["success"]]
     best = max(ok_modes or modes, key=lambda m: m["power_w"])
-    rest = {"mode": "rest", "winding": None, "power_w": 0.0, "success": True,
-            "status": "the pendulum held (no power)"}
+    rest = {"mode": "rest", "winding": None, "power_w": 0.0, "mechanical_power_w": 0.0,
+            "success": True, "status": "the pendulum held (no power)"}
     public = [{k: v for k, v in m.items() if not k.startswith("_")} for m in modes] + [rest]
     sol = best["_solution"]
     cs = sol.case
@@ -275,7 +298,10 @@ def hull_answer(hull, pendulum, wave, *, pivot, windings=(1, 0), pitch_inertia=N
                         f"{BOUND_RCOND:g} of the largest cut in its pseudo-inverse")
     owp = None if at_rest else best["one_way_power_w"]
     return HullResult(
-        power_w=p, mode="rest" if at_rest else best["mode"],
+        power_w=p, mechanical_power_w=0.0 if at_rest else float(best["mechanical_power_w"]),
+        efficiency=list(pto.efficiency) if pto.efficiency is not None else None,
+        copper_loss=pto.copper_loss, torque_limit_nm=pto.torque_limit,
+        mode="rest" if at_rest else best["mode"],
         winding=None if at_rest else best["winding"], modes=public,
         one_way_power_w=owp, one_way_ratio=(owp / p if owp is not None and p > 0 else None),
         energy_balance_residual=None if at_rest else best["energy_balance_residual"],
@@ -313,6 +339,7 @@ class HullSweepResult(Result):
 
     period_s: np.ndarray
     power_w: np.ndarray
+    mechanical_power_w: np.ndarray
     rotation_power_w: np.ndarray
     swinging_power_w: np.ndarray
     one_way_power_w: np.ndarray
@@ -350,6 +377,7 @@ class HullSweepResult(Result):
         warn = [f"T = {t:g} s: {w}" for t, r in zip(periods, results)
                 for w in list(r.warnings) + list(r.validity_warnings)]
         return cls(period_s=np.asarray(periods, dtype=float), power_w=arr("power_w"),
+                   mechanical_power_w=arr("mechanical_power_w"),
                    rotation_power_w=np.array([mode_power(r, "rotation") for r in results]),
                    swinging_power_w=np.array([mode_power(r, "swinging") for r in results]),
                    one_way_power_w=arr("one_way_power_w"),
@@ -365,8 +393,8 @@ class HullSweepResult(Result):
     def _series(self):
         import xarray as xr
 
-        names = ("power_w", "rotation_power_w", "swinging_power_w", "one_way_power_w",
-                 "radiation_bound_w", "heave_amplitude_m", "pitch_amplitude_deg",
+        names = ("power_w", "mechanical_power_w", "rotation_power_w", "swinging_power_w",
+                 "one_way_power_w", "radiation_bound_w", "heave_amplitude_m", "pitch_amplitude_deg",
                  "energy_balance_residual")
         ds = xr.Dataset({k: ("period_s", np.asarray(getattr(self, k), dtype=float))
                          for k in names}, coords={"period_s": self.period_s})

@@ -47,8 +47,8 @@ import numpy as np
 from .. import limits
 from ..errors import ParameterError
 
-__all__ = ["ElectricalProblem", "efficiency_pair", "electrical_power", "ladder", "maximize",
-           "torque_limited"]
+__all__ = ["ElectricalProblem", "PTOObjective", "efficiency_pair", "electrical_power", "ladder",
+           "maximize", "torque_limited"]
 
 
 def efficiency_pair(efficiency) -> tuple[float, float] | None:
@@ -123,7 +123,60 @@ class _Operator:
         return self.problem.hessp(self.state, np.eye(self.size))
 
 
-class ElectricalProblem:
+class PTOObjective:
+    """The power take-off's pointwise objective, shared by the heaving buoy's
+    :class:`ElectricalProblem` and the hull's :class:`~parapend.hydro.hull.HullProblem`:
+    the smoothed electrical power ``e_s(p) = a p + b sqrt(p^2 + s^2)`` (``a``, ``b`` from
+    the efficiencies, ``s`` the ``width``) and the torque limit's augmented-Lagrangian
+    penalty. A subclass provides ``points`` and ``state(x)`` (with ``"tau"`` and ``"p"``
+    on the grid)."""
+
+    a, b, width = 1.0, 0.0, 0.0
+    limit = None
+
+    def set_efficiency(self, eta) -> None:
+        """``a``, ``b`` of ``e(p) = a p + b |p|`` from ``(eta_g, eta_m)`` (None: lossless)."""
+        eg, em = (1.0, 1.0) if eta is None else eta
+        self.a = 0.5 * (eg + 1.0 / em)
+        self.b = 0.5 * (eg - 1.0 / em)
+
+    def _e(self, p):
+        s = self.width
+        if s == 0.0 or self.b == 0.0:  # the kink itself (one-sided derivatives)
+            return (self.a * p + self.b * np.abs(p), self.a + self.b * np.sign(p),
+                    np.zeros_like(p))
+        r = np.sqrt(p * p + s * s)
+        return self.a * p + self.b * r, self.a + self.b * p / r, self.b * s * s / r**3
+
+    def set_limit(self, limit: float, rho: float, lam_hi=None, lam_lo=None):
+        """Penalize ``|tau| > limit`` on the grid (PHR augmented Lagrangian, per point
+        ``tau - limit <= 0`` and ``-tau - limit <= 0`` with multipliers ``lam_hi``,
+        ``lam_lo`` and penalty ``rho``)."""
+        m = self.points
+        self.limit = float(limit)
+        self.rho = float(rho)
+        self.lam_hi = np.zeros(m) if lam_hi is None else lam_hi
+        self.lam_lo = np.zeros(m) if lam_lo is None else lam_lo
+
+    def _penalty(self, tau):
+        """``(phi, phi', phi'')`` per grid point, ``phi = -(max(0, lam + rho g)^2 - lam^2) /
+        (2 rho)`` summed over both constraints ``g = +-tau - limit``."""
+        r = self.rho
+        hi = np.maximum(0.0, self.lam_hi + r * (tau - self.limit))
+        lo = np.maximum(0.0, self.lam_lo + r * (-tau - self.limit))
+        phi = -(hi * hi - self.lam_hi**2 + lo * lo - self.lam_lo**2) / (2 * r)
+        return phi, -hi + lo, -r * ((hi > 0).astype(float) + (lo > 0))
+
+    def update_multipliers(self, x):
+        """``lam <- max(0, lam + rho g)``; returns the largest violation ``max |tau| -
+        limit`` on the grid."""
+        tau = self.state(x)["tau"]
+        self.lam_hi = np.maximum(0.0, self.lam_hi + self.rho * (tau - self.limit))
+        self.lam_lo = np.maximum(0.0, self.lam_lo + self.rho * (-tau - self.limit))
+        return float(np.max(np.abs(tau))) - self.limit
+
+
+class ElectricalProblem(PTOObjective):
     """``<e_s(p)>`` on the grid of a :class:`~parapend.hydro.coupled.CoupledProblem`, with
     its exact gradient and Hessian (dense, or an operator with ``hessian="operator"``).
 
@@ -151,9 +204,7 @@ class ElectricalProblem:
         self.hessian = base.hessian if hessian is None else hessian
         self.gk = np.asarray(gk, dtype=complex)
         self.qw = base.excitation.q_grid(base.points)
-        eg, em = eta
-        self.a = 0.5 * (eg + 1.0 / em)
-        self.b = 0.5 * (eg - 1.0 / em)
+        self.set_efficiency(eta)
         self.width = float(width)
         m, n = self.points, self.harmonics
         k = np.arange(m // 2 + 1, dtype=float)
@@ -214,14 +265,6 @@ class ElectricalProblem:
         p = -tau * thd
         return {"sn": sn, "cs": cs, "q": q, "tau": tau, "thd": thd, "p": p}
 
-    def _e(self, p):
-        s = self.width
-        if s == 0.0 or self.b == 0.0:  # the kink itself (one-sided derivatives)
-            return (self.a * p + self.b * np.abs(p), self.a + self.b * np.sign(p),
-                    np.zeros_like(p))
-        r = np.sqrt(p * p + s * s)
-        return self.a * p + self.b * r, self.a + self.b * p / r, self.b * s * s / r**3
-
     def exact(self, x) -> float:
         """The unsmoothed ``<e(p)>`` on the grid (the kink integrated on the piecewise-linear
         interpolant)."""
@@ -239,36 +282,6 @@ class ElectricalProblem:
         if self.limit is not None:
             val += float(np.mean(self._penalty(st["tau"])[0]))
         return val
-
-    # ---- a torque limit by an augmented Lagrangian -------------------------------------
-    limit = None
-
-    def set_limit(self, limit: float, rho: float, lam_hi=None, lam_lo=None):
-        """Penalize ``|tau| > limit`` on the grid (PHR augmented Lagrangian, per point
-        ``tau - limit <= 0`` and ``-tau - limit <= 0`` with multipliers ``lam_hi``,
-        ``lam_lo`` and penalty ``rho``)."""
-        m = self.points
-        self.limit = float(limit)
-        self.rho = float(rho)
-        self.lam_hi = np.zeros(m) if lam_hi is None else lam_hi
-        self.lam_lo = np.zeros(m) if lam_lo is None else lam_lo
-
-    def _penalty(self, tau):
-        """``(phi, phi', phi'')`` per grid point, ``phi = -(max(0, lam + rho g)^2 - lam^2) /
-        (2 rho)`` summed over both constraints ``g = +-tau - limit``."""
-        r = self.rho
-        hi = np.maximum(0.0, self.lam_hi + r * (tau - self.limit))
-        lo = np.maximum(0.0, self.lam_lo + r * (-tau - self.limit))
-        phi = -(hi * hi - self.lam_hi**2 + lo * lo - self.lam_lo**2) / (2 * r)
-        return phi, -hi + lo, -r * ((hi > 0).astype(float) + (lo > 0))
-
-    def update_multipliers(self, x):
-        """``lam <- max(0, lam + rho g)``; returns the largest violation ``max |tau| -
-        limit`` on the grid."""
-        tau = self.state(x)["tau"]
-        self.lam_hi = np.maximum(0.0, self.lam_hi + self.rho * (tau - self.limit))
-        self.lam_lo = np.maximum(0.0, self.lam_lo + self.rho * (-tau - self.limit))
-        return float(np.max(np.abs(tau))) - self.limit
 
     def _dtau_t(self, st, w):
         """``sum_t w dtau_i`` (the transpose of the torque's Jacobian applied to ``w``)."""
@@ -370,7 +383,8 @@ WIDTHS_REFINE = (1e-3, 1e-4, 1e-5, 1e-6)
 MAXITER = 200
 
 
-def maximize(problem: ElectricalProblem, x0: np.ndarray, widths=None, limit=None):
+def maximize(problem: ElectricalProblem, x0: np.ndarray, widths=None, limit=None,
+             max_inner: int | None = None):
     """Continuation ``s -> 0`` from ``x0``: a trust-region Newton method at each width from
     the last optimum (``trust-exact`` on the dense Hessian, ``trust-krylov`` on the
     operator's products: the smoothed objective is not concave in the coefficients, and a
@@ -378,7 +392,8 @@ def maximize(problem: ElectricalProblem, x0: np.ndarray, widths=None, limit=None
     creeps).
 
     With ``limit`` each width is solved under ``|tau| <= limit`` on the grid
-    (:func:`torque_limited`), and only iterates within the limit count.
+    (:func:`torque_limited`, at most ``max_inner`` Newton iterations per width), and only
+    iterates within the limit count.
 
     Returns ``(x, exact, runs)``: the iterate with the largest exact (unsmoothed) ``<e(p)>``
     on the grid, that value, and per width ``(s, exact, status, iterations)``.
@@ -396,7 +411,8 @@ def maximize(problem: ElectricalProblem, x0: np.ndarray, widths=None, limit=None
         best = -math.inf
         for rel in widths:
             problem.width = rel * p0
-            x, _, viol, _, inner, status = torque_limited(problem, x, limit, warm=True)
+            x, _, viol, _, inner, status = torque_limited(problem, x, limit, warm=True,
+                                                          max_inner=max_inner)
             ex = problem.exact(x)
             runs.append((rel * p0, ex, status, inner))
             if math.isfinite(ex) and ex >= best and viol <= LIMIT_TOL * limit:

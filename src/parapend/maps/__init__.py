@@ -52,11 +52,11 @@ The package, in the order the data flow
 from __future__ import annotations
 
 from .compute import compute_block
-from .figures import MAP_QUANTITIES, map_data, plot_map
+from .figures import MAP_QUANTITIES, map_data, plot_map, plot_sweep
 from .run import SweepRun, sweep
 from .spec import AXES, NOT_COMPUTED, STATUSES, VARIABLES, SweepSpec, parse_axis, sweep_spec
 from .store import open_sweep
 
 __all__ = ["AXES", "MAP_QUANTITIES", "NOT_COMPUTED", "STATUSES", "VARIABLES", "SweepRun",
            "SweepSpec", "compute_block", "map_data", "open_sweep", "parse_axis", "plot_map",
-           "sweep", "sweep_spec"]
+           "plot_sweep", "sweep", "sweep_spec"]

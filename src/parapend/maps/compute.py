@@ -145,6 +145,8 @@ def _point_input(spec: SweepSpec, p: dict):
             r = optimize_pto(torque_limit=p.get("torque_limit"), efficiency=p.get("efficiency"),
                              gamma=gamma, harmonics=spec.harmonics, **kw)
             out.update(power=r.power, electrical_power=r.electrical_power, status=r.status)
+            if spec.lossy:  # the headline is the electrical power, as optimize's
+                out.update(power=r.electrical_power, mechanical_power=r.power)
             return out, "pto"
         if lim.power <= 0:  # constant q: as optimize, the uniform rotation's loss
             out.update(power=-gamma * exc.omega**2, status="no_power", branch_gap=0.0)

@@ -11,19 +11,20 @@ import numpy as np
 from ..errors import ParameterError
 from .spec import _AXIS_ATTRS, _CODE, _SUCCESS, AXES, VARIABLES
 
-__all__ = ["MAP_QUANTITIES", "map_data", "plot_map"]
+__all__ = ["MAP_QUANTITIES", "map_data", "plot_map", "plot_sweep"]
 
 
 # -- heat maps -----------------------------------------------------------------------------
 
 #: What ``parapend map`` can draw: a variable of the store, or ``gain`` (over uniform).
 MAP_QUANTITIES = ("power", "gain", "damping_threshold", "uniform_power", "limit_power",
-                  "electrical_power", "branch_gap")
+                  "electrical_power", "mechanical_power", "branch_gap")
 _PAPER = {"omega": 1.8, "delta": -0.3, "gamma": 0.0}
 _SHORT = {"power": "optimal power P", "gain": "gain over the best uniform rotation",
           "damping_threshold": "damping threshold gamma*",
           "uniform_power": "power of the best uniform rotation",
           "limit_power": "limit power (gamma -> 0)", "electrical_power": "electrical power",
+          "mechanical_power": "mechanical power of the electrical optimum",
           "branch_gap": "continued branch above the global search"}
 _LABELS = {"omega": r"$\omega$", "delta": r"$\delta$", "gamma": r"$\gamma$",
            "torque_limit": r"$T_{max}$", "efficiency": r"$\eta$"}
@@ -45,7 +46,11 @@ def map_data(ds, quantity: str = "power", x: str | None = None, y: str | None = 
     if quantity not in MAP_QUANTITIES:
         raise ParameterError(f"variable: expected one of {', '.join(MAP_QUANTITIES)}, got "
                              f"{quantity!r:.40}")
-    need = "power" if quantity == "gain" else quantity
+    # with an efficiency, power is the electrical power (the headline) and the gain stays the
+    # mechanical power's over the (ideal) uniform rotation's, as before
+    lossy = "mechanical_power" in ds
+    top = "mechanical_power" if lossy else "power"
+    need = top if quantity == "gain" else quantity
     if need not in ds:
         raise ParameterError(f"variable: {quantity!r} is not in this store (threshold maps "
                              "need a sweep with --threshold)")
@@ -76,10 +81,12 @@ def map_data(ds, quantity: str = "power", x: str | None = None, y: str | None = 
     if quantity == "gain":  # as optimize's gain_over_uniform: none where uniform <= 0
         pu = sub["uniform_power"].values
         with np.errstate(divide="ignore", invalid="ignore"):
-            z = np.where(pu > 0, 100.0 * (sub["power"].values / pu - 1.0), np.nan)
+            z = np.where(pu > 0, 100.0 * (sub[top].values / pu - 1.0), np.nan)
     else:
         z = np.array(sub[quantity].values, dtype=float)
-    label = _SHORT[quantity]
+    label = ("optimal electrical power" if quantity == "power" and lossy else
+             "gain of the mechanical power over the best uniform rotation"
+             if quantity == "gain" and lossy else _SHORT[quantity])
     units = "%" if quantity == "gain" else VARIABLES[quantity][1]
     label = f"{label} ({units})" if units else label
     if quantity == "damping_threshold":
@@ -239,7 +246,7 @@ def plot_map(ds, quantity: str = "power", x=None, y=None, at=None, path=None, sc
         paper = (px is not None and py is not None and xs.min() <= px <= xs.max()
                  and ys.min() <= py <= ys.max())
         # the power's zero contour is drawn black (where gamma crosses gamma*), not white
-        zero = (quantity in ("power", "electrical_power") and finite.any()
+        zero = (quantity in ("power", "electrical_power", "mechanical_power") and finite.any()
                 and np.nanmin(z) < 0 < np.nanmax(z))
         levels = [v for v in nice if lo < v < hi and not (zero and v == 0)]
         avoid = [(px, py)] if paper else []
@@ -267,6 +274,73 @@ def plot_map(ds, quantity: str = "power", x=None, y=None, at=None, path=None, sc
         ax.grid(False)
         if title:
             ax.set_title(title)
+    if path is not None:
+        save_figure(fig, path)
+    return fig
+
+
+#: the curves of a map with one swept axis, in the order drawn: name -> (legend, style)
+_CURVES = {"limit_power": ("limit (gamma -> 0)", ":"), "power": ("optimum", "-"),
+           "mechanical_power": ("mechanical power of the electrical optimum", "-."),
+           "uniform_power": ("best uniform rotation", "--")}
+
+
+def plot_sweep(ds, path=None, units=None):
+    """The figure of a sweep's result (``parapend.sweep(...).plot()``): the heat map of the
+    power over the first two swept axes (:func:`plot_map`), or, over one swept axis, the
+    power, the uniform rotation's and the limit against it (with an efficiency ``power`` is
+    the electrical power and the mechanical one is drawn too), failed points crossed.
+    ``units`` (a :class:`parapend.units.Units`, the pendulum the sweep was given): SI scales
+    beside the non-dimensional ones, as ``parapend map`` draws them."""
+    from ..fileio import save_figure
+    from ..style import figure_style
+
+    dims = [d for d in AXES if d in ds.dims]
+    if len(dims) >= 2:
+        if units is None:
+            return plot_map(ds, "power", path=path)
+        from ..units import add_si_axes
+
+        fig = plot_map(ds, "power", scale=(float(units.power), "W"))
+        with figure_style():
+            add_si_axes(fig, units)
+        if path is not None:
+            save_figure(fig, path)
+        return fig
+    from ..style import use_agg
+
+    use_agg()
+    import matplotlib.pyplot as plt
+
+    x = dims[0]
+    xs = ds[x].values
+    done = ds["done"].values
+    ok = done & np.isin(ds["status"].values, [_CODE[s] for s in _SUCCESS])
+    lossy = "mechanical_power" in ds
+    with figure_style():
+        fig, ax = plt.subplots(figsize=(6.4, 4.2), layout="constrained")
+        for name, (legend, style) in _CURVES.items():
+            if name not in ds:
+                continue
+            mask = ok if name in ("power", "mechanical_power") else done
+            y = np.where(mask, ds[name].values, np.nan)
+            if name == "power" and lossy:
+                legend = "optimum, electrical power"
+            ax.plot(xs, y, style, lw=1.2, label=legend)
+        failed = done & ~ok
+        if failed.any():
+            ax.plot(xs[failed], np.zeros(int(failed.sum())), "x", color="red", ms=5,
+                    label="failed (see status)")
+        ax.set_xlabel(_axis_label(x))
+        ax.set_ylabel(f"mean power ({VARIABLES['power'][1]})")
+        fixed = {a: float(ds[a]) for a in AXES if a in ds.coords and ds[a].ndim == 0}
+        if fixed:
+            ax.set_title(", ".join(f"{k} = {v:.4g}" for k, v in fixed.items()))
+        ax.legend(frameon=False, fontsize=8)
+    if units is not None:
+        from ..units import si_figure
+
+        si_figure(fig, units)
     if path is not None:
         save_figure(fig, path)
     return fig

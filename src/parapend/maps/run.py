@@ -14,6 +14,7 @@ import time
 
 import numpy as np
 
+from ..defaults import GAMMA
 from ..errors import OutputError, ParameterError, SolverError, check_int
 from ._forkserver import WorkerContext
 from .compute import compute_block
@@ -46,7 +47,9 @@ class SweepRun:
     ``dataset`` has one variable per quantity (see :data:`VARIABLES`) over the swept
     dimensions, plus ``done``; ``computed_points`` were computed by this run,
     ``resumed_points`` found finished in the store; ``repaired_points`` (of the computed)
-    were marked finished in the store but had missing or unreadable data.
+    were marked finished in the store but had missing or unreadable data. ``units``: the
+    pendulum in SI given to :func:`sweep` (a :class:`parapend.units.Units`, or None; the
+    map itself stays non-dimensional); ``netcdf``: the file the map was exported to.
     """
 
     dataset: object
@@ -58,6 +61,8 @@ class SweepRun:
     seconds: float
     executor: str
     repaired_points: int = 0
+    units: object = None
+    netcdf: str | None = None
 
 
 def _worker_init(parent: int) -> None:
@@ -335,21 +340,30 @@ def _run_dask(spec, todo, client, done_cb):
     return f"Dask cluster at {client.scheduler.address}"
 
 
-def sweep(store=None, *, omega=1.8, delta=None, gamma=0.0, torque_limit=None, efficiency=None,
-          harmonics: int = 24, excitation=None, square_alpha=None, fourier=None,
-          threshold: bool = False, workers: int | None = None, scheduler=None,
+def sweep(store=None, *, omega=1.8, delta=None, gamma=GAMMA["sweep"], torque_limit=None,
+          efficiency=None, harmonics: int = 24, excitation=None, square_alpha=None,
+          fourier=None, threshold: bool = False, workers: int | None = None, scheduler=None,
           overwrite: bool = False, command: str | None = None, progress=None,
-          block_points: int | None = None) -> SweepRun:
+          block_points: int | None = None, netcdf=None, length=None, mass=None, inertia=None,
+          gravity=None):
     """A design map: the optimum (and more) at every point of a grid; see the module text.
+
+    The parameters of the command ``sweep``, declared here once: ``parapend.sweep`` takes
+    them as they are (and returns the command's result, a
+    :class:`~parapend.results.Record` around this :class:`SweepRun`), and the command line
+    reads its options' defaults from this signature.
 
     Parameters
     ----------
     store : path or None
         Zarr store (a directory, e.g. ``map.zarr``) written block by block and resumed when
-        it already holds this sweep; None computes in memory.
+        it already holds this sweep; None computes in memory (the command line's default
+        is ``map.zarr``).
     omega, delta, gamma, torque_limit, efficiency : number, sequence, or str
         One value, a sequence, ``"START:STOP:COUNT"`` or ``"A,B,C"`` (:func:`parse_axis`).
-        ``torque_limit`` or ``efficiency`` makes each point :func:`parapend.pto.optimize_pto`.
+        ``torque_limit`` or ``efficiency`` makes each point :func:`parapend.pto.optimize_pto`;
+        with an efficiency ``power`` is the electrical power (the motion maximizes it) and
+        ``mechanical_power`` the same motion's mechanical power, as ``parapend.optimize``.
     harmonics : int
         N of every solve (at most 128).
     excitation, square_alpha, fourier
@@ -360,7 +374,7 @@ def sweep(store=None, *, omega=1.8, delta=None, gamma=0.0, torque_limit=None, ef
         Local processes (default: the number of CPUs, at most the number of blocks).
     scheduler : str or distributed.Client or None
         Address of a Dask distributed scheduler (``tcp://host:8786``), or a Client: the
-        blocks run there, and are written here as they finish.
+        blocks run there, and are written here as they finish (not with ``workers``).
     overwrite : bool
         Replace a store that holds a different sweep. A directory that is not a parapend
         sweep store (or a store holding files a sweep does not write) is refused either
@@ -372,13 +386,42 @@ def sweep(store=None, *, omega=1.8, delta=None, gamma=0.0, torque_limit=None, ef
     block_points : int or None
         Points per block (one chunk, one task), about: default 512 (8 with a power
         take-off). Part of the sweep's identity, as it sets where continuation runs start.
+    netcdf : path or None
+        Also export the finished map to this NetCDF file (atomically).
+    length, mass, inertia, gravity : float or None
+        A pendulum in SI (m, kg, kg m^2, m/s^2; docs/units.md): the map stays
+        non-dimensional (one map serves every pendulum), the run carries the units
+        (``units``) and ``parapend.sweep`` adds the largest power in W.
+
+    Returns
+    -------
+    SweepRun
+        (``parapend.sweep``: the command's :class:`~parapend.results.Record` around it; no
+        return annotation here, as the command's signature is this one.)
     """
+    from ..units import from_options
+
+    units, _ = from_options(length=length, mass=mass, inertia=inertia, gravity=gravity)
+    if scheduler is not None and workers is not None:
+        raise ParameterError("workers: the processes are the cluster's with --scheduler; "
+                             "drop --workers")
+    if scheduler is not None:
+        try:
+            import distributed  # noqa: F401
+        except ImportError:
+            raise ParameterError("scheduler: needs the 'distributed' package (python -m pip "
+                                 "install distributed)") from None
     spec = sweep_spec(omega=omega, delta=delta, gamma=gamma, torque_limit=torque_limit,
                       efficiency=efficiency, harmonics=harmonics, excitation=excitation,
                       square_alpha=square_alpha, fourier=fourier, threshold=threshold,
                       block_points=block_points)
-    return run_spec(spec, store, workers=workers, scheduler=scheduler, overwrite=overwrite,
-                    command=command, progress=progress)
+    run = run_spec(spec, store, workers=workers, scheduler=scheduler, overwrite=overwrite,
+                   command=command, progress=progress)
+    if netcdf:
+        from .. import fileio
+
+        fileio.write_dataset(run.dataset, netcdf)
+    return dataclasses.replace(run, units=units, netcdf=netcdf)
 
 
 def run_spec(spec, store=None, *, workers: int | None = None, scheduler=None,

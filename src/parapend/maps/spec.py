@@ -34,7 +34,7 @@ _POWER_UNITS = "m g l sqrt(g/l)"
 #: fill value, "not computed". "error": the point raised (logged), "other": a status this
 #: version does not know.
 STATUSES = ("converged", "no_power", "stalled", "max_iterations", "nonfinite", "infeasible",
-            "unresolved", "error", "other")
+            "unresolved", "error", "other", "above_bound")
 _CODE = {s: i for i, s in enumerate(STATUSES)}
 NOT_COMPUTED = -1
 _SUCCESS = ("converged", "no_power")
@@ -47,6 +47,9 @@ VARIABLES = {
     "limit_power": ("gamma -> 0 limit of the power, omega TV(q) / 2 pi (Eqs. 19, 24, 32)",
                     _POWER_UNITS),
     "electrical_power": ("electrical power of the power take-off optimum", _POWER_UNITS),
+    "mechanical_power": ("mechanical power P = -<T theta'> of the motion that maximizes the "
+                         "electrical power (with an efficiency; power is the electrical)",
+                         _POWER_UNITS),
     "branch_gap": ("power of the branch continued from the neighbouring point above the "
                    "global search's (0: the global search found the best)", _POWER_UNITS),
     "status": ("solver status of the optimum", None),
@@ -54,6 +57,10 @@ VARIABLES = {
                           "(Fig. 6; ideal power take-off)", "sqrt(g/l)"),
     "threshold_status": ("solver status of the damping threshold", None),
 }
+#: ``power`` of a map with an efficiency: the headline is the electrical power (issue 32, as
+#: ``optimize``), the same motion's mechanical power is ``mechanical_power``
+ELECTRICAL_POWER = ("optimal mean electrical power through the power take-off (the motion "
+                    "maximizes it; its mechanical power is mechanical_power)", _POWER_UNITS)
 #: points per block (one chunk, one task): about half a second of work at N = 24; smaller
 #: blocks cost the writing process more than the computing ones (measured on the benchmark's
 #: map: 3.7 s of its CPU with 128-point blocks, 1.0 s with 512)
@@ -164,9 +171,16 @@ class SweepSpec:
         return bool(self.values["torque_limit"] or self.values["efficiency"])
 
     @property
+    def lossy(self) -> bool:
+        """An efficiency is given: ``power`` is the electrical power, ``mechanical_power``
+        the mechanical (the rule of ``optimize``)."""
+        return bool(self.values["efficiency"])
+
+    @property
     def variables(self) -> tuple[str, ...]:
         out = ["power", "uniform_power", "limit_power"]
         out += ["electrical_power"] if self.pto else ["branch_gap"]
+        out += ["mechanical_power"] if self.lossy else []
         out += ["status"]
         if self.threshold:
             out += ["damping_threshold", "threshold_status"]
@@ -197,12 +211,20 @@ class SweepSpec:
                      for i, c, n in zip(idx, self.chunks, self.shape))
 
     def to_json(self) -> str:
-        """The sweep's identity (stored in the attributes; a resume must match it)."""
-        return json.dumps({"axes": {a: list(self.values[a]) for a in AXES},
-                           "excitation": self.excitation, "square_alpha": self.square_alpha,
-                           "fourier": self.fourier, "harmonics": self.harmonics,
-                           "threshold": self.threshold, "chunks": list(self.chunks)},
-                          sort_keys=True)
+        """The sweep's identity (stored in the attributes; a resume must match it). With an
+        efficiency it says that ``power`` is the electrical power: a store an earlier version
+        wrote (``power`` the mechanical one) is another sweep, never resumed into."""
+        ident = {"axes": {a: list(self.values[a]) for a in AXES},
+                 "excitation": self.excitation, "square_alpha": self.square_alpha,
+                 "fourier": self.fourier, "harmonics": self.harmonics,
+                 "threshold": self.threshold, "chunks": list(self.chunks)}
+        if self.lossy:
+            ident["power"] = "electrical"
+        return json.dumps(ident, sort_keys=True)
+
+    def attrs(self, name: str) -> tuple:
+        """``(long name, units)`` of the variable ``name`` in this map."""
+        return ELECTRICAL_POWER if name == "power" and self.lossy else VARIABLES[name]
 
     def excitation_args(self, omega: float, delta: float | None) -> dict:
         kw = {"excitation": self.excitation, "omega": omega}

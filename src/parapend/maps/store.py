@@ -43,8 +43,8 @@ def _attrs(spec: SweepSpec, command: str | None) -> dict:
     return a
 
 
-def _var_attrs(name: str) -> dict:
-    long, units = VARIABLES[name]
+def _var_attrs(name: str, spec: SweepSpec | None = None) -> dict:
+    long, units = VARIABLES[name] if spec is None else spec.attrs(name)
     a = {"long_name": long}
     if units:
         a["units"] = units
@@ -75,7 +75,7 @@ def _template(spec: SweepSpec, command: str | None):
             fill, attrs = NOT_COMPUTED, _var_attrs(v)
         else:
             arr = da.full(shape, np.nan, dtype=float, chunks=chunks)
-            fill, attrs = np.nan, _var_attrs(v)
+            fill, attrs = np.nan, _var_attrs(v, spec)
         data[v] = (dims, arr, attrs)
         # zstd with its checksum: a chunk altered on disk fails to decode (found by _verify)
         enc[v] = {"chunks": chunks, "fill_value": fill,
@@ -260,8 +260,9 @@ def _prepare(path: Path, spec: SweepSpec, command: str | None, overwrite: bool) 
     if kind == "store" and not overwrite:
         if recorded != spec.to_json():
             raise ParameterError(f"store: {str(path)!r} holds a different sweep (other axes, "
-                                 "excitation, harmonics or threshold); choose another "
-                                 "--store, or --overwrite to replace it")
+                                 "excitation, harmonics or threshold, or an efficiency map "
+                                 "of an earlier version); choose another --store, or "
+                                 "--overwrite to replace it")
         for p in path.rglob("*.partial"):  # a chunk write cut short by kill -9
             with contextlib.suppress(OSError):
                 p.unlink()

@@ -24,8 +24,8 @@ from .annual import HOURS_PER_YEAR
 from .resource import bin_edges, energy_flux, record_spectrum, repeat_period, te_over_tp
 from .spec import DEVICES, QUANTITIES, MatrixSpec
 
-__all__ = ["HOURS_PER_YEAR", "STATISTICS", "MatrixSpec", "matrix_dataset", "matrix_spec",
-           "parse_bins", "power_matrix", "to_mhkit"]
+__all__ = ["HOURS_PER_YEAR", "STATISTICS", "MatrixSpec", "matrix_dataset",
+           "matrix_quantities", "matrix_spec", "parse_bins", "power_matrix", "to_mhkit"]
 
 log = logging.getLogger(__name__)
 
@@ -96,11 +96,14 @@ def matrix_spec(*, hs="1:3:3", te=None, tp=None, realizations: int = 3, waves: f
                 horizon=None, length=None, mass=None, inertia=None,
                 gravity: float = 9.81, gamma=None, damping_coefficient=None, winding=1,
                 harmonics=None, efficiency=None, torque_limit=None, body=None, radius=None,
-                draft=None, mesh=None, hydro=None) -> MatrixSpec:
+                draft=None, mesh=None, hydro=None, density: float = 1025.0,
+                depth=None) -> MatrixSpec:
     """Check everything a matrix's bins depend on (one line naming the parameter).
     ``length``, ``mass``: None is the device's default (``parapend.defaults.SEA`` for the
     prescribed-heave pendulum, ``BUOY`` for the buoy); ``body, radius, draft, mesh, hydro``
-    are the buoy's body as ``parapend buoy`` takes them."""
+    are the buoy's body as ``parapend buoy`` takes them; ``density`` (kg/m^3) and ``depth``
+    (m, None deep water) the water the buoy's body is solved in (a ``hydro`` dataset's
+    own otherwise; the prescribed device's record does not depend on them)."""
     from ..seas import _check_sea, check_response, read_response
     from ..units import Units
 
@@ -154,7 +157,8 @@ def matrix_spec(*, hs="1:3:3", te=None, tp=None, realizations: int = 3, waves: f
                           inertia=inertia, gravity=gravity, gamma=gamma,
                           damping_coefficient=damping_coefficient, winding=winding,
                           harmonics=harmonics, efficiency=efficiency, body=body,
-                          radius=radius, draft=draft, mesh=mesh, hydro=hydro)
+                          radius=radius, draft=draft, mesh=mesh, hydro=hydro,
+                          density=density, depth=depth)
     units = Units(length, mass, gravity, inertia)
     if gamma is not None and damping_coefficient is not None:
         raise ParameterError("gamma: give either gamma or damping-coefficient, not both")
@@ -191,7 +195,8 @@ def matrix_spec(*, hs="1:3:3", te=None, tp=None, realizations: int = 3, waves: f
 
 
 def _buoy_spec(hm0, period, kind, tps, realizations, waves, seed, spectrum, gamma_peak,
-               cutoff, *, body, radius, draft, mesh, hydro, **pendulum) -> MatrixSpec:
+               cutoff, *, body, radius, draft, mesh, hydro, density=1025.0, depth=None,
+               **pendulum) -> MatrixSpec:
     """The coupled buoy's spec: the pendulum and the body checked as ``parapend buoy`` checks
     them, the BEM solved (or loaded) once over every bin's band, every bin checked to lie
     in the data."""
@@ -201,6 +206,9 @@ def _buoy_spec(hm0, period, kind, tps, realizations, waves, seed, spectrum, gamm
     from . import buoy_device
 
     pend, winding, harmonics, efficiency = buoy_device.check_buoy(**pendulum)
+    density = check_range("density", density, 500.0, 2000.0, why="kg/m^3")
+    depth = None if depth is None else check_depth(depth)
+    _check_breaking(hm0, depth)  # before the body's BEM
     body = "cylinder" if body is None else body
     if not isinstance(body, str) or body not in ("cylinder", "sphere"):
         raise ParameterError(f"body: expected cylinder or sphere, got {body!r:.40}")
@@ -216,7 +224,11 @@ def _buoy_spec(hm0, period, kind, tps, realizations, waves, seed, spectrum, gamm
                       draft=None if draft is None else float(draft),
                       mesh=None if mesh is None else os.path.abspath(mesh),
                       hydro=None if hydro is None else os.path.abspath(hydro),
-                      damping_coefficient=float(pend.damping_coefficient))
+                      damping_coefficient=float(pend.damping_coefficient),
+                      # a dataset was solved in its own water (water_of reads it back)
+                      water_density=1025.0 if hydro is not None else float(density),
+                      water_depth=None if hydro is not None or depth is None
+                      else float(depth))
     spec = dataclasses.replace(spec, band=buoy_device.band(spec),
                                digest=buoy_device.file_digest(mesh if hydro is None
                                                               else hydro))
@@ -239,6 +251,41 @@ def _stats(x: np.ndarray, ok: np.ndarray) -> dict:
     return out
 
 
+#: the quantities of the optimum's solve: their statistics count only its successes
+_SOLVED = ("power", "mechanical_power", "electrical_power")
+
+
+def matrix_quantities(spec: MatrixSpec) -> tuple:
+    """The per-realization quantities of the full Dataset (W), the headline ``power`` first:
+    the store's, and with an efficiency ``mechanical_power`` (:func:`_headline`)."""
+    q = spec.variables[:-1]
+    return (q[0], "mechanical_power", *q[1:]) if spec.efficiency is not None else q
+
+
+def _headline(ds, spec: MatrixSpec):
+    """The store's per-realization Dataset as the user reads it (issue 32's rule, as
+    ``parapend buoy`` and ``optimize``): with an efficiency, ``power`` is the electrical
+    power (what the take-off delivers: the power matrix, capture width and annual energy
+    are of it) and ``mechanical_power`` the same motion's mechanical power; the store keeps
+    its own names (``power`` mechanical), so a store resumes whatever reads it."""
+    for q in spec.variables[:-1]:
+        ds[q].attrs["long_name"] = QUANTITIES[q]
+    if spec.efficiency is None:
+        return ds
+    mech, elec = ds["power"].copy(), ds["electrical_power"]
+    mech.attrs = {"long_name": "mechanical power -<T theta'> of the motion whose electrical "
+                               "power is the power", "units": "W"}
+    ds["mechanical_power"] = mech
+    ds["power"] = elec.copy()
+    ds["power"].attrs = {
+        "long_name": ("coupled electrical optimum (the take-off's output)"
+                      if spec.device == "buoy" else
+                      "electrical power of the ideal optimum's motion through the take-off "
+                      "(a lower bound on the electrical optimum)"), "units": "W",
+        "efficiency": spec.efficiency}
+    return ds
+
+
 def matrix_dataset(raw, spec: MatrixSpec, *, depth=None, density: float = 1025.0,
                    width=None, frequency=None, outside=None, rated_power=None):
     """The full Dataset from the engine's per-realization Dataset ``raw``: statistics,
@@ -247,19 +294,21 @@ def matrix_dataset(raw, spec: MatrixSpec, *, depth=None, density: float = 1025.0
     from .annual import annual_energy, bin_power, capacity_factor
 
     pk = spec.period_kind
-    ds = raw.copy()
+    ds = _headline(raw.copy(), spec)
     status = ds["status"].values
     done = ds["done"].values.astype(bool)
-    conv = done & (status == _CODE["converged"])
+    # a solve counts where it succeeded: converged, or no_power (no motion harvests: the
+    # device rests in that record, its optimum's power <= 0 kept as solved)
+    solved = done & np.isin(status, [_CODE["converged"], _CODE["no_power"]])
     dims2 = ("hm0", pk)
-    for q in spec.variables[:-1]:
-        ok = conv if q in ("power", "electrical_power") else done & np.isfinite(ds[q].values)
+    for q in matrix_quantities(spec):
+        solve_q = q in _SOLVED
+        ok = (solved if solve_q else done) & np.isfinite(ds[q].values)
         st = _stats(ds[q].values, ok)
         for s in STATISTICS:
             ds[f"{q}_{s}"] = (dims2, st[s], {
-                "long_name": f"{s} over the realizations of the {QUANTITIES[q]}"
-                             + (" (converged solves only)" if q in ("power", "electrical_power")
-                                else ""),
+                "long_name": f"{s} over the realizations of the {ds[q].attrs['long_name']}"
+                             + (" (successful solves only)" if solve_q else ""),
                 **({"units": "W"} if s != "count" else {})})
     # the resource of each bin
     j = np.empty((len(spec.hm0), len(spec.period)))
@@ -290,9 +339,15 @@ def matrix_dataset(raw, spec: MatrixSpec, *, depth=None, density: float = 1025.0
         "flag_meanings": "no_result rest rotation"})
     ds["capture_width_matrix"] = (dims2, pm / j, {
         "long_name": "capture width P / J of the power matrix", "units": "m"})
+    # over the realizations, each record's power as the device delivers it: max(P, 0) (at
+    # rest where its optimum is negative), so no capture width is negative and
+    # min <= capture_width_matrix <= max
+    rec = bin_power(ds["power"].values)
+    st = _stats(rec, solved & np.isfinite(rec))
     for s in ("std", "min", "max"):
-        ds[f"capture_width_{s}"] = (dims2, ds[f"power_{s}"].values / j, {
-            "long_name": f"capture width P / J, {s} over the realizations", "units": "m"})
+        ds[f"capture_width_{s}"] = (dims2, st[s] / j, {
+            "long_name": f"capture width max(P, 0) / J, {s} over the realizations",
+            "units": "m"})
     if width is not None:
         ds["capture_width_ratio_matrix"] = (dims2, pm / j / width, {
             "long_name": f"capture width ratio P / (J w), w = {width:g} m", "units": "1",
@@ -306,7 +361,7 @@ def matrix_dataset(raw, spec: MatrixSpec, *, depth=None, density: float = 1025.0
     if frequency is not None:
         ds["frequency"] = (dims2, frequency, {"long_name": "share of the year of the bin"})
         annual = {}
-        for q in spec.variables[:-1]:
+        for q in matrix_quantities(spec):
             a = annual_energy(ds[f"{q}_mean"].values, frequency,
                               outside["frequency"] if outside else 0.0)
             a["bins_without_power"] = [{"hm0": spec.hm0[i], pk: spec.period[k],
@@ -322,12 +377,25 @@ def matrix_dataset(raw, spec: MatrixSpec, *, depth=None, density: float = 1025.0
                     a["capacity_factor_bounds"] = [capacity_factor(w, rated_power)
                                                    for w in a["wh_bounds"]]
             annual[q] = a
+        # the completeness in the file too (NetCDF has no boolean attribute: 1 or 0)
+        ds.attrs["annual_energy_complete"] = int(annual["power"]["complete"])
         if annual["power"]["complete"]:
             ds.attrs["annual_energy_mwh"] = annual["power"]["mwh"]
         else:
             ds.attrs["annual_energy_mwh_bounds"] = annual["power"]["mwh_bounds"]
+            ds.attrs["annual_energy_uncounted_frequency"] = \
+                annual["power"]["uncounted_frequency"]
     ds.attrs["hours_per_year"] = HOURS_PER_YEAR
     return ds, annual
+
+
+def _check_breaking(hm0, depth) -> None:
+    """The largest of the Hm0 bins ``hm0`` must not break in ``depth`` (m; None deep)."""
+    if depth is not None and depth < hm0[-1] / BREAKING:
+        raise ParameterError(f"depth: expected at least Hm0 / {BREAKING:g} = "
+                             f"{hm0[-1] / BREAKING:.4g} m for the largest Hm0 bin "
+                             f"({hm0[-1]:g} m: waves that high break in shallower "
+                             f"water), got {depth:g} m")
 
 
 #: work estimated above this many seconds is announced before it starts
@@ -372,15 +440,6 @@ def power_matrix(*, hs="1:3:3", te=None, tp=None, realizations: int = 3, waves: 
     if not isinstance(device, str) or device not in DEVICES:
         raise ParameterError(f"device: expected one of {', '.join(DEVICES)}, got "
                              f"{device!r:.60}")
-    if device == "buoy":
-        # the body is solved at 1025 kg/m^3 in deep water (parapend buoy): a flux at another
-        # density or depth would not be the body's sea (capture widths off by their ratio)
-        if density != 1025.0:
-            raise ParameterError(f"density: the buoy's body is solved at 1025 kg/m^3, got "
-                                 f"{density:g}; drop --density with --device buoy")
-        if depth is not None:
-            raise ParameterError(f"depth: the buoy's body is solved in deep water, got "
-                                 f"{depth:g} m; drop --depth with --device buoy")
     if width is not None:
         width = check_positive("width", width)
     if rated_power is not None:
@@ -412,18 +471,29 @@ def power_matrix(*, hs="1:3:3", te=None, tp=None, realizations: int = 3, waves: 
                        mass=mass, inertia=inertia, gravity=gravity, gamma=gamma,
                        damping_coefficient=damping_coefficient, winding=winding,
                        harmonics=harmonics, efficiency=efficiency, torque_limit=torque_limit,
-                       body=body, radius=radius, draft=draft, mesh=mesh, hydro=hydro)
-    if depth is not None and depth < spec.hm0[-1] / BREAKING:
-        raise ParameterError(f"depth: expected at least Hm0 / {BREAKING:g} = "
-                             f"{spec.hm0[-1] / BREAKING:.4g} m for the largest Hm0 bin "
-                             f"({spec.hm0[-1]:g} m: waves that high break in shallower "
-                             f"water), got {depth:g} m")
+                       body=body, radius=radius, draft=draft, mesh=mesh, hydro=hydro,
+                       density=density, depth=depth)
+    _check_breaking(spec.hm0, depth)
     if spec.device == "buoy":
         from .buoy_device import water_of
 
-        # the flux of the water the body was solved in (a --hydro dataset's own rho and
-        # depth), never another: the capture widths would be off by the ratio
-        density, depth = water_of(spec)
+        # the flux of the water the body was solved in (the matrix's --density and
+        # --depth, or a --hydro dataset's own rho and depth), never another: the capture
+        # widths would be off by the ratio. Options that contradict the dataset: refused
+        rho, h = water_of(spec)
+        if spec.hydro is not None:
+            if density != 1025.0 and not math.isclose(density, rho, rel_tol=1e-9):
+                raise ParameterError(f"density: the dataset {spec.hydro} was solved at rho = "
+                                     f"{rho:g} kg/m^3, got {density:g}; drop --density (the "
+                                     "dataset's own is used) or solve the body in that water")
+            if depth is not None and not (h is not None
+                                          and math.isclose(depth, h, rel_tol=1e-9)):
+                raise ParameterError(f"depth: the dataset {spec.hydro} was solved in "
+                                     + ("deep water" if h is None else f"{h:g} m of water")
+                                     + f", got {depth:g} m; drop --depth (the dataset's own "
+                                     "is used) or solve the body at that depth")
+            _check_breaking(spec.hm0, h)
+        density, depth = rho, h
         if width is None:
             width = spec.width  # the body's diameter (None for a mesh or a dataset)
     est = check_size(spec, workers, scheduler)
@@ -521,7 +591,7 @@ def matrix_csv(ds, spec: MatrixSpec) -> str:
     cols = ["wave_energy_flux_matrix", "capture_width_matrix"]
     if "capture_width_ratio_matrix" in ds:
         cols.append("capture_width_ratio_matrix")
-    for q in spec.variables[:-1]:
+    for q in matrix_quantities(spec):
         cols += [f"{q}_{s}" for s in STATISTICS]
     if "frequency" in ds:
         cols.append("frequency")

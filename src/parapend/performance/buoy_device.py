@@ -56,7 +56,7 @@ def _band(spec, j: int) -> tuple:
 
 def _key(spec) -> str:
     return repr((spec.body, spec.radius, spec.draft, spec.mesh, spec.hydro, spec.digest,
-                 spec.band))
+                 spec.band, spec.water_density, spec.water_depth))
 
 
 def check_file(path, name: str) -> str:
@@ -108,8 +108,69 @@ def body_hydro(spec):
     if key not in _HYDRO:
         from ..hydro.api import _hydro
 
-        _HYDRO[key] = _hydro(spec.body, spec.radius, spec.draft, spec.mesh, spec.hydro)
+        if spec.hydro is not None or (spec.water_density == 1025.0
+                                      and spec.water_depth is None):
+            _HYDRO[key] = _hydro(spec.body, spec.radius, spec.draft, spec.mesh, spec.hydro)
+        else:
+            _HYDRO[key] = _body_in_water(spec)
     return _HYDRO[key]
+
+
+def _body_in_water(spec):
+    """The body of ``spec`` solved in the matrix's water (``water_density``, ``water_depth``;
+    ``parapend buoy`` solves it at 1025 kg/m^3 in deep water): the same checks and mesh as
+    :func:`parapend.hydro.api._hydro`, another ``rho`` and depth; in deep water its
+    frequency grid too, at a finite depth :func:`_finite_grid` (a ``--mesh``: 48
+    frequencies over the bins' band); deeper than ``DEEP_RATIO`` wavelengths of its lowest
+    frequency, in deep water (the flux then too). The BEM refuses a draft (a sphere's
+    radius) not less than the depth in one line."""
+    from ..hydro import bem as hy
+    from ..hydro.api import _dimensions
+    from .resource import DEEP_RATIO
+
+    depth = math.inf if spec.water_depth is None else spec.water_depth
+
+    def deep(omega):
+        # deeper than DEEP_RATIO wavelengths at the lowest frequency (the flux's rule):
+        # deep water to about exp(-4 pi DEEP_RATIO) ~ 1e-11; Capytaine's finite-depth Green
+        # function gave NaN coefficients at 1e300 m
+        return depth >= DEEP_RATIO * 2 * math.pi * 9.81 / float(omega[0]) ** 2
+
+    if spec.mesh is not None:
+        for name in ("radius", "draft"):
+            if getattr(spec, name) is not None:
+                raise ParameterError(f"{name}: the body comes from --mesh; drop it")
+        if spec.body not in (None, "cylinder"):
+            raise ParameterError("body: the body comes from --mesh; drop --body")
+        omega = "body"
+        if math.isfinite(depth):  # the band's grid (the file's mesh kept), see _finite_grid
+            lo, hi = spec.band
+            omega = np.linspace(0.9 * lo, 1.05 * hi, hy.BODY_FREQUENCIES)
+            if deep(omega):
+                omega, depth = "body", math.inf
+        return hy.from_mesh(spec.mesh, omega=omega, rho=spec.water_density,
+                            water_depth=depth), None
+    r, d = _dimensions(spec.body, spec.radius, spec.draft)
+    scale = r if spec.body == "sphere" else min(r, d)
+    omega = "body" if not math.isfinite(depth) else _finite_grid(spec, scale, depth)
+    if not isinstance(omega, str) and deep(omega):
+        omega, depth = "body", math.inf
+    water = {"rho": spec.water_density, "water_depth": depth}
+    if spec.body == "sphere":
+        return hy.sphere(r, omega=omega, **water), 2 * r
+    return hy.cylinder(r, d, omega=omega, **water), 2 * r
+
+
+def _finite_grid(spec, scale: float, depth: float) -> np.ndarray:
+    """The body's own frequency grid in water of ``depth`` (the same mesh: its top
+    frequency sets the panel), from its last point at or below the matrix's band: Capytaine's
+    finite-depth Green function gives NaN at the grid's first point (a 100 s wave, ``k h``
+    below its tables), which no bin uses."""
+    from ..hydro import bem as hy
+
+    full = hy.body_frequencies(scale / hy.GEOMETRY_PANELS, g=9.81, water_depth=depth)
+    first = max(0, int(np.searchsorted(full, spec.band[0], side="right")) - 1)
+    return full[first:]
 
 
 def check_buoy(*, response, gamma, gravity, winding, harmonics, efficiency, mass, length,
@@ -169,9 +230,10 @@ def prepare(spec):
 
 def water_of(spec) -> tuple:
     """``(density, depth)`` of the water the body was solved in (``depth`` None: deep), for
-    the waves' energy flux: a ``--hydro`` dataset's own ``rho`` and depth, 1025 kg/m^3 in
-    deep water for a body solved here. A dataset's ``g`` must be the pendulum's 9.81 m/s^2
-    and its ``rho`` a water's (a rho of 1e-300 gave a capture width of 5.6e302 m)."""
+    the waves' energy flux: a ``--hydro`` dataset's own ``rho`` and depth, the matrix's
+    (``spec.water_density``, ``spec.water_depth``) for a body solved here. A dataset's
+    ``g`` must be the pendulum's 9.81 m/s^2 and its ``rho`` a water's (a rho of 1e-300
+    gave a capture width of 5.6e302 m)."""
     h, _ = body_hydro(spec)
     rho, g, depth = float(h.rho), float(h.g), float(h.water_depth)
     where = f" of {spec.hydro}" if spec.hydro is not None else ""

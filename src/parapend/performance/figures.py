@@ -217,10 +217,18 @@ def text_report(ds, out: dict, drawn: list) -> str:
              f"computed now {out['computed_bins']} bins, found finished "
              f"{out['resumed_bins']}; {out['seconds']:.1f} s ({out['executor']})"
              + (f"; store {out['store']}" if out["store"] else ""), "",
-             "mean optimum power, rows Hm0, columns " + pk + ":"]
+             ("mean electrical power (the take-off's output; mechanical_power beside it "
+              "in --json)" if "mechanical_power_mean" in ds else "mean optimum power")
+             + ", rows Hm0, columns " + pk + ":"]
     rows = [[f"{h:g} m", *(with_unit(v, "W") for v in ds["power_mean"].values[i])]
             for i, h in enumerate(hm0)]
     lines += [_right_table(rows, ["Hm0 \\ " + pk, *(f"{t:g} s" for t in per)]), ""]
+    if "operating_mode" in ds:
+        m = ds["operating_mode"].values
+        lines.append("operating mode of the bins: " + ", ".join(
+            f"{int((m == v).sum())} {name}" for v, name in ((1, "rotation"), (0, "rest"),
+                                                            (-1, "no result"))
+            if (m == v).any()))
     if "operating_mode" in ds and (ds["operating_mode"].values == 0).any():
         lines.append(f"{int((ds['operating_mode'].values == 0).sum())} bins with a negative "
                      "mean optimum: the pendulum rests there (0 W in the power matrix and "
@@ -231,8 +239,10 @@ def text_report(ds, out: dict, drawn: list) -> str:
     a = out["annual_energy"]
     if a is not None:
         p = a["power"]
+        eff = "mechanical_power" in a  # with an efficiency the headline is electrical
         names = (("limit_power", "limit"), ("uniform_power", "uniform rotation"),
-                 ("electrical_power", "electrical"),
+                 ("mechanical_power", "mechanical"),
+                 *(() if eff else (("electrical_power", "electrical"),)),
                  ("radiation_bound_power", "radiation bound"), ("one_way_power", "one-way"))
         def aep(e):
             # an incomplete AEP is never one plain number: its bounds
@@ -241,8 +251,11 @@ def text_report(ds, out: dict, drawn: list) -> str:
             lo, hi = e["wh_bounds"]
             return f"{_per_year(lo)} to {_per_year(hi)}"
 
-        lines.append(f"mean annual energy (8766 h/yr): optimum {aep(p)}"
+        lines.append(f"mean annual energy (8766 h/yr): {'electrical' if eff else 'optimum'} "
+                     f"{aep(p)}"
                      + "".join(f", {label} {aep(a[q])}" for q, label in names if q in a))
+        if p.get("complete") is True:
+            lines.append("complete: every sea state of the site lies in a bin with a result")
         if not p.get("complete", True) and "uncounted_frequency" in p:
             lines.append(f"incomplete: {p['uncounted_frequency']:.4g} of the year has no "
                          "power (the bounds count it at 0 and at the largest bin's power)")

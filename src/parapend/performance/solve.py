@@ -2,9 +2,15 @@
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
-__all__ = ["electrical_power", "solve_bin"]
+__all__ = ["BOUND_TOL", "electrical_power", "solve_bin", "verdict"]
+
+#: relative margin of the bounds' checks in :func:`verdict`: the discretization's 0.1 %
+#: (as ``parapend buoy``'s radiation-bound check)
+BOUND_TOL = 1e-3
 
 
 def electrical_power(result, efficiency: float) -> float:
@@ -32,3 +38,24 @@ def solve_bin(spec, i: int, j: int, r: int) -> dict:
     if spec.efficiency is not None:
         out["electrical_power"] = electrical_power(res, spec.efficiency)
     return out
+
+
+def verdict(vals: dict) -> dict:
+    """One realization's values with a status that never calls an impossible number a
+    success: a NaN or infinite power (or bound) is "nonfinite"; a power above the bound of
+    its device (the gamma -> 0 limit ``limit_power`` for the prescribed heave, the radiation
+    bound for the buoy, beyond :data:`BOUND_TOL`) or an electrical power above the
+    mechanical one is "above_bound". Other statuses are kept."""
+    if vals.get("status") not in ("converged", "no_power"):
+        return vals
+    names = [k for k in ("power", "electrical_power", "limit_power", "radiation_bound_power")
+             if k in vals]
+    if not all(math.isfinite(vals[k]) for k in names):
+        return {**vals, "status": "nonfinite"}
+    p = vals["power"]
+    bound = vals.get("radiation_bound_power", vals.get("limit_power"))
+    e = vals.get("electrical_power")
+    if (bound is not None and p > 0 and p > bound * (1.0 + BOUND_TOL)) or \
+            (e is not None and e > 0 and e > p + 1e-9 * abs(p)):
+        return {**vals, "status": "above_bound"}
+    return vals

@@ -13,7 +13,6 @@ from __future__ import annotations
 import dataclasses
 import json
 import logging
-import math
 
 import numpy as np
 
@@ -41,7 +40,10 @@ STORE_NAMES = ("hm0", "te", "tp", "realization", "seed", "done", "status", *QUAN
 DEVICES = ("prescribed-heave", "buoy")
 #: the spec's fields only the buoy uses (left out of a prescribed-heave spec's JSON)
 _BUOY_FIELDS = ("body", "radius", "draft", "mesh", "hydro", "digest", "damping_coefficient",
-                "band", "width")
+                "band", "width", "water_density", "water_depth")
+#: the buoy's water when nothing else is given (1025 kg/m^3, deep): left out of the JSON, so
+#: that a store written before the body took the matrix's water still resumes
+_DEFAULT_WATER = {"water_density": 1025.0, "water_depth": None}
 
 
 @dataclasses.dataclass(frozen=True)
@@ -80,6 +82,10 @@ class MatrixSpec:
     damping_coefficient: float | None = None
     band: tuple | None = None
     width: float | None = None
+    # the water the buoy's body is solved in (kg/m^3; m, None deep): the waves' own
+    # (--density, --depth), so the flux and the body see one sea
+    water_density: float = 1025.0
+    water_depth: float | None = None
 
     kind = "power_matrix"
     pto = False
@@ -140,6 +146,10 @@ class MatrixSpec:
         if self.device != "buoy":
             for k in _BUOY_FIELDS:
                 d.pop(k)
+        else:
+            for k, v in _DEFAULT_WATER.items():
+                if d[k] == v:
+                    d.pop(k)
         return json.dumps(d, sort_keys=True)
 
     @classmethod
@@ -242,7 +252,7 @@ class MatrixSpec:
     # -- one block ---------------------------------------------------------------------------
     def compute_block(self, block: int) -> dict:
         from ..maps.spec import _CODE
-        from .solve import solve_bin
+        from .solve import solve_bin, verdict
 
         i, j, _ = (s.start for s in self.block_slices(block))
         out = {v: (np.full(self.chunks, -1, dtype=np.int8) if v == "status"
@@ -255,9 +265,12 @@ class MatrixSpec:
                             self.hm0[i], self.period_kind, self.period[j], r,
                             type(err).__name__, err)
                 vals = {"status": "error"}
-            if vals.get("status") == "converged" and not math.isfinite(vals.get("power",
-                                                                                math.nan)):
-                vals["status"] = "nonfinite"
+            checked = verdict(vals)  # no impossible number is a success
+            if checked["status"] != vals["status"]:
+                log.warning("power matrix bin hm0=%g %s=%g realization %d: %s (power %r W): "
+                            "not a success", self.hm0[i], self.period_kind, self.period[j],
+                            r, checked["status"], vals.get("power"))
+            vals = checked
             for k, v in vals.items():
                 if k == "status":
                     out[k][0, 0, r] = _CODE.get(v, _CODE["other"])

@@ -1,0 +1,141 @@
+"""The hull through a real power take-off (issue 30 item 4): the efficiency's electrical
+power, the copper loss ``r <tau^2>`` and the torque limit, on the kernel of
+:mod:`parapend.hydro.hull`.
+
+Checked against: central differences (the chain rule through the torque), the independent
+CasADi/IPOPT reference of tests/hull_reference.py with the same PTO (the limit as
+constraints, the efficiency as a split of the power into non-negative parts: exact and
+smooth, where ours smooths the kink and integrates it on the piecewise-linear interpolant),
+and invariants (ideal PTO = the ideal problem; electrical <= eta_g x ideal)."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from hull_reference import hull_reference_pto
+from hull_synthetic import case
+from test_hull_ipopt import CASES, _hull_case
+
+from parapend.cli import main
+from parapend.hydro.hull import HullProblem
+from parapend.hydro.hull_optimum import HullPTO, hull_search
+
+
+def _x(n, winding, seed):
+    x = 0.3 * np.random.default_rng(seed).standard_normal(2 * n + 1)
+    x[0] += math.pi if winding == 0 else 0.0
+    return x
+
+
+@pytest.mark.parametrize("kind", ["efficiency", "copper", "limit", "all"])
+@pytest.mark.parametrize("coupled", [False, True])
+@pytest.mark.parametrize("winding", [0, 1])
+def test_pto_derivatives_are_exact(kind, coupled, winding):
+    """Central differences (step 1e-5) of the PTO's objective agree with the exact gradient
+    and Hessian to 1e-6 of their size (measured 1e-11 to 7e-9), and evaluate's value is
+    the objective."""
+    cs = case(winding=winding, harmonics=5)
+    pr = HullProblem(cs, coupled=coupled,
+                     eta=(0.8, 0.7) if kind in ("efficiency", "all") else None,
+                     copper_loss=1e-4 if kind in ("copper", "all") else 0.0)
+    x = _x(cs.harmonics, winding, winding + 3)
+    st = pr.state(x)
+    if kind in ("efficiency", "all"):
+        pr.width = 0.1 * float(np.max(np.abs(st["p"])))
+    if kind in ("limit", "all"):
+        lam = np.random.default_rng(1).random(pr.points)
+        pr.set_limit(0.5 * float(np.max(np.abs(st["tau"]))), 10.0, lam, None)
+    val, g, h = pr.evaluate(x)
+    assert val == pytest.approx(pr.power(x), rel=1e-14)
+    eps, eye = 1e-5, np.eye(x.size)
+    gfd = np.array([(pr.power(x + eps * e) - pr.power(x - eps * e)) / (2 * eps) for e in eye])
+    hfd = np.array([(pr.evaluate(x + eps * e)[1] - pr.evaluate(x - eps * e)[1]) / (2 * eps)
+                    for e in eye])
+    assert np.max(np.abs(g - gfd)) <= 1e-6 * np.max(np.abs(g))
+    assert np.max(np.abs(h - hfd)) <= 1e-6 * np.max(np.abs(h))
+
+
+def test_an_ideal_pto_is_the_ideal_problem():
+    """Efficiency 1 both ways, no loss, no limit: the PTO is inactive and the answer is the
+    ideal one, bit for bit."""
+    assert not HullPTO(efficiency=(1.0, 1.0)).active
+    def make(s):
+        return case(winding=1, harmonics=12 * s, hull_harmonics=13 * s)
+    a = hull_search(make, refine=False)
+    b = hull_search(make, refine=False, pto=HullPTO(efficiency=(1.0, 1.0)))
+    assert a.power == b.power
+
+
+def _ours(name, pto):
+    kw = CASES[name]()
+    cs = _hull_case(kw)
+    sol = hull_search(lambda s: cs, refine=False, pto=HullPTO(**pto))
+    assert sol.success, sol.status
+    return kw, cs, sol
+
+
+def test_copper_loss_equals_ipopt():
+    """The copper loss alone: IPOPT from our optimum stays there (1e-9; measured 6e-16), and
+    the least-torque start finds the small swing a real generator's loss leaves."""
+    kw, cs, sol = _ours("box-swing", {"copper_loss": 1e-4})
+    ref = hull_reference_pto(x0=sol.x, pto={"copper_loss": 1e-4}, **kw)
+    assert ref["status"] == "Solve_Succeeded"
+    assert ref["objective"] == pytest.approx(sol.power, rel=1e-9)
+    ideal = hull_search(lambda s: cs, refine=False)
+    assert 0 < sol.power < ideal.power
+    assert sol.mechanical_power > sol.power
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("name", ["box-swing", "causal-rotate"])
+def test_torque_limit_against_ipopt(name):
+    """Half the ideal optimum's peak torque: our limited optimum keeps the limit on the grid
+    (to 1e-7), and IPOPT with the limit as constraints, from it, finds nothing better
+    (measured: equal to 4e-11 on the box; 2e-5 below ours on the causal hull, a
+    neighbouring maximum)."""
+    kw = CASES[name]()
+    cs = _hull_case(kw)
+    ideal = hull_search(lambda s: cs, refine=False)
+    limit = 0.5 * float(np.max(np.abs(HullProblem(cs).grid_state(ideal.x)["tau"])))
+    _, _, sol = _ours(name, {"torque_limit": limit})
+    tau = HullProblem(cs).grid_state(sol.x)["tau"]
+    assert np.max(np.abs(tau)) <= limit * (1 + 1e-7)
+    ref = hull_reference_pto(x0=sol.x, pto={"torque_limit": limit}, **kw)
+    assert ref["status"] == "Solve_Succeeded"
+    assert np.max(np.abs(ref["tau"])) <= limit * (1 + 1e-7)
+    assert sol.power >= ref["objective"] * (1 - 1e-9)
+    assert sol.power == pytest.approx(ref["objective"], rel=1e-4)
+    assert sol.power < ideal.power
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("name", ["box-swing", "causal-rotate"])
+def test_efficiency_against_ipopt(name):
+    """Efficiency 0.9 generating, 0.85 motoring. The two codes integrate the kink of
+    ``e(p)`` differently on the grid (ours on the piecewise-linear interpolant, IPOPT's
+    split the grid's mean): ours is not below IPOPT's motion in our measure, the two optima
+    and the two measures of our motion agree to 1e-3 (measured 3e-6 to 5e-4), and it does
+    not exceed eta_g times the ideal optimum."""
+    eta = (0.9, 0.85)
+    kw, cs, sol = _ours(name, {"efficiency": eta})
+    ref = hull_reference_pto(x0=sol.x, pto={"efficiency": eta}, **kw)
+    pr = HullPTO(efficiency=eta).problem(cs)
+    assert sol.power >= pr.exact(ref["x"]) - 1e-9 * abs(sol.power)
+    # (IPOPT's own answer is not always at its measure's maximum: its interior point on
+    # the split of the power ends at an acceptable level, at times below our motion in its
+    # measure, so only ours is held to being a maximum)
+    p = pr.state(sol.x)["p"]
+    ours_in_theirs = float(np.mean(np.where(p > 0, eta[0] * p, p / eta[1])))
+    assert ours_in_theirs == pytest.approx(sol.power, rel=1e-3)
+    assert sol.power == pytest.approx(ref["objective"], rel=1e-3)
+    ideal = hull_search(lambda s: cs, refine=False)
+    assert sol.power <= eta[0] * ideal.power
+    assert sol.power <= sol.mechanical_power
+
+
+def test_cli_copper_loss_only_with_the_hull(capsys):
+    assert main(["buoy", "--copper-loss", "1e-4"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "copper-loss" in err[0]
