@@ -287,6 +287,10 @@ def test_long_mpc_record_refused_before_work(capsys):
      ["repeat-period"]),
     (["--hs", "2", "--tp", "8", "--repeat-period", "40", "--efficiency", "0.9", "--harmonics",
       "512"], ["harmonics"]),
+    # without a take-off: 7904 and 5056 harmonics by default (the 250 s default record's
+    # 1976 took 79 s, a 1000 s record ran past 150 s)
+    (["--hs", "0.5", "--tp", "2.5", "--repeat-period", "1000"], ["repeat-period"]),
+    (["--hs", "0.5", "--tp", "2.5", "--repeat-period", "640"], ["repeat-period"]),
 ])
 def test_record_with_take_off_refused_before_work(capsys, args, names):
     assert "at most" in _refused(capsys, *args, names=names)

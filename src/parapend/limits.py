@@ -241,6 +241,10 @@ BUOY_MAX_MPC_WORK = 1.4e5
 #: --repeat-period 40 --efficiency 0.9) took 14 s of CPU, 512 (--repeat-period 256) over
 #: 2 minutes and 1.3 GB, 800 (--repeat-period 160 --winding 20) 163 s of CPU
 BUOY_MAX_PTO_RECORD_HARMONICS = 256
+#: the same without a take-off (the operator Newton): the default 250 s record at Tp 2.5 s
+#: (about 1600 harmonics) took 79 s under load, --harmonics 4096 over it 126 s, a 1000 s
+#: record (6400 by default) over 150 s
+BUOY_MAX_RECORD_HARMONICS = 4096
 
 #: ``buoy --dofs surge,heave,pitch``: at most this many harmonics of the pendulum's motion
 #: (the hull's harmonics follow; a Newton step costs O(N^3) with dense matrices, the

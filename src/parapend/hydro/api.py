@@ -192,18 +192,20 @@ def _check_design(count, pto):
                          f"design search may take; {fix}")
 
 
-def _check_record_harmonics(h, wave, harmonics, winding, record):
-    """Refuse a power take-off over an irregular record whose motion needs more harmonics
-    than finish in about two minutes (:data:`parapend.limits.BUOY_MAX_PTO_RECORD_HARMONICS`;
-    the default is :func:`.optimum._default_harmonics`'s), naming the option."""
+def _check_record_harmonics(h, wave, harmonics, winding, record, pto=True):
+    """Refuse an optimum over an irregular record whose motion needs more harmonics than
+    finish in about two minutes (:data:`parapend.limits.BUOY_MAX_PTO_RECORD_HARMONICS` with
+    a power take-off, ``BUOY_MAX_RECORD_HARMONICS`` without; the default is
+    :func:`.optimum._default_harmonics`'s), naming the option."""
     from .optimum import HARMONICS_PER_WAVE
 
-    cap = limits.BUOY_MAX_PTO_RECORD_HARMONICS
+    cap = limits.BUOY_MAX_PTO_RECORD_HARMONICS if pto else limits.BUOY_MAX_RECORD_HARMONICS
+    with_pto = "with --efficiency or --torque-limit " if pto else ""
     if harmonics is not None:
         if harmonics > cap:
-            raise ParameterError(f"harmonics: expected at most {cap} over a record with "
-                                 f"--efficiency or --torque-limit (the most that finish in "
-                                 f"about two minutes), got {harmonics}")
+            raise ParameterError(f"harmonics: expected at most {cap} over a record "
+                                 f"{with_pto}(the most that finish in about two minutes), "
+                                 f"got {harmonics}")
         return
     kk = np.arange(1, np.asarray(wave.amplitudes).size + 1)
     _, _, f = h.coefficients(kk * wave.omega)
@@ -213,8 +215,8 @@ def _check_record_harmonics(h, wave, harmonics, winding, record):
     if n > cap:
         name = "winding" if winding >= km else ("record" if record is not None
                                                  else "repeat-period")
-        raise ParameterError(f"{name}: with --efficiency or --torque-limit this record needs "
-                             f"{n} harmonics ({HARMONICS_PER_WAVE} per wave, {max(km, winding)} "
+        raise ParameterError(f"{name}: {with_pto}this record needs {n} harmonics "
+                             f"({HARMONICS_PER_WAVE} per wave, {max(km, winding)} "
                              f"waves or turns), more than the {cap} that finish in about two "
                              f"minutes; use a record of at most {cap // HARMONICS_PER_WAVE} "
                              "waves and turns, or give --harmonics")
@@ -425,6 +427,8 @@ def buoy(*, wave_height=None, wave_period=None, hs=None, tp=None, spectrum=None,
                        name="tp" if record is None else "record")
         if torque_limit is not None or efficiency is not None:
             _check_record_harmonics(h, wave, harmonics, winding, record)
+        elif controller == "optimum":
+            _check_record_harmonics(h, wave, harmonics, winding, record, pto=False)
     else:
         if periods is None:
             period = _period(BUOY["wave_period"] if wave_period is None else wave_period)
