@@ -58,6 +58,7 @@ def _refused(capsys, *args, names):
     (["--hydro", "/"], ["hydro"]),
     (["--mesh", "/dev/zero"], ["mesh"]),
     (["--mesh", "/"], ["mesh"]),
+    (["--wave-period", "1.2:3:200", "--harmonics", "40960"], ["harmonics"]),
 ])
 def test_refused_in_one_line(capsys, args, names):
     _refused(capsys, *args, names=names)
@@ -238,10 +239,39 @@ def test_low_torque_limit_blames_the_limit():
     (["--harmonics", "48", "--torque-limit", "10"], ["harmonics"]),
     (["--winding", "64"], ["winding"]),
     (["--winding", "2", "--efficiency", "0.9"], ["winding"]),
+    (["--wave-period", "1.2:3:200", "--harmonics", "4096"], ["harmonics"]),
+    (["--wave-period", "1.2:3:200", "--harmonics", "512"], ["wave-period"]),
+    (["--wave-period", "1.2:3:200", "--harmonics", "409"], ["wave-period"]),
+    (["--wave-period", "1.2:3:200"], ["wave-period"]),
+    (["--wave-period", "1.2:3:4", "--efficiency", "0.9"], ["wave-period"]),
+    (["--wave-period", "1.2:3:4", "--torque-limit", "100"], ["wave-period"]),
+    (["--wave-period", "1.2:3:4", "--harmonics", "512"], ["wave-period"]),
 ])
 def test_sizes_refused_before_work(capsys, args, names):
     err = _refused(capsys, *args, names=names)
     assert "at most" in err
+
+
+def test_sweep_estimate():
+    """The sweep's estimate: the periods times one period's time, within
+    BUOY_MAX_SWEEP_SECONDS; the message names the most periods that fit, and that many
+    pass."""
+    import re
+
+    from parapend.hydro.api import _check_sweep
+
+    for harmonics, pto in ((None, False), (128, False), (512, False), (None, True)):
+        with pytest.raises(ParameterError, match=r"^wave-period: 200 periods") as got:
+            _check_sweep(200, harmonics, 1, pto)
+        assert "\n" not in str(got.value)
+        most = re.search(r"at most (\d+) periods", str(got.value))
+        if most is None:  # one period at a time
+            assert "one period at a time" in str(got.value)
+            continue
+        _check_sweep(int(most.group(1)), harmonics, 1, pto)
+        with pytest.raises(ParameterError):
+            _check_sweep(int(most.group(1)) + 1, harmonics, 1, pto)
+    _check_sweep(10, None, 1, False)  # docs/buoy.md's 1.2:3:10
 
 
 def test_long_mpc_record_refused_before_work(capsys):
@@ -257,6 +287,10 @@ def test_long_mpc_record_refused_before_work(capsys):
      ["repeat-period"]),
     (["--hs", "2", "--tp", "8", "--repeat-period", "40", "--efficiency", "0.9", "--harmonics",
       "512"], ["harmonics"]),
+    # without a take-off: 7904 and 5056 harmonics by default (the 250 s default record's
+    # 1976 took 79 s, a 1000 s record ran past 150 s)
+    (["--hs", "0.5", "--tp", "2.5", "--repeat-period", "1000"], ["repeat-period"]),
+    (["--hs", "0.5", "--tp", "2.5", "--repeat-period", "640"], ["repeat-period"]),
 ])
 def test_record_with_take_off_refused_before_work(capsys, args, names):
     assert "at most" in _refused(capsys, *args, names=names)
@@ -280,6 +314,11 @@ def test_mesh_of_too_many_panels_refused_before_the_bem(tmp_path):
     (dict(efficiency=[0.9, "a"]), "efficiency"), (dict(torque_limit="1"), "torque-limit"),
     (dict(radius=[1]), "radius"), (dict(efficiency=Decimal("0.9"), harmonics=100),
                                    "harmonics"),
+    # a bare ValueError or TypeError before
+    (dict(body=np.array([1.0, 2.0])), "body"), (dict(controller=np.array([1.0])), "controller"),
+    (dict(dofs=1.0), "dofs"), (dict(optimize_design=0), "optimize-design"),
+    (dict(mesh=1.0), "mesh"), (dict(mesh=["a.gdf"]), "mesh"),
+    (dict(wave_period="1.2:3:200", harmonics=512), "wave-period"),
 ])
 def test_api_raises_parameter_error(kw, name):
     with pytest.raises(ParameterError, match=f"^{name}:"):
@@ -289,10 +328,150 @@ def test_api_raises_parameter_error(kw, name):
 def test_out_of_memory_names_options_of_buoy(monkeypatch, capsys):
     import parapend.cli.buoy as cb
 
-    def boom(a):
+    def boom(a, **kw):
         raise MemoryError
 
     monkeypatch.setattr(cb, "_run", boom)
     assert main(["buoy"]) == 1
     err = capsys.readouterr().err.strip()
     assert "out of memory" in err and "--points" not in err and "\n" not in err
+
+
+def test_small_torque_limit_is_the_constant_brake():
+    """A limit far below the ideal peak torque (1 N m against 279 N m; ``buoy
+    --torque-limit 1`` stalled for minutes at 3.434 W): the rotation under ``T = -T_max``,
+    whose torque on a dense grid is ``-T_max`` at every instant and which never turns back,
+    so its power is the bound ``T_max K omega`` of every such rotation (closed form; the
+    power itself is computed from the motion's torque on the fine grid)."""
+    import math
+
+    from parapend.hydro.coupled import Pendulum, Wave
+    from parapend.hydro.optimum import (
+        BALANCE_TOL,
+        _grid_motion,
+        _heave_and_balance,
+        coupled_optimum,
+    )
+
+    h = toy_hydro(radius=0.5)
+    p = Pendulum(80.0, 0.3, 7.2, 1.0)
+    wave = Wave.regular(0.2, 1.8)
+    lim = 1.0
+    r = coupled_optimum(h, p, wave, torque_limit=lim)
+    assert r.success and "constant brake" in r.status, r.status
+    # the closed form: the brake extracts T_max <theta'> = T_max K omega exactly
+    assert r.power == pytest.approx(lim * 2 * math.pi / 1.8, rel=1e-9)
+    assert r.power < coupled_optimum(h, p, wave).power
+    x = r.theta_coefficients["x"]
+    m = 8192
+    _, _, _, tau = _heave_and_balance(h, p, wave, x, 1, m, True, torque=True)
+    assert np.max(np.abs(tau + lim)) <= 1e-6 * lim
+    assert np.min(_grid_motion(x, 1, m)[1]) > 0
+    assert r.energy_balance_residual <= BALANCE_TOL
+
+
+@pytest.mark.slow  # the default body's BEM and four solves: about 10 s
+def test_torque_limit_one_newton_metre_takes_seconds(capsys):
+    """``buoy --torque-limit 1`` at the defaults: the constant brake, converged, its power
+    ``2 pi / 1.8`` W (T_max K omega)."""
+    import json
+    import math
+
+    assert main(["buoy", "--torque-limit", "1", "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert out["success"], out["status"]
+    assert out["power_w"] == pytest.approx(2 * math.pi / 1.8, rel=1e-9)
+
+
+@pytest.mark.parametrize("change, match", [
+    (lambda d: d.assign_coords(rho=1e-300), "expected rho in"),
+    (lambda d: d.assign_coords(rho=1e300), "expected rho in"),
+    (lambda d: d.assign_coords(rho=1e-3), "expected rho in"),
+    (lambda d: d.assign_coords(g=1e-300), "expected g in"),
+    (lambda d: d.assign_coords(water_depth=1e-300), "water_depth"),
+    (lambda d: d.assign_coords(water_depth=1e-3), "water_depth"),
+    (lambda d: d.assign(excitation_force=d["excitation_force"] * 1e300), "excitation_force "
+                                                                           "reaches"),
+    (lambda d: d.assign(radiation_damping=d["radiation_damping"] * 1e300), "radiation_damping "
+                                                                            "reaches"),
+    (lambda d: d.assign(inertia_matrix=d["inertia_matrix"] * 1e300), "mass reaches"),
+])
+def test_dataset_scales_out_of_reach_refused(change, match):
+    """A dataset's rho of 1e-300 gave a capture width of -1e302 m, a depth of 1e-300 one of
+    -5e148 m, a g of 1e-300 blamed ``gamma``, an excitation of 1e300 N/m an infinite
+    radiation bound: each is refused in one line naming the dataset's variable."""
+    with pytest.raises(ParameterError, match=f"^hydro: .*{match}") as got:
+        bem.load(change(_ds()))
+    assert "\n" not in str(got.value)
+
+
+def test_dataset_scales_in_reach_accepted():
+    d = _ds().assign_coords(rho=1000.0, g=9.8, water_depth=0.5)
+    h = bem.load(d)
+    assert (h.rho, h.g, h.water_depth) == (1000.0, 9.8, 0.5)
+
+
+@pytest.mark.parametrize("args", [
+    ["--optimize-design", "mass,length", "--efficiency", "0.9"],
+    ["--optimize-design", "mass,length,inertia,damping-coefficient", "--torque-limit", "100"],
+])
+def test_design_search_refused_before_work(capsys, args):
+    """A design search whose solves cannot finish in about ten minutes (four variables with
+    an efficiency: about 40 minutes) is refused before any solve, naming what fits."""
+    assert "at most 1 of them" in _refused(capsys, *args, names=["optimize-design"])
+
+
+@pytest.mark.parametrize("names", [["length"], ["mass", "length", "inertia",
+                                                 "damping_coefficient"]])
+def test_design_search_reports_progress(names):
+    """The search calls ``progress(done, total)`` after each solve, never past its estimate
+    (design_solves, what buoy checks), and ends at ``(total, total)``."""
+    from types import SimpleNamespace
+
+    from parapend.hydro.coupled import Pendulum
+    from parapend.hydro.design import design_solves, optimize_design
+
+    def solve(p):  # a smooth power with one maximum inside the box
+        power = 10 - (p.length - 0.4) ** 2 - (p.mass - 90) ** 2 / 1e3
+        return SimpleNamespace(power=power, success=True, electrical_power=None)
+
+    calls = []
+    pend = Pendulum(80.0, 0.3, 7.2, 1.0)
+    bounds = {"mass": (40.0, 160.0), "length": (0.1, 0.8), "inertia": (7.2, 20.0),
+              "damping_coefficient": (0.0, 5.0)}
+    found = optimize_design(solve, pend, names, {n: bounds[n] for n in names},
+                            progress=lambda d, t: calls.append((d, t)))
+    total = design_solves(len(names))
+    assert calls[-1] == (total, total)
+    assert all(t == total and 0 <= d <= total for d, t in calls)
+    assert [d for d, _ in calls] == sorted(d for d, _ in calls)
+    assert found.evaluations <= total
+    assert found.best["length_m"] == pytest.approx(0.4, abs=1e-2)
+
+
+def test_large_gdf_mesh_refused_before_capytaine_reads_it(tmp_path, monkeypatch):
+    """A GDF mesh whose panels wholly below the waterline exceed the cap is refused from its
+    own numbers (Capytaine's reader took 25 s for 40 000 panels): Capytaine is not called."""
+    from parapend import limits
+
+    n = limits.BUOY_MAX_MESH_PANELS + 1
+    quad = np.array([[0, 0, -1], [1, 0, -1], [1, 1, -1], [0, 1, -1]], dtype=float)
+    rows = "\n".join(" ".join(f"{x:g}" for x in v) for _ in range(n) for v in quad)
+    path = tmp_path / "many.gdf"
+    path.write_text(f"test\n1.0 9.81\n0 0\n{n}\n{rows}\n")
+
+    def unread(*a, **k):
+        raise AssertionError("Capytaine read the mesh")
+
+    monkeypatch.setattr(bem, "_quiet_capytaine", unread)
+    with pytest.raises(ParameterError, match=rf"^mesh: .* at least {n} immersed panels; .* "
+                                             rf"at most {n - 1}") as got:
+        bem.from_mesh(path, omega="body")
+    assert "\n" not in str(got.value)
+    # panels above the waterline do not count; a count the numbers contradict is left to
+    # Capytaine
+    for text in (f"test\n1.0 9.81\n0 0\n{n}\n{rows.replace('-1', '1')}\n",
+                 f"test\n1.0 9.81\n0 0\n{n + 5}\n{rows}\n"):
+        path.write_text(text)
+        with pytest.raises(AssertionError, match="Capytaine read"):
+            bem.from_mesh(path, omega="body")

@@ -194,6 +194,14 @@ BUOY_SYMMETRY_TOL = 1e-2
 #: negative heave radiation damping a dataset may hold at a frequency, as a fraction of its
 #: largest B, before it is refused (at most this much: the frequencies are dropped, named)
 BUOY_NEGATIVE_DAMPING_TOL = 1e-2
+#: a dataset's water density (kg/m^3; power-matrix --density's range), and its smallest
+#: water depth (m): a rho of 1e-300 gave a capture width of -1e302 m, a depth of 1e-300 one
+#: of -5e148 m (the energy flux vanishes), a g of 1e-300 blamed a gamma
+BUOY_RHO_RANGE = (500.0, 2000.0)
+BUOY_MIN_DEPTH = 1e-2
+#: the largest magnitude of a dataset's coefficient (A, B, F, C, M in SI units): the powers
+#: square them (an excitation of 1e300 N/m gave an infinite radiation bound)
+BUOY_MAX_COEFFICIENT = 1e100
 #: radians a chosen wave direction may differ from one in the dataset
 BUOY_DIRECTION_TOL = 1e-6
 #: harmonics of the buoy's motion in a regular wave (--harmonics, or the default 24 per turn
@@ -204,6 +212,25 @@ BUOY_MAX_HARMONICS = 512
 #: with an efficiency and 57 s with a 1 N m torque limit; 48, 64 and 128 with an efficiency
 #: over 2 minutes
 BUOY_MAX_PTO_HARMONICS = 24
+#: a sweep over wave periods (--wave-period FROM:TO:N or T1,T2,...) solves each period as
+#: alone: the periods times one period's estimated time must stay within this many seconds
+#: (200 periods at 512 harmonics, about 2 hours, ran on unbounded)
+BUOY_MAX_SWEEP_SECONDS = 120.0
+#: one period's time (s; the solve and its error estimates, two shared cores under load),
+#: ``a + b (N / 512)^2`` at N harmonics: 4 periods took 1.5 s each at the default 24, 2.7 s
+#: at 128 and 34 s at 512
+BUOY_PERIOD_SECONDS = (1.2, 33.0)
+#: one period's time (s) with a power take-off (--efficiency, --torque-limit; at most 24
+#: harmonics): 4 periods with --efficiency 0.9 or --torque-limit 100 ran past 150 s
+BUOY_PTO_PERIOD_SECONDS = 40.0
+#: --optimize-design: the estimated time of the search (its solves times one solve's) must
+#: stay within this many seconds; it shows a progress bar on a terminal (four variables ran
+#: silently past 150 s, one with --efficiency past 150 s)
+BUOY_MAX_DESIGN_SECONDS = 600.0
+#: one inner solve of the design search (s; the coupled optimum alone, two shared cores
+#: under load): without and with a power take-off (241 solves of four variables took over
+#: 150 s; about 25 of one variable with --efficiency 0.9 over 150 s)
+BUOY_DESIGN_SOLVE_SECONDS = (0.7, 10.0)
 #: a receding-horizon run of the buoy (--controller mpc): updates x horizon samples x solves
 #: per update. The default run (100 peak periods, horizon 1, update 1/8: 832 x 64 x 2 =
 #: 1.06e5) took 87 s under load; the cap keeps a run near two minutes (about 130 peak
@@ -214,6 +241,10 @@ BUOY_MAX_MPC_WORK = 1.4e5
 #: --repeat-period 40 --efficiency 0.9) took 14 s of CPU, 512 (--repeat-period 256) over
 #: 2 minutes and 1.3 GB, 800 (--repeat-period 160 --winding 20) 163 s of CPU
 BUOY_MAX_PTO_RECORD_HARMONICS = 256
+#: the same without a take-off (the operator Newton): the default 250 s record at Tp 2.5 s
+#: (about 1600 harmonics) took 79 s under load, --harmonics 4096 over it 126 s, a 1000 s
+#: record (6400 by default) over 150 s
+BUOY_MAX_RECORD_HARMONICS = 4096
 
 #: ``buoy --dofs surge,heave,pitch``: at most this many harmonics of the pendulum's motion
 #: (the hull's harmonics follow; a Newton step costs O(N^3) with dense matrices, the

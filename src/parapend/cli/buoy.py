@@ -8,7 +8,7 @@ from pathlib import Path
 from ..defaults import BUOY
 from ..errors import ParameterError
 from . import _output
-from ._common import _check_output, _finite_float, _fmt, _int, _run, _table
+from ._common import _check_output, _finite_float, _fmt, _int, _Progress, _run, _table
 
 
 def _text(name):
@@ -179,7 +179,8 @@ def _cmd_buoy(a) -> dict | str:
     if a.controller != "optimum" and a.plot:
         raise ParameterError("plot: not drawn with --controller mpc (use --save)")
     try:
-        r = _run(a)
+        bar = _Progress("buoy: optimize-design") if a.optimize_design and not a.json else None
+        r = _run(a, progress=bar)
     except MemoryError:
         # the generic message names --points, which this command has not
         from ..errors import SolverError

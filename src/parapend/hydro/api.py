@@ -14,6 +14,7 @@ response); this module checks the input and builds the wave, the body and the pe
 from __future__ import annotations
 
 import math
+import os
 
 import numpy as np
 
@@ -52,6 +53,25 @@ def _hydro(body, radius, draft, mesh, hydro, wave_direction=None):
     if body == "sphere":
         return hy.sphere(r, omega="body"), 2 * r
     return hy.cylinder(r, d, omega="body"), 2 * r
+
+
+def _check_kinds(**opts):
+    """Refuse, in one line naming the option, a value of the wrong kind where a name, a list
+    of names or a path is expected (a number for ``dofs``, ``optimize_design`` or ``mesh``
+    raised a bare TypeError)."""
+    for name, v in opts.items():
+        if v is None:
+            continue
+        if name == "mesh":
+            ok = isinstance(v, (str, os.PathLike))
+            want = "a path (str or os.PathLike)"
+        else:
+            ok = isinstance(v, str) or (isinstance(v, (list, tuple))
+                                        and all(isinstance(x, str) for x in v))
+            want = "a comma list of names (str) or a list of them"
+        if not ok:
+            raise ParameterError(f"{name.replace('_', '-')}: expected {want}, got "
+                                 f"{type(v).__name__}")
 
 
 def _dimensions(body, radius, draft):
@@ -126,18 +146,66 @@ def _check_harmonics(harmonics, winding, pto):
                              f"--harmonics, at least 2 per turn")
 
 
-def _check_record_harmonics(h, wave, harmonics, winding, record):
-    """Refuse a power take-off over an irregular record whose motion needs more harmonics
-    than finish in about two minutes (:data:`parapend.limits.BUOY_MAX_PTO_RECORD_HARMONICS`;
-    the default is :func:`.optimum._default_harmonics`'s), naming the option."""
+def _check_sweep(count, harmonics, winding, pto):
+    """Refuse a sweep over ``count`` wave periods whose estimated time (the periods times one
+    period's, :data:`parapend.limits.BUOY_PERIOD_SECONDS` or ``BUOY_PTO_PERIOD_SECONDS``)
+    exceeds :data:`parapend.limits.BUOY_MAX_SWEEP_SECONDS`, naming ``--wave-period`` and the
+    most periods that fit."""
+    from .optimum import HARMONICS_PER_TURN
+
+    n = harmonics if harmonics is not None else HARMONICS_PER_TURN * winding
+    if pto:
+        each = limits.BUOY_PTO_PERIOD_SECONDS
+    else:
+        a, b = limits.BUOY_PERIOD_SECONDS
+        each = a + b * (n / 512) ** 2
+    cap = limits.BUOY_MAX_SWEEP_SECONDS
+    if count * each <= cap:
+        return
+    most = int(cap // each)
+    what = "with --efficiency or --torque-limit" if pto else f"of {n} harmonics"
+    fix = (f"give at most {most} periods" if most >= 2 else "solve one period at a time")
+    if harmonics is not None and not pto:
+        fix += " or fewer --harmonics"
+    raise ParameterError(f"wave-period: {count} periods {what} need about {count * each:.0f} "
+                         f"s ({each:.3g} s each), more than the {cap:g} s a sweep may take; "
+                         f"{fix}")
+
+
+def _check_design(count, pto):
+    """Refuse a design search whose estimated time (its solves, :func:`.design.design_solves`,
+    times one solve's, :data:`parapend.limits.BUOY_DESIGN_SOLVE_SECONDS`) exceeds
+    :data:`parapend.limits.BUOY_MAX_DESIGN_SECONDS`, naming the most variables that fit."""
+    from .design import design_solves
+
+    each = limits.BUOY_DESIGN_SOLVE_SECONDS[1 if pto else 0]
+    cap = limits.BUOY_MAX_DESIGN_SECONDS
+    if design_solves(count) * each <= cap:
+        return
+    fits = [k for k in range(1, count) if design_solves(k) * each <= cap]
+    what = " with --efficiency or --torque-limit" if pto else ""
+    fix = (f"choose at most {fits[-1]} of them" if fits else
+           "drop --efficiency and --torque-limit from the search")
+    raise ParameterError(f"optimize-design: {count} variables{what} need up to "
+                         f"{design_solves(count)} solves of about {each:g} s "
+                         f"({design_solves(count) * each:.0f} s), more than the {cap:g} s a "
+                         f"design search may take; {fix}")
+
+
+def _check_record_harmonics(h, wave, harmonics, winding, record, pto=True):
+    """Refuse an optimum over an irregular record whose motion needs more harmonics than
+    finish in about two minutes (:data:`parapend.limits.BUOY_MAX_PTO_RECORD_HARMONICS` with
+    a power take-off, ``BUOY_MAX_RECORD_HARMONICS`` without; the default is
+    :func:`.optimum._default_harmonics`'s), naming the option."""
     from .optimum import HARMONICS_PER_WAVE
 
-    cap = limits.BUOY_MAX_PTO_RECORD_HARMONICS
+    cap = limits.BUOY_MAX_PTO_RECORD_HARMONICS if pto else limits.BUOY_MAX_RECORD_HARMONICS
+    with_pto = "with --efficiency or --torque-limit " if pto else ""
     if harmonics is not None:
         if harmonics > cap:
-            raise ParameterError(f"harmonics: expected at most {cap} over a record with "
-                                 f"--efficiency or --torque-limit (the most that finish in "
-                                 f"about two minutes), got {harmonics}")
+            raise ParameterError(f"harmonics: expected at most {cap} over a record "
+                                 f"{with_pto}(the most that finish in about two minutes), "
+                                 f"got {harmonics}")
         return
     kk = np.arange(1, np.asarray(wave.amplitudes).size + 1)
     _, _, f = h.coefficients(kk * wave.omega)
@@ -147,8 +215,8 @@ def _check_record_harmonics(h, wave, harmonics, winding, record):
     if n > cap:
         name = "winding" if winding >= km else ("record" if record is not None
                                                  else "repeat-period")
-        raise ParameterError(f"{name}: with --efficiency or --torque-limit this record needs "
-                             f"{n} harmonics ({HARMONICS_PER_WAVE} per wave, {max(km, winding)} "
+        raise ParameterError(f"{name}: {with_pto}this record needs {n} harmonics "
+                             f"({HARMONICS_PER_WAVE} per wave, {max(km, winding)} "
                              f"waves or turns), more than the {cap} that finish in about two "
                              f"minutes; use a record of at most {cap // HARMONICS_PER_WAVE} "
                              "waves and turns, or give --harmonics")
@@ -196,7 +264,7 @@ def buoy(*, wave_height=None, wave_period=None, hs=None, tp=None, spectrum=None,
          inertia_bounds=None, damping_coefficient_bounds=None, controller="optimum",
          horizon=None, update_interval=None, wave_direction=None, dofs="heave",
          pivot_height=None, pivot_offset=None, hull_pitch_inertia=None, barge_length=None,
-         barge_beam=None, barge_draft=None, copper_loss=None):
+         barge_beam=None, barge_draft=None, copper_loss=None, progress=None):
     """The coupled optimum of a pendulum inside a floating buoy (command ``buoy``).
 
     Parameters
@@ -244,6 +312,9 @@ def buoy(*, wave_height=None, wave_period=None, hs=None, tp=None, spectrum=None,
         take the embedded hull design's values (``parapend.defaults.HULL``).
         ``copper_loss`` ``r`` (W per (N m)^2; hull only) subtracts the winding loss ``r
         tau^2`` from the power: holding an angle then costs what it costs a generator.
+    progress : callable or None
+        With ``optimize_design``: called ``progress(done, total)`` after every inner solve
+        of the search (the command line draws it as a bar on a terminal).
 
     Returns
     -------
@@ -256,14 +327,18 @@ def buoy(*, wave_height=None, wave_period=None, hs=None, tp=None, spectrum=None,
     from .hull_api import hull_buoy, parse_dofs
 
     opts = dict(locals())
+    _check_kinds(dofs=dofs, optimize_design=optimize_design, mesh=mesh)
     if parse_dofs(dofs) != ("heave",):
         return hull_buoy(**{k: v for k, v in opts.items() if k not in (
-            "dofs", "Wave", "hull_buoy", "parse_dofs")})
+            "dofs", "Wave", "hull_buoy", "parse_dofs", "progress")})
     for name in ("pivot_height", "pivot_offset", "hull_pitch_inertia", "barge_length",
                  "barge_beam", "barge_draft", "copper_loss"):
         if opts[name] is not None:
             raise ParameterError(f"{name.replace('_', '-')}: a hull's option; needs --dofs "
                                  "surge,heave,pitch")
+    for name, v in (("body", body), ("controller", controller), ("spectrum", spectrum)):
+        if v is not None and not isinstance(v, str):
+            raise ParameterError(f"{name}: expected a name (str), got {type(v).__name__}")
     if controller not in ("optimum", "mpc", "one-way-mpc"):
         raise ParameterError(f"controller: expected optimum, mpc or one-way-mpc, got "
                              f"{controller!r:.40}")
@@ -325,7 +400,10 @@ def buoy(*, wave_height=None, wave_period=None, hs=None, tp=None, spectrum=None,
         if efficiency == (1.0, 1.0):
             efficiency = None  # lossless: the ideal problem
     if not irregular:
-        _check_harmonics(harmonics, winding, torque_limit is not None or efficiency is not None)
+        pto = torque_limit is not None or efficiency is not None
+        _check_harmonics(harmonics, winding, pto)
+        if periods is not None:
+            _check_sweep(periods.size, harmonics, winding, pto)
     variables, bounds = _design_request(optimize_design, pend, mass_bounds=mass_bounds,
                                         length_bounds=length_bounds,
                                         inertia_bounds=inertia_bounds,
@@ -334,6 +412,8 @@ def buoy(*, wave_height=None, wave_period=None, hs=None, tp=None, spectrum=None,
                          else wave_height, 1e-4, 30.0, why="regular wave height, m")
     if periods is not None and variables:
         raise ParameterError("optimize-design: one wave period at a time (drop FROM:TO:N)")
+    if variables:
+        _check_design(len(variables), torque_limit is not None or efficiency is not None)
     if irregular:
         from ..units import Units
 
@@ -347,6 +427,8 @@ def buoy(*, wave_height=None, wave_period=None, hs=None, tp=None, spectrum=None,
                        name="tp" if record is None else "record")
         if torque_limit is not None or efficiency is not None:
             _check_record_harmonics(h, wave, harmonics, winding, record)
+        elif controller == "optimum":
+            _check_record_harmonics(h, wave, harmonics, winding, record, pto=False)
     else:
         if periods is None:
             period = _period(BUOY["wave_period"] if wave_period is None else wave_period)
@@ -391,7 +473,8 @@ def buoy(*, wave_height=None, wave_period=None, hs=None, tp=None, spectrum=None,
         from .design import optimize_design as _outer
 
         found = _outer(lambda p: _solve(h, p, wave, one_way=False, **opts)[0], pend,
-                       variables, bounds, check=lambda p: _check_floats(h, p))
+                       variables, bounds, check=lambda p: _check_floats(h, p),
+                       progress=progress)
         pend, design = found.pendulum, found.to_dict()
     sol, ow, notes = _solve(h, pend, wave, **opts)
     errors = _error_powers(h, coarse, pend, wave, **opts)

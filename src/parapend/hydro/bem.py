@@ -659,6 +659,7 @@ def _mesh_file(path, omega, g, water_depth, file_format):
     p = Path(path)
     name = "mesh"
     _regular_file(p, name, "a mesh file")
+    _gdf_precount(p, file_format, limits.BUOY_MAX_MESH_PANELS)
     cpt = _quiet_capytaine()
     try:
         raw = cpt.load_mesh(p, file_format)
@@ -700,6 +701,29 @@ def _mesh_file(path, omega, g, water_depth, file_format):
     desc = f"mesh {p.name}, immersed part"
     parts = b"file|" + str(file_format).encode() + b"|" + p.read_bytes()
     return hull, omega, desc, parts
+
+
+def _gdf_precount(p: Path, file_format, cap: int) -> None:
+    """Refuse a WAMIT ``.gdf`` mesh whose panels lying wholly below the waterline (a lower
+    bound of its immersed part) already exceed ``cap``, before Capytaine reads it (its reader
+    took 25 s for 40 000 panels). Any other file, or a GDF this simple reading does not
+    follow (its panel count and its numbers disagree), is left to Capytaine."""
+    fmt = (file_format or p.suffix.lstrip(".")).lower()
+    if fmt not in ("gdf", "wamit"):
+        return
+    try:
+        lines = p.read_text().splitlines()
+        count = int(lines[3].split()[0])
+        xyz = np.array(" ".join(lines[4:]).split(), dtype=float)
+    except (OSError, ValueError, IndexError, UnicodeDecodeError):
+        return
+    if count <= cap or xyz.size != 12 * count:
+        return
+    below = int(np.sum(np.all(xyz.reshape(count, 4, 3)[:, :, 2] <= 0.0, axis=1)))
+    if below > cap:
+        raise ParameterError(f"mesh: {str(p)!r} has at least {below} immersed panels; the BEM "
+                             f"(a dense panels x panels solve per frequency) takes at most "
+                             f"{cap} in about a minute and 2 GB: coarsen the mesh")
 
 
 def _regular_file(p: Path, name: str, what: str) -> None:
@@ -780,6 +804,30 @@ def _scalar(ds, name, default):
             raise ParameterError(f"hydro: {name} is not a number (type {v.dtype})")
         return float(v[0])
     return default
+
+
+def _check_scales(path, rho, g, depth, values):
+    """Refuse (one line) a dataset whose water, gravity or coefficients are out of physical
+    reach: ``rho`` in :data:`parapend.limits.BUOY_RHO_RANGE`, ``g`` in
+    ``UNIT_GRAVITY_RANGE``, a depth of at least ``BUOY_MIN_DEPTH`` (or infinite), every
+    coefficient at most ``BUOY_MAX_COEFFICIENT`` in magnitude."""
+    from .. import limits
+
+    checks = (("rho", rho, limits.BUOY_RHO_RANGE, "kg/m^3"),
+              ("g", g, limits.UNIT_GRAVITY_RANGE, "m/s^2"))
+    for name, v, (lo, hi), unit in checks:
+        if not lo <= v <= hi:
+            raise ParameterError(f"hydro: {path}: expected {name} in [{lo:g}, {hi:g}] "
+                                 f"{unit}, got {v:g}")
+    if not (depth >= limits.BUOY_MIN_DEPTH):
+        raise ParameterError(f"hydro: {path}: expected a water_depth of at least "
+                             f"{limits.BUOY_MIN_DEPTH:g} m (or inf, deep water), got {depth:g}")
+    cap = limits.BUOY_MAX_COEFFICIENT
+    for name, v in values.items():
+        top = float(np.max(np.abs(np.asarray(v))))
+        if top > cap:
+            raise ParameterError(f"hydro: {path}: {name} reaches {top:.3g} in magnitude, "
+                                 f"more than {cap:g} (SI units; the powers square it)")
 
 
 def _direction(fx, wave_direction, path):
@@ -1022,6 +1070,10 @@ def _from_dataset(ds, *, c=None, mass=None, description="", path="the dataset",
     rho = _scalar(ds, "rho", 1025.0)
     g = _scalar(ds, "g", 9.81)
     depth = _scalar(ds, "water_depth", math.inf)
+    if check:
+        _check_scales(path, rho, g, depth, {"added_mass": a, "radiation_damping": b,
+                                            "excitation_force": f,
+                                            "hydrostatic_stiffness": c, "mass": mass})
     return Hydro(omega=w, added_mass=a, radiation_damping=b, excitation=f,
                  hydrostatic_stiffness=c, mass=mass, rho=rho, g=g, water_depth=depth,
                  description=description or str(ds.attrs.get("description", "")),

@@ -26,6 +26,17 @@ __all__ = ["DesignResult", "optimize_design", "period_sweep"]
 #: grid points per variable before the polish, by the number of variables
 GRID = {1: 7, 2: 5, 3: 3, 4: 3}
 
+#: inner solves of the polish at most, by the number of variables (bounded Brent on one: at
+#: about 25 with its tolerance; Nelder-Mead: its ``maxfev`` of 40 per variable)
+POLISH = {1: 25, 2: 80, 3: 120, 4: 160}
+
+
+def design_solves(count: int) -> int:
+    """The inner solves of a search over ``count`` variables at most (the grid and the
+    polish): the estimate ``parapend buoy`` checks and the progress bar counts."""
+    return GRID[count] ** count + POLISH[count]
+
+
 #: a best value within this fraction of its box's width from a bound lies on the bound
 BOUND_TOL = 1e-3
 
@@ -75,7 +86,8 @@ def _physical(pend, names, x):
     return dataclasses.replace(pend, **kw)
 
 
-def optimize_design(solve, pendulum, variables, bounds, *, check=None) -> DesignResult:
+def optimize_design(solve, pendulum, variables, bounds, *, check=None,
+                    progress=None) -> DesignResult:
     """The pendulum parameters ``variables`` (within ``bounds``) that maximize the coupled
     power ``solve(pendulum).power``.
 
@@ -92,6 +104,9 @@ def optimize_design(solve, pendulum, variables, bounds, *, check=None) -> Design
     check : callable or None
         ``check(Pendulum)`` raising ParameterError for a design out of reach (a pendulum
         heavier than the body); such designs count as no power.
+    progress : callable or None
+        Called ``progress(done, total)`` after every inner solve (``total`` the most the
+        search makes, :func:`design_solves`), and ``progress(total, total)`` at the end.
     """
     from scipy.optimize import minimize, minimize_scalar
 
@@ -102,6 +117,7 @@ def optimize_design(solve, pendulum, variables, bounds, *, check=None) -> Design
     hi = np.array([bounds[n][1] for n in names], dtype=float)
     cache: dict = {}
     failed = [0]
+    total = design_solves(len(names))
 
     def power(u):
         u = np.clip(np.asarray(u, dtype=float), 0.0, 1.0)
@@ -122,6 +138,8 @@ def optimize_design(solve, pendulum, variables, bounds, *, check=None) -> Design
         except ParameterError:
             val = -math.inf
         cache[key] = val
+        if progress is not None:
+            progress(min(len(cache), total - 1), total)
         return val
 
     g = GRID[len(names)]
@@ -156,6 +174,8 @@ def optimize_design(solve, pendulum, variables, bounds, *, check=None) -> Design
     p = _physical(pendulum, names, lo + best_u * (hi - lo))
     at_bound = {n: ("lower" if u <= BOUND_TOL else "upper") for n, u in zip(names, best_u)
                 if u <= BOUND_TOL or u >= 1 - BOUND_TOL}
+    if progress is not None:
+        progress(total, total)
     return DesignResult(
         variables=names, bounds={n: [float(a), float(b)] for n, a, b in zip(names, lo, hi)},
         best={"mass_kg": p.mass, "length_m": p.length, "inertia_kg_m2": p.inertia,
