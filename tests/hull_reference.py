@@ -521,7 +521,6 @@ def hull_reference_pto(*, x0, pto, tol=1e-10, max_iter=3000, **case) -> dict:
     its sign). Returns ``objective`` (W: the electrical power, the grid's mean of
     ``eta_g p+ - p- / eta_m``, less the copper loss), ``power`` (mechanical), ``x``,
     ``tau`` (the grid's torque), ``status``."""
-    import casadi as ca
 
     gr = _Grid(**case)
     solver, pfun, ofun = _build(gr, tol, max_iter, "MX", False, pto)
