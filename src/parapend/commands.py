@@ -35,7 +35,7 @@ import math
 
 from . import limits
 from .defaults import DELTA, DYNAMICS, GAMMA, OMEGA, SEA, given  # noqa: F401
-from .errors import OutputError, ParameterError, check_int, check_range
+from .errors import OutputError, ParameterError, check_int, check_positive, check_range
 from .results import Record
 
 __all__ = ["PRESENTATION", "basins", "damping_sweep", "figure", "harmonics", "map",
@@ -87,7 +87,8 @@ def _physical(kw: dict, *, length=None, mass=None, inertia=None, gravity=None,
         if torque_limit is not None:
             raise ParameterError("torque-limit-nm: give either --torque-limit or "
                                  "--torque-limit-nm, not both")
-        torque_limit = units.from_newton_metres(torque_limit_nm)
+        torque_limit = units.from_newton_metres(
+            check_positive("torque-limit-nm", torque_limit_nm))
     return units, kw, torque_limit
 
 
@@ -639,7 +640,7 @@ def _track_mpc(*, excitation, omega, delta, square_alpha, fourier, file, gamma, 
     from .api import build_excitation
     from .control.mpc import track_mpc
 
-    if runs != 1:
+    if check_int("runs", runs, 1) != 1:
         raise ParameterError("runs: --controller mpc runs one record; use parapend horizon "
                              "for seeded batches")
     given = [k for k, v in errors.items() if v != 0.0]
@@ -651,8 +652,10 @@ def _track_mpc(*, excitation, omega, delta, square_alpha, fourier, file, gamma, 
     units, kw, torque_limit = _physical(kw, torque_limit=torque_limit, **units_kw)
     kw.pop("harmonics", None)
     gamma = check_range("gamma", kw.pop("gamma"), 0.0, limits.MAX_GAMMA)
-    if torque_limit is not None and not torque_limit > 0:
-        raise ParameterError(f"torque-limit: expected a number > 0, got {torque_limit!r}")
+    if torque_limit is not None:
+        torque_limit = check_range("torque-limit", torque_limit, 0.0, limits.MAX_TORQUE_LIMIT)
+        if not torque_limit > 0:
+            raise ParameterError(f"torque-limit: expected a number > 0, got {torque_limit!r}")
     periods = check_int("periods", periods, 20, limits.MAX_TRACK_PERIODS)
     seed = check_int("seed", seed, 0, 2**63 - 1)
     exc = build_excitation(kw.pop("excitation", None), **kw)

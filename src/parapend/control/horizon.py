@@ -29,7 +29,7 @@ import numpy as np
 
 from .. import limits
 from ..defaults import HORIZON, SEA
-from ..errors import ParameterError, check_int, check_range
+from ..errors import ParameterError, check_int, check_positive, check_range
 from ..results import _Result
 
 __all__ = ["HorizonResult", "horizon_curve", "plot_horizon", "horizon_dataset"]
@@ -160,16 +160,18 @@ class HorizonResult(_Result):
 
 
 def _names(value, allowed, what):
+    expected = f"names from {', '.join(allowed)} (comma separated, or none)"
     if isinstance(value, str):
         items = [s.strip() for s in value.split(",") if s.strip()]
         if items == ["none"]:
             items = []
-    else:
+    elif isinstance(value, (list, tuple)):
         items = list(value)
+    else:
+        raise ParameterError(f"{what}: expected {expected}, got {value!r:.40}")
     for s in items:
         if s not in allowed:
-            raise ParameterError(f"{what}: expected names from {', '.join(allowed)} (comma "
-                                 f"separated, or none), got {s!r:.40}")
+            raise ParameterError(f"{what}: expected {expected}, got {s!r:.40}")
     if len(set(items)) != len(items):
         raise ParameterError(f"{what}: expected distinct names, got {','.join(items)}")
     return items
@@ -183,7 +185,19 @@ def _horizons(value):
             raise ParameterError(f"horizons: expected a comma list of numbers, got "
                                  f"{value!r:.60}") from None
     else:
-        hs = [float(v) for v in np.atleast_1d(value)]
+        # a sequence or array of real numbers; the CLI's message for anything else (None,
+        # bytes, a bool, strings, nested lists)
+        bad = ParameterError(f"horizons: expected a comma list of numbers, got "
+                             f"{value!r:.60}")
+        if isinstance(value, (bytes, bool, np.bool_)) or value is None:
+            raise bad
+        try:
+            arr = np.asarray(value)
+        except (TypeError, ValueError):
+            raise bad from None
+        if arr.ndim > 1 or arr.dtype.kind not in "iuf":
+            raise bad
+        hs = [float(v) for v in np.atleast_1d(arr)]
     if not 1 <= len(hs) <= MAX_HORIZONS:
         raise ParameterError(f"horizons: expected 1 to {MAX_HORIZONS} horizons, got {len(hs)}")
     for h in hs:
@@ -262,12 +276,16 @@ def horizon_curve(*, hs=None, tp=None, spectrum: str = "jonswap", gamma_peak: fl
         if torque_limit is not None:
             raise ParameterError("torque-limit-nm: give either --torque-limit or "
                                  "--torque-limit-nm, not both")
-        torque_limit = units.from_newton_metres(torque_limit_nm)
+        torque_limit = units.from_newton_metres(
+            check_positive("torque-limit-nm", torque_limit_nm))
     if gamma is not None and damping_coefficient is not None:
         raise ParameterError("gamma: give either gamma or damping-coefficient, not both")
     if damping_coefficient is not None:
         gamma = units.gamma(damping_coefficient)
     gamma = check_range("gamma", 0.01 if gamma is None else gamma, 0.0, limits.MAX_GAMMA)
+    if progress is not None and not callable(progress):
+        raise ParameterError(f"progress: expected a callable progress(done, total) or None, "
+                             f"got {progress!r:.40}")
     hz = _horizons(horizons)
     fc = _names(forecasts, FORECASTS, "forecasts")
     bl = _names(baselines, BASELINES, "baselines")

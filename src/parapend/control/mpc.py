@@ -782,8 +782,10 @@ def track_mpc(excitation, *, gamma, horizon=2.0, update_interval=0.03125, foreca
     record as ``track --irregular`` with the same seed); ``horizon`` and ``update_interval``
     in forcing (peak) periods. The powers are over the run after ``WARMUP_PERIODS``
     (:class:`MPCTrackResult`)."""
-    from .track import SEA_WAVES, _on_grid, design_sea
+    from .track import SEA_WAVES, _check_state, _on_grid, check_flag, design_sea
 
+    theta0, theta_dot0 = _check_state((theta0, theta_dot0))
+    irregular = check_flag("irregular", irregular)
     horizon = check_range("horizon", horizon, 0.01, 20.0)
     update_interval = check_range("update-interval", update_interval, 1.0 / samples, 20.0)
     if update_interval > horizon:
