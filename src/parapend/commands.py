@@ -598,7 +598,7 @@ def track(*, excitation=None, omega=OMEGA, delta=None, square_alpha=None, fourie
                 frequency=frequency, amplitude=amplitude,
                 damping_coefficient=damping_coefficient, torque_limit_nm=torque_limit_nm),
             horizon=horizon, update_interval=update_interval, forecast=forecast,
-            speed_limit=speed_limit)
+            speed_limit=speed_limit, progress=progress)
     if (horizon, update_interval, forecast) != (2.0, 0.03125, "perfect"):
         raise ParameterError("horizon: --horizon, --update-interval and --forecast belong to "
                              "--controller mpc")
@@ -635,7 +635,7 @@ def track(*, excitation=None, omega=OMEGA, delta=None, square_alpha=None, fourie
 
 def _track_mpc(*, excitation, omega, delta, square_alpha, fourier, file, gamma, torque_limit,
                theta0, theta_dot0, periods, seed, runs, errors, irregular, units_kw, horizon,
-               update_interval, forecast, speed_limit=None):
+               update_interval, forecast, speed_limit=None, progress=None):
     """``track --controller mpc`` (:func:`parapend.control.mpc.track_mpc`)."""
     from .api import build_excitation
     from .control.mpc import track_mpc
@@ -662,7 +662,7 @@ def _track_mpc(*, excitation, omega, delta, square_alpha, fourier, file, gamma, 
     r = track_mpc(exc, gamma=gamma, horizon=horizon, update_interval=update_interval,
                   forecast=forecast, torque_limit=torque_limit, periods=periods, seed=seed,
                   irregular=irregular, theta0=theta0, theta_dot0=theta_dot0,
-                  speed_limit=speed_limit)
+                  speed_limit=speed_limit, progress=progress)
     if units is None:
         return r
     tp = 2 * math.pi / r.omega

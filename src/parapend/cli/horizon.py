@@ -79,11 +79,14 @@ def _mean(values) -> str:
 
 
 def _cmd_horizon(a) -> dict | str:
-    from ._common import SAVE_GRID, _Progress
+    from ._common import SAVE_GRID
+    from ._notice import install
+    from .sweep import _EtaProgress
 
     _check_output(a.plot, "--plot", FIGURE_SUFFIXES)
     _check_output(a.save, "--save", SAVE_GRID)
-    r = _run(a, progress=None if a.json else _Progress("horizon"))
+    install("parapend.control")  # the library's estimate of long work, on stderr
+    r = _run(a, progress=_EtaProgress("horizon"))
     if a.save:
         _output.save_result(r, a.save)
     if a.plot:

@@ -251,7 +251,11 @@ def horizon_curve(*, hs=None, tp=None, spectrum: str = "jonswap", gamma_peak: fl
     update_interval : float
         MPC update interval in peak periods.
     progress : callable or None
-        Called ``progress(done, total)`` after every run.
+        Called ``progress(done, total)`` as the work goes, in torque samples (64 a peak
+        period): every run counts its samples (the non-causal optimum and each baseline
+        the record's); within a receding-horizon run at most every 0.25 s. A curve whose
+        receding-horizon runs are estimated to take more than 30 s is announced on the
+        ``parapend.control`` logger (INFO) before any work.
     warm_up : float
         Peak periods of the receding-horizon runs left out of their mean (start-up from
         rest); the run is then ``warm_up`` plus one whole repeat of the record long, so the
@@ -311,14 +315,34 @@ def horizon_curve(*, hs=None, tp=None, spectrum: str = "jonswap", gamma_peak: fl
     excs = [sea_record(units, seed=seed + r, **sea_kw) for r in range(records)]
     tp_n = tp / units.time
     wp = 2 * math.pi / tp_n
-    total = records * (1 + len(fc) * len(hz) + len(bl))
+    # progress and the estimate in torque samples (dt = tp_n / 64) of every run
+    rec_samples = [int(math.floor(exc.period / (tp_n / 64) + 1e-9)) for exc in excs]
+    mpc_samples = [int(math.floor((exc.period + warm_up * tp_n) / (tp_n / 64) + 1e-9))
+                   for exc in excs]
+    total = (sum(rec_samples) * (1 + len(bl)) + sum(mpc_samples) * len(fc) * len(hz))
     done = 0
 
-    def tick():
+    def tick(samples):
         nonlocal done
-        done += 1
+        done += samples
         if progress is not None:
             progress(done, total)
+
+    def within(now, _total):
+        if progress is not None:
+            progress(done + now, total)
+
+    from .mpc import ANNOUNCE_SECONDS, _duration, log, update_seconds
+
+    upd_samples = max(1, round(upd * 64))
+    est = sum(math.ceil(n / upd_samples) for n in mpc_samples) * sum(
+        update_seconds(h, torque_limit, f) for f in fc for h in hz)
+    if est > ANNOUNCE_SECONDS:
+        log.info("horizon: %d record(s) x %d forecast(s) x %d horizon(s) of receding-horizon "
+                 "runs, %d updates each: roughly %s on one core, besides the records' optima "
+                 "and the baselines (the progress bar gives the rate; Ctrl-C stops it)",
+                 records, len(fc), len(hz), math.ceil(mpc_samples[0] / upd_samples),
+                 _duration(est))
 
     opt, lim = [], []
     for r in range(records):
@@ -326,7 +350,7 @@ def horizon_curve(*, hs=None, tp=None, spectrum: str = "jonswap", gamma_peak: fl
                 gamma=gamma, **sea_kw)
         opt.append(s.power)
         lim.append(s.limit_power)
-        tick()
+        tick(rec_samples[r])
     mpc_p = [[[math.nan] * records for _ in hz] for _ in fc]
     mpc_st = [[[""] * records for _ in hz] for _ in fc]
     mpc_w, mpc_de, mpc_fail, mpc_xf, mpc_xp = ([[[math.nan] * records for _ in hz]
@@ -346,7 +370,7 @@ def horizon_curve(*, hs=None, tp=None, spectrum: str = "jonswap", gamma_peak: fl
                                   average_from=warm_up * tp_n,
                                   torque_limit=torque_limit, efficiency=eff,
                                   forecast=fo, t_end=exc.period + warm_up * tp_n, seed=seed + r,
-                                  speed_limit=speed_limit)
+                                  speed_limit=speed_limit, progress=within)
                     mpc_p[i][j][r] = (float(res.mean_electrical_power) if res.success
                                       else math.nan)
                     mpc_st[i][j][r] = str(res.status)
@@ -363,7 +387,7 @@ def horizon_curve(*, hs=None, tp=None, spectrum: str = "jonswap", gamma_peak: fl
                             first[i][j] = float(ut[0])
                         times[i][j].append(ut[1:] if r == 0 else ut)
                     used[i][j] = float(getattr(res, "horizon", h * tp_n)) / tp_n
-                    tick()
+                    tick(mpc_samples[r])
     base_p = [[math.nan] * records for _ in bl]
     base_st = [[""] * records for _ in bl]
     base_w = [[math.nan] * records for _ in bl]
@@ -383,7 +407,7 @@ def horizon_curve(*, hs=None, tp=None, spectrum: str = "jonswap", gamma_peak: fl
                 base_de[b][r] = de
                 base_p[b][r] = float(run.mean_power) + eta_g * de / span
             base_st[b][r] = run.status
-            tick()
+            tick(rec_samples[r])
     leads, err = [], []
     if "ar" in fc:
         leads = list(AR_LEADS)
