@@ -68,7 +68,8 @@ class HorizonResult(_Result):
         ``mpc_update_time_p99`` fits in it (measured on one process).
     mpc_failed_solves : nested list of int ``[f][h][r]``
         Horizon solves that did not converge (the last iterate applied, or the previous
-        plan where that was not finite).
+        plan where that was not finite); ``mpc_failed_kept_previous``: of them, those after
+        which the previous plan went on.
     mpc_speed_exceeded_fraction, mpc_speed_peak : nested lists ``[f][h][r]``
         With ``speed_limit`` (a penalty, not a hard bound): the fraction of samples after
         the hand-over with ``|theta'|`` above it and the largest ``|theta'|``.
@@ -141,6 +142,7 @@ class HorizonResult(_Result):
     update_interval_s: float | None = None
     realtime_fits: bool | None = None
     mpc_failed_solves: list = field(default_factory=list)
+    mpc_failed_kept_previous: list = field(default_factory=list)
     mpc_speed_exceeded_fraction: list = field(default_factory=list)
     mpc_speed_peak: list = field(default_factory=list)
     convention: str = ("power positive when harvested; (harvested energy + change of the "
@@ -353,8 +355,8 @@ def horizon_curve(*, hs=None, tp=None, spectrum: str = "jonswap", gamma_peak: fl
         tick(rec_samples[r])
     mpc_p = [[[math.nan] * records for _ in hz] for _ in fc]
     mpc_st = [[[""] * records for _ in hz] for _ in fc]
-    mpc_w, mpc_de, mpc_fail, mpc_xf, mpc_xp = ([[[math.nan] * records for _ in hz]
-                                                for _ in fc] for _ in range(5))
+    mpc_w, mpc_de, mpc_fail, mpc_kept, mpc_xf, mpc_xp = (
+        [[[math.nan] * records for _ in hz] for _ in fc] for _ in range(6))
     times = [[[] for _ in hz] for _ in fc]
     first = [[math.nan for _ in hz] for _ in fc]
     used = [[h for h in hz] for _ in fc]
@@ -379,6 +381,7 @@ def horizon_curve(*, hs=None, tp=None, spectrum: str = "jonswap", gamma_peak: fl
                                                        math.nan))
                         mpc_de[i][j][r] = float(getattr(res, "stored_energy_change", math.nan))
                     mpc_fail[i][j][r] = int(getattr(res, "failed_solves", 0))
+                    mpc_kept[i][j][r] = int(getattr(res, "failed_kept_previous", 0))
                     mpc_xf[i][j][r] = getattr(res, "speed_exceeded_fraction", None)
                     mpc_xp[i][j][r] = getattr(res, "speed_peak", None)
                     ut = np.asarray(getattr(res, "update_times", ()), dtype=float)
@@ -481,6 +484,8 @@ def horizon_curve(*, hs=None, tp=None, spectrum: str = "jonswap", gamma_peak: fl
         realtime_fits=fits,
         mpc_failed_solves=[[[int(v) if v == v else None for v in col] for col in row]
                            for row in mpc_fail],
+        mpc_failed_kept_previous=[[[int(v) if v == v else None for v in col] for col in row]
+                                  for row in mpc_kept],
         mpc_speed_exceeded_fraction=opt_list(mpc_xf), mpc_speed_peak=opt_list(mpc_xp))
 
 
@@ -509,10 +514,11 @@ def horizon_dataset(r: HorizonResult):
                      "mpc_stored_energy_change_j"):
             if getattr(r, name):
                 data[name] = (dims, np.asarray(getattr(r, name), dtype=float))
-        if r.mpc_failed_solves:
-            data["mpc_failed_solves"] = (dims, np.asarray(
-                [[[-1 if v is None else v for v in c] for c in row]
-                 for row in r.mpc_failed_solves], dtype=np.int64))
+        for name in ("mpc_failed_solves", "mpc_failed_kept_previous"):
+            if getattr(r, name):
+                data[name] = (dims, np.asarray(
+                    [[[-1 if v is None else v for v in c] for c in row]
+                     for row in getattr(r, name)], dtype=np.int64))
         for name in ("first", "median", "p99", "max"):
             v = getattr(r, f"mpc_update_time_{name}")
             if v:
@@ -548,6 +554,7 @@ def horizon_dataset(r: HorizonResult):
         "mpc_stored_energy_change_j": ("J", "change of the stored energy"),
         "baseline_stored_energy_change_j": ("J", "change of the stored energy"),
         "mpc_failed_solves": ("1", "horizon solves not converged (-1: no run)"),
+        "mpc_failed_kept_previous": ("1", "of them, the previous plan kept (-1: no run)"),
         **{f"mpc_update_time_{k}": ("s", f"wall time of an update (forecast + solve), {k}")
            for k in ("first", "median", "p99", "max")}}
     for name, (unit, long_name) in described.items():
