@@ -84,7 +84,7 @@ class BuoyMPCResult(_Result):
         electrical counterpart.
     harvested_energy_j, stored_energy_change_j : float
         ``W``, and ``E(end) - E(average_from_s)`` of the mechanical energy of buoy and
-        pendulum (:meth:`_Plant.energy`), in J.
+        pendulum (``_Plant.energy``), in J.
     absorbed_w, damping_w, stored_w : float
         Over the same window: the mean power the buoy absorbs from the waves
         ``<(F_exc - mu) z'>`` (excitation less radiation, ``mu`` the memory force), the
