@@ -196,3 +196,46 @@ def test_default_design_coupled_controller_harvests_where_one_way_loses():
     assert o.mean_power_w < 0 < c.mean_power_w
     assert c.energy_balance_residual < 1e-6 and o.energy_balance_residual < 1e-4
     assert c.fixed_point_residual < 0.05
+
+
+def test_the_headline_is_storage_corrected_over_whole_repeats(one_way):
+    """The energy account from the saved series alone: the harvested energy is the integral
+    of the saved (held) power over the window after the start-up, the stored energy's
+    change is the state's mechanical energy of buoy and pendulum at its ends (recomputed
+    here from the saved z, z', theta, theta'), and the headline is their sum per unit
+    time; the timings report the first update apart and the failed solves what was
+    applied."""
+    r = one_way
+    s = r.series
+    pend = _pendulum(20.0)
+    t, p = s["t"], s["power"]
+    i0 = int(round(r.average_from_s / r.dt_s))
+    assert t[i0] == pytest.approx(r.average_from_s, abs=1e-9)
+    span = t[-1] - t[i0]
+    assert span == pytest.approx(TR, rel=1e-9)  # one whole repeat of the record
+    w = float(np.sum(p[i0:]) * r.dt_s)
+    assert r.harvested_energy_j == pytest.approx(w, rel=1e-12)
+    assert r.harvested_power_w == pytest.approx(w / span, rel=1e-12)
+    # the mechanical energy of buoy and pendulum, written out here: the floating mass M
+    # (pendulum included) with the infinite-frequency added mass, the hydrostatic spring,
+    # and the pendulum (point of mass m at l, inertia I about the pivot, which heaves with
+    # the buoy; theta from the upright): its change between the saved states at the
+    # window's ends
+    m, ell, inertia, g = pend.mass, pend.length, pend.inertia, HYDRO.g
+    mt = HYDRO.mass + r.units["a_inf_kg"]
+
+    def energy(k):
+        z, zd, th, om = s["z"][k], s["z_dot"][k], s["theta"][k], s["theta_dot"][k]
+        return (0.5 * mt * zd**2 - m * ell * math.sin(th) * zd * om + 0.5 * inertia * om**2
+                + 0.5 * HYDRO.hydrostatic_stiffness * z**2 + m * g * ell * math.cos(th))
+
+    de = energy(-1) - energy(i0)
+    scale = abs(energy(i0)) + abs(energy(-1))
+    assert r.stored_energy_change_j == pytest.approx(de, abs=1e-12 * scale)
+    assert r.stored_w == pytest.approx(r.stored_energy_change_j / span, rel=1e-12)
+    assert r.mean_power_w == pytest.approx((w + de) / span, rel=1e-9)
+    assert r.electrical_power_w == pytest.approx(r.mean_power_w)  # no efficiency
+    assert r.update_time_first_s is not None and r.update_time_median_s is not None
+    assert r.update_time_p99_s <= r.update_time_max_s
+    assert r.realtime_fits == (r.update_time_p99_s <= r.update_interval_s)
+    assert 0 <= r.failed_kept_previous <= r.failed_solves

@@ -38,7 +38,7 @@ import math
 
 from . import limits
 from .defaults import DELTA, DYNAMICS, GAMMA, OMEGA, SEA, given  # noqa: F401
-from .errors import OutputError, ParameterError, check_int, check_range
+from .errors import OutputError, ParameterError, check_int, check_positive, check_range
 from .results import Record
 
 __all__ = ["PRESENTATION", "basins", "damping_sweep", "figure", "harmonics", "map",
@@ -90,7 +90,8 @@ def _physical(kw: dict, *, length=None, mass=None, inertia=None, gravity=None,
         if torque_limit is not None:
             raise ParameterError("torque-limit-nm: give either --torque-limit or "
                                  "--torque-limit-nm, not both")
-        torque_limit = units.from_newton_metres(torque_limit_nm)
+        torque_limit = units.from_newton_metres(
+            check_positive("torque-limit-nm", torque_limit_nm))
     return units, kw, torque_limit
 
 
@@ -600,7 +601,7 @@ def track(*, excitation=None, omega=OMEGA, delta=None, square_alpha=None, fourie
                 frequency=frequency, amplitude=amplitude,
                 damping_coefficient=damping_coefficient, torque_limit_nm=torque_limit_nm),
             horizon=horizon, update_interval=update_interval, forecast=forecast,
-            speed_limit=speed_limit)
+            speed_limit=speed_limit, progress=progress)
     if (horizon, update_interval, forecast) != (2.0, 0.03125, "perfect"):
         raise ParameterError("horizon: --horizon, --update-interval and --forecast belong to "
                              "--controller mpc")
@@ -637,12 +638,12 @@ def track(*, excitation=None, omega=OMEGA, delta=None, square_alpha=None, fourie
 
 def _track_mpc(*, excitation, omega, delta, square_alpha, fourier, file, gamma, torque_limit,
                theta0, theta_dot0, periods, seed, runs, errors, irregular, units_kw, horizon,
-               update_interval, forecast, speed_limit=None):
+               update_interval, forecast, speed_limit=None, progress=None):
     """``track --controller mpc`` (:func:`parapend.control.mpc.track_mpc`)."""
     from .api import build_excitation
     from .control.mpc import track_mpc
 
-    if runs != 1:
+    if check_int("runs", runs, 1) != 1:
         raise ParameterError("runs: --controller mpc runs one record; use parapend horizon "
                              "for seeded batches")
     given = [k for k, v in errors.items() if v != 0.0]
@@ -654,15 +655,17 @@ def _track_mpc(*, excitation, omega, delta, square_alpha, fourier, file, gamma, 
     units, kw, torque_limit = _physical(kw, torque_limit=torque_limit, **units_kw)
     kw.pop("harmonics", None)
     gamma = check_range("gamma", kw.pop("gamma"), 0.0, limits.MAX_GAMMA)
-    if torque_limit is not None and not torque_limit > 0:
-        raise ParameterError(f"torque-limit: expected a number > 0, got {torque_limit!r}")
+    if torque_limit is not None:
+        torque_limit = check_range("torque-limit", torque_limit, 0.0, limits.MAX_TORQUE_LIMIT)
+        if not torque_limit > 0:
+            raise ParameterError(f"torque-limit: expected a number > 0, got {torque_limit!r}")
     periods = check_int("periods", periods, 20, limits.MAX_TRACK_PERIODS)
     seed = check_int("seed", seed, 0, 2**63 - 1)
     exc = build_excitation(kw.pop("excitation", None), **kw)
     r = track_mpc(exc, gamma=gamma, horizon=horizon, update_interval=update_interval,
                   forecast=forecast, torque_limit=torque_limit, periods=periods, seed=seed,
                   irregular=irregular, theta0=theta0, theta_dot0=theta_dot0,
-                  speed_limit=speed_limit)
+                  speed_limit=speed_limit, progress=progress)
     if units is None:
         return r
     tp = 2 * math.pi / r.omega

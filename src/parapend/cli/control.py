@@ -119,7 +119,14 @@ def _si_lines(r) -> list[str]:
 def _cmd_track(a) -> dict | str:
     _check_output(a.plot, "--plot", FIGURE_SUFFIXES)
     _check_output(a.save, "--save", SAVE_TABLE)
-    r = _run(a, progress=_Progress("track")) if a.runs != 1 else _run(a)
+    if a.controller == "mpc":
+        from ._notice import install
+        from .sweep import _EtaProgress
+
+        install("parapend.control")  # the library's estimate of long work, on stderr
+        r = _run(a, progress=_EtaProgress("track"))
+    else:
+        r = _run(a, progress=_Progress("track")) if a.runs != 1 else _run(a)
     if getattr(r, "controller", None) == "mpc":
         return _mpc_out(a, r)
     if a.runs != 1:

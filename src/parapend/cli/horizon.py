@@ -79,11 +79,14 @@ def _mean(values) -> str:
 
 
 def _cmd_horizon(a) -> dict | str:
-    from ._common import SAVE_GRID, _Progress
+    from ._common import SAVE_GRID
+    from ._notice import install
+    from .sweep import _EtaProgress
 
     _check_output(a.plot, "--plot", FIGURE_SUFFIXES)
     _check_output(a.save, "--save", SAVE_GRID)
-    r = _run(a, progress=None if a.json else _Progress("horizon"))
+    install("parapend.control")  # the library's estimate of long work, on stderr
+    r = _run(a, progress=_EtaProgress("horizon"))
     if a.save:
         _output.save_result(r, a.save)
     if a.plot:
@@ -140,10 +143,13 @@ def _cmd_horizon(a) -> dict | str:
         for i, f in enumerate(r.forecasts):
             for j, h in enumerate(r.horizons):
                 fails = [v for v in r.mpc_failed_solves[i][j] if v is not None]
+                kept = [v for v in (r.mpc_failed_kept_previous[i][j]
+                                    if r.mpc_failed_kept_previous else []) if v is not None]
                 row = [f, f"{h:g}", f"{1e3 * r.mpc_update_time_median[i][j]:.3g}",
                        f"{1e3 * r.mpc_update_time_p99[i][j]:.3g}",
                        f"{1e3 * r.mpc_update_time_max[i][j]:.3g}",
-                       f"{1e3 * r.mpc_update_time_first[i][j]:.3g}", f"{sum(fails)}"]
+                       f"{1e3 * r.mpc_update_time_first[i][j]:.3g}",
+                       f"{sum(fails)} ({sum(kept)})"]
                 if r.speed_limit is not None:
                     xf = [v for v in r.mpc_speed_exceeded_fraction[i][j] if v is not None]
                     xp = [v for v in r.mpc_speed_peak[i][j] if v is not None]
@@ -151,7 +157,7 @@ def _cmd_horizon(a) -> dict | str:
                             f"{max(xp):.4g}" if xp else "nan"]
                 trows.append(row)
         cols = ["forecast", "horizon (Tp)", "median (ms)", "p99 (ms)", "max (ms)",
-                "first (ms)", "failed solves"]
+                "first (ms)", "failed solves (previous plan kept)"]
         if r.speed_limit is not None:
             cols += ["speed above the penalty's w", "peak |theta'|"]
         out += ["", f"receding-horizon updates (forecast + solve) against the update interval "

@@ -29,7 +29,7 @@ import numpy as np
 
 from .. import limits
 from ..defaults import HORIZON, SEA
-from ..errors import ParameterError, check_int, check_range
+from ..errors import ParameterError, check_int, check_positive, check_range
 from ..results import _Result
 
 __all__ = ["HorizonResult", "horizon_curve", "plot_horizon", "horizon_dataset"]
@@ -68,7 +68,8 @@ class HorizonResult(_Result):
         ``mpc_update_time_p99`` fits in it (measured on one process).
     mpc_failed_solves : nested list of int ``[f][h][r]``
         Horizon solves that did not converge (the last iterate applied, or the previous
-        plan where that was not finite).
+        plan where that was not finite); ``mpc_failed_kept_previous``: of them, those after
+        which the previous plan went on.
     mpc_speed_exceeded_fraction, mpc_speed_peak : nested lists ``[f][h][r]``
         With ``speed_limit`` (a penalty, not a hard bound): the fraction of samples after
         the hand-over with ``|theta'|`` above it and the largest ``|theta'|``.
@@ -141,6 +142,7 @@ class HorizonResult(_Result):
     update_interval_s: float | None = None
     realtime_fits: bool | None = None
     mpc_failed_solves: list = field(default_factory=list)
+    mpc_failed_kept_previous: list = field(default_factory=list)
     mpc_speed_exceeded_fraction: list = field(default_factory=list)
     mpc_speed_peak: list = field(default_factory=list)
     convention: str = ("power positive when harvested; (harvested energy + change of the "
@@ -160,16 +162,18 @@ class HorizonResult(_Result):
 
 
 def _names(value, allowed, what):
+    expected = f"names from {', '.join(allowed)} (comma separated, or none)"
     if isinstance(value, str):
         items = [s.strip() for s in value.split(",") if s.strip()]
         if items == ["none"]:
             items = []
-    else:
+    elif isinstance(value, (list, tuple)):
         items = list(value)
+    else:
+        raise ParameterError(f"{what}: expected {expected}, got {value!r:.40}")
     for s in items:
         if s not in allowed:
-            raise ParameterError(f"{what}: expected names from {', '.join(allowed)} (comma "
-                                 f"separated, or none), got {s!r:.40}")
+            raise ParameterError(f"{what}: expected {expected}, got {s!r:.40}")
     if len(set(items)) != len(items):
         raise ParameterError(f"{what}: expected distinct names, got {','.join(items)}")
     return items
@@ -183,7 +187,19 @@ def _horizons(value):
             raise ParameterError(f"horizons: expected a comma list of numbers, got "
                                  f"{value!r:.60}") from None
     else:
-        hs = [float(v) for v in np.atleast_1d(value)]
+        # a sequence or array of real numbers; the CLI's message for anything else (None,
+        # bytes, a bool, strings, nested lists)
+        bad = ParameterError(f"horizons: expected a comma list of numbers, got "
+                             f"{value!r:.60}")
+        if isinstance(value, (bytes, bool, np.bool_)) or value is None:
+            raise bad
+        try:
+            arr = np.asarray(value)
+        except (TypeError, ValueError):
+            raise bad from None
+        if arr.ndim > 1 or arr.dtype.kind not in "iuf":
+            raise bad
+        hs = [float(v) for v in np.atleast_1d(arr)]
     if not 1 <= len(hs) <= MAX_HORIZONS:
         raise ParameterError(f"horizons: expected 1 to {MAX_HORIZONS} horizons, got {len(hs)}")
     for h in hs:
@@ -237,7 +253,11 @@ def horizon_curve(*, hs=None, tp=None, spectrum: str = "jonswap", gamma_peak: fl
     update_interval : float
         MPC update interval in peak periods.
     progress : callable or None
-        Called ``progress(done, total)`` after every run.
+        Called ``progress(done, total)`` as the work goes, in torque samples (64 a peak
+        period): every run counts its samples (the non-causal optimum and each baseline
+        the record's); within a receding-horizon run at most every 0.25 s. A curve whose
+        receding-horizon runs are estimated to take more than 30 s is announced on the
+        ``parapend.control`` logger (INFO) before any work.
     warm_up : float
         Peak periods of the receding-horizon runs left out of their mean (start-up from
         rest); the run is then ``warm_up`` plus one whole repeat of the record long, so the
@@ -262,12 +282,16 @@ def horizon_curve(*, hs=None, tp=None, spectrum: str = "jonswap", gamma_peak: fl
         if torque_limit is not None:
             raise ParameterError("torque-limit-nm: give either --torque-limit or "
                                  "--torque-limit-nm, not both")
-        torque_limit = units.from_newton_metres(torque_limit_nm)
+        torque_limit = units.from_newton_metres(
+            check_positive("torque-limit-nm", torque_limit_nm))
     if gamma is not None and damping_coefficient is not None:
         raise ParameterError("gamma: give either gamma or damping-coefficient, not both")
     if damping_coefficient is not None:
         gamma = units.gamma(damping_coefficient)
     gamma = check_range("gamma", 0.01 if gamma is None else gamma, 0.0, limits.MAX_GAMMA)
+    if progress is not None and not callable(progress):
+        raise ParameterError(f"progress: expected a callable progress(done, total) or None, "
+                             f"got {progress!r:.40}")
     hz = _horizons(horizons)
     fc = _names(forecasts, FORECASTS, "forecasts")
     bl = _names(baselines, BASELINES, "baselines")
@@ -293,14 +317,34 @@ def horizon_curve(*, hs=None, tp=None, spectrum: str = "jonswap", gamma_peak: fl
     excs = [sea_record(units, seed=seed + r, **sea_kw) for r in range(records)]
     tp_n = tp / units.time
     wp = 2 * math.pi / tp_n
-    total = records * (1 + len(fc) * len(hz) + len(bl))
+    # progress and the estimate in torque samples (dt = tp_n / 64) of every run
+    rec_samples = [int(math.floor(exc.period / (tp_n / 64) + 1e-9)) for exc in excs]
+    mpc_samples = [int(math.floor((exc.period + warm_up * tp_n) / (tp_n / 64) + 1e-9))
+                   for exc in excs]
+    total = (sum(rec_samples) * (1 + len(bl)) + sum(mpc_samples) * len(fc) * len(hz))
     done = 0
 
-    def tick():
+    def tick(samples):
         nonlocal done
-        done += 1
+        done += samples
         if progress is not None:
             progress(done, total)
+
+    def within(now, _total):
+        if progress is not None:
+            progress(done + now, total)
+
+    from .mpc import ANNOUNCE_SECONDS, _duration, log, update_seconds
+
+    upd_samples = max(1, round(upd * 64))
+    est = sum(math.ceil(n / upd_samples) for n in mpc_samples) * sum(
+        update_seconds(h, torque_limit, f) for f in fc for h in hz)
+    if est > ANNOUNCE_SECONDS:
+        log.info("horizon: %d record(s) x %d forecast(s) x %d horizon(s) of receding-horizon "
+                 "runs, %d updates each: roughly %s on one core, besides the records' optima "
+                 "and the baselines (the progress bar gives the rate; Ctrl-C stops it)",
+                 records, len(fc), len(hz), math.ceil(mpc_samples[0] / upd_samples),
+                 _duration(est))
 
     opt, lim = [], []
     for r in range(records):
@@ -308,11 +352,11 @@ def horizon_curve(*, hs=None, tp=None, spectrum: str = "jonswap", gamma_peak: fl
                 gamma=gamma, **sea_kw)
         opt.append(s.power)
         lim.append(s.limit_power)
-        tick()
+        tick(rec_samples[r])
     mpc_p = [[[math.nan] * records for _ in hz] for _ in fc]
     mpc_st = [[[""] * records for _ in hz] for _ in fc]
-    mpc_w, mpc_de, mpc_fail, mpc_xf, mpc_xp = ([[[math.nan] * records for _ in hz]
-                                                for _ in fc] for _ in range(5))
+    mpc_w, mpc_de, mpc_fail, mpc_kept, mpc_xf, mpc_xp = (
+        [[[math.nan] * records for _ in hz] for _ in fc] for _ in range(6))
     times = [[[] for _ in hz] for _ in fc]
     first = [[math.nan for _ in hz] for _ in fc]
     used = [[h for h in hz] for _ in fc]
@@ -328,7 +372,7 @@ def horizon_curve(*, hs=None, tp=None, spectrum: str = "jonswap", gamma_peak: fl
                                   average_from=warm_up * tp_n,
                                   torque_limit=torque_limit, efficiency=eff,
                                   forecast=fo, t_end=exc.period + warm_up * tp_n, seed=seed + r,
-                                  speed_limit=speed_limit)
+                                  speed_limit=speed_limit, progress=within)
                     mpc_p[i][j][r] = (float(res.mean_electrical_power) if res.success
                                       else math.nan)
                     mpc_st[i][j][r] = str(res.status)
@@ -337,6 +381,7 @@ def horizon_curve(*, hs=None, tp=None, spectrum: str = "jonswap", gamma_peak: fl
                                                        math.nan))
                         mpc_de[i][j][r] = float(getattr(res, "stored_energy_change", math.nan))
                     mpc_fail[i][j][r] = int(getattr(res, "failed_solves", 0))
+                    mpc_kept[i][j][r] = int(getattr(res, "failed_kept_previous", 0))
                     mpc_xf[i][j][r] = getattr(res, "speed_exceeded_fraction", None)
                     mpc_xp[i][j][r] = getattr(res, "speed_peak", None)
                     ut = np.asarray(getattr(res, "update_times", ()), dtype=float)
@@ -345,7 +390,7 @@ def horizon_curve(*, hs=None, tp=None, spectrum: str = "jonswap", gamma_peak: fl
                             first[i][j] = float(ut[0])
                         times[i][j].append(ut[1:] if r == 0 else ut)
                     used[i][j] = float(getattr(res, "horizon", h * tp_n)) / tp_n
-                    tick()
+                    tick(mpc_samples[r])
     base_p = [[math.nan] * records for _ in bl]
     base_st = [[""] * records for _ in bl]
     base_w = [[math.nan] * records for _ in bl]
@@ -365,7 +410,7 @@ def horizon_curve(*, hs=None, tp=None, spectrum: str = "jonswap", gamma_peak: fl
                 base_de[b][r] = de
                 base_p[b][r] = float(run.mean_power) + eta_g * de / span
             base_st[b][r] = run.status
-            tick()
+            tick(rec_samples[r])
     leads, err = [], []
     if "ar" in fc:
         leads = list(AR_LEADS)
@@ -439,6 +484,8 @@ def horizon_curve(*, hs=None, tp=None, spectrum: str = "jonswap", gamma_peak: fl
         realtime_fits=fits,
         mpc_failed_solves=[[[int(v) if v == v else None for v in col] for col in row]
                            for row in mpc_fail],
+        mpc_failed_kept_previous=[[[int(v) if v == v else None for v in col] for col in row]
+                                  for row in mpc_kept],
         mpc_speed_exceeded_fraction=opt_list(mpc_xf), mpc_speed_peak=opt_list(mpc_xp))
 
 
@@ -467,10 +514,11 @@ def horizon_dataset(r: HorizonResult):
                      "mpc_stored_energy_change_j"):
             if getattr(r, name):
                 data[name] = (dims, np.asarray(getattr(r, name), dtype=float))
-        if r.mpc_failed_solves:
-            data["mpc_failed_solves"] = (dims, np.asarray(
-                [[[-1 if v is None else v for v in c] for c in row]
-                 for row in r.mpc_failed_solves], dtype=np.int64))
+        for name in ("mpc_failed_solves", "mpc_failed_kept_previous"):
+            if getattr(r, name):
+                data[name] = (dims, np.asarray(
+                    [[[-1 if v is None else v for v in c] for c in row]
+                     for row in getattr(r, name)], dtype=np.int64))
         for name in ("first", "median", "p99", "max"):
             v = getattr(r, f"mpc_update_time_{name}")
             if v:
@@ -506,6 +554,7 @@ def horizon_dataset(r: HorizonResult):
         "mpc_stored_energy_change_j": ("J", "change of the stored energy"),
         "baseline_stored_energy_change_j": ("J", "change of the stored energy"),
         "mpc_failed_solves": ("1", "horizon solves not converged (-1: no run)"),
+        "mpc_failed_kept_previous": ("1", "of them, the previous plan kept (-1: no run)"),
         **{f"mpc_update_time_{k}": ("s", f"wall time of an update (forecast + solve), {k}")
            for k in ("first", "median", "p99", "max")}}
     for name, (unit, long_name) in described.items():

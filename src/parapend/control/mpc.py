@@ -23,6 +23,7 @@ over.
 
 from __future__ import annotations
 
+import logging
 import math
 import time
 from dataclasses import dataclass, field
@@ -34,7 +35,10 @@ from ..results import _Result
 from .swingup import pump_torque, ready_to_catch
 
 __all__ = ["HorizonProblem", "MPCResult", "MPCTrackResult", "horizon_problem", "mpc_run",
-           "track_mpc"]
+           "track_mpc", "update_seconds"]
+
+#: the estimate of long work is logged here (INFO); the command line prints it on stderr
+log = logging.getLogger("parapend.control")
 
 #: q samples (RK4 steps) per torque sample in the ``qn`` of :class:`HorizonProblem`
 MODEL_STEPS = 4
@@ -54,6 +58,32 @@ RESOLVED_TURN = 2 * math.pi
 #: least damping the plans price (docs/control.md: at gamma = 0 without a torque limit the
 #: horizon problem has no optimum; its supremum is the gamma -> 0 limit's instant flips)
 PLAN_DAMPING = 3e-3
+#: least seconds between two calls of a run's ``progress``
+PROGRESS_EVERY = 0.25
+#: work estimated above this many seconds is announced (``log``, INFO)
+ANNOUNCE_SECONDS = 30.0
+
+
+def update_seconds(horizon_periods: float, torque_limit=None, forecast: str = "perfect"
+                   ) -> float:
+    """A rough wall time (s) of one update at 64 torque samples per peak period, for the
+    estimate announced before long work: the means measured on the paper case on one core
+    of the development machine (docs/control.md, "Real time"), rounded up: about
+    ``3 + 3 H`` ms a solve (``H`` the horizon in peak periods), 6 ms more under a torque
+    limit, and ``8 + 6 H`` ms more for the AR forecast. Only an estimate: the progress
+    bar reports the run's own rate."""
+    h = float(horizon_periods)
+    sec = 0.003 + 0.003 * h + (0.006 if torque_limit is not None else 0.0)
+    if forecast == "ar":
+        sec += 0.008 + 0.006 * h
+    return sec
+
+
+def _duration(seconds: float) -> str:
+    for unit, size in (("hours", 3600.0), ("minutes", 60.0)):
+        if seconds >= 2 * size:
+            return f"{seconds / size:.0f} {unit}"
+    return f"{seconds:.0f} s"
 
 
 @dataclass(frozen=True, eq=False, repr=False)
@@ -314,7 +344,7 @@ def mpc_run(q_record, *, gamma, horizon, update_interval, dt, torque_limit=None,
             warm=True, seed=0, terminal_weight=None, average_from=0.0,
             interval_samples=INTERVAL_SAMPLES, plant_steps=PLANT_STEPS, max_iter=MAX_ITER,
             pump_level=1.0, tracking=TRACKING, terminal="energy", speed_limit=None,
-            speed_weight=None, plan_damping=None) -> MPCResult:
+            speed_weight=None, plan_damping=None, progress=None) -> MPCResult:
     """Receding-horizon control of Eq. 14 driven by the record ``q_record``.
 
     Parameters
@@ -375,6 +405,9 @@ def mpc_run(q_record, *, gamma, horizon, update_interval, dt, torque_limit=None,
         Least damping the plans' objective prices, ``max(gamma, plan_damping)`` (the torque
         keeps ``gamma``); None: ``PLAN_DAMPING``. At ``gamma = 0`` without it the horizon
         problem has no optimum (docs/control.md) and the plans spin the pendulum up.
+    progress : callable or None
+        Called ``progress(done, total)`` in torque samples of the run, at most every
+        ``PROGRESS_EVERY`` seconds and at the end.
 
     A run whose speed exceeds a turn per held torque sample stops with the status
     "unresolved" (``success`` False).
@@ -454,7 +487,11 @@ def mpc_run(q_record, *, gamma, horizon, update_interval, dt, torque_limit=None,
     q_samples = qp[::2 * plant_steps]
     tn = hh * np.arange(kk + 1)
     j = 0
+    ticked = time.monotonic()
     while j < total:
+        if progress is not None and time.monotonic() - ticked >= PROGRESS_EVERY:
+            progress(j, total)
+            ticked = time.monotonic()
         x = (th[j], v[j])
         if caught is None and ready_to_catch(x[0], x[1], CATCH_MARGIN):
             caught = j
@@ -547,6 +584,8 @@ def mpc_run(q_record, *, gamma, horizon, update_interval, dt, torque_limit=None,
         if plan is not None:
             since += steps_now
     th, v, u_all = th[:total + 1], v[:total + 1], u_all[:total]
+    if progress is not None:
+        progress(total, total)
     t = dt * np.arange(total + 1)
     p = -u_all * np.diff(th) / dt
     pe = _electrical(p, eta)
@@ -776,14 +815,17 @@ def track_mpc(excitation, *, gamma, horizon=2.0, update_interval=0.03125, foreca
               torque_limit=None, efficiency=None, periods=100, seed=0, irregular=False,
               theta0=math.pi, theta_dot0=0.0, terminal_weight=None,
               samples=TRACK_SAMPLES, terminal="energy", speed_limit=None,
-              speed_weight=None, plan_damping=None) -> MPCTrackResult:
+              speed_weight=None, plan_damping=None, progress=None) -> MPCTrackResult:
     """Receding-horizon control of the case ``excitation`` (or, with ``irregular``, of the
     seeded sea record of ``parapend.control.track.design_sea`` built from it, the same
     record as ``track --irregular`` with the same seed); ``horizon`` and ``update_interval``
     in forcing (peak) periods. The powers are over the run after ``WARMUP_PERIODS``
-    (:class:`MPCTrackResult`)."""
-    from .track import SEA_WAVES, _on_grid, design_sea
+    (:class:`MPCTrackResult`). ``progress(done, total)``: in torque samples (:func:`mpc_run`);
+    a run estimated to take more than ``ANNOUNCE_SECONDS`` is announced on ``log``."""
+    from .track import SEA_WAVES, _check_state, _on_grid, check_flag, design_sea
 
+    theta0, theta_dot0 = _check_state((theta0, theta_dot0))
+    irregular = check_flag("irregular", irregular)
     horizon = check_range("horizon", horizon, 0.01, 20.0)
     update_interval = check_range("update-interval", update_interval, 1.0 / samples, 20.0)
     if update_interval > horizon:
@@ -791,6 +833,9 @@ def track_mpc(excitation, *, gamma, horizon=2.0, update_interval=0.03125, foreca
                              f"peak periods, got {update_interval:g}")
     if forecast not in ("perfect", "ar"):
         raise ParameterError(f"forecast: expected perfect or ar, got {forecast!r:.40}")
+    if progress is not None and not callable(progress):
+        raise ParameterError(f"progress: expected a callable progress(done, total) or None, "
+                             f"got {progress!r:.40}")
     tp = excitation.period
     omega = excitation.omega
     sea_info = None
@@ -812,12 +857,21 @@ def track_mpc(excitation, *, gamma, horizon=2.0, update_interval=0.03125, foreca
                                  "installation lacks") from None
         fo = make_forecast("ar", qf, tp)
     dt = tp / samples
+    # the swing-up takes a few periods without solves; counted as updates here (an upper
+    # bound)
+    updates = math.ceil(periods / max(round(update_interval * samples), 1) * samples)
+    est = updates * update_seconds(horizon, torque_limit, forecast)
+    if est > ANNOUNCE_SECONDS:
+        log.info("track --controller mpc: %d periods = about %d updates of a %g-period "
+                 "horizon (%s forecast): roughly %s on one core (the progress bar gives the "
+                 "rate; Ctrl-C stops it)", periods, updates, horizon, forecast,
+                 _duration(est))
     r = mpc_run(qf, gamma=gamma, horizon=horizon * tp, update_interval=update_interval * tp,
                 dt=dt, torque_limit=torque_limit, efficiency=efficiency, forecast=fo,
                 theta0=theta0, theta_dot0=theta_dot0, t_end=periods * tp, seed=seed,
                 terminal_weight=terminal_weight, average_from=WARMUP_PERIODS * tp,
                 terminal=terminal, speed_limit=speed_limit, speed_weight=speed_weight,
-                plan_damping=plan_damping)
+                plan_damping=plan_damping, progress=progress)
     record_power = None
     n_rec = SEA_WAVES * samples
     if irregular and r.power_series.size >= (SEA_WAVES + WARMUP_PERIODS) * samples:

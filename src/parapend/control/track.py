@@ -266,12 +266,21 @@ def lock_analysis(run, target, tol: float):
 
 
 def _check_state(state0):
+    """``(theta0, theta_dot0)`` as floats, each named in its message as the CLI names it."""
     try:
-        th, om = (float(v) for v in state0)
+        th, om = state0
     except (TypeError, ValueError):
         raise ParameterError("state0: expected (theta0, theta_dot0), two numbers") from None
     return (check_range("theta0", th, 0.0, 1e3, absolute=True),
             check_range("theta-dot0", om, 0.0, 1e3, absolute=True))
+
+
+def check_flag(name: str, value) -> bool:
+    """``value`` as a bool: True, False (or a NumPy bool); anything else is refused (a
+    string such as ``"no"`` would otherwise count as true)."""
+    if isinstance(value, (bool, np.bool_)):
+        return bool(value)
+    raise ParameterError(f"{name}: expected True or False, got {value!r:.40}")
 
 
 #: peak periods in one repeat of the irregular record (``T_r = SEA_WAVES T_p``)
@@ -437,7 +446,8 @@ def track(*, torque_limit=None, torque_margin: float = 0.1, periods: int = 100,
     d = _design(design, torque_limit, torque_margin, r_weight, optimize_args)
     return _result(d, periods=periods, seed=seed, gamma_error=gamma_error,
                    delta_error=delta_error, noise_theta=noise_theta, noise_speed=noise_speed,
-                   irregular=bool(irregular), lock_tolerance=lock_tolerance, state0=state0,
+                   irregular=check_flag("irregular", irregular),
+                   lock_tolerance=lock_tolerance, state0=state0,
                    throw=throw)
 
 

@@ -68,18 +68,31 @@ class BuoyMPCResult(_Result):
     Attributes
     ----------
     mean_power_w : float
-        Mean harvested (mechanical) power over the last ``repeats`` repeats of the record,
-        ``-<tau theta'>``, exact for the held torque: comparable with the record's periodic
-        optimum (``parapend.buoy`` with the same record).
+        The headline: over the last ``repeats`` whole repeats of the record (after the
+        start-up ``average_from_s``), the harvested (mechanical) energy plus the change of
+        the stored energy (buoy and pendulum, ``stored_energy_change_j``) per unit time,
+        ``harvested_power_w + stored_w``: the energy left in the device counted as
+        harvested and energy drawn from it as not, so a storage swing cannot flip it;
+        comparable with the record's periodic optimum (``parapend.buoy`` with the same
+        record).
     electrical_power_w : float
-        The same through the efficiency model (equal without one).
+        The same through the efficiency model, the stored energy counted at ``eta_g``
+        (equal without one).
+    harvested_power_w, harvested_electrical_power_w : float
+        The harvested energy alone per unit time over the same window, ``-<tau theta'>``
+        (exact for the held torque; the mean of the saved ``power`` series there), and its
+        electrical counterpart.
+    harvested_energy_j, stored_energy_change_j : float
+        ``W``, and ``E(end) - E(average_from_s)`` of the mechanical energy of buoy and
+        pendulum (``_Plant.energy``), in J.
     absorbed_w, damping_w, stored_w : float
         Over the same window: the mean power the buoy absorbs from the waves
         ``<(F_exc - mu) z'>`` (excitation less radiation, ``mu`` the memory force), the
-        pendulum's damping ``c <theta'^2>``, and the change of the mechanical energy of buoy
-        and pendulum over the window divided by its length.
+        pendulum's damping ``c <theta'^2>``, and ``stored_energy_change_j`` divided by the
+        window's length.
     energy_balance_residual : float
-        ``|P + damping + stored - absorbed|`` over ``absorbed``: the plant's energy balance.
+        ``|harvested + damping + stored - absorbed|`` over ``absorbed``: the plant's energy
+        balance.
     fixed_point_change : list
         ``coupled``: median over the updates of the relative change of the predicted ``q``
         at each iteration (``||q_k - q_{k-1}|| / ||q_k||``, k = 1..iterations - 1).
@@ -87,14 +100,26 @@ class BuoyMPCResult(_Result):
         ``coupled``: median over the updates of ``||q(plan) - q|| / ||q||`` for the applied
         plan, the heave it makes against the heave it was planned on (one extra prediction
         per update, outside the timed part).
-    solve_time_median_s, solve_time_max_s : float
-        Wall time of one update's planning (every solve and prediction), against
-        ``update_interval_s``.
+    update_time_first_s : float or None
+        Wall time of the first update's planning (it loads or compiles the kernels),
+        reported apart.
+    update_time_median_s, update_time_p99_s, update_time_max_s : float or None
+        Wall time of one update's planning (every solve and prediction; the forecast is the
+        record itself, precomputed) over the updates after the first, on this process.
+    realtime_fits : bool or None
+        Whether ``update_time_p99_s`` fits in ``update_interval_s``.
+    failed_kept_previous : int
+        Of ``failed_solves``, those whose iterate was not finite, after which the previous
+        plan went on (the others applied their last iterate).
     """
 
     controller: str
     mean_power_w: float
     electrical_power_w: float
+    harvested_power_w: float
+    harvested_electrical_power_w: float
+    harvested_energy_j: float
+    stored_energy_change_j: float
     absorbed_w: float
     damping_w: float
     stored_w: float
@@ -113,8 +138,12 @@ class BuoyMPCResult(_Result):
     fixed_point_residual: float | None
     solves: int
     failed_solves: int
-    solve_time_median_s: float
-    solve_time_max_s: float
+    update_time_first_s: float | None
+    update_time_median_s: float | None
+    update_time_p99_s: float | None
+    update_time_max_s: float | None
+    realtime_fits: bool | None
+    failed_kept_previous: int
     torque_limit_nm: float
     torque_limit_given: bool
     efficiency: tuple | None
@@ -134,7 +163,8 @@ class BuoyMPCResult(_Result):
     _plant: object = field(default=None, repr=False)
 
     command = "buoy"
-    headline = ("mean_power_w", "electrical_power_w", "stored_w", "failed_solves", "status")
+    headline = ("mean_power_w", "electrical_power_w", "harvested_power_w", "stored_w",
+                "failed_solves", "status")
 
     @property
     def series(self) -> dict:
@@ -175,7 +205,9 @@ class BuoyMPCResult(_Result):
             ax[2].set_ylabel("harvested energy (J)")
             ax[2].set_xlabel("time t (s)")
             ax[0].set_title(f"buoy, {self.controller}: mean power {self.mean_power_w:.4g} W "
-                            f"over the averaging window", fontsize=10)
+                            f"(harvested {self.harvested_power_w:.4g} W + stored "
+                            f"{self.stored_w:.4g} W) from {self.average_from_s:.4g} s",
+                            fontsize=10)
             fig.tight_layout()
         return fig
 
@@ -382,9 +414,11 @@ def _efficiency(efficiency):
 
 
 def _check_solve(res, u):
+    """The plan to apply and whether the solve failed: a non-finite iterate keeps the
+    previous plan ``u`` (``bad`` 2), a failed finite one is applied (``bad`` 1)."""
     x = np.asarray(res.x, dtype=float)
     if not np.all(np.isfinite(x)):
-        return u, 1
+        return u, 2
     bad = not getattr(res, "success", True) and getattr(res, "status", 0) not in (0, 1)
     return x, int(bad)
 
@@ -401,7 +435,7 @@ def _plan_coupled(plant, prob, u0, fseg, ps, stride, iterations, relaxation, max
     out = plant.predict(u0 * tu, ps, fseg, memory_force=True)
     mu = out[1] if out is not None else np.full(fseg.size, plant.mus[0])
     y0 = plant.y.copy()
-    u, ch, failed = u0, [], 0
+    u, ch, failed, kept = u0, [], 0, 0
     for it in range(iterations):
         if it:
             out = plant.predict(u * tu, ps, fseg, memory_force=True)
@@ -410,21 +444,22 @@ def _plan_coupled(plant, prob, u0, fseg, ps, stride, iterations, relaxation, max
                 mu = (1 - relaxation) * mu + relaxation * out[1]
         res = prob.solve(y0, (fseg - mu)[::stride], u, max_iter=max_iter)
         u, bad = _check_solve(res, u)
-        failed += bad
+        failed += bad > 0
+        kept += bad == 2
     res_fp = None
     if residual:
         t1 = time.perf_counter()
         out = plant.predict(u * tu, ps, fseg, memory_force=True)
         if out is not None:
             res_fp = (_rel(out[1], mu), time.perf_counter() - t1)
-    return u, ch, res_fp, iterations, failed
+    return u, ch, res_fp, iterations, (int(failed), int(kept))
 
 
 def _plan_fixed_point(plant, prob, x0, q, u0, fseg, ps, stride, rounds, relaxation, max_iter,
                       residual, g, tu):
     """Plan the pendulum alone (:class:`parapend.control.mpc.HorizonProblem`) on the heave
     ``q``; ``fixed-point``: the heave predicted again under the new plan, ``rounds`` times."""
-    u, ch, failed = u0, [], 0
+    u, ch, failed, kept = u0, [], 0, 0
     for it in range(rounds):
         if it:
             zdd = plant.predict(u * tu, ps, fseg)
@@ -435,14 +470,15 @@ def _plan_fixed_point(plant, prob, x0, q, u0, fseg, ps, stride, rounds, relaxati
         # the pendulum's horizon problem through its documented call only
         res = prob.solve(x0, q, u)
         u, bad = _check_solve(res, u)
-        failed += bad
+        failed += bad > 0
+        kept += bad == 2
     res_fp = None
     if residual:
         t1 = time.perf_counter()
         zdd = plant.predict(u * tu, ps, fseg)
         if zdd is not None:
             res_fp = (_rel(zdd[::stride] / g, q), time.perf_counter() - t1)
-    return u, ch, res_fp, rounds, failed
+    return u, ch, res_fp, rounds, (int(failed), int(kept))
 
 
 def buoy_mpc(hydro, pendulum, wave, *, peak_period, horizon=2.0, update_interval=0.125,
@@ -584,7 +620,7 @@ def buoy_mpc(hydro, pendulum, wave, *, peak_period, horizon=2.0, update_interval
     caught, braking = None, False
     plan = np.zeros(n)
     times, changes, residuals = [], [], []
-    solves = failed = 0
+    solves = failed = kept = 0
     status = "ok"
     j = 0
     while j < total:
@@ -618,7 +654,8 @@ def buoy_mpc(hydro, pendulum, wave, *, peak_period, horizon=2.0, update_interval
                     residual and controller == "fixed-point", g, tu)
             times.append(time.perf_counter() - tic - (0.0 if res_fp is None else res_fp[1]))
             solves += nsolve
-            failed += nfail
+            failed += nfail[0]
+            kept += nfail[1]
             changes.append(ch)
             if res_fp is not None:
                 residuals.append(res_fp[0])
@@ -645,16 +682,23 @@ def buoy_mpc(hydro, pendulum, wave, *, peak_period, horizon=2.0, update_interval
     pe = p if eta is None else np.where(p > 0, eta[0] * p, p / eta[1])
     a0 = max(0, total - repeats * per_record)
     span = (total - a0) * dt
+    eta_g = 1.0 if eta is None else float(eta[0])
     if span > 0:
-        mean_p = float(np.mean(p[a0:]))
-        mean_e = float(np.mean(pe[a0:]))
+        # the harvested energy W and the stored energy's change dE over whole repeats of
+        # the record after the start-up; the headline is (W + dE) / span
+        work = float(np.sum(p[a0:]) * dt)
+        work_e = float(np.sum(pe[a0:]) * dt)
+        de = float(energy[-1] - energy[a0])
+        harvested, harvested_e = work / span, work_e / span
+        stored = de / span
+        mean_p = harvested + stored
+        mean_e = harvested_e + eta_g * stored
         d = (acc[-1] - acc[a0]) / span
-        stored = (energy[-1] - energy[a0]) / span
     else:
-        mean_p = mean_e = stored = math.nan
+        work = de = harvested = harvested_e = mean_p = mean_e = stored = math.nan
         d = np.full(3, math.nan)
     absorbed, damping = float(d[0]), float(d[1])
-    resid = abs(mean_p + damping + stored - absorbed) / max(abs(absorbed), 1e-300)
+    resid = abs(harvested + damping + stored - absorbed) / max(abs(absorbed), 1e-300)
     if status == "ok" and not math.isfinite(mean_p):
         status = "nonfinite"
     if status == "ok" and float(np.max(np.abs(ys[:, 3]))) * h > RESOLVED:
@@ -663,16 +707,20 @@ def buoy_mpc(hydro, pendulum, wave, *, peak_period, horizon=2.0, update_interval
         # a run whose plans mostly failed is not a success, whatever its power
         status = "solves_failed"
     st = np.asarray(times)
+    timing = _mpc.timing_summary(st, m * dt)
     fp = []
     if controller != "one-way" and iterations > 1 and changes:
         for k in range(iterations - 1):
             col = [c[k] for c in changes if len(c) > k]
             fp.append(float(np.median(col)) if col else math.nan)
-    msg = {"ok": f"{solves} horizon solves in {st.size} updates, {failed} ended abnormally",
+    applied = (f" (applied instead: the last iterate of {failed - kept}, the previous plan "
+               f"continued for {kept})" if failed else "")
+    msg = {"ok": f"{solves} horizon solves in {st.size} updates, {failed} ended abnormally"
+                 + applied,
            "diverged": "the closed loop diverged (|theta'| > 1e6 rad/s)",
            "nonfinite": "non-finite power",
            "solves_failed": (f"{failed} of {solves} horizon solves ended abnormally: the "
-                             "controller did not plan this run"),
+                             "controller did not plan this run" + applied),
            "unresolved": (f"the pendulum turned more than {RESOLVED:g} rad in one plant step: "
                           "the integration does not resolve the run; lower the torque "
                           "limit")}[status]
@@ -681,6 +729,8 @@ def buoy_mpc(hydro, pendulum, wave, *, peak_period, horizon=2.0, update_interval
     zwin = ys[a0 * 1:, 0]
     return BuoyMPCResult(
         controller=controller, mean_power_w=mean_p, electrical_power_w=mean_e,
+        harvested_power_w=harvested, harvested_electrical_power_w=harvested_e,
+        harvested_energy_j=work, stored_energy_change_j=de,
         absorbed_w=absorbed, damping_w=damping, stored_w=float(stored),
         energy_balance_residual=float(resid),
         peak_torque_nm=float(np.max(np.abs(u_all))) if total else 0.0,
@@ -691,8 +741,8 @@ def buoy_mpc(hydro, pendulum, wave, *, peak_period, horizon=2.0, update_interval
         fixed_point_change=fp,
         fixed_point_residual=float(np.median(residuals)) if residuals else None,
         solves=solves, failed_solves=failed,
-        solve_time_median_s=float(np.median(st)) if st.size else 0.0,
-        solve_time_max_s=float(np.max(st)) if st.size else 0.0,
+        **{f"{k}_s": v for k, v in timing.items() if k != "realtime_fits"},
+        realtime_fits=timing["realtime_fits"], failed_kept_previous=kept,
         torque_limit_nm=torque_limit, torque_limit_given=limit_given, efficiency=eta,
         success=status == "ok", status=status, message=msg,
         pendulum={"mass_kg": pendulum.mass, "length_m": pendulum.length,
@@ -729,6 +779,20 @@ def mpc_command(hydro, pendulum, wave, info, *, controller, horizon, update_inte
                                optimum_winding=int(winding), wave=info)
 
 
+def _timing_line(r) -> str:
+    """Planning time per update against the update interval (the first apart)."""
+    if r.update_time_median_s is None:
+        first = ("" if r.update_time_first_s is None else
+                 f" (one update, {1e3 * r.update_time_first_s:.3g} ms with the kernel load)")
+        return f"planning per update: too few updates to time{first}"
+    return (f"planning per update after the first: median {1e3 * r.update_time_median_s:.3g} "
+            f"ms, p99 {1e3 * r.update_time_p99_s:.3g} ms, max "
+            f"{1e3 * r.update_time_max_s:.3g} ms against the update interval "
+            f"{1e3 * r.update_interval_s:.4g} ms: p99 "
+            + ("fits" if r.realtime_fits else "does NOT fit")
+            + f" (one process); the first {1e3 * r.update_time_first_s:.3g} ms (kernel load)")
+
+
 def mpc_text(r) -> list:
     """The text report of :func:`mpc_command`'s result."""
     def f(x, unit=""):
@@ -746,7 +810,11 @@ def mpc_text(r) -> list:
            f"{r.torque_limit_nm:.6g} N m" + ("" if r.torque_limit_given else
                                             " (2 m g l, the default)"),
            "",
-           f"mean power over the last repeat    {f(r.mean_power_w, ' W')}",
+           f"mean power over the last repeat    {f(r.mean_power_w, ' W')} (harvested + "
+           f"stored energy's change, after a {r.average_from_s:.4g} s start-up)",
+           f"  harvested alone                  {f(r.harvested_power_w, ' W')}",
+           f"  stored energy's change           {f(r.stored_energy_change_j, ' J')} "
+           "(buoy and pendulum)",
            f"  electrical                       {f(r.electrical_power_w, ' W')}",
            f"non-causal coupled optimum         {f(r.optimum_power_w, ' W')} (winding "
            f"{r.optimum_winding})",
@@ -757,7 +825,6 @@ def mpc_text(r) -> list:
            f"  energy balance residual          {r.energy_balance_residual:.1e}",
            f"heave amplitude (half range)       {f(r.heave_amplitude_m, ' m')}",
            f"peak torque                        {f(r.peak_torque_nm, ' N m')}",
-           f"solve per update: median {r.solve_time_median_s:.3g} s, max "
-           f"{r.solve_time_max_s:.3g} s, against the update interval {r.update_interval_s:.4g} s",
+           _timing_line(r),
            f"status: {r.status}; {r.message}"]
     return out
