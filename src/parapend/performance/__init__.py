@@ -263,8 +263,8 @@ def matrix_quantities(spec: MatrixSpec) -> tuple:
 
 
 def _headline(ds, spec: MatrixSpec):
-    """The store's per-realization Dataset as the user reads it (the rule of the electrical headline, as
-    ``parapend buoy`` and ``optimize``): with an efficiency, ``power`` is the electrical
+    """The store's per-realization Dataset as the user reads it (the electrical headline,
+    as ``parapend buoy`` and ``optimize``): with an efficiency, ``power`` is the electrical
     power (what the take-off delivers: the power matrix, capture width and annual energy
     are of it) and ``mechanical_power`` the same motion's mechanical power; the store keeps
     its own names (``power`` mechanical), so a store resumes whatever reads it."""
