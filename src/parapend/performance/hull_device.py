@@ -108,11 +108,13 @@ def largest_waves(spec) -> float | None:
     if not _fits(spec, lo):
         return None
     hi = spec.waves
-    while hi - lo > 0.005:
+    while hi - lo > 0.002:
         mid = 0.5 * (lo + hi)
         lo, hi = (mid, hi) if _fits(spec, mid) else (lo, mid)
     best = math.floor(lo * 100) / 100
-    return best if _fits(spec, best) else lo
+    while _fits(spec, round(best + 0.01, 2)):  # the bisection's last step, to the 0.01
+        best = round(best + 0.01, 2)
+    return best
 
 
 def check_records(spec) -> None:
