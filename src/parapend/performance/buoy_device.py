@@ -239,7 +239,7 @@ def water_of(spec) -> tuple:
     (``spec.water_density``, ``spec.water_depth``) for a body solved here. A dataset's
     ``g`` must be the pendulum's 9.81 m/s^2 and its ``rho`` a water's (a rho of 1e-300
     gave a capture width of 5.6e302 m)."""
-    if spec.dofs != "heave":
+    if getattr(spec, "dofs", "heave") != "heave":
         from .hull_device import hull_of
 
         h = hull_of(spec)
