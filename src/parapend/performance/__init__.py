@@ -600,10 +600,12 @@ def power_matrix(*, hs="1:3:3", te=None, tp=None, realizations: int = 3, waves: 
     # announced once nothing is left to refuse
     if est["seconds"] is not None and est["seconds"] > _ANNOUNCE_SECONDS:
         log.info("power matrix: %d bins x %d realizations = %d solves of %g-wave records on "
-                 "%s: roughly %s (about 3 s a 50-wave solve; the progress bar gives the rate)",
+                 "%s: roughly %s (about %s; the progress bar gives the rate)",
                  est["bins"], spec.realizations, est["solves"], spec.waves,
                  f"{est['processes']} processes" if est["processes"] else "the cluster",
-                 _duration(est["seconds"]) + ("" if est["processes"] else " of one core"))
+                 _duration(est["seconds"]) + ("" if est["processes"] else " of one core"),
+                 "3 s a 50-wave solve" if spec.dofs == "heave" else
+                 "2 minutes a 9-wave record of the hull")
     t0 = time.monotonic()
     run = run_spec(spec, store, workers=workers, scheduler=scheduler, overwrite=overwrite,
                    command=command, progress=progress)
