@@ -134,6 +134,21 @@ def test_a_lossy_take_off_shows_the_electrical_power(dataset, stand_in):
     assert ds["mode"].dtype == np.int8
 
 
+def test_the_command_line_reports_the_modes(dataset, capsys, stand_in):
+    """The command line's JSON names each bin's mode (swinging included) and its text
+    report counts them."""
+    args = ["power-matrix", "--device", "buoy", "--dofs", "surge,heave,pitch", "--hydro",
+            dataset, "--hs", "1,2", "--tp", "5,6", "--waves", "2", "--realizations", "1",
+            "--workers", "1", *(x for k, v in PEND.items()
+                                for x in (f"--{k.replace('_', '-')}", repr(v)))]
+    assert main([*args, "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert out["operating_mode"] == [["rest", "rest"], ["rotation", "swinging"]]
+    assert main(args) == 0
+    text = capsys.readouterr().out
+    assert "1 rotation, 1 swinging, 2 rest" in text
+
+
 def test_dofs_heave_keeps_the_store_identity():
     """The new fields at their defaults are left out of the store's identity, so a store
     written before them still resumes; a hull's spec round-trips through the JSON."""
