@@ -124,14 +124,21 @@ def test_the_store_holds_each_records_answer_and_the_aep_invariant(dataset, scat
     assert annual["power"]["complete"]
 
 
-def test_a_lossy_take_off_shows_the_electrical_power(dataset, stand_in):
+def test_a_lossy_take_off_shows_the_electrical_power(dataset, stand_in, tmp_path):
     """With a copper loss (or an efficiency) the Dataset's power is the hull's power_w (the
-    electrical one) and mechanical_power its motion's, as for the heave buoy."""
-    ds, _, _, _ = power_matrix(**BINS, realizations=1, hydro=dataset, workers=1,
-                               copper_loss=1e-6, **HULL)
+    electrical one) and mechanical_power its motion's, as for the heave buoy; the store
+    resumes to the same numbers and modes."""
+    store = str(tmp_path / "m.zarr")
+    ds, _, run, _ = power_matrix(**BINS, realizations=1, hydro=dataset, workers=1,
+                                 copper_loss=1e-6, store=store, **HULL)
     p, m = ds["power"].values, ds["mechanical_power"].values
-    assert np.array_equal(p, 0.9 * m)
+    assert np.array_equal(p, 0.9 * m) and (m > 0).any()
     assert ds["mode"].dtype == np.int8
+    again, _, run2, _ = power_matrix(**BINS, realizations=1, hydro=dataset, workers=1,
+                                     copper_loss=1e-6, store=store, **HULL)
+    assert run.computed_points == 4 and run2.resumed_points == 4
+    for v in ("power", "mechanical_power", "mode", "status", "radiation_bound_power"):
+        assert np.array_equal(again[v].values, ds[v].values, equal_nan=True), v
 
 
 def test_the_command_line_reports_the_modes(dataset, capsys, stand_in):
