@@ -176,6 +176,20 @@ def test_the_hull_spec_round_trips(dataset):
                               "status")
 
 
+def test_the_take_off_reaches_the_hull(dataset):
+    """--efficiency, --torque-limit and --copper-loss reach the hull's take-off (HullPTO) as
+    parapend.buoy builds it, and enter the store's identity."""
+    from parapend.hydro.hull_api import _pto
+    from parapend.performance.hull_device import problem
+
+    kw = {"efficiency": 0.9, "torque_limit": 2e4, "copper_loss": 1e-6}
+    spec = matrix_spec(**BINS, realizations=1, hydro=dataset, **HULL, **kw)
+    assert problem(spec)["pto"] == _pto(kw)
+    d = json.loads(spec.to_json())
+    assert (d["efficiency"], d["torque_limit"], d["copper_loss"]) == (0.9, 2e4, 1e-6)
+    assert spec.variables[3] == "electrical_power"
+
+
 def test_the_longest_record_is_the_hulls_limit(dataset):
     """The default 50 waves are refused naming --waves and the largest that fits; that
     largest fits the hull's own size check (12 harmonics per wave, at most 128), 0.01 more
