@@ -605,7 +605,7 @@ def power_matrix(*, hs="1:3:3", te=None, tp=None, realizations: int = 3, waves: 
                  f"{est['processes']} processes" if est["processes"] else "the cluster",
                  _duration(est["seconds"]) + ("" if est["processes"] else " of one core"),
                  "3 s a 50-wave solve" if spec.dofs == "heave" else
-                 "2 minutes a 9-wave record of the hull")
+                 "100 s a 9-wave record of the hull")
     t0 = time.monotonic()
     run = run_spec(spec, store, workers=workers, scheduler=scheduler, overwrite=overwrite,
                    command=command, progress=progress)
