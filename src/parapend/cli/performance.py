@@ -6,7 +6,7 @@ from __future__ import annotations
 import shlex
 import sys
 
-from ..defaults import BUOY, SEA
+from ..defaults import BUOY, HULL, SEA
 from . import _output
 from ._common import (
     FIGURE_SUFFIXES,
@@ -85,10 +85,40 @@ def add_parsers(sub) -> None:
                    help="power take-off efficiency in [1e-6, 1]: the power reported is "
                         "the electrical one, the mechanical beside it")
     g.add_argument("--torque-limit", type=_finite_float("torque-limit"),
-                   help="not supported over a sea record (refused)")
+                   help="largest |torque|, N m (with --dofs surge,heave,pitch; refused "
+                        "otherwise: not supported over a sea record)")
     g = p.add_argument_group("the buoy's body (--device buoy; as parapend buoy)")
-    add_body_options(g, body_help="a vertical cylinder or a floating sphere (default cylinder)",
-                     hydro_help="a Capytaine NetCDF dataset, instead of --body (docs/buoy.md)")
+    add_body_options(g, body_help="a vertical cylinder or a floating sphere (default "
+                                  "cylinder); with --dofs surge,heave,pitch also a box barge "
+                                  "(its default)",
+                     hydro_help="a Capytaine NetCDF dataset, instead of --body (docs/buoy.md)",
+                     bodies=("cylinder", "sphere", "barge"))
+    g = p.add_argument_group("hull: surge, heave and pitch (--device buoy; as parapend buoy, "
+                             "docs/hull.md)")
+    g.add_argument("--dofs", metavar="DOFS",
+                   help="the hull's degrees of freedom: heave (the heaving buoy) or "
+                        "surge,heave,pitch (a hull that pitches; each record's best of "
+                        "rotation, swinging and rest; its pendulum's defaults the hull's: "
+                        f"{HULL['mass']:g} kg, {HULL['length']:g} m, "
+                        f"{HULL['damping_coefficient']:g} N m s/rad; records of at most "
+                        "about 10 waves: give --waves) (default heave)")
+    g.add_argument("--pivot-height", type=_finite_float("pivot-height"),
+                   help=f"the pivot above the hull's rotation centre (its waterplane "
+                        f"centre), m (default {HULL['pivot_height']:g})")
+    g.add_argument("--pivot-offset", type=_finite_float("pivot-offset"),
+                   help=f"the pivot ahead of it, along the waves' travel, m (default "
+                        f"{HULL['pivot_offset']:g})")
+    g.add_argument("--hull-pitch-inertia", type=_finite_float("hull-pitch-inertia"),
+                   help="the hull's pitch inertia about the rotation centre, without the "
+                        "pendulum, kg m^2 (default: the dataset's, else a homogeneous "
+                        "immersed hull's)")
+    for name, key in (("length", "barge_length"), ("beam", "barge_beam"),
+                      ("draft", "barge_draft")):
+        g.add_argument(f"--barge-{name}", type=_finite_float(f"barge-{name}"),
+                       help=f"the box barge's {name}, m (default {HULL[key]:g})")
+    g.add_argument("--copper-loss", type=_finite_float("copper-loss"),
+                   help="the generator's winding loss r tau^2 subtracted from the power, r "
+                        "in W/(N m)^2 (with --dofs surge,heave,pitch)")
     g = p.add_argument_group("resource and site")
     g.add_argument("--depth", type=_finite_float("depth"),
                    help="water depth, m (default deep water; with --device buoy also "

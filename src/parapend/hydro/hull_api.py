@@ -17,7 +17,7 @@ from ..defaults import HULL, given
 from ..errors import ParameterError, check_int, check_range
 from .hull_optimum import waves_in
 
-__all__ = ["hull_buoy", "parse_dofs"]
+__all__ = ["hull_buoy", "hull_problem", "parse_dofs", "solve_record"]
 
 #: the hull's degrees of freedom the command takes
 DOF_SETS = {("heave",): "heave", ("surge", "heave", "pitch"): "surge,heave,pitch"}
@@ -174,13 +174,10 @@ def _pivot(opts, geometry):
     return float(d), float(h)
 
 
-def hull_buoy(**opts):
-    """The optimum of a pendulum in a surging, heaving, pitching hull (see
-    :func:`parapend.buoy`, ``dofs="surge,heave,pitch"``)."""
-    from .coupled import Wave
-    from .hull_result import hull_answer
-    from .inputs import _irregular_wave, _period, parse_periods
-
+def hull_problem(**opts) -> dict:
+    """Everything but the wave, checked, and the hull's coefficients built once (the BEM runs
+    after the checks): the pieces :func:`solve_record` solves a wave with (the power matrix
+    builds them once per process and solves each bin's record)."""
     _refuse_unsupported(opts)
     pto = _pto(opts)
     pend = _pendulum(opts)
@@ -199,6 +196,44 @@ def hull_buoy(**opts):
     harmonics = opts.get("harmonics")
     if harmonics is not None:
         harmonics = check_int("harmonics", harmonics, 2, limits.HULL_MAX_HARMONICS)
+    return {"hull": hull, "pendulum": pend, "pivot": pivot, "pitch_inertia": inertia,
+            "winding": winding, "windings": windings, "harmonics": harmonics,
+            "geometry": geometry, "pto": pto}
+
+
+def solve_record(problem: dict, wave, info, *, check_only: bool = False):
+    """One irregular record ``wave`` (described by ``info``) of :func:`hull_problem`'s
+    ``problem``: its size and frequencies checked, then solved (rotation one turn per wave
+    and swinging unless a winding was given); ``check_only``: the checks alone."""
+    from .hull_result import hull_answer
+
+    windings = problem["windings"]
+    if problem["winding"] is None:
+        windings = (waves_in(wave), 0)
+    _check_size(wave, windings, problem["harmonics"])
+    amps = np.abs(np.asarray(wave.amplitudes))
+    sig = np.nonzero(amps >= 1e-3 * amps.max())[0]
+    problem["hull"].check_covers(wave.omega * (sig[0] + 1), wave.omega * (sig[-1] + 1),
+                                 name="tp")
+    if check_only:
+        return None
+    return hull_answer(problem["hull"], problem["pendulum"], wave, pivot=problem["pivot"],
+                       windings=windings, pitch_inertia=problem["pitch_inertia"],
+                       harmonics=problem["harmonics"], wave_info=info,
+                       geometry=problem["geometry"], pto=problem["pto"])
+
+
+def hull_buoy(**opts):
+    """The optimum of a pendulum in a surging, heaving, pitching hull (see
+    :func:`parapend.buoy`, ``dofs="surge,heave,pitch"``)."""
+    from .coupled import Wave
+    from .hull_result import hull_answer
+    from .inputs import _irregular_wave, _period, parse_periods
+
+    p = hull_problem(**opts)
+    hull, pend, pivot, inertia, geometry, pto, windings, harmonics = (
+        p[k] for k in ("hull", "pendulum", "pivot", "pitch_inertia", "geometry", "pto",
+                       "windings", "harmonics"))
     irregular = any(opts.get(k) is not None for k in ("hs", "tp", "record", "repeat_period",
                                                       "seed"))
     if irregular:
@@ -212,15 +247,7 @@ def hull_buoy(**opts):
             opts.get("gamma_peak") or 3.3, opts.get("repeat_period"), opts.get("seed"),
             opts.get("cutoff") or 3.0, opts.get("record"), opts.get("taper") or 0.1,
             Units(pend.length, pend.mass, 9.81, pend.inertia))
-        if winding is None:
-            windings = (waves_in(wave), 0)
-        _check_size(wave, windings, harmonics)
-        amps = np.abs(np.asarray(wave.amplitudes))
-        sig = np.nonzero(amps >= 1e-3 * amps.max())[0]
-        hull.check_covers(wave.omega * (sig[0] + 1), wave.omega * (sig[-1] + 1), name="tp")
-        return hull_answer(hull, pend, wave, pivot=pivot, windings=windings,
-                           pitch_inertia=inertia, harmonics=harmonics, wave_info=info,
-                           geometry=geometry, pto=pto)
+        return solve_record(p, wave, info)
     height = check_range("wave-height", _value(opts, "wave_height"), 1e-4, 30.0,
                          why="regular wave height, m")
     periods = parse_periods(opts.get("wave_period"))

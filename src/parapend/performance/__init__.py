@@ -97,19 +97,36 @@ def matrix_spec(*, hs="1:3:3", te=None, tp=None, realizations: int = 3, waves: f
                 gravity: float = 9.81, gamma=None, damping_coefficient=None, winding=1,
                 harmonics=None, efficiency=None, torque_limit=None, body=None, radius=None,
                 draft=None, mesh=None, hydro=None, density: float = 1025.0,
-                depth=None) -> MatrixSpec:
+                depth=None, dofs="heave", pivot_height=None, pivot_offset=None,
+                hull_pitch_inertia=None, barge_length=None, barge_beam=None,
+                barge_draft=None, copper_loss=None) -> MatrixSpec:
     """Check everything a matrix's bins depend on (one line naming the parameter).
     ``length``, ``mass``: None is the device's default (``parapend.defaults.SEA`` for the
     prescribed-heave pendulum, ``BUOY`` for the buoy); ``body, radius, draft, mesh, hydro``
     are the buoy's body as ``parapend buoy`` takes them; ``density`` (kg/m^3) and ``depth``
     (m, None deep water) the water the buoy's body is solved in (a ``hydro`` dataset's
-    own otherwise; the prescribed device's record does not depend on them)."""
+    own otherwise; the prescribed device's record does not depend on them). ``dofs``
+    ``"surge,heave,pitch"`` (with ``device="buoy"``): a pendulum in a hull that surges,
+    heaves and pitches, ``pivot_height ... copper_loss`` and ``torque_limit`` as
+    ``parapend.buoy`` takes them (:mod:`.hull_device`)."""
+    from ..hydro.hull_api import parse_dofs
     from ..seas import _check_sea, check_response, read_response
     from ..units import Units
 
     if not isinstance(device, str) or device not in DEVICES:
         raise ParameterError(f"device: expected one of {', '.join(DEVICES)}, got "
                              f"{device!r:.60}")
+    hull = {"pivot_height": pivot_height, "pivot_offset": pivot_offset,
+            "hull_pitch_inertia": hull_pitch_inertia, "barge_length": barge_length,
+            "barge_beam": barge_beam, "barge_draft": barge_draft, "copper_loss": copper_loss}
+    heave = parse_dofs(dofs) == ("heave",)
+    if not heave and device != "buoy":
+        raise ParameterError("dofs: a hull that surges, heaves and pitches needs --device buoy")
+    if heave:
+        for name, v in hull.items():
+            if v is not None:
+                raise ParameterError(f"{name.replace('_', '-')}: a hull's option; needs --dofs "
+                                     "surge,heave,pitch (with --device buoy)")
     if device != "buoy":
         given = [n for n, v in (("body", body), ("radius", radius), ("draft", draft),
                                 ("mesh", mesh), ("hydro", hydro)) if v is not None]
@@ -122,7 +139,7 @@ def matrix_spec(*, hs="1:3:3", te=None, tp=None, realizations: int = 3, waves: f
     if horizon is not None:
         raise ParameterError("horizon: the causal controller is not available yet; the matrix "
                              "gives the non-causal optimum, the limit and the uniform rotation")
-    if torque_limit is not None:
+    if torque_limit is not None and heave:
         raise ParameterError("torque-limit: not supported over a sea record (parapend sea "
                              "solves the unconstrained optimum); drop --torque-limit")
     hm0 = parse_bins("hs", hs)
@@ -151,6 +168,14 @@ def matrix_spec(*, hs="1:3:3", te=None, tp=None, realizations: int = 3, waves: f
                                  f"{limits.SEA_TP_RANGE[0]:g} to {limits.SEA_TP_RANGE[1]:g} s, "
                                  f"got {t:g} s" + (f" (Te {t * ratio:g} s)" if kind == "te"
                                                    else ""))
+    if not heave:
+        return _hull_spec(hm0, period, kind, tps, realizations, waves, seed, spectrum,
+                          gamma_peak, cutoff, response=response, length=length, mass=mass,
+                          inertia=inertia, gravity=gravity, gamma=gamma,
+                          damping_coefficient=damping_coefficient, winding=winding,
+                          harmonics=harmonics, efficiency=efficiency,
+                          torque_limit=torque_limit, body=body, radius=radius, draft=draft,
+                          mesh=mesh, hydro=hydro, density=density, depth=depth, **hull)
     if device == "buoy":
         return _buoy_spec(hm0, period, kind, tps, realizations, waves, seed, spectrum,
                           gamma_peak, cutoff, response=response, length=length, mass=mass,
@@ -210,6 +235,9 @@ def _buoy_spec(hm0, period, kind, tps, realizations, waves, seed, spectrum, gamm
     depth = None if depth is None else check_depth(depth)
     _check_breaking(hm0, depth)  # before the body's BEM
     body = "cylinder" if body is None else body
+    if body == "barge":
+        raise ParameterError("body: the barge is a hull that pitches: give --dofs "
+                             "surge,heave,pitch")
     if not isinstance(body, str) or body not in ("cylinder", "sphere"):
         raise ParameterError(f"body: expected cylinder or sphere, got {body!r:.40}")
     radius = None if radius is None else check_positive("radius", radius)
@@ -236,6 +264,42 @@ def _buoy_spec(hm0, period, kind, tps, realizations, waves, seed, spectrum, gamm
     return dataclasses.replace(spec, width=width)
 
 
+def _hull_spec(hm0, period, kind, tps, realizations, waves, seed, spectrum, gamma_peak,
+               cutoff, *, response, gamma, gravity, winding, harmonics, efficiency,
+               torque_limit, length, mass, inertia, damping_coefficient, body, radius, draft,
+               mesh, hydro, density, depth, **hull) -> MatrixSpec:
+    """The hull's spec (``dofs="surge,heave,pitch"``): the options the hull does not take
+    refused, the rest checked and resolved by the hull's own code (its defaults,
+    ``parapend.defaults.HULL``), the hull built once (its BEM), every bin's record checked."""
+    from . import buoy_device, hull_device
+
+    buoy_device.refuse_for_buoy(response=response, gamma=gamma, gravity=gravity)
+    if winding != 1:
+        raise ParameterError("winding: with --dofs surge,heave,pitch each record compares "
+                             "rotation (one turn per wave), swinging and rest; drop --winding")
+    if hydro is None:
+        for name, bad in (("density", density != 1025.0), ("depth", depth is not None)):
+            if bad:
+                raise ParameterError(f"{name}: the hull's BEM is solved in deep water at 1025 "
+                                     f"kg/m^3; drop --{name} with --dofs surge,heave,pitch (or "
+                                     "give a --hydro dataset solved in that water)")
+    if efficiency is not None:
+        from .check import check_efficiency
+
+        efficiency = float(check_efficiency(efficiency))
+    mesh = None if mesh is None else buoy_device.check_file(mesh, "mesh")
+    hydro = None if hydro is None else buoy_device.check_file(hydro, "hydro")
+    spec = MatrixSpec(hm0, period, kind, tps, realizations, float(waves), seed, spectrum,
+                      float(gamma_peak), float(cutoff), None, length, mass, inertia, 9.81,
+                      0.0, 1, harmonics, efficiency, "buoy",
+                      digest=buoy_device.file_digest(mesh if hydro is None else hydro),
+                      damping_coefficient=damping_coefficient, dofs="surge,heave,pitch")
+    spec = hull_device.resolve(spec, dict(body=body, radius=radius, draft=draft, mesh=mesh,
+                                          hydro=hydro, torque_limit=torque_limit, **hull))
+    hull_device.check_records(spec)
+    return spec
+
+
 def _stats(x: np.ndarray, ok: np.ndarray) -> dict:
     """Statistics over the last axis of ``x`` where ``ok``; NaN where nothing is."""
     v = np.where(ok, x, np.nan)
@@ -258,8 +322,13 @@ _SOLVED = ("power", "mechanical_power", "electrical_power")
 def matrix_quantities(spec: MatrixSpec) -> tuple:
     """The per-realization quantities of the full Dataset (W), the headline ``power`` first:
     the store's, and with an efficiency ``mechanical_power`` (:func:`_headline`)."""
-    q = spec.variables[:-1]
-    return (q[0], "mechanical_power", *q[1:]) if spec.efficiency is not None else q
+    q = _stored(spec)
+    return (q[0], "mechanical_power", *q[1:]) if spec.lossy else q
+
+
+def _stored(spec: MatrixSpec) -> tuple:
+    """The store's per-realization powers (W): its variables but the status and the mode."""
+    return tuple(v for v in spec.variables if v not in ("status", "mode"))
 
 
 def _headline(ds, spec: MatrixSpec):
@@ -268,9 +337,9 @@ def _headline(ds, spec: MatrixSpec):
     power (what the take-off delivers: the power matrix, capture width and annual energy
     are of it) and ``mechanical_power`` the same motion's mechanical power; the store keeps
     its own names (``power`` mechanical), so a store resumes whatever reads it."""
-    for q in spec.variables[:-1]:
+    for q in _stored(spec):
         ds[q].attrs["long_name"] = QUANTITIES[q]
-    if spec.efficiency is None:
+    if not spec.lossy:
         return ds
     mech, elec = ds["power"].copy(), ds["electrical_power"]
     mech.attrs = {"long_name": "mechanical power -<T theta'> of the motion whose electrical "
@@ -334,9 +403,21 @@ def matrix_dataset(raw, spec: MatrixSpec, *, depth=None, density: float = 1025.0
     mean = ds["power_mean"].values
     with np.errstate(invalid="ignore"):
         mode = np.where(~np.isfinite(mean), -1, np.where(mean > 0, 1, 0)).astype(np.int8)
-    ds["operating_mode"] = (dims2, mode, {
-        "long_name": "the device's mode in the bin", "flag_values": [-1, 0, 1],
-        "flag_meanings": "no_result rest rotation"})
+    mode_attrs = {"long_name": "the device's mode in the bin", "flag_values": [-1, 0, 1],
+                  "flag_meanings": "no_result rest rotation"}
+    if "mode" in ds:
+        # the hull: rotation or swinging, whichever more of the bin's solved records chose
+        # (rotation on a tie); rest where the mean is not positive
+        m = ds["mode"].values
+        rot = ((m == 1) & solved).sum(axis=-1)
+        swing = ((m == 2) & solved).sum(axis=-1)
+        mode = np.where(mode == 1, np.where(swing > rot, 2, 1), mode).astype(np.int8)
+        mode_attrs = {"long_name": "the device's mode in the bin: rotation or swinging, "
+                                   "whichever more of its solved records chose (rotation on "
+                                   "a tie); rest where the mean power is not positive",
+                      "flag_values": [-1, 0, 1, 2],
+                      "flag_meanings": "no_result rest rotation swinging"}
+    ds["operating_mode"] = (dims2, mode, mode_attrs)
     ds["capture_width_matrix"] = (dims2, pm / j, {
         "long_name": "capture width P / J of the power matrix", "units": "m"})
     # over the realizations, each record's power as the device delivers it: max(P, 0) (at
@@ -425,9 +506,13 @@ def power_matrix(*, hs="1:3:3", te=None, tp=None, realizations: int = 3, waves: 
                  density: float = 1025.0, width=None, scatter=None, timeseries=None,
                  rated_power=None, store=None, overwrite: bool = False, workers=None,
                  scheduler=None, netcdf=None, zarr=None, csv=None, command=None,
-                 progress=None):
+                 progress=None, dofs="heave", pivot_height=None, pivot_offset=None,
+                 hull_pitch_inertia=None, barge_length=None, barge_beam=None,
+                 barge_draft=None, copper_loss=None):
     """The power matrix of a device over bins of ``Hs x Te`` (or ``Tp``); see the module
-    text and docs/performance.md. Returns ``(dataset, annual, run)``."""
+    text and docs/performance.md. Returns ``(dataset, annual, run)``. ``dofs``
+    ``"surge,heave,pitch"`` with ``device="buoy"``: a pendulum in a hull that surges, heaves
+    and pitches (``pivot_height ... copper_loss`` as :func:`parapend.buoy` takes them)."""
     from ..maps.run import run_spec
     from .annual import bin_series, read_scatter, read_series
     from .check import check_bins, check_size
@@ -472,7 +557,10 @@ def power_matrix(*, hs="1:3:3", te=None, tp=None, realizations: int = 3, waves: 
                        damping_coefficient=damping_coefficient, winding=winding,
                        harmonics=harmonics, efficiency=efficiency, torque_limit=torque_limit,
                        body=body, radius=radius, draft=draft, mesh=mesh, hydro=hydro,
-                       density=density, depth=depth)
+                       density=density, depth=depth, dofs=dofs, pivot_height=pivot_height,
+                       pivot_offset=pivot_offset, hull_pitch_inertia=hull_pitch_inertia,
+                       barge_length=barge_length, barge_beam=barge_beam,
+                       barge_draft=barge_draft, copper_loss=copper_loss)
     _check_breaking(spec.hm0, depth)
     if spec.device == "buoy":
         from .buoy_device import water_of
@@ -512,10 +600,12 @@ def power_matrix(*, hs="1:3:3", te=None, tp=None, realizations: int = 3, waves: 
     # announced once nothing is left to refuse
     if est["seconds"] is not None and est["seconds"] > _ANNOUNCE_SECONDS:
         log.info("power matrix: %d bins x %d realizations = %d solves of %g-wave records on "
-                 "%s: roughly %s (about 3 s a 50-wave solve; the progress bar gives the rate)",
+                 "%s: roughly %s (about %s; the progress bar gives the rate)",
                  est["bins"], spec.realizations, est["solves"], spec.waves,
                  f"{est['processes']} processes" if est["processes"] else "the cluster",
-                 _duration(est["seconds"]) + ("" if est["processes"] else " of one core"))
+                 _duration(est["seconds"]) + ("" if est["processes"] else " of one core"),
+                 "3 s a 50-wave solve" if spec.dofs == "heave" else
+                 "100 s a 9-wave record of the hull")
     t0 = time.monotonic()
     run = run_spec(spec, store, workers=workers, scheduler=scheduler, overwrite=overwrite,
                    command=command, progress=progress)

@@ -19,7 +19,7 @@ from ..defaults import BUOY
 from ..errors import ParameterError, check_int
 
 __all__ = ["band", "body_hydro", "check_buoy", "check_file", "file_digest", "prepare",
-           "solve_buoy_bin", "water_of", "wave_of"]
+           "refuse_for_buoy", "solve_buoy_bin", "water_of", "wave_of"]
 
 #: the per-process coefficients, keyed by the body's description in the spec
 _HYDRO: dict = {}
@@ -173,12 +173,8 @@ def _finite_grid(spec, scale: float, depth: float) -> np.ndarray:
     return full[first:]
 
 
-def check_buoy(*, response, gamma, gravity, winding, harmonics, efficiency, mass, length,
-               inertia, damping_coefficient):
-    """The options the buoy device refuses or takes in its own sense; returns the checked
-    pendulum (``parapend buoy``'s checks) and ``(winding, harmonics)``."""
-    from ..hydro.api import _pendulum
-
+def refuse_for_buoy(*, response, gamma, gravity) -> None:
+    """The prescribed device's options the buoy (and the hull) refuses, one line each."""
     if response is not None:
         raise ParameterError("response: the buoy's heave is solved, not prescribed; drop "
                              "--response with --device buoy")
@@ -188,6 +184,15 @@ def check_buoy(*, response, gamma, gravity, winding, harmonics, efficiency, mass
     if gravity != 9.81:
         raise ParameterError(f"gravity: the buoy's hydrodynamics use g = 9.81 m/s^2, got "
                              f"{gravity:g}; drop --gravity with --device buoy")
+
+
+def check_buoy(*, response, gamma, gravity, winding, harmonics, efficiency, mass, length,
+               inertia, damping_coefficient):
+    """The options the buoy device refuses or takes in its own sense; returns the checked
+    pendulum (``parapend buoy``'s checks) and ``(winding, harmonics)``."""
+    from ..hydro.api import _pendulum
+
+    refuse_for_buoy(response=response, gamma=gamma, gravity=gravity)
     if efficiency is not None:
         from .check import check_efficiency
 
@@ -234,7 +239,12 @@ def water_of(spec) -> tuple:
     (``spec.water_density``, ``spec.water_depth``) for a body solved here. A dataset's
     ``g`` must be the pendulum's 9.81 m/s^2 and its ``rho`` a water's (a rho of 1e-300
     gave a capture width of 5.6e302 m)."""
-    h, _ = body_hydro(spec)
+    if getattr(spec, "dofs", "heave") != "heave":
+        from .hull_device import hull_of
+
+        h = hull_of(spec)
+    else:
+        h, _ = body_hydro(spec)
     rho, g, depth = float(h.rho), float(h.g), float(h.water_depth)
     where = f" of {spec.hydro}" if spec.hydro is not None else ""
     if not abs(g - 9.81) <= 1e-9 * 9.81:

@@ -33,6 +33,10 @@ _SOLVE_BYTES = 128
 WORKER_BYTES = 300 << 20
 
 
+#: CPU seconds of one hull record of 9 waves (--dofs surge,heave,pitch; the default barge)
+HULL_SOLVE_SECONDS = 100.0
+
+
 #: the lowest power take-off efficiency a matrix takes: below it the motoring power p / eta
 #: of a record overflows (a subnormal eta gave NaN bins); 1e-6 is far below any machine
 MIN_EFFICIENCY = 1e-6
@@ -177,5 +181,10 @@ def check_size(spec, workers=None, scheduler=None, available=None) -> dict:
     # a rough time: a 50-wave record solves in about 3 s on one core, a 400-wave one in
     # about 9 s (measured on the shared 2-core machine): as the square root of the length
     seconds = solves * 3.0 * math.sqrt(max(1.0, spec.waves / 50.0)) / max(1, procs or 1)
+    if getattr(spec, "dofs", "heave") != "heave":
+        # the hull: a 9-wave record of the default barge took 92 to 122 s of CPU (both
+        # modes and their refinement; measured on the shared 2-core machine), roughly as
+        # its length
+        seconds = solves * HULL_SOLVE_SECONDS * spec.waves / 9.0 / max(1, procs or 1)
     return {"bins": bins, "solves": solves, "processes": procs, "memory_bytes": need,
             "seconds": seconds if math.isfinite(seconds) else None}

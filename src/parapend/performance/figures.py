@@ -226,8 +226,8 @@ def text_report(ds, out: dict, drawn: list) -> str:
     if "operating_mode" in ds:
         m = ds["operating_mode"].values
         lines.append("operating mode of the bins: " + ", ".join(
-            f"{int((m == v).sum())} {name}" for v, name in ((1, "rotation"), (0, "rest"),
-                                                            (-1, "no result"))
+            f"{int((m == v).sum())} {name}" for v, name in ((1, "rotation"), (2, "swinging"),
+                                                            (0, "rest"), (-1, "no result"))
             if (m == v).any()))
     if "operating_mode" in ds and (ds["operating_mode"].values == 0).any():
         lines.append(f"{int((ds['operating_mode'].values == 0).sum())} bins with a negative "

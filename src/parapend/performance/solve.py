@@ -26,6 +26,10 @@ def electrical_power(result, efficiency: float) -> float:
 
 
 def solve_bin(spec, i: int, j: int, r: int) -> dict:
+    if spec.device == "buoy" and spec.dofs != "heave":
+        from .hull_device import solve_hull_bin
+
+        return solve_hull_bin(spec, i, j, r)
     if spec.device == "buoy":
         from .buoy_device import solve_buoy_bin
 

@@ -33,9 +33,12 @@ QUANTITIES = {
     "one_way_power": "one-way optimum: the pendulum's reaction on the buoy left out (the "
                      "pivot moves as the free buoy), its predicted power",
 }
+#: the hull's per-realization mode (--dofs surge,heave,pitch): an int8 code, -1 not computed
+MODE_LONG_NAME = "best mode of the record: 0 rest, 1 rotation (one turn per wave), 2 swinging"
 _TITLE = "parapend design map"
 #: every top-level name a power-matrix store holds (coordinates and variables)
-STORE_NAMES = ("hm0", "te", "tp", "realization", "seed", "done", "status", *QUANTITIES)
+STORE_NAMES = ("hm0", "te", "tp", "realization", "seed", "done", "status", "mode",
+               *QUANTITIES)
 #: devices a matrix can be computed for
 DEVICES = ("prescribed-heave", "buoy")
 #: the spec's fields only the buoy uses (left out of a prescribed-heave spec's JSON)
@@ -44,6 +47,11 @@ _BUOY_FIELDS = ("body", "radius", "draft", "mesh", "hydro", "digest", "damping_c
 #: the buoy's water when nothing else is given (1025 kg/m^3, deep): left out of the JSON, so
 #: that a store written before the body took the matrix's water still resumes
 _DEFAULT_WATER = {"water_density": 1025.0, "water_depth": None}
+#: the hull's fields (--dofs surge,heave,pitch) at their defaults, the heaving buoy's: left
+#: out of the JSON, so that a store written before the hull came still resumes
+_DEFAULT_HULL = {"dofs": "heave", "pivot_height": None, "pivot_offset": None,
+                 "hull_pitch_inertia": None, "barge_length": None, "barge_beam": None,
+                 "barge_draft": None, "copper_loss": None, "torque_limit": None}
 
 
 @dataclasses.dataclass(frozen=True)
@@ -86,6 +94,18 @@ class MatrixSpec:
     # (--density, --depth), so the flux and the body see one sea
     water_density: float = 1025.0
     water_depth: float | None = None
+    # the hull that surges, heaves and pitches (dofs "surge,heave,pitch"): the pivot (m),
+    # the hull's pitch inertia (kg m^2), the barge (m), the take-off's copper loss
+    # (W/(N m)^2) and torque limit (N m), as parapend buoy takes them (hydro/hull_api.py)
+    dofs: str = "heave"
+    pivot_height: float | None = None
+    pivot_offset: float | None = None
+    hull_pitch_inertia: float | None = None
+    barge_length: float | None = None
+    barge_beam: float | None = None
+    barge_draft: float | None = None
+    copper_loss: float | None = None
+    torque_limit: float | None = None
 
     kind = "power_matrix"
     pto = False
@@ -121,10 +141,17 @@ class MatrixSpec:
                 slice(0, self.realizations))
 
     @property
+    def lossy(self) -> bool:
+        """A take-off with losses (an efficiency, or the hull's copper loss): the store holds
+        the electrical power beside the mechanical one."""
+        return self.efficiency is not None or self.copper_loss is not None
+
+    @property
     def variables(self) -> tuple:
         if self.device == "buoy":
-            e = ("electrical_power",) if self.efficiency is not None else ()
-            return ("power", "radiation_bound_power", "one_way_power", *e, "status")
+            e = ("electrical_power",) if self.lossy else ()
+            m = ("mode",) if self.dofs != "heave" else ()
+            return ("power", "radiation_bound_power", "one_way_power", *e, *m, "status")
         out = ["power", "limit_power", "uniform_power"]
         if self.efficiency is not None:
             out.append("electrical_power")
@@ -150,6 +177,9 @@ class MatrixSpec:
             for k, v in _DEFAULT_WATER.items():
                 if d[k] == v:
                     d.pop(k)
+        for k, v in _DEFAULT_HULL.items():
+            if d[k] == v:
+                d.pop(k)
         return json.dumps(d, sort_keys=True)
 
     @classmethod
@@ -201,6 +231,12 @@ class MatrixSpec:
             if v == "done":
                 arr, fill = da.zeros(self.shape, dtype=bool, chunks=self.chunks), False
                 attrs = {"long_name": "bin finished (written after the bin's data)"}
+            elif v == "mode":
+                arr = da.full(self.shape, -1, dtype=np.int8, chunks=self.chunks)
+                fill = -1
+                attrs = {"long_name": MODE_LONG_NAME, "flag_values": [0, 1, 2],
+                         "flag_meanings": "rest rotation swinging",
+                         "comment": "-1: not computed"}
             elif v == "status":
                 arr = da.full(self.shape, -1, dtype=np.int8, chunks=self.chunks)
                 fill = -1
@@ -255,7 +291,7 @@ class MatrixSpec:
         from .solve import solve_bin, verdict
 
         i, j, _ = (s.start for s in self.block_slices(block))
-        out = {v: (np.full(self.chunks, -1, dtype=np.int8) if v == "status"
+        out = {v: (np.full(self.chunks, -1, dtype=np.int8) if v in ("status", "mode")
                    else np.full(self.chunks, np.nan)) for v in self.variables}
         for r in range(self.realizations):
             try:

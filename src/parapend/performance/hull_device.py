@@ -1,0 +1,174 @@
+"""The pendulum in a hull that surges, heaves and pitches as a power-matrix device
+(``--device buoy --dofs surge,heave,pitch``): the hull checked and built as ``parapend buoy
+--dofs surge,heave,pitch`` builds it (:func:`parapend.hydro.hull_api.hull_problem`, once per
+process), every bin's record checked before any bin runs, and one bin's realization solved
+as ``parapend buoy --dofs surge,heave,pitch --hs --tp --repeat-period --seed`` solves it
+(:func:`parapend.hydro.hull_api.solve_record`).
+
+The record of bin ``(i, j)``, realization ``r`` is the heave buoy's (:func:`.buoy_device.wave_of`).
+Per realization the store keeps the best of rotation (one turn per wave), swinging and rest
+(``power``, never below zero; ``mode``), the radiation bound, the one-way power and, with a
+lossy take-off (``efficiency`` or ``copper_loss``), the electrical power; all in W.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+
+from ..errors import ParameterError
+
+__all__ = ["MODES", "check_records", "hull_of", "hull_opts", "problem", "solve_hull_bin"]
+
+#: the per-realization ``mode`` codes (-1: not computed)
+MODES = ("rest", "rotation", "swinging")
+#: the per-process hull problems, keyed by the spec's hull
+_PROBLEMS: dict = {}
+#: the hull options of the spec (besides the pendulum's)
+HULL_FIELDS = ("pivot_height", "pivot_offset", "hull_pitch_inertia", "barge_length",
+               "barge_beam", "barge_draft", "copper_loss", "torque_limit")
+
+
+def hull_opts(spec) -> dict:
+    """``parapend.buoy``'s keyword arguments for the spec's hull and pendulum (no wave)."""
+    opts = {k: getattr(spec, k) for k in HULL_FIELDS}
+    opts.update(mass=spec.mass, length=spec.length, inertia=spec.inertia,
+                damping_coefficient=spec.damping_coefficient, body=spec.body,
+                radius=spec.radius, draft=spec.draft, mesh=spec.mesh, hydro=spec.hydro,
+                harmonics=spec.harmonics, efficiency=spec.efficiency, winding=None)
+    if opts["mesh"] is not None or opts["hydro"] is not None:
+        opts["body"] = None
+    return opts
+
+
+def _key(spec) -> str:
+    return repr((sorted(hull_opts(spec).items()), spec.digest))
+
+
+def problem(spec) -> dict:
+    """The spec's hull problem (:func:`parapend.hydro.hull_api.hull_problem`): the checks
+    and the hull's coefficients (BEM cached on disk), built once per process."""
+    key = _key(spec)
+    if key not in _PROBLEMS:
+        from ..hydro.hull_api import hull_problem
+
+        _PROBLEMS[key] = hull_problem(**hull_opts(spec))
+    return _PROBLEMS[key]
+
+
+def hull_of(spec):
+    """The spec's :class:`~parapend.hydro.hull_data.HullHydro`."""
+    return problem(spec)["hull"]
+
+
+def resolve(spec, user: dict):
+    """The spec with the hull's defaults filled in as the hull's code resolved them (the
+    pendulum, the pivot, the barge), so that the store's identity is the hull solved:
+    ``user`` the options as given. Builds the hull (its BEM) after its checks."""
+    p = problem(dataclasses.replace(spec, **user))
+    pend, geo = p["pendulum"], p["geometry"] or {}
+    barge = geo.get("body") == "barge"
+    resolved = dict(
+        body=geo.get("body", user.get("body")),
+        mass=float(pend.mass), length=float(pend.length), inertia=float(pend.inertia),
+        damping_coefficient=float(pend.damping_coefficient),
+        pivot_offset=float(p["pivot"][0]), pivot_height=float(p["pivot"][1]),
+        barge_length=float(geo["length_m"]) if barge else None,
+        barge_beam=float(geo["beam_m"]) if barge else None,
+        barge_draft=float(geo["draft_m"]) if barge else None,
+        # the width facing the waves (they travel along the barge's length)
+        width=(float(geo["beam_m"]) if barge else 2 * float(geo["radius_m"])
+               if "radius_m" in geo else None))
+    out = dataclasses.replace(spec, **{**user, **resolved})
+    _PROBLEMS[_key(out)] = p  # the same problem: not built again in this process
+    return out
+
+
+def _fits(spec, waves: float) -> bool:
+    """Whether every period bin's record of ``waves`` peak periods fits the hull's size."""
+    from ..hydro.hull_api import solve_record
+    from .buoy_device import wave_of
+
+    s = dataclasses.replace(spec, waves=float(waves))
+    p = problem(spec)
+    try:
+        for j in range(len(spec.period)):
+            solve_record(p, wave_of(s, 0, j, 0)[0], None, check_only=True)
+    except ParameterError as err:
+        return not str(err).startswith("repeat-period:")
+    return True
+
+
+def largest_waves(spec) -> float | None:
+    """The largest ``waves`` (to 0.01 peak period) whose records fit every period bin (None
+    where not even the shortest does)."""
+    from .. import limits
+
+    lo = limits.SEA_WAVES_RANGE[0]
+    if not _fits(spec, lo):
+        return None
+    hi = spec.waves
+    while hi - lo > 0.002:
+        mid = 0.5 * (lo + hi)
+        lo, hi = (mid, hi) if _fits(spec, mid) else (lo, mid)
+    best = math.floor(lo * 100) / 100
+    while _fits(spec, round(best + 0.01, 2)):  # the bisection's last step, to the 0.01
+        best = round(best + 0.01, 2)
+    return best
+
+
+def check_records(spec) -> None:
+    """Every period bin's record checked as the hull's code checks it (its size: the harmonics
+    it needs, at most ``limits.HULL_MAX_HARMONICS``; its band inside the hull's data), before
+    any bin runs; refused in one line naming ``--waves`` (and the largest that fits) or the
+    period bin. The records of one period bin differ in Hm0 and seed only: the same band
+    and, with the amplitudes' shape unchanged, the same size."""
+    from .. import limits
+    from ..hydro.hull_api import solve_record
+    from ..hydro.hull_optimum import HARMONICS_PER_TURN
+    from .buoy_device import wave_of
+
+    p = problem(spec)
+    pk = spec.period_kind
+    for j, per in enumerate(spec.period):
+        try:
+            solve_record(p, wave_of(spec, 0, j, 0)[0], None, check_only=True)
+        except ParameterError as err:
+            head, _, rest = str(err).partition(": ")
+            if head == "repeat-period":
+                most = largest_waves(spec)
+                cap = limits.HULL_MAX_HARMONICS
+                fit = ("no record fits" if most is None
+                       else f"at most {most:g} peak periods fit")
+                raise ParameterError(
+                    f"waves: with --dofs surge,heave,pitch a record is solved with at most "
+                    f"{cap} harmonics ({HARMONICS_PER_TURN} per wave, about "
+                    f"{cap // HARMONICS_PER_TURN} waves): {fit}, got {spec.waves:g}") from None
+            raise ParameterError(f"{pk}: the record of the bin {per:g} s: {rest}") from None
+
+
+def solve_hull_bin(spec, i: int, j: int, r: int) -> dict:
+    """The hull's answer to one record: the best mode's power (never below zero), its mode,
+    the radiation bound, the one-way power, the mechanical power of a lossy take-off."""
+    from ..hydro.hull_api import solve_record
+    from ..maps.spec import _CODE
+    from .buoy_device import wave_of
+
+    wave, info = wave_of(spec, i, j, r)
+    res = solve_record(problem(spec), wave, info)
+    p = float(res.power_w)
+    out = {"power": p}
+    if spec.lossy:
+        # the store keeps the mechanical power as "power" (the heave buoy's layout; the
+        # Dataset shows the electrical one as power)
+        out = {"power": float(res.mechanical_power_w), "electrical_power": p}
+    if res.success:
+        status = "no_power" if res.mode == "rest" else "converged"
+    else:
+        bad = [m for m in res.modes if not m["success"]]
+        head = str(bad[0]["status"]).split(";")[0].strip() if bad else ""
+        status = head if head in _CODE and head not in ("converged", "no_power") else "other"
+    owp = res.one_way_power_w
+    return {**out, "radiation_bound_power": float(res.radiation_bound_w),
+            "one_way_power": math.nan if owp is None else float(owp),
+            "mode": MODES.index(res.mode), "status": status}

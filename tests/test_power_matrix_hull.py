@@ -1,0 +1,290 @@
+"""``parapend power-matrix --device buoy --dofs surge,heave,pitch``: each bin's record solved
+as ``parapend buoy --dofs surge,heave,pitch --hs --tp --repeat-period --seed`` solves it
+(checked against ``parapend.buoy`` run by hand, slow), the store's layout and the annual
+energy's invariant (fast: the hull's solve replaced by a stand-in, everything else real),
+every refusal in one line before any bin runs, and ``--dofs heave`` unchanged.
+
+The hull is the synthetic one of tests/test_hull_cli.py, as a ``--hydro`` dataset."""
+
+from __future__ import annotations
+
+import json
+import math
+from types import SimpleNamespace
+
+import numpy as np
+import pytest
+from hull_timedomain import RHO_V, synthetic_hull
+
+import parapend
+from parapend.cli import main
+from parapend.errors import ParameterError
+from parapend.hydro import hull_api
+from parapend.hydro.hull_data import HullHydro
+from parapend.performance import HOURS_PER_YEAR, matrix_spec, power_matrix
+from parapend.performance.resource import repeat_period
+from parapend.performance.spec import MatrixSpec
+
+PEND = {"mass": 4000.0, "length": 1.0, "inertia": 5000.0, "damping_coefficient": 50.0,
+        "pivot_height": 1.5, "pivot_offset": 1.0}
+HULL = {"device": "buoy", "dofs": "surge,heave,pitch", **PEND}
+BINS = {"hs": "1,2", "tp": "5,6", "waves": 2.0, "seed": 3}
+
+
+def _save(path, **kw):
+    from capytaine.io.xarray import save_dataset_as_netcdf
+
+    h = synthetic_hull(**kw)
+    hull = HullHydro(omega=h["omega_data"], added_mass=h["A"], radiation_damping=h["B"],
+                     excitation=h["F"], hydrostatic_stiffness=h["C"], mass=RHO_V,
+                     pitch_inertia=float(h["Mh"][2, 2]), description="synthetic hull")
+    save_dataset_as_netcdf(path, hull.to_dataset())
+    return str(path)
+
+
+@pytest.fixture(scope="module")
+def dataset(tmp_path_factory):
+    return _save(tmp_path_factory.mktemp("hull") / "hull.nc")
+
+
+@pytest.fixture(scope="module")
+def scatter(tmp_path_factory):
+    """A site over the 2 x 2 bins (shares summing to 1)."""
+    path = tmp_path_factory.mktemp("site") / "scatter.csv"
+    rows = [(1, 5, 0.4), (1, 6, 0.3), (2, 5, 0.2), (2, 6, 0.1)]
+    path.write_text("hs,tp,frequency\n" + "".join(f"{h},{t},{f}\n" for h, t, f in rows))
+    return str(path), {(h, t): f for h, t, f in rows}
+
+
+# -- the stand-in for the hull's solve (fast tests) --------------------------------------------
+
+def _stand_in(real):
+    """``solve_record`` with the checks real and the solve replaced: the power a function
+    of the record (its sum |a_k|^2, so bins and seeds differ), rest below a threshold,
+    swinging for the longer records."""
+
+    def fake(problem, wave, info, *, check_only=False):
+        if check_only:
+            return real(problem, wave, info, check_only=True)
+        e = float(np.sum(np.abs(np.asarray(wave.amplitudes)) ** 2))
+        long = 2 * math.pi / wave.omega > 11.0
+        mode = "rest" if e < 0.5 else "swinging" if long else "rotation"
+        p = 0.0 if mode == "rest" else 1e4 * e
+        loss = 0.9 if problem["pto"].copper_loss else 1.0
+        return SimpleNamespace(power_w=loss * p, mechanical_power_w=p, mode=mode,
+                               success=True, modes=[], radiation_bound_w=1e5 * e,
+                               one_way_power_w=None if mode == "rest" else 2e4 * e)
+    return fake
+
+
+@pytest.fixture
+def stand_in(monkeypatch):
+    monkeypatch.setattr(hull_api, "solve_record", _stand_in(hull_api.solve_record))
+
+
+def _energy(spec, i, j, r):
+    from parapend.performance.buoy_device import wave_of
+
+    wave, _ = wave_of(spec, i, j, r)
+    return float(np.sum(np.abs(np.asarray(wave.amplitudes)) ** 2))
+
+
+def test_the_store_holds_each_records_answer_and_the_aep_invariant(dataset, scatter,
+                                                                   stand_in):
+    """Per realization: the best mode's power (0 at rest), its mode, the bound, the one-way
+    power (NaN at rest); the power matrix max(mean, 0); the annual energy is 8766 h x
+    sum(P f) over the site's bins, summed here independently."""
+    path, freq = scatter
+    ds, annual, _, _ = power_matrix(**BINS, realizations=2, hydro=dataset, scatter=path,
+                                    workers=1, **HULL)
+    spec = MatrixSpec.from_json(ds.attrs["sweep"])
+    assert spec.dofs == "surge,heave,pitch" and spec.pivot_height == 1.5
+    modes = {"rest": 0, "rotation": 1, "swinging": 2}
+    seen = set()
+    for i in range(2):
+        for j in range(2):
+            for r in range(2):
+                e = _energy(spec, i, j, r)
+                mode = "rest" if e < 0.5 else "swinging" if j == 1 else "rotation"
+                seen.add(mode)
+                p = 0.0 if mode == "rest" else 1e4 * e
+                assert ds["power"].values[i, j, r] == p
+                assert ds["mode"].values[i, j, r] == modes[mode]
+                assert ds["radiation_bound_power"].values[i, j, r] == 1e5 * e
+                ow = ds["one_way_power"].values[i, j, r]
+                assert (math.isnan(ow) if mode == "rest" else ow == 2e4 * e)
+                assert ds["status"].values[i, j, r] == (1 if mode == "rest" else 0)
+    assert seen == {"rest", "rotation", "swinging"}
+    pm = ds["power_matrix"].values
+    assert np.array_equal(pm, np.maximum(ds["power"].values.mean(axis=-1), 0.0))
+    assert (ds["operating_mode"].values == np.where(pm > 0, [[1, 2], [1, 2]], 0)).all()
+    want = HOURS_PER_YEAR * sum(pm[i, j] * freq[(h, t)] for i, h in enumerate((1, 2))
+                                for j, t in enumerate((5, 6)))
+    assert annual["power"]["wh"] == pytest.approx(want, rel=1e-12)
+    assert annual["power"]["complete"]
+
+
+def test_a_lossy_take_off_shows_the_electrical_power(dataset, stand_in, tmp_path):
+    """With a copper loss (or an efficiency) the Dataset's power is the hull's power_w (the
+    electrical one) and mechanical_power its motion's, as for the heave buoy; the store
+    resumes to the same numbers and modes."""
+    store = str(tmp_path / "m.zarr")
+    ds, _, run, _ = power_matrix(**BINS, realizations=1, hydro=dataset, workers=1,
+                                 copper_loss=1e-6, store=store, **HULL)
+    p, m = ds["power"].values, ds["mechanical_power"].values
+    assert np.array_equal(p, 0.9 * m) and (m > 0).any()
+    assert ds["mode"].dtype == np.int8
+    again, _, run2, _ = power_matrix(**BINS, realizations=1, hydro=dataset, workers=1,
+                                     copper_loss=1e-6, store=store, **HULL)
+    assert run.computed_points == 4 and run2.resumed_points == 4
+    for v in ("power", "mechanical_power", "mode", "status", "radiation_bound_power"):
+        assert np.array_equal(again[v].values, ds[v].values, equal_nan=True), v
+
+
+def test_the_command_line_reports_the_modes(dataset, capsys, stand_in):
+    """The command line's JSON names each bin's mode (swinging included) and its text
+    report counts them."""
+    args = ["power-matrix", "--device", "buoy", "--dofs", "surge,heave,pitch", "--hydro",
+            dataset, "--hs", "1,2", "--tp", "5,6", "--waves", "2", "--realizations", "1",
+            "--workers", "1", *(x for k, v in PEND.items()
+                                for x in (f"--{k.replace('_', '-')}", repr(v)))]
+    assert main([*args, "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert out["operating_mode"] == [["rest", "rest"], ["rotation", "swinging"]]
+    assert main(args) == 0
+    text = capsys.readouterr().out
+    assert "1 rotation, 1 swinging, 2 rest" in text
+
+
+def test_dofs_heave_keeps_the_store_identity():
+    """The new fields at their defaults are left out of the store's identity, so a store
+    written before them still resumes; a hull's spec round-trips through the JSON."""
+    spec = matrix_spec(hs="1,2", te="6,7", realizations=1)
+    d = json.loads(spec.to_json())
+    for k in ("dofs", "pivot_height", "pivot_offset", "hull_pitch_inertia", "barge_length",
+              "barge_beam", "barge_draft", "copper_loss", "torque_limit"):
+        assert k not in d
+    assert spec == matrix_spec(hs="1,2", te="6,7", realizations=1, dofs="heave")
+    assert MatrixSpec.from_json(spec.to_json()) == spec
+    assert spec.variables == ("power", "limit_power", "uniform_power", "status")
+
+
+def test_the_hull_spec_round_trips(dataset):
+    spec = matrix_spec(**BINS, realizations=1, hydro=dataset, **HULL)
+    assert MatrixSpec.from_json(spec.to_json()) == spec
+    assert spec.variables == ("power", "radiation_bound_power", "one_way_power", "mode",
+                              "status")
+
+
+def test_the_take_off_reaches_the_hull(dataset):
+    """--efficiency, --torque-limit and --copper-loss reach the hull's take-off (HullPTO) as
+    parapend.buoy builds it, and enter the store's identity."""
+    from parapend.hydro.hull_api import _pto
+    from parapend.performance.hull_device import problem
+
+    kw = {"efficiency": 0.9, "torque_limit": 2e4, "copper_loss": 1e-6}
+    spec = matrix_spec(**BINS, realizations=1, hydro=dataset, **HULL, **kw)
+    assert problem(spec)["pto"] == _pto(kw)
+    d = json.loads(spec.to_json())
+    assert (d["efficiency"], d["torque_limit"], d["copper_loss"]) == (0.9, 2e4, 1e-6)
+    assert spec.variables[3] == "electrical_power"
+
+
+def test_the_longest_record_is_the_hulls_limit(dataset):
+    """The default 50 waves are refused naming --waves and the largest that fits; that
+    largest fits the hull's own size check (12 harmonics per wave, at most 128), 0.01 more
+    does not."""
+    from parapend import limits
+    from parapend.hydro.hull_optimum import HARMONICS_PER_TURN, waves_in
+    from parapend.performance.buoy_device import wave_of
+
+    with pytest.raises(ParameterError, match=r"^waves: .*at most ([0-9.]+) peak periods "
+                                             r"fit, got 50$") as err:
+        matrix_spec(hs="1,2", tp="5,6", realizations=1, hydro=dataset, **HULL)
+    most = float(str(err.value).split("at most ")[-1].split(" peak")[0])
+    spec = matrix_spec(**{**BINS, "waves": most}, realizations=1, hydro=dataset, **HULL)
+
+    def size(waves):
+        import dataclasses
+
+        s = dataclasses.replace(spec, waves=waves)
+        return max(HARMONICS_PER_TURN * waves_in(wave_of(s, 0, j, 0)[0]) for j in range(2))
+    assert size(most) <= limits.HULL_MAX_HARMONICS < size(most + 0.01)
+
+
+@pytest.mark.parametrize("kw, match", [
+    ({"device": "prescribed-heave", "dofs": "surge,heave,pitch"}, r"^dofs: .*--device buoy"),
+    ({"device": "buoy", "pivot_height": 1.0}, r"^pivot-height: a hull's option"),
+    ({"device": "buoy", "copper_loss": 1.0}, r"^copper-loss: a hull's option"),
+    ({"device": "buoy", "barge_length": 9.0}, r"^barge-length: a hull's option"),
+    ({"device": "buoy", "torque_limit": 1.0}, r"^torque-limit: not supported"),
+    ({**HULL, "winding": 2}, r"^winding: "),
+    ({**HULL, "density": 1000.0, "hydro": None}, r"^density: the hull's BEM"),
+    ({**HULL, "depth": 50.0, "hydro": None}, r"^depth: the hull's BEM"),
+    ({**HULL, "response": "x.csv"}, r"^response: "),
+    ({**HULL, "pivot_offset": 50.0, "hydro": None}, r"^pivot-offset: the pivot must lie"),
+    ({**HULL, "body": "barge", "radius": 1.0, "hydro": None}, r"^radius: "),
+    ({**HULL, "harmonics": 500}, r"^harmonics: "),
+    ({**HULL, "dofs": "surge,heave"}, r"^dofs: "),
+    ({"device": "buoy", "body": "barge"}, r"^body: the barge is a hull that pitches"),
+])
+def test_refusals_in_one_line(kw, match, dataset):
+    kw = {"hydro": dataset, **kw}
+    if kw.get("device") != "buoy" or "dofs" not in kw:
+        kw.pop("hydro")
+    with pytest.raises(ParameterError, match=match) as err:
+        matrix_spec(**BINS, realizations=1, **kw)
+    assert "\n" not in str(err.value)
+
+
+def test_a_bin_outside_the_hulls_data_is_refused(tmp_path):
+    """Every period bin's record checked before any bin runs: the longest lies below the
+    dataset's lowest frequency, refused naming tp and the bin."""
+    path = _save(tmp_path / "narrow.nc", n=60, w_min=1.2)
+    with pytest.raises(ParameterError, match=r"^tp: the record of the bin 6 s: "):
+        matrix_spec(**BINS, realizations=1, hydro=path, **HULL)
+
+
+def test_the_command_line_refuses_in_one_line(dataset, capsys):
+    assert main(["power-matrix", "--dofs", "surge,heave,pitch", "--hs", "1,2", "--tp",
+                 "5,6"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err.count("\n") == 0 and "dofs" in err and "Traceback" not in err
+    assert main(["power-matrix", "--device", "buoy", "--dofs", "surge,heave,pitch", "--hydro",
+                 dataset, "--hs", "1,2", "--tp", "5,6"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err.count("\n") == 0 and "waves" in err
+
+
+@pytest.mark.slow
+def test_each_bin_is_parapend_buoy_by_hand(dataset, scatter, capsys, tmp_path):
+    """The command line's matrix (2 x 2 bins, one realization of 2-wave records): each bin's
+    power, mode and radiation bound equal ``parapend.buoy(dofs="surge,heave,pitch", ...)``
+    on that bin's record, run by hand, to 1e-9; the annual energy 8766 h x sum(P f)."""
+    path, freq = scatter
+    nc = str(tmp_path / "m.nc")
+    args = ["power-matrix", "--device", "buoy", "--dofs", "surge,heave,pitch", "--hydro",
+            dataset, "--hs", "1,2", "--tp", "5,6", "--waves", "2", "--seed", "3",
+            "--realizations", "1", "--workers", "1", "--scatter", path, "--netcdf", nc,
+            "--json", *(x for k, v in PEND.items()
+                        for x in (f"--{k.replace('_', '-')}", repr(v)))]
+    assert main(args) == 0
+    out = json.loads(capsys.readouterr().out)
+    import xarray as xr
+
+    ds = xr.load_dataset(nc)
+    pm = np.array(out["power_matrix"])
+    for i, h in enumerate((1.0, 2.0)):
+        for j, t in enumerate((5.0, 6.0)):
+            r = parapend.buoy(dofs="surge,heave,pitch", hydro=dataset, hs=h, tp=t,
+                              repeat_period=repeat_period(2.0, t), seed=3, **PEND)
+            assert r.success
+            assert ds["power"].values[i, j, 0] == pytest.approx(r.power_w, rel=1e-9)
+            assert pm[i, j] == pytest.approx(max(r.power_w, 0.0), rel=1e-9)
+            assert ds["radiation_bound_power"].values[i, j, 0] == pytest.approx(
+                r.radiation_bound_w, rel=1e-9)
+            assert ds["mode"].values[i, j, 0] == ("rest", "rotation",
+                                                  "swinging").index(r.mode)
+    want = HOURS_PER_YEAR * sum(pm[i, j] * freq[(h, t)] for i, h in enumerate((1, 2))
+                                for j, t in enumerate((5, 6)))
+    assert out["annual_energy"]["power"]["wh"] == pytest.approx(want, rel=1e-12)
