@@ -71,6 +71,7 @@ def test_limit_motion_power_equals_total_variation_formula():
         assert limit_motion_power(lim.motion, exc) == pytest.approx(lim.power, abs=1e-14)
 
 
+@pytest.mark.slow  # about 2-6 s: the default set stays under 5 minutes
 def test_peak_torque_against_dense_sampling_and_the_bvp(paper):
     """Peak |T| (printed by the CLI): equals a 200k-point pointwise maximum, and the Fourier
     and BVP optima (two methods, same problem) need the same peak torque."""

@@ -147,6 +147,7 @@ def _cross_check(gamma, kw):
     assert r.electrical_power == pytest.approx(c["electrical_power"], abs=1e-4)
 
 
+@pytest.mark.slow  # about 2-6 s: the default set stays under 5 minutes
 @pytest.mark.parametrize("gamma,kw", CASES)
 def test_casadi_cross_check(gamma, kw):
     _cross_check(gamma, kw)

@@ -250,6 +250,7 @@ def test_reproduce_is_deterministic_fast(tmp_path, monkeypatch):
     assert a == b
 
 
+@pytest.mark.slow  # about 2-6 s: the default set stays under 5 minutes
 @pytest.mark.parametrize("exc", [KeyboardInterrupt, RuntimeError("solver blew up"),
                                  OSError(28, "No space left on device")])
 def test_failed_run_leaves_the_old_report_and_no_staging(tmp_path, monkeypatch, exc):
@@ -265,6 +266,7 @@ def test_failed_run_leaves_the_old_report_and_no_staging(tmp_path, monkeypatch, 
     assert _snapshot(out) == before and _hidden(tmp_path) == []
 
 
+@pytest.mark.slow  # about 2-6 s: the default set stays under 5 minutes
 def test_failed_swap_restores_the_old_report(tmp_path, monkeypatch):
     _fake_paper(monkeypatch)
     out = tmp_path / "rep"

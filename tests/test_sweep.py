@@ -715,6 +715,7 @@ def test_a_foreign_directory_is_never_deleted(reference, tmp_path, capsys, monke
     assert sw.sweep(tmp_path / "empty", omega="1.8,1.9", workers=1).computed_points == 2
 
 
+@pytest.mark.slow  # about 2-6 s: the default set stays under 5 minutes
 @pytest.mark.skipif(sys.platform == "win32", reason="kill -9")
 def test_kill_9_during_creation_leaves_nothing_behind(reference, tmp_path, capsys):
     """kill -9 while the store is created (after its first two arrays are moved in): the
@@ -1028,6 +1029,7 @@ def test_ctrl_c_with_local_processes_is_one_line(tmp_path):
     sw.open_sweep(tmp_path / "m.zarr")  # verified: no damage
 
 
+@pytest.mark.slow  # about 2-6 s: the default set stays under 5 minutes
 def test_bad_scheduler_address_is_one_line(tmp_path):
     """`--scheduler garbage` printed its line, then a TimeoutError traceback 20 s later
     (the half-made Client's destructor): now one line, exit 2, nothing created."""

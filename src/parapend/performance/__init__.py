@@ -568,7 +568,12 @@ def power_matrix(*, hs="1:3:3", te=None, tp=None, realizations: int = 3, waves: 
         # the flux of the water the body was solved in (the matrix's --density and
         # --depth, or a --hydro dataset's own rho and depth), never another: the capture
         # widths would be off by the ratio. Options that contradict the dataset: refused
-        rho, h = water_of(spec)
+        body = None
+        if spec.dofs != "heave":
+            from .hull_device import hull_of
+
+            body = hull_of(spec)
+        rho, h = water_of(spec, body)
         if spec.hydro is not None:
             if density != 1025.0 and not math.isclose(density, rho, rel_tol=1e-9):
                 raise ParameterError(f"density: the dataset {spec.hydro} was solved at rho = "

@@ -233,18 +233,14 @@ def prepare(spec):
     return width
 
 
-def water_of(spec) -> tuple:
+def water_of(spec, body=None) -> tuple:
     """``(density, depth)`` of the water the body was solved in (``depth`` None: deep), for
     the waves' energy flux: a ``--hydro`` dataset's own ``rho`` and depth, the matrix's
     (``spec.water_density``, ``spec.water_depth``) for a body solved here. A dataset's
     ``g`` must be the pendulum's 9.81 m/s^2 and its ``rho`` a water's (a rho of 1e-300
-    gave a capture width of 5.6e302 m)."""
-    if getattr(spec, "dofs", "heave") != "heave":
-        from .hull_device import hull_of
-
-        h = hull_of(spec)
-    else:
-        h, _ = body_hydro(spec)
+    gave a capture width of 5.6e302 m). ``body``: the coefficients when the caller holds
+    them (the hull's, :func:`.hull_device.hull_of`), else the body's of ``spec``."""
+    h = body if body is not None else body_hydro(spec)[0]
     rho, g, depth = float(h.rho), float(h.g), float(h.water_depth)
     where = f" of {spec.hydro}" if spec.hydro is not None else ""
     if not abs(g - 9.81) <= 1e-9 * 9.81:
