@@ -77,6 +77,27 @@ def _finite_float(name):
     return conv
 
 
+
+def hull_options(g) -> None:
+    """The hull's placement options (``buoy`` and ``power-matrix`` with ``--dofs
+    surge,heave,pitch``): the pivot, the hull's pitch inertia, the barge's size."""
+    from ..defaults import HULL
+
+    g.add_argument("--pivot-height", type=_finite_float("pivot-height"),
+                   help=f"the pivot above the hull's rotation centre (its waterplane "
+                        f"centre), m (default {HULL['pivot_height']:g})")
+    g.add_argument("--pivot-offset", type=_finite_float("pivot-offset"),
+                   help=f"the pivot ahead of it, along the waves' travel, m (default "
+                        f"{HULL['pivot_offset']:g})")
+    g.add_argument("--hull-pitch-inertia", type=_finite_float("hull-pitch-inertia"),
+                   help="the hull's pitch inertia about the rotation centre, without the "
+                        "pendulum, kg m^2 (default: the dataset's, else a homogeneous "
+                        "immersed hull's)")
+    for name, key in (("length", "barge_length"), ("beam", "barge_beam"),
+                      ("draft", "barge_draft")):
+        g.add_argument(f"--barge-{name}", type=_finite_float(f"barge-{name}"),
+                       help=f"the box barge's {name}, m (default {HULL[key]:g})")
+
 def _int(text):
     t = text.strip()
     if len(t) > 30:  # int() of a thousand-digit string is slow and never a valid count

@@ -8,7 +8,7 @@ from pathlib import Path
 from ..defaults import BUOY
 from ..errors import ParameterError
 from . import _output
-from ._common import _check_output, _finite_float, _fmt, _int, _Progress, _run, _table
+from ._common import _check_output, _finite_float, _fmt, _int, _Progress, _run, _table, hull_options
 
 
 def _text(name):
@@ -75,27 +75,13 @@ def add_parsers(sub) -> None:
     g.add_argument("--wave-direction", type=_finite_float("wave-direction"),
                    metavar="RAD", help="with --hydro: the dataset's wave direction to use, rad "
                                        "(default 0, waves travelling along +x)")
-    from ..defaults import HULL
 
     g = p.add_argument_group("hull: surge, heave and pitch (docs/hull.md)")
     g.add_argument("--dofs", metavar="DOFS",
                    help="the hull's degrees of freedom: heave (default, the heaving buoy) "
                         "or surge,heave,pitch (a hull that pitches; the pendulum rotates or "
                         "swings)")
-    g.add_argument("--pivot-height", type=_finite_float("pivot-height"),
-                   help=f"the pivot above the hull's rotation centre (its waterplane "
-                        f"centre), m (default {HULL['pivot_height']:g})")
-    g.add_argument("--pivot-offset", type=_finite_float("pivot-offset"),
-                   help=f"the pivot ahead of it, along the waves' travel, m (default "
-                        f"{HULL['pivot_offset']:g})")
-    g.add_argument("--hull-pitch-inertia", type=_finite_float("hull-pitch-inertia"),
-                   help="the hull's pitch inertia about the rotation centre, "
-                                      "without the pendulum, kg m^2 (default: the dataset's, "
-                                      "else a homogeneous immersed hull's)")
-    for name, key in (("length", "barge_length"), ("beam", "barge_beam"),
-                      ("draft", "barge_draft")):
-        g.add_argument(f"--barge-{name}", type=_finite_float(f"barge-{name}"),
-                       help=f"the box barge's {name}, m (default {HULL[key]:g})")
+    hull_options(g)
     g = p.add_argument_group("motion and power take-off")
     g.add_argument("--winding", type=_int,
                    help="turns per wave (per record in an irregular sea) (default 1; with "

@@ -15,6 +15,7 @@ from ._common import (
     _int,
     _run,
     add_body_options,
+    hull_options,
 )
 from .sweep import _NEGATIVE_VALUE, _EtaProgress
 
@@ -102,20 +103,7 @@ def add_parsers(sub) -> None:
                         f"{HULL['mass']:g} kg, {HULL['length']:g} m, "
                         f"{HULL['damping_coefficient']:g} N m s/rad; records of at most "
                         "about 10 waves: give --waves) (default heave)")
-    g.add_argument("--pivot-height", type=_finite_float("pivot-height"),
-                   help=f"the pivot above the hull's rotation centre (its waterplane "
-                        f"centre), m (default {HULL['pivot_height']:g})")
-    g.add_argument("--pivot-offset", type=_finite_float("pivot-offset"),
-                   help=f"the pivot ahead of it, along the waves' travel, m (default "
-                        f"{HULL['pivot_offset']:g})")
-    g.add_argument("--hull-pitch-inertia", type=_finite_float("hull-pitch-inertia"),
-                   help="the hull's pitch inertia about the rotation centre, without the "
-                        "pendulum, kg m^2 (default: the dataset's, else a homogeneous "
-                        "immersed hull's)")
-    for name, key in (("length", "barge_length"), ("beam", "barge_beam"),
-                      ("draft", "barge_draft")):
-        g.add_argument(f"--barge-{name}", type=_finite_float(f"barge-{name}"),
-                       help=f"the box barge's {name}, m (default {HULL[key]:g})")
+    hull_options(g)
     g.add_argument("--copper-loss", type=_finite_float("copper-loss"),
                    help="the generator's winding loss r tau^2 subtracted from the power, r "
                         "in W/(N m)^2 (with --dofs surge,heave,pitch)")
