@@ -475,3 +475,12 @@ def test_large_gdf_mesh_refused_before_capytaine_reads_it(tmp_path, monkeypatch)
         path.write_text(text)
         with pytest.raises(AssertionError, match="Capytaine read"):
             bem.from_mesh(path, omega="body")
+
+
+@pytest.mark.skipif(not os.path.isdir("/proc/self"), reason="needs /proc")
+def test_plot_into_proc_refused_before_the_work(capsys):
+    """``--plot /proc/x``: /proc passes access() for root but takes no new directory: the
+    probe refuses it in one line before any solve (it failed with exit 1 after the work)."""
+    assert main(["buoy", "--plot", "/proc/x", "--torque-limit", "10"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "plot:" in err[0]

@@ -137,6 +137,19 @@ def _check_dir(path):
         raise ParameterError(f"plot: directory {str(parent)!r} does not exist")
     if not os.access(parent, os.W_OK):
         raise ParameterError(f"plot: directory {str(parent)!r} is not writable")
+    # a probe before the work: access() says yes to root on /proc, where nothing is made
+    try:
+        if d.exists():
+            import tempfile
+
+            with tempfile.TemporaryFile(dir=d):
+                pass
+        else:
+            d.mkdir()
+            d.rmdir()
+    except OSError as exc:
+        raise ParameterError(f"plot: cannot write into {path!r}: "
+                             f"{exc.strerror or exc}") from None
 
 
 def _figures(r, directory) -> list:

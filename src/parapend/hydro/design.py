@@ -106,7 +106,7 @@ def optimize_design(solve, pendulum, variables, bounds, *, check=None,
         heavier than the body); such designs count as no power.
     progress : callable or None
         Called ``progress(done, total)`` after every inner solve (``total`` the most the
-        search makes, :func:`design_solves`), and ``progress(total, total)`` at the end.
+        search makes, ``design_solves``), and ``progress(total, total)`` at the end.
     """
     from scipy.optimize import minimize, minimize_scalar
 

@@ -152,11 +152,11 @@ class HullProblem(PTOObjective):
     ``coupled=False``: the hull moves as if the pendulum were not there (its free response,
     the pendulum's mass lumped at the pivot): the one-way problem.
 
-    A real power take-off (:class:`~parapend.hydro.pto.PTOObjective`): ``eta = (eta_g,
+    A real power take-off (``parapend.hydro.pto.PTOObjective``): ``eta = (eta_g,
     eta_m)`` makes the objective the electrical power ``<e(p)>`` of the generator's
     mechanical power ``p = -tau (phi' - beta')`` (its kink smoothed by ``width``),
     ``copper_loss`` ``r`` (W per (N m)^2) subtracts the winding loss ``r <tau^2>`` (holding
-    an angle then costs power), and :meth:`set_limit` penalizes ``|tau|`` above a torque
+    an angle then costs power), and ``set_limit`` penalizes ``|tau|`` above a torque
     limit on the grid; :func:`parapend.hydro.pto.maximize` drives the continuation. Without
     them the objective is the mechanical power.
     """

@@ -780,7 +780,7 @@ def coupled_optimum(hydro, pendulum: Pendulum, wave: Wave, *, winding: int = 1,
         the peak between grid points is checked (within ``TORQUE_SLACK``, else
         ``success`` is False) and stated in ``status``. A limit whose constant brake
         exists (``T_max K omega`` at most the ideal power) gets the brake instead
-        (:func:`_limited`).
+        (``_limited``).
     efficiency : float, (eta_g, eta_m), "ETA_G[,ETA_M]" or None
         Maximize the electrical power ``<e(p)>`` instead (:mod:`parapend.hydro.pto`): a
         smoothed kink with a continuation to zero width and in the harmonics (N/4 to N),

@@ -108,7 +108,7 @@ def matrix_spec(*, hs="1:3:3", te=None, tp=None, realizations: int = 3, waves: f
     own otherwise; the prescribed device's record does not depend on them). ``dofs``
     ``"surge,heave,pitch"`` (with ``device="buoy"``): a pendulum in a hull that surges,
     heaves and pitches, ``pivot_height ... copper_loss`` and ``torque_limit`` as
-    ``parapend.buoy`` takes them (:mod:`.hull_device`)."""
+    ``parapend.buoy`` takes them (``parapend.performance.hull_device``)."""
     from ..hydro.hull_api import parse_dofs
     from ..seas import _check_sea, check_response, read_response
     from ..units import Units
@@ -321,7 +321,7 @@ _SOLVED = ("power", "mechanical_power", "electrical_power")
 
 def matrix_quantities(spec: MatrixSpec) -> tuple:
     """The per-realization quantities of the full Dataset (W), the headline ``power`` first:
-    the store's, and with an efficiency ``mechanical_power`` (:func:`_headline`)."""
+    the store's, and with an efficiency ``mechanical_power`` (``_headline``)."""
     q = _stored(spec)
     return (q[0], "mechanical_power", *q[1:]) if spec.lossy else q
 
