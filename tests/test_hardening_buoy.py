@@ -484,3 +484,18 @@ def test_plot_into_proc_refused_before_the_work(capsys):
     assert main(["buoy", "--plot", "/proc/x", "--torque-limit", "10"]) == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and "plot:" in err[0]
+
+
+def test_a_long_design_search_announces_its_estimate(caplog):
+    """Four variables fit the cap but take minutes: the estimate is logged first (the CLI
+    prints the logger ``parapend.hydro`` on stderr), where a short search stays silent."""
+    import logging
+
+    from parapend.hydro.api import _check_design
+
+    with caplog.at_level(logging.INFO, logger="parapend.hydro"):
+        _check_design(1, False)
+        assert not caplog.records
+        _check_design(4, False)
+    assert len(caplog.records) == 1
+    assert "optimize-design over 4 variables" in caplog.records[0].getMessage()

@@ -178,6 +178,10 @@ def _cmd_buoy(a) -> dict | str:
     if a.controller != "optimum" and a.plot:
         raise ParameterError("plot: not drawn with --controller mpc (use --save)")
     try:
+        if a.optimize_design:
+            from ._notice import install
+
+            install("parapend.hydro")  # the design search's estimate, on stderr
         bar = _Progress("buoy: optimize-design") if a.optimize_design and not a.json else None
         r = _run(a, progress=bar)
     except MemoryError:

@@ -172,6 +172,10 @@ def _check_sweep(count, harmonics, winding, pto):
                          f"{fix}")
 
 
+#: a design search estimated longer than this announces its estimate (as horizon and track)
+DESIGN_ANNOUNCE_SECONDS = 30.0
+
+
 def _check_design(count, pto):
     """Refuse a design search whose estimated time (its solves, :func:`.design.design_solves`,
     times one solve's, :data:`parapend.limits.BUOY_DESIGN_SOLVE_SECONDS`) exceeds
@@ -180,7 +184,14 @@ def _check_design(count, pto):
 
     each = limits.BUOY_DESIGN_SOLVE_SECONDS[1 if pto else 0]
     cap = limits.BUOY_MAX_DESIGN_SECONDS
-    if design_solves(count) * each <= cap:
+    est = design_solves(count) * each
+    if est <= cap:
+        if est > DESIGN_ANNOUNCE_SECONDS:  # long legitimate work: its estimate first
+            import logging
+
+            logging.getLogger("parapend.hydro").info(
+                "buoy: optimize-design over %d variables: up to %d solves of about %g s, "
+                "roughly %.0f s (Ctrl-C stops it)", count, design_solves(count), each, est)
         return
     fits = [k for k in range(1, count) if design_solves(k) * each <= cap]
     what = " with --efficiency or --torque-limit" if pto else ""
