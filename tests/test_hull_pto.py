@@ -139,3 +139,13 @@ def test_cli_copper_loss_only_with_the_hull(capsys):
     assert main(["buoy", "--copper-loss", "1e-4"]) == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and "copper-loss" in err[0]
+
+
+def test_the_copper_loss_field_carries_its_unit():
+    """The result's copper-loss coefficient is SI (W per (N m)^2) and says so in its name,
+    as the torque limit's ``torque_limit_nm`` does."""
+    from parapend.hydro.hull_result import HullResult
+    from parapend.results import quantity
+
+    assert "copper_loss_w_per_nm2" in HullResult.__dataclass_fields__
+    assert quantity("copper_loss_w_per_nm2") == ("W/(N m)^2", "copper loss")

@@ -105,7 +105,8 @@ QUANTITIES = {
 
 
 #: A field's unit from its name's suffix (longest first).
-SUFFIX_UNITS = (("_w_per_m", "W/m"), ("_mwh_per_year", "MWh/yr"), ("_rad_per_s", "rad/s"),
+SUFFIX_UNITS = (("_w_per_nm2", "W/(N m)^2"), ("_w_per_m", "W/m"), ("_mwh_per_year", "MWh/yr"),
+                ("_rad_per_s", "rad/s"),
                 ("_m_per_s", "m/s"), ("_kg_m2", "kg m2"), ("_per_year", "1/yr"),
                 ("_kwh", "kWh"), ("_mwh", "MWh"), ("_deg", "degree"), ("_hz", "Hz"),
                 ("_nm", "N m"), ("_w", "W"), ("_j", "J"), ("_m", "m"), ("_s", "s"),

@@ -355,7 +355,8 @@ def _hull_text(r) -> list:
               _w(m.get("peak_torque_nm")), str(m.get("distinct_maxima", "-")),
               m["status"]] for m in r.modes]
     rows = [["best mode", r.mode, "-"],
-            ["power" if r.efficiency is None and not r.copper_loss else "electrical power",
+            ["power" if r.efficiency is None and not r.copper_loss_w_per_nm2
+             else "electrical power",
              _w(r.power_w), "W"],
             ["  discretization error (half the harmonics)", _w(r.refinement_change_w), "W"],
             ["one-way (reaction left out)", _w(r.one_way_power_w), "W"],
@@ -371,10 +372,11 @@ def _hull_text(r) -> list:
             ["mean heel", f"{r.mean_heel_deg:.4g}", "deg"],
             ["peak torque", _w(r.peak_torque_nm), "N m"],
             ["peak bearing load", _w(r.peak_pivot_force_n), "N"]]
-    if r.efficiency is not None or r.copper_loss:
+    if r.efficiency is not None or r.copper_loss_w_per_nm2:
         pto = [f"efficiency {r.efficiency[0]:g} generating, {r.efficiency[1]:g} motoring"
                if r.efficiency is not None else None,
-               f"copper loss {r.copper_loss:g} W/(N m)^2" if r.copper_loss else None]
+               f"copper loss {r.copper_loss_w_per_nm2:g} W/(N m)^2"
+               if r.copper_loss_w_per_nm2 else None]
         rows.insert(3, ["  mechanical power (" + ", ".join(x for x in pto if x) + ")",
                         _w(r.mechanical_power_w), "W"])
     if r.torque_limit_nm is not None:

@@ -88,7 +88,7 @@ class HullResult(Result):
     power_w : the best mode's mean power: the mechanical ``P = -<tau (phi' - beta')>``
         with an ideal power take-off; with ``efficiency`` (``[eta_g, eta_m]``) the
         electrical ``<e(p)>`` (``eta_g p`` generating, ``p / eta_m`` motoring, ``p`` the
-        instantaneous mechanical power), less ``copper_loss`` times ``<tau^2>``.
+        instantaneous mechanical power), less ``copper_loss_w_per_nm2`` times ``<tau^2>``.
     mechanical_power_w : the mechanical power ``P`` of that motion (= power_w ideal).
     torque_limit_nm : ``|tau|`` held below it on the solve grid (its peak between the grid
         points checked, ``TORQUE_SLACK``).
@@ -119,7 +119,7 @@ class HullResult(Result):
     power_w: float
     mechanical_power_w: float
     efficiency: list | None
-    copper_loss: float
+    copper_loss_w_per_nm2: float
     torque_limit_nm: float | None
     mode: str
     winding: int
@@ -300,7 +300,7 @@ def hull_answer(hull, pendulum, wave, *, pivot, windings=(1, 0), pitch_inertia=N
     return HullResult(
         power_w=p, mechanical_power_w=0.0 if at_rest else float(best["mechanical_power_w"]),
         efficiency=list(pto.efficiency) if pto.efficiency is not None else None,
-        copper_loss=pto.copper_loss, torque_limit_nm=pto.torque_limit,
+        copper_loss_w_per_nm2=pto.copper_loss, torque_limit_nm=pto.torque_limit,
         mode="rest" if at_rest else best["mode"],
         winding=None if at_rest else best["winding"], modes=public,
         one_way_power_w=owp, one_way_ratio=(owp / p if owp is not None and p > 0 else None),
