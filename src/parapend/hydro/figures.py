@@ -119,8 +119,11 @@ def plot_hull(result, path=None, points: int = 600):
     w = result.wave
     what = (f"H = {w['height_m']:g} m, T = {w['period_s']:g} s" if w.get("kind") == "regular"
             else "irregular record")
-    ax1.set_title(f"{result.mode.capitalize()} ({what}): P = {result.power_w:.4g} W, "
-                  f"one-way {_w(result.one_way_power_w)}")
+    lossy = result.efficiency is not None or bool(result.copper_loss_w_per_nm2)
+    power = (f"P_el = {result.power_w:.4g} W (mechanical {result.mechanical_power_w:.4g} W)"
+             if lossy else f"P = {result.power_w:.4g} W")
+    ax1.set_title(f"{result.mode.capitalize()} ({what}): {power},"
+                  + ("\n" if lossy else " ") + f"one-way {_w(result.one_way_power_w)}")
     ax2.plot(t, s["xi"][0], lw=1.4, color="C1", label="surge (m)")
     ax2.plot(t, s["xi"][1], lw=1.4, color="C2", label="heave (m)")
     ax2.plot(t, np.degrees(s["xi"][2]), lw=1.4, color="C4", label="pitch (deg)")
