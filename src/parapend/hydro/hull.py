@@ -443,12 +443,13 @@ class HullProblem(PTOObjective):
         d2tau = {("phi", "phi"): ml * wgt, ("phi", "qx"): -ml * sn, ("phi", "qz"): -ml * co}
         return dtau, d2tau, {"phi1": 1.0, "b1": -1.0}
 
-    def _objective_derivatives(self, st):
+    def _objective_derivatives(self, st, terms=None):
         """The first and second derivatives of the objective's mean ``<f(tau, v)>`` in
         ``_VARS`` (chain rule through :meth:`_tau_derivatives`): dicts of arrays, the
-        second only on the pairs that can be non-zero (:data:`_PAIRS`)."""
+        second only on the pairs that can be non-zero (:data:`_PAIRS`). ``terms``:
+        :meth:`_objective` at ``st`` when the caller holds it."""
         mm = self.points
-        _, ft, fv, ftt, ftv, fvv = self._objective(st)
+        _, ft, fv, ftt, ftv, fvv = self._objective(st) if terms is None else terms
         dtau, d2tau, dv = self._tau_derivatives(st)
         zero = np.zeros(mm)
         d1 = {u: (ft * dtau[u] + (fv * dv[u] if u in dv else 0.0) + zero) / mm
@@ -517,7 +518,8 @@ class HullProblem(PTOObjective):
         st = self.grid_state(x, y)
         maps = self._maps()
         xv = ("phi", "phi1", "phi2")
-        obj = self._objective_derivatives(st)
+        terms = self._objective(st)
+        obj = self._objective_derivatives(st, terms)
         mu = None
         if lu is not None:
             gy = self._objective_gy(st, obj[0])
@@ -537,7 +539,7 @@ class HullProblem(PTOObjective):
         v = spectra([p[2] for p in pairs] + [p[2] for p in sens])
         fused = self._fused(tuple((u, w_) for u, w_, _ in pairs), bool(sens))
         hxx = fused["xx"](v)
-        val = st["power"] if self.lossless else float(np.mean(self._objective(st)[0]))
+        val = st["power"] if self.lossless else float(np.mean(terms[0]))
         if lu is None:
             return val, grad, 0.5 * (hxx + hxx.T)
         hxy, hyy, gx = fused["xy"](v), fused["yy"](v), fused["sens"](v)
