@@ -14,6 +14,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from ._hull_kernel import fused_gram
+
 __all__ = ["FusedGram", "GramPlan", "TrigColumns"]
 
 
@@ -35,9 +37,20 @@ class TrigColumns:
         return np.where(self.kind == 0, np.cos(arg), np.sin(arg)) * self.scale
 
 
+def _half(i, c, m: int):
+    """Indices ``i`` into ``[Re W, Im W]`` (2M) of a real weight's DFT moved to its half
+    spectrum ``[Re R, Im R]`` (``R = W_0..W_{M/2}``, 2 (M/2 + 1)), with the signs: ``W_k =
+    conj(W_{M-k})``."""
+    k, im = i % m, i >= m
+    kk = np.minimum(k, m - k)
+    sign = np.where(im & (k > m // 2), -1.0, 1.0)
+    return np.where(im, m // 2 + 1 + kk, kk), c * sign
+
+
 class GramPlan:
     """``G(w) = sum_j w_j a_i(s_j) b_l(s_j)`` for two :class:`TrigColumns`, as
-    ``G = c1 * V[i1] + c2 * V[i2]`` with ``V = [Re W, Im W]``, ``W = fft(w)``."""
+    ``G = c1 * V[i1] + c2 * V[i2]`` with ``V = [Re R, Im R]``, ``R = rfft(w)``
+    (:func:`spectra`)."""
 
     def __init__(self, a: TrigColumns, b: TrigColumns, m: int):
         fa, fb = a.freq[:, None], b.freq[None, :]
@@ -47,10 +60,10 @@ class GramPlan:
         cos_part = ka == kb  # cos cos, sin sin: the real parts (C_k = Re W_k)
         # C_{a-b} +- C_{a+b} (cos cos: +, sin sin: -); S_{a+b} +- S_{a-b} with S_k = -Im W_k
         # (sin cos: S_P + S_D; cos sin: S_P - S_D)
-        self.i1 = np.where(cos_part, minus, m + minus)
-        self.i2 = np.where(cos_part, plus, m + plus)
-        self.c1 = np.where(cos_part, half, np.where(ka == 1, -half, half))
-        self.c2 = np.where(cos_part, np.where(ka == 0, half, -half), -half)
+        self.i1, self.c1 = _half(np.where(cos_part, minus, m + minus),
+                                 np.where(cos_part, half, np.where(ka == 1, -half, half)), m)
+        self.i2, self.c2 = _half(np.where(cos_part, plus, m + plus),
+                                 np.where(cos_part, np.where(ka == 0, half, -half), -half), m)
 
     def __call__(self, v: np.ndarray) -> np.ndarray:
         return self.c1 * v[self.i1] + self.c2 * v[self.i2]
@@ -61,22 +74,28 @@ class FusedGram:
     weight ``k_p``, transposed where asked) in one gather from the stacked spectra: the
     per-plan calls' overhead, not their arithmetic, is what it saves."""
 
-    def __init__(self, terms, m: int):
-        """``terms``: ``(plan, k, transposed)`` of one shape (after the transposition)."""
+    def __init__(self, terms, m: int, symmetric: bool = False):
+        """``terms``: ``(plan, k, transposed)`` of one shape (after the transposition);
+        ``symmetric``: the sum is symmetric (each term's transpose among the terms, or
+        square with symmetric columns): half the gathers."""
+        self.symmetric = bool(symmetric)
         idx, coef = [], []
         for plan, k, tr in terms:
             for i, c in ((plan.i1, plan.c1), (plan.i2, plan.c2)):
-                idx.append((i.T if tr else i) + 2 * m * k)
+                idx.append((i.T if tr else i) + 2 * (m // 2 + 1) * k)
                 coef.append(c.T if tr else c)
-        self.idx = np.stack(idx)
-        self.coef = np.stack(coef)
+        # (n1, n2, P): an entry's gathers side by side
+        self.idx = np.ascontiguousarray(np.stack(idx, axis=-1), dtype=np.int32)
+        self.coef = np.ascontiguousarray(np.stack(coef, axis=-1), dtype=float)
 
     def __call__(self, v: np.ndarray) -> np.ndarray:
-        """``v`` the stacked spectra (K, 2M) of :func:`spectra`."""
-        return np.einsum("pij,pij->ij", self.coef, v.ravel()[self.idx])
+        """``v`` the stacked spectra of :func:`spectra` (the gathers compiled:
+        :func:`parapend.hydro._hull_kernel.fused_gram`)."""
+        return fused_gram(np.ascontiguousarray(v).ravel(), self.idx, self.coef, self.symmetric)
 
 
 def spectra(weights) -> np.ndarray:
-    """``[Re W, Im W]`` (K, 2M) of the K weights (K, M)."""
-    w = np.fft.fft(np.asarray(weights, dtype=float), axis=-1)
+    """``[Re R, Im R]`` (K, 2 (M/2 + 1)) of the K real weights (K, M), ``R`` the half
+    spectrum (``numpy.fft.rfft``)."""
+    w = np.fft.rfft(np.asarray(weights, dtype=float), axis=-1)
     return np.concatenate((w.real, w.imag), axis=-1)

@@ -28,7 +28,7 @@ sensitivity ``T = S^{-1} g_x`` (one LU, ``2N + 1`` solves):
     H = L_xx + L_xy T + T^T L_yx + T^T L_yy T
 
 with ``L`` the Lagrangian, whose dependence on ``x`` and ``y`` is a sum over grid points of
-a function of ``(phi, phi', phi'', p_x'', p_z'', beta')`` (:func:`_pointwise`): every
+a function of ``(phi, phi', phi'', p_x'', p_z'', beta')`` (:mod:`._hull_kernel`): every
 block is a weighted Gram matrix of the grid maps. With the hull fixed at its free response
 (``coupled=False``) the same code gives the one-way problem (``T = 0``, no adjoint).
 """
@@ -42,6 +42,7 @@ import numpy as np
 from scipy.linalg.lapack import dgetrf, dgetrs
 
 from ..errors import ParameterError
+from ._hull_kernel import constraint_weights, objective_weights, reaction, torque
 from ._trig import FusedGram, GramPlan, TrigColumns, spectra
 from .pto import PTOObjective, _abs
 
@@ -55,6 +56,9 @@ _VARS = ("phi", "phi1", "phi2", "qx", "qz", "b1")
 _PAIRS = {"all": [(u, w) for i, u in enumerate(_VARS) for w in _VARS[i:]]}
 _PAIRS["lossless"] = [(u, w) for u, w in _PAIRS["all"] if (u, w) in (
     ("phi", "phi"), ("phi", "qx"), ("phi", "qz")) or {u, w} & {"phi1", "b1"}]
+#: the pairs on which the hull's reaction weighted by the adjoint has second derivatives
+_CONSTRAINT_PAIRS = (("phi", "phi"), ("phi", "phi1"), ("phi", "phi2"), ("phi", "qx"),
+                     ("phi", "qz"), ("phi1", "phi1"))
 
 
 def _lu(a):
@@ -69,6 +73,15 @@ def _lu(a):
 def _solve(lu, b, trans=0):
     x, info = dgetrs(lu[0], lu[1], b, trans=trans)
     return x
+
+
+def _full(t, m: int) -> np.ndarray:
+    """A pointwise term as an array of ``m`` values (None: zero; a scalar: constant)."""
+    if t is None:
+        return np.zeros(m)
+    if np.ndim(t) == 0:
+        return np.full(m, float(t))
+    return t
 
 
 def hull_points(harmonics: int, hull_harmonics: int, winding: int, wave_harmonics: int) -> int:
@@ -180,6 +193,8 @@ class HullProblem(PTOObjective):
         self.P0 = np.hstack((np.ones((m, 1)), sn, cn))
         self.P1 = w * np.hstack((np.zeros((m, 1)), kn * cn, -kn * sn))
         self.P2 = -w**2 * np.hstack((np.zeros((m, 1)), kn**2 * sn, kn**2 * cn))
+        self._P012 = np.vstack((self.P0, self.P1, self.P2))  # x -> (phi, phi', phi''): one product
+        self._P012T = np.ascontiguousarray(self._P012.T)
         # the hull's unknowns y: Xi_0 on the DOFs with stiffness, then (Re, Im) Xi_k
         cp = case.stiffness()
         self.static = [d for d in range(3) if cp[d, d] > 0]
@@ -206,6 +221,8 @@ class HullProblem(PTOObjective):
         dp, hp = case.pivot
         self.Qx = E2[0] + hp * E2[2]
         self.Qz = E2[1] - dp * E2[2]
+        self._Q3 = np.vstack((self.Qx, self.Qz, E1[2]))  # y -> (p_x'', p_z'', beta')
+        self._Q3T = np.ascontiguousarray(self._Q3.T)
         self._trig_maps(kn, kh, j0)
         # Z (real form) and the wave's force
         Z = np.zeros((ny, ny))
@@ -266,7 +283,10 @@ class HullProblem(PTOObjective):
         self._pi_cols = [TrigColumns(freq, kp, sp * on[d]) for d in range(3)]
         self._plans = {}
         self._fused_plans = {}
+        self._key_cache = {}
+        self._hull_gram = None
         self._last = None
+        self._last_state = None
         self._last_phi = None
 
     def _plan(self, a: str, b: str) -> GramPlan:
@@ -293,8 +313,8 @@ class HullProblem(PTOObjective):
             if coupled:
                 for j, (d, i) in enumerate((d, i) for d in range(3) for i in range(3)):
                     blocks["sens"].append((self._plan(f"pi{d}", xv[i]), len(keys) + j, False))
-            self._fused_plans[ck] = {b: FusedGram(t, self.points) for b, t in blocks.items()
-                                     if t}
+            self._fused_plans[ck] = {b: FusedGram(t, self.points, symmetric=b in ("xx", "yy"))
+                                     for b, t in blocks.items() if t}
         return self._fused_plans[ck]
 
     # --------------------------------------------------------------------------------------
@@ -303,30 +323,10 @@ class HullProblem(PTOObjective):
         x = np.asarray(x, dtype=float)
         key = x.tobytes()
         if self._last_phi is None or self._last_phi[0] != key:
-            kw, w = self.winding, self.omega
-            self._last_phi = (key, (kw * self.s + self.P0 @ x, w * kw + self.P1 @ x,
-                                    self.P2 @ x))
+            kw, w, m = self.winding, self.omega, self.points
+            r = (self._P012 @ x).reshape(3, m)
+            self._last_phi = (key, (kw * self.s + r[0], w * kw + r[1], r[2]))
         return self._last_phi[1]
-
-    def _rho(self, ph, y):
-        """The pendulum's reaction on the hull on the grid, ``r`` (3, M), and the
-        pointwise derivatives of its three rows in ``(phi, phi', phi'')``."""
-        cs = self.case
-        ml = cs.m * cs.l
-        dp, hp = cs.pivot
-        f, f1, f2 = ph
-        sn, co = np.sin(f), np.cos(f)
-        qx, qz = self.Qx @ y, self.Qz @ y
-        rx = -ml * (co * f2 - sn * f1**2)
-        rz = ml * (sn * f2 + co * f1**2)
-        wgt = (cs.g + qz) * sn - qx * co
-        rb = hp * rx - dp * rz - cs.I * f2 + ml * wgt
-        dx = (rz, 2 * ml * sn * f1, -ml * co)
-        dz = (-rx, 2 * ml * co * f1, ml * sn)
-        wphi = (cs.g + qz) * co + qx * sn
-        db = (hp * dx[0] - dp * dz[0] + ml * wphi, hp * dx[1] - dp * dz[1],
-              hp * dx[2] - dp * dz[2] - cs.I)
-        return np.array((rx, rz, rb)), (dx, dz, db)
 
     def solve_hull(self, x):
         """The hull's unknowns ``y`` at ``phi(x)``, and the factorized ``S`` (None when
@@ -339,21 +339,15 @@ class HullProblem(PTOObjective):
         if not self.coupled:
             y, lu = self.y_free, None
         else:
-            ph = self.phi(x)
             cs = self.case
-            ml = cs.m * cs.l
             dp, hp = cs.pivot
-            f, f1, f2 = ph
-            sn, co = np.sin(f), np.cos(f)
-            rx = -ml * (co * f2 - sn * f1**2)
-            rz = ml * (sn * f2 + co * f1**2)
-            rb = hp * rx - dp * rz - cs.I * f2 + ml * cs.g * sn
-            v = spectra([sn, co])
-            s_mat = self.Z - ml * (self._plan("pi2", "qz")(v[0])
-                                   - self._plan("pi2", "qx")(v[1]))
-            b = self.fa_real + self.Pi_all @ np.concatenate((rx, rz, rb))
-            lu = _lu(s_mat)
-            y = _solve(lu, b)
+            f, f1, f2 = self.phi(x)
+            r, wz = reaction(f, f1, f2, cs.m * cs.l, cs.I, cs.g, dp, hp)
+            if self._hull_gram is None:
+                self._hull_gram = FusedGram([(self._plan("pi2", "qz"), 0, False),
+                                             (self._plan("pi2", "qx"), 1, False)], self.points)
+            lu = _lu(self.Z + self._hull_gram(spectra(wz)))
+            y = _solve(lu, self.fa_real + self.Pi_all @ r.ravel())
         self._last = (key, y, lu)
         return y, lu
 
@@ -362,14 +356,17 @@ class HullProblem(PTOObjective):
         pivot's acceleration, the pitch rate, the torque and the power."""
         if y is None:
             y, _ = self.solve_hull(x)
+        key = (np.asarray(x, dtype=float).tobytes(), y.tobytes())
+        if self._last_state is not None and self._last_state[0] == key:
+            return self._last_state[1]
         cs = self.case
         f, f1, f2 = self.phi(x)
-        qx, qz = self.Qx @ y, self.Qz @ y
-        b1 = self.E1[2] @ y
-        v = f1 - b1
-        tau = cs.I * f2 + cs.c * v - cs.m * cs.l * ((cs.g + qz) * np.sin(f) - qx * np.cos(f))
-        return {"phi": f, "phi1": f1, "phi2": f2, "qx": qx, "qz": qz, "b1": b1, "y": y,
-                "tau": tau, "relative_speed": v, "power": -float(np.mean(tau * v))}
+        qx, qz, b1 = (self._Q3 @ y).reshape(3, self.points)
+        tau, v, p = torque(f, f1, f2, qx, qz, b1, cs.I, cs.c, cs.m * cs.l, cs.g)
+        st = {"phi": f, "phi1": f1, "phi2": f2, "qx": qx, "qz": qz, "b1": b1, "y": y,
+              "tau": tau, "relative_speed": v, "power": p}
+        self._last_state = (key, st)
+        return st
 
     @property
     def lossless(self) -> bool:
@@ -379,7 +376,7 @@ class HullProblem(PTOObjective):
 
     def state(self, x) -> dict:
         """The grid state with the generator's mechanical power ``p = -tau v`` per point."""
-        st = self.grid_state(x)
+        st = dict(self.grid_state(x))
         st["p"] = -st["tau"] * st["relative_speed"]
         return st
 
@@ -430,117 +427,56 @@ class HullProblem(PTOObjective):
         return f, ft, fv, ftt, ftv, fvv
 
     # --------------------------------------------------------------------------------------
-    def _tau_derivatives(self, st):
-        """``dtau`` and ``d2tau`` in ``_VARS`` (pointwise), and ``dv`` (``v = phi' - b1``)."""
-        cs = self.case
-        ml = cs.m * cs.l
-        f = st["phi"]
-        sn, co = np.sin(f), np.cos(f)
-        wgt = (cs.g + st["qz"]) * sn - st["qx"] * co
-        wph = (cs.g + st["qz"]) * co + st["qx"] * sn
-        dtau = {"phi": -ml * wph, "phi1": cs.c, "phi2": cs.I, "qx": ml * co, "qz": -ml * sn,
-                "b1": -cs.c}
-        d2tau = {("phi", "phi"): ml * wgt, ("phi", "qx"): -ml * sn, ("phi", "qz"): -ml * co}
-        return dtau, d2tau, {"phi1": 1.0, "b1": -1.0}
-
-    def _objective_derivatives(self, st, terms=None):
-        """The first and second derivatives of the objective's mean ``<f(tau, v)>`` in
-        ``_VARS`` (chain rule through :meth:`_tau_derivatives`): dicts of arrays, the
-        second only on the pairs that can be non-zero (:data:`_PAIRS`). ``terms``:
-        :meth:`_objective` at ``st`` when the caller holds it."""
-        mm = self.points
-        _, ft, fv, ftt, ftv, fvv = self._objective(st) if terms is None else terms
-        dtau, d2tau, dv = self._tau_derivatives(st)
-        zero = np.zeros(mm)
-        d1 = {u: (ft * dtau[u] + (fv * dv[u] if u in dv else 0.0) + zero) / mm
-              for u in _VARS}
-        d2 = {}
-        for u, w in _PAIRS["all" if ftt is not None else "lossless"]:
-            h = ft * d2tau[(u, w)] if (u, w) in d2tau else zero
-            if u in dv or w in dv:
-                h = h + ftv * (dtau[u] * dv.get(w, 0.0) + dv.get(u, 0.0) * dtau[w])
-            if ftt is not None:
-                h = h + ftt * (dtau[u] * dtau[w])
-            if fvv is not None and u in dv and w in dv:
-                h = h + fvv * (dv[u] * dv[w])
-            d2[(u, w)] = (h + zero) / mm
-        return d1, d2
-
-    def _pointwise(self, st, mu, obj=None):
-        """First and second derivatives of the Lagrangian's pointwise part ``<f(tau, v)> +
-        sum_d mu_d rho_d`` in ``_VARS`` (the constraint's weights ``mu`` (3, M), zero for
-        the one-way problem: None). Returns ``(d1, d2)``: dicts of arrays."""
-        d1, d2 = self._objective_derivatives(st) if obj is None else obj
-        if mu is None:
-            return d1, d2
-        cs = self.case
-        ml = cs.m * cs.l
-        dp, hp = cs.pivot
-        f, f1, f2 = st["phi"], st["phi1"], st["phi2"]
-        qx, qz = st["qx"], st["qz"]
-        sn, co = np.sin(f), np.cos(f)
-        e = mu[2]
-        a = mu[0] + hp * e
-        b = mu[1] - dp * e
-        wgt = (cs.g + qz) * sn - qx * co
-        wph = (cs.g + qz) * co + qx * sn
-        X = a * sn + b * co
-        Y = b * sn - a * co
-        d1, d2 = dict(d1), dict(d2)
-        con1 = {"phi": ml * e * wph + ml * (f2 * X - f1**2 * Y), "phi1": 2 * ml * f1 * X,
-                "phi2": ml * Y - cs.I * e, "qx": -ml * e * co, "qz": ml * e * sn}
-        con2 = {("phi", "phi"): -ml * e * wgt + ml * (-f2 * Y - f1**2 * X),
-                ("phi", "phi1"): -2 * ml * f1 * Y, ("phi", "phi2"): ml * X,
-                ("phi", "qx"): ml * e * sn, ("phi", "qz"): ml * e * co,
-                ("phi1", "phi1"): 2 * ml * X}
-        for k, v in con1.items():
-            d1[k] = d1[k] + v
-        for k, v in con2.items():
-            d2[k] = d2[k] + v if k in d2 else v
-        return d1, d2
-
-    def _objective_gy(self, st, d1=None):
-        """``d<f>/dy`` at fixed phi (the adjoint's right side): the objective's pointwise
-        derivatives in ``(p_x'', p_z'', beta')`` mapped to ``y``."""
-        if d1 is None:
-            d1 = self._objective_derivatives(st)[0]
-        return self.Qx.T @ d1["qx"] + self.Qz.T @ d1["qz"] + self.E1[2].T @ d1["b1"]
-
-    def _maps(self):
-        """The linear maps of ``_VARS`` from x (first three) and y (last three)."""
-        return {"phi": self.P0, "phi1": self.P1, "phi2": self.P2, "qx": self.Qx,
-                "qz": self.Qz, "b1": self.E1[2]}
+    def _keys(self, lossless: bool, coupled: bool) -> tuple:
+        """The pairs of ``_VARS`` whose second-derivative weights can be non-zero (in
+        ``_PAIRS["all"]``'s order), and their rows there."""
+        ck = (lossless, coupled)
+        if ck not in self._key_cache:
+            need = set(_PAIRS["lossless" if lossless else "all"])
+            xv = ("phi", "phi1", "phi2")
+            if coupled:
+                need |= set(_CONSTRAINT_PAIRS)
+            else:
+                need = {(u, w) for u, w in need if u in xv and w in xv}
+            keys = tuple(p for p in _PAIRS["all"] if p in need)
+            rows = np.array([_PAIRS["all"].index(p) for p in keys], dtype=np.int64)
+            self._key_cache[ck] = (keys, rows)
+        return self._key_cache[ck]
 
     def evaluate(self, x):
-        """``(P, gradient, Hessian)`` of the (reduced) power in ``x``."""
+        """``(P, gradient, Hessian)`` of the (reduced) power in ``x``.
+
+        The Lagrangian ``<f(tau, v)> + mu . rho`` (``mu`` the adjoint of the hull's
+        equations ``S y = b``, ``S^T lambda = d<f>/dy``) has pointwise derivatives in
+        ``_VARS`` (:mod:`._hull_kernel`); the gradient maps the first ones back to ``x``,
+        the Hessian's blocks are their Gram matrices (one FFT per weight), reduced by the
+        sensitivity ``T = S^{-1} g_x``: ``H = L_xx + L_xy T + T^T L_yx + T^T L_yy T``."""
         x = np.asarray(x, dtype=float)
         y, lu = self.solve_hull(x)
         st = self.grid_state(x, y)
-        maps = self._maps()
-        xv = ("phi", "phi1", "phi2")
+        cs = self.case
+        m, ml = self.points, cs.m * cs.l
         terms = self._objective(st)
-        obj = self._objective_derivatives(st, terms)
-        mu = None
-        if lu is not None:
-            gy = self._objective_gy(st, obj[0])
-            lam = _solve(lu, gy, trans=1)
-            mu = np.array([self.Pi[d].T @ lam for d in range(3)])
-        d1, d2 = self._pointwise(st, mu, obj)
-        grad = sum(maps[k].T @ d1[k] for k in xv)
-        # the Hessian of L in (x, y) as Gram matrices of the grid maps (one FFT per weight),
-        # then the reduced Hessian [I; T]^T (Hessian of L) [I; T]
-        pairs = [(u, v, wgt) for (u, v), wgt in d2.items()
-                 if lu is not None or (u in xv and v in xv)]
-        if lu is not None:
-            _, dr = self._rho(self.phi(x), y)
-            sens = [(f"pi{d}", xv[i], dr[d][i]) for d in range(3) for i in range(3)]
+        ft, fv, ftt, ftv, fvv = (_full(t, m) for t in terms[1:])
+        d1, d2 = objective_weights(st["phi"], st["qx"], st["qz"], ft, fv, ftt, ftv, fvv, ml,
+                                   cs.I, cs.c, cs.g)
+        coupled = lu is not None
+        keys, rows = self._keys(terms[3] is None, coupled)
+        if coupled:
+            lam = _solve(lu, self._Q3T @ d1[3:].ravel(), trans=1)
+            mu = (self.Pi_all.T @ lam).reshape(3, m)
+            dp, hp = cs.pivot
+            c1, c2, sens = constraint_weights(st["phi"], st["phi1"], st["phi2"], st["qx"],
+                                              st["qz"], mu, ml, cs.I, cs.g, dp, hp)
+            d1, d2 = d1 + c1, d2 + c2
+            v = spectra(np.concatenate((d2[rows], sens)))
         else:
-            sens = []
-        v = spectra([p[2] for p in pairs] + [p[2] for p in sens])
-        fused = self._fused(tuple((u, w_) for u, w_, _ in pairs), bool(sens))
+            v = spectra(d2[rows])
+        grad = self._P012T @ d1[:3].ravel()
+        fused = self._fused(keys, coupled)
         hxx = fused["xx"](v)
         val = st["power"] if self.lossless else float(np.mean(terms[0]))
-        if lu is None:
+        if not coupled:
             return val, grad, 0.5 * (hxx + hxx.T)
         hxy, hyy, gx = fused["xy"](v), fused["yy"](v), fused["sens"](v)
         t = _solve(lu, gx)

@@ -1,0 +1,168 @@
+r"""Compiled (numba) pointwise weights and Gram gathers of the hull problem (:mod:`.hull`).
+
+:meth:`parapend.hydro.hull.HullProblem.evaluate` needs, on each of the grid's ``M``
+points, the first and second derivatives of the Lagrangian's pointwise part in the six grid
+variables ``(phi, phi', phi'', p_x'', p_z'', beta')`` (``_VARS``; the 21 pairs ``u <= w``
+in that order), the weights of the sensitivity's right side, and Gram matrices gathered
+from the weights' spectra (:class:`parapend.hydro._trig.FusedGram`). Written with NumPy
+these are some two hundred small array operations per evaluation, whose call overhead (not
+their arithmetic) was most of a Newton step on the hull's harmonics (tens of points); here
+they are three loops.
+
+The formulas are those of the hull's module docstring, point by point:
+
+- the torque ``tau = I phi'' + c v - m l [(g + p_z'') sin phi - p_x'' cos phi]``,
+  ``v = phi' - beta'``, and the objective ``f(tau, v)`` with its derivatives
+  ``(f_tau, f_v, f_tautau, f_tauv, f_vv)`` given (:meth:`.hull.HullProblem._objective`):
+  :func:`objective_weights`, the chain rule through ``tau`` divided by ``M`` (the mean);
+- the hull's projected equation's reaction ``rho = (r_x, r_z, r_beta)`` weighted by the
+  adjoint's ``mu`` (3, M): :func:`constraint_weights`, with the reaction's own
+  derivatives (the sensitivity's weights).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numba as nb
+import numpy as np
+
+from .._jit import announce_compiles
+
+announce_compiles()  # log a first-use compile (parapend._jit)
+
+__all__ = ["constraint_weights", "fused_gram", "objective_weights", "reaction", "torque"]
+
+
+@nb.njit(cache=True)
+def _pair(u, w):
+    """Row of the pair ``(u, w)``, ``u <= w``, among the 21 pairs of six variables."""
+    return u * 6 - (u * (u - 1)) // 2 + (w - u)
+
+
+@nb.njit(cache=True)
+def torque(f, f1, f2, qx, qz, b1, inertia, c, ml, g):
+    """``(tau, v, P)`` on the grid: the generator's torque (P) ``tau = I phi'' + c v -
+    m l [(g + p_z'') sin phi - p_x'' cos phi]``, the relative speed ``v = phi' - beta'``
+    and the mechanical power ``P = -<tau v>``."""
+    m = f.size
+    tau = np.empty(m)
+    v = np.empty(m)
+    acc = 0.0
+    for j in range(m):
+        v[j] = f1[j] - b1[j]
+        tau[j] = (inertia * f2[j] + c * v[j]
+                  - ml * ((g + qz[j]) * math.sin(f[j]) - qx[j] * math.cos(f[j])))
+        acc += tau[j] * v[j]
+    return tau, v, -acc / m
+
+
+@nb.njit(cache=True)
+def objective_weights(f, qx, qz, ft, fv, ftt, ftv, fvv, ml, inertia, c, g):
+    """``(d1, d2)``: the mean ``<f(tau, v)>``'s derivatives in the six grid variables,
+    pointwise ((6, M) and (21, M), divided by ``M``), by the chain rule through ``tau``
+    (``d tau = (-m l w_phi, c, I, m l cos, -m l sin, -c)``, ``d v = (0, 1, 0, 0, 0, -1)``,
+    ``tau``'s own second derivatives on ``(phi, phi)``, ``(phi, p_x'')``, ``(phi, p_z'')``)."""
+    m = f.size
+    d1 = np.zeros((6, m))
+    d2 = np.zeros((21, m))
+    dt = np.empty(6)
+    dv = np.zeros(6)
+    dv[1] = 1.0
+    dv[5] = -1.0
+    for j in range(m):
+        sn, co = math.sin(f[j]), math.cos(f[j])
+        wgt = (g + qz[j]) * sn - qx[j] * co
+        wph = (g + qz[j]) * co + qx[j] * sn
+        dt[0], dt[1], dt[2] = -ml * wph, c, inertia
+        dt[3], dt[4], dt[5] = ml * co, -ml * sn, -c
+        a, b = ft[j] / m, fv[j] / m
+        aa, ab, bb = ftt[j] / m, ftv[j] / m, fvv[j] / m
+        for u in range(6):
+            d1[u, j] = a * dt[u] + b * dv[u]
+            for w in range(u, 6):
+                d2[_pair(u, w), j] = (aa * dt[u] * dt[w] + ab * (dt[u] * dv[w] + dv[u] * dt[w])
+                                      + bb * dv[u] * dv[w])
+        d2[0, j] += a * ml * wgt
+        d2[3, j] += -a * ml * sn
+        d2[4, j] += -a * ml * co
+    return d1, d2
+
+
+@nb.njit(cache=True)
+def reaction(f, f1, f2, ml, inertia, g, dp, hp):
+    """The pendulum's reaction on the hull at rest in the hull's frame, on the grid:
+    ``(r_x, r_z, r_beta)`` (3, M) with the weight's ``m l g sin phi`` (the pivot's
+    acceleration's part enters the hull matrix), and ``-m l sin phi``, ``m l cos phi``: the
+    weights of the hull matrix's ``p_z''`` and ``p_x''`` parts."""
+    m = f.size
+    r = np.empty((3, m))
+    s = np.empty((2, m))
+    for j in range(m):
+        sn, co = math.sin(f[j]), math.cos(f[j])
+        rx = -ml * (co * f2[j] - sn * f1[j] ** 2)
+        rz = ml * (sn * f2[j] + co * f1[j] ** 2)
+        r[0, j], r[1, j] = rx, rz
+        r[2, j] = hp * rx - dp * rz - inertia * f2[j] + ml * g * sn
+        s[0, j], s[1, j] = -ml * sn, ml * co
+    return r, s
+
+
+@nb.njit(cache=True)
+def constraint_weights(f, f1, f2, qx, qz, mu, ml, inertia, g, dp, hp):
+    """``(c1, c2, sens)``: the derivatives of ``sum_d mu_d rho_d`` pointwise in the six grid
+    variables ((6, M), (21, M)), and the reaction's derivatives ``d rho_d / d(phi, phi',
+    phi'')`` (9, M), row ``3 d + i``: the sensitivity's weights."""
+    m = f.size
+    c1 = np.zeros((6, m))
+    c2 = np.zeros((21, m))
+    sens = np.empty((9, m))
+    for j in range(m):
+        sn, co = math.sin(f[j]), math.cos(f[j])
+        p1, p2 = f1[j], f2[j]
+        wgt = (g + qz[j]) * sn - qx[j] * co
+        wph = (g + qz[j]) * co + qx[j] * sn
+        e = mu[2, j]
+        a = mu[0, j] + hp * e
+        b = mu[1, j] - dp * e
+        x = a * sn + b * co
+        y = b * sn - a * co
+        c1[0, j] = ml * e * wph + ml * (p2 * x - p1 * p1 * y)
+        c1[1, j] = 2.0 * ml * p1 * x
+        c1[2, j] = ml * y - inertia * e
+        c1[3, j] = -ml * e * co
+        c1[4, j] = ml * e * sn
+        c2[0, j] = -ml * e * wgt + ml * (-p2 * y - p1 * p1 * x)
+        c2[1, j] = -2.0 * ml * p1 * y
+        c2[2, j] = ml * x
+        c2[3, j] = ml * e * sn
+        c2[4, j] = ml * e * co
+        c2[6, j] = 2.0 * ml * x
+        rx = -ml * (co * p2 - sn * p1 * p1)
+        rz = ml * (sn * p2 + co * p1 * p1)
+        dx0, dx1, dx2 = rz, 2.0 * ml * sn * p1, -ml * co
+        dz0, dz1, dz2 = -rx, 2.0 * ml * co * p1, ml * sn
+        sens[0, j], sens[1, j], sens[2, j] = dx0, dx1, dx2
+        sens[3, j], sens[4, j], sens[5, j] = dz0, dz1, dz2
+        sens[6, j] = hp * dx0 - dp * dz0 + ml * wph
+        sens[7, j] = hp * dx1 - dp * dz1
+        sens[8, j] = hp * dx2 - dp * dz2 - inertia
+    return c1, c2, sens
+
+
+@nb.njit(cache=True)
+def fused_gram(v, idx, coef, symmetric):
+    """``sum_p coef[:, :, p] * v[idx[:, :, p]]`` (the gathers of :class:`.FusedGram`,
+    ``v`` the stacked spectra flattened); ``symmetric``: a sum known to be symmetric,
+    gathered on and above the diagonal and mirrored."""
+    n1, n2, np_ = idx.shape
+    out = np.zeros((n1, n2))
+    for i in range(n1):
+        for k in range(i if symmetric else 0, n2):
+            acc = 0.0
+            for p in range(np_):
+                acc += coef[i, k, p] * v[idx[i, k, p]]
+            out[i, k] = acc
+            if symmetric:
+                out[k, i] = acc
+    return out
