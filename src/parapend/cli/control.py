@@ -142,7 +142,8 @@ def _cmd_track(a) -> dict | str:
             f"locked: {sum(r.run_locked)} of {r.runs} runs ({100 * r.fraction_locked:.3g} %)"
             + (f", the latest after {r.lock_period_max} periods"
                if r.lock_period_max is not None else ""),
-            f"mean power over the last 10 periods: mean {_fmt(r.mean_power, 6)} (min "
+            f"mean power (each run's from its lock, else its last 10 periods, with the "
+            f"change of stored energy): mean {_fmt(r.mean_power, 6)} (min "
             f"{_fmt(r.power_min, 6)}, max {_fmt(r.power_max, 6)}); locked runs "
             f"{_fmt(r.locked_mean_power, 6)}; predicted {_fmt(r.predicted_power, 6)}",
             f"peak torque {_fmt(r.peak_torque, 5)}", *_si_lines(r)])
@@ -156,7 +157,11 @@ def _cmd_track(a) -> dict | str:
            f"gamma = {r.gamma:g}, omega = {r.omega:g}, T_max = {_fmt(r.torque_limit)}"
            + (f" (tracking the optimum at {r.design_torque_limit:.6g})"
               if r.design_torque_limit is not None else ""),
-           f"mean power (last 10 periods) {_fmt(r.mean_power, 8)}; predicted "
+           f"mean power {_fmt(r.mean_power, 8)} over periods {r.average_start_period} to "
+           f"{r.average_start_period + r.averaged_periods}"
+           + (" (from the lock" if r.locked else " (the last ones: not locked")
+           + f"; the harvested power {_fmt(r.harvested_power, 8)} with the span's change of "
+           f"stored energy {_fmt(r.stored_energy_change, 6)} m g l); predicted "
            f"{_fmt(r.predicted_power, 8)}"
            + (f"; optimum at T_max {_fmt(r.optimum_at_torque_limit, 8)}"
               if r.optimum_at_torque_limit is not None else ""),

@@ -28,7 +28,8 @@ class RobustnessResult(_Result):
     """A seeded batch (fields = JSON keys of ``parapend track --runs N --json``).
 
     ``fraction_locked``: runs that end locked; ``mean_power``: the mean over the runs of
-    each run's power over its last 10 periods (``power_min``, ``power_max`` the extremes);
+    each run's ``mean_power`` (:class:`.track.TrackResult`: from its lock, else over its last
+    10 periods, the stored energy's change counted; ``power_min``, ``power_max`` the extremes);
     ``locked_mean_power``: the same over the locked runs only; ``lock_period_max``: the
     latest lock among the locked runs. The per-run values are in ``run_*``.
     """
@@ -108,7 +109,7 @@ class RobustnessResult(_Result):
             ax.axhline(self.predicted_power, color="k", ls="--", lw=0.8,
                        label=f"predicted {self.predicted_power:.4g}")
             ax.set_xlabel(r"damping error of the plant, $\Delta\gamma$")
-            ax.set_ylabel(r"mean power, last 10 periods ($mgl/t_0$)")
+            ax.set_ylabel(r"mean power from the lock ($mgl/t_0$)")
             ax.set_title(f"track: {self.runs} runs, {100 * self.fraction_locked:.3g} % "
                          f"locked", fontsize=10)
             ax.legend(loc="best")

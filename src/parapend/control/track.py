@@ -23,7 +23,7 @@ import numpy as np
 from .. import limits
 from ..errors import ParameterError, SolverError, check_finite, check_int, check_range
 from ..results import _Result
-from .closedloop import Diverged, energy_series, run_closed_loop
+from .closedloop import Diverged, energy_series, mechanical_energy, run_closed_loop
 from .riccati import periodic_lqr
 from .target import build_target
 
@@ -49,8 +49,16 @@ class TrackResult(_Result):
     catch_period : float or None
         Time (periods) when the swing-up handed over to tracking.
     mean_power : float
-        ``-sum T_k (theta_{k+1} - theta_k)`` over the last 10 periods, divided by their
-        duration (exact for the held torque; positive = harvested).
+        From the lock to the end (not locked: over the last 10 periods): the harvested
+        energy ``-sum T_k (theta_{k+1} - theta_k)`` (exact for the held torque; positive =
+        harvested) plus the change of the pendulum's stored energy ``E = theta'^2 / 2 +
+        cos(theta)`` over that span, divided by its duration.
+    harvested_power : float
+        The harvested energy alone over the same span, per unit time.
+    stored_energy_change : float
+        ``E(end) - E(start of the span)`` (m g l).
+    average_start_period, averaged_periods : int
+        The span: its first period (the lock period when locked) and its length.
     predicted_power : float
         Power of the optimum the controller tracks.
     optimum_at_torque_limit : float or None
@@ -82,6 +90,10 @@ class TrackResult(_Result):
     lock_period: int | None
     catch_period: float | None
     mean_power: float
+    harvested_power: float
+    stored_energy_change: float
+    average_start_period: int
+    averaged_periods: int
     predicted_power: float
     optimum_at_torque_limit: float | None
     peak_torque: float
@@ -375,9 +387,16 @@ def simulate_design(d: Design, *, periods: int, seed: int = 0, gamma_error: floa
                           noise=(noise_theta, noise_speed), rng=rng)
     m = tg.samples
     w = energy_series(run)
-    tail = AVERAGE_PERIODS * m
-    mean_power = float((w[-1] - w[-1 - tail]) / (AVERAGE_PERIODS * tg.period))
     per, lock, err = lock_analysis(run, tg, lock_tolerance)
+    # the account from the lock to the end (else the last AVERAGE_PERIODS periods): the
+    # harvested energy plus the change of the pendulum's stored energy, per unit time
+    start = lock if lock is not None else max(per.size - AVERAGE_PERIODS, 0)
+    span = (per.size - start) * tg.period
+    i0 = start * m
+    harvested = float(w[-1] - w[i0])
+    e = mechanical_energy(run)
+    stored = float(e[-1] - e[i0])
+    mean_power = (harvested + stored) / span
     catch = np.nonzero(run.mode)[0]
     e_lock = None if lock is None else float(w[lock * m])
     payback = None
@@ -387,7 +406,10 @@ def simulate_design(d: Design, *, periods: int, seed: int = 0, gamma_error: floa
                                            if mean_power > 0 else None)
     fields = {"locked": lock is not None, "lock_period": lock,
               "catch_period": float(catch[0] / m) if catch.size else None,
-              "mean_power": mean_power, "peak_torque": float(np.max(np.abs(run.torque))),
+              "mean_power": mean_power, "harvested_power": harvested / span,
+              "stored_energy_change": stored, "average_start_period": start,
+              "averaged_periods": per.size - start,
+              "peak_torque": float(np.max(np.abs(run.torque))),
               "energy_before_lock": e_lock, "payback_periods": payback,
               "tracking_error": err, "plant_gamma": plant_gamma, "sea": sea_info}
     return run, fields
@@ -469,7 +491,9 @@ def _result(d: Design, *, periods, seed, gamma_error, delta_error, noise_theta, 
             irregular, lock_tolerance, state0, throw, rng=None) -> TrackResult:
     tg = d.target
     failed = {"locked": False, "lock_period": None, "catch_period": None,
-              "mean_power": math.nan, "peak_torque": math.nan, "energy_before_lock": None,
+              "mean_power": math.nan, "harvested_power": math.nan,
+              "stored_energy_change": math.nan, "average_start_period": 0,
+              "averaged_periods": 0, "peak_torque": math.nan, "energy_before_lock": None,
               "payback_periods": None, "tracking_error": math.nan, "plant_gamma": math.nan}
     if d.status == "infeasible":
         msg = f"no rotation within the design torque limit: {d.message}"
