@@ -31,7 +31,8 @@ from .._jit import announce_compiles
 
 announce_compiles()  # log a first-use compile (parapend._jit)
 
-__all__ = ["constraint_weights", "fused_gram", "objective_weights", "reaction", "torque"]
+__all__ = ["constraint_weights", "fused_gram", "gradient_and_weights", "objective_weights",
+           "reaction", "reduced_hessian", "torque"]
 
 
 @nb.njit(cache=True)
@@ -166,3 +167,47 @@ def fused_gram(v, idx, coef, symmetric):
             if symmetric:
                 out[k, i] = acc
     return out
+
+
+@nb.njit(cache=True)
+def gradient_and_weights(f, f1, f2, qx, qz, ft, fv, ftt, ftv, fvv, rows, coupled, sinv, q3t,
+                         pi_t, p012t, ml, inertia, c, g, dp, hp):
+    """The first half of an evaluation: the Lagrangian's pointwise derivatives (the
+    objective's; with ``coupled``, plus the hull's reaction weighted by the adjoint ``mu``,
+    ``S^T lambda = d<f>/dy``, ``mu = Pi^T lambda``), the reduced gradient ``P^T d1`` and
+    the weights whose spectra give the Hessian: the pairs ``rows`` of the second
+    derivatives, then (coupled) the nine sensitivity weights. ``sinv`` is ``S^{-1}``,
+    ``q3t`` the map ``y -> (p_x'', p_z'', beta')`` transposed, ``pi_t`` the projection
+    transposed (3M, ny), ``p012t`` the map ``x -> (phi, phi', phi'')`` transposed."""
+    m = f.size
+    d1, d2 = objective_weights(f, qx, qz, ft, fv, ftt, ftv, fvv, ml, inertia, c, g)
+    nr = rows.size
+    w = np.empty((nr + (9 if coupled else 0), m))
+    if coupled:
+        gy = q3t @ d1[3:].copy().reshape(3 * m)
+        lam = sinv.T @ gy
+        mu = (pi_t @ lam).reshape(3, m)
+        c1, c2, sens = constraint_weights(f, f1, f2, qx, qz, mu, ml, inertia, g, dp, hp)
+        d1 += c1
+        d2 += c2
+        w[nr:] = sens
+    for i in range(nr):
+        w[i] = d2[rows[i]]
+    grad = p012t @ d1[:3].copy().reshape(3 * m)
+    return grad, w
+
+
+@nb.njit(cache=True)
+def reduced_hessian(v, xx_idx, xx_coef, xy_idx, xy_coef, yy_idx, yy_coef, s_idx, s_coef,
+                    coupled, sinv):
+    """The second half: the Hessian's blocks gathered from the weights' spectra ``v``
+    (flattened), reduced by the sensitivity ``T = S^{-1} g_x``:
+    ``H = L_xx + L_xy T + T^T L_yx + T^T L_yy T``, symmetrized."""
+    hxx = fused_gram(v, xx_idx, xx_coef, True)
+    if coupled:
+        hxy = fused_gram(v, xy_idx, xy_coef, False)
+        hyy = fused_gram(v, yy_idx, yy_coef, True)
+        t = sinv @ fused_gram(v, s_idx, s_coef, False)
+        ht = hxy @ t
+        hxx = hxx + ht + ht.T + t.T @ (hyy @ t)
+    return 0.5 * (hxx + hxx.T)

@@ -88,6 +88,15 @@ class FusedGram:
         self.idx = np.ascontiguousarray(np.stack(idx, axis=-1), dtype=np.int32)
         self.coef = np.ascontiguousarray(np.stack(coef, axis=-1), dtype=float)
 
+    @classmethod
+    def empty(cls) -> FusedGram:
+        """No terms (an absent block: gathers nothing)."""
+        g = cls.__new__(cls)
+        g.symmetric = False
+        g.idx = np.zeros((0, 0, 0), dtype=np.int32)
+        g.coef = np.zeros((0, 0, 0))
+        return g
+
     def __call__(self, v: np.ndarray) -> np.ndarray:
         """``v`` the stacked spectra of :func:`spectra` (the gathers compiled:
         :func:`parapend.hydro._hull_kernel.fused_gram`)."""

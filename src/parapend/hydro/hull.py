@@ -39,10 +39,10 @@ import math
 from dataclasses import dataclass, field
 
 import numpy as np
-from scipy.linalg.lapack import dgetrf, dgetrs
+from scipy.linalg.lapack import dgetrf, dgetri, dgetrs
 
 from ..errors import ParameterError
-from ._hull_kernel import constraint_weights, objective_weights, reaction, torque
+from ._hull_kernel import gradient_and_weights, reaction, reduced_hessian, torque
 from ._trig import FusedGram, GramPlan, TrigColumns, spectra
 from .pto import PTOObjective, _abs
 
@@ -73,6 +73,15 @@ def _lu(a):
 def _solve(lu, b, trans=0):
     x, info = dgetrs(lu[0], lu[1], b, trans=trans)
     return x
+
+
+def _inverse(lu):
+    """``S^{-1}`` from its LU factors (LAPACK getri): the adjoint and the sensitivity's
+    ``2N + 2`` right sides as products in the compiled kernel."""
+    inv, info = dgetri(lu[0], lu[1])
+    if info != 0:
+        raise np.linalg.LinAlgError("the hull's equations are singular at this motion")
+    return inv
 
 
 def _full(t, m: int) -> np.ndarray:
@@ -223,6 +232,10 @@ class HullProblem(PTOObjective):
         self.Qz = E2[1] - dp * E2[2]
         self._Q3 = np.vstack((self.Qx, self.Qz, E1[2]))  # y -> (p_x'', p_z'', beta')
         self._Q3T = np.ascontiguousarray(self._Q3.T)
+        self._Pi_t = np.ascontiguousarray(self.Pi_all.T)
+        # the uncoupled problem's absent blocks, typed as the kernel expects
+        self._none2 = np.zeros((0, 0))
+        self._none3 = FusedGram.empty()
         self._trig_maps(kn, kh, j0)
         # Z (real form) and the wave's force
         Z = np.zeros((ny, ny))
@@ -448,41 +461,29 @@ class HullProblem(PTOObjective):
 
         The Lagrangian ``<f(tau, v)> + mu . rho`` (``mu`` the adjoint of the hull's
         equations ``S y = b``, ``S^T lambda = d<f>/dy``) has pointwise derivatives in
-        ``_VARS`` (:mod:`._hull_kernel`); the gradient maps the first ones back to ``x``,
-        the Hessian's blocks are their Gram matrices (one FFT per weight), reduced by the
-        sensitivity ``T = S^{-1} g_x``: ``H = L_xx + L_xy T + T^T L_yx + T^T L_yy T``."""
+        ``_VARS``; the gradient maps the first ones back to ``x``, the Hessian's blocks are
+        their Gram matrices (one FFT per weight), reduced by the sensitivity ``T = S^{-1}
+        g_x``: ``H = L_xx + L_xy T + T^T L_yx + T^T L_yy T`` (:mod:`._hull_kernel`: the
+        work before and after the FFT, each one compiled call)."""
         x = np.asarray(x, dtype=float)
         y, lu = self.solve_hull(x)
         st = self.grid_state(x, y)
         cs = self.case
-        m, ml = self.points, cs.m * cs.l
+        m = self.points
         terms = self._objective(st)
-        ft, fv, ftt, ftv, fvv = (_full(t, m) for t in terms[1:])
-        d1, d2 = objective_weights(st["phi"], st["qx"], st["qz"], ft, fv, ftt, ftv, fvv, ml,
-                                   cs.I, cs.c, cs.g)
         coupled = lu is not None
         keys, rows = self._keys(terms[3] is None, coupled)
-        if coupled:
-            lam = _solve(lu, self._Q3T @ d1[3:].ravel(), trans=1)
-            mu = (self.Pi_all.T @ lam).reshape(3, m)
-            dp, hp = cs.pivot
-            c1, c2, sens = constraint_weights(st["phi"], st["phi1"], st["phi2"], st["qx"],
-                                              st["qz"], mu, ml, cs.I, cs.g, dp, hp)
-            d1, d2 = d1 + c1, d2 + c2
-            v = spectra(np.concatenate((d2[rows], sens)))
-        else:
-            v = spectra(d2[rows])
-        grad = self._P012T @ d1[:3].ravel()
+        sinv = _inverse(lu) if coupled else self._none2
+        grad, w = gradient_and_weights(
+            st["phi"], st["phi1"], st["phi2"], st["qx"], st["qz"],
+            *(_full(t, m) for t in terms[1:]), rows, coupled, sinv, self._Q3T, self._Pi_t,
+            self._P012T, cs.m * cs.l, cs.I, cs.c, cs.g, *cs.pivot)
         fused = self._fused(keys, coupled)
-        hxx = fused["xx"](v)
+        blocks = [fused.get(b, self._none3) for b in ("xx", "xy", "yy", "sens")]
+        h = reduced_hessian(spectra(w).ravel(), *(a for fg in blocks for a in (fg.idx, fg.coef)),
+                            coupled, sinv)
         val = st["power"] if self.lossless else float(np.mean(terms[0]))
-        if not coupled:
-            return val, grad, 0.5 * (hxx + hxx.T)
-        hxy, hyy, gx = fused["xy"](v), fused["yy"](v), fused["sens"](v)
-        t = _solve(lu, gx)
-        ht = hxy @ t
-        h = hxx + ht + ht.T + t.T @ (hyy @ t)
-        return val, grad, 0.5 * (h + h.T)
+        return val, grad, h
 
     # --------------------------------------------------------------------------------------
     def harmonics_of(self, y) -> np.ndarray:
