@@ -152,17 +152,18 @@ def constraint_weights(f, f1, f2, qx, qz, mu, ml, inertia, g, dp, hp):
 
 
 @nb.njit(cache=True)
-def fused_gram(v, idx, coef, symmetric):
-    """``sum_p coef[:, :, p] * v[idx[:, :, p]]`` (the gathers of :class:`.FusedGram`,
-    ``v`` the stacked spectra flattened); ``symmetric``: a sum known to be symmetric,
-    gathered on and above the diagonal and mirrored."""
-    n1, n2, np_ = idx.shape
+def fused_gram(v, ptr, idx, coef, n1, n2, symmetric):
+    """The (n1, n2) sum of :class:`.FusedGram`: entry ``e = i n2 + k`` is
+    ``sum coef[j] v[idx[j]]`` over ``j`` in ``ptr[e]:ptr[e + 1]`` (``v`` the stacked
+    spectra flattened); ``symmetric``: only the entries on and above the diagonal are
+    stored, mirrored."""
     out = np.zeros((n1, n2))
     for i in range(n1):
         for k in range(i if symmetric else 0, n2):
+            e = i * n2 + k
             acc = 0.0
-            for p in range(np_):
-                acc += coef[i, k, p] * v[idx[i, k, p]]
+            for j in range(ptr[e], ptr[e + 1]):
+                acc += coef[j] * v[idx[j]]
             out[i, k] = acc
             if symmetric:
                 out[k, i] = acc
@@ -198,16 +199,16 @@ def gradient_and_weights(f, f1, f2, qx, qz, ft, fv, ftt, ftv, fvv, rows, coupled
 
 
 @nb.njit(cache=True)
-def reduced_hessian(v, xx_idx, xx_coef, xy_idx, xy_coef, yy_idx, yy_coef, s_idx, s_coef,
-                    coupled, sinv):
+def reduced_hessian(v, xx, xy, yy, sens, coupled, sinv):
     """The second half: the Hessian's blocks gathered from the weights' spectra ``v``
-    (flattened), reduced by the sensitivity ``T = S^{-1} g_x``:
-    ``H = L_xx + L_xy T + T^T L_yx + T^T L_yy T``, symmetrized."""
-    hxx = fused_gram(v, xx_idx, xx_coef, True)
+    (flattened; each block the arguments of :func:`fused_gram` after ``v``), reduced by
+    the sensitivity ``T = S^{-1} g_x``: ``H = L_xx + L_xy T + T^T L_yx + T^T L_yy T``,
+    symmetrized."""
+    hxx = fused_gram(v, *xx)
     if coupled:
-        hxy = fused_gram(v, xy_idx, xy_coef, False)
-        hyy = fused_gram(v, yy_idx, yy_coef, True)
-        t = sinv @ fused_gram(v, s_idx, s_coef, False)
+        hxy = fused_gram(v, *xy)
+        hyy = fused_gram(v, *yy)
+        t = sinv @ fused_gram(v, *sens)
         ht = hxy @ t
         hxx = hxx + ht + ht.T + t.T @ (hyy @ t)
     return 0.5 * (hxx + hxx.T)

@@ -71,36 +71,51 @@ class GramPlan:
 
 class FusedGram:
     """A sum of Gram matrices ``sum_p G_p(w_{k_p})`` (each :class:`GramPlan` ``p`` on the
-    weight ``k_p``, transposed where asked) in one gather from the stacked spectra: the
-    per-plan calls' overhead, not their arithmetic, is what it saves."""
+    weight ``k_p``, transposed where asked) in one gather from the stacked spectra, the
+    gathers of each entry stored compressed (row pointers ``ptr`` over the entries in row
+    order, then their spectrum indices ``idx`` and coefficients ``coef``): the zero
+    coefficients (a hull column of one DOF in a map of another, half of them and more)
+    are left out, and a symmetric sum keeps the entries on and above the diagonal only."""
 
     def __init__(self, terms, m: int, symmetric: bool = False):
         """``terms``: ``(plan, k, transposed)`` of one shape (after the transposition);
         ``symmetric``: the sum is symmetric (each term's transpose among the terms, or
-        square with symmetric columns): half the gathers."""
+        square with symmetric columns)."""
         self.symmetric = bool(symmetric)
         idx, coef = [], []
         for plan, k, tr in terms:
             for i, c in ((plan.i1, plan.c1), (plan.i2, plan.c2)):
                 idx.append((i.T if tr else i) + 2 * (m // 2 + 1) * k)
                 coef.append(c.T if tr else c)
-        # (n1, n2, P): an entry's gathers side by side
-        self.idx = np.ascontiguousarray(np.stack(idx, axis=-1), dtype=np.int32)
-        self.coef = np.ascontiguousarray(np.stack(coef, axis=-1), dtype=float)
+        idx, coef = np.stack(idx, axis=-1), np.stack(coef, axis=-1)  # (n1, n2, P)
+        n1, n2, _ = idx.shape
+        keep = coef != 0.0
+        if symmetric:
+            keep &= (np.arange(n2)[None, :] >= np.arange(n1)[:, None])[:, :, None]
+        self.shape = (n1, n2)
+        self.ptr = np.zeros(n1 * n2 + 1, dtype=np.int32)
+        np.cumsum(keep.reshape(n1 * n2, -1).sum(axis=1), out=self.ptr[1:])
+        self.idx = np.ascontiguousarray(idx[keep], dtype=np.int32)
+        self.coef = np.ascontiguousarray(coef[keep], dtype=float)
 
     @classmethod
     def empty(cls) -> FusedGram:
         """No terms (an absent block: gathers nothing)."""
         g = cls.__new__(cls)
-        g.symmetric = False
-        g.idx = np.zeros((0, 0, 0), dtype=np.int32)
-        g.coef = np.zeros((0, 0, 0))
+        g.symmetric, g.shape = False, (0, 0)
+        g.ptr = np.zeros(1, dtype=np.int32)
+        g.idx = np.zeros(0, dtype=np.int32)
+        g.coef = np.zeros(0)
         return g
+
+    def arrays(self) -> tuple:
+        """``(ptr, idx, coef, n1, n2, symmetric)``: the compiled gather's arguments."""
+        return self.ptr, self.idx, self.coef, self.shape[0], self.shape[1], self.symmetric
 
     def __call__(self, v: np.ndarray) -> np.ndarray:
         """``v`` the stacked spectra of :func:`spectra` (the gathers compiled:
         :func:`parapend.hydro._hull_kernel.fused_gram`)."""
-        return fused_gram(np.ascontiguousarray(v).ravel(), self.idx, self.coef, self.symmetric)
+        return fused_gram(np.ascontiguousarray(v).ravel(), *self.arrays())
 
 
 def spectra(weights) -> np.ndarray:

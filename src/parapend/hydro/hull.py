@@ -479,9 +479,8 @@ class HullProblem(PTOObjective):
             *(_full(t, m) for t in terms[1:]), rows, coupled, sinv, self._Q3T, self._Pi_t,
             self._P012T, cs.m * cs.l, cs.I, cs.c, cs.g, *cs.pivot)
         fused = self._fused(keys, coupled)
-        blocks = [fused.get(b, self._none3) for b in ("xx", "xy", "yy", "sens")]
-        h = reduced_hessian(spectra(w).ravel(), *(a for fg in blocks for a in (fg.idx, fg.coef)),
-                            coupled, sinv)
+        blocks = [fused.get(b, self._none3).arrays() for b in ("xx", "xy", "yy", "sens")]
+        h = reduced_hessian(spectra(w).ravel(), *blocks, coupled, sinv)
         val = st["power"] if self.lossless else float(np.mean(terms[0]))
         return val, grad, h
 
