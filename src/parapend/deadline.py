@@ -60,12 +60,13 @@ def duration(seconds: float) -> str:
 
 
 def refuse_untimed(option: str, what: str, seconds: float, fix: str,
-                   time_limit=None) -> None:
+                   time_limit=None, cap: float | None = None) -> None:
     """Raise the one-line refusal of work estimated at ``seconds`` when no ``time_limit`` is
-    given and the estimate exceeds :data:`parapend.limits.MAX_UNTIMED_SECONDS`: ``option``
-    names the option to change, ``what`` the work, ``fix`` the largest value that fits (e.g.
-    ``"use --records at most 3"``). Returns without a word otherwise."""
-    cap = limits.MAX_UNTIMED_SECONDS
+    given and the estimate exceeds ``cap`` (default
+    :data:`parapend.limits.MAX_UNTIMED_SECONDS`): ``option`` names the option to change,
+    ``what`` the work, ``fix`` the largest value that fits (e.g. ``"use --records at most
+    3"``). Returns without a word otherwise."""
+    cap = limits.MAX_UNTIMED_SECONDS if cap is None else cap
     if time_limit is not None or not seconds > cap:
         return
     raise ParameterError(f"{option}: {what} is estimated at roughly {duration(seconds)}, more "
