@@ -880,7 +880,12 @@ def _power_matrix_result(power_matrix, arguments):
                                else annual["power"].get("capacity_factor")),
            "store": run.store, "computed_bins": run.computed_points // int(a["realizations"]),
            "resumed_bins": run.resumed_points // int(a["realizations"]), "seconds": seconds,
-           "executor": run.executor, "netcdf": netcdf, "zarr": zarr, "csv": csv}
+           "executor": run.executor, "netcdf": netcdf, "zarr": zarr, "csv": csv,
+           # a time limit may stop the run: a partial matrix (parapend.deadline)
+           "status": ds.attrs.get("status", "ok"), "success": not run.stopped,
+           "bins_finished": int(ds.attrs.get("bins_finished", ds["hm0"].size
+                                             * ds[pk].size)),
+           "bins": int(ds["hm0"].size * ds[pk].size)}
     return Record("power-matrix", out, dataset=ds, run=run,
                   draw=_draw_dataset("performance.figures", "plot_matrix"))
 
