@@ -142,7 +142,8 @@ def matrix_spec(*, hs="1:3:3", te=None, tp=None, realizations: int = 3, waves: f
     if torque_limit is not None and heave:
         raise ParameterError("torque-limit: not supported over a sea record (parapend sea "
                              "solves the unconstrained optimum); drop --torque-limit")
-    hm0 = parse_bins("hs", hs)
+    # None: the default bins, as te (parse_bins(None) read as one centre: "got 1")
+    hm0 = parse_bins("hs", "1:3:3" if hs is None else hs)
     if te is not None and tp is not None:
         raise ParameterError("te, tp: give the period bins as one of --te or --tp")
     kind, per = ("tp", tp) if tp is not None else ("te", "6:10:3" if te is None else te)
