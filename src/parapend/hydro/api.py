@@ -117,11 +117,20 @@ def _check_bem_size(radius, draft):
         mid = math.sqrt(a * b)
         w = work(mid, small) if big == "radius" else work(small, mid)
         a, b = (mid, b) if w <= cap else (a, mid)
+    other = ""
+    if big == "radius" and work(radius, radius) <= cap:
+        # the panels follow the draft: a deeper draft coarsens them (a wide, shallow body's
+        # mesh is the costly one); the smallest draft that fits at this radius
+        lo_d, hi_d = draft, radius
+        for _ in range(60):
+            mid = math.sqrt(lo_d * hi_d)
+            lo_d, hi_d = (lo_d, mid) if work(radius, mid) <= cap else (mid, hi_d)
+        other = f", or --draft at least {hi_d * (1 + 1e-3):.3g} m at this radius"
     raise ParameterError(f"{big}: a cylinder of radius {radius:g} m and draft {draft:g} m "
                          f"needs a BEM of about {work(radius, draft):.3g} influence "
                          f"coefficients per frequency, more than the {cap:.3g} that finish in "
                          f"about a minute (the panels follow the smaller dimension); use "
-                         f"--{big} at most {a:.3g} m")
+                         f"--{big} at most {a:.3g} m{other}")
 
 
 def _check_harmonics(harmonics, winding, pto):
