@@ -119,8 +119,9 @@ def optimize_design(solve, pendulum, variables, bounds, *, check=None,
         search makes, ``design_solves``), and ``progress(total, total)`` at the end.
     deadline : float or None
         A :func:`time.monotonic` time (:func:`parapend.deadline.deadline`): once it has
-        passed, the search stops before its next inner solve (after at least one) and
-        returns the best design evaluated, with ``status`` ``"time_limit"``.
+        passed, the search stops before its next inner solve (once a design that harvests
+        power is found) and returns the best design evaluated, with ``status``
+        ``"time_limit"``.
     """
     from scipy.optimize import minimize, minimize_scalar
 
@@ -140,8 +141,8 @@ def optimize_design(solve, pendulum, variables, bounds, *, check=None,
         key = tuple(np.round(u, 12))
         if key in cache:
             return cache[key]
-        if cache and expired(deadline):
-            raise _TimeUp
+        if expired(deadline) and any(v > 0 for v in cache.values()):
+            raise _TimeUp  # (a design that harvests power is found first: it is the answer)
         p = _physical(pendulum, names, lo + u * (hi - lo))
         try:
             if check is not None:
