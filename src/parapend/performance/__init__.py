@@ -601,6 +601,7 @@ def power_matrix(*, hs="1:3:3", te=None, tp=None, realizations: int = 3, waves: 
     est = check_size(spec, workers, scheduler)
     if scheduler is None:
         workers = est["processes"]
+    check_bins(spec)
     if est["seconds"] is not None and store is None:
         # resumable work (--store) is announced and runs; in memory it must fit the cap
         each = est["seconds"] / est["solves"]  # one solve's share of the wall time
@@ -614,7 +615,6 @@ def power_matrix(*, hs="1:3:3", te=None, tp=None, realizations: int = 3, waves: 
                         f"use at most {max(1, most // spec.realizations)} bins (--hs times "
                         f"--{spec.period_kind} centres) at {spec.realizations} realizations")
                        + " or --store (resumable work: a rerun resumes)", time_limit)
-    check_bins(spec)
     frequency, outside = None, None
     pk = spec.period_kind
     if scatter is not None:
