@@ -298,3 +298,20 @@ def test_power_matrix_partial_text_is_marked(capsys):
     assert main(argv) == 0
     out = capsys.readouterr().out
     assert "status: time_limit: PARTIAL matrix, bins 1 of 4 finished" in out
+
+
+@pytest.mark.slow
+def test_power_matrix_partial_on_local_processes(full_matrix):
+    """Two worker processes: the deadline passes once the first bin is written; the bins
+    still running are abandoned (never marked done), and the finished ones equal a full
+    run's."""
+    from parapend import deadline
+    from parapend.performance import power_matrix
+
+    ds, _, run, _ = power_matrix(**{**TINY, "workers": 2}, time_limit=1e-9)
+    assert run.stopped and ds.attrs["status"] == "time_limit"
+    p, ref = ds["power_mean"].values, full_matrix["power_mean"].values
+    done = np.isfinite(p)
+    assert 1 <= done.sum() == ds.attrs["bins_finished"] < 4
+    assert np.allclose(p[done], ref[done], rtol=1e-12, atol=0)
+    assert deadline.expired(0.0) and not deadline.expired(None)
