@@ -215,6 +215,14 @@ def _stats(a):
     return float(np.mean(a[ok])), float(np.min(a[ok])), float(np.max(a[ok]))
 
 
+def _longest_record(exc, warm_up, tp_n, records, est, cap) -> float:
+    """The longest record (pendulum time) one curve of the estimate ``est`` (s, over
+    ``records`` records like ``exc``) fits in ``cap`` seconds with: the estimate is in
+    proportion to each run's length, the record plus the warm-up."""
+    run = exc.period + warm_up * tp_n
+    return max(run * cap / (est / records) - warm_up * tp_n, 0.0)
+
+
 def horizon_curve(*, hs=None, tp=None, spectrum: str = "jonswap", gamma_peak: float = 3.3,
                   repeat_period=None, seed=None, cutoff: float = 3.0,
                   length: float = SEA["length"], mass: float = SEA["mass"], inertia=None,
@@ -351,12 +359,14 @@ def horizon_curve(*, hs=None, tp=None, spectrum: str = "jonswap", gamma_peak: fl
         update_seconds(h, torque_limit, f) for f in fc for h in hz)
     cap = limits.HORIZON_MAX_UNTIMED_SECONDS
     most = int(cap / (est / records)) if est > 0 else records
+    longest = _longest_record(excs[0], warm_up, tp_n, records, est, cap) * units.time
     refuse_untimed("records" if most >= 1 else "repeat-period",
                    f"{records} record(s) x {len(fc)} forecast(s) x {len(hz)} horizon(s) of "
                    f"receding-horizon runs, {math.ceil(mpc_samples[0] / upd_samples)} "
                    "updates each,", est,
                    f"use --records at most {most}" if most >= 1 else
-                   "use a shorter --repeat-period, fewer --horizons or --forecasts",
+                   f"use --repeat-period at most {longest:.4g} s (one record), or fewer "
+                   "--horizons or --forecasts",
                    time_limit, cap)
     if est > ANNOUNCE_SECONDS:
         log.info("horizon: %d record(s) x %d forecast(s) x %d horizon(s) of receding-horizon "
