@@ -359,7 +359,8 @@ def horizon_curve(*, hs=None, tp=None, spectrum: str = "jonswap", gamma_peak: fl
         update_seconds(h, torque_limit, f) for f in fc for h in hz)
     cap = limits.HORIZON_MAX_UNTIMED_SECONDS
     most = int(cap / (est / records)) if est > 0 else records
-    longest = _longest_record(excs[0], warm_up, tp_n, records, est, cap) * units.time
+    longest = (_longest_record(excs[0], warm_up, tp_n, records, est, cap) * units.time
+               if est > 0 else math.inf)  # (no receding-horizon run: nothing to refuse)
     refuse_untimed("records" if most >= 1 else "repeat-period",
                    f"{records} record(s) x {len(fc)} forecast(s) x {len(hz)} horizon(s) of "
                    f"receding-horizon runs, {math.ceil(mpc_samples[0] / upd_samples)} "
