@@ -416,9 +416,12 @@ def test_dataset_scales_in_reach_accepted():
     ["--optimize-design", "mass,length,inertia,damping-coefficient", "--torque-limit", "100"],
 ])
 def test_design_search_refused_before_work(capsys, args):
-    """A design search whose solves cannot finish in about ten minutes (four variables with
-    an efficiency: about 40 minutes) is refused before any solve, naming what fits."""
-    assert "at most 1 of them" in _refused(capsys, *args, names=["optimize-design"])
+    """A design search whose solves cannot finish in two minutes without a time limit (one
+    variable with an efficiency: about 5 minutes, four about 40) is refused before any
+    solve, naming what fits and --time-limit (docs/limits-of-input.md)."""
+    err = _refused(capsys, *args, names=["optimize-design"])
+    assert "drop --efficiency and --torque-limit from the search" in err
+    assert "--time-limit SECONDS" in err
 
 
 @pytest.mark.parametrize("names", [["length"], ["mass", "length", "inertia",
@@ -487,8 +490,9 @@ def test_plot_into_proc_refused_before_the_work(capsys):
 
 
 def test_a_long_design_search_announces_its_estimate(caplog):
-    """Four variables fit the cap but take minutes: the estimate is logged first (the CLI
-    prints the logger ``parapend.hydro`` on stderr), where a short search stays silent."""
+    """Three variables fit the cap but take over a minute, four run under a time limit: the
+    estimate is logged first (the CLI prints the logger ``parapend.hydro`` on stderr), where
+    a short search stays silent."""
     import logging
 
     from parapend.hydro.api import _check_design
@@ -496,6 +500,8 @@ def test_a_long_design_search_announces_its_estimate(caplog):
     with caplog.at_level(logging.INFO, logger="parapend.hydro"):
         _check_design(1, False)
         assert not caplog.records
-        _check_design(4, False)
-    assert len(caplog.records) == 1
-    assert "optimize-design over 4 variables" in caplog.records[0].getMessage()
+        _check_design(3, False)
+        _check_design(4, False, time_limit=60.0)
+    assert len(caplog.records) == 2
+    assert "optimize-design over 3 variables" in caplog.records[0].getMessage()
+    assert "stopped after the time limit 60 s" in caplog.records[1].getMessage()

@@ -400,12 +400,13 @@ def test_the_zarr_export_is_checked_before_and_written_after(tmp_path, monkeypat
 
 
 def test_long_work_is_announced_before_it_starts(caplog, no_solve):
-    """300 solves of 50-wave records on 2 processes: about 3 s each, 8 minutes."""
+    """300 solves of 50-wave records on 2 processes: about 3 s each, 8 minutes (over the
+    2 minutes a matrix in memory may take without --time-limit: given here)."""
     import logging
 
     with caplog.at_level(logging.INFO, logger="parapend.performance"), \
             pytest.raises(AssertionError, match="the engine ran"):
-        parapend.power_matrix(hs="0.5:5:10", te="4:13:10", workers=2)
+        parapend.power_matrix(hs="0.5:5:10", te="4:13:10", workers=2, time_limit=3600.0)
     (msg,) = [r.getMessage() for r in caplog.records if r.name == "parapend.performance"]
     assert msg.startswith("power matrix: 100 bins x 3 realizations = 300 solves of 50-wave "
                           "records on 2 processes: roughly 8 minutes")

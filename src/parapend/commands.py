@@ -571,7 +571,8 @@ def track(*, excitation=None, omega=OMEGA, delta=None, square_alpha=None, fourie
           amplitude=None, damping_coefficient=None, torque_limit_nm=None, progress=None,
           controller: str = TRACK["controller"], horizon: float = TRACK["horizon"],
           update_interval: float = TRACK["update_interval"],
-          forecast: str = TRACK["forecast"], speed_limit=TRACK["speed_limit"]):
+          forecast: str = TRACK["forecast"], speed_limit=TRACK["speed_limit"],
+          time_limit=None):
     """Swing up from rest, catch and hold the optimal rotation (command ``track``): a
     :class:`~parapend.control.track.TrackResult` (``runs`` 1) or a
     :class:`~parapend.control.robustness.RobustnessResult` (more seeded runs). With
@@ -583,7 +584,8 @@ def track(*, excitation=None, omega=OMEGA, delta=None, square_alpha=None, fourie
     :class:`~parapend.control.mpc.MPCTrackResult`), with ``horizon`` and
     ``update_interval`` in forcing (peak) periods and the wave ``forecast`` ("perfect" or
     "ar") and the plans' rated ``speed_limit`` (none by default); one run, no model error
-    or noise."""
+    or noise; ``time_limit`` (s) runs it under a time limit (:mod:`parapend.deadline`: a
+    run estimated over two minutes is refused without one)."""
     from .control.robustness import track_runs
     from .control.track import track as _track
 
@@ -601,7 +603,9 @@ def track(*, excitation=None, omega=OMEGA, delta=None, square_alpha=None, fourie
                 frequency=frequency, amplitude=amplitude,
                 damping_coefficient=damping_coefficient, torque_limit_nm=torque_limit_nm),
             horizon=horizon, update_interval=update_interval, forecast=forecast,
-            speed_limit=speed_limit, progress=progress)
+            speed_limit=speed_limit, progress=progress, time_limit=time_limit)
+    if time_limit is not None:
+        raise ParameterError("time-limit: bounds long work only: needs --controller mpc")
     if (horizon, update_interval, forecast) != (2.0, 0.03125, "perfect"):
         raise ParameterError("horizon: --horizon, --update-interval and --forecast belong to "
                              "--controller mpc")
@@ -638,7 +642,7 @@ def track(*, excitation=None, omega=OMEGA, delta=None, square_alpha=None, fourie
 
 def _track_mpc(*, excitation, omega, delta, square_alpha, fourier, file, gamma, torque_limit,
                theta0, theta_dot0, periods, seed, runs, errors, irregular, units_kw, horizon,
-               update_interval, forecast, speed_limit=None, progress=None):
+               update_interval, forecast, speed_limit=None, progress=None, time_limit=None):
     """``track --controller mpc`` (:func:`parapend.control.mpc.track_mpc`)."""
     from .api import build_excitation
     from .control.mpc import track_mpc
@@ -665,7 +669,7 @@ def _track_mpc(*, excitation, omega, delta, square_alpha, fourier, file, gamma, 
     r = track_mpc(exc, gamma=gamma, horizon=horizon, update_interval=update_interval,
                   forecast=forecast, torque_limit=torque_limit, periods=periods, seed=seed,
                   irregular=irregular, theta0=theta0, theta_dot0=theta_dot0,
-                  speed_limit=speed_limit, progress=progress)
+                  speed_limit=speed_limit, progress=progress, time_limit=time_limit)
     if units is None:
         return r
     tp = 2 * math.pi / r.omega
@@ -876,7 +880,12 @@ def _power_matrix_result(power_matrix, arguments):
                                else annual["power"].get("capacity_factor")),
            "store": run.store, "computed_bins": run.computed_points // int(a["realizations"]),
            "resumed_bins": run.resumed_points // int(a["realizations"]), "seconds": seconds,
-           "executor": run.executor, "netcdf": netcdf, "zarr": zarr, "csv": csv}
+           "executor": run.executor, "netcdf": netcdf, "zarr": zarr, "csv": csv,
+           # a time limit may stop the run: a partial matrix (parapend.deadline)
+           "status": ds.attrs.get("status", "ok"), "success": not run.stopped,
+           "bins_finished": int(ds.attrs.get("bins_finished", ds["hm0"].size
+                                             * ds[pk].size)),
+           "bins": int(ds["hm0"].size * ds[pk].size)}
     return Record("power-matrix", out, dataset=ds, run=run,
                   draw=_draw_dataset("performance.figures", "plot_matrix"))
 

@@ -17,7 +17,25 @@ __all__ = [
     "SQUARE_ALPHA_MIN", "MAP_MAX_POINTS", "MAP_MAX_PTO_POINTS", "MAP_MAX_HARMONICS",
     "MAP_MAX_WORK", "UNIT_GRAVITY_RANGE", "UNIT_INERTIA_RATIO", "UNIT_LENGTH_RANGE",
     "UNIT_MASS_RANGE", "SEA_MAX_RESAMPLED", "SEA_MIN_HS", "TRACK_MAX_STEP_RATE",
+    "MAX_UNTIMED_SECONDS", "MAX_TIME_LIMIT", "HORIZON_MAX_UNTIMED_SECONDS",
 ]
+
+# --- long work: estimate first, then refuse or run under a time limit (parapend.deadline) ---
+#: work whose up-front estimate exceeds this many seconds is refused in one line unless
+#: ``--time-limit`` is given (then it runs until the limit and returns a partial result
+#: marked "time_limit"): the design search, the buoy's period sweep and receding-horizon
+#: run, horizon, track --controller mpc, and the power matrix without --store (a store
+#: resumes, so its long work is announced and runs). Two minutes: the audits' bound on a
+#: command; the estimates are rounded up, so work near it takes less
+MAX_UNTIMED_SECONDS = 120.0
+#: the same for ``parapend horizon``: its default curve (one 800 s record, two forecasts x
+#: five horizons, 3200 updates each) is estimated at 9 minutes and its documented curves (a
+#: torque limit and an efficiency: 12 minutes) must run, so its cap is 15 minutes; the
+#: 20-record curve of 3200 s records (about 12 hours) is refused
+HORIZON_MAX_UNTIMED_SECONDS = 900.0
+#: the largest --time-limit, s (a week: a resumable power matrix may run for days; the
+#: bound keeps the deadline a finite float)
+MAX_TIME_LIMIT = 7 * 86400.0
 
 #: forcing frequency omega, units sqrt(g/l)
 OMEGA_RANGE = (1e-3, 1e3)
@@ -215,7 +233,7 @@ BUOY_MAX_PTO_HARMONICS = 24
 #: a sweep over wave periods (--wave-period FROM:TO:N or T1,T2,...) solves each period as
 #: alone: the periods times one period's estimated time must stay within this many seconds
 #: (200 periods at 512 harmonics, about 2 hours, ran on unbounded)
-BUOY_MAX_SWEEP_SECONDS = 120.0
+BUOY_MAX_SWEEP_SECONDS = MAX_UNTIMED_SECONDS
 #: one period's time (s; the solve and its error estimates, two shared cores under load),
 #: ``a + b (N / 512)^2`` at N harmonics: 4 periods took 1.5 s each at the default 24, 2.7 s
 #: at 128 and 34 s at 512
@@ -224,9 +242,10 @@ BUOY_PERIOD_SECONDS = (1.2, 33.0)
 #: harmonics): 4 periods with --efficiency 0.9 or --torque-limit 100 ran past 150 s
 BUOY_PTO_PERIOD_SECONDS = 40.0
 #: --optimize-design: the estimated time of the search (its solves times one solve's) must
-#: stay within this many seconds; it shows a progress bar on a terminal (four variables ran
-#: silently past 150 s, one with --efficiency past 150 s)
-BUOY_MAX_DESIGN_SECONDS = 600.0
+#: stay within this many seconds without --time-limit; it shows a progress bar on a terminal
+#: (four variables ran silently past 150 s, one with --efficiency past 150 s; at 600 s the
+#: four variables, estimated at about 3 minutes, were accepted and ran past 2 minutes)
+BUOY_MAX_DESIGN_SECONDS = MAX_UNTIMED_SECONDS
 #: one inner solve of the design search (s; the coupled optimum alone, two shared cores
 #: under load): without and with a power take-off (241 solves of four variables took over
 #: 150 s; about 25 of one variable with --efficiency 0.9 over 150 s)

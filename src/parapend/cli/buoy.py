@@ -118,6 +118,10 @@ def add_parsers(sub) -> None:
                    help="with mpc: forecast horizon, peak periods (default 1)")
     g.add_argument("--update-interval", type=_finite_float("update-interval"),
                    help="with mpc: re-planning interval, peak periods (default 0.125)")
+    p.add_argument("--time-limit", type=_finite_float("time-limit"), metavar="SECONDS",
+                   help="run long work (--optimize-design, a period sweep, --controller mpc) "
+                        "for at most about this long, then stop with a partial result marked "
+                        "time_limit (without it, work estimated over 2 minutes is refused)")
     p.add_argument("--plot", metavar="DIR",
                    help="draw the figures (PNG and SVG) into this directory")
     p.add_argument("--save", metavar="NC", help="write the motion (or the sweep) as NetCDF")
@@ -280,6 +284,8 @@ def _text_result(r) -> list:
             out.append(f"design: {k} lies on its {side} bound {lo if side == 'lower' else hi:g}"
                        f": the best design may lie beyond it (widen "
                        f"--{k.replace('_', '-')}-bounds)")
+        if d.get("status") == "time_limit":
+            out.append(f"design: PARTIAL: {d['message']}")
     out.append(f"status: {r.status}; N = {r.harmonics}, winding {r.winding}; energy balance "
                f"residual {r.energy_balance_residual:.1e}")
     out += [f"note: {n}" for n in r.warnings]

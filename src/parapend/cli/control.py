@@ -79,6 +79,10 @@ def add_parsers(sub) -> None:
     g.add_argument("--update-interval", type=_finite_float("update-interval"),
                    help="MPC update interval in peak periods, at most the horizon "
                         f"(default {TRACK['update_interval']:g})")
+    g.add_argument("--time-limit", type=_finite_float("time-limit"), metavar="SECONDS",
+                   help="run the MPC for at most about this long, then stop with a partial "
+                        "result marked time_limit (without it, a run estimated over 2 "
+                        "minutes is refused)")
     g.add_argument("--forecast", choices=("perfect", "ar"),
                    help="MPC wave forecast: perfect (the record's own future) or ar "
                         f"(autoregressive, fitted on the past; default {TRACK['forecast']})")

@@ -62,6 +62,10 @@ def add_parsers(sub) -> None:
                         "the plans' speeds above it, not a hard bound; the exceedance is "
                         "reported), in units of sqrt(g/l), > 0 (default none; "
                         "docs/control.md)")
+    p.add_argument("--time-limit", type=_finite_float("time-limit"), metavar="SECONDS",
+                   help="run for at most about this long, then stop with a partial curve "
+                        "marked time_limit (without it, runs estimated over 2 minutes are "
+                        "refused)")
     p.add_argument("--plot", metavar="PNG", help="draw the fraction of the optimum against "
                                                  "the horizon")
     p.add_argument("--save", metavar="FILE",
@@ -100,8 +104,10 @@ def _cmd_horizon(a) -> dict | str:
             f"{u['mass_kg']:g} kg, gamma = {r.gamma:g}"
             + ("" if r.torque_limit is None else f", T_max = {r.torque_limit:g}")
             + ("" if r.efficiency is None else f", efficiency {r.efficiency:g}"))
-    nopt = sum(r.optimum_power_w) / len(r.optimum_power_w)
-    nlim = sum(r.limit_power_w) / len(r.limit_power_w)
+    # the mean over the records whose optimum was solved (all, unless a time limit stopped)
+    opt = [v for v in r.optimum_power_w if v == v] or [float("nan")]
+    lim = [v for v in r.limit_power_w if v == v] or [float("nan")]
+    nopt, nlim = sum(opt) / len(opt), sum(lim) / len(lim)
     rows = []
     for i, f in enumerate(r.forecasts):
         for j, h in enumerate(r.horizons):
@@ -162,7 +168,8 @@ def _cmd_horizon(a) -> dict | str:
             cols += ["speed above the penalty's w", "peak |theta'|"]
         out += ["", f"receding-horizon updates (forecast + solve) against the update interval "
                     f"{1e3 * r.update_interval_s:.4g} ms: p99 "
-                    + ("fits" if r.realtime_fits else "does NOT fit")
+                    + ("fits" if r.realtime_fits else "does NOT fit"
+                       if r.realtime_fits is not None else "not known (runs not finished)")
                     + " (one process; the first update, kernel load, apart)",
                 _table(trows, cols)]
     if r.ar_leads:

@@ -135,6 +135,10 @@ def add_parsers(sub) -> None:
     g.add_argument("--netcdf", metavar="FILE.nc", help="the full Dataset as NetCDF")
     g.add_argument("--zarr", metavar="DIR", help="the full Dataset as a Zarr store")
     g.add_argument("--csv", metavar="FILE.csv", help="the matrix as a table, one row a bin")
+    g.add_argument("--time-limit", type=_finite_float("time-limit"), metavar="SECONDS",
+                   help="start no bin after this long: a partial matrix marked time_limit "
+                        "(with --store a rerun computes the rest); without it or --store, "
+                        "a matrix estimated over 2 minutes is refused")
     p.add_argument("--plot", metavar="PREFIX",
                    help="figures PREFIX-matrix.png, PREFIX-capture-width.png and, with a "
                         "site, PREFIX-scatter.png")
@@ -172,7 +176,13 @@ def _cmd_power_matrix(a) -> dict | str:
     out = rec.to_dict()
     if a.json:
         return out
-    return figures.text_report(ds, out, drawn)
+    text = figures.text_report(ds, out, drawn)
+    if out["status"] == "time_limit":
+        text += (f"\nstatus: time_limit: PARTIAL matrix, bins {out['bins_finished']} of "
+                 f"{out['bins']} finished (time limit {a.time_limit:g} s; the rest NaN, "
+                 "not counted in the annual energy)"
+                 + ("; run the same command again to compute them" if a.store else ""))
+    return text
 
 
 COMMANDS = {"power-matrix": _cmd_power_matrix}

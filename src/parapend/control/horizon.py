@@ -215,6 +215,14 @@ def _stats(a):
     return float(np.mean(a[ok])), float(np.min(a[ok])), float(np.max(a[ok]))
 
 
+def _longest_record(exc, warm_up, tp_n, records, est, cap) -> float:
+    """The longest record (pendulum time) one curve of the estimate ``est`` (s, over
+    ``records`` records like ``exc``) fits in ``cap`` seconds with: the estimate is in
+    proportion to each run's length, the record plus the warm-up."""
+    run = exc.period + warm_up * tp_n
+    return max(run * cap / (est / records) - warm_up * tp_n, 0.0)
+
+
 def horizon_curve(*, hs=None, tp=None, spectrum: str = "jonswap", gamma_peak: float = 3.3,
                   repeat_period=None, seed=None, cutoff: float = 3.0,
                   length: float = SEA["length"], mass: float = SEA["mass"], inertia=None,
@@ -224,7 +232,7 @@ def horizon_curve(*, hs=None, tp=None, spectrum: str = "jonswap", gamma_peak: fl
                   baselines=HORIZON["baselines"], records: int = HORIZON["records"],
                   update_interval: float = HORIZON["update_interval"], progress=None,
                   warm_up: float = HORIZON["warm_up"],
-                  speed_limit=HORIZON["speed_limit"]) -> HorizonResult:
+                  speed_limit=HORIZON["speed_limit"], time_limit=None) -> HorizonResult:
     """Mean power of causal control against the horizon, as a fraction of the record's
     non-causal optimum and of its limit (command ``horizon``: ``parapend.horizon`` is this
     function; module docstring).
@@ -266,7 +274,15 @@ def horizon_curve(*, hs=None, tp=None, spectrum: str = "jonswap", gamma_peak: fl
         Rated-speed penalty of the receding-horizon plans, not a hard bound (its exceedance
         is reported; units ``sqrt(g / l)``;
         :func:`parapend.control.mpc.mpc_run`); None: none.
+    time_limit : float or None
+        Seconds for the whole curve: without it, receding-horizon runs estimated above
+        ``parapend.limits.HORIZON_MAX_UNTIMED_SECONDS`` are refused (naming the most records that
+        fit); with it the work stops at the first run (a record's optimum, receding-horizon
+        run or baseline) after the limit: the runs not finished are NaN with the status
+        ``"time_limit"``, and the result's ``status`` is ``"time_limit"`` (``success``
+        False; :mod:`parapend.deadline`).
     """
+    from ..deadline import check_time_limit, deadline, expired, refuse_untimed
     from ..irregular import sea
     from ..seas import sea_record
     from ..units import Units
@@ -274,6 +290,8 @@ def horizon_curve(*, hs=None, tp=None, spectrum: str = "jonswap", gamma_peak: fl
     from .forecast import FORECASTS, ARForecast, prediction_error
     from .mpc import stored_energy
 
+    time_limit = check_time_limit(time_limit)
+    until = deadline(time_limit)
     units = Units(length, mass, gravity, inertia)
     hs = SEA["hs"] if hs is None else hs
     tp = SEA["tp"] if tp is None else tp
@@ -339,19 +357,44 @@ def horizon_curve(*, hs=None, tp=None, spectrum: str = "jonswap", gamma_peak: fl
     upd_samples = max(1, round(upd * 64))
     est = sum(math.ceil(n / upd_samples) for n in mpc_samples) * sum(
         update_seconds(h, torque_limit, f) for f in fc for h in hz)
+    cap = limits.HORIZON_MAX_UNTIMED_SECONDS
+    most = int(cap / (est / records)) if est > 0 else records
+    longest = (_longest_record(excs[0], warm_up, tp_n, records, est, cap) * units.time
+               if est > 0 else math.inf)  # (no receding-horizon run: nothing to refuse)
+    refuse_untimed("records" if most >= 1 else "repeat-period",
+                   f"{records} record(s) x {len(fc)} forecast(s) x {len(hz)} horizon(s) of "
+                   f"receding-horizon runs, {math.ceil(mpc_samples[0] / upd_samples)} "
+                   "updates each,", est,
+                   f"use --records at most {most}" if most >= 1 else
+                   f"use --repeat-period at most {longest:.4g} s (one record), or fewer "
+                   "--horizons or --forecasts",
+                   time_limit, cap)
     if est > ANNOUNCE_SECONDS:
         log.info("horizon: %d record(s) x %d forecast(s) x %d horizon(s) of receding-horizon "
                  "runs, %d updates each: roughly %s on one core, besides the records' optima "
                  "and the baselines (the progress bar gives the rate; Ctrl-C stops it)",
                  records, len(fc), len(hz), math.ceil(mpc_samples[0] / upd_samples),
-                 _duration(est))
+                 _duration(est) + ("" if time_limit is None else
+                                   f" (stopped after the time limit {time_limit:g} s)"))
+    runs_done = [0]  # runs finished; the time limit is checked before each next one
+    stopped = [False]
+
+    def out_of_time() -> bool:
+        if not stopped[0] and runs_done[0] and expired(until):
+            stopped[0] = True
+        return stopped[0]
 
     opt, lim = [], []
     for r in range(records):
+        if out_of_time():
+            opt.append(math.nan)
+            lim.append(math.nan)
+            continue
         s = sea(seed=seed + r, length=length, mass=mass, inertia=inertia, gravity=gravity,
                 gamma=gamma, **sea_kw)
         opt.append(s.power)
         lim.append(s.limit_power)
+        runs_done[0] += 1
         tick(rec_samples[r])
     mpc_p = [[[math.nan] * records for _ in hz] for _ in fc]
     mpc_st = [[[""] * records for _ in hz] for _ in fc]
@@ -366,13 +409,21 @@ def horizon_curve(*, hs=None, tp=None, spectrum: str = "jonswap", gamma_peak: fl
         for i, name in enumerate(fc):
             for j, h in enumerate(hz):
                 for r, exc in enumerate(excs):
+                    if out_of_time():
+                        mpc_st[i][j][r] = "time_limit"
+                        continue
                     fo = None if name == "perfect" else ARForecast(tp_n)
                     res = mpc_run(exc.q, gamma=gamma, horizon=h * tp_n,
                                   update_interval=upd * tp_n, dt=tp_n / 64,
                                   average_from=warm_up * tp_n,
                                   torque_limit=torque_limit, efficiency=eff,
                                   forecast=fo, t_end=exc.period + warm_up * tp_n, seed=seed + r,
-                                  speed_limit=speed_limit, progress=within)
+                                  speed_limit=speed_limit, progress=within,
+                                  deadline=until)
+                    if res.status == "time_limit":  # cut short: not a finished run
+                        stopped[0] = True
+                    else:
+                        runs_done[0] += 1
                     mpc_p[i][j][r] = (float(res.mean_electrical_power) if res.success
                                       else math.nan)
                     mpc_st[i][j][r] = str(res.status)
@@ -399,6 +450,9 @@ def horizon_curve(*, hs=None, tp=None, spectrum: str = "jonswap", gamma_peak: fl
     for b, name in enumerate(bl):
         fn = tracker_baseline if name == "tracker" else extremum_baseline
         for r, exc in enumerate(excs):
+            if out_of_time():
+                base_st[b][r] = "time_limit"
+                continue
             run = fn(exc.q, peak_omega=wp, gamma=gamma, t_end=exc.period,
                      torque_limit=torque_limit, efficiency=efficiency)
             if run.success:
@@ -410,9 +464,10 @@ def horizon_curve(*, hs=None, tp=None, spectrum: str = "jonswap", gamma_peak: fl
                 base_de[b][r] = de
                 base_p[b][r] = float(run.mean_power) + eta_g * de / span
             base_st[b][r] = run.status
+            runs_done[0] += 1
             tick(rec_samples[r])
     leads, err = [], []
-    if "ar" in fc:
+    if "ar" in fc and not stopped[0]:  # (a partial curve: not after the time limit)
         leads = list(AR_LEADS)
         errs = [prediction_error(ARForecast(tp_n), exc.q, t_start=min(45 * tp_n,
                                  0.5 * exc.period), t_end=exc.period, dt=tp_n / 64,
@@ -428,9 +483,16 @@ def horizon_curve(*, hs=None, tp=None, spectrum: str = "jonswap", gamma_peak: fl
     bst = [_stats(np.asarray(base_p[b]) / o) for b in range(len(bl))]
     nan_runs = int(np.sum(~np.isfinite(np.asarray(mpc_p)))) if fc else 0
     nan_runs += int(np.sum(~np.isfinite(np.asarray(base_p)))) if bl else 0
-    ok = nan_runs == 0
+    ok = nan_runs == 0 and not stopped[0]
     msg = (f"{records} record(s) of {excs[0].period * units.time:g} s; "
            + ("every run finished" if ok else f"{nan_runs} run(s) failed (NaN power)"))
+    if stopped[0]:
+        runs = records * (1 + len(fc) * len(hz) + len(bl))
+        msg = (f"time limit reached ({time_limit:g} s): {runs_done[0]} of {runs} runs "
+               f"finished (the records' optima, {len(fc) * len(hz)} receding-horizon runs "
+               f"and {len(bl)} baseline(s) per record), the rest NaN with the status "
+               f"time_limit; a partial curve of {records} record(s) of "
+               f"{excs[0].period * units.time:g} s")
     rec = {k: v for k, v in excs[0].describe().items() if k not in ("omega", "seed")}
     w = units.to_watts
 
@@ -469,7 +531,8 @@ def horizon_curve(*, hs=None, tp=None, spectrum: str = "jonswap", gamma_peak: fl
         mpc_status=mpc_st, baseline_status=base_st, ar_leads=leads, ar_error=err,
         peak_period=tp_n, update_interval=upd, gamma=gamma, torque_limit=torque_limit,
         efficiency=efficiency, record=rec, units=units.describe(), success=ok,
-        status="done" if ok else "failed_runs", message=msg, warm_up=warm_up,
+        status="done" if ok else ("time_limit" if stopped[0] else "failed_runs"),
+        message=msg, warm_up=warm_up,
         speed_limit=speed_limit,
         optimum_power_w=[w(v) for v in opt], limit_power_w=[w(v) for v in lim],
         mpc_power_w=[[[w(v) for v in col] for col in row] for row in mpc_p],

@@ -344,7 +344,7 @@ def mpc_run(q_record, *, gamma, horizon, update_interval, dt, torque_limit=None,
             warm=True, seed=0, terminal_weight=None, average_from=0.0,
             interval_samples=INTERVAL_SAMPLES, plant_steps=PLANT_STEPS, max_iter=MAX_ITER,
             pump_level=1.0, tracking=TRACKING, terminal="energy", speed_limit=None,
-            speed_weight=None, plan_damping=None, progress=None) -> MPCResult:
+            speed_weight=None, plan_damping=None, progress=None, deadline=None) -> MPCResult:
     """Receding-horizon control of Eq. 14 driven by the record ``q_record``.
 
     Parameters
@@ -408,6 +408,11 @@ def mpc_run(q_record, *, gamma, horizon, update_interval, dt, torque_limit=None,
     progress : callable or None
         Called ``progress(done, total)`` in torque samples of the run, at most every
         ``PROGRESS_EVERY`` seconds and at the end.
+    deadline : float or None
+        A :func:`time.monotonic` time (:func:`parapend.deadline.deadline`): once it has
+        passed, the run stops before its next update (after at least one) with the status
+        "time_limit" (``success`` False): a partial run, its powers over the samples run
+        (NaN if it stopped before ``average_from``).
 
     A run whose speed exceeds a turn per held torque sample stops with the status
     "unresolved" (``success`` False).
@@ -500,6 +505,9 @@ def mpc_run(q_record, *, gamma, horizon, update_interval, dt, torque_limit=None,
             steps_now = 1
             seg = np.array([tq])
         elif plan is None or since >= m:
+            if plan is not None and deadline is not None and time.monotonic() >= deadline:
+                status, total = "time_limit", j  # before this update: a partial run
+                break
             tj = t_samples[j]
             tu = time.perf_counter()
             if forecast is None:
@@ -604,7 +612,9 @@ def mpc_run(q_record, *, gamma, horizon, update_interval, dt, torque_limit=None,
                           f"{float(np.max(np.abs(v))):.4g}, more than a turn per held torque "
                           f"sample (dt = {dt:.4g}); the sampled loop does not resolve the "
                           f"motion, its numbers mean nothing; {done}"),
-           "nonfinite": "non-finite power"}[status]
+           "nonfinite": "non-finite power",
+           "time_limit": (f"time limit reached at t = {t[-1]:.6g} of {t_end:.6g}, after "
+                          f"{done} (a partial run: its powers over the samples run)")}[status]
     after = t >= (caught if caught is not None else total + 1) * dt - 1e-9 * dt
     speed = np.abs(v[after])
     exceed = peak = None
@@ -815,15 +825,23 @@ def track_mpc(excitation, *, gamma, horizon=2.0, update_interval=0.03125, foreca
               torque_limit=None, efficiency=None, periods=100, seed=0, irregular=False,
               theta0=math.pi, theta_dot0=0.0, terminal_weight=None,
               samples=TRACK_SAMPLES, terminal="energy", speed_limit=None,
-              speed_weight=None, plan_damping=None, progress=None) -> MPCTrackResult:
+              speed_weight=None, plan_damping=None, progress=None,
+              time_limit=None) -> MPCTrackResult:
     """Receding-horizon control of the case ``excitation`` (or, with ``irregular``, of the
     seeded sea record of ``parapend.control.track.design_sea`` built from it, the same
     record as ``track --irregular`` with the same seed); ``horizon`` and ``update_interval``
     in forcing (peak) periods. The powers are over the run after ``WARMUP_PERIODS``
     (:class:`MPCTrackResult`). ``progress(done, total)``: in torque samples (:func:`mpc_run`);
-    a run estimated to take more than ``ANNOUNCE_SECONDS`` is announced on ``log``."""
+    a run estimated to take more than ``ANNOUNCE_SECONDS`` is announced on ``log``. Without
+    ``time_limit`` (s) a run estimated above ``parapend.limits.MAX_UNTIMED_SECONDS`` is
+    refused; with it the run stops at its first update after the limit, marked
+    "time_limit" (:mod:`parapend.deadline`)."""
+    from .. import limits
+    from ..deadline import check_time_limit, deadline, refuse_untimed
     from .track import SEA_WAVES, _check_state, _on_grid, check_flag, design_sea
 
+    time_limit = check_time_limit(time_limit)
+    until = deadline(time_limit)
     theta0, theta_dot0 = _check_state((theta0, theta_dot0))
     irregular = check_flag("irregular", irregular)
     horizon = check_range("horizon", horizon, 0.01, 20.0)
@@ -860,18 +878,25 @@ def track_mpc(excitation, *, gamma, horizon=2.0, update_interval=0.03125, foreca
     # the swing-up takes a few periods without solves; counted as updates here (an upper
     # bound)
     updates = math.ceil(periods / max(round(update_interval * samples), 1) * samples)
-    est = updates * update_seconds(horizon, torque_limit, forecast)
+    each = update_seconds(horizon, torque_limit, forecast)
+    est = updates * each
+    most = int(limits.MAX_UNTIMED_SECONDS / (each * updates / periods))
+    refuse_untimed("periods", f"a receding-horizon run of {periods} periods (about {updates} "
+                   f"updates of a {horizon:g}-period horizon)", est,
+                   f"use --periods at most {most}" if most >= 20 else
+                   "use a shorter --horizon or a longer --update-interval", time_limit)
     if est > ANNOUNCE_SECONDS:
         log.info("track --controller mpc: %d periods = about %d updates of a %g-period "
-                 "horizon (%s forecast): roughly %s on one core (the progress bar gives the "
+                 "horizon (%s forecast): roughly %s on one core%s (the progress bar gives the "
                  "rate; Ctrl-C stops it)", periods, updates, horizon, forecast,
-                 _duration(est))
+                 _duration(est), "" if time_limit is None else
+                 f", stopped after the time limit {time_limit:g} s")
     r = mpc_run(qf, gamma=gamma, horizon=horizon * tp, update_interval=update_interval * tp,
                 dt=dt, torque_limit=torque_limit, efficiency=efficiency, forecast=fo,
                 theta0=theta0, theta_dot0=theta_dot0, t_end=periods * tp, seed=seed,
                 terminal_weight=terminal_weight, average_from=WARMUP_PERIODS * tp,
                 terminal=terminal, speed_limit=speed_limit, speed_weight=speed_weight,
-                plan_damping=plan_damping, progress=progress)
+                plan_damping=plan_damping, progress=progress, deadline=until)
     record_power = None
     n_rec = SEA_WAVES * samples
     if irregular and r.power_series.size >= (SEA_WAVES + WARMUP_PERIODS) * samples:

@@ -117,11 +117,20 @@ def _check_bem_size(radius, draft):
         mid = math.sqrt(a * b)
         w = work(mid, small) if big == "radius" else work(small, mid)
         a, b = (mid, b) if w <= cap else (a, mid)
+    other = ""
+    if big == "radius" and work(radius, radius) <= cap:
+        # the panels follow the draft: a deeper draft coarsens them (a wide, shallow body's
+        # mesh is the costly one); the smallest draft that fits at this radius
+        lo_d, hi_d = draft, radius
+        for _ in range(60):
+            mid = math.sqrt(lo_d * hi_d)
+            lo_d, hi_d = (lo_d, mid) if work(radius, mid) <= cap else (mid, hi_d)
+        other = f", or --draft at least {hi_d * (1 + 1e-3):.3g} m at this radius"
     raise ParameterError(f"{big}: a cylinder of radius {radius:g} m and draft {draft:g} m "
                          f"needs a BEM of about {work(radius, draft):.3g} influence "
                          f"coefficients per frequency, more than the {cap:.3g} that finish in "
                          f"about a minute (the panels follow the smaller dimension); use "
-                         f"--{big} at most {a:.3g} m")
+                         f"--{big} at most {a:.3g} m{other}")
 
 
 def _check_harmonics(harmonics, winding, pto):
@@ -146,11 +155,12 @@ def _check_harmonics(harmonics, winding, pto):
                              f"--harmonics, at least 2 per turn")
 
 
-def _check_sweep(count, harmonics, winding, pto):
+def _check_sweep(count, harmonics, winding, pto, time_limit=None):
     """Refuse a sweep over ``count`` wave periods whose estimated time (the periods times one
     period's, :data:`parapend.limits.BUOY_PERIOD_SECONDS` or ``BUOY_PTO_PERIOD_SECONDS``)
     exceeds :data:`parapend.limits.BUOY_MAX_SWEEP_SECONDS`, naming ``--wave-period`` and the
-    most periods that fit."""
+    most periods that fit; with ``time_limit`` the sweep runs under it instead
+    (:mod:`parapend.deadline`)."""
     from .optimum import HARMONICS_PER_TURN
 
     n = harmonics if harmonics is not None else HARMONICS_PER_TURN * winding
@@ -160,7 +170,7 @@ def _check_sweep(count, harmonics, winding, pto):
         a, b = limits.BUOY_PERIOD_SECONDS
         each = a + b * (n / 512) ** 2
     cap = limits.BUOY_MAX_SWEEP_SECONDS
-    if count * each <= cap:
+    if count * each <= cap or time_limit is not None:
         return
     most = int(cap // each)
     what = "with --efficiency or --torque-limit" if pto else f"of {n} harmonics"
@@ -168,30 +178,33 @@ def _check_sweep(count, harmonics, winding, pto):
     if harmonics is not None and not pto:
         fix += " or fewer --harmonics"
     raise ParameterError(f"wave-period: {count} periods {what} need about {count * each:.0f} "
-                         f"s ({each:.3g} s each), more than the {cap:g} s a sweep may take; "
-                         f"{fix}")
+                         f"s ({each:.3g} s each), more than the {cap:g} s a sweep may take "
+                         f"without a time limit; {fix}, or give --time-limit SECONDS (a "
+                         "partial result, marked time_limit)")
 
 
 #: a design search estimated longer than this announces its estimate (as horizon and track)
 DESIGN_ANNOUNCE_SECONDS = 30.0
 
 
-def _check_design(count, pto):
+def _check_design(count, pto, time_limit=None):
     """Refuse a design search whose estimated time (its solves, :func:`.design.design_solves`,
     times one solve's, :data:`parapend.limits.BUOY_DESIGN_SOLVE_SECONDS`) exceeds
-    :data:`parapend.limits.BUOY_MAX_DESIGN_SECONDS`, naming the most variables that fit."""
+    :data:`parapend.limits.BUOY_MAX_DESIGN_SECONDS`, naming the most variables that fit;
+    with ``time_limit`` the search runs under it instead (:mod:`parapend.deadline`)."""
     from .design import design_solves
 
     each = limits.BUOY_DESIGN_SOLVE_SECONDS[1 if pto else 0]
     cap = limits.BUOY_MAX_DESIGN_SECONDS
     est = design_solves(count) * each
-    if est <= cap:
+    if est <= cap or time_limit is not None:
         if est > DESIGN_ANNOUNCE_SECONDS:  # long legitimate work: its estimate first
             import logging
 
             logging.getLogger("parapend.hydro").info(
                 "buoy: optimize-design over %d variables: up to %d solves of about %g s, "
-                "roughly %.0f s (Ctrl-C stops it)", count, design_solves(count), each, est)
+                "roughly %.0f s%s (Ctrl-C stops it)", count, design_solves(count), each, est,
+                "" if time_limit is None else f", stopped after the time limit {time_limit:g} s")
         return
     fits = [k for k in range(1, count) if design_solves(k) * each <= cap]
     what = " with --efficiency or --torque-limit" if pto else ""
@@ -200,7 +213,8 @@ def _check_design(count, pto):
     raise ParameterError(f"optimize-design: {count} variables{what} need up to "
                          f"{design_solves(count)} solves of about {each:g} s "
                          f"({design_solves(count) * each:.0f} s), more than the {cap:g} s a "
-                         f"design search may take; {fix}")
+                         f"design search may take without a time limit; {fix}, or give "
+                         "--time-limit SECONDS (a partial result, marked time_limit)")
 
 
 def _check_record_harmonics(h, wave, harmonics, winding, record, pto=True):
@@ -275,7 +289,7 @@ def buoy(*, wave_height=None, wave_period=None, hs=None, tp=None, spectrum=None,
          inertia_bounds=None, damping_coefficient_bounds=None, controller="optimum",
          horizon=None, update_interval=None, wave_direction=None, dofs="heave",
          pivot_height=None, pivot_offset=None, hull_pitch_inertia=None, barge_length=None,
-         barge_beam=None, barge_draft=None, copper_loss=None, progress=None):
+         barge_beam=None, barge_draft=None, copper_loss=None, time_limit=None, progress=None):
     """The coupled optimum of a pendulum inside a floating buoy (command ``buoy``).
 
     Parameters
@@ -323,6 +337,12 @@ def buoy(*, wave_height=None, wave_period=None, hs=None, tp=None, spectrum=None,
         take the embedded hull design's values (``parapend.defaults.HULL``).
         ``copper_loss`` ``r`` (W per (N m)^2; hull only) subtracts the winding loss ``r
         tau^2`` from the power: holding an angle then costs what it costs a generator.
+    time_limit : float or None
+        Seconds for the long work (``optimize_design``, a period sweep, ``controller``):
+        without it, work estimated above ``parapend.limits.MAX_UNTIMED_SECONDS`` is refused;
+        with it, the work stops at the first design evaluation, period or update after the
+        limit and the result is partial: ``status`` ``"time_limit"``, ``success`` False, and
+        what was done (:mod:`parapend.deadline`).
     progress : callable or None
         With ``optimize_design``: called ``progress(done, total)`` after every inner solve
         of the search (the command line draws it as a bar on a terminal).
@@ -338,10 +358,17 @@ def buoy(*, wave_height=None, wave_period=None, hs=None, tp=None, spectrum=None,
     from .hull_api import hull_buoy, parse_dofs
 
     opts = dict(locals())
+    from ..deadline import check_time_limit, deadline
+
     _check_kinds(dofs=dofs, optimize_design=optimize_design, mesh=mesh)
+    time_limit = check_time_limit(time_limit)
+    until = deadline(time_limit)  # the limit counts from the call (the BEM included)
     if parse_dofs(dofs) != ("heave",):
+        if time_limit is not None:
+            raise ParameterError("time-limit: not used with --dofs surge,heave,pitch (its "
+                                 "work is bounded by its harmonics); drop it")
         return hull_buoy(**{k: v for k, v in opts.items() if k not in (
-            "dofs", "Wave", "hull_buoy", "parse_dofs", "progress")})
+            "dofs", "Wave", "hull_buoy", "parse_dofs", "progress", "time_limit")})
     for name in ("pivot_height", "pivot_offset", "hull_pitch_inertia", "barge_length",
                  "barge_beam", "barge_draft", "copper_loss"):
         if opts[name] is not None:
@@ -354,6 +381,10 @@ def buoy(*, wave_height=None, wave_period=None, hs=None, tp=None, spectrum=None,
         raise ParameterError(f"controller: expected optimum, mpc or one-way-mpc, got "
                              f"{controller!r:.40}")
     periods = parse_periods(wave_period)
+    if time_limit is not None and controller == "optimum" and periods is None and not (
+            optimize_design is not None and str(optimize_design).strip()):
+        raise ParameterError("time-limit: bounds long work only: needs --optimize-design, a "
+                             "period sweep (--wave-period FROM:TO:N) or --controller mpc")
     if controller != "optimum" and (periods is not None or not any(
             v is not None for v in (hs, tp, repeat_period, seed))):
         raise ParameterError("controller: mpc runs in an irregular sea state: give --hs and "
@@ -414,7 +445,7 @@ def buoy(*, wave_height=None, wave_period=None, hs=None, tp=None, spectrum=None,
         pto = torque_limit is not None or efficiency is not None
         _check_harmonics(harmonics, winding, pto)
         if periods is not None:
-            _check_sweep(periods.size, harmonics, winding, pto)
+            _check_sweep(periods.size, harmonics, winding, pto, time_limit)
     variables, bounds = _design_request(optimize_design, pend, mass_bounds=mass_bounds,
                                         length_bounds=length_bounds,
                                         inertia_bounds=inertia_bounds,
@@ -424,7 +455,8 @@ def buoy(*, wave_height=None, wave_period=None, hs=None, tp=None, spectrum=None,
     if periods is not None and variables:
         raise ParameterError("optimize-design: one wave period at a time (drop FROM:TO:N)")
     if variables:
-        _check_design(len(variables), torque_limit is not None or efficiency is not None)
+        _check_design(len(variables), torque_limit is not None or efficiency is not None,
+                      time_limit)
     if irregular:
         from ..units import Units
 
@@ -464,7 +496,8 @@ def buoy(*, wave_height=None, wave_period=None, hs=None, tp=None, spectrum=None,
 
         return period_sweep(h, width, pend, height, periods_all, winding=winding,
                             harmonics=harmonics, torque_limit=torque_limit,
-                            efficiency=efficiency, coarse=coarse, geometry=geometry)
+                            efficiency=efficiency, coarse=coarse, geometry=geometry,
+                            deadline=until)
     if not irregular:
         wave = Wave.regular(height, float(periods_all[0]))
         info = {"kind": "regular", "height_m": height, "period_s": float(periods_all[0]),
@@ -476,7 +509,7 @@ def buoy(*, wave_height=None, wave_period=None, hs=None, tp=None, spectrum=None,
                            update_interval=update_interval, winding=winding,
                            harmonics=harmonics, torque_limit=torque_limit,
                            efficiency=efficiency, irregular=irregular,
-                           design=bool(variables))
+                           design=bool(variables), time_limit=time_limit, deadline=until)
     opts = {"winding": winding, "harmonics": harmonics, "torque_limit": torque_limit,
             "efficiency": efficiency}
     design = None
@@ -485,13 +518,21 @@ def buoy(*, wave_height=None, wave_period=None, hs=None, tp=None, spectrum=None,
 
         found = _outer(lambda p: _solve(h, p, wave, one_way=False, **opts)[0], pend,
                        variables, bounds, check=lambda p: _check_floats(h, p),
-                       progress=progress)
+                       progress=progress, deadline=until)
         pend, design = found.pendulum, found.to_dict()
     sol, ow, notes = _solve(h, pend, wave, **opts)
     errors = _error_powers(h, coarse, pend, wave, **opts)
-    return _result(h, width, pend, wave, info, sol, ow, torque_limit=torque_limit,
-                   efficiency=efficiency, winding=winding, design=design, notes=notes,
-                   error_powers=errors, geometry=geometry)
+    res = _result(h, width, pend, wave, info, sol, ow, torque_limit=torque_limit,
+                  efficiency=efficiency, winding=winding, design=design, notes=notes,
+                  error_powers=errors, geometry=geometry)
+    if design is not None and design["status"] == "time_limit":
+        import dataclasses
+
+        # the best design evaluated, solved in full; the search itself is unfinished
+        res = dataclasses.replace(res, success=False, status="time_limit",
+                                  message=f"optimize-design: {design['message']} "
+                                          f"(time limit {time_limit:g} s)")
+    return res
 
 
 def _bounds(name, text, value):

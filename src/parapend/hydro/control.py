@@ -239,15 +239,16 @@ def record_force(hydro, wave):
     return force
 
 
-def _check_work(total, n, m, iterations, warm, repeats, dt):
+def _check_work(total, n, m, iterations, warm, repeats, dt, time_limit=None):
     """Refuse, before any work, a run whose horizon solves (updates x horizon samples x
     solves per update) exceed :data:`parapend.limits.BUOY_MAX_MPC_WORK`, naming the longest
-    record that fits."""
+    record that fits; with ``time_limit`` the run goes under it instead
+    (:mod:`parapend.deadline`)."""
     from .. import limits
 
     cap = limits.BUOY_MAX_MPC_WORK
     work = math.ceil(total / m) * n * iterations
-    if work <= cap:
+    if work <= cap or time_limit is not None:
         return
     most = (cap / (n * iterations) * m - warm) / repeats * dt
     fits = (f"use --repeat-period at most {most:.4g} s (or --record that long), or a shorter "
@@ -255,7 +256,8 @@ def _check_work(total, n, m, iterations, warm, repeats, dt):
             "use a shorter --horizon or a longer --update-interval")
     raise ParameterError(f"repeat-period: a receding-horizon run of {math.ceil(total / m)} "
                          f"updates x {n} horizon samples x {iterations} solves is more than "
-                         f"finishes in about two minutes ({cap:.3g}); {fits}")
+                         f"finishes in about two minutes ({cap:.3g}); {fits}, or give "
+                         "--time-limit SECONDS (a partial result, marked time_limit)")
 
 
 def force_nodes(hydro, wave, per_record, plant_steps, count):
@@ -485,7 +487,8 @@ def buoy_mpc(hydro, pendulum, wave, *, peak_period, horizon=2.0, update_interval
              controller="coupled", iterations=2, relaxation=1.0, samples=SAMPLES,
              warmup=4.0, repeats=1, torque_limit=None, efficiency=None, terminal_weight=None,
              model_steps=MODEL_STEPS, plant_steps=PLANT_STEPS, memory=None, a_inf=None,
-             max_iter=None, residual=True, terminal="total") -> BuoyMPCResult:
+             max_iter=None, residual=True, terminal="total", time_limit=None,
+             deadline=None) -> BuoyMPCResult:
     """Receding-horizon control of the pendulum inside the buoy in a periodic record.
 
     Parameters
@@ -528,6 +531,12 @@ def buoy_mpc(hydro, pendulum, wave, *, peak_period, horizon=2.0, update_interval
     residual : bool
         ``coupled``: also measure the fixed point's residual (one extra prediction per
         update, not timed).
+    time_limit, deadline : float or None
+        Seconds the run may take (work above the cap is then not refused) and the
+        :func:`time.monotonic` time it stops at (:func:`parapend.deadline.deadline`; default
+        ``time_limit`` from now): once it has passed the run stops before its next update
+        (after at least one) with the status ``"time_limit"``: a partial run, no success,
+        its powers over the samples run.
     """
     from ..control import mpc as _mpc
     from ..control.mpc import HorizonProblem
@@ -579,7 +588,12 @@ def buoy_mpc(hydro, pendulum, wave, *, peak_period, horizon=2.0, update_interval
     warm_samples = int(round(warmup * tp / dt))
     total = warm_samples + repeats * per_record
     _check_work(total, n, m, iterations if controller != "one-way" else 1, warm_samples,
-                repeats, dt)
+                repeats, dt, time_limit)
+    if deadline is None and time_limit is not None:
+        from ..deadline import deadline as _deadline
+
+        deadline = _deadline(time_limit)
+    planned = total  # the samples asked for (a time limit may stop the run before)
     ps, ms = plant_steps, model_steps
     stride = ps // ms
     h = dt / ps
@@ -631,6 +645,9 @@ def buoy_mpc(hydro, pendulum, wave, *, peak_period, horizon=2.0, update_interval
             tq, braking = pump_torque(th, om, level, CATCH_MARGIN, braking)
             seg = np.array([tq])
         else:
+            if solves and deadline is not None and time.monotonic() >= deadline:
+                status, total = "time_limit", j  # before this update: a partial run
+                break
             a = 2 * j * ps
             fseg = fn[a:a + 2 * n * ps + 1]
             u0 = (np.concatenate((plan[m:], np.full(m, plan[-1]))) if solves
@@ -723,7 +740,10 @@ def buoy_mpc(hydro, pendulum, wave, *, peak_period, horizon=2.0, update_interval
                              "controller did not plan this run" + applied),
            "unresolved": (f"the pendulum turned more than {RESOLVED:g} rad in one plant step: "
                           "the integration does not resolve the run; lower the torque "
-                          "limit")}[status]
+                          "limit"),
+           "time_limit": (f"time limit reached after {st.size} updates: {total * dt:.6g} s of "
+                          f"the {planned * dt:.6g} s run (a partial run; its powers over the "
+                          f"samples run, from {a0 * dt:.4g} s)")}[status]
     series = {"t": t, "theta": ys[:, 2], "theta_dot": ys[:, 3], "z": ys[:, 0],
               "z_dot": ys[:, 1], "torque": u_all, "power": p}
     zwin = ys[a0 * 1:, 0]
@@ -754,7 +774,8 @@ def buoy_mpc(hydro, pendulum, wave, *, peak_period, horizon=2.0, update_interval
 
 
 def mpc_command(hydro, pendulum, wave, info, *, controller, horizon, update_interval, winding,
-                harmonics, torque_limit, efficiency, irregular, design):
+                harmonics, torque_limit, efficiency, irregular, design, time_limit=None,
+                deadline=None):
     """``parapend buoy --controller mpc|one-way-mpc``: the closed loop on the record (4 peak
     periods of warm-up, then one repeat) beside the record's coupled non-causal optimum
     (mechanical, without torque limit or efficiency, at ``winding`` turns per record);
@@ -769,7 +790,8 @@ def mpc_command(hydro, pendulum, wave, info, *, controller, horizon, update_inte
     r = buoy_mpc(hydro, pendulum, wave, peak_period=float(info["tp"]), horizon=horizon,
                  update_interval=update_interval,
                  controller="coupled" if controller == "mpc" else "one-way",
-                 torque_limit=torque_limit, efficiency=efficiency)
+                 torque_limit=torque_limit, efficiency=efficiency, time_limit=time_limit,
+                 deadline=deadline)
     sol, _, _ = _solve(hydro, pendulum, wave, winding=winding, harmonics=harmonics,
                        torque_limit=None, efficiency=None, one_way=False)
     opt = float(sol.power) if sol.success else None

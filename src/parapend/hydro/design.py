@@ -55,6 +55,9 @@ class DesignResult(_Result):
     at_bound : ``{name: "lower" | "upper"}`` for each variable whose best value lies on a
         bound of its box (within 1e-3 of the box's width): the search stopped there, and
         the best design may lie beyond it (widen the bounds).
+    status, message : ``"ok"``, or ``"time_limit"`` when the time limit stopped the search
+        (``best`` is then the best of the ``evaluations`` made, of at most ``total``).
+    total : the inner solves the whole search makes at most (:func:`design_solves`).
     """
 
     variables: list
@@ -66,6 +69,9 @@ class DesignResult(_Result):
     failed: int
     method: str
     at_bound: dict = dataclasses.field(default_factory=dict)
+    status: str = "ok"
+    message: str = ""
+    total: int = 0
     _pendulum: object = dataclasses.field(default=None, repr=False)
 
     @property
@@ -86,8 +92,12 @@ def _physical(pend, names, x):
     return dataclasses.replace(pend, **kw)
 
 
+class _TimeUp(Exception):
+    """The search's time limit ran out (raised between two inner solves)."""
+
+
 def optimize_design(solve, pendulum, variables, bounds, *, check=None,
-                    progress=None) -> DesignResult:
+                    progress=None, deadline=None) -> DesignResult:
     """The pendulum parameters ``variables`` (within ``bounds``) that maximize the coupled
     power ``solve(pendulum).power``.
 
@@ -107,15 +117,22 @@ def optimize_design(solve, pendulum, variables, bounds, *, check=None,
     progress : callable or None
         Called ``progress(done, total)`` after every inner solve (``total`` the most the
         search makes, ``design_solves``), and ``progress(total, total)`` at the end.
+    deadline : float or None
+        A :func:`time.monotonic` time (:func:`parapend.deadline.deadline`): once it has
+        passed, the search stops before its next inner solve (once a design that harvests
+        power is found) and returns the best design evaluated, with ``status``
+        ``"time_limit"``.
     """
     from scipy.optimize import minimize, minimize_scalar
 
+    from ..deadline import expired
     from ..errors import ParameterError
 
     names = list(variables)
     lo = np.array([bounds[n][0] for n in names], dtype=float)
     hi = np.array([bounds[n][1] for n in names], dtype=float)
     cache: dict = {}
+    points: dict = {}  # the designs evaluated (box coordinates), by the cache's key
     failed = [0]
     total = design_solves(len(names))
 
@@ -124,6 +141,8 @@ def optimize_design(solve, pendulum, variables, bounds, *, check=None,
         key = tuple(np.round(u, 12))
         if key in cache:
             return cache[key]
+        if expired(deadline) and any(v > 0 for v in cache.values()):
+            raise _TimeUp  # (a design that harvests power is found first: it is the answer)
         p = _physical(pendulum, names, lo + u * (hi - lo))
         try:
             if check is not None:
@@ -138,11 +157,49 @@ def optimize_design(solve, pendulum, variables, bounds, *, check=None,
         except ParameterError:
             val = -math.inf
         cache[key] = val
+        points[key] = u
         if progress is not None:
             progress(min(len(cache), total - 1), total)
         return val
 
     g = GRID[len(names)]
+    try:
+        u0, grid_best, cand, method = _search(power, names, g, minimize, minimize_scalar)
+        best_u = max([u0, *cand], key=lambda u: power(u))
+        status, message = "ok", ""
+    except _TimeUp:
+        vals = {k: v for k, v in cache.items() if math.isfinite(v) and v > 0}
+        if not vals:
+            raise ParameterError(f"time-limit: no design that harvests power was found in "
+                                 f"the time limit ({len(cache)} of at most {total} inner "
+                                 "solves); give a longer --time-limit") from None
+        key = max(vals, key=vals.get)
+        best_u = points[key]
+        grid_best = max(vals.values())
+        method = f"grid of {g}^{len(names)}, stopped by the time limit"
+        status = "time_limit"
+        message = (f"time limit reached after {len(cache)} of at most {total} inner solves: "
+                   "the best design evaluated, not the search's optimum")
+    best_u = np.clip(best_u, 0, 1)
+    p = _physical(pendulum, names, lo + best_u * (hi - lo))
+    at_bound = {n: ("lower" if u <= BOUND_TOL else "upper") for n, u in zip(names, best_u)
+                if u <= BOUND_TOL or u >= 1 - BOUND_TOL}
+    if progress is not None:
+        progress(total, total)
+    return DesignResult(
+        variables=names, bounds={n: [float(a), float(b)] for n, a, b in zip(names, lo, hi)},
+        best={"mass_kg": p.mass, "length_m": p.length, "inertia_kg_m2": p.inertia,
+              "damping_coefficient_nm_s_per_rad": p.damping_coefficient},
+        power_w=power(best_u), grid_best_w=grid_best, evaluations=len(cache),
+        failed=failed[0], method=method, at_bound=at_bound, status=status, message=message,
+        total=total, _pendulum=p)
+
+
+def _search(power, names, g, minimize, minimize_scalar):
+    """The grid over the box, then the polish from its best point: ``(u0, grid_best,
+    candidates, method)`` (box coordinates in [0, 1])."""
+    from ..errors import ParameterError
+
     axes = [np.linspace(0.0, 1.0, g)] * len(names)
     grid = np.array(np.meshgrid(*axes, indexing="ij")).reshape(len(names), -1).T
     vals = np.array([power(u) for u in grid])
@@ -169,19 +226,7 @@ def optimize_design(solve, pendulum, variables, bounds, *, check=None,
                               "initial_simplex": _simplex(u0, 0.5 / (g - 1))})
         cand = [np.asarray(r.x)]
         method = f"grid of {g}^{len(names)}, then Nelder-Mead within the bounds"
-    best_u = max([u0, *cand], key=lambda u: power(u))
-    best_u = np.clip(best_u, 0, 1)
-    p = _physical(pendulum, names, lo + best_u * (hi - lo))
-    at_bound = {n: ("lower" if u <= BOUND_TOL else "upper") for n, u in zip(names, best_u)
-                if u <= BOUND_TOL or u >= 1 - BOUND_TOL}
-    if progress is not None:
-        progress(total, total)
-    return DesignResult(
-        variables=names, bounds={n: [float(a), float(b)] for n, a, b in zip(names, lo, hi)},
-        best={"mass_kg": p.mass, "length_m": p.length, "inertia_kg_m2": p.inertia,
-              "damping_coefficient_nm_s_per_rad": p.damping_coefficient},
-        power_w=power(best_u), grid_best_w=grid_best, evaluations=len(cache),
-        failed=failed[0], method=method, at_bound=at_bound, _pendulum=p)
+    return u0, grid_best, cand, method
 
 
 def _simplex(u0, step):
@@ -195,16 +240,23 @@ def _simplex(u0, step):
 
 
 def period_sweep(hydro, width, pendulum, height, periods, *, winding=1, harmonics=None,
-                 torque_limit=None, efficiency=None, coarse=None, geometry=None):
+                 torque_limit=None, efficiency=None, coarse=None, geometry=None,
+                 deadline=None):
     """Coupled and one-way optima of one design in regular waves of height ``height`` (m)
     over ``periods`` (s): a :class:`~parapend.hydro.result.BuoySweepResult`. Each period is
     solved as alone (the same body, mesh and frequencies); ``coarse`` (the body on the
     error estimate's mesh, or None) gives ``mesh_error_w``, ``geometry`` (draft and
-    freeboard, or None) the validity checks."""
+    freeboard, or None) the validity checks. ``deadline`` (a :func:`time.monotonic` time,
+    :func:`parapend.deadline.deadline`): once it has passed, the periods not yet begun (all
+    but the first at least) are left out, NaN with the status ``"time_limit"``, and the
+    sweep is no success."""
+    from ..deadline import TIME_LIMIT, expired
     from .coupled import Wave
 
     rows = []
     for period in periods:
+        if rows and expired(deadline):
+            break
         wave = Wave.regular(height, float(period))
         sol, ow, notes = _solve(hydro, pendulum, wave, winding=winding, harmonics=harmonics,
                                 torque_limit=torque_limit, efficiency=efficiency)
@@ -216,15 +268,20 @@ def period_sweep(hydro, width, pendulum, height, periods, *, winding=1, harmonic
                             torque_limit=torque_limit, efficiency=efficiency, winding=winding,
                             notes=notes, error_powers=errors, geometry=geometry))
 
+    left = len(periods) - len(rows)  # periods the time limit left out
+
     def col(name):
         return np.array([np.nan if getattr(r, name) is None else getattr(r, name)
-                         for r in rows], dtype=float)
+                         for r in rows] + [np.nan] * left, dtype=float)
 
     above = sum(1 for r in rows if r.warnings)
     notes = ([f"at {above} of {len(rows)} periods, harmonics of the motion lie above the "
               f"dataset's highest frequency {float(max(hydro.omega)):.4g} rad/s: there A is "
               "held and B = F = 0 (each period's note: the results in _results)"]
              if above else [])
+    if left:
+        notes.append(f"time limit reached: {len(rows)} of {len(periods)} periods solved, the "
+                     f"other {left} left out (NaN, status {TIME_LIMIT}); a partial sweep")
     return BuoySweepResult(
         period_s=np.asarray(periods, dtype=float), power_w=col("power_w"),
         one_way_power_w=col("one_way_power_w"), radiation_bound_w=col("radiation_bound_w"),
@@ -232,7 +289,8 @@ def period_sweep(hydro, width, pendulum, height, periods, *, winding=1, harmonic
         capture_width_m=col("capture_width_m"), heave_amplitude_m=col("heave_amplitude_m"),
         free_heave_amplitude_m=col("free_heave_amplitude_m"),
         energy_balance_residual=col("energy_balance_residual"),
-        status=[r.status for r in rows], success=all(r.success for r in rows),
+        status=[r.status for r in rows] + [TIME_LIMIT] * left,
+        success=not left and all(r.success for r in rows),
         wave_height_m=height, pendulum=rows[0].pendulum, body=rows[0].body, warnings=notes,
         _results=tuple(rows),
         electrical_power_w=None if efficiency is None else col("electrical_power_w"),

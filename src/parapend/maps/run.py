@@ -46,7 +46,8 @@ class SweepRun:
 
     ``dataset`` has one variable per quantity (see :data:`VARIABLES`) over the swept
     dimensions, plus ``done``; ``computed_points`` were computed by this run,
-    ``resumed_points`` found finished in the store; ``repaired_points`` (of the computed)
+    ``resumed_points`` found finished in the store (``stopped``: a time limit ended the run
+    before every block was computed); ``repaired_points`` (of the computed)
     were marked finished in the store but had missing or unreadable data. ``units``: the
     pendulum in SI given to :func:`sweep` (a :class:`parapend.units.Units`, or None; the
     map itself stays non-dimensional); ``netcdf``: the file the map was exported to.
@@ -63,6 +64,9 @@ class SweepRun:
     repaired_points: int = 0
     units: object = None
     netcdf: str | None = None
+    #: the time limit stopped the run before every block was computed (``done`` says which
+    #: were; a block cut mid-way is never marked done)
+    stopped: bool = False
 
 
 def _worker_init(parent: int) -> None:
@@ -208,11 +212,16 @@ def _compile_kernels(spec) -> None:
         optimize_pto(efficiency=0.9, gamma=0.03, harmonics=4)
 
 
-def _run_local(spec, todo, pool, done_cb, store=False):
+def _run_local(spec, todo, pool, done_cb, store=False, until=None, state=None):
     import concurrent.futures as cf
 
+    from ..deadline import expired
+
     if pool is None or len(todo) <= 1:
-        for b in todo:
+        for i, b in enumerate(todo):
+            if i and expired(until):  # the time limit: stop before the next block
+                state["stopped"] = True
+                break
             done_cb(b, compute_block(spec, b))
         return "serial"
     pool.start()
@@ -221,8 +230,22 @@ def _run_local(spec, todo, pool, done_cb, store=False):
     try:
         try:
             futs = {ex.submit(compute_block, spec, b): b for b in todo}
-            for f in cf.as_completed(futs):
-                done_cb(futs[f], f.result())
+            pending, written = set(futs), 0
+            while pending:
+                # with a time limit, wait no longer than it (once a block is written)
+                wait = (None if until is None or not written
+                        else max(0.0, until - time.monotonic()))
+                done, pending = cf.wait(pending, timeout=wait,
+                                        return_when=cf.FIRST_COMPLETED)
+                for f in done:
+                    done_cb(futs[f], f.result())
+                    written += 1
+                if pending and written and expired(until):
+                    # the time limit: the blocks still running are not waited for, nor
+                    # written (a block cut mid-way is never marked done)
+                    state["stopped"] = True
+                    _stop_workers(ex)
+                    break
         except cf.process.BrokenProcessPool:
             ex.shutdown(wait=True, cancel_futures=True)  # the exit codes are known after
             raise SolverError(worker_death(pool, store)) from None
@@ -322,10 +345,13 @@ def _close(client) -> None:
         _discard(client)
 
 
-def _run_dask(spec, todo, client, done_cb):
+def _run_dask(spec, todo, client, done_cb, until=None, state=None):
     from distributed import as_completed
 
+    from ..deadline import expired
+
     futs = {client.submit(compute_block, spec, b, pure=False): b for b in todo}
+    left = set(futs)
     for f in as_completed(list(futs), loop=client.loop):
         try:
             vals = f.result()
@@ -337,6 +363,12 @@ def _run_dask(spec, todo, client, done_cb):
                               "in the store: run the same command again to resume") from None
         done_cb(futs[f], vals)
         f.release()
+        left.discard(f)
+        if left and expired(until):
+            # the time limit: the blocks not yet returned are cancelled, never written
+            state["stopped"] = True
+            client.cancel(list(left))
+            break
     return f"Dask cluster at {client.scheduler.address}"
 
 
@@ -426,10 +458,13 @@ def sweep(store=None, *, omega=1.8, delta=None, gamma=GAMMA["sweep"], torque_lim
 
 def run_spec(spec, store=None, *, workers: int | None = None, scheduler=None,
              overwrite: bool = False, command: str | None = None,
-             progress=None) -> SweepRun:
+             progress=None, deadline=None) -> SweepRun:
     """Run a checked spec (a :class:`SweepSpec`, or another product's spec with the same
     layout, e.g. :class:`parapend.performance.spec.MatrixSpec`) on the engine: store,
-    resume, local processes or Dask; the parameters are :func:`sweep`'s."""
+    resume, local processes or Dask; the parameters are :func:`sweep`'s. ``deadline`` (a
+    :func:`time.monotonic` time, :func:`parapend.deadline.deadline`): once it has passed no
+    further block is started or waited for (after at least one), and the run says
+    ``stopped``."""
     if workers is not None:
         # never more processes than blocks (--workers 256 started 57 processes for 4 bins)
         workers = min(check_int("workers", workers, 1, 256), max(1, spec.blocks))
@@ -450,7 +485,7 @@ def run_spec(spec, store=None, *, workers: int | None = None, scheduler=None,
         _compile_kernels(spec)
     pool = _LocalPool(workers, start=not resume) if local else None
     try:
-        return _sweep(spec, store, pool, client, overwrite, command, progress, t0)
+        return _sweep(spec, store, pool, client, overwrite, command, progress, t0, deadline)
     finally:
         if pool is not None:
             pool.shutdown()
@@ -458,8 +493,10 @@ def run_spec(spec, store=None, *, workers: int | None = None, scheduler=None,
             _close(client)
 
 
-def _sweep(spec, store, pool, client, overwrite, command, progress, t0) -> SweepRun:
+def _sweep(spec, store, pool, client, overwrite, command, progress, t0,
+           until=None) -> SweepRun:
     total = spec.points
+    state = {"stopped": False}
     sizes = [int(np.prod([s.stop - s.start for s in spec.block_slices(b)]))
              for b in range(spec.blocks)]
     if store is None:
@@ -477,15 +514,17 @@ def _sweep(spec, store, pool, client, overwrite, command, progress, t0) -> Sweep
             if progress is not None:
                 progress(counted[0], total)
 
-        how = _execute(spec, list(range(spec.blocks)), pool, client, write)
+        how = _execute(spec, list(range(spec.blocks)), pool, client, write, until=until,
+                       state=state)
         for k, v in arrays.items():
             ds[k] = (spec.dims, v, ds[k].attrs)
-        return SweepRun(ds, None, total, spec.blocks, total, 0, time.monotonic() - t0, how)
+        return SweepRun(ds, None, total, spec.blocks, counted[0], 0, time.monotonic() - t0,
+                        how, stopped=state["stopped"])
     path = _check_store_path(store)
     path.mkdir(exist_ok=True)
     try:
         return _sweep_store(spec, path, pool, client, overwrite, command, progress, t0,
-                            sizes)
+                            sizes, until, state)
     except OSError as exc:  # a full disk, a store made read-only, ...
         raise OutputError(f"cannot write {str(path)!r}: {_short_os(exc)}; the finished blocks "
                           "are in the store: run the same command again to resume") from None
@@ -495,7 +534,8 @@ def _short_os(exc: OSError) -> str:
     return " ".join(str(exc.strerror or exc).split())[:160]
 
 
-def _sweep_store(spec, path, pool, client, overwrite, command, progress, t0, sizes):
+def _sweep_store(spec, path, pool, client, overwrite, command, progress, t0, sizes,
+                 until=None, state=None):
     import zarr
 
     total = spec.points
@@ -537,14 +577,15 @@ def _sweep_store(spec, path, pool, client, overwrite, command, progress, t0, siz
             if progress is not None:
                 progress(counted[0], total)
 
-        how = (_execute(spec, todo, pool, client, write, store=True) if todo
-               else "nothing to do")
+        how = (_execute(spec, todo, pool, client, write, store=True, until=until,
+                        state=state) if todo else "nothing to do")
     ds = open_sweep(path)
-    return SweepRun(ds, str(path), total, spec.blocks, total - resumed, resumed,
-                    time.monotonic() - t0, how, repaired)
+    return SweepRun(ds, str(path), total, spec.blocks, counted[0] - resumed, resumed,
+                    time.monotonic() - t0, how, repaired,
+                    stopped=bool(state and state["stopped"]))
 
 
-def _execute(spec, todo, pool, client, write, store=False) -> str:
+def _execute(spec, todo, pool, client, write, store=False, until=None, state=None) -> str:
     if client is not None:
-        return _run_dask(spec, todo, client, write)
-    return _run_local(spec, todo, pool, write, store)
+        return _run_dask(spec, todo, client, write, until, state)
+    return _run_local(spec, todo, pool, write, store, until, state)

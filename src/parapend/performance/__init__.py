@@ -142,7 +142,8 @@ def matrix_spec(*, hs="1:3:3", te=None, tp=None, realizations: int = 3, waves: f
     if torque_limit is not None and heave:
         raise ParameterError("torque-limit: not supported over a sea record (parapend sea "
                              "solves the unconstrained optimum); drop --torque-limit")
-    hm0 = parse_bins("hs", hs)
+    # None: the default bins, as te (parse_bins(None) read as one centre: "got 1")
+    hm0 = parse_bins("hs", "1:3:3" if hs is None else hs)
     if te is not None and tp is not None:
         raise ParameterError("te, tp: give the period bins as one of --te or --tp")
     kind, per = ("tp", tp) if tp is not None else ("te", "6:10:3" if te is None else te)
@@ -508,11 +509,16 @@ def power_matrix(*, hs="1:3:3", te=None, tp=None, realizations: int = 3, waves: 
                  scheduler=None, netcdf=None, zarr=None, csv=None, command=None,
                  progress=None, dofs="heave", pivot_height=None, pivot_offset=None,
                  hull_pitch_inertia=None, barge_length=None, barge_beam=None,
-                 barge_draft=None, copper_loss=None):
+                 barge_draft=None, copper_loss=None, time_limit=None):
     """The power matrix of a device over bins of ``Hs x Te`` (or ``Tp``); see the module
     text and docs/performance.md. Returns ``(dataset, annual, run)``. ``dofs``
     ``"surge,heave,pitch"`` with ``device="buoy"``: a pendulum in a hull that surges, heaves
-    and pitches (``pivot_height ... copper_loss`` as :func:`parapend.buoy` takes them)."""
+    and pitches (``pivot_height ... copper_loss`` as :func:`parapend.buoy` takes them).
+    ``time_limit`` (s): no bin is started after it (:mod:`parapend.deadline`); the matrix
+    then holds the bins finished (the rest NaN, count 0), its attributes say ``status``
+    ``"time_limit"`` and ``bins_finished`` of ``bins``, and with ``store`` a rerun computes
+    the rest. Without ``time_limit`` or ``store`` a matrix estimated above
+    ``parapend.limits.MAX_UNTIMED_SECONDS`` is refused."""
     from ..maps.run import run_spec
     from .annual import bin_series, read_scatter, read_series
     from .check import check_bins, check_size
@@ -535,7 +541,10 @@ def power_matrix(*, hs="1:3:3", te=None, tp=None, realizations: int = 3, waves: 
         raise ParameterError("rated-power: the capacity factor needs a site: give --scatter "
                              "or --timeseries")
     from .. import fileio
+    from ..deadline import check_time_limit, deadline, refuse_untimed
 
+    time_limit = check_time_limit(time_limit)
+    until = deadline(time_limit)
     for path, flag, sfx in ((netcdf, "netcdf", ".nc"), (csv, "csv", ".csv")):
         if path is not None:
             fileio.check_target(path, flag, (sfx,))
@@ -593,6 +602,19 @@ def power_matrix(*, hs="1:3:3", te=None, tp=None, realizations: int = 3, waves: 
     if scheduler is None:
         workers = est["processes"]
     check_bins(spec)
+    if est["seconds"] is not None and store is None:
+        # resumable work (--store) is announced and runs; in memory it must fit the cap
+        each = est["seconds"] / est["solves"]  # one solve's share of the wall time
+        most = int(limits.MAX_UNTIMED_SECONDS / each)
+        by_r = most >= est["bins"]  # fewer realizations suffice
+        refuse_untimed("realizations" if by_r else "hs",
+                       f"a power matrix of {est['bins']} bins x {spec.realizations} "
+                       f"realizations ({est['solves']} solves on "
+                       f"{est['processes']} process(es))", est["seconds"],
+                       (f"use --realizations at most {most // est['bins']}" if by_r else
+                        f"use at most {max(1, most // spec.realizations)} bins (--hs times "
+                        f"--{spec.period_kind} centres) at {spec.realizations} realizations")
+                       + " or --store (resumable work: a rerun resumes)", time_limit)
     frequency, outside = None, None
     pk = spec.period_kind
     if scatter is not None:
@@ -613,9 +635,18 @@ def power_matrix(*, hs="1:3:3", te=None, tp=None, realizations: int = 3, waves: 
                  "100 s a 9-wave record of the hull")
     t0 = time.monotonic()
     run = run_spec(spec, store, workers=workers, scheduler=scheduler, overwrite=overwrite,
-                   command=command, progress=progress)
+                   command=command, progress=progress, deadline=until)
     ds, annual = matrix_dataset(run.dataset, spec, depth=depth, density=density, width=width,
                                 frequency=frequency, outside=outside, rated_power=rated_power)
+    if run.stopped:
+        # a partial matrix says so, in the Dataset and every file written from it
+        done = np.asarray(run.dataset["done"].values, dtype=bool)
+        finished = int(done.reshape(len(spec.hm0), len(spec.period), -1).all(axis=-1).sum())
+        ds.attrs.update(status="time_limit", bins=int(len(spec.hm0) * len(spec.period)),
+                        bins_finished=finished, time_limit_s=float(time_limit),
+                        partial=("time limit reached: the bins not finished are NaN (count "
+                                 "0)" + ("; run the same command again to compute them"
+                                         if store is not None else "")))
     seconds = time.monotonic() - t0
     if netcdf is not None:
         fileio.write_dataset(ds, netcdf)
