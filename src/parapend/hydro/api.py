@@ -210,7 +210,8 @@ def _check_design(count, pto, time_limit=None):
     what = " with --efficiency or --torque-limit" if pto else ""
     fix = (f"choose at most {fits[-1]} of them" if fits else
            "drop --efficiency and --torque-limit from the search")
-    raise ParameterError(f"optimize-design: {count} variables{what} need up to "
+    plural = "s" if count != 1 else ""
+    raise ParameterError(f"optimize-design: {count} variable{plural}{what} need up to "
                          f"{design_solves(count)} solves of about {each:g} s "
                          f"({design_solves(count) * each:.0f} s), more than the {cap:g} s a "
                          f"design search may take without a time limit; {fix}, or give "
