@@ -82,6 +82,13 @@ class _Targets:
         self.bp0 = _hermite_rows(tp, h)[0]  # (T, 4, 4)
         self.cw = np.cos(w * self.t)
         self.sw = np.sin(w * self.t)
+        nt = self.t.size
+        # flat and outer-product forms for the matrix products of the derivatives
+        self.af2 = self.a_full.reshape(nt, 4 * k)
+        self.bf2 = self.b_full.reshape(nt, 4 * k)
+        self.bpo = (self.bp0[:, :, :, None] * self.bp0[:, :, None, :]).reshape(nt, 4, 16)
+        self.inc = np.zeros((k, nt))
+        self.inc[self.j, np.arange(nt)] = 1.0
 
 
 class CoupledPlan:
@@ -117,6 +124,7 @@ class CoupledPlan:
                            mtot)
         self.wgt = np.concatenate((np.tile(h * W_G, k), np.zeros(self.nc)))
         self.b0g = _hermite_rows(TAU_G, h)[0]  # (4, 4) the whole intervals' sources
+        self.b0o = (self.b0g[:, :, None] * self.b0g[:, None, :]).reshape(4, 16)
         self.samples = None
         if sample_leads is not None:
             s = np.asarray(sample_leads, dtype=float)
@@ -148,9 +156,9 @@ class CoupledPlan:
         f_t = np.asarray(self.fm(tg.t), dtype=float)
         f_p = np.asarray(self.fm(tg.part_t), dtype=float)
         yc = (self.yy0 * tg.cw + self.yd0 * tg.sw / w
-              + np.einsum("tig,ig->t", tg.a_full, self.f_full) + np.sum(tg.a_part * f_p, 1))
+              + tg.af2 @ self.f_full.ravel() + np.sum(tg.a_part * f_p, 1))
         ydc = (-self.yy0 * w * tg.sw + self.yd0 * tg.cw
-               + np.einsum("tig,ig->t", tg.b_full, self.f_full) + np.sum(tg.b_part * f_p, 1))
+               + tg.bf2 @ self.f_full.ravel() + np.sum(tg.b_part * f_p, 1))
         return f_t, yc, ydc
 
     def full(self, x):
@@ -167,10 +175,10 @@ class CoupledPlan:
         thd = np.sum(tg.b1 * lt, 1)
         thdd = np.sum(tg.b2 * lt, 1)
         thf = loc @ self.b0g.T
-        thp = np.einsum("tga,ta->tg", tg.bp0, lt)
+        thp = np.matmul(tg.bp0, lt[:, :, None])[:, :, 0]
         cf, cp = np.cos(thf), np.cos(thp)
-        af, ap = (tg.b_full, tg.b_part) if derivative else (tg.a_full, tg.a_part)
-        y = yc + self.kap * (np.einsum("tig,ig->t", af, cf) + np.sum(ap * cp, 1))
+        af, ap = (tg.bf2, tg.b_part) if derivative else (tg.af2, tg.a_part)
+        y = yc + self.kap * (af @ cf.ravel() + np.sum(ap * cp, 1))
         return th, thd, thdd, thf, thp, y
 
     # -- values ------------------------------------------------------------------------------
@@ -189,6 +197,18 @@ class CoupledPlan:
         th, thd, _, _, _, yd = self._motion(tg, loc, ydc, derivative=True)
         zd = yd + self.r * np.sin(th) * thd
         return float(np.sum(self.wgt * (-f_t * zd + self.p[4] * thd * thd)))
+
+    def values(self, x):
+        """The minimized ``-J`` and the constraint torques (N m, ``(3K,)``) together."""
+        loc = self._local(self.full(x))
+        tg = self.tg
+        f_t, yc, ydc = self._fixed[0]
+        th, thd, thdd, thf, thp, y = self._motion(tg, loc, yc)
+        kap = self.kap
+        yd = ydc + kap * (tg.bf2 @ np.cos(thf).ravel() + np.sum(tg.b_part * np.cos(thp), 1))
+        zd = yd + self.r * np.sin(th) * thd
+        phi = float(np.sum(self.wgt * (-f_t * zd + self.p[4] * thd * thd)))
+        return phi, self._torque(th, thd, thdd, f_t, y)[self.ng:]
 
     def constraint_torques(self, x):
         """The torque (N m) at the constraint points, ``(K, 3)``."""
@@ -241,7 +261,7 @@ class CoupledPlan:
         ml, inertia, c, g, mtot = self.p[2], self.p[3], self.p[4], self.p[5], self.p[0]
         r, kap = self.r, self.kap
         th, thd, thdd, thf, thp, y = self._motion(tg, loc, yc)
-        yd = ydc + kap * (np.einsum("tig,ig->t", tg.b_full, np.cos(thf))
+        yd = ydc + kap * (tg.bf2 @ np.cos(thf).ravel()
                           + np.sum(tg.b_part * np.cos(thp), 1))
         s, co = np.sin(th), np.cos(th)
         sf, cf, sp, cp = np.sin(thf), np.cos(thf), np.sin(thp), np.cos(thp)
@@ -250,17 +270,17 @@ class CoupledPlan:
         phi = float(np.sum(wgt * (-f_t * zd + c * thd * thd)))
         # objective: the sources' cos(theta) weighted by the adjoint of y'
         lam_t = -wgt * f_t
-        lam_f = np.einsum("t,tig->ig", lam_t, tg.b_full)
+        lam_f = (lam_t @ tg.bf2).reshape(k, 4)
         lam_p = lam_t[:, None] * tg.b_part
         gloc = np.zeros((k, 4))
         hloc = np.zeros((k, 4, 4))
         cf1 = -kap * lam_f * sf
         gloc += cf1 @ self.b0g
-        hloc += np.einsum("ig,ga,gb->iab", -kap * lam_f * cf, self.b0g, self.b0g)
+        hloc += ((-kap * lam_f * cf) @ self.b0o).reshape(k, 4, 4)
         cp1 = -kap * lam_p * sp
         cp2 = -kap * lam_p * cp
-        gp = np.einsum("tg,tga->ta", cp1, tg.bp0)
-        hp = np.einsum("tg,tga,tgb->tab", cp2, tg.bp0, tg.bp0)
+        gp = np.matmul(cp1[:, None, :], tg.bp0)[:, 0]
+        hp = np.matmul(cp2[:, None, :], tg.bpo)[:, 0].reshape(-1, 4, 4)
         # the points' own terms
         d_th = -wgt * f_t * r * co * thd
         d_thd = -wgt * f_t * r * s + 2.0 * c * wgt * thd
@@ -290,16 +310,16 @@ class CoupledPlan:
         jac = self._scatter_rows(jl, jc, nfull)
         # the heave's part: kap sin(theta) dy, dy = kap sum A (-sin theta_s) row_s
         af, ap = tg.a_full[cs], tg.a_part[cs]
-        mf = np.einsum("tig,ig,ga->tia", af, -kap * sf, self.b0g)
+        mf = (af * (-kap * sf)[None]) @ self.b0g
         dy = np.zeros((self.nc, nfull))
         for a in range(4):
             dy[:, a:a + 2 * k:2] += mf[:, :, a]
-        mp = np.einsum("tg,tg,tga->ta", ap, -kap * sp[cs], tg.bp0[cs])
+        mp = np.matmul((ap * (-kap * sp[cs]))[:, None, :], tg.bp0[cs])[:, 0]
         dy += self._scatter_rows(mp, jc, nfull)
         jac += (kap * sc)[:, None] * dy
         gfull = np.zeros(nfull)
-        np.add.at(hloc, tg.j, hp)
-        np.add.at(gloc, tg.j, gp)
+        hloc += (tg.inc @ hp.reshape(-1, 16)).reshape(k, 4, 4)
+        gloc += tg.inc @ gp
         for a in range(4):
             gfull[a:a + 2 * k:2] += gloc[:, a]
         hess = None
@@ -317,14 +337,15 @@ class CoupledPlan:
                 + p_tdd[:, None, None] * (b0c[:, :, None] * b2c[:, None, :]
                                           + b2c[:, :, None] * b0c[:, None, :])
                 + p_dd[:, None, None] * b1c[:, :, None] * b1c[:, None, :])
-            np.add.at(hloc, jc, hc)
+            inc_c = tg.inc[:, cs]
+            hloc += (inc_c @ hc.reshape(-1, 16)).reshape(k, 4, 4)
             # the second derivative of y: sources weighted by mu_s = sum nu kap sin A
             wv = nu * kap * sc
-            mu_f = np.einsum("t,tig->ig", wv, af)
-            hloc += np.einsum("ig,ga,gb->iab", -kap * mu_f * cf, self.b0g, self.b0g)
+            mu_f = (wv @ tg.af2[cs]).reshape(k, 4)
+            hloc += ((-kap * mu_f * cf) @ self.b0o).reshape(k, 4, 4)
             mu_p = wv[:, None] * ap
-            hpp = np.einsum("tg,tga,tgb->tab", -kap * mu_p * cp[cs], tg.bp0[cs], tg.bp0[cs])
-            np.add.at(hloc, jc, hpp)
+            hpp = np.matmul((-kap * mu_p * cp[cs])[:, None, :], tg.bpo[cs])[:, 0]
+            hloc += (inc_c @ hpp).reshape(k, 4, 4)
             hess = self._scatter_hess(hloc, nfull)
             # the cross terms nu kap cos(theta) (row0 dy^T + dy row0^T)
             e0 = self._scatter_rows(b0c, jc, nfull)
@@ -398,9 +419,9 @@ class CoupledPlan:
             for _ in range(30):
                 xt = x + a * dx
                 st = s + a * ds
-                tt = self.constraint_torques(xt).ravel()
+                ft, tt = self.values(xt)
                 gt = np.concatenate((tt / tm - 1.0, -tt / tm - 1.0))
-                mt = (self.objective(xt) - mu * float(np.sum(np.log(st)))
+                mt = (ft - mu * float(np.sum(np.log(st)))
                       + rho * float(np.sum(np.abs(gt + st))))
                 if np.isfinite(mt) and mt <= m0 + 1e-4 * a * min(dm, 0.0):
                     ok = True

@@ -543,7 +543,8 @@ class _MotionPlanner:
                     mu = (1 - relaxation) * mu + relaxation * out[1]
             fm = fseg - mu
             pr.set_start(y0, lambda s, fm=fm: np.interp(s, self.tf, fm))
-            xs, status, _ = pr.solve(x, max_iter=PLAN_MAX_ITER)
+            with _blas_controller().limit(limits=1, user_api="blas"):
+                xs, status, _ = pr.solve(x, max_iter=PLAN_MAX_ITER)
             if not np.all(np.isfinite(xs)):
                 failed += 1
                 kept += 1
