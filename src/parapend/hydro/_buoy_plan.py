@@ -132,7 +132,6 @@ class CoupledPlan:
             self.samples = _Targets(js, s / h - js, k, h, self.w, mtot)
         self.n = 2 * k
         self.x0 = np.zeros(4)
-        self.trace = None
 
     # -- the update's data -------------------------------------------------------------------
     def set_start(self, y0, fm):
@@ -373,7 +372,8 @@ class CoupledPlan:
         status = 1
         it = 0
         delta_last = 0.0
-        for it in range(1, max_iter + 1):
+        while it < max_iter:
+            it += 1
             nu = (lam[:nc] - lam[nc:]) / tm
             phi, gr, hess, tau, jac = self.derivatives(x, nu)
             if not (np.isfinite(phi) and np.all(np.isfinite(gr))):
@@ -433,9 +433,6 @@ class CoupledPlan:
                 else:
                     status = 2
                 break
-            if self.trace is not None:
-                self.trace.append((it, phi, a, ap, ad, mu, comp, float(np.max(np.abs(rd))),
-                                   float(np.max(np.abs(rp))), delta))
             x = xt
             s = st
             lam = lam + min(ad, 1.0) * dl

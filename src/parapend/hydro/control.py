@@ -24,6 +24,15 @@ pendulum units: time ``t0 = sqrt(I / (m g l))``, torque ``m g l``, ``q = z'' / g
 - ``"one-way"``: the pendulum MPC planning on the FREE buoy's heave (the buoy's response to
   the record without the pendulum, from the same start, by the plant's own model), ignoring
   its reaction; one solve per update.
+- ``"plan"`` (experimental): the pendulum's MOTION as the unknown, as the pendulum's planner
+  (:mod:`parapend.control.plan`): the angle a C1 cubic Hermite on the horizon, the heave
+  the buoy's linear equation driven by ``F_exc - mu`` (the memory force predicted under the
+  previous plan and frozen) and the pendulum's reaction, a causal convolution of
+  ``cos(theta)``; the torque by inverse dynamics on that heave, bounded at three points per
+  interval; the objective the ``coupled`` controller's (work plus the energy of buoy and
+  pendulum at the end); a dense primal-dual interior point with the exact Hessian
+  (:mod:`._buoy_plan`), warm-started from the previous motion. The held torques are the
+  plan's torque averaged over each sample. Without efficiency (mechanical only).
 - ``"fixed-point"``: the pendulum MPC planning on the heave the coupled model predicts under
   its current plan, predicted again under the new plan, ``iterations`` times (plan <->
   heave); it does not converge for a heavy pendulum (docs/buoy.md).
@@ -583,10 +592,11 @@ def buoy_mpc(hydro, pendulum, wave, *, peak_period, horizon=2.0, update_interval
         sample ``Tp / samples`` (rounded so that the record holds whole samples).
     horizon, update_interval : float
         In peak periods.
-    controller : "coupled" or "one-way"
+    controller : "coupled", "one-way", "fixed-point" or "plan"
         The module docstring.
     iterations : int
-        ``coupled``: solves per update (plan <-> heave), at least 1.
+        ``coupled``, ``plan``: solves per update (plan <-> memory force), at least 1
+        (``plan`` gains nothing from a second: give 1).
     relaxation : float
         ``alpha`` in (0, 1] of the fixed-point iteration.
     warmup : float
