@@ -69,6 +69,12 @@ def test_derivatives_against_central_differences():
     hfd = np.array([(lagrangian_gradient(x + e * d) - lagrangian_gradient(x - e * d)) / (2 * e)
                     for d in eye])
     assert np.max(np.abs(hess - hfd)) < 1e-7 * np.max(np.abs(hess))
+    # the compiled kernel that the solver uses: the same to round-off
+    for a, b in zip(pr.derivatives(x, nu), pr.compiled(x, nu)):
+        assert np.allclose(a, b, rtol=1e-12, atol=1e-12 * np.max(np.abs(a)))
+    v0, v1 = pr.values(x), pr.compiled(x, order=0)
+    assert v1[0] == pytest.approx(v0[0], rel=1e-12)
+    assert np.allclose(v1[1], v0[1], rtol=1e-12, atol=1e-9)
     # the objective's Hessian alone is banded (one interval's nodes per term)
     h0 = pr.derivatives(x)[2]
     band = np.abs(np.subtract.outer(np.arange(2 * K), np.arange(2 * K))) > 3

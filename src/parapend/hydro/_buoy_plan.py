@@ -132,6 +132,7 @@ class CoupledPlan:
             self.samples = _Targets(js, s / h - js, k, h, self.w, mtot)
         self.n = 2 * k
         self.x0 = np.zeros(4)
+        self._work = None
 
     # -- the update's data -------------------------------------------------------------------
     def set_start(self, y0, fm):
@@ -355,6 +356,26 @@ class CoupledPlan:
             hess = self._scatter_hess(hloc, nfull)[2:, 2:]
         return phi, gfull[2:], hess, tau, jac[:, 2:]
 
+    def compiled(self, x, nu=None, order=2):
+        """:meth:`derivatives` (``order`` 1 without ``nu``, 2 with it) or :meth:`values`
+        (``order`` 0) by the compiled kernel (:mod:`._buoy_plan_kernel`)."""
+        from ._buoy_plan_kernel import evaluate
+
+        k, tg = self.k, self.tg
+        nfull = 2 * k + 2
+        f_t, yc, ydc = self._fixed[0]
+        if self._work is None:
+            self._work = (np.empty(nfull), np.empty((nfull, nfull)), np.empty(self.nc),
+                          np.empty((self.nc, nfull)))
+        grad, hess, tau, jac = self._work
+        nu = np.zeros(self.nc) if nu is None else np.asarray(nu, dtype=float)
+        phi = evaluate(self.full(x), tg.j, tg.b0, tg.b1, tg.b2, tg.a_full, tg.b_full,
+                       tg.a_part, tg.b_part, tg.bp0, self.b0g, self.wgt, f_t, yc, ydc,
+                       self.ng, self.p, self.r, self.kap, nu, order, grad, hess, tau, jac)
+        if order == 0:
+            return phi, tau.copy()
+        return phi, grad[2:].copy(), hess[2:, 2:].copy(), tau.copy(), jac[:, 2:].copy()
+
     # -- the solver --------------------------------------------------------------------------
     def solve(self, x, *, max_iter=100, tol=1e-8):
         """The interior point (module docstring) from ``x`` (need not be feasible). Returns
@@ -362,7 +383,7 @@ class CoupledPlan:
         x = np.asarray(x, dtype=float).copy()
         tm = self.tmax
         nc = self.nc
-        phi, gr, _, tau, jac = self.derivatives(x)
+        phi, gr, _, tau, jac = self.compiled(x, None, 1)
         gv = np.concatenate((tau / tm - 1.0, -tau / tm - 1.0))
         scale = max(1.0, float(np.max(np.abs(gr))))
         mu = MU0 * scale
@@ -375,7 +396,7 @@ class CoupledPlan:
         while it < max_iter:
             it += 1
             nu = (lam[:nc] - lam[nc:]) / tm
-            phi, gr, hess, tau, jac = self.derivatives(x, nu)
+            phi, gr, hess, tau, jac = self.compiled(x, nu)
             if not (np.isfinite(phi) and np.all(np.isfinite(gr))):
                 status = 3
                 break
@@ -419,7 +440,7 @@ class CoupledPlan:
             for _ in range(30):
                 xt = x + a * dx
                 st = s + a * ds
-                ft, tt = self.values(xt)
+                ft, tt = self.compiled(xt, order=0)
                 gt = np.concatenate((tt / tm - 1.0, -tt / tm - 1.0))
                 mt = (ft - mu * float(np.sum(np.log(st)))
                       + rho * float(np.sum(np.abs(gt + st))))
