@@ -209,3 +209,19 @@ def test_closed_loop_is_causal(monkeypatch):
 def test_plan_controller_refuses_what_it_does_not_model():
     with pytest.raises(ParameterError, match="controller"):
         bc.buoy_mpc(SYN, Pendulum(20.0, 0.3, 1.8, 0.25), WAVE, **{**OPTS, "efficiency": 0.9})
+
+
+@pytest.mark.slow
+def test_default_design_plan_controller_harvests():
+    # docs/buoy.md's measurement, seed 0, two peak periods: 28.8 W, 56 % of the record's
+    # coupled optimum (winding 10); the energy balance closes
+    import parapend
+
+    opt = parapend.buoy(hs=0.5, tp=2.5, repeat_period=25, seed=0, winding=10)
+    pend = Pendulum(mass=80.0, length=0.3, inertia=7.2, damping_coefficient=1.0)
+    r = bc.buoy_mpc(opt._hydro, pend, opt._wave, peak_period=2.5, horizon=2.0,
+                    controller="plan", iterations=1)
+    assert r.success
+    assert 0.4 < r.mean_power_w / opt.power_w < 0.8
+    assert r.energy_balance_residual < 1e-6
+    assert r.peak_torque_nm <= r.torque_limit_nm * (1 + 1e-12)
