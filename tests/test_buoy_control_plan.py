@@ -81,6 +81,17 @@ def test_derivatives_against_central_differences():
     assert not np.any(h0[band])
 
 
+def test_compiled_solver_follows_the_reference_loop():
+    # the interior point compiled (solve) and in Python (solve_python): the same iterates
+    # to round-off (the same formulas; BLAS and loop sums differ in order)
+    pr, x = _problem(limit=300.0)
+    xa, sa, ia = pr.solve_python(x)
+    xb, sb, ib = pr.solve(x)
+    assert sa == sb == "converged" and ia == ib
+    assert np.max(np.abs(xa - xb)) < 1e-7 * np.max(np.abs(xa))
+    assert np.max(np.abs(pr.constraint_torques(xb))) <= 300.0 * (1 + 1e-6)
+
+
 def _reference_heave(plan, t_eval):
     """``M z'' + C z = f - m l (cos theta)''`` by an adaptive integrator on the plan's angle
     (each interval's cubic written out), interval by interval (``theta''`` jumps at the

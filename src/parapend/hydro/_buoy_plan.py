@@ -378,8 +378,20 @@ class CoupledPlan:
 
     # -- the solver --------------------------------------------------------------------------
     def solve(self, x, *, max_iter=100, tol=1e-8):
-        """The interior point (module docstring) from ``x`` (need not be feasible). Returns
-        ``(x, status, iterations)``."""
+        """The interior point (module docstring) from ``x`` (need not be feasible), compiled
+        (:func:`._buoy_plan_kernel.solve`). Returns ``(x, status, iterations)``."""
+        from ._buoy_plan_kernel import solve
+
+        tg = self.tg
+        f_t, yc, ydc = self._fixed[0]
+        xs, st, it = solve(np.ascontiguousarray(x, dtype=float), self.x0[2:].copy(), tg.j,
+                           tg.b0, tg.b1, tg.b2, tg.a_full, tg.b_full, tg.a_part, tg.b_part,
+                           tg.bp0, self.b0g, self.wgt, f_t, yc, ydc, self.ng, self.p, self.r,
+                           self.kap, self.tmax, int(max_iter), float(tol), MU0)
+        return xs, STATUS[st], int(it)
+
+    def solve_python(self, x, *, max_iter=100, tol=1e-8):
+        """:meth:`solve` with the loop in Python (the reference of the compiled one)."""
         x = np.asarray(x, dtype=float).copy()
         tm = self.tmax
         nc = self.nc

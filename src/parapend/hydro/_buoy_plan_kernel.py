@@ -182,3 +182,189 @@ def evaluate(full, j, b0, b1, b2, af, bf, ap, bp, bp0, b0g, wgt, f_t, yc, ydc, n
                 for b in range(4):
                     hess[2 * i + a, 2 * i + b] += c2 * b0g[q, a] * b0g[q, b]
     return phi
+
+
+@nb.njit(cache=True)
+def _cholesky(a, out):
+    """Lower Cholesky factor of ``a`` into ``out``; False if ``a`` is not positive definite."""
+    n = a.shape[0]
+    for i in range(n):
+        for j in range(i + 1):
+            v = a[i, j]
+            for k in range(j):
+                v -= out[i, k] * out[j, k]
+            if i == j:
+                if not v > 0.0:
+                    return False
+                out[i, i] = math.sqrt(v)
+            else:
+                out[i, j] = v / out[j, j]
+        for j in range(i + 1, n):
+            out[i, j] = 0.0
+    return True
+
+
+@nb.njit(cache=True)
+def _cho_solve(low, b):
+    n = b.size
+    y = np.empty(n)
+    for i in range(n):
+        v = b[i]
+        for k in range(i):
+            v -= low[i, k] * y[k]
+        y[i] = v / low[i, i]
+    x = np.empty(n)
+    for i in range(n - 1, -1, -1):
+        v = y[i]
+        for k in range(i + 1, n):
+            v -= low[k, i] * x[k]
+        x[i] = v / low[i, i]
+    return x
+
+
+@nb.njit(cache=True)
+def _max_step(v, dv, frac):
+    a = 1.0
+    for i in range(v.size):
+        if dv[i] < 0.0:
+            a = min(a, -frac * v[i] / dv[i])
+    return a
+
+
+@nb.njit(cache=True)
+def solve(x, start, j, b0, b1, b2, af, bf, ap, bp, bp0, b0g, wgt, f_t, yc, ydc, ng, p, r,
+          kap, tmax, max_iter, tol, mu0):
+    """The interior point of :meth:`._buoy_plan.CoupledPlan.solve` as one compiled call:
+    returns ``(x, status, iterations)`` (status 0 converged, 1 iteration limit, 2 line
+    search, 3 not finite)."""
+    n = x.size
+    nfull = n + 2
+    nt = j.size
+    nc = nt - ng
+    m = 2 * nc
+    full = np.empty(nfull)
+    full[0], full[1] = start[0], start[1]
+    x = x.copy()
+    full[2:] = x
+    grad = np.empty(nfull)
+    hess = np.empty((nfull, nfull))
+    tau = np.empty(nc)
+    jac = np.empty((nc, nfull))
+    nu = np.zeros(nc)
+    evaluate(full, j, b0, b1, b2, af, bf, ap, bp, bp0, b0g, wgt, f_t, yc, ydc, ng, p, r, kap,
+             nu, 1, grad, hess, tau, jac)
+    scale = 1.0
+    for i in range(n):
+        scale = max(scale, abs(grad[2 + i]))
+    mu = mu0 * scale
+    s = np.empty(m)
+    gv = np.empty(m)
+    for i in range(nc):
+        gv[i] = tau[i] / tmax - 1.0
+        gv[nc + i] = -tau[i] / tmax - 1.0
+    for i in range(m):
+        s[i] = max(-gv[i], 1e-2)
+    lam = mu / s
+    rho = 0.0
+    status = 1
+    it = 0
+    delta_last = 0.0
+    low = np.empty((n, n))
+    kmat = np.empty((n, n))
+    tau_t = np.empty(nc)
+    while it < max_iter:
+        it += 1
+        for i in range(nc):
+            nu[i] = (lam[i] - lam[nc + i]) / tmax
+        phi = evaluate(full, j, b0, b1, b2, af, bf, ap, bp, bp0, b0g, wgt, f_t, yc, ydc, ng,
+                       p, r, kap, nu, 2, grad, hess, tau, jac)
+        fin = math.isfinite(phi)
+        for i in range(n):
+            fin = fin and math.isfinite(grad[2 + i])
+        if not fin:
+            status = 3
+            break
+        gr = grad[2:].copy()
+        jc = jac[:, 2:].copy()
+        for i in range(nc):
+            gv[i] = tau[i] / tmax - 1.0
+            gv[nc + i] = -tau[i] / tmax - 1.0
+        rd = gr + jc.T @ nu
+        rp = gv + s
+        comp = 0.0
+        for i in range(m):
+            comp += s[i] * lam[i]
+        comp /= m
+        rdm = np.max(np.abs(rd))
+        rpm = np.max(np.abs(rp))
+        if rdm < tol * scale and rpm < 1e-7 and comp < tol * scale:
+            status = 0
+            break
+        err = max(rdm / scale, rpm, np.max(np.abs(s * lam - mu)) / scale)
+        if err <= 10.0 * mu / scale:
+            mu = max(min(0.2 * mu, mu ** 1.5 / scale ** 0.5), 0.1 * tol * scale)
+        sig = lam / s
+        wj = (sig[:nc] + sig[nc:]) / (tmax * tmax)
+        v = mu / s + sig * rp
+        vv = (v[:nc] - v[nc:]) / tmax
+        rhs = -(gr + jc.T @ vv)
+        hm = hess[2:, 2:]
+        jw = jc * wj.reshape(-1, 1)
+        kmat[:, :] = hm + jc.T @ jw
+        dmin = 1.0
+        for a in range(n):
+            dmin = max(dmin, abs(hm[a, a]))
+        dmin *= 1e-8
+        delta = 0.0
+        while True:
+            for a in range(n):
+                kmat[a, a] += delta
+            ok = _cholesky(kmat, low)
+            for a in range(n):
+                kmat[a, a] -= delta
+            if ok:
+                break
+            delta = max(dmin, delta_last / 3.0, 8.0 * delta)
+        if delta > 0.0:
+            delta_last = delta
+        dx = _cho_solve(low, rhs)
+        jdx = jc @ dx
+        ds = np.empty(m)
+        for i in range(nc):
+            ds[i] = -rp[i] - jdx[i] / tmax
+            ds[nc + i] = -rp[nc + i] + jdx[i] / tmax
+        dl = mu / s - lam - sig * ds
+        a_p = _max_step(s, ds, 0.995)
+        a_d = _max_step(lam, dl, 0.995)
+        rho = max(rho, 1.1 * np.max(np.abs(lam)))
+        m0 = phi - mu * np.sum(np.log(s)) + rho * np.sum(np.abs(rp))
+        dm = gr @ dx - mu * np.sum(ds / s) - rho * np.sum(np.abs(rp))
+        a = a_p
+        ok = False
+        for _ in range(30):
+            for i in range(n):
+                full[2 + i] = x[i] + a * dx[i]
+            st = s + a * ds
+            ft = evaluate(full, j, b0, b1, b2, af, bf, ap, bp, bp0, b0g, wgt, f_t, yc, ydc,
+                          ng, p, r, kap, nu, 0, grad, hess, tau_t, jac)
+            mt = ft - mu * np.sum(np.log(st))
+            for i in range(nc):
+                mt += rho * (abs(tau_t[i] / tmax - 1.0 + st[i])
+                             + abs(-tau_t[i] / tmax - 1.0 + st[nc + i]))
+            if math.isfinite(mt) and mt <= m0 + 1e-4 * a * min(dm, 0.0):
+                ok = True
+                break
+            a *= 0.5
+        if not ok:
+            for i in range(n):
+                full[2 + i] = x[i]
+            if rpm < 1e-6 and comp < 10.0 * tol * scale:
+                status = 0
+            else:
+                status = 2
+            break
+        for i in range(n):
+            x[i] = full[2 + i]
+        s = st
+        lam = lam + min(a_d, 1.0) * dl
+    return x, status, it
