@@ -24,6 +24,15 @@ pendulum units: time ``t0 = sqrt(I / (m g l))``, torque ``m g l``, ``q = z'' / g
 - ``"one-way"``: the pendulum MPC planning on the FREE buoy's heave (the buoy's response to
   the record without the pendulum, from the same start, by the plant's own model), ignoring
   its reaction; one solve per update.
+- ``"plan"`` (experimental): the pendulum's MOTION as the unknown, as the pendulum's planner
+  (:mod:`parapend.control.plan`): the angle a C1 cubic Hermite on the horizon, the heave
+  the buoy's linear equation driven by ``F_exc - mu`` (the memory force predicted under the
+  previous plan and frozen) and the pendulum's reaction, a causal convolution of
+  ``cos(theta)``; the torque by inverse dynamics on that heave, bounded at three points per
+  interval; the objective the ``coupled`` controller's (work plus the energy of buoy and
+  pendulum at the end); a dense primal-dual interior point with the exact Hessian
+  (:mod:`._buoy_plan`), warm-started from the previous motion. The held torques are the
+  plan's torque averaged over each sample. Without efficiency (mechanical only).
 - ``"fixed-point"``: the pendulum MPC planning on the heave the coupled model predicts under
   its current plan, predicted again under the new plan, ``iterations`` times (plan <->
   heave); it does not converge for a heavy pendulum (docs/buoy.md).
@@ -58,7 +67,11 @@ CATCH_MARGIN = 0.05
 DEFAULT_LIMIT = 2.0
 #: a run whose pendulum turns more than this (rad) in one plant step is not resolved
 RESOLVED = 0.5
-CONTROLLERS = ("coupled", "fixed-point", "one-way")
+CONTROLLERS = ("coupled", "fixed-point", "one-way", "plan")
+#: ``plan``: torque samples per Hermite interval of the motion
+PLAN_INTERVAL_SAMPLES = 4
+#: ``plan``: interior-point iterations per solve at most
+PLAN_MAX_ITER = 40
 
 
 @dataclass(frozen=True, eq=False, repr=False)
@@ -483,6 +496,85 @@ def _plan_fixed_point(plant, prob, x0, q, u0, fseg, ps, stride, rounds, relaxati
     return u, ch, res_fp, rounds, (int(failed), int(kept))
 
 
+class _MotionPlanner:
+    """``controller="plan"``: the motion-as-unknown horizon problem
+    (:class:`._buoy_plan.CoupledPlan`) of every update, warm-started from the previous
+    motion shifted by the samples since."""
+
+    def __init__(self, n, dt, ps, p, torque_limit, tu):
+        from ..control.mpc import _gauss3
+        from ._buoy_plan import CoupledPlan
+
+        self.n, self.dt, self.ps, self.tu = n, dt, ps, tu
+        self.k = max(1, -(-n // PLAN_INTERVAL_SAMPLES))
+        self.hh = n * dt / self.k
+        off, self.w3 = _gauss3(dt)
+        leads = ((dt * np.arange(n))[:, None] + off[None, :]).ravel()
+        self.prob = CoupledPlan(self.k, self.hh, p, torque_limit, sample_leads=leads)
+        self.tmax = torque_limit
+        self.nodes = None
+        self.tn = self.hh * np.arange(self.k + 1)
+        self.tf = 0.5 * dt / ps * np.arange(2 * n * ps + 1)
+
+    def start(self, y, shift):
+        """Variables: the previous motion shifted by ``shift`` s, continued at its end speed
+        beyond its end, through the measured angle (whole turns); at first a rotation at the
+        measured speed."""
+        from ..control.plan import HorizonPlan
+
+        th0, om0 = float(y[2]), float(y[3])
+        if self.nodes is None:
+            th, v = th0 + om0 * self.tn, np.full(self.k + 1, om0)
+        else:
+            old = HorizonPlan(self.hh, self.nodes[0], self.nodes[1], 0.0)
+            s = self.tn + shift
+            th, v, _ = old.evaluate(s)
+            beyond = s > old.horizon * (1 + 1e-12)
+            th = np.where(beyond, old.theta[-1] + old.v[-1] * (s - old.horizon), th)
+            v = np.where(beyond, old.v[-1], v)
+            th = th + 2 * math.pi * round((th0 - th[0]) / (2 * math.pi))
+        x = np.empty(2 * self.k)
+        x[0::2], x[1::2] = th[1:], v[1:]
+        return x
+
+    def plan(self, plant, u0, fseg, iterations, relaxation, shift, residual):
+        """The held torques (units ``tu``) of the horizon, the memory force's changes, the
+        residual (and its untimed seconds), the solves and the failures."""
+        pr = self.prob
+        y0 = plant.y.copy()
+        out = plant.predict(u0 * self.tu, self.ps, fseg, memory_force=True)
+        mu = out[1] if out is not None else np.full(fseg.size, plant.mus[0])
+        x = self.start(y0, shift)
+        u, ch, failed, kept = u0, [], 0, 0
+        for it in range(iterations):
+            if it:
+                out = plant.predict(u * self.tu, self.ps, fseg, memory_force=True)
+                if out is not None:
+                    ch.append(_rel(out[1], mu))
+                    mu = (1 - relaxation) * mu + relaxation * out[1]
+            fm = fseg - mu
+            pr.set_start(y0, lambda s, fm=fm: np.interp(s, self.tf, fm))
+            with _blas_controller().limit(limits=1, user_api="blas"):
+                xs, status, _ = pr.solve(x, max_iter=PLAN_MAX_ITER)
+            if not np.all(np.isfinite(xs)):
+                failed += 1
+                kept += 1
+                continue
+            failed += status != "converged"
+            x = xs
+            held = pr.torques(x).reshape(self.n, 3) @ self.w3
+            u = np.clip(held, -self.tmax, self.tmax) / self.tu
+            full = pr.full(x)
+            self.nodes = (full[0::2].copy(), full[1::2].copy())
+        res_fp = None
+        if residual:
+            t1 = time.perf_counter()
+            out = plant.predict(u * self.tu, self.ps, fseg, memory_force=True)
+            if out is not None:
+                res_fp = (_rel(out[1], mu), time.perf_counter() - t1)
+        return u, ch, res_fp, iterations, (int(failed), int(kept))
+
+
 def buoy_mpc(hydro, pendulum, wave, *, peak_period, horizon=2.0, update_interval=0.125,
              controller="coupled", iterations=2, relaxation=1.0, samples=SAMPLES,
              warmup=4.0, repeats=1, torque_limit=None, efficiency=None, terminal_weight=None,
@@ -503,10 +595,11 @@ def buoy_mpc(hydro, pendulum, wave, *, peak_period, horizon=2.0, update_interval
         sample ``Tp / samples`` (rounded so that the record holds whole samples).
     horizon, update_interval : float
         In peak periods.
-    controller : "coupled" or "one-way"
+    controller : "coupled", "one-way", "fixed-point" or "plan"
         The module docstring.
     iterations : int
-        ``coupled``: solves per update (plan <-> heave), at least 1.
+        ``coupled``, ``plan``: solves per update (plan <-> memory force), at least 1
+        (``plan`` gains nothing from a second: give 1).
     relaxation : float
         ``alpha`` in (0, 1] of the fixed-point iteration.
     warmup : float
@@ -545,8 +638,13 @@ def buoy_mpc(hydro, pendulum, wave, *, peak_period, horizon=2.0, update_interval
     if terminal not in ("total", "pendulum"):
         raise ParameterError(f"terminal: expected total or pendulum, got {terminal!r:.40}")
     if controller not in CONTROLLERS:
-        raise ParameterError(f"controller: expected coupled, fixed-point or one-way, got "
-                             f"{controller!r:.40}")
+        raise ParameterError(f"controller: expected coupled, fixed-point, one-way or plan, "
+                             f"got {controller!r:.40}")
+    if controller == "plan" and (efficiency is not None or terminal != "total"
+                                 or terminal_weight not in (None, 1, 1.0)):
+        raise ParameterError("controller: plan maximizes the mechanical work plus the energy "
+                             "of buoy and pendulum (no efficiency, terminal or "
+                             "terminal_weight yet)")
     tp = check_range("tp", peak_period, 1e-3, 1e3)
     samples = check_int("samples", samples, 8, 4096)
     horizon = check_range("horizon", horizon, 1.0 / samples, 20.0, why="peak periods")
@@ -617,7 +715,9 @@ def buoy_mpc(hydro, pendulum, wave, *, peak_period, horizon=2.0, update_interval
         if zfree is not None:
             qw = zfree / g
     tl_nd = None if torque_limit is None else torque_limit / tu
-    if controller == "coupled":
+    if controller == "plan":
+        prob = _MotionPlanner(n, dt, ps, plant.p, torque_limit, tu)
+    elif controller == "coupled":
         prob = CoupledHorizon(n, dt / ms, ms, plant.p, tu, tl_nd, eta, terminal_weight,
                               terminal)
     else:
@@ -654,7 +754,11 @@ def buoy_mpc(hydro, pendulum, wave, *, peak_period, horizon=2.0, update_interval
                   else np.zeros(n))
             x0 = np.array([th, om])
             tic = time.perf_counter()
-            if controller == "coupled":
+            if controller == "plan":
+                u, ch, res_fp, nsolve, nfail = prob.plan(
+                    plant, u0, fseg, iterations, relaxation, m * dt if solves else 0.0,
+                    residual)
+            elif controller == "coupled":
                 u, ch, res_fp, nsolve, nfail = _plan_coupled(
                     plant, prob, u0, fseg, ps, stride, iterations, relaxation, max_iter,
                     residual, tic)

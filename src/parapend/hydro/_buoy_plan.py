@@ -1,0 +1,479 @@
+r"""The buoy's horizon problem with the pendulum's MOTION as the unknown (``controller="plan"``
+of :func:`parapend.hydro.control.buoy_mpc`).
+
+On the horizon ``[t, t + H]`` the angle is a ``C^1`` piecewise cubic Hermite on ``K`` uniform
+intervals of ``h`` (nodes ``theta_k, v_k``, node 0 the measured state), as the pendulum's
+planner :mod:`parapend.control.plan`. The heave over the horizon is not an unknown: it is the
+buoy's linear equation driven by the excitation less the (frozen) radiation memory force
+``f(t) = F_exc - mu`` and the pendulum's reaction,
+
+    M z'' + C z = f - m l (cos theta)''          (M = mass + A_inf),
+
+which with ``y = z + r cos(theta)``, ``r = m l / M``, reads ``M y'' + C y = f + kappa
+cos(theta)``, ``kappa = C m l / M``: ``y`` is the measured start's free oscillation plus the
+convolution of ``f + kappa cos(theta)`` with ``G(s) = sin(w s) / (M w)`` (``w^2 = C / M``),
+a lower-triangular (causal) linear map of ``cos(theta)`` over the horizon. The integrals are
+4-point Gauss-Legendre rules: on every whole interval before a point, and on the part of its
+own interval before it (the angle there from the Hermite, so the rule is exact to the
+quadrature's order, not to a step).
+
+The torque follows by the pendulum's inverse dynamics on that heave,
+
+    tau = I theta'' + c theta' - m l sin(theta) (g + z''),
+    z'' = (f - C z) / M + r (cos(theta) theta'^2 + sin(theta) theta''),
+
+bounded, ``|tau| <= T_max``, at ``tau = 0, 1/2, 1`` of every interval. The objective is the
+harvested work plus the mechanical energy of buoy AND pendulum at the horizon's end (the
+terminal value of the ``coupled`` controller, docs/buoy.md); by the energy balance of the
+coupled model this is, up to the start's energy,
+
+    J = int (f z' - c theta'^2) dt,    z' = y' + r sin(theta) theta',
+
+whose variable part is a sum of terms each of one interval's nodes (``y'`` is linear in the
+``cos(theta)`` of the points before it): its Hessian is banded; only the torque constraints
+couple the whole horizon (through ``z``), so the Newton matrix is dense but small (``2 K``).
+
+**Solver.** A primal-dual interior point with slacks (``g(x) + s = 0``, ``s > 0``; an
+infeasible warm start needs no repair), the exact Hessian of the Lagrangian (objective and
+constraints), an inertia correction (Cholesky of ``H + J^T S^-1 Lambda J + delta I``) and a
+backtracking line search on the merit ``phi - mu sum log s + rho |g + s|_1``.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from scipy.linalg import LinAlgError, cho_factor, cho_solve
+
+from ..optimal.hermite import _hermite_rows
+
+_XG, _WG = np.polynomial.legendre.leggauss(4)
+TAU_G = (_XG + 1.0) / 2.0
+W_G = _WG / 2.0
+TORQUE_TAU = np.array([0.0, 0.5, 1.0])
+#: the barrier's first weight, relative to the objective's largest derivative
+MU0 = 1e-2
+STATUS = ("converged", "max_iter", "line_search", "nonfinite")
+
+
+class _Targets:
+    """Points ``(j, tau)`` of the horizon (interval, local coordinate) where the heave is
+    needed, with the weights of the convolutions that give ``y`` and ``y'`` there."""
+
+    def __init__(self, j, tau, k, h, w, mtot):
+        self.j = np.asarray(j, dtype=np.int64)
+        self.tau = np.asarray(tau, dtype=float)
+        self.t = (self.j + self.tau) * h
+        self.b0, self.b1, self.b2 = _hermite_rows(self.tau, h)
+        src = (np.arange(k)[:, None] + TAU_G[None, :]) * h  # (K, 4) whole intervals
+        lag = self.t[:, None, None] - src[None, :, :]
+        before = (np.arange(k)[None, :] < self.j[:, None])[:, :, None]
+        wq = h * W_G[None, None, :]
+        self.a_full = np.where(before, wq * np.sin(w * lag) / (mtot * w), 0.0)
+        self.b_full = np.where(before, wq * np.cos(w * lag) / mtot, 0.0)
+        # the part of the point's own interval before it
+        tp = self.tau[:, None] * TAU_G[None, :]
+        self.part_t = (self.j[:, None] + tp) * h
+        lagp = self.t[:, None] - self.part_t
+        wp = self.tau[:, None] * h * W_G[None, :]
+        self.a_part = wp * np.sin(w * lagp) / (mtot * w)
+        self.b_part = wp * np.cos(w * lagp) / mtot
+        self.bp0 = _hermite_rows(tp, h)[0]  # (T, 4, 4)
+        self.cw = np.cos(w * self.t)
+        self.sw = np.sin(w * self.t)
+        nt = self.t.size
+        # flat and outer-product forms for the matrix products of the derivatives
+        self.af2 = self.a_full.reshape(nt, 4 * k)
+        self.bf2 = self.b_full.reshape(nt, 4 * k)
+        self.bpo = (self.bp0[:, :, :, None] * self.bp0[:, :, None, :]).reshape(nt, 4, 16)
+        self.inc = np.zeros((k, nt))
+        self.inc[self.j, np.arange(nt)] = 1.0
+
+
+class CoupledPlan:
+    """The horizon problem of one update (module docstring) in SI units.
+
+    Parameters
+    ----------
+    k, h : int, float
+        Hermite intervals and their length (s).
+    p : array
+        ``(M + A_inf, C, m l, I, c, g)`` (:class:`parapend.hydro.control._Plant`).
+    torque_limit : float
+        ``T_max`` (N m).
+    sample_leads : array or None
+        Lead times (s) where :meth:`torques` gives the plan's torque (the held torques'
+        quadrature points).
+    """
+
+    def __init__(self, k, h, p, torque_limit, sample_leads=None):
+        self.k, self.h = int(k), float(h)
+        self.p = np.asarray(p, dtype=float)
+        mtot, cst, ml = self.p[0], self.p[1], self.p[2]
+        self.w = math.sqrt(cst / mtot)
+        self.r = ml / mtot
+        self.kap = cst * ml / mtot
+        self.tmax = float(torque_limit)
+        kk = np.arange(k)
+        jg, tg = np.repeat(kk, 4), np.tile(TAU_G, k)
+        jc, tc = np.repeat(kk, 3), np.tile(TORQUE_TAU, k)
+        self.ng = 4 * k
+        self.nc = 3 * k
+        self.tg = _Targets(np.concatenate((jg, jc)), np.concatenate((tg, tc)), k, h, self.w,
+                           mtot)
+        self.wgt = np.concatenate((np.tile(h * W_G, k), np.zeros(self.nc)))
+        self.b0g = _hermite_rows(TAU_G, h)[0]  # (4, 4) the whole intervals' sources
+        self.b0o = (self.b0g[:, :, None] * self.b0g[:, None, :]).reshape(4, 16)
+        self.samples = None
+        if sample_leads is not None:
+            s = np.asarray(sample_leads, dtype=float)
+            js = np.minimum(np.floor(s / h), k - 1).astype(np.int64)
+            self.samples = _Targets(js, s / h - js, k, h, self.w, mtot)
+        self.n = 2 * k
+        self.x0 = np.zeros(4)
+        self._work = None
+
+    # -- the update's data -------------------------------------------------------------------
+    def set_start(self, y0, fm):
+        """The measured ``(z, z', theta, theta')`` and ``f = F - mu`` (N) as a vectorized
+        callable of the lead time (s)."""
+        self.x0 = np.asarray(y0, dtype=float).copy()
+        self.fm = fm
+        z, zd, th, om = self.x0
+        self.yy0 = z + self.r * math.cos(th)
+        self.yd0 = zd - self.r * math.sin(th) * om
+        src = (np.arange(self.k)[:, None] + TAU_G[None, :]) * self.h
+        self.f_full = np.asarray(fm(src), dtype=float)
+        self._fixed = [self._constant(self.tg)]
+        if self.samples is not None:
+            self._fixed.append(self._constant(self.samples))
+
+    def _constant(self, tg):
+        """``f`` at the points, and the parts of ``y``, ``y'`` that do not depend on the
+        motion (the free oscillation and the convolution of ``f``)."""
+        w = self.w
+        f_t = np.asarray(self.fm(tg.t), dtype=float)
+        f_p = np.asarray(self.fm(tg.part_t), dtype=float)
+        yc = (self.yy0 * tg.cw + self.yd0 * tg.sw / w
+              + tg.af2 @ self.f_full.ravel() + np.sum(tg.a_part * f_p, 1))
+        ydc = (-self.yy0 * w * tg.sw + self.yd0 * tg.cw
+               + tg.bf2 @ self.f_full.ravel() + np.sum(tg.b_part * f_p, 1))
+        return f_t, yc, ydc
+
+    def full(self, x):
+        return np.concatenate((self.x0[2:], np.asarray(x, dtype=float)))
+
+    def _local(self, f):
+        return np.stack([f[0:-2:2], f[1:-2:2], f[2::2], f[3::2]], axis=1)
+
+    def _motion(self, tg, loc, yc, derivative=False):
+        """Angle, speed, acceleration at the points, the angle at the sources, and ``y`` (or
+        ``y'``)."""
+        lt = loc[tg.j]
+        th = np.sum(tg.b0 * lt, 1)
+        thd = np.sum(tg.b1 * lt, 1)
+        thdd = np.sum(tg.b2 * lt, 1)
+        thf = loc @ self.b0g.T
+        thp = np.matmul(tg.bp0, lt[:, :, None])[:, :, 0]
+        cf, cp = np.cos(thf), np.cos(thp)
+        af, ap = (tg.bf2, tg.b_part) if derivative else (tg.af2, tg.a_part)
+        y = yc + self.kap * (af @ cf.ravel() + np.sum(ap * cp, 1))
+        return th, thd, thdd, thf, thp, y
+
+    # -- values ------------------------------------------------------------------------------
+    def _torque(self, th, thd, thdd, f_t, y):
+        mtot, ml, inertia, c, g = self.p[0], self.p[2], self.p[3], self.p[4], self.p[5]
+        r, kap = self.r, self.kap
+        s, co = np.sin(th), np.cos(th)
+        return ((inertia - ml * r * s * s) * thdd + c * thd
+                - ml * s * (g + f_t / mtot + r * co * thd * thd) + kap * s * (y - r * co))
+
+    def objective(self, x):
+        """The minimized ``-J`` (module docstring; J without the start's energy)."""
+        loc = self._local(self.full(x))
+        tg = self.tg
+        f_t, _, ydc = self._fixed[0]
+        th, thd, _, _, _, yd = self._motion(tg, loc, ydc, derivative=True)
+        zd = yd + self.r * np.sin(th) * thd
+        return float(np.sum(self.wgt * (-f_t * zd + self.p[4] * thd * thd)))
+
+    def values(self, x):
+        """The minimized ``-J`` and the constraint torques (N m, ``(3K,)``) together."""
+        loc = self._local(self.full(x))
+        tg = self.tg
+        f_t, yc, ydc = self._fixed[0]
+        th, thd, thdd, thf, thp, y = self._motion(tg, loc, yc)
+        kap = self.kap
+        yd = ydc + kap * (tg.bf2 @ np.cos(thf).ravel() + np.sum(tg.b_part * np.cos(thp), 1))
+        zd = yd + self.r * np.sin(th) * thd
+        phi = float(np.sum(self.wgt * (-f_t * zd + self.p[4] * thd * thd)))
+        return phi, self._torque(th, thd, thdd, f_t, y)[self.ng:]
+
+    def constraint_torques(self, x):
+        """The torque (N m) at the constraint points, ``(K, 3)``."""
+        loc = self._local(self.full(x))
+        f_t, yc, _ = self._fixed[0]
+        th, thd, thdd, _, _, y = self._motion(self.tg, loc, yc)
+        return self._torque(th, thd, thdd, f_t, y)[self.ng:]
+
+    def torques(self, x):
+        """The plan's torque (N m) at ``sample_leads``."""
+        loc = self._local(self.full(x))
+        f_t, yc, _ = self._fixed[1]
+        th, thd, thdd, _, _, y = self._motion(self.samples, loc, yc)
+        return self._torque(th, thd, thdd, f_t, y)
+
+    def heave(self, x, leads):
+        """``z`` (m) at lead times (s) of the plan (for tests)."""
+        s = np.asarray(leads, dtype=float)
+        j = np.minimum(np.floor(s / self.h), self.k - 1).astype(np.int64)
+        tg = _Targets(j, s / self.h - j, self.k, self.h, self.w, self.p[0])
+        _, yc, _ = self._constant(tg)
+        th, _, _, _, _, y = self._motion(tg, self._local(self.full(x)), yc)
+        return y - self.r * np.cos(th)
+
+    # -- derivatives -------------------------------------------------------------------------
+    def _scatter_hess(self, hloc, nfull):
+        """Dense matrix from per-interval 4x4 blocks ``(K, 4, 4)``."""
+        hm = np.zeros((nfull, nfull))
+        for i in range(self.k):
+            hm[2 * i:2 * i + 4, 2 * i:2 * i + 4] += hloc[i]
+        return hm
+
+    def _scatter_rows(self, rows, j, nfull):
+        """Dense ``(T, nfull)`` from per-point rows ``(T, 4)`` at intervals ``j``."""
+        out = np.zeros((rows.shape[0], nfull))
+        idx = np.arange(rows.shape[0])
+        for a in range(4):
+            out[idx, 2 * j + a] += rows[:, a]
+        return out
+
+    def derivatives(self, x, nu=None):
+        """``phi`` (minimized), its gradient and Hessian, the constraint torques, their
+        Jacobian (``(3K, 2K)``), and with ``nu`` (per torque point) the Hessian of
+        ``phi + nu . tau`` (all over the free variables)."""
+        k = self.k
+        nfull = 2 * k + 2
+        loc = self._local(self.full(x))
+        tg = self.tg
+        f_t, yc, ydc = self._fixed[0]
+        ml, inertia, c, g, mtot = self.p[2], self.p[3], self.p[4], self.p[5], self.p[0]
+        r, kap = self.r, self.kap
+        th, thd, thdd, thf, thp, y = self._motion(tg, loc, yc)
+        yd = ydc + kap * (tg.bf2 @ np.cos(thf).ravel()
+                          + np.sum(tg.b_part * np.cos(thp), 1))
+        s, co = np.sin(th), np.cos(th)
+        sf, cf, sp, cp = np.sin(thf), np.cos(thf), np.sin(thp), np.cos(thp)
+        wgt = self.wgt
+        zd = yd + r * s * thd
+        phi = float(np.sum(wgt * (-f_t * zd + c * thd * thd)))
+        # objective: the sources' cos(theta) weighted by the adjoint of y'
+        lam_t = -wgt * f_t
+        lam_f = (lam_t @ tg.bf2).reshape(k, 4)
+        lam_p = lam_t[:, None] * tg.b_part
+        gloc = np.zeros((k, 4))
+        hloc = np.zeros((k, 4, 4))
+        cf1 = -kap * lam_f * sf
+        gloc += cf1 @ self.b0g
+        hloc += ((-kap * lam_f * cf) @ self.b0o).reshape(k, 4, 4)
+        cp1 = -kap * lam_p * sp
+        cp2 = -kap * lam_p * cp
+        gp = np.matmul(cp1[:, None, :], tg.bp0)[:, 0]
+        hp = np.matmul(cp2[:, None, :], tg.bpo)[:, 0].reshape(-1, 4, 4)
+        # the points' own terms
+        d_th = -wgt * f_t * r * co * thd
+        d_thd = -wgt * f_t * r * s + 2.0 * c * wgt * thd
+        gp += d_th[:, None] * tg.b0 + d_thd[:, None] * tg.b1
+        h_tt = wgt * f_t * r * s * thd
+        h_td = -wgt * f_t * r * co
+        h_dd = 2.0 * c * wgt
+        b0, b1, b2 = tg.b0, tg.b1, tg.b2
+        hp += (h_tt[:, None, None] * b0[:, :, None] * b0[:, None, :]
+               + h_td[:, None, None] * (b0[:, :, None] * b1[:, None, :]
+                                        + b1[:, :, None] * b0[:, None, :])
+               + h_dd[:, None, None] * b1[:, :, None] * b1[:, None, :])
+        # the torque at the constraint points
+        cs = slice(self.ng, None)
+        fc, sc, cc = f_t[cs], s[cs], co[cs]
+        thc, thdc, thddc, ycc = th[cs], thd[cs], thdd[cs], y[cs]
+        tau = ((inertia - ml * r * sc * sc) * thddc + c * thdc
+               - ml * sc * (g + fc / mtot + r * cc * thdc * thdc) + kap * sc * (ycc - r * cc))
+        c2, s2 = np.cos(2 * thc), np.sin(2 * thc)
+        t_th = (-ml * r * s2 * thddc - ml * cc * (g + fc / mtot) - ml * r * c2 * thdc * thdc
+                + kap * cc * ycc - kap * r * c2)
+        t_thd = c - ml * r * s2 * thdc
+        t_thdd = inertia - ml * r * sc * sc
+        jc = tg.j[cs]
+        b0c, b1c, b2c = b0[cs], b1[cs], b2[cs]
+        jl = t_th[:, None] * b0c + t_thd[:, None] * b1c + t_thdd[:, None] * b2c
+        jac = self._scatter_rows(jl, jc, nfull)
+        # the heave's part: kap sin(theta) dy, dy = kap sum A (-sin theta_s) row_s
+        af, ap = tg.a_full[cs], tg.a_part[cs]
+        mf = (af * (-kap * sf)[None]) @ self.b0g
+        dy = np.zeros((self.nc, nfull))
+        for a in range(4):
+            dy[:, a:a + 2 * k:2] += mf[:, :, a]
+        mp = np.matmul((ap * (-kap * sp[cs]))[:, None, :], tg.bp0[cs])[:, 0]
+        dy += self._scatter_rows(mp, jc, nfull)
+        jac += (kap * sc)[:, None] * dy
+        gfull = np.zeros(nfull)
+        hloc += (tg.inc @ hp.reshape(-1, 16)).reshape(k, 4, 4)
+        gloc += tg.inc @ gp
+        for a in range(4):
+            gfull[a:a + 2 * k:2] += gloc[:, a]
+        hess = None
+        if nu is not None:
+            nu = np.asarray(nu, dtype=float)
+            p_tt = (-2.0 * ml * r * c2 * thddc + ml * sc * (g + fc / mtot)
+                    + 2.0 * ml * r * s2 * thdc * thdc - kap * sc * ycc + 2.0 * kap * r * s2)
+            p_td = -2.0 * ml * r * c2 * thdc
+            p_tdd = -ml * r * s2
+            p_dd = -ml * r * s2
+            hc = nu[:, None, None] * (
+                p_tt[:, None, None] * b0c[:, :, None] * b0c[:, None, :]
+                + p_td[:, None, None] * (b0c[:, :, None] * b1c[:, None, :]
+                                         + b1c[:, :, None] * b0c[:, None, :])
+                + p_tdd[:, None, None] * (b0c[:, :, None] * b2c[:, None, :]
+                                          + b2c[:, :, None] * b0c[:, None, :])
+                + p_dd[:, None, None] * b1c[:, :, None] * b1c[:, None, :])
+            inc_c = tg.inc[:, cs]
+            hloc += (inc_c @ hc.reshape(-1, 16)).reshape(k, 4, 4)
+            # the second derivative of y: sources weighted by mu_s = sum nu kap sin A
+            wv = nu * kap * sc
+            mu_f = (wv @ tg.af2[cs]).reshape(k, 4)
+            hloc += ((-kap * mu_f * cf) @ self.b0o).reshape(k, 4, 4)
+            mu_p = wv[:, None] * ap
+            hpp = np.matmul((-kap * mu_p * cp[cs])[:, None, :], tg.bpo[cs])[:, 0]
+            hloc += (inc_c @ hpp).reshape(k, 4, 4)
+            hess = self._scatter_hess(hloc, nfull)
+            # the cross terms nu kap cos(theta) (row0 dy^T + dy row0^T)
+            e0 = self._scatter_rows(b0c, jc, nfull)
+            cross = e0.T @ ((nu * kap * cc)[:, None] * dy)
+            hess += cross + cross.T
+            hess = hess[2:, 2:]
+        else:
+            hess = self._scatter_hess(hloc, nfull)[2:, 2:]
+        return phi, gfull[2:], hess, tau, jac[:, 2:]
+
+    def compiled(self, x, nu=None, order=2):
+        """:meth:`derivatives` (``order`` 1 without ``nu``, 2 with it) or :meth:`values`
+        (``order`` 0) by the compiled kernel (:mod:`._buoy_plan_kernel`)."""
+        from ._buoy_plan_kernel import evaluate
+
+        k, tg = self.k, self.tg
+        nfull = 2 * k + 2
+        f_t, yc, ydc = self._fixed[0]
+        if self._work is None:
+            self._work = (np.empty(nfull), np.empty((nfull, nfull)), np.empty(self.nc),
+                          np.empty((self.nc, nfull)))
+        grad, hess, tau, jac = self._work
+        nu = np.zeros(self.nc) if nu is None else np.asarray(nu, dtype=float)
+        phi = evaluate(self.full(x), tg.j, tg.b0, tg.b1, tg.b2, tg.a_full, tg.b_full,
+                       tg.a_part, tg.b_part, tg.bp0, self.b0g, self.wgt, f_t, yc, ydc,
+                       self.ng, self.p, self.r, self.kap, nu, order, grad, hess, tau, jac)
+        if order == 0:
+            return phi, tau.copy()
+        return phi, grad[2:].copy(), hess[2:, 2:].copy(), tau.copy(), jac[:, 2:].copy()
+
+    # -- the solver --------------------------------------------------------------------------
+    def solve(self, x, *, max_iter=100, tol=1e-8):
+        """The interior point (module docstring) from ``x`` (need not be feasible), compiled
+        (:func:`._buoy_plan_kernel.solve`). Returns ``(x, status, iterations)``."""
+        from ._buoy_plan_kernel import solve
+
+        tg = self.tg
+        f_t, yc, ydc = self._fixed[0]
+        xs, st, it = solve(np.ascontiguousarray(x, dtype=float), self.x0[2:].copy(), tg.j,
+                           tg.b0, tg.b1, tg.b2, tg.a_full, tg.b_full, tg.a_part, tg.b_part,
+                           tg.bp0, self.b0g, self.wgt, f_t, yc, ydc, self.ng, self.p, self.r,
+                           self.kap, self.tmax, int(max_iter), float(tol), MU0)
+        return xs, STATUS[st], int(it)
+
+    def solve_python(self, x, *, max_iter=100, tol=1e-8):
+        """:meth:`solve` with the loop in Python (the reference of the compiled one)."""
+        x = np.asarray(x, dtype=float).copy()
+        tm = self.tmax
+        nc = self.nc
+        phi, gr, _, tau, jac = self.compiled(x, None, 1)
+        gv = np.concatenate((tau / tm - 1.0, -tau / tm - 1.0))
+        scale = max(1.0, float(np.max(np.abs(gr))))
+        mu = MU0 * scale
+        s = np.maximum(-gv, 1e-2)
+        lam = mu / s
+        rho = 0.0
+        status = 1
+        it = 0
+        delta_last = 0.0
+        while it < max_iter:
+            it += 1
+            nu = (lam[:nc] - lam[nc:]) / tm
+            phi, gr, hess, tau, jac = self.compiled(x, nu)
+            if not (np.isfinite(phi) and np.all(np.isfinite(gr))):
+                status = 3
+                break
+            jg = np.concatenate((jac, -jac)) / tm
+            gv = np.concatenate((tau / tm - 1.0, -tau / tm - 1.0))
+            rd = gr + jg.T @ lam
+            rp = gv + s
+            comp = float(s @ lam) / s.size
+            if (np.max(np.abs(rd)) < tol * scale and np.max(np.abs(rp)) < 1e-7
+                    and comp < tol * scale):
+                status = 0
+                break
+            # the barrier's weight falls once its problem is solved to about its size
+            err = max(np.max(np.abs(rd)) / scale, np.max(np.abs(rp)),
+                      np.max(np.abs(s * lam - mu)) / scale)
+            if err <= 10.0 * mu / scale:
+                mu = max(min(0.2 * mu, mu ** 1.5 / scale ** 0.5), 0.1 * tol * scale)
+            sig = lam / s
+            kmat = hess + jg.T @ (sig[:, None] * jg)
+            rhs = -(gr + jg.T @ (mu / s + sig * rp))
+            delta = 0.0
+            dmin = 1e-8 * max(1.0, float(np.max(np.abs(np.diag(hess)))))
+            while True:
+                try:
+                    fac = cho_factor(kmat + delta * np.eye(self.n), check_finite=False)
+                    break
+                except LinAlgError:
+                    delta = max(dmin, delta_last / 3.0, 8.0 * delta)
+            delta_last = delta if delta else delta_last
+            dx = cho_solve(fac, rhs, check_finite=False)
+            ds = -rp - jg @ dx
+            dl = mu / s - lam - sig * ds
+            # fraction to the boundary
+            ap = _max_step(s, ds, 0.995)
+            ad = _max_step(lam, dl, 0.995)
+            rho = max(rho, 1.1 * float(np.max(np.abs(lam))) if lam.size else 0.0)
+            m0 = phi - mu * float(np.sum(np.log(s))) + rho * float(np.sum(np.abs(rp)))
+            dm = (gr @ dx - mu * float(np.sum(ds / s)) - rho * float(np.sum(np.abs(rp))))
+            a = ap
+            ok = False
+            for _ in range(30):
+                xt = x + a * dx
+                st = s + a * ds
+                ft, tt = self.compiled(xt, order=0)
+                gt = np.concatenate((tt / tm - 1.0, -tt / tm - 1.0))
+                mt = (ft - mu * float(np.sum(np.log(st)))
+                      + rho * float(np.sum(np.abs(gt + st))))
+                if np.isfinite(mt) and mt <= m0 + 1e-4 * a * min(dm, 0.0):
+                    ok = True
+                    break
+                a *= 0.5
+            if not ok:
+                if np.max(np.abs(rp)) < 1e-6 and comp < 10 * tol * scale:
+                    status = 0
+                else:
+                    status = 2
+                break
+            x = xt
+            s = st
+            lam = lam + min(ad, 1.0) * dl
+        return x, STATUS[status], it
+
+
+def _max_step(v, dv, frac):
+    neg = dv < 0
+    if not np.any(neg):
+        return 1.0
+    return float(min(1.0, frac * np.min(-v[neg] / dv[neg])))

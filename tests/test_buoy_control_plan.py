@@ -1,0 +1,238 @@
+"""The buoy's motion-as-unknown horizon planner (hydro/_buoy_plan.py, ``controller="plan"`` of
+hydro/control.py): its derivatives against central differences, its heave and torque against
+an independent integrator of the buoy's equation, its horizon optimum against the
+L-BFGS-B problem of the ``coupled`` controller, and causality in the closed loop (synthetic,
+exactly causal dataset of tests/buoy_synthetic.py, no BEM)."""
+
+import math
+
+import numpy as np
+import pytest
+from buoy_synthetic import synthetic
+from scipy.integrate import solve_ivp
+
+from parapend.control.plan import HorizonPlan
+from parapend.errors import ParameterError
+from parapend.hydro import control as bc
+from parapend.hydro._buoy_plan import CoupledPlan
+from parapend.hydro.coupled import Pendulum, Wave
+
+# (M + A_inf, C, m l, I, c, g): a heavy pendulum (80 kg, 0.3 m) in a 0.5 m cylinder
+P = np.array([500.0, 7900.0, 24.0, 7.2, 1.0, 9.81])
+K, H = 16, 5.0 / 16
+Y0 = np.array([0.1, -0.2, 2.0, 3.0])
+
+
+def _force(t):
+    t = np.asarray(t, dtype=float)
+    return 3000.0 * np.sin(2.5 * t + 0.3) + 1000.0 * np.cos(4.0 * t)
+
+
+def _problem(leads=None, limit=400.0, k=K, h=H):
+    pr = CoupledPlan(k, h, P, limit, sample_leads=leads)
+    pr.set_start(Y0, _force)
+    tn = h * np.arange(1, k + 1)
+    x = np.empty(2 * k)
+    x[0::2] = 2.0 + 2.5 * tn + 0.3 * np.sin(tn)
+    x[1::2] = 2.5 + 0.3 * np.cos(tn)
+    return pr, x
+
+
+def _energy(y):
+    """``_Plant.energy``: buoy and pendulum (J)."""
+    z, zd, th, om = y
+    mt, cst, ml, inertia, _, g = P
+    return (0.5 * mt * zd * zd - ml * math.sin(th) * zd * om + 0.5 * inertia * om * om
+            + 0.5 * cst * z * z + ml * g * math.cos(th))
+
+
+def test_derivatives_against_central_differences():
+    pr, x = _problem()
+    nu = np.random.default_rng(0).normal(size=3 * K)
+    phi, g, hess, tau, jac = pr.derivatives(x, nu)
+    assert phi == pytest.approx(pr.objective(x), rel=1e-14)
+    assert np.array_equal(tau, pr.constraint_torques(x).ravel())
+    eye = np.eye(2 * K)
+    e = 1e-6
+    gfd = np.array([(pr.objective(x + e * d) - pr.objective(x - e * d)) / (2 * e)
+                    for d in eye])
+    jfd = np.array([(pr.constraint_torques(x + e * d).ravel()
+                     - pr.constraint_torques(x - e * d).ravel()) / (2 * e) for d in eye]).T
+    # central differences of O(1e3) values at 1e-6: truncation ~1e-9, round-off ~1e-10
+    assert np.max(np.abs(g - gfd)) < 1e-7 * np.max(np.abs(g))
+    assert np.max(np.abs(jac - jfd)) < 1e-7 * np.max(np.abs(jac))
+
+    def lagrangian_gradient(v):
+        _, gv, _, _, jv = pr.derivatives(v)
+        return gv + jv.T @ nu
+    e = 1e-5
+    hfd = np.array([(lagrangian_gradient(x + e * d) - lagrangian_gradient(x - e * d)) / (2 * e)
+                    for d in eye])
+    assert np.max(np.abs(hess - hfd)) < 1e-7 * np.max(np.abs(hess))
+    # the compiled kernel that the solver uses: the same to round-off
+    for a, b in zip(pr.derivatives(x, nu), pr.compiled(x, nu)):
+        assert np.allclose(a, b, rtol=1e-12, atol=1e-12 * np.max(np.abs(a)))
+    v0, v1 = pr.values(x), pr.compiled(x, order=0)
+    assert v1[0] == pytest.approx(v0[0], rel=1e-12)
+    assert np.allclose(v1[1], v0[1], rtol=1e-12, atol=1e-9)
+    # the objective's Hessian alone is banded (one interval's nodes per term)
+    h0 = pr.derivatives(x)[2]
+    band = np.abs(np.subtract.outer(np.arange(2 * K), np.arange(2 * K))) > 3
+    assert not np.any(h0[band])
+
+
+def test_compiled_solver_follows_the_reference_loop():
+    # the interior point compiled (solve) and in Python (solve_python): the same iterates
+    # to round-off (the same formulas; BLAS and loop sums differ in order)
+    pr, x = _problem(limit=300.0)
+    xa, sa, ia = pr.solve_python(x)
+    xb, sb, ib = pr.solve(x)
+    assert sa == sb == "converged" and ia == ib
+    assert np.max(np.abs(xa - xb)) < 1e-7 * np.max(np.abs(xa))
+    assert np.max(np.abs(pr.constraint_torques(xb))) <= 300.0 * (1 + 1e-6)
+
+
+def _reference_heave(plan, t_eval):
+    """``M z'' + C z = f - m l (cos theta)''`` by an adaptive integrator on the plan's angle
+    (each interval's cubic written out), interval by interval (``theta''`` jumps at the
+    nodes); ``z`` and ``z''`` at ``t_eval``."""
+    t_eval = np.asarray(t_eval, dtype=float)
+    z, zdd = np.empty(t_eval.size), np.empty(t_eval.size)
+    y = Y0[:2].copy()
+    h = plan.h
+    for j in range(plan.intervals):
+        a = j * h
+        ta, va, tb, vb = plan.theta[j], plan.v[j], plan.theta[j + 1], plan.v[j + 1]
+        c2 = (3.0 * (tb - ta) / h - 2.0 * va - vb) / h
+        c3 = (2.0 * (ta - tb) / h + va + vb) / h ** 2
+
+        def rhs(t, y, a=a, ta=ta, va=va, c2=c2, c3=c3):
+            s = t - a
+            th = ta + s * (va + s * (c2 + s * c3))
+            thd = va + s * (2.0 * c2 + 3.0 * c3 * s)
+            thdd = 2.0 * c2 + 6.0 * c3 * s
+            cdd = -math.cos(th) * thd ** 2 - math.sin(th) * thdd
+            f = 3000.0 * math.sin(2.5 * t + 0.3) + 1000.0 * math.cos(4.0 * t)
+            return [y[1], (f - P[1] * y[0] - P[2] * cdd) / P[0]]
+        sol = solve_ivp(rhs, (a, a + h), y, method="DOP853", rtol=1e-12, atol=1e-12,
+                        dense_output=True)
+        last = j == plan.intervals - 1
+        for i in np.flatnonzero((t_eval >= a) & ((t_eval < a + h) | last)):
+            yi = sol.sol(t_eval[i])
+            z[i], zdd[i] = yi[0], rhs(t_eval[i], yi)[1]
+        y = sol.y[:, -1]
+    return z, zdd
+
+
+def test_heave_and_torque_against_an_independent_integrator():
+    leads = np.linspace(0.0, 1.3, 9)
+    pr, x = _problem(leads)
+    f = pr.full(x)
+    plan = HorizonPlan(H, f[0::2], f[1::2], 0.0)
+    ts = np.linspace(0.0, K * H, 41)
+    z, _ = _reference_heave(plan, ts)
+    # the convolution by 4-point Gauss rules: error ~ (h w)^8, far below 1e-6 m
+    assert np.max(np.abs(pr.heave(x, ts) - z)) < 1e-6
+    _, zdd = _reference_heave(plan, leads)
+    th, thd, thdd = plan.evaluate(leads)
+    tau = P[3] * thdd + P[4] * thd - P[2] * np.sin(th) * (P[5] + zdd)
+    assert np.max(np.abs(pr.torques(x) - tau)) < 1e-6 * np.max(np.abs(tau))
+
+
+def test_horizon_optimum_is_not_beaten_by_the_coupled_controllers_problem():
+    # one horizon of 1 s (8 intervals, 4 held torques each, as buoy_mpc), no memory (f = F),
+    # solved by the motion planner; its held torques are a start of the L-BFGS-B problem of
+    # controller="coupled" (8 RK4 steps per torque), which must not find much better
+    from parapend.control.mpc import _gauss3
+    from parapend.hydro._control_kernel import plan_objective
+
+    k, h = 8, 0.125
+    n, steps = 4 * k, 8
+    dt = k * h / n
+    tu = 80 * 9.81 * 0.3
+    limit = 1.5 * tu
+    off, w3 = _gauss3(dt)
+    leads = ((dt * np.arange(n))[:, None] + off[None, :]).ravel()
+    pr, x = _problem(leads, limit, k, h)
+    xs, status, _ = pr.solve(x)
+    assert status == "converged"
+    assert np.max(np.abs(pr.constraint_torques(xs))) <= limit * (1 + 1e-6)
+    j_plan = _energy(Y0) - pr.objective(xs)  # W + E(end) of the planned motion
+    u = np.clip(pr.torques(xs).reshape(n, 3) @ w3, -limit, limit) / tu
+    hs = dt / steps
+    fnet = _force(0.5 * hs * np.arange(2 * n * steps + 1))
+    grad, ys = np.empty(n), np.empty((n * steps + 1, 4))
+
+    def j_old(v):
+        return -tu * plan_objective(v, Y0, fnet, hs, steps, P, tu, 1.0, 1.0, 1.0,
+                                    np.zeros(2), 1.0, grad, ys)
+    # the plan's held torques on the RK4 model: J to the held torque's discretization
+    # (its sample means of a torque that varies on the scale of h; measured 1.3e-4)
+    assert j_old(u) == pytest.approx(j_plan, rel=1e-3)
+    res = bc.CoupledHorizon(n, hs, steps, P, tu, torque_limit=limit / tu).solve(
+        Y0, fnet, u, max_iter=500)
+    # a local optimum of the same problem: L-BFGS-B gains no more than that (measured 7e-4)
+    assert j_old(res.x) <= j_plan * (1 + 2e-3)
+
+
+SYN = synthetic()
+TR, TP = 5.0, 2.5  # a record of 5 s: components of 2.5 s and 1.67 s
+AMPS = np.zeros(6, complex)
+AMPS[1], AMPS[2] = 0.25, 0.12j
+WAVE = Wave(2 * math.pi / TR, AMPS)
+OPTS = {"peak_period": TP, "horizon": 0.5, "update_interval": 0.125, "warmup": 1.0,
+        "samples": 32, "memory": 8.0, "controller": "plan", "iterations": 1}
+
+
+def _run(monkeypatch, cut=None):
+    """A short closed loop with the excitation altered from node ``cut`` on (None: not)."""
+    real = bc.force_nodes
+
+    def altered(*a):
+        fn = real(*a).copy()
+        if cut is not None:
+            fn[cut:] += 500.0 * np.sin(0.7 * np.arange(fn.size - cut))
+        return fn
+    monkeypatch.setattr(bc, "force_nodes", altered)
+    return bc.buoy_mpc(SYN, Pendulum(20.0, 0.3, 1.8, 0.25), WAVE, **OPTS)
+
+
+def test_closed_loop_is_causal(monkeypatch):
+    base = _run(monkeypatch)
+    assert base.success and base.catch_time_s is not None
+    dt = base.dt_s
+    ps = bc.PLANT_STEPS
+    n = int(round(base.horizon_s / dt))
+    m = int(round(base.update_interval_s / dt))
+    j0 = int(round(base.catch_time_s / dt)) + 3 * m  # an update's sample
+    # the torques before j0 were planned at j0 - m at the latest, on the excitation up to
+    # t0 + H, t0 = (j0 - m) dt: its plant half-step nodes up to 2 (j0 - m + n) ps
+    last = 2 * (j0 - m + n) * ps
+    after = _run(monkeypatch, cut=last + 1)
+    assert np.array_equal(after.series["torque"][:j0], base.series["torque"][:j0])
+    # the test has the power to see a look past t0 + H: the same alteration one sample
+    # earlier, inside that horizon, changes them
+    inside = _run(monkeypatch, cut=last + 1 - 2 * ps)
+    assert not np.array_equal(inside.series["torque"][:j0], base.series["torque"][:j0])
+    assert np.array_equal(inside.series["torque"][:j0 - m], base.series["torque"][:j0 - m])
+
+
+def test_plan_controller_refuses_what_it_does_not_model():
+    with pytest.raises(ParameterError, match="controller"):
+        bc.buoy_mpc(SYN, Pendulum(20.0, 0.3, 1.8, 0.25), WAVE, **{**OPTS, "efficiency": 0.9})
+
+
+@pytest.mark.slow
+def test_default_design_plan_controller_harvests():
+    # docs/buoy.md's measurement, seed 0, two peak periods: 28.8 W, 56 % of the record's
+    # coupled optimum (winding 10); the energy balance closes
+    import parapend
+
+    opt = parapend.buoy(hs=0.5, tp=2.5, repeat_period=25, seed=0, winding=10)
+    pend = Pendulum(mass=80.0, length=0.3, inertia=7.2, damping_coefficient=1.0)
+    r = bc.buoy_mpc(opt._hydro, pend, opt._wave, peak_period=2.5, horizon=2.0,
+                    controller="plan", iterations=1)
+    assert r.success
+    assert 0.4 < r.mean_power_w / opt.power_w < 0.8
+    assert r.energy_balance_residual < 1e-6
+    assert r.peak_torque_nm <= r.torque_limit_nm * (1 + 1e-12)
