@@ -46,6 +46,7 @@ def _energy(y):
             + 0.5 * cst * z * z + ml * g * math.cos(th))
 
 
+@pytest.mark.slow  # its first run compiles the planner's evaluation (6 s)
 def test_derivatives_against_central_differences():
     pr, x = _problem()
     nu = np.random.default_rng(0).normal(size=3 * K)
@@ -81,6 +82,7 @@ def test_derivatives_against_central_differences():
     assert not np.any(h0[band])
 
 
+@pytest.mark.slow  # its first run compiles the planner's interior point (35 to 60 s)
 def test_compiled_solver_follows_the_reference_loop():
     # the interior point compiled (solve) and in Python (solve_python): the same iterates
     # to round-off (the same formulas; BLAS and loop sums differ in order)

@@ -37,6 +37,7 @@ KERNELS = {
     # (the horizon solver: 27 s cold at load 5 to 6, of which 16.5 s its one large function)
     "parapend.control._plan_kernel": ("the receding-horizon controller's horizon solver", 20),
     "parapend.hydro._hull_kernel": ("the hull problem's kernels", 10),
+    "parapend.hydro._buoy_plan_kernel": ("the buoy's motion planner", 60),
 }
 
 _lock = threading.Lock()
