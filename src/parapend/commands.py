@@ -842,7 +842,9 @@ def _power_matrix_result(power_matrix, arguments):
                 for row in ds[name].values]
 
     quantities = [q for q in ("power", "mechanical_power", "limit_power", "uniform_power",
-                              "electrical_power", "radiation_bound_power", "one_way_power")
+                              "electrical_power", "radiation_bound_power", "one_way_power",
+                              *(f"causal_{f}_{k}" for f in ("perfect", "ar")
+                                for k in ("power", "harvested_power")))
                   if q in ds]
     stats = {q: {s: (ds[f"{q}_{s}"].values.astype(int).tolist() if s == "count"
                      else grid(f"{q}_{s}")) for s in STATISTICS} for q in quantities}
@@ -877,6 +879,10 @@ def _power_matrix_result(power_matrix, arguments):
            "store": run.store, "computed_bins": run.computed_points // int(a["realizations"]),
            "resumed_bins": run.resumed_points // int(a["realizations"]), "seconds": seconds,
            "executor": run.executor, "netcdf": netcdf, "zarr": zarr, "csv": csv}
+    if "controller" in ds.attrs:  # the causal column (parapend.performance.causal)
+        from .performance.causal import causal_json
+
+        out["causal"] = causal_json(ds, grid)
     return Record("power-matrix", out, dataset=ds, run=run,
                   draw=_draw_dataset("performance.figures", "plot_matrix"))
 
