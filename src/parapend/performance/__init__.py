@@ -22,7 +22,7 @@ from .. import limits
 from ..errors import ParameterError, check_int, check_positive, check_range
 from .annual import HOURS_PER_YEAR
 from .resource import bin_edges, energy_flux, record_spectrum, repeat_period, te_over_tp
-from .spec import DEVICES, QUANTITIES, MatrixSpec  # noqa: F401 - re-exported
+from .spec import DEVICES, MatrixSpec
 
 __all__ = ["HOURS_PER_YEAR", "STATISTICS", "MatrixSpec", "matrix_dataset",
            "matrix_quantities", "matrix_spec", "parse_bins", "power_matrix", "to_mhkit"]
