@@ -108,7 +108,7 @@ def add_parsers(sub) -> None:
                         "--controller mpc)")
     g.add_argument("--plan-samples", type=_int,
                    help="torque samples per Hermite interval of the plan, 1 to 64 (default "
-                        "4 with --controller mpc)")
+                        "2 with --controller mpc, as horizon)")
     g = p.add_argument_group("the buoy's body (--device buoy; as parapend buoy)")
     add_body_options(g, body_help="a vertical cylinder or a floating sphere (default "
                                   "cylinder); with --dofs surge,heave,pitch also a box barge "

@@ -603,8 +603,8 @@ def power_matrix(*, hs="1:3:3", te=None, tp=None, realizations: int = 3, waves: 
     ``"perfect"``): the receding-horizon controller on the same records, its
     storage-corrected mean electrical power after ``warm_up`` peak periods (default 4), with
     a ``horizon`` (peak periods, default 2), an ``update_interval`` (peak periods, default
-    1/32) and ``plan_samples`` torque samples per Hermite interval of the plan (default 4);
-    :mod:`parapend.performance.causal`."""
+    1/32) and ``plan_samples`` torque samples per Hermite interval of the plan (default 2,
+    as ``horizon``); :mod:`parapend.performance.causal`."""
     from ..maps.run import run_spec
     from .annual import bin_series, read_scatter, read_series
     from .check import check_bins, check_size

@@ -7,9 +7,9 @@ hanging rest, 64 torque samples a peak period, ``warm_up`` peak periods left out
 and then one whole repeat of the record, the mean electrical power storage-corrected
 (``(W_e + eta_g dE) / tau``: the harvested energy plus the change of the pendulum's stored
 energy ``E = theta'^2 / 2 + cos(theta)`` per unit time). Only the planner's samples per
-Hermite interval differ by default (:data:`CAUSAL`: 4, not the 2 of ``horizon``; measured on
-the README's sea state, docs/performance.md). The horizon, the update interval and the
-warm-up are in peak periods, as ``horizon`` and ``track --controller mpc`` take them.
+Hermite interval are an option here (``plan_samples``, :data:`CAUSAL`: 2, ``horizon``'s). The
+horizon, the update interval and the warm-up are in peak periods, as ``horizon`` and
+``track --controller mpc`` take them.
 
 Per bin the causal power is the best of the controller's run and rest: ``max(P, 0)`` of the
 mean over the records (a real device stops the pendulum where the controller loses energy);
@@ -31,16 +31,18 @@ log = logging.getLogger(__name__)
 #: the forecasts of the causal column (:mod:`parapend.control.forecast`)
 FORECASTS = ("perfect", "ar")
 #: the causal column's defaults: horizon, update interval and warm-up in peak periods,
-#: the forecasts, and the planner's torque samples per Hermite interval. The update
-#: interval is ``horizon``'s (two torque samples): one of 1/16 lost 13 % of the power on
-#: the README's sea state. 4 samples an interval (2 in ``horizon``) cost 25 % less and
-#: gave the same power to 0.03 % (docs/performance.md, "The causal column")
+#: the forecasts, and the planner's torque samples per Hermite interval, all as ``horizon``
+#: and ``track --controller mpc`` have them. Measured on the README's sea state (Hs 2 m, Tp
+#: 8 s, 50 waves): an update interval of 1/16 lost 13 % of the power; 4 samples an
+#: interval cost a third less with the same power (to 0.03 %) but ran away (|theta'| past a
+#: turn a sample, "unresolved") on every record at Hs 3 m, Te 6 s (docs/performance.md)
 CAUSAL = {"horizon": 2.0, "forecast": "perfect", "update_interval": 0.03125,
-          "warm_up": 4.0, "plan_samples": 4}
-#: CPU seconds of one causal run over a 50-wave record with each forecast at the defaults
-#: (measured on the shared 2-core machine, one BLAS thread: 6.8 s perfect, 12.7 s AR at
-#: Hs 2 m, Tp 8 s), rounded up; a run's cost grows as its length
-CAUSAL_SECONDS = {"perfect": 7.0, "ar": 13.0}
+          "warm_up": 4.0, "plan_samples": 2}
+#: CPU seconds of one causal run over a 50-wave record (and the 4-period warm-up) with each
+#: forecast at the defaults, measured on the shared 2-core machine at a load of 3 to 5
+#: (one BLAS thread; Hs 2 m, Tp 8 s: 9.1 s perfect, 13.0 s AR), rounded up; a run's cost
+#: grows as its length
+CAUSAL_SECONDS = {"perfect": 10.0, "ar": 14.0}
 
 
 def check_causal(*, controller, horizon, forecast, update_interval, warm_up, plan_samples,
