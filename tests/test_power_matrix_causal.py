@@ -268,3 +268,60 @@ def test_bad_causal_options_one_line_exit_2(extra, needle, capsys):
     assert code == 2
     assert len(err.strip().splitlines()) == 1, err
     assert needle in err, err
+
+
+class _PeekingForecast:
+    """A tampered forecast: the record's own future at the leads asked for, plus a trace of
+    it one horizon further on (a controller that looks further ahead than it says)."""
+
+    reach = None
+
+    def __init__(self, q, horizon):
+        self.q, self.horizon = q, horizon
+
+    def predict(self, t_now, past_t, past_q, leads):
+        t = t_now + np.asarray(leads, dtype=float)
+        return self.q(t) + 1e-3 * self.q(t + self.horizon)
+
+
+def _torques(q, t0_periods, forecast, *, horizon=0.5, tamper_after=None):
+    """The held torques before ``t0`` of a short causal run (4 peak periods of the README's
+    sea state) driven by ``q``, or by ``q`` altered from ``tamper_after`` on (peak
+    periods); ``forecast``: "perfect", "ar" or "peek" (:class:`_PeekingForecast`)."""
+    from parapend.control.forecast import ARForecast
+    from parapend.control.mpc import mpc_run
+    from parapend.units import Units
+
+    tn = 8.0 / Units(1.0, 10.0, 9.81, None).time
+    qq = q
+    if tamper_after is not None:
+        def qq(t):
+            t = np.asarray(t, dtype=float)
+            return q(t) + np.where(t > tamper_after * tn, 0.05 * np.cos(3.0 * t), 0.0)
+    fo = {"perfect": None, "ar": ARForecast(tn) if forecast == "ar" else None,
+          "peek": _PeekingForecast(qq, horizon * tn)}[forecast]
+    res = mpc_run(qq, gamma=0.01, horizon=horizon * tn, update_interval=tn / 16,
+                  dt=tn / 64, t_end=4 * tn, forecast=fo)
+    return res.torque[: int(round(t0_periods * 64))]
+
+
+@pytest.mark.parametrize("forecast, after, causal", [
+    ("perfect", 2.5, True),   # altered after t0 + H: nothing before t0 changes
+    ("ar", 2.0, True),        # the AR forecast reads the past only: altered after t0
+    ("peek", 2.5, False),     # a controller that looks further ahead fails the test
+])
+def test_torques_before_t0_ignore_the_sea_after_t0_plus_h(forecast, after, causal):
+    """Causality (issue 31's acceptance, on the pendulum's controller that the causal
+    column runs): altering the sea only after ``t0 + H`` (perfect forecast; after ``t0``
+    with the AR one) leaves every torque held before ``t0`` bit-identical; a tampered
+    forecast that peeks one horizon further fails the same check. t0 = 2 peak periods,
+    H = 0.5."""
+    from parapend.seas import sea_record
+    from parapend.units import Units
+
+    exc = sea_record(Units(1.0, 10.0, 9.81, None), hs=2.0, tp=8.0, repeat_period=80.0,
+                     seed=1)
+    a = _torques(exc.q, 2.0, forecast)
+    b = _torques(exc.q, 2.0, forecast, tamper_after=after)
+    assert a.size == 128 and np.any(a != 0)
+    assert np.array_equal(a, b) is causal
