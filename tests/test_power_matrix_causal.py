@@ -205,13 +205,14 @@ def test_aep_of_each_column_is_8766_h_sum_p_f_and_incomplete_everywhere(stubbed)
 def test_a_losing_controller_rests_and_the_aep_is_never_negative(stubbed):
     """Where the controller's mean power is negative the bin rests: 0 W in the causal power
     matrix and the annual energy, the choice recorded; the stored per-record powers keep
-    their sign. A complete site: one plain number per column, 8766 h sum max(P, 0) f."""
+    their sign. On a complete site each column is one plain number, 8766 h sum max(P, 0) f."""
     rec = stubbed([[-3.0, 1.5], [2.5, -0.1]], complete=True)
     ds, out = rec.dataset, rec.to_dict()
     assert ds["causal_perfect_power_mean"].values[0, 0] == -3.0
     assert ds["causal_perfect_power_matrix"].values.tolist() == [[0.0, 1.5], [2.5, 0.0]]
     assert out["causal"]["mode"]["perfect"] == [["rest", "controller"], ["controller", "rest"]]
-    for k, (col, q) in enumerate((("optimum", "power"), ("causal_perfect", "causal_perfect_power"),
+    for k, (col, q) in enumerate((("optimum", "power"),
+                                  ("causal_perfect", "causal_perfect_power"),
                                   ("causal_ar", "causal_ar_power"))):
         want = HOURS_PER_YEAR * 0.25 * float(np.sum(np.maximum(ds[f"{q}_mean"].values, 0)))
         assert out["annual_energy"][q]["wh"] == pytest.approx(want, rel=1e-12)
@@ -223,6 +224,32 @@ def test_a_losing_controller_rests_and_the_aep_is_never_negative(stubbed):
         assert ds["annual_energy"].values[k] >= 0
 
 
+def test_a_bin_without_a_causal_result_makes_only_its_column_incomplete(stubbed):
+    """A failed causal run (NaN) in the only record of a bin: that bin has no causal result,
+    so the causal columns' annual energies are incomplete (bounds with the bin's share at 0
+    and at the largest bin's power) while the optimum's stays complete; the text says how
+    many runs failed."""
+    from parapend.performance.figures import text_report
+
+    rec = stubbed([[1.0, 1.5], [2.5, math.nan]], complete=True)
+    ds, out = rec.dataset, rec.to_dict()
+    assert ds["causal_perfect_mode"].values[1, 1] == -1
+    assert ds["causal_perfect_power_count"].values[1, 1] == 0
+    side = out["causal"]["annual_energy"]
+    assert side["optimum"]["complete"] is True
+    for col in ("causal_perfect", "causal_ar"):
+        p = ds[f"{col}_power_matrix"].values
+        lo = HOURS_PER_YEAR * 0.25 * float(np.nansum(p))
+        hi = lo + HOURS_PER_YEAR * 0.25 * float(np.nanmax(p))
+        assert side[col]["complete"] is False and side[col]["annual_energy_mwh"] is None
+        assert side[col]["annual_energy_mwh_bounds"] == pytest.approx([lo / 1e6, hi / 1e6],
+                                                                      rel=1e-12)
+    assert ds["annual_energy_complete"].values.tolist() == [1, 0, 0]
+    text = text_report(ds, out, [])
+    assert "1 of 4 causal runs failed" in text
+    assert "1 bins without a causal result" in text
+
+
 def test_the_store_identity_without_a_controller_is_unchanged():
     """A matrix without the controller writes the spec it wrote before (a store resumes);
     with it, the settings are part of the identity and read back."""
@@ -232,8 +259,9 @@ def test_the_store_identity_without_a_controller_is_unchanged():
     assert "controller" not in json.loads(plain.to_json())
     assert "causal_perfect_power" not in plain.variables
     spec = matrix_spec(hs="1,2", tp="6,8", controller="mpc", forecast="ar,perfect",
-                       horizon=1.5)
+                       horizon=1.5, speed_limit=4)
     assert MatrixSpec.from_json(spec.to_json()) == spec
+    assert spec.speed_limit == 4.0
     assert spec.forecasts == ("perfect", "ar") and spec.horizon == 1.5
     assert spec.update_interval == 0.03125 and spec.warm_up == 4.0 and spec.plan_samples == 2
 
@@ -260,6 +288,8 @@ def test_the_work_is_capped_in_one_line():
     (["--controller", "mpc", "--warm-up", "-1"], "warm-up: expected"),
     (["--controller", "mpc", "--plan-samples", "0"], "plan-samples: expected"),
     (["--warm-up", "2"], "warm-up: an option of the causal column"),
+    (["--speed-limit", "4"], "speed-limit: an option of the causal column"),
+    (["--controller", "mpc", "--speed-limit", "0"], "speed-limit: expected"),
 ])
 def test_bad_causal_options_one_line_exit_2(extra, needle, capsys):
     code = main(["power-matrix", "--hs", "1,2", "--te", "6,7", "--realizations", "1",

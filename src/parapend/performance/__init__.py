@@ -100,7 +100,8 @@ def matrix_spec(*, hs="1:3:3", te=None, tp=None, realizations: int = 3, waves: f
                 depth=None, dofs="heave", pivot_height=None, pivot_offset=None,
                 hull_pitch_inertia=None, barge_length=None, barge_beam=None,
                 barge_draft=None, copper_loss=None, controller=None, forecast=None,
-                update_interval=None, warm_up=None, plan_samples=None) -> MatrixSpec:
+                update_interval=None, warm_up=None, plan_samples=None,
+                speed_limit=None) -> MatrixSpec:
     """Check everything a matrix's bins depend on (one line naming the parameter).
     ``length``, ``mass``: None is the device's default (``parapend.defaults.SEA`` for the
     prescribed-heave pendulum, ``BUOY`` for the buoy); ``body, radius, draft, mesh, hydro``
@@ -111,7 +112,7 @@ def matrix_spec(*, hs="1:3:3", te=None, tp=None, realizations: int = 3, waves: f
     heaves and pitches, ``pivot_height ... copper_loss`` and ``torque_limit`` as
     ``parapend.buoy`` takes them (``parapend.performance.hull_device``). ``controller``
     ``"mpc"`` (``device="prescribed-heave"``): the causal column, ``horizon``, ``forecast``,
-    ``update_interval``, ``warm_up`` and ``plan_samples`` as
+    ``update_interval``, ``warm_up``, ``plan_samples`` and ``speed_limit`` as
     :func:`parapend.performance.causal.check_causal` takes them (None: ``CAUSAL``)."""
     from ..hydro.hull_api import parse_dofs
     from ..seas import _check_sea, check_response, read_response
@@ -143,7 +144,8 @@ def matrix_spec(*, hs="1:3:3", te=None, tp=None, realizations: int = 3, waves: f
         mass = SEA["mass"] if mass is None else mass
     causal = check_causal(controller=controller, horizon=horizon, forecast=forecast,
                           update_interval=update_interval, warm_up=warm_up,
-                          plan_samples=plan_samples, device=device, heave=heave)
+                          plan_samples=plan_samples, speed_limit=speed_limit,
+                          device=device, heave=heave)
     if torque_limit is not None and heave:
         raise ParameterError("torque-limit: not supported over a sea record (parapend sea "
                              "solves the unconstrained optimum); drop --torque-limit")
@@ -514,6 +516,8 @@ def _causal_matrix(ds, spec: MatrixSpec) -> None:
                      "causal_update_interval_peak_periods": spec.update_interval,
                      "causal_warm_up_peak_periods": spec.warm_up,
                      "causal_plan_samples": spec.plan_samples,
+                     "causal_speed_limit": ("none" if spec.speed_limit is None
+                                            else spec.speed_limit),
                      "causal_convention": "from the hanging rest, 64 torque samples a peak "
                                           "period; the mean over one repeat of the record "
                                           "after the warm-up, (W_e + eta_g dE) / tau"})
@@ -592,7 +596,7 @@ def power_matrix(*, hs="1:3:3", te=None, tp=None, realizations: int = 3, waves: 
                  progress=None, dofs="heave", pivot_height=None, pivot_offset=None,
                  hull_pitch_inertia=None, barge_length=None, barge_beam=None,
                  barge_draft=None, copper_loss=None, controller=None, forecast=None,
-                 update_interval=None, warm_up=None, plan_samples=None):
+                 update_interval=None, warm_up=None, plan_samples=None, speed_limit=None):
     """The power matrix of a device over bins of ``Hs x Te`` (or ``Tp``); see the module
     text and docs/performance.md. Returns ``(dataset, annual, run)``. ``dofs``
     ``"surge,heave,pitch"`` with ``device="buoy"``: a pendulum in a hull that surges, heaves
@@ -604,7 +608,8 @@ def power_matrix(*, hs="1:3:3", te=None, tp=None, realizations: int = 3, waves: 
     storage-corrected mean electrical power after ``warm_up`` peak periods (default 4), with
     a ``horizon`` (peak periods, default 2), an ``update_interval`` (peak periods, default
     1/32) and ``plan_samples`` torque samples per Hermite interval of the plan (default 2,
-    as ``horizon``); :mod:`parapend.performance.causal`."""
+    as ``horizon``), and ``speed_limit`` the plans' rated-speed penalty (units
+    ``sqrt(g / l)``, default none, as ``horizon``); :mod:`parapend.performance.causal`."""
     from ..maps.run import run_spec
     from .annual import bin_series, read_scatter, read_series
     from .check import check_bins, check_size
@@ -655,7 +660,7 @@ def power_matrix(*, hs="1:3:3", te=None, tp=None, realizations: int = 3, waves: 
                        barge_draft=barge_draft, copper_loss=copper_loss,
                        controller=controller, forecast=forecast,
                        update_interval=update_interval, warm_up=warm_up,
-                       plan_samples=plan_samples)
+                       plan_samples=plan_samples, speed_limit=speed_limit)
     _check_breaking(spec.hm0, depth)
     if spec.device == "buoy":
         from .buoy_device import water_of

@@ -46,11 +46,11 @@ CAUSAL_SECONDS = {"perfect": 10.0, "ar": 14.0}
 
 
 def check_causal(*, controller, horizon, forecast, update_interval, warm_up, plan_samples,
-                 device: str, heave: bool) -> dict | None:
+                 device: str, heave: bool, speed_limit=None) -> dict | None:
     """The causal column's options, checked (one line naming the option); None without a
     controller (then every other option of it is refused)."""
     opts = {"horizon": horizon, "forecast": forecast, "update-interval": update_interval,
-            "warm-up": warm_up, "plan-samples": plan_samples}
+            "warm-up": warm_up, "plan-samples": plan_samples, "speed-limit": speed_limit}
     if controller is None or controller == "none":
         given = [k for k, v in opts.items() if v is not None]
         if given:
@@ -82,9 +82,13 @@ def check_causal(*, controller, horizon, forecast, update_interval, warm_up, pla
     warm = check_range("warm-up", warm, 0.0, 100.0, why="peak periods")
     ps = CAUSAL["plan_samples"] if plan_samples is None else plan_samples
     ps = check_int("plan-samples", ps, 1, 64)
+    if speed_limit is not None:
+        speed_limit = float(check_range("speed-limit", speed_limit, 1e-9, 1e6,
+                                        why="units sqrt(g / l)"))
     return {"controller": "mpc", "horizon": float(horizon),
             "forecasts": tuple(n for n in FORECASTS if n in names),
-            "update_interval": float(upd), "warm_up": float(warm), "plan_samples": int(ps)}
+            "update_interval": float(upd), "warm_up": float(warm), "plan_samples": int(ps),
+            "speed_limit": speed_limit}
 
 
 def causal_quantities(forecasts) -> tuple:
@@ -136,7 +140,7 @@ def run_record(spec, exc, units, j: int, r: int, forecast: str):
                    update_interval=spec.update_interval * tp_n, dt=tp_n / 64,
                    average_from=spec.warm_up * tp_n, torque_limit=None, efficiency=eff,
                    forecast=fo, t_end=exc.period + spec.warm_up * tp_n,
-                   seed=int(spec.seeds[r]), speed_limit=None,
+                   seed=int(spec.seeds[r]), speed_limit=spec.speed_limit,
                    interval_samples=spec.plan_samples)
 
 
@@ -181,6 +185,8 @@ def causal_json(ds, grid) -> dict:
                float(ds.attrs["causal_update_interval_peak_periods"]),
            "warm_up_peak_periods": float(ds.attrs["causal_warm_up_peak_periods"]),
            "plan_samples": int(ds.attrs["causal_plan_samples"]),
+           "speed_limit": (None if ds.attrs["causal_speed_limit"] == "none"
+                           else float(ds.attrs["causal_speed_limit"])),
            "convention": ds.attrs["causal_convention"],
            "power_matrix": {f: grid(f"causal_{f}_power_matrix") for f in forecasts},
            "mode": {f: [[{1: "controller", 0: "rest"}.get(int(v)) for v in row]

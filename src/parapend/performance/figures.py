@@ -296,7 +296,10 @@ def _causal_lines(ds, c: dict, hm0, per, pk) -> list:
     controller's run and rest) and the bins at rest."""
     lines = ["", f"causal receding-horizon control (horizon {c['horizon_peak_periods']:g} "
                  f"peak periods, a plan every {c['update_interval_peak_periods']:g} of them, "
-                 f"{c['plan_samples']} torque samples per plan interval): storage-corrected "
+                 f"{c['plan_samples']} torque samples per plan interval"
+                 + ("" if c.get("speed_limit") is None else
+                    f", speed penalty above {c['speed_limit']:g} sqrt(g/l)")
+                 + "): storage-corrected "
                  f"mean power over one repeat after a warm-up of "
                  f"{c['warm_up_peak_periods']:g} peak periods from rest, the bin's best of "
                  "the controller and rest"]
@@ -307,6 +310,13 @@ def _causal_lines(ds, c: dict, hm0, per, pk) -> list:
                                ds[f"causal_{f}_power_matrix"].values[i])]
                 for i, h in enumerate(hm0)]
         lines += [_right_table(rows, ["Hm0 \\ " + pk, *(f"{t:g} s" for t in per)])]
+        runs = ds[f"causal_{f}_power"].values
+        bad = int((~np.isfinite(runs)).sum())
+        if bad:
+            lines.append(f"{bad} of {runs.size} causal runs failed (the log names them; "
+                         "\"unresolved\": the plans spun the pendulum past a turn per torque "
+                         "sample, see --speed-limit): left out of the bins' means, see the "
+                         "count in --json")
         m = ds[f"causal_{f}_mode"].values
         rest, none = int((m == 0).sum()), int((m == -1).sum())
         if rest or none:

@@ -42,7 +42,7 @@ STORE_NAMES = ("hm0", "te", "tp", "realization", "seed", "done", "status", "mode
                               for q in ("power", "harvested_power")))
 #: the causal column's fields (left out of the JSON without a controller)
 _CAUSAL_FIELDS = ("controller", "horizon", "forecasts", "update_interval", "warm_up",
-                  "plan_samples")
+                  "plan_samples", "speed_limit")
 #: devices a matrix can be computed for
 DEVICES = ("prescribed-heave", "buoy")
 #: the spec's fields only the buoy uses (left out of a prescribed-heave spec's JSON)
@@ -118,6 +118,7 @@ class MatrixSpec:
     update_interval: float | None = None
     warm_up: float | None = None
     plan_samples: int | None = None
+    speed_limit: float | None = None  # the plans' rated-speed penalty, units sqrt(g / l)
 
     kind = "power_matrix"
     pto = False
