@@ -33,10 +33,11 @@ SERIES = "hs,tp\n1,6\n1,8\n2,6\n2,8\n2,8\n4,8\n"
 
 
 def _by_hand(hs, tp, seed, *, waves=2, warm_up=0.5, horizon=2.0, update_interval=0.0625,
-             plan_samples=2, gamma=0.01, forecast="perfect"):
+             plan_samples=2, gamma=0.01, forecast="perfect", speed_limit=4.0):
     """The causal run of one record written out: the record as ``sea`` builds it for the
     default pendulum (1 m, 10 kg), ``mpc_run`` from the hanging rest, 64 samples a peak
-    period, the mean over one repeat after the warm-up; (storage-corrected, harvested) W,
+    period, the rated-speed penalty at 4 sqrt(g/l), the mean over one repeat after the
+    warm-up; (storage-corrected, harvested) W,
     the units and the record."""
     from parapend.control.forecast import ARForecast
     from parapend.control.mpc import mpc_run
@@ -48,7 +49,7 @@ def _by_hand(hs, tp, seed, *, waves=2, warm_up=0.5, horizon=2.0, update_interval
     tn = tp / units.time
     res = mpc_run(exc.q, gamma=gamma, horizon=horizon * tn, update_interval=update_interval * tn,
                   dt=tn / 64, average_from=warm_up * tn, t_end=exc.period + warm_up * tn,
-                  seed=seed, interval_samples=plan_samples,
+                  seed=seed, interval_samples=plan_samples, speed_limit=speed_limit,
                   forecast=None if forecast == "perfect" else ARForecast(tn))
     assert res.success
     return (units.to_watts(res.mean_electrical_power),
@@ -93,7 +94,7 @@ def test_a_record_is_horizon_curve():
     got = solve_causal(spec, 0, 1, 0)
     ref = parapend.horizon(hs=1.0, tp=8.0, repeat_period=16.0, seed=3, horizons="2",
                            forecasts="perfect", baselines="none", warm_up=0.5,
-                           update_interval=0.0625)
+                           update_interval=0.0625, speed_limit=4.0)
     assert got["causal_perfect_power"] == pytest.approx(ref.mpc_power_w[0][0][0],
                                                         rel=1e-12, abs=0)
 
@@ -259,9 +260,11 @@ def test_the_store_identity_without_a_controller_is_unchanged():
     assert "controller" not in json.loads(plain.to_json())
     assert "causal_perfect_power" not in plain.variables
     spec = matrix_spec(hs="1,2", tp="6,8", controller="mpc", forecast="ar,perfect",
-                       horizon=1.5, speed_limit=4)
+                       horizon=1.5)
     assert MatrixSpec.from_json(spec.to_json()) == spec
     assert spec.speed_limit == 4.0
+    assert matrix_spec(hs="1,2", tp="6,8", controller="mpc",
+                       speed_limit=math.inf).speed_limit is None
     assert spec.forecasts == ("perfect", "ar") and spec.horizon == 1.5
     assert spec.update_interval == 0.03125 and spec.warm_up == 4.0 and spec.plan_samples == 2
 

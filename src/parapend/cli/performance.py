@@ -109,11 +109,11 @@ def add_parsers(sub) -> None:
     g.add_argument("--plan-samples", type=_int,
                    help="torque samples per Hermite interval of the plan, 1 to 64 (default "
                         "2 with --controller mpc, as horizon)")
-    g.add_argument("--speed-limit", type=_finite_float("speed-limit"),
+    g.add_argument("--speed-limit", type=float,
                    help="rated speed priced in the plans, units sqrt(g/l): a penalty, as "
-                        "parapend horizon's (default none); without it the plans can spin "
-                        "the pendulum past a turn per torque sample in steep seas, and such "
-                        "a run counts as failed")
+                        "parapend horizon's; inf for none, horizon's default (default 4 "
+                        "with --controller mpc: without it the plans spun the pendulum "
+                        "past a turn per torque sample in steep seas, a failed run)")
     g = p.add_argument_group("the buoy's body (--device buoy; as parapend buoy)")
     add_body_options(g, body_help="a vertical cylinder or a floating sphere (default "
                                   "cylinder); with --dofs surge,heave,pitch also a box barge "

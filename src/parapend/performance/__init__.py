@@ -609,7 +609,8 @@ def power_matrix(*, hs="1:3:3", te=None, tp=None, realizations: int = 3, waves: 
     a ``horizon`` (peak periods, default 2), an ``update_interval`` (peak periods, default
     1/32) and ``plan_samples`` torque samples per Hermite interval of the plan (default 2,
     as ``horizon``), and ``speed_limit`` the plans' rated-speed penalty (units
-    ``sqrt(g / l)``, default none, as ``horizon``); :mod:`parapend.performance.causal`."""
+    ``sqrt(g / l)``, default 4; ``inf``: none, ``horizon``'s default);
+    :mod:`parapend.performance.causal`."""
     from ..maps.run import run_spec
     from .annual import bin_series, read_scatter, read_series
     from .check import check_bins, check_size
