@@ -88,10 +88,12 @@ def check_causal(*, controller, horizon, forecast, update_interval, warm_up, pla
     ps = check_int("plan-samples", ps, 1, 64)
     if speed_limit is None:
         speed_limit = CAUSAL["speed_limit"]
-    speed_limit = float(check_range("speed-limit", speed_limit, 1e-9, math.inf,
-                                    why="units sqrt(g / l); inf for none"))
-    if math.isinf(speed_limit):
-        speed_limit = None  # none: horizon's default
+    try:
+        none = float(speed_limit) == math.inf  # none: horizon's default
+    except (TypeError, ValueError, OverflowError):
+        none = False
+    speed_limit = None if none else float(check_range(
+        "speed-limit", speed_limit, 1e-9, 1e6, why="units sqrt(g / l); inf for none"))
     return {"controller": "mpc", "horizon": float(horizon),
             "forecasts": tuple(n for n in FORECASTS if n in names),
             "update_interval": float(upd), "warm_up": float(warm), "plan_samples": int(ps),
