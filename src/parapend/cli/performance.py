@@ -37,7 +37,9 @@ def add_parsers(sub) -> None:
         description="Mean, std, min, max and count of the power over seeded records in each "
                     "sea-state bin (the non-causal optimum, the gamma -> 0 limit, the uniform "
                     "rotation; with --device buoy the coupled optimum, the radiation bound, "
-                    "the one-way answer), the wave energy flux and capture width of each "
+                    "the one-way answer; with --controller mpc the causal controller on "
+                    "the same records beside them), the wave energy flux and capture width "
+                    "of each "
                     "bin, and the mean annual energy at a site (IEC TS 62600-100; MHKiT's layout). "
                     "Resumable with --store.")
     p._negative_number_matcher = _NEGATIVE_VALUE
