@@ -32,7 +32,7 @@ KW = {"hs": "1,2", "tp": "6,8", "realizations": 1, "waves": 2, "controller": "mp
 SERIES = "hs,tp\n1,6\n1,8\n2,6\n2,8\n2,8\n4,8\n"
 
 
-def _by_hand(hs, tp, seed, *, waves=2, warm_up=0.5, horizon=2.0, update_interval=0.0625,
+def _by_hand(hs, tp, seed, *, waves=2, warm_up=0.5, horizon=1.0, update_interval=0.0625,
              plan_samples=2, gamma=0.01, forecast="perfect", speed_limit=4.0):
     """The causal run of one record written out: the record as ``sea`` builds it for the
     default pendulum (1 m, 10 kg), ``mpc_run`` from the hanging rest, 64 samples a peak
@@ -92,7 +92,7 @@ def test_a_record_is_horizon_curve():
     same planner, 2 torque samples an interval)."""
     spec = matrix_spec(**{**KW, "seed": 3})
     got = solve_causal(spec, 0, 1, 0)
-    ref = parapend.horizon(hs=1.0, tp=8.0, repeat_period=16.0, seed=3, horizons="2",
+    ref = parapend.horizon(hs=1.0, tp=8.0, repeat_period=16.0, seed=3, horizons="1",
                            forecasts="perfect", baselines="none", warm_up=0.5,
                            update_interval=0.0625, speed_limit=4.0)
     assert got["causal_perfect_power"] == pytest.approx(ref.mpc_power_w[0][0][0],
@@ -266,12 +266,13 @@ def test_the_store_identity_without_a_controller_is_unchanged():
     assert matrix_spec(hs="1,2", tp="6,8", controller="mpc",
                        speed_limit=math.inf).speed_limit is None
     assert spec.forecasts == ("perfect", "ar") and spec.horizon == 1.5
+    assert matrix_spec(hs="1,2", tp="6,8", controller="mpc").horizon == 1.0
     assert spec.update_interval == 0.03125 and spec.warm_up == 4.0 and spec.plan_samples == 2
 
 
 def test_the_work_is_capped_in_one_line():
     """The causal runs count in the cap on the solves: 400 bins x 1000 records fit the
-    optimum alone, not with the causal column (a record's runs count as 4.3 solves)."""
+    optimum alone, not with the causal column (a record's runs count as 3.5 solves)."""
     from parapend.performance.check import MAX_SOLVES, check_size
 
     kw = {"hs": "1:3:20", "te": "6:10:20", "realizations": 1000}

@@ -95,7 +95,7 @@ def add_parsers(sub) -> None:
                         "on the same records (storage-corrected, after --warm-up), and the "
                         "annual energy of each column side by side (default none)")
     g.add_argument("--horizon", type=_finite_float("horizon"),
-                   help="the controller's horizon in peak periods, 0.05 to 20 (default 2 "
+                   help="the controller's horizon in peak periods, 0.05 to 20 (default 1 "
                         "with --controller mpc)")
     g.add_argument("--forecast", metavar="NAMES",
                    help="perfect, ar (autoregressive, fitted on the past only) or "

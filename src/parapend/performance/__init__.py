@@ -606,7 +606,7 @@ def power_matrix(*, hs="1:3:3", te=None, tp=None, realizations: int = 3, waves: 
     causal column of each ``forecast`` (``"perfect"``, ``"ar"`` or ``"perfect,ar"``; default
     ``"perfect"``): the receding-horizon controller on the same records, its
     storage-corrected mean electrical power after ``warm_up`` peak periods (default 4), with
-    a ``horizon`` (peak periods, default 2), an ``update_interval`` (peak periods, default
+    a ``horizon`` (peak periods, default 1), an ``update_interval`` (peak periods, default
     1/32) and ``plan_samples`` torque samples per Hermite interval of the plan (default 2,
     as ``horizon``), and ``speed_limit`` the plans' rated-speed penalty (units
     ``sqrt(g / l)``, default 4; ``inf``: none, ``horizon``'s default);

@@ -31,22 +31,23 @@ log = logging.getLogger(__name__)
 #: the forecasts of the causal column (:mod:`parapend.control.forecast`)
 FORECASTS = ("perfect", "ar")
 #: the causal column's defaults: horizon, update interval and warm-up in peak periods,
-#: the forecasts, and the planner's torque samples per Hermite interval, all as ``horizon``
-#: and ``track --controller mpc`` have them. Measured on the README's sea state (Hs 2 m, Tp
-#: 8 s, 50 waves): an update interval of 1/16 lost 13 % of the power; 4 samples an
-#: interval cost a third less with the same power (to 0.03 %) but ran away (|theta'| past a
-#: turn a sample, "unresolved") on every record at Hs 3 m, Te 6 s. Unlike ``horizon``'s, the
-#: plans price a rated speed by default (``speed_limit``, units sqrt(g / l), a penalty):
-#: without it 2 of 3 records at Hs 3 m, Te 6 s ran away (unresolved) and one reached 98.1 %
-#: of the optimum; with 4 all reached 99.98 %, and at Hs 2 m, Tp 8 s and Hs 1 m, Te 10 s
-#: the power was the same (docs/performance.md)
-CAUSAL = {"horizon": 2.0, "forecast": "perfect", "update_interval": 0.03125,
+#: the forecasts, the planner's torque samples per Hermite interval and the plans' rated
+#: speed (units sqrt(g / l), a penalty). Measured on 50-wave records (docs/performance.md):
+#: a horizon of 1 peak period gave the power of 2 (``track``'s default) to 5 digits at Hs
+#: 1, 2 and 3 m, in two thirds of the time; an update interval of 1/16 (``horizon``'s is
+#: 1/32) lost 13 % of the power; 4 samples an interval (``horizon``'s 2) cost a third less
+#: with the same power (to 0.03 %) but ran away (|theta'| past a turn a sample,
+#: "unresolved") at Hs 3 m, Te 6 s. Unlike ``horizon``, the plans price a rated speed:
+#: without it 2 of 3 records at Hs 3 m, Te 6 s ran away and one reached 98.1 % of the
+#: optimum; with 4 all reached 99.98 %, and at Hs 2 m, Tp 8 s and Hs 1 m, Te 10 s the power
+#: was the same
+CAUSAL = {"horizon": 1.0, "forecast": "perfect", "update_interval": 0.03125,
           "warm_up": 4.0, "plan_samples": 2, "speed_limit": 4.0}
 #: CPU seconds of one causal run over a 50-wave record (and the 4-period warm-up) with each
-#: forecast at the defaults, measured on the shared 2-core machine at a load of 3 to 5
-#: (one BLAS thread; Hs 2 m, Tp 8 s: 9.1 s perfect, 13.0 s AR), rounded up; a run's cost
+#: forecast at the defaults, measured on the shared 2-core machine (one BLAS thread; 6.5 to
+#: 7.1 s perfect at Hs 1 to 3 m, 9.9 s AR at Hs 2 m, Tp 8 s), rounded up; a run's cost
 #: grows as its length
-CAUSAL_SECONDS = {"perfect": 10.0, "ar": 14.0}
+CAUSAL_SECONDS = {"perfect": 7.5, "ar": 10.5}
 
 
 def check_causal(*, controller, horizon, forecast, update_interval, warm_up, plan_samples,
