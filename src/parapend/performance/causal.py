@@ -157,6 +157,8 @@ def run_record(spec, exc, units, j: int, r: int, forecast: str):
 def solve_causal(spec, i: int, j: int, r: int) -> dict:
     """The causal quantities (W) of bin ``(i, j)``, realization ``r``: NaN where a run did
     not succeed (or raised: logged)."""
+    from threadpoolctl import threadpool_limits
+
     from .check import _record, _units
 
     units = _units(spec)
@@ -165,7 +167,11 @@ def solve_causal(spec, i: int, j: int, r: int) -> dict:
     for f in spec.forecasts:
         p = w = math.nan
         try:
-            res = run_record(spec, exc, units, j, r, f)
+            # one BLAS thread, as the command line's own process has it: the engine's worker
+            # processes do not, and the record's q (a small complex matrix-vector product
+            # at every update) ran 2 to 3 times slower with threads that only spin
+            with threadpool_limits(1, user_api="blas"):
+                res = run_record(spec, exc, units, j, r, f)
             if res.success:
                 p = units.to_watts(float(res.mean_electrical_power))
                 w = units.to_watts(float(res.harvested_electrical_power))
