@@ -171,7 +171,8 @@ def test_aep_of_each_column_is_8766_h_sum_p_f_and_incomplete_everywhere(stubbed)
     cols = {"optimum": "power_matrix", "causal_perfect": "causal_perfect_power_matrix",
             "causal_ar": "causal_ar_power_matrix"}
     with xr.open_dataset(out["netcdf"]) as nc:
-        assert list(nc["column"].values) == list(cols)
+        assert nc["column"].attrs["flag_meanings"].split() == list(cols)
+        assert nc["column"].values.tolist() == [0, 1, 2]
         for k, (col, var) in enumerate(cols.items()):
             p = ds[var].values
             lo = HOURS_PER_YEAR * float(np.sum(p * f)) / 1e6
@@ -225,7 +226,7 @@ def test_a_losing_controller_rests_and_the_aep_is_never_negative(stubbed):
         assert ds["annual_energy"].values[k] >= 0
 
 
-def test_a_bin_without_a_causal_result_makes_only_its_column_incomplete(stubbed):
+def test_a_bin_without_a_causal_result_makes_only_its_column_incomplete(stubbed, tmp_path):
     """A failed causal run (NaN) in the only record of a bin: that bin has no causal result,
     so the causal columns' annual energies are incomplete (bounds with the bin's share at 0
     and at the largest bin's power) while the optimum's stays complete; the text says how
@@ -246,6 +247,15 @@ def test_a_bin_without_a_causal_result_makes_only_its_column_incomplete(stubbed)
         assert side[col]["annual_energy_mwh_bounds"] == pytest.approx([lo / 1e6, hi / 1e6],
                                                                       rel=1e-12)
     assert ds["annual_energy_complete"].values.tolist() == [1, 0, 0]
+    # the Zarr export reads back without a warning (filterwarnings = error)
+    import xarray as xr
+
+    from parapend.performance import _write_zarr
+
+    _write_zarr(ds, tmp_path / "m.zarr")
+    with xr.open_zarr(tmp_path / "m.zarr", consolidated=False) as z:
+        assert z["annual_energy_complete"].values.tolist() == [1, 0, 0]
+        assert z["column"].attrs["flag_meanings"] == "optimum causal_perfect causal_ar"
     text = text_report(ds, out, [])
     assert "1 of 4 causal runs failed" in text
     assert "1 bins without a causal result" in text

@@ -529,9 +529,12 @@ def _annual_columns(ds, spec: MatrixSpec, annual: dict) -> None:
     cols = annual_columns(spec)
     recs = [annual[q] for q in cols.values()]
     nan = float("nan")
-    ds.coords["column"] = ("column", list(cols), {
+    # an integer coordinate with CF flag meanings: a string one is not in Zarr 3's
+    # specification (zarr warns that other readers may not read it)
+    ds.coords["column"] = ("column", np.arange(len(cols), dtype=np.int8), {
         "long_name": "power column: the non-causal optimum, the causal controller with "
-                     "each forecast"})
+                     "each forecast", "flag_values": list(range(len(cols))),
+        "flag_meanings": " ".join(cols)})
     ds["annual_energy"] = ("column", [a["mwh"] if a["complete"] else nan for a in recs], {
         "long_name": "mean annual energy production 8766 h sum P f (NaN: incomplete, see "
                      "the bounds)", "units": "MWh"})

@@ -212,7 +212,7 @@ def causal_json(ds, grid) -> dict:
             v = float(v)
             return v if math.isfinite(v) else None
 
-        cols = [str(c) for c in ds["column"].values]
+        cols = ds["column"].attrs["flag_meanings"].split()
         side = {}
         for k, c in enumerate(cols):
             e = {"annual_energy_mwh": num(ds["annual_energy"].values[k]),
