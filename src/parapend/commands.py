@@ -846,7 +846,9 @@ def _power_matrix_result(power_matrix, arguments):
                 for row in ds[name].values]
 
     quantities = [q for q in ("power", "mechanical_power", "limit_power", "uniform_power",
-                              "electrical_power", "radiation_bound_power", "one_way_power")
+                              "electrical_power", "radiation_bound_power", "one_way_power",
+                              *(f"causal_{f}_{k}" for f in ("perfect", "ar")
+                                for k in ("power", "harvested_power")))
                   if q in ds]
     stats = {q: {s: (ds[f"{q}_{s}"].values.astype(int).tolist() if s == "count"
                      else grid(f"{q}_{s}")) for s in STATISTICS} for q in quantities}
@@ -886,6 +888,10 @@ def _power_matrix_result(power_matrix, arguments):
            "bins_finished": int(ds.attrs.get("bins_finished", ds["hm0"].size
                                              * ds[pk].size)),
            "bins": int(ds["hm0"].size * ds[pk].size)}
+    if "controller" in ds.attrs:  # the causal column (parapend.performance.causal)
+        from .performance.causal import causal_json
+
+        out["causal"] = causal_json(ds, grid)
     return Record("power-matrix", out, dataset=ds, run=run,
                   draw=_draw_dataset("performance.figures", "plot_matrix"))
 

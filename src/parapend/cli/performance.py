@@ -37,7 +37,9 @@ def add_parsers(sub) -> None:
         description="Mean, std, min, max and count of the power over seeded records in each "
                     "sea-state bin (the non-causal optimum, the gamma -> 0 limit, the uniform "
                     "rotation; with --device buoy the coupled optimum, the radiation bound, "
-                    "the one-way answer), the wave energy flux and capture width of each "
+                    "the one-way answer; with --controller mpc the causal controller on "
+                    "the same records beside them), the wave energy flux and capture width "
+                    "of each "
                     "bin, and the mean annual energy at a site (IEC TS 62600-100; MHKiT's layout). "
                     "Resumable with --store.")
     p._negative_number_matcher = _NEGATIVE_VALUE
@@ -65,8 +67,6 @@ def add_parsers(sub) -> None:
     g.add_argument("--device", choices=["prescribed-heave", "buoy"],
                    help="the prescribed-heave pendulum, or the coupled buoy (the body "
                         "below, the pendulum in SI as parapend buoy)")
-    g.add_argument("--horizon", type=_finite_float("horizon"),
-                   help="causal controller's horizon, s (not available yet: refused)")
     g.add_argument("--length", type=_finite_float("length"),
                    help=f"m (default {SEA['length']:g}; buoy {BUOY['length']:g})")
     g.add_argument("--mass", type=_finite_float("mass"),
@@ -88,6 +88,34 @@ def add_parsers(sub) -> None:
     g.add_argument("--torque-limit", type=_finite_float("torque-limit"),
                    help="largest |torque|, N m (with --dofs surge,heave,pitch; refused "
                         "otherwise: not supported over a sea record)")
+    g = p.add_argument_group("the causal column (--device prescribed-heave; as parapend "
+                             "horizon, docs/performance.md)")
+    g.add_argument("--controller", choices=["mpc", "none"],
+                   help="mpc: beside the non-causal optimum, the receding-horizon controller "
+                        "on the same records (storage-corrected, after --warm-up), and the "
+                        "annual energy of each column side by side (default none)")
+    g.add_argument("--horizon", type=_finite_float("horizon"),
+                   help="the controller's horizon in peak periods, 0.05 to 20 (default 1 "
+                        "with --controller mpc)")
+    g.add_argument("--forecast", metavar="NAMES",
+                   help="perfect, ar (autoregressive, fitted on the past only) or "
+                        "perfect,ar: one causal column each (default perfect with "
+                        "--controller mpc; ar costs about twice perfect)")
+    g.add_argument("--update-interval", type=_finite_float("update-interval"),
+                   help="peak periods between two plans, 0.001 to 1 (default 1/32 with "
+                        "--controller mpc)")
+    g.add_argument("--warm-up", type=_finite_float("warm-up"),
+                   help="peak periods from the hanging rest left out of the mean, which is "
+                        "over one repeat of the record after it (default 4 with "
+                        "--controller mpc)")
+    g.add_argument("--plan-samples", type=_int,
+                   help="torque samples per Hermite interval of the plan, 1 to 64 (default "
+                        "2 with --controller mpc, as horizon)")
+    g.add_argument("--speed-limit", type=float,
+                   help="rated speed priced in the plans, units sqrt(g/l): a penalty, as "
+                        "parapend horizon's; inf for none, horizon's default (default 4 "
+                        "with --controller mpc: without it the plans spun the pendulum "
+                        "past a turn per torque sample in steep seas, a failed run)")
     g = p.add_argument_group("the buoy's body (--device buoy; as parapend buoy)")
     add_body_options(g, body_help="a vertical cylinder or a floating sphere (default "
                                   "cylinder); with --dofs surge,heave,pitch also a box barge "

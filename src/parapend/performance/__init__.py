@@ -22,7 +22,7 @@ from .. import limits
 from ..errors import ParameterError, check_int, check_positive, check_range
 from .annual import HOURS_PER_YEAR
 from .resource import bin_edges, energy_flux, record_spectrum, repeat_period, te_over_tp
-from .spec import DEVICES, QUANTITIES, MatrixSpec
+from .spec import DEVICES, MatrixSpec
 
 __all__ = ["HOURS_PER_YEAR", "STATISTICS", "MatrixSpec", "matrix_dataset",
            "matrix_quantities", "matrix_spec", "parse_bins", "power_matrix", "to_mhkit"]
@@ -99,7 +99,9 @@ def matrix_spec(*, hs="1:3:3", te=None, tp=None, realizations: int = 3, waves: f
                 draft=None, mesh=None, hydro=None, density: float = 1025.0,
                 depth=None, dofs="heave", pivot_height=None, pivot_offset=None,
                 hull_pitch_inertia=None, barge_length=None, barge_beam=None,
-                barge_draft=None, copper_loss=None) -> MatrixSpec:
+                barge_draft=None, copper_loss=None, controller=None, forecast=None,
+                update_interval=None, warm_up=None, plan_samples=None,
+                speed_limit=None) -> MatrixSpec:
     """Check everything a matrix's bins depend on (one line naming the parameter).
     ``length``, ``mass``: None is the device's default (``parapend.defaults.SEA`` for the
     prescribed-heave pendulum, ``BUOY`` for the buoy); ``body, radius, draft, mesh, hydro``
@@ -108,10 +110,14 @@ def matrix_spec(*, hs="1:3:3", te=None, tp=None, realizations: int = 3, waves: f
     own otherwise; the prescribed device's record does not depend on them). ``dofs``
     ``"surge,heave,pitch"`` (with ``device="buoy"``): a pendulum in a hull that surges,
     heaves and pitches, ``pivot_height ... copper_loss`` and ``torque_limit`` as
-    ``parapend.buoy`` takes them (``parapend.performance.hull_device``)."""
+    ``parapend.buoy`` takes them (``parapend.performance.hull_device``). ``controller``
+    ``"mpc"`` (``device="prescribed-heave"``): the causal column, ``horizon``, ``forecast``,
+    ``update_interval``, ``warm_up``, ``plan_samples`` and ``speed_limit`` as
+    :func:`parapend.performance.causal.check_causal` takes them (None: ``CAUSAL``)."""
     from ..hydro.hull_api import parse_dofs
     from ..seas import _check_sea, check_response, read_response
     from ..units import Units
+    from .causal import check_causal
 
     if not isinstance(device, str) or device not in DEVICES:
         raise ParameterError(f"device: expected one of {', '.join(DEVICES)}, got "
@@ -136,9 +142,10 @@ def matrix_spec(*, hs="1:3:3", te=None, tp=None, realizations: int = 3, waves: f
 
         length = SEA["length"] if length is None else length
         mass = SEA["mass"] if mass is None else mass
-    if horizon is not None:
-        raise ParameterError("horizon: the causal controller is not available yet; the matrix "
-                             "gives the non-causal optimum, the limit and the uniform rotation")
+    causal = check_causal(controller=controller, horizon=horizon, forecast=forecast,
+                          update_interval=update_interval, warm_up=warm_up,
+                          plan_samples=plan_samples, speed_limit=speed_limit,
+                          device=device, heave=heave)
     if torque_limit is not None and heave:
         raise ParameterError("torque-limit: not supported over a sea record (parapend sea "
                              "solves the unconstrained optimum); drop --torque-limit")
@@ -217,7 +224,8 @@ def matrix_spec(*, hs="1:3:3", te=None, tp=None, realizations: int = 3, waves: f
                       float(gamma_peak), float(cutoff), response, float(length), float(mass),
                       None if inertia is None else float(inertia), float(gravity),
                       float(gamma), winding, harmonics,
-                      None if efficiency is None else float(efficiency), device)
+                      None if efficiency is None else float(efficiency), device,
+                      **(causal or {}))
 
 
 def _buoy_spec(hm0, period, kind, tps, realizations, waves, seed, spectrum, gamma_peak,
@@ -338,8 +346,9 @@ def _headline(ds, spec: MatrixSpec):
     power (what the take-off delivers: the power matrix, capture width and annual energy
     are of it) and ``mechanical_power`` the same motion's mechanical power; the store keeps
     its own names (``power`` mechanical), so a store resumes whatever reads it."""
+    names = spec.long_names()
     for q in _stored(spec):
-        ds[q].attrs["long_name"] = QUANTITIES[q]
+        ds[q].attrs["long_name"] = names[q]
     if not spec.lossy:
         return ds
     mech, elec = ds["power"].copy(), ds["electrical_power"]
@@ -419,6 +428,8 @@ def matrix_dataset(raw, spec: MatrixSpec, *, depth=None, density: float = 1025.0
                       "flag_values": [-1, 0, 1, 2],
                       "flag_meanings": "no_result rest rotation swinging"}
     ds["operating_mode"] = (dims2, mode, mode_attrs)
+    if spec.controller is not None:
+        _causal_matrix(ds, spec)
     ds["capture_width_matrix"] = (dims2, pm / j, {
         "long_name": "capture width P / J of the power matrix", "units": "m"})
     # over the realizations, each record's power as the device delivers it: max(P, 0) (at
@@ -444,6 +455,8 @@ def matrix_dataset(raw, spec: MatrixSpec, *, depth=None, density: float = 1025.0
         ds["frequency"] = (dims2, frequency, {"long_name": "share of the year of the bin"})
         annual = {}
         for q in matrix_quantities(spec):
+            if q.endswith("_harvested_power"):
+                continue  # without its storage correction: no annual energy
             a = annual_energy(ds[f"{q}_mean"].values, frequency,
                               outside["frequency"] if outside else 0.0)
             a["bins_without_power"] = [{"hm0": spec.hm0[i], pk: spec.period[k],
@@ -467,8 +480,85 @@ def matrix_dataset(raw, spec: MatrixSpec, *, depth=None, density: float = 1025.0
             ds.attrs["annual_energy_mwh_bounds"] = annual["power"]["mwh_bounds"]
             ds.attrs["annual_energy_uncounted_frequency"] = \
                 annual["power"]["uncounted_frequency"]
+        if spec.controller is not None:
+            _annual_columns(ds, spec, annual)
     ds.attrs["hours_per_year"] = HOURS_PER_YEAR
     return ds, annual
+
+
+def annual_columns(spec: MatrixSpec) -> dict:
+    """The power columns whose annual energies stand side by side: the non-causal
+    optimum, then each forecast's causal column: label -> quantity."""
+    return {"optimum": "power", **{f"causal_{f}": f"causal_{f}_power"
+                                   for f in spec.forecasts}}
+
+
+def _causal_matrix(ds, spec: MatrixSpec) -> None:
+    """Each forecast's causal power matrix (the bin's best of the controller's run and
+    rest) and the choice, and the controller's settings in the attributes."""
+    from .annual import bin_power
+
+    dims2 = ("hm0", spec.period_kind)
+    for f in spec.forecasts:
+        mean = ds[f"causal_{f}_power_mean"].values
+        ds[f"causal_{f}_power_matrix"] = (dims2, bin_power(mean), {
+            "long_name": f"causal power matrix, {f} forecast: the bin's best of the "
+                         "controller's run and rest, max(causal mean power, 0)",
+            "units": "W"})
+        with np.errstate(invalid="ignore"):
+            mode = np.where(~np.isfinite(mean), -1, np.where(mean > 0, 1, 0)).astype(np.int8)
+        ds[f"causal_{f}_mode"] = (dims2, mode, {
+            "long_name": f"the causal device's choice in the bin, {f} forecast: the "
+                         "controller where its mean power is positive, else rest",
+            "flag_values": [-1, 0, 1], "flag_meanings": "no_result rest controller"})
+    ds.attrs.update({"controller": spec.controller,
+                     "causal_forecasts": ",".join(spec.forecasts),
+                     "causal_horizon_peak_periods": spec.horizon,
+                     "causal_update_interval_peak_periods": spec.update_interval,
+                     "causal_warm_up_peak_periods": spec.warm_up,
+                     "causal_plan_samples": spec.plan_samples,
+                     "causal_speed_limit": ("none" if spec.speed_limit is None
+                                            else spec.speed_limit),
+                     "causal_convention": "from the hanging rest, 64 torque samples a peak "
+                                          "period; the mean over one repeat of the record "
+                                          "after the warm-up, (W_e + eta_g dE) / tau"})
+
+
+def _annual_columns(ds, spec: MatrixSpec, annual: dict) -> None:
+    """The annual energy of each column side by side as variables over ``column``
+    (MWh; NaN where incomplete, its bounds beside it), the capacity factors likewise."""
+    cols = annual_columns(spec)
+    recs = [annual[q] for q in cols.values()]
+    nan = float("nan")
+    # an integer coordinate with CF flag meanings: a string one is not in Zarr 3's
+    # specification (zarr warns that other readers may not read it)
+    ds.coords["column"] = ("column", np.arange(len(cols), dtype=np.int8), {
+        "long_name": "power column: the non-causal optimum, the causal controller with "
+                     "each forecast", "flag_values": list(range(len(cols))),
+        "flag_meanings": " ".join(cols)})
+    ds["annual_energy"] = ("column", [a["mwh"] if a["complete"] else nan for a in recs], {
+        "long_name": "mean annual energy production 8766 h sum P f (NaN: incomplete, see "
+                     "the bounds)", "units": "MWh"})
+    ds["annual_energy_lower"] = ("column", [a.get("mwh_bounds", [a["mwh"]] * 2)[0]
+                                            for a in recs], {
+        "long_name": "annual energy, the uncounted share of the year at 0 W", "units": "MWh"})
+    ds["annual_energy_upper"] = ("column", [a.get("mwh_bounds", [a["mwh"]] * 2)[1]
+                                            for a in recs], {
+        "long_name": "annual energy, the uncounted share of the year at the largest bin's "
+                     "power", "units": "MWh"})
+    ds["annual_energy_complete"] = ("column", np.array([int(a["complete"]) for a in recs],
+                                                       dtype=np.int8), {
+        "long_name": "every sea state of the site in a bin with a result (1) or not (0)"})
+    if recs[0].get("capacity_factor") is not None or recs[0].get("capacity_factor_bounds"):
+        ds["capacity_factor"] = ("column", [nan if a.get("capacity_factor") is None
+                                            else a["capacity_factor"] for a in recs], {
+            "long_name": "capacity factor AEP / (8766 h x rated power) (NaN: incomplete)",
+            "units": "1"})
+        for k, name in ((0, "lower"), (1, "upper")):
+            ds[f"capacity_factor_{name}"] = ("column", [
+                a["capacity_factor_bounds"][k] if a.get("capacity_factor_bounds")
+                else a["capacity_factor"] for a in recs], {
+                "long_name": f"capacity factor, {name} bound", "units": "1"})
 
 
 def _check_breaking(hm0, depth) -> None:
@@ -509,7 +599,9 @@ def power_matrix(*, hs="1:3:3", te=None, tp=None, realizations: int = 3, waves: 
                  scheduler=None, netcdf=None, zarr=None, csv=None, command=None,
                  progress=None, dofs="heave", pivot_height=None, pivot_offset=None,
                  hull_pitch_inertia=None, barge_length=None, barge_beam=None,
-                 barge_draft=None, copper_loss=None, time_limit=None):
+                 barge_draft=None, copper_loss=None, controller=None, forecast=None,
+                 update_interval=None, warm_up=None, plan_samples=None, speed_limit=None,
+                 time_limit=None):
     """The power matrix of a device over bins of ``Hs x Te`` (or ``Tp``); see the module
     text and docs/performance.md. Returns ``(dataset, annual, run)``. ``dofs``
     ``"surge,heave,pitch"`` with ``device="buoy"``: a pendulum in a hull that surges, heaves
@@ -518,7 +610,17 @@ def power_matrix(*, hs="1:3:3", te=None, tp=None, realizations: int = 3, waves: 
     then holds the bins finished (the rest NaN, count 0), its attributes say ``status``
     ``"time_limit"`` and ``bins_finished`` of ``bins``, and with ``store`` a rerun computes
     the rest. Without ``time_limit`` or ``store`` a matrix estimated above
-    ``parapend.limits.MAX_UNTIMED_SECONDS`` is refused."""
+    ``parapend.limits.MAX_UNTIMED_SECONDS`` is refused.
+
+    ``controller="mpc"`` (``device="prescribed-heave"``): beside the non-causal optimum, the
+    causal column of each ``forecast`` (``"perfect"``, ``"ar"`` or ``"perfect,ar"``; default
+    ``"perfect"``): the receding-horizon controller on the same records, its
+    storage-corrected mean electrical power after ``warm_up`` peak periods (default 4), with
+    a ``horizon`` (peak periods, default 1), an ``update_interval`` (peak periods, default
+    1/32) and ``plan_samples`` torque samples per Hermite interval of the plan (default 2,
+    as ``horizon``), and ``speed_limit`` the plans' rated-speed penalty (units
+    ``sqrt(g / l)``, default 4; ``inf``: none, ``horizon``'s default);
+    :mod:`parapend.performance.causal`."""
     from ..maps.run import run_spec
     from .annual import bin_series, read_scatter, read_series
     from .check import check_bins, check_size
@@ -569,7 +671,10 @@ def power_matrix(*, hs="1:3:3", te=None, tp=None, realizations: int = 3, waves: 
                        density=density, depth=depth, dofs=dofs, pivot_height=pivot_height,
                        pivot_offset=pivot_offset, hull_pitch_inertia=hull_pitch_inertia,
                        barge_length=barge_length, barge_beam=barge_beam,
-                       barge_draft=barge_draft, copper_loss=copper_loss)
+                       barge_draft=barge_draft, copper_loss=copper_loss,
+                       controller=controller, forecast=forecast,
+                       update_interval=update_interval, warm_up=warm_up,
+                       plan_samples=plan_samples, speed_limit=speed_limit)
     _check_breaking(spec.hm0, depth)
     if spec.device == "buoy":
         from .buoy_device import water_of
@@ -631,8 +736,9 @@ def power_matrix(*, hs="1:3:3", te=None, tp=None, realizations: int = 3, waves: 
                  est["bins"], spec.realizations, est["solves"], spec.waves,
                  f"{est['processes']} processes" if est["processes"] else "the cluster",
                  _duration(est["seconds"]) + ("" if est["processes"] else " of one core"),
-                 "3 s a 50-wave solve" if spec.dofs == "heave" else
-                 "100 s a 9-wave record of the hull")
+                 ("3 s a 50-wave solve" if spec.controller is None else
+                  f"3 s a 50-wave solve and {est['causal_seconds']:.0f} s its causal runs")
+                 if spec.dofs == "heave" else "100 s a 9-wave record of the hull")
     t0 = time.monotonic()
     run = run_spec(spec, store, workers=workers, scheduler=scheduler, overwrite=overwrite,
                    command=command, progress=progress, deadline=until)

@@ -157,6 +157,18 @@ def check_size(spec, workers=None, scheduler=None, available=None) -> dict:
             f"{big}: at most {MAX_BINS} bins in all, got {nh} Hm0 x {npk} {pk} = {bins}; "
             f"with {ns} {small} bins, --{big} may have at most {MAX_BINS // ns} bins")
     solves = bins * r
+    # the causal column (--controller mpc): each record's runs counted as the solves of a
+    # 50-wave record their time would buy (3 s each), so the cap bounds the work
+    from .causal import record_seconds
+
+    causal = record_seconds(spec)
+    if causal and solves * (1.0 + causal / 3.0) > MAX_SOLVES:
+        per = 1.0 + causal / 3.0
+        raise ParameterError(
+            f"realizations: at most {MAX_SOLVES} solves' work in all, and each record's "
+            f"causal runs count as {per:.3g} solves: {bins} bins x {r} realizations is "
+            f"{solves * per:.4g}; with {bins} bins, --realizations may be at most "
+            f"{max(0, int(MAX_SOLVES // (bins * per)))} (or fewer forecasts)")
     if solves > MAX_SOLVES:
         raise ParameterError(
             f"realizations: at most {MAX_SOLVES} solves (bins x realizations) in all, got "
@@ -180,11 +192,13 @@ def check_size(spec, workers=None, scheduler=None, available=None) -> dict:
             f"{have / 2**30:.3g} GB is available; give fewer bins or realizations")
     # a rough time: a 50-wave record solves in about 3 s on one core, a 400-wave one in
     # about 9 s (measured on the shared 2-core machine): as the square root of the length
-    seconds = solves * 3.0 * math.sqrt(max(1.0, spec.waves / 50.0)) / max(1, procs or 1)
+    seconds = (solves * (3.0 * math.sqrt(max(1.0, spec.waves / 50.0)) + causal)
+               / max(1, procs or 1))
     if getattr(spec, "dofs", "heave") != "heave":
         # the hull: a 9-wave record of the default barge took 92 to 122 s of CPU (both
         # modes and their refinement; measured on the shared 2-core machine), roughly as
         # its length
         seconds = solves * HULL_SOLVE_SECONDS * spec.waves / 9.0 / max(1, procs or 1)
     return {"bins": bins, "solves": solves, "processes": procs, "memory_bytes": need,
-            "seconds": seconds if math.isfinite(seconds) else None}
+            "seconds": seconds if math.isfinite(seconds) else None,
+            "causal_seconds": causal}

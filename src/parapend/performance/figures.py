@@ -236,6 +236,9 @@ def text_report(ds, out: dict, drawn: list) -> str:
     if out["failed_solves"]:
         lines.append(f"{out['failed_solves']} solves did not converge (status in the store; "
                      "left out of the statistics: see the count)")
+    c = out.get("causal")
+    if c is not None:
+        lines += _causal_lines(ds, c, hm0, per, pk)
     a = out["annual_energy"]
     if a is not None:
         p = a["power"]
@@ -278,9 +281,71 @@ def text_report(ds, out: dict, drawn: list) -> str:
             o = p["outside_frequency"]
             lines.append(f"{o['sea_states']} sea states ({o['frequency']:.4g} of the year) "
                          "lie outside the matrix's bins (not counted: see the bounds)")
+    if c is not None and "annual_energy" in c:
+        lines.append(_side_by_side(c))
     for key in ("netcdf", "zarr", "csv"):
         if out[key]:
             lines.append(f"{key} written to {out[key]}")
     for d in drawn:
         lines.append(f"figure written to {d}")
     return "\n".join(lines)
+
+
+def _causal_lines(ds, c: dict, hm0, per, pk) -> list:
+    """The causal column's tables: each forecast's power matrix (the bin's best of the
+    controller's run and rest) and the bins at rest."""
+    lines = ["", f"causal receding-horizon control (horizon {c['horizon_peak_periods']:g} "
+                 f"peak periods, a plan every {c['update_interval_peak_periods']:g} of them, "
+                 f"{c['plan_samples']} torque samples per plan interval"
+                 + ("" if c.get("speed_limit") is None else
+                    f", speed penalty above {c['speed_limit']:g} sqrt(g/l)")
+                 + "): storage-corrected "
+                 f"mean power over one repeat after a warm-up of "
+                 f"{c['warm_up_peak_periods']:g} peak periods from rest, the bin's best of "
+                 "the controller and rest"]
+    for f in c["forecasts"]:
+        name = "perfect forecast" if f == "perfect" else "autoregressive forecast"
+        lines.append(f"causal power matrix, {name}, rows Hm0, columns {pk}:")
+        rows = [[f"{h:g} m", *(with_unit(v, "W") for v in
+                               ds[f"causal_{f}_power_matrix"].values[i])]
+                for i, h in enumerate(hm0)]
+        lines += [_right_table(rows, ["Hm0 \\ " + pk, *(f"{t:g} s" for t in per)])]
+        runs = ds[f"causal_{f}_power"].values
+        bad = int((~np.isfinite(runs)).sum())
+        if bad:
+            lines.append(f"{bad} of {runs.size} causal runs failed (the log names them; "
+                         "\"unresolved\": the plans spun the pendulum past a turn per torque "
+                         "sample, see --speed-limit): left out of the bins' means, see the "
+                         "count in --json")
+        m = ds[f"causal_{f}_mode"].values
+        rest, none = int((m == 0).sum()), int((m == -1).sum())
+        if rest or none:
+            lines.append(", ".join(
+                s for s in (f"{rest} bins at rest (the controller's mean power is not "
+                            "positive: 0 W)" if rest else "",
+                            f"{none} bins without a causal result" if none else "") if s))
+        lines.append("")
+    return lines
+
+
+def _side_by_side(c: dict) -> str:
+    """The annual energy of the optimum and of each causal column on one line (bounds
+    where incomplete), with the capacity factors."""
+    labels = {"optimum": "non-causal optimum", "causal_perfect": "causal, perfect forecast",
+              "causal_ar": "causal, AR forecast"}
+    parts = []
+    for col, e in c["annual_energy"].items():
+        if e["complete"]:
+            text = _per_year(e["annual_energy_mwh"] * 1e6)
+        else:
+            lo, hi = e["annual_energy_mwh_bounds"]
+            text = f"{_per_year(lo * 1e6)} to {_per_year(hi * 1e6)} (incomplete)"
+        if "capacity_factor" in e:
+            cf = e["capacity_factor"]
+            if cf is not None:
+                text += f", capacity factor {cf:.4g}"
+            else:
+                lo, hi = e["capacity_factor_bounds"]
+                text += f", capacity factor {lo:.4g} to {hi:.4g}"
+        parts.append(f"{labels.get(col, col) + ':':27s} {text}")
+    return "\n".join(["annual energy side by side (8766 h/yr):", *("  " + p for p in parts)])

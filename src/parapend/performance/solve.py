@@ -41,6 +41,10 @@ def solve_bin(spec, i: int, j: int, r: int) -> dict:
            "uniform_power": res.uniform_power_w, "status": res.status}
     if spec.efficiency is not None:
         out["electrical_power"] = electrical_power(res, spec.efficiency)
+    if spec.controller is not None:
+        from .causal import solve_causal
+
+        out.update(solve_causal(spec, i, j, r))  # the same record, run causally
     return out
 
 

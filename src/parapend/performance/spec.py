@@ -38,7 +38,11 @@ MODE_LONG_NAME = "best mode of the record: 0 rest, 1 rotation (one turn per wave
 _TITLE = "parapend design map"
 #: every top-level name a power-matrix store holds (coordinates and variables)
 STORE_NAMES = ("hm0", "te", "tp", "realization", "seed", "done", "status", "mode",
-               *QUANTITIES)
+               *QUANTITIES, *(f"causal_{f}_{q}" for f in ("perfect", "ar")
+                              for q in ("power", "harvested_power")))
+#: the causal column's fields (left out of the JSON without a controller)
+_CAUSAL_FIELDS = ("controller", "horizon", "forecasts", "update_interval", "warm_up",
+                  "plan_samples", "speed_limit")
 #: devices a matrix can be computed for
 DEVICES = ("prescribed-heave", "buoy")
 #: the spec's fields only the buoy uses (left out of a prescribed-heave spec's JSON)
@@ -106,6 +110,15 @@ class MatrixSpec:
     barge_draft: float | None = None
     copper_loss: float | None = None
     torque_limit: float | None = None
+    # the causal column (--controller mpc, parapend.performance.causal): the horizon, update
+    # interval and warm-up in peak periods, the forecasts, the planner's samples an interval
+    controller: str | None = None
+    horizon: float | None = None
+    forecasts: tuple = ()
+    update_interval: float | None = None
+    warm_up: float | None = None
+    plan_samples: int | None = None
+    speed_limit: float | None = None  # the plans' rated-speed penalty, units sqrt(g / l)
 
     kind = "power_matrix"
     pto = False
@@ -155,6 +168,10 @@ class MatrixSpec:
         out = ["power", "limit_power", "uniform_power"]
         if self.efficiency is not None:
             out.append("electrical_power")
+        if self.controller is not None:
+            from .causal import causal_quantities
+
+            out += causal_quantities(self.forecasts)
         return (*out, "status")
 
     @property
@@ -180,6 +197,9 @@ class MatrixSpec:
         for k, v in _DEFAULT_HULL.items():
             if d[k] == v:
                 d.pop(k)
+        if self.controller is None:  # a store written before the causal column resumes
+            for k in _CAUSAL_FIELDS:
+                d.pop(k)
         return json.dumps(d, sort_keys=True)
 
     @classmethod
@@ -193,6 +213,8 @@ class MatrixSpec:
             d["response"] = tuple(tuple(float(v) for v in c) for c in d["response"])
         if d.get("band") is not None:
             d["band"] = tuple(float(v) for v in d["band"])
+        if "forecasts" in d:
+            d["forecasts"] = tuple(d["forecasts"])
         return cls(**d)
 
     def coordinates(self) -> dict:
@@ -215,6 +237,14 @@ class MatrixSpec:
         if self.response is not None:
             kw["response"] = tuple(np.array(c) for c in self.response)
         return kw
+
+    def long_names(self) -> dict:
+        """Long names of the stored quantities (the causal column's included)."""
+        if self.controller is None:
+            return QUANTITIES
+        from .causal import long_names
+
+        return {**QUANTITIES, **long_names(self.forecasts)}
 
     # -- the store -------------------------------------------------------------------------
     def template(self, command: str | None):
@@ -246,7 +276,7 @@ class MatrixSpec:
                          "comment": "-1: not computed; success: converged"}
             else:
                 arr = da.full(self.shape, np.nan, dtype=float, chunks=self.chunks)
-                fill, attrs = np.nan, {"long_name": QUANTITIES[v], "units": "W"}
+                fill, attrs = np.nan, {"long_name": self.long_names()[v], "units": "W"}
             data[v] = (self.dims, arr, attrs)
             enc[v] = {"chunks": self.chunks, "fill_value": fill,
                       "compressors": (ZstdCodec(level=0, checksum=True),)}

@@ -1,0 +1,228 @@
+r"""The causal column of a power matrix (``--controller mpc``): per bin and record, the
+receding-horizon controller of :func:`parapend.control.mpc.mpc_run` on the record the
+non-causal column solves (same seed, same heave), with each forecast asked for.
+
+One record's run is the one :func:`parapend.control.horizon.horizon_curve` makes: from the
+hanging rest, 64 torque samples a peak period, ``warm_up`` peak periods left out of the mean
+and then one whole repeat of the record, the mean electrical power storage-corrected
+(``(W_e + eta_g dE) / tau``: the harvested energy plus the change of the pendulum's stored
+energy ``E = theta'^2 / 2 + cos(theta)`` per unit time). Only the planner's samples per
+Hermite interval are an option here (``plan_samples``, :data:`CAUSAL`: 2, ``horizon``'s). The
+horizon, the update interval and the warm-up are in peak periods, as ``horizon`` and
+``track --controller mpc`` take them.
+
+Per bin the causal power is the best of the controller's run and rest: ``max(P, 0)`` of the
+mean over the records (a real device stops the pendulum where the controller loses energy);
+the choice is recorded (``causal_<forecast>_mode``).
+"""
+
+from __future__ import annotations
+
+import logging
+import math
+
+from ..errors import ParameterError, check_int, check_range
+
+__all__ = ["CAUSAL", "CAUSAL_SECONDS", "FORECASTS", "causal_json", "causal_quantities",
+           "check_causal", "record_seconds", "solve_causal"]
+
+log = logging.getLogger(__name__)
+
+#: the forecasts of the causal column (:mod:`parapend.control.forecast`)
+FORECASTS = ("perfect", "ar")
+#: the causal column's defaults: horizon, update interval and warm-up in peak periods,
+#: the forecasts, the planner's torque samples per Hermite interval and the plans' rated
+#: speed (units sqrt(g / l), a penalty). Measured on 50-wave records (docs/performance.md):
+#: a horizon of 1 peak period gave the power of 2 (``track``'s default) to 5 digits at Hs
+#: 1, 2 and 3 m, in two thirds of the time; an update interval of 1/16 (``horizon``'s is
+#: 1/32) lost 13 % of the power; 4 samples an interval (``horizon``'s 2) cost a third less
+#: with the same power (to 0.03 %) but ran away (|theta'| past a turn a sample,
+#: "unresolved") at Hs 3 m, Te 6 s. Unlike ``horizon``, the plans price a rated speed:
+#: without it 2 of 3 records at Hs 3 m, Te 6 s ran away and one reached 98.1 % of the
+#: optimum; with 4 all reached 99.98 %, and at Hs 2 m, Tp 8 s and Hs 1 m, Te 10 s the power
+#: was the same
+CAUSAL = {"horizon": 1.0, "forecast": "perfect", "update_interval": 0.03125,
+          "warm_up": 4.0, "plan_samples": 2, "speed_limit": 4.0}
+#: CPU seconds of one causal run over a 50-wave record (and the 4-period warm-up) with each
+#: forecast at the defaults, measured on the shared 2-core machine (one BLAS thread; 6.5 to
+#: 7.1 s perfect at Hs 1 to 3 m, 9.9 s AR at Hs 2 m, Tp 8 s), rounded up; a run's cost
+#: grows as its length
+CAUSAL_SECONDS = {"perfect": 7.5, "ar": 10.5}
+
+
+def check_causal(*, controller, horizon, forecast, update_interval, warm_up, plan_samples,
+                 device: str, heave: bool, speed_limit=None) -> dict | None:
+    """The causal column's options, checked (one line naming the option); None without a
+    controller (then every other option of it is refused)."""
+    opts = {"horizon": horizon, "forecast": forecast, "update-interval": update_interval,
+            "warm-up": warm_up, "plan-samples": plan_samples, "speed-limit": speed_limit}
+    if controller is None or controller == "none":
+        given = [k for k, v in opts.items() if v is not None]
+        if given:
+            raise ParameterError(f"{given[0]}: an option of the causal column; needs "
+                                 "--controller mpc")
+        return None
+    if controller != "mpc":
+        raise ParameterError(f"controller: expected mpc (or none), got {controller!r:.40}")
+    if device != "prescribed-heave" or not heave:
+        raise ParameterError("controller: the causal column is computed for --device "
+                             "prescribed-heave only; the buoy's causal controller is "
+                             "parapend buoy --controller mpc (one sea state)")
+    horizon = CAUSAL["horizon"] if horizon is None else horizon
+    horizon = check_range("horizon", horizon, 0.05, 20.0, why="peak periods")
+    forecast = CAUSAL["forecast"] if forecast is None else forecast
+    if isinstance(forecast, str):
+        names = [s.strip() for s in forecast.split(",") if s.strip()]
+    elif isinstance(forecast, (list, tuple)):
+        names = list(forecast)
+    else:
+        raise ParameterError(f"forecast: expected perfect, ar or perfect,ar, got "
+                             f"{forecast!r:.40}")
+    if not names or any(n not in FORECASTS for n in names) or len(set(names)) != len(names):
+        raise ParameterError(f"forecast: expected perfect, ar or perfect,ar, got "
+                             f"{forecast!r:.40}")
+    upd = CAUSAL["update_interval"] if update_interval is None else update_interval
+    upd = check_range("update-interval", upd, 1e-3, 1.0, why="peak periods")
+    warm = CAUSAL["warm_up"] if warm_up is None else warm_up
+    warm = check_range("warm-up", warm, 0.0, 100.0, why="peak periods")
+    ps = CAUSAL["plan_samples"] if plan_samples is None else plan_samples
+    ps = check_int("plan-samples", ps, 1, 64)
+    if speed_limit is None:
+        speed_limit = CAUSAL["speed_limit"]
+    try:
+        none = float(speed_limit) == math.inf  # none: horizon's default
+    except (TypeError, ValueError, OverflowError):
+        none = False
+    speed_limit = None if none else float(check_range(
+        "speed-limit", speed_limit, 1e-9, 1e6, why="units sqrt(g / l); inf for none"))
+    return {"controller": "mpc", "horizon": float(horizon),
+            "forecasts": tuple(n for n in FORECASTS if n in names),
+            "update_interval": float(upd), "warm_up": float(warm), "plan_samples": int(ps),
+            "speed_limit": speed_limit}
+
+
+def causal_quantities(forecasts) -> tuple:
+    """The stored per-record quantities (W) of the causal column, per forecast: the
+    storage-corrected power and the harvested power alone."""
+    return tuple(q for f in forecasts
+                 for q in (f"causal_{f}_power", f"causal_{f}_harvested_power"))
+
+
+def long_names(forecasts) -> dict:
+    """Long names of :func:`causal_quantities`."""
+    out = {}
+    for f in forecasts:
+        what = "perfect forecast" if f == "perfect" else "autoregressive forecast (past only)"
+        out[f"causal_{f}_power"] = (
+            f"causal receding-horizon control, {what}: mean electrical power after the "
+            "warm-up, storage-corrected (harvested energy + eta_g x change of the stored "
+            "energy, per unit time)")
+        out[f"causal_{f}_harvested_power"] = (
+            f"causal receding-horizon control, {what}: harvested electrical energy per unit "
+            "time after the warm-up (no storage correction)")
+    return out
+
+
+def record_seconds(spec) -> float:
+    """A rough CPU time (s) of the causal runs of one record of ``spec``
+    (:data:`CAUSAL_SECONDS`, as the run's length); 0 without a controller."""
+    if getattr(spec, "controller", None) is None:
+        return 0.0
+    scale = (spec.waves + spec.warm_up) / 54.0  # the measured runs: 50 waves + 4 warm-up
+    return sum(CAUSAL_SECONDS[f] for f in spec.forecasts) * scale
+
+
+def run_record(spec, exc, units, j: int, r: int, forecast: str):
+    """The receding-horizon run of one record ``exc`` (bin period ``j``, realization ``r``)
+    with ``forecast``: :func:`parapend.control.mpc.mpc_run` with the arguments
+    :func:`parapend.control.horizon.horizon_curve` gives it (and ``plan_samples``)."""
+    from ..control.forecast import ARForecast
+    from ..control.mpc import mpc_run
+
+    eff = None
+    if spec.efficiency is not None:
+        from ..pto import efficiencies
+
+        eff = efficiencies(spec.efficiency)
+    tp_n = spec.tp[j] / units.time
+    fo = None if forecast == "perfect" else ARForecast(tp_n)
+    return mpc_run(exc.q, gamma=spec.gamma, horizon=spec.horizon * tp_n,
+                   update_interval=spec.update_interval * tp_n, dt=tp_n / 64,
+                   average_from=spec.warm_up * tp_n, torque_limit=None, efficiency=eff,
+                   forecast=fo, t_end=exc.period + spec.warm_up * tp_n,
+                   seed=int(spec.seeds[r]), speed_limit=spec.speed_limit,
+                   interval_samples=spec.plan_samples)
+
+
+def solve_causal(spec, i: int, j: int, r: int) -> dict:
+    """The causal quantities (W) of bin ``(i, j)``, realization ``r``: NaN where a run did
+    not succeed (or raised: logged)."""
+    from threadpoolctl import threadpool_limits
+
+    from .check import _record, _units
+
+    units = _units(spec)
+    exc = _record(spec, units, i, j, r)
+    out = {}
+    for f in spec.forecasts:
+        p = w = math.nan
+        try:
+            # one BLAS thread, as the command line's own process has it: the engine's worker
+            # processes do not, and the record's q (a small complex matrix-vector product
+            # at every update) ran 2 to 3 times slower with threads that only spin
+            with threadpool_limits(1, user_api="blas"):
+                res = run_record(spec, exc, units, j, r, f)
+            if res.success:
+                p = units.to_watts(float(res.mean_electrical_power))
+                w = units.to_watts(float(res.harvested_electrical_power))
+            else:
+                log.warning("power matrix bin hm0=%g %s=%g realization %d: the causal run "
+                            "(%s forecast) ended %s", spec.hm0[i], spec.period_kind,
+                            spec.period[j], r, f, res.status)
+        except Exception as err:  # noqa: BLE001 - a NaN in the column, logged
+            log.warning("power matrix bin hm0=%g %s=%g realization %d: the causal run (%s "
+                        "forecast) failed: %s: %s", spec.hm0[i], spec.period_kind,
+                        spec.period[j], r, f, type(err).__name__, err)
+        out[f"causal_{f}_power"] = p
+        out[f"causal_{f}_harvested_power"] = w
+    return out
+
+
+
+def causal_json(ds, grid) -> dict:
+    """The causal column of ``parapend power-matrix --json`` (``causal``): the controller's
+    settings, each forecast's power matrix and choice per bin (``grid`` turns a variable
+    into nested lists, None for NaN), and the annual energy of each column side by side
+    (MWh; None where incomplete, the bounds beside it)."""
+    forecasts = ds.attrs["causal_forecasts"].split(",")
+    out = {"controller": ds.attrs["controller"], "forecasts": forecasts,
+           "horizon_peak_periods": float(ds.attrs["causal_horizon_peak_periods"]),
+           "update_interval_peak_periods":
+               float(ds.attrs["causal_update_interval_peak_periods"]),
+           "warm_up_peak_periods": float(ds.attrs["causal_warm_up_peak_periods"]),
+           "plan_samples": int(ds.attrs["causal_plan_samples"]),
+           "speed_limit": (None if ds.attrs["causal_speed_limit"] == "none"
+                           else float(ds.attrs["causal_speed_limit"])),
+           "convention": ds.attrs["causal_convention"],
+           "power_matrix": {f: grid(f"causal_{f}_power_matrix") for f in forecasts},
+           "mode": {f: [[{1: "controller", 0: "rest"}.get(int(v)) for v in row]
+                        for row in ds[f"causal_{f}_mode"].values] for f in forecasts}}
+    if "annual_energy" in ds:
+        def num(v):
+            v = float(v)
+            return v if math.isfinite(v) else None
+
+        cols = ds["column"].attrs["flag_meanings"].split()
+        side = {}
+        for k, c in enumerate(cols):
+            e = {"annual_energy_mwh": num(ds["annual_energy"].values[k]),
+                 "complete": bool(ds["annual_energy_complete"].values[k]),
+                 "annual_energy_mwh_bounds": [num(ds["annual_energy_lower"].values[k]),
+                                              num(ds["annual_energy_upper"].values[k])]}
+            if "capacity_factor" in ds:
+                e["capacity_factor"] = num(ds["capacity_factor"].values[k])
+                e["capacity_factor_bounds"] = [num(ds["capacity_factor_lower"].values[k]),
+                                               num(ds["capacity_factor_upper"].values[k])]
+            side[c] = e
+        out["annual_energy"] = side
+    return out

@@ -1,0 +1,371 @@
+"""``power-matrix --controller mpc`` (issue 31 item 4): the causal column beside the
+non-causal optimum, per bin the best of the controller's run and rest, the annual energy of
+each column side by side, and the incomplete site marked in every column.
+
+Independent sources: the receding-horizon controller run by hand on the same record
+(:func:`parapend.control.mpc.mpc_run` with the arguments written out here, and
+:func:`parapend.control.horizon.horizon_curve`), the energy identity of Eq. 14 (no motion
+over a window harvests more than the ``gamma -> 0`` limit plus the boundary term), and the
+closed form ``AEP = 8766 h sum max(P, 0) f`` for each column.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+
+import numpy as np
+import pytest
+
+import parapend
+from parapend.cli import main
+from parapend.errors import ParameterError
+from parapend.performance import matrix_spec
+from parapend.performance.annual import HOURS_PER_YEAR
+from parapend.performance.causal import solve_causal
+
+#: a small matrix: 2 x 2 bins, one 2-wave record each, a warm-up of half a peak period, a
+#: plan every 1/16 peak period (a cheap run: the tests compare computations, not settings)
+KW = {"hs": "1,2", "tp": "6,8", "realizations": 1, "waves": 2, "controller": "mpc",
+      "forecast": "perfect", "warm_up": 0.5, "update_interval": 0.0625}
+#: a site with a sea state outside the matrix (Hm0 4 m): the annual energy is incomplete
+SERIES = "hs,tp\n1,6\n1,8\n2,6\n2,8\n2,8\n4,8\n"
+
+
+def _by_hand(hs, tp, seed, *, waves=2, warm_up=0.5, horizon=1.0, update_interval=0.0625,
+             plan_samples=2, gamma=0.01, forecast="perfect", speed_limit=4.0):
+    """The causal run of one record written out: the record as ``sea`` builds it for the
+    default pendulum (1 m, 10 kg), ``mpc_run`` from the hanging rest, 64 samples a peak
+    period, the rated-speed penalty at 4 sqrt(g/l), the mean over one repeat after the
+    warm-up; (storage-corrected, harvested) W,
+    the units and the record."""
+    from parapend.control.forecast import ARForecast
+    from parapend.control.mpc import mpc_run
+    from parapend.seas import sea_record
+    from parapend.units import Units
+
+    units = Units(1.0, 10.0, 9.81, None)
+    exc = sea_record(units, hs=hs, tp=tp, repeat_period=waves * tp, seed=seed)
+    tn = tp / units.time
+    res = mpc_run(exc.q, gamma=gamma, horizon=horizon * tn, update_interval=update_interval * tn,
+                  dt=tn / 64, average_from=warm_up * tn, t_end=exc.period + warm_up * tn,
+                  seed=seed, interval_samples=plan_samples, speed_limit=speed_limit,
+                  forecast=None if forecast == "perfect" else ARForecast(tn))
+    assert res.success
+    return (units.to_watts(res.mean_electrical_power),
+            units.to_watts(res.harvested_electrical_power), units, exc)
+
+
+@pytest.mark.parametrize("forecast", ["perfect", pytest.param("ar", marks=pytest.mark.slow)])
+def test_a_record_is_the_controller_run_by_hand(forecast):
+    """A bin's record (Hm0 2 m, Tp 8 s, realization 0, seed 5): the column's powers are
+    those of ``mpc_run`` run by hand on the same record (same seed, same heave), to
+    round-off, beside the optimum of ``sea`` on it."""
+    from parapend.performance.solve import solve_bin
+
+    spec = matrix_spec(**{**KW, "forecast": forecast, "seed": 5})
+    got = solve_bin(spec, 1, 1, 0)
+    p, w, *_ = _by_hand(2.0, 8.0, 5, forecast=forecast)
+    assert got[f"causal_{forecast}_power"] == pytest.approx(p, rel=1e-12, abs=0)
+    assert got[f"causal_{forecast}_harvested_power"] == pytest.approx(w, rel=1e-12, abs=0)
+    s = parapend.sea(hs=2.0, tp=8.0, repeat_period=16.0, seed=5)
+    assert got["power"] == pytest.approx(s.power_w, rel=1e-12)
+
+
+@pytest.mark.slow
+def test_every_bin_of_the_matrix_is_the_controller_run_by_hand():
+    """Through the engine (store, statistics, the Dataset): each bin's causal power and
+    its causal power matrix are ``mpc_run`` by hand on the bin's record."""
+    ds = parapend.power_matrix(**KW, workers=1).dataset
+    for i, hs in enumerate((1.0, 2.0)):
+        for j, tp in enumerate((6.0, 8.0)):
+            p, w, *_ = _by_hand(hs, tp, 0)
+            assert ds["causal_perfect_power"].values[i, j, 0] == pytest.approx(p, rel=1e-12)
+            assert ds["causal_perfect_power_mean"].values[i, j] == pytest.approx(p, rel=1e-12)
+            assert ds["causal_perfect_power_matrix"].values[i, j] == pytest.approx(
+                max(p, 0.0), rel=1e-12)
+            assert ds["causal_perfect_mode"].values[i, j] == (1 if p > 0 else 0)
+
+
+def test_a_record_is_horizon_curve():
+    """One record's causal power is that of ``parapend horizon`` on the same record (the
+    same planner, 2 torque samples an interval)."""
+    spec = matrix_spec(**{**KW, "seed": 3})
+    got = solve_causal(spec, 0, 1, 0)
+    ref = parapend.horizon(hs=1.0, tp=8.0, repeat_period=16.0, seed=3, horizons="1",
+                           forecasts="perfect", baselines="none", warm_up=0.5,
+                           update_interval=0.0625, speed_limit=4.0)
+    assert got["causal_perfect_power"] == pytest.approx(ref.mpc_power_w[0][0][0],
+                                                        rel=1e-12, abs=0)
+
+
+@pytest.mark.parametrize("i, j", [(0, 0), (1, 1)])
+def test_causal_never_beats_what_the_sea_allows(i, j):
+    """The invariant. Eq. 14's energy balance gives, for any motion over a window of length
+    ``tau``, ``W + dE = int (q sin(theta) theta' - gamma theta'^2) dt <= [-q cos(theta)] +
+    int |q'| dt``: so the storage-corrected causal power is at most the record's
+    ``gamma -> 0`` limit ``TV(q) / T_r`` plus ``2 max|q| / tau`` (units ``m g l``), over
+    one repeat ``tau = T_r``. Against the non-causal optimum (the best periodic motion of
+    the record) no exact bound holds for a motion that is not periodic: the causal power
+    exceeds it by at most the storage term ``|P - P_harvested|`` (the change of stored
+    energy per unit time) plus the boundary term ``2 max|q| / tau``."""
+    from parapend.performance.check import _record, _units
+    from parapend.performance.solve import solve_bin
+
+    spec = matrix_spec(**KW)
+    got = solve_bin(spec, i, j, 0)
+    units = _units(spec)
+    exc = _record(spec, units, i, j, 0)
+    qmax = float(np.max(np.abs(exc.q(np.linspace(0, exc.period, 4097)))))
+    boundary = units.to_watts(2 * qmax / exc.period)
+    p = got["causal_perfect_power"]
+    stored = abs(p - got["causal_perfect_harvested_power"])
+    assert p <= got["limit_power"] + boundary
+    assert p <= got["power"] + stored + boundary
+
+
+def _stub(causal_power):
+    """solve_bin with the optimum 1 + i + j W, the limit 10 W and the causal column
+    ``causal_power[i][j]`` (harvested: the same), without a solve."""
+    def solve_bin(spec, i, j, r):
+        out = {"power": 1.0 + i + j, "limit_power": 10.0, "uniform_power": 0.5,
+               "status": "converged"}
+        for f in spec.forecasts:
+            out[f"causal_{f}_power"] = out[f"causal_{f}_harvested_power"] = \
+                causal_power[i][j] * (0.9 if f == "ar" else 1.0)
+        return out
+    return solve_bin
+
+
+@pytest.fixture
+def stubbed(monkeypatch, tmp_path):
+    """``parapend.power_matrix`` at ``KW`` (both forecasts) with the solve stood in by
+    :func:`_stub`, on the site ``SERIES`` (incomplete) or a complete scatter."""
+    import parapend.performance.solve as solve
+
+    def run(causal_power, complete=False):
+        monkeypatch.setattr(solve, "solve_bin", _stub(causal_power))
+        site = tmp_path / "site.csv"
+        if complete:
+            site.write_text("hs,tp,frequency\n1,6,0.25\n1,8,0.25\n2,6,0.25\n2,8,0.25\n")
+            where = {"scatter": str(site)}
+        else:
+            site.write_text(SERIES)
+            where = {"timeseries": str(site)}
+        return parapend.power_matrix(**{**KW, "forecast": "perfect,ar"}, workers=1,
+                                     rated_power=20.0, netcdf=str(tmp_path / "m.nc"),
+                                     **where)
+    return run
+
+
+def test_aep_of_each_column_is_8766_h_sum_p_f_and_incomplete_everywhere(stubbed):
+    """Each column's annual energy is ``8766 h sum max(P, 0) f`` over the bins, the
+    uncounted share (the sea state outside) bounds it at 0 and at the largest bin's power,
+    and every column says incomplete: in the JSON, the NetCDF variables and the text."""
+    import xarray as xr
+
+    rec = stubbed([[0.5, 1.5], [2.5, 2.0]])
+    ds, out = rec.dataset, rec.to_dict()
+    f = np.array([[1, 1], [1, 2]]) / 6.0
+    assert np.allclose(ds["frequency"].values, f)
+    cols = {"optimum": "power_matrix", "causal_perfect": "causal_perfect_power_matrix",
+            "causal_ar": "causal_ar_power_matrix"}
+    with xr.open_dataset(out["netcdf"]) as nc:
+        assert nc["column"].attrs["flag_meanings"].split() == list(cols)
+        assert nc["column"].values.tolist() == [0, 1, 2]
+        for k, (col, var) in enumerate(cols.items()):
+            p = ds[var].values
+            lo = HOURS_PER_YEAR * float(np.sum(p * f)) / 1e6
+            hi = lo + HOURS_PER_YEAR * float(p.max()) / 6.0 / 1e6
+            e = out["causal"]["annual_energy"][col]
+            assert e["complete"] is False and e["annual_energy_mwh"] is None
+            assert e["annual_energy_mwh_bounds"] == pytest.approx([lo, hi], rel=1e-12)
+            assert e["capacity_factor"] is None
+            assert e["capacity_factor_bounds"] == pytest.approx(
+                [lo * 1e6 / (HOURS_PER_YEAR * 20.0), hi * 1e6 / (HOURS_PER_YEAR * 20.0)],
+                rel=1e-12)
+            assert math.isnan(nc["annual_energy"].values[k])
+            assert nc["annual_energy_complete"].values[k] == 0
+            assert nc["annual_energy_lower"].values[k] == pytest.approx(lo, rel=1e-12)
+            assert nc["annual_energy_upper"].values[k] == pytest.approx(hi, rel=1e-12)
+            assert math.isnan(nc["capacity_factor"].values[k])
+        assert nc["annual_energy_lower"].attrs["units"] == "MWh"
+        assert nc["causal_perfect_power_mean"].attrs["units"] == "W"
+    assert out["annual_energy"]["causal_ar_power"]["complete"] is False
+    assert out["hours_per_year"] == HOURS_PER_YEAR
+    json.dumps(out["causal"])  # plain JSON
+    from parapend.performance.figures import text_report
+
+    text = text_report(ds, out, [])
+    assert "annual energy side by side (8766 h/yr):" in text
+    side = text.split("annual energy side by side (8766 h/yr):\n")[1].splitlines()[:3]
+    assert [line.endswith("(incomplete)") or "(incomplete)," in line for line in side] == \
+        [True] * 3
+    assert "causal power matrix, autoregressive forecast" in text
+
+
+def test_a_losing_controller_rests_and_the_aep_is_never_negative(stubbed):
+    """Where the controller's mean power is negative the bin rests: 0 W in the causal power
+    matrix and the annual energy, the choice recorded; the stored per-record powers keep
+    their sign. On a complete site each column is one plain number, 8766 h sum max(P, 0) f."""
+    rec = stubbed([[-3.0, 1.5], [2.5, -0.1]], complete=True)
+    ds, out = rec.dataset, rec.to_dict()
+    assert ds["causal_perfect_power_mean"].values[0, 0] == -3.0
+    assert ds["causal_perfect_power_matrix"].values.tolist() == [[0.0, 1.5], [2.5, 0.0]]
+    assert out["causal"]["mode"]["perfect"] == [["rest", "controller"], ["controller", "rest"]]
+    for k, (col, q) in enumerate((("optimum", "power"),
+                                  ("causal_perfect", "causal_perfect_power"),
+                                  ("causal_ar", "causal_ar_power"))):
+        want = HOURS_PER_YEAR * 0.25 * float(np.sum(np.maximum(ds[f"{q}_mean"].values, 0)))
+        assert out["annual_energy"][q]["wh"] == pytest.approx(want, rel=1e-12)
+        e = out["causal"]["annual_energy"][col]
+        assert e["complete"] is True
+        assert e["annual_energy_mwh"] == pytest.approx(want / 1e6, rel=1e-12)
+        assert e["capacity_factor"] == pytest.approx(want / (HOURS_PER_YEAR * 20.0),
+                                                     rel=1e-12)
+        assert ds["annual_energy"].values[k] >= 0
+
+
+def test_a_bin_without_a_causal_result_makes_only_its_column_incomplete(stubbed, tmp_path):
+    """A failed causal run (NaN) in the only record of a bin: that bin has no causal result,
+    so the causal columns' annual energies are incomplete (bounds with the bin's share at 0
+    and at the largest bin's power) while the optimum's stays complete; the text says how
+    many runs failed."""
+    from parapend.performance.figures import text_report
+
+    rec = stubbed([[1.0, 1.5], [2.5, math.nan]], complete=True)
+    ds, out = rec.dataset, rec.to_dict()
+    assert ds["causal_perfect_mode"].values[1, 1] == -1
+    assert ds["causal_perfect_power_count"].values[1, 1] == 0
+    side = out["causal"]["annual_energy"]
+    assert side["optimum"]["complete"] is True
+    for col in ("causal_perfect", "causal_ar"):
+        p = ds[f"{col}_power_matrix"].values
+        lo = HOURS_PER_YEAR * 0.25 * float(np.nansum(p))
+        hi = lo + HOURS_PER_YEAR * 0.25 * float(np.nanmax(p))
+        assert side[col]["complete"] is False and side[col]["annual_energy_mwh"] is None
+        assert side[col]["annual_energy_mwh_bounds"] == pytest.approx([lo / 1e6, hi / 1e6],
+                                                                      rel=1e-12)
+    assert ds["annual_energy_complete"].values.tolist() == [1, 0, 0]
+    # the Zarr export reads back without a warning (filterwarnings = error)
+    import xarray as xr
+
+    from parapend.performance import _write_zarr
+
+    _write_zarr(ds, tmp_path / "m.zarr")
+    with xr.open_zarr(tmp_path / "m.zarr", consolidated=False) as z:
+        assert z["annual_energy_complete"].values.tolist() == [1, 0, 0]
+        assert z["column"].attrs["flag_meanings"] == "optimum causal_perfect causal_ar"
+    text = text_report(ds, out, [])
+    assert "1 of 4 causal runs failed" in text
+    assert "1 bins without a causal result" in text
+
+
+def test_the_store_identity_without_a_controller_is_unchanged():
+    """A matrix without the controller writes the spec it wrote before (a store resumes);
+    with it, the settings are part of the identity and read back."""
+    from parapend.performance.spec import MatrixSpec
+
+    plain = matrix_spec(hs="1,2", tp="6,8")
+    assert "controller" not in json.loads(plain.to_json())
+    assert "causal_perfect_power" not in plain.variables
+    spec = matrix_spec(hs="1,2", tp="6,8", controller="mpc", forecast="ar,perfect",
+                       horizon=1.5)
+    assert MatrixSpec.from_json(spec.to_json()) == spec
+    assert spec.speed_limit == 4.0
+    assert matrix_spec(hs="1,2", tp="6,8", controller="mpc",
+                       speed_limit=math.inf).speed_limit is None
+    assert spec.forecasts == ("perfect", "ar") and spec.horizon == 1.5
+    assert matrix_spec(hs="1,2", tp="6,8", controller="mpc").horizon == 1.0
+    assert spec.update_interval == 0.03125 and spec.warm_up == 4.0 and spec.plan_samples == 2
+
+
+def test_the_work_is_capped_in_one_line():
+    """The causal runs count in the cap on the solves: 400 bins x 1000 records fit the
+    optimum alone, not with the causal column (a record's runs count as 3.5 solves)."""
+    from parapend.performance.check import MAX_SOLVES, check_size
+
+    kw = {"hs": "1:3:20", "te": "6:10:20", "realizations": 1000}
+    assert check_size(matrix_spec(**kw), workers=1, available=1 << 40)["solves"] < MAX_SOLVES
+    with pytest.raises(ParameterError, match=r"^realizations: at most 1000000 solves' work"):
+        check_size(matrix_spec(**kw, controller="mpc"), workers=1, available=1 << 40)
+
+
+@pytest.mark.parametrize("extra, needle", [
+    (["--controller", "mpc", "--device", "buoy"], "controller: the causal column is "
+                                                   "computed for --device prescribed-heave"),
+    (["--forecast", "ar"], "forecast: an option of the causal column; needs --controller"),
+    (["--controller", "mpc", "--forecast", "oracle"], "forecast: expected perfect, ar"),
+    (["--controller", "mpc", "--forecast", "ar,ar"], "forecast: expected perfect, ar"),
+    (["--controller", "mpc", "--horizon", "0.01"], "horizon: expected"),
+    (["--controller", "mpc", "--update-interval", "2"], "update-interval: expected"),
+    (["--controller", "mpc", "--warm-up", "-1"], "warm-up: expected"),
+    (["--controller", "mpc", "--plan-samples", "0"], "plan-samples: expected"),
+    (["--warm-up", "2"], "warm-up: an option of the causal column"),
+    (["--speed-limit", "4"], "speed-limit: an option of the causal column"),
+    (["--controller", "mpc", "--speed-limit", "0"], "speed-limit: expected"),
+])
+def test_bad_causal_options_one_line_exit_2(extra, needle, capsys):
+    code = main(["power-matrix", "--hs", "1,2", "--te", "6,7", "--realizations", "1",
+                 "--waves", "3", "--workers", "1", *extra])
+    err = capsys.readouterr().err
+    assert code == 2
+    assert len(err.strip().splitlines()) == 1, err
+    assert needle in err, err
+
+
+class _PeekingForecast:
+    """A tampered forecast: the record's own future at the leads asked for, plus a trace of
+    it one horizon further on (a controller that looks further ahead than it says)."""
+
+    reach = None
+
+    def __init__(self, q, horizon):
+        self.q, self.horizon = q, horizon
+
+    def predict(self, t_now, past_t, past_q, leads):
+        t = t_now + np.asarray(leads, dtype=float)
+        return self.q(t) + 1e-3 * self.q(t + self.horizon)
+
+
+def _torques(q, t0_periods, forecast, *, horizon=0.5, tamper_after=None):
+    """The held torques before ``t0`` of a short causal run (4 peak periods of the README's
+    sea state) driven by ``q``, or by ``q`` altered from ``tamper_after`` on (peak
+    periods); ``forecast``: "perfect", "ar" or "peek" (:class:`_PeekingForecast`)."""
+    from parapend.control.forecast import ARForecast
+    from parapend.control.mpc import mpc_run
+    from parapend.units import Units
+
+    tn = 8.0 / Units(1.0, 10.0, 9.81, None).time
+    qq = q
+    if tamper_after is not None:
+        def qq(t):
+            t = np.asarray(t, dtype=float)
+            return q(t) + np.where(t > tamper_after * tn, 0.05 * np.cos(3.0 * t), 0.0)
+    fo = {"perfect": None, "ar": ARForecast(tn) if forecast == "ar" else None,
+          "peek": _PeekingForecast(qq, horizon * tn)}[forecast]
+    res = mpc_run(qq, gamma=0.01, horizon=horizon * tn, update_interval=tn / 16,
+                  dt=tn / 64, t_end=4 * tn, forecast=fo)
+    return res.torque[: int(round(t0_periods * 64))]
+
+
+@pytest.mark.parametrize("forecast, after, causal", [
+    ("perfect", 2.5, True),   # altered after t0 + H: nothing before t0 changes
+    ("ar", 2.0, True),        # the AR forecast reads the past only: altered after t0
+    ("peek", 2.5, False),     # a controller that looks further ahead fails the test
+])
+def test_torques_before_t0_ignore_the_sea_after_t0_plus_h(forecast, after, causal):
+    """Causality (issue 31's acceptance, on the pendulum's controller that the causal
+    column runs): altering the sea only after ``t0 + H`` (perfect forecast; after ``t0``
+    with the AR one) leaves every torque held before ``t0`` bit-identical; a tampered
+    forecast that peeks one horizon further fails the same check. t0 = 2 peak periods,
+    H = 0.5."""
+    from parapend.seas import sea_record
+    from parapend.units import Units
+
+    exc = sea_record(Units(1.0, 10.0, 9.81, None), hs=2.0, tp=8.0, repeat_period=80.0,
+                     seed=1)
+    a = _torques(exc.q, 2.0, forecast)
+    b = _torques(exc.q, 2.0, forecast, tamper_after=after)
+    assert a.size == 128 and np.any(a != 0)
+    assert np.array_equal(a, b) is causal
