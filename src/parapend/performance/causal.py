@@ -23,8 +23,8 @@ import math
 
 from ..errors import ParameterError, check_int, check_range
 
-__all__ = ["CAUSAL", "CAUSAL_SECONDS", "FORECASTS", "causal_json", "causal_quantities",
-           "check_causal", "record_seconds", "solve_causal"]
+__all__ = ["CAUSAL", "FORECASTS", "causal_json", "causal_quantities", "check_causal",
+           "solve_causal"]
 
 log = logging.getLogger(__name__)
 
@@ -43,11 +43,6 @@ FORECASTS = ("perfect", "ar")
 #: was the same
 CAUSAL = {"horizon": 1.0, "forecast": "perfect", "update_interval": 0.03125,
           "warm_up": 4.0, "plan_samples": 2, "speed_limit": 4.0}
-#: CPU seconds of one causal run over a 50-wave record (and the 4-period warm-up) with each
-#: forecast at the defaults, measured on the shared 2-core machine (one BLAS thread; 6.5 to
-#: 7.1 s perfect at Hs 1 to 3 m, 9.9 s AR at Hs 2 m, Tp 8 s), rounded up; a run's cost
-#: grows as its length
-CAUSAL_SECONDS = {"perfect": 7.5, "ar": 10.5}
 
 
 def check_causal(*, controller, horizon, forecast, update_interval, warm_up, plan_samples,
@@ -121,15 +116,6 @@ def long_names(forecasts) -> dict:
             f"causal receding-horizon control, {what}: harvested electrical energy per unit "
             "time after the warm-up (no storage correction)")
     return out
-
-
-def record_seconds(spec) -> float:
-    """A rough CPU time (s) of the causal runs of one record of ``spec``
-    (:data:`CAUSAL_SECONDS`, as the run's length); 0 without a controller."""
-    if getattr(spec, "controller", None) is None:
-        return 0.0
-    scale = (spec.waves + spec.warm_up) / 54.0  # the measured runs: 50 waves + 4 warm-up
-    return sum(CAUSAL_SECONDS[f] for f in spec.forecasts) * scale
 
 
 def run_record(spec, exc, units, j: int, r: int, forecast: str):

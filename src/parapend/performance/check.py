@@ -54,6 +54,22 @@ def _where(spec, i: int, j: int, r: int | None = None) -> str:
             + ("" if r is None else f" (realization {r}, seed {int(spec.seeds[r])})"))
 
 
+#: CPU seconds of one causal run over a 50-wave record (and the 4-period warm-up) with each
+#: forecast at the defaults, measured on the shared 2-core machine (one BLAS thread; 6.5 to
+#: 7.1 s perfect at Hs 1 to 3 m, 9.9 s AR at Hs 2 m, Tp 8 s), rounded up; a run's cost
+#: grows as its length
+CAUSAL_SECONDS = {"perfect": 7.5, "ar": 10.5}
+
+
+def record_seconds(spec) -> float:
+    """A rough CPU time (s) of the causal runs of one record of ``spec``
+    (:data:`CAUSAL_SECONDS`, as the run's length); 0 without a controller."""
+    if getattr(spec, "controller", None) is None:
+        return 0.0
+    scale = (spec.waves + spec.warm_up) / 54.0  # the measured runs: 50 waves + 4 warm-up
+    return sum(CAUSAL_SECONDS[f] for f in spec.forecasts) * scale
+
+
 def _units(spec):
     """The pendulum's units (the buoy's at g = 9.81, as its spec holds)."""
     from ..units import Units
@@ -159,8 +175,6 @@ def check_size(spec, workers=None, scheduler=None, available=None) -> dict:
     solves = bins * r
     # the causal column (--controller mpc): each record's runs counted as the solves of a
     # 50-wave record their time would buy (3 s each), so the cap bounds the work
-    from .causal import record_seconds
-
     causal = record_seconds(spec)
     if causal and solves * (1.0 + causal / 3.0) > MAX_SOLVES:
         per = 1.0 + causal / 3.0
