@@ -9,7 +9,7 @@ and ``--time-limit``). With ``time_limit`` it runs; the loop checks :func:`expir
 its units (a design evaluation, a wave period, an update, a record, a bin) and, once the
 deadline has passed, stops at the next one: the result says ``status`` ``"time_limit"``,
 ``success`` False and how much was done, and holds only finished units (at least one).
-This is what :func:`parapend.dynamics.continuation.rotation_boundaries` does for
+This is what ``parapend.dynamics.continuation.rotation_boundaries`` does for
 ``rotations --time-limit``; as there, the command line prints the partial result and exits
 with code 0.
 """
@@ -40,7 +40,7 @@ def check_time_limit(time_limit) -> float | None:
 
 
 def deadline(time_limit) -> float | None:
-    """The :func:`time.monotonic` time at which ``time_limit`` seconds from now run out
+    """The ``time.monotonic`` time at which ``time_limit`` seconds from now run out
     (None: no limit); ``time_limit`` is checked (:func:`check_time_limit`)."""
     t = check_time_limit(time_limit)
     return None if t is None else time.monotonic() + t

@@ -409,7 +409,7 @@ def mpc_run(q_record, *, gamma, horizon, update_interval, dt, torque_limit=None,
         Called ``progress(done, total)`` in torque samples of the run, at most every
         ``PROGRESS_EVERY`` seconds and at the end.
     deadline : float or None
-        A :func:`time.monotonic` time (:func:`parapend.deadline.deadline`): once it has
+        A ``time.monotonic`` time (:func:`parapend.deadline.deadline`): once it has
         passed, the run stops before its next update (after at least one) with the status
         "time_limit" (``success`` False): a partial run, its powers over the samples run
         (NaN if it stopped before ``average_from``).

@@ -626,7 +626,7 @@ def buoy_mpc(hydro, pendulum, wave, *, peak_period, horizon=2.0, update_interval
         update, not timed).
     time_limit, deadline : float or None
         Seconds the run may take (work above the cap is then not refused) and the
-        :func:`time.monotonic` time it stops at (:func:`parapend.deadline.deadline`; default
+        ``time.monotonic`` time it stops at (:func:`parapend.deadline.deadline`; default
         ``time_limit`` from now): once it has passed the run stops before its next update
         (after at least one) with the status ``"time_limit"``: a partial run, no success,
         its powers over the samples run.

@@ -57,7 +57,7 @@ class DesignResult(_Result):
         the best design may lie beyond it (widen the bounds).
     status, message : ``"ok"``, or ``"time_limit"`` when the time limit stopped the search
         (``best`` is then the best of the ``evaluations`` made, of at most ``total``).
-    total : the inner solves the whole search makes at most (:func:`design_solves`).
+    total : the inner solves the whole search makes at most (``design_solves``).
     """
 
     variables: list
@@ -118,7 +118,7 @@ def optimize_design(solve, pendulum, variables, bounds, *, check=None,
         Called ``progress(done, total)`` after every inner solve (``total`` the most the
         search makes, ``design_solves``), and ``progress(total, total)`` at the end.
     deadline : float or None
-        A :func:`time.monotonic` time (:func:`parapend.deadline.deadline`): once it has
+        A ``time.monotonic`` time (:func:`parapend.deadline.deadline`): once it has
         passed, the search stops before its next inner solve (once a design that harvests
         power is found) and returns the best design evaluated, with ``status``
         ``"time_limit"``.
@@ -246,7 +246,7 @@ def period_sweep(hydro, width, pendulum, height, periods, *, winding=1, harmonic
     over ``periods`` (s): a :class:`~parapend.hydro.result.BuoySweepResult`. Each period is
     solved as alone (the same body, mesh and frequencies); ``coarse`` (the body on the
     error estimate's mesh, or None) gives ``mesh_error_w``, ``geometry`` (draft and
-    freeboard, or None) the validity checks. ``deadline`` (a :func:`time.monotonic` time,
+    freeboard, or None) the validity checks. ``deadline`` (a ``time.monotonic`` time,
     :func:`parapend.deadline.deadline`): once it has passed, the periods not yet begun (all
     but the first at least) are left out, NaN with the status ``"time_limit"``, and the
     sweep is no success."""

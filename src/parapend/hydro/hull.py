@@ -28,7 +28,7 @@ sensitivity ``T = S^{-1} g_x`` (one LU, ``2N + 1`` solves):
     H = L_xx + L_xy T + T^T L_yx + T^T L_yy T
 
 with ``L`` the Lagrangian, whose dependence on ``x`` and ``y`` is a sum over grid points of
-a function of ``(phi, phi', phi'', p_x'', p_z'', beta')`` (:mod:`._hull_kernel`): every
+a function of ``(phi, phi', phi'', p_x'', p_z'', beta')`` (``hydro/_hull_kernel.py``): every
 block is a weighted Gram matrix of the grid maps. With the hull fixed at its free response
 (``coupled=False``) the same code gives the one-way problem (``T = 0``, no adjoint).
 """
@@ -463,7 +463,7 @@ class HullProblem(PTOObjective):
         equations ``S y = b``, ``S^T lambda = d<f>/dy``) has pointwise derivatives in
         ``_VARS``; the gradient maps the first ones back to ``x``, the Hessian's blocks are
         their Gram matrices (one FFT per weight), reduced by the sensitivity ``T = S^{-1}
-        g_x``: ``H = L_xx + L_xy T + T^T L_yx + T^T L_yy T`` (:mod:`._hull_kernel`: the
+        g_x``: ``H = L_xx + L_xy T + T^T L_yx + T^T L_yy T`` (``hydro/_hull_kernel.py``: the
         work before and after the FFT, each one compiled call)."""
         x = np.asarray(x, dtype=float)
         y, lu = self.solve_hull(x)

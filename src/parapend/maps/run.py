@@ -462,7 +462,7 @@ def run_spec(spec, store=None, *, workers: int | None = None, scheduler=None,
     """Run a checked spec (a :class:`SweepSpec`, or another product's spec with the same
     layout, e.g. :class:`parapend.performance.spec.MatrixSpec`) on the engine: store,
     resume, local processes or Dask; the parameters are :func:`sweep`'s. ``deadline`` (a
-    :func:`time.monotonic` time, :func:`parapend.deadline.deadline`): once it has passed no
+    ``time.monotonic`` time, :func:`parapend.deadline.deadline`): once it has passed no
     further block is started or waited for (after at least one), and the run says
     ``stopped``."""
     if workers is not None:

@@ -113,7 +113,7 @@ def matrix_spec(*, hs="1:3:3", te=None, tp=None, realizations: int = 3, waves: f
     ``parapend.buoy`` takes them (``parapend.performance.hull_device``). ``controller``
     ``"mpc"`` (``device="prescribed-heave"``): the causal column, ``horizon``, ``forecast``,
     ``update_interval``, ``warm_up``, ``plan_samples`` and ``speed_limit`` as
-    :func:`parapend.performance.causal.check_causal` takes them (None: ``CAUSAL``)."""
+    ``parapend.performance.causal.check_causal`` takes them (None: ``CAUSAL``)."""
     from ..hydro.hull_api import parse_dofs
     from ..seas import _check_sea, check_response, read_response
     from ..units import Units
@@ -620,7 +620,7 @@ def power_matrix(*, hs="1:3:3", te=None, tp=None, realizations: int = 3, waves: 
     1/32) and ``plan_samples`` torque samples per Hermite interval of the plan (default 2,
     as ``horizon``), and ``speed_limit`` the plans' rated-speed penalty (units
     ``sqrt(g / l)``, default 4; ``inf``: none, ``horizon``'s default);
-    :mod:`parapend.performance.causal`."""
+    ``parapend.performance.causal``."""
     from ..maps.run import run_spec
     from .annual import bin_series, read_scatter, read_series
     from .check import check_bins, check_size
