@@ -272,6 +272,7 @@ def test_power_matrix_partial_bins_equal_the_full_runs(full_matrix, tmp_path):
     assert ds.attrs["annual_energy_complete"] == 0
 
 
+@pytest.mark.slow  # 4 s: two runs of a matrix through its store
 def test_power_matrix_partial_store_resumes(tmp_path, capsys):
     from parapend.maps.store import open_sweep
     from parapend.performance import power_matrix
