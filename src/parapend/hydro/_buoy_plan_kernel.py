@@ -11,6 +11,7 @@ import numba as nb
 import numpy as np
 
 from .._jit import announce_compiles
+from ..optimal._hermite_kernel import max_step
 
 announce_compiles()  # log a first-use compile (parapend._jit)
 
@@ -223,15 +224,6 @@ def _cho_solve(low, b):
 
 
 @nb.njit(cache=True)
-def _max_step(v, dv, frac):
-    a = 1.0
-    for i in range(v.size):
-        if dv[i] < 0.0:
-            a = min(a, -frac * v[i] / dv[i])
-    return a
-
-
-@nb.njit(cache=True)
 def solve(x, start, j, b0, b1, b2, af, bf, ap, bp, bp0, b0g, wgt, f_t, yc, ydc, ng, p, r,
           kap, tmax, max_iter, tol, mu0):
     """The interior point of :meth:`._buoy_plan.CoupledPlan.solve` as one compiled call:
@@ -334,8 +326,8 @@ def solve(x, start, j, b0, b1, b2, af, bf, ap, bp, bp0, b0g, wgt, f_t, yc, ydc, 
             ds[i] = -rp[i] - jdx[i] / tmax
             ds[nc + i] = -rp[nc + i] + jdx[i] / tmax
         dl = mu / s - lam - sig * ds
-        a_p = _max_step(s, ds, 0.995)
-        a_d = _max_step(lam, dl, 0.995)
+        a_p = max_step(s, ds, 0.995)
+        a_d = max_step(lam, dl, 0.995)
         rho = max(rho, 1.1 * np.max(np.abs(lam)))
         m0 = phi - mu * np.sum(np.log(s)) + rho * np.sum(np.abs(rp))
         dm = gr @ dx - mu * np.sum(ds / s) - rho * np.sum(np.abs(rp))
