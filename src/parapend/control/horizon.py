@@ -282,7 +282,7 @@ def horizon_curve(*, hs=None, tp=None, spectrum: str = "jonswap", gamma_peak: fl
         ``"time_limit"``, and the result's ``status`` is ``"time_limit"`` (``success``
         False; :mod:`parapend.deadline`).
     """
-    from ..deadline import check_time_limit, deadline, expired, refuse_untimed
+    from ..deadline import check_time_limit, deadline, duration, expired, refuse_untimed
     from ..irregular import sea
     from ..seas import sea_record
     from ..units import Units
@@ -352,7 +352,7 @@ def horizon_curve(*, hs=None, tp=None, spectrum: str = "jonswap", gamma_peak: fl
         if progress is not None:
             progress(done + now, total)
 
-    from .mpc import ANNOUNCE_SECONDS, _duration, log, update_seconds
+    from .mpc import ANNOUNCE_SECONDS, log, update_seconds
 
     upd_samples = max(1, round(upd * 64))
     est = sum(math.ceil(n / upd_samples) for n in mpc_samples) * sum(
@@ -374,7 +374,7 @@ def horizon_curve(*, hs=None, tp=None, spectrum: str = "jonswap", gamma_peak: fl
                  "runs, %d updates each: roughly %s on one core, besides the records' optima "
                  "and the baselines (the progress bar gives the rate; Ctrl-C stops it)",
                  records, len(fc), len(hz), math.ceil(mpc_samples[0] / upd_samples),
-                 _duration(est) + ("" if time_limit is None else
+                 duration(est) + ("" if time_limit is None else
                                    f" (stopped after the time limit {time_limit:g} s)"))
     runs_done = [0]  # runs finished; the time limit is checked before each next one
     stopped = [False]

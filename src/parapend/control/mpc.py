@@ -79,13 +79,6 @@ def update_seconds(horizon_periods: float, torque_limit=None, forecast: str = "p
     return sec
 
 
-def _duration(seconds: float) -> str:
-    for unit, size in (("hours", 3600.0), ("minutes", 60.0)):
-        if seconds >= 2 * size:
-            return f"{seconds / size:.0f} {unit}"
-    return f"{seconds:.0f} s"
-
-
 @dataclass(frozen=True, eq=False, repr=False)
 class MPCResult(_Result):
     """One receding-horizon run (non-dimensional, pendulum units; theta from the upright).
@@ -837,7 +830,7 @@ def track_mpc(excitation, *, gamma, horizon=2.0, update_interval=0.03125, foreca
     refused; with it the run stops at its first update after the limit, marked
     "time_limit" (:mod:`parapend.deadline`)."""
     from .. import limits
-    from ..deadline import check_time_limit, deadline, refuse_untimed
+    from ..deadline import check_time_limit, deadline, duration, refuse_untimed
     from .track import SEA_WAVES, _check_state, _on_grid, check_flag, design_sea
 
     time_limit = check_time_limit(time_limit)
@@ -889,7 +882,7 @@ def track_mpc(excitation, *, gamma, horizon=2.0, update_interval=0.03125, foreca
         log.info("track --controller mpc: %d periods = about %d updates of a %g-period "
                  "horizon (%s forecast): roughly %s on one core%s (the progress bar gives the "
                  "rate; Ctrl-C stops it)", periods, updates, horizon, forecast,
-                 _duration(est), "" if time_limit is None else
+                 duration(est), "" if time_limit is None else
                  f", stopped after the time limit {time_limit:g} s")
     r = mpc_run(qf, gamma=gamma, horizon=horizon * tp, update_interval=update_interval * tp,
                 dt=dt, torque_limit=torque_limit, efficiency=efficiency, forecast=fo,

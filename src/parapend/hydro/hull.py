@@ -199,10 +199,10 @@ class HullProblem(PTOObjective):
         # phi's maps: phi = K s + P0 x, phi' = w K + P1 x, phi'' = P2 x
         kn = np.arange(1, n + 1)
         sn, cn = np.sin(np.outer(s, kn)), np.cos(np.outer(s, kn))
-        self.P0 = np.hstack((np.ones((m, 1)), sn, cn))
-        self.P1 = w * np.hstack((np.zeros((m, 1)), kn * cn, -kn * sn))
-        self.P2 = -w**2 * np.hstack((np.zeros((m, 1)), kn**2 * sn, kn**2 * cn))
-        self._P012 = np.vstack((self.P0, self.P1, self.P2))  # x -> (phi, phi', phi''): one product
+        p0 = np.hstack((np.ones((m, 1)), sn, cn))
+        p1 = w * np.hstack((np.zeros((m, 1)), kn * cn, -kn * sn))
+        p2 = -w**2 * np.hstack((np.zeros((m, 1)), kn**2 * sn, kn**2 * cn))
+        self._P012 = np.vstack((p0, p1, p2))  # x -> (phi, phi', phi''): one product
         self._P012T = np.ascontiguousarray(self._P012.T)
         # the hull's unknowns y: Xi_0 on the DOFs with stiffness, then (Re, Im) Xi_k
         cp = case.stiffness()
@@ -225,12 +225,10 @@ class HullProblem(PTOObjective):
             E2[d][:, re], E2[d][:, im] = -(w * kh) ** 2 * ch, (w * kh) ** 2 * sh
             Pi[d][re, :] = (2.0 / m) * ch.T
             Pi[d][im, :] = -(2.0 / m) * sh.T
-        self.E1, self.Pi = E1, Pi
         self.Pi_all = np.concatenate(list(Pi), axis=1)  # (ny, 3M): the three rows at once
         dp, hp = case.pivot
-        self.Qx = E2[0] + hp * E2[2]
-        self.Qz = E2[1] - dp * E2[2]
-        self._Q3 = np.vstack((self.Qx, self.Qz, E1[2]))  # y -> (p_x'', p_z'', beta')
+        # y -> (p_x'', p_z'', beta') on the grid
+        self._Q3 = np.vstack((E2[0] + hp * E2[2], E2[1] - dp * E2[2], E1[2]))
         self._Q3T = np.ascontiguousarray(self._Q3.T)
         self._Pi_t = np.ascontiguousarray(self.Pi_all.T)
         # the uncoupled problem's absent blocks, typed as the kernel expects

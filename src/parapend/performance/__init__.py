@@ -574,13 +574,6 @@ def _check_breaking(hm0, depth) -> None:
 _ANNOUNCE_SECONDS = 120.0
 
 
-def _duration(seconds: float) -> str:
-    for unit, size in (("days", 86400.0), ("hours", 3600.0), ("minutes", 60.0)):
-        if seconds >= 2 * size:
-            return f"{seconds / size:.0f} {unit}"
-    return f"{seconds:.0f} s"
-
-
 def to_mhkit(da):
     """A matrix variable with MHKiT's dimension names (``x_centers``, ``y_centers``), for
     ``mhkit.wave.performance`` (e.g. ``mean_annual_energy_production_matrix``)."""
@@ -643,7 +636,7 @@ def power_matrix(*, hs="1:3:3", te=None, tp=None, realizations: int = 3, waves: 
         raise ParameterError("rated-power: the capacity factor needs a site: give --scatter "
                              "or --timeseries")
     from .. import fileio
-    from ..deadline import check_time_limit, deadline, refuse_untimed
+    from ..deadline import check_time_limit, deadline, duration, refuse_untimed
 
     time_limit = check_time_limit(time_limit)
     until = deadline(time_limit)
@@ -735,7 +728,7 @@ def power_matrix(*, hs="1:3:3", te=None, tp=None, realizations: int = 3, waves: 
                  "%s: roughly %s (about %s; the progress bar gives the rate)",
                  est["bins"], spec.realizations, est["solves"], spec.waves,
                  f"{est['processes']} processes" if est["processes"] else "the cluster",
-                 _duration(est["seconds"]) + ("" if est["processes"] else " of one core"),
+                 duration(est["seconds"]) + ("" if est["processes"] else " of one core"),
                  ("3 s a 50-wave solve" if spec.controller is None else
                   f"3 s a 50-wave solve and {est['causal_seconds']:.0f} s its causal runs")
                  if spec.dofs == "heave" else "100 s a 9-wave record of the hull")
