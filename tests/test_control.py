@@ -489,3 +489,15 @@ def test_cli_states_the_irregular_sea(capsys):
     _, info = design_sea(1.8, 0.3 / math.sqrt(2), sea["record_seed"])
     assert sea["hs"] == pytest.approx(info["hs"], rel=1e-12)
     assert f"Hs {sea['hs']:.4g}" in line and line.endswith("seed 2") and sea["seed"] == 2
+
+
+def test_cli_robustness_batch_writes_its_plot_and_table(tmp_path):
+    """``--runs N`` with ``--plot`` and ``--save``: both written (they were ignored)."""
+    from parapend.cli import main
+
+    png, csv = tmp_path / "b.png", tmp_path / "b.csv"
+    assert main(["track", "--gamma", "0.01", "--torque-limit", "24.85", "--runs", "2",
+                 "--periods", "20", "--plot", str(png), "--save", str(csv)]) in (0, None)
+    assert png.stat().st_size > 1000
+    rows = csv.read_text().splitlines()
+    assert rows[0].startswith("run,run_power") and len(rows) == 2 + 2

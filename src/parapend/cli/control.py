@@ -134,6 +134,10 @@ def _cmd_track(a) -> dict | str:
     if getattr(r, "controller", None) == "mpc":
         return _mpc_out(a, r)
     if a.runs != 1:
+        if a.save:
+            _output.save_result(r, a.save)
+        if a.plot:
+            _output.save_plot(r, a.plot)
         if a.json:
             return r.to_dict()
         return "\n".join([

@@ -109,7 +109,7 @@ class RobustnessResult(_Result):
             ax.axhline(self.predicted_power, color="k", ls="--", lw=0.8,
                        label=f"predicted {self.predicted_power:.4g}")
             ax.set_xlabel(r"damping error of the plant, $\Delta\gamma$")
-            ax.set_ylabel(r"mean power from the lock ($mgl/t_0$)")
+            ax.set_ylabel(r"mean power from the lock, else last 10 periods ($mgl/t_0$)")
             ax.set_title(f"track: {self.runs} runs, {100 * self.fraction_locked:.3g} % "
                          f"locked", fontsize=10)
             ax.legend(loc="best")
