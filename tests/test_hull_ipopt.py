@@ -66,7 +66,7 @@ def test_same_power_as_ipopt(name):
     bound, _ = radiation_bound(cs)
     assert 0 < sol.power <= bound
     pr = HullProblem(cs)
-    xi = pr.harmonics_of(pr.solve_hull(sol.x)[0])
+    xi = pr.harmonics_of(pr.solve_hull(sol.x))
     assert np.allclose(ref["Xi"], xi, rtol=0, atol=1e-6 * np.max(np.abs(xi[1])))
 
 

@@ -47,7 +47,7 @@ def test_optimum_equals_an_independent_hull_response(winding):
     assert sol.success
     cs = sol.case
     pr = HullProblem(cs)
-    xi = pr.harmonics_of(pr.solve_hull(sol.x)[0])
+    xi = pr.harmonics_of(pr.solve_hull(sol.x))
     ref = harmonic_response(**_common(cs), phi=phi_fourier(sol.x, winding, W),
                             harmonics=cs.hull_harmonics, grid=cs.points)
     assert np.allclose(ref["Xi"], xi, rtol=0, atol=1e-10 * np.max(np.abs(xi[1])))
@@ -66,7 +66,7 @@ def test_optimum_replayed_in_the_time_domain(winding):
     sol = hull_search(lambda s: _case(winding, s))
     cs = sol.case
     pr = HullProblem(cs)
-    xi = pr.harmonics_of(pr.solve_hull(sol.x)[0])
+    xi = pr.harmonics_of(pr.solve_hull(sol.x))
     kw = dict(**_common(cs), phi=phi_fourier(sol.x, winding, W), periods=24, ramp_periods=6,
               harmonics=2)
     lo = replay(**kw, steps_per_period=STEPS)

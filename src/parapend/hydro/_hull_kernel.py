@@ -31,8 +31,9 @@ from .._jit import announce_compiles
 
 announce_compiles()  # log a first-use compile (parapend._jit)
 
-__all__ = ["constraint_weights", "fused_gram", "gradient_and_weights", "objective_weights",
-           "reaction", "reduced_hessian", "torque"]
+__all__ = ["constraint_weights", "fused_gram", "grid_motion", "gradient_and_weights",
+           "hull_solve", "hull_torque", "objective_weights", "reaction", "reduced_hessian",
+           "torque"]
 
 
 @nb.njit(cache=True)
@@ -107,6 +108,50 @@ def reaction(f, f1, f2, ml, inertia, g, dp, hp):
         r[2, j] = hp * rx - dp * rz - inertia * f2[j] + ml * g * sn
         s[0, j], s[1, j] = -ml * sn, ml * co
     return r, s
+
+
+@nb.njit(cache=True)
+def grid_motion(x, p012, s, winding, w, ml, inertia, g, dp, hp):
+    """``(phi, phi', phi'', r, wz)`` on the grid from the coefficients ``x``: ``phi = K s +
+    P0 x``, ``phi' = w K + P1 x``, ``phi'' = P2 x`` (``p012`` the three maps stacked), and
+    :func:`reaction` there."""
+    m = s.size
+    q = p012 @ x
+    f = np.empty(m)
+    f1 = np.empty(m)
+    f2 = np.empty(m)
+    for j in range(m):
+        f[j] = winding * s[j] + q[j]
+        f1[j] = w * winding + q[m + j]
+        f2[j] = q[2 * m + j]
+    r, wz = reaction(f, f1, f2, ml, inertia, g, dp, hp)
+    return f, f1, f2, r, wz
+
+
+@nb.njit(cache=True)
+def hull_torque(q3, y, f, f1, f2, inertia, c, ml, g):
+    """``(p_x'', p_z'', beta', tau, v, P)`` on the grid for the hull's unknowns ``y``
+    (``q3`` the map ``y -> (p_x'', p_z'', beta')``; :func:`torque`)."""
+    m = f.size
+    q = q3 @ y
+    qx, qz, b1 = q[:m], q[m:2 * m], q[2 * m:]
+    tau, v, p = torque(f, f1, f2, qx, qz, b1, inertia, c, ml, g)
+    return qx, qz, b1, tau, v, p
+
+
+@nb.njit(cache=True)
+def hull_solve(v, ptr, idx, coef, n1, n2, symmetric, z, b0, pi_all, r, q3, f, f1, f2,
+               inertia, c, ml, g):
+    """``(S^{-1}, y, p_x'', p_z'', beta', tau, v, P)``: the hull's unknowns at the motion
+    whose reaction is ``r`` (3, M) and whose hull-matrix weights have the spectra ``v``,
+    ``y = S^{-1} (b0 + Pi r)`` with ``S = Z + G(v)`` (the gathers of :func:`fused_gram`),
+    and :func:`hull_torque` there. The inverse (LAPACK getrf and getri), not a
+    factorization: the adjoint and the sensitivity's right sides are products with it in
+    :func:`gradient_and_weights` and :func:`reduced_hessian`, and nearly every point whose
+    power is asked is then evaluated (a line search's first trial is accepted)."""
+    sinv = np.linalg.inv(z + fused_gram(v, ptr, idx, coef, n1, n2, symmetric))
+    y = sinv @ (b0 + pi_all @ r.copy().reshape(r.size))
+    return (sinv, y) + hull_torque(q3, y, f, f1, f2, inertia, c, ml, g)
 
 
 @nb.njit(cache=True)

@@ -13,6 +13,7 @@ and its hull matrix this way.
 from __future__ import annotations
 
 import numpy as np
+import scipy.fft
 
 from ._hull_kernel import fused_gram
 
@@ -120,6 +121,6 @@ class FusedGram:
 
 def spectra(weights) -> np.ndarray:
     """``[Re R, Im R]`` (K, 2 (M/2 + 1)) of the K real weights (K, M), ``R`` the half
-    spectrum (``numpy.fft.rfft``)."""
-    w = np.fft.rfft(np.asarray(weights, dtype=float), axis=-1)
+    spectrum (``scipy.fft.rfft``: for these short rows its call costs less than NumPy's)."""
+    w = scipy.fft.rfft(np.asarray(weights, dtype=float), axis=-1)
     return np.concatenate((w.real, w.imag), axis=-1)

@@ -39,10 +39,15 @@ import math
 from dataclasses import dataclass, field
 
 import numpy as np
-from scipy.linalg.lapack import dgetrf, dgetri, dgetrs
 
 from ..errors import ParameterError
-from ._hull_kernel import gradient_and_weights, reaction, reduced_hessian, torque
+from ._hull_kernel import (
+    gradient_and_weights,
+    grid_motion,
+    hull_solve,
+    hull_torque,
+    reduced_hessian,
+)
 from ._trig import FusedGram, GramPlan, TrigColumns, spectra
 from .pto import PTOObjective, _abs
 
@@ -59,29 +64,6 @@ _PAIRS["lossless"] = [(u, w) for u, w in _PAIRS["all"] if (u, w) in (
 #: the pairs on which the hull's reaction weighted by the adjoint has second derivatives
 _CONSTRAINT_PAIRS = (("phi", "phi"), ("phi", "phi1"), ("phi", "phi2"), ("phi", "qx"),
                      ("phi", "qz"), ("phi1", "phi1"))
-
-
-def _lu(a):
-    """LU factors of ``a`` (LAPACK getrf, called directly: for these small systems the
-    wrappers' checks cost more than the work)."""
-    lu, piv, info = dgetrf(a)
-    if info != 0:
-        raise np.linalg.LinAlgError("the hull's equations are singular at this motion")
-    return lu, piv
-
-
-def _solve(lu, b, trans=0):
-    x, info = dgetrs(lu[0], lu[1], b, trans=trans)
-    return x
-
-
-def _inverse(lu):
-    """``S^{-1}`` from its LU factors (LAPACK getri): the adjoint and the sensitivity's
-    ``2N + 2`` right sides as products in the compiled kernel."""
-    inv, info = dgetri(lu[0], lu[1])
-    if info != 0:
-        raise np.linalg.LinAlgError("the hull's equations are singular at this motion")
-    return inv
 
 
 def _full(t, m: int) -> np.ndarray:
@@ -295,10 +277,9 @@ class HullProblem(PTOObjective):
         self._plans = {}
         self._fused_plans = {}
         self._key_cache = {}
-        self._hull_gram = None
+        self._hull_gram = FusedGram([(self._plan("pi2", "qz"), 0, False),
+                                     (self._plan("pi2", "qx"), 1, False)], self.points)
         self._last = None
-        self._last_state = None
-        self._last_phi = None
 
     def _plan(self, a: str, b: str) -> GramPlan:
         key = (a, b)
@@ -329,55 +310,39 @@ class HullProblem(PTOObjective):
         return self._fused_plans[ck]
 
     # --------------------------------------------------------------------------------------
-    def phi(self, x):
-        """``(phi, phi', phi'')`` on the grid (the last point's kept)."""
-        x = np.asarray(x, dtype=float)
-        key = x.tobytes()
-        if self._last_phi is None or self._last_phi[0] != key:
-            kw, w, m = self.winding, self.omega, self.points
-            r = (self._P012 @ x).reshape(3, m)
-            self._last_phi = (key, (kw * self.s + r[0], w * kw + r[1], r[2]))
-        return self._last_phi[1]
-
-    def solve_hull(self, x):
-        """The hull's unknowns ``y`` at ``phi(x)``, and the factorized ``S`` (None when
-        not coupled). The last point's answer is kept: the line search's power and the
-        next Newton step's evaluation share it."""
+    def _at(self, x) -> tuple:
+        """``(st, S^{-1})`` at ``x``: the grid state (:meth:`grid_state`) and the hull
+        matrix's inverse (None when not coupled). Two compiled calls around one FFT
+        (``hydro/_hull_kernel.py``). The last point's is kept: the line search's power and
+        the next Newton step's evaluation share it."""
         x = np.asarray(x, dtype=float)
         key = x.tobytes()
         if self._last is not None and self._last[0] == key:
-            return self._last[1], self._last[2]
-        if not self.coupled:
-            y, lu = self.y_free, None
-        else:
-            cs = self.case
-            dp, hp = cs.pivot
-            f, f1, f2 = self.phi(x)
-            r, wz = reaction(f, f1, f2, cs.m * cs.l, cs.I, cs.g, dp, hp)
-            if self._hull_gram is None:
-                self._hull_gram = FusedGram([(self._plan("pi2", "qz"), 0, False),
-                                             (self._plan("pi2", "qx"), 1, False)], self.points)
-            lu = _lu(self.Z + self._hull_gram(spectra(wz)))
-            y = _solve(lu, self.fa_real + self.Pi_all @ r.ravel())
-        self._last = (key, y, lu)
-        return y, lu
-
-    def grid_state(self, x, y=None):
-        """Everything on the grid at ``x``: phi and its derivatives, the hull's ``y``, the
-        pivot's acceleration, the pitch rate, the torque and the power."""
-        if y is None:
-            y, _ = self.solve_hull(x)
-        key = (np.asarray(x, dtype=float).tobytes(), y.tobytes())
-        if self._last_state is not None and self._last_state[0] == key:
-            return self._last_state[1]
+            return self._last[1]
         cs = self.case
-        f, f1, f2 = self.phi(x)
-        qx, qz, b1 = (self._Q3 @ y).reshape(3, self.points)
-        tau, v, p = torque(f, f1, f2, qx, qz, b1, cs.I, cs.c, cs.m * cs.l, cs.g)
+        ml = cs.m * cs.l
+        f, f1, f2, r, wz = grid_motion(x, self._P012, self.s, float(self.winding),
+                                       self.omega, ml, cs.I, cs.g, *cs.pivot)
+        if self.coupled:
+            sinv, y, qx, qz, b1, tau, v, p = hull_solve(
+                spectra(wz).ravel(), *self._hull_gram.arrays(), self.Z, self.fa_real,
+                self.Pi_all, r, self._Q3, f, f1, f2, cs.I, cs.c, ml, cs.g)
+        else:
+            sinv, y = None, self.y_free
+            qx, qz, b1, tau, v, p = hull_torque(self._Q3, y, f, f1, f2, cs.I, cs.c, ml, cs.g)
         st = {"phi": f, "phi1": f1, "phi2": f2, "qx": qx, "qz": qz, "b1": b1, "y": y,
               "tau": tau, "relative_speed": v, "power": p}
-        self._last_state = (key, st)
-        return st
+        self._last = (key, (st, sinv))
+        return self._last[1]
+
+    def solve_hull(self, x) -> np.ndarray:
+        """The hull's unknowns ``y`` at ``phi(x)`` (the free response when not coupled)."""
+        return self._at(x)[0]["y"]
+
+    def grid_state(self, x) -> dict:
+        """Everything on the grid at ``x``: phi and its derivatives, the hull's ``y``, the
+        pivot's acceleration, the pitch rate, the torque and the power."""
+        return self._at(x)[0]
 
     @property
     def lossless(self) -> bool:
@@ -463,15 +428,14 @@ class HullProblem(PTOObjective):
         their Gram matrices (one FFT per weight), reduced by the sensitivity ``T = S^{-1}
         g_x``: ``H = L_xx + L_xy T + T^T L_yx + T^T L_yy T`` (``hydro/_hull_kernel.py``: the
         work before and after the FFT, each one compiled call)."""
-        x = np.asarray(x, dtype=float)
-        y, lu = self.solve_hull(x)
-        st = self.grid_state(x, y)
+        st, sinv = self._at(x)
         cs = self.case
         m = self.points
         terms = self._objective(st)
-        coupled = lu is not None
+        coupled = self.coupled
         keys, rows = self._keys(terms[3] is None, coupled)
-        sinv = _inverse(lu) if coupled else self._none2
+        if not coupled:
+            sinv = self._none2
         grad, w = gradient_and_weights(
             st["phi"], st["phi1"], st["phi2"], st["qx"], st["qz"],
             *(_full(t, m) for t in terms[1:]), rows, coupled, sinv, self._Q3T, self._Pi_t,
@@ -493,11 +457,11 @@ class HullProblem(PTOObjective):
         xi[1:] = body[:, 0, :] + 1j * body[:, 1, :]
         return xi
 
-    def balance(self, x, y=None) -> tuple[float, float, float]:
+    def balance(self, x) -> tuple[float, float, float]:
         """``(P, hull side, residual)`` of the energy balance
         ``P + c <(phi' - beta')^2> = sum_k Re((F a)_k^H U_k) / 2 - U_k^H B_k U_k / 2``, the
         residual relative to the larger of the wave's and the radiated power."""
-        st = self.grid_state(x, y)
+        st = self.grid_state(x)
         xi = self.harmonics_of(st["y"])
         cs = self.case
         fa = cs.wave_force()

@@ -203,7 +203,7 @@ def _deg(v) -> float:
 
 def _mode(sol) -> dict:
     pr = HullProblem(sol.case)
-    y, _ = pr.solve_hull(sol.x)
+    y = pr.solve_hull(sol.x)
     mot = MotionAt(pr, sol.x, y)
     period = 2 * math.pi / sol.case.omega
     pk = peak(lambda t: np.abs(mot(t)["tau"]), period)
