@@ -6,8 +6,14 @@ variables ``(phi, phi', phi'', p_x'', p_z'', beta')`` (``_VARS``; the 21 pairs `
 in that order), the weights of the sensitivity's right side, and Gram matrices gathered
 from the weights' spectra (:class:`parapend.hydro._trig.FusedGram`). Written with NumPy
 these are some two hundred small array operations per evaluation, whose call overhead (not
-their arithmetic) was most of a Newton step on the hull's harmonics (tens of points); here
-they are three loops.
+their arithmetic) was most of a Newton step on the hull's harmonics (tens of points). Here
+an evaluation is four compiled calls around two FFTs: :func:`grid_motion` (phi and the
+reaction on the grid), :func:`hull_solve` (the hull matrix from the reaction's spectra, its
+inverse, the hull's unknowns, the torque and the power), :func:`gradient_and_weights` and
+:func:`reduced_hessian`. Their products and sums are written as loops rather than NumPy's
+``@`` and array expressions: each of those compiles apart (a second or more each), and at
+these sizes the loops are as fast; the whole kernel compiles in about 9 s of CPU on first
+use, then loads from numba's cache.
 
 The formulas are those of the hull's module docstring, point by point:
 
@@ -40,6 +46,65 @@ __all__ = ["constraint_weights", "fused_gram", "grid_motion", "gradient_and_weig
 def _pair(u, w):
     """Row of the pair ``(u, w)``, ``u <= w``, among the 21 pairs of six variables."""
     return u * 6 - (u * (u - 1)) // 2 + (w - u)
+
+
+@nb.njit(cache=True)
+def _tx(a, x):
+    """``a^T x`` (``a`` C order): a sum of ``a``'s rows, the zero entries of ``x`` skipped.
+    These products and :func:`_mv`, :func:`_matmul`, :func:`_tmatmul` are loops rather
+    than ``@``: each of NumPy's products costs its own second of compilation per layout,
+    and at these sizes (tens by hundreds) the loops are as fast."""
+    k, n = a.shape
+    out = np.zeros(n)
+    for j in range(k):
+        xj = x[j]
+        if xj != 0.0:
+            for i in range(n):
+                out[i] += xj * a[j, i]
+    return out
+
+
+@nb.njit(cache=True)
+def _mv(a, x):
+    """``a x`` (``a`` C order)."""
+    n, k = a.shape
+    out = np.empty(n)
+    for i in range(n):
+        acc = 0.0
+        for j in range(k):
+            acc += a[i, j] * x[j]
+        out[i] = acc
+    return out
+
+
+@nb.njit(cache=True)
+def _matmul(a, b):
+    """``a b`` (both C order), the zero entries of ``a`` skipped."""
+    n, k = a.shape
+    p = b.shape[1]
+    out = np.zeros((n, p))
+    for i in range(n):
+        for j in range(k):
+            aij = a[i, j]
+            if aij != 0.0:
+                for q in range(p):
+                    out[i, q] += aij * b[j, q]
+    return out
+
+
+@nb.njit(cache=True)
+def _tmatmul(a, b):
+    """``a^T b`` (both C order), the zero entries of ``a`` skipped."""
+    k, n = a.shape
+    p = b.shape[1]
+    out = np.zeros((n, p))
+    for j in range(k):
+        for i in range(n):
+            aji = a[j, i]
+            if aji != 0.0:
+                for q in range(p):
+                    out[i, q] += aji * b[j, q]
+    return out
 
 
 @nb.njit(cache=True)
@@ -111,12 +176,13 @@ def reaction(f, f1, f2, ml, inertia, g, dp, hp):
 
 
 @nb.njit(cache=True)
-def grid_motion(x, p012, s, winding, w, ml, inertia, g, dp, hp):
+def grid_motion(x, p012t, s, winding, w, ml, inertia, g, dp, hp):
     """``(phi, phi', phi'', r, wz)`` on the grid from the coefficients ``x``: ``phi = K s +
-    P0 x``, ``phi' = w K + P1 x``, ``phi'' = P2 x`` (``p012`` the three maps stacked), and
+    P0 x``, ``phi' = w K + P1 x``, ``phi'' = P2 x`` (``p012t`` the three maps stacked,
+    transposed), and
     :func:`reaction` there."""
     m = s.size
-    q = p012 @ x
+    q = _tx(p012t, x)
     f = np.empty(m)
     f1 = np.empty(m)
     f2 = np.empty(m)
@@ -129,18 +195,18 @@ def grid_motion(x, p012, s, winding, w, ml, inertia, g, dp, hp):
 
 
 @nb.njit(cache=True)
-def hull_torque(q3, y, f, f1, f2, inertia, c, ml, g):
+def hull_torque(q3t, y, f, f1, f2, inertia, c, ml, g):
     """``(p_x'', p_z'', beta', tau, v, P)`` on the grid for the hull's unknowns ``y``
-    (``q3`` the map ``y -> (p_x'', p_z'', beta')``; :func:`torque`)."""
+    (``q3t`` the map ``y -> (p_x'', p_z'', beta')`` transposed; :func:`torque`)."""
     m = f.size
-    q = q3 @ y
+    q = _tx(q3t, y)
     qx, qz, b1 = q[:m], q[m:2 * m], q[2 * m:]
     tau, v, p = torque(f, f1, f2, qx, qz, b1, inertia, c, ml, g)
     return qx, qz, b1, tau, v, p
 
 
 @nb.njit(cache=True)
-def hull_solve(v, ptr, idx, coef, n1, n2, symmetric, z, b0, pi_all, r, q3, f, f1, f2,
+def hull_solve(v, ptr, idx, coef, n1, n2, symmetric, z, b0, pi_t, r, q3t, f, f1, f2,
                inertia, c, ml, g):
     """``(S^{-1}, y, p_x'', p_z'', beta', tau, v, P)``: the hull's unknowns at the motion
     whose reaction is ``r`` (3, M) and whose hull-matrix weights have the spectra ``v``,
@@ -149,9 +215,16 @@ def hull_solve(v, ptr, idx, coef, n1, n2, symmetric, z, b0, pi_all, r, q3, f, f1
     factorization: the adjoint and the sensitivity's right sides are products with it in
     :func:`gradient_and_weights` and :func:`reduced_hessian`, and nearly every point whose
     power is asked is then evaluated (a line search's first trial is accepted)."""
-    sinv = np.linalg.inv(z + fused_gram(v, ptr, idx, coef, n1, n2, symmetric))
-    y = sinv @ (b0 + pi_all @ r.copy().reshape(r.size))
-    return (sinv, y) + hull_torque(q3, y, f, f1, f2, inertia, c, ml, g)
+    # C order, as the uncoupled problem's empty stand-in: one compiled version downstream
+    sm = fused_gram(v, ptr, idx, coef, n1, n2, symmetric)
+    b = _tx(pi_t, r.copy().reshape(r.size))
+    for i in range(b.size):
+        b[i] += b0[i]
+        for k in range(b.size):
+            sm[i, k] += z[i, k]
+    sinv = np.ascontiguousarray(np.linalg.inv(sm))
+    y = _mv(sinv, b)
+    return (sinv, y) + hull_torque(q3t, y, f, f1, f2, inertia, c, ml, g)
 
 
 @nb.njit(cache=True)
@@ -216,30 +289,35 @@ def fused_gram(v, ptr, idx, coef, n1, n2, symmetric):
 
 
 @nb.njit(cache=True)
-def gradient_and_weights(f, f1, f2, qx, qz, ft, fv, ftt, ftv, fvv, rows, coupled, sinv, q3t,
-                         pi_t, p012t, ml, inertia, c, g, dp, hp):
+def gradient_and_weights(f, f1, f2, qx, qz, ft, fv, ftt, ftv, fvv, rows, coupled, sinv, q3,
+                         pi_all, p012, ml, inertia, c, g, dp, hp):
     """The first half of an evaluation: the Lagrangian's pointwise derivatives (the
     objective's; with ``coupled``, plus the hull's reaction weighted by the adjoint ``mu``,
     ``S^T lambda = d<f>/dy``, ``mu = Pi^T lambda``), the reduced gradient ``P^T d1`` and
     the weights whose spectra give the Hessian: the pairs ``rows`` of the second
     derivatives, then (coupled) the nine sensitivity weights. ``sinv`` is ``S^{-1}``,
-    ``q3t`` the map ``y -> (p_x'', p_z'', beta')`` transposed, ``pi_t`` the projection
-    transposed (3M, ny), ``p012t`` the map ``x -> (phi, phi', phi'')`` transposed."""
+    ``q3`` the map ``y -> (p_x'', p_z'', beta')`` (3M, ny), ``pi_all`` the projection
+    (ny, 3M), ``p012`` the map ``x -> (phi, phi', phi'')`` (3M, nx)."""
     m = f.size
     d1, d2 = objective_weights(f, qx, qz, ft, fv, ftt, ftv, fvv, ml, inertia, c, g)
     nr = rows.size
     w = np.empty((nr + (9 if coupled else 0), m))
     if coupled:
-        gy = q3t @ d1[3:].copy().reshape(3 * m)
-        lam = sinv.T @ gy
-        mu = (pi_t @ lam).reshape(3, m)
+        gy = _tx(q3, d1[3:].copy().reshape(3 * m))
+        lam = _tx(sinv, gy)
+        mu = _tx(pi_all, lam).reshape(3, m)
         c1, c2, sens = constraint_weights(f, f1, f2, qx, qz, mu, ml, inertia, g, dp, hp)
-        d1 += c1
-        d2 += c2
-        w[nr:] = sens
+        for j in range(m):  # loops, not array expressions: each of those compiles apart
+            for u in range(6):
+                d1[u, j] += c1[u, j]
+            for u in range(21):
+                d2[u, j] += c2[u, j]
+            for u in range(9):
+                w[nr + u, j] = sens[u, j]
     for i in range(nr):
-        w[i] = d2[rows[i]]
-    grad = p012t @ d1[:3].copy().reshape(3 * m)
+        for j in range(m):
+            w[i, j] = d2[rows[i], j]
+    grad = _tx(p012, d1[:3].copy().reshape(3 * m))
     return grad, w
 
 
@@ -253,7 +331,15 @@ def reduced_hessian(v, xx, xy, yy, sens, coupled, sinv):
     if coupled:
         hxy = fused_gram(v, *xy)
         hyy = fused_gram(v, *yy)
-        t = sinv @ fused_gram(v, *sens)
-        ht = hxy @ t
-        hxx = hxx + ht + ht.T + t.T @ (hyy @ t)
-    return 0.5 * (hxx + hxx.T)
+        t = _matmul(sinv, fused_gram(v, *sens))
+        ht = _matmul(hxy, t)
+        tt = _tmatmul(t, _matmul(hyy, t))
+        for i in range(hxx.shape[0]):
+            for k in range(hxx.shape[1]):
+                hxx[i, k] += ht[i, k] + ht[k, i] + tt[i, k]
+    n = hxx.shape[0]
+    h = np.empty((n, n))
+    for i in range(n):
+        for k in range(n):
+            h[i, k] = 0.5 * (hxx[i, k] + hxx[k, i])
+    return h

@@ -321,15 +321,15 @@ class HullProblem(PTOObjective):
             return self._last[1]
         cs = self.case
         ml = cs.m * cs.l
-        f, f1, f2, r, wz = grid_motion(x, self._P012, self.s, float(self.winding),
+        f, f1, f2, r, wz = grid_motion(x, self._P012T, self.s, float(self.winding),
                                        self.omega, ml, cs.I, cs.g, *cs.pivot)
         if self.coupled:
             sinv, y, qx, qz, b1, tau, v, p = hull_solve(
                 spectra(wz).ravel(), *self._hull_gram.arrays(), self.Z, self.fa_real,
-                self.Pi_all, r, self._Q3, f, f1, f2, cs.I, cs.c, ml, cs.g)
+                self._Pi_t, r, self._Q3T, f, f1, f2, cs.I, cs.c, ml, cs.g)
         else:
             sinv, y = None, self.y_free
-            qx, qz, b1, tau, v, p = hull_torque(self._Q3, y, f, f1, f2, cs.I, cs.c, ml, cs.g)
+            qx, qz, b1, tau, v, p = hull_torque(self._Q3T, y, f, f1, f2, cs.I, cs.c, ml, cs.g)
         st = {"phi": f, "phi1": f1, "phi2": f2, "qx": qx, "qz": qz, "b1": b1, "y": y,
               "tau": tau, "relative_speed": v, "power": p}
         self._last = (key, (st, sinv))
@@ -427,7 +427,7 @@ class HullProblem(PTOObjective):
         ``_VARS``; the gradient maps the first ones back to ``x``, the Hessian's blocks are
         their Gram matrices (one FFT per weight), reduced by the sensitivity ``T = S^{-1}
         g_x``: ``H = L_xx + L_xy T + T^T L_yx + T^T L_yy T`` (``hydro/_hull_kernel.py``: the
-        work before and after the FFT, each one compiled call)."""
+        work before and after each FFT one compiled call)."""
         st, sinv = self._at(x)
         cs = self.case
         m = self.points
@@ -438,8 +438,8 @@ class HullProblem(PTOObjective):
             sinv = self._none2
         grad, w = gradient_and_weights(
             st["phi"], st["phi1"], st["phi2"], st["qx"], st["qz"],
-            *(_full(t, m) for t in terms[1:]), rows, coupled, sinv, self._Q3T, self._Pi_t,
-            self._P012T, cs.m * cs.l, cs.I, cs.c, cs.g, *cs.pivot)
+            *(_full(t, m) for t in terms[1:]), rows, coupled, sinv, self._Q3, self.Pi_all,
+            self._P012, cs.m * cs.l, cs.I, cs.c, cs.g, *cs.pivot)
         fused = self._fused(keys, coupled)
         blocks = [fused.get(b, self._none3).arrays() for b in ("xx", "xy", "yy", "sens")]
         h = reduced_hessian(spectra(w).ravel(), *blocks, coupled, sinv)
