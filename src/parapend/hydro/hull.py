@@ -288,10 +288,11 @@ class HullProblem(PTOObjective):
             self._plans[key] = GramPlan(ca, self._cols[b], self.points)
         return self._plans[key]
 
-    def _fused(self, keys: tuple, coupled: bool) -> dict:
+    def _fused(self, keys: tuple, coupled: bool) -> list:
         """The Hessian's blocks ``xx``, ``xy``, ``yy`` and the sensitivity's right side
         ``sens`` as :class:`FusedGram` s over the weights in the order :meth:`evaluate`
-        stacks them (the pairs ``keys``, then the nine sensitivity weights)."""
+        stacks them (the pairs ``keys``, then the nine sensitivity weights), as the
+        compiled gather's arguments (an absent block: an empty one)."""
         ck = (keys, coupled)
         if ck not in self._fused_plans:
             xv = ("phi", "phi1", "phi2")
@@ -305,8 +306,9 @@ class HullProblem(PTOObjective):
             if coupled:
                 for j, (d, i) in enumerate((d, i) for d in range(3) for i in range(3)):
                     blocks["sens"].append((self._plan(f"pi{d}", xv[i]), len(keys) + j, False))
-            self._fused_plans[ck] = {b: FusedGram(t, self.points, symmetric=b in ("xx", "yy"))
-                                     for b, t in blocks.items() if t}
+            fused = {b: FusedGram(t, self.points, symmetric=b in ("xx", "yy"))
+                     for b, t in blocks.items() if t}
+            self._fused_plans[ck] = [fused.get(b, self._none3).arrays() for b in blocks]
         return self._fused_plans[ck]
 
     # --------------------------------------------------------------------------------------
@@ -440,8 +442,7 @@ class HullProblem(PTOObjective):
             st["phi"], st["phi1"], st["phi2"], st["qx"], st["qz"],
             *(_full(t, m) for t in terms[1:]), rows, coupled, sinv, self._Q3, self.Pi_all,
             self._P012, cs.m * cs.l, cs.I, cs.c, cs.g, *cs.pivot)
-        fused = self._fused(keys, coupled)
-        blocks = [fused.get(b, self._none3).arrays() for b in ("xx", "xy", "yy", "sens")]
+        blocks = self._fused(keys, coupled)
         h = reduced_hessian(spectra(w).ravel(), *blocks, coupled, sinv)
         val = st["power"] if self.lossless else float(np.mean(terms[0]))
         return val, grad, h
