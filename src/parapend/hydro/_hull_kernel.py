@@ -51,7 +51,7 @@ def _pair(u, w):
 @nb.njit(cache=True)
 def _tx(a, x):
     """``a^T x`` (``a`` C order): a sum of ``a``'s rows, the zero entries of ``x`` skipped.
-    These products and :func:`_mv`, :func:`_matmul`, :func:`_tmatmul` are loops rather
+    These products and :func:`_mv`, :func:`_matmul` are loops rather
     than ``@``: each of NumPy's products costs its own second of compilation per layout,
     and at these sizes (tens by hundreds) the loops are as fast."""
     k, n = a.shape
@@ -78,32 +78,18 @@ def _mv(a, x):
 
 
 @nb.njit(cache=True)
-def _matmul(a, b):
-    """``a b`` (both C order), the zero entries of ``a`` skipped."""
-    n, k = a.shape
+def _matmul(a, b, transpose):
+    """``a b``, or ``a^T b`` with ``transpose`` (both C order), the zero entries of ``a``
+    skipped."""
+    n, k = (a.shape[1], a.shape[0]) if transpose else a.shape
     p = b.shape[1]
     out = np.zeros((n, p))
     for i in range(n):
         for j in range(k):
-            aij = a[i, j]
+            aij = a[j, i] if transpose else a[i, j]
             if aij != 0.0:
                 for q in range(p):
                     out[i, q] += aij * b[j, q]
-    return out
-
-
-@nb.njit(cache=True)
-def _tmatmul(a, b):
-    """``a^T b`` (both C order), the zero entries of ``a`` skipped."""
-    k, n = a.shape
-    p = b.shape[1]
-    out = np.zeros((n, p))
-    for j in range(k):
-        for i in range(n):
-            aji = a[j, i]
-            if aji != 0.0:
-                for q in range(p):
-                    out[i, q] += aji * b[j, q]
     return out
 
 
@@ -331,9 +317,9 @@ def reduced_hessian(v, xx, xy, yy, sens, coupled, sinv):
     if coupled:
         hxy = fused_gram(v, *xy)
         hyy = fused_gram(v, *yy)
-        t = _matmul(sinv, fused_gram(v, *sens))
-        ht = _matmul(hxy, t)
-        tt = _tmatmul(t, _matmul(hyy, t))
+        t = _matmul(sinv, fused_gram(v, *sens), False)
+        ht = _matmul(hxy, t, False)
+        tt = _matmul(t, _matmul(hyy, t, False), True)
         for i in range(hxx.shape[0]):
             for k in range(hxx.shape[1]):
                 hxx[i, k] += ht[i, k] + ht[k, i] + tt[i, k]
