@@ -111,9 +111,10 @@ def matrix_spec(*, hs="1:3:3", te=None, tp=None, realizations: int = 3, waves: f
     ``"surge,heave,pitch"`` (with ``device="buoy"``): a pendulum in a hull that surges,
     heaves and pitches, ``pivot_height ... copper_loss`` and ``torque_limit`` as
     ``parapend.buoy`` takes them (``parapend.performance.hull_device``). ``controller``
-    ``"mpc"`` (``device="prescribed-heave"``): the causal column, ``horizon``, ``forecast``,
-    ``update_interval``, ``warm_up``, ``plan_samples`` and ``speed_limit`` as
-    ``parapend.performance.causal.check_causal`` takes them (None: ``CAUSAL``)."""
+    ``"mpc"`` (``device="prescribed-heave"`` or the heaving ``"buoy"``): the causal column,
+    ``horizon``, ``forecast``, ``update_interval``, ``warm_up``, ``plan_samples`` and
+    ``speed_limit`` as ``parapend.performance.causal.check_causal`` takes them (None:
+    ``CAUSAL``, the buoy's ``BUOY_CAUSAL``)."""
     from ..hydro.hull_api import parse_dofs
     from ..seas import _check_sea, check_response, read_response
     from ..units import Units
@@ -624,7 +625,10 @@ def power_matrix(*, hs="1:3:3", te=None, tp=None, realizations: int = 3, waves: 
     1/32) and ``plan_samples`` torque samples per Hermite interval of the plan (default 2,
     as ``horizon``), and ``speed_limit`` the plans' rated-speed penalty (units
     ``sqrt(g / l)``, default 4; ``inf``: none, ``horizon``'s default);
-    ``parapend.performance.causal``."""
+    ``parapend.performance.causal``. With ``device="buoy"`` (heave only) the column is the
+    buoy's causal controller (``parapend.hydro.control.buoy_mpc``, perfect forecast,
+    ``horizon`` 1 and ``update_interval`` 1/8 by default; no ``plan_samples`` or
+    ``speed_limit``), the controller named in ``causal.buoy_controller``."""
     from ..maps.run import run_spec
     from .annual import bin_series, read_scatter, read_series
     from .check import check_bins, check_size
