@@ -521,3 +521,33 @@ def test_the_buoy_column_is_estimated_and_a_tiny_time_limit_marks_a_partial(buoy
     from parapend.performance.solve import solve_bin
 
     assert p[0, 0] == solve_bin(spec, 0, 0, 0)["causal_perfect_power"]
+
+
+def test_the_shifted_q_is_the_records_q_to_round_off():
+    """The perfect forecast's cheaper ``q`` (:class:`parapend.performance.causal.ShiftedQ`:
+    the leads' exponentials kept, one matrix-vector product an update) against the record's
+    own ``q`` (the direct sum) along a 50-wave record: equal to the round-off of the phase
+    ``k w t`` (``k w t`` reaches 1e3 rad here: 1e-13 of ``q``'s scale); scalars, short and
+    long arrays and offset sets beyond the kept ones are the direct sum itself."""
+    from parapend.performance.causal import ShiftedQ
+    from parapend.seas import sea_record
+    from parapend.units import Units
+
+    units = Units(1.0, 10.0, 9.81, None)
+    exc = sea_record(units, hs=2.0, tp=8.0, repeat_period=400.0, seed=2)
+    tn = 8.0 / units.time
+    sq = ShiftedQ(exc, tn)
+    leads = np.sort(np.random.default_rng(0).uniform(0.0, tn, 300))
+    scale = float(np.max(np.abs(exc.q(np.linspace(0, exc.period, 4001)))))
+    for tj in np.linspace(0.0, exc.period, 37):
+        got, ref = sq(tj + leads), exc.q(tj + leads)
+        assert np.max(np.abs(got - ref)) < 1e-12 * scale
+    assert len(sq.cache) == 1  # one offset set, built once
+    assert sq(1.5) == exc.q(1.5)
+    assert np.array_equal(sq(np.linspace(0, 3, 7)), exc.q(np.linspace(0, 3, 7)))
+    long = np.linspace(0, 30, 9000)
+    assert np.array_equal(sq(long), exc.q(long))
+    for k in range(ShiftedQ.KEEP + 2):
+        t = 10.0 + leads * (1.0 + 0.01 * k)
+        assert np.max(np.abs(sq(t) - exc.q(t))) < 1e-12 * scale
+    assert len(sq.cache) == ShiftedQ.KEEP

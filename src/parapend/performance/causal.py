@@ -32,6 +32,8 @@ from __future__ import annotations
 import logging
 import math
 
+import numpy as np
+
 from ..errors import ParameterError, check_int, check_range
 
 __all__ = ["BUOY_CAUSAL", "BUOY_CONTROLLER", "CAUSAL", "FORECASTS", "causal_json",
@@ -165,6 +167,53 @@ def long_names(forecasts) -> dict:
     return out
 
 
+class ShiftedQ:
+    """The record's ``q(t)`` for :func:`parapend.control.mpc.mpc_run`, cheaper on the perfect
+    forecast's repeated leads: ``q(t0 + d) = Re sum_k Q_k exp(i k w t0) exp(i k w d)``, the
+    matrix ``exp(i k w d)`` of a set of offsets ``d`` (the horizon's leads, the same at every
+    update up to round-off) built once and kept, so an update costs a matrix-vector product
+    instead of the matrix's complex exponentials (they were half of a record's causal run:
+    issue 31, docs/performance.md). An offset set is recognised by ``d`` rounded to 1e-9 of
+    the peak period ``tp`` and evaluated at the offsets of its first call: the leads
+    ``(t_j + leads) - t_j`` differ from one update to the next by the round-off of ``t_j``
+    (1e-16 of the run's length), so ``q`` is the direct evaluation's to round-off (the
+    direct one rounds ``k w t`` at that length too); a set that differs by more than
+    ``5e-10 tp`` is another set. Arrays of other sizes than 8 to 8192, and scalars, are
+    the excitation's own :meth:`parapend.excitation.Excitation.q`.
+
+    Parameters
+    ----------
+    exc : parapend.excitation.Excitation
+        The record (``spectrum``, ``omega``, ``q``).
+    tp : float
+        The peak period (the record's time unit): the offsets' resolution.
+    """
+
+    #: offset sets kept (the leads; a few others are evaluated directly)
+    KEEP = 4
+
+    def __init__(self, exc, tp: float):
+        self.exc = exc
+        self.spec = np.asarray(exc.spectrum, dtype=complex)
+        self.kw = np.arange(self.spec.size) * float(exc.omega)
+        self.res = 1e-9 * float(tp)
+        self.cache = {}
+
+    def __call__(self, t):
+        t = np.asarray(t, dtype=float)
+        if t.ndim != 1 or not 8 <= t.size <= 8192:
+            return self.exc.q(t)
+        t0 = float(t[0])
+        d = t - t0
+        key = np.round(d / self.res).tobytes()
+        e = self.cache.get(key)
+        if e is None:
+            if len(self.cache) >= self.KEEP:
+                return self.exc.q(t)
+            e = self.cache[key] = np.exp(1j * np.multiply.outer(d, self.kw))
+        return (e @ (self.spec * np.exp(1j * self.kw * t0))).real
+
+
 def run_record(spec, exc, units, j: int, r: int, forecast: str):
     """The receding-horizon run of one record ``exc`` (bin period ``j``, realization ``r``)
     with ``forecast``: :func:`parapend.control.mpc.mpc_run` with the arguments
@@ -179,7 +228,7 @@ def run_record(spec, exc, units, j: int, r: int, forecast: str):
         eff = efficiencies(spec.efficiency)
     tp_n = spec.tp[j] / units.time
     fo = None if forecast == "perfect" else ARForecast(tp_n)
-    return mpc_run(exc.q, gamma=spec.gamma, horizon=spec.horizon * tp_n,
+    return mpc_run(ShiftedQ(exc, tp_n), gamma=spec.gamma, horizon=spec.horizon * tp_n,
                    update_interval=spec.update_interval * tp_n, dt=tp_n / 64,
                    average_from=spec.warm_up * tp_n, torque_limit=None, efficiency=eff,
                    forecast=fo, t_end=exc.period + spec.warm_up * tp_n,
