@@ -315,10 +315,12 @@ def _causal_lines(ds, c: dict, hm0, per, pk) -> list:
         runs = ds[f"causal_{f}_power"].values
         bad = int((~np.isfinite(runs)).sum())
         if bad:
-            lines.append(f"{bad} of {runs.size} causal runs failed (the log names them; "
-                         "\"unresolved\": the plans spun the pendulum past a turn per torque "
-                         "sample, see --speed-limit): left out of the bins' means, see the "
-                         "count in --json")
+            why = ("the log names them and their status, e.g. \"solves_failed\": most of "
+                   "the buoy's horizon solves failed" if c.get("buoy_controller") else
+                   "the log names them; \"unresolved\": the plans spun the pendulum past a "
+                   "turn per torque sample, see --speed-limit")
+            lines.append(f"{bad} of {runs.size} causal runs failed ({why}): left out of the "
+                         "bins' means, see the count in --json")
         m = ds[f"causal_{f}_mode"].values
         rest, none = int((m == 0).sum()), int((m == -1).sum())
         if rest or none:
