@@ -424,15 +424,14 @@ def test_a_buoy_bin_is_buoy_mpc_by_hand(buoy_bin, sphere_nc):
     from parapend.units import Units
 
     spec, got = buoy_bin
-    assert spec.buoy_controller == "plan" and spec.horizon == 1.0
+    assert spec.buoy_controller == "coupled" and spec.horizon == 1.0
     assert spec.update_interval == 0.125 and spec.forecasts == ("perfect",)
     pend = Pendulum(mass=20.0, length=0.3, inertia=20.0 * 0.3**2, damping_coefficient=0.5)
     exc = sea_record(Units(0.3, 20.0, 9.81, pend.inertia), hs=0.2, tp=3.0,
                      repeat_period=4 * 3.0, seed=7)
     wave = Wave(2 * math.pi / (4 * 3.0), np.asarray(exc.heave[1:], dtype=complex))
     r = buoy_mpc(load(sphere_nc), pend, wave, peak_period=3.0, horizon=1.0,
-                 update_interval=0.125, warmup=1.0, repeats=1, controller="plan",
-                 iterations=1)
+                 update_interval=0.125, warmup=1.0, repeats=1)
     assert r.success
     assert r.t_end_s - r.average_from_s == pytest.approx(12.0, rel=1e-9)  # one repeat
     assert got["causal_perfect_power"] == pytest.approx(r.mean_power_w, rel=1e-12, abs=0)
@@ -472,7 +471,7 @@ def test_the_buoy_column_rests_its_aep_is_8766_h_sum_p_f(monkeypatch, sphere_nc,
     assert ds["causal_perfect_power_matrix"].values.tolist() == [[0.0, 1.5], [2.5, 0.0]]
     assert out["causal"]["mode"]["perfect"] == [["rest", "controller"],
                                                 ["controller", "rest"]]
-    assert out["causal"]["buoy_controller"] == "plan"
+    assert out["causal"]["buoy_controller"] == "coupled"
     assert out["causal"]["plan_samples"] is None and out["causal"]["speed_limit"] is None
     for col, q in (("optimum", "power"), ("causal_perfect", "causal_perfect_power")):
         want = HOURS_PER_YEAR * 0.25 * float(np.sum(np.maximum(ds[f"{q}_mean"].values, 0)))
@@ -481,20 +480,25 @@ def test_the_buoy_column_rests_its_aep_is_8766_h_sum_p_f(monkeypatch, sphere_nc,
         assert e["complete"] is True and e["annual_energy_mwh"] >= 0
         assert e["annual_energy_mwh"] == pytest.approx(want / 1e6, rel=1e-12)
     with xr.open_dataset(out["netcdf"]) as nc:
-        assert nc.attrs["causal_buoy_controller"] == "plan"
+        assert nc.attrs["causal_buoy_controller"] == "coupled"
         assert "causal_plan_samples" not in nc.attrs
         assert nc["annual_energy"].values.tolist() == pytest.approx(
             [out["causal"]["annual_energy"][c]["annual_energy_mwh"]
              for c in ("optimum", "causal_perfect")], rel=1e-12)
-    assert "the buoy's plan controller, perfect forecast" in text_report(ds, out, [])
+    assert "the buoy's coupled controller, perfect forecast" in text_report(ds, out, [])
 
 
 @pytest.mark.slow  # the sphere's BEM (10 s, once a module), then solves
-def test_the_buoy_column_takes_coupled_with_an_efficiency(sphere_nc):
+def test_the_buoy_column_runs_coupled_with_an_efficiency(sphere_nc, monkeypatch):
     """The plan controller prices no losses: with an efficiency the column runs the coupled
-    one (which does), and says so."""
-    assert matrix_spec(**BUOY_KW, hydro=sphere_nc, efficiency=0.8).buoy_controller == \
-        "coupled"
+    one (which does), whichever is the column's default, and says so."""
+    from parapend.performance import causal
+
+    for default in ("coupled", "plan"):
+        monkeypatch.setattr(causal, "BUOY_CONTROLLER", default)
+        spec = matrix_spec(**BUOY_KW, hydro=sphere_nc, efficiency=0.8)
+        assert spec.buoy_controller == "coupled"
+        assert matrix_spec(**BUOY_KW, hydro=sphere_nc).buoy_controller == default
 
 
 @pytest.mark.slow  # the sphere's BEM (10 s, once a module), then solves

@@ -61,21 +61,23 @@ CAUSAL = {"horizon": 1.0, "forecast": "perfect", "update_interval": 0.03125,
 BUOY_CAUSAL = {"horizon": 1.0, "forecast": "perfect", "update_interval": 0.125,
                "warm_up": 4.0}
 #: ``--device buoy``: which of :func:`parapend.hydro.control.buoy_mpc`'s controllers runs
-#: (``controller=``; recorded in the spec and the output's metadata): "plan" (one solve an
-#: update), "coupled" with an efficiency (the plan prices no losses). Measured on the default
-#: buoy (80 kg, 0.3 m pendulum in the 0.5 m cylinder), Hs 0.5 m, Tp 2.5 s, a 10-wave record,
-#: seed 0, a plan every 1/8 peak period, 4 peak periods of warm-up, on the shared 2-core
-#: machine: horizon 1, plan 29.35 W and coupled 29.34 W (57.4 % of the record's optimum
-#: 51.1 W) in 2.9 s and 19.3 s of CPU; horizon 2, plan 28.8 W (56.3 %) and coupled 24.9 W
-#: (48.7 %) in 4.5 s and 42.9 s
-BUOY_CONTROLLER = "plan"
+#: (``controller=``; recorded in the spec and the output's metadata): "coupled", the
+#: default's. Measured on the default buoy (80 kg, 0.3 m pendulum in the 0.5 m cylinder),
+#: 10-wave records, seed 0, horizon 1, a plan every 1/8 peak period, 4 peak periods of
+#: warm-up, on the shared 2-core machine (docs/performance.md): at Hs 0.5 m, Tp 2.5 s the
+#: experimental "plan" gave the same power (29.35 W against 29.34 W, 57.4 % of the
+#: record's optimum) in 1/7 of the CPU (2.9 s against 19.3 s; at horizon 2, 28.8 W against
+#: 24.9 W); but at Hs 1 m it gave 37.4 W (Tp 2.5 s) where "coupled" gave 77.8 W, and at
+#: Tp 3 s most of its solves failed where "coupled" gave 39.5 W
+BUOY_CONTROLLER = "coupled"
 
 
 def check_causal(*, controller, horizon, forecast, update_interval, warm_up, plan_samples,
                  device: str, heave: bool, speed_limit=None, lossy: bool = False) -> dict | None:
     """The causal column's options, checked (one line naming the option); None without a
     controller (then every other option of it is refused). ``lossy``: the device has an
-    efficiency (the buoy then runs the ``coupled`` controller, which prices it)."""
+    efficiency (the buoy's ``plan`` controller prices none: were it
+    :data:`BUOY_CONTROLLER`, ``coupled`` would run)."""
     opts = {"horizon": horizon, "forecast": forecast, "update-interval": update_interval,
             "warm-up": warm_up, "plan-samples": plan_samples, "speed-limit": speed_limit}
     if controller is None or controller == "none":
@@ -128,7 +130,8 @@ def check_causal(*, controller, horizon, forecast, update_interval, warm_up, pla
         return {"controller": "mpc", "horizon": float(horizon), "forecasts": ("perfect",),
                 "update_interval": float(upd), "warm_up": float(warm), "plan_samples": None,
                 "speed_limit": None,
-                "buoy_controller": "coupled" if lossy else BUOY_CONTROLLER}
+                "buoy_controller": ("coupled" if lossy and BUOY_CONTROLLER == "plan"
+                                    else BUOY_CONTROLLER)}
     ps = CAUSAL["plan_samples"] if plan_samples is None else plan_samples
     ps = check_int("plan-samples", ps, 1, 64)
     if speed_limit is None:
