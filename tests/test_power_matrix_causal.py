@@ -1,12 +1,15 @@
 """``power-matrix --controller mpc`` (issue 31 item 4): the causal column beside the
-non-causal optimum, per bin the best of the controller's run and rest, the annual energy of
-each column side by side, and the incomplete site marked in every column.
+non-causal optimum (of the prescribed-heave pendulum and of the heaving buoy), per bin the
+best of the controller's run and rest, the annual energy of each column side by side, and
+the incomplete site marked in every column.
 
 Independent sources: the receding-horizon controller run by hand on the same record
 (:func:`parapend.control.mpc.mpc_run` with the arguments written out here, and
-:func:`parapend.control.horizon.horizon_curve`), the energy identity of Eq. 14 (no motion
-over a window harvests more than the ``gamma -> 0`` limit plus the boundary term), and the
-closed form ``AEP = 8766 h sum max(P, 0) f`` for each column.
+:func:`parapend.control.horizon.horizon_curve`; for the buoy
+:func:`parapend.hydro.control.buoy_mpc` on the record built from ``sea_record``), the
+energy identity of Eq. 14 (no motion over a window harvests more than the ``gamma -> 0``
+limit plus the boundary term), and the closed form ``AEP = 8766 h sum max(P, 0) f`` for
+each column.
 """
 
 from __future__ import annotations
@@ -292,8 +295,19 @@ def test_the_work_is_capped_in_one_line():
 
 
 @pytest.mark.parametrize("extra, needle", [
-    (["--controller", "mpc", "--device", "buoy"], "controller: the causal column is "
-                                                   "computed for --device prescribed-heave"),
+    (["--controller", "mpc", "--device", "buoy", "--dofs", "surge,heave,pitch"],
+     "controller: the causal column is computed for --device prescribed-heave and the "
+     "heaving --device buoy"),
+    (["--controller", "mpc", "--device", "buoy", "--forecast", "ar"],
+     "forecast: the buoy's controller has the perfect forecast only"),
+    (["--controller", "mpc", "--device", "buoy", "--plan-samples", "4"],
+     "plan-samples: an option of the prescribed-heave pendulum's planner"),
+    (["--controller", "mpc", "--device", "buoy", "--speed-limit", "4"],
+     "speed-limit: an option of the prescribed-heave pendulum's planner"),
+    (["--controller", "mpc", "--device", "buoy", "--update-interval", "0.01"],
+     "update-interval: expected at least one torque sample"),
+    (["--controller", "mpc", "--device", "buoy", "--horizon", "0.1"],
+     "update-interval: expected at most the horizon 0.1"),
     (["--forecast", "ar"], "forecast: an option of the causal column; needs --controller"),
     (["--controller", "mpc", "--forecast", "oracle"], "forecast: expected perfect, ar"),
     (["--controller", "mpc", "--forecast", "ar,ar"], "forecast: expected perfect, ar"),
@@ -369,3 +383,175 @@ def test_torques_before_t0_ignore_the_sea_after_t0_plus_h(forecast, after, causa
     b = _torques(exc.q, 2.0, forecast, tamper_after=after)
     assert a.size == 128 and np.any(a != 0)
     assert np.array_equal(a, b) is causal
+
+
+# --- the buoy (--device buoy): parapend.hydro.control.buoy_mpc on the optimum's record -------
+
+#: the buoy's small matrix (the sphere of tests/test_performance_buoy.py): 2 x 2 bins, one
+#: 4-wave record each, a warm-up of one peak period
+BUOY_KW = {"device": "buoy", "hs": "0.1,0.2", "tp": "2.6,3.0", "realizations": 1,
+           "waves": 4, "seed": 7, "mass": 20.0, "length": 0.3, "damping_coefficient": 0.5,
+           "harmonics": 24, "controller": "mpc", "warm_up": 1.0}
+
+
+@pytest.fixture(scope="module")
+def sphere_nc(tmp_path_factory):
+    from test_buoy_cli import _capytaine_dataset
+
+    return _capytaine_dataset(tmp_path_factory.mktemp("hydro") / "sphere.nc")
+
+
+@pytest.fixture(scope="module")
+def buoy_bin(sphere_nc):
+    """The bin Hs 0.2 m, Tp 3 s of the buoy's matrix, solved as the matrix solves it."""
+    from parapend.performance.solve import solve_bin
+
+    spec = matrix_spec(**BUOY_KW, hydro=sphere_nc)
+    return spec, solve_bin(spec, 1, 1, 0)
+
+
+@pytest.mark.slow  # the sphere's BEM (10 s, once a module), then solves
+def test_a_buoy_bin_is_buoy_mpc_by_hand(buoy_bin, sphere_nc):
+    """A buoy bin's causal powers are :func:`parapend.hydro.control.buoy_mpc` run by hand on
+    the record the buoy's optimum solves (built here from ``sea_record``, as
+    tests/test_performance_buoy.py builds it), with the column's settings written out: the
+    plan controller (one solve an update), horizon 1 and a plan every 1/8 peak period (as
+    ``parapend buoy --controller mpc``), the warm-up, one repeat; to round-off."""
+    from parapend.hydro.bem import load
+    from parapend.hydro.control import buoy_mpc
+    from parapend.hydro.coupled import Pendulum, Wave
+    from parapend.seas import sea_record
+    from parapend.units import Units
+
+    spec, got = buoy_bin
+    assert spec.buoy_controller == "coupled" and spec.horizon == 1.0
+    assert spec.update_interval == 0.125 and spec.forecasts == ("perfect",)
+    pend = Pendulum(mass=20.0, length=0.3, inertia=20.0 * 0.3**2, damping_coefficient=0.5)
+    exc = sea_record(Units(0.3, 20.0, 9.81, pend.inertia), hs=0.2, tp=3.0,
+                     repeat_period=4 * 3.0, seed=7)
+    wave = Wave(2 * math.pi / (4 * 3.0), np.asarray(exc.heave[1:], dtype=complex))
+    r = buoy_mpc(load(sphere_nc), pend, wave, peak_period=3.0, horizon=1.0,
+                 update_interval=0.125, warmup=1.0, repeats=1)
+    assert r.success
+    assert r.t_end_s - r.average_from_s == pytest.approx(12.0, rel=1e-9)  # one repeat
+    assert got["causal_perfect_power"] == pytest.approx(r.mean_power_w, rel=1e-12, abs=0)
+    assert got["causal_perfect_harvested_power"] == pytest.approx(r.harvested_power_w,
+                                                                  rel=1e-12, abs=0)
+    # storage-corrected: the stored energy of buoy and pendulum counted
+    assert r.mean_power_w == pytest.approx(r.harvested_power_w + r.stored_w, rel=1e-12)
+
+
+def _buoy_stub(causal_power):
+    """The buoy's solve_bin with the optimum 1 + i + j W and the causal column
+    ``causal_power[i][j]`` (harvested: the same), without a solve."""
+    def solve_bin(spec, i, j, r):
+        return {"power": 1.0 + i + j, "radiation_bound_power": 10.0, "one_way_power": 0.5,
+                "causal_perfect_power": causal_power[i][j],
+                "causal_perfect_harvested_power": causal_power[i][j], "status": "converged"}
+    return solve_bin
+
+
+@pytest.mark.slow  # the sphere's BEM (10 s, once a module), then solves
+def test_the_buoy_column_rests_its_aep_is_8766_h_sum_p_f(monkeypatch, sphere_nc, tmp_path):
+    """The buoy's causal column: a bin where the controller loses rests (0 W, the choice
+    recorded), each column's annual energy is ``8766 h sum max(P, 0) f`` and never negative,
+    and the controller that ran is named in the JSON, the text and the NetCDF."""
+    import xarray as xr
+
+    import parapend.performance.solve as solve
+    from parapend.performance.figures import text_report
+
+    monkeypatch.setattr(solve, "solve_bin", _buoy_stub([[-3.0, 1.5], [2.5, -0.1]]))
+    site = tmp_path / "site.csv"
+    site.write_text("hs,tp,frequency\n0.1,2.6,0.25\n0.1,3.0,0.25\n0.2,2.6,0.25\n"
+                    "0.2,3.0,0.25\n")
+    rec = parapend.power_matrix(**BUOY_KW, hydro=sphere_nc, workers=1, scatter=str(site),
+                                netcdf=str(tmp_path / "m.nc"))
+    ds, out = rec.dataset, rec.to_dict()
+    assert ds["causal_perfect_power_matrix"].values.tolist() == [[0.0, 1.5], [2.5, 0.0]]
+    assert out["causal"]["mode"]["perfect"] == [["rest", "controller"],
+                                                ["controller", "rest"]]
+    assert out["causal"]["buoy_controller"] == "coupled"
+    assert out["causal"]["plan_samples"] is None and out["causal"]["speed_limit"] is None
+    for col, q in (("optimum", "power"), ("causal_perfect", "causal_perfect_power")):
+        want = HOURS_PER_YEAR * 0.25 * float(np.sum(np.maximum(ds[f"{q}_mean"].values, 0)))
+        assert out["annual_energy"][q]["wh"] == pytest.approx(want, rel=1e-12)
+        e = out["causal"]["annual_energy"][col]
+        assert e["complete"] is True and e["annual_energy_mwh"] >= 0
+        assert e["annual_energy_mwh"] == pytest.approx(want / 1e6, rel=1e-12)
+    with xr.open_dataset(out["netcdf"]) as nc:
+        assert nc.attrs["causal_buoy_controller"] == "coupled"
+        assert "causal_plan_samples" not in nc.attrs
+        assert nc["annual_energy"].values.tolist() == pytest.approx(
+            [out["causal"]["annual_energy"][c]["annual_energy_mwh"]
+             for c in ("optimum", "causal_perfect")], rel=1e-12)
+    assert "the buoy's coupled controller, perfect forecast" in text_report(ds, out, [])
+
+
+@pytest.mark.slow  # the sphere's BEM (10 s, once a module), then solves
+def test_the_buoy_column_runs_coupled_with_an_efficiency(sphere_nc, monkeypatch):
+    """The plan controller prices no losses: with an efficiency the column runs the coupled
+    one (which does), whichever is the column's default, and says so."""
+    from parapend.performance import causal
+
+    for default in ("coupled", "plan"):
+        monkeypatch.setattr(causal, "BUOY_CONTROLLER", default)
+        spec = matrix_spec(**BUOY_KW, hydro=sphere_nc, efficiency=0.8)
+        assert spec.buoy_controller == "coupled"
+        assert matrix_spec(**BUOY_KW, hydro=sphere_nc).buoy_controller == default
+
+
+@pytest.mark.slow  # the sphere's BEM (10 s, once a module), then solves
+def test_the_buoy_column_is_estimated_and_a_tiny_time_limit_marks_a_partial(buoy_bin,
+                                                                            sphere_nc):
+    """Untimed work estimated past two minutes is refused in one line naming the largest
+    size that fits (the causal runs counted); a tiny ``time_limit`` finishes one bin, the
+    same as the full computation's, and marks the matrix partial."""
+    from parapend.performance.check import check_size, record_seconds
+
+    big = {**BUOY_KW, "waves": 400, "hydro": sphere_nc}
+    est = check_size(matrix_spec(**big), workers=1)
+    assert est["causal_seconds"] == pytest.approx(record_seconds(matrix_spec(**big)))
+    assert est["seconds"] > 120
+    with pytest.raises(ParameterError, match=r"^hs: a power matrix of 4 bins .* or give "
+                                             r"--time-limit SECONDS"):
+        parapend.power_matrix(**big, workers=1)
+    spec, got = buoy_bin
+    rec = parapend.power_matrix(**BUOY_KW, hydro=sphere_nc, workers=1, time_limit=1e-9)
+    ds = rec.dataset
+    assert ds.attrs["status"] == "time_limit" and ds.attrs["bins_finished"] == 1
+    p = ds["causal_perfect_power_mean"].values
+    assert np.isfinite(p).sum() == 1 and np.isfinite(p[0, 0])
+    from parapend.performance.solve import solve_bin
+
+    assert p[0, 0] == solve_bin(spec, 0, 0, 0)["causal_perfect_power"]
+
+
+def test_the_shifted_q_is_the_records_q_to_round_off():
+    """The perfect forecast's cheaper ``q`` (:class:`parapend.performance.causal.ShiftedQ`:
+    the leads' exponentials kept, one matrix-vector product an update) against the record's
+    own ``q`` (the direct sum) along a 50-wave record: equal to the round-off of the phase
+    ``k w t`` (``k w t`` reaches 1e3 rad here: 1e-13 of ``q``'s scale); scalars, short and
+    long arrays and offset sets beyond the kept ones are the direct sum itself."""
+    from parapend.performance.causal import ShiftedQ
+    from parapend.seas import sea_record
+    from parapend.units import Units
+
+    units = Units(1.0, 10.0, 9.81, None)
+    exc = sea_record(units, hs=2.0, tp=8.0, repeat_period=400.0, seed=2)
+    tn = 8.0 / units.time
+    sq = ShiftedQ(exc, tn)
+    leads = np.sort(np.random.default_rng(0).uniform(0.0, tn, 300))
+    scale = float(np.max(np.abs(exc.q(np.linspace(0, exc.period, 4001)))))
+    for tj in np.linspace(0.0, exc.period, 37):
+        got, ref = sq(tj + leads), exc.q(tj + leads)
+        assert np.max(np.abs(got - ref)) < 1e-12 * scale
+    assert len(sq.cache) == 1  # one offset set, built once
+    assert sq(1.5) == exc.q(1.5)
+    assert np.array_equal(sq(np.linspace(0, 3, 7)), exc.q(np.linspace(0, 3, 7)))
+    long = np.linspace(0, 30, 9000)
+    assert np.array_equal(sq(long), exc.q(long))
+    for k in range(ShiftedQ.KEEP + 2):
+        t = 10.0 + leads * (1.0 + 0.01 * k)
+        assert np.max(np.abs(sq(t) - exc.q(t))) < 1e-12 * scale
+    assert len(sq.cache) == ShiftedQ.KEEP

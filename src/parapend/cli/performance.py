@@ -88,22 +88,24 @@ def add_parsers(sub) -> None:
     g.add_argument("--torque-limit", type=_finite_float("torque-limit"),
                    help="largest |torque|, N m (with --dofs surge,heave,pitch; refused "
                         "otherwise: not supported over a sea record)")
-    g = p.add_argument_group("the causal column (--device prescribed-heave; as parapend "
-                             "horizon, docs/performance.md)")
+    g = p.add_argument_group("the causal column (--device prescribed-heave, as parapend "
+                             "horizon; and the heaving --device buoy, as parapend buoy "
+                             "--controller mpc: perfect forecast, horizon 1, update 1/8; "
+                             "docs/performance.md)")
     g.add_argument("--controller", choices=["mpc", "none"],
                    help="mpc: beside the non-causal optimum, the receding-horizon controller "
                         "on the same records (storage-corrected, after --warm-up), and the "
                         "annual energy of each column side by side (default none)")
     g.add_argument("--horizon", type=_finite_float("horizon"),
                    help="the controller's horizon in peak periods, 0.05 to 20 (default 1 "
-                        "with --controller mpc)")
+                        "with --controller mpc, both devices)")
     g.add_argument("--forecast", metavar="NAMES",
                    help="perfect, ar (autoregressive, fitted on the past only) or "
                         "perfect,ar: one causal column each (default perfect with "
                         "--controller mpc; ar costs about twice perfect)")
     g.add_argument("--update-interval", type=_finite_float("update-interval"),
                    help="peak periods between two plans, 0.001 to 1 (default 1/32 with "
-                        "--controller mpc)")
+                        "--controller mpc; the buoy's 1/8, at least 1/64)")
     g.add_argument("--warm-up", type=_finite_float("warm-up"),
                    help="peak periods from the hanging rest left out of the mean, which is "
                         "over one repeat of the record after it (default 4 with "

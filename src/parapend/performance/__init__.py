@@ -111,9 +111,10 @@ def matrix_spec(*, hs="1:3:3", te=None, tp=None, realizations: int = 3, waves: f
     ``"surge,heave,pitch"`` (with ``device="buoy"``): a pendulum in a hull that surges,
     heaves and pitches, ``pivot_height ... copper_loss`` and ``torque_limit`` as
     ``parapend.buoy`` takes them (``parapend.performance.hull_device``). ``controller``
-    ``"mpc"`` (``device="prescribed-heave"``): the causal column, ``horizon``, ``forecast``,
-    ``update_interval``, ``warm_up``, ``plan_samples`` and ``speed_limit`` as
-    ``parapend.performance.causal.check_causal`` takes them (None: ``CAUSAL``)."""
+    ``"mpc"`` (``device="prescribed-heave"`` or the heaving ``"buoy"``): the causal column,
+    ``horizon``, ``forecast``, ``update_interval``, ``warm_up``, ``plan_samples`` and
+    ``speed_limit`` as ``parapend.performance.causal.check_causal`` takes them (None:
+    ``CAUSAL``, the buoy's ``BUOY_CAUSAL``)."""
     from ..hydro.hull_api import parse_dofs
     from ..seas import _check_sea, check_response, read_response
     from ..units import Units
@@ -145,7 +146,8 @@ def matrix_spec(*, hs="1:3:3", te=None, tp=None, realizations: int = 3, waves: f
     causal = check_causal(controller=controller, horizon=horizon, forecast=forecast,
                           update_interval=update_interval, warm_up=warm_up,
                           plan_samples=plan_samples, speed_limit=speed_limit,
-                          device=device, heave=heave)
+                          device=device, heave=heave,
+                          lossy=efficiency is not None and efficiency != 1.0)
     if torque_limit is not None and heave:
         raise ParameterError("torque-limit: not supported over a sea record (parapend sea "
                              "solves the unconstrained optimum); drop --torque-limit")
@@ -191,7 +193,7 @@ def matrix_spec(*, hs="1:3:3", te=None, tp=None, realizations: int = 3, waves: f
                           damping_coefficient=damping_coefficient, winding=winding,
                           harmonics=harmonics, efficiency=efficiency, body=body,
                           radius=radius, draft=draft, mesh=mesh, hydro=hydro,
-                          density=density, depth=depth)
+                          density=density, depth=depth, causal=causal)
     units = Units(length, mass, gravity, inertia)
     if gamma is not None and damping_coefficient is not None:
         raise ParameterError("gamma: give either gamma or damping-coefficient, not both")
@@ -230,7 +232,7 @@ def matrix_spec(*, hs="1:3:3", te=None, tp=None, realizations: int = 3, waves: f
 
 def _buoy_spec(hm0, period, kind, tps, realizations, waves, seed, spectrum, gamma_peak,
                cutoff, *, body, radius, draft, mesh, hydro, density=1025.0, depth=None,
-               **pendulum) -> MatrixSpec:
+               causal=None, **pendulum) -> MatrixSpec:
     """The coupled buoy's spec: the pendulum and the body checked as ``parapend buoy`` checks
     them, the BEM solved (or loaded) once over every bin's band, every bin checked to lie
     in the data."""
@@ -265,7 +267,7 @@ def _buoy_spec(hm0, period, kind, tps, realizations, waves, seed, spectrum, gamm
                       # a dataset was solved in its own water (water_of reads it back)
                       water_density=1025.0 if hydro is not None else float(density),
                       water_depth=None if hydro is not None or depth is None
-                      else float(depth))
+                      else float(depth), **(causal or {}))
     spec = dataclasses.replace(spec, band=buoy_device.band(spec),
                                digest=buoy_device.file_digest(mesh if hydro is None
                                                               else hydro))
@@ -516,12 +518,22 @@ def _causal_matrix(ds, spec: MatrixSpec) -> None:
                      "causal_horizon_peak_periods": spec.horizon,
                      "causal_update_interval_peak_periods": spec.update_interval,
                      "causal_warm_up_peak_periods": spec.warm_up,
-                     "causal_plan_samples": spec.plan_samples,
-                     "causal_speed_limit": ("none" if spec.speed_limit is None
-                                            else spec.speed_limit),
                      "causal_convention": "from the hanging rest, 64 torque samples a peak "
                                           "period; the mean over one repeat of the record "
                                           "after the warm-up, (W_e + eta_g dE) / tau"})
+    if spec.device == "buoy":
+        # the buoy's controller (parapend.hydro.control.buoy_mpc): dE the mechanical energy
+        # of buoy and pendulum; no planner samples or speed penalty (the pendulum's)
+        ds.attrs["causal_buoy_controller"] = spec.buoy_controller
+        ds.attrs["causal_convention"] = (
+            "parapend.hydro.control.buoy_mpc, controller " + spec.buoy_controller + ": from "
+            "the hanging rest, the buoy in its free periodic motion, 64 torque samples a peak "
+            "period; the mean over one repeat of the record after the warm-up, "
+            "(W_e + eta_g dE) / tau, E the mechanical energy of buoy and pendulum")
+    else:
+        ds.attrs["causal_plan_samples"] = spec.plan_samples
+        ds.attrs["causal_speed_limit"] = ("none" if spec.speed_limit is None
+                                          else spec.speed_limit)
 
 
 def _annual_columns(ds, spec: MatrixSpec, annual: dict) -> None:
@@ -613,7 +625,10 @@ def power_matrix(*, hs="1:3:3", te=None, tp=None, realizations: int = 3, waves: 
     1/32) and ``plan_samples`` torque samples per Hermite interval of the plan (default 2,
     as ``horizon``), and ``speed_limit`` the plans' rated-speed penalty (units
     ``sqrt(g / l)``, default 4; ``inf``: none, ``horizon``'s default);
-    ``parapend.performance.causal``."""
+    ``parapend.performance.causal``. With ``device="buoy"`` (heave only) the column is the
+    buoy's causal controller (``parapend.hydro.control.buoy_mpc``, perfect forecast,
+    ``horizon`` 1 and ``update_interval`` 1/8 by default; no ``plan_samples`` or
+    ``speed_limit``), the controller named in ``causal.buoy_controller``."""
     from ..maps.run import run_spec
     from .annual import bin_series, read_scatter, read_series
     from .check import check_bins, check_size

@@ -14,6 +14,17 @@ horizon, the update interval and the warm-up are in peak periods, as ``horizon``
 Per bin the causal power is the best of the controller's run and rest: ``max(P, 0)`` of the
 mean over the records (a real device stops the pendulum where the controller loses energy);
 the choice is recorded (``causal_<forecast>_mode``).
+
+With ``--device buoy`` (the heaving buoy) the column is the buoy's causal controller,
+:func:`parapend.hydro.control.buoy_mpc` (:data:`BUOY_CONTROLLER`), on the record the buoy's
+optimum solves (same seed, same wave): from the hanging rest with the buoy in its free
+periodic motion, 64 torque samples a peak period, ``warm_up`` peak periods and then one whole
+repeat of the record, its storage-corrected power (the harvested energy plus the change of
+the mechanical energy of buoy AND pendulum, per unit time; electrical with an efficiency,
+the stored energy counted at ``eta_g``). Its horizon, update interval and warm-up default to
+``parapend buoy --controller mpc``'s (:data:`BUOY_CAUSAL`); the perfect forecast only (the
+buoy's controller has no AR forecast), and neither ``plan_samples`` nor ``speed_limit``
+(options of the pendulum's planner).
 """
 
 from __future__ import annotations
@@ -21,10 +32,12 @@ from __future__ import annotations
 import logging
 import math
 
+import numpy as np
+
 from ..errors import ParameterError, check_int, check_range
 
-__all__ = ["CAUSAL", "FORECASTS", "causal_json", "causal_quantities", "check_causal",
-           "solve_causal"]
+__all__ = ["BUOY_CAUSAL", "BUOY_CONTROLLER", "CAUSAL", "FORECASTS", "causal_json",
+           "causal_quantities", "check_causal", "run_buoy_record", "solve_causal"]
 
 log = logging.getLogger(__name__)
 
@@ -43,12 +56,28 @@ FORECASTS = ("perfect", "ar")
 #: was the same
 CAUSAL = {"horizon": 1.0, "forecast": "perfect", "update_interval": 0.03125,
           "warm_up": 4.0, "plan_samples": 2, "speed_limit": 4.0}
+#: ``--device buoy``: the causal column's defaults, ``parapend buoy --controller mpc``'s
+#: (horizon 1 and a plan every 1/8 peak period) and the prescribed device's warm-up
+BUOY_CAUSAL = {"horizon": 1.0, "forecast": "perfect", "update_interval": 0.125,
+               "warm_up": 4.0}
+#: ``--device buoy``: which of :func:`parapend.hydro.control.buoy_mpc`'s controllers runs
+#: (``controller=``; recorded in the spec and the output's metadata): "coupled", the
+#: default's. Measured on the default buoy (80 kg, 0.3 m pendulum in the 0.5 m cylinder),
+#: 10-wave records, seed 0, horizon 1, a plan every 1/8 peak period, 4 peak periods of
+#: warm-up, on the shared 2-core machine (docs/performance.md): at Hs 0.5 m, Tp 2.5 s the
+#: experimental "plan" gave the same power (29.35 W against 29.34 W, 57.4 % of the
+#: record's optimum) in 1/7 of the CPU (2.9 s against 19.3 s; at horizon 2, 28.8 W against
+#: 24.9 W); but at Hs 1 m it gave 37.4 W (Tp 2.5 s) where "coupled" gave 77.8 W, and at
+#: Tp 3 s most of its solves failed where "coupled" gave 39.5 W
+BUOY_CONTROLLER = "coupled"
 
 
 def check_causal(*, controller, horizon, forecast, update_interval, warm_up, plan_samples,
-                 device: str, heave: bool, speed_limit=None) -> dict | None:
+                 device: str, heave: bool, speed_limit=None, lossy: bool = False) -> dict | None:
     """The causal column's options, checked (one line naming the option); None without a
-    controller (then every other option of it is refused)."""
+    controller (then every other option of it is refused). ``lossy``: the device has an
+    efficiency (the buoy's ``plan`` controller prices none: were it
+    :data:`BUOY_CONTROLLER`, ``coupled`` would run)."""
     opts = {"horizon": horizon, "forecast": forecast, "update-interval": update_interval,
             "warm-up": warm_up, "plan-samples": plan_samples, "speed-limit": speed_limit}
     if controller is None or controller == "none":
@@ -59,13 +88,20 @@ def check_causal(*, controller, horizon, forecast, update_interval, warm_up, pla
         return None
     if controller != "mpc":
         raise ParameterError(f"controller: expected mpc (or none), got {controller!r:.40}")
-    if device != "prescribed-heave" or not heave:
+    if not heave:
         raise ParameterError("controller: the causal column is computed for --device "
-                             "prescribed-heave only; the buoy's causal controller is "
-                             "parapend buoy --controller mpc (one sea state)")
-    horizon = CAUSAL["horizon"] if horizon is None else horizon
+                             "prescribed-heave and the heaving --device buoy, not for a hull "
+                             "that surges, heaves and pitches")
+    buoy = device == "buoy"
+    if buoy:
+        for name, v in (("plan-samples", plan_samples), ("speed-limit", speed_limit)):
+            if v is not None:
+                raise ParameterError(f"{name}: an option of the prescribed-heave pendulum's "
+                                     "planner; drop it with --device buoy")
+    base = BUOY_CAUSAL if buoy else CAUSAL
+    horizon = base["horizon"] if horizon is None else horizon
     horizon = check_range("horizon", horizon, 0.05, 20.0, why="peak periods")
-    forecast = CAUSAL["forecast"] if forecast is None else forecast
+    forecast = base["forecast"] if forecast is None else forecast
     if isinstance(forecast, str):
         names = [s.strip() for s in forecast.split(",") if s.strip()]
     elif isinstance(forecast, (list, tuple)):
@@ -76,10 +112,26 @@ def check_causal(*, controller, horizon, forecast, update_interval, warm_up, pla
     if not names or any(n not in FORECASTS for n in names) or len(set(names)) != len(names):
         raise ParameterError(f"forecast: expected perfect, ar or perfect,ar, got "
                              f"{forecast!r:.40}")
-    upd = CAUSAL["update_interval"] if update_interval is None else update_interval
+    if buoy and names != ["perfect"]:
+        raise ParameterError("forecast: the buoy's controller has the perfect forecast only "
+                             "(no autoregressive one yet); give --forecast perfect with "
+                             "--device buoy")
+    upd = base["update_interval"] if update_interval is None else update_interval
     upd = check_range("update-interval", upd, 1e-3, 1.0, why="peak periods")
-    warm = CAUSAL["warm_up"] if warm_up is None else warm_up
+    if buoy and upd < 1.0 / 64:
+        raise ParameterError(f"update-interval: expected at least one torque sample (1/64 "
+                             f"peak period) with --device buoy, got {upd:g}")
+    if buoy and upd > horizon:
+        raise ParameterError(f"update-interval: expected at most the horizon {horizon:g} peak "
+                             f"periods with --device buoy, got {upd:g}")
+    warm = base["warm_up"] if warm_up is None else warm_up
     warm = check_range("warm-up", warm, 0.0, 100.0, why="peak periods")
+    if buoy:
+        return {"controller": "mpc", "horizon": float(horizon), "forecasts": ("perfect",),
+                "update_interval": float(upd), "warm_up": float(warm), "plan_samples": None,
+                "speed_limit": None,
+                "buoy_controller": ("coupled" if lossy and BUOY_CONTROLLER == "plan"
+                                    else BUOY_CONTROLLER)}
     ps = CAUSAL["plan_samples"] if plan_samples is None else plan_samples
     ps = check_int("plan-samples", ps, 1, 64)
     if speed_limit is None:
@@ -118,6 +170,53 @@ def long_names(forecasts) -> dict:
     return out
 
 
+class ShiftedQ:
+    """The record's ``q(t)`` for :func:`parapend.control.mpc.mpc_run`, cheaper on the perfect
+    forecast's repeated leads: ``q(t0 + d) = Re sum_k Q_k exp(i k w t0) exp(i k w d)``, the
+    matrix ``exp(i k w d)`` of a set of offsets ``d`` (the horizon's leads, the same at every
+    update up to round-off) built once and kept, so an update costs a matrix-vector product
+    instead of the matrix's complex exponentials (they were half of a record's causal run:
+    issue 31, docs/performance.md). An offset set is recognised by ``d`` rounded to 1e-9 of
+    the peak period ``tp`` and evaluated at the offsets of its first call: the leads
+    ``(t_j + leads) - t_j`` differ from one update to the next by the round-off of ``t_j``
+    (1e-16 of the run's length), so ``q`` is the direct evaluation's to round-off (the
+    direct one rounds ``k w t`` at that length too); a set that differs by more than
+    ``5e-10 tp`` is another set. Arrays of other sizes than 8 to 8192, and scalars, are
+    the excitation's own :meth:`parapend.excitation.Excitation.q`.
+
+    Parameters
+    ----------
+    exc : parapend.excitation.Excitation
+        The record (``spectrum``, ``omega``, ``q``).
+    tp : float
+        The peak period (the record's time unit): the offsets' resolution.
+    """
+
+    #: offset sets kept (the leads; a few others are evaluated directly)
+    KEEP = 4
+
+    def __init__(self, exc, tp: float):
+        self.exc = exc
+        self.spec = np.asarray(exc.spectrum, dtype=complex)
+        self.kw = np.arange(self.spec.size) * float(exc.omega)
+        self.res = 1e-9 * float(tp)
+        self.cache = {}
+
+    def __call__(self, t):
+        t = np.asarray(t, dtype=float)
+        if t.ndim != 1 or not 8 <= t.size <= 8192:
+            return self.exc.q(t)
+        t0 = float(t[0])
+        d = t - t0
+        key = np.round(d / self.res).tobytes()
+        e = self.cache.get(key)
+        if e is None:
+            if len(self.cache) >= self.KEEP:
+                return self.exc.q(t)
+            e = self.cache[key] = np.exp(1j * np.multiply.outer(d, self.kw))
+        return (e @ (self.spec * np.exp(1j * self.kw * t0))).real
+
+
 def run_record(spec, exc, units, j: int, r: int, forecast: str):
     """The receding-horizon run of one record ``exc`` (bin period ``j``, realization ``r``)
     with ``forecast``: :func:`parapend.control.mpc.mpc_run` with the arguments
@@ -132,12 +231,34 @@ def run_record(spec, exc, units, j: int, r: int, forecast: str):
         eff = efficiencies(spec.efficiency)
     tp_n = spec.tp[j] / units.time
     fo = None if forecast == "perfect" else ARForecast(tp_n)
-    return mpc_run(exc.q, gamma=spec.gamma, horizon=spec.horizon * tp_n,
+    return mpc_run(ShiftedQ(exc, tp_n), gamma=spec.gamma, horizon=spec.horizon * tp_n,
                    update_interval=spec.update_interval * tp_n, dt=tp_n / 64,
                    average_from=spec.warm_up * tp_n, torque_limit=None, efficiency=eff,
                    forecast=fo, t_end=exc.period + spec.warm_up * tp_n,
                    seed=int(spec.seeds[r]), speed_limit=spec.speed_limit,
                    interval_samples=spec.plan_samples)
+
+
+def run_buoy_record(spec, i: int, j: int, r: int):
+    """The buoy's causal run of bin ``(i, j)``, realization ``r`` (``--device buoy``):
+    :func:`parapend.hydro.control.buoy_mpc` on the body, pendulum and record
+    :func:`parapend.performance.buoy_device.solve_buoy_bin` solves (same seed, same wave),
+    ``warm_up`` peak periods then one repeat, the matrix's efficiency. The run's work is not
+    capped here (the matrix estimates and limits its own time: a bin is never started past
+    ``--time-limit``)."""
+    from .. import limits
+    from ..hydro.control import buoy_mpc
+    from .buoy_device import body_hydro, pendulum, wave_of
+
+    h, _ = body_hydro(spec)
+    wave, _ = wave_of(spec, i, j, r)
+    kw = {"iterations": 1} if spec.buoy_controller == "plan" else {}
+    eta = spec.efficiency
+    return buoy_mpc(h, pendulum(spec), wave, peak_period=spec.tp[j], horizon=spec.horizon,
+                    update_interval=spec.update_interval, warmup=spec.warm_up, repeats=1,
+                    controller=spec.buoy_controller,
+                    efficiency=None if eta is None or eta == 1.0 else eta,
+                    time_limit=limits.MAX_TIME_LIMIT, deadline=math.inf, **kw)
 
 
 def solve_causal(spec, i: int, j: int, r: int) -> dict:
@@ -147,8 +268,10 @@ def solve_causal(spec, i: int, j: int, r: int) -> dict:
 
     from .check import _record, _units
 
-    units = _units(spec)
-    exc = _record(spec, units, i, j, r)
+    buoy = spec.device == "buoy"
+    if not buoy:
+        units = _units(spec)
+        exc = _record(spec, units, i, j, r)
     out = {}
     for f in spec.forecasts:
         p = w = math.nan
@@ -157,8 +280,12 @@ def solve_causal(spec, i: int, j: int, r: int) -> dict:
             # processes do not, and the record's q (a small complex matrix-vector product
             # at every update) ran 2 to 3 times slower with threads that only spin
             with threadpool_limits(1, user_api="blas"):
-                res = run_record(spec, exc, units, j, r, f)
-            if res.success:
+                res = (run_buoy_record(spec, i, j, r) if buoy
+                       else run_record(spec, exc, units, j, r, f))
+            if res.success and buoy:
+                p = float(res.electrical_power_w)
+                w = float(res.harvested_electrical_power_w)
+            elif res.success:
                 p = units.to_watts(float(res.mean_electrical_power))
                 w = units.to_watts(float(res.harvested_electrical_power))
             else:
@@ -186,10 +313,13 @@ def causal_json(ds, grid) -> dict:
            "update_interval_peak_periods":
                float(ds.attrs["causal_update_interval_peak_periods"]),
            "warm_up_peak_periods": float(ds.attrs["causal_warm_up_peak_periods"]),
-           "plan_samples": int(ds.attrs["causal_plan_samples"]),
-           "speed_limit": (None if ds.attrs["causal_speed_limit"] == "none"
+           "plan_samples": (int(ds.attrs["causal_plan_samples"])
+                            if "causal_plan_samples" in ds.attrs else None),
+           "speed_limit": (None if ds.attrs.get("causal_speed_limit", "none") == "none"
                            else float(ds.attrs["causal_speed_limit"])),
            "convention": ds.attrs["causal_convention"],
+           **({"buoy_controller": ds.attrs["causal_buoy_controller"]}
+              if "causal_buoy_controller" in ds.attrs else {}),
            "power_matrix": {f: grid(f"causal_{f}_power_matrix") for f in forecasts},
            "mode": {f: [[{1: "controller", 0: "rest"}.get(int(v)) for v in row]
                         for row in ds[f"causal_{f}_mode"].values] for f in forecasts}}

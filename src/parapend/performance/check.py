@@ -61,11 +61,25 @@ def _where(spec, i: int, j: int, r: int | None = None) -> str:
 CAUSAL_SECONDS = {"perfect": 7.5, "ar": 10.5}
 
 
+#: ``--device buoy``: CPU seconds of the buoy's causal run per peak period of run (warm-up
+#: and record) at a horizon of 1 peak period and a plan every 1/8, per controller, rounded
+#: up from the measurements of :data:`parapend.performance.causal.BUOY_CONTROLLER` (10-wave
+#: records of the default buoy, the shared 2-core machine: plan 0.21 s; coupled 1.38 s at
+#: Hs 0.5 m, Tp 2.5 s, 1.6 and 1.9 s at Hs 1 m, Tp 2.5 and 3 s; at a horizon of 2, 0.32 and
+#: 3.06 s at Hs 0.5 m): taken as the horizon (at least half a peak period) over the update
+#: interval
+BUOY_CAUSAL_SECONDS = {"plan": 0.25, "coupled": 2.0}
+
+
 def record_seconds(spec) -> float:
     """A rough CPU time (s) of the causal runs of one record of ``spec``
-    (:data:`CAUSAL_SECONDS`, as the run's length); 0 without a controller."""
+    (:data:`CAUSAL_SECONDS`, as the run's length; the buoy's :data:`BUOY_CAUSAL_SECONDS`);
+    0 without a controller."""
     if getattr(spec, "controller", None) is None:
         return 0.0
+    if spec.device == "buoy":
+        return (BUOY_CAUSAL_SECONDS[spec.buoy_controller] * (spec.waves + spec.warm_up)
+                * max(spec.horizon, 0.5) * (0.125 / spec.update_interval))
     scale = (spec.waves + spec.warm_up) / 54.0  # the measured runs: 50 waves + 4 warm-up
     return sum(CAUSAL_SECONDS[f] for f in spec.forecasts) * scale
 

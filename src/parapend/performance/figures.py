@@ -296,7 +296,9 @@ def _causal_lines(ds, c: dict, hm0, per, pk) -> list:
     controller's run and rest) and the bins at rest."""
     lines = ["", f"causal receding-horizon control (horizon {c['horizon_peak_periods']:g} "
                  f"peak periods, a plan every {c['update_interval_peak_periods']:g} of them, "
-                 f"{c['plan_samples']} torque samples per plan interval"
+                 + (f"{c['plan_samples']} torque samples per plan interval"
+                    if c.get("buoy_controller") is None else
+                    f"the buoy's {c['buoy_controller']} controller, perfect forecast")
                  + ("" if c.get("speed_limit") is None else
                     f", speed penalty above {c['speed_limit']:g} sqrt(g/l)")
                  + "): storage-corrected "
@@ -313,10 +315,12 @@ def _causal_lines(ds, c: dict, hm0, per, pk) -> list:
         runs = ds[f"causal_{f}_power"].values
         bad = int((~np.isfinite(runs)).sum())
         if bad:
-            lines.append(f"{bad} of {runs.size} causal runs failed (the log names them; "
-                         "\"unresolved\": the plans spun the pendulum past a turn per torque "
-                         "sample, see --speed-limit): left out of the bins' means, see the "
-                         "count in --json")
+            why = ("the log names them and their status, e.g. \"solves_failed\": most of "
+                   "the buoy's horizon solves failed" if c.get("buoy_controller") else
+                   "the log names them; \"unresolved\": the plans spun the pendulum past a "
+                   "turn per torque sample, see --speed-limit")
+            lines.append(f"{bad} of {runs.size} causal runs failed ({why}): left out of the "
+                         "bins' means, see the count in --json")
         m = ds[f"causal_{f}_mode"].values
         rest, none = int((m == 0).sum()), int((m == -1).sum())
         if rest or none:

@@ -119,6 +119,8 @@ class MatrixSpec:
     warm_up: float | None = None
     plan_samples: int | None = None
     speed_limit: float | None = None  # the plans' rated-speed penalty, units sqrt(g / l)
+    # --device buoy: which controller of parapend.hydro.control.buoy_mpc the column runs
+    buoy_controller: str | None = None
 
     kind = "power_matrix"
     pto = False
@@ -164,7 +166,12 @@ class MatrixSpec:
         if self.device == "buoy":
             e = ("electrical_power",) if self.lossy else ()
             m = ("mode",) if self.dofs != "heave" else ()
-            return ("power", "radiation_bound_power", "one_way_power", *e, *m, "status")
+            c = ()
+            if self.controller is not None:
+                from .causal import causal_quantities
+
+                c = causal_quantities(self.forecasts)
+            return ("power", "radiation_bound_power", "one_way_power", *e, *m, *c, "status")
         out = ["power", "limit_power", "uniform_power"]
         if self.efficiency is not None:
             out.append("electrical_power")
@@ -200,6 +207,8 @@ class MatrixSpec:
         if self.controller is None:  # a store written before the causal column resumes
             for k in _CAUSAL_FIELDS:
                 d.pop(k)
+        if d["buoy_controller"] is None:  # the same: the prescribed device's column
+            d.pop("buoy_controller")
         return json.dumps(d, sort_keys=True)
 
     @classmethod
