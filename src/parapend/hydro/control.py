@@ -30,7 +30,9 @@ pendulum units: time ``t0 = sqrt(I / (m g l))``, torque ``m g l``, ``q = z'' / g
   previous plan and frozen) and the pendulum's reaction, a causal convolution of
   ``cos(theta)``; the torque by inverse dynamics on that heave, bounded at three points per
   interval; the objective the ``coupled`` controller's (work plus the energy of buoy and
-  pendulum at the end); a dense primal-dual interior point with the exact Hessian
+  pendulum at the end) with, by default, the marginal cost of the radiation the plan's own
+  motion causes (:func:`marginal_radiation`); a dense primal-dual interior point with the
+  exact Hessian
   (:mod:`._buoy_plan`), warm-started from the previous motion. The held torques are the
   plan's torque averaged over each sample. Without efficiency (mechanical only).
 - ``"fixed-point"``: the pendulum MPC planning on the heave the coupled model predicts under
