@@ -135,9 +135,11 @@ class CoupledPlan:
         self._work = None
 
     # -- the update's data -------------------------------------------------------------------
-    def set_start(self, y0, fm):
+    def set_start(self, y0, fm, fobj=None):
         """The measured ``(z, z', theta, theta')`` and ``f = F - mu`` (N) as a vectorized
-        callable of the lead time (s)."""
+        callable of the lead time (s); ``fobj`` (same form, default ``fm``): the force that
+        weights ``z'`` in the objective, ``int (fobj z' - c theta'^2) dt`` (the dynamics keep
+        ``fm``; :func:`parapend.hydro.control.marginal_radiation`)."""
         self.x0 = np.asarray(y0, dtype=float).copy()
         self.fm = fm
         z, zd, th, om = self.x0
@@ -146,6 +148,11 @@ class CoupledPlan:
         src = (np.arange(self.k)[:, None] + TAU_G[None, :]) * self.h
         self.f_full = np.asarray(fm(src), dtype=float)
         self._fixed = [self._constant(self.tg)]
+        if fobj is not None:
+            f_t, yc, ydc = self._fixed[0]
+            f_t = f_t.copy()
+            f_t[:self.ng] = np.asarray(fobj(self.tg.t[:self.ng]), dtype=float)
+            self._fixed[0] = (f_t, yc, ydc)
         if self.samples is not None:
             self._fixed.append(self._constant(self.samples))
 

@@ -30,7 +30,9 @@ pendulum units: time ``t0 = sqrt(I / (m g l))``, torque ``m g l``, ``q = z'' / g
   previous plan and frozen) and the pendulum's reaction, a causal convolution of
   ``cos(theta)``; the torque by inverse dynamics on that heave, bounded at three points per
   interval; the objective the ``coupled`` controller's (work plus the energy of buoy and
-  pendulum at the end); a dense primal-dual interior point with the exact Hessian
+  pendulum at the end) with, by default, the marginal cost of the radiation the plan's own
+  motion causes (:func:`marginal_radiation`); a dense primal-dual interior point with the
+  exact Hessian
   (:mod:`._buoy_plan`), warm-started from the previous motion. The held torques are the
   plan's torque averaged over each sample. Without efficiency (mechanical only).
 - ``"fixed-point"``: the pendulum MPC planning on the heave the coupled model predicts under
@@ -333,10 +335,11 @@ class _Plant:
         self.k0 += n * steps
         return ok, ys
 
-    def predict(self, u, steps, fn, memory_force=False):
+    def predict(self, u, steps, fn, memory_force=False, velocity=False):
         """The heave acceleration (m/s^2) at the half-step nodes under the held torques ``u``
         from the current state, without changing the plant (and, with ``memory_force``, the
-        memory force there, N); None if it diverged."""
+        memory force there, N, and with ``velocity`` also the heave speed, m/s, at the step
+        points from now on); None if it diverged."""
         from ._control_kernel import advance
 
         nk, n = self.nk, u.size
@@ -349,6 +352,8 @@ class _Plant:
                      self.h, self.w, self.p, ys, zdd, np.zeros(3), mun)
         if not ok:
             return None
+        if velocity:
+            return zdd, mun, vel[nk:].copy()
         return (zdd, mun) if memory_force else zdd
 
 
@@ -438,6 +443,35 @@ def _check_solve(res, u):
     return x, int(bad)
 
 
+def marginal_radiation(w, v):
+    r"""The part of the marginal cost of radiation that the frozen memory force leaves out.
+
+    With the memory force ``mu_i = sum_q w_q v_{i-q}`` (the plant's weights ``w``, ``q = 0..
+    nk``, on its step ``h``) the energy radiated through it over the steps ``i >= 0``,
+    ``R = h sum_i v_i mu_i``, changes with the speed ``v_i`` at a step of the horizon by
+    ``dR / dv_i = h (mu_i + a_i)``, ``a_i = sum_q w_q v_{i+q}``: the memory force now, and the
+    force this speed will exert on the later speeds. A plan with ``mu`` frozen sees only the
+    first (its optimum drives the buoy past the absorption optimum: docs/buoy.md); ``plan``
+    with ``radiation_cost`` weights ``z'`` in its objective by ``F - mu - a`` instead.
+
+    Parameters
+    ----------
+    w : array
+        The memory weights ``(nk + 1,)`` (N s/m; :func:`.timedomain._memory_weights`).
+    v : array
+        The predicted speed (m/s) at the steps ``i = 0..`` of the horizon; zero after it.
+
+    Returns
+    -------
+    array
+        ``a`` (N) at the same steps.
+    """
+    v = np.asarray(v, dtype=float)
+    # the weights beyond the horizon meet only the zeros after it
+    w = np.asarray(w, dtype=float)[:v.size]
+    return np.correlate(np.concatenate((v, np.zeros(w.size - 1))), w, mode="valid")
+
+
 def _rel(a, b) -> float:
     return float(np.linalg.norm(a - b) / max(np.linalg.norm(a), 1e-300))
 
@@ -501,11 +535,12 @@ class _MotionPlanner:
     (:class:`._buoy_plan.CoupledPlan`) of every update, warm-started from the previous
     motion shifted by the samples since."""
 
-    def __init__(self, n, dt, ps, p, torque_limit, tu):
+    def __init__(self, n, dt, ps, p, torque_limit, tu, radiation_cost=True):
         from ..control.mpc import _gauss3
         from ._buoy_plan import CoupledPlan
 
         self.n, self.dt, self.ps, self.tu = n, dt, ps, tu
+        self.radiation_cost = bool(radiation_cost)
         self.k = max(1, -(-n // PLAN_INTERVAL_SAMPLES))
         self.hh = n * dt / self.k
         off, self.w3 = _gauss3(dt)
@@ -542,18 +577,30 @@ class _MotionPlanner:
         residual (and its untimed seconds), the solves and the failures."""
         pr = self.prob
         y0 = plant.y.copy()
-        out = plant.predict(u0 * self.tu, self.ps, fseg, memory_force=True)
+        rc = self.radiation_cost
+        ts = plant.h * np.arange(self.n * self.ps + 1)  # the plant's steps
+        out = plant.predict(u0 * self.tu, self.ps, fseg, memory_force=True, velocity=rc)
         mu = out[1] if out is not None else np.full(fseg.size, plant.mus[0])
+        adj = (marginal_radiation(plant.w, out[2]) if rc and out is not None
+               else np.zeros(ts.size))
         x = self.start(y0, shift)
         u, ch, failed, kept = u0, [], 0, 0
         for it in range(iterations):
             if it:
-                out = plant.predict(u * self.tu, self.ps, fseg, memory_force=True)
+                out = plant.predict(u * self.tu, self.ps, fseg, memory_force=True,
+                                    velocity=rc)
                 if out is not None:
                     ch.append(_rel(out[1], mu))
                     mu = (1 - relaxation) * mu + relaxation * out[1]
+                    if rc:
+                        adj = ((1 - relaxation) * adj
+                               + relaxation * marginal_radiation(plant.w, out[2]))
             fm = fseg - mu
-            pr.set_start(y0, lambda s, fm=fm: np.interp(s, self.tf, fm))
+            fobj = None
+            if rc:
+                def fobj(s, fm=fm, adj=adj):
+                    return np.interp(s, self.tf, fm) - np.interp(s, ts, adj)
+            pr.set_start(y0, lambda s, fm=fm: np.interp(s, self.tf, fm), fobj)
             with _blas_controller().limit(limits=1, user_api="blas"):
                 xs, status, _ = pr.solve(x, max_iter=PLAN_MAX_ITER)
             if not np.all(np.isfinite(xs)):
@@ -580,7 +627,7 @@ def buoy_mpc(hydro, pendulum, wave, *, peak_period, horizon=2.0, update_interval
              warmup=4.0, repeats=1, torque_limit=None, efficiency=None, terminal_weight=None,
              model_steps=MODEL_STEPS, plant_steps=PLANT_STEPS, memory=None, a_inf=None,
              max_iter=None, residual=True, terminal="total", time_limit=None,
-             deadline=None) -> BuoyMPCResult:
+             deadline=None, radiation_cost=True) -> BuoyMPCResult:
     """Receding-horizon control of the pendulum inside the buoy in a periodic record.
 
     Parameters
@@ -630,6 +677,11 @@ def buoy_mpc(hydro, pendulum, wave, *, peak_period, horizon=2.0, update_interval
         ``time_limit`` from now): once it has passed the run stops before its next update
         (after at least one) with the status ``"time_limit"``: a partial run, no success,
         its powers over the samples run.
+    radiation_cost : bool
+        ``plan``: weight the heave speed in the horizon objective by ``F_exc - mu - a``
+        (:func:`marginal_radiation`: the radiation the plan's own motion causes later in the
+        horizon, from the motion predicted under the previous plan) instead of ``F_exc -
+        mu`` (False: the memory force frozen alone, the planner before; docs/buoy.md).
     """
     from ..control import mpc as _mpc
     from ..control.mpc import HorizonProblem
@@ -716,7 +768,7 @@ def buoy_mpc(hydro, pendulum, wave, *, peak_period, horizon=2.0, update_interval
             qw = zfree / g
     tl_nd = None if torque_limit is None else torque_limit / tu
     if controller == "plan":
-        prob = _MotionPlanner(n, dt, ps, plant.p, torque_limit, tu)
+        prob = _MotionPlanner(n, dt, ps, plant.p, torque_limit, tu, radiation_cost)
     elif controller == "coupled":
         prob = CoupledHorizon(n, dt / ms, ms, plant.p, tu, tl_nd, eta, terminal_weight,
                               terminal)
