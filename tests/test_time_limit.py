@@ -39,25 +39,26 @@ def _refused(argv, capsys) -> str:
     (["buoy", "--optimize-design", "mass,length,inertia,damping-coefficient"],
      "optimize-design:", "choose at most 3 of them"),
     (["horizon", "--records", "20", "--repeat-period", "3200"], "repeat-period:",
-     "--repeat-period at most 174 s (one record)"),
+     "--repeat-period at most 271.8 s (one record)"),
     (["power-matrix", "--hs", "0.5:5:100", "--te", "4:13:100"], "hs:", "--store"),
     (["track", "--controller", "mpc", "--periods", "2000"], "periods:",
      "--periods at most 416"),
     # neighbours: the same work a decade smaller, still over the cap
     (["horizon", "--records", "2", "--repeat-period", "3200"], "repeat-period:",
-     "--repeat-period at most 174 s (one record)"),
+     "--repeat-period at most 271.8 s (one record)"),
     (["horizon", "--records", "2", "--repeat-period", "320"], "repeat-period:",
-     "--repeat-period at most 174 s (one record)"),
+     "--repeat-period at most 271.8 s (one record)"),
     (["horizon", "--records", "3", "--repeat-period", "800"], "repeat-period:",
-     "--repeat-period at most 174 s (one record)"),
+     "--repeat-period at most 271.8 s (one record)"),
     (["horizon", "--records", "3", "--repeat-period", "160"], "records:",
      "--records at most 1"),
-    # the curve's old default record (100 waves, estimated at 9 minutes), and with an
-    # efficiency and a torque limit on the default 20-wave record (about 143 s)
+    # the curve's old default record (100 waves, estimated at 6 minutes), and with an
+    # efficiency and a torque limit on a 20-wave record at five horizons (about 143 s)
     (["horizon", "--repeat-period", "800"], "repeat-period:",
-     "--repeat-period at most 174 s (one record)"),
-    (["horizon", "--hs", "1.5", "--tp", "7", "--torque-limit", "1", "--efficiency", "0.9"],
-     "repeat-period:", "--repeat-period at most 113 s (one record)"),
+     "--repeat-period at most 271.8 s (one record)"),
+    (["horizon", "--hs", "1.5", "--tp", "7", "--torque-limit", "1", "--efficiency", "0.9",
+      "--horizons", "0.25,0.5,1,2,4"], "repeat-period:",
+     "--repeat-period at most 113 s (one record)"),
     # the records' optima and baselines count too (20 x 400 waves: roughly 40 minutes)
     (["horizon", "--records", "20", "--repeat-period", "3200", "--forecasts", "none"],
      "records:", "--records at most 1"),
@@ -84,7 +85,7 @@ class _Started(Exception):
 
 
 @pytest.mark.parametrize("kw", [
-    {},  # the default curve: one 20-wave record, estimated at about 104 s
+    {},  # the default curve: one 20-wave record, 4 horizons, estimated at 71 s
     {"hs": 1.5, "tp": 7, "torque_limit": 1, "efficiency": 0.9, "horizons": "0.5,1,2"},
     {"repeat_period": 160, "horizons": "0.25,0.5,1,2,4", "records": 3,
      "forecasts": "perfect", "baselines": "none", "warm_up": 4},
