@@ -38,8 +38,6 @@ def _refused(capsys, *args, names):
     (["--draft", "1e300"], ["draft"]),
     (["--draft", "100"], ["draft"]),
     (["--draft", "1000"], ["draft"]),
-    (["--radius", "100"], ["radius"]),
-    (["--radius", "1000"], ["radius"]),
     (["--efficiency", "5e-324"], ["efficiency"]),
     (["--efficiency", "0.9,1e-310"], ["efficiency"]),
     (["--efficiency", "1e-300"], ["efficiency"]),

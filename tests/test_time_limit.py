@@ -39,15 +39,29 @@ def _refused(argv, capsys) -> str:
     (["buoy", "--optimize-design", "mass,length,inertia,damping-coefficient"],
      "optimize-design:", "choose at most 3 of them"),
     (["horizon", "--records", "20", "--repeat-period", "3200"], "repeat-period:",
-     "--repeat-period at most 1380 s (one record)"),
+     "--repeat-period at most 271.8 s (one record)"),
     (["power-matrix", "--hs", "0.5:5:100", "--te", "4:13:100"], "hs:", "--store"),
     (["track", "--controller", "mpc", "--periods", "2000"], "periods:",
      "--periods at most 416"),
     # neighbours: the same work a decade smaller, still over the cap
     (["horizon", "--records", "2", "--repeat-period", "3200"], "repeat-period:",
-     "--repeat-period at most 1380 s (one record)"),
-    (["horizon", "--records", "3", "--repeat-period", "800"], "records:",
+     "--repeat-period at most 271.8 s (one record)"),
+    (["horizon", "--records", "2", "--repeat-period", "320"], "repeat-period:",
+     "--repeat-period at most 271.8 s (one record)"),
+    (["horizon", "--records", "3", "--repeat-period", "800"], "repeat-period:",
+     "--repeat-period at most 271.8 s (one record)"),
+    (["horizon", "--records", "3", "--repeat-period", "160"], "records:",
      "--records at most 1"),
+    # the curve's old default record (100 waves, estimated at 6 minutes), and with an
+    # efficiency and a torque limit on a 20-wave record at five horizons (about 143 s)
+    (["horizon", "--repeat-period", "800"], "repeat-period:",
+     "--repeat-period at most 271.8 s (one record)"),
+    (["horizon", "--hs", "1.5", "--tp", "7", "--torque-limit", "1", "--efficiency", "0.9",
+      "--horizons", "0.25,0.5,1,2,4"], "repeat-period:",
+     "--repeat-period at most 113 s (one record)"),
+    # the records' optima and baselines count too (20 x 400 waves: roughly 40 minutes)
+    (["horizon", "--records", "20", "--repeat-period", "3200", "--forecasts", "none"],
+     "records:", "--records at most 1"),
     (["power-matrix", "--hs", "1:3:3", "--te", "6:10:3", "--realizations", "100"],
      "realizations:", "--realizations at most"),
     (["buoy", "--wave-period", "1.2:3:200"], "wave-period:", "at most 94 periods"),
@@ -64,6 +78,34 @@ def test_the_largest_value_named_fits():
 
     each = update_seconds(2.0) * 32  # 32 updates a period at the default 1/32
     assert 416 * each <= limits.MAX_UNTIMED_SECONDS < 417 * each
+
+
+class _Started(Exception):
+    """Raised where the work would start: the estimate let it through."""
+
+
+@pytest.mark.parametrize("kw", [
+    {},  # the default curve: one 20-wave record, 4 horizons, estimated at 71 s
+    {"hs": 1.5, "tp": 7, "torque_limit": 1, "efficiency": 0.9, "horizons": "0.5,1,2"},
+    {"repeat_period": 160, "horizons": "0.25,0.5,1,2,4", "records": 3,
+     "forecasts": "perfect", "baselines": "none", "warm_up": 4},
+])
+def test_horizon_documented_curves_run_untimed(kw, monkeypatch):
+    # the documented curves pass the 2-minute estimate (stopped where the first record's
+    # optimum would start: the curve itself takes a minute); the default record is 20 Tp
+    import parapend.irregular
+
+    seen = {}
+
+    def started(**kwargs):
+        seen.update(kwargs)
+        raise _Started
+
+    monkeypatch.setattr(parapend.irregular, "sea", started)
+    with pytest.raises(_Started):
+        parapend.horizon(**kw)
+    tp = kw.get("tp", 8.0)
+    assert seen["repeat_period"] == pytest.approx(kw.get("repeat_period", 20 * tp))
 
 
 @pytest.mark.parametrize("argv, match", [
@@ -83,6 +125,8 @@ def test_the_helpers():
     with pytest.raises(ParameterError, match="time-limit"):
         check_time_limit(math.inf)
     assert duration(45) == "45 s" and duration(600) == "10 minutes"
+    # beside the 120 s cap a refused 143 s must not read "2 minutes"
+    assert duration(143) == "143 s" and duration(299) == "299 s"
     assert duration(12 * 3600) == "12 hours" and duration(3 * 86400) == "3 days"
     cap = limits.MAX_UNTIMED_SECONDS
     refuse_untimed("x", "work", cap, "fix")  # at the cap: runs

@@ -52,9 +52,10 @@ def expired(when) -> bool:
 
 
 def duration(seconds: float) -> str:
-    """A rough duration in words: ``"45 s"``, ``"12 minutes"``, ``"3 hours"``."""
-    for unit, size in (("days", 86400.0), ("hours", 3600.0), ("minutes", 60.0)):
-        if seconds >= 2 * size:
+    """A rough duration in words: ``"45 s"``, ``"143 s"``, ``"12 minutes"``, ``"3 hours"``
+    (seconds below 5 minutes: "2 minutes" beside the 120 s cap read as no more than it)."""
+    for unit, size, least in (("days", 86400.0, 2), ("hours", 3600.0, 2), ("minutes", 60.0, 5)):
+        if seconds >= least * size:
             return f"{seconds / size:.0f} {unit}"
     return f"{seconds:.0f} s"
 

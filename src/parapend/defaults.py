@@ -72,10 +72,14 @@ HULL = {"wave_height": 1.0, "wave_period": 6.0, "hs": 1.0, "tp": 6.0, "repeat_pe
         "pivot_height": 0.5, "pivot_offset": 0.0}
 
 #: ``horizon``: the horizons (peak periods), forecasts and baselines of the curve, the
-#: number of seeded records and the update interval of the receding-horizon controller
-HORIZON = {"horizons": "0.25,0.5,1,2,4", "forecasts": "perfect,ar",
+#: number of seeded records and the update interval of the receding-horizon controller; each
+#: record ``repeat_periods`` peak periods long without ``--repeat-period`` (20 waves: the
+#: curve of docs/control.md; the 100 of ``sea``'s record cost ten receding-horizon runs of
+#: 3200 updates, estimated at 9 minutes, past the 2 minutes a command runs untimed; the
+#: horizon 4, 40 % of the estimate, took the curve to 118 s at a load of 8 and is left out)
+HORIZON = {"horizons": "0.25,0.5,1,2", "forecasts": "perfect,ar",
            "baselines": "tracker,extremum", "records": 1, "update_interval": 0.03125,
-           "warm_up": 0.0, "speed_limit": None}
+           "warm_up": 0.0, "speed_limit": None, "repeat_periods": 20}
 
 #: ``track --controller``: the regular-wave controller by default; with ``mpc`` the horizon
 #: and the update interval (peak periods) and the wave forecast of the receding-horizon

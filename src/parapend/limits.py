@@ -17,7 +17,7 @@ __all__ = [
     "SQUARE_ALPHA_MIN", "MAP_MAX_POINTS", "MAP_MAX_PTO_POINTS", "MAP_MAX_HARMONICS",
     "MAP_MAX_WORK", "UNIT_GRAVITY_RANGE", "UNIT_INERTIA_RATIO", "UNIT_LENGTH_RANGE",
     "UNIT_MASS_RANGE", "SEA_MAX_RESAMPLED", "SEA_MIN_HS", "TRACK_MAX_STEP_RATE",
-    "MAX_UNTIMED_SECONDS", "MAX_TIME_LIMIT", "HORIZON_MAX_UNTIMED_SECONDS",
+    "MAX_UNTIMED_SECONDS", "MAX_TIME_LIMIT",
 ]
 
 # --- long work: estimate first, then refuse or run under a time limit (parapend.deadline) ---
@@ -28,11 +28,6 @@ __all__ = [
 #: resumes, so its long work is announced and runs). Two minutes: the audits' bound on a
 #: command; the estimates are rounded up, so work near it takes less
 MAX_UNTIMED_SECONDS = 120.0
-#: the same for ``parapend horizon``: its default curve (one 800 s record, two forecasts x
-#: five horizons, 3200 updates each) is estimated at 9 minutes and its documented curves (a
-#: torque limit and an efficiency: 12 minutes) must run, so its cap is 15 minutes; the
-#: 20-record curve of 3200 s records (about 12 hours) is refused
-HORIZON_MAX_UNTIMED_SECONDS = 900.0
 #: the largest --time-limit, s (a week: a resumable power matrix may run for days; the
 #: bound keeps the deadline a finite float)
 MAX_TIME_LIMIT = 7 * 86400.0

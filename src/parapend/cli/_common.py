@@ -139,11 +139,13 @@ def _excitation_kwargs(a) -> dict:
 def add_sea_options(g, *, repeat_period: str = "the record repeats with it",
                     seed: str = "seed of the random phases (default 0)",
                     cutoff: str = "highest frequency, in units of the peak frequency, 1.5 "
-                                  "to 10 (default 3)") -> None:
+                                  "to 10 (default 3)",
+                    repeat_default: float = 100) -> None:
     """The sea state of ``sea`` and ``horizon`` into the argument group ``g``: ``--hs --tp
     --spectrum --gamma-peak --repeat-period --seed --cutoff`` (the defaults are
     :func:`parapend.seas` 's). ``repeat_period`` (what the record length is), ``seed`` and
-    ``cutoff`` are the commands' own help texts."""
+    ``cutoff`` are the commands' own help texts, ``repeat_default`` the default record in
+    peak periods."""
     from .. import limits
 
     g.add_argument("--hs", type=_finite_float("hs"),
@@ -156,7 +158,8 @@ def add_sea_options(g, *, repeat_period: str = "the record repeats with it",
                    help="JONSWAP peak enhancement in [1, 20] (default 3.3)")
     g.add_argument("--repeat-period", type=_finite_float("repeat-period"),
                    help=f"T_r, s: {repeat_period}; {limits.SEA_WAVES_RANGE[0]:g} "
-                        f"to {limits.SEA_WAVES_RANGE[1]:g} peak periods (default 100 Tp)")
+                        f"to {limits.SEA_WAVES_RANGE[1]:g} peak periods (default "
+                        f"{repeat_default:g} Tp)")
     g.add_argument("--seed", type=_int, help=seed)
     g.add_argument("--cutoff", type=_finite_float("cutoff"), help=cutoff)
 

@@ -29,7 +29,8 @@ def add_parsers(sub) -> None:
     add_sea_options(g, repeat_period="the length of each record",
                     seed="seed of the first record's phases; record r has seed + r "
                          "(default 0)",
-                    cutoff="highest frequency, in units of the peak frequency (default 3)")
+                    cutoff="highest frequency, in units of the peak frequency (default 3)",
+                    repeat_default=HORIZON["repeat_periods"])
     g.add_argument("--records", type=_int,
                    help="seeded records, 1 to 20 (default 1)")
     g = p.add_argument_group("pendulum (SI units) and power take-off")

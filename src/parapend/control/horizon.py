@@ -215,12 +215,20 @@ def _stats(a):
     return float(np.mean(a[ok])), float(np.min(a[ok])), float(np.max(a[ok]))
 
 
-def _longest_record(exc, warm_up, tp_n, records, est, cap) -> float:
-    """The longest record (pendulum time) one curve of the estimate ``est`` (s, over
-    ``records`` records like ``exc``) fits in ``cap`` seconds with: the estimate is in
-    proportion to each run's length, the record plus the warm-up."""
-    run = exc.period + warm_up * tp_n
-    return max(run * cap / (est / records) - warm_up * tp_n, 0.0)
+#: rough wall time (s) per peak period of a record of its non-causal optimum (``sea``) and of
+#: each baseline, for the estimate: one record with both baselines took 2.8 s (20 waves), 5.7
+#: s (20 waves, a torque limit and an efficiency) and 16 s (100 waves) on 2 cores at a load
+#: of 4; ``RECORD_SECONDS * (1 + baselines)`` a peak period counts 6 s and 30 s
+RECORD_SECONDS = 0.1
+
+
+def _longest_record(exc, warm_up, tp_n, mpc_est, rec_est, cap) -> float:
+    """The longest record (pendulum time) one record's estimate fits in ``cap`` seconds with:
+    ``mpc_est`` (s, its receding-horizon runs) is in proportion to each run's length, the
+    record ``exc`` plus the warm-up, ``rec_est`` (its optimum and baselines) to the record's."""
+    run, rec = exc.period + warm_up * tp_n, exc.period
+    a, b = mpc_est / run, rec_est / rec  # seconds per unit time of run and of record
+    return max((cap - a * warm_up * tp_n) / (a + b), 0.0)
 
 
 def horizon_curve(*, hs=None, tp=None, spectrum: str = "jonswap", gamma_peak: float = 3.3,
@@ -241,7 +249,8 @@ def horizon_curve(*, hs=None, tp=None, spectrum: str = "jonswap", gamma_peak: fl
     ----------
     hs, tp, spectrum, gamma_peak, repeat_period, seed, cutoff :
         The sea state (:func:`parapend.seas.sea_record`; ``repeat_period`` in s, default
-        ``100 tp``); record ``r`` has the seed ``seed + r``. ``hs``, ``tp``, ``seed`` None:
+        ``20 tp``, ``parapend.defaults.HORIZON["repeat_periods"]`` peak periods, not ``sea``'s
+        100); record ``r`` has the seed ``seed + r``. ``hs``, ``tp``, ``seed`` None:
         2 m, 8 s, 0 (``parapend.defaults.SEA``).
     length, mass, inertia, gravity, gamma, damping_coefficient :
         The pendulum, as :func:`parapend.irregular.sea` (default ``gamma = 0.01``).
@@ -263,8 +272,8 @@ def horizon_curve(*, hs=None, tp=None, spectrum: str = "jonswap", gamma_peak: fl
     progress : callable or None
         Called ``progress(done, total)`` as the work goes, in torque samples (64 a peak
         period): every run counts its samples (the non-causal optimum and each baseline
-        the record's); within a receding-horizon run at most every 0.25 s. A curve whose
-        receding-horizon runs are estimated to take more than 30 s is announced on the
+        the record's); within a receding-horizon run at most every 0.25 s. A curve estimated
+        to take more than 30 s (``time_limit``) is announced on the
         ``parapend.control`` logger (INFO) before any work.
     warm_up : float
         Peak periods of the receding-horizon runs left out of their mean (start-up from
@@ -275,12 +284,14 @@ def horizon_curve(*, hs=None, tp=None, spectrum: str = "jonswap", gamma_peak: fl
         is reported; units ``sqrt(g / l)``;
         :func:`parapend.control.mpc.mpc_run`); None: none.
     time_limit : float or None
-        Seconds for the whole curve: without it, receding-horizon runs estimated above
-        ``parapend.limits.HORIZON_MAX_UNTIMED_SECONDS`` are refused (naming the most records that
-        fit); with it the work stops at the first run (a record's optimum, receding-horizon
-        run or baseline) after the limit: the runs not finished are NaN with the status
-        ``"time_limit"``, and the result's ``status`` is ``"time_limit"`` (``success``
-        False; :mod:`parapend.deadline`).
+        Seconds for the whole curve: without it, a curve estimated above
+        ``parapend.limits.MAX_UNTIMED_SECONDS`` (its receding-horizon updates at
+        :func:`parapend.control.mpc.update_seconds`, its records' optima and baselines at
+        ``RECORD_SECONDS`` a peak period each) is refused, naming the most records that fit
+        or the longest record; with it the work stops at the first run (a record's optimum,
+        receding-horizon run or baseline) after the limit: the runs not finished are NaN
+        with the status ``"time_limit"``, and the result's ``status`` is ``"time_limit"``
+        (``success`` False; :mod:`parapend.deadline`).
     """
     from ..deadline import check_time_limit, deadline, duration, expired, refuse_untimed
     from ..irregular import sea
@@ -296,6 +307,11 @@ def horizon_curve(*, hs=None, tp=None, spectrum: str = "jonswap", gamma_peak: fl
     hs = SEA["hs"] if hs is None else hs
     tp = SEA["tp"] if tp is None else tp
     seed = SEA["seed"] if seed is None else seed
+    if repeat_period is None:  # the curve's own record length, not sea's 100 waves
+        from ..seas import _check_sea
+
+        tp = _check_sea(hs, tp, spectrum, gamma_peak, None, cutoff)[1]
+        repeat_period = HORIZON["repeat_periods"] * tp
     if torque_limit_nm is not None:
         if torque_limit is not None:
             raise ParameterError("torque-limit-nm: give either --torque-limit or "
@@ -355,27 +371,29 @@ def horizon_curve(*, hs=None, tp=None, spectrum: str = "jonswap", gamma_peak: fl
     from .mpc import ANNOUNCE_SECONDS, log, update_seconds
 
     upd_samples = max(1, round(upd * 64))
-    est = sum(math.ceil(n / upd_samples) for n in mpc_samples) * sum(
-        update_seconds(h, torque_limit, f) for f in fc for h in hz)
-    cap = limits.HORIZON_MAX_UNTIMED_SECONDS
-    most = int(cap / (est / records)) if est > 0 else records
-    longest = (_longest_record(excs[0], warm_up, tp_n, records, est, cap) * units.time
-               if est > 0 else math.inf)  # (no receding-horizon run: nothing to refuse)
-    refuse_untimed("records" if most >= 1 else "repeat-period",
-                   f"{records} record(s) x {len(fc)} forecast(s) x {len(hz)} horizon(s) of "
-                   f"receding-horizon runs, {math.ceil(mpc_samples[0] / upd_samples)} "
-                   "updates each,", est,
+    # the estimate: the receding-horizon updates, and each record's optimum and baselines
+    per_update = sum(update_seconds(h, torque_limit, f) for f in fc for h in hz)
+    mpc_est = [math.ceil(n / upd_samples) * per_update for n in mpc_samples]
+    rec_est = [RECORD_SECONDS * (1 + len(bl)) * exc.period / tp_n for exc in excs]
+    est = sum(mpc_est) + sum(rec_est)
+    cap = limits.MAX_UNTIMED_SECONDS
+    most = int(cap / (est / records))
+    longest = _longest_record(excs[0], warm_up, tp_n, mpc_est[0], rec_est[0], cap) * units.time
+    what = (f"{records} record(s) x {len(fc)} forecast(s) x {len(hz)} horizon(s) of "
+            f"receding-horizon runs, {math.ceil(mpc_samples[0] / upd_samples)} updates each, "
+            "with the records' optima and baselines," if fc else
+            f"{records} record(s) of {excs[0].period / tp_n:.4g} peak periods (their optima "
+            "and baselines)")
+    refuse_untimed("records" if most >= 1 else "repeat-period", what, est,
                    f"use --records at most {most}" if most >= 1 else
-                   f"use --repeat-period at most {longest:.4g} s (one record), or fewer "
-                   "--horizons or --forecasts",
+                   f"use --repeat-period at most {longest:.4g} s (one record)"
+                   + (", or fewer --horizons or --forecasts" if fc else ""),
                    time_limit, cap)
     if est > ANNOUNCE_SECONDS:
-        log.info("horizon: %d record(s) x %d forecast(s) x %d horizon(s) of receding-horizon "
-                 "runs, %d updates each: roughly %s on one core, besides the records' optima "
-                 "and the baselines (the progress bar gives the rate; Ctrl-C stops it)",
-                 records, len(fc), len(hz), math.ceil(mpc_samples[0] / upd_samples),
-                 duration(est) + ("" if time_limit is None else
-                                   f" (stopped after the time limit {time_limit:g} s)"))
+        log.info("horizon: %s: roughly %s on one core%s (the progress bar gives the rate; "
+                 "Ctrl-C stops it)", what.rstrip(","), duration(est),
+                 "" if time_limit is None else
+                 f" (stopped after the time limit {time_limit:g} s)")
     runs_done = [0]  # runs finished; the time limit is checked before each next one
     stopped = [False]
 

@@ -95,42 +95,48 @@ def _dimensions(body, radius, draft):
 
 
 def _check_bem_size(radius, draft):
-    """Refuse a cylinder whose BEM would not finish in about a minute: the panels of its
-    mesh (Capytaine's own count for the panel radius :func:`.bem.cylinder` uses) times the
-    panels of one slice, against :data:`parapend.limits.BUOY_MAX_BEM_WORK`."""
-    from .bem import GEOMETRY_PANELS
+    """Refuse a cylinder whose BEM would not finish in about a minute: the influence
+    coefficients of its mesh (:func:`.bem.cylinder_work` at the panel radius
+    :func:`.bem.cylinder` uses) against :data:`parapend.limits.BUOY_MAX_BEM_WORK`. A wide,
+    shallow body's panels follow the shortest wave solved (:func:`.bem.cylinder_scale`), so
+    only a tall one (its panels follow the radius) is refused."""
+    from .bem import GEOMETRY_PANELS, cylinder_scale, cylinder_work
 
     def work(r, d):
-        hh = math.sqrt(2) * min(r, d) / GEOMETRY_PANELS
-        nr, nth, nz = math.ceil(r / hh), 2 * math.ceil(math.pi * r / hh), math.ceil(2 * d / hh)
-        piece = nr + math.ceil(nz / 2)
-        return piece * nth * piece
+        return cylinder_work(r, d, cylinder_scale(r, d) / GEOMETRY_PANELS)
 
     cap = limits.BUOY_MAX_BEM_WORK
     if work(radius, draft) <= cap:
         return
-    # the largest value of the larger dimension that fits, the other held
-    big = "radius" if radius >= draft else "draft"
-    small = min(radius, draft)
-    a, b = small, max(radius, draft)
+    # the largest draft that fits, the radius held (a wide body is never refused)
+    a, b = radius, draft
     for _ in range(60):
         mid = math.sqrt(a * b)
-        w = work(mid, small) if big == "radius" else work(small, mid)
-        a, b = (mid, b) if w <= cap else (a, mid)
-    other = ""
-    if big == "radius" and work(radius, radius) <= cap:
-        # the panels follow the draft: a deeper draft coarsens them (a wide, shallow body's
-        # mesh is the costly one); the smallest draft that fits at this radius
-        lo_d, hi_d = draft, radius
-        for _ in range(60):
-            mid = math.sqrt(lo_d * hi_d)
-            lo_d, hi_d = (lo_d, mid) if work(radius, mid) <= cap else (mid, hi_d)
-        other = f", or --draft at least {hi_d * (1 + 1e-3):.3g} m at this radius"
-    raise ParameterError(f"{big}: a cylinder of radius {radius:g} m and draft {draft:g} m "
+        a, b = (mid, b) if work(radius, mid) <= cap else (a, mid)
+    raise ParameterError(f"draft: a cylinder of radius {radius:g} m and draft {draft:g} m "
                          f"needs a BEM of about {work(radius, draft):.3g} influence "
                          f"coefficients per frequency, more than the {cap:.3g} that finish in "
                          f"about a minute (the panels follow the smaller dimension); use "
-                         f"--{big} at most {a:.3g} m{other}")
+                         f"--draft at most {a:.3g} m")
+
+
+def _parametric_top(body, radius, draft) -> float:
+    """The highest frequency (rad/s) of a parametric body's own grid, without its BEM: the
+    wave whose length is 12 panel radii (:func:`.bem.body_frequencies`)."""
+    from . import bem as hy
+
+    r, d = _dimensions(body, radius, draft)
+    scale = r if body == "sphere" else hy.cylinder_scale(r, d)
+    return float(hy.body_frequencies(scale / hy.GEOMETRY_PANELS)[-1])
+
+
+def _check_short(top, periods, body=None, radius=None) -> None:
+    """Refuse waves shorter than the body's grid reaches (``top``, rad/s) in one line."""
+    if float(np.max(2 * math.pi / periods)) > top * (1 + 1e-9):
+        what = "" if radius is None else f" ({body or 'cylinder'} of radius {radius:g} m)"
+        raise ParameterError(f"wave-period: the waves are too short for the body's "
+                             f"mesh{what}; its frequencies cover periods from "
+                             f"{2 * math.pi / top:.4g} s up, got {float(np.min(periods)):g} s")
 
 
 def _check_harmonics(harmonics, winding, pto):
@@ -479,13 +485,12 @@ def buoy(*, wave_height=None, wave_period=None, hs=None, tp=None, spectrum=None,
             periods_all = np.array([period])
         else:
             periods_all = np.array([_period(p) for p in periods])
+        if mesh is None and hydro is None:  # known before the BEM: refuse before it
+            _check_short(_parametric_top(body, radius, draft), periods_all, body, radius)
         h, width = _hydro(body, radius, draft, mesh, hydro, wave_direction)
         w = 2 * math.pi / periods_all
-        top = float(np.max(h.omega))
-        if hydro is None and float(np.max(w)) > top * (1 + 1e-9):
-            raise ParameterError(f"wave-period: the waves are too short for the body's mesh; "
-                                 f"its frequencies cover periods from {2 * math.pi / top:.4g} "
-                                 f"s up, got {float(np.min(periods_all)):g} s")
+        if hydro is None:
+            _check_short(float(np.max(h.omega)), periods_all)
         h.check_covers(float(np.min(w)), float(np.max(w)), name="wave-period")
     _check_floats(h, pend)
     # the body on a second, coarser mesh: the estimate of the discretization error

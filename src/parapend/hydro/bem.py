@@ -40,8 +40,8 @@ import numpy as np
 
 from ..errors import ParameterError, check_int, check_positive
 
-__all__ = ["Hydro", "body_frequencies", "cache_dir", "cylinder", "frequencies_for",
-           "from_mesh", "load", "mesh_size", "sphere"]
+__all__ = ["Hydro", "body_frequencies", "cache_dir", "cylinder", "cylinder_scale",
+           "cylinder_work", "frequencies_for", "from_mesh", "load", "mesh_size", "sphere"]
 
 #: Bump when the cached content or the meshing rule changes (old entries are then ignored).
 CACHE_VERSION = 1
@@ -350,6 +350,45 @@ def mesh_size(scale, omega_max, *, g=9.81, water_depth=math.inf, refine=1.0):
     return max(h, scale / FINEST_PANELS) / refine
 
 
+def cylinder_work(radius, draft, h) -> float:
+    """Influence coefficients of one BEM frequency of a vertical cylinder meshed at panel
+    radius ``h`` (Capytaine's own panel counts for ``faces_max_radius=h``, rotation-symmetric:
+    the panels of one slice times the panels of the mesh, over the slices)."""
+    hh = math.sqrt(2) * h
+    nr = math.ceil(radius / hh)
+    nth = 2 * math.ceil(math.pi * radius / hh)
+    nz = math.ceil(2 * draft / hh)
+    piece = nr + math.ceil(nz / 2)
+    return float(piece * nth * piece)
+
+
+def cylinder_scale(radius, draft) -> float:
+    """The size (m) a cylinder's mesh follows (panel radius ``scale / GEOMETRY_PANELS``): the
+    smaller of radius and draft; for a wide, shallow body whose mesh at the draft's scale
+    exceeds :data:`parapend.limits.BUOY_MAX_BEM_WORK`, the smallest scale up to the radius
+    whose work is at most half of it (its BEM and the error estimate's on a mesh 1.5 times
+    coarser: radius 10 m at the full cap took 109 s under a load of 6, past the minute the
+    cap means). The panels then follow the shortest wave solved, not the draft: the body's
+    grid (:func:`body_frequencies`) ends where a wavelength is 12 panel radii, and the side
+    has fewer than 12 rows (the result's mesh error, from a mesh 1.5 times coarser, says what
+    that costs). A tall body (draft above the radius) is left to the caller's refusal."""
+    from .. import limits
+
+    scale = min(radius, draft)
+    cap = limits.BUOY_MAX_BEM_WORK
+    if radius <= draft or cylinder_work(radius, draft, scale / GEOMETRY_PANELS) <= cap:
+        return scale
+    cap = cap / 2
+    lo, hi = scale, radius  # work(lo) > cap; work(radius) fits any radius up to 1e3 m
+    if cylinder_work(radius, draft, hi / GEOMETRY_PANELS) > cap:
+        return hi
+    for _ in range(60):
+        mid = math.sqrt(lo * hi)
+        lo, hi = (mid, hi) if cylinder_work(radius, draft, mid / GEOMETRY_PANELS) > cap \
+            else (lo, mid)
+    return hi
+
+
 def _resolvable(omega, h, g, depth):
     """Mask of the frequencies whose wavelength is at least 8 panel radii ``h``."""
     return np.array([2 * math.pi / _wavenumber(float(w), g, depth) >= 8 * h * (1 - 1e-9)
@@ -548,7 +587,8 @@ def cylinder(radius, draft, *, omega=None, rho=1025.0, g=9.81, water_depth=math.
     radius = check_positive("radius", radius)
     draft = check_positive("draft", draft)
     rho, g, water_depth, refine = _common(rho, g, water_depth, refine)
-    h, omega = _mesh_and_grid(min(radius, draft), omega, g, water_depth, refine)
+    scale = cylinder_scale(radius, draft)
+    h, omega = _mesh_and_grid(scale, omega, g, water_depth, refine)
     if math.isfinite(water_depth) and draft >= water_depth:
         raise ParameterError(f"draft: expected less than the water depth {water_depth:g} m, "
                              f"got {draft!r}")
@@ -560,6 +600,9 @@ def cylinder(radius, draft, *, omega=None, rho=1025.0, g=9.81, water_depth=math.
                 cpt.mesh_vertical_cylinder(**kw).immersed_part())
 
     desc = f"vertical cylinder, radius {radius:g} m, draft {draft:g} m"
+    if scale > min(radius, draft):
+        desc += (f", panel radius {h:.3g} m (a wide, shallow body: the panels follow the "
+                 "shortest wave solved, not the draft)")
     return _solve(build, omega, rho=rho, g=g, water_depth=water_depth, description=desc,
                   cache=cache, key_parts=_params(body="cylinder", **kw))
 

@@ -151,7 +151,7 @@ def _body_in_water(spec):
         return hy.from_mesh(spec.mesh, omega=omega, rho=spec.water_density,
                             water_depth=depth), None
     r, d = _dimensions(spec.body, spec.radius, spec.draft)
-    scale = r if spec.body == "sphere" else min(r, d)
+    scale = r if spec.body == "sphere" else hy.cylinder_scale(r, d)  # bem.cylinder's
     omega = "body" if not math.isfinite(depth) else _finite_grid(spec, scale, depth)
     if not isinstance(omega, str) and deep(omega):
         omega, depth = "body", math.inf
