@@ -2,10 +2,10 @@
 acceptance, on :func:`parapend.hydro.control.buoy_mpc`).
 
 Causality: altering the sea only after ``t0 + H`` leaves
-every torque held before ``t0`` bit-identical (perfect forecast, the only one the buoy's
-controller has), for the default ``coupled`` controller and the experimental ``plan``; a
-controller that peeks one horizon further fails the same check. The shape of the pendulum's
-test in tests/test_power_matrix_causal.py.
+every torque held before ``t0`` bit-identical (perfect forecast), and altering it after
+``t0`` does with the AR forecast, for the default ``coupled`` controller and the
+experimental ``plan``; a controller that peeks one horizon further fails the same check.
+The shape of the pendulum's test in tests/test_power_matrix_causal.py.
 
 The sea is altered where the run reads it: the excitation force on the plant's half-step
 nodes (:func:`parapend.hydro.control.force_nodes`, the plant's and the perfect forecast's one
@@ -45,7 +45,7 @@ REPEATS = 1
 CONTROLLERS = {"coupled": {}, "plan": {"controller": "plan", "iterations": 1}}
 
 
-def _run(monkeypatch, controller, cut=None, peek=False):
+def _run(monkeypatch, controller, cut=None, peek=False, forecast="perfect"):
     """A short closed loop (a warm-up of one peak period, one repeat of the 5 s record) with
     the excitation altered from plant node ``cut`` on (None: not); ``peek``: the controller
     is handed, beside its horizon's force, a trace (1e-3) of the force one horizon further
@@ -80,7 +80,7 @@ def _run(monkeypatch, controller, cut=None, peek=False):
             return plan(self, plant, u0, further(plant, fseg), *rest)
         monkeypatch.setattr(bc._MotionPlanner, "plan", peeking)
     return bc.buoy_mpc(SYN, PENDULUM, WAVE, **OPTS, **CONTROLLERS[controller],
-                       repeats=REPEATS)
+                       repeats=REPEATS, forecast=forecast)
 
 
 @pytest.mark.parametrize("controller, peek, causal", [
@@ -108,6 +108,33 @@ def test_torques_before_t0_ignore_the_sea_after_t0_plus_h(monkeypatch, controlle
     a, b = base.series["torque"][:j0], after.series["torque"][:j0]
     assert np.any(a != 0)
     assert np.array_equal(a, b) is causal
+
+
+@pytest.mark.parametrize("controller, forecast, peek, causal", [
+    ("coupled", "ar", False, True),  # altered after t0: nothing before t0 changes
+    ("coupled", "ar", True, False),  # an AR forecast that also peeks fails
+    ("coupled", "perfect", False, False),  # so does the perfect forecast, at this cut
+    ("plan", "ar", False, True),
+])
+def test_ar_torques_before_t0_ignore_the_sea_after_t0(monkeypatch, controller, forecast,
+                                                       peek, causal):
+    """The AR forecast (fitted at each update on the force measured so far): the torques
+    before ``t0`` were planned at ``t0 - u`` at the latest, from the state there and the
+    force measured up to it, its plant half-step node ``2 (j0 - m) ps``; the sea altered
+    from the next node on leaves them bit-identical. The perfect forecast, which reads the
+    horizon beyond ``t0 - u``, fails the same check (the test can see a look ahead)."""
+    base = _run(monkeypatch, controller, peek=peek, forecast=forecast)
+    assert base.success and base.catch_time_s is not None and base.forecast == forecast
+    dt, ps = base.dt_s, bc.PLANT_STEPS
+    m = int(round(base.update_interval_s / dt))
+    j0 = int(round(base.catch_time_s / dt)) + 3 * m
+    last = 2 * (j0 - m) * ps
+    after = _run(monkeypatch, controller, cut=last + 1, peek=peek, forecast=forecast)
+    a, b = base.series["torque"][:j0], after.series["torque"][:j0]
+    assert np.any(a != 0)
+    assert np.array_equal(a, b) is causal
+    if causal:  # and the sea after t0 did change what followed
+        assert not np.array_equal(base.series["torque"], after.series["torque"])
 
 
 #: Gauss-Legendre nodes and weights on [-1, 1] (the convolution's quadrature per sample)

@@ -118,6 +118,10 @@ def add_parsers(sub) -> None:
                    help="with mpc: forecast horizon, peak periods (default 1)")
     g.add_argument("--update-interval", type=_finite_float("update-interval"),
                    help="with mpc: re-planning interval, peak periods (default 0.125)")
+    g.add_argument("--forecast", choices=("perfect", "ar"),
+                   help="with mpc: what the controller knows of the excitation force over "
+                        "the horizon: perfect (the record's own future; default) or ar "
+                        "(autoregressive, fitted on the force measured so far)")
     p.add_argument("--time-limit", type=_finite_float("time-limit"), metavar="SECONDS",
                    help="run long work (--optimize-design, a period sweep, --controller mpc) "
                         "for at most about this long, then stop with a partial result marked "

@@ -294,7 +294,7 @@ def buoy(*, wave_height=None, wave_period=None, hs=None, tp=None, spectrum=None,
          draft=None, mesh=None, hydro=None, winding=None, harmonics=None, torque_limit=None,
          efficiency=None, optimize_design=None, mass_bounds=None, length_bounds=None,
          inertia_bounds=None, damping_coefficient_bounds=None, controller="optimum",
-         horizon=None, update_interval=None, wave_direction=None, dofs="heave",
+         horizon=None, update_interval=None, forecast=None, wave_direction=None, dofs="heave",
          pivot_height=None, pivot_offset=None, hull_pitch_inertia=None, barge_length=None,
          barge_beam=None, barge_draft=None, copper_loss=None, time_limit=None, progress=None):
     """The coupled optimum of a pendulum inside a floating buoy (command ``buoy``).
@@ -326,11 +326,13 @@ def buoy(*, wave_height=None, wave_period=None, hs=None, tp=None, spectrum=None,
     optimize_design : comma list of pendulum parameters to choose (``"length,inertia"``)
         for the largest coupled power, each within ``<name>_bounds`` ``"LO:HI"``.
 
-    controller, horizon, update_interval : ``"optimum"`` (the non-causal coupled optimum),
+    controller, horizon, update_interval, forecast : ``"optimum"`` (the non-causal coupled optimum),
         or a causal receding-horizon controller run on the coupled time-domain plant in an
         irregular sea (:mod:`parapend.hydro.control`): ``"mpc"`` (planned on the coupled model) or
         ``"one-way-mpc"`` (planned on the free buoy's heave); horizon and update interval in
-        peak periods.
+        peak periods; ``forecast`` ``"perfect"`` (default: the record's own excitation
+        force over the horizon) or ``"ar"`` (autoregressive, fitted on the force measured
+        so far), with ``"mpc"``.
 
     dofs : ``"heave"`` (default: the heaving buoy) or ``"surge,heave,pitch"``: a hull that
         surges, heaves and pitches, with a pendulum that rotates or swings (docs/hull.md;
@@ -399,11 +401,14 @@ def buoy(*, wave_height=None, wave_period=None, hs=None, tp=None, spectrum=None,
     irregular = any(v is not None for v in (hs, tp, record, repeat_period, seed))
     # options that would be accepted and ignored: refused with what they need
     if controller == "optimum":
-        for name, v in (("horizon", horizon), ("update-interval", update_interval)):
+        for name, v in (("horizon", horizon), ("update-interval", update_interval),
+                        ("forecast", forecast)):
             if v is not None:
-                raise ParameterError(f"{name}: needs --controller mpc (or one-way-mpc)")
+                raise ParameterError(f"{name}: needs --controller mpc"
+                                     + ("" if name == "forecast" else " (or one-way-mpc)"))
     horizon = 1.0 if horizon is None else horizon
     update_interval = 0.125 if update_interval is None else update_interval
+    forecast = "perfect" if forecast is None else forecast
     sea_opts = (("spectrum", spectrum), ("gamma-peak", gamma_peak), ("cutoff", cutoff),
                 ("taper", taper))
     for name, v in sea_opts:
@@ -515,7 +520,8 @@ def buoy(*, wave_height=None, wave_period=None, hs=None, tp=None, spectrum=None,
                            update_interval=update_interval, winding=winding,
                            harmonics=harmonics, torque_limit=torque_limit,
                            efficiency=efficiency, irregular=irregular,
-                           design=bool(variables), time_limit=time_limit, deadline=until)
+                           design=bool(variables), time_limit=time_limit, deadline=until,
+                           forecast=forecast)
     opts = {"winding": winding, "harmonics": harmonics, "torque_limit": torque_limit,
             "efficiency": efficiency}
     design = None

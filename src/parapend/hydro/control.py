@@ -82,6 +82,9 @@ class BuoyMPCResult(_Result):
 
     Attributes
     ----------
+    controller, forecast : str
+        The planner (:func:`buoy_mpc`'s ``controller``) and what it knew of the force over
+        the horizon (``perfect`` or ``ar``).
     mean_power_w : float
         The headline: over the last ``repeats`` whole repeats of the record (after the
         start-up ``average_from_s``), the harvested (mechanical) energy plus the change of
@@ -119,8 +122,9 @@ class BuoyMPCResult(_Result):
         Wall time of the first update's planning (it loads or compiles the kernels),
         reported apart.
     update_time_median_s, update_time_p99_s, update_time_max_s : float or None
-        Wall time of one update's planning (every solve and prediction; the forecast is the
-        record itself, precomputed) over the updates after the first, on this process.
+        Wall time of one update (the forecast, every solve and prediction; a perfect
+        forecast is the record itself, precomputed) over the updates after the first, on
+        this process.
     realtime_fits : bool or None
         Whether ``update_time_p99_s`` fits in ``update_interval_s``.
     failed_kept_previous : int
@@ -129,6 +133,7 @@ class BuoyMPCResult(_Result):
     """
 
     controller: str
+    forecast: str
     mean_power_w: float
     electrical_power_w: float
     harvested_power_w: float
@@ -627,7 +632,7 @@ def buoy_mpc(hydro, pendulum, wave, *, peak_period, horizon=2.0, update_interval
              warmup=4.0, repeats=1, torque_limit=None, efficiency=None, terminal_weight=None,
              model_steps=MODEL_STEPS, plant_steps=PLANT_STEPS, memory=None, a_inf=None,
              max_iter=None, residual=True, terminal="total", time_limit=None,
-             deadline=None, radiation_cost=True) -> BuoyMPCResult:
+             deadline=None, radiation_cost=True, forecast="perfect") -> BuoyMPCResult:
     """Receding-horizon control of the pendulum inside the buoy in a periodic record.
 
     Parameters
@@ -682,6 +687,12 @@ def buoy_mpc(hydro, pendulum, wave, *, peak_period, horizon=2.0, update_interval
         (:func:`marginal_radiation`: the radiation the plan's own motion causes later in the
         horizon, from the motion predicted under the previous plan) instead of ``F_exc -
         mu`` (False: the memory force frozen alone, the planner before; docs/buoy.md).
+    forecast : "perfect" or "ar"
+        What the controller knows of the excitation force over the horizon: the record's
+        own future (``perfect``), or the autoregressive forecast of
+        :class:`parapend.control.forecast.ARForecast` fitted at each update on the force
+        measured so far (every torque sample from the run's start; ``ar``: causal). Not
+        with ``one-way``, whose free heave is the record's.
     """
     from ..control import mpc as _mpc
     from ..control.mpc import HorizonProblem
@@ -697,6 +708,11 @@ def buoy_mpc(hydro, pendulum, wave, *, peak_period, horizon=2.0, update_interval
         raise ParameterError("controller: plan maximizes the mechanical work plus the energy "
                              "of buoy and pendulum (no efficiency, terminal or "
                              "terminal_weight yet)")
+    if forecast not in ("perfect", "ar"):
+        raise ParameterError(f"forecast: expected perfect or ar, got {forecast!r:.40}")
+    if forecast == "ar" and controller == "one-way":
+        raise ParameterError("forecast: ar is not with the one-way controller (it plans on "
+                             "the free buoy's heave, the record's own)")
     tp = check_range("tp", peak_period, 1e-3, 1e3)
     samples = check_int("samples", samples, 8, 4096)
     horizon = check_range("horizon", horizon, 1.0 / samples, 20.0, why="peak periods")
@@ -760,6 +776,11 @@ def buoy_mpc(hydro, pendulum, wave, *, peak_period, horizon=2.0, update_interval
         return np.real(np.exp(1j * np.multiply.outer(t, wk)) @ (1j * wk * zk))
 
     plant = _Plant(hydro, pendulum, h, total * ps, memory, a_inf, z0, zd0, history)
+    if forecast == "ar":
+        from ..control.forecast import ARForecast
+
+        ar = ARForecast(tp)  # seconds and newtons: the force itself, fitted on its past
+        leads = 0.5 * h * np.arange(2 * n * ps + 1)  # the horizon's half-step nodes
     if controller == "one-way":
         # the free buoy's heave as the plant's model gives it (the pendulum hanging at rest
         # exerts no reaction): what the pendulum MPC is told when the reaction is ignored
@@ -801,11 +822,15 @@ def buoy_mpc(hydro, pendulum, wave, *, peak_period, horizon=2.0, update_interval
                 status, total = "time_limit", j  # before this update: a partial run
                 break
             a = 2 * j * ps
-            fseg = fn[a:a + 2 * n * ps + 1]
+            tic = time.perf_counter()  # the forecast is part of the update's time
+            if forecast == "ar":
+                # the force measured at every torque sample up to now, nothing later
+                fseg = ar.predict(j * dt, dt * np.arange(j + 1), fn[:a + 1:2 * ps], leads)
+            else:
+                fseg = fn[a:a + 2 * n * ps + 1]
             u0 = (np.concatenate((plan[m:], np.full(m, plan[-1]))) if solves
                   else np.zeros(n))
             x0 = np.array([th, om])
-            tic = time.perf_counter()
             if controller == "plan":
                 u, ch, res_fp, nsolve, nfail = prob.plan(
                     plant, u0, fseg, iterations, relaxation, m * dt if solves else 0.0,
@@ -904,7 +929,7 @@ def buoy_mpc(hydro, pendulum, wave, *, peak_period, horizon=2.0, update_interval
               "z_dot": ys[:, 1], "torque": u_all, "power": p}
     zwin = ys[a0 * 1:, 0]
     return BuoyMPCResult(
-        controller=controller, mean_power_w=mean_p, electrical_power_w=mean_e,
+        controller=controller, forecast=forecast, mean_power_w=mean_p, electrical_power_w=mean_e,
         harvested_power_w=harvested, harvested_electrical_power_w=harvested_e,
         harvested_energy_j=work, stored_energy_change_j=de,
         absorbed_w=absorbed, damping_w=damping, stored_w=float(stored),
@@ -931,7 +956,7 @@ def buoy_mpc(hydro, pendulum, wave, *, peak_period, horizon=2.0, update_interval
 
 def mpc_command(hydro, pendulum, wave, info, *, controller, horizon, update_interval, winding,
                 harmonics, torque_limit, efficiency, irregular, design, time_limit=None,
-                deadline=None):
+                deadline=None, forecast="perfect"):
     """``parapend buoy --controller mpc|one-way-mpc``: the closed loop on the record (4 peak
     periods of warm-up, then one repeat) beside the record's coupled non-causal optimum
     (mechanical, without torque limit or efficiency, at ``winding`` turns per record);
@@ -947,7 +972,7 @@ def mpc_command(hydro, pendulum, wave, info, *, controller, horizon, update_inte
                  update_interval=update_interval,
                  controller="coupled" if controller == "mpc" else "one-way",
                  torque_limit=torque_limit, efficiency=efficiency, time_limit=time_limit,
-                 deadline=deadline)
+                 deadline=deadline, forecast=forecast)
     sol, _, _ = _solve(hydro, pendulum, wave, winding=winding, harmonics=harmonics,
                        torque_limit=None, efficiency=None, one_way=False)
     opt = float(sol.power) if sol.success else None
@@ -983,7 +1008,8 @@ def mpc_text(r) -> list:
            f"pendulum: m = {p['mass_kg']:g} kg, l = {p['length_m']:g} m, I = "
            f"{p['inertia_kg_m2']:.6g} kg m^2, c = {p['damping_coefficient_nm_s_per_rad']:g} "
            "N m s/rad",
-           f"controller: {r.controller} receding horizon, horizon {r.horizon_s:.4g} s, update "
+           f"controller: {r.controller} receding horizon, {r.forecast} forecast, horizon "
+           f"{r.horizon_s:.4g} s, update "
            f"every {r.update_interval_s:.4g} s, torque held over {r.dt_s:.4g} s, limit "
            f"{r.torque_limit_nm:.6g} N m" + ("" if r.torque_limit_given else
                                             " (2 m g l, the default)"),
