@@ -10,9 +10,9 @@ their arithmetic) was most of a Newton step on the hull's harmonics (tens of poi
 an evaluation is four compiled calls around two FFTs: :func:`grid_motion` (phi and the
 reaction on the grid), :func:`hull_solve` (the hull matrix from the reaction's spectra, its
 inverse, the hull's unknowns, the torque and the power), :func:`gradient_and_weights` and
-:func:`reduced_hessian`. Their products and sums are written as loops rather than NumPy's
-``@`` and array expressions: each of those compiles apart (a second or more each), and at
-these sizes the loops are as fast; the whole kernel compiles in about 9 s of CPU on first
+:func:`reduced_hessian`. Their sums are loops rather than array expressions, each of which
+compiles apart (up to a second each); the products are BLAS's (``np.dot``, the maps stored
+in the orientation each product reads). The kernel compiles in about 10 s of CPU on first
 use, then loads from numba's cache.
 
 The formulas are those of the hull's module docstring, point by point:
@@ -50,10 +50,8 @@ def _pair(u, w):
 
 @nb.njit(cache=True)
 def _tx(a, x):
-    """``a^T x`` (``a`` C order): a sum of ``a``'s rows, the zero entries of ``x`` skipped.
-    These products and :func:`_mv`, :func:`_matmul` are loops rather
-    than ``@``: each of NumPy's products costs its own second of compilation per layout,
-    and at these sizes (tens by hundreds) the loops are as fast."""
+    """``a^T x`` (``a`` C order): a sum of ``a``'s rows, the zero entries of ``x`` skipped
+    (a loop: NumPy's product with a transposed operand compiles apart)."""
     k, n = a.shape
     out = np.zeros(n)
     for j in range(k):
@@ -61,35 +59,6 @@ def _tx(a, x):
         if xj != 0.0:
             for i in range(n):
                 out[i] += xj * a[j, i]
-    return out
-
-
-@nb.njit(cache=True)
-def _mv(a, x):
-    """``a x`` (``a`` C order)."""
-    n, k = a.shape
-    out = np.empty(n)
-    for i in range(n):
-        acc = 0.0
-        for j in range(k):
-            acc += a[i, j] * x[j]
-        out[i] = acc
-    return out
-
-
-@nb.njit(cache=True)
-def _matmul(a, b, transpose):
-    """``a b``, or ``a^T b`` with ``transpose`` (both C order), the zero entries of ``a``
-    skipped."""
-    n, k = (a.shape[1], a.shape[0]) if transpose else a.shape
-    p = b.shape[1]
-    out = np.zeros((n, p))
-    for i in range(n):
-        for j in range(k):
-            aij = a[j, i] if transpose else a[i, j]
-            if aij != 0.0:
-                for q in range(p):
-                    out[i, q] += aij * b[j, q]
     return out
 
 
@@ -162,13 +131,12 @@ def reaction(f, f1, f2, ml, inertia, g, dp, hp):
 
 
 @nb.njit(cache=True)
-def grid_motion(x, p012t, s, winding, w, ml, inertia, g, dp, hp):
+def grid_motion(x, p012, s, winding, w, ml, inertia, g, dp, hp):
     """``(phi, phi', phi'', r, wz)`` on the grid from the coefficients ``x``: ``phi = K s +
-    P0 x``, ``phi' = w K + P1 x``, ``phi'' = P2 x`` (``p012t`` the three maps stacked,
-    transposed), and
+    P0 x``, ``phi' = w K + P1 x``, ``phi'' = P2 x`` (``p012`` the three maps stacked), and
     :func:`reaction` there."""
     m = s.size
-    q = _tx(p012t, x)
+    q = np.dot(p012, x)
     f = np.empty(m)
     f1 = np.empty(m)
     f2 = np.empty(m)
@@ -181,18 +149,18 @@ def grid_motion(x, p012t, s, winding, w, ml, inertia, g, dp, hp):
 
 
 @nb.njit(cache=True)
-def hull_torque(q3t, y, f, f1, f2, inertia, c, ml, g):
+def hull_torque(q3, y, f, f1, f2, inertia, c, ml, g):
     """``(p_x'', p_z'', beta', tau, v, P)`` on the grid for the hull's unknowns ``y``
-    (``q3t`` the map ``y -> (p_x'', p_z'', beta')`` transposed; :func:`torque`)."""
+    (``q3`` the map ``y -> (p_x'', p_z'', beta')``; :func:`torque`)."""
     m = f.size
-    q = _tx(q3t, y)
+    q = np.dot(q3, y)
     qx, qz, b1 = q[:m], q[m:2 * m], q[2 * m:]
     tau, v, p = torque(f, f1, f2, qx, qz, b1, inertia, c, ml, g)
     return qx, qz, b1, tau, v, p
 
 
 @nb.njit(cache=True)
-def hull_solve(v, ptr, idx, coef, n1, n2, symmetric, z, b0, pi_t, r, q3t, f, f1, f2,
+def hull_solve(v, ptr, idx, coef, n1, n2, symmetric, z, b0, pi_all, r, q3, f, f1, f2,
                inertia, c, ml, g):
     """``(S^{-1}, y, p_x'', p_z'', beta', tau, v, P)``: the hull's unknowns at the motion
     whose reaction is ``r`` (3, M) and whose hull-matrix weights have the spectra ``v``,
@@ -203,14 +171,14 @@ def hull_solve(v, ptr, idx, coef, n1, n2, symmetric, z, b0, pi_t, r, q3t, f, f1,
     power is asked is then evaluated (a line search's first trial is accepted)."""
     # C order, as the uncoupled problem's empty stand-in: one compiled version downstream
     sm = fused_gram(v, ptr, idx, coef, n1, n2, symmetric)
-    b = _tx(pi_t, r.copy().reshape(r.size))
+    b = np.dot(pi_all, r.copy().reshape(r.size))
     for i in range(b.size):
         b[i] += b0[i]
         for k in range(b.size):
             sm[i, k] += z[i, k]
     sinv = np.ascontiguousarray(np.linalg.inv(sm))
-    y = _mv(sinv, b)
-    return (sinv, y) + hull_torque(q3t, y, f, f1, f2, inertia, c, ml, g)
+    y = np.dot(sinv, b)
+    return (sinv, y) + hull_torque(q3, y, f, f1, f2, inertia, c, ml, g)
 
 
 @nb.njit(cache=True)
@@ -275,23 +243,24 @@ def fused_gram(v, ptr, idx, coef, n1, n2, symmetric):
 
 
 @nb.njit(cache=True)
-def gradient_and_weights(f, f1, f2, qx, qz, ft, fv, ftt, ftv, fvv, rows, coupled, sinv, q3,
-                         pi_all, p012, ml, inertia, c, g, dp, hp):
+def gradient_and_weights(f, f1, f2, qx, qz, ft, fv, ftt, ftv, fvv, rows, coupled, sinv, q3t,
+                         pi_t, p012t, ml, inertia, c, g, dp, hp):
     """The first half of an evaluation: the Lagrangian's pointwise derivatives (the
     objective's; with ``coupled``, plus the hull's reaction weighted by the adjoint ``mu``,
     ``S^T lambda = d<f>/dy``, ``mu = Pi^T lambda``), the reduced gradient ``P^T d1`` and
     the weights whose spectra give the Hessian: the pairs ``rows`` of the second
     derivatives, then (coupled) the nine sensitivity weights. ``sinv`` is ``S^{-1}``,
-    ``q3`` the map ``y -> (p_x'', p_z'', beta')`` (3M, ny), ``pi_all`` the projection
-    (ny, 3M), ``p012`` the map ``x -> (phi, phi', phi'')`` (3M, nx)."""
+    ``q3t`` the map ``y -> (p_x'', p_z'', beta')`` transposed (ny, 3M), ``pi_t`` the
+    projection transposed (3M, ny), ``p012t`` the map ``x -> (phi, phi', phi'')`` transposed
+    (nx, 3M)."""
     m = f.size
     d1, d2 = objective_weights(f, qx, qz, ft, fv, ftt, ftv, fvv, ml, inertia, c, g)
     nr = rows.size
     w = np.empty((nr + (9 if coupled else 0), m))
     if coupled:
-        gy = _tx(q3, d1[3:].copy().reshape(3 * m))
-        lam = _tx(sinv, gy)
-        mu = _tx(pi_all, lam).reshape(3, m)
+        gy = np.dot(q3t, d1[3:].copy().reshape(3 * m))
+        lam = _tx(sinv, gy)  # S^{-T} gy
+        mu = np.dot(pi_t, lam).reshape(3, m)
         c1, c2, sens = constraint_weights(f, f1, f2, qx, qz, mu, ml, inertia, g, dp, hp)
         for j in range(m):  # loops, not array expressions: each of those compiles apart
             for u in range(6):
@@ -303,7 +272,7 @@ def gradient_and_weights(f, f1, f2, qx, qz, ft, fv, ftt, ftv, fvv, rows, coupled
     for i in range(nr):
         for j in range(m):
             w[i, j] = d2[rows[i], j]
-    grad = _tx(p012, d1[:3].copy().reshape(3 * m))
+    grad = np.dot(p012t, d1[:3].copy().reshape(3 * m))
     return grad, w
 
 
@@ -317,9 +286,10 @@ def reduced_hessian(v, xx, xy, yy, sens, coupled, sinv):
     if coupled:
         hxy = fused_gram(v, *xy)
         hyy = fused_gram(v, *yy)
-        t = _matmul(sinv, fused_gram(v, *sens), False)
-        ht = _matmul(hxy, t, False)
-        tt = _matmul(t, _matmul(hyy, t, False), True)
+        # the matrix products by BLAS (np.dot; tens by tens, up to 2N + 1 columns)
+        t = np.dot(sinv, fused_gram(v, *sens))
+        ht = np.dot(hxy, t)
+        tt = np.dot(t.T, np.dot(hyy, t))
         for i in range(hxx.shape[0]):
             for k in range(hxx.shape[1]):
                 hxx[i, k] += ht[i, k] + ht[k, i] + tt[i, k]

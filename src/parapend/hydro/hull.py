@@ -323,15 +323,15 @@ class HullProblem(PTOObjective):
             return self._last[1]
         cs = self.case
         ml = cs.m * cs.l
-        f, f1, f2, r, wz = grid_motion(x, self._P012T, self.s, float(self.winding),
+        f, f1, f2, r, wz = grid_motion(x, self._P012, self.s, float(self.winding),
                                        self.omega, ml, cs.I, cs.g, *cs.pivot)
         if self.coupled:
             sinv, y, qx, qz, b1, tau, v, p = hull_solve(
                 spectra(wz).ravel(), *self._hull_gram.arrays(), self.Z, self.fa_real,
-                self._Pi_t, r, self._Q3T, f, f1, f2, cs.I, cs.c, ml, cs.g)
+                self.Pi_all, r, self._Q3, f, f1, f2, cs.I, cs.c, ml, cs.g)
         else:
             sinv, y = None, self.y_free
-            qx, qz, b1, tau, v, p = hull_torque(self._Q3T, y, f, f1, f2, cs.I, cs.c, ml, cs.g)
+            qx, qz, b1, tau, v, p = hull_torque(self._Q3, y, f, f1, f2, cs.I, cs.c, ml, cs.g)
         st = {"phi": f, "phi1": f1, "phi2": f2, "qx": qx, "qz": qz, "b1": b1, "y": y,
               "tau": tau, "relative_speed": v, "power": p}
         self._last = (key, (st, sinv))
@@ -440,8 +440,8 @@ class HullProblem(PTOObjective):
             sinv = self._none2
         grad, w = gradient_and_weights(
             st["phi"], st["phi1"], st["phi2"], st["qx"], st["qz"],
-            *(_full(t, m) for t in terms[1:]), rows, coupled, sinv, self._Q3, self.Pi_all,
-            self._P012, cs.m * cs.l, cs.I, cs.c, cs.g, *cs.pivot)
+            *(_full(t, m) for t in terms[1:]), rows, coupled, sinv, self._Q3T, self._Pi_t,
+            self._P012T, cs.m * cs.l, cs.I, cs.c, cs.g, *cs.pivot)
         blocks = self._fused(keys, coupled)
         h = reduced_hessian(spectra(w).ravel(), *blocks, coupled, sinv)
         val = st["power"] if self.lossless else float(np.mean(terms[0]))
