@@ -294,10 +294,6 @@ def solve_buoy_bin(spec, i: int, j: int, r: int) -> dict:
     else:
         head = str(sol.status).split(";")[0].strip()
         status = head if head in _CODE and head != "converged" else "other"
-    if spec.controller is not None:
-        from .causal import solve_causal
-
-        out.update(solve_causal(spec, i, j, r))  # the same record, run causally
     return {"power": p, "radiation_bound_power": float(sol.radiation_bound),
             "one_way_power": float(ow.power) if math.isfinite(ow.power) else math.nan,
             **out, "status": status}

@@ -33,14 +33,15 @@ def solve_bin(spec, i: int, j: int, r: int) -> dict:
     if spec.device == "buoy":
         from .buoy_device import solve_buoy_bin
 
-        return solve_buoy_bin(spec, i, j, r)
-    from ..irregular import sea
+        out = solve_buoy_bin(spec, i, j, r)
+    else:
+        from ..irregular import sea
 
-    res = sea(**spec.sea_kwargs(i, j, r))
-    out = {"power": res.power_w, "limit_power": res.limit_power_w,
-           "uniform_power": res.uniform_power_w, "status": res.status}
-    if spec.efficiency is not None:
-        out["electrical_power"] = electrical_power(res, spec.efficiency)
+        res = sea(**spec.sea_kwargs(i, j, r))
+        out = {"power": res.power_w, "limit_power": res.limit_power_w,
+               "uniform_power": res.uniform_power_w, "status": res.status}
+        if spec.efficiency is not None:
+            out["electrical_power"] = electrical_power(res, spec.efficiency)
     if spec.controller is not None:
         from .causal import solve_causal
 
