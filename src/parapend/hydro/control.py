@@ -31,7 +31,7 @@ pendulum units: time ``t0 = sqrt(I / (m g l))``, torque ``m g l``, ``q = z'' / g
   ``cos(theta)``; the torque by inverse dynamics on that heave, bounded at three points per
   interval; the objective the ``coupled`` controller's (work plus the energy of buoy and
   pendulum at the end) with, by default, the marginal cost of the radiation the plan's own
-  motion causes (:func:`marginal_radiation`); a dense primal-dual interior point with the
+  motion causes (``marginal_radiation``); a dense primal-dual interior point with the
   exact Hessian
   (:mod:`._buoy_plan`), warm-started from the previous motion. The held torques are the
   plan's torque averaged over each sample. Without efficiency (mechanical only).
@@ -684,7 +684,7 @@ def buoy_mpc(hydro, pendulum, wave, *, peak_period, horizon=2.0, update_interval
         its powers over the samples run.
     radiation_cost : bool
         ``plan``: weight the heave speed in the horizon objective by ``F_exc - mu - a``
-        (:func:`marginal_radiation`: the radiation the plan's own motion causes later in the
+        (``marginal_radiation``: the radiation the plan's own motion causes later in the
         horizon, from the motion predicted under the previous plan) instead of ``F_exc -
         mu`` (False: the memory force frozen alone, the planner before; docs/buoy.md).
     forecast : "perfect" or "ar"
