@@ -299,7 +299,7 @@ def test_the_work_is_capped_in_one_line():
      "controller: the causal column is computed for --device prescribed-heave and the "
      "heaving --device buoy"),
     (["--controller", "mpc", "--device", "buoy", "--forecast", "ar"],
-     "forecast: the buoy's controller has the perfect forecast only"),
+     "forecast: the buoy's column runs the perfect forecast only"),
     (["--controller", "mpc", "--device", "buoy", "--plan-samples", "4"],
      "plan-samples: an option of the prescribed-heave pendulum's planner"),
     (["--controller", "mpc", "--device", "buoy", "--speed-limit", "4"],

@@ -113,9 +113,10 @@ def check_causal(*, controller, horizon, forecast, update_interval, warm_up, pla
         raise ParameterError(f"forecast: expected perfect, ar or perfect,ar, got "
                              f"{forecast!r:.40}")
     if buoy and names != ["perfect"]:
-        raise ParameterError("forecast: the buoy's controller has the perfect forecast only "
-                             "(no autoregressive one yet); give --forecast perfect with "
-                             "--device buoy")
+        raise ParameterError("forecast: the buoy's column runs the perfect forecast only (the "
+                             "autoregressive one runs in parapend buoy --controller mpc "
+                             "--forecast ar, not yet in the matrix); give --forecast perfect "
+                             "with --device buoy")
     upd = base["update_interval"] if update_interval is None else update_interval
     upd = check_range("update-interval", upd, 1e-3, 1.0, why="peak periods")
     if buoy and upd < 1.0 / 64:
