@@ -10,6 +10,8 @@ import numpy as np
 import pytest
 from hull_synthetic import case
 
+from parapend.hydro._hull_kernel import fused_gram, grid_motion, hull_inverse, hull_solve
+from parapend.hydro._trig import spectra
 from parapend.hydro.hull import HullProblem
 from parapend.hydro.hull_optimum import GTOL, hull_search, radiation_bound
 from parapend.optimal.fourier import newton_maximize
@@ -63,6 +65,45 @@ def test_hull_equations_hold_at_the_solved_motion():
         lhs = cs.impedance(k) @ xi[k]
         assert np.allclose(lhs, fa[k] + rk, rtol=0, atol=1e-9 * np.max(np.abs(fa[1])))
     assert xi[0, 0] == 0.0  # the mean surge
+
+
+def _hull_matrix(pr, x):
+    """The hull matrix ``S`` at ``x`` formed densely (``Z`` plus the gathered pitch rows) and
+    the kernel's arguments for it."""
+    cs = pr.case
+    _, _, _, _, wz = grid_motion(x, pr._P012, pr.s, float(pr.winding), pr.omega,
+                                 cs.m * cs.l, cs.I, cs.g, *cs.pivot)
+    gm = fused_gram(spectra(wz).ravel(), *pr._hull_gram.arrays())
+    return pr.Z + gm, np.ascontiguousarray(gm[pr._prow])
+
+
+@pytest.mark.parametrize("winding", [0, 1])
+def test_woodbury_inverse_is_the_inverse(winding):
+    """``hull_inverse`` (Woodbury on the pitch rows, ``Z`` inverted block by block) equals
+    LAPACK's inverse of the dense hull matrix to rounding, the moving rows really being the
+    pitch rows only; a wrong ``Z^{-1}`` is caught by ``hull_solve``'s backward-error check,
+    which then inverts ``S`` directly."""
+    cs = case(winding=winding, harmonics=6)
+    pr = HullProblem(cs)
+    x = _x(cs.harmonics, winding, 7)
+    s, gp = _hull_matrix(pr, x)
+    moving = np.flatnonzero(np.any(s != pr.Z, axis=1))
+    assert set(moving) <= set(pr._prow) and len(moving) > 0
+    direct = np.linalg.inv(s)
+    wood = hull_inverse(gp, pr._Zinv, pr._Zp, pr._prow, pr._blocks)
+    assert np.max(np.abs(wood - direct)) <= 1e-11 * np.max(np.abs(direct))
+    st, sinv = pr._at(x)
+    assert np.max(np.abs(sinv - direct)) <= 1e-11 * np.max(np.abs(direct))
+    # the check: a Z^{-1} off by 1 % gives a y whose residual is far above rounding
+    ml = cs.m * cs.l
+    f, f1, f2, r, wz = grid_motion(x, pr._P012, pr.s, float(pr.winding), pr.omega, ml,
+                                   cs.I, cs.g, *cs.pivot)
+    bad = pr._Zinv * 1.01
+    out = hull_solve(spectra(wz).ravel(), *pr._hull_gram.arrays(), pr.Z, bad,
+                     np.ascontiguousarray(bad[:, pr._prow]), pr._prow, pr._blocks, pr.fa_real,
+                     pr.Pi_all, r, pr._Q3, f, f1, f2, cs.I, cs.c, ml, cs.g)
+    assert np.max(np.abs(out[0] - direct)) <= 1e-11 * np.max(np.abs(direct))
+    assert np.max(np.abs(out[1] - st["y"])) <= 1e-11 * np.max(np.abs(st["y"]))
 
 
 @pytest.mark.parametrize("winding", [0, 1])

@@ -9,11 +9,11 @@ these are some two hundred small array operations per evaluation, whose call ove
 their arithmetic) was most of a Newton step on the hull's harmonics (tens of points). Here
 an evaluation is four compiled calls around two FFTs: :func:`grid_motion` (phi and the
 reaction on the grid), :func:`hull_solve` (the hull matrix from the reaction's spectra, its
-inverse, the hull's unknowns, the torque and the power), :func:`gradient_and_weights` and
-:func:`reduced_hessian`. Their sums are loops rather than array expressions, each of which
-compiles apart (up to a second each); the products are BLAS's (``np.dot``, the maps stored
-in the orientation each product reads). The kernel compiles in about 10 s of CPU on first
-use, then loads from numba's cache.
+inverse by Woodbury's identity, the hull's unknowns, the torque and the power),
+:func:`gradient_and_weights` and :func:`reduced_hessian`. Their sums are loops rather than
+array expressions, each of which compiles apart (up to a second each); the products are
+BLAS's (``np.dot``, the maps stored in the orientation each product reads). The kernel
+compiles in about 10 s of CPU on first use, then loads from numba's cache.
 
 The formulas are those of the hull's module docstring, point by point:
 
@@ -38,8 +38,8 @@ from .._jit import announce_compiles
 announce_compiles()  # log a first-use compile (parapend._jit)
 
 __all__ = ["constraint_weights", "fused_gram", "grid_motion", "gradient_and_weights",
-           "hull_solve", "hull_torque", "objective_weights", "reaction", "reduced_hessian",
-           "torque"]
+           "hull_inverse", "hull_solve", "hull_torque", "objective_weights", "reaction",
+           "reduced_hessian", "torque"]
 
 
 @nb.njit(cache=True)
@@ -160,24 +160,92 @@ def hull_torque(q3, y, f, f1, f2, inertia, c, ml, g):
 
 
 @nb.njit(cache=True)
-def hull_solve(v, ptr, idx, coef, n1, n2, symmetric, z, b0, pi_all, r, q3, f, f1, f2,
-               inertia, c, ml, g):
+def hull_inverse(gp, zinv, zp, prow, blocks):
+    """``S^{-1}`` of the hull matrix ``S = Z + E gp`` by Woodbury's identity: only the pitch
+    rows ``prow`` (``E`` puts ``gp``'s rows there) of ``S`` depend on the motion, and
+    ``Z`` is block diagonal (the static block, then one 6 x 6 block per hull harmonic;
+    ``blocks`` their starts and the end) with its inverse ``zinv`` computed once
+    (``zp = zinv[:, prow]``):
+
+        S^{-1} = Z^{-1} - zp (I + gp zp)^{-1} (gp Z^{-1}),
+
+    a ``len(prow)``-square inverse (``2 Nh + 1`` against ``6 Nh + 2``) and products that
+    skip ``Z^{-1}``'s zero blocks (:func:`hull_solve` checks the result)."""
+    r, n = gp.shape
+    if r == 0:
+        return zinv.copy()
+    ra = np.zeros((r, n))  # gp Z^{-1}, block by block
+    for b in range(blocks.size - 1):
+        lo, hi = blocks[b], blocks[b + 1]
+        for i in range(r):
+            for k in range(lo, hi):
+                g = gp[i, k]
+                if g != 0.0:
+                    for c in range(lo, hi):
+                        ra[i, c] += g * zinv[k, c]
+    cap = np.empty((r, r))
+    for i in range(r):
+        for j in range(r):
+            cap[i, j] = ra[i, prow[j]]
+        cap[i, i] += 1.0
+    corr = np.dot(np.dot(zp, np.linalg.inv(cap)), ra)
+    sinv = np.empty((n, n))
+    for i in range(n):
+        for k in range(n):
+            sinv[i, k] = zinv[i, k] - corr[i, k]
+    return sinv
+
+
+@nb.njit(cache=True)
+def hull_solve(v, ptr, idx, coef, n1, n2, symmetric, z, zinv, zp, prow, blocks, b0, pi_all,
+               r, q3, f, f1, f2, inertia, c, ml, g):
     """``(S^{-1}, y, p_x'', p_z'', beta', tau, v, P)``: the hull's unknowns at the motion
     whose reaction is ``r`` (3, M) and whose hull-matrix weights have the spectra ``v``,
-    ``y = S^{-1} (b0 + Pi r)`` with ``S = Z + G(v)`` (the gathers of :func:`fused_gram`),
-    and :func:`hull_torque` there. The inverse (LAPACK getrf and getri), not a
-    factorization: the adjoint and the sensitivity's right sides are products with it in
-    :func:`gradient_and_weights` and :func:`reduced_hessian`, and nearly every point whose
-    power is asked is then evaluated (a line search's first trial is accepted)."""
-    # C order, as the uncoupled problem's empty stand-in: one compiled version downstream
-    sm = fused_gram(v, ptr, idx, coef, n1, n2, symmetric)
+    ``y = S^{-1} (b0 + Pi r)`` with ``S = Z + G(v)`` (the gathers of :func:`fused_gram`,
+    non-zero on the pitch rows ``prow`` only; :func:`hull_inverse`), and
+    :func:`hull_torque` there. The inverse, not a factorization: the adjoint and the
+    sensitivity's right sides are products with it in :func:`gradient_and_weights` and
+    :func:`reduced_hessian`, and nearly every point whose power is asked is then evaluated
+    (a line search's first trial is accepted)."""
+    gm = fused_gram(v, ptr, idx, coef, n1, n2, symmetric)
+    gp = np.empty((prow.size, gm.shape[1]))
+    for i in range(prow.size):
+        for k in range(gm.shape[1]):
+            gp[i, k] = gm[prow[i], k]
+    sinv = hull_inverse(gp, zinv, zp, prow, blocks)
     b = np.dot(pi_all, r.copy().reshape(r.size))
     for i in range(b.size):
         b[i] += b0[i]
-        for k in range(b.size):
-            sm[i, k] += z[i, k]
-    sinv = np.ascontiguousarray(np.linalg.inv(sm))
     y = np.dot(sinv, b)
+    # the check: y's backward error |S y - b| / (|S| |y| + |b|) (max norms) at rounding's
+    # scale; above 1e-10 (Woodbury's small matrix ill-conditioned where S is not), S is
+    # inverted directly (LAPACK getrf and getri)
+    res = np.dot(z, y)
+    gy = np.dot(gp, y)
+    for i in range(prow.size):
+        res[prow[i]] += gy[i]
+    worst, srow, ymax, bmax = 0.0, 0.0, 0.0, 0.0
+    for i in range(b.size):
+        worst = max(worst, abs(res[i] - b[i]))
+        ymax = max(ymax, abs(y[i]))
+        bmax = max(bmax, abs(b[i]))
+        acc = 0.0
+        for k in range(b.size):
+            acc += abs(z[i, k])
+        srow = max(srow, acc)
+    for i in range(prow.size):
+        acc = 0.0
+        for k in range(b.size):
+            acc += abs(z[prow[i], k]) + abs(gp[i, k])
+        srow = max(srow, acc)
+    scale = srow * ymax + bmax
+    if not worst <= 1e-10 * scale:
+        s = z.copy()
+        for i in range(prow.size):
+            for k in range(s.shape[1]):
+                s[prow[i], k] += gp[i, k]
+        sinv = np.ascontiguousarray(np.linalg.inv(s))
+        y = np.dot(sinv, b)
     return (sinv, y) + hull_torque(q3, y, f, f1, f2, inertia, c, ml, g)
 
 

@@ -23,7 +23,8 @@ in the reaction torque), so the hull's harmonics are solved together:
 + i k w B_k + C'``, ``C' = C - m g h_p e_beta e_beta^T``), ``Q`` the pivot's acceleration
 on the grid. The power ``P(phi) = P(phi, y(phi))`` is maximized over ``x`` alone (reduced
 space): its gradient by the adjoint ``S^T lambda = dP/dy``, its Hessian exactly, by the
-sensitivity ``T = S^{-1} g_x`` (one LU, ``2N + 1`` solves):
+sensitivity ``T = S^{-1} g_x`` (``S^{-1}`` by Woodbury's identity: only ``S``'s pitch rows
+move with ``phi``, and ``Z`` is inverted once, block by block):
 
     H = L_xx + L_xy T + T^T L_yx + T^T L_yy T
 
@@ -233,6 +234,17 @@ class HullProblem(PTOObjective):
             rhs[o + 3:o + 6] = fa[k].imag
         self.Z, self.fa_real = Z, rhs
         self.y_free = np.linalg.solve(Z, rhs)
+        # Z's blocks (the static one, then one per hull harmonic), its inverse block by
+        # block, and the pitch rows: the only ones of the hull matrix that move with phi
+        # (hydro/_hull_kernel.py's hull_inverse)
+        starts = ([0] if j0 else []) + [j0 + 6 * k for k in range(nh + 1)]
+        self._blocks = np.array(starts, dtype=np.int64)
+        zinv = np.zeros((ny, ny))
+        for lo, hi in zip(starts[:-1], starts[1:]):
+            zinv[lo:hi, lo:hi] = np.linalg.inv(Z[lo:hi, lo:hi])
+        self._Zinv = zinv
+        self._prow = np.flatnonzero(self._pitch_rows)
+        self._Zp = np.ascontiguousarray(zinv[:, self._prow])
         # a power scale for the solvers' tolerances (W): m g l w
         self.w = np.array([case.m * case.g * case.l * w])
 
@@ -269,6 +281,7 @@ class HullProblem(PTOObjective):
         cols["qx"] = TrigColumns(freq, k2, s2 * (on[0] + hp * on[2]))
         cols["qz"] = TrigColumns(freq, k2, s2 * (on[1] - dp * on[2]))
         cols["b1"] = TrigColumns(freq, k1, s1 * on[2])
+        self._pitch_rows = dof == 2
         # the projection's rows (2/M cos, -2/M sin; 1/M for the static ones) as columns
         kp = np.where(part == 2, 1, 0)
         sp = np.where(part == 0, 1.0 / m, np.where(part == 1, 2.0 / m, -2.0 / m))
@@ -327,8 +340,9 @@ class HullProblem(PTOObjective):
                                        self.omega, ml, cs.I, cs.g, *cs.pivot)
         if self.coupled:
             sinv, y, qx, qz, b1, tau, v, p = hull_solve(
-                spectra(wz).ravel(), *self._hull_gram.arrays(), self.Z, self.fa_real,
-                self.Pi_all, r, self._Q3, f, f1, f2, cs.I, cs.c, ml, cs.g)
+                spectra(wz).ravel(), *self._hull_gram.arrays(), self.Z, self._Zinv,
+                self._Zp, self._prow, self._blocks, self.fa_real, self.Pi_all, r, self._Q3,
+                f, f1, f2, cs.I, cs.c, ml, cs.g)
         else:
             sinv, y = None, self.y_free
             qx, qz, b1, tau, v, p = hull_torque(self._Q3, y, f, f1, f2, cs.I, cs.c, ml, cs.g)
