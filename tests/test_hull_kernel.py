@@ -10,7 +10,13 @@ import numpy as np
 import pytest
 from hull_synthetic import case
 
-from parapend.hydro._hull_kernel import fused_gram, grid_motion, hull_inverse, hull_solve
+from parapend.hydro._hull_kernel import (
+    fused_gram,
+    grid_motion,
+    hull_inverse,
+    hull_solve,
+    spectra_at,
+)
 from parapend.hydro._trig import spectra
 from parapend.hydro.hull import HullProblem
 from parapend.hydro.hull_optimum import GTOL, hull_search, radiation_bound
@@ -71,7 +77,7 @@ def _hull_matrix(pr, x):
     """The hull matrix ``S`` at ``x`` formed densely (``Z`` plus the gathered pitch rows) and
     the kernel's arguments for it."""
     cs = pr.case
-    _, _, _, _, wz = grid_motion(x, pr._P012, pr.s, float(pr.winding), pr.omega,
+    _, _, _, _, wz, _, _ = grid_motion(x, pr._P012, pr.s, float(pr.winding), pr.omega,
                                  cs.m * cs.l, cs.I, cs.g, *cs.pivot)
     gm = fused_gram(spectra(wz).ravel(), *pr._hull_gram.arrays())
     return pr.Z + gm, np.ascontiguousarray(gm[pr._prow])
@@ -87,6 +93,13 @@ def test_woodbury_inverse_is_the_inverse(winding):
     pr = HullProblem(cs)
     x = _x(cs.harmonics, winding, 7)
     s, gp = _hull_matrix(pr, x)
+    # the hull matrix's spectra by direct sums at the frequencies it reads = the FFT's there
+    wz = grid_motion(x, pr._P012, pr.s, float(pr.winding), pr.omega, cs.m * cs.l, cs.I,
+                     cs.g, *cs.pivot)[4]
+    assert np.allclose(fused_gram(spectra_at(wz, pr._hull_freqs, pr._hull_cos, pr._hull_sin),
+                                  *pr._hull_gram.arrays()),
+                       fused_gram(spectra(wz).ravel(), *pr._hull_gram.arrays()),
+                       rtol=0, atol=1e-12 * np.max(np.abs(gp)))
     moving = np.flatnonzero(np.any(s != pr.Z, axis=1))
     assert set(moving) <= set(pr._prow) and len(moving) > 0
     direct = np.linalg.inv(s)
@@ -96,12 +109,12 @@ def test_woodbury_inverse_is_the_inverse(winding):
     assert np.max(np.abs(sinv - direct)) <= 1e-11 * np.max(np.abs(direct))
     # the check: a Z^{-1} off by 1 % gives a y whose residual is far above rounding
     ml = cs.m * cs.l
-    f, f1, f2, r, wz = grid_motion(x, pr._P012, pr.s, float(pr.winding), pr.omega, ml,
-                                   cs.I, cs.g, *cs.pivot)
+    f, f1, f2, r, wz, sn, co = grid_motion(x, pr._P012, pr.s, float(pr.winding), pr.omega,
+                                           ml, cs.I, cs.g, *cs.pivot)
     bad = pr._Zinv * 1.01
     out = hull_solve(spectra(wz).ravel(), *pr._hull_gram.arrays(), pr.Z, bad,
                      np.ascontiguousarray(bad[:, pr._prow]), pr._prow, pr._blocks, pr.fa_real,
-                     pr.Pi_all, r, pr._Q3, f, f1, f2, cs.I, cs.c, ml, cs.g)
+                     pr.Pi_all, r, pr._Q3, sn, co, f1, f2, cs.I, cs.c, ml, cs.g)
     assert np.max(np.abs(out[0] - direct)) <= 1e-11 * np.max(np.abs(direct))
     assert np.max(np.abs(out[1] - st["y"])) <= 1e-11 * np.max(np.abs(st["y"]))
 

@@ -7,10 +7,10 @@ in that order), the weights of the sensitivity's right side, and Gram matrices g
 from the weights' spectra (:class:`parapend.hydro._trig.FusedGram`). Written with NumPy
 these are some two hundred small array operations per evaluation, whose call overhead (not
 their arithmetic) was most of a Newton step on the hull's harmonics (tens of points). Here
-an evaluation is four compiled calls around two FFTs: :func:`grid_motion` (phi and the
-reaction on the grid), :func:`hull_solve` (the hull matrix from the reaction's spectra, its
-inverse by Woodbury's identity, the hull's unknowns, the torque and the power),
-:func:`gradient_and_weights` and :func:`reduced_hessian`. Their sums are loops rather than
+an evaluation is three compiled calls around one FFT: :func:`hull_state` (phi and the
+reaction on the grid, the hull matrix from the reaction's spectra, its inverse by Woodbury's
+identity, the hull's unknowns, the torque and the power), :func:`gradient_and_weights` and
+:func:`reduced_hessian`. Their sums are loops rather than
 array expressions, each of which compiles apart (up to a second each); the products are
 BLAS's (``np.dot``, the maps stored in the orientation each product reads). The kernel
 compiles in about 10 s of CPU on first use, then loads from numba's cache.
@@ -38,8 +38,8 @@ from .._jit import announce_compiles
 announce_compiles()  # log a first-use compile (parapend._jit)
 
 __all__ = ["constraint_weights", "fused_gram", "grid_motion", "gradient_and_weights",
-           "hull_inverse", "hull_solve", "hull_torque", "objective_weights", "reaction",
-           "reduced_hessian", "torque"]
+           "hull_inverse", "hull_solve", "hull_state", "hull_torque", "objective_weights",
+           "reaction", "reduced_hessian", "spectra_at", "torque"]
 
 
 @nb.njit(cache=True)
@@ -63,29 +63,29 @@ def _tx(a, x):
 
 
 @nb.njit(cache=True)
-def torque(f, f1, f2, qx, qz, b1, inertia, c, ml, g):
+def torque(sn, co, f1, f2, qx, qz, b1, inertia, c, ml, g):
     """``(tau, v, P)`` on the grid: the generator's torque (P) ``tau = I phi'' + c v -
     m l [(g + p_z'') sin phi - p_x'' cos phi]``, the relative speed ``v = phi' - beta'``
-    and the mechanical power ``P = -<tau v>``."""
-    m = f.size
+    and the mechanical power ``P = -<tau v>`` (``sn``, ``co``: ``sin phi``, ``cos phi``)."""
+    m = sn.size
     tau = np.empty(m)
     v = np.empty(m)
     acc = 0.0
     for j in range(m):
         v[j] = f1[j] - b1[j]
         tau[j] = (inertia * f2[j] + c * v[j]
-                  - ml * ((g + qz[j]) * math.sin(f[j]) - qx[j] * math.cos(f[j])))
+                  - ml * ((g + qz[j]) * sn[j] - qx[j] * co[j]))
         acc += tau[j] * v[j]
     return tau, v, -acc / m
 
 
 @nb.njit(cache=True)
-def objective_weights(f, qx, qz, ft, fv, ftt, ftv, fvv, ml, inertia, c, g):
+def objective_weights(sin_phi, cos_phi, qx, qz, ft, fv, ftt, ftv, fvv, ml, inertia, c, g):
     """``(d1, d2)``: the mean ``<f(tau, v)>``'s derivatives in the six grid variables,
     pointwise ((6, M) and (21, M), divided by ``M``), by the chain rule through ``tau``
     (``d tau = (-m l w_phi, c, I, m l cos, -m l sin, -c)``, ``d v = (0, 1, 0, 0, 0, -1)``,
     ``tau``'s own second derivatives on ``(phi, phi)``, ``(phi, p_x'')``, ``(phi, p_z'')``)."""
-    m = f.size
+    m = sin_phi.size
     d1 = np.zeros((6, m))
     d2 = np.zeros((21, m))
     dt = np.empty(6)
@@ -93,7 +93,7 @@ def objective_weights(f, qx, qz, ft, fv, ftt, ftv, fvv, ml, inertia, c, g):
     dv[1] = 1.0
     dv[5] = -1.0
     for j in range(m):
-        sn, co = math.sin(f[j]), math.cos(f[j])
+        sn, co = sin_phi[j], cos_phi[j]
         wgt = (g + qz[j]) * sn - qx[j] * co
         wph = (g + qz[j]) * co + qx[j] * sn
         dt[0], dt[1], dt[2] = -ml * wph, c, inertia
@@ -116,25 +116,29 @@ def reaction(f, f1, f2, ml, inertia, g, dp, hp):
     """The pendulum's reaction on the hull at rest in the hull's frame, on the grid:
     ``(r_x, r_z, r_beta)`` (3, M) with the weight's ``m l g sin phi`` (the pivot's
     acceleration's part enters the hull matrix), and ``-m l sin phi``, ``m l cos phi``: the
-    weights of the hull matrix's ``p_z''`` and ``p_x''`` parts."""
+    weights of the hull matrix's ``p_z''`` and ``p_x''`` parts; and ``sin phi``,
+    ``cos phi`` (every later pointwise function reads them)."""
     m = f.size
     r = np.empty((3, m))
     s = np.empty((2, m))
+    sin_phi = np.empty(m)
+    cos_phi = np.empty(m)
     for j in range(m):
         sn, co = math.sin(f[j]), math.cos(f[j])
+        sin_phi[j], cos_phi[j] = sn, co
         rx = -ml * (co * f2[j] - sn * f1[j] ** 2)
         rz = ml * (sn * f2[j] + co * f1[j] ** 2)
         r[0, j], r[1, j] = rx, rz
         r[2, j] = hp * rx - dp * rz - inertia * f2[j] + ml * g * sn
         s[0, j], s[1, j] = -ml * sn, ml * co
-    return r, s
+    return r, s, sin_phi, cos_phi
 
 
 @nb.njit(cache=True)
 def grid_motion(x, p012, s, winding, w, ml, inertia, g, dp, hp):
-    """``(phi, phi', phi'', r, wz)`` on the grid from the coefficients ``x``: ``phi = K s +
-    P0 x``, ``phi' = w K + P1 x``, ``phi'' = P2 x`` (``p012`` the three maps stacked), and
-    :func:`reaction` there."""
+    """``(phi, phi', phi'', r, wz, sin phi, cos phi)`` on the grid from the coefficients
+    ``x``: ``phi = K s + P0 x``, ``phi' = w K + P1 x``, ``phi'' = P2 x`` (``p012`` the three
+    maps stacked), and :func:`reaction` there."""
     m = s.size
     q = np.dot(p012, x)
     f = np.empty(m)
@@ -144,18 +148,18 @@ def grid_motion(x, p012, s, winding, w, ml, inertia, g, dp, hp):
         f[j] = winding * s[j] + q[j]
         f1[j] = w * winding + q[m + j]
         f2[j] = q[2 * m + j]
-    r, wz = reaction(f, f1, f2, ml, inertia, g, dp, hp)
-    return f, f1, f2, r, wz
+    r, wz, sn, co = reaction(f, f1, f2, ml, inertia, g, dp, hp)
+    return f, f1, f2, r, wz, sn, co
 
 
 @nb.njit(cache=True)
-def hull_torque(q3, y, f, f1, f2, inertia, c, ml, g):
+def hull_torque(q3, y, sn, co, f1, f2, inertia, c, ml, g):
     """``(p_x'', p_z'', beta', tau, v, P)`` on the grid for the hull's unknowns ``y``
     (``q3`` the map ``y -> (p_x'', p_z'', beta')``; :func:`torque`)."""
-    m = f.size
+    m = sn.size
     q = np.dot(q3, y)
     qx, qz, b1 = q[:m], q[m:2 * m], q[2 * m:]
-    tau, v, p = torque(f, f1, f2, qx, qz, b1, inertia, c, ml, g)
+    tau, v, p = torque(sn, co, f1, f2, qx, qz, b1, inertia, c, ml, g)
     return qx, qz, b1, tau, v, p
 
 
@@ -198,7 +202,7 @@ def hull_inverse(gp, zinv, zp, prow, blocks):
 
 @nb.njit(cache=True)
 def hull_solve(v, ptr, idx, coef, n1, n2, symmetric, z, zinv, zp, prow, blocks, b0, pi_all,
-               r, q3, f, f1, f2, inertia, c, ml, g):
+               r, q3, sn, co, f1, f2, inertia, c, ml, g):
     """``(S^{-1}, y, p_x'', p_z'', beta', tau, v, P)``: the hull's unknowns at the motion
     whose reaction is ``r`` (3, M) and whose hull-matrix weights have the spectra ``v``,
     ``y = S^{-1} (b0 + Pi r)`` with ``S = Z + G(v)`` (the gathers of :func:`fused_gram`,
@@ -246,20 +250,55 @@ def hull_solve(v, ptr, idx, coef, n1, n2, symmetric, z, zinv, zp, prow, blocks, 
                 s[prow[i], k] += gp[i, k]
         sinv = np.ascontiguousarray(np.linalg.inv(s))
         y = np.dot(sinv, b)
-    return (sinv, y) + hull_torque(q3, y, f, f1, f2, inertia, c, ml, g)
+    return (sinv, y) + hull_torque(q3, y, sn, co, f1, f2, inertia, c, ml, g)
 
 
 @nb.njit(cache=True)
-def constraint_weights(f, f1, f2, qx, qz, mu, ml, inertia, g, dp, hp):
+def spectra_at(w, freqs, ctab, stab):
+    """``[Re R, Im R]`` of the rows of ``w`` (K, M) flattened, ``R`` the half spectrum
+    (``rfft``; :func:`parapend.hydro._trig.spectra`'s layout), at the frequencies ``freqs``
+    only (the others zero), by direct sums with the tables ``ctab``, ``stab`` (``cos``,
+    ``sin`` of ``2 pi f j / M``): the hull matrix reads the weights' spectra up to ``2 Nh``
+    only, fewer operations than an FFT's call."""
+    k, m = w.shape
+    half = m // 2 + 1
+    v = np.zeros(k * 2 * half)
+    for r in range(k):
+        for q in range(freqs.size):
+            a = 0.0
+            b = 0.0
+            for j in range(m):
+                a += w[r, j] * ctab[q, j]
+                b += w[r, j] * stab[q, j]
+            v[r * 2 * half + freqs[q]] = a
+            v[r * 2 * half + half + freqs[q]] = -b
+    return v
+
+
+@nb.njit(cache=True)
+def hull_state(x, p012, s, winding, w, ml, inertia, g, dp, hp, freqs, ctab, stab, ptr, idx,
+               coef, n1, n2, symmetric, z, zinv, zp, prow, blocks, b0, pi_all, q3, c):
+    """The coupled problem's state at ``x`` in one call: ``(phi, phi', phi'', sin phi,
+    cos phi)`` (:func:`grid_motion`), then :func:`hull_solve`'s ``(S^{-1}, y, p_x'', p_z'',
+    beta', tau, v, P)`` with the hull matrix's spectra by :func:`spectra_at`."""
+    f, f1, f2, r, wz, sn, co = grid_motion(x, p012, s, winding, w, ml, inertia, g, dp, hp)
+    v = spectra_at(wz, freqs, ctab, stab)
+    out = hull_solve(v, ptr, idx, coef, n1, n2, symmetric, z, zinv, zp, prow, blocks, b0,
+                     pi_all, r, q3, sn, co, f1, f2, inertia, c, ml, g)
+    return (f, f1, f2, sn, co) + out
+
+
+@nb.njit(cache=True)
+def constraint_weights(sin_phi, cos_phi, f1, f2, qx, qz, mu, ml, inertia, g, dp, hp):
     """``(c1, c2, sens)``: the derivatives of ``sum_d mu_d rho_d`` pointwise in the six grid
     variables ((6, M), (21, M)), and the reaction's derivatives ``d rho_d / d(phi, phi',
     phi'')`` (9, M), row ``3 d + i``: the sensitivity's weights."""
-    m = f.size
+    m = sin_phi.size
     c1 = np.zeros((6, m))
     c2 = np.zeros((21, m))
     sens = np.empty((9, m))
     for j in range(m):
-        sn, co = math.sin(f[j]), math.cos(f[j])
+        sn, co = sin_phi[j], cos_phi[j]
         p1, p2 = f1[j], f2[j]
         wgt = (g + qz[j]) * sn - qx[j] * co
         wph = (g + qz[j]) * co + qx[j] * sn
@@ -311,8 +350,8 @@ def fused_gram(v, ptr, idx, coef, n1, n2, symmetric):
 
 
 @nb.njit(cache=True)
-def gradient_and_weights(f, f1, f2, qx, qz, ft, fv, ftt, ftv, fvv, rows, coupled, sinv, q3t,
-                         pi_t, p012t, ml, inertia, c, g, dp, hp):
+def gradient_and_weights(sn, co, f1, f2, qx, qz, ft, fv, ftt, ftv, fvv, rows, coupled, sinv,
+                         q3t, pi_t, p012t, ml, inertia, c, g, dp, hp):
     """The first half of an evaluation: the Lagrangian's pointwise derivatives (the
     objective's; with ``coupled``, plus the hull's reaction weighted by the adjoint ``mu``,
     ``S^T lambda = d<f>/dy``, ``mu = Pi^T lambda``), the reduced gradient ``P^T d1`` and
@@ -321,15 +360,15 @@ def gradient_and_weights(f, f1, f2, qx, qz, ft, fv, ftt, ftv, fvv, rows, coupled
     ``q3t`` the map ``y -> (p_x'', p_z'', beta')`` transposed (ny, 3M), ``pi_t`` the
     projection transposed (3M, ny), ``p012t`` the map ``x -> (phi, phi', phi'')`` transposed
     (nx, 3M)."""
-    m = f.size
-    d1, d2 = objective_weights(f, qx, qz, ft, fv, ftt, ftv, fvv, ml, inertia, c, g)
+    m = sn.size
+    d1, d2 = objective_weights(sn, co, qx, qz, ft, fv, ftt, ftv, fvv, ml, inertia, c, g)
     nr = rows.size
     w = np.empty((nr + (9 if coupled else 0), m))
     if coupled:
         gy = np.dot(q3t, d1[3:].copy().reshape(3 * m))
         lam = _tx(sinv, gy)  # S^{-T} gy
         mu = np.dot(pi_t, lam).reshape(3, m)
-        c1, c2, sens = constraint_weights(f, f1, f2, qx, qz, mu, ml, inertia, g, dp, hp)
+        c1, c2, sens = constraint_weights(sn, co, f1, f2, qx, qz, mu, ml, inertia, g, dp, hp)
         for j in range(m):  # loops, not array expressions: each of those compiles apart
             for u in range(6):
                 d1[u, j] += c1[u, j]

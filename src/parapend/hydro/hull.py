@@ -45,7 +45,7 @@ from ..errors import ParameterError
 from ._hull_kernel import (
     gradient_and_weights,
     grid_motion,
-    hull_solve,
+    hull_state,
     hull_torque,
     reduced_hessian,
 )
@@ -292,6 +292,13 @@ class HullProblem(PTOObjective):
         self._key_cache = {}
         self._hull_gram = FusedGram([(self._plan("pi2", "qz"), 0, False),
                                      (self._plan("pi2", "qx"), 1, False)], self.points)
+        # the frequencies of the reaction's weights that the hull matrix reads, and their
+        # cos, sin tables (hydro/_hull_kernel.py's spectra_at)
+        half = self.points // 2 + 1
+        loc = np.unique(self._hull_gram.idx % (2 * half))
+        self._hull_freqs = np.unique(np.where(loc < half, loc, loc - half)).astype(np.int64)
+        arg = 2 * math.pi * np.outer(self._hull_freqs, np.arange(self.points)) / self.points
+        self._hull_cos, self._hull_sin = np.cos(arg), np.sin(arg)
         self._last = None
 
     def _plan(self, a: str, b: str) -> GramPlan:
@@ -327,27 +334,29 @@ class HullProblem(PTOObjective):
     # --------------------------------------------------------------------------------------
     def _at(self, x) -> tuple:
         """``(st, S^{-1})`` at ``x``: the grid state (:meth:`grid_state`) and the hull
-        matrix's inverse (None when not coupled). Two compiled calls around one FFT
-        (``hydro/_hull_kernel.py``). The last point's is kept: the line search's power and
-        the next Newton step's evaluation share it."""
+        matrix's inverse (None when not coupled). One compiled call
+        (``hydro/_hull_kernel.py``'s ``hull_state``; uncoupled, two). The last point's is
+        kept: the line search's power and the next Newton step's evaluation share it."""
         x = np.asarray(x, dtype=float)
         key = x.tobytes()
         if self._last is not None and self._last[0] == key:
             return self._last[1]
         cs = self.case
         ml = cs.m * cs.l
-        f, f1, f2, r, wz = grid_motion(x, self._P012, self.s, float(self.winding),
-                                       self.omega, ml, cs.I, cs.g, *cs.pivot)
         if self.coupled:
-            sinv, y, qx, qz, b1, tau, v, p = hull_solve(
-                spectra(wz).ravel(), *self._hull_gram.arrays(), self.Z, self._Zinv,
-                self._Zp, self._prow, self._blocks, self.fa_real, self.Pi_all, r, self._Q3,
-                f, f1, f2, cs.I, cs.c, ml, cs.g)
+            f, f1, f2, sn, co, sinv, y, qx, qz, b1, tau, v, p = hull_state(
+                x, self._P012, self.s, float(self.winding), self.omega, ml, cs.I, cs.g,
+                *cs.pivot, self._hull_freqs, self._hull_cos, self._hull_sin,
+                *self._hull_gram.arrays(), self.Z, self._Zinv, self._Zp, self._prow,
+                self._blocks, self.fa_real, self.Pi_all, self._Q3, cs.c)
         else:
+            f, f1, f2, _, _, sn, co = grid_motion(x, self._P012, self.s, float(self.winding),
+                                                  self.omega, ml, cs.I, cs.g, *cs.pivot)
             sinv, y = None, self.y_free
-            qx, qz, b1, tau, v, p = hull_torque(self._Q3, y, f, f1, f2, cs.I, cs.c, ml, cs.g)
+            qx, qz, b1, tau, v, p = hull_torque(self._Q3, y, sn, co, f1, f2, cs.I, cs.c, ml,
+                                                cs.g)
         st = {"phi": f, "phi1": f1, "phi2": f2, "qx": qx, "qz": qz, "b1": b1, "y": y,
-              "tau": tau, "relative_speed": v, "power": p}
+              "tau": tau, "relative_speed": v, "power": p, "sin_phi": sn, "cos_phi": co}
         self._last = (key, (st, sinv))
         return self._last[1]
 
@@ -453,7 +462,7 @@ class HullProblem(PTOObjective):
         if not coupled:
             sinv = self._none2
         grad, w = gradient_and_weights(
-            st["phi"], st["phi1"], st["phi2"], st["qx"], st["qz"],
+            st["sin_phi"], st["cos_phi"], st["phi1"], st["phi2"], st["qx"], st["qz"],
             *(_full(t, m) for t in terms[1:]), rows, coupled, sinv, self._Q3T, self._Pi_t,
             self._P012T, cs.m * cs.l, cs.I, cs.c, cs.g, *cs.pivot)
         blocks = self._fused(keys, coupled)
