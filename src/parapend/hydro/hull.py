@@ -67,15 +67,6 @@ _CONSTRAINT_PAIRS = (("phi", "phi"), ("phi", "phi1"), ("phi", "phi2"), ("phi", "
                      ("phi", "qz"), ("phi1", "phi1"))
 
 
-def _full(t, m: int) -> np.ndarray:
-    """A pointwise term as an array of ``m`` values (None: zero; a scalar: constant)."""
-    if t is None:
-        return np.zeros(m)
-    if np.ndim(t) == 0:
-        return np.full(m, float(t))
-    return t
-
-
 def hull_points(harmonics: int, hull_harmonics: int, winding: int, wave_harmonics: int) -> int:
     """A power of two with 8 points per harmonic of the motion and of the wave, and 4 per
     harmonic of the products ``sin(phi) xi''`` that the hull's projection reads."""
@@ -300,6 +291,7 @@ class HullProblem(PTOObjective):
         arg = 2 * math.pi * np.outer(self._hull_freqs, np.arange(self.points)) / self.points
         self._hull_cos, self._hull_sin = np.cos(arg), np.sin(arg)
         self._last = None
+        self._constants = {}
 
     def _plan(self, a: str, b: str) -> GramPlan:
         key = (a, b)
@@ -427,6 +419,20 @@ class HullProblem(PTOObjective):
             ftt = q2 if ftt is None else ftt + q2
         return f, ft, fv, ftt, ftv, fvv
 
+    def _full(self, t) -> np.ndarray:
+        """A pointwise term as an array on the grid (None: zero; a scalar: constant; the
+        constant ones kept: the kernel only reads them; writeable, as a read-only array
+        would compile the kernel again)."""
+        if t is not None and np.ndim(t) != 0:
+            return t
+        v = 0.0 if t is None else float(t)
+        arr = self._constants.get(v)
+        if arr is None:
+            if len(self._constants) > 8:
+                self._constants.clear()
+            arr = self._constants[v] = np.full(self.points, v)
+        return arr
+
     # --------------------------------------------------------------------------------------
     def _keys(self, lossless: bool, coupled: bool) -> tuple:
         """The pairs of ``_VARS`` whose second-derivative weights can be non-zero (in
@@ -455,7 +461,6 @@ class HullProblem(PTOObjective):
         work before and after each FFT one compiled call)."""
         st, sinv = self._at(x)
         cs = self.case
-        m = self.points
         terms = self._objective(st)
         coupled = self.coupled
         keys, rows = self._keys(terms[3] is None, coupled)
@@ -463,7 +468,7 @@ class HullProblem(PTOObjective):
             sinv = self._none2
         grad, w = gradient_and_weights(
             st["sin_phi"], st["cos_phi"], st["phi1"], st["phi2"], st["qx"], st["qz"],
-            *(_full(t, m) for t in terms[1:]), rows, coupled, sinv, self._Q3T, self._Pi_t,
+            *(self._full(t) for t in terms[1:]), rows, coupled, sinv, self._Q3T, self._Pi_t,
             self._P012T, cs.m * cs.l, cs.I, cs.c, cs.g, *cs.pivot)
         blocks = self._fused(keys, coupled)
         h = reduced_hessian(spectra(w).ravel(), *blocks, coupled, sinv)
