@@ -15,6 +15,11 @@ from parapend.hydro._hull_kernel import (
     grid_motion,
     hull_inverse,
     hull_solve,
+    lift,
+    phi_gradient,
+    pivot_adjoint,
+    pivot_grid,
+    project,
     spectra_at,
 )
 from parapend.hydro._trig import spectra
@@ -77,8 +82,8 @@ def _hull_matrix(pr, x):
     """The hull matrix ``S`` at ``x`` formed densely (``Z`` plus the gathered pitch rows) and
     the kernel's arguments for it."""
     cs = pr.case
-    _, _, _, _, wz, _, _ = grid_motion(x, pr._P012, pr.s, float(pr.winding), pr.omega,
-                                 cs.m * cs.l, cs.I, cs.g, *cs.pivot)
+    _, _, _, _, wz, _, _ = grid_motion(x, pr._geo, pr.s, float(pr.winding), cs.m * cs.l,
+                                       cs.I, cs.g)
     gm = fused_gram(spectra(wz).ravel(), *pr._hull_gram.arrays())
     return pr.Z + gm, np.ascontiguousarray(gm[pr._prow])
 
@@ -94,8 +99,7 @@ def test_woodbury_inverse_is_the_inverse(winding):
     x = _x(cs.harmonics, winding, 7)
     s, gp = _hull_matrix(pr, x)
     # the hull matrix's spectra by direct sums at the frequencies it reads = the FFT's there
-    wz = grid_motion(x, pr._P012, pr.s, float(pr.winding), pr.omega, cs.m * cs.l, cs.I,
-                     cs.g, *cs.pivot)[4]
+    wz = grid_motion(x, pr._geo, pr.s, float(pr.winding), cs.m * cs.l, cs.I, cs.g)[4]
     assert np.allclose(fused_gram(spectra_at(wz, pr._hull_freqs, pr._hull_cos, pr._hull_sin),
                                   *pr._hull_gram.arrays()),
                        fused_gram(spectra(wz).ravel(), *pr._hull_gram.arrays()),
@@ -109,12 +113,12 @@ def test_woodbury_inverse_is_the_inverse(winding):
     assert np.max(np.abs(sinv - direct)) <= 1e-11 * np.max(np.abs(direct))
     # the check: a Z^{-1} off by 1 % gives a y whose residual is far above rounding
     ml = cs.m * cs.l
-    f, f1, f2, r, wz, sn, co = grid_motion(x, pr._P012, pr.s, float(pr.winding), pr.omega,
-                                           ml, cs.I, cs.g, *cs.pivot)
+    f, f1, f2, r, wz, sn, co = grid_motion(x, pr._geo, pr.s, float(pr.winding), ml, cs.I,
+                                           cs.g)
     bad = pr._Zinv * 1.01
     out = hull_solve(spectra(wz).ravel(), *pr._hull_gram.arrays(), pr.Z, bad,
                      np.ascontiguousarray(bad[:, pr._prow]), pr._prow, pr._blocks, pr.fa_real,
-                     pr.Pi_all, r, pr._Q3, sn, co, f1, f2, cs.I, cs.c, ml, cs.g)
+                     r, pr._geo, sn, co, f1, f2, cs.I, cs.c, ml, cs.g)
     assert np.max(np.abs(out[0] - direct)) <= 1e-11 * np.max(np.abs(direct))
     assert np.max(np.abs(out[1] - st["y"])) <= 1e-11 * np.max(np.abs(st["y"]))
 
@@ -180,3 +184,56 @@ def test_heave_only_hull_equals_the_heave_kernel():
     assert ref.success
     # measured 3e-10: the locked DOFs' 1e12 mass and stiffness leave a 1e-10 coupling
     assert r.power == pytest.approx(ref.power, rel=1e-8)
+
+
+def _dense_maps(pr):
+    """The kernel's maps as dense matrices, built here from the discretization's definition
+    (tests/hull_reference.py's): ``x -> (phi - K s, phi', phi'')``, ``y -> (p_x'', p_z'',
+    beta')`` and the projection ``Pi`` of the hull's equations."""
+    cs, m, n, nh = pr.case, pr.points, pr.harmonics, pr.case.hull_harmonics
+    w, s = pr.omega, pr.s
+    kn, kh = np.arange(1, n + 1), np.arange(1, nh + 1)
+    sn, cn = np.sin(np.outer(s, kn)), np.cos(np.outer(s, kn))
+    p012 = np.vstack((np.hstack((np.ones((m, 1)), sn, cn)),
+                      w * np.hstack((np.zeros((m, 1)), kn * cn, -kn * sn)),
+                      -w**2 * np.hstack((np.zeros((m, 1)), kn**2 * sn, kn**2 * cn))))
+    j0, ny = len(pr.static), pr.ny
+    ch, sh = np.cos(np.outer(s, kh)), np.sin(np.outer(s, kh))
+    e1, e2, pi = np.zeros((3, m, ny)), np.zeros((3, m, ny)), np.zeros((3, ny, m))
+    for i, d in enumerate(pr.static):
+        pi[d, i, :] = 1.0 / m
+    for d in range(3):
+        re = j0 + 6 * (kh - 1) + d
+        im = re + 3
+        e1[d][:, re], e1[d][:, im] = -w * kh * sh, -w * kh * ch
+        e2[d][:, re], e2[d][:, im] = -(w * kh) ** 2 * ch, (w * kh) ** 2 * sh
+        pi[d][re, :], pi[d][im, :] = (2.0 / m) * ch.T, -(2.0 / m) * sh.T
+    dp, hp = cs.pivot
+    q3 = np.vstack((e2[0] + hp * e2[2], e2[1] - dp * e2[2], e1[2]))
+    return p012, q3, np.concatenate(list(pi), axis=1)
+
+
+@pytest.mark.parametrize("winding", [0, 1])
+def test_trigonometric_maps_are_the_dense_maps(winding):
+    """The kernel's sums over the cos/sin tables (``grid_motion``, ``phi_gradient``,
+    ``pivot_grid``, ``pivot_adjoint``, ``project``, ``lift``) equal the dense matrices of
+    the discretization and their transposes, to rounding."""
+    cs = case(winding=winding, harmonics=7)
+    pr = HullProblem(cs)
+    p012, q3, pi = _dense_maps(pr)
+    m, rng = pr.points, np.random.default_rng(winding)
+
+    def close(got, ref):
+        return np.allclose(got, ref, rtol=0, atol=1e-12 * np.max(np.abs(ref)))
+
+    x = _x(cs.harmonics, winding, 11)
+    f, f1, f2 = grid_motion(x, pr._geo, pr.s, float(pr.winding), cs.m * cs.l, cs.I, cs.g)[:3]
+    assert close(np.concatenate((f - winding * pr.s, f1 - pr.omega * winding, f2)), p012 @ x)
+    d1 = rng.standard_normal((6, m))
+    assert close(phi_gradient(d1, pr._geo), p012.T @ d1[:3].ravel())
+    y = rng.standard_normal(pr.ny)
+    assert close(np.concatenate(pivot_grid(y, pr._geo, m)), q3 @ y)
+    assert close(pivot_adjoint(d1, pr._geo, pr.ny), q3.T @ d1[3:].ravel())
+    r, b0 = rng.standard_normal((3, m)), rng.standard_normal(pr.ny)
+    assert close(project(r, pr._geo, b0), b0 + pi @ r.ravel())
+    assert close(lift(y, pr._geo, m), (pi.T @ y).reshape(3, m))

@@ -38,7 +38,8 @@ from .._jit import announce_compiles
 announce_compiles()  # log a first-use compile (parapend._jit)
 
 __all__ = ["constraint_weights", "fused_gram", "grid_motion", "gradient_and_weights",
-           "hull_inverse", "hull_solve", "hull_state", "hull_torque", "objective_weights",
+           "hull_inverse", "hull_solve", "hull_state", "hull_torque", "lift",
+           "objective_weights", "phi_gradient", "pivot_adjoint", "pivot_grid", "project",
            "reaction", "reduced_hessian", "spectra_at", "torque"]
 
 
@@ -134,31 +135,161 @@ def reaction(f, f1, f2, ml, inertia, g, dp, hp):
     return r, s, sin_phi, cos_phi
 
 
+@nb.njit(cache=True, fastmath={"reassoc"})
+def _analysis(rows, kmax, ct, st):
+    """``(A_c, A_s)``, (R, kmax) each: ``sum_j rows[r, j] cos(k s_j)`` and ``sin(k s_j)``
+    for ``k = 1..kmax`` (``ct``, ``st``: the tables, row ``k - 1``; the sums reassociated
+    so that they vectorize)."""
+    nr, m = rows.shape
+    ac = np.empty((nr, kmax))
+    asn = np.empty((nr, kmax))
+    for r in range(nr):
+        for k in range(kmax):
+            a = 0.0
+            b = 0.0
+            for j in range(m):
+                a += rows[r, j] * ct[k, j]
+                b += rows[r, j] * st[k, j]
+            ac[r, k] = a
+            asn[r, k] = b
+    return ac, asn
+
+
 @nb.njit(cache=True)
-def grid_motion(x, p012, s, winding, w, ml, inertia, g, dp, hp):
+def grid_motion(x, geo, s, winding, ml, inertia, g):
     """``(phi, phi', phi'', r, wz, sin phi, cos phi)`` on the grid from the coefficients
-    ``x``: ``phi = K s + P0 x``, ``phi' = w K + P1 x``, ``phi'' = P2 x`` (``p012`` the three
-    maps stacked), and :func:`reaction` there."""
+    ``x``: ``phi = K s + x_0 + sum_n x_n sin(n s) + x_{N+n} cos(n s)`` and its derivatives
+    (``geo``: :func:`pivot_grid`'s), and :func:`reaction` there."""
+    n, _, _, _, om, hp, dp, ct, st = geo
     m = s.size
-    q = np.dot(p012, x)
     f = np.empty(m)
     f1 = np.empty(m)
-    f2 = np.empty(m)
+    f2 = np.zeros(m)
     for j in range(m):
-        f[j] = winding * s[j] + q[j]
-        f1[j] = w * winding + q[m + j]
-        f2[j] = q[2 * m + j]
+        f[j] = winding * s[j] + x[0]
+        f1[j] = om * winding
+    for k in range(n):
+        a, b = x[1 + k], x[1 + n + k]
+        c1 = om * (k + 1)
+        c2 = c1 * c1
+        for j in range(m):
+            sj, cj = st[k, j], ct[k, j]
+            f[j] += a * sj + b * cj
+            f1[j] += c1 * (a * cj - b * sj)
+            f2[j] -= c2 * (a * sj + b * cj)
     r, wz, sn, co = reaction(f, f1, f2, ml, inertia, g, dp, hp)
     return f, f1, f2, r, wz, sn, co
 
 
 @nb.njit(cache=True)
-def hull_torque(q3, y, sn, co, f1, f2, inertia, c, ml, g):
+def phi_gradient(d1, geo):
+    """The reduced gradient ``P^T d1``: ``d1``'s rows 0-2 (the weights of ``phi``, ``phi'``,
+    ``phi''`` on the grid) mapped back to ``phi``'s coefficients (:func:`grid_motion`'s
+    map transposed, by :func:`_analysis`)."""
+    n, _, _, _, om, _, _, ct, st = geo
+    grad = np.empty(2 * n + 1)
+    acc = 0.0
+    for j in range(d1.shape[1]):
+        acc += d1[0, j]
+    grad[0] = acc
+    ac, asn = _analysis(d1[:3], n, ct, st)
+    for k in range(n):
+        c1 = om * (k + 1)
+        c2 = c1 * c1
+        grad[1 + k] = asn[0, k] - c2 * asn[2, k] + c1 * ac[1, k]
+        grad[1 + n + k] = ac[0, k] - c2 * ac[2, k] - c1 * asn[1, k]
+    return grad
+
+
+@nb.njit(cache=True)
+def project(r, geo, b0):
+    """``b0 + Pi r``: the hull's equations' right side, the reaction ``r`` (3, M) projected
+    on the hull's unknowns (the static DOFs' means; ``2/M sum cos``, ``-2/M sum sin`` for
+    the real and imaginary parts of each harmonic)."""
+    _, nh, j0, static, _, _, _, ct, st = geo
+    m = r.shape[1]
+    b = b0.copy()
+    for i in range(j0):
+        acc = 0.0
+        for j in range(m):
+            acc += r[static[i], j]
+        b[i] += acc / m
+    ac, asn = _analysis(r, nh, ct, st)
+    for k in range(nh):
+        for d in range(3):
+            o = j0 + 6 * k + d
+            b[o] += 2.0 / m * ac[d, k]
+            b[o + 3] -= 2.0 / m * asn[d, k]
+    return b
+
+
+@nb.njit(cache=True)
+def lift(lam, geo, m):
+    """``Pi^T lambda`` (3, M): :func:`project`'s transpose."""
+    _, nh, j0, static, _, _, _, ct, st = geo
+    mu = np.zeros((3, m))
+    for i in range(j0):
+        v = lam[i] / m
+        for j in range(m):
+            mu[static[i], j] += v
+    for k in range(nh):
+        for d in range(3):
+            o = j0 + 6 * k + d
+            cr, ci = 2.0 / m * lam[o], -2.0 / m * lam[o + 3]
+            for j in range(m):
+                mu[d, j] += cr * ct[k, j] + ci * st[k, j]
+    return mu
+
+
+@nb.njit(cache=True)
+def pivot_grid(y, geo, m):
+    """``(p_x'', p_z'', beta')`` on the grid from the hull's unknowns ``y``: ``xi_d'' =
+    sum_k -(k w)^2 (Re cos - Im sin)``, ``xi_d' = sum_k -k w (Re sin + Im cos)``,
+    ``p'' = G xi''``. ``geo = (N, Nh, j0, static, w, h_p, d_p, cos, sin)``: the harmonics of
+    phi and of the hull, the static unknowns and their DOFs, the frequency, the pivot and
+    the tables ``cos(k s_j)``, ``sin(k s_j)`` (row ``k - 1``, up to ``max(N, Nh)``)."""
+    _, nh, j0, _, om, hp, dp, ct, st = geo
+    qx = np.zeros(m)
+    qz = np.zeros(m)
+    b1 = np.zeros(m)
+    for k in range(nh):
+        c1 = om * (k + 1)
+        c2 = c1 * c1
+        o = j0 + 6 * k
+        xc, xs = -c2 * (y[o] + hp * y[o + 2]), c2 * (y[o + 3] + hp * y[o + 5])
+        zc, zs = -c2 * (y[o + 1] - dp * y[o + 2]), c2 * (y[o + 4] - dp * y[o + 5])
+        bc, bs = -c1 * y[o + 5], -c1 * y[o + 2]
+        for j in range(m):
+            cj, sj = ct[k, j], st[k, j]
+            qx[j] += xc * cj + xs * sj
+            qz[j] += zc * cj + zs * sj
+            b1[j] += bc * cj + bs * sj
+    return qx, qz, b1
+
+
+@nb.njit(cache=True)
+def pivot_adjoint(d1, geo, ny):
+    """:func:`pivot_grid`'s map transposed on ``d1``'s rows 3-5 (the weights of ``p_x''``,
+    ``p_z''``, ``beta'``): ``d<f>/dy``."""
+    _, nh, j0, _, om, hp, dp, ct, st = geo
+    gy = np.zeros(ny)
+    ac, asn = _analysis(d1[3:], nh, ct, st)
+    for k in range(nh):
+        c1 = om * (k + 1)
+        c2 = c1 * c1
+        o = j0 + 6 * k
+        gy[o], gy[o + 3] = -c2 * ac[0, k], c2 * asn[0, k]
+        gy[o + 1], gy[o + 4] = -c2 * ac[1, k], c2 * asn[1, k]
+        gy[o + 2] = -c2 * (hp * ac[0, k] - dp * ac[1, k]) - c1 * asn[2, k]
+        gy[o + 5] = c2 * (hp * asn[0, k] - dp * asn[1, k]) - c1 * ac[2, k]
+    return gy
+
+
+@nb.njit(cache=True)
+def hull_torque(y, geo, sn, co, f1, f2, inertia, c, ml, g):
     """``(p_x'', p_z'', beta', tau, v, P)`` on the grid for the hull's unknowns ``y``
-    (``q3`` the map ``y -> (p_x'', p_z'', beta')``; :func:`torque`)."""
-    m = sn.size
-    q = np.dot(q3, y)
-    qx, qz, b1 = q[:m], q[m:2 * m], q[2 * m:]
+    (:func:`pivot_grid`, :func:`torque`)."""
+    qx, qz, b1 = pivot_grid(y, geo, sn.size)
     tau, v, p = torque(sn, co, f1, f2, qx, qz, b1, inertia, c, ml, g)
     return qx, qz, b1, tau, v, p
 
@@ -201,12 +332,12 @@ def hull_inverse(gp, zinv, zp, prow, blocks):
 
 
 @nb.njit(cache=True)
-def hull_solve(v, ptr, idx, coef, n1, n2, symmetric, z, zinv, zp, prow, blocks, b0, pi_all,
-               r, q3, sn, co, f1, f2, inertia, c, ml, g):
+def hull_solve(v, ptr, idx, coef, n1, n2, symmetric, z, zinv, zp, prow, blocks, b0, r, geo,
+               sn, co, f1, f2, inertia, c, ml, g):
     """``(S^{-1}, y, p_x'', p_z'', beta', tau, v, P)``: the hull's unknowns at the motion
     whose reaction is ``r`` (3, M) and whose hull-matrix weights have the spectra ``v``,
-    ``y = S^{-1} (b0 + Pi r)`` with ``S = Z + G(v)`` (the gathers of :func:`fused_gram`,
-    non-zero on the pitch rows ``prow`` only; :func:`hull_inverse`), and
+    ``y = S^{-1} (b0 + Pi r)`` (:func:`project`) with ``S = Z + G(v)`` (the gathers of
+    :func:`fused_gram`, non-zero on the pitch rows ``prow`` only; :func:`hull_inverse`), and
     :func:`hull_torque` there. The inverse, not a factorization: the adjoint and the
     sensitivity's right sides are products with it in :func:`gradient_and_weights` and
     :func:`reduced_hessian`, and nearly every point whose power is asked is then evaluated
@@ -217,9 +348,7 @@ def hull_solve(v, ptr, idx, coef, n1, n2, symmetric, z, zinv, zp, prow, blocks, 
         for k in range(gm.shape[1]):
             gp[i, k] = gm[prow[i], k]
     sinv = hull_inverse(gp, zinv, zp, prow, blocks)
-    b = np.dot(pi_all, r.copy().reshape(r.size))
-    for i in range(b.size):
-        b[i] += b0[i]
+    b = project(r, geo, b0)
     y = np.dot(sinv, b)
     # the check: y's backward error |S y - b| / (|S| |y| + |b|) (max norms) at rounding's
     # scale; above 1e-10 (Woodbury's small matrix ill-conditioned where S is not), S is
@@ -250,7 +379,7 @@ def hull_solve(v, ptr, idx, coef, n1, n2, symmetric, z, zinv, zp, prow, blocks, 
                 s[prow[i], k] += gp[i, k]
         sinv = np.ascontiguousarray(np.linalg.inv(s))
         y = np.dot(sinv, b)
-    return (sinv, y) + hull_torque(q3, y, sn, co, f1, f2, inertia, c, ml, g)
+    return (sinv, y) + hull_torque(y, geo, sn, co, f1, f2, inertia, c, ml, g)
 
 
 @nb.njit(cache=True)
@@ -276,15 +405,15 @@ def spectra_at(w, freqs, ctab, stab):
 
 
 @nb.njit(cache=True)
-def hull_state(x, p012, s, winding, w, ml, inertia, g, dp, hp, freqs, ctab, stab, ptr, idx,
-               coef, n1, n2, symmetric, z, zinv, zp, prow, blocks, b0, pi_all, q3, c):
+def hull_state(x, geo, s, winding, ml, inertia, g, freqs, ctab, stab, ptr, idx, coef, n1,
+               n2, symmetric, z, zinv, zp, prow, blocks, b0, c):
     """The coupled problem's state at ``x`` in one call: ``(phi, phi', phi'', sin phi,
     cos phi)`` (:func:`grid_motion`), then :func:`hull_solve`'s ``(S^{-1}, y, p_x'', p_z'',
     beta', tau, v, P)`` with the hull matrix's spectra by :func:`spectra_at`."""
-    f, f1, f2, r, wz, sn, co = grid_motion(x, p012, s, winding, w, ml, inertia, g, dp, hp)
+    f, f1, f2, r, wz, sn, co = grid_motion(x, geo, s, winding, ml, inertia, g)
     v = spectra_at(wz, freqs, ctab, stab)
-    out = hull_solve(v, ptr, idx, coef, n1, n2, symmetric, z, zinv, zp, prow, blocks, b0,
-                     pi_all, r, q3, sn, co, f1, f2, inertia, c, ml, g)
+    out = hull_solve(v, ptr, idx, coef, n1, n2, symmetric, z, zinv, zp, prow, blocks, b0, r,
+                     geo, sn, co, f1, f2, inertia, c, ml, g)
     return (f, f1, f2, sn, co) + out
 
 
@@ -351,23 +480,22 @@ def fused_gram(v, ptr, idx, coef, n1, n2, symmetric):
 
 @nb.njit(cache=True)
 def gradient_and_weights(sn, co, f1, f2, qx, qz, ft, fv, ftt, ftv, fvv, rows, coupled, sinv,
-                         q3t, pi_t, p012t, ml, inertia, c, g, dp, hp):
+                         geo, ny, ml, inertia, c, g):
     """The first half of an evaluation: the Lagrangian's pointwise derivatives (the
     objective's; with ``coupled``, plus the hull's reaction weighted by the adjoint ``mu``,
     ``S^T lambda = d<f>/dy``, ``mu = Pi^T lambda``), the reduced gradient ``P^T d1`` and
     the weights whose spectra give the Hessian: the pairs ``rows`` of the second
     derivatives, then (coupled) the nine sensitivity weights. ``sinv`` is ``S^{-1}``,
-    ``q3t`` the map ``y -> (p_x'', p_z'', beta')`` transposed (ny, 3M), ``pi_t`` the
-    projection transposed (3M, ny), ``p012t`` the map ``x -> (phi, phi', phi'')`` transposed
-    (nx, 3M)."""
+    ``geo`` the maps' (:func:`pivot_grid`), ``ny`` the hull's unknowns."""
+    _, _, _, _, _, hp, dp, _, _ = geo
     m = sn.size
     d1, d2 = objective_weights(sn, co, qx, qz, ft, fv, ftt, ftv, fvv, ml, inertia, c, g)
     nr = rows.size
     w = np.empty((nr + (9 if coupled else 0), m))
     if coupled:
-        gy = np.dot(q3t, d1[3:].copy().reshape(3 * m))
+        gy = pivot_adjoint(d1, geo, ny)
         lam = _tx(sinv, gy)  # S^{-T} gy
-        mu = np.dot(pi_t, lam).reshape(3, m)
+        mu = lift(lam, geo, m)
         c1, c2, sens = constraint_weights(sn, co, f1, f2, qx, qz, mu, ml, inertia, g, dp, hp)
         for j in range(m):  # loops, not array expressions: each of those compiles apart
             for u in range(6):
@@ -379,8 +507,7 @@ def gradient_and_weights(sn, co, f1, f2, qx, qz, ft, fv, ftt, ftv, fvv, rows, co
     for i in range(nr):
         for j in range(m):
             w[i, j] = d2[rows[i], j]
-    grad = np.dot(p012t, d1[:3].copy().reshape(3 * m))
-    return grad, w
+    return phi_gradient(d1, geo), w
 
 
 @nb.njit(cache=True)

@@ -170,14 +170,7 @@ class HullProblem(PTOObjective):
         self.harmonics, self.points, self.winding, self.omega = n, m, kw, w
         s = 2 * math.pi * np.arange(m) / m
         self.s = s
-        # phi's maps: phi = K s + P0 x, phi' = w K + P1 x, phi'' = P2 x
         kn = np.arange(1, n + 1)
-        sn, cn = np.sin(np.outer(s, kn)), np.cos(np.outer(s, kn))
-        p0 = np.hstack((np.ones((m, 1)), sn, cn))
-        p1 = w * np.hstack((np.zeros((m, 1)), kn * cn, -kn * sn))
-        p2 = -w**2 * np.hstack((np.zeros((m, 1)), kn**2 * sn, kn**2 * cn))
-        self._P012 = np.vstack((p0, p1, p2))  # x -> (phi, phi', phi''): one product
-        self._P012T = np.ascontiguousarray(self._P012.T)
         # the hull's unknowns y: Xi_0 on the DOFs with stiffness, then (Re, Im) Xi_k
         cp = case.stiffness()
         self.static = [d for d in range(3) if cp[d, d] > 0]
@@ -185,26 +178,13 @@ class HullProblem(PTOObjective):
         ny = j0 + 6 * nh
         self.ny = ny
         kh = np.arange(1, nh + 1)
-        ch, sh = np.cos(np.outer(s, kh)), np.sin(np.outer(s, kh))
-        # E1[d], E2[d]: y -> xi_d', xi_d'' on the grid; Pi[d]: grid -> y rows
-        E1 = np.zeros((3, m, ny))
-        E2 = np.zeros((3, m, ny))
-        Pi = np.zeros((3, ny, m))
-        for i, d in enumerate(self.static):
-            Pi[d, i, :] = 1.0 / m
-        for d in range(3):
-            re = j0 + 6 * (kh - 1) + d
-            im = re + 3
-            E1[d][:, re], E1[d][:, im] = -w * kh * sh, -w * kh * ch
-            E2[d][:, re], E2[d][:, im] = -(w * kh) ** 2 * ch, (w * kh) ** 2 * sh
-            Pi[d][re, :] = (2.0 / m) * ch.T
-            Pi[d][im, :] = -(2.0 / m) * sh.T
-        self.Pi_all = np.concatenate(list(Pi), axis=1)  # (ny, 3M): the three rows at once
+        # the maps x -> (phi, phi', phi'') and y -> (p_x'', p_z'', beta') on the grid, the
+        # projection of the hull's equations and their transposes, as sums over the tables
+        # cos(k s_j), sin(k s_j), k = 1..max(N, Nh) (hydro/_hull_kernel.py's pivot_grid)
+        kt = np.arange(1, max(n, nh) + 1)
         dp, hp = case.pivot
-        # y -> (p_x'', p_z'', beta') on the grid
-        self._Q3 = np.vstack((E2[0] + hp * E2[2], E2[1] - dp * E2[2], E1[2]))
-        self._Q3T = np.ascontiguousarray(self._Q3.T)
-        self._Pi_t = np.ascontiguousarray(self.Pi_all.T)
+        self._geo = (n, nh, j0, np.array(self.static, dtype=np.int64), float(w), float(hp),
+                     float(dp), np.cos(np.outer(kt, s)), np.sin(np.outer(kt, s)))
         # the uncoupled problem's absent blocks, typed as the kernel expects
         self._none2 = np.zeros((0, 0))
         self._none3 = FusedGram.empty()
@@ -337,15 +317,14 @@ class HullProblem(PTOObjective):
         ml = cs.m * cs.l
         if self.coupled:
             f, f1, f2, sn, co, sinv, y, qx, qz, b1, tau, v, p = hull_state(
-                x, self._P012, self.s, float(self.winding), self.omega, ml, cs.I, cs.g,
-                *cs.pivot, self._hull_freqs, self._hull_cos, self._hull_sin,
-                *self._hull_gram.arrays(), self.Z, self._Zinv, self._Zp, self._prow,
-                self._blocks, self.fa_real, self.Pi_all, self._Q3, cs.c)
+                x, self._geo, self.s, float(self.winding), ml, cs.I, cs.g,
+                self._hull_freqs, self._hull_cos, self._hull_sin, *self._hull_gram.arrays(),
+                self.Z, self._Zinv, self._Zp, self._prow, self._blocks, self.fa_real, cs.c)
         else:
-            f, f1, f2, _, _, sn, co = grid_motion(x, self._P012, self.s, float(self.winding),
-                                                  self.omega, ml, cs.I, cs.g, *cs.pivot)
+            f, f1, f2, _, _, sn, co = grid_motion(x, self._geo, self.s, float(self.winding),
+                                                  ml, cs.I, cs.g)
             sinv, y = None, self.y_free
-            qx, qz, b1, tau, v, p = hull_torque(self._Q3, y, sn, co, f1, f2, cs.I, cs.c, ml,
+            qx, qz, b1, tau, v, p = hull_torque(y, self._geo, sn, co, f1, f2, cs.I, cs.c, ml,
                                                 cs.g)
         st = {"phi": f, "phi1": f1, "phi2": f2, "qx": qx, "qz": qz, "b1": b1, "y": y,
               "tau": tau, "relative_speed": v, "power": p, "sin_phi": sn, "cos_phi": co}
@@ -468,8 +447,8 @@ class HullProblem(PTOObjective):
             sinv = self._none2
         grad, w = gradient_and_weights(
             st["sin_phi"], st["cos_phi"], st["phi1"], st["phi2"], st["qx"], st["qz"],
-            *(self._full(t) for t in terms[1:]), rows, coupled, sinv, self._Q3T, self._Pi_t,
-            self._P012T, cs.m * cs.l, cs.I, cs.c, cs.g, *cs.pivot)
+            *(self._full(t) for t in terms[1:]), rows, coupled, sinv, self._geo, self.ny,
+            cs.m * cs.l, cs.I, cs.c, cs.g)
         blocks = self._fused(keys, coupled)
         h = reduced_hessian(spectra(w).ravel(), *blocks, coupled, sinv)
         val = st["power"] if self.lossless else float(np.mean(terms[0]))
