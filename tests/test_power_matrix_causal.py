@@ -298,8 +298,6 @@ def test_the_work_is_capped_in_one_line():
     (["--controller", "mpc", "--device", "buoy", "--dofs", "surge,heave,pitch"],
      "controller: the causal column is computed for --device prescribed-heave and the "
      "heaving --device buoy"),
-    (["--controller", "mpc", "--device", "buoy", "--forecast", "ar"],
-     "forecast: the buoy's column runs the perfect forecast only"),
     (["--controller", "mpc", "--device", "buoy", "--plan-samples", "4"],
      "plan-samples: an option of the prescribed-heave pendulum's planner"),
     (["--controller", "mpc", "--device", "buoy", "--speed-limit", "4"],
@@ -406,7 +404,7 @@ def buoy_bin(sphere_nc):
     """The bin Hs 0.2 m, Tp 3 s of the buoy's matrix, solved as the matrix solves it."""
     from parapend.performance.solve import solve_bin
 
-    spec = matrix_spec(**BUOY_KW, hydro=sphere_nc)
+    spec = matrix_spec(**BUOY_KW, forecast="perfect,ar", hydro=sphere_nc)
     return spec, solve_bin(spec, 1, 1, 0)
 
 
@@ -415,8 +413,9 @@ def test_a_buoy_bin_is_buoy_mpc_by_hand(buoy_bin, sphere_nc):
     """A buoy bin's causal powers are :func:`parapend.hydro.control.buoy_mpc` run by hand on
     the record the buoy's optimum solves (built here from ``sea_record``, as
     tests/test_performance_buoy.py builds it), with the column's settings written out: the
-    plan controller (one solve an update), horizon 1 and a plan every 1/8 peak period (as
-    ``parapend buoy --controller mpc``), the warm-up, one repeat; to round-off."""
+    default controller (``coupled``), horizon 1 and a plan every 1/8 peak period (as
+    ``parapend buoy --controller mpc``), the warm-up, one repeat, the perfect and the AR
+    forecast; to round-off."""
     from parapend.hydro.bem import load
     from parapend.hydro.control import buoy_mpc
     from parapend.hydro.coupled import Pendulum, Wave
@@ -425,20 +424,24 @@ def test_a_buoy_bin_is_buoy_mpc_by_hand(buoy_bin, sphere_nc):
 
     spec, got = buoy_bin
     assert spec.buoy_controller == "coupled" and spec.horizon == 1.0
-    assert spec.update_interval == 0.125 and spec.forecasts == ("perfect",)
+    assert spec.update_interval == 0.125 and spec.forecasts == ("perfect", "ar")
     pend = Pendulum(mass=20.0, length=0.3, inertia=20.0 * 0.3**2, damping_coefficient=0.5)
     exc = sea_record(Units(0.3, 20.0, 9.81, pend.inertia), hs=0.2, tp=3.0,
                      repeat_period=4 * 3.0, seed=7)
     wave = Wave(2 * math.pi / (4 * 3.0), np.asarray(exc.heave[1:], dtype=complex))
-    r = buoy_mpc(load(sphere_nc), pend, wave, peak_period=3.0, horizon=1.0,
-                 update_interval=0.125, warmup=1.0, repeats=1)
-    assert r.success
-    assert r.t_end_s - r.average_from_s == pytest.approx(12.0, rel=1e-9)  # one repeat
-    assert got["causal_perfect_power"] == pytest.approx(r.mean_power_w, rel=1e-12, abs=0)
-    assert got["causal_perfect_harvested_power"] == pytest.approx(r.harvested_power_w,
-                                                                  rel=1e-12, abs=0)
-    # storage-corrected: the stored energy of buoy and pendulum counted
-    assert r.mean_power_w == pytest.approx(r.harvested_power_w + r.stored_w, rel=1e-12)
+    for forecast in ("perfect", "ar"):
+        r = buoy_mpc(load(sphere_nc), pend, wave, peak_period=3.0, horizon=1.0,
+                     update_interval=0.125, warmup=1.0, repeats=1, forecast=forecast)
+        assert r.success and r.forecast == forecast
+        assert r.t_end_s - r.average_from_s == pytest.approx(12.0, rel=1e-9)  # one repeat
+        assert got[f"causal_{forecast}_power"] == pytest.approx(r.mean_power_w, rel=1e-12,
+                                                                abs=0)
+        assert got[f"causal_{forecast}_harvested_power"] == pytest.approx(
+            r.harvested_power_w, rel=1e-12, abs=0)
+        # storage-corrected: the stored energy of buoy and pendulum counted
+        assert r.mean_power_w == pytest.approx(r.harvested_power_w + r.stored_w, rel=1e-12)
+    # the AR forecast knows less: it harvests differently (not the perfect run again)
+    assert got["causal_ar_power"] != got["causal_perfect_power"]
 
 
 def _buoy_stub(causal_power):
@@ -485,7 +488,9 @@ def test_the_buoy_column_rests_its_aep_is_8766_h_sum_p_f(monkeypatch, sphere_nc,
         assert nc["annual_energy"].values.tolist() == pytest.approx(
             [out["causal"]["annual_energy"][c]["annual_energy_mwh"]
              for c in ("optimum", "causal_perfect")], rel=1e-12)
-    assert "the buoy's coupled controller, perfect forecast" in text_report(ds, out, [])
+    report = text_report(ds, out, [])
+    assert "the buoy's coupled controller)" in report
+    assert "causal power matrix, perfect forecast" in report
 
 
 @pytest.mark.slow  # the sphere's BEM (10 s, once a module), then solves

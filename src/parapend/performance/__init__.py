@@ -626,7 +626,7 @@ def power_matrix(*, hs="1:3:3", te=None, tp=None, realizations: int = 3, waves: 
     as ``horizon``), and ``speed_limit`` the plans' rated-speed penalty (units
     ``sqrt(g / l)``, default 4; ``inf``: none, ``horizon``'s default);
     ``parapend.performance.causal``. With ``device="buoy"`` (heave only) the column is the
-    buoy's causal controller (``parapend.hydro.control.buoy_mpc``, perfect forecast,
+    buoy's causal controller (``parapend.hydro.control.buoy_mpc`` with each ``forecast``,
     ``horizon`` 1 and ``update_interval`` 1/8 by default; no ``plan_samples`` or
     ``speed_limit``), the controller named in ``causal.buoy_controller``."""
     from ..maps.run import run_spec

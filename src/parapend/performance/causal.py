@@ -22,9 +22,11 @@ periodic motion, 64 torque samples a peak period, ``warm_up`` peak periods and t
 repeat of the record, its storage-corrected power (the harvested energy plus the change of
 the mechanical energy of buoy AND pendulum, per unit time; electrical with an efficiency,
 the stored energy counted at ``eta_g``). Its horizon, update interval and warm-up default to
-``parapend buoy --controller mpc``'s (:data:`BUOY_CAUSAL`); the perfect forecast only (the
-buoy's controller has no AR forecast), and neither ``plan_samples`` nor ``speed_limit``
-(options of the pendulum's planner).
+``parapend buoy --controller mpc``'s (:data:`BUOY_CAUSAL`); the perfect forecast, the AR one
+(``buoy_mpc(forecast="ar")``: the excitation force over the horizon from
+:class:`parapend.control.forecast.ARForecast` fitted at each update on the force measured so
+far), or both; neither ``plan_samples`` nor ``speed_limit`` (options of the pendulum's
+planner).
 """
 
 from __future__ import annotations
@@ -112,11 +114,6 @@ def check_causal(*, controller, horizon, forecast, update_interval, warm_up, pla
     if not names or any(n not in FORECASTS for n in names) or len(set(names)) != len(names):
         raise ParameterError(f"forecast: expected perfect, ar or perfect,ar, got "
                              f"{forecast!r:.40}")
-    if buoy and names != ["perfect"]:
-        raise ParameterError("forecast: the buoy's column runs the perfect forecast only (the "
-                             "autoregressive one runs in parapend buoy --controller mpc "
-                             "--forecast ar, not yet in the matrix); give --forecast perfect "
-                             "with --device buoy")
     upd = base["update_interval"] if update_interval is None else update_interval
     upd = check_range("update-interval", upd, 1e-3, 1.0, why="peak periods")
     if buoy and upd < 1.0 / 64:
@@ -128,7 +125,8 @@ def check_causal(*, controller, horizon, forecast, update_interval, warm_up, pla
     warm = base["warm_up"] if warm_up is None else warm_up
     warm = check_range("warm-up", warm, 0.0, 100.0, why="peak periods")
     if buoy:
-        return {"controller": "mpc", "horizon": float(horizon), "forecasts": ("perfect",),
+        return {"controller": "mpc", "horizon": float(horizon),
+                "forecasts": tuple(n for n in FORECASTS if n in names),
                 "update_interval": float(upd), "warm_up": float(warm), "plan_samples": None,
                 "speed_limit": None,
                 "buoy_controller": ("coupled" if lossy and BUOY_CONTROLLER == "plan"
@@ -240,8 +238,9 @@ def run_record(spec, exc, units, j: int, r: int, forecast: str):
                    interval_samples=spec.plan_samples)
 
 
-def run_buoy_record(spec, i: int, j: int, r: int):
-    """The buoy's causal run of bin ``(i, j)``, realization ``r`` (``--device buoy``):
+def run_buoy_record(spec, i: int, j: int, r: int, forecast: str = "perfect"):
+    """The buoy's causal run of bin ``(i, j)``, realization ``r`` (``--device buoy``) with
+    ``forecast``:
     :func:`parapend.hydro.control.buoy_mpc` on the body, pendulum and record
     :func:`parapend.performance.buoy_device.solve_buoy_bin` solves (same seed, same wave),
     ``warm_up`` peak periods then one repeat, the matrix's efficiency. The run's work is not
@@ -257,7 +256,7 @@ def run_buoy_record(spec, i: int, j: int, r: int):
     eta = spec.efficiency
     return buoy_mpc(h, pendulum(spec), wave, peak_period=spec.tp[j], horizon=spec.horizon,
                     update_interval=spec.update_interval, warmup=spec.warm_up, repeats=1,
-                    controller=spec.buoy_controller,
+                    controller=spec.buoy_controller, forecast=forecast,
                     efficiency=None if eta is None or eta == 1.0 else eta,
                     time_limit=limits.MAX_TIME_LIMIT, deadline=math.inf, **kw)
 
@@ -281,7 +280,7 @@ def solve_causal(spec, i: int, j: int, r: int) -> dict:
             # processes do not, and the record's q (a small complex matrix-vector product
             # at every update) ran 2 to 3 times slower with threads that only spin
             with threadpool_limits(1, user_api="blas"):
-                res = (run_buoy_record(spec, i, j, r) if buoy
+                res = (run_buoy_record(spec, i, j, r, f) if buoy
                        else run_record(spec, exc, units, j, r, f))
             if res.success and buoy:
                 p = float(res.electrical_power_w)

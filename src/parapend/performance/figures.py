@@ -298,7 +298,7 @@ def _causal_lines(ds, c: dict, hm0, per, pk) -> list:
                  f"peak periods, a plan every {c['update_interval_peak_periods']:g} of them, "
                  + (f"{c['plan_samples']} torque samples per plan interval"
                     if c.get("buoy_controller") is None else
-                    f"the buoy's {c['buoy_controller']} controller, perfect forecast")
+                    f"the buoy's {c['buoy_controller']} controller")
                  + ("" if c.get("speed_limit") is None else
                     f", speed penalty above {c['speed_limit']:g} sqrt(g/l)")
                  + "): storage-corrected "
