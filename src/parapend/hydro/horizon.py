@@ -30,7 +30,7 @@ from .. import limits
 from ..errors import ParameterError, check_int
 from ..results import _Result
 
-__all__ = ["BuoyHorizonResult", "buoy_horizon_curve", "BUOY_HORIZON"]
+__all__ = ["BuoyHorizonResult", "buoy_horizon_curve", "plot_buoy_horizon"]
 
 #: the buoy's curve without the options: horizons (peak periods), each record's length in
 #: peak periods, the update interval and the warm-up (peak periods; ``parapend buoy
