@@ -13,6 +13,7 @@ seconds and are slow tests. The input checks (one line, exit 2) and the keys run
 from __future__ import annotations
 
 import dataclasses
+import functools
 import json
 import math
 
@@ -105,12 +106,34 @@ def test_the_timings_and_the_realtime_verdict(curve):
 
 
 @pytest.mark.slow
-def test_the_ar_forecast_beside_the_perfect_one_and_records_pooled(sphere_nc):
+def test_the_ar_forecast_beside_the_perfect_one_and_records_pooled(sphere_nc, monkeypatch):
     """Two forecasts and two records: the AR run on the second record (seed + 1) is buoy_mpc
     with the AR forecast on parapend.buoy's record of that seed, its optimum parapend.buoy's,
-    and the mean fraction the mean over the records."""
+    and the mean fraction the mean over the records. The update times are every run's own
+    (captured here), pooled: the first record's first update apart, the rest together."""
+    import parapend.hydro.control as hc
+
+    runs = []
+    real = hc.buoy_mpc
+
+    @functools.wraps(real)
+    def spy(*args, **kw):
+        runs.append((kw["forecast"], real(*args, **kw)))
+        return runs[-1][1]
+
+    monkeypatch.setattr(hc, "buoy_mpc", spy)
     r = parapend.horizon(device="buoy", hydro=sphere_nc, horizons="0.5",
                          forecasts="ar,perfect", records=2, warm_up=1.0, **SEA, **PEND)
+    monkeypatch.setattr(hc, "buoy_mpc", real)
+    assert [f for f, _ in runs] == ["ar", "ar", "perfect", "perfect"]
+    for i in range(2):
+        a, b = runs[2 * i][1], runs[2 * i + 1][1]
+        assert r.mpc_power_w[i][0] == [a.electrical_power_w, b.electrical_power_w]
+        pooled = np.concatenate((a._update_times[1:], b._update_times))
+        assert r.mpc_update_time_first[i][0] == a._update_times[0] == a.update_time_first_s
+        assert r.mpc_update_time_median[i][0] == float(np.median(pooled))
+        assert r.mpc_update_time_p99[i][0] == float(np.percentile(pooled, 99))
+        assert r.mpc_update_time_max[i][0] == float(np.max(pooled))
     assert r.forecasts == ["ar", "perfect"] and r.seeds == [3, 4]
     from parapend.hydro.control import buoy_mpc
     from parapend.hydro.coupled import Pendulum
@@ -178,6 +201,24 @@ def test_the_default_device_is_the_pendulum_and_the_buoy_s_defaults_are_its_own(
     for name in ("horizons", "update_interval", "warm_up", "baselines", "length", "mass"):
         assert params[name].default is None  # resolved by device
     assert BUOY_HORIZON["update_interval"] == 0.125 and BUOY_HORIZON["warm_up"] == 4.0
+
+
+def test_the_pendulum_curve_keeps_its_defaults_and_keys():
+    """Without ``device`` the curve is the pendulum's: HORIZON's horizons, update interval,
+    warm-up and baselines, sea's 1 m, 10 kg pendulum, and no key of the buoy's."""
+    from parapend.defaults import HORIZON
+    from parapend.defaults import SEA as SEA_DEFAULTS
+
+    r = parapend.horizon(forecasts="none", baselines="extremum", repeat_period=16.0)
+    assert isinstance(r, HorizonResult)
+    assert r.horizons == [float(h) for h in HORIZON["horizons"].split(",")]
+    assert r.update_interval == HORIZON["update_interval"] and r.warm_up == HORIZON["warm_up"]
+    assert r.units["length_m"] == SEA_DEFAULTS["length"]
+    assert r.units["mass_kg"] == SEA_DEFAULTS["mass"]
+    d = r.to_dict()
+    assert "device" not in d and "controller" not in d
+    assert parapend.horizon(forecasts="none", repeat_period=16.0).baselines == [
+        "tracker", "extremum"]
 
 
 def _one_line(argv, name, capsys):

@@ -339,6 +339,7 @@ def buoy_horizon_curve(*, hs=None, tp=None, spectrum="jonswap", gamma_peak=3.3,
     times = [[[] for _ in hz] for _ in fc]
     first = [[math.nan for _ in hz] for _ in fc]
     upd_s = math.nan
+    ctrl = controller  # the planner that ran (buoy_mpc's default when None)
     kw = {} if controller is None else {"controller": controller}
     if controller == "plan":
         kw["iterations"] = 1
@@ -356,6 +357,7 @@ def buoy_horizon_curve(*, hs=None, tp=None, spectrum="jonswap", gamma_peak=3.3,
                 if res.status == "time_limit":
                     stopped[0] = True
                 status[i][j][r] = str(res.status)
+                ctrl = str(res.controller)
                 if res.success:
                     power[i][j][r] = float(res.electrical_power_w)
                     harvested[i][j][r] = float(res.harvested_electrical_power_w)
@@ -394,10 +396,10 @@ def buoy_horizon_curve(*, hs=None, tp=None, spectrum="jonswap", gamma_peak=3.3,
                f"finished (the records' optima and {len(fc) * len(hz)} receding-horizon runs "
                "per record), the rest NaN with the status time_limit")
     rec = {k: v for k, v in waves[0][1].items() if k not in ("seed",)}
-    import inspect
+    if ctrl is None:  # no run started (a time limit): the planner that would have run
+        import inspect
 
-    ctrl = (inspect.signature(buoy_mpc).parameters["controller"].default
-            if controller is None else controller)
+        ctrl = inspect.signature(buoy_mpc).parameters["controller"].default
     return BuoyHorizonResult(
         device="buoy", controller=ctrl, horizons=hz, forecasts=fc,
         seeds=[seed + r for r in range(records)], mpc_power_w=power,
