@@ -42,7 +42,10 @@ BUOY_HORIZON = {"horizons": "0.5,1,2", "repeat_periods": 10, "update_interval": 
 CONTROLLERS = ("coupled", "plan")
 #: seconds per unit of a run's work (updates x horizon samples x solves per update): the
 #: default ``parapend buoy --controller mpc`` run, 1.06e5, took 87 s under load
-#: (``parapend.limits.BUOY_MAX_MPC_WORK``)
+#: (``parapend.limits.BUOY_MAX_MPC_WORK``, the cap ``parapend buoy`` refuses by). The default
+#: curve (``coupled``, 1.0e5) is estimated at 82 s by it and took 140 s of CPU at a load of
+#: 2 to 3 on the 2 cores (docs/control.md): low under load, as ``parapend buoy``'s; ``plan``
+#: (counted as ``coupled`` with one solve an update) is over-estimated several times
 BUOY_MPC_SECONDS = 87.0 / 1.06e5
 
 
