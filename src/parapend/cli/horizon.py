@@ -3,7 +3,9 @@
 
 from __future__ import annotations
 
-from ..defaults import HORIZON
+from ..defaults import BUOY, HORIZON
+from ..hydro.horizon import BUOY_HORIZON
+from ..hydro.horizon import CONTROLLERS as BUOY_CONTROLLERS
 from . import _output
 from ._common import (
     FIGURE_SUFFIXES,
@@ -12,9 +14,19 @@ from ._common import (
     _int,
     _run,
     _table,
+    add_body_options,
     add_pendulum_options,
     add_sea_options,
 )
+
+
+def _buoy_defaults(g, notes: dict) -> None:
+    """Add to the help of the shared options in ``g`` what they default to (or that they are
+    refused) with ``--device buoy``: ``notes`` maps an option's dest to the text that goes
+    before the help's closing parenthesis."""
+    for action in g._group_actions:
+        if action.dest in notes and action.help.endswith(")"):
+            action.help = action.help[:-1] + notes[action.dest] + ")"
 
 
 def add_parsers(sub) -> None:
@@ -25,16 +37,30 @@ def add_parsers(sub) -> None:
                     "control with a perfect and an autoregressive forecast, against the "
                     "horizon, and of two causal baselines, as fractions of each record's "
                     "non-causal optimum (parapend sea) and of its limit (docs/control.md).")
+    p.add_argument("--device", choices=["pendulum", "buoy"],
+                   help="pendulum: the pendulum on a prescribed heave (default); buoy: the "
+                        "pendulum inside the floating buoy, coupled both ways (parapend buoy's "
+                        "body and pendulum; docs/buoy.md)")
+    p.set_defaults(device="pendulum")
     g = p.add_argument_group("sea state (IEC TS 62600-2 spectra)")
     add_sea_options(g, repeat_period="the length of each record",
                     seed="seed of the first record's phases; record r has seed + r "
                          "(default 0)",
                     cutoff="highest frequency, in units of the peak frequency (default 3)",
                     repeat_default=HORIZON["repeat_periods"])
+    _buoy_defaults(g, {"hs": f"; {BUOY['hs']:g} with --device buoy",
+                       "tp": f"; {BUOY['tp']:g} with --device buoy",
+                       "repeat_period": f"; {BUOY_HORIZON['repeat_periods']:g} Tp with "
+                                        "--device buoy"})
     g.add_argument("--records", type=_int,
                    help="seeded records, 1 to 20 (default 1)")
     g = p.add_argument_group("pendulum (SI units) and power take-off")
     add_pendulum_options(g)
+    _buoy_defaults(g, {
+        "length": f"; {BUOY['length']:g} with --device buoy",
+        "mass": f"; {BUOY['mass']:g} with --device buoy",
+        "damping_coefficient": f"; default {BUOY['damping_coefficient']:g} with --device buoy",
+        "gamma": "; not with --device buoy", "gravity": "; not with --device buoy"})
     g.add_argument("--torque-limit", type=_finite_float("torque-limit"),
                    help="|T| <= T_max, units m g l, for every controller (default none)")
     g.add_argument("--torque-limit-nm", type=_finite_float("torque-limit-nm"),
@@ -42,27 +68,39 @@ def add_parsers(sub) -> None:
     g.add_argument("--efficiency", type=_finite_float("efficiency"),
                    help="PTO efficiency in (0, 1], generating and motoring (default none: "
                         "lossless)")
+    g = p.add_argument_group("--device buoy: the body (Capytaine; the BEM result is cached on "
+                             "disk) and the controller")
+    add_body_options(g, body_help="vertical cylinder or sphere floating at its centre "
+                                  "(default cylinder)",
+                     hydro_help="a Capytaine dataset (NetCDF), instead of solving "
+                                "(docs/buoy.md)")
+    g.add_argument("--controller", choices=list(BUOY_CONTROLLERS),
+                   help="the buoy's receding-horizon planner (parapend.hydro.control.buoy_mpc"
+                        "; default its own, coupled)")
     g = p.add_argument_group("controllers")
     g.add_argument("--horizons",
                    help="horizons in peak periods, comma separated (default "
-                        f"{HORIZON['horizons']})")
+                        f"{HORIZON['horizons']}; {BUOY_HORIZON['horizons']} with --device "
+                        "buoy)")
     g.add_argument("--forecasts",
                    help="forecasts of the receding-horizon controller: perfect, ar, or none "
                         f"(default {HORIZON['forecasts']})")
     g.add_argument("--baselines",
                    help="causal baselines: tracker, extremum, or none (default "
-                        f"{HORIZON['baselines']})")
+                        f"{HORIZON['baselines']}; not with --device buoy)")
     g.add_argument("--update-interval", type=_finite_float("update-interval"),
                    help="receding-horizon update interval, peak periods (default "
-                        f"{HORIZON['update_interval']:g})")
+                        f"{HORIZON['update_interval']:g}; "
+                        f"{BUOY_HORIZON['update_interval']:g} with --device buoy)")
     g.add_argument("--warm-up", type=_finite_float("warm-up"),
                    help="peak periods of every receding-horizon run left out of its mean "
-                        "(the run is then this plus one repeat long; default 0)")
+                        "(the run is then this plus one repeat long; default 0, "
+                        f"{BUOY_HORIZON['warm_up']:g} with --device buoy)")
     g.add_argument("--speed-limit", type=_finite_float("speed-limit"),
                    help="rated-speed penalty of the receding-horizon plans (a penalty on "
                         "the plans' speeds above it, not a hard bound; the exceedance is "
                         "reported), in units of sqrt(g/l), > 0 (default none; "
-                        "docs/control.md)")
+                        "docs/control.md; not with --device buoy)")
     p.add_argument("--time-limit", type=_finite_float("time-limit"), metavar="SECONDS",
                    help="run for at most about this long, then stop with a partial curve "
                         "marked time_limit (without it, runs estimated over 2 minutes are "
@@ -98,6 +136,8 @@ def _cmd_horizon(a) -> dict | str:
         _output.save_plot(r, a.plot)
     if a.json:
         return r.to_dict()
+    if getattr(r, "device", "pendulum") == "buoy":
+        return "\n".join(_buoy_text(r, a))
     rec, u = r.record, r.units
     head = (f"horizon: {rec.get('spectrum')}, Hs = {rec.get('hs'):g} m, Tp = "
             f"{rec.get('tp'):g} s, records of {rec.get('repeat_period'):g} s, seeds "
@@ -184,6 +224,66 @@ def _cmd_horizon(a) -> dict | str:
     if a.plot:
         out.append(f"figure written to {a.plot}")
     return "\n".join(out)
+
+
+def _buoy_text(r, a) -> list:
+    """The text of ``--device buoy`` (:class:`parapend.hydro.horizon.BuoyHorizonResult`)."""
+    rec, p = r.record, r.pendulum
+    seeds = (f"seed {r.seeds[0]}" if len(r.seeds) == 1 else
+             f"seeds {r.seeds[0]}..{r.seeds[-1]}")
+    out = [f"horizon, buoy ({r.body}): {rec.get('spectrum')}, Hs = {rec.get('hs'):g} m, Tp = "
+           f"{rec.get('tp'):g} s, records of {rec.get('repeat_period'):g} s, {seeds}; "
+           f"pendulum m = {p['mass_kg']:g} kg, l = {p['length_m']:g} m, I = "
+           f"{p['inertia_kg_m2']:.4g} kg m^2, c = {p['damping_coefficient_nm_s_per_rad']:g} "
+           f"N m s/rad; {r.controller} planner"
+           + ("" if r.torque_limit_nm is None else f", torque limit {r.torque_limit_nm:.4g} N m")
+           + ("" if r.efficiency is None else
+              f", efficiency {r.efficiency[0]:g}/{r.efficiency[1]:g}")]
+    opt = [v for v in r.optimum_power_w if v == v]
+    out.append("coupled non-causal optimum (parapend buoy on each record) "
+               + (f"{sum(opt) / len(opt):.4g} W" if opt else "nan")
+               + f" (mean over the records); power = (harvested energy + change of the "
+                 f"stored energy of buoy and pendulum, mean dE in the last column) / time "
+                 f"over one repeat after {r.warm_up:g} peak periods from the hanging rest")
+    rows = []
+    for i, f in enumerate(r.forecasts):
+        for j, h in enumerate(r.horizons):
+            pw = [v for v in r.mpc_power_w[i][j] if v == v]
+            hv = [v for v in r.mpc_harvested_power_w[i][j] if v == v]
+            hu = r.mpc_horizon_used[i][j]
+            rows.append([f"{f}", f"{h:g}" if abs(hu - h) <= 1e-9 * h else
+                         f"{h:g} (plans {hu:.3g})",
+                         f"{sum(pw) / len(pw):.4g}" if pw else "nan",
+                         _pct(r.mpc_fraction_mean[i][j]),
+                         f"{_pct(r.mpc_fraction_min[i][j])} .. "
+                         f"{_pct(r.mpc_fraction_max[i][j])}",
+                         f"{sum(hv) / len(hv):.4g}" if hv else "nan",
+                         _mean(r.mpc_stored_energy_change_j[i][j])])
+    out += ["", _table(rows, ["forecast", "horizon (Tp)", "power (W)", "of optimum",
+                              "min .. max", "harvested (W)", "dE (J)"])]
+    trows = []
+    for i, f in enumerate(r.forecasts):
+        for j, h in enumerate(r.horizons):
+            fails = [v for v in r.mpc_failed_solves[i][j] if v is not None]
+            kept = [v for v in r.mpc_failed_kept_previous[i][j] if v is not None]
+            trows.append([f, f"{h:g}", f"{1e3 * r.mpc_update_time_median[i][j]:.3g}",
+                          f"{1e3 * r.mpc_update_time_p99[i][j]:.3g}",
+                          f"{1e3 * r.mpc_update_time_max[i][j]:.3g}",
+                          f"{1e3 * r.mpc_update_time_first[i][j]:.3g}",
+                          f"{sum(fails)} ({sum(kept)})"])
+    out += ["", f"receding-horizon updates (forecast + solves) against the update interval "
+                f"{1e3 * r.update_interval_s:.4g} ms: p99 "
+                + ("fits" if r.realtime_fits else "does NOT fit"
+                   if r.realtime_fits is not None else "not known (runs not finished)")
+                + " (one process; the first update, kernel load, apart)",
+            _table(trows, ["forecast", "horizon (Tp)", "median (ms)", "p99 (ms)", "max (ms)",
+                           "first (ms)", "failed solves (previous plan kept)"]),
+            "", f"status: {r.status}: {r.message}"]
+    if a.save:
+        out.append(f"curve written to {a.save}")
+    if a.plot:
+        out.append(f"figure written to {a.plot}")
+    return out
 
 
 COMMANDS = {"horizon": _cmd_horizon}

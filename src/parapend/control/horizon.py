@@ -233,27 +233,40 @@ def _longest_record(exc, warm_up, tp_n, mpc_est, rec_est, cap) -> float:
 
 def horizon_curve(*, hs=None, tp=None, spectrum: str = "jonswap", gamma_peak: float = 3.3,
                   repeat_period=None, seed=None, cutoff: float = 3.0,
-                  length: float = SEA["length"], mass: float = SEA["mass"], inertia=None,
-                  gravity: float = SEA["gravity"], gamma=None, damping_coefficient=None,
+                  length=None, mass=None, inertia=None,
+                  gravity=None, gamma=None, damping_coefficient=None,
                   torque_limit=None, torque_limit_nm=None, efficiency=None,
-                  horizons=HORIZON["horizons"], forecasts=HORIZON["forecasts"],
-                  baselines=HORIZON["baselines"], records: int = HORIZON["records"],
-                  update_interval: float = HORIZON["update_interval"], progress=None,
-                  warm_up: float = HORIZON["warm_up"],
-                  speed_limit=HORIZON["speed_limit"], time_limit=None) -> HorizonResult:
+                  horizons=None, forecasts=HORIZON["forecasts"],
+                  baselines=None, records: int = HORIZON["records"],
+                  update_interval=None, progress=None,
+                  warm_up=None, speed_limit=HORIZON["speed_limit"], time_limit=None,
+                  device: str = "pendulum", body=None, radius=None, draft=None, mesh=None,
+                  hydro=None, controller=None):
     """Mean power of causal control against the horizon, as a fraction of the record's
     non-causal optimum and of its limit (command ``horizon``: ``parapend.horizon`` is this
-    function; module docstring).
+    function; module docstring). With ``device="buoy"``: the pendulum inside the floating
+    buoy (:func:`parapend.hydro.horizon.buoy_horizon_curve`, a
+    :class:`~parapend.hydro.horizon.BuoyHorizonResult`).
 
     Parameters
     ----------
+    device : "pendulum" or "buoy"
+        The prescribed-heave pendulum (default) or the pendulum inside the buoy, coupled
+        both ways (``parapend buoy``'s body and pendulum, in SI; the options below marked
+        pendulum only are refused with it).
+    body, radius, draft, mesh, hydro, controller :
+        ``device="buoy"`` only: the floating body as ``parapend buoy`` takes it, and the
+        planner of :func:`parapend.hydro.control.buoy_mpc` (``"coupled"`` or ``"plan"``;
+        None: its default).
     hs, tp, spectrum, gamma_peak, repeat_period, seed, cutoff :
         The sea state (:func:`parapend.seas.sea_record`; ``repeat_period`` in s, default
         ``20 tp``, ``parapend.defaults.HORIZON["repeat_periods"]`` peak periods, not ``sea``'s
         100); record ``r`` has the seed ``seed + r``. ``hs``, ``tp``, ``seed`` None:
         2 m, 8 s, 0 (``parapend.defaults.SEA``).
     length, mass, inertia, gravity, gamma, damping_coefficient :
-        The pendulum, as :func:`parapend.irregular.sea` (default ``gamma = 0.01``).
+        The pendulum, as :func:`parapend.irregular.sea` (default 1 m, 10 kg, ``gravity``
+        9.81, ``gamma = 0.01``; the buoy's: ``parapend buoy``'s design, in SI, with
+        ``damping_coefficient``; ``gravity`` and ``gamma`` pendulum only).
     torque_limit : float or None
         ``T_max`` (units ``m g l``) for every controller.
     torque_limit_nm : float or None
@@ -262,13 +275,16 @@ def horizon_curve(*, hs=None, tp=None, spectrum: str = "jonswap", gamma_peak: fl
         PTO efficiency (generating and motoring) as :mod:`parapend.pto`, for every
         controller; the optimum and the limit stay mechanical.
     horizons : str or sequence of float
-        Horizons in peak periods (0.05 to 20).
+        Horizons in peak periods (0.05 to 20; default ``HORIZON["horizons"]``, the buoy's
+        ``parapend.hydro.horizon.BUOY_HORIZON["horizons"]``).
     forecasts, baselines : str or sequence of str
-        Subsets of ("perfect", "ar") and ("tracker", "extremum"); "none" for neither.
+        Subsets of ("perfect", "ar") and ("tracker", "extremum"); "none" for neither
+        (default ``HORIZON``'s; baselines pendulum only).
     records : int
         Seeded records, 1 to 20.
     update_interval : float
-        MPC update interval in peak periods.
+        MPC update interval in peak periods (default ``HORIZON["update_interval"]``, the
+        buoy's 0.125).
     progress : callable or None
         Called ``progress(done, total)`` as the work goes, in torque samples (64 a peak
         period): every run counts its samples (the non-causal optimum and each baseline
@@ -279,10 +295,11 @@ def horizon_curve(*, hs=None, tp=None, spectrum: str = "jonswap", gamma_peak: fl
         Peak periods of the receding-horizon runs left out of their mean (start-up from
         rest); the run is then ``warm_up`` plus one whole repeat of the record long, so the
         mean is over one repeat (the baselines still average the whole record from rest).
+        Default 0, the buoy's 4.
     speed_limit : float or None
         Rated-speed penalty of the receding-horizon plans, not a hard bound (its exceedance
         is reported; units ``sqrt(g / l)``;
-        :func:`parapend.control.mpc.mpc_run`); None: none.
+        :func:`parapend.control.mpc.mpc_run`); None: none. Pendulum only.
     time_limit : float or None
         Seconds for the whole curve: without it, a curve estimated above
         ``parapend.limits.MAX_UNTIMED_SECONDS`` (its receding-horizon updates at
@@ -293,6 +310,20 @@ def horizon_curve(*, hs=None, tp=None, spectrum: str = "jonswap", gamma_peak: fl
         with the status ``"time_limit"``, and the result's ``status`` is ``"time_limit"``
         (``success`` False; :mod:`parapend.deadline`).
     """
+    if device == "buoy":
+        return _buoy(locals())
+    if device != "pendulum":
+        raise ParameterError(f"device: expected pendulum or buoy, got {device!r:.40}")
+    for name in ("body", "radius", "draft", "mesh", "hydro", "controller"):
+        if locals()[name] is not None:
+            raise ParameterError(f"{name}: an option of the buoy; needs --device buoy")
+    length = SEA["length"] if length is None else length
+    mass = SEA["mass"] if mass is None else mass
+    gravity = SEA["gravity"] if gravity is None else gravity
+    horizons = HORIZON["horizons"] if horizons is None else horizons
+    baselines = HORIZON["baselines"] if baselines is None else baselines
+    update_interval = HORIZON["update_interval"] if update_interval is None else update_interval
+    warm_up = HORIZON["warm_up"] if warm_up is None else warm_up
     from ..deadline import check_time_limit, deadline, duration, expired, refuse_untimed
     from ..irregular import sea
     from ..seas import sea_record
@@ -568,6 +599,24 @@ def horizon_curve(*, hs=None, tp=None, spectrum: str = "jonswap", gamma_peak: fl
         mpc_failed_kept_previous=[[[int(v) if v == v else None for v in col] for col in row]
                                   for row in mpc_kept],
         mpc_speed_exceeded_fraction=opt_list(mpc_xf), mpc_speed_peak=opt_list(mpc_xp))
+
+
+#: options of the pendulum's curve the buoy's has not (refused by name with device="buoy")
+PENDULUM_ONLY = ("gravity", "gamma", "baselines", "speed_limit")
+
+
+def _buoy(opts: dict):
+    """``device="buoy"``: the pendulum-only options refused by name, the rest handed on."""
+    from ..hydro.horizon import buoy_horizon_curve
+
+    for name in PENDULUM_ONLY:
+        if opts[name] is not None:
+            raise ParameterError(f"{name.replace('_', '-')}: an option of the prescribed-heave "
+                                 "pendulum; not with --device buoy"
+                                 + (" (give --damping-coefficient, N m s/rad)"
+                                    if name == "gamma" else ""))
+    return buoy_horizon_curve(**{k: v for k, v in opts.items()
+                                 if k not in (*PENDULUM_ONLY, "device")})
 
 
 def horizon_dataset(r: HorizonResult):

@@ -13,6 +13,7 @@ the cache, datasets), :mod:`.timedomain` (Cummins' equation coupled with the pen
 (the electrical optimum, the torque limit), :mod:`.result` (the results and one wave's
 answer), :mod:`.api` (the command's function: input, body, wave), :mod:`.design` (power
 against wave period, the best pendulum), :mod:`.control` (receding-horizon control),
+:mod:`.horizon` (its curve against the horizon, ``parapend horizon --device buoy``),
 :mod:`.figures`.
 """
 

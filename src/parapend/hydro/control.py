@@ -181,6 +181,9 @@ class BuoyMPCResult(_Result):
                        "P = -<tau theta'>")
     _samples: dict = field(default=None, repr=False)
     _plant: object = field(default=None, repr=False)
+    #: every update's wall time (s), the first included: ``parapend horizon --device buoy``
+    #: pools them over its records
+    _update_times: object = field(default=None, repr=False)
 
     command = "buoy"
     headline = ("mean_power_w", "electrical_power_w", "harvested_power_w", "stored_w",
@@ -951,7 +954,7 @@ def buoy_mpc(hydro, pendulum, wave, *, peak_period, horizon=2.0, update_interval
                   "damping_coefficient_nm_s_per_rad": pendulum.damping_coefficient},
         units={"time_s": t0, "torque_nm": tu, "power_w": tu / t0, "a_inf_kg": plant.a_inf,
                "memory_s": plant.nk * h, "plant_step_s": h},
-        _samples=series, _plant=plant)
+        _samples=series, _plant=plant, _update_times=st)
 
 
 def mpc_command(hydro, pendulum, wave, info, *, controller, horizon, update_interval, winding,
