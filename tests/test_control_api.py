@@ -13,8 +13,10 @@ from parapend.errors import ParameterError
 
 
 @pytest.mark.parametrize("kw, match", [
-    ({"horizons": None}, "horizons: expected a comma list of numbers"),
     ({"horizons": ["x"]}, "horizons: expected a comma list of numbers"),
+    ({"horizons": "none"}, "horizons: expected a comma list of numbers"),
+    ({"baselines": 3}, "baselines: expected names from tracker, extremum"),
+    ({"update_interval": "x"}, "update-interval: expected a real number"),
     ({"horizons": [[1, 2]]}, "horizons: expected a comma list of numbers"),
     ({"horizons": True}, "horizons: expected a comma list of numbers"),
     ({"horizons": b"1"}, "horizons: expected a comma list of numbers"),
@@ -23,9 +25,7 @@ from parapend.errors import ParameterError
     ({"forecasts": None}, "forecasts: expected names from perfect, ar"),
     ({"forecasts": 3}, "forecasts: expected names from perfect, ar"),
     ({"forecasts": ["perfect", 3]}, "forecasts: expected names"),
-    ({"baselines": None}, "baselines: expected names from tracker, extremum"),
     ({"records": "x"}, "records: expected an integer"),
-    ({"update_interval": None}, "update-interval: expected a real number"),
     ({"torque_limit": "x"}, "torque-limit: expected a real number"),
     ({"torque_limit_nm": "x"}, "torque-limit-nm: expected a real number"),
     ({"torque_limit_nm": -1.0}, "torque-limit-nm: expected a number > 0"),

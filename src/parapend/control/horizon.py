@@ -31,15 +31,12 @@ from .. import limits
 from ..defaults import HORIZON, SEA
 from ..errors import ParameterError, check_int, check_positive, check_range
 from ..results import _Result
+from .curve_options import MAX_RECORDS, _horizons, _names, _stats
 
 __all__ = ["HorizonResult", "horizon_curve", "plot_horizon", "horizon_dataset"]
 
 #: lead times (peak periods) of the reported AR prediction error
 AR_LEADS = (0.0, 0.05, 0.1, 0.25, 0.5, 1.0, 2.0)
-#: most records of one curve
-MAX_RECORDS = 20
-#: most horizons of one curve
-MAX_HORIZONS = 16
 
 
 @dataclass(frozen=True, eq=False, repr=False)
@@ -159,60 +156,6 @@ class HorizonResult(_Result):
 
     def _figure(self):
         return plot_horizon(self)
-
-
-def _names(value, allowed, what):
-    expected = f"names from {', '.join(allowed)} (comma separated, or none)"
-    if isinstance(value, str):
-        items = [s.strip() for s in value.split(",") if s.strip()]
-        if items == ["none"]:
-            items = []
-    elif isinstance(value, (list, tuple)):
-        items = list(value)
-    else:
-        raise ParameterError(f"{what}: expected {expected}, got {value!r:.40}")
-    for s in items:
-        if s not in allowed:
-            raise ParameterError(f"{what}: expected {expected}, got {s!r:.40}")
-    if len(set(items)) != len(items):
-        raise ParameterError(f"{what}: expected distinct names, got {','.join(items)}")
-    return items
-
-
-def _horizons(value):
-    if isinstance(value, str):
-        try:
-            hs = [float(s) for s in value.split(",") if s.strip()]
-        except ValueError:
-            raise ParameterError(f"horizons: expected a comma list of numbers, got "
-                                 f"{value!r:.60}") from None
-    else:
-        # a sequence or array of real numbers; the CLI's message for anything else (None,
-        # bytes, a bool, strings, nested lists)
-        bad = ParameterError(f"horizons: expected a comma list of numbers, got "
-                             f"{value!r:.60}")
-        if isinstance(value, (bytes, bool, np.bool_)) or value is None:
-            raise bad
-        try:
-            arr = np.asarray(value)
-        except (TypeError, ValueError):
-            raise bad from None
-        if arr.ndim > 1 or arr.dtype.kind not in "iuf":
-            raise bad
-        hs = [float(v) for v in np.atleast_1d(arr)]
-    if not 1 <= len(hs) <= MAX_HORIZONS:
-        raise ParameterError(f"horizons: expected 1 to {MAX_HORIZONS} horizons, got {len(hs)}")
-    for h in hs:
-        check_range("horizons", h, 0.05, 20.0)
-    return hs
-
-
-def _stats(a):
-    a = np.asarray(a, dtype=float)
-    ok = np.isfinite(a)
-    if not ok.any():
-        return math.nan, math.nan, math.nan
-    return float(np.mean(a[ok])), float(np.min(a[ok])), float(np.max(a[ok]))
 
 
 #: rough wall time (s) per peak period of a record of its non-causal optimum (``sea``) and of

@@ -212,7 +212,7 @@ def buoy_horizon_curve(*, hs=None, tp=None, spectrum="jonswap", gamma_peak=3.3,
         ``progress(done, total)`` after every run (the records' optima and the
         receding-horizon runs).
     """
-    from ..control.horizon import MAX_RECORDS, _horizons, _names, _stats
+    from ..control.curve_options import MAX_RECORDS, _horizons, _names, _stats
     from ..deadline import check_time_limit, deadline, duration, expired, refuse_untimed
     from ..defaults import BUOY
     from ..units import Units
