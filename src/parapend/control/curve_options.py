@@ -69,3 +69,16 @@ def _stats(a):
     if not ok.any():
         return math.nan, math.nan, math.nan
     return float(np.mean(a[ok])), float(np.min(a[ok])), float(np.max(a[ok]))
+
+
+def update_time_stats(times, forecasts: int, horizons: int) -> tuple:
+    """``(median, p99, max)`` (s), each a ``forecasts x horizons`` list, of the update times
+    pooled over the records: ``times[i][j]`` the list of each record's array of update
+    times of forecast ``i`` at horizon ``j`` (NaN where none)."""
+
+    def pooled(i, j, fn):
+        a = np.concatenate(times[i][j]) if times[i][j] else np.zeros(0)
+        return float(fn(a)) if a.size else math.nan
+
+    return tuple([[pooled(i, j, fn) for j in range(horizons)] for i in range(forecasts)]
+                 for fn in (np.median, lambda a: np.percentile(a, 99), np.max))

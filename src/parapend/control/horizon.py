@@ -31,7 +31,7 @@ from .. import limits
 from ..defaults import HORIZON, SEA
 from ..errors import ParameterError, check_int, check_positive, check_range
 from ..results import _Result
-from .curve_options import MAX_RECORDS, _horizons, _names, _stats
+from .curve_options import MAX_RECORDS, _horizons, _names, _stats, update_time_stats
 
 __all__ = ["HorizonResult", "horizon_curve", "plot_horizon", "horizon_dataset"]
 
@@ -487,15 +487,7 @@ def horizon_curve(*, hs=None, tp=None, spectrum: str = "jonswap", gamma_peak: fl
                f"{excs[0].period * units.time:g} s")
     rec = {k: v for k, v in excs[0].describe().items() if k not in ("omega", "seed")}
     w = units.to_watts
-
-    def pct(i, j, f):
-        a = np.concatenate(times[i][j]) if times[i][j] else np.zeros(0)
-        return float(f(a)) if a.size else math.nan
-
-    t_med = [[pct(i, j, np.median) for j in range(len(hz))] for i in range(len(fc))]
-    t_p99 = [[pct(i, j, lambda a: np.percentile(a, 99)) for j in range(len(hz))]
-             for i in range(len(fc))]
-    t_max = [[pct(i, j, np.max) for j in range(len(hz))] for i in range(len(fc))]
+    t_med, t_p99, t_max = update_time_stats(times, len(fc), len(hz))
     upd_s = upd * tp
     fits = None
     if fc and np.all(np.isfinite(t_p99)):

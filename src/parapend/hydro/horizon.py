@@ -212,7 +212,13 @@ def buoy_horizon_curve(*, hs=None, tp=None, spectrum="jonswap", gamma_peak=3.3,
         ``progress(done, total)`` after every run (the records' optima and the
         receding-horizon runs).
     """
-    from ..control.curve_options import MAX_RECORDS, _horizons, _names, _stats
+    from ..control.curve_options import (
+        MAX_RECORDS,
+        _horizons,
+        _names,
+        _stats,
+        update_time_stats,
+    )
     from ..deadline import check_time_limit, deadline, duration, expired, refuse_untimed
     from ..defaults import BUOY
     from ..units import Units
@@ -380,15 +386,7 @@ def buoy_horizon_curve(*, hs=None, tp=None, spectrum="jonswap", gamma_peak=3.3,
     frac = (np.asarray(power) / o).tolist()
     st = [[_stats(np.asarray(power[i][j]) / o) for j in range(len(hz))]
           for i in range(len(fc))]
-
-    def pooled(i, j, fn):
-        a = np.concatenate(times[i][j]) if times[i][j] else np.zeros(0)
-        return float(fn(a)) if a.size else math.nan
-
-    t_med = [[pooled(i, j, np.median) for j in range(len(hz))] for i in range(len(fc))]
-    t_p99 = [[pooled(i, j, lambda a: np.percentile(a, 99)) for j in range(len(hz))]
-             for i in range(len(fc))]
-    t_max = [[pooled(i, j, np.max) for j in range(len(hz))] for i in range(len(fc))]
+    t_med, t_p99, t_max = update_time_stats(times, len(fc), len(hz))
     fits = bool(np.max(t_p99) <= upd_s) if np.all(np.isfinite(t_p99)) else None
     nan_runs = int(np.sum(~np.isfinite(np.asarray(power)))) + int(np.sum(~np.isfinite(o)))
     ok = nan_runs == 0 and not stopped[0]
