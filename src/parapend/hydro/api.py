@@ -394,6 +394,10 @@ def buoy(*, wave_height=None, wave_period=None, hs=None, tp=None, spectrum=None,
             optimize_design is not None and str(optimize_design).strip()):
         raise ParameterError("time-limit: bounds long work only: needs --optimize-design, a "
                              "period sweep (--wave-period FROM:TO:N) or --controller mpc")
+    if controller != "optimum" and wave_period is not None and any(
+            v is not None for v in (hs, tp, record, repeat_period, seed)):
+        raise ParameterError("wave-period: a regular wave or an irregular sea (--hs, --tp, "
+                             "--record), not both")
     if controller != "optimum" and (periods is not None or not any(
             v is not None for v in (hs, tp, repeat_period, seed))):
         raise ParameterError("controller: mpc runs in an irregular sea state: give --hs and "
