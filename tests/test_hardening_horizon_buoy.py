@@ -97,3 +97,13 @@ def test_hull_checks_a_zero_instead_of_replacing_it(name, value):
     flag = name.replace("_", "-")
     with pytest.raises(ParameterError, match=rf"^{flag}: expected"):
         parapend.buoy(dofs=HULL, hs=1.0, tp=6.0, **{name: value})
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("pto", [{"efficiency": 0.9}, {"torque_limit": 50.0}])
+def test_mpc_with_a_power_take_off_runs_the_default_record(pto):
+    # the optimum's cap with a power take-off (256 harmonics, 16 waves) refused the default
+    # record (about 123 waves) though the run's yardstick is the mechanical optimum
+    r = parapend.buoy(controller="mpc", hs=0.5, tp=2.5, time_limit=1.0, **pto)
+    assert r.status == "time_limit" and not r.success
+    assert r.optimum_power_w is not None and r.optimum_power_w > 0
