@@ -394,6 +394,10 @@ def buoy(*, wave_height=None, wave_period=None, hs=None, tp=None, spectrum=None,
             optimize_design is not None and str(optimize_design).strip()):
         raise ParameterError("time-limit: bounds long work only: needs --optimize-design, a "
                              "period sweep (--wave-period FROM:TO:N) or --controller mpc")
+    if controller != "optimum" and wave_period is not None and any(
+            v is not None for v in (hs, tp, record, repeat_period, seed)):
+        raise ParameterError("wave-period: a regular wave or an irregular sea (--hs, --tp, "
+                             "--record), not both")
     if controller != "optimum" and (periods is not None or not any(
             v is not None for v in (hs, tp, repeat_period, seed))):
         raise ParameterError("controller: mpc runs in an irregular sea state: give --hs and "
@@ -480,7 +484,9 @@ def buoy(*, wave_height=None, wave_period=None, hs=None, tp=None, spectrum=None,
         h, width = _hydro(body, radius, draft, mesh, hydro, wave_direction)
         h.check_covers(wave.omega * (sig[0] + 1), wave.omega * (sig[-1] + 1),
                        name="tp" if record is None else "record")
-        if torque_limit is not None or efficiency is not None:
+        # the causal controllers' yardstick is the record's mechanical optimum (mpc_command:
+        # no torque limit or efficiency); the power take-off's cap refused their records
+        if controller == "optimum" and (torque_limit is not None or efficiency is not None):
             _check_record_harmonics(h, wave, harmonics, winding, record)
         elif controller == "optimum":
             _check_record_harmonics(h, wave, harmonics, winding, record, pto=False)

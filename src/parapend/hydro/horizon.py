@@ -222,13 +222,17 @@ def buoy_horizon_curve(*, hs=None, tp=None, spectrum="jonswap", gamma_peak=3.3,
     from ..deadline import check_time_limit, deadline, duration, expired, refuse_untimed
     from ..defaults import BUOY
     from ..units import Units
-    from .api import _check_floats, _hydro
+    from .api import _check_floats, _check_kinds, _hydro
     from .control import buoy_mpc
     from .inputs import _irregular_wave, _pendulum
     from .result import _solve
 
     time_limit = check_time_limit(time_limit)
     until = deadline(time_limit)
+    if progress is not None and not callable(progress):  # called only after the first run
+        raise ParameterError(f"progress: expected a callable progress(done, total) or None, "
+                             f"got {progress!r:.40}")
+    _check_kinds(mesh=mesh)  # a number for the path: one line, not os.fspath's TypeError
     pend = _pendulum(BUOY["mass"] if mass is None else mass,
                      BUOY["length"] if length is None else length, inertia,
                      BUOY["damping_coefficient"] if damping_coefficient is None

@@ -44,7 +44,8 @@ def _refuse_unsupported(opts: dict) -> None:
     later = {"optimize_design": "optimize-design", "mass_bounds": "mass-bounds",
              "length_bounds": "length-bounds", "inertia_bounds": "inertia-bounds",
              "damping_coefficient_bounds": "damping-coefficient-bounds",
-             "horizon": "horizon", "update_interval": "update-interval"}
+             "horizon": "horizon", "update_interval": "update-interval",
+             "forecast": "forecast"}
     for key, name in later.items():
         if opts.get(key) is not None:
             raise ParameterError(f"{name}: not available with --dofs surge,heave,pitch yet; "
@@ -230,6 +231,7 @@ def hull_buoy(**opts):
     from .hull_result import hull_answer
     from .inputs import _irregular_wave, _period, parse_periods
 
+    _check_wave_kind(opts)  # before the BEM
     p = hull_problem(**opts)
     hull, pend, pivot, inertia, geometry, pto, windings, harmonics = (
         p[k] for k in ("hull", "pendulum", "pivot", "pitch_inertia", "geometry", "pto",
@@ -243,9 +245,9 @@ def hull_buoy(**opts):
             tp = opts.get("tp") or HULL["tp"]
             opts = dict(opts, repeat_period=HULL["repeat_periods"] * tp)
         wave, info = _irregular_wave(
-            opts.get("hs"), opts.get("tp"), opts.get("spectrum") or "jonswap",
-            opts.get("gamma_peak") or 3.3, opts.get("repeat_period"), opts.get("seed"),
-            opts.get("cutoff") or 3.0, opts.get("record"), opts.get("taper") or 0.1,
+            opts.get("hs"), opts.get("tp"), _or(opts, "spectrum", "jonswap"),
+            _or(opts, "gamma_peak", 3.3), opts.get("repeat_period"), opts.get("seed"),
+            _or(opts, "cutoff", 3.0), opts.get("record"), _or(opts, "taper", 0.1),
             Units(pend.length, pend.mass, 9.81, pend.inertia))
         return solve_record(p, wave, info)
     height = check_range("wave-height", _value(opts, "wave_height"), 1e-4, 30.0,
@@ -267,6 +269,35 @@ def hull_buoy(**opts):
     from .hull_result import HullSweepResult
 
     return HullSweepResult.from_results(periods, results, height)
+
+
+def _or(opts, name, default):
+    """The option, or ``default`` when not given (a 0 or "" given is checked, not replaced)."""
+    v = opts.get(name)
+    return default if v is None else v
+
+
+def _check_wave_kind(opts):
+    """Refuse, as the heaving buoy's command does, a regular wave's options beside an
+    irregular sea and a sea's options beside a regular wave (they were ignored)."""
+    irregular = any(opts.get(k) is not None for k in ("hs", "tp", "record", "repeat_period",
+                                                      "seed"))
+    if irregular:
+        for name in ("wave_height", "wave_period"):
+            if opts.get(name) is not None:
+                raise ParameterError(f"{name.replace('_', '-')}: a regular wave or an "
+                                     "irregular sea (--hs, --tp, --record), not both")
+    for name in ("spectrum", "gamma_peak", "cutoff", "taper"):
+        if opts.get(name) is None:
+            continue
+        flag = name.replace("_", "-")
+        if not irregular:
+            raise ParameterError(f"{flag}: an irregular sea's option; needs --hs and --tp "
+                                 "(or --record)")
+        if name == "taper" and opts.get("record") is None:
+            raise ParameterError("taper: needs --record")
+        if name in ("spectrum", "gamma_peak") and opts.get("record") is not None:
+            raise ParameterError(f"{flag}: not used with --record; drop it")
 
 
 def _check_size(wave, windings, harmonics):
