@@ -21,10 +21,13 @@ periods, 4 peak periods of warm-up, one repeat averaged) it prints:
    the plan) replayed in the plant over the whole horizon: the heave error and the horizon
    objective of that motion in the model and in the plant.
 
-``--frozen``: the planner without the radiation's marginal cost (``radiation_cost=False``).
+``--frozen``: the planner without the radiation's marginal cost (``radiation_cost=False``);
+``--frozen-model``: the memory force predicted under the previous plan frozen in the
+horizon model's dynamics (``radiation_model=False``, the planner before the radiation was
+put inside its model; ``--frozen`` applies to it alone).
 
     OPENBLAS_NUM_THREADS=1 python benchmarks/diagnose_buoy_plan.py --seed 0 [--horizon 1.5]
-        [--start previous|both|optimum] [--frozen]
+        [--start previous|both|optimum] [--frozen] [--frozen-model]
 
 One closed loop takes 20 to 60 s on one core; the output of the cases docs/buoy.md quotes is
 in ``benchmarks/diagnose_buoy_plan.out.txt``.
@@ -153,6 +156,9 @@ def main():
     ap.add_argument("--horizon", type=float, default=2.0, help="peak periods")
     ap.add_argument("--frozen", action="store_true",
                     help="the memory force frozen alone in the objective (radiation_cost=False)")
+    ap.add_argument("--frozen-model", action="store_true",
+                    help="the memory force frozen in the horizon model's dynamics "
+                         "(radiation_model=False, the planner before)")
     a = ap.parse_args()
     hydro, pend, wave = setup(a.seed)
     sol, _, _ = _solve(hydro, pend, wave, winding=10, harmonics=None, torque_limit=None,
@@ -161,7 +167,8 @@ def main():
     sm = sol.sample(t)
     damp = pend.damping_coefficient * float(np.mean(sm["theta_dot"] ** 2))
     print(f"seed {a.seed}, horizon {a.horizon:g} Tp, start {a.start}, objective "
-          + ("F - mu (frozen)" if a.frozen else "F - mu - a (radiation_cost)"))
+          + ("F - mu (frozen)" if a.frozen else "F - mu - a (radiation_cost)") + ", model "
+          + ("mu frozen" if a.frozen_model else "radiation (Cummins)"))
     print(f"optimum (winding 10): power {sol.power:7.2f} W, absorbed {sol.power + damp:7.2f} W, "
           f"damping {damp:6.2f} W, rms heave {np.sqrt(np.mean(sm['z'] ** 2)):.3f} m, rms "
           f"heave speed {np.sqrt(np.mean(sm['z_dot'] ** 2)):.3f} m/s, 10 turns")
@@ -169,7 +176,8 @@ def main():
     restore = probe.install()
     try:
         r = bc.buoy_mpc(hydro, pend, wave, peak_period=2.5, horizon=a.horizon, controller="plan",
-                        iterations=1, radiation_cost=not a.frozen)
+                        iterations=1, radiation_cost=not a.frozen,
+                        radiation_model=not a.frozen_model)
     finally:
         restore()
     a0 = int(round(r.average_from_s / r.dt_s))
@@ -246,6 +254,10 @@ def replay_motion(mp, plant, fseg):
     om = thd[::2]
     j_plant = _simpson((fseg[::2] - mus) * zds - c * om ** 2, h)
     j_model = _simpson(fmod * zdm - c * om ** 2, h)
+    if getattr(pr, "free", None) is not None:
+        # the radiation in the model: its own objective, F less the past's memory force
+        # against z' and the radiated energy of the plan's own motion (Gauss rules)
+        j_model = -pr.objective(nodes)
     return err, j_model, j_plant
 
 
