@@ -166,9 +166,11 @@ def main():
     t = np.linspace(0.0, 25.0, 20001)[:-1]
     sm = sol.sample(t)
     damp = pend.damping_coefficient * float(np.mean(sm["theta_dot"] ** 2))
-    print(f"seed {a.seed}, horizon {a.horizon:g} Tp, start {a.start}, objective "
-          + ("F - mu (frozen)" if a.frozen else "F - mu - a (radiation_cost)") + ", model "
-          + ("mu frozen" if a.frozen_model else "radiation (Cummins)"))
+    print(f"seed {a.seed}, horizon {a.horizon:g} Tp, start {a.start}, "
+          + ("model mu frozen, objective "
+             + ("F - mu (frozen)" if a.frozen else "F - mu - a (radiation_cost)")
+             if a.frozen_model else
+             "model radiation (Cummins), objective F - mu_past less the radiated energy"))
     print(f"optimum (winding 10): power {sol.power:7.2f} W, absorbed {sol.power + damp:7.2f} W, "
           f"damping {damp:6.2f} W, rms heave {np.sqrt(np.mean(sm['z'] ** 2)):.3f} m, rms "
           f"heave speed {np.sqrt(np.mean(sm['z_dot'] ** 2)):.3f} m/s, 10 turns")
@@ -194,7 +196,7 @@ def main():
           f"{np.median(probe.err_th):.4f}, {np.max(probe.err_th):.4f} rad")
     mo = np.array(probe.motion)
     print(f"the plan's motion over the whole horizon, replayed in the plant (median over the "
-          f"updates): rms heave error {100 * np.median(mo[:, 0]):.1f} % of the rms heave; "
+          f"updates): rms heave error {100 * np.median(mo[:, 0]):.2f} % of the rms heave; "
           f"objective int (F - mu) z' - c theta'^2: the model's {np.median(mo[:, 1]):.1f} J, "
           f"the plant's {np.median(mo[:, 2]):.1f} J (model - plant: median "
           f"{np.median(mo[:, 1] - mo[:, 2]):.1f} J, "

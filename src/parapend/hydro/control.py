@@ -75,7 +75,7 @@ CONTROLLERS = ("coupled", "fixed-point", "one-way", "plan")
 #: ``plan``: torque samples per Hermite interval of the motion
 PLAN_INTERVAL_SAMPLES = 4
 #: ``plan``: interior-point iterations per solve at most
-PLAN_MAX_ITER = 40
+PLAN_MAX_ITER = 100
 
 
 @dataclass(frozen=True, eq=False, repr=False)
@@ -699,7 +699,7 @@ class _MotionPlanner:
 
 
 def buoy_mpc(hydro, pendulum, wave, *, peak_period, horizon=2.0, update_interval=0.125,
-             controller="coupled", iterations=2, relaxation=1.0, samples=SAMPLES,
+             controller=None, iterations=2, relaxation=1.0, samples=SAMPLES,
              warmup=4.0, repeats=1, torque_limit=None, efficiency=None, terminal_weight=None,
              model_steps=MODEL_STEPS, plant_steps=PLANT_STEPS, memory=None, a_inf=None,
              max_iter=None, residual=True, terminal="total", time_limit=None,
@@ -719,8 +719,9 @@ def buoy_mpc(hydro, pendulum, wave, *, peak_period, horizon=2.0, update_interval
         sample ``Tp / samples`` (rounded so that the record holds whole samples).
     horizon, update_interval : float
         In peak periods.
-    controller : "coupled", "one-way", "fixed-point" or "plan"
-        The module docstring.
+    controller : "plan", "coupled", "one-way", "fixed-point" or None
+        The module docstring. None (default): ``plan``, or ``coupled`` where ``plan`` does
+        not model what is asked (an efficiency, another terminal value or weight).
     iterations : int
         ``coupled``, ``plan`` with ``radiation_model=False``: solves per update (plan <->
         memory force), at least 1 (``plan`` gains nothing from a second: give 1); ``plan``
@@ -780,6 +781,10 @@ def buoy_mpc(hydro, pendulum, wave, *, peak_period, horizon=2.0, update_interval
 
     if terminal not in ("total", "pendulum"):
         raise ParameterError(f"terminal: expected total or pendulum, got {terminal!r:.40}")
+    if controller is None:
+        lossy = (efficiency is not None or terminal != "total"
+                 or terminal_weight not in (None, 1, 1.0))
+        controller = "coupled" if lossy else "plan"
     if controller not in CONTROLLERS:
         raise ParameterError(f"controller: expected coupled, fixed-point, one-way or plan, "
                              f"got {controller!r:.40}")
@@ -833,7 +838,9 @@ def buoy_mpc(hydro, pendulum, wave, *, peak_period, horizon=2.0, update_interval
     m = max(1, min(n, int(round(update_interval * tp / dt))))
     warm_samples = int(round(warmup * tp / dt))
     total = warm_samples + repeats * per_record
-    _check_work(total, n, m, iterations if controller != "one-way" else 1, warm_samples,
+    solves_per_update = (1 if controller == "one-way"
+                         or (controller == "plan" and radiation_model) else iterations)
+    _check_work(total, n, m, solves_per_update, warm_samples,
                 repeats, dt, time_limit)
     if deadline is None and time_limit is not None:
         from ..deadline import deadline as _deadline
@@ -1019,7 +1026,7 @@ def buoy_mpc(hydro, pendulum, wave, *, peak_period, horizon=2.0, update_interval
         heave_amplitude_m=0.5 * float(np.ptp(zwin)) if zwin.size else math.nan,
         catch_time_s=None if caught is None else float(caught * dt), horizon_s=n * dt,
         update_interval_s=m * dt, dt_s=dt, average_from_s=a0 * dt, t_end_s=total * dt,
-        iterations=iterations if controller != "one-way" else 1, relaxation=relaxation,
+        iterations=solves_per_update, relaxation=relaxation,
         fixed_point_change=fp,
         fixed_point_residual=float(np.median(residuals)) if residuals else None,
         solves=solves, failed_solves=failed,
@@ -1051,7 +1058,7 @@ def mpc_command(hydro, pendulum, wave, info, *, controller, horizon, update_inte
                              "--tp")
     r = buoy_mpc(hydro, pendulum, wave, peak_period=float(info["tp"]), horizon=horizon,
                  update_interval=update_interval,
-                 controller="coupled" if controller == "mpc" else "one-way",
+                 controller=None if controller == "mpc" else "one-way",
                  torque_limit=torque_limit, efficiency=efficiency, time_limit=time_limit,
                  deadline=deadline, forecast=forecast)
     sol, _, _ = _solve(hydro, pendulum, wave, winding=winding, harmonics=harmonics,
