@@ -265,7 +265,7 @@ def test_plan_controller_refuses_what_it_does_not_model():
 def test_default_design_plan_controller_harvests():
     # docs/buoy.md's measurement, seed 0, 2 peak periods (issue 31's acceptance): 91.6 % of
     # the record's coupled optimum (winding 10) with the radiation inside the horizon model
-    # (51 % with the memory force frozen in it); the energy balance closes
+    # (61 % with the memory force frozen in it); the energy balance closes
     import parapend
 
     opt = parapend.buoy(hs=0.5, tp=2.5, repeat_period=25, seed=0, winding=10)
