@@ -19,7 +19,11 @@ of ``--repeat`` after one untimed warm-up, which compiles or loads the kernels) 
 ratio. The old ``coupled`` controller's L-BFGS-B problem is not on this discretization
 (held torques, RK4) and is not timed here.
 
-Run: ``OPENBLAS_NUM_THREADS=1 python benchmarks/bench_buoy_mpc.py``.
+With ``--radiation`` the model of ``buoy_mpc``'s default (the radiation inside it: the
+default buoy's impulse response from its plant's memory, the radiated energy in the
+objective; a free heave of the closed loop's size).
+
+Run: ``OPENBLAS_NUM_THREADS=1 python benchmarks/bench_buoy_mpc.py [--radiation]``.
 """
 
 from __future__ import annotations
@@ -56,6 +60,35 @@ def forcing(rng):
     return f
 
 
+def default_response():
+    """The impulse response of the default buoy's plant (its memory weights on the plant's
+    step of ``Tp / 512``, as ``buoy_mpc`` builds them)."""
+    import parapend
+    from parapend.hydro import control as bc
+    from parapend.hydro._buoy_plan import Response
+    from parapend.hydro.coupled import Pendulum
+
+    opt = parapend.buoy(hs=0.5, tp=2.5, repeat_period=25, seed=0)
+    h = TP / 64 / 8
+    plant = bc._Plant(opt._hydro, Pendulum(80.0, 0.3, 7.2, 1.0), h, 1, None, None, 0.0, 0.0,
+                      None)
+    P[:] = plant.p
+    return Response(plant.p[0], plant.p[1], plant.w, h, K * H + h)
+
+
+def free_heave(rng):
+    """A free heave ``(z, z', z'')`` of the size the closed loop sees (rms about 0.2 m)."""
+    w = 2 * math.pi / TP * rng.uniform(0.7, 1.5, 4)
+    a = rng.normal(size=4) * 0.1
+    ph = rng.uniform(0, 2 * math.pi, 4)
+
+    def free(t):
+        arg = np.multiply.outer(np.asarray(t, dtype=float), w) + ph
+        return (np.sum(a * np.sin(arg), -1), np.sum(a * w * np.cos(arg), -1),
+                np.sum(-a * w * w * np.sin(arg), -1))
+    return free
+
+
 def scatter(rows, j, nfull):
     out = np.zeros((rows.shape[0], nfull))
     for a in range(4):
@@ -71,7 +104,7 @@ def casadi_solver(pr: CoupledPlan):
     k, tg = pr.k, pr.tg
     nfull = 2 * k + 2
     nt = tg.t.size
-    mtot, ml, inertia, c, g = pr.p[0], pr.p[2], pr.p[3], pr.p[4], pr.p[5]
+    ml, inertia, c, g = pr.p[2], pr.p[3], pr.p[4], pr.p[5]
     r, kap = pr.r, pr.kap
     f_t, yc, ydc = pr._fixed[0]
     e0, e1, e2 = (ca.DM(scatter(b, tg.j, nfull)) for b in (tg.b0, tg.b1, tg.b2))
@@ -87,14 +120,18 @@ def casadi_solver(pr: CoupledPlan):
     full = ca.vertcat(pr.x0[2], pr.x0[3], x)
     th, thd, thdd = ca.mtimes(e0, full), ca.mtimes(e1, full), ca.mtimes(e2, full)
     cf, cp = ca.cos(ca.mtimes(ef, full)), ca.cos(ca.mtimes(ep, full))
-    y = ca.DM(yc) + kap * (ca.mtimes(ca.DM(tg.af2), cf) + ca.mtimes(ca.DM(sel), cp))
-    yd = ca.DM(ydc) + kap * (ca.mtimes(ca.DM(tg.bf2), cf) + ca.mtimes(ca.DM(sel_b), cp))
+    # y'' less its point's own term (the a_* weights) and y' (the b_* weights)
+    ydd = ca.DM(yc) + ca.mtimes(ca.DM(tg.af2), cf) + ca.mtimes(ca.DM(sel), cp)
+    yd = ca.DM(ydc) + ca.mtimes(ca.DM(tg.bf2), cf) + ca.mtimes(ca.DM(sel_b), cp)
     s, co = ca.sin(th), ca.cos(th)
     zd = yd + r * s * thd
     ft = ca.DM(f_t)
     phi = ca.dot(ca.DM(pr.wgt), -ft * zd + c * thd * thd)
+    if pr.wrad.shape[0]:
+        zg = zd[:pr.ng]
+        phi += 0.5 * ca.dot(zg, ca.mtimes(ca.DM(pr.wrad), zg))
     tau = ((inertia - ml * r * s * s) * thdd + c * thd
-           - ml * s * (g + ft / mtot + r * co * thd * thd) + kap * s * (y - r * co))
+           - ml * s * (g + r * co * thd * thd) - ml * s * (ydd + kap * co))
     tau_c = tau[pr.ng:]
     return ca.nlpsol("s", "ipopt", {"x": x, "f": phi, "g": tau_c},
                      {"ipopt.print_level": 0, "print_time": 0, "ipopt.tol": 1e-8,
@@ -105,16 +142,21 @@ def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--cases", type=int, default=8)
     ap.add_argument("--repeat", type=int, default=3)
+    ap.add_argument("--radiation", action="store_true",
+                    help="the radiation inside the model (buoy_mpc's default): the default "
+                         "buoy's plant kernel, its radiated energy in the objective")
     a = ap.parse_args()
     load0 = os.getloadavg()[0]
     rng = np.random.default_rng(0)
     rows = []
+    resp = default_response() if a.radiation else None
     for case in range(a.cases):
-        pr = CoupledPlan(K, H, P, TMAX)
+        pr = CoupledPlan(K, H, P, TMAX, response=resp)
         om0 = rng.choice([rng.uniform(-3, 3), rng.uniform(4, 8)])
         y0 = np.array([rng.normal() * 0.2, rng.normal() * 0.3, rng.uniform(0, 2 * math.pi),
                        om0])
-        pr.set_start(y0, forcing(rng))
+        f = forcing(rng)
+        pr.set_start(y0, f, free=free_heave(rng) if a.radiation else None)
         tn = H * np.arange(1, K + 1)
         x0 = np.empty(2 * K)
         x0[0::2], x0[1::2] = y0[2] + om0 * tn, om0

@@ -5,11 +5,14 @@ seeds 0-9; ``parapend buoy --hs 0.5 --tp 2.5 --repeat-period 25 --seed S --contr
 
 Per seed and setting: the storage-corrected mean power over the repeat after the 4-peak-
 period warm-up, its fraction of the record's coupled non-causal optimum, and the update
-time's p99 (forecast and solve) against the update interval. Settings: the default
-``coupled`` controller at a horizon of 2 peak periods (the acceptance's) and the
-experimental ``plan`` at 1.5 (its best measured, docs/buoy.md), each with both forecasts.
+time's p99 (forecast and solve) against the update interval. Settings: the ``coupled``
+controller at a horizon of 2 peak periods (the acceptance's) with both forecasts, and
+``plan`` (the radiation in its horizon model) at 1.5 and 2 peak periods with the perfect
+forecast and at 2 with the AR forecast (``--settings`` picks some; timings with
+``--workers 1`` on an otherwise idle machine).
 
     OPENBLAS_NUM_THREADS=1 python benchmarks/buoy_mpc_forecast.py [--seeds 0-9] [--workers 2]
+        [--settings plan:2:perfect,plan:2:ar]
 
 Output: ``benchmarks/buoy_mpc_forecast.out.txt``.
 """
@@ -24,7 +27,7 @@ from concurrent.futures import ProcessPoolExecutor
 import numpy as np
 
 SETTINGS = [("coupled", 2.0, "perfect"), ("coupled", 2.0, "ar"),
-            ("plan", 1.5, "perfect"), ("plan", 1.5, "ar")]
+            ("plan", 1.5, "perfect"), ("plan", 2.0, "perfect"), ("plan", 2.0, "ar")]
 
 
 def one(args):
@@ -34,14 +37,13 @@ def one(args):
     from parapend.hydro import api
     from parapend.hydro import control as bc
 
-    if controller == "plan":
-        # the API's mpc runs the default coupled controller: the experimental planner by its
-        # public keyword, the rest of the command unchanged
-        real = bc.buoy_mpc
+    # the command line's mpc with the controller named (the rest of the command unchanged)
+    real = bc.buoy_mpc
 
-        def planned(*a, **kw):
-            return real(*a, **{**kw, "controller": "plan", "iterations": 1})
-        bc.buoy_mpc = planned
+    def named(*a, **kw):
+        return real(*a, **{**kw, "controller": controller,
+                           **({"iterations": 1} if controller == "plan" else {})})
+    bc.buoy_mpc = named
     r = api.buoy(hs=0.5, tp=2.5, repeat_period=25.0, seed=seed, controller="mpc",
                  horizon=horizon, forecast=forecast, time_limit=900)
     d = dataclasses.asdict(r) if not hasattr(r, "to_dict") else r.to_dict()
@@ -54,9 +56,15 @@ def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--seeds", default="0-9")
     ap.add_argument("--workers", type=int, default=2)
+    ap.add_argument("--settings", default=None,
+                    help="controller:horizon:forecast,... (default: all of SETTINGS)")
     a = ap.parse_args()
     lo, hi = (int(x) for x in a.seeds.split("-"))
-    jobs = [(s, *st) for st in SETTINGS for s in range(lo, hi + 1)]
+    settings = SETTINGS
+    if a.settings:
+        settings = [(c, float(h), f) for c, h, f in
+                    (x.split(":") for x in a.settings.split(","))]
+    jobs = [(s, *st) for st in settings for s in range(lo, hi + 1)]
     print(f"machine: {platform.machine()}, {os.cpu_count()} cores; one BLAS thread a process")
     with ProcessPoolExecutor(a.workers) as ex:
         rows = list(ex.map(one, jobs))
@@ -66,7 +74,7 @@ def main():
         print(f"{c:10s} {h:6.2g} {f:8s} {s:4d} {p:9.4g} {opt:9.4g} {frac:9.3f} "
               f"{1e3 * p99:9.1f} {1e3 * iv:9.1f} {st}")
     print()
-    for c, h, f in SETTINGS:
+    for c, h, f in settings:
         sel = [r for r in rows if r[1:4] == (c, h, f)]
         fr = np.array([r[6] for r in sel])
         pw = np.array([r[4] for r in sel])

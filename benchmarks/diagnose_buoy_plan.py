@@ -21,10 +21,13 @@ periods, 4 peak periods of warm-up, one repeat averaged) it prints:
    the plan) replayed in the plant over the whole horizon: the heave error and the horizon
    objective of that motion in the model and in the plant.
 
-``--frozen``: the planner without the radiation's marginal cost (``radiation_cost=False``).
+``--frozen``: the planner without the radiation's marginal cost (``radiation_cost=False``);
+``--frozen-model``: the memory force predicted under the previous plan frozen in the
+horizon model's dynamics (``radiation_model=False``, the planner before the radiation was
+put inside its model; ``--frozen`` applies to it alone).
 
     OPENBLAS_NUM_THREADS=1 python benchmarks/diagnose_buoy_plan.py --seed 0 [--horizon 1.5]
-        [--start previous|both|optimum] [--frozen]
+        [--start previous|both|optimum] [--frozen] [--frozen-model]
 
 One closed loop takes 20 to 60 s on one core; the output of the cases docs/buoy.md quotes is
 in ``benchmarks/diagnose_buoy_plan.out.txt``.
@@ -153,6 +156,9 @@ def main():
     ap.add_argument("--horizon", type=float, default=2.0, help="peak periods")
     ap.add_argument("--frozen", action="store_true",
                     help="the memory force frozen alone in the objective (radiation_cost=False)")
+    ap.add_argument("--frozen-model", action="store_true",
+                    help="the memory force frozen in the horizon model's dynamics "
+                         "(radiation_model=False, the planner before)")
     a = ap.parse_args()
     hydro, pend, wave = setup(a.seed)
     sol, _, _ = _solve(hydro, pend, wave, winding=10, harmonics=None, torque_limit=None,
@@ -160,8 +166,11 @@ def main():
     t = np.linspace(0.0, 25.0, 20001)[:-1]
     sm = sol.sample(t)
     damp = pend.damping_coefficient * float(np.mean(sm["theta_dot"] ** 2))
-    print(f"seed {a.seed}, horizon {a.horizon:g} Tp, start {a.start}, objective "
-          + ("F - mu (frozen)" if a.frozen else "F - mu - a (radiation_cost)"))
+    print(f"seed {a.seed}, horizon {a.horizon:g} Tp, start {a.start}, "
+          + ("model mu frozen, objective "
+             + ("F - mu (frozen)" if a.frozen else "F - mu - a (radiation_cost)")
+             if a.frozen_model else
+             "model radiation (Cummins), objective F - mu_past less the radiated energy"))
     print(f"optimum (winding 10): power {sol.power:7.2f} W, absorbed {sol.power + damp:7.2f} W, "
           f"damping {damp:6.2f} W, rms heave {np.sqrt(np.mean(sm['z'] ** 2)):.3f} m, rms "
           f"heave speed {np.sqrt(np.mean(sm['z_dot'] ** 2)):.3f} m/s, 10 turns")
@@ -169,7 +178,8 @@ def main():
     restore = probe.install()
     try:
         r = bc.buoy_mpc(hydro, pend, wave, peak_period=2.5, horizon=a.horizon, controller="plan",
-                        iterations=1, radiation_cost=not a.frozen)
+                        iterations=1, radiation_cost=not a.frozen,
+                        radiation_model=not a.frozen_model)
     finally:
         restore()
     a0 = int(round(r.average_from_s / r.dt_s))
@@ -186,7 +196,7 @@ def main():
           f"{np.median(probe.err_th):.4f}, {np.max(probe.err_th):.4f} rad")
     mo = np.array(probe.motion)
     print(f"the plan's motion over the whole horizon, replayed in the plant (median over the "
-          f"updates): rms heave error {100 * np.median(mo[:, 0]):.1f} % of the rms heave; "
+          f"updates): rms heave error {100 * np.median(mo[:, 0]):.2f} % of the rms heave; "
           f"objective int (F - mu) z' - c theta'^2: the model's {np.median(mo[:, 1]):.1f} J, "
           f"the plant's {np.median(mo[:, 2]):.1f} J (model - plant: median "
           f"{np.median(mo[:, 1] - mo[:, 2]):.1f} J, "
@@ -246,6 +256,10 @@ def replay_motion(mp, plant, fseg):
     om = thd[::2]
     j_plant = _simpson((fseg[::2] - mus) * zds - c * om ** 2, h)
     j_model = _simpson(fmod * zdm - c * om ** 2, h)
+    if getattr(pr, "free", None) is not None:
+        # the radiation in the model: its own objective, F less the past's memory force
+        # against z' and the radiated energy of the plan's own motion (Gauss rules)
+        j_model = -pr.objective(nodes)
     return err, j_model, j_plant
 
 

@@ -40,9 +40,10 @@ WAVE = Wave(2 * math.pi / TR, AMPS)
 PENDULUM = Pendulum(20.0, 0.3, 1.8, 0.25)
 OPTS = {"peak_period": TP, "horizon": 0.5, "update_interval": 0.125, "warmup": 1.0,
         "samples": 32, "memory": 8.0}
-#: the controllers' own options: the default one as buoy_mpc has it, ``plan`` as its tests
+#: the controllers' own options (``plan``, the default, with the radiation in its model)
 REPEATS = 1
-CONTROLLERS = {"coupled": {}, "plan": {"controller": "plan", "iterations": 1}}
+CONTROLLERS = {"coupled": {"controller": "coupled"},
+               "plan": {"controller": "plan", "iterations": 1}}
 
 
 def _run(monkeypatch, controller, cut=None, peek=False, forecast="perfect"):

@@ -431,7 +431,8 @@ def test_a_buoy_bin_is_buoy_mpc_by_hand(buoy_bin, sphere_nc):
     wave = Wave(2 * math.pi / (4 * 3.0), np.asarray(exc.heave[1:], dtype=complex))
     for forecast in ("perfect", "ar"):
         r = buoy_mpc(load(sphere_nc), pend, wave, peak_period=3.0, horizon=1.0,
-                     update_interval=0.125, warmup=1.0, repeats=1, forecast=forecast)
+                     update_interval=0.125, warmup=1.0, repeats=1, forecast=forecast,
+                     controller="coupled")
         assert r.success and r.forecast == forecast
         assert r.t_end_s - r.average_from_s == pytest.approx(12.0, rel=1e-9)  # one repeat
         assert got[f"causal_{forecast}_power"] == pytest.approx(r.mean_power_w, rel=1e-12,

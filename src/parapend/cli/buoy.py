@@ -112,10 +112,11 @@ def add_parsers(sub) -> None:
     g = p.add_argument_group("causal control (an irregular sea, the coupled time-domain plant)")
     g.add_argument("--controller", choices=["optimum", "mpc", "one-way-mpc"],
                    help="optimum: the non-causal coupled optimum (default); mpc: receding-"
-                        "horizon control planned on the coupled model; one-way-mpc: planned "
-                        "on the free buoy's heave")
+                        "horizon control planned on the coupled model with its radiation "
+                        "(the motion planner; with --efficiency the torque planner); "
+                        "one-way-mpc: planned on the free buoy's heave")
     g.add_argument("--horizon", type=_finite_float("horizon"),
-                   help="with mpc: forecast horizon, peak periods (default 1)")
+                   help="with mpc: forecast horizon, peak periods (default 2; one-way-mpc 1)")
     g.add_argument("--update-interval", type=_finite_float("update-interval"),
                    help="with mpc: re-planning interval, peak periods (default 0.125)")
     g.add_argument("--forecast", choices=("perfect", "ar"),

@@ -18,14 +18,18 @@ announce_compiles()  # log a first-use compile (parapend._jit)
 
 @nb.njit(cache=True)
 def evaluate(full, j, b0, b1, b2, af, bf, ap, bp, bp0, b0g, wgt, f_t, yc, ydc, ng, p, r, kap,
-             nu, order, grad, hess, tau, jac):
+             wrad, nu, order, grad, hess, tau, jac):
     """``phi`` (returned) and ``tau`` (the constraint points, in place); with ``order >= 1``
     also ``grad``, ``jac`` and the objective's Hessian in ``hess`` (over the full node vector,
-    zeroed here); with ``order == 2`` the Hessian of ``phi + nu . tau``."""
+    zeroed here); with ``order == 2`` the Hessian of ``phi + nu . tau``. ``yc``: the constant
+    part of ``y''`` (``y'`` in ``ydc``); ``af``, ``ap`` the weights of ``y''``, ``bf``, ``bp``
+    of ``y'``; ``kap``: the weight of the point's own ``cos(theta)`` in ``y''``; ``wrad``
+    ``(ng, ng)`` (or empty): the radiated energy ``1/2 z'^T wrad z'`` over the objective's
+    points added to ``phi``."""
     k = af.shape[1]
     nt = j.size
     nfull = full.size
-    mtot, ml, inertia, c, g = p[0], p[2], p[3], p[4], p[5]
+    ml, inertia, c, g = p[2], p[3], p[4], p[5]
     thf = np.empty((k, 4))
     for i in range(k):
         for q in range(4):
@@ -66,18 +70,30 @@ def evaluate(full, j, b0, b1, b2, af, bf, ap, bp, bp0, b0g, wgt, f_t, yc, ydc, n
             cq = math.cos(v)
             sa += ap[t, q] * cq
             sb += bp[t, q] * cq
-        y[t] = yc[t] + kap * sa
-        yd[t] = ydc[t] + kap * sb
+        y[t] = yc[t] + sa
+        yd[t] = ydc[t] + sb
     phi = 0.0
+    zdv = np.empty(ng)
     for t in range(ng):
         zd = yd[t] + r * math.sin(th[t]) * thd[t]
+        zdv[t] = zd
         phi += wgt[t] * (-f_t[t] * zd + c * thd[t] * thd[t])
+    quad = wrad.shape[0] > 0
+    # the adjoint of z' at the objective's points: -w f, plus wrad z' with the radiation
+    lam = np.empty(ng)
+    for t in range(ng):
+        lam[t] = -wgt[t] * f_t[t]
+    if quad:
+        wz = wrad @ zdv
+        for t in range(ng):
+            phi += 0.5 * zdv[t] * wz[t]
+            lam[t] += wz[t]
     for t in range(ng, nt):
         s = math.sin(th[t])
         co = math.cos(th[t])
         tau[t - ng] = ((inertia - ml * r * s * s) * thdd[t] + c * thd[t]
-                       - ml * s * (g + f_t[t] / mtot + r * co * thd[t] * thd[t])
-                       + kap * s * (y[t] - r * co))
+                       - ml * s * (g + r * co * thd[t] * thd[t])
+                       - ml * s * (y[t] + kap * co))
     if order == 0:
         return phi
     grad[:] = 0.0
@@ -85,16 +101,17 @@ def evaluate(full, j, b0, b1, b2, af, bf, ap, bp, bp0, b0g, wgt, f_t, yc, ydc, n
     jac[:, :] = 0.0
     # objective: the sources weighted by the adjoint of y', and the points' own terms
     lam_f = np.zeros((k, 4))
+    gz = np.zeros((ng if quad else 0, nfull))
     for t in range(ng):
         jt = j[t]
-        lt = -wgt[t] * f_t[t]
+        lt = lam[t]
         for i in range(jt):
             for q in range(4):
                 lam_f[i, q] += lt * bf[t, i, q]
         for q in range(4):
             lp = lt * bp[t, q]
-            c1 = -kap * lp * math.sin(thp[t, q])
-            c2 = -kap * lp * math.cos(thp[t, q])
+            c1 = -lp * math.sin(thp[t, q])
+            c2 = -lp * math.cos(thp[t, q])
             for a in range(4):
                 grad[2 * jt + a] += c1 * bp0[t, q, a]
                 for b in range(4):
@@ -102,12 +119,24 @@ def evaluate(full, j, b0, b1, b2, af, bf, ap, bp, bp0, b0g, wgt, f_t, yc, ydc, n
         s = math.sin(th[t])
         co = math.cos(th[t])
         w = wgt[t]
-        ft = f_t[t]
-        d_th = -w * ft * r * co * thd[t]
-        d_thd = -w * ft * r * s + 2.0 * c * w * thd[t]
-        h_tt = w * ft * r * s * thd[t]
-        h_td = -w * ft * r * co
+        d_th = lt * r * co * thd[t]
+        d_thd = lt * r * s + 2.0 * c * w * thd[t]
+        h_tt = -lt * r * s * thd[t]
+        h_td = lt * r * co
         h_dd = 2.0 * c * w
+        if quad:
+            # the gradient of z' here: the sources, its own interval's part, its own terms
+            for i in range(jt):
+                for q in range(4):
+                    wq = -bf[t, i, q] * sf[i, q]
+                    for a in range(4):
+                        gz[t, 2 * i + a] += wq * b0g[q, a]
+            for q in range(4):
+                wq = -bp[t, q] * math.sin(thp[t, q])
+                for a in range(4):
+                    gz[t, 2 * jt + a] += wq * bp0[t, q, a]
+            for a in range(4):
+                gz[t, 2 * jt + a] += r * co * thd[t] * b0[t, a] + r * s * b1[t, a]
         for a in range(4):
             grad[2 * jt + a] += d_th * b0[t, a] + d_thd * b1[t, a]
             for b in range(4):
@@ -125,29 +154,28 @@ def evaluate(full, j, b0, b1, b2, af, bf, ap, bp, bp0, b0g, wgt, f_t, yc, ydc, n
         co = math.cos(th[t])
         c2 = math.cos(2.0 * th[t])
         s2 = math.sin(2.0 * th[t])
-        ft = f_t[t]
-        t_th = (-ml * r * s2 * thdd[t] - ml * co * (g + ft / mtot)
-                - ml * r * c2 * thd[t] * thd[t] + kap * co * y[t] - kap * r * c2)
+        t_th = (-ml * r * s2 * thdd[t] - ml * co * g
+                - ml * r * c2 * thd[t] * thd[t] - ml * co * y[t] - ml * kap * c2)
         t_thd = c - ml * r * s2 * thd[t]
         t_thdd = inertia - ml * r * s * s
         for a in range(4):
             jac[row, 2 * jt + a] += t_th * b0[t, a] + t_thd * b1[t, a] + t_thdd * b2[t, a]
         for i in range(jt):
             for q in range(4):
-                wq = -kap * af[t, i, q] * sf[i, q]
+                wq = -af[t, i, q] * sf[i, q]
                 for a in range(4):
                     dy[row, 2 * i + a] += wq * b0g[q, a]
         for q in range(4):
-            wq = -kap * ap[t, q] * math.sin(thp[t, q])
+            wq = -ap[t, q] * math.sin(thp[t, q])
             for a in range(4):
                 dy[row, 2 * jt + a] += wq * bp0[t, q, a]
         for col in range(nfull):
-            jac[row, col] += kap * s * dy[row, col]
+            jac[row, col] += -ml * s * dy[row, col]
         if order == 2:
             n_t = nu[row]
-            p_tt = (-2.0 * ml * r * c2 * thdd[t] + ml * s * (g + ft / mtot)
-                    + 2.0 * ml * r * s2 * thd[t] * thd[t] - kap * s * y[t]
-                    + 2.0 * kap * r * s2)
+            p_tt = (-2.0 * ml * r * c2 * thdd[t] + ml * s * g
+                    + 2.0 * ml * r * s2 * thd[t] * thd[t] + ml * s * y[t]
+                    + 2.0 * ml * kap * s2)
             p_td = -2.0 * ml * r * c2 * thd[t]
             p_tdd = -ml * r * s2
             p_dd = -ml * r * s2
@@ -158,26 +186,32 @@ def evaluate(full, j, b0, b1, b2, af, bf, ap, bp, bp0, b0g, wgt, f_t, yc, ydc, n
                         + p_td * (b0[t, a] * b1[t, b] + b1[t, a] * b0[t, b])
                         + p_tdd * (b0[t, a] * b2[t, b] + b2[t, a] * b0[t, b])
                         + p_dd * b1[t, a] * b1[t, b])
-            wv = n_t * kap * s
+            wv = -ml * n_t * s
             for i in range(jt):
                 for q in range(4):
                     mu_f[i, q] += wv * af[t, i, q]
             for q in range(4):
-                c2q = -kap * wv * ap[t, q] * math.cos(thp[t, q])
+                c2q = -wv * ap[t, q] * math.cos(thp[t, q])
                 for a in range(4):
                     for b in range(4):
                         hess[2 * jt + a, 2 * jt + b] += c2q * bp0[t, q, a] * bp0[t, q, b]
-            cr = n_t * kap * co
+            cr = -ml * n_t * co
             for a in range(4):
                 e = cr * b0[t, a]
                 for col in range(nfull):
                     v = e * dy[row, col]
                     hess[2 * jt + a, col] += v
                     hess[col, 2 * jt + a] += v
+    if quad:
+        # the radiated energy's gz^T wrad gz (its wrad z' term is in the adjoint lam)
+        hq = gz.T @ (wrad @ gz)
+        for a in range(nfull):
+            for b in range(nfull):
+                hess[a, b] += hq[a, b]
     for i in range(k):
         for q in range(4):
-            c2 = -kap * (lam_f[i, q] + mu_f[i, q]) * cf[i, q]
-            c1 = -kap * lam_f[i, q] * sf[i, q]
+            c2 = -(lam_f[i, q] + mu_f[i, q]) * cf[i, q]
+            c1 = -lam_f[i, q] * sf[i, q]
             for a in range(4):
                 grad[2 * i + a] += c1 * b0g[q, a]
                 for b in range(4):
@@ -225,7 +259,7 @@ def _cho_solve(low, b):
 
 @nb.njit(cache=True)
 def solve(x, start, j, b0, b1, b2, af, bf, ap, bp, bp0, b0g, wgt, f_t, yc, ydc, ng, p, r,
-          kap, tmax, max_iter, tol, mu0):
+          kap, wrad, tmax, max_iter, tol, mu0):
     """The interior point of :meth:`._buoy_plan.CoupledPlan.solve` as one compiled call:
     returns ``(x, status, iterations)`` (status 0 converged, 1 iteration limit, 2 line
     search, 3 not finite)."""
@@ -244,7 +278,7 @@ def solve(x, start, j, b0, b1, b2, af, bf, ap, bp, bp0, b0g, wgt, f_t, yc, ydc, 
     jac = np.empty((nc, nfull))
     nu = np.zeros(nc)
     evaluate(full, j, b0, b1, b2, af, bf, ap, bp, bp0, b0g, wgt, f_t, yc, ydc, ng, p, r, kap,
-             nu, 1, grad, hess, tau, jac)
+             wrad, nu, 1, grad, hess, tau, jac)
     scale = 1.0
     for i in range(n):
         scale = max(scale, abs(grad[2 + i]))
@@ -269,7 +303,7 @@ def solve(x, start, j, b0, b1, b2, af, bf, ap, bp, bp0, b0g, wgt, f_t, yc, ydc, 
         for i in range(nc):
             nu[i] = (lam[i] - lam[nc + i]) / tmax
         phi = evaluate(full, j, b0, b1, b2, af, bf, ap, bp, bp0, b0g, wgt, f_t, yc, ydc, ng,
-                       p, r, kap, nu, 2, grad, hess, tau, jac)
+                       p, r, kap, wrad, nu, 2, grad, hess, tau, jac)
         fin = math.isfinite(phi)
         for i in range(n):
             fin = fin and math.isfinite(grad[2 + i])
@@ -338,7 +372,7 @@ def solve(x, start, j, b0, b1, b2, af, bf, ap, bp, bp0, b0g, wgt, f_t, yc, ydc, 
                 full[2 + i] = x[i] + a * dx[i]
             st = s + a * ds
             ft = evaluate(full, j, b0, b1, b2, af, bf, ap, bp, bp0, b0g, wgt, f_t, yc, ydc,
-                          ng, p, r, kap, nu, 0, grad, hess, tau_t, jac)
+                          ng, p, r, kap, wrad, nu, 0, grad, hess, tau_t, jac)
             mt = ft - mu * np.sum(np.log(st))
             for i in range(nc):
                 mt += rho * (abs(tau_t[i] / tmax - 1.0 + st[i])

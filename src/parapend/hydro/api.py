@@ -329,9 +329,10 @@ def buoy(*, wave_height=None, wave_period=None, hs=None, tp=None, spectrum=None,
     controller, horizon, update_interval, forecast : ``"optimum"`` (the non-causal coupled optimum),
         or a causal receding-horizon controller run on the coupled time-domain plant in an
         irregular sea (:mod:`parapend.hydro.control`): ``"mpc"`` (planned on the coupled model) or
-        ``"one-way-mpc"`` (planned on the free buoy's heave); horizon and update interval in
-        peak periods; ``forecast`` ``"perfect"`` (default: the record's own excitation
-        force over the horizon) or ``"ar"`` (autoregressive, fitted on the force measured
+        ``"one-way-mpc"`` (planned on the free buoy's heave); horizon (default 2 with
+        ``"mpc"``, 1 with ``"one-way-mpc"``) and update interval in peak periods;
+        ``forecast`` ``"perfect"`` (default: the record's own excitation force over the
+        horizon) or ``"ar"`` (autoregressive, fitted on the force measured
         so far), with ``"mpc"``.
 
     dofs : ``"heave"`` (default: the heaving buoy) or ``"surge,heave,pitch"``: a hull that
@@ -410,7 +411,8 @@ def buoy(*, wave_height=None, wave_period=None, hs=None, tp=None, spectrum=None,
             if v is not None:
                 raise ParameterError(f"{name}: needs --controller mpc"
                                      + ("" if name == "forecast" else " (or one-way-mpc)"))
-    horizon = 1.0 if horizon is None else horizon
+    if horizon is None:  # mpc: the plan controller's measured horizon (docs/buoy.md)
+        horizon = 2.0 if controller == "mpc" else 1.0
     update_interval = 0.125 if update_interval is None else update_interval
     forecast = "perfect" if forecast is None else forecast
     sea_opts = (("spectrum", spectrum), ("gamma-peak", gamma_peak), ("cutoff", cutoff),

@@ -24,17 +24,19 @@ pendulum units: time ``t0 = sqrt(I / (m g l))``, torque ``m g l``, ``q = z'' / g
 - ``"one-way"``: the pendulum MPC planning on the FREE buoy's heave (the buoy's response to
   the record without the pendulum, from the same start, by the plant's own model), ignoring
   its reaction; one solve per update.
-- ``"plan"`` (experimental): the pendulum's MOTION as the unknown, as the pendulum's planner
+- ``"plan"``: the pendulum's MOTION as the unknown, as the pendulum's planner
   (:mod:`parapend.control.plan`): the angle a C1 cubic Hermite on the horizon, the heave
-  the buoy's linear equation driven by ``F_exc - mu`` (the memory force predicted under the
-  previous plan and frozen) and the pendulum's reaction, a causal convolution of
+  Cummins' equation as the plant has it: the buoy's free response from its measured state
+  and radiation memory under ``F_exc`` (the plant's own model, without the pendulum) plus
+  the pendulum's reaction through the plant's impulse response, a causal convolution of
   ``cos(theta)``; the torque by inverse dynamics on that heave, bounded at three points per
   interval; the objective the ``coupled`` controller's (work plus the energy of buoy and
-  pendulum at the end) with, by default, the marginal cost of the radiation the plan's own
-  motion causes (``marginal_radiation``); a dense primal-dual interior point with the
-  exact Hessian
-  (:mod:`._buoy_plan`), warm-started from the previous motion. The held torques are the
-  plan's torque averaged over each sample. Without efficiency (mechanical only).
+  pendulum at the end: ``F_exc`` less the past's memory force against ``z'``, less the
+  energy the plan's own motion radiates); a dense primal-dual interior point with the
+  exact Hessian (:mod:`._buoy_plan`), one solve an update, warm-started from the previous
+  motion. The held torques are the plan's torque averaged over each sample. Without
+  efficiency (mechanical only). ``radiation_model=False``: the planner before, the memory
+  force predicted under the previous plan and frozen in an undamped oscillator.
 - ``"fixed-point"``: the pendulum MPC planning on the heave the coupled model predicts under
   its current plan, predicted again under the new plan, ``iterations`` times (plan <->
   heave); it does not converge for a heavy pendulum (docs/buoy.md).
@@ -73,7 +75,7 @@ CONTROLLERS = ("coupled", "fixed-point", "one-way", "plan")
 #: ``plan``: torque samples per Hermite interval of the motion
 PLAN_INTERVAL_SAMPLES = 4
 #: ``plan``: interior-point iterations per solve at most
-PLAN_MAX_ITER = 40
+PLAN_MAX_ITER = 100
 
 
 @dataclass(frozen=True, eq=False, repr=False)
@@ -460,7 +462,8 @@ def marginal_radiation(w, v):
     ``dR / dv_i = h (mu_i + a_i)``, ``a_i = sum_q w_q v_{i+q}``: the memory force now, and the
     force this speed will exert on the later speeds. A plan with ``mu`` frozen sees only the
     first (its optimum drives the buoy past the absorption optimum: docs/buoy.md); ``plan``
-    with ``radiation_cost`` weights ``z'`` in its objective by ``F - mu - a`` instead.
+    with ``radiation_cost`` and ``radiation_model=False`` weights ``z'`` in its objective by
+    ``F - mu - a`` instead (with the radiation in its model the plan counts ``R`` itself).
 
     Parameters
     ----------
@@ -543,9 +546,9 @@ class _MotionPlanner:
     (:class:`._buoy_plan.CoupledPlan`) of every update, warm-started from the previous
     motion shifted by the samples since."""
 
-    def __init__(self, n, dt, ps, p, torque_limit, tu, radiation_cost=True):
+    def __init__(self, n, dt, ps, p, torque_limit, tu, radiation_cost=True, memory=None):
         from ..control.mpc import _gauss3
-        from ._buoy_plan import CoupledPlan
+        from ._buoy_plan import CoupledPlan, Response
 
         self.n, self.dt, self.ps, self.tu = n, dt, ps, tu
         self.radiation_cost = bool(radiation_cost)
@@ -553,7 +556,12 @@ class _MotionPlanner:
         self.hh = n * dt / self.k
         off, self.w3 = _gauss3(dt)
         leads = ((dt * np.arange(n))[:, None] + off[None, :]).ravel()
-        self.prob = CoupledPlan(self.k, self.hh, p, torque_limit, sample_leads=leads)
+        # memory: the plant's weights and step; the radiation in the horizon model
+        self.radiation = memory is not None
+        resp = (None if memory is None
+                else Response(p[0], p[1], memory[0], memory[1], n * dt + memory[1]))
+        self.prob = CoupledPlan(self.k, self.hh, p, torque_limit, sample_leads=leads,
+                                response=resp)
         self.tmax = torque_limit
         self.nodes = None
         self.tn = self.hh * np.arange(self.k + 1)
@@ -580,9 +588,72 @@ class _MotionPlanner:
         x[0::2], x[1::2] = th[1:], v[1:]
         return x
 
+    def free_heave(self, plant, fseg):
+        """``(z, z', z'')`` of the buoy without the pendulum from the plant's state (its
+        memory of the past included) under the forecast ``fseg``, by the plant's own model
+        (RK4 steps); a vectorized callable of the lead time (s): cubic Hermites of ``z`` and
+        ``z'`` between the steps, ``z''`` linear between the half steps."""
+        from scipy.interpolate import CubicHermiteSpline
+
+        from ._control_kernel import advance
+
+        nk, ns = plant.nk, self.n * self.ps
+        vel = np.empty(nk + 1 + ns)
+        vel[:nk + 1] = plant.vel[plant.k0:plant.k0 + nk + 1]
+        ys = np.empty((ns + 1, 4))
+        zdd = np.empty(2 * ns + 1)
+        p0 = plant.p.copy()
+        p0[2] = 0.0  # no pendulum on the buoy
+        advance(plant.y.copy(), vel, 0, plant.mus.copy(), np.zeros(ns), 1, fseg, plant.h,
+                plant.w, p0, ys, zdd, np.zeros(3), np.empty_like(zdd))
+        ts = plant.h * np.arange(ns + 1)
+        zs = CubicHermiteSpline(ts, ys[:, 0], ys[:, 1])
+        zds = CubicHermiteSpline(ts, ys[:, 1], zdd[::2])
+        tf = self.tf
+
+        def free(s):
+            return zs(s), zds(s), np.interp(s, tf, zdd)
+        return free
+
+    def past_memory(self, plant):
+        """The memory force (N) at the plant's steps over the horizon of the heave speeds
+        before now alone (the trapezoid's weight at ``s = 0`` halved: its other half is the
+        horizon's, in the radiated energy of :class:`._buoy_plan.CoupledPlan`)."""
+        nk, ns = plant.nk, self.n * self.ps
+        u = plant.vel[plant.k0:plant.k0 + nk + 1][::-1]  # u_q: the speed at -q h
+        # mu_i = sum_{q >= i} w_q u_{q - i}, i = 0..ns
+        mu = np.correlate(np.concatenate((plant.w, np.zeros(ns))), u, "valid")
+        m = min(ns + 1, nk + 1)
+        mu[:m] -= 0.5 * plant.w[:m] * u[0]
+        return mu
+
+    def plan_radiation(self, plant, fseg, shift):
+        """``plan`` with the radiation in the horizon model: one solve."""
+        pr = self.prob
+        y0 = plant.y.copy()
+        ts = plant.h * np.arange(self.n * self.ps + 1)
+        free = self.free_heave(plant, fseg)
+        mp = self.past_memory(plant)
+
+        def fm(s):
+            return np.interp(s, self.tf, fseg) - np.interp(s, ts, mp)
+        pr.set_start(y0, fm, None, free)
+        x = self.start(y0, shift)
+        with _blas_controller().limit(limits=1, user_api="blas"):
+            xs, status, _ = pr.solve(x, max_iter=PLAN_MAX_ITER)
+        if not np.all(np.isfinite(xs)):
+            return None, 1, 1
+        held = pr.torques(xs).reshape(self.n, 3) @ self.w3
+        full = pr.full(xs)
+        self.nodes = (full[0::2].copy(), full[1::2].copy())
+        return np.clip(held, -self.tmax, self.tmax) / self.tu, int(status != "converged"), 0
+
     def plan(self, plant, u0, fseg, iterations, relaxation, shift, residual):
         """The held torques (units ``tu``) of the horizon, the memory force's changes, the
         residual (and its untimed seconds), the solves and the failures."""
+        if self.radiation:
+            u, failed, kept = self.plan_radiation(plant, fseg, shift)
+            return (u0 if u is None else u), [], None, 1, (failed, kept)
         pr = self.prob
         y0 = plant.y.copy()
         rc = self.radiation_cost
@@ -631,11 +702,12 @@ class _MotionPlanner:
 
 
 def buoy_mpc(hydro, pendulum, wave, *, peak_period, horizon=2.0, update_interval=0.125,
-             controller="coupled", iterations=2, relaxation=1.0, samples=SAMPLES,
+             controller=None, iterations=2, relaxation=1.0, samples=SAMPLES,
              warmup=4.0, repeats=1, torque_limit=None, efficiency=None, terminal_weight=None,
              model_steps=MODEL_STEPS, plant_steps=PLANT_STEPS, memory=None, a_inf=None,
              max_iter=None, residual=True, terminal="total", time_limit=None,
-             deadline=None, radiation_cost=True, forecast="perfect") -> BuoyMPCResult:
+             deadline=None, radiation_cost=True, forecast="perfect",
+             radiation_model=True) -> BuoyMPCResult:
     """Receding-horizon control of the pendulum inside the buoy in a periodic record.
 
     Parameters
@@ -650,11 +722,13 @@ def buoy_mpc(hydro, pendulum, wave, *, peak_period, horizon=2.0, update_interval
         sample ``Tp / samples`` (rounded so that the record holds whole samples).
     horizon, update_interval : float
         In peak periods.
-    controller : "coupled", "one-way", "fixed-point" or "plan"
-        The module docstring.
+    controller : "plan", "coupled", "one-way", "fixed-point" or None
+        The module docstring. None (default): ``plan``, or ``coupled`` where ``plan`` does
+        not model what is asked (an efficiency, another terminal value or weight).
     iterations : int
-        ``coupled``, ``plan``: solves per update (plan <-> memory force), at least 1
-        (``plan`` gains nothing from a second: give 1).
+        ``coupled``, ``plan`` with ``radiation_model=False``: solves per update (plan <->
+        memory force), at least 1 (``plan`` gains nothing from a second: give 1); ``plan``
+        with the radiation in its model solves once.
     relaxation : float
         ``alpha`` in (0, 1] of the fixed-point iteration.
     warmup : float
@@ -686,16 +760,23 @@ def buoy_mpc(hydro, pendulum, wave, *, peak_period, horizon=2.0, update_interval
         (after at least one) with the status ``"time_limit"``: a partial run, no success,
         its powers over the samples run.
     radiation_cost : bool
-        ``plan``: weight the heave speed in the horizon objective by ``F_exc - mu - a``
-        (``marginal_radiation``: the radiation the plan's own motion causes later in the
-        horizon, from the motion predicted under the previous plan) instead of ``F_exc -
-        mu`` (False: the memory force frozen alone, the planner before; docs/buoy.md).
+        ``plan`` with ``radiation_model=False``: weight the heave speed in the horizon
+        objective by ``F_exc - mu - a`` (``marginal_radiation``: the radiation the plan's own
+        motion causes later in the horizon, from the motion predicted under the previous
+        plan) instead of ``F_exc - mu`` (False: the memory force frozen alone;
+        docs/buoy.md). With the radiation in the model its objective counts that radiation
+        exactly and this has no effect.
     forecast : "perfect" or "ar"
         What the controller knows of the excitation force over the horizon: the record's
         own future (``perfect``), or the autoregressive forecast of
         :class:`parapend.control.forecast.ARForecast` fitted at each update on the force
         measured so far (every torque sample from the run's start; ``ar``: causal). Not
         with ``one-way``, whose free heave is the record's.
+    radiation_model : bool
+        ``plan``: the radiation inside the horizon model as the plant has it (Cummins'
+        memory: the heave through the plant's impulse response, the past's memory in the
+        free response from the measured state; default), or (False) the memory force
+        predicted under the previous plan and frozen in the dynamics (the planner before).
     """
     from ..control import mpc as _mpc
     from ..control.mpc import HorizonProblem
@@ -703,6 +784,10 @@ def buoy_mpc(hydro, pendulum, wave, *, peak_period, horizon=2.0, update_interval
 
     if terminal not in ("total", "pendulum"):
         raise ParameterError(f"terminal: expected total or pendulum, got {terminal!r:.40}")
+    if controller is None:
+        lossy = (efficiency is not None or terminal != "total"
+                 or terminal_weight not in (None, 1, 1.0))
+        controller = "coupled" if lossy else "plan"
     if controller not in CONTROLLERS:
         raise ParameterError(f"controller: expected coupled, fixed-point, one-way or plan, "
                              f"got {controller!r:.40}")
@@ -756,7 +841,9 @@ def buoy_mpc(hydro, pendulum, wave, *, peak_period, horizon=2.0, update_interval
     m = max(1, min(n, int(round(update_interval * tp / dt))))
     warm_samples = int(round(warmup * tp / dt))
     total = warm_samples + repeats * per_record
-    _check_work(total, n, m, iterations if controller != "one-way" else 1, warm_samples,
+    solves_per_update = (1 if controller == "one-way"
+                         or (controller == "plan" and radiation_model) else iterations)
+    _check_work(total, n, m, solves_per_update, warm_samples,
                 repeats, dt, time_limit)
     if deadline is None and time_limit is not None:
         from ..deadline import deadline as _deadline
@@ -792,7 +879,8 @@ def buoy_mpc(hydro, pendulum, wave, *, peak_period, horizon=2.0, update_interval
             qw = zfree / g
     tl_nd = None if torque_limit is None else torque_limit / tu
     if controller == "plan":
-        prob = _MotionPlanner(n, dt, ps, plant.p, torque_limit, tu, radiation_cost)
+        prob = _MotionPlanner(n, dt, ps, plant.p, torque_limit, tu, radiation_cost,
+                              (plant.w, h) if radiation_model else None)
     elif controller == "coupled":
         prob = CoupledHorizon(n, dt / ms, ms, plant.p, tu, tl_nd, eta, terminal_weight,
                               terminal)
@@ -941,7 +1029,7 @@ def buoy_mpc(hydro, pendulum, wave, *, peak_period, horizon=2.0, update_interval
         heave_amplitude_m=0.5 * float(np.ptp(zwin)) if zwin.size else math.nan,
         catch_time_s=None if caught is None else float(caught * dt), horizon_s=n * dt,
         update_interval_s=m * dt, dt_s=dt, average_from_s=a0 * dt, t_end_s=total * dt,
-        iterations=iterations if controller != "one-way" else 1, relaxation=relaxation,
+        iterations=solves_per_update, relaxation=relaxation,
         fixed_point_change=fp,
         fixed_point_residual=float(np.median(residuals)) if residuals else None,
         solves=solves, failed_solves=failed,
@@ -973,7 +1061,7 @@ def mpc_command(hydro, pendulum, wave, info, *, controller, horizon, update_inte
                              "--tp")
     r = buoy_mpc(hydro, pendulum, wave, peak_period=float(info["tp"]), horizon=horizon,
                  update_interval=update_interval,
-                 controller="coupled" if controller == "mpc" else "one-way",
+                 controller=None if controller == "mpc" else "one-way",
                  torque_limit=torque_limit, efficiency=efficiency, time_limit=time_limit,
                  deadline=deadline, forecast=forecast)
     sol, _, _ = _solve(hydro, pendulum, wave, winding=winding, harmonics=harmonics,
