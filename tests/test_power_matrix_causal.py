@@ -413,9 +413,9 @@ def test_a_buoy_bin_is_buoy_mpc_by_hand(buoy_bin, sphere_nc):
     """A buoy bin's causal powers are :func:`parapend.hydro.control.buoy_mpc` run by hand on
     the record the buoy's optimum solves (built here from ``sea_record``, as
     tests/test_performance_buoy.py builds it), with the column's settings written out: the
-    default controller (``coupled``), horizon 1 and a plan every 1/8 peak period (as
-    ``parapend buoy --controller mpc``), the warm-up, one repeat, the perfect and the AR
-    forecast; to round-off."""
+    default controller (``plan``, one solve an update), horizon 2 and a plan every 1/8 peak
+    period (as ``parapend buoy --controller mpc``), the warm-up, one repeat, the perfect and
+    the AR forecast; to round-off."""
     from parapend.hydro.bem import load
     from parapend.hydro.control import buoy_mpc
     from parapend.hydro.coupled import Pendulum, Wave
@@ -423,16 +423,16 @@ def test_a_buoy_bin_is_buoy_mpc_by_hand(buoy_bin, sphere_nc):
     from parapend.units import Units
 
     spec, got = buoy_bin
-    assert spec.buoy_controller == "coupled" and spec.horizon == 1.0
+    assert spec.buoy_controller == "plan" and spec.horizon == 2.0
     assert spec.update_interval == 0.125 and spec.forecasts == ("perfect", "ar")
     pend = Pendulum(mass=20.0, length=0.3, inertia=20.0 * 0.3**2, damping_coefficient=0.5)
     exc = sea_record(Units(0.3, 20.0, 9.81, pend.inertia), hs=0.2, tp=3.0,
                      repeat_period=4 * 3.0, seed=7)
     wave = Wave(2 * math.pi / (4 * 3.0), np.asarray(exc.heave[1:], dtype=complex))
     for forecast in ("perfect", "ar"):
-        r = buoy_mpc(load(sphere_nc), pend, wave, peak_period=3.0, horizon=1.0,
+        r = buoy_mpc(load(sphere_nc), pend, wave, peak_period=3.0, horizon=2.0,
                      update_interval=0.125, warmup=1.0, repeats=1, forecast=forecast,
-                     controller="coupled")
+                     controller="plan", iterations=1)
         assert r.success and r.forecast == forecast
         assert r.t_end_s - r.average_from_s == pytest.approx(12.0, rel=1e-9)  # one repeat
         assert got[f"causal_{forecast}_power"] == pytest.approx(r.mean_power_w, rel=1e-12,
@@ -475,7 +475,7 @@ def test_the_buoy_column_rests_its_aep_is_8766_h_sum_p_f(monkeypatch, sphere_nc,
     assert ds["causal_perfect_power_matrix"].values.tolist() == [[0.0, 1.5], [2.5, 0.0]]
     assert out["causal"]["mode"]["perfect"] == [["rest", "controller"],
                                                 ["controller", "rest"]]
-    assert out["causal"]["buoy_controller"] == "coupled"
+    assert out["causal"]["buoy_controller"] == "plan"
     assert out["causal"]["plan_samples"] is None and out["causal"]["speed_limit"] is None
     for col, q in (("optimum", "power"), ("causal_perfect", "causal_perfect_power")):
         want = HOURS_PER_YEAR * 0.25 * float(np.sum(np.maximum(ds[f"{q}_mean"].values, 0)))
@@ -484,13 +484,13 @@ def test_the_buoy_column_rests_its_aep_is_8766_h_sum_p_f(monkeypatch, sphere_nc,
         assert e["complete"] is True and e["annual_energy_mwh"] >= 0
         assert e["annual_energy_mwh"] == pytest.approx(want / 1e6, rel=1e-12)
     with xr.open_dataset(out["netcdf"]) as nc:
-        assert nc.attrs["causal_buoy_controller"] == "coupled"
+        assert nc.attrs["causal_buoy_controller"] == "plan"
         assert "causal_plan_samples" not in nc.attrs
         assert nc["annual_energy"].values.tolist() == pytest.approx(
             [out["causal"]["annual_energy"][c]["annual_energy_mwh"]
              for c in ("optimum", "causal_perfect")], rel=1e-12)
     report = text_report(ds, out, [])
-    assert "the buoy's coupled controller)" in report
+    assert "the buoy's plan controller)" in report
     assert "causal power matrix, perfect forecast" in report
 
 
@@ -503,8 +503,10 @@ def test_the_buoy_column_runs_coupled_with_an_efficiency(sphere_nc, monkeypatch)
     for default in ("coupled", "plan"):
         monkeypatch.setattr(causal, "BUOY_CONTROLLER", default)
         spec = matrix_spec(**BUOY_KW, hydro=sphere_nc, efficiency=0.8)
-        assert spec.buoy_controller == "coupled"
-        assert matrix_spec(**BUOY_KW, hydro=sphere_nc).buoy_controller == default
+        assert spec.buoy_controller == "coupled" and spec.horizon == 1.0
+        plain = matrix_spec(**BUOY_KW, hydro=sphere_nc)
+        assert plain.buoy_controller == default
+        assert plain.horizon == {"plan": 2.0, "coupled": 1.0}[default]
 
 
 @pytest.mark.slow  # the sphere's BEM (10 s, once a module), then solves

@@ -90,7 +90,7 @@ def add_parsers(sub) -> None:
                         "otherwise: not supported over a sea record)")
     g = p.add_argument_group("the causal column (--device prescribed-heave, as parapend "
                              "horizon; and the heaving --device buoy, as parapend buoy "
-                             "--controller mpc: perfect forecast, horizon 1, update 1/8; "
+                             "--controller mpc: perfect forecast, horizon 2, update 1/8; "
                              "docs/performance.md)")
     g.add_argument("--controller", choices=["mpc", "none"],
                    help="mpc: beside the non-causal optimum, the receding-horizon controller "
@@ -98,7 +98,7 @@ def add_parsers(sub) -> None:
                         "annual energy of each column side by side (default none)")
     g.add_argument("--horizon", type=_finite_float("horizon"),
                    help="the controller's horizon in peak periods, 0.05 to 20 (default 1 "
-                        "with --controller mpc, both devices)")
+                        "with --controller mpc; the buoy's 2, 1 with --efficiency)")
     g.add_argument("--forecast", metavar="NAMES",
                    help="perfect, ar (autoregressive, fitted on the past only) or "
                         "perfect,ar: one causal column each (default perfect with "

@@ -35,18 +35,18 @@ __all__ = ["BuoyHorizonResult", "buoy_horizon_curve", "plot_buoy_horizon"]
 #: the buoy's curve without the options: horizons (peak periods), each record's length in
 #: peak periods, the update interval and the warm-up (peak periods; ``parapend buoy
 #: --controller mpc``'s), the controllers a user may choose. Ten waves a record: three
-#: horizons and two forecasts of the default ``coupled`` controller are estimated at about
-#: 90 s (BUOY_MPC_SECONDS), inside the two minutes a command runs untimed
+#: horizons and two forecasts of the default ``plan`` controller are estimated at about 40 s
+#: (BUOY_MPC_SECONDS), inside the two minutes a command runs untimed
 BUOY_HORIZON = {"horizons": "0.5,1,2", "repeat_periods": 10, "update_interval": 0.125,
                 "warm_up": 4.0}
 CONTROLLERS = ("coupled", "plan")
-#: seconds per unit of a run's work (updates x horizon samples x solves per update): the
-#: default ``parapend buoy --controller mpc`` run, 1.06e5, took 87 s under load
-#: (``parapend.limits.BUOY_MAX_MPC_WORK``, the cap ``parapend buoy`` refuses by). The default
-#: curve (``coupled``, 1.0e5) is estimated at 82 s by it and took 140 s of CPU at a load of
-#: 2 to 3 on the 2 cores (docs/control.md): low under load, as ``parapend buoy``'s; ``plan``
-#: (counted as ``coupled`` with one solve an update) is over-estimated several times
-BUOY_MPC_SECONDS = 87.0 / 1.06e5
+#: seconds per unit of a run's work (updates x horizon samples x solves per update), per
+#: controller: ``coupled``'s from the default curve's run with it (work 1.0e5, 140 s of CPU
+#: at a load of 2 to 3 on the 2 cores, docs/control.md); ``plan``'s from ``parapend buoy
+#: --controller mpc``'s (1.06e5 counted as two solves an update, 87 s under load), which
+#: over-estimates the default curve with the planner's radiation model (one solve an update,
+#: work 5.0e4, 16.5 s of CPU) about 2.5 times
+BUOY_MPC_SECONDS = {"coupled": 140.0 / 1.0e5, "plan": 87.0 / 1.06e5}
 
 
 @dataclass(frozen=True, eq=False, repr=False)
@@ -292,9 +292,11 @@ def buoy_horizon_curve(*, hs=None, tp=None, spectrum="jonswap", gamma_peak=3.3,
                              None, 0.1, units) for r in range(records)]
     tp = float(waves[0][1]["tp"])
     tr = float(waves[0][1]["repeat_period"])
-    iterations = 1 if controller == "plan" else 2
+    # the planner that will run: buoy_mpc's default when none is given
+    runs = controller or ("coupled" if efficiency is not None else "plan")
+    iterations = 1 if runs == "plan" else 2
     work = [_estimate(tp, tr, h, upd, warm_up, iterations) for h in hz]
-    est = records * len(fc) * sum(w for w, _ in work) * BUOY_MPC_SECONDS
+    est = records * len(fc) * sum(w for w, _ in work) * BUOY_MPC_SECONDS[runs]
     cap = limits.MAX_UNTIMED_SECONDS
     most = int(cap / (est / records))
     # the longest record that fits, one record: a run's work grows with warm-up + record

@@ -21,8 +21,9 @@ optimum solves (same seed, same wave): from the hanging rest with the buoy in it
 periodic motion, 64 torque samples a peak period, ``warm_up`` peak periods and then one whole
 repeat of the record, its storage-corrected power (the harvested energy plus the change of
 the mechanical energy of buoy AND pendulum, per unit time; electrical with an efficiency,
-the stored energy counted at ``eta_g``). Its horizon, update interval and warm-up default to
-``parapend buoy --controller mpc``'s (:data:`BUOY_CAUSAL`); the perfect forecast, the AR one
+the stored energy counted at ``eta_g``). Its horizon defaults to the controller's
+(:data:`BUOY_HORIZON`: 2 peak periods for ``plan``, as ``parapend buoy --controller mpc``),
+its update interval and warm-up to :data:`BUOY_CAUSAL`'s; the perfect forecast, the AR one
 (``buoy_mpc(forecast="ar")``: the excitation force over the horizon from
 :class:`parapend.control.forecast.ARForecast` fitted at each update on the force measured so
 far), or both; neither ``plan_samples`` nor ``speed_limit`` (options of the pendulum's
@@ -38,7 +39,7 @@ import numpy as np
 
 from ..errors import ParameterError, check_int, check_range
 
-__all__ = ["BUOY_CAUSAL", "BUOY_CONTROLLER", "CAUSAL", "FORECASTS", "causal_json",
+__all__ = ["BUOY_CAUSAL", "BUOY_CONTROLLER", "BUOY_HORIZON", "CAUSAL", "FORECASTS", "causal_json",
            "causal_quantities", "check_causal", "run_buoy_record", "solve_causal"]
 
 log = logging.getLogger(__name__)
@@ -58,20 +59,21 @@ FORECASTS = ("perfect", "ar")
 #: was the same
 CAUSAL = {"horizon": 1.0, "forecast": "perfect", "update_interval": 0.03125,
           "warm_up": 4.0, "plan_samples": 2, "speed_limit": 4.0}
-#: ``--device buoy``: the causal column's defaults, ``parapend buoy --controller mpc``'s
-#: (horizon 1 and a plan every 1/8 peak period) and the prescribed device's warm-up
-BUOY_CAUSAL = {"horizon": 1.0, "forecast": "perfect", "update_interval": 0.125,
+#: ``--device buoy``: the causal column's defaults: a plan every 1/8 peak period and the
+#: prescribed device's warm-up; the horizon is the controller's (:data:`BUOY_HORIZON`)
+BUOY_CAUSAL = {"horizon": None, "forecast": "perfect", "update_interval": 0.125,
                "warm_up": 4.0}
 #: ``--device buoy``: which of :func:`parapend.hydro.control.buoy_mpc`'s controllers runs
-#: (``controller=``; recorded in the spec and the output's metadata): "coupled", the
-#: default's. Measured on the default buoy (80 kg, 0.3 m pendulum in the 0.5 m cylinder),
-#: 10-wave records, seed 0, horizon 1, a plan every 1/8 peak period, 4 peak periods of
-#: warm-up, on the shared 2-core machine (docs/performance.md): at Hs 0.5 m, Tp 2.5 s the
-#: experimental "plan" gave the same power (29.35 W against 29.34 W, 57.4 % of the
-#: record's optimum) in 1/7 of the CPU (2.9 s against 19.3 s; at horizon 2, 28.8 W against
-#: 24.9 W); but at Hs 1 m it gave 37.4 W (Tp 2.5 s) where "coupled" gave 77.8 W, and at
-#: Tp 3 s most of its solves failed where "coupled" gave 39.5 W
-BUOY_CONTROLLER = "coupled"
+#: (``controller=``; recorded in the spec and the output's metadata): "plan", the default's,
+#: at a horizon of 2 peak periods; with an efficiency (which ``plan`` does not price)
+#: "coupled" at 1. Measured on the default buoy (80 kg, 0.3 m pendulum in the 0.5 m
+#: cylinder), the matrix's 10-wave records, seed 0, a plan every 1/8 peak period, 4 peak
+#: periods of warm-up (docs/buoy.md): ``plan`` at 2 gave 46.84, 25.39, 84.36 and 41.28 W at
+#: Hs 0.5 and 1 m, Tp 2.5 and 3 s, where ``coupled`` at 1 gave 29.33, 14.26, 77.76 and
+#: 39.47 W (and at 2, 97.14 W out of real time and -14.24 W at Hs 1 m)
+BUOY_CONTROLLER = "plan"
+#: the buoy's default horizon (peak periods) per controller
+BUOY_HORIZON = {"plan": 2.0, "coupled": 1.0}
 
 
 def check_causal(*, controller, horizon, forecast, update_interval, warm_up, plan_samples,
@@ -101,7 +103,9 @@ def check_causal(*, controller, horizon, forecast, update_interval, warm_up, pla
                 raise ParameterError(f"{name}: an option of the prescribed-heave pendulum's "
                                      "planner; drop it with --device buoy")
     base = BUOY_CAUSAL if buoy else CAUSAL
-    horizon = base["horizon"] if horizon is None else horizon
+    buoy_controller = ("coupled" if lossy and BUOY_CONTROLLER == "plan" else BUOY_CONTROLLER)
+    if horizon is None:
+        horizon = (BUOY_HORIZON[buoy_controller] if buoy else base["horizon"])
     horizon = check_range("horizon", horizon, 0.05, 20.0, why="peak periods")
     forecast = base["forecast"] if forecast is None else forecast
     if isinstance(forecast, str):
@@ -129,8 +133,7 @@ def check_causal(*, controller, horizon, forecast, update_interval, warm_up, pla
                 "forecasts": tuple(n for n in FORECASTS if n in names),
                 "update_interval": float(upd), "warm_up": float(warm), "plan_samples": None,
                 "speed_limit": None,
-                "buoy_controller": ("coupled" if lossy and BUOY_CONTROLLER == "plan"
-                                    else BUOY_CONTROLLER)}
+                "buoy_controller": buoy_controller}
     ps = CAUSAL["plan_samples"] if plan_samples is None else plan_samples
     ps = check_int("plan-samples", ps, 1, 64)
     if speed_limit is None:
