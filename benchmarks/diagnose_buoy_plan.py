@@ -97,10 +97,13 @@ class Probe:
     def plan_from_optimum(self, mp, plant, u0, fseg, shift):
         pr = mp.prob
         y0 = plant.y.copy()
-        out = plant.predict(u0 * mp.tu, mp.ps, fseg, memory_force=True)
-        mu = out[1] if out is not None else np.full(fseg.size, plant.mus[0])
-        fm = fseg - mu
-        pr.set_start(y0, lambda s, fm=fm: np.interp(s, mp.tf, fm))
+        if mp.radiation:
+            mp.set_radiation_start(plant, fseg)
+        else:
+            out = plant.predict(u0 * mp.tu, mp.ps, fseg, memory_force=True)
+            mu = out[1] if out is not None else np.full(fseg.size, plant.mus[0])
+            fm = fseg - mu
+            pr.set_start(y0, lambda s, fm=fm: np.interp(s, mp.tf, fm))
         sm = self.sol.sample(self.t + mp.tn)
         xo = np.empty(2 * mp.k)
         xo[0::2] = (sm["theta"] - sm["theta"][0] + y0[2])[1:]

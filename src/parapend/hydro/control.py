@@ -627,17 +627,22 @@ class _MotionPlanner:
         mu[:m] -= 0.5 * plant.w[:m] * u[0]
         return mu
 
-    def plan_radiation(self, plant, fseg, shift):
-        """``plan`` with the radiation in the horizon model: one solve."""
-        pr = self.prob
-        y0 = plant.y.copy()
+    def set_radiation_start(self, plant, fseg):
+        """The horizon problem of this update with the radiation in its model: the plant's
+        state, its free heave under ``fseg`` and ``F_exc`` less the past's memory force."""
         ts = plant.h * np.arange(self.n * self.ps + 1)
         free = self.free_heave(plant, fseg)
         mp = self.past_memory(plant)
 
         def fm(s):
             return np.interp(s, self.tf, fseg) - np.interp(s, ts, mp)
-        pr.set_start(y0, fm, None, free)
+        self.prob.set_start(plant.y.copy(), fm, None, free)
+
+    def plan_radiation(self, plant, fseg, shift):
+        """``plan`` with the radiation in the horizon model: one solve."""
+        pr = self.prob
+        y0 = plant.y.copy()
+        self.set_radiation_start(plant, fseg)
         x = self.start(y0, shift)
         with _blas_controller().limit(limits=1, user_api="blas"):
             xs, status, _ = pr.solve(x, max_iter=PLAN_MAX_ITER)
