@@ -24,6 +24,20 @@ TAU_LABEL = r"$\tau = \omega t / 2\pi$"
 LIMIT_LABEL = r"limit $\gamma \to 0$"
 
 
+def _horizon_axes(ax, hz, xlim, ylabel: str) -> None:
+    """The axes of a curve against the forecast horizon (the pendulum's and the buoy's): the
+    optimum (1) and zero marked, the horizons on a log axis labelled as given."""
+    ax.axhline(1.0, color="0.5", lw=0.8)
+    ax.axhline(0.0, color="0.7", lw=0.6)
+    ax.set_xscale("log")
+    ax.set_xlim(*xlim)
+    ax.set_xticks(hz if hz.size else [])
+    ax.set_xticklabels([f"{v:g}" for v in hz])
+    ax.minorticks_off()
+    ax.set_xlabel("horizon (peak periods)")
+    ax.set_ylabel(ylabel)
+
+
 def _finish(fig, path, layout: bool = True):
     """Lay out (``tight_layout`` unless ``layout`` is false: the figure has its own layout
     engine), save if ``path`` is given, and return the figure."""

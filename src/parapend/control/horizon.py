@@ -652,7 +652,7 @@ def plot_horizon(r: HorizonResult, path=None):
     matplotlib.use("Agg", force=False)
     import matplotlib.pyplot as plt
 
-    from ..plotting import _finish
+    from ..plotting import _finish, _horizon_axes
     from ..style import figure_style
 
     hz = np.asarray(r.horizons, dtype=float)
@@ -673,15 +673,7 @@ def plot_horizon(r: HorizonResult, path=None):
             if len(r.seeds) > 1:
                 ax.fill_between(x, r.baseline_fraction_min[b], r.baseline_fraction_max[b],
                                 color=line.get_color(), alpha=0.12, lw=0)
-        ax.axhline(1.0, color="0.5", lw=0.8)
-        ax.axhline(0.0, color="0.7", lw=0.6)
-        ax.set_xscale("log")
-        ax.set_xlim(*x)
-        ax.set_xticks(hz if hz.size else [])
-        ax.set_xticklabels([f"{v:g}" for v in hz])
-        ax.minorticks_off()
-        ax.set_xlabel("horizon (peak periods)")
-        ax.set_ylabel("mean power / non-causal optimum (-)")
+        _horizon_axes(ax, hz, x, "mean power / non-causal optimum (-)")
         u = r.units
         rec = r.record
         ax.set_title(f"{rec.get('spectrum', '')} Hs = {rec.get('hs', '')} m, Tp = "

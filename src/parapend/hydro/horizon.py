@@ -436,7 +436,7 @@ def plot_buoy_horizon(r: BuoyHorizonResult, path=None):
     matplotlib.use("Agg", force=False)
     import matplotlib.pyplot as plt
 
-    from ..plotting import _finish
+    from ..plotting import _finish, _horizon_axes
     from ..style import figure_style
 
     hz = np.asarray(r.horizons, dtype=float)
@@ -448,15 +448,8 @@ def plot_buoy_horizon(r: BuoyHorizonResult, path=None):
             if len(r.seeds) > 1:
                 ax.fill_between(hz, r.mpc_fraction_min[i], r.mpc_fraction_max[i],
                                 color=line.get_color(), alpha=0.2, lw=0)
-        ax.axhline(1.0, color="0.5", lw=0.8)
-        ax.axhline(0.0, color="0.7", lw=0.6)
-        ax.set_xscale("log")
-        ax.set_xlim(hz.min() / 1.25, hz.max() * 1.25)
-        ax.set_xticks(hz)
-        ax.set_xticklabels([f"{v:g}" for v in hz])
-        ax.minorticks_off()
-        ax.set_xlabel("horizon (peak periods)")
-        ax.set_ylabel("mean power / coupled non-causal optimum (-)")
+        _horizon_axes(ax, hz, (hz.min() / 1.25, hz.max() * 1.25),
+                      "mean power / coupled non-causal optimum (-)")
         rec, p = r.record, r.pendulum
         ax.set_title(f"buoy ({r.body}), {r.controller}: {rec.get('spectrum', '')} Hs = "
                      f"{rec.get('hs', '')} m, Tp = {rec.get('tp', '')} s, {len(r.seeds)} "
