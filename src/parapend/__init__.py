@@ -50,6 +50,10 @@ _EXPORTS = {
 _COMMANDS += ("buoy",)
 _EXPORTS["buoy"] = ".commands"
 _EXPORTS.update({"BuoyResult": ".hydro.result", "BuoySweepResult": ".hydro.result"})
+# rotation persistence over sea states (parapend.dynamics.persistence)
+_COMMANDS += ("persistence",)
+_EXPORTS["persistence"] = ".commands"
+_EXPORTS["PersistenceResult"] = ".dynamics.persistence"
 
 # `map` is left out of the star import, which would hide the builtin: use parapend.map
 __all__ = sorted([*(k for k in _EXPORTS if k != "map"), "__version__"])

@@ -902,7 +902,8 @@ def _power_matrix_result(power_matrix, arguments):
 #: signature and docstring are the command's parameters, declared once): name -> (module,
 #: function)
 IMPLEMENTED = {"sea": (".irregular", "sea"), "buoy": (".hydro.api", "buoy"),
-               "horizon": (".control.horizon", "horizon_curve")}
+               "horizon": (".control.horizon", "horizon_curve"),
+               "persistence": (".dynamics.persistence", "persistence")}
 #: commands whose parameters are declared once, in the signature (and the docstring's
 #: Parameters) of the implementing function, whose answer the command's function shapes into
 #: the command's result: name -> (module, function, shape). The command's function takes

@@ -8,7 +8,8 @@ it.
 
 from __future__ import annotations
 
-__all__ = ["Default", "given", "OMEGA", "DELTA", "GAMMA", "DYNAMICS", "SEA", "BUOY", "HULL"]
+__all__ = ["Default", "given", "OMEGA", "DELTA", "GAMMA", "DYNAMICS", "SEA", "BUOY", "HULL",
+           "PERSISTENCE"]
 
 
 class Default(float):
@@ -86,3 +87,12 @@ HORIZON = {"horizons": "0.25,0.5,1,2", "forecasts": "perfect,ar",
 #: controller (docs/control.md)
 TRACK = {"controller": "lqr", "horizon": 2.0, "update_interval": 0.03125, "forecast": "perfect",
          "speed_limit": None}
+
+#: ``persistence``: a 0.3 m, 1 kg pendulum (small-swing period T0 = 1.1 s) on a light bearing
+#: with a light generator (total damping time I / (c + c_g) = 130 s), in a wave-flume sea
+#: (Hs 2 cm, Tp 0.3 s, Tp / T0 = 0.27) where its rotation persists on part of the records:
+#: one sea state of 100 realizations of the 1200 s record (a few seconds);
+#: docs/persistence.md chooses a map's grid from T0
+PERSISTENCE = {"mass": 1.0, "length": 0.3, "damping_coefficient": 2e-4,
+               "generator_damping": 5e-4, "hs": 0.02, "tp": 0.3, "duration": 1200.0,
+               "realizations": 100}

@@ -17,7 +17,9 @@ __all__ = [
     "SQUARE_ALPHA_MIN", "MAP_MAX_POINTS", "MAP_MAX_PTO_POINTS", "MAP_MAX_HARMONICS",
     "MAP_MAX_WORK", "UNIT_GRAVITY_RANGE", "UNIT_INERTIA_RATIO", "UNIT_LENGTH_RANGE",
     "UNIT_MASS_RANGE", "SEA_MAX_RESAMPLED", "SEA_MIN_HS", "TRACK_MAX_STEP_RATE",
-    "MAX_UNTIMED_SECONDS", "MAX_TIME_LIMIT",
+    "MAX_UNTIMED_SECONDS", "MAX_TIME_LIMIT", "PERSISTENCE_TP_RANGE", "PERSISTENCE_MAX_AXIS",
+    "PERSISTENCE_MAX_WAVES", "PERSISTENCE_MAX_COMPONENTS", "PERSISTENCE_MAX_REALIZATIONS",
+    "PERSISTENCE_MAX_DAMPING",
 ]
 
 # --- long work: estimate first, then refuse or run under a time limit (parapend.deadline) ---
@@ -183,6 +185,22 @@ SEA_MAX_RECORD_ROWS = 1 << 17
 SEA_MAX_RESAMPLED = 1 << 20
 #: harmonics N of the motion over one record (operator Newton: memory O(N), time O(N log N))
 SEA_MAX_HARMONICS = 16384
+
+# --- rotation persistence (parapend persistence, docs/persistence.md) ---------------------
+#: peak period, s: wave-flume periods for a short pendulum (a 0.3 m pendulum rotates in
+#: Tp of 0.2 to 0.5 s) up to the ocean's
+PERSISTENCE_TP_RANGE = (0.05, 30.0)
+#: values of the --hs and --tp axes (and of a --generator-damping list)
+PERSISTENCE_MAX_AXIS = 256
+#: record length in peak periods (the kernel keeps no trajectory; 2e4 peak periods of 30
+#: steps each are 6e5 steps, 10 MB of z'' a record)
+PERSISTENCE_MAX_WAVES = 20000.0
+#: components of a record (its spectrum up to the cutoff)
+PERSISTENCE_MAX_COMPONENTS = 1 << 17
+#: realizations per sea state
+PERSISTENCE_MAX_REALIZATIONS = 1 << 20
+#: bearing and generator damping, N m s/rad
+PERSISTENCE_MAX_DAMPING = 1e9
 
 # --- the floating buoy (parapend buoy, docs/buoy.md) ---------------------------------------
 #: radius and draft of a parametric body, m (1e-300 and 1e300 overflowed Capytaine's panel

@@ -29,7 +29,8 @@ Modules: :mod:`._common` (parser helpers, number parsing, tables, progress),
  rotations: the uncontrolled pendulum of paper Eq. 1), :mod:`.control` (track: the
  closed loop), :mod:`.sea` (sea: irregular seas), :mod:`.sweep` (sweep, map:
  design maps), :mod:`.buoy` (buoy: the pendulum inside a floating buoy), :mod:`.horizon`
- (horizon: causal control against the forecast horizon).
+ (horizon: causal control against the forecast horizon), :mod:`.persistence`
+ (persistence: whether a rotation survives an irregular sea).
 """
 
 from __future__ import annotations
@@ -50,6 +51,7 @@ from . import horizon as _horizon_cmds
 from . import optimize as _optimize_cmds
 from . import paper as _paper_cmds
 from . import performance as _performance_cmds
+from . import persistence as _persistence_cmds
 from . import pto as _pto_cmds
 from . import sea as _sea_cmds
 from . import sweep as _sweep_cmds
@@ -64,7 +66,8 @@ __all__ = ["build_parser", "main"]
 COMMANDS = {**_optimize_cmds.COMMANDS, **_paper_cmds.COMMANDS, **_pto_cmds.COMMANDS,
             **_dynamics_cmds.COMMANDS, **_control_cmds.COMMANDS, **_sea_cmds.COMMANDS,
             **_sweep_cmds.COMMANDS,
-            **_performance_cmds.COMMANDS, **_buoy_cmds.COMMANDS, **_horizon_cmds.COMMANDS}
+            **_performance_cmds.COMMANDS, **_buoy_cmds.COMMANDS, **_horizon_cmds.COMMANDS,
+            **_persistence_cmds.COMMANDS}
 
 
 def _function(command: str):
@@ -96,6 +99,7 @@ def build_parser(*, declare: bool = True):
     _performance_cmds.add_parsers(sub)
     _buoy_cmds.add_parsers(sub)
     _horizon_cmds.add_parsers(sub)
+    _persistence_cmds.add_parsers(sub)
     for name, p in sub.choices.items():
         p.declared_by = functools.partial(_function, name)
         if declare:

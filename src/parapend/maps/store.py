@@ -335,6 +335,10 @@ def _spec_of(identity) -> SweepSpec | None:
             from ..performance.spec import MatrixSpec
 
             return MatrixSpec.from_json(identity)
+        if isinstance(d, dict) and d.get("kind") == "persistence":
+            from ..dynamics._persist_spec import PersistenceSpec
+
+            return PersistenceSpec.from_json(identity)
         values = {a: tuple(float(v) for v in d["axes"][a]) for a in AXES}
         spec = _StoredSpec(values, str(d["excitation"]), d["square_alpha"], d["fourier"],
                            int(d["harmonics"]), bool(d["threshold"]), None,

@@ -1,0 +1,154 @@
+r"""The GPU path of ``parapend persistence`` (``--gpu``): the kernel of
+:mod:`._persist_kernel`, one CUDA thread per lane (numba.cuda), the same equation, stages,
+quadratures and window bookkeeping. Imported only when asked for; never needed otherwise.
+
+The GPU's sine and its fused multiply-adds give other bits than the CPU kernel: the same
+statistics within their intervals, not the same numbers (a GPU map is another map in a
+store: ``gpu`` is part of its identity). ``z''`` is made on the GPU by CuPy's inverse FFT
+when CuPy is installed (else on the CPU and copied).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+__all__ = ["available", "run_batch_gpu"]
+
+_KERNEL = None
+
+
+def available() -> str:
+    """Why the GPU path cannot run here ("" when it can)."""
+    try:
+        from numba import cuda
+    except ImportError:
+        return "needs numba's CUDA support (python -m pip install numba-cuda)"
+    try:
+        if not cuda.is_available():
+            return "no CUDA GPU found (drop --gpu)"
+    except Exception as err:  # noqa: BLE001 - a driver that does not load
+        return f"the CUDA driver did not load ({type(err).__name__}); drop --gpu"
+    return ""
+
+
+def _kernel():
+    global _KERNEL
+    if _KERNEL is not None:
+        return _KERNEL
+    from numba import cuda
+
+    @cuda.jit
+    def persist_gpu(zdd, rows, bdamp, a, g, th0, om0, h, k0, twin, nwin, out, flags):
+        lane = cuda.grid(1)
+        if lane >= rows.size:
+            return
+        r = rows[lane]
+        n2 = zdd.shape[1]
+        m = n2 // 2
+        b = bdamp[lane]
+        th = th0
+        om = om0
+        s2 = 0.0
+        qw = 0.0
+        ok = 1
+        prev = th0
+        if k0 == 0:
+            out[lane, 0] = th0
+            out[lane, 1] = om0
+        bound = 1
+        tw = k0 * h
+        h2 = 0.5 * h
+        h6 = h / 6.0
+        for j in range(m):
+            z1 = zdd[r, 2 * j]
+            z2 = zdd[r, 2 * j + 1]
+            z3 = zdd[r, (2 * j + 2) % n2]
+            t1 = th
+            w1 = om
+            sn1 = math.sin(t1)
+            f1 = a * (g + z1) * sn1 - b * w1
+            t2 = t1 + h2 * w1
+            w2 = w1 + h2 * f1
+            sn2 = math.sin(t2)
+            f2 = a * (g + z2) * sn2 - b * w2
+            t3 = t1 + h2 * w2
+            w3 = w1 + h2 * f2
+            sn3 = math.sin(t3)
+            f3 = a * (g + z2) * sn3 - b * w3
+            t4 = t1 + h * w3
+            w4 = w1 + h * f3
+            sn4 = math.sin(t4)
+            f4 = a * (g + z3) * sn4 - b * w4
+            th = t1 + h6 * (w1 + 2.0 * w2 + 2.0 * w3 + w4)
+            om = w1 + h6 * (f1 + 2.0 * f2 + 2.0 * f3 + f4)
+            if j >= k0:
+                s2 += h6 * (w1 * w1 + 2.0 * w2 * w2 + 2.0 * w3 * w3 + w4 * w4)
+                qw += h6 * (z1 * sn1 * w1 + 2.0 * z2 * sn2 * w2 + 2.0 * z2 * sn3 * w3
+                            + z3 * sn4 * w4)
+            if j + 1 == k0:
+                out[lane, 0] = th
+                out[lane, 1] = om
+                prev = th
+            elif j >= k0 and bound <= nwin:
+                t_new = (j + 1) * h
+                tb = tw + bound * twin
+                while bound <= nwin and tb <= t_new * (1.0 + 1e-15):
+                    s = (tb - j * h) / h
+                    s = min(max(s, 0.0), 1.0)
+                    p0 = (1.0 + 2.0 * s) * (1.0 - s) * (1.0 - s)
+                    m0 = s * (1.0 - s) * (1.0 - s) * h
+                    p1 = s * s * (3.0 - 2.0 * s)
+                    m1 = s * s * (s - 1.0) * h
+                    tb_th = p0 * t1 + m0 * w1 + p1 * th + m1 * om
+                    if tb_th - prev < math.pi:
+                        ok = 0
+                    prev = tb_th
+                    bound += 1
+                    tb = tw + bound * twin
+        out[lane, 2] = th
+        out[lane, 3] = om
+        out[lane, 4] = s2
+        out[lane, 5] = qw
+        fin = (math.isfinite(th) and math.isfinite(om) and math.isfinite(s2)
+               and math.isfinite(qw))
+        flags[lane] = ok if fin else -1
+
+    _KERNEL = persist_gpu
+    return _KERNEL
+
+
+def run_batch_gpu(zdd, bdamp, *, a: float, g: float, th0: float, om0: float, h: float,
+                  k0: int, twin: float, nwin: int, rows=None):
+    """:func:`._persist_kernel.run_batch` on the GPU (``zdd`` a NumPy or CuPy array):
+    ``(out, flags)`` as NumPy arrays."""
+    from numba import cuda
+
+    rows = np.arange(zdd.shape[0]) if rows is None else np.asarray(rows, dtype=np.int64)
+    b = rows.size
+    bdamp = np.ascontiguousarray(np.broadcast_to(np.asarray(bdamp, dtype=np.float64), (b,)))
+    d_zdd = cuda.as_cuda_array(zdd) if hasattr(zdd, "__cuda_array_interface__") \
+        else cuda.to_device(np.ascontiguousarray(zdd, dtype=np.float64))
+    d_out = cuda.device_array((b, 6), dtype=np.float64)
+    d_flags = cuda.device_array(b, dtype=np.int8)
+    threads = 128
+    _kernel()[(b + threads - 1) // threads, threads](
+        d_zdd, cuda.to_device(rows.astype(np.int64)), cuda.to_device(bdamp), float(a),
+        float(g), float(th0), float(om0), float(h), int(k0), float(twin), int(nwin), d_out,
+        d_flags)
+    return d_out.copy_to_host(), d_flags.copy_to_host()
+
+
+def acceleration_gpu(heave_rows, n: int, duration: float):
+    """``z''`` on ``n`` points per record on the GPU (CuPy): ``heave_rows`` (K, kmax + 1)
+    complex heave spectra, one inverse real FFT per row. None without CuPy."""
+    try:
+        import cupy as cp
+    except ImportError:
+        return None
+    z = cp.asarray(heave_rows)
+    w2 = (2 * math.pi * cp.arange(z.shape[1]) / duration) ** 2
+    spec = cp.zeros((z.shape[0], n // 2 + 1), dtype=cp.complex128)
+    spec[:, :z.shape[1]] = -w2 * z * (n / 2)
+    return cp.fft.irfft(spec, n, axis=1)

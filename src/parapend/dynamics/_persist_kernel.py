@@ -1,0 +1,186 @@
+r"""Compiled kernel of ``parapend persistence``: many realizations of the pendulum on a sea
+record at once, fixed-step classical RK4, the accumulations done as it goes (no trajectory
+is stored).
+
+The equation (SI, theta from the upright)::
+
+    theta'' = a (g + z''(t)) sin(theta) - b theta',   a = m l / I,   b = (c + c_g) / I
+
+``z''`` is given on the grid of half steps ``t_j = j h / 2`` over one repeat period (``2 M``
+values for ``M`` steps, periodic): the stages of step ``j`` use ``z''`` at ``t_{2j}``,
+``t_{2j+1}`` (twice) and ``t_{2j+2}``. Over the window (from step ``k0`` to ``M``) the kernel
+integrates, with the same four stages (so the quadratures are those of the augmented ODE),
+
+    S2 = int theta'^2 dt            (harvested c_g S2, dissipated c S2)
+    QW = int z'' sin(theta) theta' dt   (the base's work m l QW)
+
+and the angle at the boundaries of the consecutive ``2 Tp`` windows (cubic Hermite
+interpolation between steps, from theta and theta' at both ends: fourth order, as the
+step): ``throughout`` is 1 when every full window advances at least pi.
+
+``LANES`` realizations advance in lockstep stage by stage (loops the compiler vectorizes),
+groups of lanes run in parallel (``prange``); each lane's arithmetic is the same whichever
+group or thread computes it (no ``fastmath``), so a realization gives the same bits in any
+batch. The sine is :func:`parapend.dynamics._kernel._sin` (the package's fast sine).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numba as nb
+import numpy as np
+
+from .._jit import announce_compiles
+from ._kernel import _sin
+
+announce_compiles()
+
+LANES = 8
+_PI = math.pi
+
+
+@nb.njit(cache=True, parallel=True)
+def persist_batch(zdd, rows, bdamp, a, g, th0, om0, h, k0, twin, nwin, out, flags):
+    """Integrate every row of ``zdd`` (shape ``(B, 2 M)``, ``B`` a multiple of ``LANES``).
+
+    Parameters
+    ----------
+    zdd : float64 (K, 2M)
+        Base acceleration z'' (m/s^2) at the half steps of one repeat period, per record.
+    rows : int64 (B,)
+        The record (row of ``zdd``) of each lane.
+    bdamp : float64 (B,)
+        ``(c + c_g) / I`` of each lane (1/s).
+    a, g : float
+        ``m l / I`` (1/m) and gravity (m/s^2).
+    th0, om0 : float
+        The start (rad, rad/s).
+    h : float
+        The step (s), ``M h = T_r``.
+    k0 : int
+        The step at which the window starts (``t_w = k0 h``).
+    twin : float
+        The length of the windows of "rotating throughout" (s, ``2 Tp``).
+    nwin : int
+        The number of full windows in ``[t_w, T_r]``.
+    out : float64 (B, 6)
+        Written: theta and theta' at ``t_w``, theta and theta' at ``T_r``, ``S2``, ``QW``.
+    flags : int8 (B,)
+        Written: 1 rotating throughout, 0 not, -1 non-finite state.
+    """
+    nb_rows = rows.size
+    n2 = zdd.shape[1]
+    m = n2 // 2
+    groups = nb_rows // LANES
+    h2 = 0.5 * h
+    h6 = h / 6.0
+    for grp in nb.prange(groups):
+        base = grp * LANES
+        th = np.empty(LANES)
+        om = np.empty(LANES)
+        bb = np.empty(LANES)
+        s2 = np.zeros(LANES)
+        qw = np.zeros(LANES)
+        prev = np.empty(LANES)   # theta at the last window boundary
+        ok = np.ones(LANES, dtype=np.int8)
+        tho = np.empty(LANES)
+        omo = np.empty(LANES)
+        for ln in range(LANES):
+            th[ln] = th0
+            om[ln] = om0
+            bb[ln] = bdamp[base + ln]
+        if k0 == 0:
+            for ln in range(LANES):
+                out[base + ln, 0] = th0
+                out[base + ln, 1] = om0
+                prev[ln] = th0
+        bound = 1          # index of the next window boundary
+        tw = k0 * h
+        for j in range(m):
+            i1 = 2 * j
+            i2 = i1 + 1
+            i3 = (i1 + 2) % n2
+            inside = j >= k0
+            for ln in range(LANES):
+                r = rows[base + ln]
+                z1 = zdd[r, i1]
+                z2 = zdd[r, i2]
+                z3 = zdd[r, i3]
+                t1 = th[ln]
+                w1 = om[ln]
+                b = bb[ln]
+                sn1 = _sin(t1)
+                f1 = a * (g + z1) * sn1 - b * w1
+                t2 = t1 + h2 * w1
+                w2 = w1 + h2 * f1
+                sn2 = _sin(t2)
+                f2 = a * (g + z2) * sn2 - b * w2
+                t3 = t1 + h2 * w2
+                w3 = w1 + h2 * f2
+                sn3 = _sin(t3)
+                f3 = a * (g + z2) * sn3 - b * w3
+                t4 = t1 + h * w3
+                w4 = w1 + h * f3
+                sn4 = _sin(t4)
+                f4 = a * (g + z3) * sn4 - b * w4
+                tho[ln] = t1
+                omo[ln] = w1
+                th[ln] = t1 + h6 * (w1 + 2.0 * w2 + 2.0 * w3 + w4)
+                om[ln] = w1 + h6 * (f1 + 2.0 * f2 + 2.0 * f3 + f4)
+                if inside:
+                    s2[ln] += h6 * (w1 * w1 + 2.0 * w2 * w2 + 2.0 * w3 * w3 + w4 * w4)
+                    qw[ln] += h6 * (z1 * sn1 * w1 + 2.0 * z2 * sn2 * w2
+                                    + 2.0 * z2 * sn3 * w3 + z3 * sn4 * w4)
+            if j + 1 == k0:
+                for ln in range(LANES):
+                    out[base + ln, 0] = th[ln]
+                    out[base + ln, 1] = om[ln]
+                    prev[ln] = th[ln]
+            elif inside and bound <= nwin:
+                t_new = (j + 1) * h
+                tb = tw + bound * twin
+                while bound <= nwin and tb <= t_new * (1.0 + 1e-15):
+                    s = (tb - j * h) / h
+                    s = min(max(s, 0.0), 1.0)
+                    # cubic Hermite basis on [0, 1]
+                    p0 = (1.0 + 2.0 * s) * (1.0 - s) * (1.0 - s)
+                    m0 = s * (1.0 - s) * (1.0 - s) * h
+                    p1 = s * s * (3.0 - 2.0 * s)
+                    m1 = s * s * (s - 1.0) * h
+                    for ln in range(LANES):
+                        tb_th = p0 * tho[ln] + m0 * omo[ln] + p1 * th[ln] + m1 * om[ln]
+                        if tb_th - prev[ln] < _PI:
+                            ok[ln] = 0
+                        prev[ln] = tb_th
+                    bound += 1
+                    tb = tw + bound * twin
+        for ln in range(LANES):
+            r = base + ln
+            out[r, 2] = th[ln]
+            out[r, 3] = om[ln]
+            out[r, 4] = s2[ln]
+            out[r, 5] = qw[ln]
+            fin = (math.isfinite(th[ln]) and math.isfinite(om[ln])
+                   and math.isfinite(s2[ln]) and math.isfinite(qw[ln]))
+            flags[r] = ok[ln] if fin else -1
+
+
+def run_batch(zdd: np.ndarray, bdamp, *, a: float, g: float, th0: float, om0: float,
+              h: float, k0: int, twin: float, nwin: int, rows=None):
+    """:func:`persist_batch` on any number of lanes: lane ``i`` integrates record
+    ``rows[i]`` (default: one lane per row of ``zdd``) with damping ``bdamp[i]`` (a number:
+    the same for all). The lanes are padded to whole groups of ``LANES`` (the padding's
+    results are dropped). Returns ``(out, flags)``."""
+    rows = np.arange(zdd.shape[0]) if rows is None else np.asarray(rows, dtype=np.int64)
+    b = rows.size
+    bdamp = np.broadcast_to(np.asarray(bdamp, dtype=np.float64), (b,))
+    pad = (-b) % LANES
+    rows = np.concatenate([rows, np.repeat(rows[-1:], pad)]).astype(np.int64)
+    bdamp = np.ascontiguousarray(np.concatenate([bdamp, np.repeat(bdamp[-1:], pad)]))
+    zdd = np.ascontiguousarray(zdd, dtype=np.float64)
+    out = np.empty((rows.size, 6))
+    flags = np.empty(rows.size, dtype=np.int8)
+    persist_batch(zdd, rows, bdamp, float(a), float(g), float(th0), float(om0), float(h),
+                  int(k0), float(twin), int(nwin), out, flags)
+    return out[:b], flags[:b]
