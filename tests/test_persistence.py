@@ -215,9 +215,11 @@ def test_bad_input_is_one_line_exit_2(argv, word, capsys):
 
 
 def _cli(args, store, env):
+    # the output to files: a pipe that nobody reads would block the JSON's write
+    log = open(Path(str(store) + ".log"), "w")  # noqa: SIM115 - closed with the process
     return subprocess.Popen([sys.executable, "-m", "parapend", "persistence", *args,
-                             "--store", str(store), "--json"], env=env,
-                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, cwd=ROOT)
+                             "--store", str(store), "--json"], env=env, stdout=log,
+                            stderr=subprocess.STDOUT, cwd=ROOT)
 
 
 @pytest.mark.slow
@@ -231,7 +233,7 @@ def test_kill_9_halfway_and_resume_is_bit_for_bit(tmp_path):
     env = {**os.environ, "PYTHONPATH": str(ROOT / "src")}
     whole = tmp_path / "whole.zarr"
     p = _cli(args, whole, env)
-    assert p.wait(timeout=600) == 0, p.stderr.read()
+    assert p.wait(timeout=600) == 0, (tmp_path / "whole.zarr.log").read_text()
     cut = tmp_path / "cut.zarr"
     p = _cli(args, cut, env)
     deadline = time.monotonic() + 600
@@ -242,8 +244,11 @@ def test_kill_9_halfway_and_resume_is_bit_for_bit(tmp_path):
         time.sleep(0.05)
     p.send_signal(signal.SIGKILL)
     p.wait()
+    assert p.returncode == -signal.SIGKILL
+    blocks = sum(f.is_file() for f in (cut / "done" / "c").rglob("*"))
+    assert 0 < blocks < 100, blocks
     p = _cli(args, cut, env)
-    assert p.wait(timeout=600) == 0, p.stderr.read()
+    assert p.wait(timeout=600) == 0, (tmp_path / "cut.zarr.log").read_text()
     a = xr.open_zarr(whole, consolidated=False).load()
     b = xr.open_zarr(cut, consolidated=False).load()
     assert bool(b["done"].all())

@@ -133,7 +133,7 @@ def _cmd_persistence(a) -> dict | str:
     if c:
         out.append(f"step {c['step_s']:.4g} s ({c['steps_per_peak_period']:.3g} per Tp); "
                    f"halved on {c['realizations']} records of Hs {c['hs_m']:g} m, Tp "
-                   f"{c['tp_s']:g} s: theta after the transient changed by "
+                   f"{c['tp_s']:g} s: theta after one Tp changed by "
                    f"{c['theta_change_rad']:.2g} rad, energy identity residual "
                    f"{c['energy_residual_max']:.2g}")
     out.append(f"status: {r.status}; {r.message}; {r.executor}, {r.seconds:.1f} s")

@@ -35,6 +35,11 @@ def record_heave(spec, hs: float, tp: float, seed: int) -> np.ndarray:
     """The complex heave spectrum (m) of realization ``seed``: ``z = Re sum_k Z_k e^{2 pi i k
     t / T_r}``, drawn as :func:`parapend.seas.sea_record` draws it (same generator calls),
     through the response table if any."""
+    return record_heaves(spec, hs, tp, [seed])[0]
+
+
+def record_heaves(spec, hs: float, tp: float, seeds) -> np.ndarray:
+    """:func:`record_heave` of every seed of ``seeds``, one row each (the amplitudes once)."""
     from ..seas import jonswap, pierson_moskowitz
 
     tr = spec.duration
@@ -44,10 +49,11 @@ def record_heave(spec, hs: float, tp: float, seed: int) -> np.ndarray:
          else pierson_moskowitz(f, hs, tp))
     s[0] = 0.0
     amp = np.sqrt(2.0 * s / tr)
-    phase = np.random.default_rng(int(seed)).uniform(0.0, 2 * math.pi, kmax + 1)
+    phase = np.array([np.random.default_rng(int(sd)).uniform(0.0, 2 * math.pi, kmax + 1)
+                      for sd in seeds]).reshape(len(seeds), kmax + 1)
     z = amp * np.exp(1j * phase)
-    z[0] = 0.0
-    if spec.response is not None:
+    z[:, 0] = 0.0
+    if spec.response is not None:  # in sea_record's order of operations
         rf, rg, rp = (np.asarray(c) for c in spec.response)
         z = z * np.interp(f, rf, rg, left=0.0, right=0.0) * np.exp(1j * np.interp(f, rf, rp))
     return z
@@ -100,36 +106,31 @@ def acceleration(spec, plan: dict, seeds) -> np.ndarray:
     """``z''`` (m/s^2) of the realizations ``seeds`` at the half steps, one row each: one
     inverse real FFT per record (exact at the grid's points for the periodic record)."""
     n = 2 * plan["m"]
+    z = record_heaves(spec, plan["hs"], plan["tp"], seeds)
     if spec.gpu:  # the FFTs on the GPU when CuPy is there
         from ._persist_gpu import acceleration_gpu
 
-        rows = [record_heave(spec, plan["hs"], plan["tp"], s) for s in seeds]
-        out = acceleration_gpu(np.array(rows), n, spec.duration)
+        out = acceleration_gpu(z, n, spec.duration)
         if out is not None:
             return out
-    out = np.empty((len(seeds), n))
-    w2 = None
-    for row, s in enumerate(seeds):
-        z = record_heave(spec, plan["hs"], plan["tp"], s)
-        if w2 is None:
-            w2 = (2 * math.pi * np.arange(z.size) / spec.duration) ** 2
-        spec_n = np.zeros(n // 2 + 1, dtype=complex)
-        spec_n[:z.size] = -w2 * z * (n / 2)
-        out[row] = np.fft.irfft(spec_n, n)
-    return out
+    w2 = (2 * math.pi * np.arange(z.shape[1]) / spec.duration) ** 2
+    spec_n = np.zeros((len(seeds), n // 2 + 1), dtype=complex)
+    spec_n[:, :z.shape[1]] = -w2 * z * (n / 2)
+    return np.fft.irfft(spec_n, n, axis=1)
 
 
 def _batch(spec, plan: dict) -> int:
     from ._persist_kernel import LANES
 
+    if spec.gpu:  # every realization of the block in one launch
+        return max(LANES, spec.block)
     rows = max(LANES, BATCH_BYTES // (16 * plan["m"]))
     return rows - rows % LANES
 
 
-def _integrate(spec, plan: dict, zdd, bdamp, rows=None):
+def _integrate(spec, plan: dict, zdd, bdamp):
     kw = {"a": plan["a"], "g": spec.gravity, "th0": math.pi, "om0": plan["om0"],
-          "h": plan["h"], "k0": plan["k0"], "twin": 2 * plan["tp"], "nwin": plan["nwin"],
-          "rows": rows}
+          "h": plan["h"], "k0": plan["k0"], "twin": 2 * plan["tp"], "nwin": plan["nwin"]}
     if spec.gpu:
         from ._persist_gpu import run_batch_gpu
 
@@ -197,14 +198,14 @@ def best_damping(spec, plan: dict) -> float:
     ref = plan["inertia"] * plan["om0"]
 
     def best_of(xs):
-        cg = ref * 10.0 ** np.repeat(xs, n)
-        rows = np.tile(np.arange(n), len(xs))
-        out, flags = _integrate(spec, plan, zdd, (spec.damping_coefficient + cg)
-                                / plan["inertia"], rows)
-        p = _summaries(spec, plan, cg, out, flags)["power"].reshape(len(xs), n)
-        mean = np.where(np.all(np.isfinite(p), axis=1), np.mean(p, axis=1), -np.inf)
-        k = int(np.argmax(mean))
-        return xs[k]
+        mean = []
+        for x in xs:
+            cg = ref * 10.0**x
+            out, flags = _integrate(spec, plan, zdd, (spec.damping_coefficient + cg)
+                                    / plan["inertia"])
+            p = _summaries(spec, plan, cg, out, flags)["power"]
+            mean.append(float(np.mean(p)) if np.all(np.isfinite(p)) else -np.inf)
+        return xs[int(np.argmax(mean))]
 
     x = best_of(BEST_COARSE)
     x = best_of(x + BEST_FINE)
@@ -264,8 +265,8 @@ def controller_power(spec, plan: dict, seed: int) -> float:
 
 def step_check(spec, cg=None) -> dict:
     """Run the first realizations of the hardest cell (largest Hs, shortest Tp) at the
-    chosen step and at half of it. Reported: the largest change of theta at the end of the
-    transient (``theta_change_rad``: the step's error over ``t_tr``, before the motion's
+    chosen step and at half of it. Reported: the largest change of theta after the first
+    peak period (``theta_change_rad``: the step's error over one Tp, before the motion's
     sensitivity takes over; Richardson: the error at the step is about 16/15 of it), the
     largest relative residual of the energy identity (2) at the step, and, over the
     window, the change of the mean power (relative), the largest change of ``rho`` and the
@@ -273,22 +274,25 @@ def step_check(spec, cg=None) -> dict:
     not agree: only its statistics are comparable, within their intervals)."""
     i, j = len(spec.hs) - 1, 0
     n = min(spec.realizations, STEP_CHECK_REALIZATIONS)
-    res, start = [], []
+    res, first = [], []
     for refine in (1, 2):
         plan = cell_plan(spec, i, j, refine)
         if cg is None:
             cg = best_damping(spec, plan) if spec.best else float(spec.generator[0])
         zdd = acceleration(spec, plan, [spec.seed + r for r in range(n)])
-        out, flags = _integrate(spec, plan, zdd, (spec.damping_coefficient + cg)
-                                / plan["inertia"])
+        bd = (spec.damping_coefficient + cg) / plan["inertia"]
+        out, flags = _integrate(spec, plan, zdd, bd)
         res.append(_summaries(spec, plan, cg, out, flags))
-        start.append(out[:, 0])
+        # the first peak period alone (z'' cut after it; its state is the "window start")
+        k1 = max(1, int(round(plan["tp"] / plan["h"] / refine))) * refine
+        short = _integrate(spec, {**plan, "k0": k1, "nwin": 0}, zdd[:, :2 * k1 + 1], bd)
+        first.append(short[0][:, 0])
     a, b = res
     ok = a["finite"] & b["finite"]
     pa, pb = np.mean(a["power"][ok]), np.mean(b["power"][ok])
     drho = np.abs(a["rho"] - b["rho"])[ok]
     plan = cell_plan(spec, i, j)
-    dth = np.abs(start[0] - start[1])[ok]
+    dth = np.abs(first[0] - first[1])[ok]
     return {"hs_m": spec.hs[i], "tp_s": spec.tp[j], "generator_damping_nm_s_per_rad": cg,
             "realizations": int(n), "step_s": plan["h"],
             "steps_per_peak_period": plan["tp"] / plan["h"],

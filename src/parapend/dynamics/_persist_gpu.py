@@ -40,12 +40,11 @@ def _kernel():
     from numba import cuda
 
     @cuda.jit
-    def persist_gpu(zdd, rows, bdamp, a, g, th0, om0, h, k0, twin, nwin, out, flags):
+    def persist_gpu(zdd, bdamp, a, g, th0, om0, h, k0, twin, nwin, out, flags):
         lane = cuda.grid(1)
-        if lane >= rows.size:
+        if lane >= bdamp.size:
             return
-        r = rows[lane]
-        n2 = zdd.shape[1]
+        n2 = zdd.shape[0]
         m = n2 // 2
         b = bdamp[lane]
         th = th0
@@ -62,9 +61,9 @@ def _kernel():
         h2 = 0.5 * h
         h6 = h / 6.0
         for j in range(m):
-            z1 = zdd[r, 2 * j]
-            z2 = zdd[r, 2 * j + 1]
-            z3 = zdd[r, (2 * j + 2) % n2]
+            z1 = zdd[2 * j, lane]
+            z2 = zdd[2 * j + 1, lane]
+            z3 = zdd[(2 * j + 2) % n2, lane]
             t1 = th
             w1 = om
             sn1 = math.sin(t1)
@@ -120,23 +119,26 @@ def _kernel():
 
 
 def run_batch_gpu(zdd, bdamp, *, a: float, g: float, th0: float, om0: float, h: float,
-                  k0: int, twin: float, nwin: int, rows=None):
-    """:func:`._persist_kernel.run_batch` on the GPU (``zdd`` a NumPy or CuPy array):
-    ``(out, flags)`` as NumPy arrays."""
+                  k0: int, twin: float, nwin: int):
+    """:func:`._persist_kernel.run_batch` on the GPU: ``zdd`` (B, 2M), a NumPy or CuPy
+    array, is laid out half step by half step (``(2M, B)``: the threads of a warp read
+    neighbouring values); ``(out, flags)`` as NumPy arrays."""
     from numba import cuda
 
-    rows = np.arange(zdd.shape[0]) if rows is None else np.asarray(rows, dtype=np.int64)
-    b = rows.size
+    b = zdd.shape[0]
     bdamp = np.ascontiguousarray(np.broadcast_to(np.asarray(bdamp, dtype=np.float64), (b,)))
-    d_zdd = cuda.as_cuda_array(zdd) if hasattr(zdd, "__cuda_array_interface__") \
-        else cuda.to_device(np.ascontiguousarray(zdd, dtype=np.float64))
+    if hasattr(zdd, "__cuda_array_interface__"):
+        import cupy as cp
+
+        d_zdd = cuda.as_cuda_array(cp.ascontiguousarray(zdd.T))
+    else:
+        d_zdd = cuda.to_device(np.ascontiguousarray(np.asarray(zdd, dtype=np.float64).T))
     d_out = cuda.device_array((b, 6), dtype=np.float64)
     d_flags = cuda.device_array(b, dtype=np.int8)
     threads = 128
     _kernel()[(b + threads - 1) // threads, threads](
-        d_zdd, cuda.to_device(rows.astype(np.int64)), cuda.to_device(bdamp), float(a),
-        float(g), float(th0), float(om0), float(h), int(k0), float(twin), int(nwin), d_out,
-        d_flags)
+        d_zdd, cuda.to_device(bdamp), float(a), float(g), float(th0), float(om0), float(h),
+        int(k0), float(twin), int(nwin), d_out, d_flags)
     return d_out.copy_to_host(), d_flags.copy_to_host()
 
 

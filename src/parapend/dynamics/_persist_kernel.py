@@ -18,10 +18,11 @@ and the angle at the boundaries of the consecutive ``2 Tp`` windows (cubic Hermi
 interpolation between steps, from theta and theta' at both ends: fourth order, as the
 step): ``throughout`` is 1 when every full window advances at least pi.
 
-``LANES`` realizations advance in lockstep stage by stage (loops the compiler vectorizes),
-groups of lanes run in parallel (``prange``); each lane's arithmetic is the same whichever
-group or thread computes it (no ``fastmath``), so a realization gives the same bits in any
-batch. The sine is :func:`parapend.dynamics._kernel._sin` (the package's fast sine).
+``LANES`` realizations advance in lockstep (a loop without branches over the lanes), groups
+of lanes run in parallel (threads: the kernel releases the GIL); each lane's arithmetic is
+the same whichever group or thread computes it (no ``fastmath``), so a realization gives
+the same bits in any batch. The sine is :func:`parapend.dynamics._kernel._sin` (the
+package's fast sine).
 """
 
 from __future__ import annotations
@@ -40,16 +41,43 @@ LANES = 8
 _PI = math.pi
 
 
-@nb.njit(cache=True, parallel=True)
-def persist_batch(zdd, rows, bdamp, a, g, th0, om0, h, k0, twin, nwin, out, flags):
-    """Integrate every row of ``zdd`` (shape ``(B, 2 M)``, ``B`` a multiple of ``LANES``).
+@nb.njit(inline="always", cache=True)
+def _rk4(t1, w1, z1, z2, z3, a, g, b, h):
+    """One classical RK4 step of ``theta'' = a (g + z'') sin(theta) - b theta'`` (``z''`` at
+    the step's start, middle and end) and the step's increments of the quadratures
+    ``int theta'^2`` and ``int z'' sin(theta) theta'`` by the same stages."""
+    h2 = 0.5 * h
+    h6 = h / 6.0
+    sn1 = _sin(t1)
+    f1 = a * (g + z1) * sn1 - b * w1
+    t2 = t1 + h2 * w1
+    w2 = w1 + h2 * f1
+    sn2 = _sin(t2)
+    f2 = a * (g + z2) * sn2 - b * w2
+    t3 = t1 + h2 * w2
+    w3 = w1 + h2 * f2
+    sn3 = _sin(t3)
+    f3 = a * (g + z2) * sn3 - b * w3
+    t4 = t1 + h * w3
+    w4 = w1 + h * f3
+    sn4 = _sin(t4)
+    f4 = a * (g + z3) * sn4 - b * w4
+    return (t1 + h6 * (w1 + 2.0 * w2 + 2.0 * w3 + w4),
+            w1 + h6 * (f1 + 2.0 * f2 + 2.0 * f3 + f4),
+            h6 * (w1 * w1 + 2.0 * w2 * w2 + 2.0 * w3 * w3 + w4 * w4),
+            h6 * (z1 * sn1 * w1 + 2.0 * z2 * sn2 * w2 + 2.0 * z2 * sn3 * w3 + z3 * sn4 * w4))
+
+
+@nb.njit(cache=True, nogil=True)
+def persist_batch(zdd, bdamp, a, g, th0, om0, h, k0, twin, nwin, out, flags, lo, hi):
+    """Integrate the groups ``lo`` to ``hi - 1`` of ``zdd`` (without the GIL: threads run
+    other groups at the same time).
 
     Parameters
     ----------
-    zdd : float64 (K, 2M)
-        Base acceleration z'' (m/s^2) at the half steps of one repeat period, per record.
-    rows : int64 (B,)
-        The record (row of ``zdd``) of each lane.
+    zdd : float64 (B / LANES, 2M, LANES)
+        Base acceleration z'' (m/s^2) at the half steps of one repeat period, lane ``l`` of
+        group ``k`` in ``zdd[k, :, l]`` (the lanes' values of one half step side by side).
     bdamp : float64 (B,)
         ``(c + c_g) / I`` of each lane (1/s).
     a, g : float
@@ -69,13 +97,9 @@ def persist_batch(zdd, rows, bdamp, a, g, th0, om0, h, k0, twin, nwin, out, flag
     flags : int8 (B,)
         Written: 1 rotating throughout, 0 not, -1 non-finite state.
     """
-    nb_rows = rows.size
     n2 = zdd.shape[1]
     m = n2 // 2
-    groups = nb_rows // LANES
-    h2 = 0.5 * h
-    h6 = h / 6.0
-    for grp in nb.prange(groups):
+    for grp in range(lo, hi):
         base = grp * LANES
         th = np.empty(LANES)
         om = np.empty(LANES)
@@ -102,36 +126,18 @@ def persist_batch(zdd, rows, bdamp, a, g, th0, om0, h, k0, twin, nwin, out, flag
             i2 = i1 + 1
             i3 = (i1 + 2) % n2
             inside = j >= k0
-            for ln in range(LANES):
-                r = rows[base + ln]
-                z1 = zdd[r, i1]
-                z2 = zdd[r, i2]
-                z3 = zdd[r, i3]
+            acc = 1.0 if inside else 0.0
+            for ln in range(LANES):  # no branch: the compiler vectorizes it
                 t1 = th[ln]
                 w1 = om[ln]
-                b = bb[ln]
-                sn1 = _sin(t1)
-                f1 = a * (g + z1) * sn1 - b * w1
-                t2 = t1 + h2 * w1
-                w2 = w1 + h2 * f1
-                sn2 = _sin(t2)
-                f2 = a * (g + z2) * sn2 - b * w2
-                t3 = t1 + h2 * w2
-                w3 = w1 + h2 * f2
-                sn3 = _sin(t3)
-                f3 = a * (g + z2) * sn3 - b * w3
-                t4 = t1 + h * w3
-                w4 = w1 + h * f3
-                sn4 = _sin(t4)
-                f4 = a * (g + z3) * sn4 - b * w4
+                tn, wn, ds2, dqw = _rk4(t1, w1, zdd[grp, i1, ln], zdd[grp, i2, ln],
+                                        zdd[grp, i3, ln], a, g, bb[ln], h)
                 tho[ln] = t1
                 omo[ln] = w1
-                th[ln] = t1 + h6 * (w1 + 2.0 * w2 + 2.0 * w3 + w4)
-                om[ln] = w1 + h6 * (f1 + 2.0 * f2 + 2.0 * f3 + f4)
-                if inside:
-                    s2[ln] += h6 * (w1 * w1 + 2.0 * w2 * w2 + 2.0 * w3 * w3 + w4 * w4)
-                    qw[ln] += h6 * (z1 * sn1 * w1 + 2.0 * z2 * sn2 * w2
-                                    + 2.0 * z2 * sn3 * w3 + z3 * sn4 * w4)
+                th[ln] = tn
+                om[ln] = wn
+                s2[ln] += acc * ds2
+                qw[ln] += acc * dqw
             if j + 1 == k0:
                 for ln in range(LANES):
                     out[base + ln, 0] = th[ln]
@@ -167,20 +173,39 @@ def persist_batch(zdd, rows, bdamp, a, g, th0, om0, h, k0, twin, nwin, out, flag
 
 
 def run_batch(zdd: np.ndarray, bdamp, *, a: float, g: float, th0: float, om0: float,
-              h: float, k0: int, twin: float, nwin: int, rows=None):
-    """:func:`persist_batch` on any number of lanes: lane ``i`` integrates record
-    ``rows[i]`` (default: one lane per row of ``zdd``) with damping ``bdamp[i]`` (a number:
-    the same for all). The lanes are padded to whole groups of ``LANES`` (the padding's
-    results are dropped). Returns ``(out, flags)``."""
-    rows = np.arange(zdd.shape[0]) if rows is None else np.asarray(rows, dtype=np.int64)
-    b = rows.size
+              h: float, k0: int, twin: float, nwin: int):
+    """:func:`persist_batch` on the records ``zdd`` (one per row, shape ``(B, 2M)``), each
+    with damping ``bdamp`` (a number, or one per record). The records are grouped by
+    ``LANES`` (the last group padded by repeating the last record; the padding's results
+    are dropped). Returns ``(out, flags)``."""
+    b = zdd.shape[0]
     bdamp = np.broadcast_to(np.asarray(bdamp, dtype=np.float64), (b,))
     pad = (-b) % LANES
-    rows = np.concatenate([rows, np.repeat(rows[-1:], pad)]).astype(np.int64)
+    if pad:
+        zdd = np.concatenate([zdd, np.repeat(zdd[-1:], pad, axis=0)])
     bdamp = np.ascontiguousarray(np.concatenate([bdamp, np.repeat(bdamp[-1:], pad)]))
-    zdd = np.ascontiguousarray(zdd, dtype=np.float64)
-    out = np.empty((rows.size, 6))
-    flags = np.empty(rows.size, dtype=np.int8)
-    persist_batch(zdd, rows, bdamp, float(a), float(g), float(th0), float(om0), float(h),
-                  int(k0), float(twin), int(nwin), out, flags)
+    grouped = np.ascontiguousarray(
+        np.asarray(zdd, dtype=np.float64).reshape(-1, LANES, zdd.shape[1]).transpose(0, 2, 1))
+    out = np.empty((b + pad, 6))
+    flags = np.empty(b + pad, dtype=np.int8)
+    args = (grouped, bdamp, float(a), float(g), float(th0), float(om0), float(h), int(k0),
+            float(twin), int(nwin), out, flags)
+    groups = grouped.shape[0]
+    workers = min(threads(), groups)
+    if workers <= 1:
+        persist_batch(*args, 0, groups)
+    else:  # groups interleaved over the threads in contiguous runs
+        from concurrent.futures import ThreadPoolExecutor
+
+        cuts = np.linspace(0, groups, workers + 1).astype(int)
+        with ThreadPoolExecutor(workers) as ex:
+            for f in [ex.submit(persist_batch, *args, int(cuts[i]), int(cuts[i + 1]))
+                      for i in range(workers)]:
+                f.result()
     return out[:b], flags[:b]
+
+
+def threads() -> int:
+    """Threads of :func:`run_batch`: ``numba.get_num_threads()`` (``NUMBA_NUM_THREADS``,
+    default the CPUs)."""
+    return int(nb.get_num_threads())

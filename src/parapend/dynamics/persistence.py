@@ -441,7 +441,8 @@ def persistence_spec(*, mass, length, inertia, gravity, damping_coefficient,
         if why:
             raise ParameterError(f"gpu: {why}")
     if block is None:
-        block = realizations if gens == ("best",) else min(realizations, 256)
+        # the search of best needs the whole cell; a GPU launch takes it whole as well
+        block = realizations if gens == ("best",) or gpu else min(realizations, 256)
     spec = PersistenceSpec(hs=hs_v, tp=tp_v, generator=gens, realizations=realizations,
                            block=int(block), seed=seed, spectrum=spectrum,
                            gamma_peak=float(gamma_peak), cutoff=float(cutoff),
