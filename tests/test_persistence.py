@@ -188,6 +188,17 @@ def test_result_protocol_and_json_keys(tmp_path):
     assert again.sea_states[0]["power_mean_w"] == d["sea_states"][3]["power_mean_w"]
 
 
+def test_time_limit_gives_a_marked_partial_map():
+    r = parapend.persistence(hs="0.01,0.02,0.03", tp=0.3, duration=30.0, realizations=8,
+                             time_limit=1e-6)
+    assert r.status == "time_limit" and not r.success
+    assert 1 <= r.cells_finished < 3
+    done = [s for s in r.sea_states if s["p_rot"] is not None and not math.isnan(s["p_rot"])]
+    assert len(done) == r.cells_finished
+    d = r.to_dict()
+    assert d["sea_states"][-1]["p_rot"] is None and "time limit" in d["message"]
+
+
 def test_generator_damping_best_beats_the_grid_neighbours():
     r = parapend.persistence(hs=0.02, tp=0.3, duration=30.0, realizations=8,
                              generator_damping="best")
@@ -216,10 +227,10 @@ def test_bad_input_is_one_line_exit_2(argv, word, capsys):
 
 def _cli(args, store, env):
     # the output to files: a pipe that nobody reads would block the JSON's write
-    log = open(Path(str(store) + ".log"), "w")  # noqa: SIM115 - closed with the process
-    return subprocess.Popen([sys.executable, "-m", "parapend", "persistence", *args,
-                             "--store", str(store), "--json"], env=env, stdout=log,
-                            stderr=subprocess.STDOUT, cwd=ROOT)
+    with open(Path(str(store) + ".log"), "w") as log:  # the child keeps its own descriptor
+        return subprocess.Popen([sys.executable, "-m", "parapend", "persistence", *args,
+                                 "--store", str(store), "--json"], env=env, stdout=log,
+                                stderr=subprocess.STDOUT, cwd=ROOT)
 
 
 @pytest.mark.slow

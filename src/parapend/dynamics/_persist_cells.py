@@ -241,12 +241,14 @@ def controller_power(spec, plan: dict, seed: int) -> float:
     tracker of ``parapend track --irregular``
     (:func:`parapend.control.baselines.tracker_baseline`, lossless, no torque limit) from
     the same start, over the whole record."""
+    import dataclasses
+
     from ..control.baselines import tracker_baseline
     from ..units import Units
 
     u = Units(spec.length, spec.mass, spec.gravity, spec.inertia)
     n = 8 * plan["m"]
-    zdd = acceleration(spec, {**plan, "m": n // 2}, [seed])[0]
+    zdd = acceleration(dataclasses.replace(spec, gpu=False), {**plan, "m": n // 2}, [seed])[0]
     tgrid = np.arange(n + 1) * spec.duration / n
     zq = np.append(zdd, zdd[0]) / spec.gravity
 

@@ -17,6 +17,9 @@ import numpy as np
 __all__ = ["available", "run_batch_gpu"]
 
 _KERNEL = None
+#: numba.cuda, set on first use (a module global: the kernel reads ``cuda.grid`` from here,
+#: as numba's CUDA simulator expects)
+cuda = None
 
 
 def available() -> str:
@@ -34,12 +37,14 @@ def available() -> str:
 
 
 def _kernel():
-    global _KERNEL
+    global _KERNEL, cuda
     if _KERNEL is not None:
         return _KERNEL
-    from numba import cuda
+    from numba import cuda as numba_cuda
 
-    @cuda.jit
+    cuda = numba_cuda
+
+    @numba_cuda.jit
     def persist_gpu(zdd, bdamp, a, g, th0, om0, h, k0, twin, nwin, out, flags):
         lane = cuda.grid(1)
         if lane >= bdamp.size:

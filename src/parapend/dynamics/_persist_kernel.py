@@ -207,5 +207,10 @@ def run_batch(zdd: np.ndarray, bdamp, *, a: float, g: float, th0: float, om0: fl
 
 def threads() -> int:
     """Threads of :func:`run_batch`: ``numba.get_num_threads()`` (``NUMBA_NUM_THREADS``,
-    default the CPUs)."""
+    default the CPUs) in the main process, one in a worker process (``--workers``: the
+    processes share the cores)."""
+    import multiprocessing
+
+    if multiprocessing.parent_process() is not None:
+        return 1
     return int(nb.get_num_threads())
