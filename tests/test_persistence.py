@@ -279,3 +279,28 @@ def test_cell_statistics_within_intervals_of_an_independent_integration():
     pw_ref = np.mean([x["power"] for x in ref])
     assert st["p_rot_ci"][0] <= p_ref <= st["p_rot_ci"][1]
     assert st["power_mean_ci_w"][0] <= pw_ref <= st["power_mean_ci_w"][1]
+
+
+@pytest.mark.slow
+def test_omniscient_and_controller_beside_the_passive_answer():
+    """On the same records: the omniscient optimum (parapend sea's, on the similar pendulum
+    for Tp < 1.25 s) and the regular-wave tracker; the similar pendulum gives sea's own
+    answer where sea takes the record directly."""
+    from parapend.dynamics import _persist_cells as C
+
+    r = parapend.persistence(hs=0.04, tp=1.2, length=3.0, duration=36.0, realizations=2,
+                             omniscient=1, controller="track")
+    s = r.sea_states[0]
+    assert s["omniscient_realizations"] == 1 and s["controller_realizations"] == 1
+    assert s["omniscient_power_mean_w"] > 0 and math.isfinite(s["controller_power_mean_w"])
+    alone = parapend.persistence(hs=0.04, tp=1.2, length=3.0, duration=36.0,
+                                 realizations=1).sea_states[0]["power_mean_w"]
+    assert s["passive_fraction_of_omniscient"] == pytest.approx(
+        alone / s["omniscient_power_mean_w"], rel=1e-12)
+    # the similar pendulum: the same record solved by sea at twice the length scale's
+    # square root in time (lambda = 4: lengths x 4, inertia x 16, damping x 8, power x 2)
+    spec = _spec(hs=0.04, tp=1.2, length=3.0, duration=36.0, transient=12.0)
+    plan = C.cell_plan(spec, 0, 0)
+    direct = parapend.sea(hs=0.16, tp=2.4, repeat_period=72.0, seed=0, length=12.0, mass=M,
+                          inertia=9.0 * 16, damping_coefficient=2e-4 * 8)
+    assert C.omniscient_power(spec, plan, 0) == pytest.approx(direct.power_w / 2, rel=1e-6)
