@@ -113,10 +113,14 @@ def acceleration(spec, plan: dict, seeds) -> np.ndarray:
         out = acceleration_gpu(z, n, spec.duration)
         if out is not None:
             return out
+    from scipy import fft
+
+    from ._persist_kernel import threads
+
     w2 = (2 * math.pi * np.arange(z.shape[1]) / spec.duration) ** 2
     spec_n = np.zeros((len(seeds), n // 2 + 1), dtype=complex)
     spec_n[:, :z.shape[1]] = -w2 * z * (n / 2)
-    return np.fft.irfft(spec_n, n, axis=1)
+    return fft.irfft(spec_n, n, axis=1, workers=threads())
 
 
 def _batch(spec, plan: dict) -> int:
