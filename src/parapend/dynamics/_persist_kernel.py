@@ -68,28 +68,19 @@ def _steps(zdd, grp, j, n2, a, g, bb, h, acc, th, om, tho, omo, tt, vv, ath, av,
         w2[ln] = w * w
         tt[ln] = th[ln] + h2 * w
         vv[ln] = w + h2 * kk
-    for ln in range(LANES):
-        z = zdd[grp, i2, ln]
-        sn = _sin(tt[ln])
-        w = vv[ln]
-        kk = a * (g + z) * sn - bb[ln] * w
-        ath[ln] += 2.0 * w
-        av[ln] += 2.0 * kk
-        q[ln] += 2.0 * z * sn * w
-        w2[ln] += 2.0 * w * w
-        tt[ln] = th[ln] + h2 * w
-        vv[ln] = om[ln] + h2 * kk
-    for ln in range(LANES):
-        z = zdd[grp, i2, ln]
-        sn = _sin(tt[ln])
-        w = vv[ln]
-        kk = a * (g + z) * sn - bb[ln] * w
-        ath[ln] += 2.0 * w
-        av[ln] += 2.0 * kk
-        q[ln] += 2.0 * z * sn * w
-        w2[ln] += 2.0 * w * w
-        tt[ln] = th[ln] + h * w
-        vv[ln] = om[ln] + h * kk
+    for stage in range(2):  # the two middle stages: the second's step is h / 2, the third's h
+        hs = h2 if stage == 0 else h
+        for ln in range(LANES):
+            z = zdd[grp, i2, ln]
+            sn = _sin(tt[ln])
+            w = vv[ln]
+            kk = a * (g + z) * sn - bb[ln] * w
+            ath[ln] += 2.0 * w
+            av[ln] += 2.0 * kk
+            q[ln] += 2.0 * z * sn * w
+            w2[ln] += 2.0 * w * w
+            tt[ln] = th[ln] + hs * w
+            vv[ln] = om[ln] + hs * kk
     for ln in range(LANES):
         z = zdd[grp, i3, ln]
         sn = _sin(tt[ln])
