@@ -211,7 +211,7 @@ class PersistenceResult(Result):
     small_swing_period_s : float
         ``T0 = 2 pi sqrt(I / (m g l))``.
     step_check : dict
-        The step-halving check (:func:`step_check`).
+        The step-halving check (``step_check``).
     status : str
         ``"done"`` or ``"time_limit"`` (a partial map: the cells not finished are NaN).
     """
@@ -500,7 +500,7 @@ def persistence(*, mass: float = PERSISTENCE["mass"], length: float = PERSISTENC
     generator_damping : float, sequence, str
         ``c_g`` (N m s/rad): one value, a list (``"A,B,C"``, ``"START:STOP:COUNT"``), or
         ``"best"``: per sea state the damping of the largest mean power, by a 1-D search on
-        the same records (:func:`best_damping`).
+        the same records (``best_damping``).
     hs, tp : float, sequence or str
         The sea states (m, s): a value, ``"A,B,C"`` or ``"START:STOP:COUNT"``.
     spectrum, gamma_peak, cutoff, response :
@@ -515,7 +515,7 @@ def persistence(*, mass: float = PERSISTENCE["mass"], length: float = PERSISTENC
         Seed of realization 0.
     omniscient : int
         On the first ``omniscient`` realizations of each cell also the omniscient optimum
-        (:func:`omniscient_power`: ``parapend sea``'s record optimum; records of at most 400
+        (``omniscient_power``: ``parapend sea``'s record optimum; records of at most 400
         peak periods), and the passive power as a fraction of it (default 0: not computed).
     controller : {"track", None}
         Also a causal controller on the same records (the first ``omniscient``, or 8):
