@@ -304,3 +304,13 @@ def test_omniscient_and_controller_beside_the_passive_answer():
     direct = parapend.sea(hs=0.16, tp=2.4, repeat_period=72.0, seed=0, length=12.0, mass=M,
                           inertia=9.0 * 16, damping_coefficient=2e-4 * 8)
     assert C.omniscient_power(spec, plan, 0) == pytest.approx(direct.power_w / 2, rel=1e-6)
+
+
+@pytest.mark.slow
+def test_worker_processes_give_the_same_bits():
+    kw = dict(hs="0.01,0.02", tp="0.3,0.35", duration=30.0, realizations=8)
+    a = parapend.persistence(**kw, workers=2)
+    b = parapend.persistence(**kw)
+    assert a.executor == "2 local processes"
+    for v in a.dataset.data_vars:
+        np.testing.assert_array_equal(a.dataset[v].values, b.dataset[v].values, err_msg=v)

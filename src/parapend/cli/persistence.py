@@ -20,8 +20,8 @@ from ._common import (
 from .sweep import _NEGATIVE_VALUE, _EtaProgress
 
 _AXIS = "a value, a comma list or FROM:TO:N"
-_EXAMPLE = ("example: parapend persistence --mass 1 --length 0.3 --damping-coefficient 1e-3 "
-            "--generator-damping 2e-3 --hs 0.01:0.05:5 --tp 0.2:0.5:4 --duration 120 "
+_EXAMPLE = ("example: parapend persistence --mass 1 --length 0.3 --damping-coefficient 2e-4 "
+            "--generator-damping 5e-4 --hs 0.005:0.04:8 --tp 0.2:0.6:9 --duration 300 "
             "--realizations 200 --seed 0 --json")
 
 
