@@ -104,15 +104,17 @@ def cell_plan(spec, i: int, j: int, refine: int = 1) -> dict:
 
 def acceleration(spec, plan: dict, seeds) -> np.ndarray:
     """``z''`` (m/s^2) of the realizations ``seeds`` at the half steps, one row each: one
-    inverse real FFT per record (exact at the grid's points for the periodic record)."""
+    inverse real FFT per record of unit ``Hs`` (exact at the grid's points for the periodic
+    record), times ``Hs`` (the spectrum's amplitudes are proportional to ``Hs``: the records
+    of every ``Hs`` of a ``Tp`` share their unit record, to rounding :func:`record_heave`'s)."""
     n = 2 * plan["m"]
-    z = record_heaves(spec, plan["hs"], plan["tp"], seeds)
+    z = record_heaves(spec, 1.0, plan["tp"], seeds)
     if spec.gpu:  # the FFTs on the GPU when CuPy is there
         from ._persist_gpu import acceleration_gpu
 
         out = acceleration_gpu(z, n, spec.duration)
         if out is not None:
-            return out
+            return plan["hs"] * out
     from scipy import fft
 
     from ._persist_kernel import threads
@@ -120,7 +122,31 @@ def acceleration(spec, plan: dict, seeds) -> np.ndarray:
     w2 = (2 * math.pi * np.arange(z.shape[1]) / spec.duration) ** 2
     spec_n = np.zeros((len(seeds), n // 2 + 1), dtype=complex)
     spec_n[:, :z.shape[1]] = -w2 * z * (n / 2)
-    return fft.irfft(spec_n, n, axis=1, workers=threads())
+    return plan["hs"] * fft.irfft(spec_n, n, axis=1, workers=threads())
+
+
+#: unit records in the kernel's layout, kept for the next cells of the same Tp (the blocks
+#: run Hs after Hs within a Tp): key -> array, least recently used first
+_UNIT: dict = {}
+#: at most this many bytes of them
+UNIT_CACHE_BYTES = 384 << 20
+
+
+def _grouped_unit(spec, plan: dict, seeds):
+    """The unit records of ``seeds`` (``acceleration`` at ``Hs = 1``) in the kernel's
+    grouped layout (:func:`._persist_kernel.group`), from the cache when there."""
+    from ._persist_kernel import group
+
+    key = (spec.duration, spec.cutoff, spec.spectrum, spec.gamma_peak, spec.response,
+           plan["tp"], plan["m"], tuple(int(x) for x in seeds))
+    hit = _UNIT.pop(key, None)
+    if hit is None:
+        hit = group(acceleration(spec, {**plan, "hs": 1.0}, seeds))
+    if hit.nbytes <= UNIT_CACHE_BYTES:
+        _UNIT[key] = hit
+        while sum(a.nbytes for a in _UNIT.values()) > UNIT_CACHE_BYTES:
+            _UNIT.pop(next(iter(_UNIT)))
+    return hit
 
 
 def _batch(spec, plan: dict) -> int:
@@ -132,7 +158,8 @@ def _batch(spec, plan: dict) -> int:
     return rows - rows % LANES
 
 
-def _integrate(spec, plan: dict, zdd, bdamp):
+def _integrate(spec, plan: dict, zdd, bdamp, lanes=None):
+    """The kernel on ``zdd`` (one record a row; or grouped, with ``lanes`` records)."""
     kw = {"a": plan["a"], "g": spec.gravity, "th0": math.pi, "om0": plan["om0"],
           "h": plan["h"], "k0": plan["k0"], "twin": 2 * plan["tp"], "nwin": plan["nwin"]}
     if spec.gpu:
@@ -141,7 +168,7 @@ def _integrate(spec, plan: dict, zdd, bdamp):
         return run_batch_gpu(zdd, bdamp, **kw)
     from ._persist_kernel import run_batch
 
-    return run_batch(zdd, bdamp, **kw)
+    return run_batch(zdd, bdamp, lanes=lanes, **kw)
 
 
 def _summaries(spec, plan: dict, cg, out, flags) -> dict:
@@ -171,8 +198,12 @@ def run_cell(spec, plan: dict, cg: float, realizations, *, extras: bool = True) 
     step = _batch(spec, plan)
     parts = []
     for s in range(0, len(seeds), step):
-        zdd = acceleration(spec, plan, seeds[s:s + step])
-        parts.append(_integrate(spec, plan, zdd, bd))
+        batch = seeds[s:s + step]
+        if spec.gpu:
+            parts.append(_integrate(spec, plan, acceleration(spec, plan, batch), bd))
+        else:  # the unit records shared by the cells of this Tp, times Hs
+            zg = plan["hs"] * _grouped_unit(spec, plan, batch)
+            parts.append(_integrate(spec, plan, zg, bd, lanes=len(batch)))
     out = np.concatenate([p[0] for p in parts])
     flags = np.concatenate([p[1] for p in parts])
     vals = _summaries(spec, plan, cg, out, flags)

@@ -189,29 +189,36 @@ def persist_batch(zdd, bdamp, a, g, th0, om0, h, k0, twin, nwin, out, flags, lo,
             flags[r] = ok[ln] if fin else -1
 
 
-def run_batch(zdd: np.ndarray, bdamp, *, a: float, g: float, th0: float, om0: float,
-              h: float, k0: int, twin: float, nwin: int):
-    """:func:`persist_batch` on the records ``zdd`` (one per row, shape ``(B, 2M)``), each
-    with damping ``bdamp`` (a number, or one per record). The records are grouped by
-    ``LANES`` (the last group padded by repeating the last record; the padding's results
-    are dropped). Returns ``(out, flags)``."""
-    b = zdd.shape[0]
-    bdamp = np.broadcast_to(np.asarray(bdamp, dtype=np.float64), (b,))
-    pad = (-b) % LANES
+def group(zdd: np.ndarray) -> np.ndarray:
+    """Records one a row ``(B, 2M)`` in the kernel's layout ``(G, 2M, LANES)``, the last
+    group padded by repeating the last record."""
+    pad = (-zdd.shape[0]) % LANES
     if pad:
         zdd = np.concatenate([zdd, np.repeat(zdd[-1:], pad, axis=0)])
-    bdamp = np.ascontiguousarray(np.concatenate([bdamp, np.repeat(bdamp[-1:], pad)]))
-    grouped = np.ascontiguousarray(
+    return np.ascontiguousarray(
         np.asarray(zdd, dtype=np.float64).reshape(-1, LANES, zdd.shape[1]).transpose(0, 2, 1))
-    out = np.empty((b + pad, 6))
-    flags = np.empty(b + pad, dtype=np.int8)
+
+
+def run_batch(zdd: np.ndarray, bdamp, *, a: float, g: float, th0: float, om0: float,
+              h: float, k0: int, twin: float, nwin: int, lanes: int | None = None):
+    """:func:`persist_batch` on the records ``zdd``: one per row, shape ``(B, 2M)``, or
+    already grouped (:func:`group`) with ``lanes`` records; each with damping ``bdamp`` (a
+    number, or one per record). The padding's results are dropped. Returns
+    ``(out, flags)``."""
+    grouped = zdd if lanes is not None else group(zdd)
+    b = lanes if lanes is not None else zdd.shape[0]
+    total = grouped.shape[0] * LANES
+    bdamp = np.broadcast_to(np.asarray(bdamp, dtype=np.float64), (b,))
+    bdamp = np.ascontiguousarray(np.concatenate([bdamp, np.repeat(bdamp[-1:], total - b)]))
+    out = np.empty((total, 6))
+    flags = np.empty(total, dtype=np.int8)
     args = (grouped, bdamp, float(a), float(g), float(th0), float(om0), float(h), int(k0),
             float(twin), int(nwin), out, flags)
     groups = grouped.shape[0]
     workers = min(threads(), groups)
     if workers <= 1:
         persist_batch(*args, 0, groups)
-    else:  # groups interleaved over the threads in contiguous runs
+    else:  # the groups cut into one contiguous run per thread
         from concurrent.futures import ThreadPoolExecutor
 
         cuts = np.linspace(0, groups, workers + 1).astype(int)

@@ -2,8 +2,9 @@ r"""What a persistence map computes (:class:`PersistenceSpec`) and one block of 
 product that the design-map engine (:mod:`parapend.maps.run`: Zarr store, lock, resume,
 local processes or Dask) runs, stores and resumes like a sweep.
 
-The store holds per realization (dimensions ``hs, tp, generator, realization``; a block is
-one cell's run of ``block`` realizations, one chunk): ``rho``, ``throughout`` (1 or 0),
+The store holds per realization (dimensions ``tp, hs, generator, realization``: the blocks
+run Hs after Hs within a Tp, whose cells share their unit records; a block is one cell's
+run of ``block`` realizations, one chunk): ``rho``, ``throughout`` (1 or 0),
 ``power`` (W), the four energies of the energy identity (J), the generator damping used
 (N m s/rad) and a ``status``; optionally the omniscient optimum and a causal controller's
 power (W). The statistics are drawn from them afterwards (:mod:`.persistence`).
@@ -13,7 +14,8 @@ the cells and the generator dampings), its phases drawn exactly as
 :func:`parapend.seas.sea_record` draws them: ``numpy.random.default_rng(seed + r).uniform(0,
 2 pi, K + 1)`` with ``K = floor(cutoff T_r / Tp)``. So a realization is the record of
 ``parapend sea --hs HS --tp TP --repeat-period T_r --cutoff C --seed SEED+r`` (where that
-command's ranges allow it), and the numbers are reproducible bit for bit on one machine.
+command's ranges allow it; to rounding, as the kernel takes the record of unit Hs times Hs),
+and the numbers are reproducible bit for bit on one machine.
 """
 
 from __future__ import annotations
@@ -84,11 +86,11 @@ class PersistenceSpec:
     # -- the layout the maps engine reads ------------------------------------------------
     @property
     def dims(self) -> tuple:
-        return ("hs", "tp", "generator", "realization")
+        return ("tp", "hs", "generator", "realization")
 
     @property
     def shape(self) -> tuple:
-        return (len(self.hs), len(self.tp), len(self.generator), self.realizations)
+        return (len(self.tp), len(self.hs), len(self.generator), self.realizations)
 
     @property
     def points(self) -> int:
@@ -100,7 +102,7 @@ class PersistenceSpec:
 
     @property
     def block_grid(self) -> tuple:
-        return (len(self.hs), len(self.tp), len(self.generator),
+        return (len(self.tp), len(self.hs), len(self.generator),
                 -(-self.realizations // self.block))
 
     @property
@@ -213,7 +215,7 @@ class PersistenceSpec:
         from ._persist_cells import best_damping, cell_plan, run_cell
 
         sl = self.block_slices(block)
-        i, j, k = sl[0].start, sl[1].start, sl[2].start
+        j, i, k = sl[0].start, sl[1].start, sl[2].start  # tp, hs, generator
         r0, r1 = sl[3].start, sl[3].stop
         plan = cell_plan(self, i, j)
         cg = (best_damping(self, plan) if self.best else float(self.generator[k]))

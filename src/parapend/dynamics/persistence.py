@@ -587,8 +587,8 @@ def persistence(*, mass: float = PERSISTENCE["mass"], length: float = PERSISTENC
         for j, p in enumerate(spec.tp):
             plan = cell_plan(spec, i, j)
             for k in range(len(spec.generator)):
-                vals = {v: np.asarray(ds[v].values[i, j, k]) for v in spec.variables}
-                cell_done = done[i, j, k]
+                vals = {v: np.asarray(ds[v].values[j, i, k]) for v in spec.variables}
+                cell_done = done[j, i, k]
                 finished += int(cell_done.all())
                 st = cell_statistics(vals, cell_done) if cell_done.all() else \
                     cell_statistics(vals, np.zeros_like(cell_done))
