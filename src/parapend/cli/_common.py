@@ -84,8 +84,9 @@ def hull_options(g) -> None:
     from ..defaults import HULL
 
     g.add_argument("--pivot-height", type=_finite_float("pivot-height"),
-                   help=f"the pivot above the hull's rotation centre (its waterplane "
-                        f"centre), m (default {HULL['pivot_height']:g})")
+                   help=f"the pivot above the hull's rotation centre O, m: a built-in "
+                        f"body's waterplane centre, a mesh's origin, a dataset's rotation "
+                        f"centre (default {HULL['pivot_height']:g})")
     g.add_argument("--pivot-offset", type=_finite_float("pivot-offset"),
                    help=f"the pivot ahead of it, along the waves' travel, m (default "
                         f"{HULL['pivot_offset']:g})")

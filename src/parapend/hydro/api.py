@@ -340,9 +340,10 @@ def buoy(*, wave_height=None, wave_period=None, hs=None, tp=None, spectrum=None,
         ``parapend.hydro.hull_api``). Then ``body`` is ``"barge"`` (default; its
         ``barge_length``, ``barge_beam``, ``barge_draft``, m), ``"cylinder"`` or
         ``"sphere"``, or ``mesh``/``hydro`` with these DOFs; ``pivot_height`` and
-        ``pivot_offset`` place the pivot from the rotation centre (the waterplane centre of
-        a built-in hull), m; ``hull_pitch_inertia`` (kg m^2, about it; default the
-        dataset's, else a homogeneous immersed hull); ``winding`` None reports rotation
+        ``pivot_offset`` place the pivot from the rotation centre O (a built-in
+        body's waterplane centre, a mesh's origin, a dataset's rotation centre), m;
+        ``hull_pitch_inertia`` (kg m^2, about it; default the dataset's, else a
+        homogeneous immersed hull); ``winding`` None reports rotation
         (one turn per wave) and swinging (``winding=0``) side by side. Options not given
         take the embedded hull design's values (``parapend.defaults.HULL``).
         ``copper_loss`` ``r`` (W per (N m)^2; hull only) subtracts the winding loss ``r

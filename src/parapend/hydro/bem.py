@@ -1011,6 +1011,51 @@ def _read_netcdf(path):
     return ds, shown, p
 
 
+def dataset_mass(ds, inertia_mass, path) -> tuple:
+    """The floating mass ``M`` (kg) a Capytaine dataset states, and a note or None.
+
+    The mass comes from the ``inertia_matrix`` (``inertia_mass``, its heave entry:
+    Capytaine's ``compute_rigid_body_inertia`` of the floating body, ``rho V``) unless the
+    dataset states its displacement: ``disp_mass``, or ``disp_volume`` times the dataset's
+    ``rho``, which is then used. Where both are present and differ by more than
+    :data:`parapend.limits.DATASET_MASS_RTOL` of the displacement, a :class:`UserWarning`
+    (and the returned note, which the result carries in its ``warnings``) names both
+    numbers and the one used.
+
+    Raises
+    ------
+    ParameterError
+        Neither an ``inertia_matrix`` nor a displacement.
+    """
+    import warnings
+
+    from ..limits import DATASET_MASS_RTOL
+
+    stated, source = None, None
+    if "disp_mass" in ds:
+        stated = float(_numeric(np.asarray(ds["disp_mass"].values).ravel()[:1], "disp_mass",
+                                path)[0])
+        source = "disp_mass"
+    elif "disp_volume" in ds:
+        rho = _scalar(ds, "rho", 1025.0)
+        volume = float(_numeric(np.asarray(ds["disp_volume"].values).ravel()[:1],
+                                "disp_volume", path)[0])
+        stated, source = rho * volume, f"disp_volume x rho ({volume:.6g} m^3 x {rho:g} kg/m^3)"
+    if stated is None:
+        if inertia_mass is None:
+            raise ParameterError(f"hydro: {path} has no hydrostatics: the mass is missing "
+                                 "(expected inertia_matrix, disp_mass or disp_volume)")
+        return inertia_mass, None
+    if inertia_mass is None or not abs(stated - inertia_mass) > DATASET_MASS_RTOL * abs(stated):
+        return stated, None
+    note = (f"hydro: {path}: the displacement {source} = {stated:.6g} kg and the "
+            f"inertia_matrix's mass {inertia_mass:.6g} kg differ by "
+            f"{100 * abs(stated - inertia_mass) / abs(stated):.3g} %; the displacement, "
+            f"{stated:.6g} kg, is used as the floating mass")
+    warnings.warn(note, UserWarning, stacklevel=3)
+    return stated, note
+
+
 def _from_dataset(ds, *, c=None, mass=None, description="", path="the dataset",
                   check=False, wave_direction=None):
     """A :class:`Hydro` from a Capytaine dataset (complex values merged, ``exp(-i w t)``)."""
@@ -1088,17 +1133,15 @@ def _from_dataset(ds, *, c=None, mass=None, description="", path="the dataset",
         c = float(_numeric(np.asarray(cs.values).ravel()[:1], "hydrostatic_stiffness",
                            path)[0])
     if mass is None:
+        inertia_mass = None
         if "inertia_matrix" in ds:
             ms = _pick(_pick(ds["inertia_matrix"], "radiating_dof", "Heave", "inertia_matrix",
                              path), "influenced_dof", "Heave", "inertia_matrix", path)
-            mass = float(_numeric(np.asarray(ms.values).ravel()[:1], "inertia_matrix",
-                                  path)[0])
-        elif "disp_mass" in ds:
-            mass = float(_numeric(np.asarray(ds["disp_mass"].values).ravel()[:1], "disp_mass",
-                                  path)[0])
-        else:
-            raise ParameterError(f"hydro: {path} has no hydrostatics: the mass is missing "
-                                 "(expected inertia_matrix or disp_mass)")
+            inertia_mass = float(_numeric(np.asarray(ms.values).ravel()[:1], "inertia_matrix",
+                                          path)[0])
+        mass, note = dataset_mass(ds, inertia_mass, path)
+        if note:
+            notes.append(note)
     if not (math.isfinite(c) and c > 0):
         raise ParameterError(f"hydro: {path}: expected a heave hydrostatic_stiffness > 0, "
                              f"got {c!r}")

@@ -348,19 +348,17 @@ def _hull_from_dataset(ds, *, c=None, mass=None, pitch_inertia=None, description
                                     ("influenced_dof", "radiating_dof"), path,
                                     "hydrostatic_stiffness"), "hydrostatic_stiffness", path)
     if mass is None:
+        inertia_mass = None
         if "inertia_matrix" in ds:
             m = bem._numeric(_dof_block(ds["inertia_matrix"],
                                         ("influenced_dof", "radiating_dof"), path,
                                         "inertia_matrix"), "inertia_matrix", path)
-            mass = float(m[1, 1])
+            inertia_mass = float(m[1, 1])
             if pitch_inertia is None:
                 pitch_inertia = float(m[2, 2])
-        elif "disp_mass" in ds:
-            mass = float(bem._numeric(np.asarray(ds["disp_mass"].values).ravel()[:1],
-                                      "disp_mass", path)[0])
-        else:
-            raise ParameterError(f"hydro: {path} has no hydrostatics: the mass is missing "
-                                 "(expected inertia_matrix or disp_mass)")
+        mass, note = bem.dataset_mass(ds, inertia_mass, path)
+        if note:
+            notes.append(note)
     if not (math.isfinite(mass) and mass > 0):
         raise ParameterError(f"hydro: {path}: expected a heave mass > 0, got {mass!r}")
     if pitch_inertia is not None and not pitch_inertia > 0:
