@@ -15,7 +15,6 @@ from buoy_synthetic import M, synthetic
 import parapend
 from parapend.cli import main
 from parapend.hydro import bem
-from parapend.hydro import hull_data as hd
 
 
 def _numbers(message):
@@ -62,7 +61,7 @@ def test_the_hull_reads_its_mass_by_the_same_rule():
     ds = h0.to_dataset().copy(deep=True)
     ds["disp_mass"] = h0.mass - 2.0e3  # a 2 t difference on a 41 t hull
     with pytest.warns(UserWarning, match=f"{h0.mass:.6g} kg"):
-        h = hd.load_hull(ds)
+        h = bem.load_hull(ds)
     assert h.mass == h0.mass - 2.0e3
     assert h.pitch_inertia == h0.pitch_inertia  # the pitch inertia still from inertia_matrix
     assert any("is used as the floating mass" in n for n in h.notes)

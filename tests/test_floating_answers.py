@@ -44,6 +44,11 @@ BEM_CASES = [
     pytest.param("hull default", HULL, 503.9714747336288, marks=SLOW),
     pytest.param("hull swing low pivot", {**HULL, "winding": 0, "pivot_height": -0.5},
                  [532.1204727731518, 532.1204727731518, 0.0], marks=SLOW),
+    pytest.param("hull efficiency 0.9", {**HULL, "efficiency": 0.9},
+                 [11.686760869374051, -26.229553344994102, 11.686760869374051, 0.0],
+                 marks=SLOW),
+    pytest.param("hull 4 s", {**HULL, "wave_period": 4.0},
+                 [2842.234877057094, 2554.1503415237985, 2842.234877057094, 0.0], marks=SLOW),
 ]
 
 #: the same on the synthetic hull's dataset
@@ -62,9 +67,12 @@ DATASET_CASES = [
 ]
 
 
-def _powers(r):
-    """The headline power, then each mode's (a hull), or each period's (a sweep)."""
+def _powers(r, like):
+    """The headline power, then each mode's (a hull), or each period's (a sweep); the
+    headline alone where the table holds one number (``like``)."""
     p = r.power_w
+    if not isinstance(like, list):
+        return p
     if np.ndim(p):
         return [float(x) for x in p]
     modes = getattr(r, "modes", None)
@@ -75,7 +83,7 @@ def _powers(r):
 def dataset(tmp_path_factory):
     from capytaine.io.xarray import save_dataset_as_netcdf
 
-    from parapend.hydro.hull_data import HullHydro
+    from parapend.hydro.bem import HullHydro
 
     h = synthetic_hull()
     hull = HullHydro(omega=h["omega_data"], added_mass=h["A"], radiation_damping=h["B"],
@@ -88,10 +96,47 @@ def dataset(tmp_path_factory):
 
 @pytest.mark.parametrize(("name", "kwargs", "power"), BEM_CASES)
 def test_bem_bodies_give_the_powers_of_before(name, kwargs, power):
-    assert _powers(parapend.buoy(**kwargs)) == pytest.approx(power, rel=RTOL, abs=0.0), name
+    assert _powers(parapend.buoy(**kwargs), power) == pytest.approx(power, rel=RTOL, abs=0.0), name
 
 
 @pytest.mark.parametrize(("name", "kwargs", "power"), DATASET_CASES)
 def test_synthetic_hull_gives_the_powers_of_before(dataset, name, kwargs, power):
-    got = _powers(parapend.buoy(hydro=dataset, **kwargs))
+    got = _powers(parapend.buoy(hydro=dataset, **kwargs), power)
     assert got == pytest.approx(power, rel=RTOL, abs=0.0), name
+
+
+def test_one_function_computes_the_optimum_of_either_dof_set(dataset):
+    """``optimum`` dispatches on the data's degrees of freedom: the hull's data give the
+    command's hull answer, the same file's heave data the heaving buoy's, bit for bit, and
+    one result type carries both (its JSON keys those of its DOF set)."""
+    from parapend.hydro.bem import load, load_hull
+    from parapend.hydro.coupled import Pendulum, Wave
+    from parapend.hydro.hull import HullPTO
+    from parapend.hydro.result import HEAVE_KEYS, HULL_KEYS, BuoyResult, optimum
+
+    wave = Wave.regular(1.0, PERIOD)
+    info = {"kind": "regular", "height_m": 1.0, "period_s": PERIOD}
+    hull = optimum(load_hull(dataset), Pendulum(4000.0, 1.0, 5000.0, 50.0), wave,
+                   wave_info=info, winding=0, pivot=(1.0, 1.5), pto=HullPTO())
+    cmd = parapend.buoy(hydro=dataset, **{**ON, "wave_period": PERIOD, "winding": 0})
+    assert hull.power_w == cmd.power_w and list(hull.to_dict()) == list(HULL_KEYS)
+    heave = optimum(load(dataset), Pendulum(400.0, 0.5, 100.0, 0.0), wave, wave_info=info)
+    cmd = parapend.buoy(hydro=dataset, wave_period=PERIOD, mass=400.0, length=0.5,
+                        damping_coefficient=0.0, wave_height=1.0)
+    assert heave.power_w == cmd.power_w and list(heave.to_dict()) == list(HEAVE_KEYS)
+    assert type(hull) is type(heave) is BuoyResult
+
+
+@pytest.mark.parametrize("args", [
+    ["horizon", "--device", "buoy", "--dofs", "surge,heave,pitch"],
+    ["buoy", "--dofs", "surge,heave,pitch", "--controller", "mpc", "--hs", "1", "--tp", "6"],
+    ["buoy", "--dofs", "surge,heave,pitch", "--optimize-design", "mass"],
+    ["power-matrix", "--device", "buoy", "--dofs", "surge,heave,pitch", "--controller",
+     "mpc", "--hs", "1", "--tp", "6"],
+])
+def test_where_only_the_buoy_is_taken_a_hull_is_refused_in_one_line(args, capsys):
+    from parapend.cli import main
+
+    assert main(args) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and ("surge,heave,pitch" in err or "hull" in err), err

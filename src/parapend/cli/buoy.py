@@ -206,7 +206,7 @@ def _cmd_buoy(a) -> dict | str:
             _output.write_dataset(r.to_dataset(), a.save)
         return r.to_dict() if a.json else "\n".join(
             mpc_text(r) + ([f"written: {a.save}"] if a.save else []))
-    if hasattr(r, "dofs") or hasattr(r, "rotation_power_w"):
+    if tuple(r.dofs) != ("heave",):
         return _hull_output(r, a)
     sweep = hasattr(r, "period_s")
     if not sweep and r.status == "no_power":
