@@ -57,6 +57,14 @@ def _hydro(body, radius, draft, mesh, hydro, wave_direction=None):
     return hy.cylinder(r, d, omega="body"), 2 * r
 
 
+def _heave_hydro(barge, body, radius, draft, mesh, hydro, wave_direction):
+    """:func:`_hydro`, or the barge's heave alone (``barge``: :func:`_hull_body`'s builder and
+    geometry; its width the beam, across the waves)."""
+    if barge is None:
+        return _hydro(body, radius, draft, mesh, hydro, wave_direction)
+    return barge[0]().heave(), barge[1]["beam_m"]
+
+
 def _check_kinds(**opts):
     """Refuse, in one line naming the option, a value of the wrong kind where a name, a list
     of names or a path is expected (a number for ``dofs``, ``optimize_design`` or ``mesh``
@@ -383,9 +391,12 @@ def buoy(*, wave_height=None, wave_period=None, hs=None, tp=None, spectrum=None,
             "dofs", "Wave", "progress", "time_limit")})
     for name in ("pivot_height", "pivot_offset", "hull_pitch_inertia", "barge_length",
                  "barge_beam", "barge_draft", "copper_loss"):
-        if opts[name] is not None:
+        if opts[name] is not None and not (isinstance(body, str) and body == "barge"
+                                           and name.startswith("barge_")):
             raise ParameterError(f"{name.replace('_', '-')}: a hull's option; needs --dofs "
                                  "surge,heave,pitch")
+    # the barge in heave alone: the hull's coefficients, their heave entries
+    barge = _hull_body(opts) if isinstance(body, str) and body == "barge" else None
     for name, v in (("body", body), ("controller", controller), ("spectrum", spectrum)):
         if v is not None and not isinstance(v, str):
             raise ParameterError(f"{name}: expected a name (str), got {type(v).__name__}")
@@ -485,7 +496,7 @@ def buoy(*, wave_height=None, wave_period=None, hs=None, tp=None, spectrum=None,
                                                           pend.inertia))
         amps = np.abs(np.asarray(wave.amplitudes))
         sig = np.nonzero(amps >= 1e-3 * amps.max())[0]  # the components that matter
-        h, width = _hydro(body, radius, draft, mesh, hydro, wave_direction)
+        h, width = _heave_hydro(barge, body, radius, draft, mesh, hydro, wave_direction)
         h.check_covers(wave.omega * (sig[0] + 1), wave.omega * (sig[-1] + 1),
                        name="tp" if record is None else "record")
         # the causal controllers' yardstick is the record's mechanical optimum (mpc_command:
@@ -500,18 +511,19 @@ def buoy(*, wave_height=None, wave_period=None, hs=None, tp=None, spectrum=None,
             periods_all = np.array([period])
         else:
             periods_all = np.array([_period(p) for p in periods])
-        if mesh is None and hydro is None:  # known before the BEM: refuse before it
+        if mesh is None and hydro is None and barge is None:  # refused before the BEM
             _check_short(_parametric_top(body, radius, draft), periods_all, body, radius)
-        h, width = _hydro(body, radius, draft, mesh, hydro, wave_direction)
+        h, width = _heave_hydro(barge, body, radius, draft, mesh, hydro, wave_direction)
         w = 2 * math.pi / periods_all
         if hydro is None:
             _check_short(float(np.max(h.omega)), periods_all)
         h.check_covers(float(np.min(w)), float(np.max(w)), name="wave-period")
     _check_floats(h, pend)
     # the body on a second, coarser mesh: the estimate of the discretization error
-    coarse = (_coarse_hydro(body, radius, draft, mesh, hydro) if controller == "optimum"
-              else None)
-    geometry = _geometry(body, radius, draft, mesh, hydro)
+    coarse = (_coarse_hydro(body, radius, draft, mesh, hydro)
+              if controller == "optimum" and barge is None else None)
+    geometry = (_geometry(body, radius, draft, mesh, hydro) if barge is None else
+                {k: barge[1][k] for k in ("draft_m", "freeboard_m")})
     if not irregular and periods is not None:
         from .design import period_sweep
 
