@@ -14,7 +14,7 @@ import re
 from pathlib import Path
 
 import pytest
-from hull_timedomain import RHO_V, synthetic_hull
+from hull_timedomain import synthetic_hull_netcdf
 
 import parapend
 from parapend import commands
@@ -60,17 +60,7 @@ def test_each_name_is_declared_in_one_object_and_the_run_options_are_documented(
 
 @pytest.fixture(scope="module")
 def dataset(tmp_path_factory):
-    from capytaine.io.xarray import save_dataset_as_netcdf
-
-    from parapend.hydro.bem import HullHydro
-
-    h = synthetic_hull()
-    hull = HullHydro(omega=h["omega_data"], added_mass=h["A"], radiation_damping=h["B"],
-                     excitation=h["F"], hydrostatic_stiffness=h["C"], mass=RHO_V,
-                     pitch_inertia=float(h["Mh"][2, 2]), description="synthetic hull")
-    path = tmp_path_factory.mktemp("hull") / "hull.nc"
-    save_dataset_as_netcdf(path, hull.to_dataset())
-    return str(path)
+    return synthetic_hull_netcdf(tmp_path_factory.mktemp("hull") / "hull.nc")
 
 
 def test_the_objects_give_the_keyword_functions_answers(dataset):
