@@ -123,3 +123,21 @@ def test_the_documented_script_runs(tmp_path, monkeypatch, capsys):
     assert grid[1][0] == pytest.approx(best.power_w, rel=1e-9)
     assert run.mean_power_w <= run.optimum_power_w * (1 + 1e-6)  # causal: never above it
     assert "optimum" in capsys.readouterr().out
+
+
+def test_buoy_s_sea_pendulum_take_off_and_controller_options_are_generated():
+    """``parapend buoy``'s options of the sea, the pendulum, the take-off and the controller
+    are made from their declarations: the help states the declared help, unit and default
+    (the defaults of the embedded buoy and hull, read from parapend.defaults)."""
+    from parapend.defaults import BUOY, HULL
+
+    generated = {f.name: f.metadata for cls in (dv.Sea, dv.Pendulum, dv.PowerTakeOff,
+                                                 dv.Controller)
+                 for f in dataclasses.fields(cls) if f.name != "wave_direction"}
+    options = {a.dest: a for a in _options("buoy")}
+    for name, meta in generated.items():
+        assert options[name].help == dv.option_help(meta), name
+        if meta["choices"]:
+            assert tuple(options[name].choices) == meta["choices"], name
+    assert options["mass"].help.endswith(f"(default {BUOY['mass']:g}; a hull's "
+                                         f"{HULL['mass']:g})")

@@ -184,6 +184,29 @@ def add_pendulum_options(g, *, gamma_note: str = "") -> None:
                    help="viscous damping c, N m s/rad (instead of --gamma)")
 
 
+def add_declared(g, cls, names) -> None:
+    """The options ``--NAME`` of the parameters ``names`` of an input object ``cls``
+    (:mod:`parapend.hydro.device`) into the argument group ``g``, generated from their
+    declarations: the help, the unit and the default stated, the type, the choices."""
+    import dataclasses
+
+    from ..hydro.device import option_help
+
+    meta = {f.name: f.metadata for f in dataclasses.fields(cls)}
+    for name in names:
+        m, flag = meta[name], name.replace("_", "-")
+        kw = {"help": option_help(m)}
+        if m["choices"]:
+            kw["choices"] = list(m["choices"])
+        elif m["kind"] == "float":
+            kw["type"] = _finite_float(flag)
+        elif m["kind"] == "int":
+            kw["type"] = _int
+        if m["metavar"]:
+            kw["metavar"] = m["metavar"]
+        g.add_argument(f"--{flag}", **kw)
+
+
 def add_body_options(g, *, body_help: str, hydro_help: str,
                      bodies=("cylinder", "sphere")) -> None:
     """The buoy's body of ``buoy`` and ``power-matrix --device buoy`` into the argument group

@@ -27,16 +27,36 @@ from __future__ import annotations
 import dataclasses
 from dataclasses import dataclass, field
 
+from ..defaults import BUOY, HULL
+
 __all__ = ["Body", "Controller", "Device", "Pendulum", "PowerTakeOff", "RUN_OPTIONS", "Sea",
-           "causal", "declaration", "declarations", "horizon", "optimum", "power_matrix"]
+           "causal", "declaration", "declarations", "horizon", "option_help", "optimum",
+           "power_matrix"]
 
 
-def _param(unit: str, help: str, *, default=None, bounds=None, default_text=None):
+def _param(unit: str, help: str, *, default=None, bounds=None, default_text=None,
+           kind: str = "float", choices=None, metavar=None):
     """A parameter's declaration: a field whose metadata hold its unit, bounds (the range the
-    command accepts, or None where it depends on other parameters) and help; ``default``
-    None means the command's default, described by ``default_text``."""
-    return field(default=default, metadata={"unit": unit, "help": help, "bounds": bounds,
-                                            "default": default_text or repr(default)})
+    command accepts, or None where it depends on other parameters), help, how the command
+    line reads it (``kind``: float, int, text; ``choices``, ``metavar``) and the default it
+    states (``default_text``; ``default`` None means the command's default)."""
+    return field(default=default, metadata={
+        "unit": unit, "help": help, "bounds": bounds, "kind": kind, "choices": choices,
+        "metavar": metavar, "default": default_text or repr(default)})
+
+
+def _both(name: str, note: str = "") -> str:
+    """The default stated for the embedded buoy and the embedded hull
+    (``parapend.defaults.BUOY``, ``HULL``)."""
+    return f"{BUOY[name]:g}{note}; a hull's {HULL[name]:g}"
+
+
+def option_help(meta) -> str:
+    """The command line's help of a declared parameter: its help, its unit and its
+    default."""
+    unit = "" if meta["unit"] == "-" else f", {meta['unit']}"
+    default = "" if meta["default"] == "None" else f" (default {meta['default']})"
+    return f"{meta['help']}{unit}{default}"
 
 
 class _Inputs:
@@ -54,30 +74,31 @@ class Sea(_Inputs):
     """The sea: a regular wave (:meth:`regular`), a spectrum's sea state (:meth:`state`) or a
     measured record (:meth:`measured`), each taken as a periodic record."""
 
-    wave_height: float | None = _param("m", "a regular wave's height, crest to trough",
-                                       bounds=(1e-4, 30.0), default_text="0.2 (buoy), 1 (hull)")
+    wave_height: float | None = _param("m", "H, crest to trough", bounds=(1e-4, 30.0),
+                                       default_text=_both("wave_height"))
     wave_period: float | str | None = _param(
-        "s", "a regular wave's period; FROM:TO:N or T1,T2,... for power against period",
-        bounds=(0.1, 100.0), default_text="1.8 (buoy), 6 (hull)")
-    hs: float | None = _param("m", "a sea state's significant wave height",
-                              default_text="0.5 (buoy), 1 (hull)")
-    tp: float | None = _param("s", "a sea state's peak period",
-                              default_text="2.5 (buoy), 6 (hull)")
-    spectrum: str | None = _param("-", "jonswap or pierson-moskowitz",
-                                  default_text="'jonswap'")
-    gamma_peak: float | None = _param("-", "the JONSWAP peak enhancement",
-                                      default_text="3.3")
-    repeat_period: float | None = _param("s", "the periodic record's length",
-                                         default_text="100 tp (buoy), 4 tp (hull)")
-    seed: int | None = _param("-", "the random phases' seed", default_text="0")
-    cutoff: float | None = _param("-", "the highest frequency kept, in peak frequencies",
+        "s", "the period; FROM:TO:N or a comma list T1,T2,... for power against period",
+        bounds=(0.1, 100.0), default_text=_both("wave_period"), kind="text", metavar="T")
+    hs: float | None = _param("m", "significant wave height",
+                              default_text=_both("hs", " with --tp"))
+    tp: float | None = _param("s", "peak period", default_text=_both("tp", " with --hs"))
+    spectrum: str | None = _param("-", "spectrum shape", default_text="jonswap",
+                                  kind="text", choices=("jonswap", "pierson-moskowitz"))
+    gamma_peak: float | None = _param("-", "JONSWAP peak enhancement in [1, 20]",
+                                      bounds=(1.0, 20.0), default_text="3.3")
+    repeat_period: float | None = _param(
+        "s", "T_r: the record repeats with it",
+        default_text=f"100 Tp; a hull's {HULL['repeat_periods']:g} Tp")
+    seed: int | None = _param("-", "seed of the random phases", default_text="0", kind="int")
+    cutoff: float | None = _param("-", "highest frequency, in units of the peak frequency",
                                   default_text="3")
-    record: str | None = _param("m", "a measured surface elevation at the body, CSV t,z")
-    taper: float | None = _param("-", "the fraction of a measured record tapered to make it "
-                                      "periodic", bounds=(0.0, 0.5), default_text="0.1")
+    record: str | None = _param("s, m", "measured surface elevation at the body, CSV 't,z'",
+                                kind="text", metavar="CSV")
+    taper: float | None = _param("-", "with --record: fraction under the Tukey taper",
+                                 bounds=(0.0, 0.5), default_text="0.1")
     wave_direction: float | None = _param(
-        "rad", "with a dataset: the wave direction to use", bounds=(0.0, 6.283185307179586),
-        default_text="0")
+        "rad", "with --hydro: the dataset's wave direction to use",
+        bounds=(0.0, 6.283185307179586), default_text="0, the waves travelling along +x")
 
     @classmethod
     def regular(cls, height=None, period=None) -> Sea:
@@ -100,15 +121,13 @@ class Sea(_Inputs):
 class Pendulum(_Inputs):
     """The pendulum on its pivot (SI)."""
 
-    mass: float | None = _param("kg", "the pendulum's mass", bounds=(0.0, None),
-                                default_text="80 (buoy), 2000 (hull)")
-    length: float | None = _param("m", "pivot to centre of mass", bounds=(0.0, None),
-                                  default_text="0.3 (buoy), 1 (hull)")
+    mass: float | None = _param("kg", "m", bounds=(0.0, None), default_text=_both("mass"))
+    length: float | None = _param("m", "pivot to centre of mass l", bounds=(0.0, None),
+                                  default_text=_both("length"))
     inertia: float | None = _param("kg m^2", "about the pivot, at least m l^2",
                                    default_text="m l^2")
-    damping_coefficient: float | None = _param("N m s/rad", "the bearing's viscous damping",
-                                               bounds=(0.0, None),
-                                               default_text="1 (buoy), 50 (hull)")
+    damping_coefficient: float | None = _param("N m s/rad", "viscous c", bounds=(0.0, None),
+                                               default_text=_both("damping_coefficient"))
 
 
 @dataclass(frozen=True)
@@ -117,24 +136,31 @@ class Body(_Inputs):
     a Capytaine dataset; its degrees of freedom; the pivot's placement in it."""
 
     body: str | None = _param("-", "cylinder, sphere or barge (a hull)",
-                              default_text="cylinder (buoy), barge (hull)")
-    radius: float | None = _param("m", "a cylinder's or sphere's radius", default_text="0.5")
-    draft: float | None = _param("m", "a cylinder's draft", default_text="0.5")
-    mesh: str | None = _param("-", "a mesh file Capytaine reads (z = 0 the free surface)")
-    hydro: object = _param("-", "a Capytaine dataset (NetCDF path or xarray.Dataset)")
+                              default_text="cylinder; a hull's barge", kind="text")
+    radius: float | None = _param("m", "a cylinder's or sphere's radius",
+                                  default_text=f"{BUOY['radius']:g}")
+    draft: float | None = _param("m", "a cylinder's draft", default_text=f"{BUOY['draft']:g}")
+    mesh: str | None = _param("-", "a mesh file Capytaine reads (z = 0 the free surface)",
+                              kind="text", metavar="FILE")
+    hydro: object = _param("-", "a Capytaine dataset (NetCDF path or xarray.Dataset)",
+                           kind="text", metavar="FILE")
     dofs: str | None = _param("-", "heave (the buoy) or surge,heave,pitch (a hull)",
-                              default_text="'heave'")
+                              default_text="heave", kind="text", metavar="DOFS")
     pivot_height: float | None = _param(
         "m", "the pivot above the rotation centre O: a built-in body's waterplane centre, a "
-             "mesh's origin, a dataset's rotation centre", default_text="0.5")
+             "mesh's origin, a dataset's rotation centre",
+        default_text=f"{HULL['pivot_height']:g}")
     pivot_offset: float | None = _param("m", "the pivot ahead of O along the waves' travel",
-                                        default_text="0")
+                                        default_text=f"{HULL['pivot_offset']:g}")
     hull_pitch_inertia: float | None = _param(
         "kg m^2", "the hull's pitch inertia about O without the pendulum",
         bounds=(1e-6, 1e12), default_text="the dataset's, else a homogeneous hull's")
-    barge_length: float | None = _param("m", "the barge's length", default_text="10")
-    barge_beam: float | None = _param("m", "the barge's beam", default_text="4")
-    barge_draft: float | None = _param("m", "the barge's draft", default_text="1")
+    barge_length: float | None = _param("m", "the barge's length",
+                                        default_text=f"{HULL['barge_length']:g}")
+    barge_beam: float | None = _param("m", "the barge's beam",
+                                      default_text=f"{HULL['barge_beam']:g}")
+    barge_draft: float | None = _param("m", "the barge's draft",
+                                       default_text=f"{HULL['barge_draft']:g}")
 
     @classmethod
     def barge(cls, length=None, beam=None, draft=None, **kw) -> Body:
@@ -160,13 +186,14 @@ class Body(_Inputs):
 class PowerTakeOff(_Inputs):
     """The power take-off: all None is the ideal, lossless one."""
 
-    torque_limit: float | None = _param("N m", "the largest |torque| the generator gives",
-                                         bounds=(0.0, None))
+    torque_limit: float | None = _param("N m", "largest |torque|", bounds=(0.0, None))
     efficiency: float | str | tuple | None = _param(
-        "-", "ETA_G[,ETA_M] in (0, 1]: generating[, motoring]", bounds=(0.01, 1.0),
-        default_text="1 (ideal)")
-    copper_loss: float | None = _param("W/(N m)^2", "the winding loss r tau^2 (a hull)",
-                                       bounds=(0.0, 1e6), default_text="0")
+        "-", "power take-off efficiency in (0, 1], generating[,motoring]: the motion "
+             "maximizes the electrical power", bounds=(0.01, 1.0), kind="text",
+        metavar="ETA_G[,ETA_M]")
+    copper_loss: float | None = _param(
+        "W/(N m)^2", "the generator's winding loss r tau^2 subtracted from the power (with "
+                     "--dofs surge,heave,pitch)", bounds=(0.0, 1e6))
 
 
 @dataclass(frozen=True)
@@ -175,14 +202,20 @@ class Controller(_Inputs):
     ``"optimum"``) or a receding-horizon controller (``"mpc"``, ``"one-way-mpc"``) with its
     horizon and update interval (peak periods) and forecast."""
 
-    controller: str | None = _param("-", "optimum, mpc or one-way-mpc",
-                                    default_text="'optimum'")
-    horizon: float | None = _param("peak periods", "the receding horizon",
-                                   default_text="2 (mpc), 1 (one-way-mpc)")
-    update_interval: float | None = _param("peak periods", "between two plans",
+    controller: str | None = _param(
+        "-", "optimum: the non-causal coupled optimum; mpc: receding-horizon control planned "
+             "on the coupled model with its radiation (the motion planner; with --efficiency "
+             "the torque planner); one-way-mpc: planned on the free buoy's heave",
+        default_text="optimum", kind="text", choices=("optimum", "mpc", "one-way-mpc"))
+    horizon: float | None = _param("peak periods", "with mpc: forecast horizon",
+                                   default_text="2; one-way-mpc 1")
+    update_interval: float | None = _param("peak periods", "with mpc: re-planning interval",
                                            default_text="0.125")
-    forecast: str | None = _param("-", "perfect or ar (autoregressive)",
-                                  default_text="'perfect'")
+    forecast: str | None = _param(
+        "-", "with mpc: what the controller knows of the excitation force over the horizon: "
+             "perfect (the record's own future) or ar (autoregressive, fitted on the force "
+             "measured so far)", default_text="perfect", kind="text",
+        choices=("perfect", "ar"))
 
     @classmethod
     def receding_horizon(cls, horizon=None, *, forecast=None, update_interval=None,
