@@ -370,10 +370,10 @@ def buoy(*, wave_height=None, wave_period=None, hs=None, tp=None, spectrum=None,
 
     Returns
     -------
-    result : BuoyResult, BuoySweepResult or BuoyMPCResult (HullResult, HullSweepResult
-        with ``dofs="surge,heave,pitch"``)
+    result : BuoyResult, BuoySweepResult or BuoyMPCResult
         One design; a period sweep; a receding-horizon run (``controller``, the result of
-        :func:`parapend.hydro.control.buoy_mpc`).
+        :func:`parapend.hydro.control.buoy_mpc`). The result types are those of every DOF set
+        (:func:`parapend.hydro.result.optimum`); their JSON holds their set's fields.
     """
     from .coupled import Wave
 
