@@ -125,15 +125,16 @@ def test_the_documented_script_runs(tmp_path, monkeypatch, capsys):
     assert "optimum" in capsys.readouterr().out
 
 
-def test_buoy_s_sea_pendulum_take_off_and_controller_options_are_generated():
-    """``parapend buoy``'s options of the sea, the pendulum, the take-off and the controller
-    are made from their declarations: the help states the declared help, unit and default
+def test_buoy_s_options_are_generated_from_the_declarations():
+    """``parapend buoy``'s options of the sea, the pendulum, the body (but ``--body`` and
+    ``--hydro``, whose help is the command's), the take-off and the controller are made from
+    their declarations: the help states the declared help, unit and default
     (the defaults of the embedded buoy and hull, read from parapend.defaults)."""
     from parapend.defaults import BUOY, HULL
 
-    generated = {f.name: f.metadata for cls in (dv.Sea, dv.Pendulum, dv.PowerTakeOff,
-                                                 dv.Controller)
-                 for f in dataclasses.fields(cls) if f.name != "wave_direction"}
+    generated = {f.name: f.metadata for cls in (dv.Sea, dv.Pendulum, dv.Body,
+                                                 dv.PowerTakeOff, dv.Controller)
+                 for f in dataclasses.fields(cls) if f.name not in ("body", "hydro")}
     options = {a.dest: a for a in _options("buoy")}
     for name, meta in generated.items():
         assert options[name].help == dv.option_help(meta), name

@@ -7,7 +7,7 @@ from pathlib import Path
 
 from ..defaults import BUOY
 from ..errors import ParameterError
-from ..hydro.device import Controller, Pendulum, PowerTakeOff, Sea
+from ..hydro.device import Body, Controller, Pendulum, PowerTakeOff, Sea
 from . import _output
 from ._common import (
     _check_output,
@@ -59,15 +59,10 @@ def add_parsers(sub) -> None:
                      hydro_help="a Capytaine dataset (NetCDF), instead of solving "
                                 "(docs/buoy.md)")
     p.set_defaults(body=None)  # so that --body given beside --hydro or --mesh is refused
-    g.add_argument("--wave-direction", type=_finite_float("wave-direction"),
-                   metavar="RAD", help="with --hydro: the dataset's wave direction to use, rad "
-                                       "(default 0, waves travelling along +x)")
+    add_declared(g, Sea, ("wave_direction",))
 
     g = p.add_argument_group("hull: surge, heave and pitch (docs/hull.md)")
-    g.add_argument("--dofs", metavar="DOFS",
-                   help="the hull's degrees of freedom: heave (default, the heaving buoy) "
-                        "or surge,heave,pitch (a hull that pitches; the pendulum rotates or "
-                        "swings)")
+    add_declared(g, Body, ("dofs",))
     hull_options(g)
     g = p.add_argument_group("motion and power take-off")
     g.add_argument("--winding", type=_int,

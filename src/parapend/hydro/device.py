@@ -98,7 +98,8 @@ class Sea(_Inputs):
                                  bounds=(0.0, 0.5), default_text="0.1")
     wave_direction: float | None = _param(
         "rad", "with --hydro: the dataset's wave direction to use",
-        bounds=(0.0, 6.283185307179586), default_text="0, the waves travelling along +x")
+        bounds=(0.0, 6.283185307179586), default_text="0, the waves travelling along +x",
+        metavar="RAD")
 
     @classmethod
     def regular(cls, height=None, period=None) -> Sea:
@@ -137,29 +138,32 @@ class Body(_Inputs):
 
     body: str | None = _param("-", "cylinder, sphere or barge (a hull)",
                               default_text="cylinder; a hull's barge", kind="text")
-    radius: float | None = _param("m", "a cylinder's or sphere's radius",
+    radius: float | None = _param("m", "the cylinder's or the sphere's radius",
                                   default_text=f"{BUOY['radius']:g}")
-    draft: float | None = _param("m", "a cylinder's draft", default_text=f"{BUOY['draft']:g}")
-    mesh: str | None = _param("-", "a mesh file Capytaine reads (z = 0 the free surface)",
-                              kind="text", metavar="FILE")
+    draft: float | None = _param("m", "the cylinder's draft",
+                                 default_text=f"{BUOY['draft']:g}")
+    mesh: str | None = _param("-", "a mesh file Capytaine reads, instead of --body (z = 0 "
+                                   "the free surface)", kind="text", metavar="FILE")
     hydro: object = _param("-", "a Capytaine dataset (NetCDF path or xarray.Dataset)",
                            kind="text", metavar="FILE")
-    dofs: str | None = _param("-", "heave (the buoy) or surge,heave,pitch (a hull)",
-                              default_text="heave", kind="text", metavar="DOFS")
+    dofs: str | None = _param(
+        "-", "the body's degrees of freedom: heave (the heaving buoy) or surge,heave,pitch (a "
+             "hull that pitches; the pendulum rotates or swings)", default_text="heave",
+        kind="text", metavar="DOFS")
     pivot_height: float | None = _param(
         "m", "the pivot above the rotation centre O: a built-in body's waterplane centre, a "
              "mesh's origin, a dataset's rotation centre",
         default_text=f"{HULL['pivot_height']:g}")
-    pivot_offset: float | None = _param("m", "the pivot ahead of O along the waves' travel",
+    pivot_offset: float | None = _param("m", "the pivot ahead of O, along the waves' travel",
                                         default_text=f"{HULL['pivot_offset']:g}")
     hull_pitch_inertia: float | None = _param(
-        "kg m^2", "the hull's pitch inertia about O without the pendulum",
-        bounds=(1e-6, 1e12), default_text="the dataset's, else a homogeneous hull's")
-    barge_length: float | None = _param("m", "the barge's length",
+        "kg m^2", "the hull's pitch inertia about O, without the pendulum",
+        bounds=(1e-6, 1e12), default_text="the dataset's, else a homogeneous immersed hull's")
+    barge_length: float | None = _param("m", "the box barge's length",
                                         default_text=f"{HULL['barge_length']:g}")
-    barge_beam: float | None = _param("m", "the barge's beam",
+    barge_beam: float | None = _param("m", "the box barge's beam",
                                       default_text=f"{HULL['barge_beam']:g}")
-    barge_draft: float | None = _param("m", "the barge's draft",
+    barge_draft: float | None = _param("m", "the box barge's draft",
                                        default_text=f"{HULL['barge_draft']:g}")
 
     @classmethod

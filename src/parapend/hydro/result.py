@@ -1,9 +1,11 @@
-"""The buoy's results and one wave's answer: :class:`BuoyResult` (one wave, or one periodic
-record), :class:`BuoySweepResult` (power against wave period), and how a result is made from
-the body's coefficients, the pendulum and the wave (:func:`_solve`: the coupled optimum and
-the one-way one; :func:`_result`: what a designer reads). :mod:`.api` (the command),
-:mod:`.design` (sweeps, the design search) and :mod:`.control` (receding-horizon control)
-all build their answers from here.
+"""The floating body's results and one wave's answer, for every degree-of-freedom set:
+:class:`BuoyResult` (one wave, or one periodic record) and :class:`BuoySweepResult` (power
+against wave period), one type each whatever the body's DOFs; :func:`optimum`, the one
+function of the coupled optimum, which dispatches on the coefficients' DOFs to the heaving
+buoy's kernel (:func:`_solve`: the coupled optimum and the one-way one; :func:`_result`:
+what a designer reads) or to the hull's (:func:`hull_answer`: rotation, swinging and rest
+side by side). :mod:`.api` (the command), :mod:`.design` (sweeps, the design search) and
+:mod:`.control` (receding-horizon control) all build their answers from here.
 """
 
 from __future__ import annotations
@@ -240,7 +242,8 @@ class BuoyResult(_Result):
     @property
     def hydrodynamics(self):
         """The body's hydrodynamic coefficients the optimum was solved with
-        (:class:`parapend.hydro.bem.Hydro`; None for a hull)."""
+        (:class:`parapend.hydro.bem.Hydro`, or a hull's
+        :class:`~parapend.hydro.bem.HullHydro`)."""
         return self._hydro
 
     @property
@@ -921,6 +924,6 @@ def hull_answer(hull, pendulum, wave, *, pivot, windings=(1, 0), pitch_inertia=N
                   "damping_coefficient": pendulum.damping_coefficient},
         body=dict(geometry or {}, description=getattr(hull, "description", "")),
         pivot={"pivot_offset_m": cs.pivot[0], "pivot_height_m": cs.pivot[1]},
-        warnings=warnings, validity_warnings=validity, _motion=mot)
+        warnings=warnings, validity_warnings=validity, _motion=mot, _hydro=hull, _wave=wave)
 
 
