@@ -142,3 +142,20 @@ def test_buoy_s_options_are_generated_from_the_declarations():
             assert tuple(options[name].choices) == meta["choices"], name
     assert options["mass"].help.endswith(f"(default {BUOY['mass']:g}; a hull's "
                                          f"{HULL['mass']:g})")
+
+
+@pytest.mark.slow
+def test_the_barge_in_heave_alone():
+    """``--body barge`` without ``--dofs``: the hull's heave coefficients (its floating mass
+    and stiffness the barge's, rho L B D and rho g L B) under the heaving buoy's model, the
+    energy balance closed and the power within the radiation bound."""
+    from parapend.defaults import HULL
+
+    r = parapend.buoy(body="barge", mass=2000.0, length=1.0, damping_coefficient=50.0,
+                      wave_height=1.0, wave_period=6.0)
+    length, beam, draft = (HULL[k] for k in ("barge_length", "barge_beam", "barge_draft"))
+    assert r.body["mass_kg"] == pytest.approx(1025.0 * length * beam * draft, rel=1e-3)
+    assert r.body["hydrostatic_stiffness_n_per_m"] == pytest.approx(
+        1025.0 * 9.81 * length * beam, rel=1e-3)
+    assert r.body["width_m"] == beam
+    assert r.energy_balance_residual < 1e-9 and 0 < r.power_w <= r.radiation_bound_w

@@ -88,8 +88,8 @@ def _dimensions(body, radius, draft):
     """Radius and draft (m) of a parametric body (a sphere's draft is its radius)."""
     body = "cylinder" if body is None else body
     if body == "barge":
-        raise ParameterError("body: the barge is a hull that pitches: give --dofs "
-                             "surge,heave,pitch")
+        raise ParameterError("body: expected cylinder or sphere here; the barge is taken by "
+                             "parapend buoy (heave alone or --dofs surge,heave,pitch)")
     if body not in ("cylinder", "sphere"):
         raise ParameterError(f"body: expected cylinder or sphere, got {body!r:.40}")
     lo, hi = limits.BUOY_SIZE_RANGE
