@@ -56,11 +56,46 @@ HULL_SWEEP_KEYS = ("period_s", "power_w", "mechanical_power_w", "rotation_power_
                    "status", "success", "wave_height_m", "pendulum", "body", "pivot", "warnings")
 
 
+#: the fields' types (the others: ``float | None``), of one answer and of a sweep
+_TYPES = {**dict.fromkeys(("harmonics", "winding", "bound_cut", "hull_harmonics"),
+                          "int | None"),
+          **dict.fromkeys(("status", "message", "mode"), "str | None"),
+          **dict.fromkeys(("wave", "pendulum", "body", "design", "pivot"), "dict | None"),
+          **dict.fromkeys(("efficiency", "modes"), "list | None"), "success": "bool | None"}
+_SWEEP_TYPES = {**dict.fromkeys(("status", "mode"), "list | None"),
+                **dict.fromkeys(("pendulum", "body", "pivot"), "dict | None"),
+                "success": "bool | None", "wave_height_m": "float | None"}
+
+
+def _union_fields(*key_sets, types, default="float | None"):
+    """Class decorator (before :func:`dataclasses.dataclass`): the public fields of a result
+    of several DOF sets are the union of their JSON keys, in order, each None by default
+    (``warnings``, ``validity_warnings``: an empty list; ``dofs``: ``["heave"]``), typed by
+    ``types``, else ``default`` (a sweep's: ``np.ndarray | None``); the class's own
+    annotated fields (its private ones) follow."""
+
+    def add(cls):
+        names = list(dict.fromkeys(k for keys in key_sets for k in keys))
+        public = {}
+        for name in names:
+            if name in ("warnings", "validity_warnings", "dofs"):
+                public[name] = "list"
+                setattr(cls, name, field(default_factory=(
+                    (lambda: ["heave"]) if name == "dofs" else list)))
+            else:
+                public[name] = types.get(name, default)
+                setattr(cls, name, None)
+        cls.__annotations__ = {**public, **cls.__dict__.get("__annotations__", {})}
+        return cls
+    return add
+
+
 def _heave_only(dofs) -> bool:
     return tuple(dofs) == ("heave",)
 
 
 @dataclass(frozen=True, eq=False, repr=False)
+@_union_fields(HEAVE_KEYS, HULL_KEYS, types=_TYPES)
 class BuoyResult(_Result):
     """The coupled optimum of a pendulum in a floating body, for its degrees of freedom
     ``dofs`` (``["heave"]``: the heaving buoy; ``["surge", "heave", "pitch"]``: a hull), in
@@ -159,60 +194,6 @@ class BuoyResult(_Result):
         from the answer with half as many (the stated discretization error).
     """
 
-    power_w: float | None = None
-    heave_amplitude_m: float | None = None
-    peak_torque_nm: float | None = None
-    radiation_bound_w: float | None = None
-    bound_fraction: float | None = None
-    limit_w: float | None = None
-    capture_width_m: float | None = None
-    capture_width_ratio: float | None = None
-    energy_flux_w_per_m: float | None = None
-    one_way_power_w: float | None = None
-    one_way_ratio: float | None = None
-    free_heave_amplitude_m: float | None = None
-    energy_balance_residual: float | None = None
-    harmonics: int | None = None
-    winding: int | None = None
-    success: bool | None = None
-    status: str | None = None
-    message: str | None = None
-    wave: dict | None = None
-    pendulum: dict | None = None
-    body: dict | None = None
-    torque_limit_nm: float | None = None
-    efficiency: list | None = None
-    design: dict | None = None
-    warnings: list = field(default_factory=list)
-    electrical_power_w: float | None = None
-    mechanical_power_w: float | None = None
-    pto_loss_w: float | None = None
-    generated_power_w: float | None = None
-    motoring_power_w: float | None = None
-    ideal_power_w: float | None = None
-    one_way_electrical_power_w: float | None = None
-    mesh_error_w: float | None = None
-    mesh_error_relative: float | None = None
-    grid_error_w: float | None = None
-    validity_warnings: list = field(default_factory=list)
-    copper_loss_w_per_nm2: float | None = None
-    mode: str | None = None
-    modes: list | None = None
-    bound_rcond: float | None = None
-    bound_cut: int | None = None
-    surge_amplitude_m: float | None = None
-    pitch_amplitude_deg: float | None = None
-    surge_phase_deg: float | None = None
-    heave_phase_deg: float | None = None
-    pitch_phase_deg: float | None = None
-    mean_heel_deg: float | None = None
-    mean_angle_deg: float | None = None
-    swing_amplitude_deg: float | None = None
-    peak_pivot_force_n: float | None = None
-    hull_harmonics: int | None = None
-    refinement_change_w: float | None = None
-    dofs: list = field(default_factory=lambda: ["heave"])
-    pivot: dict | None = None
     _solution: object = field(default=None, repr=False)
     _one_way: object = field(default=None, repr=False)
     _hydro: object = field(default=None, repr=False)
@@ -323,6 +304,8 @@ class BuoyResult(_Result):
 
 
 @dataclass(frozen=True, eq=False, repr=False)
+@_union_fields(HEAVE_SWEEP_KEYS, HULL_SWEEP_KEYS, ("dofs",), types=_SWEEP_TYPES,
+               default="np.ndarray | None")
 class BuoySweepResult(_Result):
     """Power of one design against wave period (``wave_period="FROM:TO:N"`` or a list),
     regular waves of one height, for the body's degrees of freedom ``dofs``: arrays over
@@ -335,33 +318,6 @@ class BuoySweepResult(_Result):
     prefixed with the period). A hull: rotation against swinging, ``mode`` the best per
     period; each period's :class:`BuoyResult` in :attr:`results`."""
 
-    period_s: np.ndarray | None = None
-    power_w: np.ndarray | None = None
-    one_way_power_w: np.ndarray | None = None
-    radiation_bound_w: np.ndarray | None = None
-    limit_w: np.ndarray | None = None
-    bound_fraction: np.ndarray | None = None
-    capture_width_m: np.ndarray | None = None
-    heave_amplitude_m: np.ndarray | None = None
-    free_heave_amplitude_m: np.ndarray | None = None
-    energy_balance_residual: np.ndarray | None = None
-    status: list | None = None
-    success: bool | None = None
-    wave_height_m: float | None = None
-    pendulum: dict | None = None
-    body: dict | None = None
-    warnings: list = field(default_factory=list)
-    electrical_power_w: np.ndarray | None = None
-    mechanical_power_w: np.ndarray | None = None
-    mesh_error_w: np.ndarray | None = None
-    validity_warnings: list = field(default_factory=list)
-    grid_error_w: np.ndarray | None = None
-    rotation_power_w: np.ndarray | None = None
-    swinging_power_w: np.ndarray | None = None
-    pitch_amplitude_deg: np.ndarray | None = None
-    mode: list | None = None
-    pivot: dict | None = None
-    dofs: list = field(default_factory=lambda: ["heave"])
     _results: tuple = field(default=(), repr=False)
 
     command = "buoy"
