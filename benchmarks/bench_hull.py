@@ -14,7 +14,7 @@ causal hull whose A and B come from one set of damped modes), K = 0 (swinging) a
    sensitivity) against IPOPT on the full space. "IPOPT (s)" is its solve alone (the
    comparison favours IPOPT); "IPOPT+setup" the whole call, CasADi's graph and IPOPT's
    set-up included (what a new case costs a CasADi user: the data are in the graph).
-2. **search**: parapend's whole search (:func:`parapend.hydro.hull_optimum.hull_search`
+2. **search**: parapend's whole search (:func:`parapend.hydro.hull.hull_search`
    without refinement: the one-way maxima from every start, then the coupled problem from
    them and from the starts) against IPOPT from its eight starts.
 
@@ -42,8 +42,11 @@ from _timing import best_of  # noqa: E402  (benchmarks/_timing.py)
 from hull_reference import box_case, hull_reference  # noqa: E402
 from test_hull_ipopt import _causal, _hull_case  # noqa: E402
 
-from parapend.hydro.hull import HullProblem  # noqa: E402
-from parapend.hydro.hull_optimum import GTOL, hull_search  # noqa: E402
+from parapend.hydro.hull import (  # noqa: E402
+    GTOL,
+    HullProblem,  # noqa: E402
+    hull_search,
+)
 from parapend.optimal.fourier import newton_maximize  # noqa: E402
 
 

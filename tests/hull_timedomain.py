@@ -501,3 +501,18 @@ def synthetic_hull(n=300, w_min=0.1, w_max=25.0, m=4000.0, l=1.0, I=5000.0, c=50
     mh = np.diag([RHO_V - m, RHO_V - m, 3.4e5])
     return {"omega_data": om, "A": a, "B": b, "F": f, "C": C_HULL.copy(), "Mh": mh, "m": m,
             "l": l, "I": I, "c": c, "g": 9.81, "pivot": pivot}
+
+
+def synthetic_hull_netcdf(path) -> str:
+    """:func:`synthetic_hull` as a Capytaine NetCDF dataset with surge, heave and pitch (the
+    tests' hull ``--hydro`` file), written to ``path``; returns the path as text."""
+    from capytaine.io.xarray import save_dataset_as_netcdf
+
+    from parapend.hydro.bem import HullHydro
+
+    h = synthetic_hull()
+    hull = HullHydro(omega=h["omega_data"], added_mass=h["A"], radiation_damping=h["B"],
+                     excitation=h["F"], hydrostatic_stiffness=h["C"], mass=RHO_V,
+                     pitch_inertia=float(h["Mh"][2, 2]), description="synthetic hull")
+    save_dataset_as_netcdf(path, hull.to_dataset())
+    return str(path)

@@ -38,8 +38,10 @@ def _capytaine_dataset(path, *, dofs=("Heave",), hydrostatics=True):
     mesh = cpt.mesh_sphere(radius=0.5, center=(0, 0, 0), resolution=(8, 8))
     full = cpt.FloatingBody(mesh=mesh, dofs=cpt.rigid_body_dofs(rotation_center=(0, 0, 0)),
                             center_of_mass=(0, 0, 0)).immersed_part()
+    # floating at its draft: the mass is the displacement (the immersed mesh is open at
+    # the waterline, where the mesh's own volume differs from the displaced one)
     body = cpt.FloatingBody(mesh=full.mesh, dofs={d: full.dofs[d] for d in dofs},
-                            center_of_mass=(0, 0, 0))
+                            center_of_mass=(0, 0, 0), mass=full.disp_mass(rho=1025.0))
     body.inertia_matrix = body.compute_rigid_body_inertia()
     body.hydrostatic_stiffness = body.compute_hydrostatic_stiffness()
     test = xr.Dataset(coords={"omega": np.linspace(1.0, 8.0, 8), "wave_direction": [0.0],

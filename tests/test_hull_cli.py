@@ -12,8 +12,8 @@ import pytest
 from hull_timedomain import RHO_V, synthetic_hull
 
 from parapend.cli import main
-from parapend.hydro.hull_data import HullHydro, load_hull
-from parapend.hydro.hull_optimum import hull_search, make_case, radiation_bound
+from parapend.hydro.bem import HullHydro, load_hull
+from parapend.hydro.hull import hull_search, make_case, radiation_bound
 
 PERIOD = 2 * math.pi / 1.2
 PEND = ["--mass", "4000", "--length", "1", "--inertia", "5000", "--damping-coefficient",

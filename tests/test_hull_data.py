@@ -1,4 +1,4 @@
-"""Surge, heave and pitch hydrodynamics of a hull (hydro/hull_data.py, issue 30):
+"""Surge, heave and pitch hydrodynamics of a hull (hydro/bem.py, issue 30):
 interpolation rules, mass matrix, datasets and bad input (no BEM); the BEM of a coarse barge
 (144 panels, 4 frequencies, 1 s) against closed forms (hydrostatics, long-wave limits that fix
 the signs), a six-DOF dataset Capytaine wrote; the heave entries against bem's heave-only BEM,
@@ -12,7 +12,6 @@ import xarray as xr
 
 from parapend.errors import ParameterError
 from parapend.hydro import bem
-from parapend.hydro import hull_data as hd
 
 RHO, G = 1025.0, 9.81
 
@@ -32,7 +31,7 @@ def synthetic(pitch_inertia=2.0e5):
     f = np.array([[1e4j * (i + 1), 3e5 - 1e4 * i + 2e3j, 5e3 + 8e4j * (i + 1)]
                   for i in range(4)])
     c = np.diag([0.0, 4.0e5, 3.0e6])
-    return hd.HullHydro(omega=w, added_mass=a, radiation_damping=b, excitation=f,
+    return bem.HullHydro(omega=w, added_mass=a, radiation_damping=b, excitation=f,
                         hydrostatic_stiffness=c, mass=4.1e4, pitch_inertia=pitch_inertia,
                         description="synthetic")
 
@@ -71,7 +70,7 @@ def test_symmetrised_and_psd():
     a[:, 0, 2] *= 1.01
     b = np.array(h.radiation_damping)
     b[:, 1, 1] -= 1e-3 * b[:, 1, 1].max() + b[:, 1, 1]  # slightly negative: noise
-    g = hd.HullHydro(omega=h.omega, added_mass=a, radiation_damping=b,
+    g = bem.HullHydro(omega=h.omega, added_mass=a, radiation_damping=b,
                      excitation=h.excitation, hydrostatic_stiffness=h.hydrostatic_stiffness,
                      mass=h.mass)
     assert np.array_equal(g.added_mass, np.swapaxes(g.added_mass, 1, 2))
@@ -79,7 +78,7 @@ def test_symmetrised_and_psd():
     assert any("positive semidefinite" in n for n in g.notes)
     b[:, 1, 1] = -0.5 * np.abs(b).max()
     with pytest.raises(ParameterError, match="not positive semidefinite"):
-        hd.HullHydro(omega=h.omega, added_mass=a, radiation_damping=b,
+        bem.HullHydro(omega=h.omega, added_mass=a, radiation_damping=b,
                      excitation=h.excitation, hydrostatic_stiffness=h.hydrostatic_stiffness,
                      mass=h.mass)
 
@@ -112,7 +111,7 @@ def test_dataset_round_trip(tmp_path, inertia):
     h = synthetic(pitch_inertia=inertia)
     path = tmp_path / "hull.nc"
     save_dataset_as_netcdf(path, h.to_dataset())
-    g = hd.load_hull(path)
+    g = bem.load_hull(path)
     for name in ("omega", "added_mass", "radiation_damping", "excitation",
                  "hydrostatic_stiffness"):
         assert np.allclose(getattr(g, name), getattr(h, name), rtol=1e-14, atol=0), name
@@ -125,7 +124,7 @@ def test_dataset_round_trip(tmp_path, inertia):
                        influenced_dof=["Heave", "Surge", "Sway", "Pitch"], fill_value=0.0)
     inf_row = extra.isel(omega=[0]).assign_coords(omega=[np.inf])
     inf_row["excitation_force"] = inf_row["excitation_force"] * np.nan
-    g2 = hd.load_hull(xr.concat([extra, inf_row], dim="omega",
+    g2 = bem.load_hull(xr.concat([extra, inf_row], dim="omega",
                                 data_vars="minimal", coords="minimal", compat="override"))
     assert np.allclose(g2.added_mass, h.added_mass) and np.allclose(g2.excitation, h.excitation)
     assert np.allclose(g2.hydrostatic_stiffness, h.hydrostatic_stiffness)
@@ -133,7 +132,7 @@ def test_dataset_round_trip(tmp_path, inertia):
 
 def _bad(ds, match):
     with pytest.raises(ParameterError, match=match) as err:
-        hd.load_hull(ds)
+        bem.load_hull(ds)
     assert "\n" not in str(err.value)
 
 
@@ -159,39 +158,39 @@ def test_bad_datasets_refused_in_one_line():
     _bad(bad, "heave hydrostatic_stiffness > 0")
     _bad(ds.assign_coords(wave_direction=[1.0]), "no wave direction 0")
     with pytest.raises(ParameterError, match="no such file"):
-        hd.load_hull("/nonexistent/hull.nc")
+        bem.load_hull("/nonexistent/hull.nc")
 
 
 def test_unstable_hulls_refused_before_any_bem():
     with pytest.raises(ParameterError, match=r"^draft: a sphere .* neutral .* draft below"):
-        hd.sphere_hull(2.0)
+        bem.sphere_hull(2.0)
     with pytest.raises(ParameterError, match=r"^draft: a box barge .* below length/sqrt\(6\)"):
-        hd.barge(length=2.0, beam=4.0, draft=1.0)
+        bem.barge(length=2.0, beam=4.0, draft=1.0)
     with pytest.raises(ParameterError, match=r"^draft: a cylinder .* radius/sqrt\(2\)"):
-        hd.cylinder_hull(1.0, 1.0)
+        bem.cylinder_hull(1.0, 1.0)
     with pytest.raises(ParameterError, match="^beam:"):
-        hd.barge(beam=-1.0)
+        bem.barge(beam=-1.0)
 
 
 @pytest.mark.slow
 def test_immersed_inertia_closed_forms():
     # hemisphere: V = 2 pi R^3 / 3, integral of x^2 = integral of z^2 = V R^2 / 5
-    v, ix, iz = hd._cap_integrals(2.0, 2.0)
+    v, ix, iz = bem._cap_integrals(2.0, 2.0)
     assert v == pytest.approx(2 * math.pi * 8 / 3, rel=1e-13)
     assert ix == pytest.approx(v * 4 / 5, rel=1e-13) and iz == pytest.approx(v * 4 / 5, rel=1e-13)
     # a shallow cap against the panels' quadrature of the same solid (mesh error only)
     cpt = bem._quiet_capytaine()
     r, d = 3.0, 1.0
     mesh = cpt.mesh_sphere(radius=r, center=(0, 0, r - d), resolution=(60, 80)).immersed_part()
-    v, ix, iz = hd._cap_integrals(r, d)
+    v, ix, iz = bem._cap_integrals(r, d)
     assert v == pytest.approx(math.pi * d * d * (3 * r - d) / 3, rel=1e-13)
-    assert hd._mesh_pitch_inertia(mesh, RHO) == pytest.approx(RHO * (ix + iz), rel=1e-2)
+    assert bem._mesh_pitch_inertia(mesh, RHO) == pytest.approx(RHO * (ix + iz), rel=1e-2)
     # box: the midpoint rule on flat panels is exact up to the known dx^2 / 12 term
     L, B, D, h = 10.0, 4.0, 1.0, 1 / 3
-    _, hull, _ = hd._box_meshes(L, B, D, h, 3.0)
+    _, hull, _ = bem._box_meshes(L, B, D, h, 3.0)
     dx = L / (2 * math.ceil(L / (2 * math.sqrt(2) * h)))
     exact = RHO * L * B * D * (L * L / 12 - dx * dx / 12 + D * D / 3)
-    assert hd._mesh_pitch_inertia(hull, RHO) == pytest.approx(exact, rel=1e-12)
+    assert bem._mesh_pitch_inertia(hull, RHO) == pytest.approx(exact, rel=1e-12)
 
 
 # -- BEM (a coarse barge, cached for the module) ------------------------------------------------
@@ -203,7 +202,7 @@ OMEGA = np.array([0.05, 0.6, 1.0, 1.6])
 def coarse_barge(tmp_path_factory):
     with pytest.MonkeyPatch.context() as mp:
         mp.setenv("PARAPEND_CACHE", str(tmp_path_factory.mktemp("cache")))
-        return hd.barge(L, B, D, omega=OMEGA, refine=0.5)
+        return bem.barge(L, B, D, omega=OMEGA, refine=0.5)
 
 
 def _dx(h):
@@ -249,16 +248,16 @@ def test_haskind_relation_for_the_barge(coarse_barge):
     diffraction problems from 16 directions on the same mesh and lid."""
     cpt = bem._quiet_capytaine()
     h_panel = bem.mesh_size(min(L, B), OMEGA[-1]) / 0.5
-    mesh, _, lid = hd._box_meshes(L, B, D, h_panel, OMEGA[-1])
+    mesh, _, lid = bem._box_meshes(L, B, D, h_panel, OMEGA[-1])
     body = cpt.FloatingBody(mesh=mesh, lid_mesh=lid, center_of_mass=(0, 0, 0),
-                            dofs=cpt.rigid_body_dofs(only=list(hd.DOFS),
+                            dofs=cpt.rigid_body_dofs(only=list(bem.DOFS),
                                                      rotation_center=(0, 0, 0)))
     dirs = np.linspace(0, 2 * np.pi, 16, endpoint=False)
     w = OMEGA[1:3]
     test = xr.Dataset(coords={"omega": w, "wave_direction": dirs, "water_depth": [np.inf],
                               "rho": [RHO], "g": [G]})
     ds = cpt.BEMSolver(method="direct").fill_dataset(test, body, n_jobs=1, progress_bar=False)
-    fx = (ds["excitation_force"].sel(influenced_dof=list(hd.DOFS))
+    fx = (ds["excitation_force"].sel(influenced_dof=list(bem.DOFS))
           .transpose("omega", "wave_direction", "influenced_dof").values)
     # the trapezoidal rule on a periodic function: spectral accuracy in the directions
     integral = np.sum(np.abs(fx) ** 2, axis=1) * (2 * np.pi / dirs.size)
@@ -275,7 +274,7 @@ def test_haskind_relation_for_the_barge(coarse_barge):
 @pytest.mark.slow
 def test_cylinder_heave_entries_are_bem_cylinder(tmp_path):
     w = np.array([0.5, 1.0, 2.0])
-    h3 = hd.cylinder_hull(2.0, 1.0, omega=w, refine=0.5)
+    h3 = bem.cylinder_hull(2.0, 1.0, omega=w, refine=0.5)
     h1 = bem.cylinder(2.0, 1.0, omega=w, refine=0.5)
     hv = h3.heave()
     assert np.array_equal(hv.omega, h1.omega)
@@ -287,7 +286,7 @@ def test_cylinder_heave_entries_are_bem_cylinder(tmp_path):
     # the true cylinder's (the panels' polygon displaces 0.2 % less)
     assert h3.pitch_inertia == pytest.approx(RHO * math.pi * 4 * (4 / 4 + 1 / 3), rel=1e-14)
     # cached: a second call reads the same numbers back
-    again = hd.cylinder_hull(2.0, 1.0, omega=w, refine=0.5)
+    again = bem.cylinder_hull(2.0, 1.0, omega=w, refine=0.5)
     assert np.array_equal(again.added_mass, h3.added_mass)
     assert again.pitch_inertia == h3.pitch_inertia and again.notes == h3.notes
 
@@ -298,10 +297,10 @@ def test_barge_from_a_mesh_file_and_its_dataset(tmp_path, coarse_barge):
     from test_buoy_hydro import _gdf
 
     h_panel = bem.mesh_size(min(L, B), OMEGA[-1]) / 0.5
-    _, hull, _ = hd._box_meshes(L, B, D, h_panel, OMEGA[-1])
+    _, hull, _ = bem._box_meshes(L, B, D, h_panel, OMEGA[-1])
     path = _gdf(tmp_path / "barge.gdf", hull)
     w = OMEGA[1:3]
-    h3 = hd.hull_from_mesh(path, omega=w)
+    h3 = bem.hull_from_mesh(path, omega=w)
     h1 = bem.from_mesh(path, omega=w)
     # the heave entries are the heave-only BEM's on the same panels (no lid in either)
     hv = h3.heave()
@@ -317,7 +316,7 @@ def test_barge_from_a_mesh_file_and_its_dataset(tmp_path, coarse_barge):
                                              rel=1e-12)
     # the built-in barge's real data through NetCDF and back
     save_dataset_as_netcdf(tmp_path / "barge.nc", coarse_barge.to_dataset())
-    back = hd.load_hull(tmp_path / "barge.nc")
+    back = bem.load_hull(tmp_path / "barge.nc")
     for name in ("omega", "added_mass", "radiation_damping", "excitation",
                  "hydrostatic_stiffness"):
         assert np.allclose(getattr(back, name), getattr(coarse_barge, name), rtol=1e-14,
@@ -328,7 +327,7 @@ def test_barge_from_a_mesh_file_and_its_dataset(tmp_path, coarse_barge):
 @pytest.mark.slow
 def test_a_sphere_above_its_centre_is_stable():
     r, d = 2.0, 1.0
-    h = hd.sphere_hull(r, draft=d, omega=[0.5, 1.0], refine=0.5)
+    h = bem.sphere_hull(r, draft=d, omega=[0.5, 1.0], refine=0.5)
     v = math.pi * d * d * (3 * r - d) / 3
     c = h.hydrostatic_stiffness
     # panels: volume and waterplane to the mesh's error (about 1 %)
@@ -336,7 +335,7 @@ def test_a_sphere_above_its_centre_is_stable():
     assert c[1, 1] == pytest.approx(RHO * G * math.pi * (r * r - (r - d) ** 2), rel=0.02)
     # the metacentre is the sphere's centre: C55 = rho g V (r - d)
     assert c[2, 2] == pytest.approx(RHO * G * v * (r - d), rel=0.05)
-    _, ix, iz = hd._cap_integrals(r, d)
+    _, ix, iz = bem._cap_integrals(r, d)
     assert h.pitch_inertia == RHO * (ix + iz)
 
 
@@ -357,10 +356,10 @@ def test_load_a_six_dof_dataset_capytaine_wrote(tmp_path):
                               "rho": [RHO], "g": [G]})
     ds = cpt.BEMSolver().fill_dataset(test, body, progress_bar=False)
     save_dataset_as_netcdf(tmp_path / "user.nc", ds)
-    h = hd.load_hull(tmp_path / "user.nc")
+    h = bem.load_hull(tmp_path / "user.nc")
     w = [1.0, 2.0, 3.0]
     assert np.array_equal(h.omega, w)
-    dofs = list(hd.DOFS)
+    dofs = list(bem.DOFS)
     sub = ds.sel(radiating_dof=dofs, influenced_dof=dofs, omega=w)
     a = sub["added_mass"].transpose("omega", "radiating_dof", "influenced_dof").values
     assert np.allclose(h.added_mass, 0.5 * (a + np.swapaxes(a, 1, 2)), rtol=1e-12)
@@ -373,7 +372,7 @@ def test_load_a_six_dof_dataset_capytaine_wrote(tmp_path):
     assert h.pitch_inertia == pytest.approx(m[2, 2], rel=1e-12)
     # the other direction on request
     f1 = ds["excitation_force"].sel(influenced_dof=dofs, wave_direction=1.0, omega=w).values
-    assert np.allclose(hd.load_hull(tmp_path / "user.nc", wave_direction=1.0).excitation,
+    assert np.allclose(bem.load_hull(tmp_path / "user.nc", wave_direction=1.0).excitation,
                        np.conj(f1), rtol=1e-12)
 
 
@@ -385,7 +384,7 @@ def test_own_bem_frequencies_with_indefinite_damping_left_out():
     ds["radiation_damping"][3, 0, 2] = ds["radiation_damping"][3, 2, 0] = 1e5
     ds["radiation_damping"][1, 0, 2] = 3e4  # asymmetric: a spike
     ds["added_mass"][:, 0, 2] *= 1.05
-    g = hd._hull_from_dataset(ds, c=h.hydrostatic_stiffness, mass=h.mass, own=True,
+    g = bem._hull_from_dataset(ds, c=h.hydrostatic_stiffness, mass=h.mass, own=True,
                               path="the BEM")
     assert np.array_equal(g.omega, h.omega[[0, 2]])
     assert any("at 1, 4 rad/s: left out" in n for n in g.notes)

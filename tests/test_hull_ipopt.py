@@ -1,4 +1,4 @@
-"""The hull optimum (parapend.hydro.hull_optimum) against the independent CasADi/IPOPT
+"""The hull optimum (parapend.hydro.hull) against the independent CasADi/IPOPT
 implementation of the same model on the same discretization (tests/hull_reference.py: the
 pendulum's and the hull's coefficients both variables, the projected hull equations as
 constraints, exact AD derivatives). Four cases of two bodies (a synthetic box, the
@@ -11,8 +11,7 @@ import pytest
 from hull_reference import box_case, hull_power, hull_reference
 from hull_timedomain import interpolator, synthetic_hull
 
-from parapend.hydro.hull import HullCase, HullProblem
-from parapend.hydro.hull_optimum import hull_search, radiation_bound
+from parapend.hydro.hull import HullCase, HullProblem, hull_search, radiation_bound
 
 
 def _causal(winding, harmonics=12, hull_harmonics=8):

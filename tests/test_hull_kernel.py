@@ -23,8 +23,7 @@ from parapend.hydro._hull_kernel import (
     spectra_at,
 )
 from parapend.hydro._trig import spectra
-from parapend.hydro.hull import HullProblem
-from parapend.hydro.hull_optimum import GTOL, hull_search, radiation_bound
+from parapend.hydro.hull import GTOL, HullProblem, hull_search, radiation_bound
 from parapend.optimal.fourier import newton_maximize
 
 

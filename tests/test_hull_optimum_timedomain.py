@@ -1,4 +1,4 @@
-"""The hull optimum (parapend.hydro.hull_optimum) replayed by code that does not share it
+"""The hull optimum (parapend.hydro.hull) replayed by code that does not share it
 (tests/hull_timedomain.py): the same discretization's hull response to the optimum's phi
 (a second frequency-domain solve, written apart), and Cummins' time domain with the
 radiation memory, integrated from rest until periodic."""
@@ -9,8 +9,7 @@ import numpy as np
 import pytest
 from hull_timedomain import harmonic_response, interpolator, phi_fourier, replay, synthetic_hull
 
-from parapend.hydro.hull import HullCase, HullProblem, hull_points
-from parapend.hydro.hull_optimum import hull_search
+from parapend.hydro.hull import HullCase, HullProblem, hull_points, hull_search
 
 W = 1.2
 #: steps per period of the coarser replay: the swinging optimum holds harmonics up to about

@@ -19,8 +19,8 @@ from hull_timedomain import RHO_V, synthetic_hull
 import parapend
 from parapend.cli import main
 from parapend.errors import ParameterError
-from parapend.hydro import hull_api
-from parapend.hydro.hull_data import HullHydro
+from parapend.hydro import api as hull_api
+from parapend.hydro.bem import HullHydro
 from parapend.performance import HOURS_PER_YEAR, matrix_spec, power_matrix
 from parapend.performance.resource import repeat_period
 from parapend.performance.spec import MatrixSpec
@@ -182,7 +182,7 @@ def test_the_hull_spec_round_trips(dataset):
 def test_the_take_off_reaches_the_hull(dataset):
     """--efficiency, --torque-limit and --copper-loss reach the hull's take-off (HullPTO) as
     parapend.buoy builds it, and enter the store's identity."""
-    from parapend.hydro.hull_api import _pto
+    from parapend.hydro.api import _hull_pto as _pto
     from parapend.performance.hull_device import problem
 
     kw = {"efficiency": 0.9, "torque_limit": 2e4, "copper_loss": 1e-6}
@@ -198,7 +198,7 @@ def test_the_longest_record_is_the_hulls_limit(dataset):
     largest fits the hull's own size check (12 harmonics per wave, at most 128), 0.01 more
     does not."""
     from parapend import limits
-    from parapend.hydro.hull_optimum import HARMONICS_PER_TURN, waves_in
+    from parapend.hydro.hull import HARMONICS_PER_TURN, waves_in
     from parapend.performance.buoy_device import wave_of
 
     with pytest.raises(ParameterError, match=r"^waves: .*at most ([0-9.]+) peak periods "

@@ -222,6 +222,9 @@ BUOY_MIN_EFFICIENCY = 1e-2
 #: relative asymmetry of A and B (between DOFs) a dataset may have before it is refused;
 #: below it they are symmetrised (with a warning where above round-off)
 BUOY_SYMMETRY_TOL = 1e-2
+#: relative difference between a dataset's stated displacement (disp_mass, disp_volume x rho)
+#: and its inertia_matrix's mass above which the result warns, naming both and the one used
+DATASET_MASS_RTOL = 1e-3
 #: negative heave radiation damping a dataset may hold at a frequency, as a fraction of its
 #: largest B, before it is refused (at most this much: the frequencies are dropped, named)
 BUOY_NEGATIVE_DAMPING_TOL = 1e-2

@@ -80,23 +80,13 @@ def _finite_float(name):
 
 def hull_options(g) -> None:
     """The hull's placement options (``buoy`` and ``power-matrix`` with ``--dofs
-    surge,heave,pitch``): the pivot, the hull's pitch inertia, the barge's size."""
-    from ..defaults import HULL
+    surge,heave,pitch``): the pivot, the hull's pitch inertia, the barge's size, generated
+    from their declarations (:class:`parapend.hydro.device.Body`)."""
+    from ..hydro.device import Body
 
-    g.add_argument("--pivot-height", type=_finite_float("pivot-height"),
-                   help=f"the pivot above the hull's rotation centre (its waterplane "
-                        f"centre), m (default {HULL['pivot_height']:g})")
-    g.add_argument("--pivot-offset", type=_finite_float("pivot-offset"),
-                   help=f"the pivot ahead of it, along the waves' travel, m (default "
-                        f"{HULL['pivot_offset']:g})")
-    g.add_argument("--hull-pitch-inertia", type=_finite_float("hull-pitch-inertia"),
-                   help="the hull's pitch inertia about the rotation centre, without the "
-                        "pendulum, kg m^2 (default: the dataset's, else a homogeneous "
-                        "immersed hull's)")
-    for name, key in (("length", "barge_length"), ("beam", "barge_beam"),
-                      ("draft", "barge_draft")):
-        g.add_argument(f"--barge-{name}", type=_finite_float(f"barge-{name}"),
-                       help=f"the box barge's {name}, m (default {HULL[key]:g})")
+    add_declared(g, Body, ("pivot_height", "pivot_offset", "hull_pitch_inertia",
+                           "barge_length", "barge_beam", "barge_draft"))
+
 
 def _int(text):
     t = text.strip()
@@ -183,21 +173,40 @@ def add_pendulum_options(g, *, gamma_note: str = "") -> None:
                    help="viscous damping c, N m s/rad (instead of --gamma)")
 
 
+def add_declared(g, cls, names) -> None:
+    """The options ``--NAME`` of the parameters ``names`` of an input object ``cls``
+    (:mod:`parapend.hydro.device`) into the argument group ``g``, generated from their
+    declarations: the help, the unit and the default stated, the type, the choices."""
+    import dataclasses
+
+    from ..hydro.device import option_help
+
+    meta = {f.name: f.metadata for f in dataclasses.fields(cls)}
+    for name in names:
+        m, flag = meta[name], name.replace("_", "-")
+        kw = {"help": option_help(m)}
+        if m["choices"]:
+            kw["choices"] = list(m["choices"])
+        elif m["kind"] == "float":
+            kw["type"] = _finite_float(flag)
+        elif m["kind"] == "int":
+            kw["type"] = _int
+        if m["metavar"]:
+            kw["metavar"] = m["metavar"]
+        g.add_argument(f"--{flag}", **kw)
+
+
 def add_body_options(g, *, body_help: str, hydro_help: str,
                      bodies=("cylinder", "sphere")) -> None:
     """The buoy's body of ``buoy`` and ``power-matrix --device buoy`` into the argument group
-    ``g``: ``--body --radius --draft --mesh --hydro`` (sizes default to ``defaults.BUOY``'s);
-    the help of ``--body`` and ``--hydro`` are the commands' own."""
-    from ..defaults import BUOY
+    ``g``: ``--body --radius --draft --mesh --hydro`` (``--radius --draft --mesh`` generated
+    from their declarations, :class:`parapend.hydro.device.Body`); the help of ``--body``
+    and ``--hydro`` are the commands' own."""
+    from ..hydro.device import Body
 
     g.add_argument("--body", choices=list(bodies),
                    help=body_help)
-    g.add_argument("--radius", type=_finite_float("radius"),
-                   help=f"m (default {BUOY['radius']:g})")
-    g.add_argument("--draft", type=_finite_float("draft"),
-                   help=f"cylinder's draft, m (default {BUOY['draft']:g})")
-    g.add_argument("--mesh", metavar="FILE",
-                   help="a mesh file Capytaine reads, instead of --body")
+    add_declared(g, Body, ("radius", "draft", "mesh"))
     g.add_argument("--hydro", metavar="FILE", help=hydro_help)
 
 

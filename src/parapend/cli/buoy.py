@@ -7,8 +7,19 @@ from pathlib import Path
 
 from ..defaults import BUOY
 from ..errors import ParameterError
+from ..hydro.device import Body, Controller, Pendulum, PowerTakeOff, Sea
 from . import _output
-from ._common import _check_output, _finite_float, _fmt, _int, _Progress, _run, _table, hull_options
+from ._common import (
+    _check_output,
+    _finite_float,
+    _fmt,
+    _int,
+    _Progress,
+    _run,
+    _table,
+    add_declared,
+    hull_options,
+)
 
 
 def _text(name):
@@ -28,40 +39,16 @@ def add_parsers(sub) -> None:
                     "bound, the one-way answer (reaction left out) and the free buoy. SI "
                     "units. With no options: the embedded default design (docs/buoy.md, "
                     "docs/defaults.md).")
+    # the sea's, the pendulum's, the take-off's and the controller's options: generated from
+    # their declarations (parapend.hydro.device), the one place of each name, unit, default
+    # and help
     g = p.add_argument_group("regular wave")
-    g.add_argument("--wave-height", type=_finite_float("wave-height"),
-                   help=f"H, m, crest to trough (default {BUOY['wave_height']:g})")
-    g.add_argument("--wave-period", type=_text("wave-period"), metavar="T",
-                   help=f"s (default {BUOY['wave_period']:g}); FROM:TO:N or a comma list "
-                        "T1,T2,... for power against period")
+    add_declared(g, Sea, ("wave_height", "wave_period"))
     g = p.add_argument_group("irregular sea (as 'parapend sea' takes it)")
-    g.add_argument("--hs", type=_finite_float("hs"),
-                   help=f"significant wave height, m (default {BUOY['hs']:g} with --tp)")
-    g.add_argument("--tp", type=_finite_float("tp"),
-                   help=f"peak period, s (default {BUOY['tp']:g} with --hs)")
-    g.add_argument("--spectrum", choices=["jonswap", "pierson-moskowitz"],
-                   help="spectrum shape (default jonswap)")
-    g.add_argument("--gamma-peak", type=_finite_float("gamma-peak"),
-                   help="JONSWAP peak enhancement in [1, 20] (default 3.3)")
-    g.add_argument("--repeat-period", type=_finite_float("repeat-period"),
-                   help="T_r, s: the record repeats with it (default 100 Tp)")
-    g.add_argument("--seed", type=_int, help="seed of the random phases "
-                                             "(default 0)")
-    g.add_argument("--cutoff", type=_finite_float("cutoff"),
-                   help="highest frequency, in units of the peak frequency (default 3)")
-    g.add_argument("--record", metavar="CSV",
-                   help="measured surface elevation at the body, CSV 't,z' (s, m)")
-    g.add_argument("--taper", type=_finite_float("taper"),
-                   help="with --record: fraction under the Tukey taper (default 0.1)")
+    add_declared(g, Sea, ("hs", "tp", "spectrum", "gamma_peak", "repeat_period", "seed",
+                          "cutoff", "record", "taper"))
     g = p.add_argument_group("pendulum (SI units)")
-    g.add_argument("--mass", type=_finite_float("mass"),
-                   help=f"m, kg (default {BUOY['mass']:g})")
-    g.add_argument("--length", type=_finite_float("length"),
-                   help=f"pivot to centre of mass l, m (default {BUOY['length']:g})")
-    g.add_argument("--inertia", type=_finite_float("inertia"),
-                   help="about the pivot, kg m^2, at least m l^2 (default m l^2)")
-    g.add_argument("--damping-coefficient", type=_finite_float("damping-coefficient"),
-                   help=f"viscous c, N m s/rad (default {BUOY['damping_coefficient']:g})")
+    add_declared(g, Pendulum, ("mass", "length", "inertia", "damping_coefficient"))
     g = p.add_argument_group("body (Capytaine; the BEM result is cached on disk)")
     from ._common import add_body_options
 
@@ -72,15 +59,10 @@ def add_parsers(sub) -> None:
                      hydro_help="a Capytaine dataset (NetCDF), instead of solving "
                                 "(docs/buoy.md)")
     p.set_defaults(body=None)  # so that --body given beside --hydro or --mesh is refused
-    g.add_argument("--wave-direction", type=_finite_float("wave-direction"),
-                   metavar="RAD", help="with --hydro: the dataset's wave direction to use, rad "
-                                       "(default 0, waves travelling along +x)")
+    add_declared(g, Sea, ("wave_direction",))
 
     g = p.add_argument_group("hull: surge, heave and pitch (docs/hull.md)")
-    g.add_argument("--dofs", metavar="DOFS",
-                   help="the hull's degrees of freedom: heave (default, the heaving buoy) "
-                        "or surge,heave,pitch (a hull that pitches; the pendulum rotates or "
-                        "swings)")
+    add_declared(g, Body, ("dofs",))
     hull_options(g)
     g = p.add_argument_group("motion and power take-off")
     g.add_argument("--winding", type=_int,
@@ -89,15 +71,7 @@ def add_parsers(sub) -> None:
                         "side)")
     g.add_argument("--harmonics", type=_int,
                    help="N of the motion (default chosen from the problem and checked)")
-    g.add_argument("--torque-limit", type=_finite_float("torque-limit"),
-                   help="largest |torque|, N m")
-    g.add_argument("--efficiency", type=_text("efficiency"),
-                   metavar="ETA_G[,ETA_M]",
-                   help="power take-off efficiency in (0, 1], generating[,motoring]: the "
-                        "motion maximizes the electrical power")
-    g.add_argument("--copper-loss", type=_finite_float("copper-loss"),
-                   help="the generator's winding loss r tau^2 subtracted from the power, r "
-                        "in W/(N m)^2 (with --dofs surge,heave,pitch)")
+    add_declared(g, PowerTakeOff, ("torque_limit", "efficiency", "copper_loss"))
     g = p.add_argument_group("design")
     g.add_argument("--optimize-design", metavar="NAMES",
                    help="choose these pendulum parameters for the most power: a comma list "
@@ -110,19 +84,7 @@ def add_parsers(sub) -> None:
                                f"{BUOY['design_bounds'][name][0]:g} to "
                                f"{BUOY['design_bounds'][name][1]:g} x the design's") + ")")
     g = p.add_argument_group("causal control (an irregular sea, the coupled time-domain plant)")
-    g.add_argument("--controller", choices=["optimum", "mpc", "one-way-mpc"],
-                   help="optimum: the non-causal coupled optimum (default); mpc: receding-"
-                        "horizon control planned on the coupled model with its radiation "
-                        "(the motion planner; with --efficiency the torque planner); "
-                        "one-way-mpc: planned on the free buoy's heave")
-    g.add_argument("--horizon", type=_finite_float("horizon"),
-                   help="with mpc: forecast horizon, peak periods (default 2; one-way-mpc 1)")
-    g.add_argument("--update-interval", type=_finite_float("update-interval"),
-                   help="with mpc: re-planning interval, peak periods (default 0.125)")
-    g.add_argument("--forecast", choices=("perfect", "ar"),
-                   help="with mpc: what the controller knows of the excitation force over "
-                        "the horizon: perfect (the record's own future; default) or ar "
-                        "(autoregressive, fitted on the force measured so far)")
+    add_declared(g, Controller, ("controller", "horizon", "update_interval", "forecast"))
     p.add_argument("--time-limit", type=_finite_float("time-limit"), metavar="SECONDS",
                    help="run long work (--optimize-design, a period sweep, --controller mpc) "
                         "for at most about this long, then stop with a partial result marked "
@@ -206,7 +168,7 @@ def _cmd_buoy(a) -> dict | str:
             _output.write_dataset(r.to_dataset(), a.save)
         return r.to_dict() if a.json else "\n".join(
             mpc_text(r) + ([f"written: {a.save}"] if a.save else []))
-    if hasattr(r, "dofs") or hasattr(r, "rotation_power_w"):
+    if tuple(r.dofs) != ("heave",):
         return _hull_output(r, a)
     sweep = hasattr(r, "period_s")
     if not sweep and r.status == "no_power":

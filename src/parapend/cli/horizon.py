@@ -77,6 +77,9 @@ def add_parsers(sub) -> None:
     g.add_argument("--controller", choices=list(BUOY_CONTROLLERS),
                    help="the buoy's receding-horizon planner (parapend.hydro.control.buoy_mpc"
                         "; default its own, coupled)")
+    g.add_argument("--dofs", metavar="DOFS",
+                   help="the body's degrees of freedom: heave (default, the heaving buoy); "
+                        "a hull's (surge,heave,pitch) has no causal controller yet")
     g = p.add_argument_group("controllers")
     g.add_argument("--horizons",
                    help="horizons in peak periods, comma separated (default "

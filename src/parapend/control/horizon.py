@@ -184,7 +184,7 @@ def horizon_curve(*, hs=None, tp=None, spectrum: str = "jonswap", gamma_peak: fl
                   update_interval=None, progress=None,
                   warm_up=None, speed_limit=HORIZON["speed_limit"], time_limit=None,
                   device: str = "pendulum", body=None, radius=None, draft=None, mesh=None,
-                  hydro=None, controller=None):
+                  hydro=None, controller=None, dofs=None):
     """Mean power of causal control against the horizon, as a fraction of the record's
     non-causal optimum and of its limit (command ``horizon``: ``parapend.horizon`` is this
     function; module docstring). With ``device="buoy"``: the pendulum inside the floating
@@ -201,6 +201,9 @@ def horizon_curve(*, hs=None, tp=None, spectrum: str = "jonswap", gamma_peak: fl
         ``device="buoy"`` only: the floating body as ``parapend buoy`` takes it, and the
         planner of :func:`parapend.hydro.control.buoy_mpc` (``"coupled"`` or ``"plan"``;
         None: its default).
+    dofs : ``device="buoy"`` only: the body's degrees of freedom, ``"heave"`` (default,
+        the heaving buoy); a hull's (``"surge,heave,pitch"``) is refused in one line, as it
+        has no causal controller yet.
     hs, tp, spectrum, gamma_peak, repeat_period, seed, cutoff :
         The sea state (:func:`parapend.seas.sea_record`; ``repeat_period`` in s, default
         ``20 tp``, ``parapend.defaults.HORIZON["repeat_periods"]`` peak periods, not ``sea``'s
@@ -257,7 +260,7 @@ def horizon_curve(*, hs=None, tp=None, spectrum: str = "jonswap", gamma_peak: fl
         return _buoy(locals())
     if device != "pendulum":
         raise ParameterError(f"device: expected pendulum or buoy, got {device!r:.40}")
-    for name in ("body", "radius", "draft", "mesh", "hydro", "controller"):
+    for name in ("body", "radius", "draft", "mesh", "hydro", "controller", "dofs"):
         if locals()[name] is not None:
             raise ParameterError(f"{name}: an option of the buoy; needs --device buoy")
     length = SEA["length"] if length is None else length
@@ -542,8 +545,10 @@ PENDULUM_ONLY = ("gravity", "gamma", "baselines", "speed_limit")
 
 def _buoy(opts: dict):
     """``device="buoy"``: the pendulum-only options refused by name, the rest handed on."""
+    from ..hydro.api import refuse_hull
     from ..hydro.horizon import buoy_horizon_curve
 
+    refuse_hull(opts["dofs"], "horizon --device buoy")
     for name in PENDULUM_ONLY:
         if opts[name] is not None:
             raise ParameterError(f"{name.replace('_', '-')}: an option of the prescribed-heave "
@@ -551,7 +556,7 @@ def _buoy(opts: dict):
                                  + (" (give --damping-coefficient, N m s/rad)"
                                     if name == "gamma" else ""))
     return buoy_horizon_curve(**{k: v for k, v in opts.items()
-                                 if k not in (*PENDULUM_ONLY, "device")})
+                                 if k not in (*PENDULUM_ONLY, "device", "dofs")})
 
 
 def horizon_dataset(r: HorizonResult):

@@ -19,7 +19,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..results import _Result
-from .result import BuoySweepResult, _error_powers, _result, _solve
+from .result import BuoySweepResult, optimum
 
 __all__ = ["DesignResult", "optimize_design", "period_sweep"]
 
@@ -252,21 +252,18 @@ def period_sweep(hydro, width, pendulum, height, periods, *, winding=1, harmonic
     sweep is no success."""
     from ..deadline import TIME_LIMIT, expired
     from .coupled import Wave
+    from .hull import HullPTO
 
+    pto = HullPTO(efficiency=efficiency, torque_limit=torque_limit)
     rows = []
     for period in periods:
         if rows and expired(deadline):
             break
         wave = Wave.regular(height, float(period))
-        sol, ow, notes = _solve(hydro, pendulum, wave, winding=winding, harmonics=harmonics,
-                                torque_limit=torque_limit, efficiency=efficiency)
         info = {"kind": "regular", "height_m": height, "period_s": float(period)}
-        errors = _error_powers(hydro, coarse, pendulum, wave, winding=winding,
-                               harmonics=harmonics, torque_limit=torque_limit,
-                               efficiency=efficiency)
-        rows.append(_result(hydro, width, pendulum, wave, info, sol, ow,
-                            torque_limit=torque_limit, efficiency=efficiency, winding=winding,
-                            notes=notes, error_powers=errors, geometry=geometry))
+        rows.append(optimum(hydro, pendulum, wave, wave_info=info, winding=winding,
+                            harmonics=harmonics, pto=pto, geometry=geometry, width=width,
+                            coarse=coarse))
 
     left = len(periods) - len(rows)  # periods the time limit left out
 

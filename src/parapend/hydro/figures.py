@@ -107,7 +107,7 @@ def plot_sweep(sweep, path=None):
 @figure_style()
 def plot_hull(result, path=None, points: int = 600):
     """The best mode of a pendulum in a surging, heaving, pitching hull over one period (a
-    :class:`~parapend.hydro.hull_result.HullResult`): the pendulum's angle, the hull's
+    :class:`~parapend.hydro.result.BuoyResult` of a hull): the pendulum's angle, the hull's
     motion, the generator torque."""
     import matplotlib.pyplot as plt
 
@@ -135,7 +135,7 @@ def plot_hull(result, path=None, points: int = 600):
 @figure_style()
 def plot_hull_sweep(sweep, path=None):
     """Rotation against swinging over wave period (a
-    :class:`~parapend.hydro.hull_result.HullSweepResult`): each mode's optimum, the one-way
+    :class:`~parapend.hydro.result.BuoySweepResult` of a hull): each mode's optimum, the one-way
     answer and the radiation bound; the hull's heave and pitch."""
     return _power_against_period(
         np.asarray(sweep.period_s),

@@ -1,6 +1,5 @@
-"""The inputs of ``parapend buoy`` that the heaving buoy (:mod:`.api`) and the hull
-(:mod:`.hull_api`) share: the wave periods, the pendulum, an irregular sea's periodic
-record."""
+"""The inputs of ``parapend buoy`` that every degree-of-freedom set shares (:mod:`.api`):
+the wave periods, the pendulum, an irregular sea's periodic record."""
 
 from __future__ import annotations
 

@@ -1,9 +1,11 @@
-"""The buoy's results and one wave's answer: :class:`BuoyResult` (one wave, or one periodic
-record), :class:`BuoySweepResult` (power against wave period), and how a result is made from
-the body's coefficients, the pendulum and the wave (:func:`_solve`: the coupled optimum and
-the one-way one; :func:`_result`: what a designer reads). :mod:`.api` (the command),
-:mod:`.design` (sweeps, the design search) and :mod:`.control` (receding-horizon control)
-all build their answers from here.
+"""The floating body's results and one wave's answer, for every degree-of-freedom set:
+:class:`BuoyResult` (one wave, or one periodic record) and :class:`BuoySweepResult` (power
+against wave period), one type each whatever the body's DOFs; :func:`optimum`, the one
+function of the coupled optimum, which dispatches on the coefficients' DOFs to the heaving
+buoy's kernel (:func:`_solve`: the coupled optimum and the one-way one; :func:`_result`:
+what a designer reads) or to the hull's (:func:`hull_answer`: rotation, swinging and rest
+side by side). :mod:`.api` (the command), :mod:`.design` (sweeps, the design search) and
+:mod:`.control` (receding-horizon control) all build their answers from here.
 """
 
 from __future__ import annotations
@@ -13,20 +15,100 @@ import math
 from dataclasses import dataclass, field
 
 import numpy as np
+from scipy.optimize import minimize_scalar
 
 from ..results import _Result
+from .hull import BOUND_RCOND, HullProblem, HullPTO, hull_search, make_case, radiation_bound
+from .optimum import TORQUE_SLACK
 from .waves import energy_flux
 
-__all__ = ["BuoyResult", "BuoySweepResult", "free_heave"]
+__all__ = ["BuoyResult", "BuoySweepResult", "MotionAt", "free_heave", "hull_answer", "optimum"]
+
+
+#: the JSON keys of a heave-only answer (a buoy), in their order
+HEAVE_KEYS = ("power_w", "heave_amplitude_m", "peak_torque_nm", "radiation_bound_w",
+              "bound_fraction", "limit_w", "capture_width_m", "capture_width_ratio",
+              "energy_flux_w_per_m", "one_way_power_w", "one_way_ratio", "free_heave_amplitude_m",
+              "energy_balance_residual", "harmonics", "winding", "success", "status", "message",
+              "wave", "pendulum", "body", "torque_limit_nm", "efficiency", "design", "warnings",
+              "electrical_power_w", "mechanical_power_w", "pto_loss_w", "generated_power_w",
+              "motoring_power_w", "ideal_power_w", "one_way_electrical_power_w", "mesh_error_w",
+              "mesh_error_relative", "grid_error_w", "validity_warnings")
+#: the JSON keys of an answer in surge, heave and pitch (a hull), in their order
+HULL_KEYS = ("power_w", "mechanical_power_w", "efficiency", "copper_loss_w_per_nm2",
+             "torque_limit_nm", "mode", "winding", "modes", "one_way_power_w", "one_way_ratio",
+             "energy_balance_residual", "radiation_bound_w", "bound_fraction", "bound_rcond",
+             "bound_cut", "capture_width_m", "energy_flux_w_per_m", "surge_amplitude_m",
+             "heave_amplitude_m", "pitch_amplitude_deg", "surge_phase_deg", "heave_phase_deg",
+             "pitch_phase_deg", "mean_heel_deg", "mean_angle_deg", "swing_amplitude_deg",
+             "peak_torque_nm", "peak_pivot_force_n", "harmonics", "hull_harmonics",
+             "refinement_change_w", "success", "status", "dofs", "wave", "pendulum", "body",
+             "pivot", "warnings", "validity_warnings")
+#: the same of a period sweep
+HEAVE_SWEEP_KEYS = ("period_s", "power_w", "one_way_power_w", "radiation_bound_w", "limit_w",
+                    "bound_fraction", "capture_width_m", "heave_amplitude_m",
+                    "free_heave_amplitude_m", "energy_balance_residual", "status", "success",
+                    "wave_height_m", "pendulum", "body", "warnings", "electrical_power_w",
+                    "mechanical_power_w", "mesh_error_w", "validity_warnings", "grid_error_w")
+HULL_SWEEP_KEYS = ("period_s", "power_w", "mechanical_power_w", "rotation_power_w",
+                   "swinging_power_w", "one_way_power_w", "radiation_bound_w",
+                   "heave_amplitude_m", "pitch_amplitude_deg", "energy_balance_residual", "mode",
+                   "status", "success", "wave_height_m", "pendulum", "body", "pivot", "warnings")
+
+
+#: the fields' types (the others: ``float | None``), of one answer and of a sweep
+_TYPES = {**dict.fromkeys(("harmonics", "winding", "bound_cut", "hull_harmonics"),
+                          "int | None"),
+          **dict.fromkeys(("status", "message", "mode"), "str | None"),
+          **dict.fromkeys(("wave", "pendulum", "body", "design", "pivot"), "dict | None"),
+          **dict.fromkeys(("efficiency", "modes"), "list | None"), "success": "bool | None"}
+_SWEEP_TYPES = {**dict.fromkeys(("status", "mode"), "list | None"),
+                **dict.fromkeys(("pendulum", "body", "pivot"), "dict | None"),
+                "success": "bool | None", "wave_height_m": "float | None"}
+
+
+def _union_fields(*key_sets, types, default="float | None"):
+    """Class decorator (before :func:`dataclasses.dataclass`): the public fields of a result
+    of several DOF sets are the union of their JSON keys, in order, each None by default
+    (``warnings``, ``validity_warnings``: an empty list; ``dofs``: ``["heave"]``), typed by
+    ``types``, else ``default`` (a sweep's: ``np.ndarray | None``); the class's own
+    annotated fields (its private ones) follow."""
+
+    def add(cls):
+        names = list(dict.fromkeys(k for keys in key_sets for k in keys))
+        public = {}
+        for name in names:
+            if name in ("warnings", "validity_warnings", "dofs"):
+                public[name] = "list"
+                setattr(cls, name, field(default_factory=(
+                    (lambda: ["heave"]) if name == "dofs" else list)))
+            else:
+                public[name] = types.get(name, default)
+                setattr(cls, name, None)
+        cls.__annotations__ = {**public, **cls.__dict__.get("__annotations__", {})}
+        return cls
+    return add
+
+
+def _heave_only(dofs) -> bool:
+    return tuple(dofs) == ("heave",)
 
 
 @dataclass(frozen=True, eq=False, repr=False)
+@_union_fields(HEAVE_KEYS, HULL_KEYS, types=_TYPES)
 class BuoyResult(_Result):
-    """The coupled optimum of one design in one sea (field names = JSON keys of ``parapend
-    buoy``; SI units, named in each field).
+    """The coupled optimum of a pendulum in a floating body, for its degrees of freedom
+    ``dofs`` (``["heave"]``: the heaving buoy; ``["surge", "heave", "pitch"]``: a hull), in
+    one wave or one periodic record (field names = JSON keys of ``parapend buoy``; SI units,
+    named in each field). The JSON holds the fields of its DOF set (:data:`HEAVE_KEYS`,
+    :data:`HULL_KEYS`); the others are None.
 
     Attributes
     ----------
+    dofs : the body's degrees of freedom (in the JSON of a hull).
+
+    Heave alone (the buoy):
+
     power_w : mean harvested power of the coupled optimum, ``P = -<tau theta'>``.
     heave_amplitude_m : half the buoy's peak-to-peak heave over the period, coupled.
     peak_torque_nm : largest ``|tau|`` of the optimal motion.
@@ -78,58 +160,71 @@ class BuoyResult(_Result):
         heave amplitude above the draft or the freeboard, the body's bottom out of the water
         or its top under it (the motion relative to the wave), a regular wave steeper than
         the breaking limit ``H / lambda = 1/7`` (docs/buoy.md).
+
+    Surge, heave and pitch (a hull):
+
+    power_w : the best mode's mean power: the mechanical ``P = -<tau (phi' - beta')>``
+        with an ideal power take-off; with ``efficiency`` (``[eta_g, eta_m]``) the
+        electrical ``<e(p)>`` (``eta_g p`` generating, ``p / eta_m`` motoring, ``p`` the
+        instantaneous mechanical power), less ``copper_loss_w_per_nm2`` times ``<tau^2>``.
+    mechanical_power_w : the mechanical power ``P`` of that motion (= power_w ideal).
+    torque_limit_nm : ``|tau|`` held below it on the solve grid (its peak between the grid
+        points checked, ``TORQUE_SLACK``).
+    mode : ``"rotation"``, ``"swinging"`` or ``"rest"`` (the pendulum held: 0 W) - the
+        best; ``winding`` its turns per wave (0: swinging).
+    modes : each mode's answer side by side (power, one-way power, mean angle, peak torque,
+        status, the search's evidence).
+    one_way_power_w : the best mode's optimum with the hull moving as if the pendulum were
+        not there; one_way_ratio : ``one_way_power_w / power_w``.
+    energy_balance_residual
+        The relative residual of the energy balance ``P + c <(phi' - beta')^2> =
+        sum_k Re((F a)_k^H U_k) / 2 - U_k^H B_k U_k / 2`` (below 1e-9 when the solve is
+        right).
+    radiation_bound_w : ``sum_k (F a)_k^H B_k^+ (F a)_k / 8``, singular values of ``B_k``
+        below ``bound_rcond`` of the largest cut (``bound_cut`` of them); bound_fraction.
+    surge_amplitude_m, heave_amplitude_m, pitch_amplitude_deg : half the peak-to-peak hull
+        motion; surge_phase_deg, heave_phase_deg, pitch_phase_deg: the phase of its first
+        harmonic against the wave's elevation at O (regular waves); mean_heel_deg : the mean
+        pitch (the mean generator torque heels the hull).
+    mean_angle_deg : the pendulum's mean absolute angle from the upward vertical (180:
+        hanging); swing_amplitude_deg : half its peak-to-peak swing (swinging only).
+    peak_torque_nm, peak_pivot_force_n : largest ``|tau|`` and bearing load over the motion
+        (located on the motion itself, between samples).
+    harmonics, hull_harmonics : of the answer; refinement_change_w : the power's change
+        from the answer with half as many (the stated discretization error).
     """
 
-    power_w: float
-    heave_amplitude_m: float
-    peak_torque_nm: float
-    radiation_bound_w: float
-    bound_fraction: float | None
-    limit_w: float
-    capture_width_m: float
-    capture_width_ratio: float | None
-    energy_flux_w_per_m: float
-    one_way_power_w: float | None
-    one_way_ratio: float | None
-    free_heave_amplitude_m: float
-    energy_balance_residual: float
-    harmonics: int
-    winding: int
-    success: bool
-    status: str
-    message: str
-    wave: dict
-    pendulum: dict
-    body: dict
-    torque_limit_nm: float | None
-    efficiency: list | None
-    design: dict | None
-    warnings: list
-    electrical_power_w: float | None = None
-    mechanical_power_w: float | None = None
-    pto_loss_w: float | None = None
-    generated_power_w: float | None = None
-    motoring_power_w: float | None = None
-    ideal_power_w: float | None = None
-    one_way_electrical_power_w: float | None = None
-    mesh_error_w: float | None = None
-    mesh_error_relative: float | None = None
-    grid_error_w: float | None = None
-    validity_warnings: list = field(default_factory=list)
     _solution: object = field(default=None, repr=False)
     _one_way: object = field(default=None, repr=False)
     _hydro: object = field(default=None, repr=False)
     _wave: object = field(default=None, repr=False)
+    _motion: object = field(default=None, repr=False)
+
+    command = "buoy"
+
+    @property
+    def headline(self) -> tuple:
+        """The fields the repr shows."""
+        if _heave_only(self.dofs):
+            return ("power_w", "electrical_power_w", "one_way_power_w", "radiation_bound_w",
+                    "heave_amplitude_m", "status")
+        return ("power_w", "mode", "one_way_power_w", "radiation_bound_w", "status")
+
+    def to_dict(self) -> dict:
+        d = super().to_dict()
+        return {k: d[k] for k in (HEAVE_KEYS if _heave_only(self.dofs) else HULL_KEYS)}
 
     @property
     def solution(self):
-        """The coupled optimum (:class:`parapend.hydro.optimum.CoupledSolution`)."""
+        """The coupled optimum (heave alone: :class:`parapend.hydro.optimum.CoupledSolution`;
+        a hull: None, its modes' in :attr:`modes`)."""
         return self._solution
 
     @property
     def hydrodynamics(self):
         """The body's hydrodynamic coefficients the optimum was solved with
-        (:class:`parapend.hydro.bem.Hydro`)."""
+        (:class:`parapend.hydro.bem.Hydro`, or a hull's
+        :class:`~parapend.hydro.bem.HullHydro`)."""
         return self._hydro
 
     @property
@@ -137,7 +232,23 @@ class BuoyResult(_Result):
         """The incident wave (regular or a periodic record) the optimum was solved for."""
         return self._wave
 
-    def samples(self, points: int = 400) -> dict:
+    @property
+    def motion(self):
+        """A hull's best mode's motion at any time: a callable ``t -> dict`` (s; None at
+        rest, and for the heaving buoy, whose motion is :meth:`samples`)."""
+        return self._motion
+
+    def samples(self, points: int | None = None) -> dict:
+        """One period on a uniform grid. Heave alone (400 points): ``t`` (s), ``theta``
+        (rad), ``theta_dot`` (rad/s), ``z`` (m), ``z_dot`` (m/s), ``tau`` (N m), ``power``
+        (``-tau theta'``, W) of the coupled optimum, and ``z_free`` (m), the free buoy's
+        heave. A hull (801 points): its best mode's motion (the hull at rest when the mode
+        is rest)."""
+        if _heave_only(self.dofs):
+            return self._heave_samples(400 if points is None else points)
+        return self._hull_samples(801 if points is None else points)
+
+    def _heave_samples(self, points: int) -> dict:
         """One period on a uniform grid: ``t`` (s), ``theta`` (rad), ``theta_dot`` (rad/s),
         ``z`` (m), ``z_dot`` (m/s), ``tau`` (N m), ``power`` (``-tau theta'``, W) of the
         coupled optimum, and ``z_free`` (m), the free buoy's heave."""
@@ -150,11 +261,21 @@ class BuoyResult(_Result):
         out["z_free"] = free_heave(self._hydro, self._wave, t)
         return out
 
-    command = "buoy"
-    headline = ("power_w", "electrical_power_w", "one_way_power_w", "radiation_bound_w",
-                "heave_amplitude_m", "status")
+    def _hull_samples(self, points: int) -> dict:
+        """One period of the best mode's motion (the hull at rest when the mode is rest)."""
+        period = 2 * math.pi / float(self.wave["omega_rad_per_s"])
+        t = period * np.arange(points) / (points - 1)
+        if self._motion is None:
+            z = np.zeros_like(t)
+            return {"t": t, "phi": z + math.pi, "phi_dot": z, "xi": np.zeros((3, t.size)),
+                    "tau": z, "power": z, "pivot_force": z, "relative_speed": z}
+        return self._motion(t)
 
     def _series(self):
+        """The motion over one period (SI): what ``--save`` writes beside the scalars."""
+        return self._heave_series() if _heave_only(self.dofs) else self._hull_series()
+
+    def _heave_series(self):
         """The motion over one period (SI): what ``--save`` writes beside the scalars."""
         import xarray as xr
 
@@ -165,48 +286,84 @@ class BuoyResult(_Result):
         return xr.Dataset({names[k]: ("time_s", s[k]) for k in names},
                           coords={"time_s": s["t"]})
 
-    def _figure(self):
-        from .figures import plot_motion
+    def _hull_series(self):
+        import xarray as xr
 
-        return plot_motion(self)
+        s = self.samples()
+        cols = {"phi": s["phi"], "theta": s["phi"] - s["xi"][2], "torque_nm": s["tau"],
+                "instantaneous_power_w": s["power"], "surge_m": s["xi"][0],
+                "heave_m": s["xi"][1], "pitch_deg": np.degrees(s["xi"][2]),
+                "pivot_force_n": s["pivot_force"]}
+        return xr.Dataset({k: ("time_s", np.asarray(v, float)) for k, v in cols.items()},
+                          coords={"time_s": s["t"]})
+
+    def _figure(self):
+        from .figures import plot_hull, plot_motion
+
+        return plot_motion(self) if _heave_only(self.dofs) else plot_hull(self)
 
 
 @dataclass(frozen=True, eq=False, repr=False)
+@_union_fields(HEAVE_SWEEP_KEYS, HULL_SWEEP_KEYS, ("dofs",), types=_SWEEP_TYPES,
+               default="np.ndarray | None")
 class BuoySweepResult(_Result):
-    """Power of one design against wave period (``wave_period="FROM:TO:N"``), regular waves
-    of one height: arrays over ``period_s``, each field named with its unit
-    (``electrical_power_w`` with an efficiency, else None). Every period is solved on the
-    same mesh and frequencies as alone (:class:`BuoyResult`: the same numbers);
-    ``mesh_error_w``, ``grid_error_w`` and ``validity_warnings`` are those of each period
-    (the warnings prefixed with the period)."""
+    """Power of one design against wave period (``wave_period="FROM:TO:N"`` or a list),
+    regular waves of one height, for the body's degrees of freedom ``dofs``: arrays over
+    ``period_s``, each field named with its unit; the JSON holds the fields of its DOF set
+    (:data:`HEAVE_SWEEP_KEYS`, :data:`HULL_SWEEP_KEYS`). Every period is solved on the same
+    mesh and frequencies as alone (:class:`BuoyResult`: the same numbers).
 
-    period_s: np.ndarray
-    power_w: np.ndarray
-    one_way_power_w: np.ndarray
-    radiation_bound_w: np.ndarray
-    limit_w: np.ndarray
-    bound_fraction: np.ndarray
-    capture_width_m: np.ndarray
-    heave_amplitude_m: np.ndarray
-    free_heave_amplitude_m: np.ndarray
-    energy_balance_residual: np.ndarray
-    status: list
-    success: bool
-    wave_height_m: float
-    pendulum: dict
-    body: dict
-    warnings: list
+    Heave alone: ``electrical_power_w`` with an efficiency, else None; ``mesh_error_w``,
+    ``grid_error_w`` and ``validity_warnings`` are those of each period (the warnings
+    prefixed with the period). A hull: rotation against swinging, ``mode`` the best per
+    period; each period's :class:`BuoyResult` in :attr:`results`."""
+
     _results: tuple = field(default=(), repr=False)
-    electrical_power_w: np.ndarray | None = None
-    mechanical_power_w: np.ndarray | None = None
-    mesh_error_w: np.ndarray | None = None
-    validity_warnings: list = field(default_factory=list)
-    grid_error_w: np.ndarray | None = None
 
     command = "buoy"
     headline = ("period_s", "power_w", "success")
 
+    def to_dict(self) -> dict:
+        d = super().to_dict()
+        keys = HEAVE_SWEEP_KEYS if _heave_only(self.dofs) else HULL_SWEEP_KEYS
+        return {k: d[k] for k in keys}
+
+    @property
+    def results(self) -> tuple:
+        """Each period's :class:`BuoyResult` (a hull's sweep)."""
+        return self._results
+
+    @classmethod
+    def from_results(cls, periods, results, height) -> BuoySweepResult:
+        def arr(name):
+            return np.array([np.nan if getattr(r, name) is None else getattr(r, name)
+                             for r in results], dtype=float)
+
+        def mode_power(r, mode):
+            return next((m["power_w"] for m in r.modes if m["mode"] == mode), np.nan)
+
+        warn = [f"T = {t:g} s: {w}" for t, r in zip(periods, results)
+                for w in list(r.warnings) + list(r.validity_warnings)]
+        return cls(period_s=np.asarray(periods, dtype=float), power_w=arr("power_w"),
+                   mechanical_power_w=arr("mechanical_power_w"),
+                   rotation_power_w=np.array([mode_power(r, "rotation") for r in results]),
+                   swinging_power_w=np.array([mode_power(r, "swinging") for r in results]),
+                   one_way_power_w=arr("one_way_power_w"),
+                   radiation_bound_w=arr("radiation_bound_w"),
+                   heave_amplitude_m=arr("heave_amplitude_m"),
+                   pitch_amplitude_deg=arr("pitch_amplitude_deg"),
+                   energy_balance_residual=arr("energy_balance_residual"),
+                   mode=[r.mode for r in results], status=[r.status for r in results],
+                   success=all(r.success for r in results), wave_height_m=float(height),
+                   pendulum=results[0].pendulum, body=results[0].body,
+                   pivot=results[0].pivot, warnings=warn, _results=tuple(results),
+                   dofs=list(results[0].dofs))
+
     def _series(self):
+        """The sweep over ``period_s`` (what ``--save`` writes)."""
+        return self._heave_series() if _heave_only(self.dofs) else self._hull_series()
+
+    def _heave_series(self):
         """The sweep over ``period_s`` (what ``--save`` writes)."""
         import xarray as xr
 
@@ -225,13 +382,21 @@ class BuoySweepResult(_Result):
             ds["grid_error_w"] = ("period_s", np.asarray(self.grid_error_w, dtype=float))
         return ds
 
-    def to_dict(self) -> dict:
-        return super().to_dict()
+    def _hull_series(self):
+        import xarray as xr
+
+        names = ("power_w", "mechanical_power_w", "rotation_power_w", "swinging_power_w",
+                 "one_way_power_w", "radiation_bound_w", "heave_amplitude_m", "pitch_amplitude_deg",
+                 "energy_balance_residual")
+        ds = xr.Dataset({k: ("period_s", np.asarray(getattr(self, k), dtype=float))
+                         for k in names}, coords={"period_s": self.period_s})
+        ds["mode"] = ("period_s", np.asarray(self.mode, dtype=str))
+        return ds
 
     def _figure(self):
-        from .figures import plot_sweep
+        from .figures import plot_hull_sweep, plot_sweep
 
-        return plot_sweep(self)
+        return plot_sweep(self) if _heave_only(self.dofs) else plot_hull_sweep(self)
 
     def __repr__(self) -> str:
         p = np.asarray(self.period_s, dtype=float)
@@ -319,6 +484,60 @@ def _power_on(hydro, pendulum, wave, *, winding, harmonics, torque_limit, effici
         warnings.simplefilter("ignore")
         sol = coupled_optimum(hydro, pendulum, wave, **kw)
     return float(sol.power)
+
+
+def optimum(h, pendulum, wave, *, wave_info=None, winding=None, harmonics=None, pto=None,
+            pivot=(0.0, 0.0), pitch_inertia=None, geometry=None, width=None, coarse=None,
+            design=None) -> BuoyResult:
+    """The coupled optimum of a pendulum in a floating body, for any of its degree-of-freedom
+    sets: one wave or one periodic record, one :class:`BuoyResult`.
+
+    Parameters
+    ----------
+    h : :class:`~parapend.hydro.bem.Hydro` or :class:`~parapend.hydro.bem.HullHydro`
+        The body's coefficients; their ``dofs`` choose the kernel: heave alone, the heaving
+        buoy's specialised kernel (:mod:`.coupled`, :func:`.optimum.coupled_optimum`: the
+        heave is linear in ``cos(theta)``); surge, heave and pitch, the hull's
+        (:mod:`.hull`). The hull's kernel with surge and pitch locked out gives the heave
+        kernel's answer (to 3e-10, tests/test_hull_kernel.py).
+    pendulum : :class:`~parapend.hydro.coupled.Pendulum`; wave : :class:`~.coupled.Wave`.
+    wave_info : dict, the wave's description for the result.
+    winding : turns of the pendulum per wave (per record); None: 1 in heave alone, a hull's
+        rotation (1) and swinging (0) side by side; a tuple: those windings (a hull).
+    harmonics : N of the motion (None: chosen from the problem).
+    pto : :class:`~parapend.hydro.hull.HullPTO` (torque limit, N m; efficiency; copper loss,
+        W per (N m)^2; heave alone has no copper loss) or None (ideal).
+    pivot, pitch_inertia : a hull's pivot ``(offset, height)`` from O (m) and its pitch
+        inertia about O without the pendulum (kg m^2; None: the data's, else a homogeneous
+        hull's).
+    geometry, width, coarse, design : the body's dimensions (validity checks), width (m,
+        capture-width ratio), the body on the error estimate's coarser mesh (heave alone),
+        and the design search's record, for the result.
+    """
+    from .hull import HullPTO
+
+    pto = pto or HullPTO()
+    if tuple(h.dofs) != ("heave",):
+        windings = ((1, 0) if winding is None else (winding,) if np.ndim(winding) == 0
+                    else tuple(winding))
+        return hull_answer(h, pendulum, wave, pivot=pivot, windings=windings,
+                           pitch_inertia=pitch_inertia, harmonics=harmonics,
+                           wave_info=wave_info, geometry=geometry, pto=pto)
+    if pto.copper_loss:
+        from ..errors import ParameterError
+
+        raise ParameterError("copper-loss: the heaving buoy's optimum has no copper loss yet; "
+                             "needs --dofs surge,heave,pitch")
+    eff = pto.efficiency
+    eff = None if eff is None or tuple(eff) == (1.0, 1.0) else eff
+    winding = 1 if winding is None else winding
+    opts = {"winding": winding, "harmonics": harmonics, "torque_limit": pto.torque_limit,
+            "efficiency": eff}
+    sol, ow, notes = _solve(h, pendulum, wave, **opts)
+    errors = _error_powers(h, coarse, pendulum, wave, **opts)
+    return _result(h, width, pendulum, wave, wave_info, sol, ow, torque_limit=pto.torque_limit,
+                   efficiency=eff, winding=winding, design=design, notes=notes,
+                   error_powers=errors, geometry=geometry)
 
 
 def _half_grid(h):
@@ -469,5 +688,198 @@ def _message(sol, p, pendulum, electrical=None, *, bound=None, torque_limit=None
     return (f"the pendulum cannot rotate with positive power in this wave (best P = {p:.3g} W): "
             f"its damping c = {pendulum.damping_coefficient:g} N m s/rad takes more than the "
             "wave gives; lower the damping or raise the wave height")
+
+
+# -- a hull in surge, heave and pitch: one wave's answer
+#: pitch beyond which linear hull theory is stretched (deg)
+PITCH_VALIDITY_DEG = 15.0
+#: points per period on which the extremes are first located (then refined by Brent)
+PEAK_POINTS = 2048
+
+
+class MotionAt:
+    """The motion of one solution at any time (s), from its coefficients: ``phi`` and the
+    hull exactly (trigonometric sums), the torque and the bearing load from (P)."""
+
+    def __init__(self, problem: HullProblem, x, y):
+        cs = problem.case
+        self.case, self.x = cs, np.asarray(x, dtype=float)
+        self.xi = problem.harmonics_of(y)
+
+    def __call__(self, t) -> dict:
+        cs, x, w = self.case, self.x, self.case.omega
+        t = np.atleast_1d(np.asarray(t, dtype=float))
+        s = w * t
+        n = cs.harmonics
+        k = np.arange(1, n + 1)
+        sn, cn = np.sin(np.outer(s, k)), np.cos(np.outer(s, k))
+        a, b = x[1:n + 1], x[n + 1:]
+        phi = cs.winding * s + x[0] + sn @ a + cn @ b
+        phi1 = w * (cs.winding + (cn * k) @ a - (sn * k) @ b)
+        phi2 = -w**2 * ((sn * k**2) @ a + (cn * k**2) @ b)
+        kh = np.arange(1, cs.hull_harmonics + 1)
+        e = np.exp(1j * np.outer(s, kh))
+        xi = (self.xi[0].real + (e @ self.xi[1:]).real).T
+        xi1 = (e @ (1j * w * kh[:, None] * self.xi[1:])).real.T
+        xi2 = (e @ (-(w * kh[:, None]) ** 2 * self.xi[1:])).real.T
+        g = cs.G
+        p2 = g @ xi2
+        ml = cs.m * cs.l
+        sp, cp = np.sin(phi), np.cos(phi)
+        v = phi1 - xi1[2]
+        tau = cs.I * phi2 + cs.c * v - ml * ((cs.g + p2[1]) * sp - p2[0] * cp)
+        # the bearing's load: the pendulum's mass times its centre's acceleration, plus its
+        # weight (the force the pivot applies to the pendulum)
+        fx = cs.m * p2[0] + ml * (cp * phi2 - sp * phi1**2)
+        fz = cs.m * p2[1] - ml * (sp * phi2 + cp * phi1**2) + cs.m * cs.g
+        return {"t": t, "phi": phi, "phi_dot": phi1, "xi": xi, "xi_dot": xi1, "tau": tau,
+                "relative_speed": v, "power": -tau * v, "pivot_force": np.hypot(fx, fz)}
+
+
+def peak(fun, period: float, points: int = PEAK_POINTS) -> float:
+    """The largest value of the periodic ``fun(t)`` (vectorized): located on ``points``
+    samples, then refined between the neighbours of the largest by Brent's method."""
+    t = period * np.arange(points) / points
+    v = fun(t)
+    i = int(np.argmax(v))
+    h = period / points
+    r = minimize_scalar(lambda s: -float(fun(np.array([s]))[0]),
+                        bounds=(t[i] - h, t[i] + h), method="bounded",
+                        options={"xatol": 1e-12 * period})
+    return max(float(v[i]), -float(r.fun))
+
+
+def _deg(v) -> float:
+    return float(np.degrees(v))
+
+
+def _mode(sol) -> dict:
+    pr = HullProblem(sol.case)
+    y = pr.solve_hull(sol.x)
+    mot = MotionAt(pr, sol.x, y)
+    period = 2 * math.pi / sol.case.omega
+    pk = peak(lambda t: np.abs(mot(t)["tau"]), period)
+    status, ok = sol.status, sol.success
+    limit = sol.pto.torque_limit
+    if limit is not None and math.isfinite(sol.power) and pk > limit * (1 + 1e-12):
+        # the limit is imposed on the solve grid: checked between its points
+        over = pk / limit - 1
+        ok = ok and over <= TORQUE_SLACK
+        status += (f"; between the grid points the peak torque is {pk:.6g} N m "
+                   f"({over:.1e} above the limit)")
+    s = mot(period * np.arange(PEAK_POINTS) / PEAK_POINTS)
+    k = sol.case.winding
+    swing = None if k else 0.5 * _deg(np.max(s["phi"]) - np.min(s["phi"]))
+    mean = _deg(math.remainder(float(np.mean(s["phi"])) - math.pi, 2 * math.pi) + math.pi)
+    return {"mode": "swinging" if k == 0 else "rotation", "winding": k,
+            "power_w": sol.power, "mechanical_power_w": (
+                sol.power if sol.mechanical_power is None else sol.mechanical_power),
+            "one_way_power_w": sol.one_way_power,
+            "energy_balance_residual": sol.energy_balance_residual,
+            "refinement_change_w": sol.refinement_change, "harmonics": sol.case.harmonics,
+            "mean_angle_deg": mean if k == 0 else None, "swing_amplitude_deg": swing,
+            "peak_torque_nm": pk, "distinct_maxima": sol.distinct_maxima,
+            "found_by": sol.found_by, "starts": sol.runs, "success": ok,
+            "status": status, "_solution": sol, "_motion": mot}
+
+
+def _solve_mode(hull, pendulum, wave, k, harmonics, pivot, pitch_inertia, pto) -> dict:
+    def make(scale):
+        base = make_case(hull, pendulum, wave, winding=k, harmonics=harmonics, pivot=pivot,
+                         pitch_inertia=pitch_inertia)
+        if scale == 1:
+            return base
+        return make_case(hull, pendulum, wave, winding=k, harmonics=scale * base.harmonics,
+                         hull_harmonics=scale * base.hull_harmonics, pivot=pivot,
+                         pitch_inertia=pitch_inertia)
+    return _mode(hull_search(make, pto=pto))
+
+
+def hull_answer(hull, pendulum, wave, *, pivot, windings=(1, 0), pitch_inertia=None,
+                harmonics=None, wave_info=None, geometry=None, notes=(),
+                pto: HullPTO | None = None) -> BuoyResult:
+    """Solve each winding of ``windings`` (0: swinging), put them beside rest, and build
+    the result from the best; ``pto`` the power take-off (None: ideal)."""
+    pto = pto or HullPTO()
+    from threadpoolctl import threadpool_limits
+
+    modes = []
+    # small dense matrices (a few hundred): BLAS threads cost more than they save
+    with threadpool_limits(1, user_api="blas"):
+        for k in windings:
+            modes.append(_solve_mode(hull, pendulum, wave, k, harmonics, pivot,
+                                     pitch_inertia, pto))
+    ok_modes = [m for m in modes if m["success"]]
+    best = max(ok_modes or modes, key=lambda m: m["power_w"])
+    rest = {"mode": "rest", "winding": None, "power_w": 0.0, "mechanical_power_w": 0.0,
+            "success": True, "status": "the pendulum held (no power)"}
+    public = [{k: v for k, v in m.items() if not k.startswith("_")} for m in modes] + [rest]
+    sol = best["_solution"]
+    cs = sol.case
+    at_rest = best["power_w"] <= 0 and len(windings) > 1
+    mot = None if at_rest else best["_motion"]
+    period = 2 * math.pi / wave.omega
+    s = (mot or best["_motion"])(period * np.arange(PEAK_POINTS) / PEAK_POINTS)
+    xi1 = best["_motion"].xi[1] if not at_rest else np.zeros(3)
+    amps = np.asarray(wave.amplitudes)
+    regular = amps.size == 1
+    def ph(z):
+        return (_deg(np.angle(z / amps[0])) if regular and abs(z) > 0 else None)
+    def half(v):
+        return (0.0 if at_rest else 0.5 * float(np.max(v) - np.min(v)))
+    bound, cut = radiation_bound(cs)
+    flux = energy_flux(wave.omega, amps, hull.rho, hull.g, hull.water_depth)
+    p = 0.0 if at_rest else float(best["power_w"])
+    pitch_amp = _deg(half(s["xi"][2]))
+    validity = []
+    peak_pitch = 0.0 if at_rest else _deg(np.max(np.abs(s["xi"][2])))
+    if peak_pitch > PITCH_VALIDITY_DEG:
+        validity.append(f"linear theory: the pitch reaches {peak_pitch:.3g} degrees, beyond "
+                        f"about {PITCH_VALIDITY_DEG:g}; the answer is outside its validity")
+    if geometry is not None and not at_rest:
+        d = geometry.get("draft_m")
+        half_len = geometry.get("half_length_m", 0.0)
+        ends = np.abs(s["xi"][1]) + half_len * np.abs(np.sin(s["xi"][2]))
+        if d is not None and float(np.max(ends)) > d:
+            validity.append(f"linear theory: the hull's heave and pitch move its ends by up "
+                            f"to {float(np.max(ends)):.3g} m, more than its draft {d:.3g} m")
+    warnings = list(getattr(hull, "notes", ())) + list(notes) + [
+        f"{m['mode']}: {m['status']}" for m in modes if not m["success"]]
+    if cut:
+        warnings.append(f"radiation bound: {cut} singular value(s) of B below "
+                        f"{BOUND_RCOND:g} of the largest cut in its pseudo-inverse")
+    owp = None if at_rest else best["one_way_power_w"]
+    return BuoyResult(
+        power_w=p, mechanical_power_w=0.0 if at_rest else float(best["mechanical_power_w"]),
+        efficiency=list(pto.efficiency) if pto.efficiency is not None else None,
+        copper_loss_w_per_nm2=pto.copper_loss, torque_limit_nm=pto.torque_limit,
+        mode="rest" if at_rest else best["mode"],
+        winding=None if at_rest else best["winding"], modes=public,
+        one_way_power_w=owp, one_way_ratio=(owp / p if owp is not None and p > 0 else None),
+        energy_balance_residual=None if at_rest else best["energy_balance_residual"],
+        radiation_bound_w=bound, bound_fraction=(p / bound if bound > 0 else None),
+        bound_rcond=BOUND_RCOND, bound_cut=cut,
+        capture_width_m=(p / flux if flux > 0 else None), energy_flux_w_per_m=flux,
+        surge_amplitude_m=half(s["xi"][0]), heave_amplitude_m=half(s["xi"][1]),
+        pitch_amplitude_deg=pitch_amp, surge_phase_deg=ph(xi1[0]),
+        heave_phase_deg=ph(xi1[1]), pitch_phase_deg=ph(xi1[2]),
+        mean_heel_deg=0.0 if at_rest else _deg(best["_motion"].xi[0, 2].real),
+        mean_angle_deg=None if at_rest else best["mean_angle_deg"],
+        swing_amplitude_deg=None if at_rest else best["swing_amplitude_deg"],
+        peak_torque_nm=0.0 if at_rest else best["peak_torque_nm"],
+        peak_pivot_force_n=peak(lambda t: (mot or best["_motion"])(t)["pivot_force"],
+                                period) if not at_rest else pendulum.mass * hull.g,
+        harmonics=cs.harmonics, hull_harmonics=cs.hull_harmonics,
+        refinement_change_w=None if at_rest else best["refinement_change_w"],
+        success=all(m["success"] for m in modes),
+        status="; ".join(f"{m['mode']}: {m['status']}" for m in modes),
+        dofs=["surge", "heave", "pitch"], wave=dict(wave_info or {},
+                                                    omega_rad_per_s=wave.omega),
+        pendulum={"mass_kg": pendulum.mass, "length_m": pendulum.length,
+                  "inertia_kg_m2": pendulum.inertia,
+                  "damping_coefficient": pendulum.damping_coefficient},
+        body=dict(geometry or {}, description=getattr(hull, "description", "")),
+        pivot={"pivot_offset_m": cs.pivot[0], "pivot_height_m": cs.pivot[1]},
+        warnings=warnings, validity_warnings=validity, _motion=mot, _hydro=hull, _wave=wave)
 
 

@@ -115,7 +115,7 @@ def matrix_spec(*, hs="1:3:3", te=None, tp=None, realizations: int = 3, waves: f
     ``horizon``, ``forecast``, ``update_interval``, ``warm_up``, ``plan_samples`` and
     ``speed_limit`` as ``parapend.performance.causal.check_causal`` takes them (None:
     ``CAUSAL``, the buoy's ``BUOY_CAUSAL``)."""
-    from ..hydro.hull_api import parse_dofs
+    from ..hydro.api import parse_dofs
     from ..seas import _check_sea, check_response, read_response
     from ..units import Units
     from .causal import check_causal

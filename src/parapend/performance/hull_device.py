@@ -1,9 +1,9 @@
 """The pendulum in a hull that surges, heaves and pitches as a power-matrix device
 (``--device buoy --dofs surge,heave,pitch``): the hull checked and built as ``parapend buoy
---dofs surge,heave,pitch`` builds it (:func:`parapend.hydro.hull_api.hull_problem`, once per
+--dofs surge,heave,pitch`` builds it (:func:`parapend.hydro.api.hull_problem`, once per
 process), every bin's record checked before any bin runs, and one bin's realization solved
 as ``parapend buoy --dofs surge,heave,pitch --hs --tp --repeat-period --seed`` solves it
-(:func:`parapend.hydro.hull_api.solve_record`).
+(:func:`parapend.hydro.api.solve_record`).
 
 The record of bin ``(i, j)``, realization ``r`` is the heave buoy's (:func:`.buoy_device.wave_of`).
 Per realization the store keeps the best of rotation (one turn per wave), swinging and rest
@@ -46,18 +46,18 @@ def _key(spec) -> str:
 
 
 def problem(spec) -> dict:
-    """The spec's hull problem (:func:`parapend.hydro.hull_api.hull_problem`): the checks
+    """The spec's hull problem (:func:`parapend.hydro.api.hull_problem`): the checks
     and the hull's coefficients (BEM cached on disk), built once per process."""
     key = _key(spec)
     if key not in _PROBLEMS:
-        from ..hydro.hull_api import hull_problem
+        from ..hydro.api import hull_problem
 
         _PROBLEMS[key] = hull_problem(**hull_opts(spec))
     return _PROBLEMS[key]
 
 
 def hull_of(spec):
-    """The spec's :class:`~parapend.hydro.hull_data.HullHydro`."""
+    """The spec's :class:`~parapend.hydro.bem.HullHydro`."""
     return problem(spec)["hull"]
 
 
@@ -86,7 +86,7 @@ def resolve(spec, user: dict):
 
 def _fits(spec, waves: float) -> bool:
     """Whether every period bin's record of ``waves`` peak periods fits the hull's size."""
-    from ..hydro.hull_api import solve_record
+    from ..hydro.api import solve_record
     from .buoy_device import wave_of
 
     s = dataclasses.replace(spec, waves=float(waves))
@@ -124,8 +124,8 @@ def check_records(spec) -> None:
     period bin. The records of one period bin differ in Hm0 and seed only: the same band
     and, with the amplitudes' shape unchanged, the same size."""
     from .. import limits
-    from ..hydro.hull_api import solve_record
-    from ..hydro.hull_optimum import HARMONICS_PER_TURN
+    from ..hydro.api import solve_record
+    from ..hydro.hull import HARMONICS_PER_TURN
     from .buoy_device import wave_of
 
     p = problem(spec)
@@ -150,7 +150,7 @@ def check_records(spec) -> None:
 def solve_hull_bin(spec, i: int, j: int, r: int) -> dict:
     """The hull's answer to one record: the best mode's power (never below zero), its mode,
     the radiation bound, the one-way power, the mechanical power of a lossy take-off."""
-    from ..hydro.hull_api import solve_record
+    from ..hydro.api import solve_record
     from ..maps.spec import _CODE
     from .buoy_device import wave_of
 

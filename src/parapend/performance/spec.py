@@ -100,7 +100,7 @@ class MatrixSpec:
     water_depth: float | None = None
     # the hull that surges, heaves and pitches (dofs "surge,heave,pitch"): the pivot (m),
     # the hull's pitch inertia (kg m^2), the barge (m), the take-off's copper loss
-    # (W/(N m)^2) and torque limit (N m), as parapend buoy takes them (hydro/hull_api.py)
+    # (W/(N m)^2) and torque limit (N m), as parapend buoy takes them (hydro/api.py)
     dofs: str = "heave"
     pivot_height: float | None = None
     pivot_offset: float | None = None
