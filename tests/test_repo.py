@@ -44,3 +44,35 @@ def test_ci_portability_step_names_tests_that_exist():
         assert (ROOT / path).is_file(), name
         if func:
             assert f"def {func}(" in (ROOT / path).read_text(), name
+
+
+def _tracked_files() -> list[Path]:
+    """Every file git tracks in this checkout (skips outside a git checkout)."""
+    import shutil
+    import subprocess
+
+    if shutil.which("git") is None or not (ROOT / ".git").exists():
+        pytest.skip("not a git checkout")
+    out = subprocess.run(["git", "ls-files", "-z"], cwd=ROOT, capture_output=True, check=True)
+    return [ROOT / name for name in out.stdout.decode().split("\0") if name]
+
+
+#: the largest file git may track: the repository holds source, text and small data, no binaries
+MAX_TRACKED_BYTES = 1_000_000
+
+
+def test_no_large_file_or_build_output_is_tracked():
+    files = _tracked_files()
+    assert len(files) > 100 and ROOT / "README.md" in files
+    big = [f"{p.relative_to(ROOT)}: {p.stat().st_size} bytes" for p in files
+           if p.is_file() and p.stat().st_size > MAX_TRACKED_BYTES]
+    assert not big, "files over 1 MB are tracked by git:\n" + "\n".join(big)
+    built = [str(p.relative_to(ROOT)) for p in files
+             if p.name.endswith((".whl", ".tar.gz", ".so", ".o", ".pyc"))]
+    assert not built, f"build outputs are tracked by git: {built}"
+
+
+def test_gitignore_covers_build_outputs():
+    ignored = (ROOT / ".gitignore").read_text().split()
+    for pattern in ("*.whl", "*.tar.gz", "build/", "dist/", "*.egg-info/", "__pycache__/"):
+        assert pattern in ignored, pattern
