@@ -111,8 +111,8 @@ def _run_ci_with_stubs(tmp_path, failpat: str):
     return proc, rows
 
 
-STAGES = ["README's command", "install '.[docs]'", "the slow set", "OPENBLAS_CORETYPE=",
-          "NUMBA_DISABLE_JIT=1", "sphinx build", "links and anchors"]
+STAGES = ["README's command", "install '.[docs]'", "the slow set, main", "OPENBLAS_CORETYPE=",
+          "NUMBA_DISABLE_JIT=1", "sphinx build", "links and anchors", "slow set, beside"]
 
 
 def test_ci_prints_every_stages_time(tmp_path):
@@ -125,7 +125,8 @@ def test_ci_prints_every_stages_time(tmp_path):
 
 
 @pytest.mark.parametrize("failpat,stage", [
-    ("-m pytest -m slow", "the slow set"),
+    ("--ignore=tests/test_global.py", "the slow set, main"),
+    ("-m slow -p no:cacheprovider tests/", "slow set, beside"),
     ("pip install -q .[test]", "README's command"),
     ("tests/test_hermite.py", "NUMBA_DISABLE_JIT=1"),
     ("check_site", "links and anchors"),
@@ -139,3 +140,22 @@ def test_a_failing_stage_fails_the_run_and_the_table_still_prints(tmp_path, fail
     # nothing after a failed stage of its own sequence runs
     if stage == "README's command":
         assert not any("slow set" in r for r in rows)
+
+
+def test_ci_splits_the_slow_set_into_files_that_exist():
+    """The slow set runs in two sessions: the files listed in slow_beside, and every other
+    file (--ignore of the same list): together the whole set, each test once."""
+    import re
+
+    run = ROOT / ".ci" / "run"
+    if not run.exists():
+        pytest.skip("not a source checkout")
+    text = run.read_text()
+    (listed,) = re.findall(r"^slow_beside=\(([^)]*)\)$", text, re.M)
+    names = listed.split()
+    assert names and len(set(names)) == len(names)
+    for name in names:
+        assert (ROOT / name).is_file() and "pytest.mark.slow" in (ROOT / name).read_text(), name
+    lines = text.splitlines()
+    assert 'python -m pytest -m slow "${slow_beside[@]/#/--ignore=}"' in lines
+    assert '  python -m pytest -m slow -p no:cacheprovider "${slow_beside[@]}"' in lines
