@@ -2,11 +2,11 @@
 work of the uncontrolled-pendulum commands (paper Eq. 1).
 
 Independent references: SciPy's Wilson interval (``binomtest(...).proportion_ci``); SciPy's
-DOP853 (``solve_ivp`` on paper Eq. 1 written in the test, all points in one system at a
-tolerance no looser per point than rtol = atol = 1e-11) with :func:`classify` on its
-Poincare samples for the labels; the period-doubling multiplier -1 at the curve E (Floquet, DOP853
-variational equations) and the value found by an independent audit (E = 3.289 at
-omega = 2.1).
+DOP853 (``solve_ivp`` on paper Eq. 1 written in tests/dop853_labels.py, all points in one
+system, at a tolerance no looser per point than rtol = atol = 1e-11) with :func:`classify` on
+its Poincare samples for the labels; the period-doubling multiplier -1 at the curve E
+(Floquet, DOP853 variational equations) and the value found by an independent audit
+(E = 3.289 at omega = 2.1).
 """
 
 from __future__ import annotations
@@ -22,11 +22,11 @@ import time
 import numpy as np
 import pytest
 import xarray as xr
-from scipy.integrate import solve_ivp
+from dop853_labels import dop853_labels
 from scipy.stats import binomtest
 
 from parapend.cli import main
-from parapend.dynamics import basin_map, classify, periodic_orbit
+from parapend.dynamics import basin_map, periodic_orbit
 from parapend.dynamics.basins import wilson_interval
 from parapend.dynamics.continuation import rotation_boundaries_at
 from parapend.errors import ParameterError
@@ -247,52 +247,6 @@ def test_basins_ctrl_c_during_first_compile_one_line_exit_130(tmp_path):
 
 
 # --- acceptance: the estimate brackets DOP853's mislabel fraction ------------------------
-def _dop853_labels(phi0, dphi0, gamma, p, omega, periods=300, chunk=30, tol=1e-11):
-    """Attractor reached from each (phi0[i], phi0'[i]) at t = 0: DOP853 on all the points at
-    once, Poincare samples every period, :func:`classify` (the engine's rules) on each
-    point's samples after every ``chunk`` periods; a labelled point leaves the system.
-
-    Paper Eq. 1 is written here, not taken from the package. One system of ``n`` equations
-    has one step size and SciPy's error norm is the RMS over its components; its tolerance
-    is ``tol sqrt(2 / n)``, so that no component's local error may exceed what ``rtol =
-    atol = tol`` allows the same component integrated alone (a system of 2). All the points
-    share each call of the right-hand side, which makes this about 30 times faster than
-    one ``solve_ivp`` per point.
-    """
-    period = 2 * math.pi / omega
-    y = np.concatenate([np.asarray(phi0, dtype=float), np.asarray(dphi0, dtype=float)])
-    m = y.size // 2
-    ph, dph = [[v] for v in y[:m]], [[v] for v in y[m:]]
-    labels = np.full(m, "other", dtype=object)
-    active = np.arange(m)
-    t = 0.0
-    while active.size and len(ph[active[0]]) <= periods:
-        k = active.size
-
-        def f(tt, yy, k=k):
-            phi, dphi = yy[:k], yy[k:]
-            return np.concatenate([dphi, -gamma * dphi - (1.0 + p * math.cos(omega * tt))
-                                   * np.sin(phi)])
-
-        te = t + period * np.arange(1, chunk + 1)
-        tol_n = tol * math.sqrt(2.0 / (2 * k))
-        sol = solve_ivp(f, (t, te[-1]), y, method="DOP853", t_eval=te, rtol=tol_n,
-                        atol=tol_n)
-        assert sol.success
-        y, t = sol.y[:, -1], te[-1]
-        keep = np.ones(k, dtype=bool)
-        for r, i in enumerate(active):
-            ph[i].extend(sol.y[r])
-            dph[i].extend(sol.y[k + r])
-            c = classify(np.array(ph[i]), np.array(dph[i]), tol=1e-6)
-            if c.name != "other":
-                labels[i] = c.name
-                keep[r] = False
-        active = active[keep]
-        y = np.concatenate([y[:k][keep], y[k:][keep]])
-    return labels
-
-
 @pytest.mark.slow
 @pytest.mark.parametrize("case", [INTERTWINED, COEX])
 def test_accuracy_estimate_brackets_dop853_mislabel_fraction(case):
@@ -314,7 +268,7 @@ def test_accuracy_estimate_brackets_dop853_mislabel_fraction(case):
     names = [str(x) for x in ds["name"].values]
     j, i = np.divmod(pick, 60)
     mine = np.array([names[int(a)] for a in ds["attractor"].values[j, i]])
-    ref = _dop853_labels(ds["phi"].values[i], ds["dphi"].values[j], *case).astype(str)
+    ref = dop853_labels(ds["phi"].values[i], ds["dphi"].values[j], *case).astype(str)
     bad = int(np.count_nonzero(mine != ref))
     dlo, dhi = wilson_interval(bad, m)
     assert dlo <= hi and dhi >= lo           # the two 95 % intervals overlap
