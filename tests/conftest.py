@@ -50,3 +50,12 @@ def _one_bem_cache_per_session():
     assert os.environ.get("PARAPEND_CACHE") == before, (
         f"a test changed PARAPEND_CACHE from {before!r} to "
         f"{os.environ.get('PARAPEND_CACHE')!r} without restoring it")
+
+
+@pytest.fixture(scope="session")
+def sphere_nc(tmp_path_factory):
+    """The coarse floating sphere of tests/test_buoy_cli.py solved by Capytaine once a
+    session and written as a dataset (``--hydro``), for every module that runs a buoy on it."""
+    from test_buoy_cli import _capytaine_dataset
+
+    return _capytaine_dataset(tmp_path_factory.mktemp("hydro") / "sphere.nc")
