@@ -1,7 +1,8 @@
 """Sphinx configuration of the parapend documentation site.
 
-Build (from the repository root) with the README's docs command, ``python -m sphinx -W
---keep-going -b html docs docs/_build/html`` after ``python -m pip install '.[docs]'``.
+Build (from the repository root) with the docs command of CONTRIBUTING.md, ``python -m
+sphinx -W --keep-going -b html docs docs/_build/html`` after ``python -m pip install
+'.[docs]'``.
 
 The tutorials (``tutorials/*.md``, MyST notebooks) execute at every build; a failing cell
 fails the build. The API reference is generated from the docstrings (autosummary +

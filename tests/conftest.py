@@ -36,3 +36,26 @@ def paper():
     import parapend
 
     return parapend.harmonic(-0.3, 1.8)
+
+
+@pytest.fixture(scope="session", autouse=True)
+def _one_bem_cache_per_session():
+    """The BEM cache (``PARAPEND_CACHE``, or ``~/.cache/parapend``) is shared by the whole
+    session, so that each body the tests use is solved by Capytaine once. A test or fixture
+    that needs a cold or a private cache sets its own with ``monkeypatch`` (restored after
+    it); one that changed the variable for good would send every later test to an empty
+    cache, to solve its bodies again: this fails the session at its end instead."""
+    before = os.environ.get("PARAPEND_CACHE")
+    yield
+    assert os.environ.get("PARAPEND_CACHE") == before, (
+        f"a test changed PARAPEND_CACHE from {before!r} to "
+        f"{os.environ.get('PARAPEND_CACHE')!r} without restoring it")
+
+
+@pytest.fixture(scope="session")
+def sphere_nc(tmp_path_factory):
+    """The coarse floating sphere of tests/test_buoy_cli.py solved by Capytaine once a
+    session and written as a dataset (``--hydro``), for every module that runs a buoy on it."""
+    from test_buoy_cli import _capytaine_dataset
+
+    return _capytaine_dataset(tmp_path_factory.mktemp("hydro") / "sphere.nc")

@@ -56,11 +56,6 @@ def _capytaine_dataset(path, *, dofs=("Heave",), hydrostatics=True):
 
 
 @pytest.fixture(scope="module")
-def sphere_nc(tmp_path_factory):
-    return _capytaine_dataset(tmp_path_factory.mktemp("hydro") / "sphere.nc")
-
-
-@pytest.fixture(scope="module")
 def solved(sphere_nc):
     return parapend.buoy(hydro=sphere_nc, wave_period=PERIOD, mass=20.0, length=0.3,
                          damping_coefficient=0.5, harmonics=8)

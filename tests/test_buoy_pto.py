@@ -170,28 +170,23 @@ def test_cli_bad_efficiency(argv, match, capsys, tmp_path):
 
 
 @pytest.mark.slow
-def test_cli_efficiency_json(capsys):
-    import tempfile
-    from pathlib import Path
-
+def test_cli_efficiency_json(capsys, sphere_nc):
     from test_buoy_cli import PEND as CLI_PEND
-    from test_buoy_cli import PERIOD, _capytaine_dataset
+    from test_buoy_cli import PERIOD
 
-    with tempfile.TemporaryDirectory() as d:
-        nc = _capytaine_dataset(Path(d) / "sphere.nc")
-        capsys.readouterr()  # Capytaine's progress bar
-        assert main(["buoy", "--hydro", nc, "--wave-period", str(PERIOD), *CLI_PEND,
-                     "--efficiency", "0.9,0.8", "--json"]) == 0
-        out = json.loads(capsys.readouterr().out)
-        assert out["efficiency"] == [0.9, 0.8]
-        assert out["success"], out["status"]
-        assert out["power_w"] == out["electrical_power_w"]  # the headline: electrical
-        assert out["pto_loss_w"] == pytest.approx(out["mechanical_power_w"]
-                                                  - out["electrical_power_w"],
-                                                  rel=1e-12)
-        assert 0 < out["electrical_power_w"] <= 0.9 * out["ideal_power_w"]
-        assert out["generated_power_w"] - out["motoring_power_w"] == pytest.approx(
-            out["mechanical_power_w"], rel=1e-9)
+    nc = sphere_nc
+    assert main(["buoy", "--hydro", nc, "--wave-period", str(PERIOD), *CLI_PEND,
+                 "--efficiency", "0.9,0.8", "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert out["efficiency"] == [0.9, 0.8]
+    assert out["success"], out["status"]
+    assert out["power_w"] == out["electrical_power_w"]  # the headline: electrical
+    assert out["pto_loss_w"] == pytest.approx(out["mechanical_power_w"]
+                                              - out["electrical_power_w"],
+                                              rel=1e-12)
+    assert 0 < out["electrical_power_w"] <= 0.9 * out["ideal_power_w"]
+    assert out["generated_power_w"] - out["motoring_power_w"] == pytest.approx(
+        out["mechanical_power_w"], rel=1e-9)
 
 
 @pytest.mark.slow

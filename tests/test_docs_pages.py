@@ -54,21 +54,29 @@ def test_the_history_patterns_catch_what_they_should():
         assert not any(re.search(p, text, re.IGNORECASE) for p in HISTORY), text
 
 
-def _readme_docs_command() -> str:
-    lines = (ROOT / "README.md").read_text().splitlines()
+def _documented_docs_command() -> str:
+    """CONTRIBUTING.md's docs command: its one indented line that runs Sphinx."""
+    lines = (ROOT / "CONTRIBUTING.md").read_text().splitlines()
     cmds = [ln.strip() for ln in lines if ln.startswith("    ") and "python -m sphinx" in ln]
     assert len(cmds) == 1, cmds
     return cmds[0]
 
 
-def test_ci_builds_the_site_with_the_readme_command_and_checks_it():
+def test_ci_builds_the_site_with_the_documented_command_and_checks_it():
+    """.ci/run runs the docs command of CONTRIBUTING.md: its install as a stage of its own
+    (before the stages that run beside the tests), then its Sphinx build verbatim, warnings
+    as errors, then the link and browser checks of the built site."""
     run = ROOT / ".ci" / "run"
     if not run.exists():
         pytest.skip("not a source checkout")
-    cmd = _readme_docs_command()
+    cmd = _documented_docs_command()
     assert "-W" in cmd.split() and "'.[docs]'" in cmd
+    install, _, build = cmd.partition(" && ")
+    assert install == "python -m pip install '.[docs]'" and build.startswith("python -m sphinx")
     script = run.read_text().splitlines()
-    assert cmd in script
-    after = script[script.index(cmd):]
+    assert build in script
+    installs = [i for i, ln in enumerate(script) if ln.startswith(install)]
+    assert installs and installs[0] < script.index(build)
+    after = script[script.index(build):]
     assert any(ln.startswith("python docs/check_links.py ") for ln in after)
     assert any(ln.startswith("python docs/check_site.py ") for ln in after)

@@ -19,7 +19,6 @@ import math
 
 import numpy as np
 import pytest
-from test_buoy_cli import _capytaine_dataset
 
 import parapend
 from parapend.cli import main
@@ -32,11 +31,6 @@ SEA = {"hs": 0.3, "tp": 2.5, "repeat_period": 10.0, "seed": 3}
 PEND = {"mass": 20.0, "length": 0.3, "damping_coefficient": 0.5}
 ARGV = ["--hs", "0.3", "--tp", "2.5", "--repeat-period", "10", "--seed", "3", "--mass", "20",
         "--length", "0.3", "--damping-coefficient", "0.5"]
-
-
-@pytest.fixture(scope="module")
-def sphere_nc(tmp_path_factory):
-    return _capytaine_dataset(tmp_path_factory.mktemp("hydro") / "sphere.nc")
 
 
 @pytest.fixture(scope="module")

@@ -8,7 +8,6 @@ import math
 
 import numpy as np
 import pytest
-from test_buoy_cli import _capytaine_dataset
 
 from parapend.cli import main
 from parapend.hydro.bem import load
@@ -23,11 +22,6 @@ PEND = {"mass": 20.0, "length": 0.3, "damping_coefficient": 0.5, "harmonics": 24
 ARGS = ["--hs", "0.1,0.2", "--tp", "2.6,3.0", "--realizations", "1", "--waves", "4",
         "--seed", "7", "--mass", "20", "--length", "0.3", "--damping-coefficient", "0.5",
         "--harmonics", "24", "--workers", "1"]
-
-
-@pytest.fixture(scope="module")
-def sphere_nc(tmp_path_factory):
-    return _capytaine_dataset(tmp_path_factory.mktemp("hydro") / "sphere.nc")
 
 
 @pytest.fixture(scope="module")

@@ -393,13 +393,6 @@ BUOY_KW = {"device": "buoy", "hs": "0.1,0.2", "tp": "2.6,3.0", "realizations": 1
 
 
 @pytest.fixture(scope="module")
-def sphere_nc(tmp_path_factory):
-    from test_buoy_cli import _capytaine_dataset
-
-    return _capytaine_dataset(tmp_path_factory.mktemp("hydro") / "sphere.nc")
-
-
-@pytest.fixture(scope="module")
 def buoy_bin(sphere_nc):
     """The bin Hs 0.2 m, Tp 3 s of the buoy's matrix, solved as the matrix solves it."""
     from parapend.performance.solve import solve_bin

@@ -177,13 +177,6 @@ def test_design_search_stops_after_its_first_solve(monkeypatch):
 
 
 # --- the buoy: a period sweep and the receding-horizon run (no BEM) ------------------------
-@pytest.fixture(scope="module")
-def sphere_nc(tmp_path_factory):
-    from test_buoy_cli import _capytaine_dataset
-
-    return _capytaine_dataset(tmp_path_factory.mktemp("hydro") / "sphere.nc")
-
-
 PEND = {"mass": 20.0, "length": 0.3, "damping_coefficient": 0.5, "harmonics": 8}
 
 
