@@ -11,7 +11,8 @@ import math
 import numpy as np
 
 __all__ = ["acceleration", "best_damping", "cell_plan", "choose_step", "controller_power",
-           "energy_residual", "omniscient_power", "record_heave", "run_cell", "step_check"]
+           "energy_residual", "omniscient_power", "record_heave", "run_cell", "run_column",
+           "step_check"]
 
 #: steps of RK4 per period of the highest component of the record
 STEPS_PER_CUTOFF_PERIOD = 10
@@ -207,15 +208,62 @@ def run_cell(spec, plan: dict, cg: float, realizations, *, extras: bool = True) 
     out = np.concatenate([p[0] for p in parts])
     flags = np.concatenate([p[1] for p in parts])
     vals = _summaries(spec, plan, cg, out, flags)
-    if extras and spec.omniscient:
+    return _extras(spec, plan, vals, idx) if extras else vals
+
+
+def _extras(spec, plan: dict, vals: dict, idx) -> dict:
+    """``vals`` with the optional columns (omniscient optimum, controller) of the
+    realizations ``idx`` that get them."""
+    if spec.omniscient:
         vals["omniscient_power"] = np.array([
             omniscient_power(spec, plan, spec.seed + r) if r < spec.omniscient else math.nan
             for r in idx])
-    if extras and spec.controller:
+    if spec.controller:
         vals["controller_power"] = np.array([
             controller_power(spec, plan, spec.seed + r) if r < _controlled(spec) else math.nan
             for r in idx])
     return vals
+
+
+#: the GPU path takes at most this many bytes of unit records per launch
+GPU_RECORD_BYTES = 2 << 30
+
+
+def run_column(spec, j: int) -> list:
+    """GPU: every cell of the ``Tp`` column ``j`` (all ``Hs``, generator settings and
+    realizations), each as :func:`run_cell` gives it, in one dict of lists indexed
+    ``[i][k]`` (``Hs``, generator). The cells of one step share one launch per batch of
+    realizations (:data:`GPU_RECORD_BYTES` of unit records; the acceptance map's columns
+    take one): the unit records made once on the GPU, scaled by each lane's ``Hs``."""
+    from ._persist_gpu import run_column_gpu
+
+    nh, ng, nr = len(spec.hs), len(spec.generator), spec.realizations
+    plans = [cell_plan(spec, i, j) for i in range(nh)]
+    cgs = np.array([[best_damping(spec, plans[i]) if spec.best else float(spec.generator[k])
+                     for k in range(ng)] for i in range(nh)])
+    out = np.empty((nh, ng, nr, 6))
+    flags = np.empty((nh, ng, nr), dtype=np.int8)
+    steps: dict = {}
+    for i, p in enumerate(plans):  # cells of the same step share their records
+        steps.setdefault((p["m"], p["k0"], p["nwin"]), []).append(i)
+    for rows in steps.values():
+        plan = plans[rows[0]]
+        kw = {"a": plan["a"], "g": spec.gravity, "th0": math.pi, "om0": plan["om0"],
+              "h": plan["h"], "k0": plan["k0"], "twin": 2 * plan["tp"], "nwin": plan["nwin"]}
+        scale = np.repeat([plans[i]["hs"] for i in rows], ng)
+        bd = ((spec.damping_coefficient + cgs[rows]) / plan["inertia"]).ravel()
+        per = max(1, GPU_RECORD_BYTES // (16 * plan["m"]))
+        for r0 in range(0, nr, per):
+            r1 = min(nr, r0 + per)
+            seeds = [spec.seed + r for r in range(r0, r1)]
+            zu = acceleration(spec, {**plan, "hs": 1.0}, seeds)
+            o, f = run_column_gpu(zu, scale, bd, **kw)
+            out[rows, :, r0:r1] = o.reshape(len(rows), ng, r1 - r0, 6)
+            flags[rows, :, r0:r1] = f.reshape(len(rows), ng, r1 - r0)
+    idx = list(range(nr))
+    return [[_extras(spec, plans[i], _summaries(spec, plans[i], cgs[i, k], out[i, k],
+                                                flags[i, k]), idx)
+             for k in range(ng)] for i in range(nh)]
 
 
 def _controlled(spec) -> int:
