@@ -323,7 +323,7 @@ import zarr
 import parapend
 from parapend.dynamics._persist_gpu import run_column_gpu  # noqa: F401 - importable
 kw = dict(mass=1.0, length=0.3, damping_coefficient=2e-4, generator_damping="5e-4,2e-3",
-          hs="0.01,0.03", tp=0.3, duration=6.0, transient=0.6, realizations=3, seed=0)
+          hs="0.01,0.03,0.4", tp=0.3, duration=6.0, transient=0.6, realizations=3, seed=0)
 g = parapend.persistence(**kw, gpu=True, store=sys.argv[1])
 again = parapend.persistence(**kw, gpu=True, store=sys.argv[1])
 c = parapend.persistence(**kw)
@@ -338,10 +338,12 @@ print(json.dumps(out))
 
 @pytest.mark.slow
 def test_gpu_kernel_on_the_cuda_simulator_gives_the_cpu_kernel_s_numbers(tmp_path):
-    """numba's CUDA simulator (no GPU needed) runs the GPU path: a Tp column of 2 Hs x 2
-    generator dampings x 3 realizations in one launch per step (one block, one chunk, in a
-    store that a second run resumes), against the CPU kernel on the same records (20 peak
-    periods, not sensitive: the sines differ in the last bit, the numbers to 1e-9)."""
+    """numba's CUDA simulator (no GPU needed) runs the GPU path: a Tp column of 3 Hs (two
+    step sizes) x 2 generator dampings x 3 realizations in one launch (one block, one chunk,
+    in a store that a second run resumes), against the CPU kernel on the same records (20
+    peak periods; the sines differ in the last bit, which the violent 0.4 m records grow to
+    4e-8: the numbers to 1e-6, where a lane given another cell's Hs, step or damping is off
+    by far more)."""
     import importlib.util
 
     if importlib.util.find_spec("numba.cuda") is None:
@@ -351,12 +353,12 @@ def test_gpu_kernel_on_the_cuda_simulator_gives_the_cpu_kernel_s_numbers(tmp_pat
                        capture_output=True, text=True, timeout=600)
     assert p.returncode == 0, p.stderr[-2000:]
     out = json.loads(p.stdout.splitlines()[-1])
-    assert out.pop("chunks") == [1, 2, 2, 3]
+    assert out.pop("chunks") == [1, 3, 2, 3]
     for v, (gpu, cpu, again) in out.items():
         gpu, cpu = np.array(gpu), np.array(cpu)
         np.testing.assert_array_equal(gpu, np.array(again), err_msg=v)
         if v in ("throughout", "status"):
             np.testing.assert_array_equal(gpu, cpu, err_msg=v)
         else:
-            np.testing.assert_allclose(gpu, cpu, rtol=1e-9, atol=1e-12, err_msg=v)
+            np.testing.assert_allclose(gpu, cpu, rtol=1e-6, atol=1e-12, err_msg=v)
     assert np.ptp(np.array(out["power"][1])) > 0  # the cells and dampings differ

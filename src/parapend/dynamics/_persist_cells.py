@@ -108,22 +108,27 @@ def acceleration(spec, plan: dict, seeds) -> np.ndarray:
     inverse real FFT per record of unit ``Hs`` (exact at the grid's points for the periodic
     record), times ``Hs`` (the spectrum's amplitudes are proportional to ``Hs``: the records
     of every ``Hs`` of a ``Tp`` share their unit record, to rounding :func:`record_heave`'s)."""
-    n = 2 * plan["m"]
     z = record_heaves(spec, 1.0, plan["tp"], seeds)
-    if spec.gpu:  # the FFTs on the GPU when CuPy is there
+    return plan["hs"] * _unit_acceleration(spec, z, 2 * plan["m"])
+
+
+def _unit_acceleration(spec, z, n: int):
+    """``z''`` on ``n`` points per record of the heave spectra ``z`` (one a row): on the GPU
+    by CuPy when asked for and there (a CuPy array), else by SciPy."""
+    if spec.gpu:
         from ._persist_gpu import acceleration_gpu
 
         out = acceleration_gpu(z, n, spec.duration)
         if out is not None:
-            return plan["hs"] * out
+            return out
     from scipy import fft
 
     from ._persist_kernel import threads
 
     w2 = (2 * math.pi * np.arange(z.shape[1]) / spec.duration) ** 2
-    spec_n = np.zeros((len(seeds), n // 2 + 1), dtype=complex)
+    spec_n = np.zeros((z.shape[0], n // 2 + 1), dtype=complex)
     spec_n[:, :z.shape[1]] = -w2 * z * (n / 2)
-    return plan["hs"] * fft.irfft(spec_n, n, axis=1, workers=threads())
+    return fft.irfft(spec_n, n, axis=1, workers=threads())
 
 
 #: unit records in the kernel's layout, kept for the next cells of the same Tp (the blocks
@@ -231,35 +236,35 @@ GPU_RECORD_BYTES = 2 << 30
 
 def run_column(spec, j: int) -> list:
     """GPU: every cell of the ``Tp`` column ``j`` (all ``Hs``, generator settings and
-    realizations), each as :func:`run_cell` gives it, in one dict of lists indexed
-    ``[i][k]`` (``Hs``, generator). The cells of one step share one launch per batch of
-    realizations (:data:`GPU_RECORD_BYTES` of unit records; the acceptance map's columns
-    take one): the unit records made once on the GPU, scaled by each lane's ``Hs``."""
+    realizations), each as :func:`run_cell` gives it, in lists indexed ``[i][k]`` (``Hs``,
+    generator). One launch per batch of realizations (:data:`GPU_RECORD_BYTES` of unit
+    records; the acceptance map's columns take one): the phases drawn once, the unit
+    records made on the GPU once per step size among the column's cells, each lane
+    scaled by its cell's ``Hs``."""
     from ._persist_gpu import run_column_gpu
 
     nh, ng, nr = len(spec.hs), len(spec.generator), spec.realizations
     plans = [cell_plan(spec, i, j) for i in range(nh)]
     cgs = np.array([[best_damping(spec, plans[i]) if spec.best else float(spec.generator[k])
                      for k in range(ng)] for i in range(nh)])
+    steps: dict = {}  # the step sizes of the column's cells, in order of appearance
+    group = [steps.setdefault(p["m"], len(steps)) for p in plans]
+    ms = list(steps)
+    cells = {"group": np.repeat(group, ng), "scale": np.repeat([p["hs"] for p in plans], ng),
+             "bdamp": ((spec.damping_coefficient + cgs) / plans[0]["inertia"]).ravel()}
+    for key in ("h", "k0", "nwin"):
+        cells[key] = np.repeat([p[key] for p in plans], ng)
     out = np.empty((nh, ng, nr, 6))
     flags = np.empty((nh, ng, nr), dtype=np.int8)
-    steps: dict = {}
-    for i, p in enumerate(plans):  # cells of the same step share their records
-        steps.setdefault((p["m"], p["k0"], p["nwin"]), []).append(i)
-    for rows in steps.values():
-        plan = plans[rows[0]]
-        kw = {"a": plan["a"], "g": spec.gravity, "th0": math.pi, "om0": plan["om0"],
-              "h": plan["h"], "k0": plan["k0"], "twin": 2 * plan["tp"], "nwin": plan["nwin"]}
-        scale = np.repeat([plans[i]["hs"] for i in rows], ng)
-        bd = ((spec.damping_coefficient + cgs[rows]) / plan["inertia"]).ravel()
-        per = max(1, GPU_RECORD_BYTES // (16 * plan["m"]))
-        for r0 in range(0, nr, per):
-            r1 = min(nr, r0 + per)
-            seeds = [spec.seed + r for r in range(r0, r1)]
-            zu = acceleration(spec, {**plan, "hs": 1.0}, seeds)
-            o, f = run_column_gpu(zu, scale, bd, **kw)
-            out[rows, :, r0:r1] = o.reshape(len(rows), ng, r1 - r0, 6)
-            flags[rows, :, r0:r1] = f.reshape(len(rows), ng, r1 - r0)
+    per = max(1, GPU_RECORD_BYTES // (16 * sum(ms)))
+    for r0 in range(0, nr, per):
+        r1 = min(nr, r0 + per)
+        z = record_heaves(spec, 1.0, plans[0]["tp"], [spec.seed + r for r in range(r0, r1)])
+        o, f = run_column_gpu([_unit_acceleration(spec, z, 2 * m) for m in ms], cells,
+                              a=plans[0]["a"], g=spec.gravity, th0=math.pi,
+                              om0=plans[0]["om0"], twin=2 * plans[0]["tp"])
+        out[:, :, r0:r1] = o.reshape(nh, ng, r1 - r0, 6)
+        flags[:, :, r0:r1] = f.reshape(nh, ng, r1 - r0)
     idx = list(range(nr))
     return [[_extras(spec, plans[i], _summaries(spec, plans[i], cgs[i, k], out[i, k],
                                                 flags[i, k]), idx)

@@ -3,12 +3,13 @@ r"""The GPU path of ``parapend persistence`` (``--gpu``): the kernel of
 quadratures and window bookkeeping. Imported only when asked for; never needed otherwise.
 
 A launch takes a whole ``Tp`` column (:func:`run_column_gpu`): one unit record ``z''`` per
-realization (``Hs = 1``, laid out half step by half step so that the threads of a warp,
-neighbouring realizations, read neighbouring values) and per lane a cell's scale (its
-``Hs``) and damping, so every ``Hs`` x generator damping x realization of the column runs
-at once; the state, the accumulations and the window bookkeeping stay in registers, and
-the results come back in one transfer. ``z''`` is made on the GPU by CuPy's inverse FFT
-when CuPy is installed (else on the CPU and copied).
+realization and step size among the column's cells (``Hs = 1``, laid out half step by half
+step so that the threads of a warp, neighbouring realizations, read neighbouring values)
+and per lane a cell's scale (its ``Hs``), damping and step, so every ``Hs`` x generator
+damping x realization of the column runs at once; the state, the accumulations and the
+window bookkeeping stay in registers, and the results come back in one transfer. ``z''``
+is made on the GPU by CuPy's inverse FFT when CuPy is installed (else on the CPU and
+copied).
 
 The GPU's sine and its fused multiply-adds give other bits than the CPU kernel: the same
 statistics within their intervals, not the same numbers (a GPU map is another map in a
@@ -54,17 +55,21 @@ def _kernel():
     cuda = numba_cuda
 
     @numba_cuda.jit
-    def persist_gpu(zu, scale, bdamp, a, g, th0, om0, h, k0, twin, nwin, out, flags):
-        nrec = zu.shape[1]
+    def persist_gpu(zf, nrec, off, steps, hstep, start, wins, scale, bdamp, a, g, th0, om0,
+                    twin, out, flags):
         lane = cuda.grid(1)
         if lane >= scale.size * nrec:
             return
         cell = lane // nrec
         rec = lane - cell * nrec
+        base = off[cell] + rec  # z'' at half step i: zf[base + i nrec]
         hs = scale[cell]
         b = bdamp[cell]
-        n2 = zu.shape[0]
-        m = n2 // 2
+        m = steps[cell]
+        n2 = 2 * m
+        h = hstep[cell]
+        k0 = start[cell]
+        nwin = wins[cell]
         th = th0
         om = om0
         s2 = 0.0
@@ -78,11 +83,11 @@ def _kernel():
         tw = k0 * h
         h2 = 0.5 * h
         h6 = h / 6.0
-        z3 = hs * zu[0, rec]
+        z3 = hs * zf[base]
         for j in range(m):
             z1 = z3
-            z2 = hs * zu[2 * j + 1, rec]
-            z3 = hs * zu[(2 * j + 2) % n2, rec]
+            z2 = hs * zf[base + (2 * j + 1) * nrec]
+            z3 = hs * zf[base + ((2 * j + 2) % n2) * nrec]
             t1 = th
             w1 = om
             sn1 = math.sin(t1)
@@ -137,35 +142,47 @@ def _kernel():
     return _KERNEL
 
 
-def _device_records(zdd):
-    """``zdd`` (B, 2M), NumPy or CuPy, on the GPU laid out ``(2M, B)``."""
+def _device_records(zus):
+    """The records ``zus`` (a list of (B, 2M_g) arrays, NumPy or CuPy, the same B) on the
+    GPU as one flat array, each laid out ``(2M_g, B)``; and the offset of each."""
     from numba import cuda
 
-    if hasattr(zdd, "__cuda_array_interface__"):
+    sizes = [z.shape[0] * z.shape[1] for z in zus]
+    off = np.concatenate([[0], np.cumsum(sizes)[:-1]]).astype(np.int64)
+    if all(hasattr(z, "__cuda_array_interface__") for z in zus):
         import cupy as cp
 
-        return cuda.as_cuda_array(cp.ascontiguousarray(zdd.T))
-    return cuda.to_device(np.ascontiguousarray(np.asarray(zdd, dtype=np.float64).T))
+        flat = cp.concatenate([cp.ascontiguousarray(z.T).ravel() for z in zus])
+        return cuda.as_cuda_array(flat), off
+    flat = np.concatenate([np.ascontiguousarray(np.asarray(z, dtype=np.float64).T).ravel()
+                           for z in zus])
+    return cuda.to_device(flat), off
 
 
-def run_column_gpu(zu, scale, bdamp, *, a: float, g: float, th0: float, om0: float,
-                   h: float, k0: int, twin: float, nwin: int):
-    """One launch over ``C x B`` lanes: the unit records ``zu`` (B, 2M; NumPy or CuPy),
-    record ``r`` times ``scale[c]`` with damping ``bdamp[c]`` (``(c + c_g) / I``, 1/s) in
-    lane ``c B + r`` (``C = len(scale)``). Returns ``(out, flags)`` as NumPy arrays of
-    ``C B`` rows (:func:`._persist_kernel.persist_batch`'s columns), copied back at once."""
+def run_column_gpu(zus, cells: dict, *, a: float, g: float, th0: float, om0: float,
+                   twin: float):
+    """One launch over ``C x B`` lanes (``C`` cells, ``B`` records): the unit records
+    ``zus`` (a list of (B, 2M_g) arrays, NumPy or CuPy: one per step size ``g``), record
+    ``r`` of group ``cells["group"][c]`` times ``cells["scale"][c]`` with damping
+    ``cells["bdamp"][c]`` (``(c + c_g) / I``, 1/s), step ``cells["h"][c]``, window start
+    ``cells["k0"][c]`` and ``cells["nwin"][c]`` windows in lane ``c B + r``. Returns ``(out,
+    flags)`` as NumPy arrays of ``C B`` rows (:func:`._persist_kernel.persist_batch`'s
+    columns), copied back at once."""
     from numba import cuda
 
-    scale = np.ascontiguousarray(np.asarray(scale, dtype=np.float64).ravel())
-    bdamp = np.ascontiguousarray(np.broadcast_to(np.asarray(bdamp, dtype=np.float64),
-                                                 scale.shape))
-    lanes = scale.size * zu.shape[0]
-    d_zu = _device_records(zu)
+    nrec = int(zus[0].shape[0])
+    d_z, off = _device_records(zus)
+    grp = np.asarray(cells["group"], dtype=np.int64)
+    m = np.array([z.shape[1] // 2 for z in zus], dtype=np.int64)[grp]
+    args = [off[grp], m] + [np.asarray(cells[k], dtype=t) for k, t in (
+        ("h", np.float64), ("k0", np.int64), ("nwin", np.int64), ("scale", np.float64),
+        ("bdamp", np.float64))]
+    lanes = grp.size * nrec
     d_out = cuda.device_array((lanes, 6), dtype=np.float64)
     d_flags = cuda.device_array(lanes, dtype=np.int8)
     _kernel()[(lanes + THREADS - 1) // THREADS, THREADS](
-        d_zu, cuda.to_device(scale), cuda.to_device(bdamp), float(a), float(g), float(th0),
-        float(om0), float(h), int(k0), float(twin), int(nwin), d_out, d_flags)
+        d_z, nrec, *(cuda.to_device(np.ascontiguousarray(x)) for x in args), float(a),
+        float(g), float(th0), float(om0), float(twin), d_out, d_flags)
     return d_out.copy_to_host(), d_flags.copy_to_host()
 
 
@@ -177,8 +194,9 @@ def run_batch_gpu(zdd, bdamp, *, a: float, g: float, th0: float, om0: float, h: 
     bd = np.asarray(bdamp, dtype=np.float64)
     if bd.size != 1:
         raise ValueError("run_batch_gpu: one damping for all the records")
-    return run_column_gpu(zdd, [1.0], bd.reshape(1), a=a, g=g, th0=th0, om0=om0, h=h,
-                          k0=k0, twin=twin, nwin=nwin)
+    cells = {"group": [0], "scale": [1.0], "bdamp": bd.reshape(1), "h": [h], "k0": [k0],
+             "nwin": [nwin]}
+    return run_column_gpu([zdd], cells, a=a, g=g, th0=th0, om0=om0, twin=twin)
 
 
 def acceleration_gpu(heave_rows, n: int, duration: float):
