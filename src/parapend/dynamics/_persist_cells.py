@@ -230,8 +230,9 @@ def _extras(spec, plan: dict, vals: dict, idx) -> dict:
     return vals
 
 
-#: the GPU path takes at most this many bytes of unit records per launch
-GPU_RECORD_BYTES = 2 << 30
+#: the GPU path takes at most this many bytes of unit records per launch (with the FFT's
+#: buffers and the transposed copy, about four times this on the GPU)
+GPU_RECORD_BYTES = 1 << 30
 
 
 def run_column(spec, j: int) -> list:
