@@ -1,36 +1,54 @@
 #!/usr/bin/env bash
 # The GPU path of `parapend persistence` on a machine with a CUDA GPU (run from the
 # repository root): the same statistics as the CPU path side by side, then the time of the
-# 20 Hs x 20 Tp x 1000 realizations x 400 Tp map on the GPU.
+# 20 Hs x 20 Tp x 1000 realizations x 400 Tp map on the GPU (compiled first, then timed).
 #
-#   bash benchmarks/gpu_persistence.sh            # everything (a few minutes)
+#   bash benchmarks/gpu_persistence.sh            # everything (about a minute)
 #   QUICK=1 bash benchmarks/gpu_persistence.sh    # the comparison only
 #
 # Needs numba's CUDA support (numba.cuda, or the numba-cuda package); CuPy is used for the
-# FFTs when installed (else they run on the CPU and are copied). Prints what it could not do.
+# FFTs when installed (else they run on the CPU and are copied). Python: $PYTHON, else
+# python3, else python. Wheels in .whl/ (packages the machine lacks: zarr, dask, ...) are
+# installed into /tmp/site first. numba-cuda releases that call numpy.row_stack (removed in
+# NumPy 2.5) get it as numpy.vstack in this script's Python (not in the library). Prints
+# what it could not do.
 set -u
-export PYTHONPATH="$PWD/src${PYTHONPATH:+:$PYTHONPATH}"
-PY=${PYTHON:-python}
+if [ -n "${PYTHON:-}" ]; then PY=$PYTHON
+elif command -v python3 >/dev/null 2>&1; then PY=python3
+else PY=python; fi
+if compgen -G ".whl/*.whl" >/dev/null; then
+  $PY -m pip install -q --no-index --no-deps --no-compile --no-cache-dir --upgrade \
+    --target /tmp/site .whl/*.whl || exit 1
+  export PYTHONPATH="/tmp/site${PYTHONPATH:+:$PYTHONPATH}"
+fi
+export PYTHONPATH="$PWD/src:$PWD/benchmarks${PYTHONPATH:+:$PYTHONPATH}"
+export PYTHONUNBUFFERED=1
+# the compatibility line, run before anything imports numba.cuda
+SHIM='import numpy as np
+if not hasattr(np, "row_stack"):
+    np.row_stack = np.vstack
+'
 
 nvidia-smi --query-gpu=name,memory.total,driver_version --format=csv,noheader 2>/dev/null \
   || echo "nvidia-smi: not found"
-$PY - <<'EOF'
+$PY - <<EOF2
+$SHIM
 import importlib.util
 from parapend.dynamics._persist_gpu import available
 why = available()
-print("numba.cuda:", "ready" if not why else why)
+print("numpy", np.__version__, "| numba.cuda:", "ready" if not why else why)
 print("cupy:", "installed" if importlib.util.find_spec("cupy") else "not installed (FFTs on the CPU)")
 if why:
     raise SystemExit(1)
-EOF
+EOF2
 [ $? -eq 0 ] || exit 1
 
 # 1. The same cells on the CPU and on the GPU: 2 Hs x 2 Tp x 1000 realizations of 400 Tp.
 #    The GPU's sine and fused multiply-adds differ in the last bits and the motion is
 #    chaotic: the statistics must agree within their intervals, the realizations need not.
-$PY - <<'EOF'
+$PY - <<EOF2
+$SHIM
 import math, time
-import numpy as np
 import parapend
 
 t0 = 2 * math.pi * math.sqrt(0.3 / 9.81)
@@ -56,9 +74,13 @@ for tp in (0.25 * t0, 0.45 * t0):
         print(f"   energy residual max: CPU {sc['energy_residual_max']:.2g}, "
               f"GPU {sg['energy_residual_max']:.2g}")
     print(f"   time for 2 cells x 1000: CPU {out[False][1]:.1f} s, GPU {out[True][1]:.1f} s")
-EOF
+EOF2
 
 [ "${QUICK:-0}" = "1" ] && exit 0
 # 2. The acceptance map on the GPU (one persistence call per Tp column: 400 peak periods
-#    each), and its step check.
-$PY benchmarks/bench_persistence.py --gpu --skip-kernel --grid 20 --realizations 1000
+#    each; a column is one block, one launch), its time, steps per second and step check.
+$PY - <<EOF2
+$SHIM
+import bench_persistence
+bench_persistence.main(["--gpu", "--skip-kernel", "--grid", "20", "--realizations", "1000"])
+EOF2

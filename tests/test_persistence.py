@@ -314,3 +314,51 @@ def test_worker_processes_give_the_same_bits():
     assert a.executor == "2 local processes"
     for v in a.dataset.data_vars:
         np.testing.assert_array_equal(a.dataset[v].values, b.dataset[v].values, err_msg=v)
+
+
+_SIMULATED = r"""
+import json, sys
+import numpy as np
+import zarr
+import parapend
+from parapend.dynamics._persist_gpu import run_column_gpu  # noqa: F401 - importable
+kw = dict(mass=1.0, length=0.3, damping_coefficient=2e-4, generator_damping="5e-4,2e-3",
+          hs="0.01,0.03,0.4", tp=0.3, duration=6.0, transient=0.6, realizations=3, seed=0)
+g = parapend.persistence(**kw, gpu=True, store=sys.argv[1])
+again = parapend.persistence(**kw, gpu=True, store=sys.argv[1])
+c = parapend.persistence(**kw)
+out = {"chunks": list(zarr.open_group(sys.argv[1], mode="r")["rho"].chunks)}
+for v in ("rho", "throughout", "power", "harvested_energy", "dissipated_energy", "base_work",
+          "stored_energy_change", "status"):
+    out[v] = [g.dataset[v].values.tolist(), c.dataset[v].values.tolist(),
+              again.dataset[v].values.tolist()]
+print(json.dumps(out))
+"""
+
+
+@pytest.mark.slow
+def test_gpu_kernel_on_the_cuda_simulator_gives_the_cpu_kernel_s_numbers(tmp_path):
+    """numba's CUDA simulator (no GPU needed) runs the GPU path: a Tp column of 3 Hs (two
+    step sizes) x 2 generator dampings x 3 realizations in one launch (one block, one chunk,
+    in a store that a second run resumes), against the CPU kernel on the same records (20
+    peak periods; the sines differ in the last bit, which the violent 0.4 m records grow to
+    4e-8: the numbers to 1e-6, where a lane given another cell's Hs, step or damping is off
+    by far more)."""
+    import importlib.util
+
+    if importlib.util.find_spec("numba.cuda") is None:
+        pytest.skip("numba has no CUDA support (simulator included) here")
+    env = {**os.environ, "PYTHONPATH": str(ROOT / "src"), "NUMBA_ENABLE_CUDASIM": "1"}
+    p = subprocess.run([sys.executable, "-c", _SIMULATED, str(tmp_path / "g.zarr")], env=env,
+                       capture_output=True, text=True, timeout=600)
+    assert p.returncode == 0, p.stderr[-2000:]
+    out = json.loads(p.stdout.splitlines()[-1])
+    assert out.pop("chunks") == [1, 3, 2, 3]
+    for v, (gpu, cpu, again) in out.items():
+        gpu, cpu = np.array(gpu), np.array(cpu)
+        np.testing.assert_array_equal(gpu, np.array(again), err_msg=v)
+        if v in ("throughout", "status"):
+            np.testing.assert_array_equal(gpu, cpu, err_msg=v)
+        else:
+            np.testing.assert_allclose(gpu, cpu, rtol=1e-6, atol=1e-12, err_msg=v)
+    assert np.ptp(np.array(out["power"][1])) > 0  # the cells and dampings differ

@@ -11,7 +11,8 @@ import math
 import numpy as np
 
 __all__ = ["acceleration", "best_damping", "cell_plan", "choose_step", "controller_power",
-           "energy_residual", "omniscient_power", "record_heave", "run_cell", "step_check"]
+           "energy_residual", "omniscient_power", "record_heave", "run_cell", "run_column",
+           "step_check"]
 
 #: steps of RK4 per period of the highest component of the record
 STEPS_PER_CUTOFF_PERIOD = 10
@@ -107,22 +108,27 @@ def acceleration(spec, plan: dict, seeds) -> np.ndarray:
     inverse real FFT per record of unit ``Hs`` (exact at the grid's points for the periodic
     record), times ``Hs`` (the spectrum's amplitudes are proportional to ``Hs``: the records
     of every ``Hs`` of a ``Tp`` share their unit record, to rounding :func:`record_heave`'s)."""
-    n = 2 * plan["m"]
     z = record_heaves(spec, 1.0, plan["tp"], seeds)
-    if spec.gpu:  # the FFTs on the GPU when CuPy is there
+    return plan["hs"] * _unit_acceleration(spec, z, 2 * plan["m"])
+
+
+def _unit_acceleration(spec, z, n: int):
+    """``z''`` on ``n`` points per record of the heave spectra ``z`` (one a row): on the GPU
+    by CuPy when asked for and there (a CuPy array), else by SciPy."""
+    if spec.gpu:
         from ._persist_gpu import acceleration_gpu
 
         out = acceleration_gpu(z, n, spec.duration)
         if out is not None:
-            return plan["hs"] * out
+            return out
     from scipy import fft
 
     from ._persist_kernel import threads
 
     w2 = (2 * math.pi * np.arange(z.shape[1]) / spec.duration) ** 2
-    spec_n = np.zeros((len(seeds), n // 2 + 1), dtype=complex)
+    spec_n = np.zeros((z.shape[0], n // 2 + 1), dtype=complex)
     spec_n[:, :z.shape[1]] = -w2 * z * (n / 2)
-    return plan["hs"] * fft.irfft(spec_n, n, axis=1, workers=threads())
+    return fft.irfft(spec_n, n, axis=1, workers=threads())
 
 
 #: unit records in the kernel's layout, kept for the next cells of the same Tp (the blocks
@@ -207,15 +213,63 @@ def run_cell(spec, plan: dict, cg: float, realizations, *, extras: bool = True) 
     out = np.concatenate([p[0] for p in parts])
     flags = np.concatenate([p[1] for p in parts])
     vals = _summaries(spec, plan, cg, out, flags)
-    if extras and spec.omniscient:
+    return _extras(spec, plan, vals, idx) if extras else vals
+
+
+def _extras(spec, plan: dict, vals: dict, idx) -> dict:
+    """``vals`` with the optional columns (omniscient optimum, controller) of the
+    realizations ``idx`` that get them."""
+    if spec.omniscient:
         vals["omniscient_power"] = np.array([
             omniscient_power(spec, plan, spec.seed + r) if r < spec.omniscient else math.nan
             for r in idx])
-    if extras and spec.controller:
+    if spec.controller:
         vals["controller_power"] = np.array([
             controller_power(spec, plan, spec.seed + r) if r < _controlled(spec) else math.nan
             for r in idx])
     return vals
+
+
+#: the GPU path takes at most this many bytes of unit records per launch (with the FFT's
+#: buffers and the transposed copy, about four times this on the GPU)
+GPU_RECORD_BYTES = 1 << 30
+
+
+def run_column(spec, j: int) -> list:
+    """GPU: every cell of the ``Tp`` column ``j`` (all ``Hs``, generator settings and
+    realizations), each as :func:`run_cell` gives it, in lists indexed ``[i][k]`` (``Hs``,
+    generator). One launch per batch of realizations (:data:`GPU_RECORD_BYTES` of unit
+    records; the acceptance map's columns take one): the phases drawn once, the unit
+    records made on the GPU once per step size among the column's cells, each lane
+    scaled by its cell's ``Hs``."""
+    from ._persist_gpu import run_column_gpu
+
+    nh, ng, nr = len(spec.hs), len(spec.generator), spec.realizations
+    plans = [cell_plan(spec, i, j) for i in range(nh)]
+    cgs = np.array([[best_damping(spec, plans[i]) if spec.best else float(spec.generator[k])
+                     for k in range(ng)] for i in range(nh)])
+    steps: dict = {}  # the step sizes of the column's cells, in order of appearance
+    group = [steps.setdefault(p["m"], len(steps)) for p in plans]
+    ms = list(steps)
+    cells = {"group": np.repeat(group, ng), "scale": np.repeat([p["hs"] for p in plans], ng),
+             "bdamp": ((spec.damping_coefficient + cgs) / plans[0]["inertia"]).ravel()}
+    for key in ("h", "k0", "nwin"):
+        cells[key] = np.repeat([p[key] for p in plans], ng)
+    out = np.empty((nh, ng, nr, 6))
+    flags = np.empty((nh, ng, nr), dtype=np.int8)
+    per = max(1, GPU_RECORD_BYTES // (16 * sum(ms)))
+    for r0 in range(0, nr, per):
+        r1 = min(nr, r0 + per)
+        z = record_heaves(spec, 1.0, plans[0]["tp"], [spec.seed + r for r in range(r0, r1)])
+        o, f = run_column_gpu([_unit_acceleration(spec, z, 2 * m) for m in ms], cells,
+                              a=plans[0]["a"], g=spec.gravity, th0=math.pi,
+                              om0=plans[0]["om0"], twin=2 * plans[0]["tp"])
+        out[:, :, r0:r1] = o.reshape(nh, ng, r1 - r0, 6)
+        flags[:, :, r0:r1] = f.reshape(nh, ng, r1 - r0)
+    idx = list(range(nr))
+    return [[_extras(spec, plans[i], _summaries(spec, plans[i], cgs[i, k], out[i, k],
+                                                flags[i, k]), idx)
+             for k in range(ng)] for i in range(nh)]
 
 
 def _controlled(spec) -> int:

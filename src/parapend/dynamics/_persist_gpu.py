@@ -2,10 +2,18 @@ r"""The GPU path of ``parapend persistence`` (``--gpu``): the kernel of
 :mod:`._persist_kernel`, one CUDA thread per lane (numba.cuda), the same equation, stages,
 quadratures and window bookkeeping. Imported only when asked for; never needed otherwise.
 
+A launch takes a whole ``Tp`` column (:func:`run_column_gpu`): one unit record ``z''`` per
+realization and step size among the column's cells (``Hs = 1``, laid out half step by half
+step so that the threads of a warp, neighbouring realizations, read neighbouring values)
+and per lane a cell's scale (its ``Hs``), damping and step, so every ``Hs`` x generator
+damping x realization of the column runs at once; the state, the accumulations and the
+window bookkeeping stay in registers, and the results come back in one transfer. ``z''``
+is made on the GPU by CuPy's inverse FFT when CuPy is installed (else on the CPU and
+copied).
+
 The GPU's sine and its fused multiply-adds give other bits than the CPU kernel: the same
 statistics within their intervals, not the same numbers (a GPU map is another map in a
-store: ``gpu`` is part of its identity). ``z''`` is made on the GPU by CuPy's inverse FFT
-when CuPy is installed (else on the CPU and copied).
+store: ``gpu`` is part of its identity).
 """
 
 from __future__ import annotations
@@ -14,8 +22,10 @@ import math
 
 import numpy as np
 
-__all__ = ["available", "run_batch_gpu"]
+__all__ = ["THREADS", "available", "run_batch_gpu", "run_column_gpu"]
 
+#: CUDA threads per block
+THREADS = 128
 _KERNEL = None
 #: numba.cuda, set on first use (a module global: the kernel reads ``cuda.grid`` from here,
 #: as numba's CUDA simulator expects)
@@ -45,13 +55,21 @@ def _kernel():
     cuda = numba_cuda
 
     @numba_cuda.jit
-    def persist_gpu(zdd, bdamp, a, g, th0, om0, h, k0, twin, nwin, out, flags):
+    def persist_gpu(zf, nrec, off, steps, hstep, start, wins, scale, bdamp, a, g, th0, om0,
+                    twin, out, flags):
         lane = cuda.grid(1)
-        if lane >= bdamp.size:
+        if lane >= scale.size * nrec:
             return
-        n2 = zdd.shape[0]
-        m = n2 // 2
-        b = bdamp[lane]
+        cell = lane // nrec
+        rec = lane - cell * nrec
+        base = off[cell] + rec  # z'' at half step i: zf[base + i nrec]
+        hs = scale[cell]
+        b = bdamp[cell]
+        m = steps[cell]
+        n2 = 2 * m
+        h = hstep[cell]
+        k0 = start[cell]
+        nwin = wins[cell]
         th = th0
         om = om0
         s2 = 0.0
@@ -65,10 +83,11 @@ def _kernel():
         tw = k0 * h
         h2 = 0.5 * h
         h6 = h / 6.0
+        z3 = hs * zf[base]
         for j in range(m):
-            z1 = zdd[2 * j, lane]
-            z2 = zdd[2 * j + 1, lane]
-            z3 = zdd[(2 * j + 2) % n2, lane]
+            z1 = z3
+            z2 = hs * zf[base + (2 * j + 1) * nrec]
+            z3 = hs * zf[base + ((2 * j + 2) % n2) * nrec]
             t1 = th
             w1 = om
             sn1 = math.sin(t1)
@@ -123,28 +142,61 @@ def _kernel():
     return _KERNEL
 
 
-def run_batch_gpu(zdd, bdamp, *, a: float, g: float, th0: float, om0: float, h: float,
-                  k0: int, twin: float, nwin: int):
-    """:func:`._persist_kernel.run_batch` on the GPU: ``zdd`` (B, 2M), a NumPy or CuPy
-    array, is laid out half step by half step (``(2M, B)``: the threads of a warp read
-    neighbouring values); ``(out, flags)`` as NumPy arrays."""
+def _device_records(zus):
+    """The records ``zus`` (a list of (B, 2M_g) arrays, NumPy or CuPy, the same B) on the
+    GPU as one flat array, each laid out ``(2M_g, B)``; and the offset of each."""
     from numba import cuda
 
-    b = zdd.shape[0]
-    bdamp = np.ascontiguousarray(np.broadcast_to(np.asarray(bdamp, dtype=np.float64), (b,)))
-    if hasattr(zdd, "__cuda_array_interface__"):
+    sizes = [z.shape[0] * z.shape[1] for z in zus]
+    off = np.concatenate([[0], np.cumsum(sizes)[:-1]]).astype(np.int64)
+    if all(hasattr(z, "__cuda_array_interface__") for z in zus):
         import cupy as cp
 
-        d_zdd = cuda.as_cuda_array(cp.ascontiguousarray(zdd.T))
-    else:
-        d_zdd = cuda.to_device(np.ascontiguousarray(np.asarray(zdd, dtype=np.float64).T))
-    d_out = cuda.device_array((b, 6), dtype=np.float64)
-    d_flags = cuda.device_array(b, dtype=np.int8)
-    threads = 128
-    _kernel()[(b + threads - 1) // threads, threads](
-        d_zdd, cuda.to_device(bdamp), float(a), float(g), float(th0), float(om0), float(h),
-        int(k0), float(twin), int(nwin), d_out, d_flags)
+        flat = cp.concatenate([cp.ascontiguousarray(z.T).ravel() for z in zus])
+        return cuda.as_cuda_array(flat), off
+    flat = np.concatenate([np.ascontiguousarray(np.asarray(z, dtype=np.float64).T).ravel()
+                           for z in zus])
+    return cuda.to_device(flat), off
+
+
+def run_column_gpu(zus, cells: dict, *, a: float, g: float, th0: float, om0: float,
+                   twin: float):
+    """One launch over ``C x B`` lanes (``C`` cells, ``B`` records): the unit records
+    ``zus`` (a list of (B, 2M_g) arrays, NumPy or CuPy: one per step size ``g``), record
+    ``r`` of group ``cells["group"][c]`` times ``cells["scale"][c]`` with damping
+    ``cells["bdamp"][c]`` (``(c + c_g) / I``, 1/s), step ``cells["h"][c]``, window start
+    ``cells["k0"][c]`` and ``cells["nwin"][c]`` windows in lane ``c B + r``. Returns ``(out,
+    flags)`` as NumPy arrays of ``C B`` rows (:func:`._persist_kernel.persist_batch`'s
+    columns), copied back at once."""
+    from numba import cuda
+
+    nrec = int(zus[0].shape[0])
+    d_z, off = _device_records(zus)
+    grp = np.asarray(cells["group"], dtype=np.int64)
+    m = np.array([z.shape[1] // 2 for z in zus], dtype=np.int64)[grp]
+    args = [off[grp], m] + [np.asarray(cells[k], dtype=t) for k, t in (
+        ("h", np.float64), ("k0", np.int64), ("nwin", np.int64), ("scale", np.float64),
+        ("bdamp", np.float64))]
+    lanes = grp.size * nrec
+    d_out = cuda.device_array((lanes, 6), dtype=np.float64)
+    d_flags = cuda.device_array(lanes, dtype=np.int8)
+    _kernel()[(lanes + THREADS - 1) // THREADS, THREADS](
+        d_z, nrec, *(cuda.to_device(np.ascontiguousarray(x)) for x in args), float(a),
+        float(g), float(th0), float(om0), float(twin), d_out, d_flags)
     return d_out.copy_to_host(), d_flags.copy_to_host()
+
+
+def run_batch_gpu(zdd, bdamp, *, a: float, g: float, th0: float, om0: float, h: float,
+                  k0: int, twin: float, nwin: int):
+    """:func:`._persist_kernel.run_batch` on the GPU: the records ``zdd`` (B, 2M, NumPy or
+    CuPy) as they are, one damping ``bdamp`` (a number) for all; ``(out, flags)`` as NumPy
+    arrays."""
+    bd = np.asarray(bdamp, dtype=np.float64)
+    if bd.size != 1:
+        raise ValueError("run_batch_gpu: one damping for all the records")
+    cells = {"group": [0], "scale": [1.0], "bdamp": bd.reshape(1), "h": [h], "k0": [k0],
+             "nwin": [nwin]}
+    return run_column_gpu([zdd], cells, a=a, g=g, th0=th0, om0=om0, twin=twin)
 
 
 def acceleration_gpu(heave_rows, n: int, duration: float):

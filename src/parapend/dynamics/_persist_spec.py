@@ -4,10 +4,11 @@ local processes or Dask) runs, stores and resumes like a sweep.
 
 The store holds per realization (dimensions ``tp, hs, generator, realization``: the blocks
 run Hs after Hs within a Tp, whose cells share their unit records; a block is one cell's
-run of ``block`` realizations, one chunk): ``rho``, ``throughout`` (1 or 0),
-``power`` (W), the four energies of the energy identity (J), the generator damping used
-(N m s/rad) and a ``status``; optionally the omniscient optimum and a causal controller's
-power (W). The statistics are drawn from them afterwards (:mod:`.persistence`).
+run of ``block`` realizations, one chunk; on the GPU path a whole Tp column, one chunk):
+``rho``, ``throughout`` (1 or 0), ``power`` (W), the four energies of the energy identity
+(J), the generator damping used (N m s/rad) and a ``status``; optionally the omniscient
+optimum and a causal controller's power (W). The statistics are drawn from them afterwards
+(:mod:`.persistence`).
 
 Records. Realization ``r`` of every cell is seeded ``seed + r`` (common random numbers over
 the cells and the generator dampings), its phases drawn exactly as
@@ -98,21 +99,22 @@ class PersistenceSpec:
 
     @property
     def chunks(self) -> tuple:
+        if self.gpu:  # a block is a whole Tp column: one launch (run_column)
+            return (1, len(self.hs), len(self.generator), self.realizations)
         return (1, 1, 1, self.block)
 
     @property
     def block_grid(self) -> tuple:
-        return (len(self.tp), len(self.hs), len(self.generator),
-                -(-self.realizations // self.block))
+        return tuple(-(-n // c) for n, c in zip(self.shape, self.chunks))
 
     @property
     def blocks(self) -> int:
         return int(np.prod(self.block_grid))
 
     def block_slices(self, block: int) -> tuple:
-        i, j, k, b = (int(x) for x in np.unravel_index(block, self.block_grid))
-        return (slice(i, i + 1), slice(j, j + 1), slice(k, k + 1),
-                slice(b * self.block, min(self.realizations, (b + 1) * self.block)))
+        at = (int(x) for x in np.unravel_index(block, self.block_grid))
+        return tuple(slice(b * c, min(n, (b + 1) * c))
+                     for b, c, n in zip(at, self.chunks, self.shape))
 
     @property
     def best(self) -> bool:
@@ -212,19 +214,27 @@ class PersistenceSpec:
     # -- one block ---------------------------------------------------------------------------
     def compute_block(self, block: int) -> dict:
         from ..maps.spec import _CODE
-        from ._persist_cells import best_damping, cell_plan, run_cell
+        from ._persist_cells import best_damping, cell_plan, run_cell, run_column
 
         sl = self.block_slices(block)
         j, i, k = sl[0].start, sl[1].start, sl[2].start  # tp, hs, generator
         r0, r1 = sl[3].start, sl[3].stop
-        plan = cell_plan(self, i, j)
-        cg = (best_damping(self, plan) if self.best else float(self.generator[k]))
-        vals = run_cell(self, plan, cg, range(r0, r1))
-        n = r1 - r0
-        out = {v: np.asarray(vals[v], dtype=float).reshape(1, 1, 1, n) for v in STORED}
-        out["status"] = np.where(np.asarray(vals["finite"]), _CODE["converged"],
-                                 _CODE["nonfinite"]).astype(np.int8).reshape(1, 1, 1, n)
+        if self.gpu:  # the whole column: cells [hs][generator]
+            cells = run_column(self, j)
+        else:
+            plan = cell_plan(self, i, j)
+            cg = (best_damping(self, plan) if self.best else float(self.generator[k]))
+            cells = [[run_cell(self, plan, cg, range(r0, r1))]]
+        shape = (1, len(cells), len(cells[0]), r1 - r0)
+
+        def stack(v, dtype=float):
+            return np.array([[np.asarray(c[v], dtype=dtype) for c in row] for row in cells]
+                            ).reshape(shape)
+
+        out = {v: stack(v) for v in STORED}
+        out["status"] = np.where(stack("finite", bool), _CODE["converged"],
+                                 _CODE["nonfinite"]).astype(np.int8)
         for v in self.variables:
             if v in OPTIONAL:
-                out[v] = np.asarray(vals[v], dtype=float).reshape(1, 1, 1, n)
+                out[v] = stack(v)
         return out
