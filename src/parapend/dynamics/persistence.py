@@ -50,6 +50,7 @@ from .. import limits
 from ..defaults import PERSISTENCE
 from ..errors import ParameterError, check_int, check_positive, check_range
 from ..results import Result
+from .basins import wilson_interval as _wilson
 from ._persist_cells import (  # noqa: F401 - the cell's functions, for the API's users
     acceleration,
     best_damping,
@@ -77,14 +78,13 @@ CONTROLLERS = ("track",)
 
 def wilson_interval(successes: int, n: int, z: float = _Z95) -> tuple[float, float]:
     """Wilson's score interval of a binomial fraction (95 % by default); (nan, nan) for n = 0.
+
+    :func:`parapend.dynamics.basins.wilson_interval`'s, whose ends are exactly 0 for no
+    success and 1 for all.
     """
     if n <= 0:
         return (math.nan, math.nan)
-    p = successes / n
-    d = 1.0 + z * z / n
-    centre = (p + z * z / (2 * n)) / d
-    half = z * math.sqrt(p * (1 - p) / n + z * z / (4 * n * n)) / d
-    return (max(0.0, centre - half), min(1.0, centre + half))
+    return _wilson(successes, n, z)
 
 
 def t_interval(x) -> tuple[float, float]:
