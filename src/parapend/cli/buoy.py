@@ -8,7 +8,17 @@ from pathlib import Path
 from ..defaults import BUOY
 from ..errors import ParameterError
 from . import _output
-from ._common import _check_output, _finite_float, _fmt, _int, _Progress, _run, _table, hull_options
+from ._common import (
+    _check_output,
+    _finite_float,
+    _fmt,
+    _int,
+    _Progress,
+    _run,
+    _table,
+    hull_options,
+    unresolved_if,
+)
 
 
 def _text(name):
@@ -204,8 +214,8 @@ def _cmd_buoy(a) -> dict | str:
 
         if a.save:
             _output.write_dataset(r.to_dataset(), a.save)
-        return r.to_dict() if a.json else "\n".join(
-            mpc_text(r) + ([f"written: {a.save}"] if a.save else []))
+        return unresolved_if(r.to_dict() if a.json else "\n".join(
+            mpc_text(r) + ([f"written: {a.save}"] if a.save else [])), r)
     if hasattr(r, "dofs") or hasattr(r, "rotation_power_w"):
         return _hull_output(r, a)
     sweep = hasattr(r, "period_s")

@@ -187,14 +187,19 @@ def bin_power(mean_power) -> np.ndarray:
         return np.where(np.isfinite(p), np.maximum(p, 0.0), np.nan)
 
 
-def annual_energy(mean_power, frequency, outside_frequency: float = 0.0) -> dict:
+def annual_energy(mean_power, frequency, outside_frequency: float = 0.0,
+                  bound=None, bound_name: str = "bound") -> dict:
     """AEP (Wh, MWh) of a matrix of mean powers (W) and bin frequencies: ``8766 h sum P f``
     over the bins with a frequency and a power, each power :func:`bin_power` (never below
-    0). Bins with a frequency and no power are listed (``missing``, ``missing_frequency``);
-    with them and ``outside_frequency`` (sea states outside the matrix) the result is
-    incomplete: ``complete`` false, ``uncounted_frequency`` their share, and ``wh_bounds``
-    the AEP with the uncounted share at zero power and at the largest bin power (``wh`` is
-    the lower bound: the sum over the bins counted)."""
+    0). Bins with a frequency and no power are listed (``missing``); their share and that
+    of the sea states outside the matrix (``outside_frequency``) is ``missing_frequency``
+    (positive exactly when ``complete`` is false; ``missing_bin_frequency`` the bins' part).
+    Incomplete, ``wh_bounds`` is the AEP with that share at zero power (``wh``, the sum over
+    the bins counted) and at a true bound of the power there: ``bound``, each bin's upper
+    bound of its mean power (W; the device's radiation bound or gamma -> 0 limit, named
+    ``bound_name``). The upper end is None (no upper bound, ``upper_bound_note`` says why)
+    where a missing bin has no finite bound or sea states lie outside the matrix (nothing
+    bounds them): never the largest finished bin, which bounds nothing."""
     p = bin_power(mean_power)
     f = np.asarray(frequency, dtype=float)
     used = f > 0
@@ -203,18 +208,30 @@ def annual_energy(mean_power, frequency, outside_frequency: float = 0.0) -> dict
     # the sum scaled by the largest power: powers near the float range's top do not
     # overflow, and each term stays P f exactly as 8766 h sum P f states
     wh = HOURS_PER_YEAR * float(np.sum(np.where(counted, p * f, 0.0)))
-    uncounted = float(f[missing].sum()) + float(outside_frequency or 0.0)
-    top = float(np.max(p[np.isfinite(p)])) if np.isfinite(p).any() else 0.0
-    upper = wh + HOURS_PER_YEAR * top * uncounted
+    outside = float(outside_frequency or 0.0)
+    in_bins = float(f[missing].sum())
+    uncounted = in_bins + outside
     out = {"wh": wh, "mwh": wh / 1e6, "missing": np.argwhere(missing).tolist(),
-           "missing_frequency": float(f[missing].sum()),
+           "missing_frequency": uncounted, "missing_bin_frequency": in_bins,
            "mean_power_w": wh / HOURS_PER_YEAR, "complete": uncounted == 0.0,
            "hours_per_year": HOURS_PER_YEAR, "counted_frequency": float(f[counted].sum()),
            "rest_frequency": float(f[counted & (p == 0.0)].sum())}
     if uncounted:
+        b = None if bound is None else np.broadcast_to(np.asarray(bound, float), f.shape)
+        upper, note = None, None
+        if outside:
+            note = (f"{outside:.4g} of the year lies outside the matrix's bins, where "
+                    "nothing bounds the power: no upper bound")
+        elif b is None or not np.all(np.isfinite(b[missing])):
+            note = (f"no {bound_name} for every bin without power: no upper bound")
+        else:
+            upper = wh + HOURS_PER_YEAR * float(np.sum(np.maximum(b[missing], 0.0)
+                                                       * f[missing]))
+            note = f"the bins without power at their {bound_name}"
         out["uncounted_frequency"] = uncounted
         out["wh_bounds"] = [wh, upper]
-        out["mwh_bounds"] = [wh / 1e6, upper / 1e6]
+        out["mwh_bounds"] = [wh / 1e6, None if upper is None else upper / 1e6]
+        out["upper_bound_note"] = note
     return out
 
 

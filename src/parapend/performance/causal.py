@@ -285,9 +285,12 @@ def solve_causal(spec, i: int, j: int, r: int) -> dict:
             with threadpool_limits(1, user_api="blas"):
                 res = (run_buoy_record(spec, i, j, r, f) if buoy
                        else run_record(spec, exc, units, j, r, f))
-            if res.success and buoy:
+            # a run that loses energy is a measurement (the bin then rests: max(P, 0))
+            if buoy and (res.success or res.status == "loses_energy"):
                 p = float(res.electrical_power_w)
                 w = float(res.harvested_electrical_power_w)
+            elif buoy and res.status == "not_caught" and res.catch_time_s is None:
+                p = w = 0.0  # the swing-up never reached the top: the device rests
             elif res.success:
                 p = units.to_watts(float(res.mean_electrical_power))
                 w = units.to_watts(float(res.harvested_electrical_power))
@@ -324,6 +327,8 @@ def causal_json(ds, grid) -> dict:
            **({"buoy_controller": ds.attrs["causal_buoy_controller"]}
               if "causal_buoy_controller" in ds.attrs else {}),
            "power_matrix": {f: grid(f"causal_{f}_power_matrix") for f in forecasts},
+           "above_optimum": {f: int(ds[f"causal_{f}_power"].attrs.get("above_optimum", 0))
+                             for f in forecasts},
            "mode": {f: [[{1: "controller", 0: "rest"}.get(int(v)) for v in row]
                         for row in ds[f"causal_{f}_mode"].values] for f in forecasts}}
     if "annual_energy" in ds:
