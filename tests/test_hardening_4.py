@@ -224,3 +224,217 @@ def test_a_timeseries_outside_every_bin_is_incomplete_and_says_how_much(monkeypa
     assert a["complete"] is False and a["missing_frequency"] == 1.0
     assert a["wh"] == 0.0 and a["wh_bounds"] == [0.0, None]
     assert "outside the matrix's bins" in a["upper_bound_note"]
+
+
+# -- the rest of the list ----------------------------------------------------------------------
+
+@pytest.mark.parametrize("f, s, match", [
+    ([0.1], [1.0], "f: expected a 1-d sequence of at least 2 numbers, got 1"),  # IndexError
+    (np.array(0.1), np.array(1.0), r"f: expected a 1-d sequence .* got shape \(\)"),
+    ([0.1, 0.2], [1.0], "s: expected a 1-d sequence of at least 2"),
+    ([0.1, 0.2, 0.3], [1.0, 2.0], r"s: expected as many values as f \(3\), got 2"),
+    ([0.2, 0.1], [1.0, 1.0], "f: expected positive, increasing frequencies"),
+    ([0.1, 0.2], [1.0, -1.0], "s: expected a spectrum that is nowhere negative"),
+    ([0.1, np.nan], [1.0, 1.0], "f: expected finite numbers"),
+])
+def test_energy_flux_refuses_what_is_not_a_spectrum_in_one_line(f, s, match):
+    from parapend.errors import ParameterError
+    from parapend.performance import energy_flux
+
+    with pytest.raises(ParameterError, match=match):
+        energy_flux(f, s)
+
+
+def test_energy_flux_of_one_component_given_as_a_0d_array():
+    """``rho g^2 H^2 T / (32 pi)`` of a regular wave in deep water (it raised TypeError)."""
+    from parapend.hydro.waves import energy_flux
+
+    t, height = 5.0, 1.0
+    assert energy_flux(2 * math.pi / t, np.array(height / 2)) == pytest.approx(
+        1025.0 * 9.81**2 * height**2 * t / (32 * math.pi), rel=1e-12)
+
+
+def test_every_help_has_an_example_that_parses_and_no_doubled_percent():
+    import shlex
+
+    from parapend.cli import EXAMPLES, build_parser
+
+    parser = build_parser()
+    sub = next(a for a in parser._actions if a.__class__.__name__ == "_SubParsersAction")
+    assert set(EXAMPLES) == set(sub.choices)
+    for name, p in sub.choices.items():
+        text = p.format_help()
+        assert f"example: {EXAMPLES[name]}" in " ".join(text.split()), name
+        assert "%%" not in text, name  # basins' "95 %% interval"
+        args = parser.parse_args(shlex.split(EXAMPLES[name])[1:])
+        assert args.command == name
+
+
+def test_power_matrix_and_basins_save_csv(tmp_path, monkeypatch):
+    """``save("x.csv")`` refused both ("a CSV holds one table"): the matrix writes the table
+    ``--csv`` writes (byte for byte), the basins one row per grid point."""
+    import parapend.performance.solve as solve
+
+    monkeypatch.setattr(solve, "solve_bin", _stub([[0.5, 1.5], [1.9, 2.5]]))
+    kw = {k: v for k, v in KW.items() if k not in ("controller", "forecast", "warm_up",
+                                                    "update_interval")}
+    r = parapend.power_matrix(**kw, csv=str(tmp_path / "cli.csv"))
+    r.save(tmp_path / "m.csv")
+    assert (tmp_path / "m.csv").read_text() == (tmp_path / "cli.csv").read_text()
+    rows = (tmp_path / "m.csv").read_text().splitlines()
+    assert len(rows) == 5 and rows[0].startswith("hm0,tp,te,")
+    b = parapend.basins(resolution=4, periods=5)
+    b.save(tmp_path / "b.csv")
+    rows = (tmp_path / "b.csv").read_text().splitlines()
+    assert rows[0] == "dphi,phi,attractor,phase,periods_used" and len(rows) == 2 + 16
+    ds = b.dataset
+    # the row of (dphi[i], phi[j]) holds attractor[i, j]
+    cells = [r.split(",") for r in rows[2:]]
+    assert [int(c[2]) for c in cells] == ds["attractor"].values.ravel().tolist()
+    assert float(cells[5][0]) == ds["dphi"].values[1] and float(cells[5][1]) == \
+        ds["phi"].values[1]
+
+
+@pytest.mark.parametrize("suffix, magic", [(".pdf", b"%PDF"), (".svg", b"<?xml"),
+                                           (".png", b"\x89PNG"), (".csv", b"value,")])
+def test_pto_curve_saves_every_format_its_result_writes(suffix, magic, tmp_path, capsys):
+    path = tmp_path / f"c{suffix}"
+    assert main(["pto-curve", "--points", "3", "--harmonics", "4", "--save", str(path)]) == 0
+    assert path.read_bytes()[:len(magic)] == magic
+
+
+@pytest.mark.parametrize("argv, flag", [
+    (["optimize", "--harmonics", "4", "--save"], "--save"),
+    (["power-matrix", "--hs", "1,2", "--te", "6,7", "--realizations", "1", "--netcdf"],
+     "netcdf"),
+    (["power-matrix", "--hs", "1,2", "--te", "6,7", "--realizations", "1", "--csv"], "csv"),
+    (["sweep", "--omega", "1.8", "--delta=-0.3,-0.2", "--netcdf"], "--netcdf"),
+])
+def test_a_fifo_is_refused_as_an_output_before_the_work(argv, flag, tmp_path, capsys):
+    """Written in place, a FIFO waited for a reader for ever (the command hung)."""
+    import os
+
+    fifo = tmp_path / ("f.nc" if "netcdf" in flag else "f.csv")
+    os.mkfifo(fifo)
+    extra = ["--store", str(tmp_path / "s.zarr")] if argv[0] == "sweep" else []
+    assert main([*argv, str(fifo), *extra]) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and f"{flag}: " in err and "FIFO" in err
+    from parapend.errors import OutputError
+
+    r = parapend.optimize(harmonics=4)
+    with pytest.raises(OutputError, match="FIFO"):
+        r.save(fifo)
+
+
+def test_a_store_through_a_link_to_a_missing_directory_is_made_there(tmp_path, capsys):
+    """A link to a store not made yet: "cannot write: File exists"; the store is made where
+    the link points."""
+    link = tmp_path / "link.zarr"
+    link.symlink_to(tmp_path / "real.zarr")
+    argv = ["sweep", "--omega", "1.8", "--delta=-0.3,-0.2", "--store", str(link), "--json"]
+    assert main(argv) == 0
+    assert json.loads(capsys.readouterr().out)["computed_points"] == 2
+    assert (tmp_path / "real.zarr").is_dir() and link.is_symlink()
+    assert main(argv) == 0  # and resumes there
+    assert json.loads(capsys.readouterr().out)["resumed_points"] == 2
+
+
+def test_the_untimed_advice_is_never_a_change_the_command_refuses():
+    """It advised "use at most 1 bins"; a matrix has at least 2 centres a side."""
+    from parapend.performance import MIN_BINS, untimed_advice
+
+    assert untimed_advice(40, 4, 20, "te") == ("realizations", "use --realizations at most 10")
+    assert untimed_advice(12, 16, 3, "te")[1].startswith("use at most 4 bins")
+    assert untimed_advice(6, 9, 3, "tp")[1].startswith("use --realizations 1 and at most 6")
+    name, text = untimed_advice(1, 4, 1, "te")
+    assert name == "waves" and f"not even {MIN_BINS} bins" in text
+    for most in range(0, 60):
+        for bins in (4, 6, 9, 16):
+            for reps in (1, 2, 3, 5):
+                _, text = untimed_advice(most, bins, reps, "te")
+                if "bins" in text and text.startswith("use"):
+                    n = int(text.split("at most ")[1].split()[0])
+                    assert n >= MIN_BINS
+
+
+def test_scatter_hours_that_are_not_a_year_are_warned(tmp_path, caplog):
+    from parapend.performance.annual import read_scatter
+
+    (tmp_path / "h.csv").write_text("hs,te,hours\n1,6,1000\n2,7,2000\n")
+    with caplog.at_level("WARNING", logger="parapend.performance.annual"):
+        f = read_scatter(tmp_path / "h.csv", (1.0, 2.0), (6.0, 7.0), "te")
+    assert f.tolist() == [[pytest.approx(1 / 3), 0.0], [0.0, pytest.approx(2 / 3)]]
+    assert "sum to 3000 h, not a year" in caplog.text
+    caplog.clear()
+    (tmp_path / "y.csv").write_text("hs,te,hours\n1,6,2922\n2,7,5844\n")
+    with caplog.at_level("WARNING", logger="parapend.performance.annual"):
+        read_scatter(tmp_path / "y.csv", (1.0, 2.0), (6.0, 7.0), "te")
+    assert caplog.text == ""
+
+
+def test_the_progress_bar_shows_the_time_left(capsys, monkeypatch):
+    import sys
+
+    from parapend.cli._common import _Progress
+
+    monkeypatch.setattr(sys.stderr, "isatty", lambda: True, raising=False)
+    now = [100.0]
+    monkeypatch.setattr(_Progress, "clock", staticmethod(lambda: now[0]))
+    bar = _Progress("matrix", delay=0.0)
+    now[0] = 120.0  # 20 s for 3 of 12 steps: 60 s for the other 9
+    bar(3, 12)
+    assert "3/12, about 60 s left" in capsys.readouterr().err
+    now[0] = 1100.0  # 1000 s for 4 steps: 2000 s for 8 more
+    bar(4, 12)
+    assert "about 33 min left" in capsys.readouterr().err
+
+
+def test_a_result_s_figure_is_not_left_open_in_pyplot(tmp_path):
+    """A notebook showed every figure twice: pyplot's inline backend drew the open figure
+    at the cell's end, and the returned Figure was the cell's value."""
+    import matplotlib.pyplot as plt
+
+    before = set(plt.get_fignums())
+    fig = parapend.optimize(harmonics=4).plot()
+    assert set(plt.get_fignums()) == before
+    fig.savefig(tmp_path / "o.png")  # still a figure to save
+    assert (tmp_path / "o.png").read_bytes()[:4] == b"\x89PNG"
+
+
+#: files another change rewrites at the same time (their tracker numbers go with it)
+_ELSEWHERE = {"src/parapend/hydro/hull.py", "src/parapend/hydro/hull_data.py",
+              "src/parapend/hydro/hull_optimum.py", "tests/test_hull_data.py",
+              "tests/test_hull_timedomain.py", "tests/hull_timedomain.py",
+              "tests/test_hull_pto.py", "tests/hull_reference.py",
+              "tests/test_docs_pages.py", "tests/test_hardening_4.py"}
+
+
+def test_no_tracker_numbers_in_the_code():
+    """The code is written for its readers: no issue numbers in docstrings or comments
+    (the pages are checked by tests/test_docs_pages.py)."""
+    import re
+    from pathlib import Path
+
+    root = Path(__file__).resolve().parents[1]
+    pattern = re.compile(r"\b(issue|ticket|pull request)s?\s*#?\s*\d+|\(#\d{1,5}\)",
+                         re.IGNORECASE)
+    found = [f"{p.relative_to(root)}:{n}"
+             for p in [*root.glob("src/parapend/**/*.py"), *root.glob("tests/*.py")]
+             if str(p.relative_to(root)) not in _ELSEWHERE
+             for n, line in enumerate(p.read_text().splitlines(), 1) if pattern.search(line)]
+    assert not found, found
+
+
+def test_no_leaked_semaphore_warning_from_the_resource_tracker():
+    """After a kill -9 of a power matrix with workers, the resource tracker printed "There
+    appear to be 5 leaked semaphore objects": the engine's worker context starts it with
+    that warning ignored (a child gets the parent's warning options as -W)."""
+    import sys
+    from multiprocessing import util
+
+    from parapend.maps._forkserver import QUIET_TRACKER, WorkerContext
+
+    WorkerContext()
+    assert QUIET_TRACKER in sys.warnoptions
+    assert f"-W{QUIET_TRACKER}" in util._args_from_interpreter_flags()

@@ -1,4 +1,4 @@
-"""Hardening of ``power-matrix`` (issue 33): bad input, absurd sizes, unwritable outputs,
+"""Hardening of ``power-matrix``: bad input, absurd sizes, unwritable outputs,
 odd files and the annual energy's bookkeeping, each refused before any bin runs (one line,
 exit 2, the API's ParameterError with the same text) or answered with a correct result.
 

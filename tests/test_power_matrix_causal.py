@@ -1,4 +1,4 @@
-"""``power-matrix --controller mpc`` (issue 31 item 4): the causal column beside the
+"""``power-matrix --controller mpc``: the causal column beside the
 non-causal optimum (of the prescribed-heave pendulum and of the heaving buoy), per bin the
 best of the controller's run and rest, the annual energy of each column side by side, and
 the incomplete site marked in every column.
@@ -367,7 +367,7 @@ def _torques(q, t0_periods, forecast, *, horizon=0.5, tamper_after=None):
     ("peek", 2.5, False),     # a controller that looks further ahead fails the test
 ])
 def test_torques_before_t0_ignore_the_sea_after_t0_plus_h(forecast, after, causal):
-    """Causality (issue 31's acceptance, on the pendulum's controller that the causal
+    """Causality (the acceptance, on the pendulum's controller that the causal
     column runs): altering the sea only after ``t0 + H`` (perfect forecast; after ``t0``
     with the AR one) leaves every torque held before ``t0`` bit-identical; a tampered
     forecast that peeks one horizon further fails the same check. t0 = 2 peak periods,

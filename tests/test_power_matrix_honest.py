@@ -1,4 +1,4 @@
-"""``power-matrix`` honest (issues 31 item 4 and 33): no impossible number is a success, a
+"""``power-matrix`` honest: no impossible number is a success, a
 bin without power (``no_power``) is at rest and counted at 0 W, the headline power with an
 efficiency is the electrical one (``mechanical_power`` beside it), the buoy's body is solved
 in the matrix's water, and the mode and the completeness of the annual energy reach the

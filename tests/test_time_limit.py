@@ -1,4 +1,4 @@
-"""Long work under ``--time-limit`` (:mod:`parapend.deadline`), issue #33 item 1.
+"""Long work under ``--time-limit`` (:mod:`parapend.deadline`).
 
 Without a time limit, work estimated above the cap is refused in one line (exit 2) naming
 the option to change, the largest value that fits and ``--time-limit``; with one, the work

@@ -69,6 +69,28 @@ COMMANDS = {**_optimize_cmds.COMMANDS, **_paper_cmds.COMMANDS, **_pto_cmds.COMMA
             **_performance_cmds.COMMANDS, **_buoy_cmds.COMMANDS, **_horizon_cmds.COMMANDS}
 
 
+#: one example per command, printed at the end of its ``--help`` (each parses: the tests)
+EXAMPLES = {
+    "optimize": "parapend optimize --delta -0.3 --omega 1.8 --gamma 0.05",
+    "threshold": "parapend threshold --excitation square --square-alpha 0.2",
+    "damping-sweep": "parapend damping-sweep --points 20 --json",
+    "harmonics": "parapend harmonics --from 4 --to 32 --plot figures",
+    "figure": "parapend figure 4 --plot figures",
+    "reproduce": "parapend reproduce --out paper-figures",
+    "pto-curve": "parapend pto-curve --vary efficiency --points 9 --save curve.csv",
+    "simulate": "parapend simulate --gamma 0.1 --p 0.8 --omega 2.1 --periods 50",
+    "basins": "parapend basins --resolution 200 --plot figures",
+    "rotations": "parapend rotations --gamma 0.1 --omega 2.1 --p-max 2",
+    "track": "parapend track --controller mpc --horizon 2 --periods 40",
+    "sea": "parapend sea --hs 2 --tp 8 --length 1 --mass 10 --gamma 0.01",
+    "sweep": "parapend sweep --omega 1:3:21 --delta=-0.5:-0.1:21 --store map.zarr",
+    "map": "parapend map --store map.zarr --variable power --plot figures",
+    "power-matrix": "parapend power-matrix --hs 1:3:3 --te 6:10:3 --scatter site.csv",
+    "buoy": "parapend buoy --hs 0.5 --tp 2.5 --controller mpc",
+    "horizon": "parapend horizon --hs 2 --tp 8 --horizons 0.25,0.5,1,2",
+}
+
+
 def _function(command: str):
     """The function of ``command`` (:mod:`parapend.commands`)."""
     from .. import commands
@@ -102,6 +124,8 @@ def build_parser(*, declare: bool = True):
     _buoy_cmds.add_parsers(sub)
     _horizon_cmds.add_parsers(sub)
     for name, p in sub.choices.items():
+        if name in EXAMPLES:
+            p.epilog = f"example: {EXAMPLES[name]}"
         p.declared_by = functools.partial(_function, name)
         if declare:
             p.declare_defaults()

@@ -227,15 +227,21 @@ FIGURE_SUFFIXES = (".png", ".svg", ".pdf")
 #: one table, and one with several dimensions (no CSV)
 SAVE_TABLE = (".csv", ".nc", ".json")
 SAVE_GRID = (".nc", ".json")
+#: every format a result's ``save`` writes (:data:`parapend.results.SAVE_SUFFIXES`)
+SAVE_ALL = (".csv", ".nc", ".json", ".png", ".svg", ".pdf")
 
 
-def add_output_options(p, *, plot: str, save: str, table: bool = True) -> None:
+def add_output_options(p, *, plot: str, save: str, table: bool = True,
+                       figures: bool = False) -> None:
     """``--plot``, ``--save`` and ``--json``: how a command's result is drawn, written and
     printed (:meth:`~parapend.results.Result.plot`, :meth:`~parapend.results.Result.save`,
     :meth:`~parapend.results.Result.to_dict`). ``plot`` and ``save`` say what is drawn and
-    written; ``table`` is False for a result of several dimensions (no CSV)."""
+    written; ``table`` is False for a result of several dimensions (no CSV); ``figures``:
+    ``--save`` also writes the figure (``SAVE_ALL``: every format the result writes)."""
     p.add_argument("--plot", metavar="PNG", help=f"draw {plot} (PNG, SVG or PDF)")
     kinds = ".csv (with a row of units), .nc or .json" if table else ".nc or .json"
+    if figures:
+        kinds = ".csv (with a row of units), .nc, .json, or the figure as .png, .svg or .pdf"
     p.add_argument("--save", metavar="FILE", help=f"write {save}: {kinds}")
     p.add_argument("--json", action="store_true", help="print one JSON object")
 
@@ -273,6 +279,11 @@ def _check_output(path: str | None, what: str, suffixes) -> None:
         raise ParameterError(f"{what}: directory {str(parent)!r} does not exist")
     if p.is_dir():
         raise ParameterError(f"{what}: {path!r} is a directory, expected a file name")
+    from ..fileio import named_fifo
+
+    if named_fifo(p):
+        raise ParameterError(f"{what}: {path!r} is a FIFO (named pipe), which waits for a "
+                             "reader for ever; expected a regular file")
     from ._output import OutputError, probe_dir
 
     try:
@@ -334,12 +345,19 @@ class _Progress:
 
     Call it as ``bar(done, total)`` (or ``bar(done, total, label)``); it draws nothing for
     the first ``delay`` seconds, so quick runs stay silent, and erases itself at the end.
+    Once a step is done it shows the time left, the elapsed time per step times the steps
+    left (``about 40 s left``).
     """
+
+    #: the clock (seconds; a test sets its own)
+    clock = staticmethod(time.monotonic)
+    #: show the time left (a subclass with its own estimate turns it off)
+    time_left = True
 
     def __init__(self, label: str, delay: float = 1.0):
         self.label = label
         self.delay = delay
-        self.start = time.monotonic()
+        self.start = self.clock()
         self.drawn = False
         try:
             self.on = sys.stderr is not None and sys.stderr.isatty()
@@ -347,13 +365,15 @@ class _Progress:
             self.on = False
 
     def __call__(self, done: int, total: int, label: str | None = None) -> None:
-        if not self.on or (not self.drawn and time.monotonic() - self.start < self.delay
-                           and done < total):
+        elapsed = self.clock() - self.start
+        if not self.on or (not self.drawn and elapsed < self.delay and done < total):
             return
         width = 30
         k = int(width * done / max(total, 1))
         what = self.label if label is None else f"{self.label}: {label}"
         line = f"{what[:40]} [{'#' * k}{'.' * (width - k)}] {done}/{total}"
+        if self.time_left and 0 < done < total:
+            line += f", about {_duration(elapsed / done * (total - done))} left"
         try:
             if done >= total:
                 if self.drawn:
@@ -364,6 +384,15 @@ class _Progress:
             sys.stderr.flush()
         except (OSError, ValueError):
             self.on = False
+
+
+def _duration(seconds: float) -> str:
+    """``seconds`` for a person: ``8 s``, ``3 min``, ``2.5 h``."""
+    if seconds < 90:
+        return f"{max(seconds, 1.0):.0f} s"
+    if seconds < 5400:
+        return f"{seconds / 60:.0f} min"
+    return f"{seconds / 3600:.1f} h"
 
 
 def _fmt(x, digits=6):

@@ -148,8 +148,9 @@ def add_parsers(sub) -> None:
                    help="characteristic width, m: adds the capture-width ratio (buoy "
                         "default: the body's diameter)")
     g.add_argument("--scatter", metavar="CSV",
-                   help="scatter diagram 'hs,te,frequency' (shares summing to 1) or "
-                        "'hs,te,count'; bin centres of the matrix")
+                   help="scatter diagram 'hs,te,frequency' (shares summing to 1), "
+                        "'hs,te,count' (occurrences) or 'hs,te,hours' (warned unless they "
+                        "sum to a year); bin centres of the matrix")
     g.add_argument("--timeseries", metavar="CSV",
                    help="sea states 'hs,te', one a row, binned with the matrix's edges")
     g.add_argument("--rated-power", type=_finite_float("rated-power"),

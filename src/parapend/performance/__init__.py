@@ -509,6 +509,27 @@ def annual_columns(spec: MatrixSpec) -> dict:
                                    for f in spec.forecasts}}
 
 
+#: the fewest bins a matrix has: two centres on each axis
+MIN_BINS = 4
+
+
+def untimed_advice(most: int, bins: int, realizations: int, period_kind: str):
+    """``(option, advice)`` for a matrix of ``bins`` x ``realizations`` solves of which
+    ``most`` fit in the untimed cap: fewer realizations where they suffice, else fewer bins
+    where at least :data:`MIN_BINS` fit (the command refuses fewer: two centres an axis),
+    else shorter records (``--waves``): never a change the command itself refuses."""
+    if most >= bins:
+        return "realizations", f"use --realizations at most {most // bins}"
+    if most // realizations >= MIN_BINS:
+        return "hs", (f"use at most {most // realizations} bins (--hs times --{period_kind} "
+                      f"centres) at {realizations} realizations")
+    if most >= MIN_BINS:
+        return "hs", (f"use --realizations 1 and at most {most} bins (--hs times "
+                      f"--{period_kind} centres)")
+    return "waves", (f"not even {MIN_BINS} bins (2 --hs and 2 --{period_kind} centres) of one "
+                     "realization fit: use fewer --waves")
+
+
 def _nan_none(x) -> float:
     """``x`` as a float, NaN for None (no bound)."""
     return math.nan if x is None else float(x)
@@ -798,15 +819,12 @@ def power_matrix(*, hs="1:3:3", te=None, tp=None, realizations: int = 3, waves: 
         # resumable work (--store) is announced and runs; in memory it must fit the cap
         each = est["seconds"] / est["solves"]  # one solve's share of the wall time
         most = int(limits.MAX_UNTIMED_SECONDS / each)
-        by_r = most >= est["bins"]  # fewer realizations suffice
-        refuse_untimed("realizations" if by_r else "hs",
+        name, advice = untimed_advice(most, est["bins"], spec.realizations, spec.period_kind)
+        refuse_untimed(name,
                        f"a power matrix of {est['bins']} bins x {spec.realizations} "
                        f"realizations ({est['solves']} solves on "
                        f"{est['processes']} process(es))", est["seconds"],
-                       (f"use --realizations at most {most // est['bins']}" if by_r else
-                        f"use at most {max(1, most // spec.realizations)} bins (--hs times "
-                        f"--{spec.period_kind} centres) at {spec.realizations} realizations")
-                       + " or --store (resumable work: a rerun resumes)", time_limit)
+                       advice + " or --store (resumable work: a rerun resumes)", time_limit)
     frequency, outside = None, None
     pk = spec.period_kind
     if scatter is not None:
@@ -903,21 +921,29 @@ def _write_zarr(ds, path) -> None:
         shutil.rmtree(tmp, ignore_errors=True)
 
 
-def matrix_csv(ds, spec: MatrixSpec) -> str:
+def matrix_csv(ds, spec: MatrixSpec | None = None) -> str:
     """The matrix as a table, one row per bin: centres, J, the statistics of each quantity,
-    the capture width (and ratio), the frequency."""
-    pk = spec.period_kind
+    the capture width (and ratio), the frequency. Without ``spec`` the bins and quantities
+    are the Dataset's own (``PowerMatrixResult.save("m.csv")``: the same table)."""
+    if spec is None:
+        pk = "tp" if "tp" in ds.dims else "te"
+        hm0 = [float(v) for v in ds["hm0"].values]
+        period = [float(v) for v in ds[pk].values]
+        quantities = [str(v)[:-5] for v in ds.data_vars if str(v).endswith("_mean")]
+    else:
+        pk, hm0, period = spec.period_kind, spec.hm0, spec.period
+        quantities = matrix_quantities(spec)
     cols = ["wave_energy_flux_matrix", "capture_width_matrix"]
     if "capture_width_ratio_matrix" in ds:
         cols.append("capture_width_ratio_matrix")
-    for q in matrix_quantities(spec):
+    for q in quantities:
         cols += [f"{q}_{s}" for s in STATISTICS]
     if "frequency" in ds:
         cols.append("frequency")
     lines = [",".join(["hm0", pk, "tp" if pk == "te" else "te", *cols])]
     other = ds["tp" if pk == "te" else "te"].values
-    for i, h in enumerate(spec.hm0):
-        for k, t in enumerate(spec.period):
+    for i, h in enumerate(hm0):
+        for k, t in enumerate(period):
             vals = [ds[c].values[i, k] for c in cols]
             lines.append(",".join([repr(h), repr(t), repr(float(other[k])),
                                    *(str(int(v)) if c.endswith("count") else repr(float(v))

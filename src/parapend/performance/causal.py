@@ -178,7 +178,7 @@ class ShiftedQ:
     matrix ``exp(i k w d)`` of a set of offsets ``d`` (the horizon's leads, the same at every
     update up to round-off) built once and kept, so an update costs a matrix-vector product
     instead of the matrix's complex exponentials (they were half of a record's causal run:
-    issue 31, docs/performance.md). An offset set is recognised by ``d`` rounded to 1e-9 of
+    docs/performance.md). An offset set is recognised by ``d`` rounded to 1e-9 of
     the peak period ``tp`` and evaluated at the offsets of its first call: the leads
     ``(t_j + leads) - t_j`` differ from one update to the next by the round-off of ``t_j``
     (1e-16 of the run's length), so ``q`` is the direct evaluation's to round-off (the
