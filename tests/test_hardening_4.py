@@ -438,3 +438,22 @@ def test_no_leaked_semaphore_warning_from_the_resource_tracker():
     WorkerContext()
     assert QUIET_TRACKER in sys.warnoptions
     assert f"-W{QUIET_TRACKER}" in util._args_from_interpreter_flags()
+
+
+@pytest.mark.slow  # the default buoy's BEM (cached on disk after its first solve)
+def test_the_buoys_missing_bin_bound_is_the_capture_width_limit():
+    """The heaving buoy's bound of a missing bin is its radiation bound ``sum_k |F_k a_k|^2
+    / (8 B_k)``, which for an axisymmetric heaving body is the capture-width limit ``sum_k
+    J_k lambda_k / 2 pi`` (Haskind's relation; ``J_k = rho g a_k^2 c_g / 2``, deep water):
+    the two agree to the BEM's accuracy."""
+    from parapend.performance import _record_bound, matrix_spec
+    from parapend.performance.buoy_device import wave_of
+
+    spec = matrix_spec(hs="0.5,1", tp="2.5,3", realizations=1, waves=2, device="buoy")
+    got = _record_bound(spec, 1, 0, 0)
+    wave, _ = wave_of(spec, 1, 0, 0)
+    w = wave.frequencies
+    a = np.abs(np.asarray(wave.amplitudes))
+    g, rho = 9.81, spec.water_density
+    limit = float(np.sum(rho * g * a**2 / 2 * (g / (2 * w)) * (g / w**2)))
+    assert got == pytest.approx(limit, rel=0.03)
