@@ -457,3 +457,25 @@ def test_the_buoys_missing_bin_bound_is_the_capture_width_limit():
     g, rho = 9.81, spec.water_density
     limit = float(np.sum(rho * g * a**2 / 2 * (g / (2 * w)) * (g / w**2)))
     assert got == pytest.approx(limit, rel=0.03)
+
+
+@pytest.mark.parametrize("status, success, catch, want", [
+    ("ok", True, 1.0, 12.5),
+    ("loses_energy", False, 1.0, -3.0),  # a measurement: the bin then rests (max(P, 0))
+    ("not_caught", False, None, 0.0),    # the swing-up never reached the top: at rest
+    ("not_caught", False, 30.0, math.nan),  # handed over inside the window: no answer
+    ("time_limit", False, 1.0, math.nan),
+])
+def test_the_matrix_takes_a_buoy_run_by_its_status(status, success, catch, want,
+                                                   monkeypatch):
+    import parapend.performance.causal as causal
+    from parapend.performance import matrix_spec
+
+    p = {"ok": 12.5, "loses_energy": -3.0}.get(status, math.nan)
+    res = SimpleNamespace(status=status, success=success, catch_time_s=catch,
+                          electrical_power_w=p, harvested_electrical_power_w=p)
+    monkeypatch.setattr(causal, "run_buoy_record", lambda *a, **k: res)
+    spec = matrix_spec(hs="0.5,1", tp="2.5,3", realizations=1, waves=2, device="buoy",
+                       controller="mpc")
+    got = causal.solve_causal(spec, 0, 0, 0)["causal_perfect_power"]
+    assert got == want or (math.isnan(want) and math.isnan(got))

@@ -235,10 +235,11 @@ class BuoyMPCResult(_Result):
             ax[2].plot(t, e, lw=1.0, color="C0")
             ax[2].set_ylabel("harvested energy (J)")
             ax[2].set_xlabel("time t (s)")
-            ax[0].set_title(f"buoy, {self.controller}: mean power {self.mean_power_w:.4g} W "
-                            f"(harvested {self.harvested_power_w:.4g} W + stored "
-                            f"{self.stored_w:.4g} W) from {self.average_from_s:.4g} s",
-                            fontsize=10)
+            head = (f"mean power {self.mean_power_w:.4g} W (harvested "
+                    f"{self.harvested_power_w:.4g} W + stored {self.stored_w:.4g} W) from "
+                    f"{self.average_from_s:.4g} s" if self.headline_reason is None else
+                    f"no mean power ({self.status})")
+            ax[0].set_title(f"buoy, {self.controller}: {head}", fontsize=10)
             fig.tight_layout()
         return fig
 
