@@ -433,7 +433,8 @@ def test_a_buoy_bin_is_buoy_mpc_by_hand(buoy_bin, sphere_nc):
         r = buoy_mpc(load(sphere_nc), pend, wave, peak_period=3.0, horizon=2.0,
                      update_interval=0.125, warmup=1.0, repeats=1, forecast=forecast,
                      controller="plan", iterations=1)
-        assert r.success and r.forecast == forecast
+        # a loss is a measurement the matrix keeps (the bin then rests)
+        assert r.status in ("ok", "loses_energy") and r.forecast == forecast
         assert r.t_end_s - r.average_from_s == pytest.approx(12.0, rel=1e-9)  # one repeat
         assert got[f"causal_{forecast}_power"] == pytest.approx(r.mean_power_w, rel=1e-12,
                                                                 abs=0)
@@ -465,7 +466,7 @@ def test_the_buoy_column_rests_its_aep_is_8766_h_sum_p_f(monkeypatch, sphere_nc,
     import parapend.performance.solve as solve
     from parapend.performance.figures import text_report
 
-    monkeypatch.setattr(solve, "solve_bin", _buoy_stub([[-3.0, 1.5], [2.5, -0.1]]))
+    monkeypatch.setattr(solve, "solve_bin", _buoy_stub([[-3.0, 1.5], [1.9, -0.1]]))
     site = tmp_path / "site.csv"
     site.write_text("hs,tp,frequency\n0.1,2.6,0.25\n0.1,3.0,0.25\n0.2,2.6,0.25\n"
                     "0.2,3.0,0.25\n")
@@ -521,8 +522,10 @@ def test_the_buoy_column_is_estimated_and_a_tiny_time_limit_marks_a_partial(buoy
     est = check_size(matrix_spec(**big), workers=1)
     assert est["causal_seconds"] == pytest.approx(record_seconds(matrix_spec(**big)))
     assert est["seconds"] > 120
-    with pytest.raises(ParameterError, match=r"^hs: a power matrix of 4 bins .* or give "
-                                             r"--time-limit SECONDS"):
+    # not even the fewest bins fit: the advice is fewer --waves (it said "at most 1 bins",
+    # which the command refuses)
+    with pytest.raises(ParameterError, match=r"^waves: a power matrix of 4 bins .* not even 4 "
+                                             r"bins .* or give --time-limit SECONDS"):
         parapend.power_matrix(**big, workers=1)
     spec, got = buoy_bin
     rec = parapend.power_matrix(**BUOY_KW, hydro=sphere_nc, workers=1, time_limit=1e-9)

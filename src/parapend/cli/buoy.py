@@ -8,17 +8,7 @@ from pathlib import Path
 from ..defaults import BUOY
 from ..errors import ParameterError
 from . import _output
-from ._common import (
-    _check_output,
-    _finite_float,
-    _fmt,
-    _int,
-    _Progress,
-    _run,
-    _table,
-    hull_options,
-    unresolved_if,
-)
+from ._common import _check_output, _finite_float, _fmt, _int, _Progress, _run, _table, hull_options
 
 
 def _text(name):
@@ -211,6 +201,7 @@ def _cmd_buoy(a) -> dict | str:
                           "record (--repeat-period, --record), or a smaller --mesh") from None
     if hasattr(r, "controller"):
         from ..hydro.control import mpc_text
+        from ._common import unresolved_if
 
         if a.save:
             _output.write_dataset(r.to_dataset(), a.save)
