@@ -1,4 +1,4 @@
-"""Causality and re-integration of the buoy's receding-horizon controller (issue 31's
+"""Causality and re-integration of the buoy's receding-horizon controller (the
 acceptance, on :func:`parapend.hydro.control.buoy_mpc`).
 
 Causality: altering the sea only after ``t0 + H`` leaves

@@ -263,7 +263,7 @@ def test_plan_controller_refuses_what_it_does_not_model():
 
 @pytest.mark.slow
 def test_default_design_plan_controller_harvests():
-    # docs/buoy.md's measurement, seed 0, 2 peak periods (issue 31's acceptance): 91.6 % of
+    # docs/buoy.md's measurement, seed 0, 2 peak periods (the acceptance): 91.6 % of
     # the record's coupled optimum (winding 10) with the radiation inside the horizon model
     # (61 % with the memory force frozen in it); the energy balance closes
     import parapend
@@ -467,7 +467,7 @@ def _replay(plant, hp, fseg, ns):
 
 
 def test_radiation_model_heave_against_the_plants_replay():
-    # issue 31: the horizon model's heave against the plant's own scheme replaying the same
+    # the horizon model's heave against the plant's own scheme replaying the same
     # motion over 2 peak periods, from a state with a radiation memory of a rotating past
     # (synthetic dataset, its BEM-like piecewise-linear B): with the radiation inside the
     # model the two agree to the plant's discretization (measured 9e-5 of the rms heave);

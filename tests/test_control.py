@@ -1,4 +1,4 @@
-"""Issue 11: the closed loop. Swing-up from rest, catch and hold of the optimal rotation on
+"""The closed loop. Swing-up from rest, catch and hold of the optimal rotation on
 the full nonlinear Eq. 14; periodic LQR and Floquet multipliers; the saved series checked
 by re-integration with a different integrator; robustness batches; the command line."""
 

@@ -1,6 +1,6 @@
 """The Python API of ``horizon`` and ``track`` (both controllers) under bad values: each is a
 one-line :class:`~parapend.errors.ParameterError` that names the parameter as the command
-line does (#33), never a bare ``TypeError``/``ValueError``/``IndexError``; and the options
+line does, never a bare ``TypeError``/``ValueError``/``IndexError``; and the options
 the signature allows are accepted as keywords."""
 
 import math

@@ -1,4 +1,4 @@
-"""Issue 10: the uncontrolled pendulum (paper Eq. 1) from the command line, the compiled
+"""The uncontrolled pendulum (paper Eq. 1) from the command line, the compiled
 basin kernel, and stability by continuation against direct simulation."""
 
 from __future__ import annotations

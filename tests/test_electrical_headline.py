@@ -1,4 +1,4 @@
-"""With an efficiency the headline field is the electrical power (issue 32, item 2).
+"""With an efficiency the headline field is the electrical power.
 
 ``optimize`` and ``pto-curve`` through a lossy take-off give ``power``/``power_w`` as the
 electrical power (what the take-off delivers, the headline of the text) and the mechanical

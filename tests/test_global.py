@@ -1,4 +1,4 @@
-"""Globality (issue 7): the optimum against brute force, its evidence, resolutions checked.
+"""Globality: the optimum against brute force, its evidence, resolutions checked.
 
 The brute force here shares only the objective with the search under test: it starts a
 plain Newton run (no pruning) from every half-turn direction pattern and from many seeded
@@ -124,7 +124,7 @@ def test_dynamic_programme_finds_the_exhaustive_optimum(monkeypatch, gamma):
 
 
 def test_threshold_covers_the_spectrum():
-    """A 40th harmonic that N = 8 and 16 both miss: N starts from the spectrum (issue 7)."""
+    """A 40th harmonic that N = 8 and 16 both miss: N starts from the spectrum."""
     r = parapend.threshold(excitation="fourier", fourier="1:0.3,40:0.05")
     assert r.success and r.harmonics >= 64
     assert r.damping_threshold == pytest.approx(0.0860792, abs=1e-6)
@@ -164,7 +164,7 @@ def test_bvp_peak_torque_from_its_own_mesh():
 
 @pytest.mark.slow
 def test_brute_force_on_200_random_excitations():
-    """Acceptance of issue 7: 200 seeded excitations (1 to 6 harmonics), three dampings,
+    """Acceptance: 200 seeded excitations (1 to 6 harmonics), three dampings,
     each against all patterns plus 200 random starts: never below by more than 1e-8."""
     rng = np.random.default_rng(2026)
     for _ in range(200):

@@ -1,4 +1,4 @@
-"""Issue 33 (hardening 3), the buoy: every bad input ends in one line naming the option
+"""The buoy, hardened: every bad input ends in one line naming the option
 (exit 2; ``ParameterError`` from Python), datasets are checked as physics, and the sizes
 that ran for minutes or past 2 GB are refused before any work."""
 

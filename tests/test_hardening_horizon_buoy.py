@@ -1,5 +1,5 @@
-"""Issue 31 (hardening the newest surfaces: ``horizon --device buoy``, ``buoy --controller
-mpc``, ``buoy --dofs surge,heave,pitch``): what benchmarks/fuzz31.py found, each refused in
+"""Hardening the newest surfaces: ``horizon --device buoy``, ``buoy --controller
+mpc``, ``buoy --dofs surge,heave,pitch``: what benchmarks/fuzz31.py found, each refused in
 one line naming the parameter before any BEM (the cases below are all refusals, fast)."""
 
 from __future__ import annotations

@@ -1,4 +1,4 @@
-"""Issue 8 (first half): every bad input becomes one line and a non-zero exit, work is
+"""Every bad input becomes one line and a non-zero exit, work is
 bounded, nothing is silently ignored or misleading. Fast: no solve here takes over ~1 s."""
 
 import json

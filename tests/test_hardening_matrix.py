@@ -1,4 +1,4 @@
-"""Hardening of ``power-matrix`` (issue 33): bad input, absurd sizes, unwritable outputs,
+"""Hardening of ``power-matrix``: bad input, absurd sizes, unwritable outputs,
 odd files and the annual energy's bookkeeping, each refused before any bin runs (one line,
 exit 2, the API's ParameterError with the same text) or answered with a correct result.
 
@@ -267,14 +267,24 @@ F = np.array([[0.25, 0.25], [0.125, 0.25]])
 
 def test_annual_energy_is_never_negative_and_an_incomplete_one_has_bounds():
     """8766 h sum max(P, 0) f over the counted bins; the (2, 1) bin has no power (1/8 of
-    the year) and 1/8 lies outside the matrix: bounds at 0 W and at 4 W for that quarter."""
+    the year) and 1/8 lies outside the matrix: the lower bound counts that quarter at 0 W,
+    and nothing bounds the sea states outside the bins (no upper bound); without them the
+    missing bin at its own bound (7 W, not the largest finished bin's 4 W)."""
     assert np.array_equal(bin_power(P), [[1.0, 0.0], [np.nan, 4.0]], equal_nan=True)
-    a = annual_energy(P, F, outside_frequency=0.125)
+    bound = np.full((2, 2), 7.0)
+    a = annual_energy(P, F, outside_frequency=0.125, bound=bound)
     lo = HOURS_PER_YEAR * (1.0 * 0.25 + 0.0 * 0.25 + 4.0 * 0.25)
     assert a["wh"] == lo == HOURS_PER_YEAR * 1.25
     assert not a["complete"]
-    assert a["uncounted_frequency"] == 0.25 and a["missing_frequency"] == 0.125
-    assert a["wh_bounds"] == [lo, lo + HOURS_PER_YEAR * 4.0 * 0.25]
+    # missing_frequency agrees with complete: the bins' share and the outside share
+    assert a["uncounted_frequency"] == 0.25 == a["missing_frequency"]
+    assert a["missing_bin_frequency"] == 0.125
+    assert a["wh_bounds"] == [lo, None] and "outside" in a["upper_bound_note"]
+    c = annual_energy(P, F / F.sum(), bound=bound)
+    lo_c = lo / F.sum()
+    assert c["wh_bounds"] == pytest.approx([lo_c, lo_c + HOURS_PER_YEAR * 7.0 * 0.125
+                                            / F.sum()], rel=1e-15)
+    assert annual_energy(P, F / F.sum())["wh_bounds"] == [pytest.approx(lo_c), None]
     assert a["hours_per_year"] == 8766.0
     assert a["counted_frequency"] == 0.75 and a["rest_frequency"] == 0.25
     # complete: a plain number, no bounds
@@ -326,7 +336,7 @@ def test_the_command_reports_rest_bins_and_an_incomplete_aep(tmp_path, monkeypat
     monkeypatch.setattr(solve, "solve_bin", _stub([[1.0, -2.0], [3.0, 4.0]]))
     (tmp_path / "t.csv").write_text("hs,te\n1,6\n1,7\n2,7\n9,9\n")
     argv = _argv(["--timeseries", str(tmp_path / "t.csv"), "--rated-power", "10"])
-    assert main(argv + ["--json"]) == 0
+    assert main(argv + ["--json"]) == 3  # the annual energy incomplete: no resolved answer
     out = json.loads(capsys.readouterr().out)
     assert out["operating_mode"] == [["rotation", "rest"], ["rotation", "rotation"]]
     assert out["power_matrix"] == [[1.0, 0.0], [3.0, 4.0]]
@@ -336,21 +346,24 @@ def test_the_command_reports_rest_bins_and_an_incomplete_aep(tmp_path, monkeypat
     assert out["capacity_factor"] is None
     lo = 8766.0 * (1.0 * 0.25 + 0.0 * 0.25 + 4.0 * 0.25)  # (1, 6), (1, 7) at rest, (2, 7)
     assert a["wh"] == pytest.approx(lo, rel=1e-15)
-    assert a["wh_bounds"] == pytest.approx([lo, lo + 8766.0 * 4.0 * 0.25], rel=1e-15)
-    assert a["capacity_factor_bounds"] == pytest.approx(
-        [lo / 8766 / 10, (lo + 8766.0) / 8766 / 10], rel=1e-15)
-    assert a["uncounted_frequency"] == 0.25 and not a["complete"]
+    # the sea state outside every bin: nothing bounds its power, so no upper bound
+    assert a["wh_bounds"][0] == pytest.approx(lo, rel=1e-15) and a["wh_bounds"][1] is None
+    assert a["capacity_factor_bounds"][0] == pytest.approx(lo / 8766 / 10, rel=1e-15)
+    assert a["capacity_factor_bounds"][1] is None
+    assert a["uncounted_frequency"] == 0.25 == a["missing_frequency"]
+    assert not a["complete"]
     # the JSON's AEP is 8766 h sum P f over the bins it counted
     pm = np.array(out["power_matrix"])
     freq = np.array(out["frequency"])
     assert np.array_equal(freq, [[0.25, 0.25], [0.0, 0.25]])
     assert a["wh"] == pytest.approx(8766.0 * float(np.sum(pm * freq)), rel=1e-15)
     assert a["counted_frequency"] == float(freq.sum())
-    assert main(argv) == 0
+    assert main(argv) == 3
     text = capsys.readouterr().out
-    assert "optimum 10.96 kWh/yr to 19.72 kWh/yr" in text  # 1.25 W and 2.25 W
+    assert "optimum at least 10.96 kWh/yr" in text  # 1.25 W, no upper bound
     assert "incomplete: 0.25 of the year has no power" in text
-    assert "capacity factor 0.125 to 0.225 (incomplete)" in text
+    assert "outside the matrix's bins, where nothing bounds the power" in text
+    assert "capacity factor at least 0.125 (no upper bound) (incomplete)" in text
     assert "1 bins with a negative mean optimum: the pendulum rests there" in text
 
 

@@ -1,4 +1,4 @@
-"""Issue 33 (hardening 3): a wide, shallow buoy (``--radius 10`` beside the 0.5 m draft) was
+"""Hardening: a wide, shallow buoy (``--radius 10`` beside the 0.5 m draft) was
 refused by the BEM's size ("use --draft ..."): its panels followed the draft. Its panels now
 follow the shortest wave solved (12 panel radii a wavelength, the body's own grid ending
 there), within half the BEM cap; every body that fitted before keeps its mesh."""

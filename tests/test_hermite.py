@@ -1,4 +1,4 @@
-"""The time-domain PTO solver (issue 9): Hermite motion, banded Newton system, interior point."""
+"""The time-domain PTO solver: Hermite motion, banded Newton system, interior point."""
 
 from __future__ import annotations
 

@@ -170,7 +170,7 @@ def test_a_bin_with_an_efficiency_is_parapend_buoy_by_hand(run_eff, sphere_nc):
                       harmonics=PEND["harmonics"])
     assert st["electrical_power"]["mean"][1][1] == pytest.approx(r.electrical_power_w,
                                                                  rel=1e-9)
-    # the headline is the electrical power, as buoy's power_w (issue 32's rule)
+    # the headline is the electrical power, as buoy's power_w (the rule)
     assert st["power"] == st["electrical_power"]
     assert st["power"]["mean"][1][1] == pytest.approx(r.power_w, rel=1e-9)
     assert first["power_matrix"][1][1] == pytest.approx(r.power_w, rel=1e-9)

@@ -1,4 +1,4 @@
-"""``power-matrix`` honest (issues 31 item 4 and 33): no impossible number is a success, a
+"""``power-matrix`` honest: no impossible number is a success, a
 bin without power (``no_power``) is at rest and counted at 0 W, the headline power with an
 efficiency is the electrical one (``mechanical_power`` beside it), the buoy's body is solved
 in the matrix's water, and the mode and the completeness of the annual energy reach the
@@ -86,7 +86,9 @@ def test_a_bin_above_its_bound_is_stored_as_such_and_not_counted(stub, tmp_path)
     a = r.annual_energy["power"]
     assert not a["complete"] and r.annual_energy_mwh is None
     assert a["wh"] == pytest.approx(8766.0 * 0.25 * (1 + 2 + 3), rel=1e-15)
-    assert a["wh_bounds"][1] == pytest.approx(8766.0 * 0.25 * (1 + 2 + 3 + 3), rel=1e-15)
+    # the bin above its bound at that bound (its gamma -> 0 limit, 10 W), not at the
+    # largest finished bin's power (3 W), which bounds nothing
+    assert a["wh_bounds"][1] == pytest.approx(8766.0 * 0.25 * (1 + 2 + 3 + 10), rel=1e-15)
 
 
 # -- no power is a bin at rest ---------------------------------------------------------------
@@ -139,15 +141,16 @@ def test_text_json_and_netcdf_carry_the_mode_and_the_completeness(stub, tmp_path
         assert ds["operating_mode"].attrs["flag_meanings"] == "no_result rest rotation"
     nc2 = tmp_path / "t.nc"
     assert main([*base, "--timeseries", str(tmp_path / "t.csv"), "--netcdf", str(nc2),
-                 "--json"]) == 0
+                 "--json"]) == 3  # incomplete: the annual energy is no resolved answer
     out = json.loads(capsys.readouterr().out)
     assert out["annual_energy_complete"] is False and out["hours_per_year"] == 8766.0
     assert out["operating_mode"] == [["rotation", "rest"], ["rotation", "rotation"]]
     with xr.open_dataset(nc2) as ds:
         assert ds.attrs["annual_energy_complete"] == 0
         assert ds.attrs["annual_energy_uncounted_frequency"] == 0.5
-        assert list(ds.attrs["annual_energy_mwh_bounds"]) == pytest.approx(
-            [8766.0 * 0.5 * 2.0 / 1e6, 8766.0 * (0.5 * 2.0 + 0.5 * 4.0) / 1e6], rel=1e-15)
+        # a sea state outside every bin: no upper bound (NaN in the file)
+        lo, hi = ds.attrs["annual_energy_mwh_bounds"]
+        assert lo == pytest.approx(8766.0 * 0.5 * 2.0 / 1e6, rel=1e-15) and math.isnan(hi)
 
 
 # -- the efficiency: the headline is electrical --------------------------------------------

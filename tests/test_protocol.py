@@ -1,4 +1,4 @@
-"""One result protocol for every public function (DESIGN.md section 4, issue 32): each
+"""One result protocol for every public function (DESIGN.md section 4): each
 result has ``to_dict`` (= ``--json``), ``to_dataset`` (units and long_name on every
 variable and coordinate, the command and version in the attributes), ``plot`` (a matplotlib
 figure), ``save`` by extension (.json, .csv with a row of units, .nc, a figure) and a short
@@ -110,6 +110,12 @@ def _check(result, tmp: Path):
             col = np.array([float(r[i]) for r in rows[2:]])
             np.testing.assert_array_equal(col, np.atleast_1d(ds[n].values.astype(float)),
                                           err_msg=n)
+    elif result.command in ("basins", "power-matrix"):
+        # a grid's table: one row per grid point (per bin), the grid's coordinates first
+        result.save(tmp / "r.csv")
+        rows = list(csv.reader((tmp / "r.csv").read_text().splitlines()))
+        first = ["dphi", "phi"] if result.command == "basins" else ["hm0"]
+        assert rows[0][:len(first)] == first and len(rows) > 2
     else:
         with pytest.raises(parapend.ParameterError, match="path: a CSV file holds one table"):
             result.save(tmp / "r.csv")

@@ -1,4 +1,4 @@
-"""Physical units and the power take-off (issue 9): torque limit, efficiency, profiles."""
+"""Physical units and the power take-off: torque limit, efficiency, profiles."""
 
 from __future__ import annotations
 

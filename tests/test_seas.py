@@ -1,4 +1,4 @@
-"""Irregular seas (issue 12): spectra, records, winding K, the operator Hessian, ``sea``.
+"""Irregular seas: spectra, records, winding K, the operator Hessian, ``sea``.
 
 Independent sources: the spectra's published closed forms (and MHKiT when installed), the
 spectral moments, finite differences, the state form of the power (Eq. 15) against the
@@ -500,7 +500,7 @@ def test_sea_cli_json_text_and_errors(tmp_path, capsys):
 
 @pytest.mark.slow
 def test_hundred_wave_jonswap_record_acceptance():
-    """Issue 12: a 100-wave JONSWAP record (Hs 2 m, Tp 8 s, T_r 800 s, l = 1 m, m = 10 kg,
+    """A 100-wave JONSWAP record (Hs 2 m, Tp 8 s, T_r 800 s, l = 1 m, m = 10 kg,
     gamma = 0.01): optimum, limit and uniform rotation in watts; the limit never exceeded."""
     r = sea(hs=2.0, tp=8.0, repeat_period=800.0, seed=0)
     assert r.success and r.record["max_abs_q"] < 1

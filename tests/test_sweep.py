@@ -1,4 +1,4 @@
-"""Design maps (issue 13): sweep engine, resumable Zarr store, Dask execution, heat maps."""
+"""Design maps: sweep engine, resumable Zarr store, Dask execution, heat maps."""
 
 from __future__ import annotations
 
@@ -149,7 +149,7 @@ def test_torque_limit_axis_equals_optimize_pto():
 
 def test_efficiency_axis_headline_is_the_electrical_power(tmp_path, capsys):
     """With an efficiency the map's ``power`` is the electrical power of the electrically
-    optimal motion and ``mechanical_power`` that motion's mechanical power (issue 32: the
+    optimal motion and ``mechanical_power`` that motion's mechanical power (the
     rule of ``optimize``, ``pto-curve`` and ``buoy``), each equal to the same point through
     ``parapend.optimize(..., efficiency=...)``, an independent call (at efficiency 1 the
     three are the ideal optimum); the JSON and the text headline name the electrical power

@@ -1,4 +1,4 @@
-"""Long work under ``--time-limit`` (:mod:`parapend.deadline`), issue #33 item 1.
+"""Long work under ``--time-limit`` (:mod:`parapend.deadline`).
 
 Without a time limit, work estimated above the cap is refused in one line (exit 2) naming
 the option to change, the largest value that fits and ``--time-limit``; with one, the work
@@ -241,7 +241,8 @@ def test_buoy_mpc_partial_is_marked():
 @pytest.mark.slow
 def test_buoy_mpc_partial_is_the_full_runs_beginning():
     full, part = _buoy_mpc(), _buoy_mpc(deadline=0.0)
-    assert full.status == "ok" and part.t_end_s < full.t_end_s
+    # the full one-way run loses energy on this record (marked loses_energy, not ok)
+    assert full.status == "loses_energy" and part.t_end_s < full.t_end_s
     n = part.series["theta"].size
     assert np.allclose(part.series["theta"], full.series["theta"][:n], rtol=0, atol=1e-12)
 

@@ -1,6 +1,6 @@
 """Every tutorial's calls, run as a plain ``python script.py`` (no ``__main__`` guard, no
 notebook kernel), work: the parallel functions, the figures and the files they write
-(issue 32's acceptance; the documentation build runs the same cells in a Jupyter kernel)."""
+(the acceptance; the documentation build runs the same cells in a Jupyter kernel)."""
 
 from __future__ import annotations
 

@@ -485,8 +485,11 @@ def basins(*, gamma=GAMMA["basins"], p=DYNAMICS["p"], omega=DYNAMICS["omega"],
                    phi_range=phi_range, periods=periods, steps_per_period=steps,
                    split_phases=split_phases, engine=engine, progress=progress,
                    accuracy_sample=sample, accuracy_seed=seed)
-    return Record("basins", basins_json(ds), dataset=ds, draw=_draw_dataset("dynamics.figures",
-                                                                           "plot_basins"))
+    from .results import grid_csv
+
+    return Record("basins", basins_json(ds), dataset=ds,
+                  draw=_draw_dataset("dynamics.figures", "plot_basins"),
+                  table=lambda r: grid_csv(r.dataset, ["attractor", "phase", "periods_used"]))
 
 
 def _draw_dataset(module: str, function: str, **kw):
@@ -892,8 +895,11 @@ def _power_matrix_result(power_matrix, arguments):
         from .performance.causal import causal_json
 
         out["causal"] = causal_json(ds, grid)
+    from .performance import matrix_csv
+
     return Record("power-matrix", out, dataset=ds, run=run,
-                  draw=_draw_dataset("performance.figures", "plot_matrix"))
+                  draw=_draw_dataset("performance.figures", "plot_matrix"),
+                  table=lambda r: matrix_csv(r.dataset))
 
 
 # --- sea, buoy, horizon: the implementation is the command's function; sweep, power-matrix:

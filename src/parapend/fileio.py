@@ -88,6 +88,21 @@ def _target(path) -> Path:
     return p
 
 
+def named_fifo(path) -> bool:
+    """True when ``path`` (or the file a link leads to) is a named pipe in the file system:
+    writing there waits for ever for a reader, so no output goes there. A pipe reached
+    through ``/dev/stdout`` or ``/dev/fd/N`` (``parapend ... --save /dev/stdout | ...``)
+    is the process's own descriptor, not a named pipe."""
+    try:
+        st = os.stat(path)
+    except (OSError, ValueError):
+        return False
+    if not stat.S_ISFIFO(st.st_mode):
+        return False
+    real = os.path.realpath(path)
+    return not (real.startswith(("/proc/", "/dev/fd/")) or ":[" in real)
+
+
 def _write_in_place(path: Path, write: Callable[[str], None], shown) -> None:
     """Write to a destination that is not a regular file (device, FIFO) directly."""
     try:
@@ -126,6 +141,9 @@ def _atomic(path, write: Callable[[str], None]) -> Path:
     except OSError:
         st = None
     if st is not None and not stat.S_ISREG(st.st_mode):
+        if named_fifo(target):
+            raise OutputError(f"cannot write {str(path)!r}: a FIFO (named pipe), which waits "
+                              "for a reader for ever; give a regular file")
         _write_in_place(target, write, path)
         return target
     directory = target.parent if str(target.parent) else Path(".")
@@ -270,6 +288,9 @@ def check_target(path, name: str, suffixes=None, directory: bool = False) -> Pat
             raise ParameterError(f"{name}: directory {str(parent)!r} does not exist")
         if p.is_dir() and not directory:
             raise ParameterError(f"{name}: {str(path)!r} is a directory, expected a file name")
+        if named_fifo(p):
+            raise ParameterError(f"{name}: {str(path)!r} is a FIFO (named pipe), which waits "
+                                 "for a reader for ever; expected a regular file")
         try:
             max_name = os.pathconf(parent, "PC_NAME_MAX")
         except (OSError, ValueError, AttributeError):

@@ -786,7 +786,7 @@ def pto_curve(vary: str = "torque-limit", *, values=None, points: int = 12,
 def electrical_headline(result):
     """An optimum through a lossy take-off as the user reads it: ``power`` and ``power_w``
     the electrical power (what the take-off delivers, the headline of the text), the
-    mechanical one as ``mechanical_power`` and ``mechanical_power_w`` (issue 32)."""
+    mechanical one as ``mechanical_power`` and ``mechanical_power_w``."""
     return dataclasses.replace(result, power=result.electrical_power,
                                power_w=result.electrical_power_w,
                                mechanical_power=result.power,

@@ -178,6 +178,28 @@ def scalars_dataset(data: dict, series=None):
     return ds
 
 
+def grid_csv(ds, names) -> str:
+    """CSV text of the variables ``names`` of a Dataset over the same dimensions, one row per
+    grid point (long format): the dimensions' coordinates first, then the variables; a row
+    of names, a row of units, then the values (``repr(float)``)."""
+    import csv
+    import io
+
+    dims = ds[names[0]].dims
+    cols = [str(d) for d in dims] + [str(n) for n in names]
+    grids = np.meshgrid(*[np.asarray(ds[d].values, dtype=float) for d in dims],
+                        indexing="ij")
+    vals = [g.ravel() for g in grids] + [np.asarray(ds[n].transpose(*dims).values).ravel()
+                                         for n in names]
+    buf = io.StringIO()
+    w = csv.writer(buf, lineterminator="\n")
+    w.writerow(cols)
+    w.writerow([ds[c].attrs.get("units", quantity(c)[0]) for c in cols])
+    for row in zip(*vals):  # integers (labels, counts) as integers
+        w.writerow([str(int(v)) if isinstance(v, np.integer) else repr(float(v)) for v in row])
+    return buf.getvalue()
+
+
 def dataset_csv(ds) -> str:
     """CSV text of a Dataset's table: the variables along its one dimension as columns (the
     dimension's coordinate first), a header row of names, then a row of units, then the
@@ -291,6 +313,10 @@ class Result:
         ``units`` and ``long_name``."""
         return annotate(scalars_dataset(self.to_dict(), self._series()), self.command)
 
+    def _csv_text(self) -> str:
+        """What ``save("x.csv")`` writes: the table of ``to_dataset`` (:func:`dataset_csv`)."""
+        return dataset_csv(self.to_dataset())
+
     def _figure(self):
         from .errors import ParameterError
 
@@ -298,8 +324,16 @@ class Result:
 
     def plot(self):
         """The figure of the result, as the command line's ``--plot`` draws it (a matplotlib
-        ``Figure``; save it with :meth:`save` or ``fig.savefig``)."""
-        return self._figure()
+        ``Figure``; save it with :meth:`save` or ``fig.savefig``). The figure is not left
+        open in pyplot: a notebook shows it once, as the cell's value (pyplot's inline
+        backend also showed every figure still open at the cell's end: twice)."""
+        fig = self._figure()
+        import sys
+
+        plt = sys.modules.get("matplotlib.pyplot")
+        if plt is not None and hasattr(fig, "number"):
+            plt.close(fig)
+        return fig
 
     def save(self, path):
         """Write the result to ``path`` by its extension: ``.json``, ``.csv`` (with a units
@@ -315,7 +349,7 @@ class Result:
         if suffix == ".json":
             return fileio.write_text(path, json.dumps(self.to_dict(), indent=2) + "\n")
         if suffix == ".csv":
-            return fileio.write_text(path, dataset_csv(self.to_dataset()))
+            return fileio.write_text(path, self._csv_text())
         if suffix == ".nc":
             return fileio.write_dataset(self.to_dataset(), path)
         if suffix.lstrip(".") in fileio.FIGURE_FORMATS:
@@ -734,18 +768,23 @@ class Record(Result):
         ``draw(record)``: the command's figure (a matplotlib ``Figure``).
     series : callable or None
         ``series(record)``: the curves of the result as a Dataset (default: ``dataset``).
+    table : callable or None
+        ``table(record)``: the CSV text ``save("x.csv")`` writes, for a result of more than
+        one dimension (a grid, a matrix; default: the table of ``to_dataset``).
     **objects
         The objects behind the fields, by public name.
     """
 
-    __slots__ = ("_kind", "_data", "_objects", "_draw", "_series_of")
+    __slots__ = ("_kind", "_data", "_objects", "_draw", "_series_of", "_table_of")
 
-    def __init__(self, kind: str, data: dict, *, draw=None, series=None, **objects):
+    def __init__(self, kind: str, data: dict, *, draw=None, series=None, table=None,
+                 **objects):
         object.__setattr__(self, "_kind", kind)
         object.__setattr__(self, "_data", dict(data))
         object.__setattr__(self, "_objects", objects)
         object.__setattr__(self, "_draw", draw)
         object.__setattr__(self, "_series_of", series)
+        object.__setattr__(self, "_table_of", table)
 
     @property
     def command(self) -> str:
@@ -810,6 +849,11 @@ class Record(Result):
         if self._draw is None:
             return super()._figure()
         return self._draw(self)
+
+    def _csv_text(self) -> str:
+        if self._table_of is None:
+            return super()._csv_text()
+        return self._table_of(self)
 
     def to_dict(self) -> dict:
         return to_jsonable(self._data)

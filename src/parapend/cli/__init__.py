@@ -17,7 +17,9 @@ User errors print one line and exit with code 2; only this package prints.
 
 Exit codes: 0 success; 1 a file or standard output could not be written, or a solver
 error; 2 a usage error (bad value, unknown option, unreadable input file, and a bare
-``parapend`` with no command, which prints the list of commands to stderr); 130 when
+``parapend`` with no command, which prints the list of commands to stderr); 3 the command
+ran but has no resolved answer (its headline printed as none with the reason, or a status
+that says the number is not one: a causal run that loses energy); 130 when
 interrupted (Ctrl-C; a shell also reports 130 for a process that CPython ends by SIGINT,
 as it does after an interrupt during an extension module's import). The console script
 enters through :mod:`parapend._entry`, which loads this package inside its Ctrl-C handler.
@@ -55,7 +57,7 @@ from . import persistence as _persistence_cmds
 from . import pto as _pto_cmds
 from . import sea as _sea_cmds
 from . import sweep as _sweep_cmds
-from ._common import EXIT_USAGE, _Parser
+from ._common import EXIT_UNRESOLVED, EXIT_USAGE, Unresolved, _Parser
 from ._notice import install as _compile_notice
 from ._output import OutputError
 
@@ -68,6 +70,28 @@ COMMANDS = {**_optimize_cmds.COMMANDS, **_paper_cmds.COMMANDS, **_pto_cmds.COMMA
             **_sweep_cmds.COMMANDS,
             **_performance_cmds.COMMANDS, **_buoy_cmds.COMMANDS, **_horizon_cmds.COMMANDS,
             **_persistence_cmds.COMMANDS}
+
+
+#: one example per command, printed at the end of its ``--help`` (each parses: the tests)
+EXAMPLES = {
+    "optimize": "parapend optimize --delta -0.3 --omega 1.8 --gamma 0.05",
+    "threshold": "parapend threshold --excitation square --square-alpha 0.2",
+    "damping-sweep": "parapend damping-sweep --points 20 --json",
+    "harmonics": "parapend harmonics --from 4 --to 32 --plot figures",
+    "figure": "parapend figure 4 --plot figures",
+    "reproduce": "parapend reproduce --out paper-figures",
+    "pto-curve": "parapend pto-curve --vary efficiency --points 9 --save curve.csv",
+    "simulate": "parapend simulate --gamma 0.1 --p 0.8 --omega 2.1 --periods 50",
+    "basins": "parapend basins --resolution 200 --plot figures",
+    "rotations": "parapend rotations --gamma 0.1 --omega 2.1 --p-max 2",
+    "track": "parapend track --controller mpc --horizon 2 --periods 40",
+    "sea": "parapend sea --hs 2 --tp 8 --length 1 --mass 10 --gamma 0.01",
+    "sweep": "parapend sweep --omega 1:3:21 --delta=-0.5:-0.1:21 --store map.zarr",
+    "map": "parapend map --store map.zarr --variable power --plot figures",
+    "power-matrix": "parapend power-matrix --hs 1:3:3 --te 6:10:3 --scatter site.csv",
+    "buoy": "parapend buoy --hs 0.5 --tp 2.5 --controller mpc",
+    "horizon": "parapend horizon --hs 2 --tp 8 --horizons 0.25,0.5,1,2",
+}
 
 
 def _function(command: str):
@@ -85,7 +109,10 @@ def build_parser(*, declare: bool = True):
     parser = _Parser(prog="parapend", description=(
         "Optimal energy extraction from period-1 rotations of a parametrically excited "
         "pendulum: theta'' + gamma theta' - (1 + q(t)) sin(theta) = T(t). Power P = -<T "
-        "theta'> is positive when harvested."))
+        "theta'> is positive when harvested."),
+        epilog="exit status: 0 success; 1 an output could not be written, or a solver error; "
+               "2 a usage error; 3 ran, but no resolved answer (the headline is none, with "
+               "its reason; or a causal run that loses energy); 130 interrupted")
     parser.add_argument("--version", action="version", version=f"parapend {__version__}")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser,
                                 title="commands")
@@ -101,6 +128,8 @@ def build_parser(*, declare: bool = True):
     _horizon_cmds.add_parsers(sub)
     _persistence_cmds.add_parsers(sub)
     for name, p in sub.choices.items():
+        if name in EXAMPLES:
+            p.epilog = f"example: {EXAMPLES[name]}"
         p.declared_by = functools.partial(_function, name)
         if declare:
             p.declare_defaults()
@@ -200,6 +229,9 @@ def main(argv=None) -> int:
         _err(f"{name}: interrupted")
         _quiet_after_interrupt()
         return 130
+    code = 0
+    if isinstance(out, Unresolved):  # printed as any result, then exit status 3
+        out, code = out.out, EXIT_UNRESOLVED
     if closed:
         _err(f"{name}: error: standard output is closed; the result was not printed")
         return EXIT_FAILURE
@@ -216,4 +248,4 @@ def main(argv=None) -> int:
         _err(f"{name}: error: cannot write to standard output: "
              f"{getattr(exc, 'strerror', None) or exc}")
         return EXIT_FAILURE
-    return 0
+    return code

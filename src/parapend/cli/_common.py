@@ -15,6 +15,27 @@ from ..defaults import OMEGA, Default, given  # noqa: F401  (Default, given re-e
 from ..errors import ParameterError
 
 EXIT_USAGE = 2
+#: the command ran but has no resolved answer: its headline is null (the reason printed
+#: with it) or its status says the number is not one (a causal run that loses energy)
+EXIT_UNRESOLVED = 3
+
+
+class Unresolved:
+    """A command's output (its text or its JSON dict) printed as any other, after which the
+    command exits with :data:`EXIT_UNRESOLVED`: it ran, and its result says that its headline
+    is not a resolved answer (``headline_reason``, or a status such as ``loses_energy``)."""
+
+    def __init__(self, out):
+        self.out = out
+
+
+def unresolved_if(out, result):
+    """``out`` wrapped in :class:`Unresolved` when ``result`` has no resolved answer: a
+    null headline with its reason (``headline_reason``) or the status ``loses_energy``."""
+    if getattr(result, "headline_reason", None) or getattr(result, "status",
+                                                           None) == "loses_energy":
+        return Unresolved(out)
+    return out
 
 
 # a leading '-' followed by a number in any notation (-1, -.5, -1e-3, -1E+2, -inf) is a
@@ -215,15 +236,21 @@ FIGURE_SUFFIXES = (".png", ".svg", ".pdf")
 #: one table, and one with several dimensions (no CSV)
 SAVE_TABLE = (".csv", ".nc", ".json")
 SAVE_GRID = (".nc", ".json")
+#: every format a result's ``save`` writes (:data:`parapend.results.SAVE_SUFFIXES`)
+SAVE_ALL = (".csv", ".nc", ".json", ".png", ".svg", ".pdf")
 
 
-def add_output_options(p, *, plot: str, save: str, table: bool = True) -> None:
+def add_output_options(p, *, plot: str, save: str, table: bool = True,
+                       figures: bool = False) -> None:
     """``--plot``, ``--save`` and ``--json``: how a command's result is drawn, written and
     printed (:meth:`~parapend.results.Result.plot`, :meth:`~parapend.results.Result.save`,
     :meth:`~parapend.results.Result.to_dict`). ``plot`` and ``save`` say what is drawn and
-    written; ``table`` is False for a result of several dimensions (no CSV)."""
+    written; ``table`` is False for a result of several dimensions (no CSV); ``figures``:
+    ``--save`` also writes the figure (``SAVE_ALL``: every format the result writes)."""
     p.add_argument("--plot", metavar="PNG", help=f"draw {plot} (PNG, SVG or PDF)")
     kinds = ".csv (with a row of units), .nc or .json" if table else ".nc or .json"
+    if figures:
+        kinds = ".csv (with a row of units), .nc, .json, or the figure as .png, .svg or .pdf"
     p.add_argument("--save", metavar="FILE", help=f"write {save}: {kinds}")
     p.add_argument("--json", action="store_true", help="print one JSON object")
 
@@ -261,6 +288,11 @@ def _check_output(path: str | None, what: str, suffixes) -> None:
         raise ParameterError(f"{what}: directory {str(parent)!r} does not exist")
     if p.is_dir():
         raise ParameterError(f"{what}: {path!r} is a directory, expected a file name")
+    from ..fileio import named_fifo
+
+    if named_fifo(p):
+        raise ParameterError(f"{what}: {path!r} is a FIFO (named pipe), which waits for a "
+                             "reader for ever; expected a regular file")
     from ._output import OutputError, probe_dir
 
     try:
@@ -322,12 +354,19 @@ class _Progress:
 
     Call it as ``bar(done, total)`` (or ``bar(done, total, label)``); it draws nothing for
     the first ``delay`` seconds, so quick runs stay silent, and erases itself at the end.
+    Once a step is done it shows the time left, the elapsed time per step times the steps
+    left (``about 40 s left``).
     """
+
+    #: the clock (seconds; a test sets its own)
+    clock = staticmethod(time.monotonic)
+    #: show the time left (a subclass with its own estimate turns it off)
+    time_left = True
 
     def __init__(self, label: str, delay: float = 1.0):
         self.label = label
         self.delay = delay
-        self.start = time.monotonic()
+        self.start = self.clock()
         self.drawn = False
         try:
             self.on = sys.stderr is not None and sys.stderr.isatty()
@@ -335,13 +374,15 @@ class _Progress:
             self.on = False
 
     def __call__(self, done: int, total: int, label: str | None = None) -> None:
-        if not self.on or (not self.drawn and time.monotonic() - self.start < self.delay
-                           and done < total):
+        elapsed = self.clock() - self.start
+        if not self.on or (not self.drawn and elapsed < self.delay and done < total):
             return
         width = 30
         k = int(width * done / max(total, 1))
         what = self.label if label is None else f"{self.label}: {label}"
         line = f"{what[:40]} [{'#' * k}{'.' * (width - k)}] {done}/{total}"
+        if self.time_left and 0 < done < total:
+            line += f", about {_duration(elapsed / done * (total - done))} left"
         try:
             if done >= total:
                 if self.drawn:
@@ -352,6 +393,15 @@ class _Progress:
             sys.stderr.flush()
         except (OSError, ValueError):
             self.on = False
+
+
+def _duration(seconds: float) -> str:
+    """``seconds`` for a person: ``8 s``, ``3 min``, ``2.5 h``."""
+    if seconds < 90:
+        return f"{max(seconds, 1.0):.0f} s"
+    if seconds < 5400:
+        return f"{seconds / 60:.0f} min"
+    return f"{seconds / 3600:.1f} h"
 
 
 def _fmt(x, digits=6):

@@ -163,11 +163,12 @@ def _cmd_buoy(a) -> dict | str:
                           "record (--repeat-period, --record), or a smaller --mesh") from None
     if hasattr(r, "controller"):
         from ..hydro.control import mpc_text
+        from ._common import unresolved_if
 
         if a.save:
             _output.write_dataset(r.to_dataset(), a.save)
-        return r.to_dict() if a.json else "\n".join(
-            mpc_text(r) + ([f"written: {a.save}"] if a.save else []))
+        return unresolved_if(r.to_dict() if a.json else "\n".join(
+            mpc_text(r) + ([f"written: {a.save}"] if a.save else [])), r)
     if tuple(r.dofs) != ("heave",):
         return _hull_output(r, a)
     sweep = hasattr(r, "period_s")

@@ -118,7 +118,7 @@ def add_parsers(sub) -> None:
                                    "capture). Every map reports how many of its labels are "
                                    "uncertain: a seeded sample of points is re-run with "
                                    "twice the steps and from 1e-6 away, and the share of "
-                                   "labels that change is given with a 95 %% interval.")
+                                   "labels that change is given with a 95 % interval.")
     p._negative_number_matcher = _RANGE_OR_NUMBER
     _add_model(p)
     p.add_argument("--resolution", type=_int,

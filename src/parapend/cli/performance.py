@@ -10,6 +10,7 @@ from ..defaults import BUOY, HULL, SEA
 from . import _output
 from ._common import (
     FIGURE_SUFFIXES,
+    Unresolved,
     _check_output,
     _finite_float,
     _int,
@@ -148,8 +149,9 @@ def add_parsers(sub) -> None:
                    help="characteristic width, m: adds the capture-width ratio (buoy "
                         "default: the body's diameter)")
     g.add_argument("--scatter", metavar="CSV",
-                   help="scatter diagram 'hs,te,frequency' (shares summing to 1) or "
-                        "'hs,te,count'; bin centres of the matrix")
+                   help="scatter diagram 'hs,te,frequency' (shares summing to 1), "
+                        "'hs,te,count' (occurrences) or 'hs,te,hours' (warned unless they "
+                        "sum to a year); bin centres of the matrix")
     g.add_argument("--timeseries", metavar="CSV",
                    help="sea states 'hs,te', one a row, binned with the matrix's edges")
     g.add_argument("--rated-power", type=_finite_float("rated-power"),
@@ -204,15 +206,18 @@ def _cmd_power_matrix(a) -> dict | str:
             _output.plot(figures.plot_scatter, ds, f"{a.plot}-scatter.png")
             drawn.append(f"{a.plot}-scatter.png")
     out = rec.to_dict()
+    # with a site, the annual energy is the headline: incomplete, it is null (its bounds
+    # and the share missing beside it) and the command exits with status 3
+    aep_unresolved = out["annual_energy"] is not None and not out["annual_energy_complete"]
     if a.json:
-        return out
+        return Unresolved(out) if aep_unresolved else out
     text = figures.text_report(ds, out, drawn)
     if out["status"] == "time_limit":
         text += (f"\nstatus: time_limit: PARTIAL matrix, bins {out['bins_finished']} of "
                  f"{out['bins']} finished (time limit {a.time_limit:g} s; the rest NaN, "
                  "not counted in the annual energy)"
                  + ("; run the same command again to compute them" if a.store else ""))
-    return text
+    return Unresolved(text) if aep_unresolved else text
 
 
 COMMANDS = {"power-matrix": _cmd_power_matrix}

@@ -8,7 +8,7 @@ from .. import limits
 from . import _output
 from ._common import (
     FIGURE_SUFFIXES,
-    SAVE_TABLE,
+    SAVE_ALL,
     _add_excitation,
     _check_output,
     _finite_float,
@@ -194,12 +194,12 @@ def add_parsers(sub) -> None:
                    help=f"number of values, 2 to {limits.MAX_PTO_POINTS} (default 10)")
     add_pto_options(p)
     add_unit_options(p)
-    add_output_options(p, plot="the curve", save="the curve")
+    add_output_options(p, plot="the curve", save="the curve", figures=True)
 
 
 def _cmd_pto_curve(a) -> dict | str:
     _check_output(a.plot, "--plot", FIGURE_SUFFIXES)
-    _check_output(a.save, "--save", SAVE_TABLE)
+    _check_output(a.save, "--save", SAVE_ALL)
     ds = _run(a, progress=_Progress("pto-curve"))
     units = ds.attrs.get("power_unit_w")
     if a.plot:

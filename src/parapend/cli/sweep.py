@@ -30,7 +30,10 @@ _AXIS_HELP = "one value, START:STOP:COUNT (COUNT values, ends included) or a com
 
 
 class _EtaProgress(_Progress):
-    """The progress bar with the points per second of this run and the time left."""
+    """The progress bar with the points per second of this run and the time left (the
+    points found finished in the store not counted)."""
+
+    time_left = False
 
     def __init__(self, label: str):
         super().__init__(label)

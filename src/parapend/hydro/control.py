@@ -72,6 +72,9 @@ DEFAULT_LIMIT = 2.0
 #: a run whose pendulum turns more than this (rad) in one plant step is not resolved
 RESOLVED = 0.5
 CONTROLLERS = ("coupled", "fixed-point", "one-way", "plan")
+#: the non-causal reference is resolved when its refinement N -> 2N changed it by at most
+#: this (relative), and a causal run's fraction of it may exceed 1 by at most this
+REFERENCE_TOL = 1e-3
 #: ``plan``: torque samples per Hermite interval of the motion
 PLAN_INTERVAL_SAMPLES = 4
 #: ``plan``: interior-point iterations per solve at most
@@ -174,8 +177,11 @@ class BuoyMPCResult(_Result):
     message: str
     pendulum: dict
     units: dict
+    headline_reason: str | None = None
+    warnings: tuple = ()
     optimum_power_w: float | None = None
     optimum_fraction: float | None = None
+    optimum_resolved: bool | None = None
     optimum_winding: int | None = None
     wave: dict | None = None
     convention: str = ("theta from the upright (hanging at rest is theta = pi), z up from "
@@ -229,10 +235,11 @@ class BuoyMPCResult(_Result):
             ax[2].plot(t, e, lw=1.0, color="C0")
             ax[2].set_ylabel("harvested energy (J)")
             ax[2].set_xlabel("time t (s)")
-            ax[0].set_title(f"buoy, {self.controller}: mean power {self.mean_power_w:.4g} W "
-                            f"(harvested {self.harvested_power_w:.4g} W + stored "
-                            f"{self.stored_w:.4g} W) from {self.average_from_s:.4g} s",
-                            fontsize=10)
+            head = (f"mean power {self.mean_power_w:.4g} W (harvested "
+                    f"{self.harvested_power_w:.4g} W + stored {self.stored_w:.4g} W) from "
+                    f"{self.average_from_s:.4g} s" if self.headline_reason is None else
+                    f"no mean power ({self.status})")
+            ax[0].set_title(f"buoy, {self.controller}: {head}", fontsize=10)
             fig.tight_layout()
         return fig
 
@@ -1000,6 +1007,14 @@ def buoy_mpc(hydro, pendulum, wave, *, peak_period, horizon=2.0, update_interval
     if status == "ok" and solves and 2 * failed > solves:
         # a run whose plans mostly failed is not a success, whatever its power
         status = "solves_failed"
+    if status == "ok" and (caught is None or caught > a0):
+        # the window holds the swing-up, not the controller: no causal mean to report
+        status = "not_caught"
+    # the storage-corrected mean is exact for the plant up to its energy balance: a loss
+    # beyond that residual is the controller's, not the integration's
+    tol = resid * abs(absorbed) if math.isfinite(resid * absorbed) else 0.0
+    if status == "ok" and min(mean_p, mean_e) < -tol:
+        status = "loses_energy"
     st = np.asarray(times)
     timing = _mpc.timing_summary(st, m * dt)
     fp = []
@@ -1019,8 +1034,29 @@ def buoy_mpc(hydro, pendulum, wave, *, peak_period, horizon=2.0, update_interval
                           "the integration does not resolve the run; lower the torque "
                           "limit"),
            "time_limit": (f"time limit reached after {st.size} updates: {total * dt:.6g} s of "
-                          f"the {planned * dt:.6g} s run (a partial run; its powers over the "
-                          f"samples run, from {a0 * dt:.4g} s)")}[status]
+                          f"the {planned * dt:.6g} s run (a partial run: its energies over the "
+                          f"samples run, from {a0 * dt:.4g} s)"),
+           "not_caught": (f"the swing-up never handed over to the controller (0 horizon "
+                          f"solves): the pendulum did not reach the top under the torque "
+                          f"limit {torque_limit:.6g} N m" if caught is None else
+                          f"the swing-up handed over at {caught * dt:.6g} s, inside the "
+                          f"averaging window from {a0 * dt:.6g} s"),
+           "loses_energy": (f"the controller loses energy: {mean_e:.6g} W over the last "
+                            f"repeat ({solves} horizon solves in {st.size} updates, {failed} "
+                            f"ended abnormally{applied})")}[status]
+    warnings = []
+    reason = None
+    if status == "loses_energy":
+        warnings.append(f"the causal run loses energy ({mean_e:.4g} W electrical, "
+                        f"{mean_p:.4g} W mechanical): the pendulum at rest (0 W) does "
+                        "better; its power is a measurement of this controller, not an "
+                        "answer")
+    elif status != "ok":
+        # not a causal mean over a whole repeat after the warm-up: the headline is null
+        reason = (f"the run stopped at {total * dt:.4g} s of {planned * dt:.4g} s (time "
+                  "limit): no mean over one whole repeat of the record after the "
+                  f"{warm_samples * dt:.4g} s warm-up" if status == "time_limit" else msg)
+        mean_p = mean_e = harvested = harvested_e = math.nan
     series = {"t": t, "theta": ys[:, 2], "theta_dot": ys[:, 3], "z": ys[:, 0],
               "z_dot": ys[:, 1], "torque": u_all, "power": p}
     zwin = ys[a0 * 1:, 0]
@@ -1041,8 +1077,8 @@ def buoy_mpc(hydro, pendulum, wave, *, peak_period, horizon=2.0, update_interval
         **{f"{k}_s": v for k, v in timing.items() if k != "realtime_fits"},
         realtime_fits=timing["realtime_fits"], failed_kept_previous=kept,
         torque_limit_nm=torque_limit, torque_limit_given=limit_given, efficiency=eta,
-        success=status == "ok", status=status, message=msg,
-        pendulum={"mass_kg": pendulum.mass, "length_m": pendulum.length,
+        success=status == "ok", status=status, message=msg, headline_reason=reason,
+        warnings=tuple(warnings), pendulum={"mass_kg": pendulum.mass, "length_m": pendulum.length,
                   "inertia_kg_m2": pendulum.inertia,
                   "damping_coefficient_nm_s_per_rad": pendulum.damping_coefficient},
         units={"time_s": t0, "torque_nm": tu, "power_w": tu / t0, "a_inf_kg": plant.a_inf,
@@ -1073,9 +1109,34 @@ def mpc_command(hydro, pendulum, wave, info, *, controller, horizon, update_inte
                        torque_limit=None, efficiency=None, one_way=False)
     opt = float(sol.power) if sol.success else None
     # with an efficiency the fraction includes the losses (as parapend horizon's)
-    frac = r.electrical_power_w / opt if opt is not None and opt > 0 else None
+    frac = (r.electrical_power_w / opt if opt is not None and opt > 0
+            and math.isfinite(r.electrical_power_w) else None)
+    resolved, note = _reference_verdict(sol, frac)
+    warnings = r.warnings + ((note,) if note else ())
     return dataclasses.replace(r, optimum_power_w=opt, optimum_fraction=frac,
-                               optimum_winding=int(winding), wave=info)
+                               optimum_resolved=resolved, optimum_winding=int(winding),
+                               wave=info, warnings=warnings)
+
+
+def _reference_verdict(sol, fraction):
+    """``(resolved, note)`` of the non-causal reference ``sol``: resolved when its solve
+    succeeded, the refinement ``N -> 2N`` changed its power by at most ``REFERENCE_TOL``
+    (relative) and no causal run beats it (``fraction`` at most ``1 + REFERENCE_TOL``: a
+    causal controller cannot beat the non-causal optimum of the same record; one that does
+    shows the reference is not that optimum). The note says why not (None when resolved)."""
+    if not sol.success or not math.isfinite(sol.power):
+        return None, None  # no reference at all: optimum_power_w is null
+    change = float(getattr(sol, "refinement_change", 0.0) or 0.0)
+    if change > REFERENCE_TOL * abs(sol.power):
+        return False, (f"the non-causal reference is under-resolved: its refinement "
+                       f"N -> 2N changed it by {change:.3g} W ({change / abs(sol.power):.1%}"
+                       f", {sol.harmonics} harmonics); give more --harmonics (or none: the "
+                       "default)")
+    if fraction is not None and fraction > 1 + REFERENCE_TOL:
+        return False, (f"the causal run reaches {fraction:.4g} of the non-causal reference, "
+                       "above 1: the reference is not the record's optimum (a local "
+                       "maximum; try another --winding)")
+    return True, None
 
 
 def _timing_line(r) -> str:
@@ -1095,7 +1156,7 @@ def _timing_line(r) -> str:
 def mpc_text(r) -> list:
     """The text report of :func:`mpc_command`'s result."""
     def f(x, unit=""):
-        return "-" if x is None else f"{x:.6g}{unit}"
+        return "-" if x is None or not math.isfinite(x) else f"{x:.6g}{unit}"
     w = r.wave or {}
     p = r.pendulum
     out = [f"wave: irregular, {w.get('spectrum', '')}, Hs = {w.get('hs', math.nan):g} m, "
@@ -1118,7 +1179,8 @@ def mpc_text(r) -> list:
            f"  electrical                       {f(r.electrical_power_w, ' W')}",
            f"non-causal coupled optimum         {f(r.optimum_power_w, ' W')} (winding "
            f"{r.optimum_winding})",
-           f"  fraction reached (electrical)    {f(r.optimum_fraction)}",
+           f"  fraction reached (electrical)    {f(r.optimum_fraction)}"
+           + ("  (the reference under-resolved)" if r.optimum_resolved is False else ""),
            f"absorbed by the buoy               {f(r.absorbed_w, ' W')}",
            f"  pendulum damping                 {f(r.damping_w, ' W')}",
            f"  stored (change / time)           {f(r.stored_w, ' W')}",
@@ -1127,4 +1189,6 @@ def mpc_text(r) -> list:
            f"peak torque                        {f(r.peak_torque_nm, ' N m')}",
            _timing_line(r),
            f"status: {r.status}; {r.message}"]
-    return out
+    if r.headline_reason:
+        out[4:5] = [f"mean power over the last repeat    none: {r.headline_reason}"]
+    return out + [f"warning: {w}" for w in r.warnings]

@@ -373,7 +373,7 @@ def buoy_horizon_curve(*, hs=None, tp=None, spectrum="jonswap", gamma_peak=3.3,
                     stopped[0] = True
                 status[i][j][r] = str(res.status)
                 ctrl = str(res.controller)
-                if res.success:
+                if res.success or res.status == "loses_energy":  # a loss is measured
                     power[i][j][r] = float(res.electrical_power_w)
                     harvested[i][j][r] = float(res.harvested_electrical_power_w)
                     stored[i][j][r] = float(res.stored_energy_change_j)

@@ -36,8 +36,12 @@ def energy_flux(omega: float, amplitudes, rho: float = 1025.0, g: float = 9.81,
                 depth: float = math.inf) -> float:
     """Energy flux per metre of crest, W/m, of the wave ``Re sum_k a_k exp(i k omega t)``:
     ``J = rho g sum_k |a_k|^2 c_g(k omega) / 2``; a regular wave in deep water gives
-    ``rho g^2 H^2 T / (32 pi)``."""
-    a = np.asarray(amplitudes)
+    ``rho g^2 H^2 T / (32 pi)``. One amplitude may be given as a scalar or a 0-d array."""
+    a = np.atleast_1d(np.asarray(amplitudes))
+    if a.ndim != 1:
+        from ..errors import ParameterError
+
+        raise ParameterError(f"amplitudes: expected a 1-d sequence, got shape {a.shape}")
     total = 0.0
     for k, ak in enumerate(a, start=1):
         if ak != 0:

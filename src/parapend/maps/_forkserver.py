@@ -32,6 +32,18 @@ from multiprocessing import context
 
 #: the start of the name of every worker process of the engine's local pool
 WORKER_NAME = "ParapendWorker-"
+#: the warning filter the resource tracker is started with: after the main process is
+#: killed (``kill -9``) the tracker frees the pool's semaphores itself, and its "leaked
+#: semaphore objects" warning was a line of noise after the kill's own report
+QUIET_TRACKER = "ignore:resource_tracker:UserWarning"
+
+
+def quiet_resource_tracker() -> None:
+    """Start multiprocessing's resource tracker (where it is not running yet) with
+    :data:`QUIET_TRACKER`: a child process gets the parent's ``sys.warnoptions`` as ``-W``
+    options (``multiprocessing.util._args_from_interpreter_flags``)."""
+    if QUIET_TRACKER not in sys.warnoptions:
+        sys.warnoptions.append(QUIET_TRACKER)
 
 
 class ParapendWorker(context.ForkServerProcess):
@@ -45,6 +57,7 @@ class WorkerContext(context.ForkServerContext):
     lists them in order (their ``exitcode`` after the pool has shut down)."""
 
     def __init__(self):
+        quiet_resource_tracker()
         self.started: list[ParapendWorker] = []
 
     def Process(self, *args, **kwargs):  # noqa: N802 - multiprocessing's name

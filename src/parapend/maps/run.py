@@ -30,6 +30,7 @@ from .store import (
     _store_spec,
     _template,
     _verify,
+    make_store_dir,
     open_sweep,
 )
 
@@ -521,7 +522,7 @@ def _sweep(spec, store, pool, client, overwrite, command, progress, t0,
         return SweepRun(ds, None, total, spec.blocks, counted[0], 0, time.monotonic() - t0,
                         how, stopped=state["stopped"])
     path = _check_store_path(store)
-    path.mkdir(exist_ok=True)
+    make_store_dir(path)
     try:
         return _sweep_store(spec, path, pool, client, overwrite, command, progress, t0,
                             sizes, until, state)

@@ -57,7 +57,7 @@ VARIABLES = {
                           "(Fig. 6; ideal power take-off)", "sqrt(g/l)"),
     "threshold_status": ("solver status of the damping threshold", None),
 }
-#: ``power`` of a map with an efficiency: the headline is the electrical power (issue 32, as
+#: ``power`` of a map with an efficiency: the headline is the electrical power (as
 #: ``optimize``), the same motion's mechanical power is ``mechanical_power``
 ELECTRICAL_POWER = ("optimal mean electrical power through the power take-off (the motion "
                     "maximizes it; its mechanical power is mechanical_power)", _POWER_UNITS)

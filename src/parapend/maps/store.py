@@ -311,7 +311,23 @@ def _check_store_path(store) -> Path:
     if path.exists() and not path.is_dir():
         raise ParameterError(f"store: {str(path)!r} is a file, expected a Zarr store "
                              "(a directory)")
+    if path.is_symlink() and not path.exists():
+        # a link to a store not made yet: the store is made where it points
+        target = Path(os.path.realpath(path))
+        if not target.parent.is_dir():
+            raise ParameterError(f"store: {str(path)!r} is a link to {str(target)!r}, whose "
+                                 "directory does not exist")
     return path
+
+
+def make_store_dir(path: Path) -> None:
+    """Make the store's directory (none if it exists); through a link to a directory not
+    made yet, the directory it points to (``mkdir`` of the link itself says "File
+    exists")."""
+    if path.is_symlink() and not path.exists():
+        Path(os.path.realpath(path)).mkdir(exist_ok=True)
+    else:
+        path.mkdir(exist_ok=True)
 
 
 # -- verifying a store -----------------------------------------------------------------------

@@ -328,6 +328,10 @@ def _stats(x: np.ndarray, ok: np.ndarray) -> dict:
 
 #: the quantities of the optimum's solve: their statistics count only its successes
 _SOLVED = ("power", "mechanical_power", "electrical_power")
+#: a causal run above its record's non-causal optimum by more than this (relative) is not an
+#: answer: no causal controller beats the omniscient one on the same record, and the
+#: time-domain plant and the frequency-domain optimum agree far closer than this
+CAUSAL_SLACK = 0.01
 
 
 def matrix_quantities(spec: MatrixSpec) -> tuple:
@@ -382,6 +386,8 @@ def matrix_dataset(raw, spec: MatrixSpec, *, depth=None, density: float = 1025.0
     # device rests in that record, its optimum's power <= 0 kept as solved)
     solved = done & np.isin(status, [_CODE["converged"], _CODE["no_power"]])
     dims2 = ("hm0", pk)
+    if spec.controller is not None:
+        _causal_above_optimum(ds, spec, solved)
     for q in matrix_quantities(spec):
         solve_q = q in _SOLVED
         ok = (solved if solve_q else done) & np.isfinite(ds[q].values)
@@ -456,11 +462,16 @@ def matrix_dataset(raw, spec: MatrixSpec, *, depth=None, density: float = 1025.0
     if frequency is not None:
         ds["frequency"] = (dims2, frequency, {"long_name": "share of the year of the bin"})
         annual = {}
+        need = (np.asarray(frequency) > 0) & np.any(
+            [~np.isfinite(ds[f"{q}_mean"].values) for q in matrix_quantities(spec)], axis=0)
+        bound, bound_name = (_bin_bounds(ds, spec, need) if need.any() and not outside
+                             else (None, "bound"))
         for q in matrix_quantities(spec):
             if q.endswith("_harvested_power"):
                 continue  # without its storage correction: no annual energy
             a = annual_energy(ds[f"{q}_mean"].values, frequency,
-                              outside["frequency"] if outside else 0.0)
+                              outside["frequency"] if outside else 0.0, bound=bound,
+                              bound_name=bound_name)
             a["bins_without_power"] = [{"hm0": spec.hm0[i], pk: spec.period[k],
                                         "frequency": float(frequency[i, k])}
                                        for i, k in a.pop("missing")]
@@ -471,15 +482,18 @@ def matrix_dataset(raw, spec: MatrixSpec, *, depth=None, density: float = 1025.0
                 a["capacity_factor"] = (capacity_factor(a["wh"], rated_power)
                                         if a["complete"] else None)
                 if not a["complete"]:
-                    a["capacity_factor_bounds"] = [capacity_factor(w, rated_power)
-                                                   for w in a["wh_bounds"]]
+                    a["capacity_factor_bounds"] = [
+                        None if w is None else capacity_factor(w, rated_power)
+                        for w in a["wh_bounds"]]
             annual[q] = a
         # the completeness in the file too (NetCDF has no boolean attribute: 1 or 0)
         ds.attrs["annual_energy_complete"] = int(annual["power"]["complete"])
         if annual["power"]["complete"]:
             ds.attrs["annual_energy_mwh"] = annual["power"]["mwh"]
         else:
-            ds.attrs["annual_energy_mwh_bounds"] = annual["power"]["mwh_bounds"]
+            # NaN: no upper bound (a NetCDF attribute holds no None)
+            ds.attrs["annual_energy_mwh_bounds"] = [_nan_none(b) for b in
+                                                    annual["power"]["mwh_bounds"]]
             ds.attrs["annual_energy_uncounted_frequency"] = \
                 annual["power"]["uncounted_frequency"]
         if spec.controller is not None:
@@ -493,6 +507,92 @@ def annual_columns(spec: MatrixSpec) -> dict:
     optimum, then each forecast's causal column: label -> quantity."""
     return {"optimum": "power", **{f"causal_{f}": f"causal_{f}_power"
                                    for f in spec.forecasts}}
+
+
+#: the fewest bins a matrix has: two centres on each axis
+MIN_BINS = 4
+
+
+def untimed_advice(most: int, bins: int, realizations: int, period_kind: str):
+    """``(option, advice)`` for a matrix of ``bins`` x ``realizations`` solves of which
+    ``most`` fit in the untimed cap: fewer realizations where they suffice, else fewer bins
+    where at least :data:`MIN_BINS` fit (the command refuses fewer: two centres an axis),
+    else shorter records (``--waves``): never a change the command itself refuses."""
+    if most >= bins:
+        return "realizations", f"use --realizations at most {most // bins}"
+    if most // realizations >= MIN_BINS:
+        return "hs", (f"use at most {most // realizations} bins (--hs times --{period_kind} "
+                      f"centres) at {realizations} realizations")
+    if most >= MIN_BINS:
+        return "hs", (f"use --realizations 1 and at most {most} bins (--hs times "
+                      f"--{period_kind} centres)")
+    return "waves", (f"not even {MIN_BINS} bins (2 --hs and 2 --{period_kind} centres) of one "
+                     "realization fit: use fewer --waves")
+
+
+def _nan_none(x) -> float:
+    """``x`` as a float, NaN for None (no bound)."""
+    return math.nan if x is None else float(x)
+
+
+def _record_bound(spec: MatrixSpec, i: int, j: int, r: int) -> float:
+    """A true upper bound (W) of any power of realization ``r`` of bin ``(i, j)``, from its
+    record alone (no solve, no BEM beyond the body's one): the gamma -> 0 limit
+    ``omega_r TV(q) / 2 pi`` (prescribed heave), the radiation bound ``sum_k |F_k a_k|^2 /
+    (8 B_k)`` (the heaving buoy); NaN for the hull (its bound is not computed here)."""
+    if spec.device == "buoy" and spec.dofs != "heave":
+        return math.nan
+    if spec.device == "buoy":
+        from ..hydro.optimum import radiation_bound
+        from .buoy_device import body_hydro, wave_of
+
+        return radiation_bound(body_hydro(spec)[0], wave_of(spec, i, j, r)[0])
+    from ..optimal.limit import limit
+    from .check import _record, _units
+
+    units = _units(spec)
+    return units.to_watts(limit(_record(spec, units, i, j, r)).power)
+
+
+def _bin_bounds(ds, spec: MatrixSpec, need):
+    """``(bound, name)``: each bin's upper bound of its mean power (W) where ``need`` (NaN
+    elsewhere, and where none is known): the largest over its realizations of the bound
+    its solves stored (``limit_power``, ``radiation_bound_power``; each the record's own,
+    computed before the solve), else of :func:`_record_bound`. The mean over any of the
+    realizations, and each causal run's (a causal run cannot beat the optimum), is at most
+    it."""
+    name = "radiation_bound_power" if spec.device == "buoy" else "limit_power"
+    label = ("radiation bound" if spec.device == "buoy" else "gamma -> 0 limit")
+    out = np.full(need.shape, np.nan)
+    stored = ds[name].values if name in ds else None
+    for i, j in np.argwhere(need):
+        vals = (np.full(spec.realizations, np.nan) if stored is None
+                else np.array(stored[i, j], dtype=float))
+        for r in np.flatnonzero(~np.isfinite(vals)):
+            try:
+                vals[r] = _record_bound(spec, int(i), int(j), int(r))
+            except Exception as err:  # noqa: BLE001 - no bound: the upper end is not given
+                log.warning("power matrix bin hm0=%g %s=%g: no %s (%s: %s)", spec.hm0[i],
+                            spec.period_kind, spec.period[j], label, type(err).__name__, err)
+        out[i, j] = float(np.max(vals)) if np.all(np.isfinite(vals)) else np.nan
+    return out, label
+
+
+def _causal_above_optimum(ds, spec: MatrixSpec, solved) -> None:
+    """Leave out (NaN) each causal run above its own record's non-causal optimum by more
+    than ``CAUSAL_SLACK``: a causal controller cannot beat the omniscient one on the same
+    record, so such a mean is not an answer (a storage correction larger than the work, a
+    reference short of the optimum); their count per forecast is the attribute
+    ``above_optimum`` of ``causal_<forecast>_power``."""
+    opt = np.where(solved, ds["power"].values, np.nan)
+    for f in spec.forecasts:
+        v = ds[f"causal_{f}_power"].values
+        with np.errstate(invalid="ignore"):
+            above = np.isfinite(v) & (opt > 0) & (v > opt * (1 + CAUSAL_SLACK))
+        for q in (f"causal_{f}_power", f"causal_{f}_harvested_power"):
+            if q in ds:
+                ds[q] = (ds[q].dims, np.where(above, np.nan, ds[q].values),
+                         {**ds[q].attrs, "above_optimum": int(above.sum())})
 
 
 def _causal_matrix(ds, spec: MatrixSpec) -> None:
@@ -554,10 +654,10 @@ def _annual_columns(ds, spec: MatrixSpec, annual: dict) -> None:
     ds["annual_energy_lower"] = ("column", [a.get("mwh_bounds", [a["mwh"]] * 2)[0]
                                             for a in recs], {
         "long_name": "annual energy, the uncounted share of the year at 0 W", "units": "MWh"})
-    ds["annual_energy_upper"] = ("column", [a.get("mwh_bounds", [a["mwh"]] * 2)[1]
-                                            for a in recs], {
-        "long_name": "annual energy, the uncounted share of the year at the largest bin's "
-                     "power", "units": "MWh"})
+    ds["annual_energy_upper"] = ("column", [
+        _nan_none(a.get("mwh_bounds", [a["mwh"]] * 2)[1]) for a in recs], {
+        "long_name": "annual energy, the bins without power at their bound (radiation "
+                     "bound or gamma -> 0 limit; NaN: no upper bound)", "units": "MWh"})
     ds["annual_energy_complete"] = ("column", np.array([int(a["complete"]) for a in recs],
                                                        dtype=np.int8), {
         "long_name": "every sea state of the site in a bin with a result (1) or not (0)"})
@@ -568,7 +668,7 @@ def _annual_columns(ds, spec: MatrixSpec, annual: dict) -> None:
             "units": "1"})
         for k, name in ((0, "lower"), (1, "upper")):
             ds[f"capacity_factor_{name}"] = ("column", [
-                a["capacity_factor_bounds"][k] if a.get("capacity_factor_bounds")
+                _nan_none(a["capacity_factor_bounds"][k]) if a.get("capacity_factor_bounds")
                 else a["capacity_factor"] for a in recs], {
                 "long_name": f"capacity factor, {name} bound", "units": "1"})
 
@@ -719,15 +819,12 @@ def power_matrix(*, hs="1:3:3", te=None, tp=None, realizations: int = 3, waves: 
         # resumable work (--store) is announced and runs; in memory it must fit the cap
         each = est["seconds"] / est["solves"]  # one solve's share of the wall time
         most = int(limits.MAX_UNTIMED_SECONDS / each)
-        by_r = most >= est["bins"]  # fewer realizations suffice
-        refuse_untimed("realizations" if by_r else "hs",
+        name, advice = untimed_advice(most, est["bins"], spec.realizations, spec.period_kind)
+        refuse_untimed(name,
                        f"a power matrix of {est['bins']} bins x {spec.realizations} "
                        f"realizations ({est['solves']} solves on "
                        f"{est['processes']} process(es))", est["seconds"],
-                       (f"use --realizations at most {most // est['bins']}" if by_r else
-                        f"use at most {max(1, most // spec.realizations)} bins (--hs times "
-                        f"--{spec.period_kind} centres) at {spec.realizations} realizations")
-                       + " or --store (resumable work: a rerun resumes)", time_limit)
+                       advice + " or --store (resumable work: a rerun resumes)", time_limit)
     frequency, outside = None, None
     pk = spec.period_kind
     if scatter is not None:
@@ -824,21 +921,29 @@ def _write_zarr(ds, path) -> None:
         shutil.rmtree(tmp, ignore_errors=True)
 
 
-def matrix_csv(ds, spec: MatrixSpec) -> str:
+def matrix_csv(ds, spec: MatrixSpec | None = None) -> str:
     """The matrix as a table, one row per bin: centres, J, the statistics of each quantity,
-    the capture width (and ratio), the frequency."""
-    pk = spec.period_kind
+    the capture width (and ratio), the frequency. Without ``spec`` the bins and quantities
+    are the Dataset's own (``PowerMatrixResult.save("m.csv")``: the same table)."""
+    if spec is None:
+        pk = "tp" if "tp" in ds.dims else "te"
+        hm0 = [float(v) for v in ds["hm0"].values]
+        period = [float(v) for v in ds[pk].values]
+        quantities = [str(v)[:-5] for v in ds.data_vars if str(v).endswith("_mean")]
+    else:
+        pk, hm0, period = spec.period_kind, spec.hm0, spec.period
+        quantities = matrix_quantities(spec)
     cols = ["wave_energy_flux_matrix", "capture_width_matrix"]
     if "capture_width_ratio_matrix" in ds:
         cols.append("capture_width_ratio_matrix")
-    for q in matrix_quantities(spec):
+    for q in quantities:
         cols += [f"{q}_{s}" for s in STATISTICS]
     if "frequency" in ds:
         cols.append("frequency")
     lines = [",".join(["hm0", pk, "tp" if pk == "te" else "te", *cols])]
     other = ds["tp" if pk == "te" else "te"].values
-    for i, h in enumerate(spec.hm0):
-        for k, t in enumerate(spec.period):
+    for i, h in enumerate(hm0):
+        for k, t in enumerate(period):
             vals = [ds[c].values[i, k] for c in cols]
             lines.append(",".join([repr(h), repr(t), repr(float(other[k])),
                                    *(str(int(v)) if c.endswith("count") else repr(float(v))

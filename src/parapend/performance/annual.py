@@ -6,9 +6,11 @@ the same sum). ``P_ij`` is the bin's mean power (W), ``f_ij`` its share of the y
 
 Scatter CSV, long format, one row per bin: ``hs,te,frequency`` (or ``hs,tp,...``). The
 ``frequency`` column holds shares of the year that must sum to 1 within 1e-6 (MHKiT's
-rule); a column named ``count`` instead holds occurrences or hours, any non-negative
-numbers, divided by their total. Each row's centres must be centres of the matrix (to a
-relative 1e-9); bins of the matrix missing from the CSV have frequency 0. A time series
+rule); a column named ``count`` instead holds occurrences, any non-negative numbers,
+divided by their total; a column named ``hours`` holds hours, divided by their total too,
+with a warning (logged) when they do not sum to a year (8766 h, or 8760, within 1 %).
+Each row's centres must be centres of the matrix (to a relative 1e-9); bins of the
+matrix missing from the CSV have frequency 0. A time series
 CSV ``hs,te`` (or ``hs,tp``), one row per sea state, is binned with the matrix's edges
 (MHKiT's: half-open bins, the last one closed); rows outside every bin are counted and
 reported, and their share of the year contributes nothing (stated, never silent).
@@ -16,6 +18,7 @@ reported, and their share of the year contributes nothing (stated, never silent)
 
 from __future__ import annotations
 
+import logging
 import math
 from pathlib import Path
 
@@ -30,6 +33,9 @@ __all__ = ["HOURS_PER_YEAR", "annual_energy", "bin_power", "bin_series", "capaci
 HOURS_PER_YEAR = 8766.0
 _SUM_TOL = 1e-6
 _MATCH = 1e-9
+#: ``hours`` summing to a year within this (relative) are not warned about
+_YEAR_TOL = 0.01
+log = logging.getLogger(__name__)
 
 
 def _read_rows(path, name: str, what: str) -> tuple[list, list]:
@@ -103,9 +109,9 @@ def read_scatter(path, hm0, period, period_kind: str, name: str = "scatter") -> 
     long-format scatter CSV; see the module text."""
     head, body = _read_rows(path, name, f"'hs,{period_kind},frequency'")
     if len(head) != 3 or head[0] != "hs" or head[1] not in ("te", "tp") \
-            or head[2] not in ("frequency", "count"):
+            or head[2] not in ("frequency", "count", "hours"):
         raise ParameterError(f"{name}: expected a CSV header 'hs,{period_kind},frequency' (or "
-                             f"'hs,{period_kind},count') in {path}")
+                             f"'hs,{period_kind},count', 'hs,{period_kind},hours') in {path}")
     if head[1] != period_kind:
         raise ParameterError(f"{name}: its periods are {head[1]}, the matrix's {period_kind}; "
                              f"give the matrix with --{head[1]} or the scatter in "
@@ -127,14 +133,21 @@ def read_scatter(path, hm0, period, period_kind: str, name: str = "scatter") -> 
                                  f"{period[b]:g} appears twice in {path}")
         seen.add((a, b))
         freq[a, b] = f
-    if head[2] == "count":
+    if head[2] in ("count", "hours"):
         # scaled by the largest first: counts near the float range's top summed to inf
         # (every share 0, an AEP of 0 marked complete), subnormal ones lost their digits
         top = float(freq.max())
         if not top > 0:
-            raise ParameterError(f"{name}: expected a positive total count in {path}")
+            raise ParameterError(f"{name}: expected a positive total {head[2]} in {path}")
         freq = freq / top
-        return freq / float(freq.sum())
+        total = float(freq.sum())
+        if head[2] == "hours":
+            hours = total * top
+            if min(abs(hours - y) / y for y in (HOURS_PER_YEAR, 8760.0)) > _YEAR_TOL:
+                log.warning("%s: the hours in %s sum to %.6g h, not a year (%g h): each bin's "
+                            "share of the year is taken as its hours over their total",
+                            name, path, hours, HOURS_PER_YEAR)
+        return freq / total
     total = float(freq.sum())
     if abs(total - 1.0) >= _SUM_TOL:
         raise ParameterError(f"{name}: expected frequencies summing to 1 (within 1e-6), got "
@@ -187,14 +200,19 @@ def bin_power(mean_power) -> np.ndarray:
         return np.where(np.isfinite(p), np.maximum(p, 0.0), np.nan)
 
 
-def annual_energy(mean_power, frequency, outside_frequency: float = 0.0) -> dict:
+def annual_energy(mean_power, frequency, outside_frequency: float = 0.0,
+                  bound=None, bound_name: str = "bound") -> dict:
     """AEP (Wh, MWh) of a matrix of mean powers (W) and bin frequencies: ``8766 h sum P f``
     over the bins with a frequency and a power, each power :func:`bin_power` (never below
-    0). Bins with a frequency and no power are listed (``missing``, ``missing_frequency``);
-    with them and ``outside_frequency`` (sea states outside the matrix) the result is
-    incomplete: ``complete`` false, ``uncounted_frequency`` their share, and ``wh_bounds``
-    the AEP with the uncounted share at zero power and at the largest bin power (``wh`` is
-    the lower bound: the sum over the bins counted)."""
+    0). Bins with a frequency and no power are listed (``missing``); their share and that
+    of the sea states outside the matrix (``outside_frequency``) is ``missing_frequency``
+    (positive exactly when ``complete`` is false; ``missing_bin_frequency`` the bins' part).
+    Incomplete, ``wh_bounds`` is the AEP with that share at zero power (``wh``, the sum over
+    the bins counted) and at a true bound of the power there: ``bound``, each bin's upper
+    bound of its mean power (W; the device's radiation bound or gamma -> 0 limit, named
+    ``bound_name``). The upper end is None (no upper bound, ``upper_bound_note`` says why)
+    where a missing bin has no finite bound or sea states lie outside the matrix (nothing
+    bounds them): never the largest finished bin, which bounds nothing."""
     p = bin_power(mean_power)
     f = np.asarray(frequency, dtype=float)
     used = f > 0
@@ -203,18 +221,30 @@ def annual_energy(mean_power, frequency, outside_frequency: float = 0.0) -> dict
     # the sum scaled by the largest power: powers near the float range's top do not
     # overflow, and each term stays P f exactly as 8766 h sum P f states
     wh = HOURS_PER_YEAR * float(np.sum(np.where(counted, p * f, 0.0)))
-    uncounted = float(f[missing].sum()) + float(outside_frequency or 0.0)
-    top = float(np.max(p[np.isfinite(p)])) if np.isfinite(p).any() else 0.0
-    upper = wh + HOURS_PER_YEAR * top * uncounted
+    outside = float(outside_frequency or 0.0)
+    in_bins = float(f[missing].sum())
+    uncounted = in_bins + outside
     out = {"wh": wh, "mwh": wh / 1e6, "missing": np.argwhere(missing).tolist(),
-           "missing_frequency": float(f[missing].sum()),
+           "missing_frequency": uncounted, "missing_bin_frequency": in_bins,
            "mean_power_w": wh / HOURS_PER_YEAR, "complete": uncounted == 0.0,
            "hours_per_year": HOURS_PER_YEAR, "counted_frequency": float(f[counted].sum()),
            "rest_frequency": float(f[counted & (p == 0.0)].sum())}
     if uncounted:
+        b = None if bound is None else np.broadcast_to(np.asarray(bound, float), f.shape)
+        upper, note = None, None
+        if outside:
+            note = (f"{outside:.4g} of the year lies outside the matrix's bins, where "
+                    "nothing bounds the power: no upper bound")
+        elif b is None or not np.all(np.isfinite(b[missing])):
+            note = (f"no {bound_name} for every bin without power: no upper bound")
+        else:
+            upper = wh + HOURS_PER_YEAR * float(np.sum(np.maximum(b[missing], 0.0)
+                                                       * f[missing]))
+            note = f"the bins without power at their {bound_name}"
         out["uncounted_frequency"] = uncounted
         out["wh_bounds"] = [wh, upper]
-        out["mwh_bounds"] = [wh / 1e6, upper / 1e6]
+        out["mwh_bounds"] = [wh / 1e6, None if upper is None else upper / 1e6]
+        out["upper_bound_note"] = note
     return out
 
 

@@ -178,7 +178,7 @@ class ShiftedQ:
     matrix ``exp(i k w d)`` of a set of offsets ``d`` (the horizon's leads, the same at every
     update up to round-off) built once and kept, so an update costs a matrix-vector product
     instead of the matrix's complex exponentials (they were half of a record's causal run:
-    issue 31, docs/performance.md). An offset set is recognised by ``d`` rounded to 1e-9 of
+    docs/performance.md). An offset set is recognised by ``d`` rounded to 1e-9 of
     the peak period ``tp`` and evaluated at the offsets of its first call: the leads
     ``(t_j + leads) - t_j`` differ from one update to the next by the round-off of ``t_j``
     (1e-16 of the run's length), so ``q`` is the direct evaluation's to round-off (the
@@ -285,9 +285,12 @@ def solve_causal(spec, i: int, j: int, r: int) -> dict:
             with threadpool_limits(1, user_api="blas"):
                 res = (run_buoy_record(spec, i, j, r, f) if buoy
                        else run_record(spec, exc, units, j, r, f))
-            if res.success and buoy:
+            # a run that loses energy is a measurement (the bin then rests: max(P, 0))
+            if buoy and (res.success or res.status == "loses_energy"):
                 p = float(res.electrical_power_w)
                 w = float(res.harvested_electrical_power_w)
+            elif buoy and res.status == "not_caught" and res.catch_time_s is None:
+                p = w = 0.0  # the swing-up never reached the top: the device rests
             elif res.success:
                 p = units.to_watts(float(res.mean_electrical_power))
                 w = units.to_watts(float(res.harvested_electrical_power))
@@ -324,6 +327,8 @@ def causal_json(ds, grid) -> dict:
            **({"buoy_controller": ds.attrs["causal_buoy_controller"]}
               if "causal_buoy_controller" in ds.attrs else {}),
            "power_matrix": {f: grid(f"causal_{f}_power_matrix") for f in forecasts},
+           "above_optimum": {f: int(ds[f"causal_{f}_power"].attrs.get("above_optimum", 0))
+                             for f in forecasts},
            "mode": {f: [[{1: "controller", 0: "rest"}.get(int(v)) for v in row]
                         for row in ds[f"causal_{f}_mode"].values] for f in forecasts}}
     if "annual_energy" in ds:

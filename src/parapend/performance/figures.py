@@ -157,12 +157,21 @@ def plot_scatter(ds, path=None):
         aep = ds.attrs.get("annual_energy_mwh")
         bounds = ds.attrs.get("annual_energy_mwh_bounds")
         what = (f"{aep:.4g} MWh/yr" if aep is not None else
-                f"{bounds[0]:.4g} to {bounds[1]:.4g} MWh/yr, incomplete"
+                _range(bounds[0], bounds[1], "MWh/yr") + ", incomplete"
                 if bounds is not None else None)
         ax.set_title("scatter diagram: share of the year (% yr, colour) and of the annual "
                      f"energy (% E; {what})" if what is not None
                      else "scatter diagram", fontsize=9)
         return _finish(fig, path)
+
+
+def _range(lo, hi, unit: str = "") -> str:
+    """``lo to hi`` (4 digits, ``unit`` after), or ``at least lo`` without an upper end
+    (None or NaN)."""
+    tail = f" {unit}" if unit else ""
+    if hi is None or not np.isfinite(hi):
+        return f"at least {lo:.4g}{tail} (no upper bound)"
+    return f"{lo:.4g} to {hi:.4g}{tail}"
 
 
 #: SI prefixes of the text report, largest first
@@ -252,7 +261,8 @@ def text_report(ds, out: dict, drawn: list) -> str:
             if e.get("complete", True) or "wh_bounds" not in e:
                 return _per_year(e["wh"])
             lo, hi = e["wh_bounds"]
-            return f"{_per_year(lo)} to {_per_year(hi)}"
+            return (f"{_per_year(lo)} to {_per_year(hi)}" if hi is not None
+                    else f"at least {_per_year(lo)}")
 
         lines.append(f"mean annual energy (8766 h/yr): {'electrical' if eff else 'optimum'} "
                      f"{aep(p)}"
@@ -261,13 +271,14 @@ def text_report(ds, out: dict, drawn: list) -> str:
             lines.append("complete: every sea state of the site lies in a bin with a result")
         if not p.get("complete", True) and "uncounted_frequency" in p:
             lines.append(f"incomplete: {p['uncounted_frequency']:.4g} of the year has no "
-                         "power (the bounds count it at 0 and at the largest bin's power)")
+                         f"power (the lower bound counts it at 0 W; the upper: "
+                         f"{p.get('upper_bound_note', '-')})")
         if p.get("capacity_factor") is not None:
             lines.append(f"capacity factor {p['capacity_factor']:.4g} "
                          f"({100 * p['capacity_factor']:.3g} % of the rated power's energy)")
         elif p.get("capacity_factor_bounds"):
             lo, hi = p["capacity_factor_bounds"]
-            lines.append(f"capacity factor {lo:.4g} to {hi:.4g} (incomplete)")
+            lines.append(f"capacity factor {_range(lo, hi)} (incomplete)")
         if p.get("rest_frequency"):
             lines.append(f"{p['rest_frequency']:.4g} of the year in bins where the optimum is "
                          "negative: the pendulum at rest there, counted at 0 W")
@@ -276,7 +287,8 @@ def text_report(ds, out: dict, drawn: list) -> str:
                              for b in p["bins_without_power"][:8])
             lines.append(f"bins of the site without power (left out of the sum): {miss}"
                          f"{' ...' if len(p['bins_without_power']) > 8 else ''}; "
-                         f"{p['missing_frequency']:.4g} of the year")
+                         f"{p.get('missing_bin_frequency', p['missing_frequency']):.4g} "
+                         "of the year")
         if p.get("outside_frequency"):
             o = p["outside_frequency"]
             lines.append(f"{o['sea_states']} sea states ({o['frequency']:.4g} of the year) "
@@ -313,7 +325,13 @@ def _causal_lines(ds, c: dict, hm0, per, pk) -> list:
                 for i, h in enumerate(hm0)]
         lines += [_right_table(rows, ["Hm0 \\ " + pk, *(f"{t:g} s" for t in per)])]
         runs = ds[f"causal_{f}_power"].values
-        bad = int((~np.isfinite(runs)).sum())
+        above = int(ds[f"causal_{f}_power"].attrs.get("above_optimum", 0))
+        bad = int((~np.isfinite(runs)).sum()) - above
+        if above:
+            lines.append(f"{above} of {runs.size} causal runs above their record's "
+                         "non-causal optimum (no causal controller beats it: not an answer, "
+                         "e.g. a storage correction larger than the work): left out of the "
+                         "bins' means")
         if bad:
             why = ("the log names them and their status, e.g. \"solves_failed\": most of "
                    "the buoy's horizon solves failed" if c.get("buoy_controller") else
@@ -343,13 +361,15 @@ def _side_by_side(c: dict) -> str:
             text = _per_year(e["annual_energy_mwh"] * 1e6)
         else:
             lo, hi = e["annual_energy_mwh_bounds"]
-            text = f"{_per_year(lo * 1e6)} to {_per_year(hi * 1e6)} (incomplete)"
+            text = (f"{_per_year(lo * 1e6)} to {_per_year(hi * 1e6)} (incomplete)"
+                    if hi is not None else f"at least {_per_year(lo * 1e6)} (incomplete, "
+                    "no upper bound)")
         if "capacity_factor" in e:
             cf = e["capacity_factor"]
             if cf is not None:
                 text += f", capacity factor {cf:.4g}"
             else:
                 lo, hi = e["capacity_factor_bounds"]
-                text += f", capacity factor {lo:.4g} to {hi:.4g}"
+                text += f", capacity factor {_range(lo, hi)}"
         parts.append(f"{labels.get(col, col) + ':':27s} {text}")
     return "\n".join(["annual energy side by side (8766 h/yr):", *("  " + p for p in parts)])

@@ -25,6 +25,7 @@ import math
 import numpy as np
 
 from .. import limits
+from ..errors import ParameterError
 from ..seas import jonswap, pierson_moskowitz
 
 __all__ = ["bin_edges", "energy_flux", "record_spectrum", "repeat_period", "te_over_tp",
@@ -83,12 +84,38 @@ def wave_number(f, depth: float, gravity: float) -> np.ndarray:
     return k
 
 
+def _spectrum_arrays(f, s):
+    """``f`` and ``s`` as 1-d float arrays, checked (see :func:`energy_flux`)."""
+    out = []
+    for name, v in (("f", f), ("s", s)):
+        try:
+            a = np.asarray(v, dtype=float)
+        except (TypeError, ValueError):
+            raise ParameterError(f"{name}: expected a sequence of numbers, got "
+                                 f"{type(v).__name__}") from None
+        if a.ndim != 1 or a.size < 2:
+            raise ParameterError(f"{name}: expected a 1-d sequence of at least 2 numbers, got "
+                                 + (f"shape {a.shape}" if a.ndim != 1 else f"{a.size}"))
+        if not np.all(np.isfinite(a)):
+            raise ParameterError(f"{name}: expected finite numbers")
+        out.append(a)
+    f, s = out
+    if f.size != s.size:
+        raise ParameterError(f"s: expected as many values as f ({f.size}), got {s.size}")
+    if f[0] <= 0 or np.any(np.diff(f) <= 0):
+        raise ParameterError("f: expected positive, increasing frequencies (Hz)")
+    if np.any(s < 0):
+        raise ParameterError("s: expected a spectrum that is nowhere negative (m^2/Hz)")
+    return f, s
+
+
 def energy_flux(f, s, *, depth: float | None = None, density: float = DENSITY,
                 gravity: float = 9.80665) -> float:
     """``J`` (W/m) of the spectrum ``s`` (m^2/Hz) on the evenly spaced frequencies ``f`` (Hz,
-    ``df = f[1] - f[0]`` as MHKiT); ``depth`` None: deep water."""
-    f = np.asarray(f, dtype=float)
-    s = np.asarray(s, dtype=float)
+    ``df = f[1] - f[0]`` as MHKiT); ``depth`` None: deep water. ``f`` and ``s`` are
+    sequences of the same length, at least 2 (one frequency has no ``df``), ``f`` positive
+    and increasing, ``s`` finite and not negative; else :class:`ParameterError`."""
+    f, s = _spectrum_arrays(f, s)
     df = np.empty_like(f)
     df[0] = f[1] - f[0]
     df[1:] = np.diff(f)
