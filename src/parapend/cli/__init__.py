@@ -91,6 +91,9 @@ EXAMPLES = {
     "power-matrix": "parapend power-matrix --hs 1:3:3 --te 6:10:3 --scatter site.csv",
     "buoy": "parapend buoy --hs 0.5 --tp 2.5 --controller mpc",
     "horizon": "parapend horizon --hs 2 --tp 8 --horizons 0.25,0.5,1,2",
+    "persistence": "parapend persistence --mass 1 --length 0.3 --damping-coefficient 2e-4 "
+                   "--generator-damping 5e-4 --hs 0.005:0.04:8 --tp 0.2:0.6:9 --duration 300 "
+                   "--realizations 200 --seed 0 --json",
 }
 
 

@@ -20,9 +20,6 @@ from ._common import (
 from .sweep import _NEGATIVE_VALUE, _EtaProgress
 
 _AXIS = "a value, a comma list or FROM:TO:N"
-_EXAMPLE = ("example: parapend persistence --mass 1 --length 0.3 --damping-coefficient 2e-4 "
-            "--generator-damping 5e-4 --hs 0.005:0.04:8 --tp 0.2:0.6:9 --duration 300 "
-            "--realizations 200 --seed 0 --json")
 
 
 def add_parsers(sub) -> None:
@@ -34,8 +31,7 @@ def add_parsers(sub) -> None:
                     "which a pendulum started rotating (theta = pi, theta' = 2 pi / Tp) keeps "
                     "at least half a turn per peak period (P_rot), the fraction rotating "
                     "throughout, the mean rotation ratio and the mean harvested power of a "
-                    "passive generator, with 95 % intervals (docs/persistence.md). "
-                    + _EXAMPLE)
+                    "passive generator, with 95 % intervals (docs/persistence.md).")
     p._negative_number_matcher = _NEGATIVE_VALUE
     g = p.add_argument_group("pendulum and generator (SI units)")
     g.add_argument("--mass", type=_finite_float("mass"),
