@@ -50,7 +50,6 @@ from .. import limits
 from ..defaults import PERSISTENCE
 from ..errors import ParameterError, check_int, check_positive, check_range
 from ..results import Result
-from .basins import wilson_interval as _wilson
 from ._persist_cells import (  # noqa: F401 - the cell's functions, for the API's users
     acceleration,
     best_damping,
@@ -61,6 +60,7 @@ from ._persist_cells import (  # noqa: F401 - the cell's functions, for the API'
     run_cell,
     step_check,
 )
+from .basins import wilson_interval as _wilson
 
 __all__ = ["PersistenceResult", "choose_step", "persistence", "wilson_interval",
            "t_interval"]
