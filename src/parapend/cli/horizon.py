@@ -3,9 +3,10 @@
 
 from __future__ import annotations
 
+import argparse
+
 from ..defaults import BUOY, HORIZON
-from ..hydro.horizon import BUOY_HORIZON
-from ..hydro.horizon import CONTROLLERS as BUOY_CONTROLLERS
+from ..hydro.horizon import BUOY_HORIZON, PLANNERS
 from . import _output
 from ._common import (
     FIGURE_SUFFIXES,
@@ -74,9 +75,11 @@ def add_parsers(sub) -> None:
                                   "(default cylinder)",
                      hydro_help="a Capytaine dataset (NetCDF), instead of solving "
                                 "(docs/buoy.md)")
-    g.add_argument("--controller", choices=list(BUOY_CONTROLLERS),
+    g.add_argument("--planner", choices=list(PLANNERS),
                    help="the buoy's receding-horizon planner (parapend.hydro.control.buoy_mpc"
-                        "; default its own, coupled)")
+                        "; default plan, coupled with --efficiency)")
+    # the planner's former name: refused in one line naming --planner (parapend.horizon)
+    g.add_argument("--controller", help=argparse.SUPPRESS)
     g.add_argument("--dofs", metavar="DOFS",
                    help="the body's degrees of freedom: heave (default, the heaving buoy); "
                         "a hull's (surge,heave,pitch) has no causal controller yet")
@@ -238,7 +241,7 @@ def _buoy_text(r, a) -> list:
            f"{rec.get('tp'):g} s, records of {rec.get('repeat_period'):g} s, {seeds}; "
            f"pendulum m = {p['mass_kg']:g} kg, l = {p['length_m']:g} m, I = "
            f"{p['inertia_kg_m2']:.4g} kg m^2, c = {p['damping_coefficient_nm_s_per_rad']:g} "
-           f"N m s/rad; {r.controller} planner"
+           f"N m s/rad; {r.planner} planner"
            + ("" if r.torque_limit_nm is None else f", torque limit {r.torque_limit_nm:.4g} N m")
            + ("" if r.efficiency is None else
               f", efficiency {r.efficiency[0]:g}/{r.efficiency[1]:g}")]

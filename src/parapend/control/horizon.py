@@ -184,7 +184,7 @@ def horizon_curve(*, hs=None, tp=None, spectrum: str = "jonswap", gamma_peak: fl
                   update_interval=None, progress=None,
                   warm_up=None, speed_limit=HORIZON["speed_limit"], time_limit=None,
                   device: str = "pendulum", body=None, radius=None, draft=None, mesh=None,
-                  hydro=None, controller=None, dofs=None):
+                  hydro=None, planner=None, dofs=None, controller=None):
     """Mean power of causal control against the horizon, as a fraction of the record's
     non-causal optimum and of its limit (command ``horizon``: ``parapend.horizon`` is this
     function; module docstring). With ``device="buoy"``: the pendulum inside the floating
@@ -197,10 +197,13 @@ def horizon_curve(*, hs=None, tp=None, spectrum: str = "jonswap", gamma_peak: fl
         The prescribed-heave pendulum (default) or the pendulum inside the buoy, coupled
         both ways (``parapend buoy``'s body and pendulum, in SI; the options below marked
         pendulum only are refused with it).
-    body, radius, draft, mesh, hydro, controller :
+    body, radius, draft, mesh, hydro, planner :
         ``device="buoy"`` only: the floating body as ``parapend buoy`` takes it, and the
         planner of :func:`parapend.hydro.control.buoy_mpc` (``"coupled"`` or ``"plan"``;
-        None: its default).
+        None: its default; the result's ``planner``).
+    controller : None
+        The planner's former name, refused in one line that names ``planner``
+        (``controller`` is ``parapend buoy``'s optimum, mpc or one-way-mpc).
     dofs : ``device="buoy"`` only: the body's degrees of freedom, ``"heave"`` (default,
         the heaving buoy); a hull's (``"surge,heave,pitch"``) is refused in one line, as it
         has no causal controller yet.
@@ -256,11 +259,14 @@ def horizon_curve(*, hs=None, tp=None, spectrum: str = "jonswap", gamma_peak: fl
         with the status ``"time_limit"``, and the result's ``status`` is ``"time_limit"``
         (``success`` False; :mod:`parapend.deadline`).
     """
+    if controller is not None:
+        raise ParameterError("controller: renamed planner here (--planner coupled|plan; "
+                             "--controller is parapend buoy's optimum|mpc|one-way-mpc)")
     if device == "buoy":
         return _buoy(locals())
     if device != "pendulum":
         raise ParameterError(f"device: expected pendulum or buoy, got {device!r:.40}")
-    for name in ("body", "radius", "draft", "mesh", "hydro", "controller", "dofs"):
+    for name in ("body", "radius", "draft", "mesh", "hydro", "planner", "dofs"):
         if locals()[name] is not None:
             raise ParameterError(f"{name}: an option of the buoy; needs --device buoy")
     length = SEA["length"] if length is None else length
@@ -556,7 +562,8 @@ def _buoy(opts: dict):
                                  + (" (give --damping-coefficient, N m s/rad)"
                                     if name == "gamma" else ""))
     return buoy_horizon_curve(**{k: v for k, v in opts.items()
-                                 if k not in (*PENDULUM_ONLY, "device", "dofs")})
+                                 if k not in (*PENDULUM_ONLY, "device", "dofs",
+                                              "controller")})
 
 
 def horizon_dataset(r: HorizonResult):

@@ -255,6 +255,7 @@ RUN_OPTIONS = {
     "scheduler": "a Dask scheduler", "netcdf": "an output file", "zarr": "an output file",
     "csv": "an output file", "command": "the command line recorded",
     "plan_samples": "torque samples per interval of the causal plan",
+    "planner": "the horizon curve's receding-horizon planner of the buoy: coupled or plan",
 }
 
 _OBJECTS = (Sea, Pendulum, Body, PowerTakeOff, Controller)
@@ -305,8 +306,8 @@ def horizon(sea: Sea, pendulum: Pendulum, body: Body, pto: PowerTakeOff | None =
             controller: Controller | None = None, **run):
     """The causal power against the forecast horizon (:func:`parapend.horizon`,
     ``device="buoy"``): the curve sweeps the horizons and forecasts (``run``: ``horizons``,
-    ``forecasts``, ...); of ``controller`` it takes the update interval. (The command's
-    ``--controller`` there names the planner, ``coupled`` or ``plan``: a run option.)"""
+    ``forecasts``, ...); of ``controller`` it takes the update interval. (The planner,
+    ``coupled`` or ``plan``, is the run option ``planner``.)"""
     import inspect
 
     from ..control.horizon import horizon_curve
