@@ -90,6 +90,52 @@ def test_the_objects_give_the_keyword_functions_answers(dataset):
         device.horizon(state)
 
 
+def test_the_commands_take_the_objects(dataset):
+    """``parapend.buoy`` takes the objects (``sea=``, ``pendulum=``, ``body=``, ``pto=``, or a
+    ``device=``) and gives its keywords' answer bit for bit; a field given twice, of the wrong
+    object or not taken by the command is refused in one line naming it, before any work
+    (``horizon`` and ``power_matrix`` too)."""
+    period = 2 * math.pi / 1.2
+    sea = dv.Sea.regular(1.0, period)
+    pend = dv.Pendulum(mass=4000.0, length=1.0, inertia=5000.0, damping_coefficient=50.0)
+    body = dv.Body(hydro=dataset)
+    want = parapend.buoy(hydro=dataset, mass=4000.0, length=1.0, inertia=5000.0,
+                         damping_coefficient=50.0, wave_height=1.0, wave_period=period)
+    got = parapend.buoy(sea=sea, pendulum=pend, body=body)
+    assert got.power_w == want.power_w and got.to_dict() == want.to_dict()
+    assert parapend.buoy(sea=sea, device=dv.Device(body, pend)).power_w == want.power_w
+    # a keyword beside the objects: the command's own
+    assert parapend.buoy(sea=sea, body=body, mass=4000.0, length=1.0, inertia=5000.0,
+                         damping_coefficient=50.0).power_w == want.power_w
+    bad = [({"sea": sea, "wave_height": 2.0}, "^wave-height: given twice"),
+           ({"pendulum": pend, "device": dv.Device(pendulum=pend)}, "^mass: given twice"),
+           ({"sea": 3.0}, "^sea: expected a Sea"),
+           ({"pendulum": sea}, "^pendulum: expected a Pendulum, got a Sea")]
+    for kw, match in bad:
+        with pytest.raises(parapend.ParameterError, match=match.replace("a Pendulum",
+                                                                        "a Pendulum .*")):
+            parapend.buoy(**kw)
+    with pytest.raises(parapend.ParameterError, match="^wave-height: not taken by horizon"):
+        parapend.horizon(sea=sea, device=dv.Device(body, pend))
+    with pytest.raises(parapend.ParameterError, match="^horizon: not taken by horizon"):
+        parapend.horizon(device=dv.Device(body, pend),
+                         controller=dv.Controller.receding_horizon(2.0))
+    with pytest.raises(parapend.ParameterError, match="^records: .*at most"):
+        parapend.horizon(device=dv.Device(), records=20)  # the buoy's curve: its estimate
+    with pytest.raises(parapend.ParameterError, match="^hydro: given twice"):
+        parapend.power_matrix(device=dv.Device(body, pend), body=body, hs="1,2", tp="5,6")
+    with pytest.raises(parapend.ParameterError, match="^sea: expected a Sea"):
+        parapend.horizon(sea="jonswap")
+    # the take-off's torque limit is in N m, the curve's --torque-limit-nm: checked as such
+    # (the same one line as the keyword's)
+    with pytest.raises(parapend.ParameterError, match="^torque-limit-nm: ") as want:
+        parapend.horizon(device="buoy", hydro=dataset, mass=4000.0, length=1.0,
+                         torque_limit_nm=-5.0)
+    with pytest.raises(parapend.ParameterError) as got:
+        parapend.horizon(device=dv.Device(body, pend, dv.PowerTakeOff(torque_limit=-5.0)))
+    assert str(got.value) == str(want.value)
+
+
 def _script() -> str:
     text = (DOCS / "buoy.md").read_text(encoding="utf-8")
     part = text[text.index("## Inputs that compose"):]

@@ -21,6 +21,7 @@ import numpy as np
 from .. import limits
 from ..defaults import BUOY, HULL, given
 from ..errors import ParameterError, check_int, check_nonnegative, check_positive, check_range
+from .declared import expand_inputs, has_inputs
 from .hull import HullPTO, waves_in
 from .inputs import _irregular_wave, _pendulum, _period, parse_periods
 from .result import _solve, optimum
@@ -306,11 +307,17 @@ def buoy(*, wave_height=None, wave_period=None, hs=None, tp=None, spectrum=None,
          inertia_bounds=None, damping_coefficient_bounds=None, controller="optimum",
          horizon=None, update_interval=None, forecast=None, wave_direction=None, dofs="heave",
          pivot_height=None, pivot_offset=None, hull_pitch_inertia=None, barge_length=None,
-         barge_beam=None, barge_draft=None, copper_loss=None, time_limit=None, progress=None):
+         barge_beam=None, barge_draft=None, copper_loss=None, time_limit=None, progress=None,
+         sea=None, pendulum=None, pto=None, device=None):
     """The coupled optimum of a pendulum inside a floating buoy (command ``buoy``).
 
     Parameters
     ----------
+    sea, pendulum, body, pto, controller, device : the input objects
+        (:mod:`parapend.hydro.device`: ``Sea``, ``Pendulum``, ``Body``, ``PowerTakeOff``,
+        ``Controller``, or a ``Device`` for the body, the pendulum and the take-off): their
+        fields are the keywords below, checked and defaulted as those are. ``body`` and
+        ``controller`` also take the plain names below; a field given twice is refused.
     wave_height, wave_period : float
         A regular wave: height ``H`` (m, crest to trough) and period (s); ``wave_period``
         as ``"FROM:TO:N"`` gives power against period
@@ -375,6 +382,8 @@ def buoy(*, wave_height=None, wave_period=None, hs=None, tp=None, spectrum=None,
         :func:`parapend.hydro.control.buoy_mpc`). The result types are those of every DOF set
         (:func:`parapend.hydro.result.optimum`); their JSON holds their set's fields.
     """
+    if has_inputs(locals()):
+        return buoy(**expand_inputs(buoy, locals()))
     from .coupled import Wave
 
     opts = dict(locals())
@@ -388,7 +397,7 @@ def buoy(*, wave_height=None, wave_period=None, hs=None, tp=None, spectrum=None,
             raise ParameterError("time-limit: not used with --dofs surge,heave,pitch (its "
                                  "work is bounded by its harmonics); drop it")
         return hull_buoy(**{k: v for k, v in opts.items() if k not in (
-            "dofs", "Wave", "progress", "time_limit")})
+            "dofs", "Wave", "progress", "time_limit", "sea", "pendulum", "pto", "device")})
     for name in ("pivot_height", "pivot_offset", "hull_pitch_inertia", "barge_length",
                  "barge_beam", "barge_draft", "copper_loss"):
         if opts[name] is not None and not (isinstance(body, str) and body == "barge"
