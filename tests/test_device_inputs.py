@@ -136,6 +136,19 @@ def test_the_commands_take_the_objects(dataset):
     assert str(got.value) == str(want.value)
 
 
+@pytest.mark.parametrize("name, extra", [
+    ("wave_height", {}), ("wave_period", {}), ("wave_direction", {"hydro": "x.nc"}),
+    ("copper_loss", {"dofs": "surge,heave,pitch"}),
+    ("hull_pitch_inertia", {"dofs": "surge,heave,pitch"})])
+def test_a_declared_bound_is_the_command_s_check(name, extra):
+    """The bounds stand in the declaration: a value past its declared upper bound is refused
+    by the command in one line that states that bound (parapend.hydro.declared.check)."""
+    _owner, _unit, _default, (_lo, hi), _help = dv.declaration(name)
+    with pytest.raises(parapend.ParameterError,
+                       match=rf"^{name.replace('_', '-')}: expected .*{re.escape(f'{hi:g}')}\]?, got"):
+        parapend.buoy(**{name: 2 * hi + 1}, **extra)
+
+
 def _script() -> str:
     text = (DOCS / "buoy.md").read_text(encoding="utf-8")
     part = text[text.index("## Inputs that compose"):]

@@ -21,7 +21,7 @@ import numpy as np
 from .. import limits
 from ..defaults import BUOY, HULL, given
 from ..errors import ParameterError, check_int, check_nonnegative, check_positive, check_range
-from .declared import expand_inputs, has_inputs
+from .declared import check, expand_inputs, has_inputs
 from .hull import HullPTO, waves_in
 from .inputs import _irregular_wave, _pendulum, _period, parse_periods
 from .result import _solve, optimum
@@ -454,8 +454,7 @@ def buoy(*, wave_height=None, wave_period=None, hs=None, tp=None, spectrum=None,
     cutoff = 3.0 if cutoff is None else cutoff
     taper = 0.1 if taper is None else taper
     if wave_direction is not None:
-        wave_direction = check_range("wave-direction", wave_direction, 0.0, 2 * math.pi,
-                                     absolute=True, why="rad")
+        wave_direction = check("wave_direction", wave_direction, absolute=True)
         if hydro is None:
             raise ParameterError("wave-direction: needs --hydro (a dataset with several "
                                  "wave directions)")
@@ -490,8 +489,8 @@ def buoy(*, wave_height=None, wave_period=None, hs=None, tp=None, spectrum=None,
                                         length_bounds=length_bounds,
                                         inertia_bounds=inertia_bounds,
                                         damping_coefficient_bounds=damping_coefficient_bounds)
-    height = check_range("wave-height", BUOY["wave_height"] if wave_height is None
-                         else wave_height, 1e-4, 30.0, why="regular wave height, m")
+    height = check("wave_height", BUOY["wave_height"] if wave_height is None
+                   else wave_height, why="regular wave height, m")
     if periods is not None and variables:
         raise ParameterError("optimize-design: one wave period at a time (drop FROM:TO:N)")
     if variables:
@@ -677,7 +676,7 @@ def _hull_pto(opts):
     if limit is not None:
         limit = check_range("torque-limit", limit, 1e-6, 1e12, why="N m")
     r = opts.get("copper_loss")
-    r = 0.0 if r is None else check_range("copper-loss", r, 0.0, 1e6, why="W/(N m)^2")
+    r = 0.0 if r is None else check("copper_loss", r)
     return HullPTO(efficiency=eta, copper_loss=r, torque_limit=limit)
 
 
@@ -803,7 +802,7 @@ def hull_problem(**opts) -> dict:
                              "which includes the pendulum)")
     inertia = opts.get("hull_pitch_inertia")
     if inertia is not None:
-        inertia = check_range("hull-pitch-inertia", inertia, 1e-6, 1e12, why="kg m^2")
+        inertia = check("hull_pitch_inertia", inertia)
     winding = opts.get("winding")
     windings = (1, 0) if winding is None else (check_int("winding", winding, 0, 16),)
     harmonics = opts.get("harmonics")
@@ -859,8 +858,8 @@ def hull_buoy(**opts):
             _or(opts, "cutoff", 3.0), opts.get("record"), _or(opts, "taper", 0.1),
             Units(pend.length, pend.mass, 9.81, pend.inertia))
         return solve_record(p, wave, info)
-    height = check_range("wave-height", _hull_value(opts, "wave_height"), 1e-4, 30.0,
-                         why="regular wave height, m")
+    height = check("wave_height", _hull_value(opts, "wave_height"),
+                   why="regular wave height, m")
     periods = parse_periods(opts.get("wave_period"))
     if periods is None:
         periods = np.array([_period(_hull_value(opts, "wave_period"))])

@@ -15,8 +15,8 @@ from dataclasses import dataclass, field
 from ..defaults import BUOY, HULL
 
 __all__ = ["Body", "Controller", "DeviceInputs", "INPUT_KEYWORDS", "Pendulum", "PowerTakeOff",
-           "RUN_OPTIONS", "Sea", "declaration", "declarations", "expand_inputs", "has_inputs",
-           "option_help"]
+           "RUN_OPTIONS", "Sea", "check", "declaration", "declarations", "expand_inputs",
+           "has_inputs", "option_help"]
 
 
 def _param(unit: str, help: str, *, default=None, bounds=None, default_text=None,
@@ -251,6 +251,20 @@ def declarations() -> dict:
     return {f.name: (cls.__name__, f.metadata["unit"], f.metadata["default"],
                      f.metadata["bounds"], f.metadata["help"])
             for cls in _OBJECTS for f in dataclasses.fields(cls)}
+
+
+def check(name: str, value, *, why: str | None = None, absolute: bool = False) -> float:
+    """``value`` of the declared parameter ``name`` as a float in its declared bounds, or the
+    one line that names it (:func:`parapend.errors.check_range`; ``why``, the reason said,
+    default the declared unit; ``absolute``: the upper bound on ``|value|``). The commands
+    check a declared parameter with this, so its bounds stand in one place."""
+    from ..errors import check_range
+
+    meta = next(f.metadata for cls in _OBJECTS for f in dataclasses.fields(cls)
+                if f.name == name)
+    lo, hi = meta["bounds"]
+    return check_range(name.replace("_", "-"), value, lo, hi, absolute=absolute,
+                       why=meta["unit"] if why is None else why)
 
 
 def declaration(name: str):
