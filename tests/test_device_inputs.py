@@ -144,8 +144,9 @@ def test_a_declared_bound_is_the_command_s_check(name, extra):
     """The bounds stand in the declaration: a value past its declared upper bound is refused
     by the command in one line that states that bound (parapend.hydro.declared.check)."""
     _owner, _unit, _default, (_lo, hi), _help = dv.declaration(name)
+    bound = re.escape(f"{hi:g}")
     with pytest.raises(parapend.ParameterError,
-                       match=rf"^{name.replace('_', '-')}: expected .*{re.escape(f'{hi:g}')}\]?, got"):
+                       match=rf"^{name.replace('_', '-')}: expected .*{bound}\]?, got"):
         parapend.buoy(**{name: 2 * hi + 1}, **extra)
 
 
@@ -201,6 +202,36 @@ def test_buoy_s_options_are_generated_from_the_declarations():
             assert tuple(options[name].choices) == meta["choices"], name
     assert options["mass"].help.endswith(f"(default {BUOY['mass']:g}; a hull's "
                                          f"{HULL['mass']:g})")
+
+
+#: options of horizon and power-matrix named as a declared parameter but written by the
+#: command (what is left to generate): the bins, the pendulum's torque limit in m g l, a
+#: plain efficiency, the causal column's own controller options, the body's name and dataset
+#: (and horizon's hidden --controller, the planner's former name, refused)
+OWN = {"horizon": {"torque_limit", "efficiency", "dofs", "body", "hydro", "controller"},
+       "power-matrix": {"hs", "tp", "efficiency", "torque_limit", "controller", "horizon",
+                        "forecast", "update_interval", "dofs", "body", "hydro"}}
+
+
+@pytest.mark.parametrize("command", ["horizon", "power-matrix"])
+def test_horizon_s_and_power_matrix_s_options_are_generated(command):
+    """``horizon``'s and ``power-matrix``'s options of the sea and the pendulum (and the
+    body's) are made from the same declarations as ``buoy``'s, with the defaults the
+    declaration states for that command (the prescribed-heave pendulum's, the buoy's with
+    ``--device buoy``, the curve's shorter records)."""
+    from parapend.defaults import BUOY, HORIZON, SEA
+
+    metas = {f.name: f.metadata for cls in (dv.Sea, dv.Pendulum, dv.Body, dv.PowerTakeOff,
+                                            dv.Controller) for f in dataclasses.fields(cls)}
+    options = {a.dest: a for a in _options(command)}
+    generated = [n for n in options if n in metas and n not in OWN[command]]
+    assert {"seed", "spectrum", "mass", "length", "damping_coefficient"} <= set(generated)
+    for name in generated:
+        assert options[name].help == dv.option_help(metas[name], command), name
+    assert options["mass"].help.endswith(f"(default {SEA['mass']:g}; {BUOY['mass']:g} with "
+                                         "--device buoy)")
+    if command == "horizon":
+        assert f"default {HORIZON['repeat_periods']:g} Tp;" in options["repeat_period"].help
 
 
 @pytest.mark.slow

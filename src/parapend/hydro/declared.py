@@ -12,7 +12,8 @@ from __future__ import annotations
 import dataclasses
 from dataclasses import dataclass, field
 
-from ..defaults import BUOY, HULL
+from ..defaults import BUOY, BUOY_HORIZON, HORIZON, HULL, SEA
+from ..limits import SEA_WAVES_RANGE
 
 __all__ = ["Body", "Controller", "DeviceInputs", "INPUT_KEYWORDS", "Pendulum", "PowerTakeOff",
            "RUN_OPTIONS", "Sea", "check", "declaration", "declarations", "expand_inputs",
@@ -20,14 +21,18 @@ __all__ = ["Body", "Controller", "DeviceInputs", "INPUT_KEYWORDS", "Pendulum", "
 
 
 def _param(unit: str, help: str, *, default=None, bounds=None, default_text=None,
-           kind: str = "float", choices=None, metavar=None):
+           kind: str = "float", choices=None, metavar=None, commands=None):
     """A parameter's declaration: a field whose metadata hold its unit, bounds (the range the
     command accepts, or None where it depends on other parameters), help, how the command
     line reads it (``kind``: float, int, text; ``choices``, ``metavar``) and the default it
-    states (``default_text``; ``default`` None means the command's default)."""
+    states (``default_text``; ``default`` None means the command's default). ``commands``:
+    what another command (``horizon``, ``power-matrix``) states instead, its own ``help``
+    or ``default`` (a documented per-command default: the prescribed-heave pendulum's, or
+    the horizon curve's shorter records)."""
     return field(default=default, metadata={
         "unit": unit, "help": help, "bounds": bounds, "kind": kind, "choices": choices,
-        "metavar": metavar, "default": default_text or repr(default)})
+        "metavar": metavar, "default": default_text or repr(default),
+        "commands": commands or {}})
 
 
 def _both(name: str, note: str = "") -> str:
@@ -36,12 +41,21 @@ def _both(name: str, note: str = "") -> str:
     return f"{BUOY[name]:g}{note}; a hull's {HULL[name]:g}"
 
 
-def option_help(meta) -> str:
-    """The command line's help of a declared parameter: its help, its unit and its
-    default."""
+def _device(name: str) -> dict:
+    """The default ``horizon`` and ``power-matrix`` state: the prescribed-heave pendulum's
+    (``parapend.defaults.SEA``), and the buoy's with ``--device buoy``."""
+    said = {"default": f"{SEA[name]:g}; {BUOY[name]:g} with --device buoy"}
+    return {"horizon": said, "power-matrix": said}
+
+
+def option_help(meta, command: str | None = None) -> str:
+    """The command line's help of a declared parameter: its help, its unit and its default
+    (those ``command`` states instead, where its declaration says so)."""
+    own = meta.get("commands", {}).get(command, {})
     unit = "" if meta["unit"] == "-" else f", {meta['unit']}"
-    default = "" if meta["default"] == "None" else f" (default {meta['default']})"
-    return f"{meta['help']}{unit}{default}"
+    stated = own.get("default", meta["default"])
+    default = "" if stated == "None" else f" (default {stated})"
+    return f"{own.get('help', meta['help'])}{unit}{default}"
 
 
 class _Inputs:
@@ -65,16 +79,27 @@ class Sea(_Inputs):
         "s", "the period; FROM:TO:N or a comma list T1,T2,... for power against period",
         bounds=(0.1, 100.0), default_text=_both("wave_period"), kind="text", metavar="T")
     hs: float | None = _param("m", "significant wave height",
-                              default_text=_both("hs", " with --tp"))
-    tp: float | None = _param("s", "peak period", default_text=_both("tp", " with --hs"))
+                              default_text=_both("hs", " with --tp"), commands=_device("hs"))
+    tp: float | None = _param("s", "peak period", default_text=_both("tp", " with --hs"),
+                              commands=_device("tp"))
     spectrum: str | None = _param("-", "spectrum shape", default_text="jonswap",
                                   kind="text", choices=("jonswap", "pierson-moskowitz"))
     gamma_peak: float | None = _param("-", "JONSWAP peak enhancement in [1, 20]",
                                       bounds=(1.0, 20.0), default_text="3.3")
     repeat_period: float | None = _param(
         "s", "T_r: the record repeats with it",
-        default_text=f"100 Tp; a hull's {HULL['repeat_periods']:g} Tp")
-    seed: int | None = _param("-", "seed of the random phases", default_text="0", kind="int")
+        default_text=f"100 Tp; a hull's {HULL['repeat_periods']:g} Tp",
+        commands={"horizon": {  # the curve runs many controllers: records that fit 2 min
+            "help": f"T_r: the length of each record ({SEA_WAVES_RANGE[0]:g} to "
+                    f"{SEA_WAVES_RANGE[1]:g} peak periods)",
+            "default": f"{HORIZON['repeat_periods']:g} Tp; "
+                       f"{BUOY_HORIZON['repeat_periods']:g} Tp with --device buoy"}})
+    seed: int | None = _param("-", "seed of the random phases", default_text="0", kind="int",
+                              commands={
+                                  "horizon": {"help": "seed of the first record's phases; "
+                                                      "record r has seed + r"},
+                                  "power-matrix": {"help": "seed of realization 0; "
+                                                           "realization r has seed + r"}})
     cutoff: float | None = _param("-", "highest frequency, in units of the peak frequency",
                                   default_text="3")
     record: str | None = _param("s, m", "measured surface elevation at the body, CSV 't,z'",
@@ -107,13 +132,18 @@ class Sea(_Inputs):
 class Pendulum(_Inputs):
     """The pendulum on its pivot (SI)."""
 
-    mass: float | None = _param("kg", "m", bounds=(0.0, None), default_text=_both("mass"))
+    mass: float | None = _param("kg", "m", bounds=(0.0, None), default_text=_both("mass"),
+                                commands=_device("mass"))
     length: float | None = _param("m", "pivot to centre of mass l", bounds=(0.0, None),
-                                  default_text=_both("length"))
+                                  default_text=_both("length"), commands=_device("length"))
     inertia: float | None = _param("kg m^2", "about the pivot, at least m l^2",
                                    default_text="m l^2")
-    damping_coefficient: float | None = _param("N m s/rad", "viscous c", bounds=(0.0, None),
-                                               default_text=_both("damping_coefficient"))
+    damping_coefficient: float | None = _param(
+        "N m s/rad", "viscous c", bounds=(0.0, None),
+        default_text=_both("damping_coefficient"), commands=dict.fromkeys(
+            ("horizon", "power-matrix"),
+            {"help": "viscous c (instead of --gamma)",
+             "default": f"--gamma; {BUOY['damping_coefficient']:g} with --device buoy"}))
 
 
 @dataclass(frozen=True)
@@ -198,8 +228,12 @@ class Controller(_Inputs):
         default_text="optimum", kind="text", choices=("optimum", "mpc", "one-way-mpc"))
     horizon: float | None = _param("peak periods", "with mpc: forecast horizon",
                                    default_text="2; one-way-mpc 1")
-    update_interval: float | None = _param("peak periods", "with mpc: re-planning interval",
-                                           default_text="0.125")
+    update_interval: float | None = _param(
+        "peak periods", "with mpc: re-planning interval", default_text="0.125",
+        commands={"horizon": {  # the prescribed-heave pendulum's curve re-plans more often
+            "help": "receding-horizon update interval",
+            "default": f"{HORIZON['update_interval']:g}; "
+                       f"{BUOY_HORIZON['update_interval']:g} with --device buoy"}})
     forecast: str | None = _param(
         "-", "with mpc: what the controller knows of the excitation force over the horizon: "
              "perfect (the record's own future) or ar (autoregressive, fitted on the force "

@@ -27,18 +27,13 @@ from dataclasses import dataclass
 import numpy as np
 
 from .. import limits
+from ..defaults import BUOY_HORIZON
 from ..errors import ParameterError, check_int
 from ..results import _Result
 
-__all__ = ["BuoyHorizonResult", "buoy_horizon_curve", "plot_buoy_horizon"]
+__all__ = ["BUOY_HORIZON", "BuoyHorizonResult", "buoy_horizon_curve", "plot_buoy_horizon"]
 
-#: the buoy's curve without the options: horizons (peak periods), each record's length in
-#: peak periods, the update interval and the warm-up (peak periods; ``parapend buoy
-#: --controller mpc``'s), the planners a user may choose. Ten waves a record: three
-#: horizons and two forecasts of the default ``plan`` planner are estimated at about 40 s
-#: (BUOY_MPC_SECONDS), inside the two minutes a command runs untimed
-BUOY_HORIZON = {"horizons": "0.5,1,2", "repeat_periods": 10, "update_interval": 0.125,
-                "warm_up": 4.0}
+#: the planners a user may choose (the curve's defaults: ``parapend.defaults.BUOY_HORIZON``)
 PLANNERS = ("coupled", "plan")
 #: seconds per unit of a run's work (updates x horizon samples x solves per update), per
 #: planner: ``coupled``'s from the default curve's run with it (work 1.0e5, 140 s of CPU
