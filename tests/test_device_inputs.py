@@ -150,6 +150,28 @@ def test_a_declared_bound_is_the_command_s_check(name, extra):
         parapend.buoy(**{name: 2 * hi + 1}, **extra)
 
 
+def test_a_declared_default_is_the_command_s_default(monkeypatch):
+    """A default that is one value stands in the declaration: the help states it, and the
+    command uses it (a declared default changed is the command's new default)."""
+    metas = {f.name: f.metadata for cls in (dv.Sea, dv.Controller)
+             for f in dataclasses.fields(cls)}
+    valued = {k: m for k, m in metas.items() if m["value"] is not None}
+    assert {"spectrum", "gamma_peak", "cutoff", "taper", "horizon", "update_interval",
+            "forecast"} <= set(valued)
+    for name, meta in valued.items():
+        value = meta["value"]
+        for v in (value.values() if isinstance(value, dict) else [value]):
+            assert (v if isinstance(v, str) else f"{v:g}") in dv.option_help(meta), name
+    # the commands read it through default_of: a declared default changed is what they get
+    from parapend.hydro import declared
+
+    field = next(f for f in dataclasses.fields(dv.Controller) if f.name == "horizon")
+    monkeypatch.setitem(field.metadata["value"], "mpc", 1e6)
+    assert declared.default_of("horizon", None, "mpc") == 1e6
+    assert declared.default_of("horizon", None, "optimum") is None  # none applies
+    assert declared.default_of("horizon", 0.0, "mpc") == 0.0  # a value given is kept
+
+
 def _script() -> str:
     text = (DOCS / "buoy.md").read_text(encoding="utf-8")
     part = text[text.index("## Inputs that compose"):]

@@ -21,7 +21,7 @@ import numpy as np
 from .. import limits
 from ..defaults import BUOY, HULL, given
 from ..errors import ParameterError, check_int, check_nonnegative, check_positive, check_range
-from .declared import check, expand_inputs, has_inputs
+from .declared import check, default_of, expand_inputs, has_inputs
 from .hull import HullPTO, waves_in
 from .inputs import _irregular_wave, _pendulum, _period, parse_periods
 from .result import _solve, optimum
@@ -433,10 +433,9 @@ def buoy(*, wave_height=None, wave_period=None, hs=None, tp=None, spectrum=None,
             if v is not None:
                 raise ParameterError(f"{name}: needs --controller mpc"
                                      + ("" if name == "forecast" else " (or one-way-mpc)"))
-    if horizon is None:  # mpc: the plan controller's measured horizon (docs/buoy.md)
-        horizon = 2.0 if controller == "mpc" else 1.0
-    update_interval = 0.125 if update_interval is None else update_interval
-    forecast = "perfect" if forecast is None else forecast
+    horizon = default_of("horizon", horizon, controller)
+    update_interval = default_of("update_interval", update_interval)
+    forecast = default_of("forecast", forecast)
     sea_opts = (("spectrum", spectrum), ("gamma-peak", gamma_peak), ("cutoff", cutoff),
                 ("taper", taper))
     for name, v in sea_opts:
@@ -449,10 +448,9 @@ def buoy(*, wave_height=None, wave_period=None, hs=None, tp=None, spectrum=None,
             raise ParameterError("taper: needs --record")
         if name in ("spectrum", "gamma-peak") and record is not None:
             raise ParameterError(f"{name}: not used with --record; drop it")
-    spectrum = "jonswap" if spectrum is None else spectrum
-    gamma_peak = 3.3 if gamma_peak is None else gamma_peak
-    cutoff = 3.0 if cutoff is None else cutoff
-    taper = 0.1 if taper is None else taper
+    spectrum, gamma_peak, cutoff, taper = (default_of(k, v) for k, v in (
+        ("spectrum", spectrum), ("gamma_peak", gamma_peak), ("cutoff", cutoff),
+        ("taper", taper)))
     if wave_direction is not None:
         wave_direction = check("wave_direction", wave_direction, absolute=True)
         if hydro is None:
@@ -853,9 +851,10 @@ def hull_buoy(**opts):
             tp = opts.get("tp") or HULL["tp"]
             opts = dict(opts, repeat_period=HULL["repeat_periods"] * tp)
         wave, info = _irregular_wave(
-            opts.get("hs"), opts.get("tp"), _or(opts, "spectrum", "jonswap"),
-            _or(opts, "gamma_peak", 3.3), opts.get("repeat_period"), opts.get("seed"),
-            _or(opts, "cutoff", 3.0), opts.get("record"), _or(opts, "taper", 0.1),
+            opts.get("hs"), opts.get("tp"), default_of("spectrum", opts.get("spectrum")),
+            default_of("gamma_peak", opts.get("gamma_peak")), opts.get("repeat_period"),
+            opts.get("seed"), default_of("cutoff", opts.get("cutoff")), opts.get("record"),
+            default_of("taper", opts.get("taper")),
             Units(pend.length, pend.mass, 9.81, pend.inertia))
         return solve_record(p, wave, info)
     height = check("wave_height", _hull_value(opts, "wave_height"),
@@ -877,12 +876,6 @@ def hull_buoy(**opts):
     from .result import BuoySweepResult
 
     return BuoySweepResult.from_results(periods, results, height)
-
-
-def _or(opts, name, default):
-    """The option, or ``default`` when not given (a 0 or "" given is checked, not replaced)."""
-    v = opts.get(name)
-    return default if v is None else v
 
 
 def _check_wave_kind(opts):

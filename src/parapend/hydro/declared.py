@@ -16,23 +16,33 @@ from ..defaults import BUOY, BUOY_HORIZON, HORIZON, HULL, SEA
 from ..limits import SEA_WAVES_RANGE
 
 __all__ = ["Body", "Controller", "DeviceInputs", "INPUT_KEYWORDS", "Pendulum", "PowerTakeOff",
-           "RUN_OPTIONS", "Sea", "check", "declaration", "declarations", "expand_inputs",
+           "RUN_OPTIONS", "Sea", "check", "declaration", "declarations", "default_of",
+           "expand_inputs",
            "has_inputs", "option_help"]
 
 
 def _param(unit: str, help: str, *, default=None, bounds=None, default_text=None,
-           kind: str = "float", choices=None, metavar=None, commands=None):
+           kind: str = "float", choices=None, metavar=None, commands=None, value=None):
     """A parameter's declaration: a field whose metadata hold its unit, bounds (the range the
     command accepts, or None where it depends on other parameters), help, how the command
     line reads it (``kind``: float, int, text; ``choices``, ``metavar``) and the default it
     states (``default_text``; ``default`` None means the command's default). ``commands``:
     what another command (``horizon``, ``power-matrix``) states instead, its own ``help``
     or ``default`` (a documented per-command default: the prescribed-heave pendulum's, or
-    the horizon curve's shorter records)."""
+    the horizon curve's shorter records). ``value``: the command's default itself where it
+    is one value (or one per controller, a dict), which the command reads
+    (:func:`default_of`) and the help states (``default_text`` then defaults to it)."""
+    if default_text is None and value is not None and not isinstance(value, dict):
+        default_text = value if isinstance(value, str) else f"{value:g}"
     return field(default=default, metadata={
         "unit": unit, "help": help, "bounds": bounds, "kind": kind, "choices": choices,
         "metavar": metavar, "default": default_text or repr(default),
-        "commands": commands or {}})
+        "commands": commands or {}, "value": value})
+
+
+#: the receding-horizon controllers' default horizons, peak periods (the plan controller's
+#: measured horizon, docs/buoy.md)
+_MPC_HORIZON = {"mpc": 2.0, "one-way-mpc": 1.0}
 
 
 def _both(name: str, note: str = "") -> str:
@@ -82,10 +92,10 @@ class Sea(_Inputs):
                               default_text=_both("hs", " with --tp"), commands=_device("hs"))
     tp: float | None = _param("s", "peak period", default_text=_both("tp", " with --hs"),
                               commands=_device("tp"))
-    spectrum: str | None = _param("-", "spectrum shape", default_text="jonswap",
+    spectrum: str | None = _param("-", "spectrum shape", value="jonswap",
                                   kind="text", choices=("jonswap", "pierson-moskowitz"))
     gamma_peak: float | None = _param("-", "JONSWAP peak enhancement in [1, 20]",
-                                      bounds=(1.0, 20.0), default_text="3.3")
+                                      bounds=(1.0, 20.0), value=3.3)
     repeat_period: float | None = _param(
         "s", "T_r: the record repeats with it",
         default_text=f"100 Tp; a hull's {HULL['repeat_periods']:g} Tp",
@@ -101,11 +111,11 @@ class Sea(_Inputs):
                                   "power-matrix": {"help": "seed of realization 0; "
                                                            "realization r has seed + r"}})
     cutoff: float | None = _param("-", "highest frequency, in units of the peak frequency",
-                                  default_text="3")
+                                  value=3.0)
     record: str | None = _param("s, m", "measured surface elevation at the body, CSV 't,z'",
                                 kind="text", metavar="CSV")
     taper: float | None = _param("-", "with --record: fraction under the Tukey taper",
-                                 bounds=(0.0, 0.5), default_text="0.1")
+                                 bounds=(0.0, 0.5), value=0.1)
     wave_direction: float | None = _param(
         "rad", "with --hydro: the dataset's wave direction to use",
         bounds=(0.0, 6.283185307179586), default_text="0, the waves travelling along +x",
@@ -226,10 +236,11 @@ class Controller(_Inputs):
              "on the coupled model with its radiation (the motion planner; with --efficiency "
              "the torque planner); one-way-mpc: planned on the free buoy's heave",
         default_text="optimum", kind="text", choices=("optimum", "mpc", "one-way-mpc"))
-    horizon: float | None = _param("peak periods", "with mpc: forecast horizon",
-                                   default_text="2; one-way-mpc 1")
+    horizon: float | None = _param(
+        "peak periods", "with mpc: forecast horizon", value=_MPC_HORIZON,
+        default_text=f"{_MPC_HORIZON['mpc']:g}; one-way-mpc {_MPC_HORIZON['one-way-mpc']:g}")
     update_interval: float | None = _param(
-        "peak periods", "with mpc: re-planning interval", default_text="0.125",
+        "peak periods", "with mpc: re-planning interval", value=0.125,
         commands={"horizon": {  # the prescribed-heave pendulum's curve re-plans more often
             "help": "receding-horizon update interval",
             "default": f"{HORIZON['update_interval']:g}; "
@@ -237,7 +248,7 @@ class Controller(_Inputs):
     forecast: str | None = _param(
         "-", "with mpc: what the controller knows of the excitation force over the horizon: "
              "perfect (the record's own future) or ar (autoregressive, fitted on the force "
-             "measured so far)", default_text="perfect", kind="text",
+             "measured so far)", value="perfect", kind="text",
         choices=("perfect", "ar"))
 
     @classmethod
@@ -287,6 +298,21 @@ def declarations() -> dict:
             for cls in _OBJECTS for f in dataclasses.fields(cls)}
 
 
+def _meta(name: str):
+    return next(f.metadata for cls in _OBJECTS for f in dataclasses.fields(cls)
+                if f.name == name)
+
+
+def default_of(name: str, given, key=None):
+    """``given``, or the declared default of the parameter ``name`` where it is None (a 0
+    given is kept, and checked); ``key``: which of its defaults (a controller's name; None
+    where it has none)."""
+    if given is not None:
+        return given
+    value = _meta(name)["value"]
+    return value.get(key) if isinstance(value, dict) else value
+
+
 def check(name: str, value, *, why: str | None = None, absolute: bool = False) -> float:
     """``value`` of the declared parameter ``name`` as a float in its declared bounds, or the
     one line that names it (:func:`parapend.errors.check_range`; ``why``, the reason said,
@@ -294,8 +320,7 @@ def check(name: str, value, *, why: str | None = None, absolute: bool = False) -
     check a declared parameter with this, so its bounds stand in one place."""
     from ..errors import check_range
 
-    meta = next(f.metadata for cls in _OBJECTS for f in dataclasses.fields(cls)
-                if f.name == name)
+    meta = _meta(name)
     lo, hi = meta["bounds"]
     return check_range(name.replace("_", "-"), value, lo, hi, absolute=absolute,
                        why=meta["unit"] if why is None else why)
