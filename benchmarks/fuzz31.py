@@ -180,9 +180,11 @@ case("horizon buoy --torque-limit 1 (run)", H("--torque-limit", "1"), "ok")
 for v in ("0", "1.5", "nan", "-1"):
     case(f"horizon buoy --efficiency {v}", H("--efficiency", v), "refuse", must=["efficiency"])
 case("horizon buoy --efficiency 0.9 (run)", H("--efficiency", "0.9"), "ok")
-case("horizon buoy --controller plan --efficiency 0.9",
-     H("--controller", "plan", "--efficiency", "0.9"), "refuse", must=["efficiency"])
-case("horizon buoy --controller foo", H("--controller", "foo"), "refuse", must=["controller"])
+case("horizon buoy --planner plan --efficiency 0.9",
+     H("--planner", "plan", "--efficiency", "0.9"), "refuse", must=["efficiency"])
+case("horizon buoy --planner foo", H("--planner", "foo"), "refuse", must=["planner"])
+case("horizon buoy --controller plan (renamed)", H("--controller", "plan"), "refuse",
+     must=["--planner"])
 for opt, v in (("--gamma", "0.1"), ("--gravity", "9.81"), ("--baselines", "tracker"),
                ("--speed-limit", "1"), ("--baselines", "none")):
     case(f"horizon buoy {opt} {v} (pendulum only)", H(opt, v), "refuse", must=[opt[2:]])
@@ -242,8 +244,8 @@ case("horizon buoy --seed 9223372036854775788", H("--seed", "9223372036854775788
 case("horizon buoy --horizons 0.05 (below the default update interval)",
      H("--horizons", "0.05"), "refuse", must=["update-interval"])
 case("horizon buoy --warm-up 100", H("--warm-up", "100"), must=["warm-up"])
-case("horizon (pendulum) --controller plan", ["horizon", "--controller", "plan", "--json"],
-     "refuse", must=["controller"])
+case("horizon (pendulum) --planner plan", ["horizon", "--planner", "plan", "--json"],
+     "refuse", must=["planner"])
 case("horizon (pendulum) --body sphere", ["horizon", "--body", "sphere", "--json"], "refuse",
      must=["body"])
 case("horizon (pendulum) --hydro good.nc", ["horizon", "--hydro", f"{T}/good.nc", "--json"],

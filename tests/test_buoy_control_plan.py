@@ -271,7 +271,7 @@ def test_default_design_plan_controller_harvests():
     opt = parapend.buoy(hs=0.5, tp=2.5, repeat_period=25, seed=0, winding=10)
     pend = Pendulum(mass=80.0, length=0.3, inertia=7.2, damping_coefficient=1.0)
     r = bc.buoy_mpc(opt._hydro, pend, opt._wave, peak_period=2.5, horizon=2.0)
-    assert r.success and r.controller == "plan"
+    assert r.success and r.planner == "plan"
     assert 0.88 < r.mean_power_w / opt.power_w < 1.0
     assert r.energy_balance_residual < 1e-6
     assert r.peak_torque_nm <= r.torque_limit_nm * (1 + 1e-12)

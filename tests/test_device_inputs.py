@@ -90,6 +90,88 @@ def test_the_objects_give_the_keyword_functions_answers(dataset):
         device.horizon(state)
 
 
+def test_the_commands_take_the_objects(dataset):
+    """``parapend.buoy`` takes the objects (``sea=``, ``pendulum=``, ``body=``, ``pto=``, or a
+    ``device=``) and gives its keywords' answer bit for bit; a field given twice, of the wrong
+    object or not taken by the command is refused in one line naming it, before any work
+    (``horizon`` and ``power_matrix`` too)."""
+    period = 2 * math.pi / 1.2
+    sea = dv.Sea.regular(1.0, period)
+    pend = dv.Pendulum(mass=4000.0, length=1.0, inertia=5000.0, damping_coefficient=50.0)
+    body = dv.Body(hydro=dataset)
+    want = parapend.buoy(hydro=dataset, mass=4000.0, length=1.0, inertia=5000.0,
+                         damping_coefficient=50.0, wave_height=1.0, wave_period=period)
+    got = parapend.buoy(sea=sea, pendulum=pend, body=body)
+    assert got.power_w == want.power_w and got.to_dict() == want.to_dict()
+    assert parapend.buoy(sea=sea, device=dv.Device(body, pend)).power_w == want.power_w
+    # a keyword beside the objects: the command's own
+    assert parapend.buoy(sea=sea, body=body, mass=4000.0, length=1.0, inertia=5000.0,
+                         damping_coefficient=50.0).power_w == want.power_w
+    bad = [({"sea": sea, "wave_height": 2.0}, "^wave-height: given twice"),
+           ({"pendulum": pend, "device": dv.Device(pendulum=pend)}, "^mass: given twice"),
+           ({"sea": 3.0}, "^sea: expected a Sea"),
+           ({"pendulum": sea}, "^pendulum: expected a Pendulum, got a Sea")]
+    for kw, match in bad:
+        with pytest.raises(parapend.ParameterError, match=match.replace("a Pendulum",
+                                                                        "a Pendulum .*")):
+            parapend.buoy(**kw)
+    with pytest.raises(parapend.ParameterError, match="^wave-height: not taken by horizon"):
+        parapend.horizon(sea=sea, device=dv.Device(body, pend))
+    with pytest.raises(parapend.ParameterError, match="^horizon: not taken by horizon"):
+        parapend.horizon(device=dv.Device(body, pend),
+                         controller=dv.Controller.receding_horizon(2.0))
+    with pytest.raises(parapend.ParameterError, match="^records: .*at most"):
+        parapend.horizon(device=dv.Device(), records=20)  # the buoy's curve: its estimate
+    with pytest.raises(parapend.ParameterError, match="^hydro: given twice"):
+        parapend.power_matrix(device=dv.Device(body, pend), body=body, hs="1,2", tp="5,6")
+    with pytest.raises(parapend.ParameterError, match="^sea: expected a Sea"):
+        parapend.horizon(sea="jonswap")
+    # the take-off's torque limit is in N m, the curve's --torque-limit-nm: checked as such
+    # (the same one line as the keyword's)
+    with pytest.raises(parapend.ParameterError, match="^torque-limit-nm: ") as want:
+        parapend.horizon(device="buoy", hydro=dataset, mass=4000.0, length=1.0,
+                         torque_limit_nm=-5.0)
+    with pytest.raises(parapend.ParameterError) as got:
+        parapend.horizon(device=dv.Device(body, pend, dv.PowerTakeOff(torque_limit=-5.0)))
+    assert str(got.value) == str(want.value)
+
+
+@pytest.mark.parametrize("name, extra", [
+    ("wave_height", {}), ("wave_period", {}), ("wave_direction", {"hydro": "x.nc"}),
+    ("copper_loss", {"dofs": "surge,heave,pitch"}),
+    ("hull_pitch_inertia", {"dofs": "surge,heave,pitch"})])
+def test_a_declared_bound_is_the_command_s_check(name, extra):
+    """The bounds stand in the declaration: a value past its declared upper bound is refused
+    by the command in one line that states that bound (parapend.hydro.declared.check)."""
+    _owner, _unit, _default, (_lo, hi), _help = dv.declaration(name)
+    bound = re.escape(f"{hi:g}")
+    with pytest.raises(parapend.ParameterError,
+                       match=rf"^{name.replace('_', '-')}: expected .*{bound}\]?, got"):
+        parapend.buoy(**{name: 2 * hi + 1}, **extra)
+
+
+def test_a_declared_default_is_the_command_s_default(monkeypatch):
+    """A default that is one value stands in the declaration: the help states it, and the
+    command uses it (a declared default changed is the command's new default)."""
+    metas = {f.name: f.metadata for cls in (dv.Sea, dv.Controller)
+             for f in dataclasses.fields(cls)}
+    valued = {k: m for k, m in metas.items() if m["value"] is not None}
+    assert {"spectrum", "gamma_peak", "cutoff", "taper", "horizon", "update_interval",
+            "forecast"} <= set(valued)
+    for name, meta in valued.items():
+        value = meta["value"]
+        for v in (value.values() if isinstance(value, dict) else [value]):
+            assert (v if isinstance(v, str) else f"{v:g}") in dv.option_help(meta), name
+    # the commands read it through default_of: a declared default changed is what they get
+    from parapend.hydro import declared
+
+    field = next(f for f in dataclasses.fields(dv.Controller) if f.name == "horizon")
+    monkeypatch.setitem(field.metadata["value"], "mpc", 1e6)
+    assert declared.default_of("horizon", None, "mpc") == 1e6
+    assert declared.default_of("horizon", None, "optimum") is None  # none applies
+    assert declared.default_of("horizon", 0.0, "mpc") == 0.0  # a value given is kept
+
+
 def _script() -> str:
     text = (DOCS / "buoy.md").read_text(encoding="utf-8")
     part = text[text.index("## Inputs that compose"):]
@@ -142,6 +224,36 @@ def test_buoy_s_options_are_generated_from_the_declarations():
             assert tuple(options[name].choices) == meta["choices"], name
     assert options["mass"].help.endswith(f"(default {BUOY['mass']:g}; a hull's "
                                          f"{HULL['mass']:g})")
+
+
+#: options of horizon and power-matrix named as a declared parameter but written by the
+#: command (what is left to generate): the bins, the pendulum's torque limit in m g l, a
+#: plain efficiency, the causal column's own controller options, the body's name and dataset
+#: (and horizon's hidden --controller, the planner's former name, refused)
+OWN = {"horizon": {"torque_limit", "efficiency", "dofs", "body", "hydro", "controller"},
+       "power-matrix": {"hs", "tp", "efficiency", "torque_limit", "controller", "horizon",
+                        "forecast", "update_interval", "dofs", "body", "hydro"}}
+
+
+@pytest.mark.parametrize("command", ["horizon", "power-matrix"])
+def test_horizon_s_and_power_matrix_s_options_are_generated(command):
+    """``horizon``'s and ``power-matrix``'s options of the sea and the pendulum (and the
+    body's) are made from the same declarations as ``buoy``'s, with the defaults the
+    declaration states for that command (the prescribed-heave pendulum's, the buoy's with
+    ``--device buoy``, the curve's shorter records)."""
+    from parapend.defaults import BUOY, HORIZON, SEA
+
+    metas = {f.name: f.metadata for cls in (dv.Sea, dv.Pendulum, dv.Body, dv.PowerTakeOff,
+                                            dv.Controller) for f in dataclasses.fields(cls)}
+    options = {a.dest: a for a in _options(command)}
+    generated = [n for n in options if n in metas and n not in OWN[command]]
+    assert {"seed", "spectrum", "mass", "length", "damping_coefficient"} <= set(generated)
+    for name in generated:
+        assert options[name].help == dv.option_help(metas[name], command), name
+    assert options["mass"].help.endswith(f"(default {SEA['mass']:g}; {BUOY['mass']:g} with "
+                                         "--device buoy)")
+    if command == "horizon":
+        assert f"default {HORIZON['repeat_periods']:g} Tp;" in options["repeat_period"].help
 
 
 @pytest.mark.slow

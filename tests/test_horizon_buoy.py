@@ -63,7 +63,7 @@ def test_a_point_of_the_curve_is_buoy_mpc_run_directly(curve, optimum):
     assert curve.mpc_harvested_power_w[0][j][0] == r.harvested_electrical_power_w
     assert curve.mpc_stored_energy_change_j[0][j][0] == r.stored_energy_change_j
     assert curve.mpc_failed_solves[0][j][0] == r.failed_solves
-    assert curve.controller == r.controller
+    assert curve.planner == r.planner
 
 
 @pytest.mark.slow
@@ -210,7 +210,7 @@ def test_the_pendulum_curve_keeps_its_defaults_and_keys():
     assert r.units["length_m"] == SEA_DEFAULTS["length"]
     assert r.units["mass_kg"] == SEA_DEFAULTS["mass"]
     d = r.to_dict()
-    assert "device" not in d and "controller" not in d
+    assert "device" not in d and "planner" not in d
     assert parapend.horizon(forecasts="none", repeat_period=16.0).baselines == [
         "tracker", "extremum"]
 
@@ -229,11 +229,13 @@ def _one_line(argv, name, capsys):
     (["--device", "buoy", "--speed-limit", "2"], "speed-limit"),
     (["--body", "sphere"], "body"),
     (["--radius", "0.4"], "radius"),
-    (["--controller", "plan"], "controller"),
+    (["--planner", "plan"], "planner"),
+    (["--controller", "plan"], "--planner"),          # the former name, named the new one
+    (["--device", "buoy", "--controller", "coupled"], "--planner"),
     (["--hydro", "x.nc"], "hydro"),
     (["--device", "buoy", "--forecasts", "none"], "forecasts"),
     (["--device", "buoy", "--forecasts", "tracker"], "forecasts"),
-    (["--device", "buoy", "--controller", "plan", "--efficiency", "0.9"], "efficiency"),
+    (["--device", "buoy", "--planner", "plan", "--efficiency", "0.9"], "efficiency"),
     (["--device", "buoy", "--torque-limit", "1", "--torque-limit-nm", "100"],
      "torque-limit-nm"),
     (["--device", "buoy", "--torque-limit", "-1"], "torque-limit"),

@@ -833,8 +833,14 @@ def _power_matrix_result(power_matrix, arguments):
     -------
     Record
     """
+    from .hydro.declared import expand_inputs, has_inputs
     from .performance import STATISTICS
 
+    if has_inputs(arguments.arguments):  # the input objects: their fields, as keywords
+        import inspect
+
+        arguments = inspect.signature(power_matrix).bind(
+            **expand_inputs(power_matrix, arguments.arguments))
     a = arguments.arguments
     if a["scheduler"] is not None and a["workers"] is not None:
         raise ParameterError("workers: the processes are the cluster's with --scheduler; "

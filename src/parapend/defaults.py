@@ -82,6 +82,15 @@ HORIZON = {"horizons": "0.25,0.5,1,2", "forecasts": "perfect,ar",
            "baselines": "tracker,extremum", "records": 1, "update_interval": 0.03125,
            "warm_up": 0.0, "speed_limit": None, "repeat_periods": 20}
 
+#: ``horizon --device buoy``: the buoy's curve without the options: horizons (peak periods),
+#: each record's length in peak periods, the update interval and the warm-up (peak periods;
+#: ``parapend buoy --controller mpc``'s). Ten waves a record: three horizons and two
+#: forecasts of the default ``plan`` planner are estimated at about 40 s
+#: (``parapend.hydro.horizon.BUOY_MPC_SECONDS``), inside the two minutes a command runs
+#: untimed
+BUOY_HORIZON = {"horizons": "0.5,1,2", "repeat_periods": 10, "update_interval": 0.125,
+                "warm_up": 4.0}
+
 #: ``track --controller``: the regular-wave controller by default; with ``mpc`` the horizon
 #: and the update interval (peak periods) and the wave forecast of the receding-horizon
 #: controller (docs/control.md)

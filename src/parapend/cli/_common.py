@@ -194,10 +194,11 @@ def add_pendulum_options(g, *, gamma_note: str = "") -> None:
                    help="viscous damping c, N m s/rad (instead of --gamma)")
 
 
-def add_declared(g, cls, names) -> None:
+def add_declared(g, cls, names, command: str | None = None) -> None:
     """The options ``--NAME`` of the parameters ``names`` of an input object ``cls``
     (:mod:`parapend.hydro.device`) into the argument group ``g``, generated from their
-    declarations: the help, the unit and the default stated, the type, the choices."""
+    declarations: the help, the unit and the default stated (``command``'s where its
+    declaration states one), the type, the choices."""
     import dataclasses
 
     from ..hydro.device import option_help
@@ -205,7 +206,7 @@ def add_declared(g, cls, names) -> None:
     meta = {f.name: f.metadata for f in dataclasses.fields(cls)}
     for name in names:
         m, flag = meta[name], name.replace("_", "-")
-        kw = {"help": option_help(m)}
+        kw = {"help": option_help(m, command)}
         if m["choices"]:
             kw["choices"] = list(m["choices"])
         elif m["kind"] == "float":

@@ -161,7 +161,7 @@ def _cmd_buoy(a) -> dict | str:
 
         raise SolverError("out of memory; use smaller --harmonics or --winding, a shorter "
                           "record (--repeat-period, --record), or a smaller --mesh") from None
-    if hasattr(r, "controller"):
+    if hasattr(r, "planner"):  # a causal run (BuoyMPCResult)
         from ..hydro.control import mpc_text
         from ._common import unresolved_if
 

@@ -3,9 +3,11 @@
 
 from __future__ import annotations
 
-from ..defaults import BUOY, HORIZON
-from ..hydro.horizon import BUOY_HORIZON
-from ..hydro.horizon import CONTROLLERS as BUOY_CONTROLLERS
+import argparse
+
+from ..defaults import HORIZON
+from ..hydro.declared import Controller, Pendulum, Sea
+from ..hydro.horizon import BUOY_HORIZON, PLANNERS
 from . import _output
 from ._common import (
     FIGURE_SUFFIXES,
@@ -15,18 +17,8 @@ from ._common import (
     _run,
     _table,
     add_body_options,
-    add_pendulum_options,
-    add_sea_options,
+    add_declared,
 )
-
-
-def _buoy_defaults(g, notes: dict) -> None:
-    """Add to the help of the shared options in ``g`` what they default to (or that they are
-    refused) with ``--device buoy``: ``notes`` maps an option's dest to the text that goes
-    before the help's closing parenthesis."""
-    for action in g._group_actions:
-        if action.dest in notes and action.help.endswith(")"):
-            action.help = action.help[:-1] + notes[action.dest] + ")"
 
 
 def add_parsers(sub) -> None:
@@ -42,25 +34,22 @@ def add_parsers(sub) -> None:
                         "pendulum inside the floating buoy, coupled both ways (parapend buoy's "
                         "body and pendulum; docs/buoy.md)")
     p.set_defaults(device="pendulum")
+    # the sea's and the pendulum's options: generated from their declarations
+    # (parapend.hydro.declared), with the defaults they state for horizon: the
+    # prescribed-heave pendulum's, the buoy's with --device buoy, the curve's shorter records
     g = p.add_argument_group("sea state (IEC TS 62600-2 spectra)")
-    add_sea_options(g, repeat_period="the length of each record",
-                    seed="seed of the first record's phases; record r has seed + r "
-                         "(default 0)",
-                    cutoff="highest frequency, in units of the peak frequency (default 3)",
-                    repeat_default=HORIZON["repeat_periods"])
-    _buoy_defaults(g, {"hs": f"; {BUOY['hs']:g} with --device buoy",
-                       "tp": f"; {BUOY['tp']:g} with --device buoy",
-                       "repeat_period": f"; {BUOY_HORIZON['repeat_periods']:g} Tp with "
-                                        "--device buoy"})
+    add_declared(g, Sea, ("hs", "tp", "spectrum", "gamma_peak", "repeat_period", "seed",
+                          "cutoff"), command="horizon")
     g.add_argument("--records", type=_int,
                    help="seeded records, 1 to 20 (default 1)")
     g = p.add_argument_group("pendulum (SI units) and power take-off")
-    add_pendulum_options(g)
-    _buoy_defaults(g, {
-        "length": f"; {BUOY['length']:g} with --device buoy",
-        "mass": f"; {BUOY['mass']:g} with --device buoy",
-        "damping_coefficient": f"; default {BUOY['damping_coefficient']:g} with --device buoy",
-        "gamma": "; not with --device buoy", "gravity": "; not with --device buoy"})
+    add_declared(g, Pendulum, ("length", "mass", "inertia"), command="horizon")
+    g.add_argument("--gravity", type=_finite_float("gravity"),
+                   help="m/s^2 (default 9.81; not with --device buoy)")
+    g.add_argument("--gamma", type=_finite_float("gamma"),
+                   help="viscous damping, non-dimensional (default 0.01; not with --device "
+                        "buoy)")
+    add_declared(g, Pendulum, ("damping_coefficient",), command="horizon")
     g.add_argument("--torque-limit", type=_finite_float("torque-limit"),
                    help="|T| <= T_max, units m g l, for every controller (default none)")
     g.add_argument("--torque-limit-nm", type=_finite_float("torque-limit-nm"),
@@ -74,9 +63,11 @@ def add_parsers(sub) -> None:
                                   "(default cylinder)",
                      hydro_help="a Capytaine dataset (NetCDF), instead of solving "
                                 "(docs/buoy.md)")
-    g.add_argument("--controller", choices=list(BUOY_CONTROLLERS),
+    g.add_argument("--planner", choices=list(PLANNERS),
                    help="the buoy's receding-horizon planner (parapend.hydro.control.buoy_mpc"
-                        "; default its own, coupled)")
+                        "; default plan, coupled with --efficiency)")
+    # the planner's former name: refused in one line naming --planner (parapend.horizon)
+    g.add_argument("--controller", help=argparse.SUPPRESS)
     g.add_argument("--dofs", metavar="DOFS",
                    help="the body's degrees of freedom: heave (default, the heaving buoy); "
                         "a hull's (surge,heave,pitch) has no causal controller yet")
@@ -91,10 +82,7 @@ def add_parsers(sub) -> None:
     g.add_argument("--baselines",
                    help="causal baselines: tracker, extremum, or none (default "
                         f"{HORIZON['baselines']}; not with --device buoy)")
-    g.add_argument("--update-interval", type=_finite_float("update-interval"),
-                   help="receding-horizon update interval, peak periods (default "
-                        f"{HORIZON['update_interval']:g}; "
-                        f"{BUOY_HORIZON['update_interval']:g} with --device buoy)")
+    add_declared(g, Controller, ("update_interval",), command="horizon")
     g.add_argument("--warm-up", type=_finite_float("warm-up"),
                    help="peak periods of every receding-horizon run left out of its mean "
                         "(the run is then this plus one repeat long; default 0, "
@@ -238,7 +226,7 @@ def _buoy_text(r, a) -> list:
            f"{rec.get('tp'):g} s, records of {rec.get('repeat_period'):g} s, {seeds}; "
            f"pendulum m = {p['mass_kg']:g} kg, l = {p['length_m']:g} m, I = "
            f"{p['inertia_kg_m2']:.4g} kg m^2, c = {p['damping_coefficient_nm_s_per_rad']:g} "
-           f"N m s/rad; {r.controller} planner"
+           f"N m s/rad; {r.planner} planner"
            + ("" if r.torque_limit_nm is None else f", torque limit {r.torque_limit_nm:.4g} N m")
            + ("" if r.efficiency is None else
               f", efficiency {r.efficiency[0]:g}/{r.efficiency[1]:g}")]

@@ -6,7 +6,8 @@ from __future__ import annotations
 import shlex
 import sys
 
-from ..defaults import BUOY, HULL, SEA
+from ..defaults import HULL
+from ..hydro.declared import Pendulum, PowerTakeOff, Sea
 from . import _output
 from ._common import (
     FIGURE_SUFFIXES,
@@ -16,6 +17,7 @@ from ._common import (
     _int,
     _run,
     add_body_options,
+    add_declared,
     hull_options,
 )
 from .sweep import _NEGATIVE_VALUE, _EtaProgress
@@ -54,13 +56,10 @@ def add_parsers(sub) -> None:
                    help="seeded records per bin (default 3)")
     g.add_argument("--waves", type=_finite_float("waves"),
                    help="record length in peak periods, 2 to 400 (default 50)")
-    g.add_argument("--seed", type=_int,
-                   help="seed of realization 0; realization r has seed + r (default 0)")
-    g.add_argument("--spectrum", choices=["jonswap", "pierson-moskowitz"])
-    g.add_argument("--gamma-peak", type=_finite_float("gamma-peak"),
-                   help="JONSWAP peak enhancement (default 3.3)")
-    g.add_argument("--cutoff", type=_finite_float("cutoff"),
-                   help="highest frequency in units of the peak frequency (default 3)")
+    # the sea's and the pendulum's options: generated from their declarations
+    # (parapend.hydro.declared), with the defaults they state for power-matrix
+    add_declared(g, Sea, ("seed", "spectrum", "gamma_peak", "cutoff"),
+                 command="power-matrix")
     g.add_argument("--response", metavar="CSV",
                    help="heave response 'f,gain,phase' (default: the base follows the "
                         "surface)")
@@ -68,19 +67,12 @@ def add_parsers(sub) -> None:
     g.add_argument("--device", choices=["prescribed-heave", "buoy"],
                    help="the prescribed-heave pendulum, or the coupled buoy (the body "
                         "below, the pendulum in SI as parapend buoy)")
-    g.add_argument("--length", type=_finite_float("length"),
-                   help=f"m (default {SEA['length']:g}; buoy {BUOY['length']:g})")
-    g.add_argument("--mass", type=_finite_float("mass"),
-                   help=f"kg (default {SEA['mass']:g}; buoy {BUOY['mass']:g})")
-    g.add_argument("--inertia", type=_finite_float("inertia"),
-                   help="kg m^2 (default m l^2)")
+    add_declared(g, Pendulum, ("length", "mass", "inertia"), command="power-matrix")
     g.add_argument("--gravity", type=_finite_float("gravity"),
                    help="m/s^2 (default 9.81; also the waves')")
     g.add_argument("--gamma", type=_finite_float("gamma"),
                    help="viscous damping, non-dimensional (default 0.01)")
-    g.add_argument("--damping-coefficient", type=_finite_float("damping-coefficient"),
-                   help="N m s/rad (instead of --gamma; buoy default "
-                                      f"{BUOY['damping_coefficient']:g})")
+    add_declared(g, Pendulum, ("damping_coefficient",), command="power-matrix")
     g.add_argument("--winding", type=_winding, help="as sea (default 1)")
     g.add_argument("--harmonics", type=_int, help="as sea (default 16 per wave)")
     g.add_argument("--efficiency", type=_finite_float("efficiency"),
@@ -135,9 +127,7 @@ def add_parsers(sub) -> None:
                         f"{HULL['damping_coefficient']:g} N m s/rad; records of at most "
                         "about 10 waves: give --waves) (default heave)")
     hull_options(g)
-    g.add_argument("--copper-loss", type=_finite_float("copper-loss"),
-                   help="the generator's winding loss r tau^2 subtracted from the power, r "
-                        "in W/(N m)^2 (with --dofs surge,heave,pitch)")
+    add_declared(g, PowerTakeOff, ("copper_loss",))
     g = p.add_argument_group("resource and site")
     g.add_argument("--depth", type=_finite_float("depth"),
                    help="water depth, m (default deep water; with --device buoy also "

@@ -184,7 +184,8 @@ def horizon_curve(*, hs=None, tp=None, spectrum: str = "jonswap", gamma_peak: fl
                   update_interval=None, progress=None,
                   warm_up=None, speed_limit=HORIZON["speed_limit"], time_limit=None,
                   device: str = "pendulum", body=None, radius=None, draft=None, mesh=None,
-                  hydro=None, controller=None, dofs=None):
+                  hydro=None, planner=None, dofs=None, controller=None, sea=None,
+                  pendulum=None, pto=None):
     """Mean power of causal control against the horizon, as a fraction of the record's
     non-causal optimum and of its limit (command ``horizon``: ``parapend.horizon`` is this
     function; module docstring). With ``device="buoy"``: the pendulum inside the floating
@@ -197,10 +198,17 @@ def horizon_curve(*, hs=None, tp=None, spectrum: str = "jonswap", gamma_peak: fl
         The prescribed-heave pendulum (default) or the pendulum inside the buoy, coupled
         both ways (``parapend buoy``'s body and pendulum, in SI; the options below marked
         pendulum only are refused with it).
-    body, radius, draft, mesh, hydro, controller :
+    body, radius, draft, mesh, hydro, planner :
         ``device="buoy"`` only: the floating body as ``parapend buoy`` takes it, and the
         planner of :func:`parapend.hydro.control.buoy_mpc` (``"coupled"`` or ``"plan"``;
-        None: its default).
+        None: its default; the result's ``planner``).
+    controller : None or Controller
+        The planner's former name, refused in one line that names ``planner``
+        (``controller`` is ``parapend buoy``'s optimum, mpc or one-way-mpc); a
+        :class:`~parapend.hydro.device.Controller` gives its update interval.
+    sea, pendulum, body, pto, device : the input objects of :mod:`parapend.hydro.device`
+        (``device`` a ``Device``: ``device="buoy"`` with its body, pendulum and take-off), as
+        :func:`parapend.buoy` takes them: their fields are the keywords here.
     dofs : ``device="buoy"`` only: the body's degrees of freedom, ``"heave"`` (default,
         the heaving buoy); a hull's (``"surge,heave,pitch"``) is refused in one line, as it
         has no causal controller yet.
@@ -256,11 +264,16 @@ def horizon_curve(*, hs=None, tp=None, spectrum: str = "jonswap", gamma_peak: fl
         with the status ``"time_limit"``, and the result's ``status`` is ``"time_limit"``
         (``success`` False; :mod:`parapend.deadline`).
     """
+    if _has_inputs(locals()):  # the input objects of parapend.hydro.device
+        return horizon_curve(**_expanded(locals()))
+    if controller is not None:
+        raise ParameterError("controller: renamed planner here (--planner coupled|plan; "
+                             "--controller is parapend buoy's optimum|mpc|one-way-mpc)")
     if device == "buoy":
         return _buoy(locals())
     if device != "pendulum":
         raise ParameterError(f"device: expected pendulum or buoy, got {device!r:.40}")
-    for name in ("body", "radius", "draft", "mesh", "hydro", "controller", "dofs"):
+    for name in ("body", "radius", "draft", "mesh", "hydro", "planner", "dofs"):
         if locals()[name] is not None:
             raise ParameterError(f"{name}: an option of the buoy; needs --device buoy")
     length = SEA["length"] if length is None else length
@@ -543,6 +556,45 @@ def horizon_curve(*, hs=None, tp=None, spectrum: str = "jonswap", gamma_peak: fl
 PENDULUM_ONLY = ("gravity", "gamma", "baselines", "speed_limit")
 
 
+def _has_inputs(opts: dict) -> bool:
+    from ..hydro.declared import has_inputs
+
+    return has_inputs(opts)
+
+
+def _expanded(opts: dict) -> dict:
+    """The curve's keywords with the input objects of :mod:`parapend.hydro.device` replaced
+    by their fields (:func:`~parapend.hydro.device.expand_inputs`); of a ``Controller``
+    the curve takes the update interval (it runs mpc and sweeps the horizon itself)."""
+    import dataclasses
+
+    from ..hydro.api import refuse_hull
+    from ..hydro.declared import Body, Controller, PowerTakeOff, expand_inputs
+
+    for body in (opts.get("body"), getattr(opts.get("device"), "body", None)):
+        if isinstance(body, Body):  # a hull first: its own options are not the curve's
+            refuse_hull(body.dofs, "horizon --device buoy")
+    controller = opts.get("controller")
+    if isinstance(controller, Controller):
+        if controller.controller not in (None, "mpc"):
+            raise ParameterError(f"controller: the horizon curve runs the coupled receding-"
+                                 f"horizon controller (mpc), got {controller.controller!r:.40}")
+        opts = dict(opts, controller=dataclasses.replace(controller, controller=None))
+    # the take-off's torque limit is in N m: the curve's torque_limit_nm (its torque_limit
+    # is in units m g l)
+    for key in ("pto", "device"):
+        holder = opts.get(key)
+        pto = getattr(holder, "pto", holder)
+        if isinstance(pto, PowerTakeOff) and pto.torque_limit is not None:
+            if opts.get("torque_limit_nm") is not None:
+                raise ParameterError("torque-limit-nm: given twice (in a keyword and "
+                                     f"{key}=); give it once")
+            opts = dict(opts, torque_limit_nm=pto.torque_limit)
+            moved = dataclasses.replace(pto, torque_limit=None)
+            opts[key] = moved if holder is pto else dataclasses.replace(holder, pto=moved)
+    return expand_inputs(horizon_curve, opts)
+
+
 def _buoy(opts: dict):
     """``device="buoy"``: the pendulum-only options refused by name, the rest handed on."""
     from ..hydro.api import refuse_hull
@@ -556,7 +608,8 @@ def _buoy(opts: dict):
                                  + (" (give --damping-coefficient, N m s/rad)"
                                     if name == "gamma" else ""))
     return buoy_horizon_curve(**{k: v for k, v in opts.items()
-                                 if k not in (*PENDULUM_ONLY, "device", "dofs")})
+                                 if k not in (*PENDULUM_ONLY, "device", "dofs",
+                                              "controller", "sea", "pendulum", "pto")})
 
 
 def horizon_dataset(r: HorizonResult):

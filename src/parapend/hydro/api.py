@@ -21,6 +21,7 @@ import numpy as np
 from .. import limits
 from ..defaults import BUOY, HULL, given
 from ..errors import ParameterError, check_int, check_nonnegative, check_positive, check_range
+from .declared import check, default_of, expand_inputs, has_inputs
 from .hull import HullPTO, waves_in
 from .inputs import _irregular_wave, _pendulum, _period, parse_periods
 from .result import _solve, optimum
@@ -306,11 +307,17 @@ def buoy(*, wave_height=None, wave_period=None, hs=None, tp=None, spectrum=None,
          inertia_bounds=None, damping_coefficient_bounds=None, controller="optimum",
          horizon=None, update_interval=None, forecast=None, wave_direction=None, dofs="heave",
          pivot_height=None, pivot_offset=None, hull_pitch_inertia=None, barge_length=None,
-         barge_beam=None, barge_draft=None, copper_loss=None, time_limit=None, progress=None):
+         barge_beam=None, barge_draft=None, copper_loss=None, time_limit=None, progress=None,
+         sea=None, pendulum=None, pto=None, device=None):
     """The coupled optimum of a pendulum inside a floating buoy (command ``buoy``).
 
     Parameters
     ----------
+    sea, pendulum, body, pto, controller, device : the input objects
+        (:mod:`parapend.hydro.device`: ``Sea``, ``Pendulum``, ``Body``, ``PowerTakeOff``,
+        ``Controller``, or a ``Device`` for the body, the pendulum and the take-off): their
+        fields are the keywords below, checked and defaulted as those are. ``body`` and
+        ``controller`` also take the plain names below; a field given twice is refused.
     wave_height, wave_period : float
         A regular wave: height ``H`` (m, crest to trough) and period (s); ``wave_period``
         as ``"FROM:TO:N"`` gives power against period
@@ -375,6 +382,8 @@ def buoy(*, wave_height=None, wave_period=None, hs=None, tp=None, spectrum=None,
         :func:`parapend.hydro.control.buoy_mpc`). The result types are those of every DOF set
         (:func:`parapend.hydro.result.optimum`); their JSON holds their set's fields.
     """
+    if has_inputs(locals()):
+        return buoy(**expand_inputs(buoy, locals()))
     from .coupled import Wave
 
     opts = dict(locals())
@@ -388,7 +397,7 @@ def buoy(*, wave_height=None, wave_period=None, hs=None, tp=None, spectrum=None,
             raise ParameterError("time-limit: not used with --dofs surge,heave,pitch (its "
                                  "work is bounded by its harmonics); drop it")
         return hull_buoy(**{k: v for k, v in opts.items() if k not in (
-            "dofs", "Wave", "progress", "time_limit")})
+            "dofs", "Wave", "progress", "time_limit", "sea", "pendulum", "pto", "device")})
     for name in ("pivot_height", "pivot_offset", "hull_pitch_inertia", "barge_length",
                  "barge_beam", "barge_draft", "copper_loss"):
         if opts[name] is not None and not (isinstance(body, str) and body == "barge"
@@ -424,10 +433,9 @@ def buoy(*, wave_height=None, wave_period=None, hs=None, tp=None, spectrum=None,
             if v is not None:
                 raise ParameterError(f"{name}: needs --controller mpc"
                                      + ("" if name == "forecast" else " (or one-way-mpc)"))
-    if horizon is None:  # mpc: the plan controller's measured horizon (docs/buoy.md)
-        horizon = 2.0 if controller == "mpc" else 1.0
-    update_interval = 0.125 if update_interval is None else update_interval
-    forecast = "perfect" if forecast is None else forecast
+    horizon = default_of("horizon", horizon, controller)
+    update_interval = default_of("update_interval", update_interval)
+    forecast = default_of("forecast", forecast)
     sea_opts = (("spectrum", spectrum), ("gamma-peak", gamma_peak), ("cutoff", cutoff),
                 ("taper", taper))
     for name, v in sea_opts:
@@ -440,13 +448,11 @@ def buoy(*, wave_height=None, wave_period=None, hs=None, tp=None, spectrum=None,
             raise ParameterError("taper: needs --record")
         if name in ("spectrum", "gamma-peak") and record is not None:
             raise ParameterError(f"{name}: not used with --record; drop it")
-    spectrum = "jonswap" if spectrum is None else spectrum
-    gamma_peak = 3.3 if gamma_peak is None else gamma_peak
-    cutoff = 3.0 if cutoff is None else cutoff
-    taper = 0.1 if taper is None else taper
+    spectrum, gamma_peak, cutoff, taper = (default_of(k, v) for k, v in (
+        ("spectrum", spectrum), ("gamma_peak", gamma_peak), ("cutoff", cutoff),
+        ("taper", taper)))
     if wave_direction is not None:
-        wave_direction = check_range("wave-direction", wave_direction, 0.0, 2 * math.pi,
-                                     absolute=True, why="rad")
+        wave_direction = check("wave_direction", wave_direction, absolute=True)
         if hydro is None:
             raise ParameterError("wave-direction: needs --hydro (a dataset with several "
                                  "wave directions)")
@@ -481,8 +487,8 @@ def buoy(*, wave_height=None, wave_period=None, hs=None, tp=None, spectrum=None,
                                         length_bounds=length_bounds,
                                         inertia_bounds=inertia_bounds,
                                         damping_coefficient_bounds=damping_coefficient_bounds)
-    height = check_range("wave-height", BUOY["wave_height"] if wave_height is None
-                         else wave_height, 1e-4, 30.0, why="regular wave height, m")
+    height = check("wave_height", BUOY["wave_height"] if wave_height is None
+                   else wave_height, why="regular wave height, m")
     if periods is not None and variables:
         raise ParameterError("optimize-design: one wave period at a time (drop FROM:TO:N)")
     if variables:
@@ -668,7 +674,7 @@ def _hull_pto(opts):
     if limit is not None:
         limit = check_range("torque-limit", limit, 1e-6, 1e12, why="N m")
     r = opts.get("copper_loss")
-    r = 0.0 if r is None else check_range("copper-loss", r, 0.0, 1e6, why="W/(N m)^2")
+    r = 0.0 if r is None else check("copper_loss", r)
     return HullPTO(efficiency=eta, copper_loss=r, torque_limit=limit)
 
 
@@ -794,7 +800,7 @@ def hull_problem(**opts) -> dict:
                              "which includes the pendulum)")
     inertia = opts.get("hull_pitch_inertia")
     if inertia is not None:
-        inertia = check_range("hull-pitch-inertia", inertia, 1e-6, 1e12, why="kg m^2")
+        inertia = check("hull_pitch_inertia", inertia)
     winding = opts.get("winding")
     windings = (1, 0) if winding is None else (check_int("winding", winding, 0, 16),)
     harmonics = opts.get("harmonics")
@@ -845,13 +851,14 @@ def hull_buoy(**opts):
             tp = opts.get("tp") or HULL["tp"]
             opts = dict(opts, repeat_period=HULL["repeat_periods"] * tp)
         wave, info = _irregular_wave(
-            opts.get("hs"), opts.get("tp"), _or(opts, "spectrum", "jonswap"),
-            _or(opts, "gamma_peak", 3.3), opts.get("repeat_period"), opts.get("seed"),
-            _or(opts, "cutoff", 3.0), opts.get("record"), _or(opts, "taper", 0.1),
+            opts.get("hs"), opts.get("tp"), default_of("spectrum", opts.get("spectrum")),
+            default_of("gamma_peak", opts.get("gamma_peak")), opts.get("repeat_period"),
+            opts.get("seed"), default_of("cutoff", opts.get("cutoff")), opts.get("record"),
+            default_of("taper", opts.get("taper")),
             Units(pend.length, pend.mass, 9.81, pend.inertia))
         return solve_record(p, wave, info)
-    height = check_range("wave-height", _hull_value(opts, "wave_height"), 1e-4, 30.0,
-                         why="regular wave height, m")
+    height = check("wave_height", _hull_value(opts, "wave_height"),
+                   why="regular wave height, m")
     periods = parse_periods(opts.get("wave_period"))
     if periods is None:
         periods = np.array([_period(_hull_value(opts, "wave_period"))])
@@ -869,12 +876,6 @@ def hull_buoy(**opts):
     from .result import BuoySweepResult
 
     return BuoySweepResult.from_results(periods, results, height)
-
-
-def _or(opts, name, default):
-    """The option, or ``default`` when not given (a 0 or "" given is checked, not replaced)."""
-    v = opts.get(name)
-    return default if v is None else v
 
 
 def _check_wave_kind(opts):

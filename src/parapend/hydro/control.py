@@ -87,8 +87,9 @@ class BuoyMPCResult(_Result):
 
     Attributes
     ----------
-    controller, forecast : str
-        The planner (:func:`buoy_mpc`'s ``controller``) and what it knew of the force over
+    planner, forecast : str
+        The planner that ran (:func:`buoy_mpc`'s ``controller``: ``plan``, ``coupled``,
+        ``one-way`` or ``fixed-point``) and what it knew of the force over
         the horizon (``perfect`` or ``ar``).
     mean_power_w : float
         The headline: over the last ``repeats`` whole repeats of the record (after the
@@ -137,7 +138,7 @@ class BuoyMPCResult(_Result):
         plan went on (the others applied their last iterate).
     """
 
-    controller: str
+    planner: str
     forecast: str
     mean_power_w: float
     electrical_power_w: float
@@ -239,7 +240,7 @@ class BuoyMPCResult(_Result):
                     f"{self.harvested_power_w:.4g} W + stored {self.stored_w:.4g} W) from "
                     f"{self.average_from_s:.4g} s" if self.headline_reason is None else
                     f"no mean power ({self.status})")
-            ax[0].set_title(f"buoy, {self.controller}: {head}", fontsize=10)
+            ax[0].set_title(f"buoy, {self.planner}: {head}", fontsize=10)
             fig.tight_layout()
         return fig
 
@@ -1061,7 +1062,7 @@ def buoy_mpc(hydro, pendulum, wave, *, peak_period, horizon=2.0, update_interval
               "z_dot": ys[:, 1], "torque": u_all, "power": p}
     zwin = ys[a0 * 1:, 0]
     return BuoyMPCResult(
-        controller=controller, forecast=forecast, mean_power_w=mean_p, electrical_power_w=mean_e,
+        planner=controller, forecast=forecast, mean_power_w=mean_p, electrical_power_w=mean_e,
         harvested_power_w=harvested, harvested_electrical_power_w=harvested_e,
         harvested_energy_j=work, stored_energy_change_j=de,
         absorbed_w=absorbed, damping_w=damping, stored_w=float(stored),
@@ -1165,7 +1166,7 @@ def mpc_text(r) -> list:
            f"pendulum: m = {p['mass_kg']:g} kg, l = {p['length_m']:g} m, I = "
            f"{p['inertia_kg_m2']:.6g} kg m^2, c = {p['damping_coefficient_nm_s_per_rad']:g} "
            "N m s/rad",
-           f"controller: {r.controller} receding horizon, {r.forecast} forecast, horizon "
+           f"controller: receding horizon, {r.planner} planner, {r.forecast} forecast, horizon "
            f"{r.horizon_s:.4g} s, update "
            f"every {r.update_interval_s:.4g} s, torque held over {r.dt_s:.4g} s, limit "
            f"{r.torque_limit_nm:.6g} N m" + ("" if r.torque_limit_given else

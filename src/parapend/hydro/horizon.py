@@ -27,21 +27,16 @@ from dataclasses import dataclass
 import numpy as np
 
 from .. import limits
+from ..defaults import BUOY_HORIZON
 from ..errors import ParameterError, check_int
 from ..results import _Result
 
-__all__ = ["BuoyHorizonResult", "buoy_horizon_curve", "plot_buoy_horizon"]
+__all__ = ["BUOY_HORIZON", "BuoyHorizonResult", "buoy_horizon_curve", "plot_buoy_horizon"]
 
-#: the buoy's curve without the options: horizons (peak periods), each record's length in
-#: peak periods, the update interval and the warm-up (peak periods; ``parapend buoy
-#: --controller mpc``'s), the controllers a user may choose. Ten waves a record: three
-#: horizons and two forecasts of the default ``plan`` controller are estimated at about 40 s
-#: (BUOY_MPC_SECONDS), inside the two minutes a command runs untimed
-BUOY_HORIZON = {"horizons": "0.5,1,2", "repeat_periods": 10, "update_interval": 0.125,
-                "warm_up": 4.0}
-CONTROLLERS = ("coupled", "plan")
+#: the planners a user may choose (the curve's defaults: ``parapend.defaults.BUOY_HORIZON``)
+PLANNERS = ("coupled", "plan")
 #: seconds per unit of a run's work (updates x horizon samples x solves per update), per
-#: controller: ``coupled``'s from the default curve's run with it (work 1.0e5, 140 s of CPU
+#: planner: ``coupled``'s from the default curve's run with it (work 1.0e5, 140 s of CPU
 #: at a load of 2 to 3 on the 2 cores, docs/control.md); ``plan``'s from ``parapend buoy
 #: --controller mpc``'s (1.06e5 counted as two solves an update, 87 s under load), which
 #: over-estimates the default curve with the planner's radiation model (one solve an update,
@@ -57,8 +52,9 @@ class BuoyHorizonResult(_Result):
 
     Attributes
     ----------
-    device, controller : str
-        ``"buoy"``; the planner of :func:`parapend.hydro.control.buoy_mpc` that ran.
+    device, planner : str
+        ``"buoy"``; the planner of :func:`parapend.hydro.control.buoy_mpc` that ran
+        (``coupled`` or ``plan``).
     mpc_power_w : nested list of float
         Each run's storage-corrected electrical power (W) over one repeat after the
         warm-up (``buoy_mpc``'s ``electrical_power_w``; NaN: the run failed or was not run).
@@ -83,7 +79,7 @@ class BuoyHorizonResult(_Result):
     """
 
     device: str
-    controller: str
+    planner: str
     horizons: list
     forecasts: list
     seeds: list
@@ -169,7 +165,7 @@ def _estimate(tp, tr, horizon, update, warm_up, iterations) -> tuple:
 def buoy_horizon_curve(*, hs=None, tp=None, spectrum="jonswap", gamma_peak=3.3,
                        repeat_period=None, seed=None, cutoff=3.0, mass=None, length=None,
                        inertia=None, damping_coefficient=None, body=None, radius=None,
-                       draft=None, mesh=None, hydro=None, controller=None, torque_limit=None,
+                       draft=None, mesh=None, hydro=None, planner=None, torque_limit=None,
                        torque_limit_nm=None, efficiency=None, horizons=None,
                        forecasts="perfect,ar", records=1, update_interval=None, warm_up=None,
                        time_limit=None, progress=None) -> BuoyHorizonResult:
@@ -186,7 +182,7 @@ def buoy_horizon_curve(*, hs=None, tp=None, spectrum="jonswap", gamma_peak=3.3,
         The pendulum, kg, m, kg m^2, N m s/rad (default the embedded design's).
     body, radius, draft, mesh, hydro :
         The floating body as ``parapend buoy`` takes it.
-    controller : "coupled", "plan" or None
+    planner : "coupled", "plan" or None
         :func:`parapend.hydro.control.buoy_mpc`'s planner (None: its default; ``plan``
         with one solve per update, as the power matrix runs it).
     torque_limit, torque_limit_nm : float or None
@@ -237,11 +233,11 @@ def buoy_horizon_curve(*, hs=None, tp=None, spectrum="jonswap", gamma_peak=3.3,
                      BUOY["length"] if length is None else length, inertia,
                      BUOY["damping_coefficient"] if damping_coefficient is None
                      else damping_coefficient)
-    if controller is not None and controller not in CONTROLLERS:
-        raise ParameterError(f"controller: expected {' or '.join(CONTROLLERS)}, got "
-                             f"{controller!r:.40}")
-    if controller == "plan" and efficiency is not None:
-        raise ParameterError("efficiency: not with --controller plan (it plans the mechanical "
+    if planner is not None and planner not in PLANNERS:
+        raise ParameterError(f"planner: expected {' or '.join(PLANNERS)}, got "
+                             f"{planner!r:.40}")
+    if planner == "plan" and efficiency is not None:
+        raise ParameterError("efficiency: not with --planner plan (it plans the mechanical "
                              "work)")
     mgl = pend.mass * 9.81 * pend.length
     if torque_limit is not None and torque_limit_nm is not None:
@@ -293,7 +289,7 @@ def buoy_horizon_curve(*, hs=None, tp=None, spectrum="jonswap", gamma_peak=3.3,
     tp = float(waves[0][1]["tp"])
     tr = float(waves[0][1]["repeat_period"])
     # the planner that will run: buoy_mpc's default when none is given
-    runs = controller or ("coupled" if efficiency is not None else "plan")
+    runs = planner or ("coupled" if efficiency is not None else "plan")
     iterations = 1 if runs == "plan" else 2
     work = [_estimate(tp, tr, h, upd, warm_up, iterations) for h in hz]
     est = records * len(fc) * sum(w for w, _ in work) * BUOY_MPC_SECONDS[runs]
@@ -354,9 +350,9 @@ def buoy_horizon_curve(*, hs=None, tp=None, spectrum="jonswap", gamma_peak=3.3,
     times = [[[] for _ in hz] for _ in fc]
     first = [[math.nan for _ in hz] for _ in fc]
     upd_s = math.nan
-    ctrl = controller  # the planner that ran (buoy_mpc's default when None)
-    kw = {} if controller is None else {"controller": controller}
-    if controller == "plan":
+    ctrl = planner  # the planner that ran (buoy_mpc's default when None)
+    kw = {} if planner is None else {"controller": planner}
+    if planner == "plan":
         kw["iterations"] = 1
     for i, f in enumerate(fc):
         for j, hor in enumerate(hz):
@@ -372,7 +368,7 @@ def buoy_horizon_curve(*, hs=None, tp=None, spectrum="jonswap", gamma_peak=3.3,
                 if res.status == "time_limit":
                     stopped[0] = True
                 status[i][j][r] = str(res.status)
-                ctrl = str(res.controller)
+                ctrl = str(res.planner)
                 if res.success or res.status == "loses_energy":  # a loss is measured
                     power[i][j][r] = float(res.electrical_power_w)
                     harvested[i][j][r] = float(res.harvested_electrical_power_w)
@@ -408,7 +404,7 @@ def buoy_horizon_curve(*, hs=None, tp=None, spectrum="jonswap", gamma_peak=3.3,
 
         ctrl = inspect.signature(buoy_mpc).parameters["controller"].default
     return BuoyHorizonResult(
-        device="buoy", controller=ctrl, horizons=hz, forecasts=fc,
+        device="buoy", planner=ctrl, horizons=hz, forecasts=fc,
         seeds=[seed + r for r in range(records)], mpc_power_w=power,
         mpc_harvested_power_w=harvested, mpc_stored_energy_change_j=stored,
         optimum_power_w=opt, mpc_fraction=frac,
@@ -451,7 +447,7 @@ def plot_buoy_horizon(r: BuoyHorizonResult, path=None):
         _horizon_axes(ax, hz, (hz.min() / 1.25, hz.max() * 1.25),
                       "mean power / coupled non-causal optimum (-)")
         rec, p = r.record, r.pendulum
-        ax.set_title(f"buoy ({r.body}), {r.controller}: {rec.get('spectrum', '')} Hs = "
+        ax.set_title(f"buoy ({r.body}), {r.planner} planner: {rec.get('spectrum', '')} Hs = "
                      f"{rec.get('hs', '')} m, Tp = {rec.get('tp', '')} s, {len(r.seeds)} "
                      f"record(s); m = {p['mass_kg']:g} kg, l = {p['length_m']:g} m",
                      fontsize=9)

@@ -8,7 +8,8 @@ import math
 import numpy as np
 
 from ..defaults import BUOY
-from ..errors import ParameterError, check_int, check_nonnegative, check_positive, check_range
+from ..errors import ParameterError, check_int, check_nonnegative, check_positive
+from .declared import check
 
 __all__ = ["parse_periods"]
 
@@ -52,7 +53,7 @@ def _period(value) -> float:
         except ValueError:
             raise ParameterError(f"wave-period: expected a period in s, T1,T2,... or "
                                  f"FROM:TO:N, got {value!r:.60}") from None
-    return check_range("wave-period", value, 0.1, 100.0, why="wave period, s")
+    return check("wave_period", value, why="wave period, s")
 
 
 # --- the pieces -----------------------------------------------------------------------------

@@ -706,7 +706,7 @@ def power_matrix(*, hs="1:3:3", te=None, tp=None, realizations: int = 3, waves: 
                  hull_pitch_inertia=None, barge_length=None, barge_beam=None,
                  barge_draft=None, copper_loss=None, controller=None, forecast=None,
                  update_interval=None, warm_up=None, plan_samples=None, speed_limit=None,
-                 time_limit=None):
+                 time_limit=None, pendulum=None, pto=None):
     """The power matrix of a device over bins of ``Hs x Te`` (or ``Tp``); see the module
     text and docs/performance.md. Returns ``(dataset, annual, run)``. ``dofs``
     ``"surge,heave,pitch"`` with ``device="buoy"``: a pendulum in a hull that surges, heaves
@@ -728,7 +728,15 @@ def power_matrix(*, hs="1:3:3", te=None, tp=None, realizations: int = 3, waves: 
     ``parapend.performance.causal``. With ``device="buoy"`` (heave only) the column is the
     buoy's causal controller (``parapend.hydro.control.buoy_mpc`` with each ``forecast``,
     ``horizon`` 1 and ``update_interval`` 1/8 by default; no ``plan_samples`` or
-    ``speed_limit``), the controller named in ``causal.buoy_controller``."""
+    ``speed_limit``), the controller named in ``causal.buoy_controller``.
+
+    ``pendulum``, ``body``, ``pto``, ``controller``, ``device``: the input objects of
+    :mod:`parapend.hydro.device` (a ``Device``: ``device="buoy"`` with its body, pendulum and
+    take-off), as :func:`parapend.buoy` takes them; their fields are the keywords here."""
+    from ..hydro.declared import expand_inputs, has_inputs
+
+    if has_inputs(locals()):
+        return power_matrix(**expand_inputs(power_matrix, locals()))
     from ..maps.run import run_spec
     from .annual import bin_series, read_scatter, read_series
     from .check import check_bins, check_size
