@@ -17,7 +17,9 @@ User errors print one line and exit with code 2; only this package prints.
 
 Exit codes: 0 success; 1 a file or standard output could not be written, or a solver
 error; 2 a usage error (bad value, unknown option, unreadable input file, and a bare
-``parapend`` with no command, which prints the list of commands to stderr); 130 when
+``parapend`` with no command, which prints the list of commands to stderr); 3 the command
+ran but has no resolved answer (its headline printed as none with the reason, or a status
+that says the number is not one: a causal run that loses energy); 130 when
 interrupted (Ctrl-C; a shell also reports 130 for a process that CPython ends by SIGINT,
 as it does after an interrupt during an extension module's import). The console script
 enters through :mod:`parapend._entry`, which loads this package inside its Ctrl-C handler.
@@ -55,7 +57,7 @@ from . import persistence as _persistence_cmds
 from . import pto as _pto_cmds
 from . import sea as _sea_cmds
 from . import sweep as _sweep_cmds
-from ._common import EXIT_USAGE, _Parser
+from ._common import EXIT_UNRESOLVED, EXIT_USAGE, Unresolved, _Parser
 from ._notice import install as _compile_notice
 from ._output import OutputError
 
@@ -200,6 +202,9 @@ def main(argv=None) -> int:
         _err(f"{name}: interrupted")
         _quiet_after_interrupt()
         return 130
+    code = 0
+    if isinstance(out, Unresolved):  # printed as any result, then exit status 3
+        out, code = out.out, EXIT_UNRESOLVED
     if closed:
         _err(f"{name}: error: standard output is closed; the result was not printed")
         return EXIT_FAILURE
@@ -216,4 +221,4 @@ def main(argv=None) -> int:
         _err(f"{name}: error: cannot write to standard output: "
              f"{getattr(exc, 'strerror', None) or exc}")
         return EXIT_FAILURE
-    return 0
+    return code

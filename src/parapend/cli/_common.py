@@ -15,6 +15,27 @@ from ..defaults import OMEGA, Default, given  # noqa: F401  (Default, given re-e
 from ..errors import ParameterError
 
 EXIT_USAGE = 2
+#: the command ran but has no resolved answer: its headline is null (the reason printed
+#: with it) or its status says the number is not one (a causal run that loses energy)
+EXIT_UNRESOLVED = 3
+
+
+class Unresolved:
+    """A command's output (its text or its JSON dict) printed as any other, after which the
+    command exits with :data:`EXIT_UNRESOLVED`: it ran, and its result says that its headline
+    is not a resolved answer (``headline_reason``, or a status such as ``loses_energy``)."""
+
+    def __init__(self, out):
+        self.out = out
+
+
+def unresolved_if(out, result):
+    """``out`` wrapped in :class:`Unresolved` when ``result`` has no resolved answer: a
+    null headline with its reason (``headline_reason``) or the status ``loses_energy``."""
+    if getattr(result, "headline_reason", None) or getattr(result, "status",
+                                                           None) == "loses_energy":
+        return Unresolved(out)
+    return out
 
 
 # a leading '-' followed by a number in any notation (-1, -.5, -1e-3, -1E+2, -inf) is a

@@ -139,9 +139,9 @@ class Body(_Inputs):
     body: str | None = _param("-", "cylinder, sphere or barge (a hull)",
                               default_text="cylinder; a hull's barge", kind="text")
     radius: float | None = _param("m", "the cylinder's or the sphere's radius",
-                                  default_text=f"{BUOY['radius']:g}")
-    draft: float | None = _param("m", "the cylinder's draft",
-                                 default_text=f"{BUOY['draft']:g}")
+                                  default_text=_both("radius"))
+    draft: float | None = _param("m", "the cylinder's draft (a hull sphere's: r / 2)",
+                                 default_text=_both("draft"))
     mesh: str | None = _param("-", "a mesh file Capytaine reads, instead of --body (z = 0 "
                                    "the free surface)", kind="text", metavar="FILE")
     hydro: object = _param("-", "a Capytaine dataset (NetCDF path or xarray.Dataset)",
