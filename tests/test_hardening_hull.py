@@ -322,3 +322,24 @@ def test_the_barge_s_reproductions(capsys, args, code, mode):
     else:
         assert d["power_w"] is None and d["success"] is False
         assert d["headline_reason"] and d["bound_fraction"] is None
+
+
+def test_a_time_limit_for_one_hull_wave_is_refused(capsys, monkeypatch):
+    """One wave's work is bounded by its harmonics: --time-limit needs a period sweep."""
+    _no_bem(monkeypatch)
+    _refused(capsys, [*H, "--time-limit", "10"], "time-limit:", "period sweep")
+
+
+@pytest.mark.slow
+def test_a_hull_sweep_stops_at_its_time_limit(dataset):
+    """A period sweep under a time limit already past after its first period: the first
+    period solved (the same power as alone), the others NaN with the status time_limit, no
+    success, a note saying so."""
+    kw = dict(dofs="surge,heave,pitch", hydro=dataset, mass=4000.0, length=1.0,
+              inertia=5000.0, pivot_height=1.5, pivot_offset=1.0, winding=1)
+    r = parapend.buoy(**kw, wave_period="5,5.5,6", time_limit=0.01)
+    alone = parapend.buoy(**kw, wave_period=5.0)
+    assert r.power_w[0] == pytest.approx(alone.power_w, rel=1e-12)
+    assert np.isnan(r.power_w[1:]).all()
+    assert r.status[1:] == ["time_limit", "time_limit"] and r.success is False
+    assert any("time limit reached: 1 of 3" in w for w in r.warnings)

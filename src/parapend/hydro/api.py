@@ -384,11 +384,12 @@ def buoy(*, wave_height=None, wave_period=None, hs=None, tp=None, spectrum=None,
     time_limit = check_time_limit(time_limit)
     until = deadline(time_limit)  # the limit counts from the call (the BEM included)
     if parse_dofs(dofs) != ("heave",):
-        if time_limit is not None:
-            raise ParameterError("time-limit: not used with --dofs surge,heave,pitch (its "
-                                 "work is bounded by its harmonics); drop it")
+        if time_limit is not None and parse_periods(wave_period) is None:
+            raise ParameterError("time-limit: bounds long work only: with --dofs "
+                                 "surge,heave,pitch a period sweep (--wave-period FROM:TO:N); "
+                                 "one wave's work is bounded by its harmonics")
         return hull_buoy(**{k: v for k, v in opts.items() if k not in (
-            "dofs", "Wave", "progress", "time_limit")})
+            "dofs", "Wave", "progress", "time_limit")}, deadline=until)
     for name in ("pivot_height", "pivot_offset", "hull_pitch_inertia", "barge_length",
                  "barge_beam", "barge_draft", "copper_loss"):
         if opts[name] is not None and not (isinstance(body, str) and body == "barge"
@@ -881,9 +882,12 @@ def solve_record(problem: dict, wave, info, *, check_only: bool = False):
                    geometry=problem["geometry"])
 
 
-def hull_buoy(**opts):
+def hull_buoy(deadline=None, **opts):
     """The optimum of a pendulum in a surging, heaving, pitching hull (see
-    :func:`parapend.buoy`, ``dofs="surge,heave,pitch"``)."""
+    :func:`parapend.buoy`, ``dofs="surge,heave,pitch"``); ``deadline`` (a
+    :func:`parapend.deadline.deadline` time): a period sweep stops once it has passed, the
+    periods not begun left out (the first always solved)."""
+    from ..deadline import expired
     from .coupled import Wave
     from .inputs import _irregular_wave, _period, parse_periods
 
@@ -919,6 +923,8 @@ def hull_buoy(**opts):
     hull.check_covers(float(np.min(w)), float(np.max(w)), name="wave-period")
     results = []
     for t in periods:
+        if results and expired(deadline):
+            break
         wave = Wave.regular(height, float(t))
         info = {"kind": "regular", "height_m": height, "period_s": float(t)}
         results.append(optimum(hull, pend, wave, wave_info=info, winding=windings,

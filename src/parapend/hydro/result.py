@@ -351,26 +351,41 @@ class BuoySweepResult(_Result):
 
     @classmethod
     def from_results(cls, periods, results, height) -> BuoySweepResult:
+        """A hull's sweep from each period's result; periods past ``results`` (a time limit
+        stopped the sweep) NaN with the status ``"time_limit"``, and no success."""
+        from ..deadline import TIME_LIMIT
+
+        left = len(periods) - len(results)
+
         def arr(name):
             return np.array([np.nan if getattr(r, name) is None else getattr(r, name)
-                             for r in results], dtype=float)
+                             for r in results] + [np.nan] * left, dtype=float)
 
         def mode_power(r, mode):
-            return next((m["power_w"] for m in r.modes if m["mode"] == mode), np.nan)
+            p = next((m["power_w"] for m in r.modes if m["mode"] == mode), np.nan)
+            return np.nan if p is None else p
 
         warn = [f"T = {t:g} s: {w}" for t, r in zip(periods, results)
                 for w in list(r.warnings) + list(r.validity_warnings)]
+        if left:
+            warn.append(f"time limit reached: {len(results)} of {len(periods)} periods "
+                        f"solved, the other {left} left out (NaN, status {TIME_LIMIT}); a "
+                        "partial sweep")
         return cls(period_s=np.asarray(periods, dtype=float), power_w=arr("power_w"),
                    mechanical_power_w=arr("mechanical_power_w"),
-                   rotation_power_w=np.array([mode_power(r, "rotation") for r in results]),
-                   swinging_power_w=np.array([mode_power(r, "swinging") for r in results]),
+                   rotation_power_w=np.array([mode_power(r, "rotation") for r in results]
+                                             + [np.nan] * left, dtype=float),
+                   swinging_power_w=np.array([mode_power(r, "swinging") for r in results]
+                                             + [np.nan] * left, dtype=float),
                    one_way_power_w=arr("one_way_power_w"),
                    radiation_bound_w=arr("radiation_bound_w"),
                    heave_amplitude_m=arr("heave_amplitude_m"),
                    pitch_amplitude_deg=arr("pitch_amplitude_deg"),
                    energy_balance_residual=arr("energy_balance_residual"),
-                   mode=[r.mode for r in results], status=[r.status for r in results],
-                   success=all(r.success for r in results), wave_height_m=float(height),
+                   mode=[r.mode for r in results] + [None] * left,
+                   status=[r.status for r in results] + [TIME_LIMIT] * left,
+                   success=not left and all(r.success for r in results),
+                   wave_height_m=float(height),
                    pendulum=results[0].pendulum, body=results[0].body,
                    pivot=results[0].pivot, warnings=warn, _results=tuple(results),
                    dofs=list(results[0].dofs))
