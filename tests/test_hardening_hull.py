@@ -213,7 +213,7 @@ def test_the_bound_s_cut_is_the_data_s_noise(dataset):
     """A near-null direction of B at the noise's level is cut: B = diag(1, 1, eps) with the
     force along it; at eps below the noise the bound keeps the two resolved directions only
     (``|F_1|^2 + |F_2|^2) / 8``), at the fixed 1e-8 cut it would add ``|F_3|^2 / (8 eps)``."""
-    from parapend.hydro.hull import BOUND_RCOND, radiation_bound
+    from parapend.hydro.hull import BOUND_RCOND, bound_error, radiation_bound
 
     class Case:
         hull_harmonics = 1
@@ -227,6 +227,9 @@ def test_the_bound_s_cut_is_the_data_s_noise(dataset):
     assert (cut0, cut1) == (0, 1)
     assert fixed == pytest.approx((1 + 4 + 1e4) / 8, rel=1e-12)
     assert noisy == pytest.approx((1 + 4) / 8, rel=1e-12)
+    # its error: each kept term moved by noise x sigma_max over its sigma (here 1e-3 each)
+    assert bound_error(Case(), 1e-3) == pytest.approx(1e-3 * (1 + 4) / 8, rel=1e-12)
+    assert bound_error(Case(), 0.5) == pytest.approx(0.5 * (1 + 4) / 8, rel=1e-12)
 
 
 # -- a headline is an answer or says why not --------------------------------------------------
@@ -343,3 +346,34 @@ def test_a_hull_sweep_stops_at_its_time_limit(dataset):
     assert np.isnan(r.power_w[1:]).all()
     assert r.status[1:] == ["time_limit", "time_limit"] and r.success is False
     assert any("time limit reached: 1 of 3" in w for w in r.warnings)
+
+
+def test_the_ends_check_of_a_dataset_uses_its_hydrostatics():
+    """With --hydro the hull's draft and half-length come from its hydrostatics as a
+    wall-sided box: a box L x B x D floating at D has C33 = rho g L B, C55 ~ rho g B L^3 / 12
+    and M = rho L B D, so they give back D and L / 2."""
+    from parapend.hydro.result import _ends
+
+    rho, g, length, beam, draft = 1025.0, 9.81, 10.0, 4.0, 1.0
+
+    class Box:
+        mass = rho * length * beam * draft
+        hydrostatic_stiffness = np.diag([0.0, rho * g * length * beam,
+                                         rho * g * beam * length**3 / 12])
+    Box.g = g
+    d, half, how = _ends(Box(), None)
+    assert d == pytest.approx(draft, rel=1e-12) and half == pytest.approx(length / 2, rel=1e-12)
+    assert "estimate" in how
+    assert _ends(Box(), {"draft_m": 2.0, "half_length_m": 3.0}) == (2.0, 3.0, "")
+
+
+@pytest.mark.slow
+def test_the_barge_in_a_steep_wave():
+    """The barge at H 5 m, T 5 s (steepness 0.128: below breaking, above 1/20): an answer
+    within the radiation bound (a user's barge was named best at 1.59e10 W), with the
+    steepness warned about."""
+    r = parapend.buoy(dofs="surge,heave,pitch", wave_height=5.0, wave_period=5.0)
+    assert r.headline_reason is None and r.success
+    assert 0 <= r.power_w <= r.radiation_bound_w * (1 + 1e-3)
+    lam = 9.81 * 25 / (2 * math.pi)
+    assert any(f"{5 / lam:.3g}" in w and "1/20" in w for w in r.validity_warnings)

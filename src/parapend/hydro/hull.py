@@ -944,3 +944,28 @@ def radiation_bound(case: HullCase, rcond: float = BOUND_RCOND) -> tuple[float, 
         binv = np.linalg.pinv(b, rcond=rcond)
         total += float(np.real(np.vdot(fa[k], binv @ fa[k]))) / 8.0
     return total, cut
+
+
+def bound_error(case: HullCase, noise: float) -> float:
+    """The radiation bound's error from the noise of ``B`` (W), to first order: each kept
+    direction's term ``|u_i^H (F a)_k|^2 / (8 sigma_i)`` changes by the factor
+    ``delta / sigma_i`` when its ``sigma_i`` moves by ``delta = noise sigma_max`` (the
+    noise relative to the largest, :attr:`parapend.hydro.bem.HullHydro.damping_noise`),
+    capped at the term itself; the directions cut add nothing. Not the mesh's error: the
+    noise a BEM's asymmetry shows is a lower estimate of it (docs/hull.md)."""
+    rcond = max(float(noise), BOUND_RCOND)
+    fa = case.wave_force()
+    err = 0.0
+    for k in range(1, case.hull_harmonics + 1):
+        if not np.any(fa[k]):
+            continue
+        b = 0.5 * (case.B[k] + case.B[k].T)
+        lam, vec = np.linalg.eigh(b)
+        top = float(np.max(np.abs(lam)))
+        if top <= 0:
+            continue
+        keep = lam >= rcond * top
+        proj = np.abs(vec.conj().T @ fa[k]) ** 2
+        terms = proj[keep] / lam[keep] / 8.0
+        err += float(np.sum(terms * np.minimum(1.0, noise * top / lam[keep])))
+    return err

@@ -18,7 +18,15 @@ import numpy as np
 from scipy.optimize import minimize_scalar
 
 from ..results import _Result
-from .hull import BOUND_RCOND, HullProblem, HullPTO, hull_search, make_case, radiation_bound
+from .hull import (
+    BOUND_RCOND,
+    HullProblem,
+    HullPTO,
+    bound_error,
+    hull_search,
+    make_case,
+    radiation_bound,
+)
 from .optimum import TORQUE_SLACK
 from .waves import energy_flux
 
@@ -39,7 +47,8 @@ HULL_KEYS = ("power_w", "headline_reason", "mechanical_power_w", "efficiency",
              "copper_loss_w_per_nm2", "torque_limit_nm", "mode", "winding", "modes", "maxima",
              "maxima_powers_w", "one_way_power_w", "one_way_ratio",
              "energy_balance_residual", "radiation_bound_w", "bound_fraction", "bound_rcond",
-             "bound_cut", "capture_width_limit_w", "capture_width_m", "energy_flux_w_per_m",
+             "bound_cut", "bound_error_w", "capture_width_limit_w", "capture_width_m",
+             "energy_flux_w_per_m",
              "surge_amplitude_m",
              "heave_amplitude_m", "pitch_amplitude_deg", "surge_phase_deg", "heave_phase_deg",
              "pitch_phase_deg", "mean_heel_deg", "mean_angle_deg", "swing_amplitude_deg",
@@ -198,6 +207,9 @@ class BuoyResult(_Result):
         below ``bound_rcond`` of the largest cut (``bound_cut`` of them): ``bound_rcond`` is
         the data's noise (``HullHydro.damping_noise``: B's asymmetry or its negative part
         set to 0, relative to its largest entry), at least 1e-8; bound_fraction.
+    bound_error_w : the bound's error from that noise, to first order (each kept term's
+        ``noise sigma_max / sigma_i`` of itself, at most all of it): the data's stated
+        error, not the mesh's (a BEM's asymmetry underestimates that; docs/hull.md).
     surge_amplitude_m, heave_amplitude_m, pitch_amplitude_deg : half the peak-to-peak hull
         motion; surge_phase_deg, heave_phase_deg, pitch_phase_deg: the phase of its first
         harmonic against the wave's elevation at O (regular waves); mean_heel_deg : the mean
@@ -923,6 +935,7 @@ def hull_answer(hull, pendulum, wave, *, pivot, windings=(1, 0), pitch_inertia=N
         return (0.0 if at_rest else 0.5 * float(np.max(v) - np.min(v)))
     rcond = max(BOUND_RCOND, float(getattr(hull, "damping_noise", 0.0)))
     bound, cut = radiation_bound(cs, rcond)
+    bound_err = bound_error(cs, float(getattr(hull, "damping_noise", 0.0)))
     flux = energy_flux(wave.omega, amps, hull.rho, hull.g, hull.water_depth)
     cw_limit = capture_width_limit(wave.omega, amps, hull.rho, hull.g, hull.water_depth)
     p = 0.0 if at_rest else float(best["power_w"])
@@ -973,7 +986,8 @@ def hull_answer(hull, pendulum, wave, *, pivot, windings=(1, 0), pitch_inertia=N
         energy_balance_residual=None if at_rest else best["energy_balance_residual"],
         radiation_bound_w=bound,
         bound_fraction=(p / bound if bound > 0 and not reason else None),
-        bound_rcond=rcond, bound_cut=cut, capture_width_limit_w=cw_limit,
+        bound_rcond=rcond, bound_cut=cut, bound_error_w=bound_err,
+        capture_width_limit_w=cw_limit,
         capture_width_m=(p / flux if flux > 0 and not reason else None),
         energy_flux_w_per_m=flux,
         surge_amplitude_m=half(s["xi"][0]), heave_amplitude_m=half(s["xi"][1]),
