@@ -377,3 +377,17 @@ def test_the_barge_in_a_steep_wave():
     assert 0 <= r.power_w <= r.radiation_bound_w * (1 + 1e-3)
     lam = 9.81 * 25 / (2 * math.pi)
     assert any(f"{5 / lam:.3g}" in w and "1/20" in w for w in r.validity_warnings)
+
+
+def test_periods_outside_the_barge_s_grid_are_refused_before_the_bem(capsys, monkeypatch):
+    """The barge's own grid (panel radius min(L, B) / 12 = 1/3 m) resolves waves down to
+    12 panel radii, 4 m (deep water: T = sqrt(2 pi 4 / g) = 1.601 s): a 1 s wave is refused
+    before the BEM, naming the range."""
+    from parapend.hydro.bem import body_frequencies
+
+    _no_bem(monkeypatch)
+    top = float(body_frequencies(4.0 / 12)[-1])
+    assert 2 * math.pi / top == pytest.approx(math.sqrt(2 * math.pi * 4.0 / 9.81), rel=1e-6)
+    err = _refused(capsys, [*H, "--wave-period", "1", "--wave-height", "0.1"],
+                   "wave-period:", f"{2 * math.pi / top:.4g} s to 100 s")
+    assert "1 s lies" in err

@@ -901,6 +901,7 @@ def hull_buoy(deadline=None, **opts):
         if periods is None:
             periods = np.array([_period(_hull_value(opts, "wave_period"))])
         check_steepness(height, periods)
+        _check_grid(_hull_body(opts)[1], periods)
     p = hull_problem(**opts)
     hull, pend, pivot, inertia, geometry, pto, windings, harmonics = (
         p[k] for k in ("hull", "pendulum", "pivot", "pitch_inertia", "geometry", "pto",
@@ -935,6 +936,30 @@ def hull_buoy(deadline=None, **opts):
     from .result import BuoySweepResult
 
     return BuoySweepResult.from_results(periods, results, height)
+
+
+def _check_grid(geometry, periods) -> None:
+    """Before the BEM: refuse periods outside a parametric hull's own frequency grid
+    (:func:`.bem.body_frequencies` at the panel radius its builder uses, the smaller of its
+    sizes over ``GEOMETRY_PANELS``); the BEM may leave a few of its top frequencies out, so
+    :meth:`.bem.HullHydro.check_covers` checks again after it."""
+    from . import bem as hy
+
+    if geometry is None:
+        return
+    if geometry["body"] == "barge":
+        scale = min(geometry["length_m"], geometry["beam_m"])
+    else:
+        scale = min(geometry["radius_m"], geometry["draft_m"])
+    grid = hy.body_frequencies(scale / hy.GEOMETRY_PANELS)
+    w = 2 * math.pi / np.asarray(periods, dtype=float)
+    if float(w.max()) > grid[-1] * (1 + 1e-9) or float(w.min()) < grid[0] * (1 - 1e-9):
+        lo, hi = float(np.min(periods)), float(np.max(periods))
+        asked = f"{lo:g} s" if lo == hi else f"{lo:g} to {hi:g} s"
+        raise ParameterError(f"wave-period: {asked} lies outside the {geometry['body']}'s "
+                             f"frequencies, which cover periods from {2 * math.pi / grid[-1]:.4g} "
+                             f"s to {2 * math.pi / grid[0]:.4g} s (its mesh resolves no shorter "
+                             "wave)")
 
 
 def check_steepness(height, periods) -> None:

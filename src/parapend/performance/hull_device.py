@@ -164,7 +164,7 @@ def solve_hull_bin(spec, i: int, j: int, r: int) -> dict:
         # the store keeps the mechanical power as "power" (the heave buoy's layout; the
         # Dataset shows the electrical one as power)
         out = {"power": num(res.mechanical_power_w), "electrical_power": p}
-    if res.headline_reason:
+    if getattr(res, "headline_reason", None):  # no resolved answer: NaN, not a success
         status = "other"
     elif res.success:
         status = "no_power" if res.mode == "rest" else "converged"
