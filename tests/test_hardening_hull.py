@@ -391,3 +391,14 @@ def test_periods_outside_the_barge_s_grid_are_refused_before_the_bem(capsys, mon
     err = _refused(capsys, [*H, "--wave-period", "1", "--wave-height", "0.1"],
                    "wave-period:", f"{2 * math.pi / top:.4g} s to 100 s")
     assert "1 s lies" in err
+
+
+@pytest.mark.slow
+def test_a_result_without_an_answer_is_written_in_every_format(tmp_path):
+    """The unresolved answer (the swinging search aliased at c = 0) is saved as NetCDF,
+    JSON, CSV and a figure, its power none there too."""
+    r = parapend.buoy(dofs="surge,heave,pitch", damping_coefficient=0.0, winding=0)
+    assert r.power_w is None and r.headline_reason
+    for ext in ("nc", "json", "csv", "png"):
+        r.save(tmp_path / f"x.{ext}")
+    assert json.loads((tmp_path / "x.json").read_text())["power_w"] is None
