@@ -114,7 +114,7 @@ def test_horizon_documented_curves_run_untimed(kw, monkeypatch):
     (["power-matrix", "--time-limit", "0"], "time-limit: expected a number > 0"),
     (["horizon", "--time-limit", "1e9"], "time-limit: expected seconds in (0, 604800]"),
     (["buoy", "--dofs", "surge,heave,pitch", "--time-limit", "5"],
-     "time-limit: not used with --dofs"),
+     "time-limit: bounds long work only: with --dofs surge,heave,pitch a period sweep"),
 ])
 def test_time_limit_input_is_checked(argv, match, capsys):
     assert match in _refused(argv, capsys)

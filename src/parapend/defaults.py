@@ -66,11 +66,12 @@ BUOY = {"wave_height": 0.2, "wave_period": 1.8, "hs": 0.5, "tp": 2.5,
 #: ``buoy --dofs surge,heave,pitch``: the embedded hull design (docs/hull.md): a 10 m x 4 m
 #: x 1 m box barge, a 2 t pendulum of 1 m on a pivot 0.5 m above the waterline at midship,
 #: in a 1 m, 6 s regular wave (or a sea state of Hs 1 m, Tp 6 s in a record of 4 peak
-#: periods); the pendulum's options given to ``buoy`` replace these
+#: periods); the pendulum's options given to ``buoy`` replace these; ``--body cylinder`` or
+#: ``sphere`` in place of the barge: radius 2 m, draft 1 m (the pendulum fits inside)
 HULL = {"wave_height": 1.0, "wave_period": 6.0, "hs": 1.0, "tp": 6.0, "repeat_periods": 4,
         "barge_length": 10.0, "barge_beam": 4.0, "barge_draft": 1.0,
         "mass": 2000.0, "length": 1.0, "inertia": None, "damping_coefficient": 50.0,
-        "pivot_height": 0.5, "pivot_offset": 0.0}
+        "pivot_height": 0.5, "pivot_offset": 0.0, "radius": 2.0, "draft": 1.0}
 
 #: ``horizon``: the horizons (peak periods), forecasts and baselines of the curve, the
 #: number of seeded records and the update interval of the receding-horizon controller; each

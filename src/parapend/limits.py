@@ -232,6 +232,13 @@ BUOY_NEGATIVE_DAMPING_TOL = 1e-2
 #: water depth (m): a rho of 1e-300 gave a capture width of -1e302 m, a depth of 1e-300 one
 #: of -5e148 m (the energy flux vanishes), a g of 1e-300 blamed a gamma
 BUOY_RHO_RANGE = (500.0, 2000.0)
+#: a hull's pitch inertia (kg m^2): --hull-pitch-inertia's range, and a dataset's
+HULL_PITCH_INERTIA_RANGE = (1e-6, 1e12)
+#: panels (with the lid's) of a barge's BEM, estimated before it runs (hydro.api's
+#: barge_panels): the default barge's 486 (412 and a lid of 120) took 41 s for its 48
+#: frequencies under load, a 10 x 2 m one (1152) 52 s; 3000 (a 10 m barge 1 m wide) keeps a
+#: barge's BEM within minutes
+HULL_MAX_BEM_PANELS = 3000
 BUOY_MIN_DEPTH = 1e-2
 #: the largest magnitude of a dataset's coefficient (A, B, F, C, M in SI units): the powers
 #: square them (an excitation of 1e300 N/m gave an infinite radiation bound)

@@ -19,6 +19,7 @@ from ._common import (
     _table,
     add_declared,
     hull_options,
+    unresolved_if,
 )
 
 
@@ -220,7 +221,9 @@ def _text_result(r) -> list:
             ["  capture width P / J", _w(r.capture_width_m), "m"],
             ["  capture-width ratio (over 2 radius)", _w(r.capture_width_ratio), "-"],
             ["radiation bound |F a|^2 / 8B", _w(r.radiation_bound_w), "W"],
+            ["  its error from the data's noise", _w(r.bound_error_w), "W"],
             ["  fraction reached", _w(r.bound_fraction), "-"],
+            ["capture-width limit J 3 lambda / (2 pi)", _w(r.capture_width_limit_w), "W"],
             ["coupled limit (c = 0 supremum)", _w(r.limit_w), "W"],
             ["one-way (reaction left out): power", _w(r.one_way_power_w), "W"],
             ["  one-way / coupled", _w(r.one_way_ratio), "-"],
@@ -305,9 +308,9 @@ def _hull_output(r, a):
             save_figure(fig, d / f"{name}.{ext}", close=ext == "svg")
             written.append(str(d / f"{name}.{ext}"))
     if a.json:
-        return r.to_dict()
+        return unresolved_if(r.to_dict(), r)
     out = _hull_sweep_text(r) if hasattr(r, "period_s") else _hull_text(r)
-    return "\n".join(out + [f"written: {w}" for w in written])
+    return unresolved_if("\n".join(out + [f"written: {w}" for w in written]), r)
 
 
 def _hull_head(r) -> list:
@@ -333,9 +336,13 @@ def _hull_text(r) -> list:
              else "electrical power",
              _w(r.power_w), "W"],
             ["  discretization error (half the harmonics)", _w(r.refinement_change_w), "W"],
+            ["local maxima found (count; powers)", f"{r.maxima}; " + ", ".join(
+                f"{v:.4g}" for v in (r.maxima_powers_w or [])[:6]), "-; W"],
             ["one-way (reaction left out)", _w(r.one_way_power_w), "W"],
             ["radiation bound (F a)^H B^+ (F a) / 8", _w(r.radiation_bound_w), "W"],
+            ["  its error from the data's noise", _w(r.bound_error_w), "W"],
             ["  fraction reached", _w(r.bound_fraction), "-"],
+            ["capture-width limit J 3 lambda / (2 pi)", _w(r.capture_width_limit_w), "W"],
             ["capture width P / J", _w(r.capture_width_m), "m"],
             ["surge amplitude / phase", f"{r.surge_amplitude_m:.4g} / "
              f"{_w(r.surge_phase_deg)}", "m / deg"],
@@ -355,13 +362,17 @@ def _hull_text(r) -> list:
                         _w(r.mechanical_power_w), "W"])
     if r.torque_limit_nm is not None:
         rows.insert(3, ["  torque limit", _w(r.torque_limit_nm), "N m"])
+    if r.headline_reason:
+        rows[1][1] = "none (below)"
     out = [wave, *_hull_head(r), "",
            _table(modes, ["mode", "power (W)", "one-way (W)", "mean angle (deg)",
                           "swing (deg)", "peak torque (N m)", "maxima", "status"]), "",
            _table(rows, ["quantity", "value", "unit"]), "",
            f"status: {r.status}; N = {r.harmonics}, hull harmonics {r.hull_harmonics}; "
            f"energy balance residual {_w(r.energy_balance_residual)}"]
-    out += [f"note: {n}" for n in r.warnings]
+    if r.headline_reason:
+        out.append(f"power: none, no resolved answer: {r.headline_reason}")
+    out += [f"note: {n}" for n in r.warnings if not n.startswith("no resolved answer")]
     out += [f"warning: {n}" for n in r.validity_warnings]
     return out
 

@@ -393,11 +393,13 @@ def buoy(*, wave_height=None, wave_period=None, hs=None, tp=None, spectrum=None,
     time_limit = check_time_limit(time_limit)
     until = deadline(time_limit)  # the limit counts from the call (the BEM included)
     if parse_dofs(dofs) != ("heave",):
-        if time_limit is not None:
-            raise ParameterError("time-limit: not used with --dofs surge,heave,pitch (its "
-                                 "work is bounded by its harmonics); drop it")
+        if time_limit is not None and parse_periods(wave_period) is None:
+            raise ParameterError("time-limit: bounds long work only: with --dofs "
+                                 "surge,heave,pitch a period sweep (--wave-period FROM:TO:N); "
+                                 "one wave's work is bounded by its harmonics")
         return hull_buoy(**{k: v for k, v in opts.items() if k not in (
-            "dofs", "Wave", "progress", "time_limit", "sea", "pendulum", "pto", "device")})
+            "dofs", "Wave", "progress", "time_limit", "sea", "pendulum", "pto", "device")},
+            deadline=until)
     for name in ("pivot_height", "pivot_offset", "hull_pitch_inertia", "barge_length",
                  "barge_beam", "barge_draft", "copper_loss"):
         if opts[name] is not None and not (isinstance(body, str) and body == "barge"
@@ -726,6 +728,7 @@ def _hull_body(opts):
                              why="m")
         beam = check_range("barge-beam", _hull_value(opts, "barge_beam"), lo, hi, why="m")
         draft = check_range("barge-draft", _hull_value(opts, "barge_draft"), lo, hi, why="m")
+        _check_barge_size(length, beam, draft)  # an estimate before long work
         def build():
             try:
                 return hd.barge(length, beam, draft, omega="body")
@@ -741,12 +744,9 @@ def _hull_body(opts):
     for k, v in barge_opts.items():
         if v is not None:
             raise ParameterError(f"{k.replace('_', '-')}: only with --body barge; drop it")
-    from ..defaults import BUOY
-
     if body not in ("cylinder", "sphere"):
         raise ParameterError(f"body: expected barge, cylinder or sphere, got {body!r:.40}")
-    r = check_range("radius", BUOY["radius"] if opts.get("radius") is None
-                    else opts["radius"], lo, hi, why="m")
+    r = check_range("radius", _hull_value(opts, "radius"), lo, hi, why="m")
     if body == "sphere":
         # a sphere floating at its centre has no pitch stiffness about its waterplane
         # centre: a hull that pitches floats higher (default: half its radius immersed)
@@ -756,8 +756,7 @@ def _hull_body(opts):
         def build():
             return (hd.sphere_hull(r, draft=d, omega="body"))
     else:
-        d = check_range("draft", BUOY["draft"] if opts.get("draft") is None
-                        else opts["draft"], lo, hi, why="m")
+        d = check_range("draft", _hull_value(opts, "draft"), lo, hi, why="m")
         top = d  # its mesh: a cylinder of length twice the draft
         def build():
             return (hd.cylinder_hull(r, d, omega="body"))
@@ -784,6 +783,63 @@ def _hull_pivot(opts, geometry):
     return float(d), float(h)
 
 
+def barge_panels(length, beam, draft) -> float:
+    """The panels (and the lid's) of the barge's BEM, estimated: its immersed surface and
+    waterplane over the area ``2 h^2`` of a panel of radius ``h = min(L, B) / 12``
+    (:data:`.bem.GEOMETRY_PANELS`; the default 10 x 4 x 1 m: 486 against its 412 and 120)."""
+    from .bem import GEOMETRY_PANELS
+
+    h = min(length, beam) / GEOMETRY_PANELS
+    return (2 * length * beam + 2 * draft * (length + beam)) / (2 * h * h)
+
+
+def _check_barge_size(length, beam, draft) -> None:
+    """Refuse a barge whose BEM would take hours: more than
+    :data:`parapend.limits.HULL_MAX_BEM_PANELS` panels estimated (:func:`barge_panels`)."""
+    cap = limits.HULL_MAX_BEM_PANELS
+    n = barge_panels(length, beam, draft)
+    if n <= cap:
+        return
+    name, small = ("barge-beam", beam) if beam <= length else ("barge-length", length)
+    a, b = small, max(length, beam)  # the smaller side that fits: bisection
+    for _ in range(60):
+        mid = math.sqrt(a * b)
+        fits = barge_panels(*((length, mid) if name == "barge-beam" else (mid, beam)),
+                            draft) <= cap
+        a, b = (a, mid) if fits else (mid, b)
+    raise ParameterError(f"{name}: a {length:g} x {beam:g} x {draft:g} m barge needs a BEM of "
+                         f"about {n:.3g} panels (they follow its smaller side), more than the "
+                         f"{cap:g} that finish in minutes; expected {name} of at least "
+                         f"{b:.3g} m")
+
+
+def _check_fits(pend, pivot, geometry) -> None:
+    """Before the BEM: refuse a pendulum at or above the floating mass ``rho V`` (``rho`` =
+    1025 kg/m^3, the BEM's; ``V`` the body's analytic displaced volume: a box ``L B D``, a
+    cylinder ``pi r^2 d``, a sphere's cap ``pi d^2 (3 r - d) / 3``), and one whose circle
+    about the pivot reaches beyond the hull's ends (``|d_p| + l`` above its half-length)."""
+    if geometry is None:
+        return
+    d = geometry["draft_m"]
+    if geometry["body"] == "barge":
+        volume = geometry["length_m"] * geometry["beam_m"] * d
+    elif geometry["body"] == "cylinder":
+        volume = math.pi * geometry["radius_m"] ** 2 * d
+    else:
+        volume = math.pi * d * d * (3 * geometry["radius_m"] - d) / 3
+    mass = 1025.0 * volume
+    if not pend.mass < mass:
+        raise ParameterError(f"mass: the pendulum's {pend.mass:g} kg is not less than the "
+                             f"floating mass {mass:.6g} kg (rho x displaced volume "
+                             f"{volume:.6g} m^3, which includes the pendulum); expected less")
+    room = geometry["half_length_m"] - abs(pivot[0])
+    if pend.length > room:
+        raise ParameterError(f"length: a {pend.length:g} m pendulum on a pivot "
+                             f"{pivot[0]:g} m from the centre turns beyond the hull's ends "
+                             f"(+-{geometry['half_length_m']:g} m); expected at most "
+                             f"{room:g} m")
+
+
 def hull_problem(**opts) -> dict:
     """Everything but the wave, checked, and the hull's coefficients built once (the BEM runs
     after the checks): the pieces :func:`solve_record` solves a wave with (the power matrix
@@ -793,6 +849,7 @@ def hull_problem(**opts) -> dict:
     pend = _hull_pendulum(opts)
     build, geometry = _hull_body(opts)
     pivot = _hull_pivot(opts, geometry)  # before the BEM: a pivot outside the hull is refused
+    _check_fits(pend, pivot, geometry)  # and a pendulum too heavy or too long for it
     hull = build()
     if not pend.mass < hull.mass:
         raise ParameterError(f"mass: the pendulum's {pend.mass:g} kg is not less than the "
@@ -831,13 +888,26 @@ def solve_record(problem: dict, wave, info, *, check_only: bool = False):
                    geometry=problem["geometry"])
 
 
-def hull_buoy(**opts):
+def hull_buoy(deadline=None, **opts):
     """The optimum of a pendulum in a surging, heaving, pitching hull (see
-    :func:`parapend.buoy`, ``dofs="surge,heave,pitch"``)."""
+    :func:`parapend.buoy`, ``dofs="surge,heave,pitch"``); ``deadline`` (a
+    :func:`parapend.deadline.deadline` time): a period sweep stops once it has passed, the
+    periods not begun left out (the first always solved)."""
+    from ..deadline import expired
     from .coupled import Wave
     from .inputs import _irregular_wave, _period, parse_periods
 
     _check_wave_kind(opts)  # before the BEM
+    regular = not any(opts.get(k) is not None for k in ("hs", "tp", "record",
+                                                        "repeat_period", "seed"))
+    if regular:  # the wave's checks before the BEM too
+        height = check("wave_height", _hull_value(opts, "wave_height"),
+                       why="regular wave height, m")
+        periods = parse_periods(opts.get("wave_period"))
+        if periods is None:
+            periods = np.array([_period(_hull_value(opts, "wave_period"))])
+        check_steepness(height, periods)
+        _check_grid(_hull_body(opts)[1], periods)
     p = hull_problem(**opts)
     hull, pend, pivot, inertia, geometry, pto, windings, harmonics = (
         p[k] for k in ("hull", "pendulum", "pivot", "pitch_inertia", "geometry", "pto",
@@ -857,15 +927,12 @@ def hull_buoy(**opts):
             default_of("taper", opts.get("taper")),
             Units(pend.length, pend.mass, 9.81, pend.inertia))
         return solve_record(p, wave, info)
-    height = check("wave_height", _hull_value(opts, "wave_height"),
-                   why="regular wave height, m")
-    periods = parse_periods(opts.get("wave_period"))
-    if periods is None:
-        periods = np.array([_period(_hull_value(opts, "wave_period"))])
     w = 2 * math.pi / periods
     hull.check_covers(float(np.min(w)), float(np.max(w)), name="wave-period")
     results = []
     for t in periods:
+        if results and expired(deadline):
+            break
         wave = Wave.regular(height, float(t))
         info = {"kind": "regular", "height_m": height, "period_s": float(t)}
         results.append(optimum(hull, pend, wave, wave_info=info, winding=windings,
@@ -876,6 +943,46 @@ def hull_buoy(**opts):
     from .result import BuoySweepResult
 
     return BuoySweepResult.from_results(periods, results, height)
+
+
+def _check_grid(geometry, periods) -> None:
+    """Before the BEM: refuse periods outside a parametric hull's own frequency grid
+    (:func:`.bem.body_frequencies` at the panel radius its builder uses, the smaller of its
+    sizes over ``GEOMETRY_PANELS``); the BEM may leave a few of its top frequencies out, so
+    :meth:`.bem.HullHydro.check_covers` checks again after it."""
+    from . import bem as hy
+
+    if geometry is None:
+        return
+    if geometry["body"] == "barge":
+        scale = min(geometry["length_m"], geometry["beam_m"])
+    else:
+        scale = min(geometry["radius_m"], geometry["draft_m"])
+    grid = hy.body_frequencies(scale / hy.GEOMETRY_PANELS)
+    w = 2 * math.pi / np.asarray(periods, dtype=float)
+    if float(w.max()) > grid[-1] * (1 + 1e-9) or float(w.min()) < grid[0] * (1 - 1e-9):
+        lo, hi = float(np.min(periods)), float(np.max(periods))
+        asked = f"{lo:g} s" if lo == hi else f"{lo:g} to {hi:g} s"
+        raise ParameterError(f"wave-period: {asked} lies outside the {geometry['body']}'s "
+                             f"frequencies, which cover periods from {2 * math.pi / grid[-1]:.4g} "
+                             f"s to {2 * math.pi / grid[0]:.4g} s (its mesh resolves no shorter "
+                             "wave)")
+
+
+def check_steepness(height, periods) -> None:
+    """Refuse a regular wave past breaking, ``H / lambda > 1/7`` (Michell's limit; ``lambda``
+    the deep-water ``g T^2 / (2 pi)``, the longest a period has: a finite depth's wave is
+    shorter and steeper), before any work; the result warns past 1/20."""
+    from .result import BREAKING_STEEPNESS
+
+    lam = 9.81 * np.asarray(periods, dtype=float) ** 2 / (2 * math.pi)
+    steep = float(np.max(height / lam))
+    if steep > BREAKING_STEEPNESS:
+        t = float(np.asarray(periods).ravel()[int(np.argmax(height / lam))])
+        raise ParameterError(f"wave-height: H = {height:g} m in a {t:g} s wave (wavelength "
+                             f"{height / steep:.4g} m) is steepness H / lambda = {steep:.3g}, "
+                             f"past breaking (1/7); expected at most "
+                             f"{t * t * 9.81 / (14 * math.pi):.4g} m")
 
 
 def _check_wave_kind(opts):

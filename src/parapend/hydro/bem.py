@@ -970,9 +970,11 @@ def _physics(w, a_full, b_full, b, path):
     if np.any(slight):
         named = ", ".join(f"{x:.4g}" for x in w[slight][:8]) + (
             ", ..." if np.sum(slight) > 8 else "")
+        fix = float(np.max(-low[slight]))
         notes.append(f"hydro: radiation damping slightly negative (BEM noise, at most "
                      f"{limits.BUOY_NEGATIVE_DAMPING_TOL:g} of its largest) set to 0 at "
-                     f"{int(np.sum(slight))} frequencies: {named} rad/s")
+                     f"{int(np.sum(slight))} frequencies: {named} rad/s (largest "
+                     f"correction {fix:.3g} N s/m, {fix / top:.2g} of its largest)")
     return keep, notes
 
 
@@ -1233,6 +1235,24 @@ def _interp_columns(x, xp, fp, right=None):
                     axis=-1)
 
 
+def _stated_noise(notes) -> list:
+    """The relative noise of the radiation damping stated in ``notes`` (its asymmetry, its
+    negative part set to 0): what a cached or loaded dataset's reading measured."""
+    import re
+
+    out = []
+    for n in notes:
+        if "radiation" not in n or "damping" not in n:
+            continue
+        for pat in (r"relative asymmetry ([0-9.eE+-]+)", r", ([0-9.eE+-]+) of its largest\)"):
+            for v in re.findall(pat, n):
+                try:
+                    out.append(float(v))
+                except ValueError:
+                    pass
+    return out
+
+
 @dataclass(frozen=True, eq=False)
 class HullHydro:
     """Surge, heave and pitch coefficients of a floating hull (SI, convention ``exp(+i w t)``).
@@ -1276,6 +1296,10 @@ class HullHydro:
     water_depth: float = math.inf
     description: str = ""
     notes: tuple = ()
+    #: the relative noise of ``B`` (its asymmetry, or its negative eigenvalues set to 0,
+    #: over its largest entry; at least as stated in ``notes``): the radiation bound's
+    #: pseudo-inverse cuts singular values below it (:func:`parapend.hydro.hull.radiation_bound`)
+    damping_noise: float = 0.0
     #: the degrees of freedom these coefficients are of (a class constant, not a field)
     dofs = ("surge", "heave", "pitch")
 
@@ -1302,10 +1326,13 @@ class HullHydro:
             raise ParameterError(f"hydro: expected a heave hydrostatic stiffness C[1, 1] > 0, "
                                  f"got {c[1, 1]!r}")
         a = 0.5 * (a + np.swapaxes(a, 1, 2))
+        top = max(float(np.max(np.abs(b))), 1e-300)
+        noise = max(float(self.damping_noise),
+                    float(np.max(np.abs(b - np.swapaxes(b, 1, 2)))) / top,
+                    *_stated_noise(self.notes))
         b = 0.5 * (b + np.swapaxes(b, 1, 2))
         notes = tuple(self.notes)
         lam, vec = np.linalg.eigh(b)
-        top = max(float(np.max(np.abs(b))), 1e-300)
         if np.any(lam < -limits.BUOY_NEGATIVE_DAMPING_TOL * top):
             i = int(np.argmin(lam.min(axis=1)))
             raise ParameterError(f"hydro: radiation_damping is not positive semidefinite at "
@@ -1317,10 +1344,14 @@ class HullHydro:
             b[neg] = np.einsum("nij,nj,nkj->nik", vec[neg], np.maximum(lam[neg], 0.0),
                                vec[neg])
             b[neg] = 0.5 * (b[neg] + np.swapaxes(b[neg], 1, 2))
+            fix = float(-lam[neg].min())
             note = (f"hydro: radiation damping slightly indefinite (BEM noise) made positive "
-                    f"semidefinite at {int(np.sum(neg))} frequencies")
+                    f"semidefinite at {int(np.sum(neg))} frequencies (largest "
+                    f"correction {fix:.3g}, {fix / top:.2g} of its largest)")
             if note not in notes:
                 notes = notes + (note,)
+            noise = max(noise, fix / top)
+        object.__setattr__(self, "damping_noise", noise)
         for name, arr in (("omega", w), ("added_mass", a), ("radiation_damping", b),
                           ("excitation", f), ("hydrostatic_stiffness", c)):
             arr.setflags(write=False)
@@ -1548,12 +1579,54 @@ def _hull_from_dataset(ds, *, c=None, mass=None, pitch_inertia=None, description
     if not np.asarray(c)[1, 1] > 0:
         raise ParameterError(f"hydro: {path}: expected a heave hydrostatic_stiffness > 0, "
                              f"got {np.asarray(c)[1, 1]!r}")
+    rho, g = _scalar(ds, "rho", 1025.0), _scalar(ds, "g", 9.81)
+    depth = _scalar(ds, "water_depth", math.inf)
+    _check_hull_data(ds, path, rho, g, depth, a, b, f, c, mass, pitch_inertia)
     return HullHydro(omega=w, added_mass=a, radiation_damping=b, excitation=f,
                      hydrostatic_stiffness=c, mass=mass, pitch_inertia=pitch_inertia,
-                     rho=_scalar(ds, "rho", 1025.0), g=_scalar(ds, "g", 9.81),
-                     water_depth=_scalar(ds, "water_depth", math.inf),
+                     rho=rho, g=g, water_depth=depth,
                      description=description or str(ds.attrs.get("description", "")),
                      notes=tuple(notes))
+
+
+def _check_hull_data(ds, path, rho, g, depth, a, b, f, c, mass, pitch_inertia):
+    """Refuse (one line naming the field) a hull dataset outside the limits the command's
+    options have: ``rho``, ``g``, the depth and the coefficients' scales
+    (:func:`_check_scales`), a pitch inertia beyond ``--hull-pitch-inertia``'s range
+    (:data:`parapend.limits.HULL_PITCH_INERTIA_RANGE`), a rigid-body-plus-added mass matrix
+    ``diag(M, M, I) + A(w)`` that is not positive definite at some frequency, and a
+    ``rotation_center`` other than the origin O (the point every coefficient, the pivot and
+    the wave's phase are taken about; the data are refused rather than moved)."""
+    from .. import limits
+
+    _check_scales(path, rho, g, depth, {"added_mass": a, "radiation_damping": b,
+                                        "excitation_force": f, "hydrostatic_stiffness": c,
+                                        "mass": mass})
+    lo, hi = limits.HULL_PITCH_INERTIA_RANGE
+    if pitch_inertia is not None and not lo <= pitch_inertia <= hi:
+        raise ParameterError(f"hydro: {path}: expected a pitch inertia (inertia_matrix) in "
+                             f"[{lo:g}, {hi:g}] kg m^2, got {pitch_inertia:g}")
+    rigid = np.diag([mass, mass, 0.0 if pitch_inertia is None else pitch_inertia])
+    low = np.linalg.eigvalsh(rigid + a).min(axis=1)
+    scale = np.abs(rigid + a).max(axis=(1, 2))
+    bad = np.nonzero(low <= 1e-9 * scale)[0]
+    if bad.size:
+        i = int(bad[0])
+        raise ParameterError(f"hydro: {path}: added_mass plus the rigid-body mass is not "
+                             f"positive definite at {bad.size} frequencies (eigenvalue "
+                             f"{low[i]:.3g} at the first): not a body's inertia")
+    rc = None
+    for where in (ds.coords, ds.data_vars):
+        if "rotation_center" in where:
+            rc = np.asarray(where["rotation_center"].values, dtype=float).ravel()
+    if "rotation_center" in ds.attrs:
+        rc = np.asarray(ds.attrs["rotation_center"], dtype=float).ravel()
+    if rc is not None and np.any(np.abs(rc[np.isfinite(rc)]) > 1e-9):
+        shown = ", ".join(f"{v:g}" for v in rc[:3])
+        raise ParameterError(f"hydro: {path}: rotation_center is ({shown}) m; the hull's "
+                             "coefficients must be about the origin O (0, 0, 0), the rotation "
+                             "centre the pivot and the wave phase are taken about: recompute "
+                             "them with rotation_center=(0, 0, 0)")
 
 
 def load_hull(path, *, wave_direction=None) -> HullHydro:

@@ -13,7 +13,7 @@ import dataclasses
 from dataclasses import dataclass, field
 
 from ..defaults import BUOY, BUOY_HORIZON, HORIZON, HULL, SEA
-from ..limits import SEA_WAVES_RANGE
+from ..limits import HULL_PITCH_INERTIA_RANGE, SEA_WAVES_RANGE
 
 __all__ = ["Body", "Controller", "DeviceInputs", "INPUT_KEYWORDS", "Pendulum", "PowerTakeOff",
            "RUN_OPTIONS", "Sea", "check", "declaration", "declarations", "default_of",
@@ -164,9 +164,9 @@ class Body(_Inputs):
     body: str | None = _param("-", "cylinder, sphere or barge (a hull)",
                               default_text="cylinder; a hull's barge", kind="text")
     radius: float | None = _param("m", "the cylinder's or the sphere's radius",
-                                  default_text=f"{BUOY['radius']:g}")
-    draft: float | None = _param("m", "the cylinder's draft",
-                                 default_text=f"{BUOY['draft']:g}")
+                                  default_text=_both("radius"))
+    draft: float | None = _param("m", "the cylinder's draft (a hull sphere's: r / 2)",
+                                 default_text=_both("draft"))
     mesh: str | None = _param("-", "a mesh file Capytaine reads, instead of --body (z = 0 "
                                    "the free surface)", kind="text", metavar="FILE")
     hydro: object = _param("-", "a Capytaine dataset (NetCDF path or xarray.Dataset)",
@@ -183,7 +183,8 @@ class Body(_Inputs):
                                         default_text=f"{HULL['pivot_offset']:g}")
     hull_pitch_inertia: float | None = _param(
         "kg m^2", "the hull's pitch inertia about O, without the pendulum",
-        bounds=(1e-6, 1e12), default_text="the dataset's, else a homogeneous immersed hull's")
+        bounds=HULL_PITCH_INERTIA_RANGE,
+        default_text="the dataset's, else a homogeneous immersed hull's")
     barge_length: float | None = _param("m", "the box barge's length",
                                         default_text=f"{HULL['barge_length']:g}")
     barge_beam: float | None = _param("m", "the box barge's beam",

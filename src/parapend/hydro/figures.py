@@ -120,7 +120,8 @@ def plot_hull(result, path=None, points: int = 600):
     what = (f"H = {w['height_m']:g} m, T = {w['period_s']:g} s" if w.get("kind") == "regular"
             else "irregular record")
     lossy = result.efficiency is not None or bool(result.copper_loss_w_per_nm2)
-    power = (f"P_el = {result.power_w:.4g} W (mechanical {result.mechanical_power_w:.4g} W)"
+    power = ("P none (no resolved answer)" if result.headline_reason else
+             f"P_el = {result.power_w:.4g} W (mechanical {result.mechanical_power_w:.4g} W)"
              if lossy else f"P = {result.power_w:.4g} W")
     ax1.set_title(f"{result.mode.capitalize()} ({what}): {power},"
                   + ("\n" if lossy else " ") + f"one-way {_w(result.one_way_power_w)}")

@@ -616,6 +616,8 @@ class HullSolution:
     #: the mechanical power ``<-tau (phi' - beta')>`` (= ``power`` for an ideal PTO)
     mechanical_power: float | None = None
     pto: HullPTO = HullPTO()
+    #: the powers (W) of the distinct converged maxima the search found, best first
+    maxima_powers: tuple = ()
 
 
 def aliased(problem: HullProblem, x) -> bool:
@@ -646,13 +648,19 @@ def _search(problem: HullProblem, seeds, gtol: float):
 
 
 def _distinct(runs, best) -> int:
+    return max(1, len(_maxima(runs))) if best is not None else 0
+
+
+def _maxima(runs) -> tuple:
+    """The powers (W) of the distinct converged maxima among ``runs`` (motions apart by more
+    than ``1e3 DISTINCT_RMS``), best first."""
     seen = []
-    for r in runs:
+    for r in sorted(runs, key=lambda r: -r.power if math.isfinite(r.power) else math.inf):
         if r.status != "converged" or not math.isfinite(r.power):
             continue
         if all(motion_distance(r.x, s.x) > 1e3 * DISTINCT_RMS for s in seen):
             seen.append(r)
-    return max(1, len(seen)) if best is not None else 0
+    return tuple(float(r.power) for r in seen)
 
 
 def hull_search(make, *, refine: bool = True, pto: HullPTO | None = None) -> HullSolution:
@@ -686,6 +694,7 @@ def hull_search(make, *, refine: bool = True, pto: HullPTO | None = None) -> Hul
                        one_way_power=float(best_one.power) if best_one else math.nan,
                        one_way_x=best_one.x if best_one else starts[0][1], status=status,
                        success=ok, found_by=best.seed, distinct_maxima=_distinct(runs, best),
+                       maxima_powers=_maxima(runs),
                        runs=len(runs) + len(runs_one),
                        iterations=sum(r.iterations for r in runs + runs_one),
                        energy_balance_residual=float(resid))
@@ -905,6 +914,8 @@ def _pto_stage(case, make, pto: HullPTO, runs, best_one, refine: bool) -> HullSo
                        one_way_power=float(one[1]) if one else math.nan,
                        one_way_x=one[0] if one else x, status=status, success=ok,
                        found_by=name, distinct_maxima=max(distinct, 1),
+                       maxima_powers=tuple(sorted({round(e, 9) for e, st in tried
+                                                   if st == "converged"}, reverse=True)),
                        runs=len(tried) + 1, iterations=its,
                        energy_balance_residual=float(HullProblem(case).balance(x)[2]),
                        mechanical_power=float(pr.mechanical(x)), pto=pto)
@@ -913,10 +924,13 @@ def _pto_stage(case, make, pto: HullPTO, runs, best_one, refine: bool) -> HullSo
     return sol
 
 
-def radiation_bound(case: HullCase) -> tuple[float, int]:
+def radiation_bound(case: HullCase, rcond: float = BOUND_RCOND) -> tuple[float, int]:
     """``sum_k (F a)_k^H B_k^+ (F a)_k / 8`` (W) and the number of singular values cut
-    (below ``BOUND_RCOND`` of the largest, per harmonic): no mechanism inside the hull
-    absorbs more."""
+    (below ``rcond`` of the largest, per harmonic): no mechanism inside the hull absorbs
+    more. ``rcond``: at least ``BOUND_RCOND``; the data's noise
+    (:attr:`parapend.hydro.bem.HullHydro.damping_noise`): a direction of ``B`` whose damping
+    is within the noise is not resolved, and its ``1 / sigma`` would be the noise's."""
+    rcond = max(float(rcond), BOUND_RCOND)
     fa = case.wave_force()
     total, cut = 0.0, 0
     for k in range(1, case.hull_harmonics + 1):
@@ -926,7 +940,32 @@ def radiation_bound(case: HullCase) -> tuple[float, int]:
         sv = np.linalg.svd(b, compute_uv=False)
         if sv[0] <= 0:
             continue
-        cut += int(np.sum(sv < BOUND_RCOND * sv[0]))
-        binv = np.linalg.pinv(b, rcond=BOUND_RCOND)
+        cut += int(np.sum(sv < rcond * sv[0]))
+        binv = np.linalg.pinv(b, rcond=rcond)
         total += float(np.real(np.vdot(fa[k], binv @ fa[k]))) / 8.0
     return total, cut
+
+
+def bound_error(case: HullCase, noise: float) -> float:
+    """The radiation bound's error from the noise of ``B`` (W), to first order: each kept
+    direction's term ``|u_i^H (F a)_k|^2 / (8 sigma_i)`` changes by the factor
+    ``delta / sigma_i`` when its ``sigma_i`` moves by ``delta = noise sigma_max`` (the
+    noise relative to the largest, :attr:`parapend.hydro.bem.HullHydro.damping_noise`),
+    capped at the term itself; the directions cut add nothing. Not the mesh's error: the
+    noise a BEM's asymmetry shows is a lower estimate of it (docs/hull.md)."""
+    rcond = max(float(noise), BOUND_RCOND)
+    fa = case.wave_force()
+    err = 0.0
+    for k in range(1, case.hull_harmonics + 1):
+        if not np.any(fa[k]):
+            continue
+        b = 0.5 * (case.B[k] + case.B[k].T)
+        lam, vec = np.linalg.eigh(b)
+        top = float(np.max(np.abs(lam)))
+        if top <= 0:
+            continue
+        keep = lam >= rcond * top
+        proj = np.abs(vec.conj().T @ fa[k]) ** 2
+        terms = proj[keep] / lam[keep] / 8.0
+        err += float(np.sum(terms * np.minimum(1.0, noise * top / lam[keep])))
+    return err

@@ -18,7 +18,15 @@ import numpy as np
 from scipy.optimize import minimize_scalar
 
 from ..results import _Result
-from .hull import BOUND_RCOND, HullProblem, HullPTO, hull_search, make_case, radiation_bound
+from .hull import (
+    BOUND_RCOND,
+    HullProblem,
+    HullPTO,
+    bound_error,
+    hull_search,
+    make_case,
+    radiation_bound,
+)
 from .optimum import TORQUE_SLACK
 from .waves import energy_flux
 
@@ -35,10 +43,13 @@ HEAVE_KEYS = ("power_w", "heave_amplitude_m", "peak_torque_nm", "radiation_bound
               "motoring_power_w", "ideal_power_w", "one_way_electrical_power_w", "mesh_error_w",
               "mesh_error_relative", "grid_error_w", "validity_warnings")
 #: the JSON keys of an answer in surge, heave and pitch (a hull), in their order
-HULL_KEYS = ("power_w", "mechanical_power_w", "efficiency", "copper_loss_w_per_nm2",
-             "torque_limit_nm", "mode", "winding", "modes", "one_way_power_w", "one_way_ratio",
+HULL_KEYS = ("power_w", "headline_reason", "mechanical_power_w", "efficiency",
+             "copper_loss_w_per_nm2", "torque_limit_nm", "mode", "winding", "modes", "maxima",
+             "maxima_powers_w", "one_way_power_w", "one_way_ratio",
              "energy_balance_residual", "radiation_bound_w", "bound_fraction", "bound_rcond",
-             "bound_cut", "capture_width_m", "energy_flux_w_per_m", "surge_amplitude_m",
+             "bound_cut", "bound_error_w", "capture_width_limit_w", "capture_width_m",
+             "energy_flux_w_per_m",
+             "surge_amplitude_m",
              "heave_amplitude_m", "pitch_amplitude_deg", "surge_phase_deg", "heave_phase_deg",
              "pitch_phase_deg", "mean_heel_deg", "mean_angle_deg", "swing_amplitude_deg",
              "peak_torque_nm", "peak_pivot_force_n", "harmonics", "hull_harmonics",
@@ -57,11 +68,12 @@ HULL_SWEEP_KEYS = ("period_s", "power_w", "mechanical_power_w", "rotation_power_
 
 
 #: the fields' types (the others: ``float | None``), of one answer and of a sweep
-_TYPES = {**dict.fromkeys(("harmonics", "winding", "bound_cut", "hull_harmonics"),
+_TYPES = {**dict.fromkeys(("harmonics", "winding", "bound_cut", "hull_harmonics", "maxima"),
                           "int | None"),
-          **dict.fromkeys(("status", "message", "mode"), "str | None"),
+          **dict.fromkeys(("status", "message", "mode", "headline_reason"), "str | None"),
           **dict.fromkeys(("wave", "pendulum", "body", "design", "pivot"), "dict | None"),
-          **dict.fromkeys(("efficiency", "modes"), "list | None"), "success": "bool | None"}
+          **dict.fromkeys(("efficiency", "modes", "maxima_powers_w"), "list | None"),
+          "success": "bool | None"}
 _SWEEP_TYPES = {**dict.fromkeys(("status", "mode"), "list | None"),
                 **dict.fromkeys(("pendulum", "body", "pivot"), "dict | None"),
                 "success": "bool | None", "wave_height_m": "float | None"}
@@ -167,6 +179,17 @@ class BuoyResult(_Result):
         with an ideal power take-off; with ``efficiency`` (``[eta_g, eta_m]``) the
         electrical ``<e(p)>`` (``eta_g p`` generating, ``p / eta_m`` motoring, ``p`` the
         instantaneous mechanical power), less ``copper_loss_w_per_nm2`` times ``<tau^2>``.
+        An answer only when resolved and plausible: the best mode's search converged, the
+        power at most the radiation bound, at least rest's 0 W (rest is the answer when no
+        motion beats it); otherwise None, with the reason in ``headline_reason`` (the
+        command exits with status 3).
+    headline_reason : why ``power_w`` is None (None when it is the answer).
+    maxima, maxima_powers_w : the count and the powers (W) of the distinct local maxima the
+        search found, over the modes (each mode's also in :attr:`modes`).
+    capture_width_limit_w : ``sum_k J_k 3 lambda_k / (2 pi)``: a body moving in surge, heave
+        and pitch absorbs at most the power of a crest that wide (heave ``lambda / (2 pi)``,
+        surge and pitch together ``lambda / pi``); beside the radiation bound, which uses the
+        body's own coefficients.
     mechanical_power_w : the mechanical power ``P`` of that motion (= power_w ideal).
     torque_limit_nm : ``|tau|`` held below it on the solve grid (its peak between the grid
         points checked, ``TORQUE_SLACK``).
@@ -181,7 +204,12 @@ class BuoyResult(_Result):
         sum_k Re((F a)_k^H U_k) / 2 - U_k^H B_k U_k / 2`` (below 1e-9 when the solve is
         right).
     radiation_bound_w : ``sum_k (F a)_k^H B_k^+ (F a)_k / 8``, singular values of ``B_k``
-        below ``bound_rcond`` of the largest cut (``bound_cut`` of them); bound_fraction.
+        below ``bound_rcond`` of the largest cut (``bound_cut`` of them): ``bound_rcond`` is
+        the data's noise (``HullHydro.damping_noise``: B's asymmetry or its negative part
+        set to 0, relative to its largest entry), at least 1e-8; bound_fraction.
+    bound_error_w : the bound's error from that noise, to first order (each kept term's
+        ``noise sigma_max / sigma_i`` of itself, at most all of it): the data's stated
+        error, not the mesh's (a BEM's asymmetry underestimates that; docs/hull.md).
     surge_amplitude_m, heave_amplitude_m, pitch_amplitude_deg : half the peak-to-peak hull
         motion; surge_phase_deg, heave_phase_deg, pitch_phase_deg: the phase of its first
         harmonic against the wave's elevation at O (regular waves); mean_heel_deg : the mean
@@ -335,26 +363,41 @@ class BuoySweepResult(_Result):
 
     @classmethod
     def from_results(cls, periods, results, height) -> BuoySweepResult:
+        """A hull's sweep from each period's result; periods past ``results`` (a time limit
+        stopped the sweep) NaN with the status ``"time_limit"``, and no success."""
+        from ..deadline import TIME_LIMIT
+
+        left = len(periods) - len(results)
+
         def arr(name):
             return np.array([np.nan if getattr(r, name) is None else getattr(r, name)
-                             for r in results], dtype=float)
+                             for r in results] + [np.nan] * left, dtype=float)
 
         def mode_power(r, mode):
-            return next((m["power_w"] for m in r.modes if m["mode"] == mode), np.nan)
+            p = next((m["power_w"] for m in r.modes if m["mode"] == mode), np.nan)
+            return np.nan if p is None else p
 
         warn = [f"T = {t:g} s: {w}" for t, r in zip(periods, results)
                 for w in list(r.warnings) + list(r.validity_warnings)]
+        if left:
+            warn.append(f"time limit reached: {len(results)} of {len(periods)} periods "
+                        f"solved, the other {left} left out (NaN, status {TIME_LIMIT}); a "
+                        "partial sweep")
         return cls(period_s=np.asarray(periods, dtype=float), power_w=arr("power_w"),
                    mechanical_power_w=arr("mechanical_power_w"),
-                   rotation_power_w=np.array([mode_power(r, "rotation") for r in results]),
-                   swinging_power_w=np.array([mode_power(r, "swinging") for r in results]),
+                   rotation_power_w=np.array([mode_power(r, "rotation") for r in results]
+                                             + [np.nan] * left, dtype=float),
+                   swinging_power_w=np.array([mode_power(r, "swinging") for r in results]
+                                             + [np.nan] * left, dtype=float),
                    one_way_power_w=arr("one_way_power_w"),
                    radiation_bound_w=arr("radiation_bound_w"),
                    heave_amplitude_m=arr("heave_amplitude_m"),
                    pitch_amplitude_deg=arr("pitch_amplitude_deg"),
                    energy_balance_residual=arr("energy_balance_residual"),
-                   mode=[r.mode for r in results], status=[r.status for r in results],
-                   success=all(r.success for r in results), wave_height_m=float(height),
+                   mode=[r.mode for r in results] + [None] * left,
+                   status=[r.status for r in results] + [TIME_LIMIT] * left,
+                   success=not left and all(r.success for r in results),
+                   wave_height_m=float(height),
                    pendulum=results[0].pendulum, body=results[0].body,
                    pivot=results[0].pivot, warnings=warn, _results=tuple(results),
                    dofs=list(results[0].dofs))
@@ -565,6 +608,8 @@ def _error_powers(h, coarse, pendulum, wave, **opts):
 
 #: A regular wave steeper than this breaks (Michell's limit, H / lambda ~ 0.142).
 BREAKING_STEEPNESS = 1 / 7
+#: a regular wave steeper than this is warned about (linear theory stretched)
+STEEP_WARNING = 1 / 20
 
 
 def _validity(z, eta, wave, wave_info, h, geometry) -> list:
@@ -779,8 +824,64 @@ def _mode(sol) -> dict:
             "refinement_change_w": sol.refinement_change, "harmonics": sol.case.harmonics,
             "mean_angle_deg": mean if k == 0 else None, "swing_amplitude_deg": swing,
             "peak_torque_nm": pk, "distinct_maxima": sol.distinct_maxima,
+            "maxima_powers_w": [float(v) for v in sol.maxima_powers],
             "found_by": sol.found_by, "starts": sol.runs, "success": ok,
             "status": status, "_solution": sol, "_motion": mot}
+
+
+#: a power above the radiation bound by more than this (relative: the discretization's)
+#: is not an answer
+BOUND_SLACK = 1e-3
+
+
+def capture_width_limit(omega, amplitudes, rho, g, depth) -> float:
+    """``sum_k J_k 3 lambda_k / (2 pi)`` (W): the most a body in surge, heave and pitch
+    absorbs from the wave ``sum_k a_k exp(i k omega t)`` (heave: a crest of
+    ``lambda / (2 pi)``; surge and pitch, one antisymmetric pattern: ``lambda / pi``;
+    ``J_k`` each harmonic's energy flux, :func:`~parapend.hydro.waves.energy_flux`)."""
+    from .waves import wavenumber
+
+    total = 0.0
+    for k, a in enumerate(np.asarray(amplitudes), start=1):
+        if a != 0:
+            w = k * omega
+            lam = 2 * math.pi / wavenumber(w, depth, g)
+            total += energy_flux(w, [a], rho, g, depth) * 3 * lam / (2 * math.pi)
+    return float(total)
+
+
+def _ends(hull, geometry) -> tuple:
+    """The hull's draft and half-length (m) for the validity check, and how they were had:
+    the geometry's, or (a dataset) the wall-sided box's of the same hydrostatics: draft
+    ``M g / C_33``, half-length ``sqrt(3 C_55 / C_33)`` (a box's waterplane, ``C_55 ~ rho g
+    A_wp L^2 / 12``)."""
+    if geometry is not None:
+        return geometry.get("draft_m"), geometry.get("half_length_m", 0.0), ""
+    c = np.asarray(getattr(hull, "hydrostatic_stiffness", np.zeros((3, 3))), float)
+    if not (c.shape == (3, 3) and c[1, 1] > 0 and c[2, 2] > 0):
+        return None, 0.0, ""
+    d = float(hull.mass) * float(hull.g) / float(c[1, 1])
+    return (d, math.sqrt(3 * float(c[2, 2]) / float(c[1, 1])),
+            " (the dataset's hydrostatics as a wall-sided box: an estimate)")
+
+
+def headline_reason(modes, best, power, bound, at_rest) -> str | None:
+    """Why the best mode's ``power`` (W) is not the answer, or None when it is: rest (0 W)
+    answers when a mode converged and none beats it; a search that did not converge, or a
+    power above the radiation ``bound`` (beyond ``BOUND_SLACK``), is no answer."""
+    if at_rest:
+        if any(m["success"] for m in modes):
+            return None
+        return ("no mode's search converged (" + "; ".join(
+            f"{m['mode']}: {m['status']}" for m in modes) + "); rest's 0 W is only a "
+            "lower bound")
+    if not best["success"]:
+        return f"the best mode ({best['mode']}) did not converge: {best['status']}"
+    if not power <= bound * (1 + BOUND_SLACK):
+        return (f"the {best['mode']}'s {power:.4g} W is {power / bound:.4g} times the "
+                f"radiation bound {bound:.4g} W: impossible (the inputs, the data or the "
+                "solve are wrong)")
+    return None
 
 
 def _solve_mode(hull, pendulum, wave, k, harmonics, pivot, pitch_inertia, pto) -> dict:
@@ -809,14 +910,19 @@ def hull_answer(hull, pendulum, wave, *, pivot, windings=(1, 0), pitch_inertia=N
         for k in windings:
             modes.append(_solve_mode(hull, pendulum, wave, k, harmonics, pivot,
                                      pitch_inertia, pto))
-    ok_modes = [m for m in modes if m["success"]]
-    best = max(ok_modes or modes, key=lambda m: m["power_w"])
+    def power_of(m):
+        p = m["power_w"]
+        return p if p is not None and math.isfinite(p) else -math.inf
+    ok_modes = [m for m in modes if m["success"] and power_of(m) > -math.inf]
+    best = max(ok_modes or modes, key=power_of)
     rest = {"mode": "rest", "winding": None, "power_w": 0.0, "mechanical_power_w": 0.0,
             "success": True, "status": "the pendulum held (no power)"}
     public = [{k: v for k, v in m.items() if not k.startswith("_")} for m in modes] + [rest]
     sol = best["_solution"]
     cs = sol.case
-    at_rest = best["power_w"] <= 0 and len(windings) > 1
+    # rest (0 W: no torque, or the pendulum held) is the answer when no motion beats it,
+    # whatever the windings asked for
+    at_rest = not power_of(best) > 0
     mot = None if at_rest else best["_motion"]
     period = 2 * math.pi / wave.omega
     s = (mot or best["_motion"])(period * np.arange(PEAK_POINTS) / PEAK_POINTS)
@@ -827,8 +933,11 @@ def hull_answer(hull, pendulum, wave, *, pivot, windings=(1, 0), pitch_inertia=N
         return (_deg(np.angle(z / amps[0])) if regular and abs(z) > 0 else None)
     def half(v):
         return (0.0 if at_rest else 0.5 * float(np.max(v) - np.min(v)))
-    bound, cut = radiation_bound(cs)
+    rcond = max(BOUND_RCOND, float(getattr(hull, "damping_noise", 0.0)))
+    bound, cut = radiation_bound(cs, rcond)
+    bound_err = bound_error(cs, float(getattr(hull, "damping_noise", 0.0)))
     flux = energy_flux(wave.omega, amps, hull.rho, hull.g, hull.water_depth)
+    cw_limit = capture_width_limit(wave.omega, amps, hull.rho, hull.g, hull.water_depth)
     p = 0.0 if at_rest else float(best["power_w"])
     pitch_amp = _deg(half(s["xi"][2]))
     validity = []
@@ -836,30 +945,51 @@ def hull_answer(hull, pendulum, wave, *, pivot, windings=(1, 0), pitch_inertia=N
     if peak_pitch > PITCH_VALIDITY_DEG:
         validity.append(f"linear theory: the pitch reaches {peak_pitch:.3g} degrees, beyond "
                         f"about {PITCH_VALIDITY_DEG:g}; the answer is outside its validity")
-    if geometry is not None and not at_rest:
-        d = geometry.get("draft_m")
-        half_len = geometry.get("half_length_m", 0.0)
+    w_info = wave_info or {}
+    if w_info.get("kind") == "regular":
+        from .waves import wavenumber
+
+        lam = 2 * math.pi / wavenumber(wave.omega, hull.water_depth, hull.g)
+        steep = float(w_info["height_m"]) / lam
+        if steep > STEEP_WARNING:
+            validity.append(f"linear theory: the wave's steepness H / lambda = {steep:.3g} "
+                            f"exceeds {STEEP_WARNING:.3g} (1/20; breaking at 1/7): a steep "
+                            "wave's nonlinearity is left out")
+    d, half_len, est = _ends(hull, geometry)
+    if d is not None and not at_rest:
         ends = np.abs(s["xi"][1]) + half_len * np.abs(np.sin(s["xi"][2]))
-        if d is not None and float(np.max(ends)) > d:
+        if float(np.max(ends)) > d:
             validity.append(f"linear theory: the hull's heave and pitch move its ends by up "
-                            f"to {float(np.max(ends)):.3g} m, more than its draft {d:.3g} m")
+                            f"to {float(np.max(ends)):.3g} m, more than its draft {d:.3g} m"
+                            + est)
     warnings = list(getattr(hull, "notes", ())) + list(notes) + [
         f"{m['mode']}: {m['status']}" for m in modes if not m["success"]]
     if cut:
         warnings.append(f"radiation bound: {cut} singular value(s) of B below "
-                        f"{BOUND_RCOND:g} of the largest cut in its pseudo-inverse")
+                        f"{rcond:.3g} of the largest (the data's noise) cut in its "
+                        "pseudo-inverse")
+    maxima = sorted((v for m in modes for v in m.get("maxima_powers_w") or ()), reverse=True)
+    reason = headline_reason(modes, best, p, bound, at_rest)
+    if reason:
+        warnings.append(f"no resolved answer: {reason}")
     owp = None if at_rest else best["one_way_power_w"]
     return BuoyResult(
-        power_w=p, mechanical_power_w=0.0 if at_rest else float(best["mechanical_power_w"]),
+        power_w=None if reason else p, headline_reason=reason,
+        maxima=len(maxima), maxima_powers_w=maxima,
+        mechanical_power_w=(None if reason else 0.0 if at_rest
+                            else float(best["mechanical_power_w"])),
         efficiency=list(pto.efficiency) if pto.efficiency is not None else None,
         copper_loss_w_per_nm2=pto.copper_loss, torque_limit_nm=pto.torque_limit,
         mode="rest" if at_rest else best["mode"],
         winding=None if at_rest else best["winding"], modes=public,
         one_way_power_w=owp, one_way_ratio=(owp / p if owp is not None and p > 0 else None),
         energy_balance_residual=None if at_rest else best["energy_balance_residual"],
-        radiation_bound_w=bound, bound_fraction=(p / bound if bound > 0 else None),
-        bound_rcond=BOUND_RCOND, bound_cut=cut,
-        capture_width_m=(p / flux if flux > 0 else None), energy_flux_w_per_m=flux,
+        radiation_bound_w=bound,
+        bound_fraction=(p / bound if bound > 0 and not reason else None),
+        bound_rcond=rcond, bound_cut=cut, bound_error_w=bound_err,
+        capture_width_limit_w=cw_limit,
+        capture_width_m=(p / flux if flux > 0 and not reason else None),
+        energy_flux_w_per_m=flux,
         surge_amplitude_m=half(s["xi"][0]), heave_amplitude_m=half(s["xi"][1]),
         pitch_amplitude_deg=pitch_amp, surge_phase_deg=ph(xi1[0]),
         heave_phase_deg=ph(xi1[1]), pitch_phase_deg=ph(xi1[2]),
@@ -871,7 +1001,7 @@ def hull_answer(hull, pendulum, wave, *, pivot, windings=(1, 0), pitch_inertia=N
                                 period) if not at_rest else pendulum.mass * hull.g,
         harmonics=cs.harmonics, hull_harmonics=cs.hull_harmonics,
         refinement_change_w=None if at_rest else best["refinement_change_w"],
-        success=all(m["success"] for m in modes),
+        success=all(m["success"] for m in modes) and not reason,
         status="; ".join(f"{m['mode']}: {m['status']}" for m in modes),
         dofs=["surge", "heave", "pitch"], wave=dict(wave_info or {},
                                                     omega_rad_per_s=wave.omega),

@@ -156,13 +156,17 @@ def solve_hull_bin(spec, i: int, j: int, r: int) -> dict:
 
     wave, info = wave_of(spec, i, j, r)
     res = solve_record(problem(spec), wave, info)
-    p = float(res.power_w)
+    def num(v):
+        return math.nan if v is None else float(v)
+    p = num(res.power_w)  # None: no resolved answer (headline_reason), kept as NaN
     out = {"power": p}
     if spec.lossy:
         # the store keeps the mechanical power as "power" (the heave buoy's layout; the
         # Dataset shows the electrical one as power)
-        out = {"power": float(res.mechanical_power_w), "electrical_power": p}
-    if res.success:
+        out = {"power": num(res.mechanical_power_w), "electrical_power": p}
+    if getattr(res, "headline_reason", None):  # no resolved answer: NaN, not a success
+        status = "other"
+    elif res.success:
         status = "no_power" if res.mode == "rest" else "converged"
     else:
         bad = [m for m in res.modes if not m["success"]]
