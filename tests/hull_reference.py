@@ -1,4 +1,4 @@
-r"""Independent reference of the hull model (issue 30): CasADi + IPOPT on the spec's grid.
+r"""Independent reference of the hull model: CasADi + IPOPT on the spec's grid.
 
 The model and its discretization are those of /work/notes/hull_spec.md (a surge, heave and
 pitch hull ``xi = (x, z, beta)`` carrying a pendulum; equations (P) and (H)). This module

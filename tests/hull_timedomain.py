@@ -1,4 +1,4 @@
-"""An independent check of the hull model of issue 30 (surge, heave, pitch with a pendulum):
+"""An independent check of the hull model (surge, heave, pitch with a pendulum):
 Cummins' equation in the time domain against the spec's frequency-domain Galerkin equations.
 
 Written from /work/notes/hull_spec.md only (it imports nothing of the package's hull kernel).

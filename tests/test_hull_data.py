@@ -1,4 +1,4 @@
-"""Surge, heave and pitch hydrodynamics of a hull (hydro/bem.py, issue 30):
+"""Surge, heave and pitch hydrodynamics of a hull (hydro/bem.py):
 interpolation rules, mass matrix, datasets and bad input (no BEM); the BEM of a coarse barge
 (144 panels, 4 frequencies, 1 s) against closed forms (hydrostatics, long-wave limits that fix
 the signs), a six-DOF dataset Capytaine wrote; the heave entries against bem's heave-only BEM,

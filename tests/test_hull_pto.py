@@ -1,4 +1,4 @@
-"""The hull through a real power take-off (issue 30 item 4): the efficiency's electrical
+"""The hull through a real power take-off: the efficiency's electrical
 power, the copper loss ``r <tau^2>`` and the torque limit, on the kernel of
 :mod:`parapend.hydro.hull`.
 

@@ -1,4 +1,4 @@
-"""The hull model of issue 30 (surge, heave, pitch; hull_spec.md) replayed in the time domain
+"""The hull model (surge, heave, pitch; hull_spec.md) replayed in the time domain
 (Cummins' equation, 3 x 3 radiation convolution; tests/hull_timedomain.py) against the spec's
 frequency-domain Galerkin equations for the same prescribed pendulum motion, on a synthetic,
 exactly causal hull with a 10 x 4 x 1 m barge's magnitudes and a cut-off at 25 rad/s.
