@@ -8,8 +8,8 @@ from pathlib import Path
 from ..defaults import BUOY
 from ..errors import ParameterError
 from ..hydro.device import Body, Controller, Pendulum, PowerTakeOff, Sea
-from . import _output
 from ._common import (
+    SAVE_ALL,
     _check_output,
     _finite_float,
     _fmt,
@@ -92,7 +92,9 @@ def add_parsers(sub) -> None:
                         "time_limit (without it, work estimated over 2 minutes is refused)")
     p.add_argument("--plot", metavar="DIR",
                    help="draw the figures (PNG and SVG) into this directory")
-    p.add_argument("--save", metavar="NC", help="write the motion (or the sweep) as NetCDF")
+    p.add_argument("--save", metavar="FILE",
+                   help="write the motion (or the sweep, or the causal run) by its extension: "
+                        ".nc, .json, .csv (a row of units under the header), .png, .svg, .pdf")
     p.add_argument("--json", action="store_true", help="print one JSON object")
 
 
@@ -146,7 +148,7 @@ def _figures(r, directory) -> list:
 
 def _cmd_buoy(a) -> dict | str:
     _check_dir(a.plot)
-    _check_output(a.save, "--save", (".nc",))
+    _check_output(a.save, "--save", SAVE_ALL)
     if a.controller != "optimum" and a.plot:
         raise ParameterError("plot: not drawn with --controller mpc (use --save)")
     try:
@@ -164,10 +166,9 @@ def _cmd_buoy(a) -> dict | str:
                           "record (--repeat-period, --record), or a smaller --mesh") from None
     if hasattr(r, "planner"):  # a causal run (BuoyMPCResult)
         from ..hydro.control import mpc_text
-        from ._common import unresolved_if
 
         if a.save:
-            _output.write_dataset(r.to_dataset(), a.save)
+            r.save(a.save)
         return unresolved_if(r.to_dict() if a.json else "\n".join(
             mpc_text(r) + ([f"written: {a.save}"] if a.save else [])), r)
     if tuple(r.dofs) != ("heave",):
@@ -181,7 +182,7 @@ def _cmd_buoy(a) -> dict | str:
         raise ParameterError(f"{name}: {r.message}")
     written = []
     if a.save:
-        _output.write_dataset(r.to_dataset(), a.save)
+        r.save(a.save)
         written.append(a.save)
     if a.plot:
         written += _figures(r, a.plot)
@@ -292,7 +293,7 @@ def _hull_output(r, a):
     """Text, JSON, NetCDF and figures of a hull result (``--dofs surge,heave,pitch``)."""
     written = []
     if a.save:
-        _output.write_dataset(r.to_dataset(), a.save)
+        r.save(a.save)
         written.append(a.save)
     if a.plot:
         from ..fileio import output_error, save_figure

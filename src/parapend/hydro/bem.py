@@ -90,6 +90,17 @@ def _as_omega(w) -> np.ndarray:
     return np.asarray(w, dtype=float)
 
 
+def _coefficient_array(name: str, value, dtype=float) -> np.ndarray:
+    """``value`` as an array of numbers, or a one-line :class:`ParameterError` naming the
+    coefficient (``Hydro("x", ...)`` raised NumPy's bare "could not convert string")."""
+    try:
+        return np.array(value, dtype=dtype)
+    except (TypeError, ValueError):
+        kind = "complex numbers" if dtype is complex else "numbers"
+        raise ParameterError(f"hydro: expected {name} as an array of {kind}, got "
+                             f"{value!r:.40}") from None
+
+
 @dataclass(frozen=True, eq=False)
 class Hydro:
     """Heave coefficients of a floating body (SI units, convention ``exp(+i w t)``).
@@ -132,10 +143,9 @@ class Hydro:
     dofs = ("heave",)
 
     def __post_init__(self):
-        w = np.array(self.omega, dtype=float).ravel()
-        a = np.array(self.added_mass, dtype=float).ravel()
-        b = np.array(self.radiation_damping, dtype=float).ravel()
-        f = np.array(self.excitation, dtype=complex).ravel()
+        w, a, b = (_coefficient_array(n, getattr(self, n)).ravel() for n in (
+            "omega", "added_mass", "radiation_damping"))
+        f = _coefficient_array("excitation", self.excitation, complex).ravel()
         if not (w.size >= 1 and a.size == b.size == f.size == w.size):
             raise ParameterError("hydro: expected omega, added_mass, radiation_damping and "
                                  "excitation of one common length >= 1")
@@ -218,12 +228,15 @@ class Hydro:
         tol = 1e-9
         if w_min >= lo * (1 - tol) and w_max <= hi * (1 + tol):
             return
-        if "period" in name:
-            need = f"{2 * math.pi / w_max:.4g} s to {2 * math.pi / w_min:.4g} s"
-            have = f"{2 * math.pi / hi:.4g} s to {2 * math.pi / lo:.4g} s"
-        else:
-            need = f"{w_min:.4g} to {w_max:.4g} rad/s"
-            have = f"{lo:.4g} to {hi:.4g} rad/s"
+        t_lo, t_hi = 2 * math.pi / w_max, 2 * math.pi / w_min
+        need = f"{t_lo:.4g} s" if f"{t_lo:.4g}" == f"{t_hi:.4g}" else \
+            f"{t_lo:.4g} s to {t_hi:.4g} s"
+        have = f"{2 * math.pi / hi:.4g} s to {2 * math.pi / lo:.4g} s"
+        if name in ("tp", "record"):  # a sea's components, the shortest set by --cutoff
+            raise ParameterError(
+                f"{name}: the sea's components from {need} (up to --cutoff times the peak "
+                f"frequency) lie outside the hydrodynamic data, which cover {have}; expected "
+                "a longer --tp or a smaller --cutoff")
         raise ParameterError(f"{name}: {need} lies outside the hydrodynamic data, which cover "
                              f"{have}")
 
@@ -1306,12 +1319,11 @@ class HullHydro:
     def __post_init__(self):
         from .. import limits
 
-        w = np.array(self.omega, dtype=float).ravel()
+        w = _coefficient_array("omega", self.omega).ravel()
         n = w.size
-        a = np.array(self.added_mass, dtype=float)
-        b = np.array(self.radiation_damping, dtype=float)
-        f = np.array(self.excitation, dtype=complex)
-        c = np.array(self.hydrostatic_stiffness, dtype=float)
+        a, b, c = (_coefficient_array(k, getattr(self, k)) for k in (
+            "added_mass", "radiation_damping", "hydrostatic_stiffness"))
+        f = _coefficient_array("excitation", self.excitation, complex)
         if not (n >= 1 and a.shape == b.shape == (n, 3, 3) and f.shape == (n, 3)
                 and c.shape == (3, 3)):
             raise ParameterError("hydro: expected omega (n,), added_mass and "
