@@ -108,7 +108,7 @@ def _dimensions(body, radius, draft):
 def _check_bem_size(radius, draft):
     """Refuse a cylinder whose BEM would not finish in about a minute: the influence
     coefficients of its mesh (:func:`.bem.cylinder_work` at the panel radius
-    :func:`.bem.cylinder` uses) against :data:`parapend.limits.BUOY_MAX_BEM_WORK`. A wide,
+    :func:`.bem.cylinder` uses) against ``parapend.limits.BUOY_MAX_BEM_WORK``. A wide,
     shallow body's panels follow the shortest wave solved (:func:`.bem.cylinder_scale`), so
     only a tall one (its panels follow the radius) is refused."""
     from .bem import GEOMETRY_PANELS, cylinder_scale, cylinder_work
@@ -354,7 +354,7 @@ def buoy(*, wave_height=None, wave_period=None, hs=None, tp=None, spectrum=None,
 
     dofs : ``"heave"`` (default: the heaving buoy) or ``"surge,heave,pitch"``: a hull that
         surges, heaves and pitches, with a pendulum that rotates or swings (docs/hull.md;
-        :func:`hull_buoy`). Then ``body`` is ``"barge"`` (default; its
+        ``hull_buoy``). Then ``body`` is ``"barge"`` (default; its
         ``barge_length``, ``barge_beam``, ``barge_draft``, m), ``"cylinder"`` or
         ``"sphere"``, or ``mesh``/``hydro`` with these DOFs; ``pivot_height`` and
         ``pivot_offset`` place the pivot from the rotation centre O (a built-in

@@ -394,7 +394,7 @@ def cylinder_work(radius, draft, h) -> float:
 def cylinder_scale(radius, draft) -> float:
     """The size (m) a cylinder's mesh follows (panel radius ``scale / GEOMETRY_PANELS``): the
     smaller of radius and draft; for a wide, shallow body whose mesh at the draft's scale
-    exceeds :data:`parapend.limits.BUOY_MAX_BEM_WORK`, the smallest scale up to the radius
+    exceeds ``parapend.limits.BUOY_MAX_BEM_WORK``, the smallest scale up to the radius
     whose work is at most half of it (its BEM and the error estimate's on a mesh 1.5 times
     coarser: radius 10 m at the full cap took 109 s under a load of 6, past the minute the
     cap means). The panels then follow the shortest wave solved, not the draft: the body's
@@ -1049,7 +1049,7 @@ def dataset_mass(ds, inertia_mass, path) -> tuple:
     Capytaine's ``compute_rigid_body_inertia`` of the floating body, ``rho V``) unless the
     dataset states its displacement: ``disp_mass``, or ``disp_volume`` times the dataset's
     ``rho``, which is then used. Where both are present and differ by more than
-    :data:`parapend.limits.DATASET_MASS_RTOL` of the displacement, a :class:`UserWarning`
+    ``parapend.limits.DATASET_MASS_RTOL`` of the displacement, a :class:`UserWarning`
     (and the returned note, which the result carries in its ``warnings``) names both
     numbers and the one used.
 

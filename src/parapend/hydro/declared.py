@@ -1,7 +1,7 @@
 """The inputs of the floating body, each parameter declared once: a sea, a pendulum, a body,
 a power take-off and a controller (small frozen objects; :mod:`parapend.hydro.device`
 composes them into a device and asks the commands), their declarations (unit, default,
-bounds, help: :func:`declarations`), the run options (:data:`RUN_OPTIONS`), and
+bounds, help: :func:`declarations`), the run options (``RUN_OPTIONS``), and
 :func:`expand_inputs`, which turns the objects given to a command (``parapend.buoy``,
 ``horizon``, ``power_matrix``) into its keywords. It imports nothing of the commands, so
 that every command can read it.
@@ -80,8 +80,8 @@ class _Inputs:
 
 @dataclass(frozen=True)
 class Sea(_Inputs):
-    """The sea: a regular wave (:meth:`regular`), a spectrum's sea state (:meth:`state`) or a
-    measured record (:meth:`measured`), each taken as a periodic record."""
+    """The sea: a regular wave (``regular``), a spectrum's sea state (``state``) or a
+    measured record (``measured``), each taken as a periodic record."""
 
     wave_height: float | None = _param("m", "H, crest to trough", bounds=(1e-4, 30.0),
                                        default_text=_both("wave_height"))
@@ -347,7 +347,7 @@ def has_inputs(opts: dict) -> bool:
 
 def expand_inputs(fn, opts: dict) -> dict:
     """The keywords of ``fn`` (:func:`parapend.buoy`, ``horizon``, ``power_matrix``) with the
-    input objects among ``opts`` (:data:`INPUT_KEYWORDS`; a :class:`Device` for its body,
+    input objects among ``opts`` (``INPUT_KEYWORDS``; a ``Device`` for its body,
     pendulum and take-off) replaced by their fields: the objects' fields are the command's
     parameters, so the command checks them and applies its defaults as it does its
     keywords. A field the command does not take, or given twice (in two objects, or in an

@@ -19,7 +19,7 @@ refused in the same one line whichever way it came::
 
 The functions below (:func:`optimum`, :func:`causal`, :func:`horizon`,
 :func:`power_matrix`) hand the objects to the command's function;
-:data:`RUN_OPTIONS` names the options of ``buoy``, ``horizon`` and ``power-matrix`` that are
+``RUN_OPTIONS`` names the options of ``buoy``, ``horizon`` and ``power-matrix`` that are
 not properties of the device or the sea but of the run (its resolution, its limits, its
 outputs).
 """
@@ -50,7 +50,7 @@ __all__ = ["Body", "Controller", "Device", "Pendulum", "PowerTakeOff", "RUN_OPTI
 def optimum(sea: Sea, pendulum: Pendulum, body: Body, pto: PowerTakeOff | None = None,
             **run):
     """The coupled non-causal optimum (:func:`parapend.buoy`) of the device in ``sea``;
-    ``run``: :data:`RUN_OPTIONS` of ``buoy`` (``winding``, ``harmonics``, ...)."""
+    ``run``: ``RUN_OPTIONS`` of ``buoy`` (``winding``, ``harmonics``, ...)."""
     from .api import buoy
 
     return buoy(sea=sea, pendulum=pendulum, body=body, pto=pto, **run)

@@ -668,7 +668,7 @@ def hull_search(make, *, refine: bool = True, pto: HullPTO | None = None) -> Hul
 
     ``make(scale)`` returns the :class:`HullCase` with ``scale`` times the default
     harmonics (1, and 2 for the refinement). With an active ``pto`` the ideal search's
-    distinct maxima start the PTO's optimum (:func:`_pto_stage`)."""
+    distinct maxima start the PTO's optimum (``_pto_stage``)."""
     case = make(1)
     n, kw = case.harmonics, case.winding
     one = HullProblem(case, coupled=False)

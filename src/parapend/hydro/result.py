@@ -112,8 +112,8 @@ class BuoyResult(_Result):
     """The coupled optimum of a pendulum in a floating body, for its degrees of freedom
     ``dofs`` (``["heave"]``: the heaving buoy; ``["surge", "heave", "pitch"]``: a hull), in
     one wave or one periodic record (field names = JSON keys of ``parapend buoy``; SI units,
-    named in each field). The JSON holds the fields of its DOF set (:data:`HEAVE_KEYS`,
-    :data:`HULL_KEYS`); the others are None.
+    named in each field). The JSON holds the fields of its DOF set (``HEAVE_KEYS``,
+    ``HULL_KEYS``); the others are None.
 
     Attributes
     ----------
@@ -185,7 +185,7 @@ class BuoyResult(_Result):
         command exits with status 3).
     headline_reason : why ``power_w`` is None (None when it is the answer).
     maxima, maxima_powers_w : the count and the powers (W) of the distinct local maxima the
-        search found, over the modes (each mode's also in :attr:`modes`).
+        search found, over the modes (each mode's also in ``modes``).
     capture_width_limit_w : ``sum_k J_k 3 lambda_k / (2 pi)``: a body moving in surge, heave
         and pitch absorbs at most the power of a crest that wide (heave ``lambda / (2 pi)``,
         surge and pitch together ``lambda / pi``); beside the radiation bound, which uses the
@@ -245,7 +245,7 @@ class BuoyResult(_Result):
     @property
     def solution(self):
         """The coupled optimum (heave alone: :class:`parapend.hydro.optimum.CoupledSolution`;
-        a hull: None, its modes' in :attr:`modes`)."""
+        a hull: None, its modes' in ``modes``)."""
         return self._solution
 
     @property
@@ -338,7 +338,7 @@ class BuoySweepResult(_Result):
     """Power of one design against wave period (``wave_period="FROM:TO:N"`` or a list),
     regular waves of one height, for the body's degrees of freedom ``dofs``: arrays over
     ``period_s``, each field named with its unit; the JSON holds the fields of its DOF set
-    (:data:`HEAVE_SWEEP_KEYS`, :data:`HULL_SWEEP_KEYS`). Every period is solved on the same
+    (``HEAVE_SWEEP_KEYS``, ``HULL_SWEEP_KEYS``). Every period is solved on the same
     mesh and frequencies as alone (:class:`BuoyResult`: the same numbers).
 
     Heave alone: ``electrical_power_w`` with an efficiency, else None; ``mesh_error_w``,
