@@ -103,7 +103,8 @@ def trace(self, x, max_iter, tol):
         dl = mu / s - lam - sig * ds
         ap = bp._max_step(s, ds, 0.995)
         ad = bp._max_step(lam, dl, 0.995)
-        rho = max(rho, 1.1 * float(np.max(np.abs(lam))))
+        # the solver's rule (before the fix: rho = max(rho, 1.1 max lam), held at its largest)
+        rho = 1.1 * max(float(np.max(np.abs(lam))), float(np.max(np.abs(lam + ad * dl))))
         m0 = phi - mu * float(np.sum(np.log(s))) + rho * float(np.sum(np.abs(rp)))
         dm = gr @ dx - mu * float(np.sum(ds / s)) - rho * float(np.sum(np.abs(rp)))
         a, ok, tries = ap, False, 0
