@@ -28,7 +28,7 @@ from parapend.hydro import api
 from parapend.hydro import control as bc
 
 
-def run(seed, forecast, repeat_period, hs=0.8, tp=3.0):
+def run(seed, forecast, repeat_period, hs=0.8, tp=3.0, horizon=2.0):
     rec = []
     orig = bp.CoupledPlan.solve
 
@@ -46,7 +46,7 @@ def run(seed, forecast, repeat_period, hs=0.8, tp=3.0):
     t0 = time.perf_counter()
     try:
         r = api.buoy(hs=hs, tp=tp, seed=seed, repeat_period=repeat_period,
-                     controller="mpc", forecast=forecast)
+                     controller="mpc", forecast=forecast, horizon=horizon)
     finally:
         bp.CoupledPlan.solve = orig
     return r, rec, time.perf_counter() - t0
@@ -148,6 +148,7 @@ def main():
                     help="interior-point iterations per solve (default: the planner's)")
     ap.add_argument("--interval-samples", type=int, default=None,
                     help="torque samples per Hermite interval (default: the planner's)")
+    ap.add_argument("--horizon", type=float, default=2.0, help="peak periods")
     ap.add_argument("--show", type=int, default=3, help="failed solves traced in full")
     a = ap.parse_args()
     if a.no_trace:
@@ -157,12 +158,12 @@ def main():
         bc.PLAN_MAX_ITER = a.max_iter
     if a.interval_samples:
         bc.PLAN_INTERVAL_SAMPLES = a.interval_samples
-    r, rec, sec = run(a.seed, a.forecast, a.repeat_period)
+    r, rec, sec = run(a.seed, a.forecast, a.repeat_period, horizon=a.horizon)
     c = collections.Counter(d["status"] for d in rec)
     its = np.array([d["it"] for d in rec])
     print(f"seed {a.seed}, forecast {a.forecast}, repeat period {a.repeat_period:g} s, "
-          f"{bc.PLAN_MAX_ITER} iterations at most, {bc.PLAN_INTERVAL_SAMPLES} samples an "
-          f"interval: "
+          f"horizon {a.horizon:g} Tp, {bc.PLAN_MAX_ITER} iterations at most, "
+          f"{bc.PLAN_INTERVAL_SAMPLES} samples an interval: "
           f"power {r.mean_power_w:.2f} W, optimum {r.optimum_power_w:.2f} W, {sec:.0f} s")
     print(f"  {len(rec)} solves: " + ", ".join(f"{k} {v}" for k, v in sorted(c.items()))
           + f"; iterations median {np.median(its):.0f}, max {its.max()}")
