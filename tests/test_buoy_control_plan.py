@@ -504,3 +504,45 @@ def test_radiation_model_heave_against_the_plants_replay():
     old = bc._MotionPlanner(n, dt, ps, plant.p, 50.0, 1.0, True)
     old.prob.set_start(y0, fm)
     assert np.sqrt(np.mean((old.prob.heave(x, ts) - z) ** 2)) / rms > 30 * err
+
+
+class _Stop(Exception):
+    pass
+
+
+@pytest.mark.slow  # compiles the planner's interior point on first use (35 to 60 s)
+def test_horizon_solves_converge_riding_the_torque_limit(monkeypatch):
+    """Steep short seas (Hs 0.8 m, Tp 3 s, the command line's buoy and default torque limit,
+    perfect forecast): the first horizon solves after the catch plan a pendulum turning at
+    up to 14 rad/s against the torque limit. Each must meet its KKT conditions (status
+    ``converged``: the residuals below the tolerance) with its torques inside the limit
+    (checked here from the plan itself); an exact penalty held at the largest multiplier of
+    the first iterations made the line search crawl into the iteration limit."""
+    from parapend.hydro import _buoy_plan as bp
+    from parapend.hydro import api
+
+    got = {}
+
+    def grab(hydro, pendulum, wave, info, **kw):
+        got.update(hydro=hydro, pend=pendulum, wave=wave)
+        raise _Stop
+
+    monkeypatch.setattr(bc, "mpc_command", grab)
+    with pytest.raises(_Stop):
+        api.buoy(hs=0.8, tp=3.0, seed=0, repeat_period=36.0, controller="mpc")
+    rec = []
+    orig = bp.CoupledPlan.solve
+
+    def solve(self, x, **kw):
+        xs, st, it = orig(self, x, **kw)
+        rec.append((st, float(np.max(np.abs(self.constraint_torques(xs)))) / self.tmax))
+        if len(rec) == 3:
+            raise _Stop
+        return xs, st, it
+
+    monkeypatch.setattr(bp.CoupledPlan, "solve", solve)
+    with pytest.raises(_Stop):
+        bc.buoy_mpc(got["hydro"], got["pend"], got["wave"], peak_period=3.0,
+                    controller="plan")
+    assert [st for st, _ in rec] == ["converged"] * 3
+    assert max(t for _, t in rec) <= 1.0 + 1e-6

@@ -51,7 +51,8 @@ constraints couple the whole horizon, so the Newton matrix is dense but small (`
 **Solver.** A primal-dual interior point with slacks (``g(x) + s = 0``, ``s > 0``; an
 infeasible warm start needs no repair), the exact Hessian of the Lagrangian (objective and
 constraints), an inertia correction (Cholesky of ``H + J^T S^-1 Lambda J + delta I``) and a
-backtracking line search on the merit ``phi - mu sum log s + rho |g + s|_1``.
+backtracking line search on the merit ``phi - mu sum log s + rho |g + s|_1`` (``rho`` 1.1 times the
+largest multiplier before or after the step).
 """
 
 from __future__ import annotations
@@ -635,7 +636,10 @@ class CoupledPlan:
             # fraction to the boundary
             ap = _max_step(s, ds, 0.995)
             ad = _max_step(lam, dl, 0.995)
-            rho = max(rho, 1.1 * float(np.max(np.abs(lam))) if lam.size else 0.0)
+            # the exact penalty's weight from the multipliers now and after the step (not
+            # held at its largest: the kernel's comment)
+            rho = 1.1 * max(float(np.max(np.abs(lam))),
+                            float(np.max(np.abs(lam + min(ad, 1.0) * dl))))
             m0 = phi - mu * float(np.sum(np.log(s))) + rho * float(np.sum(np.abs(rp)))
             dm = (gr @ dx - mu * float(np.sum(ds / s)) - rho * float(np.sum(np.abs(rp))))
             a = ap

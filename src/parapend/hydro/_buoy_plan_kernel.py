@@ -362,7 +362,10 @@ def solve(x, start, j, b0, b1, b2, af, bf, ap, bp, bp0, b0g, wgt, f_t, yc, ydc, 
         dl = mu / s - lam - sig * ds
         a_p = max_step(s, ds, 0.995)
         a_d = max_step(lam, dl, 0.995)
-        rho = max(rho, 1.1 * np.max(np.abs(lam)))
+        # the exact penalty's weight from the multipliers now and after the step, not held at
+        # its largest: a weight the early multipliers left far above them makes the merit
+        # reject every step on which the torque bends away from its linearization
+        rho = 1.1 * max(np.max(np.abs(lam)), np.max(np.abs(lam + min(a_d, 1.0) * dl)))
         m0 = phi - mu * np.sum(np.log(s)) + rho * np.sum(np.abs(rp))
         dm = gr @ dx - mu * np.sum(ds / s) - rho * np.sum(np.abs(rp))
         a = a_p
