@@ -202,10 +202,9 @@ def _csv_rows(path, header: list, name: str, max_rows: int = None) -> list:
     return out
 
 
-def _check_sea(hs, tp, spectrum, gamma_peak, repeat_period, cutoff):
-    hs = check_range("hs", hs, limits.SEA_MIN_HS, limits.SEA_MAX_HS,
-                     why="significant wave height, m")
-    tp = check_range("tp", tp, *limits.SEA_TP_RANGE, why="peak period, s")
+def check_spectrum(spectrum, gamma_peak, cutoff) -> tuple[float, float]:
+    """The spectrum's shape, its JONSWAP peak enhancement and its cutoff (in units of the
+    peak frequency), checked in one line each; returns ``(gamma_peak, cutoff)``."""
     if not isinstance(spectrum, str) or spectrum not in SPECTRA:
         raise ParameterError(f"spectrum: expected one of {', '.join(SPECTRA)}, "
                              f"got {spectrum!r:.60}")
@@ -215,6 +214,14 @@ def _check_sea(hs, tp, spectrum, gamma_peak, repeat_period, cutoff):
         raise ParameterError("gamma-peak: only used by spectrum 'jonswap'")
     cutoff = check_range("cutoff", cutoff, 1.5, 10.0,
                          why="highest component frequency, in units of the peak frequency")
+    return gamma_peak, cutoff
+
+
+def _check_sea(hs, tp, spectrum, gamma_peak, repeat_period, cutoff):
+    hs = check_range("hs", hs, limits.SEA_MIN_HS, limits.SEA_MAX_HS,
+                     why="significant wave height, m")
+    tp = check_range("tp", tp, *limits.SEA_TP_RANGE, why="peak period, s")
+    gamma_peak, cutoff = check_spectrum(spectrum, gamma_peak, cutoff)
     if repeat_period is not None:
         repeat_period = check_positive("repeat-period", repeat_period)
         waves = repeat_period / tp

@@ -69,8 +69,6 @@ __all__ = ["PersistenceResult", "choose_step", "persistence", "wilson_interval",
 #: work estimate
 STEP_RATE = 5e6
 _Z95 = 1.959963984540054
-#: the spectra a persistence map takes
-SPECTRA = ("jonswap", "pierson-moskowitz")
 CONTROLLERS = ("track",)
 
 
@@ -365,7 +363,7 @@ def persistence_spec(*, mass, length, inertia, gravity, damping_coefficient,
                      duration, transient, realizations, seed, omniscient, controller,
                      gpu, block=None):
     """Check every input and make the map's :class:`._persist_spec.PersistenceSpec`."""
-    from ..seas import check_response, read_response
+    from ..seas import check_response, check_spectrum, read_response
     from ..units import Units
     from ._persist_spec import PersistenceSpec
 
@@ -384,15 +382,7 @@ def persistence_spec(*, mass, length, inertia, gravity, damping_coefficient,
         if not lo <= v <= hi:
             raise ParameterError(f"tp: expected a peak period in [{lo:g}, {hi:g}] s (the "
                                  f"spectra's range here), got {v!r}")
-    if not isinstance(spectrum, str) or spectrum not in SPECTRA:
-        raise ParameterError(f"spectrum: expected one of {', '.join(SPECTRA)}, got "
-                             f"{spectrum!r:.60}")
-    gamma_peak = check_range("gamma-peak", gamma_peak, 1.0, 20.0,
-                             why="JONSWAP peak enhancement")
-    if spectrum != "jonswap" and gamma_peak != 3.3:
-        raise ParameterError("gamma-peak: only used by spectrum 'jonswap'")
-    cutoff = check_range("cutoff", cutoff, 1.5, 10.0,
-                         why="highest component frequency, in units of the peak frequency")
+    gamma_peak, cutoff = check_spectrum(spectrum, gamma_peak, cutoff)
     duration = check_positive("duration", duration)
     if transient is not None:
         transient = check_range("transient", transient, 0.0, math.inf, why="s")
