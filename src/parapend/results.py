@@ -99,6 +99,7 @@ QUANTITIES = {
                                  "the warm-up"),
     "stored_energy": (_T, "stored energy theta'^2/2 + cos(theta)"),
     "averaged_time": (_TIME, "time the powers are averaged over"),
+    "seconds": ("s", "wall-clock time of the run"),
     "speed_peak": ("rad " + _RATE, "largest |theta'| after the hand-over"),
     "speed_limit": ("rad " + _RATE, "rated-speed penalty of the plans"),
 }
@@ -106,7 +107,7 @@ QUANTITIES = {
 
 #: A field's unit from its name's suffix (longest first).
 SUFFIX_UNITS = (("_w_per_nm2", "W/(N m)^2"), ("_w_per_m", "W/m"), ("_mwh_per_year", "MWh/yr"),
-                ("_rad_per_s", "rad/s"),
+                ("_nm_s_per_rad", "N m s/rad"), ("_m_per_s2", "m/s^2"), ("_rad_per_s", "rad/s"),
                 ("_m_per_s", "m/s"), ("_kg_m2", "kg m2"), ("_per_year", "1/yr"),
                 ("_kwh", "kWh"), ("_mwh", "MWh"), ("_deg", "degree"), ("_hz", "Hz"),
                 ("_nm", "N m"), ("_w", "W"), ("_j", "J"), ("_m", "m"), ("_s", "s"),
