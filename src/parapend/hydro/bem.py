@@ -1350,7 +1350,9 @@ class HullHydro:
             raise ParameterError(f"hydro: radiation_damping is not positive semidefinite at "
                                  f"{w[i]:.4g} rad/s (eigenvalue {lam[i].min():.3g}, beyond "
                                  f"{limits.BUOY_NEGATIVE_DAMPING_TOL:g} of its largest entry)")
-        neg = np.any(lam < 0, axis=1)
+        # eigenvalues within rounding of 0 are left alone: a dataset written after this
+        # correction reads back with the same coefficients and the same notes
+        neg = np.any(lam < -64 * np.finfo(float).eps * top, axis=1)
         if np.any(neg):
             # BEM noise: the nearest positive semidefinite matrix (negative eigenvalues to 0)
             b[neg] = np.einsum("nij,nj,nkj->nik", vec[neg], np.maximum(lam[neg], 0.0),
