@@ -301,7 +301,7 @@ def _smoothstep(x):
 
 def replay(*, omega_data, A, B, F, C, Mh, m, l, I, c, g, pivot, wave_omega, amplitudes, phi,  # noqa: E741
            periods=60, steps_per_period=200, ramp_periods=10, memory=None, a_inf=None,
-           harmonics=6, kernel_tol=1e-4, max_memory=60.0):
+           harmonics=6, kernel_tol=1e-4, max_memory=60.0, match_omega=None):
     """Integrate the hull (H) with the prescribed ``phi`` from rest (Cummins) until periodic.
 
     Parameters
@@ -320,9 +320,12 @@ def replay(*, omega_data, A, B, F, C, Mh, m, l, I, c, g, pivot, wave_omega, ampl
         stayed below ``kernel_tol * max|K(0)|``, times 1.2, at most ``max_memory``.
     a_inf : (3, 3) array, optional
         Infinite-frequency added mass. Default: the value that makes the discrete model's
-        added mass equal the data's at the fundamental (see the module's docstring).
+        added mass equal the data's at ``match_omega`` (see the module's docstring).
     harmonics : int
         How many harmonics of the last period to return.
+    match_omega : float, optional
+        Where the model's added mass is made the data's (rad/s; default the fundamental
+        ``wave_omega``; an irregular record's peak frequency, where its energy is).
 
     Returns
     -------
@@ -376,8 +379,9 @@ def replay(*, omega_data, A, B, F, C, Mh, m, l, I, c, g, pivot, wave_omega, ampl
         return np.einsum("j,jab->ab", cs, wts), np.einsum("j,jab->ab", sn, wts)
 
     if a_inf is None:
-        a1, _, _ = coef(w)
-        a_inf = a1 + transforms(w)[1] / w
+        wm = w if match_omega is None else float(match_omega)
+        a1, _, _ = coef(wm)
+        a_inf = a1 + transforms(wm)[1] / wm
     a_inf = np.asarray(a_inf, dtype=float)
 
     def model_coefficients(wv):
