@@ -42,7 +42,8 @@ import numpy as np
 from hull_timedomain import interpolator, kernel, phi_fourier, replay
 from scipy.integrate import solve_ivp
 
-__all__ = ["Memory", "hull_data", "matched_a_inf", "record_replay", "reintegrate_hull"]
+__all__ = ["Memory", "chunked", "compare_motion", "hull_data", "matched_a_inf", "memory_length",
+           "record_replay", "reintegrate_hull"]
 
 E_BETA = np.array([0.0, 0.0, 1.0])
 
@@ -116,9 +117,26 @@ def record_replay(data, pendulum, pivot, omega, amplitudes, x, winding, *, repea
                   C=data["C"], Mh=data["Mh"], m=_p(pendulum, "mass"), l=_p(pendulum, "length"),
                   I=_p(pendulum, "inertia"), c=_p(pendulum, "damping_coefficient"),
                   g=data["g"], pivot=pivot, wave_omega=omega, amplitudes=amps,
-                  phi=phi_fourier(x, winding, omega), periods=int(repeats),
+                  phi=chunked(phi_fourier(x, winding, omega)), periods=int(repeats),
                   steps_per_period=spp, ramp_periods=ramp, match_omega=match_omega,
                   **{"harmonics": 2, **kw})
+
+
+def chunked(fun, size=2048):
+    """``fun(t)`` evaluated ``size`` times at a time (a long record's trigonometric sums
+    would otherwise hold (times x harmonics) arrays); its outputs concatenated along their
+    last axis (a tuple of arrays: each)."""
+    def call(t):
+        t = np.atleast_1d(np.asarray(t, dtype=float))
+        parts = [fun(t[i:i + size]) for i in range(0, t.size, size)]
+        if isinstance(parts[0], dict):
+            return {k: np.concatenate([np.asarray(p[k]) for p in parts], axis=-1)
+                    for k in parts[0]}
+        if isinstance(parts[0], tuple):
+            return tuple(np.concatenate([p[j] for p in parts], axis=-1)
+                         for j in range(len(parts[0])))
+        return np.concatenate(parts, axis=-1)
+    return call
 
 
 def compare_motion(td, fd_xi, fd_xi_dot) -> dict:
