@@ -98,8 +98,9 @@ def short_optimum():
     return _short_optimum(0)
 
 
-def _replay_check(omega, amplitudes, x, winding, power, motion, hull, pend, pivot, dt):
-    data = hull_data(hull, pend.mass)
+def _replay_check(omega, amplitudes, x, winding, power, motion, hull, pend, pivot, dt,
+                  pitch_inertia=None):
+    data = hull_data(hull, pend.mass, pitch_inertia)
     td = record_replay(data, pend, pivot, omega, amplitudes, x, winding, dt=dt)
     fd = chunked(motion)(td["t"])
     diff = compare_motion(td, fd["xi"].T, fd["xi_dot"].T)
@@ -135,23 +136,39 @@ def dataset(tmp_path_factory):
     return synthetic_hull_netcdf(tmp_path_factory.mktemp("hull") / "hull.nc")
 
 
+#: per body: the tolerances of the power, the hull's motion and its speeds. The embedded
+#: barge's BEM data are causal only to their accuracy, and held above their top frequency
+#: (3.4 rad/s): on its default 4-wave record (Hs 1.5 m, Tp 6 s) the replay measured the
+#: power to 1.5e-4 but the motion to 3.8e-3 and the speeds to 2.6e-2 (surge), while against
+#: the frequency domain with the time-domain model's own coefficients (the memory's A and B,
+#: ``replay(...)["model_coefficients"]``, a dense solve of six minutes) to 2.5e-5 and
+#: 1.2e-4: the difference is the data's, not the integration's
+REPLAY_TOL = {"synthetic": (1e-3, 1e-3, 1e-3), "barge": (1e-3, 1e-2, 5e-2)}
+
+
 @pytest.mark.slow
-@pytest.mark.parametrize("waves", [4, 100])
-def test_api_record_optimum_replayed_through_cummins(dataset, waves):
+@pytest.mark.parametrize("body, waves", [("synthetic", 4), ("synthetic", 100),
+                                         ("barge", 100)])
+def test_api_record_optimum_replayed_through_cummins(dataset, body, waves):
     """The record optimum of ``parapend.buoy(dofs="surge,heave,pitch", hs, tp,
-    repeat_period=waves Tp, seed=0)`` (the best mode, refined), its phi prescribed to
-    Cummins' equation from rest over repeats of the record: the hull's motion and the mean
-    power over the last repeat to 1e-3 (4 waves measured: power 1.9e-4 swinging and 2.5e-4
-    rotating at 10 ms, 8.5e-5 and 9.5e-5 at 5 ms, motion below 4e-4). A record the solver
-    refuses as too long is skipped, with the refusal as the reason."""
+    repeat_period=waves Tp, seed=0)`` (the best mode, refined), on the synthetic hull
+    (Hs 1 m, Tp 5 s) or the embedded barge (its default sea, Hs 1.5 m, Tp 6 s), its phi
+    prescribed to Cummins' equation from rest over repeats of the record: the hull's motion
+    and the mean power over the last repeat (``REPLAY_TOL``; synthetic, 4 waves, measured:
+    power 1.9e-4 swinging and 2.5e-4 rotating at 10 ms, 8.5e-5 and 9.5e-5 at 5 ms, motion
+    below 4e-4). A record the solver refuses as too long is skipped, with the refusal as
+    the reason."""
     import parapend
 
+    if body == "synthetic":
+        opts = dict(hydro=dataset, hs=HS, tp=TP, mass=PEND.mass, length=PEND.length,
+                    inertia=PEND.inertia, damping_coefficient=PEND.damping_coefficient,
+                    pivot_offset=PIVOT[0], pivot_height=PIVOT[1])
+    else:
+        opts = dict(hs=1.5, tp=6.0)
     try:
-        r = parapend.buoy(dofs="surge,heave,pitch", hydro=dataset, hs=HS, tp=TP,
-                          repeat_period=waves * TP, seed=0, mass=PEND.mass,
-                          length=PEND.length, inertia=PEND.inertia,
-                          damping_coefficient=PEND.damping_coefficient,
-                          pivot_offset=PIVOT[0], pivot_height=PIVOT[1])
+        r = parapend.buoy(dofs="surge,heave,pitch", repeat_period=waves * opts["tp"], seed=0,
+                          **opts)
     except ParameterError as e:
         pytest.skip(f"the record is refused: {e}")
     assert r.success and r.power_w is not None, r.status
@@ -160,13 +177,16 @@ def test_api_record_optimum_replayed_through_cummins(dataset, waves):
     p = r.pendulum
     pend = Pendulum(p["mass_kg"], p["length_m"], p["inertia_kg_m2"], p["damping_coefficient"])
     pivot = (r.pivot["pivot_offset_m"], r.pivot["pivot_height_m"])
+    hull = r.hydrodynamics
     td, diff, rel = _replay_check(wave.omega, wave.amplitudes, mot.x, mot.case.winding,
-                                  r.power_w, mot, r.hydrodynamics, pend, pivot, dt=0.005)
-    if waves * TP < 100:  # the repeat before the last holds the ramp in a long record
+                                  r.power_w, mot, hull, pend, pivot, dt=0.005,
+                                  pitch_inertia=(hull.pitch_inertia or mot.case.Mh[2, 2]))
+    if waves * opts["tp"] < 100:  # the repeat before the last holds the ramp in a long record
         assert td["periodicity"] < 1e-4
-    assert abs(rel) < 1e-3, rel
-    assert np.all(diff["xi"] < 1e-3), diff
-    assert np.all(diff["xi_dot"] < 1e-3), diff
+    tol = REPLAY_TOL[body]
+    assert abs(rel) < tol[0], rel
+    assert np.all(diff["xi"] < tol[1]), diff
+    assert np.all(diff["xi_dot"] < tol[2]), diff
 
 
 def _excitation(data, omega, amplitudes):
