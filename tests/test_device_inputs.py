@@ -197,6 +197,8 @@ def test_the_documented_script_is_short_and_builds_each_input_once():
     for built in ("Sea.state(", "Pendulum(", "Body.barge(", "PowerTakeOff(copper_loss"):
         assert code.count(built) == 1, built
     assert "hull.with_dofs(\"heave\")" in code  # the causal run's body: the same barge
+    # the hull's own causal run, once it has one, is one word away: device.causal
+    assert "heave.causal(" in code and "device.causal" in code
     for asked in (".optimum(", ".causal(", ".power_matrix("):
         assert asked in code, asked
 

@@ -664,18 +664,12 @@ def _refuse_unsupported(opts: dict) -> None:
 
 
 def _hull_pto(opts):
-    """The power take-off (:class:`.hull.HullPTO`) from ``torque_limit`` (N m),
-    ``efficiency`` and ``copper_loss`` (W per (N m)^2)."""
-    from .hull import HullPTO
-    from .pto import efficiency_pair
+    """The hull's power take-off (:meth:`.declared.PowerTakeOff.hull`) of the keywords
+    ``torque_limit`` (N m), ``efficiency`` and ``copper_loss`` (W per (N m)^2)."""
+    from .declared import PowerTakeOff
 
-    eta = efficiency_pair(opts.get("efficiency"))
-    limit = opts.get("torque_limit")
-    if limit is not None:
-        limit = check("torque_limit", limit)
-    r = opts.get("copper_loss")
-    r = 0.0 if r is None else check("copper_loss", r)
-    return HullPTO(efficiency=eta, copper_loss=r, torque_limit=limit)
+    return PowerTakeOff(**{k: opts.get(k) for k in ("torque_limit", "efficiency",
+                                                     "copper_loss")}).hull()
 
 
 def _hull_value(opts, name):

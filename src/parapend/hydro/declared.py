@@ -186,6 +186,30 @@ class Pendulum(_Inputs):
             {"help": "viscous c (instead of --gamma)",
              "default": f"--gamma; {BUOY['damping_coefficient']:g} with --device buoy"}))
 
+    def checked(self, kind: str = "buoy"):
+        """The pendulum of the coupled model (:class:`parapend.hydro.coupled.Pendulum`): each
+        field's declared default (the embedded ``kind``'s, ``"buoy"`` or ``"hull"``) and
+        bounds applied (:func:`check`), and what ties the fields together checked: the
+        inertia at least ``m l^2`` (its default), the units' ranges
+        (``parapend.limits.UNIT_*``, each message naming the option given)."""
+        from ..errors import ParameterError
+        from ..units import Units
+        from .coupled import Pendulum as Coupled
+
+        mass = check("mass", default_of("mass", self.mass, kind))
+        length = check("length", default_of("length", self.length, kind))
+        Units(length, mass, 9.81, None)
+        ml2 = mass * length * length
+        inertia = check("inertia", ml2 if self.inertia is None else self.inertia)
+        if inertia < ml2 * (1 - 1e-12):
+            raise ParameterError(f"inertia: expected at least m l^2 = {ml2:.6g} kg m^2 (the "
+                                 f"inertia about the pivot of a mass {mass:g} kg at "
+                                 f"{length:g} m), got {inertia:g}")
+        c = check("damping_coefficient",
+                  default_of("damping_coefficient", self.damping_coefficient, kind))
+        Units(length, mass, 9.81, inertia).gamma(c)
+        return Coupled(mass=mass, length=length, inertia=inertia, damping_coefficient=c)
+
 
 @dataclass(frozen=True)
 class Body(_Inputs):
@@ -287,6 +311,18 @@ class PowerTakeOff(_Inputs):
     copper_loss: float | None = _param(
         "W/(N m)^2", "the generator's winding loss r tau^2 subtracted from the power (with "
                      "--dofs surge,heave,pitch)", bounds=(0.0, 1e6))
+
+    def hull(self):
+        """The hull's take-off (:class:`parapend.hydro.hull.HullPTO`): each field checked
+        in its declared bounds (:func:`check`); None the ideal one's (no limit, lossless, no
+        copper loss)."""
+        from .hull import HullPTO
+        from .pto import efficiency_pair
+
+        limit = None if self.torque_limit is None else check("torque_limit", self.torque_limit)
+        r = 0.0 if self.copper_loss is None else check("copper_loss", self.copper_loss)
+        return HullPTO(efficiency=efficiency_pair(self.efficiency), copper_loss=r,
+                       torque_limit=limit)
 
 
 @dataclass(frozen=True)

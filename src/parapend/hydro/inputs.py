@@ -57,27 +57,12 @@ def _period(value) -> float:
 
 # --- the pieces -----------------------------------------------------------------------------
 def _pendulum(mass, length, inertia, damping_coefficient, kind="buoy"):
-    """The pendulum, its declared defaults (``kind``: the embedded ``"buoy"``'s or
-    ``"hull"``'s) and bounds applied, and the relations between its parameters checked."""
-    from ..units import Units
-    from .coupled import Pendulum
+    """The keywords' pendulum: :meth:`.declared.Pendulum.checked` (``kind``: whose declared
+    defaults, the embedded ``"buoy"``'s or ``"hull"``'s)."""
+    from .declared import Pendulum
 
-    mass = check("mass", default_of("mass", mass, kind))
-    length = check("length", default_of("length", length, kind))
-    # the ranges of the units (limits.UNIT_*): each message names the option given
-    Units(length, mass, 9.81, None)
-    ml2 = mass * length * length
-    if inertia is None:
-        inertia = ml2
-    inertia = check("inertia", inertia)
-    if inertia < ml2 * (1 - 1e-12):
-        raise ParameterError(f"inertia: expected at least m l^2 = {ml2:.6g} kg m^2 (the "
-                             f"inertia about the pivot of a mass {mass:g} kg at {length:g} m), "
-                             f"got {inertia:g}")
-    c = check("damping_coefficient", default_of("damping_coefficient", damping_coefficient,
-                                                kind))
-    Units(length, mass, 9.81, inertia).gamma(c)
-    return Pendulum(mass=mass, length=length, inertia=inertia, damping_coefficient=c)
+    return Pendulum(mass=mass, length=length, inertia=inertia,
+                    damping_coefficient=damping_coefficient).checked(kind)
 
 
 def _irregular_wave(hs, tp, spectrum, gamma_peak, repeat_period, seed, cutoff, record, taper,
