@@ -189,8 +189,8 @@ class Pendulum(_Inputs):
     def checked(self, kind: str = "buoy"):
         """The pendulum of the coupled model (:class:`parapend.hydro.coupled.Pendulum`): each
         field's declared default (the embedded ``kind``'s, ``"buoy"`` or ``"hull"``) and
-        bounds applied (:func:`check`), and what ties the fields together checked: the
-        inertia at least ``m l^2`` (its default), the units' ranges
+        bounds applied (:func:`~parapend.hydro.declared.check`), and what ties the fields
+        together checked: the inertia at least ``m l^2`` (its default), the units' ranges
         (``parapend.limits.UNIT_*``, each message naming the option given)."""
         from ..errors import ParameterError
         from ..units import Units
@@ -287,7 +287,7 @@ class Body(_Inputs):
 class PowerTakeOff(_Inputs):
     """The power take-off: all None is the ideal, lossless one."""
 
-    torque_limit: float | None = _param("N m", "largest |torque|", bounds=POSITIVE, commands={
+    torque_limit: float | None = _param("N m", "largest |torque|", bounds=(1e-6, 1e12), commands={
         # the prescribed-heave pendulum's curve states its torque in its own unit, m g l
         # (--torque-limit-nm: this declaration's N m)
         "horizon": {"unit": "m g l", "default": "none",
@@ -314,8 +314,8 @@ class PowerTakeOff(_Inputs):
 
     def hull(self):
         """The hull's take-off (:class:`parapend.hydro.hull.HullPTO`): each field checked
-        in its declared bounds (:func:`check`); None the ideal one's (no limit, lossless, no
-        copper loss)."""
+        in its declared bounds (:func:`~parapend.hydro.declared.check`); None the ideal
+        one's (no limit, lossless, no copper loss)."""
         from .hull import HullPTO
         from .pto import efficiency_pair
 
