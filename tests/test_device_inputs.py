@@ -162,6 +162,39 @@ def test_a_declared_bound_is_the_command_s_check(name, extra):
         parapend.buoy(**{name: 2 * hi + 1}, **extra)
 
 
+def test_the_embedded_designs_defaults_and_bounds_are_declared(monkeypatch):
+    """The pendulum's, the sea's and the bodies' defaults of the embedded buoy and hull stand
+    in the declarations (``value``, one per body; ``parapend.defaults``), and the
+    objects apply them: a declared default changed is what the command gets, for the buoy
+    and the hull alike. A hull's sea state given only ``hs`` takes the hull's peak period
+    (the small buoy's 2.5 s was taken before). A declared bound is the check."""
+    from parapend.defaults import BUOY, HULL
+    from parapend.hydro import declared
+    from parapend.hydro.inputs import _irregular_wave
+    from parapend.units import Units
+
+    assert dv.Pendulum().checked().mass == BUOY["mass"]
+    assert dv.Pendulum().checked("hull").mass == HULL["mass"]
+    assert dv.Pendulum(mass=7.0).checked("hull").mass == 7.0
+    field = next(f for f in dataclasses.fields(dv.Pendulum) if f.name == "mass")
+    monkeypatch.setitem(field.metadata["value"], "hull", 1234.0)
+    assert dv.Pendulum().checked("hull").mass == 1234.0
+    units = Units(1.0, 2000.0, 9.81, None)
+    for kind, want in (("buoy", BUOY["tp"]), ("hull", HULL["tp"])):
+        _, info = _irregular_wave(1.0, None, "jonswap", 3.3, 40.0, None, 3.0, None, 0.1,
+                                  units, kind=kind)
+        assert info["tp"] == want and info["seed"] == 0, kind
+    for name, bad in (("mass", 0.0), ("length", -1.0), ("inertia", 0.0)):
+        with pytest.raises(parapend.ParameterError, match=f"^{name}: expected a number > 0"):
+            dv.Pendulum(**{name: bad}).checked()
+    lo, hi = dv.declaration("barge_length")[3]
+    with pytest.raises(parapend.ParameterError, match=rf"^barge-length: expected .*{hi:g}"):
+        parapend.buoy(dofs="surge,heave,pitch", barge_length=2 * hi)
+    with pytest.raises(parapend.ParameterError, match=r"^torque-limit: expected .*1e\+12"):
+        dv.PowerTakeOff(torque_limit=1e13).hull()
+    assert declared.default_of("barge_length", None, "hull") == HULL["barge_length"]
+
+
 def test_a_declared_default_is_the_command_s_default(monkeypatch):
     """A default that is one value stands in the declaration: the help states it, and the
     command uses it (a declared default changed is the command's new default)."""
