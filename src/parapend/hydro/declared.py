@@ -391,7 +391,8 @@ RUN_OPTIONS = {
     "records": "seeded records of the curve", "warm_up": "peak periods before measuring",
     "speed_limit": "the prescribed-heave pendulum's speed limit",
     "gravity": "the prescribed-heave pendulum's g", "gamma": "its non-dimensional damping",
-    "torque_limit_nm": "the prescribed-heave pendulum's torque limit in N m",
+    "torque_limit_nm": "the torque limit in N m where --torque-limit is in m g l (horizon's, "
+                       "the prescribed-motion commands'): a PowerTakeOff's torque_limit",
     "te": "energy periods of the bins", "realizations": "records per bin",
     "waves": "waves per record", "response": "the prescribed heave's response",
     "depth": "water depth of the bins' resource", "density": "water density",
