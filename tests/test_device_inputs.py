@@ -22,31 +22,43 @@ from parapend.cli import build_parser
 from parapend.hydro import device as dv
 
 DOCS = Path(__file__).resolve().parents[1] / "docs"
+#: the commands of the floating body, whose options are generated from the declarations
 COMMANDS = ("buoy", "horizon", "power-matrix")
+_SUB = next(a for a in build_parser()._actions if isinstance(a, argparse._SubParsersAction))
+ALL_COMMANDS = sorted(_SUB.choices)
+_METAS = {f.name: f.metadata for cls in (dv.Sea, dv.Pendulum, dv.Body, dv.PowerTakeOff,
+                                         dv.Controller) for f in dataclasses.fields(cls)}
 
 
 def _options(command):
-    sub = next(a for a in build_parser()._actions
-               if isinstance(a, argparse._SubParsersAction)).choices[command]
     skip = commands.presentation(command) | {"help"}
-    return [a for a in sub._actions if a.option_strings and a.dest not in skip]
+    return [a for a in _SUB.choices[command]._actions
+            if a.option_strings and a.dest not in skip]
 
 
-@pytest.mark.parametrize("command", COMMANDS)
+@pytest.mark.parametrize("command", ALL_COMMANDS)
 def test_every_option_is_declared_once(command):
-    """Each option is a declared parameter of one input object, or a run option, never both;
-    a declaration carries a unit, a default and a help, and names a keyword of
-    ``parapend.buoy`` (the objects are its inputs, grouped)."""
+    """Every option of every command is a declared parameter of one input object, a run
+    option of the floating body's commands or an option of the prescribed-motion commands
+    (``RUN_OPTIONS``, ``PRESCRIBED_OPTIONS``: each with what it is), exactly one of them; a
+    declaration carries a unit, a default and a help, and names a keyword of
+    ``parapend.buoy`` (the objects are its inputs, grouped). Where a command states a
+    declared parameter in its own unit (the prescribed-motion pendulum's torque in ``m g
+    l``), the declaration says so for that command, and the option's help names that unit."""
     declared = dv.declarations()
     buoy = inspect.signature(parapend.buoy).parameters
     for action in _options(command):
         name = action.dest
-        assert (name in declared) != (name in dv.RUN_OPTIONS), (command, name)
+        homes = [name in declared, name in dv.RUN_OPTIONS, name in dv.PRESCRIBED_OPTIONS]
+        assert sum(homes) == 1, (command, name, homes)
         if name in declared:
             owner, unit, default, _bounds, text = declared[name]
             assert owner in ("Sea", "Pendulum", "Body", "PowerTakeOff", "Controller")
             assert unit and default and text, name
             assert name in buoy, name
+            unit = _METAS[name]["commands"].get(command, {}).get("unit", unit)
+            if unit != "-" and action.help != argparse.SUPPRESS:
+                assert unit in (action.help or ""), (command, name, unit, action.help)
 
 
 def test_each_name_is_declared_in_one_object_and_the_run_options_are_documented():
@@ -150,6 +162,39 @@ def test_a_declared_bound_is_the_command_s_check(name, extra):
         parapend.buoy(**{name: 2 * hi + 1}, **extra)
 
 
+def test_the_embedded_designs_defaults_and_bounds_are_declared(monkeypatch):
+    """The pendulum's, the sea's and the bodies' defaults of the embedded buoy and hull stand
+    in the declarations (``value``, one per body; ``parapend.defaults``), and the
+    objects apply them: a declared default changed is what the command gets, for the buoy
+    and the hull alike. A hull's sea state given only ``hs`` takes the hull's peak period
+    (the small buoy's 2.5 s was taken before). A declared bound is the check."""
+    from parapend.defaults import BUOY, HULL
+    from parapend.hydro import declared
+    from parapend.hydro.inputs import _irregular_wave
+    from parapend.units import Units
+
+    assert dv.Pendulum().checked().mass == BUOY["mass"]
+    assert dv.Pendulum().checked("hull").mass == HULL["mass"]
+    assert dv.Pendulum(mass=7.0).checked("hull").mass == 7.0
+    field = next(f for f in dataclasses.fields(dv.Pendulum) if f.name == "mass")
+    monkeypatch.setitem(field.metadata["value"], "hull", 1234.0)
+    assert dv.Pendulum().checked("hull").mass == 1234.0
+    units = Units(1.0, 2000.0, 9.81, None)
+    for kind, want in (("buoy", BUOY["tp"]), ("hull", HULL["tp"])):
+        _, info = _irregular_wave(1.0, None, "jonswap", 3.3, 40.0, None, 3.0, None, 0.1,
+                                  units, kind=kind)
+        assert info["tp"] == want and info["seed"] == 0, kind
+    for name, bad in (("mass", 0.0), ("length", -1.0), ("inertia", 0.0)):
+        with pytest.raises(parapend.ParameterError, match=f"^{name}: expected a number > 0"):
+            dv.Pendulum(**{name: bad}).checked()
+    lo, hi = dv.declaration("barge_length")[3]
+    with pytest.raises(parapend.ParameterError, match=rf"^barge-length: expected .*{hi:g}"):
+        parapend.buoy(dofs="surge,heave,pitch", barge_length=2 * hi)
+    with pytest.raises(parapend.ParameterError, match=r"^torque-limit: expected .*1e\+12"):
+        dv.PowerTakeOff(torque_limit=1e13).hull()
+    assert declared.default_of("barge_length", None, "hull") == HULL["barge_length"]
+
+
 def test_a_declared_default_is_the_command_s_default(monkeypatch):
     """A default that is one value stands in the declaration: the help states it, and the
     command uses it (a declared default changed is the command's new default)."""
@@ -185,6 +230,8 @@ def test_the_documented_script_is_short_and_builds_each_input_once():
     for built in ("Sea.state(", "Pendulum(", "Body.barge(", "PowerTakeOff(copper_loss"):
         assert code.count(built) == 1, built
     assert "hull.with_dofs(\"heave\")" in code  # the causal run's body: the same barge
+    # the hull's own causal run, once it has one, is one word away: device.causal
+    assert "heave.causal(" in code and "device.causal" in code
     for asked in (".optimum(", ".causal(", ".power_matrix("):
         assert asked in code, asked
 
@@ -207,53 +254,41 @@ def test_the_documented_script_runs(tmp_path, monkeypatch, capsys):
     assert "optimum" in capsys.readouterr().out
 
 
-def test_buoy_s_options_are_generated_from_the_declarations():
-    """``parapend buoy``'s options of the sea, the pendulum, the body (but ``--body`` and
-    ``--hydro``, whose help is the command's), the take-off and the controller are made from
-    their declarations: the help states the declared help, unit and default
-    (the defaults of the embedded buoy and hull, read from parapend.defaults)."""
-    from parapend.defaults import BUOY, HULL
+@pytest.mark.parametrize("command", COMMANDS)
+def test_the_floating_body_s_options_are_generated(command):
+    """Every option of ``buoy``, ``horizon`` and ``power-matrix`` named as a declared
+    parameter is made from its declaration: the help states the declared help, unit and
+    default, or those the declaration states for that command (the prescribed-heave
+    pendulum's defaults, the buoy's with ``--device buoy``, the curve's shorter records, the
+    matrix's bins and causal column, the curve's torque limit in m g l), with its choices;
+    none is written by the command (but horizon's hidden --controller, the planner's former
+    name, refused in one line)."""
+    from parapend.defaults import BUOY, HORIZON, HULL, SEA
 
-    generated = {f.name: f.metadata for cls in (dv.Sea, dv.Pendulum, dv.Body,
-                                                 dv.PowerTakeOff, dv.Controller)
-                 for f in dataclasses.fields(cls) if f.name not in ("body", "hydro")}
-    options = {a.dest: a for a in _options("buoy")}
-    for name, meta in generated.items():
-        assert options[name].help == dv.option_help(meta), name
-        if meta["choices"]:
-            assert tuple(options[name].choices) == meta["choices"], name
-    assert options["mass"].help.endswith(f"(default {BUOY['mass']:g}; a hull's "
-                                         f"{HULL['mass']:g})")
-
-
-#: options of horizon and power-matrix named as a declared parameter but written by the
-#: command (what is left to generate): the bins, the pendulum's torque limit in m g l, a
-#: plain efficiency, the causal column's own controller options, the body's name and dataset
-#: (and horizon's hidden --controller, the planner's former name, refused)
-OWN = {"horizon": {"torque_limit", "efficiency", "dofs", "body", "hydro", "controller"},
-       "power-matrix": {"hs", "tp", "efficiency", "torque_limit", "controller", "horizon",
-                        "forecast", "update_interval", "dofs", "body", "hydro"}}
-
-
-@pytest.mark.parametrize("command", ["horizon", "power-matrix"])
-def test_horizon_s_and_power_matrix_s_options_are_generated(command):
-    """``horizon``'s and ``power-matrix``'s options of the sea and the pendulum (and the
-    body's) are made from the same declarations as ``buoy``'s, with the defaults the
-    declaration states for that command (the prescribed-heave pendulum's, the buoy's with
-    ``--device buoy``, the curve's shorter records)."""
-    from parapend.defaults import BUOY, HORIZON, SEA
-
-    metas = {f.name: f.metadata for cls in (dv.Sea, dv.Pendulum, dv.Body, dv.PowerTakeOff,
-                                            dv.Controller) for f in dataclasses.fields(cls)}
     options = {a.dest: a for a in _options(command)}
-    generated = [n for n in options if n in metas and n not in OWN[command]]
-    assert {"seed", "spectrum", "mass", "length", "damping_coefficient"} <= set(generated)
+    generated = [n for n in options if n in _METAS]
+    assert {"seed", "spectrum", "mass", "length", "damping_coefficient", "body", "hydro",
+            "torque_limit", "efficiency"} <= set(generated)
     for name in generated:
-        assert options[name].help == dv.option_help(metas[name], command), name
-    assert options["mass"].help.endswith(f"(default {SEA['mass']:g}; {BUOY['mass']:g} with "
-                                         "--device buoy)")
+        action, meta = options[name], _METAS[name]
+        if action.help == argparse.SUPPRESS:
+            assert (command, name) == ("horizon", "controller")
+            continue
+        assert action.help == dv.option_help(meta, command), (command, name)
+        choices = meta["commands"].get(command, {}).get("choices", meta["choices"])
+        assert (tuple(action.choices) if action.choices else None) == choices, name
+    if command == "buoy":
+        assert options["mass"].help.endswith(f"(default {BUOY['mass']:g}; a hull's "
+                                             f"{HULL['mass']:g})")
+    else:
+        assert options["mass"].help.endswith(f"(default {SEA['mass']:g}; {BUOY['mass']:g} "
+                                             "with --device buoy)")
     if command == "horizon":
         assert f"default {HORIZON['repeat_periods']:g} Tp;" in options["repeat_period"].help
+        assert ", m g l (default none)" in options["torque_limit"].help
+    if command == "power-matrix":
+        assert options["hs"].help.endswith("(default 1:3:3)")
+        assert tuple(options["controller"].choices) == ("mpc", "none")
 
 
 @pytest.mark.slow

@@ -197,8 +197,8 @@ def add_pendulum_options(g, *, gamma_note: str = "") -> None:
 def add_declared(g, cls, names, command: str | None = None) -> None:
     """The options ``--NAME`` of the parameters ``names`` of an input object ``cls``
     (:mod:`parapend.hydro.device`) into the argument group ``g``, generated from their
-    declarations: the help, the unit and the default stated (``command``'s where its
-    declaration states one), the type, the choices."""
+    declarations: the help, the unit and the default stated, the type, the choices
+    (``command``'s where its declaration states its own)."""
     import dataclasses
 
     from ..hydro.device import option_help
@@ -206,7 +206,8 @@ def add_declared(g, cls, names, command: str | None = None) -> None:
     meta = {f.name: f.metadata for f in dataclasses.fields(cls)}
     for name in names:
         m, flag = meta[name], name.replace("_", "-")
-        kw = {"help": option_help(m, command)}
+        m = {**m, **m["commands"].get(command, {})}
+        kw = {"help": option_help(meta[name], command)}
         if m["choices"]:
             kw["choices"] = list(m["choices"])
         elif m["kind"] == "float":
@@ -218,18 +219,14 @@ def add_declared(g, cls, names, command: str | None = None) -> None:
         g.add_argument(f"--{flag}", **kw)
 
 
-def add_body_options(g, *, body_help: str, hydro_help: str,
-                     bodies=("cylinder", "sphere")) -> None:
-    """The buoy's body of ``buoy`` and ``power-matrix --device buoy`` into the argument group
-    ``g``: ``--body --radius --draft --mesh --hydro`` (``--radius --draft --mesh`` generated
-    from their declarations, :class:`parapend.hydro.device.Body`); the help of ``--body``
-    and ``--hydro`` are the commands' own."""
+def add_body_options(g, command: str | None = None) -> None:
+    """The body of ``buoy``, ``horizon`` and ``power-matrix --device buoy`` into the argument
+    group ``g``: ``--body --radius --draft --mesh --hydro``, generated from their
+    declarations (:class:`parapend.hydro.device.Body`; ``command``'s help and choices of
+    ``--body`` and ``--hydro`` where the declaration states them)."""
     from ..hydro.device import Body
 
-    g.add_argument("--body", choices=list(bodies),
-                   help=body_help)
-    add_declared(g, Body, ("radius", "draft", "mesh"))
-    g.add_argument("--hydro", metavar="FILE", help=hydro_help)
+    add_declared(g, Body, ("body", "radius", "draft", "mesh", "hydro"), command=command)
 
 
 FIGURE_SUFFIXES = (".png", ".svg", ".pdf")

@@ -53,12 +53,7 @@ def add_parsers(sub) -> None:
     g = p.add_argument_group("body (Capytaine; the BEM result is cached on disk)")
     from ._common import add_body_options
 
-    add_body_options(g, bodies=("cylinder", "sphere", "barge"),
-                     body_help="vertical cylinder or sphere floating at its centre (default "
-                               "cylinder); with --dofs surge,heave,pitch also a box barge "
-                               "(the default there)",
-                     hydro_help="a Capytaine dataset (NetCDF), instead of solving "
-                                "(docs/buoy.md)")
+    add_body_options(g, command="buoy")
     p.set_defaults(body=None)  # so that --body given beside --hydro or --mesh is refused
     add_declared(g, Sea, ("wave_direction",))
 

@@ -6,7 +6,7 @@ from __future__ import annotations
 import argparse
 
 from ..defaults import HORIZON
-from ..hydro.declared import Controller, Pendulum, Sea
+from ..hydro.declared import Body, Controller, Pendulum, PowerTakeOff, Sea
 from ..hydro.horizon import BUOY_HORIZON, PLANNERS
 from . import _output
 from ._common import (
@@ -50,27 +50,20 @@ def add_parsers(sub) -> None:
                    help="viscous damping, non-dimensional (default 0.01; not with --device "
                         "buoy)")
     add_declared(g, Pendulum, ("damping_coefficient",), command="horizon")
-    g.add_argument("--torque-limit", type=_finite_float("torque-limit"),
-                   help="|T| <= T_max, units m g l, for every controller (default none)")
+    add_declared(g, PowerTakeOff, ("torque_limit",), command="horizon")
     g.add_argument("--torque-limit-nm", type=_finite_float("torque-limit-nm"),
-                   help="the torque limit in N m (instead of --torque-limit)")
-    g.add_argument("--efficiency", type=_finite_float("efficiency"),
-                   help="PTO efficiency in (0, 1], generating and motoring (default none: "
-                        "lossless)")
+                   help="the torque limit in N m (instead of --torque-limit; a "
+                        "PowerTakeOff's torque_limit)")
+    add_declared(g, PowerTakeOff, ("efficiency",), command="horizon")
     g = p.add_argument_group("--device buoy: the body (Capytaine; the BEM result is cached on "
                              "disk) and the controller")
-    add_body_options(g, body_help="vertical cylinder or sphere floating at its centre "
-                                  "(default cylinder)",
-                     hydro_help="a Capytaine dataset (NetCDF), instead of solving "
-                                "(docs/buoy.md)")
+    add_body_options(g, command="horizon")
     g.add_argument("--planner", choices=list(PLANNERS),
                    help="the buoy's receding-horizon planner (parapend.hydro.control.buoy_mpc"
                         "; default plan, coupled with --efficiency)")
     # the planner's former name: refused in one line naming --planner (parapend.horizon)
     g.add_argument("--controller", help=argparse.SUPPRESS)
-    g.add_argument("--dofs", metavar="DOFS",
-                   help="the body's degrees of freedom: heave (default, the heaving buoy); "
-                        "a hull's (surge,heave,pitch) has no causal controller yet")
+    add_declared(g, Body, ("dofs",), command="horizon")
     g = p.add_argument_group("controllers")
     g.add_argument("--horizons",
                    help="horizons in peak periods, comma separated (default "

@@ -6,8 +6,7 @@ from __future__ import annotations
 import shlex
 import sys
 
-from ..defaults import HULL
-from ..hydro.declared import Pendulum, PowerTakeOff, Sea
+from ..hydro.declared import Body, Controller, Pendulum, PowerTakeOff, Sea
 from . import _output
 from ._common import (
     FIGURE_SUFFIXES,
@@ -47,17 +46,16 @@ def add_parsers(sub) -> None:
                     "Resumable with --store.")
     p._negative_number_matcher = _NEGATIVE_VALUE
     g = p.add_argument_group("bins (bin centres: " + _BINS + ")")
-    g.add_argument("--hs", help="significant wave height Hm0, m (default "
-                                "1:3:3)")
+    # the sea's, the pendulum's, the body's, the take-off's and the causal column's options:
+    # generated from their declarations (parapend.hydro.declared), with what they state
+    # for power-matrix (its bins, its defaults)
+    add_declared(g, Sea, ("hs",), command="power-matrix")
     g.add_argument("--te", help="energy period, s (default 6:10:3)")
-    g.add_argument("--tp", help="peak period, s, instead of --te (Te = "
-                                "(Te/Tp of the spectrum) Tp)")
+    add_declared(g, Sea, ("tp",), command="power-matrix")
     g.add_argument("--realizations", type=_int,
                    help="seeded records per bin (default 3)")
     g.add_argument("--waves", type=_finite_float("waves"),
                    help="record length in peak periods, 2 to 400 (default 50)")
-    # the sea's and the pendulum's options: generated from their declarations
-    # (parapend.hydro.declared), with the defaults they state for power-matrix
     add_declared(g, Sea, ("seed", "spectrum", "gamma_peak", "cutoff"),
                  command="power-matrix")
     g.add_argument("--response", metavar="CSV",
@@ -75,30 +73,13 @@ def add_parsers(sub) -> None:
     add_declared(g, Pendulum, ("damping_coefficient",), command="power-matrix")
     g.add_argument("--winding", type=_winding, help="as sea (default 1)")
     g.add_argument("--harmonics", type=_int, help="as sea (default 16 per wave)")
-    g.add_argument("--efficiency", type=_finite_float("efficiency"),
-                   help="power take-off efficiency in [1e-6, 1]: the power reported is "
-                        "the electrical one, the mechanical beside it")
-    g.add_argument("--torque-limit", type=_finite_float("torque-limit"),
-                   help="largest |torque|, N m (with --dofs surge,heave,pitch; refused "
-                        "otherwise: not supported over a sea record)")
+    add_declared(g, PowerTakeOff, ("efficiency", "torque_limit"), command="power-matrix")
     g = p.add_argument_group("the causal column (--device prescribed-heave, as parapend "
                              "horizon; and the heaving --device buoy, as parapend buoy "
                              "--controller mpc: perfect forecast, horizon 2, update 1/8; "
                              "docs/performance.md)")
-    g.add_argument("--controller", choices=["mpc", "none"],
-                   help="mpc: beside the non-causal optimum, the receding-horizon controller "
-                        "on the same records (storage-corrected, after --warm-up), and the "
-                        "annual energy of each column side by side (default none)")
-    g.add_argument("--horizon", type=_finite_float("horizon"),
-                   help="the controller's horizon in peak periods, 0.05 to 20 (default 1 "
-                        "with --controller mpc; the buoy's 2, 1 with --efficiency)")
-    g.add_argument("--forecast", metavar="NAMES",
-                   help="perfect, ar (autoregressive, fitted on the past only) or "
-                        "perfect,ar: one causal column each (default perfect with "
-                        "--controller mpc; ar costs about twice perfect)")
-    g.add_argument("--update-interval", type=_finite_float("update-interval"),
-                   help="peak periods between two plans, 0.001 to 1 (default 1/32 with "
-                        "--controller mpc; the buoy's 1/8, at least 1/64)")
+    add_declared(g, Controller, ("controller", "horizon", "forecast", "update_interval"),
+                 command="power-matrix")
     g.add_argument("--warm-up", type=_finite_float("warm-up"),
                    help="peak periods from the hanging rest left out of the mean, which is "
                         "over one repeat of the record after it (default 4 with "
@@ -112,20 +93,10 @@ def add_parsers(sub) -> None:
                         "with --controller mpc: without it the plans spun the pendulum "
                         "past a turn per torque sample in steep seas, a failed run)")
     g = p.add_argument_group("the buoy's body (--device buoy; as parapend buoy)")
-    add_body_options(g, body_help="a vertical cylinder or a floating sphere (default "
-                                  "cylinder); with --dofs surge,heave,pitch also a box barge "
-                                  "(its default)",
-                     hydro_help="a Capytaine NetCDF dataset, instead of --body (docs/buoy.md)",
-                     bodies=("cylinder", "sphere", "barge"))
+    add_body_options(g, command="power-matrix")
     g = p.add_argument_group("hull: surge, heave and pitch (--device buoy; as parapend buoy, "
                              "docs/hull.md)")
-    g.add_argument("--dofs", metavar="DOFS",
-                   help="the hull's degrees of freedom: heave (the heaving buoy) or "
-                        "surge,heave,pitch (a hull that pitches; each record's best of "
-                        "rotation, swinging and rest; its pendulum's defaults the hull's: "
-                        f"{HULL['mass']:g} kg, {HULL['length']:g} m, "
-                        f"{HULL['damping_coefficient']:g} N m s/rad; records of at most "
-                        "about 10 waves: give --waves) (default heave)")
+    add_declared(g, Body, ("dofs",), command="power-matrix")
     hull_options(g)
     add_declared(g, PowerTakeOff, ("copper_loss",))
     g = p.add_argument_group("resource and site")

@@ -93,14 +93,13 @@ def _dimensions(body, radius, draft):
                              "parapend buoy (heave alone or --dofs surge,heave,pitch)")
     if body not in ("cylinder", "sphere"):
         raise ParameterError(f"body: expected cylinder or sphere, got {body!r:.40}")
-    lo, hi = limits.BUOY_SIZE_RANGE
-    r = check_range("radius", BUOY["radius"] if radius is None else radius, lo, hi, why="m")
+    r = check("radius", default_of("radius", radius, "buoy"))
     if body == "sphere":
         if draft is not None:
             raise ParameterError("draft: a sphere floats at its centre (draft = radius); "
                                  "drop --draft")
         return r, r
-    d = check_range("draft", BUOY["draft"] if draft is None else draft, lo, hi, why="m")
+    d = check("draft", default_of("draft", draft, "buoy"))
     _check_bem_size(r, d)
     return r, d
 
@@ -300,8 +299,7 @@ def _check_floats(h, pendulum):
 # --- the command ------------------------------------------------------------------------------
 def buoy(*, wave_height=None, wave_period=None, hs=None, tp=None, spectrum=None,
          gamma_peak=None, repeat_period=None, seed=None, cutoff=None, record=None, taper=None,
-         mass=BUOY["mass"], length=BUOY["length"], inertia=BUOY["inertia"],
-         damping_coefficient=BUOY["damping_coefficient"], body=None, radius=None,
+         mass=None, length=None, inertia=None, damping_coefficient=None, body=None, radius=None,
          draft=None, mesh=None, hydro=None, winding=None, harmonics=None, torque_limit=None,
          efficiency=None, optimize_design=None, mass_bounds=None, length_bounds=None,
          inertia_bounds=None, damping_coefficient_bounds=None, controller="optimum",
@@ -489,8 +487,8 @@ def buoy(*, wave_height=None, wave_period=None, hs=None, tp=None, spectrum=None,
                                         length_bounds=length_bounds,
                                         inertia_bounds=inertia_bounds,
                                         damping_coefficient_bounds=damping_coefficient_bounds)
-    height = check("wave_height", BUOY["wave_height"] if wave_height is None
-                   else wave_height, why="regular wave height, m")
+    height = check("wave_height", default_of("wave_height", wave_height, "buoy"),
+                   why="regular wave height, m")
     if periods is not None and variables:
         raise ParameterError("optimize-design: one wave period at a time (drop FROM:TO:N)")
     if variables:
@@ -515,7 +513,7 @@ def buoy(*, wave_height=None, wave_period=None, hs=None, tp=None, spectrum=None,
             _check_record_harmonics(h, wave, harmonics, winding, record, pto=False)
     else:
         if periods is None:
-            period = _period(BUOY["wave_period"] if wave_period is None else wave_period)
+            period = _period(default_of("wave_period", wave_period, "buoy"))
             periods_all = np.array([period])
         else:
             periods_all = np.array([_period(p) for p in periods])
@@ -666,32 +664,26 @@ def _refuse_unsupported(opts: dict) -> None:
 
 
 def _hull_pto(opts):
-    """The power take-off (:class:`.hull.HullPTO`) from ``torque_limit`` (N m),
-    ``efficiency`` and ``copper_loss`` (W per (N m)^2)."""
-    from .hull import HullPTO
-    from .pto import efficiency_pair
+    """The hull's power take-off (:meth:`.declared.PowerTakeOff.hull`) of the keywords
+    ``torque_limit`` (N m), ``efficiency`` and ``copper_loss`` (W per (N m)^2)."""
+    from .declared import PowerTakeOff
 
-    eta = efficiency_pair(opts.get("efficiency"))
-    limit = opts.get("torque_limit")
-    if limit is not None:
-        limit = check_range("torque-limit", limit, 1e-6, 1e12, why="N m")
-    r = opts.get("copper_loss")
-    r = 0.0 if r is None else check("copper_loss", r)
-    return HullPTO(efficiency=eta, copper_loss=r, torque_limit=limit)
+    return PowerTakeOff(**{k: opts.get(k) for k in ("torque_limit", "efficiency",
+                                                     "copper_loss")}).hull()
 
 
 def _hull_value(opts, name):
-    """The option, or the hull's default when the caller did not give it (the heave-only
-    command's defaults are for a 1 m buoy, not a 10 m hull)."""
+    """The option, or the hull's declared default when the caller did not give it (the
+    heave-only command's defaults are for a 1 m buoy, not a 10 m hull)."""
     v = opts.get(name)
-    return v if given(v) else HULL.get(name)
+    return default_of(name, v if given(v) else None, "hull")
 
 
 def _hull_pendulum(opts):
     from .inputs import _pendulum as build
 
-    return build(*(_hull_value(opts, k) for k in ("mass", "length", "inertia",
-                                                   "damping_coefficient")))
+    return build(*(opts.get(k) if given(opts.get(k)) else None
+                   for k in ("mass", "length", "inertia", "damping_coefficient")), kind="hull")
 
 
 def _hull_body(opts):
@@ -718,16 +710,13 @@ def _hull_body(opts):
         raise ParameterError("wave-direction: needs --hydro (a dataset with several wave "
                              "directions)")
     body = "barge" if body is None else body
-    lo, hi = limits.BUOY_SIZE_RANGE
     if body == "barge":
         for k in ("radius", "draft"):
             if opts.get(k) is not None:
                 raise ParameterError(f"{k}: the barge takes --barge-length, --barge-beam and "
                                      "--barge-draft; drop it")
-        length = check_range("barge-length", _hull_value(opts, "barge_length"), lo, hi,
-                             why="m")
-        beam = check_range("barge-beam", _hull_value(opts, "barge_beam"), lo, hi, why="m")
-        draft = check_range("barge-draft", _hull_value(opts, "barge_draft"), lo, hi, why="m")
+        length, beam, draft = (check(k, _hull_value(opts, k)) for k in (
+            "barge_length", "barge_beam", "barge_draft"))
         _check_barge_size(length, beam, draft)  # an estimate before long work
         def build():
             try:
@@ -746,17 +735,16 @@ def _hull_body(opts):
             raise ParameterError(f"{k.replace('_', '-')}: only with --body barge; drop it")
     if body not in ("cylinder", "sphere"):
         raise ParameterError(f"body: expected barge, cylinder or sphere, got {body!r:.40}")
-    r = check_range("radius", _hull_value(opts, "radius"), lo, hi, why="m")
+    r = check("radius", _hull_value(opts, "radius"))
     if body == "sphere":
         # a sphere floating at its centre has no pitch stiffness about its waterplane
         # centre: a hull that pitches floats higher (default: half its radius immersed)
-        d = check_range("draft", 0.5 * r if opts.get("draft") is None else opts["draft"],
-                        lo, hi, why="m")
+        d = check("draft", 0.5 * r if opts.get("draft") is None else opts["draft"])
         top = 2 * r - d
         def build():
             return (hd.sphere_hull(r, draft=d, omega="body"))
     else:
-        d = check_range("draft", _hull_value(opts, "draft"), lo, hi, why="m")
+        d = check("draft", _hull_value(opts, "draft"))
         top = d  # its mesh: a cylinder of length twice the draft
         def build():
             return (hd.cylinder_hull(r, d, omega="body"))
@@ -918,14 +906,14 @@ def hull_buoy(deadline=None, **opts):
         from ..units import Units
 
         if opts.get("repeat_period") is None and opts.get("record") is None:
-            tp = opts.get("tp") or HULL["tp"]
+            tp = default_of("tp", opts.get("tp"), "hull")
             opts = dict(opts, repeat_period=HULL["repeat_periods"] * tp)
         wave, info = _irregular_wave(
             opts.get("hs"), opts.get("tp"), default_of("spectrum", opts.get("spectrum")),
             default_of("gamma_peak", opts.get("gamma_peak")), opts.get("repeat_period"),
             opts.get("seed"), default_of("cutoff", opts.get("cutoff")), opts.get("record"),
             default_of("taper", opts.get("taper")),
-            Units(pend.length, pend.mass, 9.81, pend.inertia))
+            Units(pend.length, pend.mass, 9.81, pend.inertia), kind="hull")
         return solve_record(p, wave, info)
     w = 2 * math.pi / periods
     hull.check_covers(float(np.min(w)), float(np.max(w)), name="wave-period")

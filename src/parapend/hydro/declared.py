@@ -13,24 +13,28 @@ import dataclasses
 from dataclasses import dataclass, field
 
 from ..defaults import BUOY, BUOY_HORIZON, HORIZON, HULL, SEA
-from ..limits import HULL_PITCH_INERTIA_RANGE, SEA_WAVES_RANGE
+from ..limits import BUOY_SIZE_RANGE, HULL_PITCH_INERTIA_RANGE, SEA_WAVES_RANGE
 
-__all__ = ["Body", "Controller", "DeviceInputs", "INPUT_KEYWORDS", "Pendulum", "PowerTakeOff",
-           "RUN_OPTIONS", "Sea", "check", "declaration", "declarations", "default_of",
-           "expand_inputs",
-           "has_inputs", "option_help"]
+__all__ = ["Body", "Controller", "DeviceInputs", "INPUT_KEYWORDS", "PRESCRIBED_OPTIONS",
+           "Pendulum", "PowerTakeOff", "RUN_OPTIONS", "Sea", "check", "declaration",
+           "declarations", "default_of", "expand_inputs", "has_inputs", "option_help"]
 
 
 def _param(unit: str, help: str, *, default=None, bounds=None, default_text=None,
            kind: str = "float", choices=None, metavar=None, commands=None, value=None):
     """A parameter's declaration: a field whose metadata hold its unit, bounds (the range the
-    command accepts, or None where it depends on other parameters), help, how the command
+    command accepts: ``(lo, hi)`` closed, ``hi`` None for none above, ``POSITIVE`` for
+    ``> 0``; or None where it depends on other parameters; :func:`check`), help, how the command
     line reads it (``kind``: float, int, text; ``choices``, ``metavar``) and the default it
     states (``default_text``; ``default`` None means the command's default). ``commands``:
     what another command (``horizon``, ``power-matrix``) states instead, its own ``help``
     or ``default`` (a documented per-command default: the prescribed-heave pendulum's, or
-    the horizon curve's shorter records). ``value``: the command's default itself where it
-    is one value (or one per controller, a dict), which the command reads
+    the horizon curve's shorter records), and where the command reads the option otherwise
+    its ``unit``, ``kind``, ``choices`` or ``metavar`` (the power matrix's bins, comma lists
+    of its causal columns; the prescribed-heave pendulum's torque limit in ``m g l``).
+    ``value``: the command's default itself where it
+    is one value (or one per controller or per body, a dict: ``"buoy"`` the embedded buoy's,
+    ``"hull"`` the embedded hull's, ``parapend.defaults``), which the command reads
     (:func:`default_of`) and the help states (``default_text`` then defaults to it)."""
     if default_text is None and value is not None and not isinstance(value, dict):
         default_text = value if isinstance(value, str) else f"{value:g}"
@@ -38,6 +42,17 @@ def _param(unit: str, help: str, *, default=None, bounds=None, default_text=None
         "unit": unit, "help": help, "bounds": bounds, "kind": kind, "choices": choices,
         "metavar": metavar, "default": default_text or repr(default),
         "commands": commands or {}, "value": value})
+
+
+#: the bounds of a parameter that must be above 0 (:func:`check`)
+POSITIVE = (0.0, None, "> 0")
+
+
+def _per_body(name: str) -> dict:
+    """The defaults of the embedded buoy and the embedded hull (``parapend.defaults.BUOY``,
+    ``HULL``), the value of a declaration (:func:`default_of` with ``"buoy"`` or
+    ``"hull"``)."""
+    return {"buoy": BUOY[name], "hull": HULL[name]}
 
 
 #: the receding-horizon controllers' default horizons, peak periods (the plan controller's
@@ -58,13 +73,20 @@ def _device(name: str) -> dict:
     return {"horizon": said, "power-matrix": said}
 
 
+def _bins(what: str, default=None) -> dict:
+    """``power-matrix``'s own reading of a sea-state parameter: the bins' centres (FROM:TO:N
+    or a comma list, as its group of options says)."""
+    return {"help": what, "default": default, "kind": "text", "metavar": None}
+
+
 def option_help(meta, command: str | None = None) -> str:
     """The command line's help of a declared parameter: its help, its unit and its default
     (those ``command`` states instead, where its declaration says so)."""
     own = meta.get("commands", {}).get(command, {})
-    unit = "" if meta["unit"] == "-" else f", {meta['unit']}"
+    unit = own.get("unit", meta["unit"])
+    unit = "" if unit == "-" else f", {unit}"
     stated = own.get("default", meta["default"])
-    default = "" if stated == "None" else f" (default {stated})"
+    default = "" if stated in (None, "None") else f" (default {stated})"
     return f"{own.get('help', meta['help'])}{unit}{default}"
 
 
@@ -84,14 +106,21 @@ class Sea(_Inputs):
     measured record (``measured``), each taken as a periodic record."""
 
     wave_height: float | None = _param("m", "H, crest to trough", bounds=(1e-4, 30.0),
+                                       value=_per_body("wave_height"),
                                        default_text=_both("wave_height"))
     wave_period: float | str | None = _param(
         "s", "the period; FROM:TO:N or a comma list T1,T2,... for power against period",
-        bounds=(0.1, 100.0), default_text=_both("wave_period"), kind="text", metavar="T")
-    hs: float | None = _param("m", "significant wave height",
-                              default_text=_both("hs", " with --tp"), commands=_device("hs"))
+        bounds=(0.1, 100.0), default_text=_both("wave_period"), kind="text", metavar="T",
+        value=_per_body("wave_period"))
+    hs: float | None = _param("m", "significant wave height", value=_per_body("hs"),
+                              default_text=_both("hs", " with --tp"), commands={
+                                  **_device("hs"), "power-matrix": _bins(
+                                      "significant wave height Hm0", "1:3:3")})
     tp: float | None = _param("s", "peak period", default_text=_both("tp", " with --hs"),
-                              commands=_device("tp"))
+                              value=_per_body("tp"),
+                              commands={**_device("tp"), "power-matrix": _bins(
+                                  "peak period, instead of --te (Te = (Te/Tp of the "
+                                  "spectrum) Tp)")})
     spectrum: str | None = _param("-", "spectrum shape", value="jonswap",
                                   kind="text", choices=("jonswap", "pierson-moskowitz"))
     gamma_peak: float | None = _param("-", "JONSWAP peak enhancement in [1, 20]",
@@ -104,7 +133,7 @@ class Sea(_Inputs):
                     f"{SEA_WAVES_RANGE[1]:g} peak periods)",
             "default": f"{HORIZON['repeat_periods']:g} Tp; "
                        f"{BUOY_HORIZON['repeat_periods']:g} Tp with --device buoy"}})
-    seed: int | None = _param("-", "seed of the random phases", default_text="0", kind="int",
+    seed: int | None = _param("-", "seed of the random phases", value=0, kind="int",
                               commands={
                                   "horizon": {"help": "seed of the first record's phases; "
                                                       "record r has seed + r"},
@@ -142,18 +171,44 @@ class Sea(_Inputs):
 class Pendulum(_Inputs):
     """The pendulum on its pivot (SI)."""
 
-    mass: float | None = _param("kg", "m", bounds=(0.0, None), default_text=_both("mass"),
+    mass: float | None = _param("kg", "m", bounds=POSITIVE, default_text=_both("mass"),
+                                value=_per_body("mass"),
                                 commands=_device("mass"))
-    length: float | None = _param("m", "pivot to centre of mass l", bounds=(0.0, None),
+    length: float | None = _param("m", "pivot to centre of mass l", bounds=POSITIVE,
+                                  value=_per_body("length"),
                                   default_text=_both("length"), commands=_device("length"))
-    inertia: float | None = _param("kg m^2", "about the pivot, at least m l^2",
+    inertia: float | None = _param("kg m^2", "about the pivot, at least m l^2", bounds=POSITIVE,
                                    default_text="m l^2")
     damping_coefficient: float | None = _param(
-        "N m s/rad", "viscous c", bounds=(0.0, None),
+        "N m s/rad", "viscous c", bounds=(0.0, None), value=_per_body("damping_coefficient"),
         default_text=_both("damping_coefficient"), commands=dict.fromkeys(
             ("horizon", "power-matrix"),
             {"help": "viscous c (instead of --gamma)",
              "default": f"--gamma; {BUOY['damping_coefficient']:g} with --device buoy"}))
+
+    def checked(self, kind: str = "buoy"):
+        """The pendulum of the coupled model (:class:`parapend.hydro.coupled.Pendulum`): each
+        field's declared default (the embedded ``kind``'s, ``"buoy"`` or ``"hull"``) and
+        bounds applied (:func:`~parapend.hydro.declared.check`), and what ties the fields
+        together checked: the inertia at least ``m l^2`` (its default), the units' ranges
+        (``parapend.limits.UNIT_*``, each message naming the option given)."""
+        from ..errors import ParameterError
+        from ..units import Units
+        from .coupled import Pendulum as Coupled
+
+        mass = check("mass", default_of("mass", self.mass, kind))
+        length = check("length", default_of("length", self.length, kind))
+        Units(length, mass, 9.81, None)
+        ml2 = mass * length * length
+        inertia = check("inertia", ml2 if self.inertia is None else self.inertia)
+        if inertia < ml2 * (1 - 1e-12):
+            raise ParameterError(f"inertia: expected at least m l^2 = {ml2:.6g} kg m^2 (the "
+                                 f"inertia about the pivot of a mass {mass:g} kg at "
+                                 f"{length:g} m), got {inertia:g}")
+        c = check("damping_coefficient",
+                  default_of("damping_coefficient", self.damping_coefficient, kind))
+        Units(length, mass, 9.81, inertia).gamma(c)
+        return Coupled(mass=mass, length=length, inertia=inertia, damping_coefficient=c)
 
 
 @dataclass(frozen=True)
@@ -161,36 +216,52 @@ class Body(_Inputs):
     """The floating body: a built-in shape (``body``: cylinder, sphere, barge), a mesh file or
     a Capytaine dataset; its degrees of freedom; the pivot's placement in it."""
 
-    body: str | None = _param("-", "cylinder, sphere or barge (a hull)",
-                              default_text="cylinder; a hull's barge", kind="text")
+    body: str | None = _param(
+        "-", "a vertical cylinder or a sphere floating at its centre; with --dofs "
+             "surge,heave,pitch also a box barge", default_text="cylinder; a hull's barge",
+        kind="text", choices=("cylinder", "sphere", "barge"), commands={"horizon": {
+            "help": "a vertical cylinder or a sphere floating at its centre",
+            "default": "cylinder", "choices": ("cylinder", "sphere")}})
     radius: float | None = _param("m", "the cylinder's or the sphere's radius",
+                                  bounds=BUOY_SIZE_RANGE, value=_per_body("radius"),
                                   default_text=_both("radius"))
     draft: float | None = _param("m", "the cylinder's draft (a hull sphere's: r / 2)",
+                                 bounds=BUOY_SIZE_RANGE, value=_per_body("draft"),
                                  default_text=_both("draft"))
     mesh: str | None = _param("-", "a mesh file Capytaine reads, instead of --body (z = 0 "
                                    "the free surface)", kind="text", metavar="FILE")
-    hydro: object = _param("-", "a Capytaine dataset (NetCDF path or xarray.Dataset)",
+    hydro: object = _param("-", "a Capytaine dataset (NetCDF; in Python also an "
+                                "xarray.Dataset), instead of solving (docs/buoy.md)",
                            kind="text", metavar="FILE")
     dofs: str | None = _param(
         "-", "the body's degrees of freedom: heave (the heaving buoy) or surge,heave,pitch (a "
              "hull that pitches; the pendulum rotates or swings)", default_text="heave",
-        kind="text", metavar="DOFS")
+        kind="text", metavar="DOFS", commands={
+            "horizon": {"help": "the body's degrees of freedom: heave (the heaving buoy); a "
+                                "hull's (surge,heave,pitch) has no causal controller yet"},
+            "power-matrix": {"help": "the body's degrees of freedom: heave (the heaving buoy) "
+                                     "or surge,heave,pitch (a hull that pitches; each "
+                                     "record's best of rotation, swinging and rest; its "
+                                     "pendulum's defaults the hull's: "
+                                     f"{HULL['mass']:g} kg, {HULL['length']:g} m, "
+                                     f"{HULL['damping_coefficient']:g} N m s/rad; records of "
+                                     "at most about 10 waves: give --waves)"}})
     pivot_height: float | None = _param(
         "m", "the pivot above the rotation centre O: a built-in body's waterplane centre, a "
              "mesh's origin, a dataset's rotation centre",
-        default_text=f"{HULL['pivot_height']:g}")
+        value=HULL["pivot_height"])
     pivot_offset: float | None = _param("m", "the pivot ahead of O, along the waves' travel",
-                                        default_text=f"{HULL['pivot_offset']:g}")
+                                        value=HULL["pivot_offset"])
     hull_pitch_inertia: float | None = _param(
         "kg m^2", "the hull's pitch inertia about O, without the pendulum",
         bounds=HULL_PITCH_INERTIA_RANGE,
         default_text="the dataset's, else a homogeneous immersed hull's")
     barge_length: float | None = _param("m", "the box barge's length",
-                                        default_text=f"{HULL['barge_length']:g}")
+                                        value=HULL["barge_length"], bounds=BUOY_SIZE_RANGE)
     barge_beam: float | None = _param("m", "the box barge's beam",
-                                      default_text=f"{HULL['barge_beam']:g}")
+                                      value=HULL["barge_beam"], bounds=BUOY_SIZE_RANGE)
     barge_draft: float | None = _param("m", "the box barge's draft",
-                                       default_text=f"{HULL['barge_draft']:g}")
+                                       value=HULL["barge_draft"], bounds=BUOY_SIZE_RANGE)
 
     @classmethod
     def barge(cls, length=None, beam=None, draft=None, **kw) -> Body:
@@ -216,14 +287,42 @@ class Body(_Inputs):
 class PowerTakeOff(_Inputs):
     """The power take-off: all None is the ideal, lossless one."""
 
-    torque_limit: float | None = _param("N m", "largest |torque|", bounds=(0.0, None))
+    torque_limit: float | None = _param("N m", "largest |torque|", bounds=(1e-6, 1e12), commands={
+        # the prescribed-heave pendulum's curve states its torque in its own unit, m g l
+        # (--torque-limit-nm: this declaration's N m)
+        "horizon": {"unit": "m g l", "default": "none",
+                    "help": "|T| <= T_max for every controller (the prescribed-heave "
+                            "pendulum's unit; --torque-limit-nm gives it in N m)"},
+        "power-matrix": {"help": "largest |torque|; with --dofs surge,heave,pitch (refused "
+                                 "otherwise: not supported over a sea record)"},
+        # and so do the commands of the pendulum on a prescribed motion
+        **dict.fromkeys(("optimize", "pto-curve", "track", "sweep"), {"unit": "m g l"})})
     efficiency: float | str | tuple | None = _param(
         "-", "power take-off efficiency in (0, 1], generating[,motoring]: the motion "
              "maximizes the electrical power", bounds=(0.01, 1.0), kind="text",
-        metavar="ETA_G[,ETA_M]")
+        metavar="ETA_G[,ETA_M]", commands={
+            "horizon": {"kind": "float", "metavar": None, "default": "none: lossless",
+                        "help": "power take-off efficiency in (0, 1], generating and "
+                                "motoring, for every controller"},
+            "power-matrix": {"kind": "float", "metavar": None,
+                             "help": "power take-off efficiency in [1e-6, 1]: the power "
+                                     "reported is the electrical one, the mechanical beside "
+                                     "it"}})
     copper_loss: float | None = _param(
         "W/(N m)^2", "the generator's winding loss r tau^2 subtracted from the power (with "
                      "--dofs surge,heave,pitch)", bounds=(0.0, 1e6))
+
+    def hull(self):
+        """The hull's take-off (:class:`parapend.hydro.hull.HullPTO`): each field checked
+        in its declared bounds (:func:`~parapend.hydro.declared.check`); None the ideal
+        one's (no limit, lossless, no copper loss)."""
+        from .hull import HullPTO
+        from .pto import efficiency_pair
+
+        limit = None if self.torque_limit is None else check("torque_limit", self.torque_limit)
+        r = 0.0 if self.copper_loss is None else check("copper_loss", self.copper_loss)
+        return HullPTO(efficiency=efficiency_pair(self.efficiency), copper_loss=r,
+                       torque_limit=limit)
 
 
 @dataclass(frozen=True)
@@ -236,21 +335,37 @@ class Controller(_Inputs):
         "-", "optimum: the non-causal coupled optimum; mpc: receding-horizon control planned "
              "on the coupled model with its radiation (the motion planner; with --efficiency "
              "the torque planner); one-way-mpc: planned on the free buoy's heave",
-        default_text="optimum", kind="text", choices=("optimum", "mpc", "one-way-mpc"))
+        default_text="optimum", kind="text", choices=("optimum", "mpc", "one-way-mpc"),
+        commands={"power-matrix": {
+            "choices": ("mpc", "none"), "default": "none",
+            "help": "mpc: beside the non-causal optimum, the receding-horizon controller on "
+                    "the same records (storage-corrected, after --warm-up), and the annual "
+                    "energy of each column side by side"}})
     horizon: float | None = _param(
         "peak periods", "with mpc: forecast horizon", value=_MPC_HORIZON,
-        default_text=f"{_MPC_HORIZON['mpc']:g}; one-way-mpc {_MPC_HORIZON['one-way-mpc']:g}")
+        default_text=f"{_MPC_HORIZON['mpc']:g}; one-way-mpc {_MPC_HORIZON['one-way-mpc']:g}",
+        commands={"track": {"unit": "peak (forcing) periods"}, "power-matrix": {
+            "help": "the causal column's horizon, 0.05 to 20",
+            "default": f"1 with --controller mpc; the buoy's {_MPC_HORIZON['mpc']:g}, 1 with "
+                       "--efficiency"}})
     update_interval: float | None = _param(
         "peak periods", "with mpc: re-planning interval", value=0.125,
         commands={"horizon": {  # the prescribed-heave pendulum's curve re-plans more often
             "help": "receding-horizon update interval",
             "default": f"{HORIZON['update_interval']:g}; "
-                       f"{BUOY_HORIZON['update_interval']:g} with --device buoy"}})
+                       f"{BUOY_HORIZON['update_interval']:g} with --device buoy"},
+            "power-matrix": {"help": "between two plans of the causal column, 0.001 to 1",
+                             "default": "1/32 with --controller mpc; the buoy's 1/8, at "
+                                        "least 1/64"}})
     forecast: str | None = _param(
         "-", "with mpc: what the controller knows of the excitation force over the horizon: "
              "perfect (the record's own future) or ar (autoregressive, fitted on the force "
              "measured so far)", value="perfect", kind="text",
-        choices=("perfect", "ar"))
+        choices=("perfect", "ar"), commands={"power-matrix": {
+            "choices": None, "metavar": "NAMES",
+            "help": "perfect, ar (autoregressive, fitted on the past only) or perfect,ar: one "
+                    "causal column each",
+            "default": "perfect with --controller mpc; ar costs about twice perfect"}})
 
     @classmethod
     def receding_horizon(cls, horizon=None, *, forecast=None, update_interval=None,
@@ -276,7 +391,8 @@ RUN_OPTIONS = {
     "records": "seeded records of the curve", "warm_up": "peak periods before measuring",
     "speed_limit": "the prescribed-heave pendulum's speed limit",
     "gravity": "the prescribed-heave pendulum's g", "gamma": "its non-dimensional damping",
-    "torque_limit_nm": "the prescribed-heave pendulum's torque limit in N m",
+    "torque_limit_nm": "the torque limit in N m where --torque-limit is in m g l (horizon's, "
+                       "the prescribed-motion commands'): a PowerTakeOff's torque_limit",
     "te": "energy periods of the bins", "realizations": "records per bin",
     "waves": "waves per record", "response": "the prescribed heave's response",
     "depth": "water depth of the bins' resource", "density": "water density",
@@ -287,6 +403,44 @@ RUN_OPTIONS = {
     "csv": "an output file", "command": "the command line recorded",
     "plan_samples": "torque samples per interval of the causal plan",
     "planner": "the horizon curve's receding-horizon planner of the buoy: coupled or plan",
+}
+
+#: options of the commands of the pendulum on a prescribed motion (the paper's
+#: non-dimensional problem: ``simulate``, ``optimize``, ``track``, ``sweep``, ...) that no
+#: input object declares: its excitation, its solvers' and its outputs' options (each
+#: command's help states the range and the default, its function's signature holds the
+#: default: tests/test_declared_once.py)
+PRESCRIBED_OPTIONS = {
+    "excitation": "the kind of q(t): harmonic, two-harmonic, square, fourier, file",
+    "omega": "forcing frequency, units sqrt(g/l)", "delta": "q's amplitude, units g",
+    "p": "excitation strength of Eq. 1", "square_alpha": "tanh width of the square wave",
+    "fourier": "q's Fourier terms k:amp:phase", "file": "one period of q, CSV tau,q",
+    "frequency": "base heave frequency, Hz (sets omega)",
+    "amplitude": "base heave amplitude, m (sets delta)",
+    "resolution": "grid points per axis of the basins", "phi_range": "initial angles, rad",
+    "dphi_range": "initial rates, units sqrt(g/l)", "periods": "forcing periods run",
+    "steps_per_period": "RK4 steps per forcing period",
+    "accuracy_sample": "points re-run to estimate the labels' accuracy",
+    "accuracy_seed": "seed of that sample", "split_phases": "one basin per attractor phase",
+    "engine": "compiled kernel or NumPy", "gamma_max": "largest damping of the sweep",
+    "points": "points of the curve", "n_from": "smallest N", "n_to": "largest N",
+    "method": "fourier or bvp", "efficiency_generating": "eta_g, overrides efficiency",
+    "efficiency_motoring": "eta_m, overrides efficiency", "vary": "the varied parameter",
+    "generator_damping": "generator damping c_g, N m s/rad",
+    "duration": "record length, s", "transient": "left out before the window, s",
+    "omniscient": "records given the omniscient optimum", "gpu": "integrate on the GPU",
+    "p_max": "largest p followed", "phi0": "initial angle, rad",
+    "dphi0": "initial rate, units sqrt(g/l)", "points_per_period": "output samples per period",
+    "threshold": "also gamma* at every point", "block_points": "points per stored block",
+    "torque_margin": "torque limit's share kept for feedback",
+    "r_weight": "LQR torque weight", "lock_tolerance": "a locked period's angle error, rad",
+    "theta0": "initial angle from upright, rad", "theta_dot0": "initial speed",
+    "runs": "seeded runs", "gamma_error": "plant's damping error, relative",
+    "delta_error": "plant's amplitude error, relative",
+    "noise_theta": "theta's measurement noise, rad", "noise_speed": "theta' noise",
+    "irregular": "a seeded JONSWAP record for q", "variable": "the map's variable",
+    "x": "the map's horizontal axis", "y": "the map's vertical axis",
+    "at": "a further axis's value", "plot": "an output figure", "out": "an output directory",
 }
 
 _OBJECTS = (Sea, Pendulum, Body, PowerTakeOff, Controller)
@@ -319,11 +473,15 @@ def check(name: str, value, *, why: str | None = None, absolute: bool = False) -
     one line that names it (:func:`parapend.errors.check_range`; ``why``, the reason said,
     default the declared unit; ``absolute``: the upper bound on ``|value|``). The commands
     check a declared parameter with this, so its bounds stand in one place."""
-    from ..errors import check_range
+    from ..errors import check_nonnegative, check_positive, check_range
 
     meta = _meta(name)
-    lo, hi = meta["bounds"]
-    return check_range(name.replace("_", "-"), value, lo, hi, absolute=absolute,
+    lo, hi = meta["bounds"][:2]
+    flag = name.replace("_", "-")
+    if hi is None:  # a lower bound alone: 0, included (>= 0) or not (POSITIVE)
+        return (check_positive if meta["bounds"] == POSITIVE else check_nonnegative)(
+            flag, value)
+    return check_range(flag, value, lo, hi, absolute=absolute,
                        why=meta["unit"] if why is None else why)
 
 

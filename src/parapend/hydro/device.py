@@ -30,6 +30,7 @@ import dataclasses
 from dataclasses import dataclass
 
 from .declared import (
+    PRESCRIBED_OPTIONS,
     RUN_OPTIONS,
     Body,
     Controller,
@@ -42,7 +43,8 @@ from .declared import (
 )
 from .declared import DeviceInputs as _DeviceInputs
 
-__all__ = ["Body", "Controller", "Device", "Pendulum", "PowerTakeOff", "RUN_OPTIONS", "Sea",
+__all__ = ["Body", "Controller", "Device", "PRESCRIBED_OPTIONS", "Pendulum", "PowerTakeOff",
+           "RUN_OPTIONS", "Sea",
            "causal", "declaration", "declarations", "horizon", "option_help", "optimum",
            "power_matrix"]
 

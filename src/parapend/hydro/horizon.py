@@ -216,10 +216,10 @@ def buoy_horizon_curve(*, hs=None, tp=None, spectrum="jonswap", gamma_peak=3.3,
         update_time_stats,
     )
     from ..deadline import check_time_limit, deadline, duration, expired, refuse_untimed
-    from ..defaults import BUOY
     from ..units import Units
     from .api import _check_floats, _check_kinds, _hydro
     from .control import buoy_mpc
+    from .declared import default_of
     from .inputs import _irregular_wave, _pendulum
     from .result import _solve
 
@@ -229,10 +229,7 @@ def buoy_horizon_curve(*, hs=None, tp=None, spectrum="jonswap", gamma_peak=3.3,
         raise ParameterError(f"progress: expected a callable progress(done, total) or None, "
                              f"got {progress!r:.40}")
     _check_kinds(mesh=mesh)  # a number for the path: one line, not os.fspath's TypeError
-    pend = _pendulum(BUOY["mass"] if mass is None else mass,
-                     BUOY["length"] if length is None else length, inertia,
-                     BUOY["damping_coefficient"] if damping_coefficient is None
-                     else damping_coefficient)
+    pend = _pendulum(mass, length, inertia, damping_coefficient)  # the declared defaults
     if planner is not None and planner not in PLANNERS:
         raise ParameterError(f"planner: expected {' or '.join(PLANNERS)}, got "
                              f"{planner!r:.40}")
@@ -276,8 +273,7 @@ def buoy_horizon_curve(*, hs=None, tp=None, spectrum="jonswap", gamma_peak=3.3,
                              f"{min(hz):g} peak periods, got {upd:g}")
     warm_up = check_range("warm-up", BUOY_HORIZON["warm_up"] if warm_up is None else warm_up,
                           0.0, 100.0, why="peak periods")
-    tp = BUOY["tp"] if tp is None else tp
-    hs = BUOY["hs"] if hs is None else hs
+    tp, hs = default_of("tp", tp, "buoy"), default_of("hs", hs, "buoy")
     units = Units(pend.length, pend.mass, 9.81, pend.inertia)
     if repeat_period is None:
         from ..seas import _check_sea

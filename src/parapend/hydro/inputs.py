@@ -7,9 +7,8 @@ import math
 
 import numpy as np
 
-from ..defaults import BUOY
-from ..errors import ParameterError, check_int, check_nonnegative, check_positive
-from .declared import check
+from ..errors import ParameterError, check_int, check_positive
+from .declared import check, default_of
 
 __all__ = ["parse_periods"]
 
@@ -57,31 +56,19 @@ def _period(value) -> float:
 
 
 # --- the pieces -----------------------------------------------------------------------------
-def _pendulum(mass, length, inertia, damping_coefficient):
-    from ..units import Units
-    from .coupled import Pendulum
+def _pendulum(mass, length, inertia, damping_coefficient, kind="buoy"):
+    """The keywords' pendulum: :meth:`.declared.Pendulum.checked` (``kind``: whose declared
+    defaults, the embedded ``"buoy"``'s or ``"hull"``'s)."""
+    from .declared import Pendulum
 
-    mass = check_positive("mass", mass)
-    length = check_positive("length", length)
-    # the ranges of the units (limits.UNIT_*): each message names the option given
-    Units(length, mass, 9.81, None)
-    ml2 = mass * length * length
-    if inertia is None:
-        inertia = ml2
-    inertia = check_positive("inertia", inertia)
-    if inertia < ml2 * (1 - 1e-12):
-        raise ParameterError(f"inertia: expected at least m l^2 = {ml2:.6g} kg m^2 (the "
-                             f"inertia about the pivot of a mass {mass:g} kg at {length:g} m), "
-                             f"got {inertia:g}")
-    c = check_nonnegative("damping-coefficient", damping_coefficient)
-    Units(length, mass, 9.81, inertia).gamma(c)
-    return Pendulum(mass=mass, length=length, inertia=inertia, damping_coefficient=c)
+    return Pendulum(mass=mass, length=length, inertia=inertia,
+                    damping_coefficient=damping_coefficient).checked(kind)
 
 
 def _irregular_wave(hs, tp, spectrum, gamma_peak, repeat_period, seed, cutoff, record, taper,
-                    units):
-    """The Wave of a periodic irregular record (``sea``'s parsing and checks) and its
-    description."""
+                    units, kind="buoy"):
+    """The Wave of a periodic irregular record (``sea``'s parsing and checks; the declared
+    defaults of the embedded ``kind``, ``"buoy"`` or ``"hull"``) and its description."""
     from ..seas import measured_record, sea_record
     from .coupled import Wave
 
@@ -92,10 +79,10 @@ def _irregular_wave(hs, tp, spectrum, gamma_peak, repeat_period, seed, cutoff, r
             raise ParameterError(f"{', '.join(bad)}: not used with --record; drop it")
         exc = measured_record(units, record, taper=taper, cutoff=cutoff)
     else:
-        exc = sea_record(units, hs=BUOY["hs"] if hs is None else hs,
-                         tp=BUOY["tp"] if tp is None else tp, spectrum=spectrum,
-                         gamma_peak=gamma_peak, repeat_period=repeat_period,
-                         seed=0 if seed is None else seed, cutoff=cutoff)
+        exc = sea_record(units, hs=default_of("hs", hs, kind), tp=default_of("tp", tp, kind),
+                         spectrum=spectrum, gamma_peak=gamma_peak,
+                         repeat_period=repeat_period, seed=default_of("seed", seed),
+                         cutoff=cutoff)
     info = dict(exc.info)
     info.pop("response", None)
     tr = float(info["repeat_period"])

@@ -15,7 +15,6 @@ import math
 
 import numpy as np
 
-from ..defaults import BUOY
 from ..errors import ParameterError, check_int
 
 __all__ = ["band", "body_hydro", "check_buoy", "check_file", "file_digest", "prepare",
@@ -203,10 +202,7 @@ def check_buoy(*, response, gamma, gravity, winding, harmonics, efficiency, mass
     winding = check_int("winding", winding, 1, 64)
     if harmonics is not None:
         harmonics = check_int("harmonics", harmonics, 2, 4096)
-    pend = _pendulum(BUOY["mass"] if mass is None else mass,
-                     BUOY["length"] if length is None else length, inertia,
-                     BUOY["damping_coefficient"] if damping_coefficient is None
-                     else damping_coefficient)
+    pend = _pendulum(mass, length, inertia, damping_coefficient)  # the declared defaults
     # the damping's non-dimensional gamma = c t0 / I is what the solver takes (at most
     # MAX_GAMMA): checked here, not in every bin (1e300 N m s/rad failed each bin alone)
     from ..units import Units
