@@ -175,8 +175,8 @@ def test_dofs_heave_keeps_the_store_identity():
 def test_the_hull_spec_round_trips(dataset):
     spec = matrix_spec(**BINS, realizations=1, hydro=dataset, **HULL)
     assert MatrixSpec.from_json(spec.to_json()) == spec
-    assert spec.variables == ("power", "radiation_bound_power", "one_way_power", "mode",
-                              "status")
+    assert spec.variables == ("power", "radiation_bound_power", "one_way_power",
+                              "peak_torque", "peak_pivot_force", "mode", "failure", "status")
 
 
 def test_the_take_off_reaches_the_hull(dataset):

@@ -901,7 +901,11 @@ def _power_matrix_result(power_matrix, arguments):
         from .performance.causal import causal_json
 
         out["causal"] = causal_json(ds, grid)
-    from .performance import matrix_csv
+    from .performance import matrix_csv, matrix_extremes
+
+    out["power_ci_low"], out["power_ci_high"] = grid("power_ci_low"), grid("power_ci_high")
+    out["power_ci_method"] = ds["power_ci_low"].attrs["method"]
+    out.update(matrix_extremes(ds, pk))
 
     return Record("power-matrix", out, dataset=ds, run=run,
                   draw=_draw_dataset("performance.figures", "plot_matrix"),

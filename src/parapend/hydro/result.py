@@ -42,6 +42,13 @@ HEAVE_KEYS = ("power_w", "heave_amplitude_m", "peak_torque_nm", "radiation_bound
               "electrical_power_w", "mechanical_power_w", "pto_loss_w", "generated_power_w",
               "motoring_power_w", "ideal_power_w", "one_way_electrical_power_w", "mesh_error_w",
               "mesh_error_relative", "grid_error_w", "validity_warnings")
+#: a hull's sea state over seeded realizations (``realizations``; None otherwise):
+#: :mod:`.realizations`
+REALIZATION_KEYS = ("realizations", "realizations_solved", "realization_seeds",
+                    "realization_powers_w", "realization_reasons",
+                    "realization_peak_torques_nm", "realization_peak_pivot_forces_n",
+                    "mean_power_w", "power_std_w", "power_ci_w", "power_ci_half_width_w",
+                    "power_ci_method")
 #: the JSON keys of an answer in surge, heave and pitch (a hull), in their order
 HULL_KEYS = ("power_w", "headline_reason", "mechanical_power_w", "efficiency",
              "copper_loss_w_per_nm2", "torque_limit_nm", "mode", "winding", "modes", "maxima",
@@ -54,7 +61,7 @@ HULL_KEYS = ("power_w", "headline_reason", "mechanical_power_w", "efficiency",
              "pitch_phase_deg", "mean_heel_deg", "mean_angle_deg", "swing_amplitude_deg",
              "peak_torque_nm", "peak_pivot_force_n", "harmonics", "hull_harmonics",
              "refinement_change_w", "success", "status", "dofs", "wave", "pendulum", "body",
-             "pivot", "warnings", "validity_warnings")
+             "pivot", "warnings", "validity_warnings", *REALIZATION_KEYS)
 #: the same of a period sweep
 HEAVE_SWEEP_KEYS = ("period_s", "power_w", "one_way_power_w", "radiation_bound_w", "limit_w",
                     "bound_fraction", "capture_width_m", "heave_amplitude_m",
@@ -68,9 +75,13 @@ HULL_SWEEP_KEYS = ("period_s", "power_w", "mechanical_power_w", "rotation_power_
 
 
 #: the fields' types (the others: ``float | None``), of one answer and of a sweep
-_TYPES = {**dict.fromkeys(("harmonics", "winding", "bound_cut", "hull_harmonics", "maxima"),
-                          "int | None"),
-          **dict.fromkeys(("status", "message", "mode", "headline_reason"), "str | None"),
+_TYPES = {**dict.fromkeys(("harmonics", "winding", "bound_cut", "hull_harmonics", "maxima",
+                           "realizations", "realizations_solved"), "int | None"),
+          **dict.fromkeys(("status", "message", "mode", "headline_reason", "power_ci_method"),
+                          "str | None"),
+          **dict.fromkeys(("realization_seeds", "realization_powers_w", "realization_reasons",
+                           "realization_peak_torques_nm", "realization_peak_pivot_forces_n",
+                           "power_ci_w"), "list | None"),
           **dict.fromkeys(("wave", "pendulum", "body", "design", "pivot"), "dict | None"),
           **dict.fromkeys(("efficiency", "modes", "maxima_powers_w"), "list | None"),
           "success": "bool | None"}
@@ -220,6 +231,14 @@ class BuoyResult(_Result):
         (located on the motion itself, between samples).
     harmonics, hull_harmonics : of the answer; refinement_change_w : the power's change
         from the answer with half as many (the stated discretization error).
+    realizations : a sea state over ``R`` seeded records (``buoy(realizations=R)``,
+        :mod:`.realizations`; None: one record): ``realization_seeds``,
+        ``realization_powers_w`` (NaN/null: no resolved answer, ``realization_reasons``
+        says why), ``realization_peak_torques_nm``, ``realization_peak_pivot_forces_n``;
+        ``mean_power_w`` over the ``realizations_solved`` resolved ones, ``power_std_w``
+        (ddof 1), ``power_ci_w`` its 95 % interval ``[low, high]`` and
+        ``power_ci_half_width_w`` (``power_ci_method``: Student's t with ``R - 1``
+        degrees of freedom); the other fields are the first record's (seed ``seed``).
     """
 
     _solution: object = field(default=None, repr=False)
@@ -236,11 +255,42 @@ class BuoyResult(_Result):
         if _heave_only(self.dofs):
             return ("power_w", "electrical_power_w", "one_way_power_w", "radiation_bound_w",
                     "heave_amplitude_m", "status")
+        if self.realizations is not None:
+            return ("mean_power_w", "power_ci_w", "realizations", "power_w", "status")
         return ("power_w", "mode", "one_way_power_w", "radiation_bound_w", "status")
 
     def to_dict(self) -> dict:
         d = super().to_dict()
         return {k: d[k] for k in (HEAVE_KEYS if _heave_only(self.dofs) else HULL_KEYS)}
+
+    def to_dataset(self):
+        """The result's Dataset; over several realizations also each one's power, peak
+        torque and bearing load over ``realization`` (its ``seed`` a coordinate)."""
+        ds = super().to_dataset()
+        if self.realizations is None:
+            return ds
+        n = len(self.realization_seeds)
+        ds = ds.assign_coords(realization=("realization", list(range(n)),
+                                           {"long_name": "realization"}),
+                              seed=("realization", list(self.realization_seeds),
+                                    {"long_name": "seed of the record's phases"}))
+        for name, long in (("realization_powers_w", "the record's optimum power (NaN: no "
+                                                    "resolved answer)"),
+                           ("realization_peak_torques_nm", "the record's peak torque"),
+                           ("realization_peak_pivot_forces_n", "the record's peak bearing "
+                                                               "load")):
+            ds.attrs.pop(name, None)
+            unit = {"w": "W", "nm": "N m", "n": "N"}[name.rsplit("_", 1)[1]]
+            ds[name] = ("realization", [math.nan if v is None else float(v)
+                                        for v in getattr(self, name)],
+                        {"units": unit, "long_name": long})
+        if self.power_ci_w is not None:
+            ds.attrs.pop("power_ci_w", None)
+            ds["power_ci_low_w"] = ((), self.power_ci_w[0], {
+                "units": "W", "long_name": "lower end of the mean power's 95 % t-interval"})
+            ds["power_ci_high_w"] = ((), self.power_ci_w[1], {
+                "units": "W", "long_name": "upper end of the mean power's 95 % t-interval"})
+        return ds
 
     @property
     def solution(self):

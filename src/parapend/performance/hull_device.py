@@ -18,7 +18,8 @@ import math
 
 from ..errors import ParameterError
 
-__all__ = ["MODES", "check_records", "hull_of", "hull_opts", "problem", "solve_hull_bin"]
+__all__ = ["MODES", "check_records", "failure_code", "hull_of", "hull_opts", "problem",
+           "solve_hull_bin"]
 
 #: the per-realization ``mode`` codes (-1: not computed)
 MODES = ("rest", "rotation", "swinging")
@@ -147,6 +148,22 @@ def check_records(spec) -> None:
             raise ParameterError(f"{pk}: the record of the bin {per:g} s: {rest}") from None
 
 
+def failure_code(reason: str | None) -> int:
+    """The code (:data:`.spec.FAILURES`) of a record's ``headline_reason`` (None: 0)."""
+    from .spec import FAILURES
+
+    if not reason:
+        return 0
+    for name, marks in (("above the radiation bound", ("times the radiation bound",)),
+                        ("harmonics unresolved", ("not resolved",)),
+                        ("refinement failed", ("refinement to",)),
+                        ("no start converged", ("no start converged",
+                                                "no mode's search converged"))):
+        if any(m in reason for m in marks):
+            return FAILURES.index(name)
+    return FAILURES.index("other")
+
+
 def solve_hull_bin(spec, i: int, j: int, r: int) -> dict:
     """The hull's answer to one record: the best mode's power (never below zero), its mode,
     the radiation bound, the one-way power, the mechanical power of a lossy take-off."""
@@ -159,11 +176,15 @@ def solve_hull_bin(spec, i: int, j: int, r: int) -> dict:
     def num(v):
         return math.nan if v is None else float(v)
     p = num(res.power_w)  # None: no resolved answer (headline_reason), kept as NaN
-    out = {"power": p}
+    reason = getattr(res, "headline_reason", None)
+    out = {"power": p, "failure": failure_code(reason)}
+    if not reason:  # the generator's rating: located on the optimum's motion
+        out.update(peak_torque=num(getattr(res, "peak_torque_nm", None)),
+                   peak_pivot_force=num(getattr(res, "peak_pivot_force_n", None)))
     if spec.lossy:
         # the store keeps the mechanical power as "power" (the heave buoy's layout; the
         # Dataset shows the electrical one as power)
-        out = {"power": num(res.mechanical_power_w), "electrical_power": p}
+        out.update(power=num(res.mechanical_power_w), electrical_power=p)
     if getattr(res, "headline_reason", None):  # no resolved answer: NaN, not a success
         status = "other"
     elif res.success:
