@@ -274,3 +274,70 @@ def test_an_unresolved_bin_says_why_and_stays_out_of_the_aep(dataset, scatter, m
            "unresolved)" in text
     assert "the bins counted hold 90 % of the year's hours" in text
     assert FAILURES[2] == "harmonics unresolved"
+
+
+def test_a_bin_is_what_buoy_alone_answers_and_an_unresolved_one_is_retried(dataset,
+                                                                           monkeypatch):
+    """A record whose best mode is resolved while another mode did not converge is solved
+    (buoy alone answers it: the matrix stored it as 'other' before); a record left
+    unresolved is solved once more with more harmonics, and that answer kept."""
+    from parapend.hydro.hull import HARMONICS_PER_TURN, waves_in
+    from parapend.performance.buoy_device import wave_of
+    from parapend.performance.hull_device import RETRY_HARMONICS
+
+    spec = parapend.performance.matrix_spec(**BINS, realizations=1, hydro=dataset, **HULL)
+    low = _record_numbers(wave_of(spec, 0, 0, 0)[0])[0]  # Hm0 1 m, Tp 5 s
+    calls = []
+
+    def fake(problem, wave, info, *, check_only=False):
+        if check_only:
+            return _REAL(problem, wave, info, check_only=True)
+        res = _stand_in(_REAL)(problem, wave, info)
+        calls.append(problem["harmonics"])
+        e, _ = _record_numbers(wave)
+        if abs(2 * math.pi / wave.omega - 12.0) < 1e-6:  # Tp 6 s: swinging did not converge
+            import dataclasses
+
+            return dataclasses.replace(res, success=False,
+                                       status="rotation: converged; swinging: stalled")
+        if problem["harmonics"] is None and e > 2 * low:  # Tp 5 s, Hm0 2 m: unresolved first
+            return _stand_in(_REAL, fail=lambda w: True)(problem, wave, info)
+        return res
+    monkeypatch.setattr(hull_api, "solve_record", fake)
+    ds, _, _, _ = power_matrix(**BINS, realizations=1, hydro=dataset, workers=1,
+                               time_limit=3600, **HULL)
+    assert (ds["status"].values == 0).all() and (ds["failure"].values == 0).all()
+    n = HARMONICS_PER_TURN * waves_in(wave_of(spec, 1, 0, 0)[0])
+    more = int(math.ceil(RETRY_HARMONICS * n / 2)) * 2
+    assert [c for c in calls if c is not None] == [more]
+    for hs, tp, i, j, h in ((1.0, 6.0, 0, 1, None), (2.0, 6.0, 1, 1, None),
+                            (1.0, 5.0, 0, 0, None), (2.0, 5.0, 1, 0, more)):
+        alone = parapend.buoy(dofs=DOFS, hydro=dataset, hs=hs, tp=tp, repeat_period=2 * tp,
+                              seed=3, harmonics=h, **PEND)
+        assert alone.power_w == ds["power"].values[i, j, 0]
+
+
+@pytest.mark.slow
+def test_the_bearing_load_is_a_finite_difference_of_the_motion(dataset):
+    """The peak bearing load is the largest ``|m c'' + m g e_z|``, ``c = p + l (sin phi, cos
+    phi)`` the pendulum's centre, ``p = G xi`` the pivot: here ``c''`` by a central second
+    difference of the motion's positions (independent of the result's analytic
+    derivatives), on a grid of 4096 points of the period."""
+    r = parapend.buoy(dofs=DOFS, hydro=dataset, wave_height=1.0, wave_period=6.0, winding=1,
+                      **PEND)
+    m, length = r.pendulum["mass_kg"], r.pendulum["length_m"]
+    d, h = r.pivot["pivot_offset_m"], r.pivot["pivot_height_m"]
+    period, g = 6.0, 9.81
+
+    def centre(t):
+        s = r.motion(t)
+        x, z, beta = s["xi"]
+        return np.stack((x + h * beta + length * np.sin(s["phi"]),
+                         z - d * beta + length * np.cos(s["phi"])))
+    t = period * np.arange(4096) / 4096
+    dt = period * 1e-4
+    acc = (centre(t + dt) - 2 * centre(t) + centre(t - dt)) / dt**2
+    force = np.hypot(m * acc[0], m * acc[1] + m * g)
+    assert force.max() == pytest.approx(r.peak_pivot_force_n, rel=1e-5)
+    assert force.max() <= r.peak_pivot_force_n * (1 + 1e-6)  # the grid's largest at most
+    assert r.peak_pivot_force_n > m * g  # the motion loads the bearing beyond the weight
