@@ -6,7 +6,7 @@ from __future__ import annotations
 import shlex
 import sys
 
-from ..defaults import HULL
+from ..defaults import HULL, POWER_MATRIX
 from ..hydro.declared import Pendulum, PowerTakeOff, Sea
 from . import _output
 from ._common import (
@@ -55,7 +55,9 @@ def add_parsers(sub) -> None:
     g.add_argument("--realizations", type=_int,
                    help="seeded records per bin (default 3)")
     g.add_argument("--waves", type=_finite_float("waves"),
-                   help="record length in peak periods, 2 to 400 (default 50)")
+                   help="record length in peak periods, 2 to 400 (default "
+                        f"{POWER_MATRIX['waves']:g}; with --dofs surge,heave,pitch "
+                        f"{HULL['matrix_waves']:g})")
     # the sea's and the pendulum's options: generated from their declarations
     # (parapend.hydro.declared), with the defaults they state for power-matrix
     add_declared(g, Sea, ("seed", "spectrum", "gamma_peak", "cutoff"),
@@ -125,7 +127,7 @@ def add_parsers(sub) -> None:
                         "rotation, swinging and rest; its pendulum's defaults the hull's: "
                         f"{HULL['mass']:g} kg, {HULL['length']:g} m, "
                         f"{HULL['damping_coefficient']:g} N m s/rad; records of at most "
-                        "about 10 waves: give --waves) (default heave)")
+                        "about 10 waves) (default heave)")
     hull_options(g)
     add_declared(g, PowerTakeOff, ("copper_loss",))
     g = p.add_argument_group("resource and site")

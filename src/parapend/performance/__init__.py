@@ -91,7 +91,7 @@ def parse_bins(name: str, value) -> tuple:
     return tuple(float(v) for v in vals)
 
 
-def matrix_spec(*, hs="1:3:3", te=None, tp=None, realizations: int = 3, waves: float = 50,
+def matrix_spec(*, hs="1:3:3", te=None, tp=None, realizations: int = 3, waves=None,
                 seed: int = 0, spectrum: str = "jonswap", gamma_peak: float = 3.3,
                 cutoff: float = 3.0, response=None, device: str = "prescribed-heave",
                 horizon=None, length=None, mass=None, inertia=None,
@@ -163,6 +163,10 @@ def matrix_spec(*, hs="1:3:3", te=None, tp=None, realizations: int = 3, waves: f
     ratio = te_over_tp(spectrum, gamma_peak)
     tps = tuple(p / ratio for p in period) if kind == "te" else period
     realizations = check_int("realizations", realizations, 1, 1000)
+    if waves is None:  # the device's record: the hull's own (its solver's reach)
+        from ..defaults import HULL, POWER_MATRIX
+
+        waves = POWER_MATRIX["waves"] if heave else HULL["matrix_waves"]
     waves = check_range("waves", waves, *limits.SEA_WAVES_RANGE,
                         why="record length in peak periods")
     seed = check_int("seed", seed, 0, 2**62)
@@ -829,7 +833,7 @@ def to_mhkit(da):
     return da.rename({da.dims[0]: "x_centers", da.dims[1]: "y_centers"})
 
 
-def power_matrix(*, hs="1:3:3", te=None, tp=None, realizations: int = 3, waves: float = 50,
+def power_matrix(*, hs="1:3:3", te=None, tp=None, realizations: int = 3, waves=None,
                  seed: int = 0, spectrum: str = "jonswap", gamma_peak: float = 3.3,
                  cutoff: float = 3.0, response=None, device: str = "prescribed-heave",
                  horizon=None, length=None, mass=None, inertia=None,
