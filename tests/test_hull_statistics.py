@@ -341,3 +341,34 @@ def test_the_bearing_load_is_a_finite_difference_of_the_motion(dataset):
     assert force.max() == pytest.approx(r.peak_pivot_force_n, rel=1e-5)
     assert force.max() <= r.peak_pivot_force_n * (1 + 1e-6)  # the grid's largest at most
     assert r.peak_pivot_force_n > m * g  # the motion loads the bearing beyond the weight
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("height, period, winding", [(1.0, 6.0, 1), (1.5, 5.0, 1),
+                                                     (1.0, 7.0, 0)])
+def test_the_stated_discretization_error_covers_one_more_doubling(dataset, height, period,
+                                                                  winding):
+    """The stated error estimate (``error_estimate`` of the refinement's stages) is at least
+    the change of the power when the answer's harmonics (of the pendulum and of the hull)
+    are doubled once more and the maximum solved again from the answer."""
+    from parapend.hydro.coupled import Wave
+    from parapend.hydro.hull import GTOL, HullProblem, make_case
+    from parapend.hydro.result import _solve_mode, error_estimate
+    from parapend.optimal.fourier import _pad, newton_maximize
+
+    p = hull_api.hull_problem(hydro=dataset, **PEND)
+    wave = Wave.regular(height, period)
+    mode = _solve_mode(p["hull"], p["pendulum"], wave, winding, None, p["pivot"],
+                       p["pitch_inertia"], p["pto"])
+    sol = mode["_solution"]
+    assert mode["success"] and len(sol.refinement_history) >= 2
+    stated = error_estimate(sol.refinement_history)
+    assert stated == mode["discretization_error_estimate_w"]
+    assert sol.refinement_history[-1][1] == sol.power
+    n, nh = 2 * sol.case.harmonics, 2 * sol.case.hull_harmonics
+    finer = make_case(p["hull"], p["pendulum"], wave, winding=winding, harmonics=n,
+                      hull_harmonics=nh, pivot=p["pivot"], pitch_inertia=p["pitch_inertia"])
+    r = newton_maximize(HullProblem(finer), _pad(sol.x, n), "check", gtol=GTOL)
+    assert r.status == "converged"
+    observed = abs(float(r.power) - sol.power)
+    assert stated is not None and observed <= stated + 1e-9 * abs(sol.power)

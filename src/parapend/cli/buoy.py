@@ -344,7 +344,12 @@ def _hull_text(r) -> list:
             ["power" if r.efficiency is None and not r.copper_loss_w_per_nm2
              else "electrical power",
              _w(r.power_w), "W"],
-            ["  discretization error (half the harmonics)", _w(r.refinement_change_w), "W"],
+            ["  change on the last doubling of the harmonics", _w(r.refinement_change_w),
+             "W"],
+            ["  discretization error estimate (not a bound)",
+             "none: the doublings' changes do not shrink"
+             if r.discretization_error_estimate_w is None and r.refinement_change_w is not None
+             else _w(r.discretization_error_estimate_w), "W"],
             ["local maxima found (count; powers)", f"{r.maxima}; " + ", ".join(
                 f"{v:.4g}" for v in (r.maxima_powers_w or [])[:6]), "-; W"],
             ["one-way (reaction left out)", _w(r.one_way_power_w), "W"],
@@ -367,10 +372,10 @@ def _hull_text(r) -> list:
                if r.efficiency is not None else None,
                f"copper loss {r.copper_loss_w_per_nm2:g} W/(N m)^2"
                if r.copper_loss_w_per_nm2 else None]
-        rows.insert(3, ["  mechanical power (" + ", ".join(x for x in pto if x) + ")",
+        rows.insert(4, ["  mechanical power (" + ", ".join(x for x in pto if x) + ")",
                         _w(r.mechanical_power_w), "W"])
     if r.torque_limit_nm is not None:
-        rows.insert(3, ["  torque limit", _w(r.torque_limit_nm), "N m"])
+        rows.insert(4, ["  torque limit", _w(r.torque_limit_nm), "N m"])
     if r.headline_reason:
         rows[1][1] = "none (below)"
     out = [wave, *_hull_head(r), "",

@@ -30,7 +30,8 @@ from .hull import (
 from .optimum import TORQUE_SLACK
 from .waves import energy_flux
 
-__all__ = ["BuoyResult", "BuoySweepResult", "MotionAt", "free_heave", "hull_answer", "optimum"]
+__all__ = ["BuoyResult", "BuoySweepResult", "MotionAt", "error_estimate", "free_heave",
+           "hull_answer", "optimum"]
 
 
 #: the JSON keys of a heave-only answer (a buoy), in their order
@@ -60,8 +61,9 @@ HULL_KEYS = ("power_w", "headline_reason", "mechanical_power_w", "efficiency",
              "heave_amplitude_m", "pitch_amplitude_deg", "surge_phase_deg", "heave_phase_deg",
              "pitch_phase_deg", "mean_heel_deg", "mean_angle_deg", "swing_amplitude_deg",
              "peak_torque_nm", "peak_pivot_force_n", "harmonics", "hull_harmonics",
-             "refinement_change_w", "success", "status", "dofs", "wave", "pendulum", "body",
-             "pivot", "warnings", "validity_warnings", *REALIZATION_KEYS)
+             "refinement_change_w", "discretization_error_estimate_w", "refinement_history",
+             "success", "status", "dofs", "wave", "pendulum", "body", "pivot", "warnings",
+             "validity_warnings", *REALIZATION_KEYS)
 #: the same of a period sweep
 HEAVE_SWEEP_KEYS = ("period_s", "power_w", "one_way_power_w", "radiation_bound_w", "limit_w",
                     "bound_fraction", "capture_width_m", "heave_amplitude_m",
@@ -81,7 +83,7 @@ _TYPES = {**dict.fromkeys(("harmonics", "winding", "bound_cut", "hull_harmonics"
                           "str | None"),
           **dict.fromkeys(("realization_seeds", "realization_powers_w", "realization_reasons",
                            "realization_peak_torques_nm", "realization_peak_pivot_forces_n",
-                           "power_ci_w"), "list | None"),
+                           "power_ci_w", "refinement_history"), "list | None"),
           **dict.fromkeys(("wave", "pendulum", "body", "design", "pivot"), "dict | None"),
           **dict.fromkeys(("efficiency", "modes", "maxima_powers_w"), "list | None"),
           "success": "bool | None"}
@@ -230,7 +232,13 @@ class BuoyResult(_Result):
     peak_torque_nm, peak_pivot_force_n : largest ``|tau|`` and bearing load over the motion
         (located on the motion itself, between samples).
     harmonics, hull_harmonics : of the answer; refinement_change_w : the power's change
-        from the answer with half as many (the stated discretization error).
+        from the answer with half as many (the last doubling's change); refinement_history:
+        ``[harmonics, power_w]`` of each stage of the doubling, coarsest first.
+    discretization_error_estimate_w : the stated discretization error
+        (:func:`error_estimate`): an estimate from the doublings (the last change, or its
+        geometric tail where the changes shrink slowly), not a proven bound; None where the
+        changes do not shrink. It covers the discretization of the maximum found, not
+        another maximum a search at other harmonics may find.
     realizations : a sea state over ``R`` seeded records (``buoy(realizations=R)``,
         :mod:`.realizations`; None: one record): ``realization_seeds``,
         ``realization_powers_w`` (NaN/null: no resolved answer, ``realization_reasons``
@@ -844,6 +852,32 @@ def peak(fun, period: float, points: int = PEAK_POINTS) -> float:
     return max(float(v[i]), -float(r.fun))
 
 
+def error_estimate(history) -> float | None:
+    r"""The discretization error stated beside a power refined by doubling the harmonics
+    (W): from the stages' powers ``P_0, P_1, ..., P_k`` (``history``: ``(harmonics,
+    power)``, each stage twice the harmonics of the one before) and their changes
+    ``d_i = |P_i - P_{i-1}|``:
+
+    - one doubling: ``d_1``;
+    - more: with ``rho = d_k / d_{k-1}``, the geometric tail of the changes still to come,
+      ``max(d_k, d_k rho / (1 - rho))`` (Richardson's estimate of a sequence converging
+      geometrically; ``d_k`` where it converges faster than halving), None where
+      ``rho >= 1`` (the changes do not shrink: no estimate).
+
+    An estimate, not a bound: tests/test_hull_statistics.py checks, on a few cases, that it
+    exceeds the change on one more doubling. None without a doubling."""
+    p = [float(v) for _, v in history]
+    d = [abs(b - a) for a, b in zip(p, p[1:])]
+    if not d:
+        return None
+    if len(d) == 1 or d[-2] == 0.0:
+        return d[-1]
+    rho = d[-1] / d[-2]
+    if not rho < 1.0:
+        return None
+    return max(d[-1], d[-1] * rho / (1.0 - rho))
+
+
 def _deg(v) -> float:
     return float(np.degrees(v))
 
@@ -872,6 +906,8 @@ def _mode(sol) -> dict:
             "one_way_power_w": sol.one_way_power,
             "energy_balance_residual": sol.energy_balance_residual,
             "refinement_change_w": sol.refinement_change, "harmonics": sol.case.harmonics,
+            "discretization_error_estimate_w": error_estimate(sol.refinement_history),
+            "refinement_history": [[int(n), float(v)] for n, v in sol.refinement_history],
             "mean_angle_deg": mean if k == 0 else None, "swing_amplitude_deg": swing,
             "peak_torque_nm": pk, "distinct_maxima": sol.distinct_maxima,
             "maxima_powers_w": [float(v) for v in sol.maxima_powers],
@@ -1051,6 +1087,9 @@ def hull_answer(hull, pendulum, wave, *, pivot, windings=(1, 0), pitch_inertia=N
                                 period) if not at_rest else pendulum.mass * hull.g,
         harmonics=cs.harmonics, hull_harmonics=cs.hull_harmonics,
         refinement_change_w=None if at_rest else best["refinement_change_w"],
+        discretization_error_estimate_w=(None if at_rest
+                                         else best["discretization_error_estimate_w"]),
+        refinement_history=None if at_rest else best["refinement_history"],
         success=all(m["success"] for m in modes) and not reason,
         status="; ".join(f"{m['mode']}: {m['status']}" for m in modes),
         dofs=["surge", "heave", "pitch"], wave=dict(wave_info or {},
