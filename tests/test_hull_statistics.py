@@ -85,7 +85,8 @@ def stand_in(monkeypatch):
 SEA = {"hs": 1.0, "tp": 6.0, "repeat_period": 12.0, "seed": 3}
 
 
-def test_the_interval_is_students_t_over_records_each_buoy_alone(dataset, stand_in):
+def test_the_interval_is_students_t_over_records_each_buoy_alone(dataset, stand_in,
+                                                                  tmp_path):
     """Each realization's power is what ``buoy`` alone says of the record with that seed;
     the mean and its 95 % interval are scipy.stats.t's over those powers."""
     r = parapend.buoy(dofs=DOFS, hydro=dataset, **SEA, realizations=4, **PEND)
@@ -110,6 +111,9 @@ def test_the_interval_is_students_t_over_records_each_buoy_alone(dataset, stand_
     assert np.array_equal(ds["realization_powers_w"].values, p)
     assert ds["power_ci_low_w"].attrs["units"] == "W"
     assert float(ds["power_ci_high_w"]) == pytest.approx(hi, rel=1e-12)
+    rows = r.save(tmp_path / "r.csv").read_text().splitlines()
+    assert rows[0].startswith("realization,realization_powers_w") and len(rows) == 2 + 4
+    assert float(rows[3].split(",")[1]) == p[1]
 
 
 def test_an_unresolved_record_is_left_out_and_named(dataset, monkeypatch):

@@ -300,6 +300,19 @@ class BuoyResult(_Result):
                 "units": "W", "long_name": "upper end of the mean power's 95 % t-interval"})
         return ds
 
+    def _csv_text(self) -> str:
+        """``save("x.csv")``: over several realizations the records' table (seed, power,
+        peaks); else the motion over one period."""
+        if self.realizations is None:
+            return super()._csv_text()
+        from ..results import dataset_csv
+
+        ds = self.to_dataset()
+        return dataset_csv(ds[[n for n in ("realization_powers_w",
+                                           "realization_peak_torques_nm",
+                                           "realization_peak_pivot_forces_n")]]
+                           .reset_coords().set_coords([]))
+
     @property
     def solution(self):
         """The coupled optimum (heave alone: :class:`parapend.hydro.optimum.CoupledSolution`;
