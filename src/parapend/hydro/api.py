@@ -950,7 +950,7 @@ def hull_buoy(deadline=None, time_limit=None, **opts):
         if realizations is not None:
             from .realizations import solve_realizations
 
-            return solve_realizations(p, record, opts.get("seed"), realizations,
+            return solve_realizations(solve_record, p, record, opts.get("seed"), realizations,
                                       time_limit=time_limit, deadline=deadline,
                                       progress=progress)
         return solve_record(p, *record(opts.get("seed")))

@@ -68,23 +68,23 @@ def _num(v) -> float:
     return math.nan if v is None else float(v)
 
 
-def solve_realizations(problem: dict, record, seed, realizations: int, *, time_limit=None,
-                       deadline=None, progress=None):
+def solve_realizations(solve, problem: dict, record, seed, realizations: int, *,
+                       time_limit=None, deadline=None, progress=None):
     """Solve the records ``record(seed + r)`` (``(wave, info)`` each) of ``problem``
-    (:func:`.api.hull_problem`) for ``r < realizations``: the first record's
+    (:func:`.api.hull_problem`) for ``r < realizations`` with ``solve``
+    (:func:`.api.solve_record`, as ``buoy`` solves one record alone): the first record's
     :class:`~.result.BuoyResult` with the statistics over all of them; ``deadline`` stops
     the loop after the realization that passes it (the first always solved);
     ``progress(done, total)`` after each."""
     from ..confidence import METHOD, t_interval
     from ..deadline import expired
-    from .api import solve_record
 
     seed0 = 0 if seed is None else int(seed)
     results = []
     for r in range(realizations):
         if results and expired(deadline):
             break
-        results.append(solve_record(problem, *record(seed0 + r)))
+        results.append(solve(problem, *record(seed0 + r)))
         if progress is not None:
             progress(r + 1, realizations)
     powers = [_num(res.power_w) for res in results]

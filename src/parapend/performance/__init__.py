@@ -535,7 +535,7 @@ def _bin_intervals(ds, spec: MatrixSpec, solved, dims2) -> None:
                                "units": "W", "method": METHOD})
     if "failure" not in ds:
         return
-    from .spec import FAILURES
+    from .hull_device import FAILURES
 
     done = ds["done"].values.astype(bool)
     f = ds["failure"].values
@@ -610,7 +610,7 @@ def matrix_extremes(ds, pk: str) -> dict:
     unresolved realization, how many and why."""
     if "peak_torque_max" not in ds:
         return {}
-    from .spec import FAILURES
+    from .hull_device import FAILURES
 
     out = {}
     share = ds["frequency"].values > 0 if "frequency" in ds else None

@@ -18,11 +18,16 @@ import math
 
 from ..errors import ParameterError
 
-__all__ = ["MODES", "check_records", "failure_code", "hull_of", "hull_opts", "problem",
+__all__ = ["FAILURES", "MODES", "check_records", "failure_code", "hull_of", "hull_opts", "problem",
            "solve_hull_bin"]
 
 #: the per-realization ``mode`` codes (-1: not computed)
 MODES = ("rest", "rotation", "swinging")
+#: the per-realization reason for no resolved answer: an int8 code (-1 not computed)
+FAILURES = ("none", "no start converged", "harmonics unresolved",
+            "above the radiation bound", "refinement failed", "other")
+FAILURE_LONG_NAME = ("why the record has no resolved answer: " + ", ".join(
+    f"{i} {name}" for i, name in enumerate(FAILURES)))
 #: the per-process hull problems, keyed by the spec's hull
 _PROBLEMS: dict = {}
 #: the hull options of the spec (besides the pendulum's)
@@ -150,8 +155,6 @@ def check_records(spec) -> None:
 
 def failure_code(reason: str | None) -> int:
     """The code (:data:`.spec.FAILURES`) of a record's ``headline_reason`` (None: 0)."""
-    from .spec import FAILURES
-
     if not reason:
         return 0
     for name, marks in (("above the radiation bound", ("times the radiation bound",)),

@@ -16,7 +16,9 @@ import logging
 
 import numpy as np
 
-__all__ = ["MatrixSpec", "QUANTITIES", "STORE_NAMES"]
+from .hull_device import FAILURE_LONG_NAME, FAILURES
+
+__all__ = ["FAILURES", "MatrixSpec", "QUANTITIES", "STORE_NAMES"]
 
 log = logging.getLogger(__name__)
 
@@ -39,11 +41,7 @@ QUANTITIES = {
 }
 #: the stored quantities' units (the rest: W)
 UNITS = {"peak_torque": "N m", "peak_pivot_force": "N"}
-#: the hull's per-realization reason for no resolved answer: an int8 code (-1 not computed)
-FAILURES = ("none", "no start converged", "harmonics unresolved",
-            "above the radiation bound", "refinement failed", "other")
-FAILURE_LONG_NAME = ("why the record has no resolved answer: " + ", ".join(
-    f"{i} {name}" for i, name in enumerate(FAILURES)))
+
 #: the hull's per-realization mode (--dofs surge,heave,pitch): an int8 code, -1 not computed
 MODE_LONG_NAME = "best mode of the record: 0 rest, 1 rotation (one turn per wave), 2 swinging"
 _TITLE = "parapend design map"
