@@ -573,7 +573,9 @@ def annual_interval(ds, frequency, solved) -> dict:
     Every counted bin with a positive mean solved in every realization: the paired
     interval (:data:`AEP_CI_PAIRED`; a bin at rest counts 0 in each). Otherwise the
     half-widths summed (:data:`AEP_CI_SUMMED`). None where a counted bin with a positive
-    mean has fewer than two solved realizations (no interval)."""
+    mean has fewer than two solved realizations (no interval). The lower end is at least 0
+    (the annual energy is never negative: the interval cut to where it can lie keeps its
+    coverage)."""
     from ..confidence import t_interval
     from .annual import bin_power
 
@@ -589,7 +591,8 @@ def annual_interval(ds, frequency, solved) -> dict:
         per = HOURS_PER_YEAR * np.einsum("ij,ijr->r", np.where(counted, f, 0.0),
                                          np.where(counted[..., None], p, 0.0))
         ci = t_interval(per)
-        return {"mwh_ci": [ci["low"] / 1e6, ci["high"] / 1e6], "ci_method": AEP_CI_PAIRED,
+        return {"mwh_ci": [max(ci["low"], 0.0) / 1e6, ci["high"] / 1e6],
+                "ci_method": AEP_CI_PAIRED,
                 "realization_mwh": [float(v) / 1e6 for v in per]}
     half = 0.0
     for i, j in np.argwhere(counted):
@@ -598,7 +601,8 @@ def annual_interval(ds, frequency, solved) -> dict:
             return none
         half += HOURS_PER_YEAR * f[i, j] * ci["half_width"]
     wh = HOURS_PER_YEAR * float(np.sum(np.where(counted, f * mean, 0.0)))
-    return {"mwh_ci": [(wh - half) / 1e6, (wh + half) / 1e6], "ci_method": AEP_CI_SUMMED}
+    return {"mwh_ci": [max(wh - half, 0.0) / 1e6, (wh + half) / 1e6],
+            "ci_method": AEP_CI_SUMMED}
 
 
 def matrix_extremes(ds, pk: str) -> dict:
