@@ -175,8 +175,8 @@ def test_dofs_heave_keeps_the_store_identity():
 def test_the_hull_spec_round_trips(dataset):
     spec = matrix_spec(**BINS, realizations=1, hydro=dataset, **HULL)
     assert MatrixSpec.from_json(spec.to_json()) == spec
-    assert spec.variables == ("power", "radiation_bound_power", "one_way_power", "mode",
-                              "status")
+    assert spec.variables == ("power", "radiation_bound_power", "one_way_power",
+                              "peak_torque", "peak_pivot_force", "mode", "failure", "status")
 
 
 def test_the_take_off_reaches_the_hull(dataset):
@@ -194,16 +194,19 @@ def test_the_take_off_reaches_the_hull(dataset):
 
 
 def test_the_longest_record_is_the_hulls_limit(dataset):
-    """The default 50 waves are refused naming --waves and the largest that fits; that
-    largest fits the hull's own size check (12 harmonics per wave, at most 128), 0.01 more
-    does not."""
+    """50 waves are refused naming --waves and the largest that fits; that largest fits the
+    hull's own size check (12 harmonics per wave, at most 128), 0.01 more does not. The
+    hull's default record is its declared one (``defaults.HULL["matrix_waves"]``)."""
     from parapend import limits
+    from parapend.defaults import HULL as HULL_DEFAULTS
     from parapend.hydro.hull import HARMONICS_PER_TURN, waves_in
     from parapend.performance.buoy_device import wave_of
 
     with pytest.raises(ParameterError, match=r"^waves: .*at most ([0-9.]+) peak periods "
                                              r"fit, got 50$") as err:
-        matrix_spec(hs="1,2", tp="5,6", realizations=1, hydro=dataset, **HULL)
+        matrix_spec(hs="1,2", tp="5,6", realizations=1, hydro=dataset, waves=50, **HULL)
+    default = matrix_spec(hs="1,2", tp="5,6", realizations=1, hydro=dataset, **HULL)
+    assert default.waves == HULL_DEFAULTS["matrix_waves"]
     most = float(str(err.value).split("at most ")[-1].split(" peak")[0])
     spec = matrix_spec(**{**BINS, "waves": most}, realizations=1, hydro=dataset, **HULL)
 
@@ -254,7 +257,7 @@ def test_the_command_line_refuses_in_one_line(dataset, capsys):
     err = capsys.readouterr().err.strip()
     assert err.count("\n") == 0 and "dofs" in err and "Traceback" not in err
     assert main(["power-matrix", "--device", "buoy", "--dofs", "surge,heave,pitch", "--hydro",
-                 dataset, "--hs", "1,2", "--tp", "5,6"]) == 2
+                 dataset, "--hs", "1,2", "--tp", "5,6", "--waves", "50"]) == 2
     err = capsys.readouterr().err.strip()
     assert err.count("\n") == 0 and "waves" in err
 

@@ -820,6 +820,14 @@ def map(*, store: str = "map.zarr", variable: str = "power", x=None, y=None, at=
 
 
 # --- power-matrix ----------------------------------------------------------------------------
+def _matrix_waves(ds) -> float:
+    """The record length (peak periods) a power matrix's Dataset was computed with (its
+    ``sweep`` attribute: the device's default resolved)."""
+    import json
+
+    return json.loads(ds.attrs["sweep"])["waves"]
+
+
 def _power_matrix_result(power_matrix, arguments):
     """Power matrix over sea-state bins, capture width and annual energy (command
     ``power-matrix``): :func:`parapend.performance.power_matrix` (its parameters, declared
@@ -846,7 +854,7 @@ def _power_matrix_result(power_matrix, arguments):
         raise ParameterError("workers: the processes are the cluster's with --scheduler; "
                              "drop --workers")
     ds, annual, run, seconds = power_matrix(*arguments.args, **arguments.kwargs)
-    waves, device, depth = a["waves"], a["device"], a["depth"]
+    device, depth = a["device"], a["depth"]
     netcdf, zarr, csv = a["netcdf"], a["zarr"], a["csv"]
     pk = "tp" if "tp" in ds.dims else "te"
 
@@ -870,7 +878,7 @@ def _power_matrix_result(power_matrix, arguments):
            f"{pk}_edges": ds[f"{pk}_edges"].values.tolist(),
            "te_over_tp": float(ds.attrs["te_over_tp"]),
            "realizations": int(ds.sizes["realization"]),
-           "seeds": ds["seed"].values.tolist(), "waves": float(waves),
+           "seeds": ds["seed"].values.tolist(), "waves": float(_matrix_waves(ds)),
            "device": device, "power_matrix": grid("power_matrix"),
            "wave_energy_flux_matrix": grid("wave_energy_flux_matrix"),
            "capture_width_matrix": grid("capture_width_matrix"),
@@ -901,7 +909,11 @@ def _power_matrix_result(power_matrix, arguments):
         from .performance.causal import causal_json
 
         out["causal"] = causal_json(ds, grid)
-    from .performance import matrix_csv
+    from .performance import matrix_csv, matrix_extremes
+
+    out["power_ci_low"], out["power_ci_high"] = grid("power_ci_low"), grid("power_ci_high")
+    out["power_ci_method"] = ds["power_ci_low"].attrs["method"]
+    out.update(matrix_extremes(ds, pk))
 
     return Record("power-matrix", out, dataset=ds, run=run,
                   draw=_draw_dataset("performance.figures", "plot_matrix"),

@@ -294,4 +294,7 @@ BUOY_MAX_RECORD_HARMONICS = 4096
 HULL_MAX_HARMONICS = 128
 #: the harmonics' refinement (doubling until the power settles) stops here
 HULL_MAX_REFINED_HARMONICS = 256
+#: ``buoy --dofs surge,heave,pitch --realizations``: at most this many seeded records of one
+#: sea state (the power matrix's cap on realizations per bin)
+HULL_MAX_REALIZATIONS = 1000
 

@@ -81,8 +81,14 @@ def add_parsers(sub) -> None:
                                f"{BUOY['design_bounds'][name][1]:g} x the design's") + ")")
     g = p.add_argument_group("causal control (an irregular sea, the coupled time-domain plant)")
     add_declared(g, Controller, ("controller", "horizon", "update_interval", "forecast"))
+    g = p.add_argument_group("statistics of a sea state (--dofs surge,heave,pitch)")
+    g.add_argument("--realizations", type=_int, metavar="R",
+                   help="solve R records of the sea state (--hs, --tp), seeded --seed, "
+                        "--seed + 1, ...: their mean power and its 95 %% t-interval (default: "
+                        "one record)")
     p.add_argument("--time-limit", type=_finite_float("time-limit"), metavar="SECONDS",
-                   help="run long work (--optimize-design, a period sweep, --controller mpc) "
+                   help="run long work (--optimize-design, a period sweep, --controller mpc, "
+                        "--realizations) "
                         "for at most about this long, then stop with a partial result marked "
                         "time_limit (without it, work estimated over 2 minutes is refused)")
     p.add_argument("--plot", metavar="DIR",
@@ -147,11 +153,13 @@ def _cmd_buoy(a) -> dict | str:
     if a.controller != "optimum" and a.plot:
         raise ParameterError("plot: not drawn with --controller mpc (use --save)")
     try:
-        if a.optimize_design:
+        if a.optimize_design or a.realizations:
             from ._notice import install
 
             install("parapend.hydro")  # the design search's estimate, on stderr
-        bar = _Progress("buoy: optimize-design") if a.optimize_design and not a.json else None
+        bar = (_Progress("buoy: optimize-design" if a.optimize_design else
+                         "buoy: realizations")
+               if (a.optimize_design or a.realizations) and not a.json else None)
         r = _run(a, progress=bar)
     except MemoryError:
         # the generic message names --points, which this command has not
@@ -331,7 +339,12 @@ def _hull_text(r) -> list:
             ["power" if r.efficiency is None and not r.copper_loss_w_per_nm2
              else "electrical power",
              _w(r.power_w), "W"],
-            ["  discretization error (half the harmonics)", _w(r.refinement_change_w), "W"],
+            ["  change on the last doubling of the harmonics", _w(r.refinement_change_w),
+             "W"],
+            ["  discretization error estimate (not a bound)",
+             "none: the doublings' changes do not shrink"
+             if r.discretization_error_estimate_w is None and r.refinement_change_w is not None
+             else _w(r.discretization_error_estimate_w), "W"],
             ["local maxima found (count; powers)", f"{r.maxima}; " + ", ".join(
                 f"{v:.4g}" for v in (r.maxima_powers_w or [])[:6]), "-; W"],
             ["one-way (reaction left out)", _w(r.one_way_power_w), "W"],
@@ -354,10 +367,10 @@ def _hull_text(r) -> list:
                if r.efficiency is not None else None,
                f"copper loss {r.copper_loss_w_per_nm2:g} W/(N m)^2"
                if r.copper_loss_w_per_nm2 else None]
-        rows.insert(3, ["  mechanical power (" + ", ".join(x for x in pto if x) + ")",
+        rows.insert(4, ["  mechanical power (" + ", ".join(x for x in pto if x) + ")",
                         _w(r.mechanical_power_w), "W"])
     if r.torque_limit_nm is not None:
-        rows.insert(3, ["  torque limit", _w(r.torque_limit_nm), "N m"])
+        rows.insert(4, ["  torque limit", _w(r.torque_limit_nm), "N m"])
     if r.headline_reason:
         rows[1][1] = "none (below)"
     out = [wave, *_hull_head(r), "",
@@ -368,8 +381,27 @@ def _hull_text(r) -> list:
            f"energy balance residual {_w(r.energy_balance_residual)}"]
     if r.headline_reason:
         out.append(f"power: none, no resolved answer: {r.headline_reason}")
+    if r.realizations is not None:
+        out += ["", *_realizations_text(r)]
     out += [f"note: {n}" for n in r.warnings if not n.startswith("no resolved answer")]
     out += [f"warning: {n}" for n in r.validity_warnings]
+    return out
+
+
+def _realizations_text(r) -> list:
+    """The sea state's realizations: each record's power and peaks, the mean and its
+    interval."""
+    rows = [[str(sd), _w(p), _w(t), _w(f), why or "resolved"] for sd, p, t, f, why in zip(
+        r.realization_seeds, r.realization_powers_w, r.realization_peak_torques_nm,
+        r.realization_peak_pivot_forces_n, r.realization_reasons)]
+    out = [_table(rows, ["seed", "power (W)", "peak torque (N m)", "peak bearing load (N)",
+                         "answer"])]
+    ci = ("no interval (fewer than 2 resolved records)" if r.power_ci_w is None else
+          f"95 % interval [{r.power_ci_w[0]:.6g}, {r.power_ci_w[1]:.6g}] W (+- "
+          f"{r.power_ci_half_width_w:.3g} W; Student t, {r.realizations_solved - 1} "
+          "degrees of freedom)")
+    out.append(f"mean power over {r.realizations_solved} of {r.realizations} realizations: "
+               f"{_w(r.mean_power_w)} W, {ci}")
     return out
 
 

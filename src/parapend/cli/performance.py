@@ -6,6 +6,7 @@ from __future__ import annotations
 import shlex
 import sys
 
+from ..defaults import HULL, POWER_MATRIX
 from ..hydro.declared import Body, Controller, Pendulum, PowerTakeOff, Sea
 from . import _output
 from ._common import (
@@ -55,7 +56,11 @@ def add_parsers(sub) -> None:
     g.add_argument("--realizations", type=_int,
                    help="seeded records per bin (default 3)")
     g.add_argument("--waves", type=_finite_float("waves"),
-                   help="record length in peak periods, 2 to 400 (default 50)")
+                   help="record length in peak periods, 2 to 400 (default "
+                        f"{POWER_MATRIX['waves']:g}; with --dofs surge,heave,pitch "
+                        f"{HULL['matrix_waves']:g})")
+    # the sea's and the pendulum's options: generated from their declarations
+    # (parapend.hydro.declared), with the defaults they state for power-matrix
     add_declared(g, Sea, ("seed", "spectrum", "gamma_peak", "cutoff"),
                  command="power-matrix")
     g.add_argument("--response", metavar="CSV",

@@ -305,8 +305,8 @@ def buoy(*, wave_height=None, wave_period=None, hs=None, tp=None, spectrum=None,
          inertia_bounds=None, damping_coefficient_bounds=None, controller="optimum",
          horizon=None, update_interval=None, forecast=None, wave_direction=None, dofs="heave",
          pivot_height=None, pivot_offset=None, hull_pitch_inertia=None, barge_length=None,
-         barge_beam=None, barge_draft=None, copper_loss=None, time_limit=None, progress=None,
-         sea=None, pendulum=None, pto=None, device=None):
+         barge_beam=None, barge_draft=None, copper_loss=None, realizations=None,
+         time_limit=None, progress=None, sea=None, pendulum=None, pto=None, device=None):
     """The coupled optimum of a pendulum inside a floating buoy (command ``buoy``).
 
     Parameters
@@ -363,8 +363,17 @@ def buoy(*, wave_height=None, wave_period=None, hs=None, tp=None, spectrum=None,
         take the embedded hull design's values (``parapend.defaults.HULL``).
         ``copper_loss`` ``r`` (W per (N m)^2; hull only) subtracts the winding loss ``r
         tau^2`` from the power: holding an angle then costs what it costs a generator.
+    realizations : int or None
+        A hull (``dofs="surge,heave,pitch"``) in a sea state (``hs``, ``tp``): solve ``R``
+        records of it, seeded ``seed, seed + 1, ...`` (each exactly the record ``buoy``
+        solves alone with that seed), and report their mean power with its 95 %
+        t-interval (:mod:`parapend.confidence`): ``realization_powers_w``,
+        ``mean_power_w``, ``power_ci_w``; the other fields are the first record's. Work
+        estimated past :data:`parapend.limits.MAX_UNTIMED_SECONDS` needs ``time_limit``
+        (the realizations finished by then, marked ``time_limit``).
     time_limit : float or None
-        Seconds for the long work (``optimize_design``, a period sweep, ``controller``):
+        Seconds for the long work (``optimize_design``, a period sweep, ``controller``,
+        ``realizations``):
         without it, work estimated above ``parapend.limits.MAX_UNTIMED_SECONDS`` is refused;
         with it, the work stops at the first design evaluation, period or update after the
         limit and the result is partial: ``status`` ``"time_limit"``, ``success`` False, and
@@ -391,13 +400,18 @@ def buoy(*, wave_height=None, wave_period=None, hs=None, tp=None, spectrum=None,
     time_limit = check_time_limit(time_limit)
     until = deadline(time_limit)  # the limit counts from the call (the BEM included)
     if parse_dofs(dofs) != ("heave",):
-        if time_limit is not None and parse_periods(wave_period) is None:
+        if time_limit is not None and parse_periods(wave_period) is None and \
+                realizations is None:
             raise ParameterError("time-limit: bounds long work only: with --dofs "
-                                 "surge,heave,pitch a period sweep (--wave-period FROM:TO:N); "
-                                 "one wave's work is bounded by its harmonics")
+                                 "surge,heave,pitch a period sweep (--wave-period FROM:TO:N) "
+                                 "or --realizations; one wave's work is bounded by its "
+                                 "harmonics")
         return hull_buoy(**{k: v for k, v in opts.items() if k not in (
-            "dofs", "Wave", "progress", "time_limit", "sea", "pendulum", "pto", "device")},
-            deadline=until)
+            "dofs", "Wave", "time_limit", "sea", "pendulum", "pto", "device")},
+            deadline=until, time_limit=time_limit)
+    if realizations is not None:
+        raise ParameterError("realizations: the mean over seeded records is the hull's "
+                             "(--dofs surge,heave,pitch with --hs and --tp); drop it")
     for name in ("pivot_height", "pivot_offset", "hull_pitch_inertia", "barge_length",
                  "barge_beam", "barge_draft", "copper_loss"):
         if opts[name] is not None and not (isinstance(body, str) and body == "barge"
@@ -876,16 +890,22 @@ def solve_record(problem: dict, wave, info, *, check_only: bool = False):
                    geometry=problem["geometry"])
 
 
-def hull_buoy(deadline=None, **opts):
+def hull_buoy(deadline=None, time_limit=None, **opts):
     """The optimum of a pendulum in a surging, heaving, pitching hull (see
     :func:`parapend.buoy`, ``dofs="surge,heave,pitch"``); ``deadline`` (a
     :func:`parapend.deadline.deadline` time): a period sweep stops once it has passed, the
-    periods not begun left out (the first always solved)."""
+    periods not begun left out (the first always solved); so do ``realizations``
+    (:mod:`.realizations`), ``time_limit`` the seconds it stands for."""
     from ..deadline import expired
     from .coupled import Wave
     from .inputs import _irregular_wave, _period, parse_periods
 
     _check_wave_kind(opts)  # before the BEM
+    progress, realizations = opts.pop("progress", None), opts.pop("realizations", None)
+    if realizations is not None:
+        from .realizations import check_realizations
+
+        realizations = check_realizations(realizations, opts, time_limit)
     regular = not any(opts.get(k) is not None for k in ("hs", "tp", "record",
                                                         "repeat_period", "seed"))
     if regular:  # the wave's checks before the BEM too
@@ -908,13 +928,20 @@ def hull_buoy(deadline=None, **opts):
         if opts.get("repeat_period") is None and opts.get("record") is None:
             tp = default_of("tp", opts.get("tp"), "hull")
             opts = dict(opts, repeat_period=HULL["repeat_periods"] * tp)
-        wave, info = _irregular_wave(
-            opts.get("hs"), opts.get("tp"), default_of("spectrum", opts.get("spectrum")),
-            default_of("gamma_peak", opts.get("gamma_peak")), opts.get("repeat_period"),
-            opts.get("seed"), default_of("cutoff", opts.get("cutoff")), opts.get("record"),
-            default_of("taper", opts.get("taper")),
-            Units(pend.length, pend.mass, 9.81, pend.inertia), kind="hull")
-        return solve_record(p, wave, info)
+        def record(seed):
+            return _irregular_wave(
+                opts.get("hs"), opts.get("tp"), default_of("spectrum", opts.get("spectrum")),
+                default_of("gamma_peak", opts.get("gamma_peak")), opts.get("repeat_period"),
+                seed, default_of("cutoff", opts.get("cutoff")), opts.get("record"),
+                default_of("taper", opts.get("taper")),
+                Units(pend.length, pend.mass, 9.81, pend.inertia), kind="hull")
+        if realizations is not None:
+            from .realizations import solve_realizations
+
+            return solve_realizations(solve_record, p, record, opts.get("seed"), realizations,
+                                      time_limit=time_limit, deadline=deadline,
+                                      progress=progress)
+        return solve_record(p, *record(opts.get("seed")))
     w = 2 * math.pi / periods
     hull.check_covers(float(np.min(w)), float(np.max(w)), name="wave-period")
     results = []

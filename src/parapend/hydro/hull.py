@@ -618,6 +618,8 @@ class HullSolution:
     pto: HullPTO = HullPTO()
     #: the powers (W) of the distinct converged maxima the search found, best first
     maxima_powers: tuple = ()
+    #: ``(harmonics, power)`` of each stage of the refinement, coarsest first
+    refinement_history: tuple = ()
 
 
 def aliased(problem: HullProblem, x) -> bool:
@@ -714,6 +716,7 @@ def _refine(sol: HullSolution, make, x) -> HullSolution:
 
     pto = sol.pto
     x1, p1 = sol.one_way_x, sol.one_way_power
+    history = [(case.harmonics, float(power))]
     top = PTO_MAX_SCALE if pto.active else MAX_SCALE
     while scale < top and 2 * scale * sol.case.harmonics <= max(
             HULL_MAX_REFINED_HARMONICS, 2 * sol.case.harmonics):
@@ -745,6 +748,7 @@ def _refine(sol: HullSolution, make, x) -> HullSolution:
             status, ok = "converged", True
         change = abs(pr_power - power)
         x, power = xr, float(pr_power)
+        history.append((case.harmonics, power))
         if change <= (PTO_REFINE_TOL if pto.active else REFINE_TOL) * max(abs(power),
                                                                           1e-300):
             break
@@ -770,6 +774,7 @@ def _refine(sol: HullSolution, make, x) -> HullSolution:
         x1, p1, mech = r1.x, r1.power, None
     return dataclasses.replace(sol, case=case, x=x, power=power, status=status, success=ok,
                                refinement_change=None if math.isnan(change) else float(change),
+                               refinement_history=tuple(history),
                                energy_balance_residual=float(resid),
                                one_way_power=float(p1), one_way_x=x1, mechanical_power=mech)
 

@@ -30,7 +30,8 @@ from .hull import (
 from .optimum import TORQUE_SLACK
 from .waves import energy_flux
 
-__all__ = ["BuoyResult", "BuoySweepResult", "MotionAt", "free_heave", "hull_answer", "optimum"]
+__all__ = ["BuoyResult", "BuoySweepResult", "MotionAt", "error_estimate", "free_heave",
+           "hull_answer", "optimum"]
 
 
 #: the JSON keys of a heave-only answer (a buoy), in their order
@@ -42,6 +43,13 @@ HEAVE_KEYS = ("power_w", "heave_amplitude_m", "peak_torque_nm", "radiation_bound
               "electrical_power_w", "mechanical_power_w", "pto_loss_w", "generated_power_w",
               "motoring_power_w", "ideal_power_w", "one_way_electrical_power_w", "mesh_error_w",
               "mesh_error_relative", "grid_error_w", "validity_warnings")
+#: a hull's sea state over seeded realizations (``realizations``; None otherwise):
+#: :mod:`.realizations`
+REALIZATION_KEYS = ("realizations", "realizations_solved", "realization_seeds",
+                    "realization_powers_w", "realization_reasons",
+                    "realization_peak_torques_nm", "realization_peak_pivot_forces_n",
+                    "mean_power_w", "power_std_w", "power_ci_w", "power_ci_half_width_w",
+                    "power_ci_method")
 #: the JSON keys of an answer in surge, heave and pitch (a hull), in their order
 HULL_KEYS = ("power_w", "headline_reason", "mechanical_power_w", "efficiency",
              "copper_loss_w_per_nm2", "torque_limit_nm", "mode", "winding", "modes", "maxima",
@@ -53,8 +61,9 @@ HULL_KEYS = ("power_w", "headline_reason", "mechanical_power_w", "efficiency",
              "heave_amplitude_m", "pitch_amplitude_deg", "surge_phase_deg", "heave_phase_deg",
              "pitch_phase_deg", "mean_heel_deg", "mean_angle_deg", "swing_amplitude_deg",
              "peak_torque_nm", "peak_pivot_force_n", "harmonics", "hull_harmonics",
-             "refinement_change_w", "success", "status", "dofs", "wave", "pendulum", "body",
-             "pivot", "warnings", "validity_warnings")
+             "refinement_change_w", "discretization_error_estimate_w", "refinement_history",
+             "success", "status", "dofs", "wave", "pendulum", "body", "pivot", "warnings",
+             "validity_warnings", *REALIZATION_KEYS)
 #: the same of a period sweep
 HEAVE_SWEEP_KEYS = ("period_s", "power_w", "one_way_power_w", "radiation_bound_w", "limit_w",
                     "bound_fraction", "capture_width_m", "heave_amplitude_m",
@@ -68,9 +77,13 @@ HULL_SWEEP_KEYS = ("period_s", "power_w", "mechanical_power_w", "rotation_power_
 
 
 #: the fields' types (the others: ``float | None``), of one answer and of a sweep
-_TYPES = {**dict.fromkeys(("harmonics", "winding", "bound_cut", "hull_harmonics", "maxima"),
-                          "int | None"),
-          **dict.fromkeys(("status", "message", "mode", "headline_reason"), "str | None"),
+_TYPES = {**dict.fromkeys(("harmonics", "winding", "bound_cut", "hull_harmonics", "maxima",
+                           "realizations", "realizations_solved"), "int | None"),
+          **dict.fromkeys(("status", "message", "mode", "headline_reason", "power_ci_method"),
+                          "str | None"),
+          **dict.fromkeys(("realization_seeds", "realization_powers_w", "realization_reasons",
+                           "realization_peak_torques_nm", "realization_peak_pivot_forces_n",
+                           "power_ci_w", "refinement_history"), "list | None"),
           **dict.fromkeys(("wave", "pendulum", "body", "design", "pivot"), "dict | None"),
           **dict.fromkeys(("efficiency", "modes", "maxima_powers_w"), "list | None"),
           "success": "bool | None"}
@@ -219,7 +232,21 @@ class BuoyResult(_Result):
     peak_torque_nm, peak_pivot_force_n : largest ``|tau|`` and bearing load over the motion
         (located on the motion itself, between samples).
     harmonics, hull_harmonics : of the answer; refinement_change_w : the power's change
-        from the answer with half as many (the stated discretization error).
+        from the answer with half as many (the last doubling's change); refinement_history:
+        ``[harmonics, power_w]`` of each stage of the doubling, coarsest first.
+    discretization_error_estimate_w : the stated discretization error
+        (:func:`error_estimate`): an estimate from the doublings (the last change, or its
+        geometric tail where the changes shrink slowly), not a proven bound; None where the
+        changes do not shrink. It covers the discretization of the maximum found, not
+        another maximum a search at other harmonics may find.
+    realizations : a sea state over ``R`` seeded records (``buoy(realizations=R)``,
+        :mod:`.realizations`; None: one record): ``realization_seeds``,
+        ``realization_powers_w`` (NaN/null: no resolved answer, ``realization_reasons``
+        says why), ``realization_peak_torques_nm``, ``realization_peak_pivot_forces_n``;
+        ``mean_power_w`` over the ``realizations_solved`` resolved ones, ``power_std_w``
+        (ddof 1), ``power_ci_w`` its 95 % interval ``[low, high]`` and
+        ``power_ci_half_width_w`` (``power_ci_method``: Student's t with ``R - 1``
+        degrees of freedom); the other fields are the first record's (seed ``seed``).
     """
 
     _solution: object = field(default=None, repr=False)
@@ -236,11 +263,55 @@ class BuoyResult(_Result):
         if _heave_only(self.dofs):
             return ("power_w", "electrical_power_w", "one_way_power_w", "radiation_bound_w",
                     "heave_amplitude_m", "status")
+        if self.realizations is not None:
+            return ("mean_power_w", "power_ci_w", "realizations", "power_w", "status")
         return ("power_w", "mode", "one_way_power_w", "radiation_bound_w", "status")
 
     def to_dict(self) -> dict:
         d = super().to_dict()
         return {k: d[k] for k in (HEAVE_KEYS if _heave_only(self.dofs) else HULL_KEYS)}
+
+    def to_dataset(self):
+        """The result's Dataset; over several realizations also each one's power, peak
+        torque and bearing load over ``realization`` (its ``seed`` a coordinate)."""
+        ds = super().to_dataset()
+        if self.realizations is None:
+            return ds
+        n = len(self.realization_seeds)
+        ds = ds.assign_coords(realization=("realization", list(range(n)),
+                                           {"long_name": "realization"}),
+                              seed=("realization", list(self.realization_seeds),
+                                    {"long_name": "seed of the record's phases"}))
+        for name, long in (("realization_powers_w", "the record's optimum power (NaN: no "
+                                                    "resolved answer)"),
+                           ("realization_peak_torques_nm", "the record's peak torque"),
+                           ("realization_peak_pivot_forces_n", "the record's peak bearing "
+                                                               "load")):
+            ds.attrs.pop(name, None)
+            unit = {"w": "W", "nm": "N m", "n": "N"}[name.rsplit("_", 1)[1]]
+            ds[name] = ("realization", [math.nan if v is None else float(v)
+                                        for v in getattr(self, name)],
+                        {"units": unit, "long_name": long})
+        if self.power_ci_w is not None:
+            ds.attrs.pop("power_ci_w", None)
+            ds["power_ci_low_w"] = ((), self.power_ci_w[0], {
+                "units": "W", "long_name": "lower end of the mean power's 95 % t-interval"})
+            ds["power_ci_high_w"] = ((), self.power_ci_w[1], {
+                "units": "W", "long_name": "upper end of the mean power's 95 % t-interval"})
+        return ds
+
+    def _csv_text(self) -> str:
+        """``save("x.csv")``: over several realizations the records' table (seed, power,
+        peaks); else the motion over one period."""
+        if self.realizations is None:
+            return super()._csv_text()
+        from ..results import dataset_csv
+
+        ds = self.to_dataset()
+        return dataset_csv(ds[[n for n in ("realization_powers_w",
+                                           "realization_peak_torques_nm",
+                                           "realization_peak_pivot_forces_n")]]
+                           .reset_coords().set_coords([]))
 
     @property
     def solution(self):
@@ -794,6 +865,32 @@ def peak(fun, period: float, points: int = PEAK_POINTS) -> float:
     return max(float(v[i]), -float(r.fun))
 
 
+def error_estimate(history) -> float | None:
+    r"""The discretization error stated beside a power refined by doubling the harmonics
+    (W): from the stages' powers ``P_0, P_1, ..., P_k`` (``history``: ``(harmonics,
+    power)``, each stage twice the harmonics of the one before) and their changes
+    ``d_i = |P_i - P_{i-1}|``:
+
+    - one doubling: ``d_1``;
+    - more: with ``rho = d_k / d_{k-1}``, the geometric tail of the changes still to come,
+      ``max(d_k, d_k rho / (1 - rho))`` (Richardson's estimate of a sequence converging
+      geometrically; ``d_k`` where it converges faster than halving), None where
+      ``rho >= 1`` (the changes do not shrink: no estimate).
+
+    An estimate, not a bound: tests/test_hull_statistics.py checks, on a few cases, that it
+    exceeds the change on one more doubling. None without a doubling."""
+    p = [float(v) for _, v in history]
+    d = [abs(b - a) for a, b in zip(p, p[1:])]
+    if not d:
+        return None
+    if len(d) == 1 or d[-2] == 0.0:
+        return d[-1]
+    rho = d[-1] / d[-2]
+    if not rho < 1.0:
+        return None
+    return max(d[-1], d[-1] * rho / (1.0 - rho))
+
+
 def _deg(v) -> float:
     return float(np.degrees(v))
 
@@ -822,6 +919,8 @@ def _mode(sol) -> dict:
             "one_way_power_w": sol.one_way_power,
             "energy_balance_residual": sol.energy_balance_residual,
             "refinement_change_w": sol.refinement_change, "harmonics": sol.case.harmonics,
+            "discretization_error_estimate_w": error_estimate(sol.refinement_history),
+            "refinement_history": [[int(n), float(v)] for n, v in sol.refinement_history],
             "mean_angle_deg": mean if k == 0 else None, "swing_amplitude_deg": swing,
             "peak_torque_nm": pk, "distinct_maxima": sol.distinct_maxima,
             "maxima_powers_w": [float(v) for v in sol.maxima_powers],
@@ -1001,6 +1100,9 @@ def hull_answer(hull, pendulum, wave, *, pivot, windings=(1, 0), pitch_inertia=N
                                 period) if not at_rest else pendulum.mass * hull.g,
         harmonics=cs.harmonics, hull_harmonics=cs.hull_harmonics,
         refinement_change_w=None if at_rest else best["refinement_change_w"],
+        discretization_error_estimate_w=(None if at_rest
+                                         else best["discretization_error_estimate_w"]),
+        refinement_history=None if at_rest else best["refinement_history"],
         success=all(m["success"] for m in modes) and not reason,
         status="; ".join(f"{m['mode']}: {m['status']}" for m in modes),
         dofs=["surge", "heave", "pitch"], wave=dict(wave_info or {},

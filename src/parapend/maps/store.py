@@ -375,7 +375,8 @@ def _expected(name: str):
     """dtype and fill value of a store's array."""
     if name == "done":
         return np.dtype(bool), False
-    if name.endswith("status") or name == "mode":  # mode: the hull's power matrix's code
+    # mode, failure: the hull's power matrix's codes
+    if name.endswith("status") or name in ("mode", "failure"):
         return np.dtype(np.int8), NOT_COMPUTED
     return np.dtype(float), math.nan
 

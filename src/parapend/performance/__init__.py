@@ -22,10 +22,11 @@ from .. import limits
 from ..errors import ParameterError, check_int, check_positive, check_range
 from .annual import HOURS_PER_YEAR
 from .resource import bin_edges, energy_flux, record_spectrum, repeat_period, te_over_tp
-from .spec import DEVICES, MatrixSpec
+from .spec import DEVICES, UNITS, MatrixSpec
 
-__all__ = ["HOURS_PER_YEAR", "STATISTICS", "MatrixSpec", "matrix_dataset",
-           "matrix_quantities", "matrix_spec", "parse_bins", "power_matrix", "to_mhkit"]
+__all__ = ["HOURS_PER_YEAR", "STATISTICS", "MatrixSpec", "annual_interval", "matrix_dataset",
+           "matrix_extremes", "matrix_quantities", "matrix_spec", "parse_bins", "power_matrix",
+           "to_mhkit"]
 
 log = logging.getLogger(__name__)
 
@@ -90,7 +91,7 @@ def parse_bins(name: str, value) -> tuple:
     return tuple(float(v) for v in vals)
 
 
-def matrix_spec(*, hs="1:3:3", te=None, tp=None, realizations: int = 3, waves: float = 50,
+def matrix_spec(*, hs="1:3:3", te=None, tp=None, realizations: int = 3, waves=None,
                 seed: int = 0, spectrum: str = "jonswap", gamma_peak: float = 3.3,
                 cutoff: float = 3.0, response=None, device: str = "prescribed-heave",
                 horizon=None, length=None, mass=None, inertia=None,
@@ -162,6 +163,10 @@ def matrix_spec(*, hs="1:3:3", te=None, tp=None, realizations: int = 3, waves: f
     ratio = te_over_tp(spectrum, gamma_peak)
     tps = tuple(p / ratio for p in period) if kind == "te" else period
     realizations = check_int("realizations", realizations, 1, 1000)
+    if waves is None:  # the device's record: the hull's own (its solver's reach)
+        from ..defaults import HULL, POWER_MATRIX
+
+        waves = POWER_MATRIX["waves"] if heave else HULL["matrix_waves"]
     waves = check_range("waves", waves, *limits.SEA_WAVES_RANGE,
                         why="record length in peak periods")
     seed = check_int("seed", seed, 0, 2**62)
@@ -327,7 +332,7 @@ def _stats(x: np.ndarray, ok: np.ndarray) -> dict:
 
 
 #: the quantities of the optimum's solve: their statistics count only its successes
-_SOLVED = ("power", "mechanical_power", "electrical_power")
+_SOLVED = ("power", "mechanical_power", "electrical_power", "peak_torque", "peak_pivot_force")
 #: a causal run above its record's non-causal optimum by more than this (relative) is not an
 #: answer: no causal controller beats the omniscient one on the same record, and the
 #: time-domain plant and the frequency-domain optimum agree far closer than this
@@ -343,7 +348,7 @@ def matrix_quantities(spec: MatrixSpec) -> tuple:
 
 def _stored(spec: MatrixSpec) -> tuple:
     """The store's per-realization powers (W): its variables but the status and the mode."""
-    return tuple(v for v in spec.variables if v not in ("status", "mode"))
+    return tuple(v for v in spec.variables if v not in ("status", "mode", "failure"))
 
 
 def _headline(ds, spec: MatrixSpec):
@@ -392,11 +397,13 @@ def matrix_dataset(raw, spec: MatrixSpec, *, depth=None, density: float = 1025.0
         solve_q = q in _SOLVED
         ok = (solved if solve_q else done) & np.isfinite(ds[q].values)
         st = _stats(ds[q].values, ok)
+        unit = ds[q].attrs.get("units", "W")
         for s in STATISTICS:
             ds[f"{q}_{s}"] = (dims2, st[s], {
                 "long_name": f"{s} over the realizations of the {ds[q].attrs['long_name']}"
                              + (" (successful solves only)" if solve_q else ""),
-                **({"units": "W"} if s != "count" else {})})
+                **({"units": unit} if s != "count" else {})})
+    _bin_intervals(ds, spec, solved, dims2)
     # the resource of each bin
     j = np.empty((len(spec.hm0), len(spec.period)))
     te_rec = np.empty_like(j)
@@ -467,8 +474,8 @@ def matrix_dataset(raw, spec: MatrixSpec, *, depth=None, density: float = 1025.0
         bound, bound_name = (_bin_bounds(ds, spec, need) if need.any() and not outside
                              else (None, "bound"))
         for q in matrix_quantities(spec):
-            if q.endswith("_harvested_power"):
-                continue  # without its storage correction: no annual energy
+            if q.endswith("_harvested_power") or q in UNITS:
+                continue  # without its storage correction (or not a power): no annual energy
             a = annual_energy(ds[f"{q}_mean"].values, frequency,
                               outside["frequency"] if outside else 0.0, bound=bound,
                               bound_name=bound_name)
@@ -485,9 +492,15 @@ def matrix_dataset(raw, spec: MatrixSpec, *, depth=None, density: float = 1025.0
                     a["capacity_factor_bounds"] = [
                         None if w is None else capacity_factor(w, rated_power)
                         for w in a["wh_bounds"]]
+            if q == "power":
+                a.update(annual_interval(ds, frequency, solved))
             annual[q] = a
         # the completeness in the file too (NetCDF has no boolean attribute: 1 or 0)
         ds.attrs["annual_energy_complete"] = int(annual["power"]["complete"])
+        ds.attrs["annual_energy_ci_method"] = (annual["power"]["ci_method"]
+                                               or "none: fewer than 2 solved realizations")
+        ds.attrs["annual_energy_mwh_ci"] = [_nan_none(v) for v in
+                                            (annual["power"]["mwh_ci"] or [None, None])]
         if annual["power"]["complete"]:
             ds.attrs["annual_energy_mwh"] = annual["power"]["mwh"]
         else:
@@ -500,6 +513,138 @@ def matrix_dataset(raw, spec: MatrixSpec, *, depth=None, density: float = 1025.0
             _annual_columns(ds, spec, annual)
     ds.attrs["hours_per_year"] = HOURS_PER_YEAR
     return ds, annual
+
+
+def _bin_intervals(ds, spec: MatrixSpec, solved, dims2) -> None:
+    """Each bin's 95 % t-interval of its mean power over its solved realizations
+    (:func:`parapend.confidence.t_interval`: ``power_ci_low``, ``power_ci_high``; NaN below
+    two), and for the hull the reason of each bin's unsolved records (``failed_solves``,
+    ``failure``: the commonest reason among them, -1 where none failed)."""
+    from ..confidence import METHOD, t_interval
+
+    p = ds["power"].values
+    lo = np.full(p.shape[:2], np.nan)
+    hi = np.full(p.shape[:2], np.nan)
+    for i, j in np.ndindex(*p.shape[:2]):
+        ci = t_interval(p[i, j][solved[i, j] & np.isfinite(p[i, j])])
+        if ci["low"] is not None:
+            lo[i, j], hi[i, j] = ci["low"], ci["high"]
+    for name, v, end in (("power_ci_low", lo, "lower"), ("power_ci_high", hi, "upper")):
+        ds[name] = (dims2, v, {"long_name": f"{end} end of the 95 % interval of the bin's mean "
+                                            "power (NaN: fewer than 2 solved realizations)",
+                               "units": "W", "method": METHOD})
+    if "failure" not in ds:
+        return
+    from .hull_device import FAILURES
+
+    done = ds["done"].values.astype(bool)
+    f = ds["failure"].values
+    bad = done & ~solved
+    count = bad.sum(axis=-1)
+    common = np.full(count.shape, -1, dtype=np.int8)
+    for i, j in np.argwhere(count > 0):
+        codes = f[i, j][bad[i, j]]
+        codes = np.where(codes < 0, FAILURES.index("other"), codes)
+        common[i, j] = int(np.bincount(codes, minlength=len(FAILURES)).argmax())
+    ds["failed_solves"] = (dims2, count.astype(np.int64), {
+        "long_name": "realizations of the bin without a resolved answer (left out of its "
+                     "mean, and the bin out of the annual energy when none is left)"})
+    ds["bin_failure"] = (dims2, common, {
+        "long_name": "the commonest reason among the bin's unresolved realizations",
+        "flag_values": [-1, *range(len(FAILURES))],
+        "flag_meanings": " ".join(["none_failed", *(x.replace(" ", "_") for x in FAILURES)])})
+
+
+#: how the annual energy's interval is formed, by case
+AEP_CI_PAIRED = ("paired: the annual energy of each realization r, 8766 h sum_b f_b P_b,r "
+                 "(realization r has seed seed + r in every bin: common random numbers), "
+                 "its Student t-interval over the realizations (95 %, R - 1 degrees of "
+                 "freedom)")
+AEP_CI_SUMMED = ("summed: 8766 h sum_b f_b h_b, h_b each counted bin's half-width (95 % "
+                 "t-interval over its solved realizations): the bins share their seeds, so "
+                 "their errors are correlated; the sum of the half-widths holds whatever the "
+                 "correlation (conservative)")
+
+
+def annual_interval(ds, frequency, solved) -> dict:
+    """The 95 % interval (``mwh_ci``, MWh, and ``ci_method``) of the annual energy counted
+    (``8766 h sum_b f_b max(mean_b, 0)`` over the bins with a frequency and a power).
+
+    Every counted bin with a positive mean solved in every realization: the paired
+    interval (:data:`AEP_CI_PAIRED`; a bin at rest counts 0 in each). Otherwise the
+    half-widths summed (:data:`AEP_CI_SUMMED`). None where a counted bin with a positive
+    mean has fewer than two solved realizations (no interval). The lower end is at least 0
+    (the annual energy is never negative: the interval cut to where it can lie keeps its
+    coverage)."""
+    from ..confidence import t_interval
+    from .annual import bin_power
+
+    f = np.asarray(frequency, dtype=float)
+    p = ds["power"].values
+    mean = bin_power(ds["power_mean"].values)
+    counted = (f > 0) & np.isfinite(mean) & (mean > 0)
+    none = {"mwh_ci": None, "ci_method": None}
+    if not counted.any():
+        return none
+    ok = solved & np.isfinite(p)
+    if ok[counted].all() and p.shape[-1] >= 2:
+        per = HOURS_PER_YEAR * np.einsum("ij,ijr->r", np.where(counted, f, 0.0),
+                                         np.where(counted[..., None], p, 0.0))
+        ci = t_interval(per)
+        return {"mwh_ci": [max(ci["low"], 0.0) / 1e6, ci["high"] / 1e6],
+                "ci_method": AEP_CI_PAIRED,
+                "realization_mwh": [float(v) / 1e6 for v in per]}
+    half = 0.0
+    for i, j in np.argwhere(counted):
+        ci = t_interval(p[i, j][ok[i, j]])
+        if ci["half_width"] is None:
+            return none
+        half += HOURS_PER_YEAR * f[i, j] * ci["half_width"]
+    wh = HOURS_PER_YEAR * float(np.sum(np.where(counted, f * mean, 0.0)))
+    return {"mwh_ci": [max(wh - half, 0.0) / 1e6, (wh + half) / 1e6],
+            "ci_method": AEP_CI_SUMMED}
+
+
+def matrix_extremes(ds, pk: str) -> dict:
+    """The hull's generator rating and its unresolved bins, for the JSON (empty for the
+    other devices): ``peak_torque_nm`` and ``peak_pivot_force_n`` (each bin's largest over
+    its solved realizations; null where none), the site's largest (``site_peak_torque_nm``,
+    ``site_peak_pivot_force_n``: over the bins with a share of the year when a site is
+    given, else over all) and where it lies, and ``bin_failures``: each bin with an
+    unresolved realization, how many and why."""
+    if "peak_torque_max" not in ds:
+        return {}
+    from .hull_device import FAILURES
+
+    out = {}
+    share = ds["frequency"].values > 0 if "frequency" in ds else None
+    for q, key in (("peak_torque", "peak_torque_nm"), ("peak_pivot_force", "peak_pivot_force_n")):
+        v = ds[f"{q}_max"].values
+        out[key] = [[_finite(float(x)) for x in row] for row in v]
+        w = np.where(np.isfinite(v) & (True if share is None else share), v, -np.inf)
+        if np.isfinite(w).any():
+            i, j = np.unravel_index(int(np.argmax(w)), w.shape)
+            out[f"site_{key}"] = float(v[i, j])
+            out[f"site_{key.rsplit('_', 1)[0]}_bin"] = {"hm0": float(ds["hm0"].values[i]),
+                                                        pk: float(ds[pk].values[j])}
+        else:
+            out[f"site_{key}"] = None
+            out[f"site_{key.rsplit('_', 1)[0]}_bin"] = None
+    fails = []
+    if "failed_solves" in ds:
+        codes = ds["failure"].values
+        done = ds["done"].values.astype(bool)
+        for i, j in np.argwhere(ds["failed_solves"].values > 0):
+            st = ds["status"].values[i, j]
+            bad = done[i, j] & ~np.isin(st, [0, 1])
+            reasons = sorted({FAILURES[c] if c >= 0 else "other" for c in codes[i, j][bad]})
+            fails.append({"hm0": float(ds["hm0"].values[i]), pk: float(ds[pk].values[j]),
+                          "failed": int(bad.sum()), "realizations": int(codes.shape[-1]),
+                          "reasons": reasons,
+                          "frequency": (float(ds["frequency"].values[i, j])
+                                        if "frequency" in ds else None)})
+    out["bin_failures"] = fails
+    return out
 
 
 def annual_columns(spec: MatrixSpec) -> dict:
@@ -692,7 +837,7 @@ def to_mhkit(da):
     return da.rename({da.dims[0]: "x_centers", da.dims[1]: "y_centers"})
 
 
-def power_matrix(*, hs="1:3:3", te=None, tp=None, realizations: int = 3, waves: float = 50,
+def power_matrix(*, hs="1:3:3", te=None, tp=None, realizations: int = 3, waves=None,
                  seed: int = 0, spectrum: str = "jonswap", gamma_peak: float = 3.3,
                  cutoff: float = 3.0, response=None, device: str = "prescribed-heave",
                  horizon=None, length=None, mass=None, inertia=None,

@@ -232,6 +232,30 @@ def text_report(ds, out: dict, drawn: list) -> str:
     rows = [[f"{h:g} m", *(with_unit(v, "W") for v in ds["power_mean"].values[i])]
             for i, h in enumerate(hm0)]
     lines += [_right_table(rows, ["Hm0 \\ " + pk, *(f"{t:g} s" for t in per)]), ""]
+    if "power_ci_low" in ds and np.isfinite(ds["power_ci_low"].values).any():
+        lo, hi = ds["power_ci_low"].values, ds["power_ci_high"].values
+        rows = [[f"{h:g} m", *("-" if not np.isfinite(a) else
+                               f"{with_unit(a, 'W')} to {with_unit(b, 'W')}"
+                               for a, b in zip(lo[i], hi[i]))] for i, h in enumerate(hm0)]
+        lines += ["95 % interval of each bin's mean (Student t over its solved realizations):",
+                  _right_table(rows, ["Hm0 \\ " + pk, *(f"{t:g} s" for t in per)]), ""]
+    for key, what, unit in (("peak_torque_nm", "peak torque", "N m"),
+                            ("peak_pivot_force_n", "peak bearing load", "N")):
+        if out.get(key) is not None:
+            rows = [[f"{h:g} m", *("-" if v is None else f"{v:.4g}" for v in out[key][i])]
+                    for i, h in enumerate(hm0)]
+            lines += [f"{what} ({unit}), each bin's largest over its solved records:",
+                      _right_table(rows, ["Hm0 \\ " + pk, *(f"{t:g} s" for t in per)])]
+            top, where = out.get(f"site_{key}"), out.get(f"site_{key.rsplit('_', 1)[0]}_bin")
+            if top is not None:
+                lines += [f"the site's largest {what}: {top:.6g} {unit} (Hm0 {where['hm0']:g} "
+                          f"m, {pk} {where[pk]:g} s)", ""]
+    for b in out.get("bin_failures") or ():
+        lines.append(f"bin Hm0 {b['hm0']:g} m, {pk} {b[pk]:g} s: {b['failed']} of "
+                     f"{b['realizations']} records without a resolved answer ("
+                     + ", ".join(b["reasons"]) + "); left out of the bin's mean"
+                     + ("" if b["failed"] < b["realizations"] else
+                        " (the bin has no power: out of the annual energy)"))
     if "operating_mode" in ds:
         m = ds["operating_mode"].values
         lines.append("operating mode of the bins: " + ", ".join(
@@ -267,6 +291,14 @@ def text_report(ds, out: dict, drawn: list) -> str:
         lines.append(f"mean annual energy (8766 h/yr): {'electrical' if eff else 'optimum'} "
                      f"{aep(p)}"
                      + "".join(f", {label} {aep(a[q])}" for q, label in names if q in a))
+        if p.get("mwh_ci"):
+            lo, hi = p["mwh_ci"]
+            lines.append(f"95 % interval of the annual energy counted: {_per_year(lo * 1e6)} "
+                         f"to {_per_year(hi * 1e6)} ({p['ci_method'].split(':')[0]}: "
+                         "docs/performance.md)")
+        if p.get("counted_frequency") is not None and not p.get("complete", True):
+            lines.append(f"completeness: the bins counted hold "
+                         f"{100 * p['counted_frequency']:.4g} % of the year's hours")
         if p.get("complete") is True:
             lines.append("complete: every sea state of the site lies in a bin with a result")
         if not p.get("complete", True) and "uncounted_frequency" in p:

@@ -18,10 +18,16 @@ import math
 
 from ..errors import ParameterError
 
-__all__ = ["MODES", "check_records", "hull_of", "hull_opts", "problem", "solve_hull_bin"]
+__all__ = ["FAILURES", "MODES", "check_records", "failure_code", "hull_of", "hull_opts", "problem",
+           "solve_hull_bin"]
 
 #: the per-realization ``mode`` codes (-1: not computed)
 MODES = ("rest", "rotation", "swinging")
+#: the per-realization reason for no resolved answer: an int8 code (-1 not computed)
+FAILURES = ("none", "no start converged", "harmonics unresolved",
+            "above the radiation bound", "refinement failed", "other")
+FAILURE_LONG_NAME = ("why the record has no resolved answer: " + ", ".join(
+    f"{i} {name}" for i, name in enumerate(FAILURES)))
 #: the per-process hull problems, keyed by the spec's hull
 _PROBLEMS: dict = {}
 #: the hull options of the spec (besides the pendulum's)
@@ -147,6 +153,50 @@ def check_records(spec) -> None:
             raise ParameterError(f"{pk}: the record of the bin {per:g} s: {rest}") from None
 
 
+def failure_code(reason: str | None) -> int:
+    """The code (:data:`.spec.FAILURES`) of a record's ``headline_reason`` (None: 0)."""
+    if not reason:
+        return 0
+    for name, marks in (("above the radiation bound", ("times the radiation bound",)),
+                        ("harmonics unresolved", ("not resolved",)),
+                        ("refinement failed", ("refinement to",)),
+                        ("no start converged", ("no start converged",
+                                                "no mode's search converged"))):
+        if any(m in reason for m in marks):
+            return FAILURES.index(name)
+    return FAILURES.index("other")
+
+
+#: a record without a resolved answer is solved once more with this many times the default
+#: harmonics (other starts on another discretization), within ``limits.HULL_MAX_HARMONICS``
+RETRY_HARMONICS = 1.5
+
+
+def _retry(spec, wave, info, res):
+    """One more solve of a record ``res`` left unresolved, with :data:`RETRY_HARMONICS`
+    times the harmonics it had (None where they do not fit the hull's cap or a
+    ``harmonics`` was given): its answer when resolved, else ``res`` (whose reason then
+    stands)."""
+    import logging
+
+    from .. import limits
+    from ..hydro.api import solve_record
+    from ..hydro.hull import HARMONICS_PER_TURN, waves_in
+
+    p = problem(spec)
+    if p["harmonics"] is not None:
+        return res
+    n = HARMONICS_PER_TURN * max(max(p["windings"]), waves_in(wave))
+    more = int(math.ceil(RETRY_HARMONICS * n / 2)) * 2
+    if more > limits.HULL_MAX_HARMONICS:
+        return res
+    again = solve_record({**p, "harmonics": more}, wave, info)
+    logging.getLogger(__name__).info(
+        "hull record %s: %s; with %d harmonics: %s", info.get("seed"), res.headline_reason,
+        more, getattr(again, "headline_reason", None) or "resolved")
+    return res if getattr(again, "headline_reason", None) else again
+
+
 def solve_hull_bin(spec, i: int, j: int, r: int) -> dict:
     """The hull's answer to one record: the best mode's power (never below zero), its mode,
     the radiation bound, the one-way power, the mechanical power of a lossy take-off."""
@@ -156,22 +206,28 @@ def solve_hull_bin(spec, i: int, j: int, r: int) -> dict:
 
     wave, info = wave_of(spec, i, j, r)
     res = solve_record(problem(spec), wave, info)
+    if getattr(res, "headline_reason", None):
+        res = _retry(spec, wave, info, res)
     def num(v):
         return math.nan if v is None else float(v)
     p = num(res.power_w)  # None: no resolved answer (headline_reason), kept as NaN
-    out = {"power": p}
+    reason = getattr(res, "headline_reason", None)
+    out = {"power": p, "failure": failure_code(reason)}
+    if not reason:  # the generator's rating: located on the optimum's motion
+        out.update(peak_torque=num(getattr(res, "peak_torque_nm", None)),
+                   peak_pivot_force=num(getattr(res, "peak_pivot_force_n", None)))
     if spec.lossy:
         # the store keeps the mechanical power as "power" (the heave buoy's layout; the
         # Dataset shows the electrical one as power)
-        out = {"power": num(res.mechanical_power_w), "electrical_power": p}
+        out.update(power=num(res.mechanical_power_w), electrical_power=p)
+    # the record's answer is what parapend buoy answers alone: its headline power (a mode
+    # that did not converge beside a resolved best one is a note there, not a failure)
     if getattr(res, "headline_reason", None):  # no resolved answer: NaN, not a success
-        status = "other"
-    elif res.success:
-        status = "no_power" if res.mode == "rest" else "converged"
-    else:
         bad = [m for m in res.modes if not m["success"]]
         head = str(bad[0]["status"]).split(";")[0].strip() if bad else ""
         status = head if head in _CODE and head not in ("converged", "no_power") else "other"
+    else:
+        status = "no_power" if res.mode == "rest" else "converged"
     owp = res.one_way_power_w
     return {**out, "radiation_bound_power": float(res.radiation_bound_w),
             "one_way_power": math.nan if owp is None else float(owp),

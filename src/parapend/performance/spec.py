@@ -16,7 +16,9 @@ import logging
 
 import numpy as np
 
-__all__ = ["MatrixSpec", "QUANTITIES", "STORE_NAMES"]
+from .hull_device import FAILURE_LONG_NAME, FAILURES
+
+__all__ = ["FAILURES", "MatrixSpec", "QUANTITIES", "STORE_NAMES"]
 
 log = logging.getLogger(__name__)
 
@@ -32,12 +34,19 @@ QUANTITIES = {
                              "inside the buoy absorbs more",
     "one_way_power": "one-way optimum: the pendulum's reaction on the buoy left out (the "
                      "pivot moves as the free buoy), its predicted power",
+    # the hull (--dofs surge,heave,pitch): the generator's rating, from the motion itself
+    "peak_torque": "largest |tau| of the record's optimum (located on its motion)",
+    "peak_pivot_force": "largest bearing load |m (p'' + l (sin phi, cos phi)'') + m g| of the "
+                        "record's optimum (located on its motion)",
 }
+#: the stored quantities' units (the rest: W)
+UNITS = {"peak_torque": "N m", "peak_pivot_force": "N"}
+
 #: the hull's per-realization mode (--dofs surge,heave,pitch): an int8 code, -1 not computed
 MODE_LONG_NAME = "best mode of the record: 0 rest, 1 rotation (one turn per wave), 2 swinging"
 _TITLE = "parapend design map"
 #: every top-level name a power-matrix store holds (coordinates and variables)
-STORE_NAMES = ("hm0", "te", "tp", "realization", "seed", "done", "status", "mode",
+STORE_NAMES = ("hm0", "te", "tp", "realization", "seed", "done", "status", "mode", "failure",
                *QUANTITIES, *(f"causal_{f}_{q}" for f in ("perfect", "ar")
                               for q in ("power", "harvested_power")))
 #: the causal column's fields (left out of the JSON without a controller)
@@ -165,7 +174,8 @@ class MatrixSpec:
     def variables(self) -> tuple:
         if self.device == "buoy":
             e = ("electrical_power",) if self.lossy else ()
-            m = ("mode",) if self.dofs != "heave" else ()
+            m = (("peak_torque", "peak_pivot_force", "mode", "failure")
+                 if self.dofs != "heave" else ())
             c = ()
             if self.controller is not None:
                 from .causal import causal_quantities
@@ -276,6 +286,13 @@ class MatrixSpec:
                 attrs = {"long_name": MODE_LONG_NAME, "flag_values": [0, 1, 2],
                          "flag_meanings": "rest rotation swinging",
                          "comment": "-1: not computed"}
+            elif v == "failure":
+                arr = da.full(self.shape, -1, dtype=np.int8, chunks=self.chunks)
+                fill = -1
+                attrs = {"long_name": FAILURE_LONG_NAME,
+                         "flag_values": list(range(len(FAILURES))),
+                         "flag_meanings": " ".join(f.replace(" ", "_") for f in FAILURES),
+                         "comment": "-1: not computed"}
             elif v == "status":
                 arr = da.full(self.shape, -1, dtype=np.int8, chunks=self.chunks)
                 fill = -1
@@ -285,7 +302,8 @@ class MatrixSpec:
                          "comment": "-1: not computed; success: converged"}
             else:
                 arr = da.full(self.shape, np.nan, dtype=float, chunks=self.chunks)
-                fill, attrs = np.nan, {"long_name": self.long_names()[v], "units": "W"}
+                fill, attrs = np.nan, {"long_name": self.long_names()[v],
+                                       "units": UNITS.get(v, "W")}
             data[v] = (self.dims, arr, attrs)
             enc[v] = {"chunks": self.chunks, "fill_value": fill,
                       "compressors": (ZstdCodec(level=0, checksum=True),)}
@@ -330,7 +348,8 @@ class MatrixSpec:
         from .solve import solve_bin, verdict
 
         i, j, _ = (s.start for s in self.block_slices(block))
-        out = {v: (np.full(self.chunks, -1, dtype=np.int8) if v in ("status", "mode")
+        out = {v: (np.full(self.chunks, -1, dtype=np.int8) if v in ("status", "mode",
+                                                                     "failure")
                    else np.full(self.chunks, np.nan)) for v in self.variables}
         for r in range(self.realizations):
             try:
@@ -346,6 +365,10 @@ class MatrixSpec:
                             "not a success", self.hm0[i], self.period_kind, self.period[j],
                             r, checked["status"], vals.get("power"))
             vals = checked
+            if "failure" in out and vals["status"] in ("above_bound", "nonfinite", "error"):
+                vals["failure"] = FAILURES.index("above the radiation bound"
+                                                 if vals["status"] == "above_bound"
+                                                 else "other")
             for k, v in vals.items():
                 if k == "status":
                     out[k][0, 0, r] = _CODE.get(v, _CODE["other"])
