@@ -78,3 +78,74 @@ def test_buoy_save_writes_every_format(sphere_nc, tmp_path, capsys, suffix):
 def test_buoy_save_refuses_an_unknown_format(capsys, tmp_path):
     assert main(["buoy", "--save", str(tmp_path / "motion.xyz")]) == 2
     assert "--save" in capsys.readouterr().err
+
+
+# --- sizes refused before the work; estimates printed without a terminal -----------------
+def test_a_dataset_of_too_many_frequencies_is_refused_by_the_api():
+    from parapend import limits
+    from parapend.hydro.bem import HullHydro
+
+    n = limits.BUOY_MAX_DATASET_FREQUENCIES + 1
+    w = np.linspace(1.0, 5.0, n)
+    with pytest.raises(ParameterError, match=f"^hydro: expected at most {n - 1} frequencies, "
+                                             f"got {n} "):
+        Hydro(w, np.ones(n), np.ones(n), np.ones(n, complex), 8000.0, 400.0)
+    with pytest.raises(ParameterError, match=f"got {n} "):
+        HullHydro(omega=w, added_mass=np.zeros((n, 3, 3)), radiation_damping=np.zeros(
+            (n, 3, 3)), excitation=np.zeros((n, 3), complex), hydrostatic_stiffness=np.eye(3),
+            mass=1.0, pitch_inertia=None)
+
+
+def test_a_dataset_file_of_too_many_frequencies_is_one_line(tmp_path, capsys, monkeypatch):
+    """A dataset of a million frequencies (the audit's size, under the file cap when it is
+    compressed) is refused by its omega coordinate's length, before its values are merged
+    or any solve starts."""
+    from capytaine.io.xarray import separate_complex_values
+
+    n = 10**6
+    ds = _hydro().to_dataset()
+    big = ds.reindex(omega=np.linspace(1.0, 5.0, n), method="nearest")
+    path = tmp_path / "many.nc"
+    enc = {v: {"zlib": True} for v in separate_complex_values(big).data_vars}
+    separate_complex_values(big).to_netcdf(path, encoding=enc)
+
+    def merged(_):
+        raise AssertionError("merged before the count was checked")
+
+    monkeypatch.setattr("capytaine.io.xarray.merge_complex_values", merged)
+    assert main(["buoy", "--hydro", str(path)]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err.splitlines() == [err] and f"got {n} " in err and "frequencies" in err
+
+
+def _stop(*args, **kwargs):
+    raise ParameterError("stopped before the work (test)")
+
+
+def test_the_sweep_estimate_is_printed_when_stderr_is_not_a_terminal(capsys, monkeypatch,
+                                                                      tmp_path):
+    """A million-point map (about 2 ms a point at N = 24, one process: half an hour) is
+    announced on stderr even piped; pytest's captured stderr is not a terminal."""
+    from parapend.maps import run
+
+    monkeypatch.setattr(run, "run_spec", _stop)
+    argv = ["sweep", "--omega", "1:2:1000000", "--workers", "1", "--store",
+            str(tmp_path / "m.zarr")]
+    assert main(argv) == 2
+    err = capsys.readouterr().err
+    seconds = 10**6 * run.POINT_SECONDS
+    assert "sweep: 1000000 points: roughly " in err
+    assert f"roughly {round(seconds / 60)} minutes" in err
+
+
+def test_the_persistence_estimate_is_printed_when_stderr_is_not_a_terminal(capsys, monkeypatch,
+                                                                           tmp_path):
+    from parapend.maps import run
+
+    monkeypatch.setattr(run, "run_spec", _stop)
+    monkeypatch.setattr("os.cpu_count", lambda: 2)
+    argv = ["persistence", "--mass", "1", "--length", "0.3", "--damping-coefficient", "2e-4",
+            "--generator-damping", "5e-4", "--hs", "0.005:0.04:8", "--tp", "0.2:0.6:9",
+            "--duration", "300", "--realizations", "2000", "--store", str(tmp_path / "p.zarr")]
+    assert main(argv) == 2
+    assert "persistence: 72 sea states x 2000 realizations: roughly " in capsys.readouterr().err
