@@ -908,6 +908,10 @@ def hull_buoy(deadline=None, **opts):
             periods = np.array([_period(_hull_value(opts, "wave_period"))])
         check_steepness(height, periods)
         _check_grid(_hull_body(opts)[1], periods)
+    elif opts.get("record") is None:  # a sea state past breaking, before the BEM too
+        from ..seas import check_sea_state
+
+        check_sea_state(_hull_value(opts, "hs"), _hull_value(opts, "tp"))
     p = hull_problem(**opts)
     hull, pend, pivot, inertia, geometry, pto, windings, harmonics = (
         p[k] for k in ("hull", "pendulum", "pivot", "pitch_inertia", "geometry", "pto",
