@@ -521,6 +521,7 @@ def buoy(*, wave_height=None, wave_period=None, hs=None, tp=None, spectrum=None,
             periods_all = np.array([_period(p) for p in periods])
         if mesh is None and hydro is None and barge is None:  # refused before the BEM
             _check_short(_parametric_top(body, radius, draft), periods_all, body, radius)
+        check_steepness(height, periods_all)  # a wave past breaking, before the BEM too
         h, width = _heave_hydro(barge, body, radius, draft, mesh, hydro, wave_direction)
         w = 2 * math.pi / periods_all
         if hydro is None:
