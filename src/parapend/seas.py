@@ -234,15 +234,16 @@ def sea_steepness(hs: float, tp: float, g: float = 9.81) -> float:
     return hs / (g * tp * tp / (2 * math.pi))
 
 
-#: False while a power matrix builds its bins' records (:func:`bins_past_breaking`)
+#: False within :func:`steepness_unchecked`
 _REFUSE_BREAKING = contextvars.ContextVar("parapend_refuse_breaking", default=True)
 
 
 @contextlib.contextmanager
-def bins_past_breaking():
+def steepness_unchecked():
     """Within it, :func:`check_sea_steepness` refuses nothing: a power matrix's rectangle of
     bins holds corners no sea reaches (Hm0 5 m at Te 4 s), which a site's scatter gives no
-    hours; the matrix solves its bins as before."""
+    hours, and the matrix solves its bins as before; a record drawn only as a scaled base
+    excitation (``track``'s irregular sea, set by the rms of ``q``) is no sea state."""
     token = _REFUSE_BREAKING.set(False)
     try:
         yield
@@ -253,7 +254,7 @@ def bins_past_breaking():
 def check_sea_steepness(hs: float, tp: float) -> None:
     """Refuse, before any work, a sea state whose significant wave alone would break:
     ``Hs / lambda_p > 1/7`` (:data:`BREAKING_STEEPNESS`, the regular wave's limit); not
-    within :func:`bins_past_breaking`."""
+    within :func:`steepness_unchecked`."""
     steep = sea_steepness(hs, tp)
     if steep > BREAKING_STEEPNESS and _REFUSE_BREAKING.get():
         raise ParameterError(f"hs: Hs = {hs:g} m at Tp = {tp:g} s (peak wavelength "

@@ -26,9 +26,9 @@ def electrical_power(result, efficiency: float) -> float:
 
 
 def solve_bin(spec, i: int, j: int, r: int) -> dict:
-    from ..seas import bins_past_breaking
+    from ..seas import steepness_unchecked
 
-    with bins_past_breaking():  # a rectangle of bins: corners no sea reaches
+    with steepness_unchecked():  # a rectangle of bins: corners no sea reaches
         return _solve_bin(spec, i, j, r)
 
 
