@@ -991,7 +991,8 @@ def test_netcdf_on_a_full_disk_says_so(reference, tmp_path, monkeypatch, capsys)
 def _interrupt(proc, ready, timeout=120):
     """Wait until ``ready()`` (the sweep is under way), send SIGINT, return (rc, stderr);
     stderr without the first-use compile notice, which a clean install's first power
-    take-off sweep prints before its workers start."""
+    take-off sweep prints before its workers start, and the estimate of long work, printed
+    before the run starts."""
     deadline = time.monotonic() + timeout
     while time.monotonic() < deadline and proc.poll() is None and not ready():
         time.sleep(0.05)
@@ -999,7 +1000,7 @@ def _interrupt(proc, ready, timeout=120):
     proc.send_signal(signal.SIGINT)
     _, err = proc.communicate(timeout=timeout)
     err = "".join(line for line in err.splitlines(keepends=True)
-                  if not line.startswith("parapend: compiling "))
+                  if not line.startswith(("parapend: compiling ", "parapend: sweep: ")))
     return proc.returncode, err
 
 

@@ -240,6 +240,10 @@ HULL_PITCH_INERTIA_RANGE = (1e-6, 1e12)
 #: barge's BEM within minutes
 HULL_MAX_BEM_PANELS = 3000
 BUOY_MIN_DEPTH = 1e-2
+#: frequencies of a dataset (``--hydro``, ``Hydro``, ``HullHydro``): the causal plant's
+#: infinite-frequency added mass costs their square (20 000 took a minute, a million would
+#: take days); a BEM's few hundred are far below
+BUOY_MAX_DATASET_FREQUENCIES = 4096
 #: the largest magnitude of a dataset's coefficient (A, B, F, C, M in SI units): the powers
 #: square them (an excitation of 1e300 N/m gave an infinite radiation bound)
 BUOY_MAX_COEFFICIENT = 1e100

@@ -38,6 +38,8 @@ record's spectral peak) so that the measurement noise, amplified by ``f^2``, sta
 
 from __future__ import annotations
 
+import contextlib
+import contextvars
 import csv
 import math
 from dataclasses import dataclass, field
@@ -217,10 +219,73 @@ def check_spectrum(spectrum, gamma_peak, cutoff) -> tuple[float, float]:
     return gamma_peak, cutoff
 
 
-def _check_sea(hs, tp, spectrum, gamma_peak, repeat_period, cutoff):
+#: A regular wave steeper than this breaks (Michell's limit, H / lambda ~ 0.142); a sea
+#: state's significant steepness ``Hs / lambda_p`` is held to the same limit
+BREAKING_STEEPNESS = 1 / 7
+#: a wave (``H / lambda``) or a sea state (``Hs / lambda_p``) steeper than this is warned
+#: about (linear theory stretched)
+STEEP_WARNING = 1 / 20
+
+
+def sea_steepness(hs: float, tp: float, g: float = 9.81) -> float:
+    """The significant steepness ``Hs / lambda_p`` of a sea state: ``lambda_p = g Tp^2 /
+    (2 pi)``, the deep-water wavelength of the peak period (the longest it has: a finite
+    depth's waves are shorter and steeper)."""
+    return hs / (g * tp * tp / (2 * math.pi))
+
+
+#: False within :func:`steepness_unchecked`
+_REFUSE_BREAKING = contextvars.ContextVar("parapend_refuse_breaking", default=True)
+
+
+@contextlib.contextmanager
+def steepness_unchecked():
+    """Within it, :func:`check_sea_steepness` refuses nothing: a power matrix's rectangle of
+    bins holds corners no sea reaches (Hm0 5 m at Te 4 s), which a site's scatter gives no
+    hours, and the matrix solves its bins as before; a record drawn only as a scaled base
+    excitation (``track``'s irregular sea, set by the rms of ``q``) is no sea state."""
+    token = _REFUSE_BREAKING.set(False)
+    try:
+        yield
+    finally:
+        _REFUSE_BREAKING.reset(token)
+
+
+def check_sea_steepness(hs: float, tp: float) -> None:
+    """Refuse, before any work, a sea state whose significant wave alone would break:
+    ``Hs / lambda_p > 1/7`` (:data:`BREAKING_STEEPNESS`, the regular wave's limit); not
+    within :func:`steepness_unchecked`."""
+    steep = sea_steepness(hs, tp)
+    if steep > BREAKING_STEEPNESS and _REFUSE_BREAKING.get():
+        raise ParameterError(f"hs: Hs = {hs:g} m at Tp = {tp:g} s (peak wavelength "
+                             f"{hs / steep:.4g} m) is steepness Hs / lambda_p = {steep:.3g}, "
+                             f"past breaking (1/7); expected at most "
+                             f"{tp * tp * 9.81 / (14 * math.pi):.4g} m")
+
+
+def sea_steepness_warning(hs: float, tp: float) -> str | None:
+    """The validity warning of a sea state steeper than :data:`STEEP_WARNING` (the regular
+    wave's ``H / lambda`` warning, on ``Hs / lambda_p``), or None."""
+    steep = sea_steepness(hs, tp)
+    if steep <= STEEP_WARNING:
+        return None
+    return (f"linear theory: the sea's steepness Hs / lambda_p = {steep:.3g} exceeds "
+            f"{STEEP_WARNING:.3g} (1/20; breaking at 1/7): its steepest waves' nonlinearity "
+            "is left out")
+
+
+def check_sea_state(hs, tp) -> tuple[float, float]:
+    """``(hs, tp)`` checked: each in its range, and the sea not past breaking
+    (:func:`check_sea_steepness`)."""
     hs = check_range("hs", hs, limits.SEA_MIN_HS, limits.SEA_MAX_HS,
                      why="significant wave height, m")
     tp = check_range("tp", tp, *limits.SEA_TP_RANGE, why="peak period, s")
+    check_sea_steepness(hs, tp)
+    return hs, tp
+
+
+def _check_sea(hs, tp, spectrum, gamma_peak, repeat_period, cutoff):
+    hs, tp = check_sea_state(hs, tp)
     gamma_peak, cutoff = check_spectrum(spectrum, gamma_peak, cutoff)
     if repeat_period is not None:
         repeat_period = check_positive("repeat-period", repeat_period)

@@ -31,9 +31,12 @@ class Unresolved:
 
 def unresolved_if(out, result):
     """``out`` wrapped in :class:`Unresolved` when ``result`` has no resolved answer: a
-    null headline with its reason (``headline_reason``) or the status ``loses_energy``."""
-    if getattr(result, "headline_reason", None) or getattr(result, "status",
-                                                           None) == "loses_energy":
+    null headline with its reason (``headline_reason``; a sweep's, one per period: any of
+    them) or the status ``loses_energy``."""
+    reason = getattr(result, "headline_reason", None)
+    if isinstance(reason, (list, tuple)):
+        reason = any(reason)
+    if reason or getattr(result, "status", None) == "loses_energy":
         return Unresolved(out)
     return out
 

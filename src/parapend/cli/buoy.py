@@ -348,7 +348,8 @@ def _hull_text(r) -> list:
             ["local maxima found (count; powers)", f"{r.maxima}; " + ", ".join(
                 f"{v:.4g}" for v in (r.maxima_powers_w or [])[:6]), "-; W"],
             ["one-way (reaction left out)", _w(r.one_way_power_w), "W"],
-            ["radiation bound (F a)^H B^+ (F a) / 8", _w(r.radiation_bound_w), "W"],
+            ["radiation bound of this mesh's B, F: (F a)^H B^+ (F a) / 8",
+             _w(r.radiation_bound_w), "W"],
             ["  its error from the data's noise", _w(r.bound_error_w), "W"],
             ["  fraction reached", _w(r.bound_fraction), "-"],
             ["capture-width limit J 3 lambda / (2 pi)", _w(r.capture_width_limit_w), "W"],
@@ -415,6 +416,10 @@ def _hull_sweep_text(r) -> list:
             "bound (W)", "heave (m)", "pitch (deg)"]
     out = [f"regular waves, H = {r.wave_height_m:g} m", *_hull_head(r), "",
            _table(rows, head), "", f"success: {r.success}"]
+    none = [f"{t:g}" for t, why in zip(r.period_s, r.headline_reason or ()) if why]
+    if none:
+        out.append(f"power: none at T = {', '.join(none)} s, no resolved answer (the notes "
+                   "say why)")
     return out + [f"note: {n}" for n in r.warnings]
 
 

@@ -97,6 +97,9 @@ def add_parsers(sub) -> None:
 def _cmd_persistence(a) -> dict | str:
     _check_output(a.plot, "--plot", FIGURE_SUFFIXES)
     _check_output(a.save, "--save", (".nc", ".json"))
+    from ._notice import install
+
+    install("parapend.dynamics")  # the estimate of long work, on stderr (piped or not)
     argv = sys.argv[1:] if sys.argv and sys.argv[0] else []
     r = _run(a, command="parapend " + " ".join(shlex.quote(x) for x in argv),
              progress=_EtaProgress("persistence"))

@@ -133,6 +133,9 @@ def _cmd_sweep(a) -> dict | str:
     _check_output(a.netcdf, "--netcdf", (".nc",))
     if a.store is None:
         a.store = SWEEP_STORE
+    from ._notice import install
+
+    install("parapend.maps")  # the estimate of long work, on stderr (piped or not)
     rec = _run(a, command=_command_line(), progress=_EtaProgress("sweep"))
     run, out = rec.run, rec.to_dict()
     counts, best = out["status_counts"], out["largest_power"]

@@ -316,15 +316,16 @@ def design_sea(omega: float, rms: float, seed: int):
     ``Hs^2``: ``<q^2> = sum |Q_k|^2 / 2``. Returns the excitation and its description
     (``hs`` in units of ``g t0^2``, the pendulum length for a point mass).
     """
-    from ..seas import sea_record
+    from ..seas import sea_record, steepness_unchecked
     from ..units import STANDARD_GRAVITY, Units
 
     t0 = SEA_TP * omega / (2 * math.pi)
     units = Units(STANDARD_GRAVITY * t0**2, 1.0)
 
     def record(hs):
-        return sea_record(units, hs=hs, tp=SEA_TP, spectrum="jonswap",
-                          repeat_period=SEA_WAVES * SEA_TP, seed=seed)
+        with steepness_unchecked():  # a scaled q record, not a sea state in water
+            return sea_record(units, hs=hs, tp=SEA_TP, spectrum="jonswap",
+                              repeat_period=SEA_WAVES * SEA_TP, seed=seed)
 
     unit = record(1.0)
     hs = rms / math.sqrt(0.5 * float(np.sum(np.abs(unit.spec) ** 2)))

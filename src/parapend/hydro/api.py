@@ -533,6 +533,7 @@ def buoy(*, wave_height=None, wave_period=None, hs=None, tp=None, spectrum=None,
             periods_all = np.array([_period(p) for p in periods])
         if mesh is None and hydro is None and barge is None:  # refused before the BEM
             _check_short(_parametric_top(body, radius, draft), periods_all, body, radius)
+        check_steepness(height, periods_all)  # a wave past breaking, before the BEM too
         h, width = _heave_hydro(barge, body, radius, draft, mesh, hydro, wave_direction)
         w = 2 * math.pi / periods_all
         if hydro is None:
@@ -916,6 +917,10 @@ def hull_buoy(deadline=None, time_limit=None, **opts):
             periods = np.array([_period(_hull_value(opts, "wave_period"))])
         check_steepness(height, periods)
         _check_grid(_hull_body(opts)[1], periods)
+    elif opts.get("record") is None:  # a sea state past breaking, before the BEM too
+        from ..seas import check_sea_state
+
+        check_sea_state(_hull_value(opts, "hs"), _hull_value(opts, "tp"))
     p = hull_problem(**opts)
     hull, pend, pivot, inertia, geometry, pto, windings, harmonics = (
         p[k] for k in ("hull", "pendulum", "pivot", "pitch_inertia", "geometry", "pto",

@@ -90,6 +90,18 @@ def _as_omega(w) -> np.ndarray:
     return np.asarray(w, dtype=float)
 
 
+def check_frequency_count(n: int) -> None:
+    """Refuse ``n`` data frequencies above
+    :data:`parapend.limits.BUOY_MAX_DATASET_FREQUENCIES`, in one line, before any work."""
+    from .. import limits
+
+    cap = limits.BUOY_MAX_DATASET_FREQUENCIES
+    if n > cap:
+        raise ParameterError(f"hydro: expected at most {cap} frequencies, got {n} (the "
+                             "causal plant's work grows with their square; resample the "
+                             "data on fewer)")
+
+
 def _coefficient_array(name: str, value, dtype=float) -> np.ndarray:
     """``value`` as an array of numbers, or a one-line :class:`ParameterError` naming the
     coefficient (``Hydro("x", ...)`` raised NumPy's bare "could not convert string")."""
@@ -143,8 +155,10 @@ class Hydro:
     dofs = ("heave",)
 
     def __post_init__(self):
-        w, a, b = (_coefficient_array(n, getattr(self, n)).ravel() for n in (
-            "omega", "added_mass", "radiation_damping"))
+        w = _coefficient_array("omega", self.omega).ravel()
+        check_frequency_count(w.size)
+        a, b = (_coefficient_array(n, getattr(self, n)).ravel() for n in (
+            "added_mass", "radiation_damping"))
         f = _coefficient_array("excitation", self.excitation, complex).ravel()
         if not (w.size >= 1 and a.size == b.size == f.size == w.size):
             raise ParameterError("hydro: expected omega, added_mass, radiation_damping and "
@@ -996,6 +1010,9 @@ def _by_omega(ds, path):
     ``freq`` where it has no ``omega`` dimension)."""
     from capytaine.io.xarray import merge_complex_values
 
+    for dim in ("omega", "period", "freq"):  # before merging (a copy) or any other work
+        if dim in ds.dims:
+            check_frequency_count(int(ds.sizes[dim]))
     if "complex" in ds.dims:
         ds = merge_complex_values(ds)
     if "omega" not in ds.dims:
@@ -1321,6 +1338,7 @@ class HullHydro:
 
         w = _coefficient_array("omega", self.omega).ravel()
         n = w.size
+        check_frequency_count(n)
         a, b, c = (_coefficient_array(k, getattr(self, k)) for k in (
             "added_mass", "radiation_damping", "hydrostatic_stiffness"))
         f = _coefficient_array("excitation", self.excitation, complex)

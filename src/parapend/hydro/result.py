@@ -18,6 +18,7 @@ import numpy as np
 from scipy.optimize import minimize_scalar
 
 from ..results import _Result
+from ..seas import BREAKING_STEEPNESS, STEEP_WARNING, sea_steepness_warning  # noqa: F401
 from .hull import (
     BOUND_RCOND,
     HullProblem,
@@ -70,8 +71,8 @@ HEAVE_SWEEP_KEYS = ("period_s", "power_w", "one_way_power_w", "radiation_bound_w
                     "free_heave_amplitude_m", "energy_balance_residual", "status", "success",
                     "wave_height_m", "pendulum", "body", "warnings", "electrical_power_w",
                     "mechanical_power_w", "mesh_error_w", "validity_warnings", "grid_error_w")
-HULL_SWEEP_KEYS = ("period_s", "power_w", "mechanical_power_w", "rotation_power_w",
-                   "swinging_power_w", "one_way_power_w", "radiation_bound_w",
+HULL_SWEEP_KEYS = ("period_s", "power_w", "headline_reason", "mechanical_power_w",
+                   "rotation_power_w", "swinging_power_w", "one_way_power_w", "radiation_bound_w",
                    "heave_amplitude_m", "pitch_amplitude_deg", "energy_balance_residual", "mode",
                    "status", "success", "wave_height_m", "pendulum", "body", "pivot", "warnings")
 
@@ -216,7 +217,9 @@ class BuoyResult(_Result):
         The relative residual of the energy balance ``P + c <(phi' - beta')^2> =
         sum_k Re((F a)_k^H U_k) / 2 - U_k^H B_k U_k / 2`` (below 1e-9 when the solve is
         right).
-    radiation_bound_w : ``sum_k (F a)_k^H B_k^+ (F a)_k / 8``, singular values of ``B_k``
+    radiation_bound_w : ``sum_k (F a)_k^H B_k^+ (F a)_k / 8`` of these coefficients (a
+        mesh's or a dataset's: it moves with the mesh, and a warning says when it exceeds
+        the capture-width limit, which does not), singular values of ``B_k``
         below ``bound_rcond`` of the largest cut (``bound_cut`` of them): ``bound_rcond`` is
         the data's noise (``HullHydro.damping_noise``: B's asymmetry or its negative part
         set to 0, relative to its largest entry), at least 1e-8; bound_fraction.
@@ -412,6 +415,8 @@ class BuoySweepResult(_Result):
     (``HEAVE_SWEEP_KEYS``, ``HULL_SWEEP_KEYS``). Every period is solved on the same
     mesh and frequencies as alone (:class:`BuoyResult`: the same numbers).
 
+    A hull's ``headline_reason`` is each period's (None where its power is the answer):
+    a period without a resolved answer makes the command exit with status 3, as alone.
     Heave alone: ``electrical_power_w`` with an efficiency, else None; ``mesh_error_w``,
     ``grid_error_w`` and ``validity_warnings`` are those of each period (the warnings
     prefixed with the period). A hull: rotation against swinging, ``mode`` the best per
@@ -467,6 +472,7 @@ class BuoySweepResult(_Result):
                    energy_balance_residual=arr("energy_balance_residual"),
                    mode=[r.mode for r in results] + [None] * left,
                    status=[r.status for r in results] + [TIME_LIMIT] * left,
+                   headline_reason=[r.headline_reason for r in results] + [None] * left,
                    success=not left and all(r.success for r in results),
                    wave_height_m=float(height),
                    pendulum=results[0].pendulum, body=results[0].body,
@@ -505,6 +511,10 @@ class BuoySweepResult(_Result):
         ds = xr.Dataset({k: ("period_s", np.asarray(getattr(self, k), dtype=float))
                          for k in names}, coords={"period_s": self.period_s})
         ds["mode"] = ("period_s", np.asarray(self.mode, dtype=str))
+        for name in ("status", "headline_reason"):  # each period's ("" where None)
+            if getattr(self, name) is not None:
+                ds[name] = ("period_s", np.asarray(["" if v is None else str(v)
+                                                    for v in getattr(self, name)], dtype=str))
         return ds
 
     def _figure(self):
@@ -677,10 +687,6 @@ def _error_powers(h, coarse, pendulum, wave, **opts):
     return pc, None if half is None else _power_on(half, pendulum, wave, **opts)
 
 
-#: A regular wave steeper than this breaks (Michell's limit, H / lambda ~ 0.142).
-BREAKING_STEEPNESS = 1 / 7
-#: a regular wave steeper than this is warned about (linear theory stretched)
-STEEP_WARNING = 1 / 20
 
 
 def _validity(z, eta, wave, wave_info, h, geometry) -> list:
@@ -712,7 +718,16 @@ def _validity(z, eta, wave, wave_info, h, geometry) -> list:
         if steep > BREAKING_STEEPNESS:
             out.append(f"linear theory: the wave's steepness H / lambda = {steep:.3g} exceeds "
                        f"the breaking limit 1/7 (wavelength {2 * math.pi / k:.3g} m)")
+    out += _sea_validity(wave_info)
     return out
+
+
+def _sea_validity(wave_info) -> list:
+    """A sea state's steepness warning (``Hs / lambda_p`` past 1/20), as a list."""
+    if wave_info.get("kind") != "irregular" or wave_info.get("hs") is None:
+        return []
+    text = sea_steepness_warning(float(wave_info["hs"]), float(wave_info["tp"]))
+    return [text] if text else []
 
 
 def _result(h, width, pendulum, wave, wave_info, sol, ow, *, torque_limit, efficiency,
@@ -964,10 +979,11 @@ def _ends(hull, geometry) -> tuple:
             " (the dataset's hydrostatics as a wall-sided box: an estimate)")
 
 
-def headline_reason(modes, best, power, bound, at_rest) -> str | None:
+def headline_reason(modes, best, power, bound, at_rest, limit=None) -> str | None:
     """Why the best mode's ``power`` (W) is not the answer, or None when it is: rest (0 W)
     answers when a mode converged and none beats it; a search that did not converge, or a
-    power above the radiation ``bound`` (beyond ``BOUND_SLACK``), is no answer."""
+    power above the radiation ``bound`` or the capture-width ``limit`` (W; None: not
+    checked), beyond ``BOUND_SLACK``, is no answer."""
     if at_rest:
         if any(m["success"] for m in modes):
             return None
@@ -980,7 +996,23 @@ def headline_reason(modes, best, power, bound, at_rest) -> str | None:
         return (f"the {best['mode']}'s {power:.4g} W is {power / bound:.4g} times the "
                 f"radiation bound {bound:.4g} W: impossible (the inputs, the data or the "
                 "solve are wrong)")
+    if limit is not None and not power <= limit * (1 + BOUND_SLACK):
+        return (f"the {best['mode']}'s {power:.4g} W is {power / limit:.4g} times the "
+                f"capture-width limit {limit:.4g} W, which no body moving in surge, heave "
+                "and pitch beats: impossible (the data's B or F, or the solve, are wrong)")
     return None
+
+
+def bound_note(bound, error, limit) -> str | None:
+    """The warning of a radiation ``bound`` (W) above the capture-width ``limit`` (W) by
+    more than its ``error`` (W): the bound is of these coefficients, a mesh's or a
+    dataset's, and B's near-null directions inflate it; the limit does not depend on them."""
+    if not bound > (limit + error) * (1 + BOUND_SLACK):
+        return None
+    return (f"radiation bound: {bound:.4g} W is {bound / limit:.3g} times the capture-width "
+            f"limit {limit:.4g} W: it is of this mesh's (or dataset's) B and F, whose "
+            "near-null directions inflate it, and moves with the mesh; the capture-width "
+            "limit bounds the power")
 
 
 def _solve_mode(hull, pendulum, wave, k, harmonics, pivot, pitch_inertia, pto) -> dict:
@@ -1054,6 +1086,7 @@ def hull_answer(hull, pendulum, wave, *, pivot, windings=(1, 0), pitch_inertia=N
             validity.append(f"linear theory: the wave's steepness H / lambda = {steep:.3g} "
                             f"exceeds {STEEP_WARNING:.3g} (1/20; breaking at 1/7): a steep "
                             "wave's nonlinearity is left out")
+    validity += _sea_validity(w_info)
     d, half_len, est = _ends(hull, geometry)
     if d is not None and not at_rest:
         ends = np.abs(s["xi"][1]) + half_len * np.abs(np.sin(s["xi"][2]))
@@ -1068,7 +1101,10 @@ def hull_answer(hull, pendulum, wave, *, pivot, windings=(1, 0), pitch_inertia=N
                         f"{rcond:.3g} of the largest (the data's noise) cut in its "
                         "pseudo-inverse")
     maxima = sorted((v for m in modes for v in m.get("maxima_powers_w") or ()), reverse=True)
-    reason = headline_reason(modes, best, p, bound, at_rest)
+    note = bound_note(bound, bound_err, cw_limit)
+    if note:
+        warnings.append(note)
+    reason = headline_reason(modes, best, p, bound, at_rest, limit=cw_limit)
     if reason:
         warnings.append(f"no resolved answer: {reason}")
     owp = None if at_rest else best["one_way_power_w"]

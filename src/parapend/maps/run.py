@@ -448,6 +448,13 @@ def sweep(store=None, *, omega=1.8, delta=None, gamma=GAMMA["sweep"], torque_lim
                       efficiency=efficiency, harmonics=harmonics, excitation=excitation,
                       square_alpha=square_alpha, fourier=fourier, threshold=threshold,
                       block_points=block_points)
+    seconds = estimate_seconds(spec) / (1 if scheduler is not None else max(
+        1, min(workers or os.cpu_count() or 1, spec.blocks)))
+    if seconds > 60:  # announced on stderr by the command line, a terminal or not
+        from ..deadline import duration
+
+        log.info("sweep: %d points: roughly %s (the store resumes an interrupted run)",
+                 spec.points, duration(seconds))
     run = run_spec(spec, store, workers=workers, scheduler=scheduler, overwrite=overwrite,
                    command=command, progress=progress)
     if netcdf:
@@ -455,6 +462,17 @@ def sweep(store=None, *, omega=1.8, delta=None, gamma=GAMMA["sweep"], torque_lim
 
         fileio.write_dataset(run.dataset, netcdf)
     return dataclasses.replace(run, units=units, netcdf=netcdf)
+
+
+#: seconds of one point of a map at N = 24 (its cost grows as N^3), a torque-limited or lossy
+#: point's, and gamma*'s at a point (measured on the shared cores: 2 ms, 7 s, 0.2 s)
+POINT_SECONDS, PTO_POINT_SECONDS, THRESHOLD_SECONDS = 2e-3, 7.0, 0.25
+
+
+def estimate_seconds(spec) -> float:
+    """A rough single-process duration (s) of the sweep ``spec``, before any resume."""
+    per = PTO_POINT_SECONDS if spec.pto else POINT_SECONDS * (spec.harmonics / 24) ** 3
+    return spec.points * (per + (THRESHOLD_SECONDS if spec.threshold else 0.0))
 
 
 def run_spec(spec, store=None, *, workers: int | None = None, scheduler=None,

@@ -34,12 +34,14 @@ def wave_of(spec, i: int, j: int, r: int):
     """The Wave of bin ``(i, j)``, realization ``r`` (``parapend buoy``'s record builder on
     the prescribed device's arguments) and its description."""
     from ..hydro.api import _irregular_wave
+    from ..seas import steepness_unchecked
     from .resource import repeat_period
 
     tp = spec.tp[j]
-    return _irregular_wave(spec.hm0[i], tp, spec.spectrum, spec.gamma_peak,
-                           repeat_period(spec.waves, tp), int(spec.seeds[r]), spec.cutoff, None,
-                           0.1, _units(spec))
+    with steepness_unchecked():  # a rectangle of bins: corners no sea reaches
+        return _irregular_wave(spec.hm0[i], tp, spec.spectrum, spec.gamma_peak,
+                               repeat_period(spec.waves, tp), int(spec.seeds[r]), spec.cutoff,
+                               None, 0.1, _units(spec))
 
 
 def _band(spec, j: int) -> tuple:

@@ -97,15 +97,17 @@ def _units(spec):
 def _record(spec, units, i: int, j: int, r: int):
     """The excitation of bin ``(i, j)``, realization ``r``, as ``sea`` builds it; its
     ParameterError reworded to name the bin and the options that set it."""
-    from ..seas import sea_record
+    from ..seas import sea_record, steepness_unchecked
     from .resource import repeat_period
 
     tp = spec.tp[j]
     response = (None if spec.response is None else tuple(spec.response))
     try:
-        return sea_record(units, hs=spec.hm0[i], tp=tp, spectrum=spec.spectrum,
-                          gamma_peak=spec.gamma_peak, repeat_period=repeat_period(spec.waves, tp),
-                          seed=int(spec.seeds[r]), cutoff=spec.cutoff, response=response)
+        with steepness_unchecked():  # a rectangle of bins: corners no sea reaches
+            return sea_record(units, hs=spec.hm0[i], tp=tp, spectrum=spec.spectrum,
+                              gamma_peak=spec.gamma_peak,
+                              repeat_period=repeat_period(spec.waves, tp),
+                              seed=int(spec.seeds[r]), cutoff=spec.cutoff, response=response)
     except ParameterError as err:
         head, _, rest = str(err).partition(": ")
         if head == "sea":  # the record's q: set by hs, the cutoff and gravity

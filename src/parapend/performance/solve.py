@@ -26,6 +26,13 @@ def electrical_power(result, efficiency: float) -> float:
 
 
 def solve_bin(spec, i: int, j: int, r: int) -> dict:
+    from ..seas import steepness_unchecked
+
+    with steepness_unchecked():  # a rectangle of bins: corners no sea reaches
+        return _solve_bin(spec, i, j, r)
+
+
+def _solve_bin(spec, i: int, j: int, r: int) -> dict:
     if spec.device == "buoy" and spec.dofs != "heave":
         from .hull_device import solve_hull_bin
 
