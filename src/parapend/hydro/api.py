@@ -656,13 +656,17 @@ def _refuse_unsupported(opts: dict) -> None:
              "damping_coefficient_bounds": "damping-coefficient-bounds",
              "horizon": "horizon", "update_interval": "update-interval",
              "forecast": "forecast"}
+    mpc = opts.get("controller") == "mpc"
     for key, name in later.items():
-        if opts.get(key) is not None:
-            raise ParameterError(f"{name}: not available with --dofs surge,heave,pitch yet; "
-                                 "drop it")
-    if opts.get("controller") not in (None, "optimum"):
-        raise ParameterError("controller: the causal controllers run on the heaving buoy "
-                             "only; drop --controller with --dofs surge,heave,pitch")
+        if opts.get(key) is not None and not (mpc and key in (
+                "horizon", "update_interval", "forecast")):
+            raise ParameterError(f"{name}: not available with --dofs surge,heave,pitch"
+                                 + (" yet; drop it" if key not in (
+                                     "horizon", "update_interval", "forecast")
+                                    else "; needs --controller mpc"))
+    if opts.get("controller") not in (None, "optimum", "mpc"):
+        raise ParameterError("controller: a hull (--dofs surge,heave,pitch) takes optimum or "
+                             f"mpc, got {opts.get('controller')!r:.40}")
 
 
 def _hull_pto(opts):
@@ -926,7 +930,18 @@ def hull_buoy(deadline=None, **opts):
             opts.get("seed"), default_of("cutoff", opts.get("cutoff")), opts.get("record"),
             default_of("taper", opts.get("taper")),
             Units(pend.length, pend.mass, 9.81, pend.inertia))
+        if opts.get("controller") == "mpc":
+            from .hull_control import hull_mpc_command
+
+            return hull_mpc_command(
+                p, wave, info, deadline=deadline,
+                horizon=default_of("horizon", opts.get("horizon"), "mpc"),
+                update_interval=default_of("update_interval", opts.get("update_interval")),
+                forecast=default_of("forecast", opts.get("forecast")))
         return solve_record(p, wave, info)
+    if opts.get("controller") == "mpc":
+        raise ParameterError("controller: mpc runs in an irregular sea state: give --hs and "
+                             "--tp (and --repeat-period, --seed)")
     w = 2 * math.pi / periods
     hull.check_covers(float(np.min(w)), float(np.max(w)), name="wave-period")
     results = []

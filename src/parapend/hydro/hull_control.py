@@ -46,7 +46,7 @@ from ..errors import ParameterError, check_int, check_range
 from . import control as bc
 from . import timedomain as td
 
-__all__ = ["hull_mpc", "memory_weights", "a_infinity_matrix"]
+__all__ = ["a_infinity_matrix", "hull_mpc", "hull_mpc_command", "memory_weights"]
 
 #: torque samples per peak period, RK4 steps per sample (plant and model)
 SAMPLES = 24
@@ -422,3 +422,38 @@ def hull_mpc(hull, pendulum, wave, *, peak_period, pivot=(0.0, 0.0), pitch_inert
         units={"time_s": t0, "torque_nm": tu, "power_w": tu / t0, "a_inf_surge_kg": ai[0],
                "a_inf_heave_kg": ai[1], "a_inf_pitch_kg_m2": ai[2],
                "memory_s": plant.nk * h, "plant_step_s": h})
+
+
+def hull_mpc_command(problem, wave, info, *, horizon, update_interval, forecast,
+                     deadline=None):
+    """``parapend buoy --dofs surge,heave,pitch --controller mpc``: the record's non-causal
+    optimum (:func:`parapend.hydro.api.solve_record`, rotation and swinging) and the closed
+    loop on the record in its mode (4 peak periods of warm-up, one repeat), the
+    storage-corrected mean beside it: ``optimum_fraction`` is the electrical power over the
+    optimum's (with the problem's torque limit and efficiency in both)."""
+    import dataclasses
+
+    from .api import solve_record
+
+    if "tp" not in info:
+        raise ParameterError("controller: mpc runs in an irregular sea state: give --hs and "
+                             "--tp")
+    sol = solve_record(problem, wave, info)
+    winding = int(sol.winding) if sol.winding is not None else 0
+    pto = problem["pto"]
+    r = hull_mpc(problem["hull"], problem["pendulum"], wave, peak_period=float(info["tp"]),
+                 pivot=problem["pivot"], pitch_inertia=problem["pitch_inertia"],
+                 horizon=horizon, update_interval=update_interval, forecast=forecast,
+                 torque_limit=pto.torque_limit, efficiency=pto.efficiency,
+                 mode="swing" if winding == 0 else "rotate", deadline=deadline)
+    opt = float(sol.power_w) if sol.success and sol.power_w is not None else None
+    frac = (r.electrical_power_w / opt if opt is not None and opt > 0
+            and math.isfinite(r.electrical_power_w) else None)
+    warnings = r.warnings
+    if frac is not None and frac > 1 + bc.REFERENCE_TOL:
+        warnings += (f"the causal run reaches {frac:.4g} of the non-causal reference, above "
+                     "1: the reference is not the record's optimum on this plant (its "
+                     "memory and steps differ from the frequency domain's)",)
+    return dataclasses.replace(r, optimum_power_w=opt, optimum_fraction=frac,
+                               optimum_resolved=bool(sol.success), optimum_winding=winding,
+                               wave=info, warnings=warnings)
