@@ -22,9 +22,11 @@ State ``y = (x, z, beta, phi, x', z', beta', phi')`` (SI). ``vel[k0 + j]``, ``j 
 the hull's velocity at ``t - (nk - j) h``; :func:`roll` appends the new ones after it.
 ``mus[0..2]``: the memory force at ``t``, ``t - h``, ``t - 2 h``. ``par = (m, l, I, c, g)``.
 
-With tangent columns (``dys.shape[2] > 0``) :func:`roll` also carries the derivatives of the
-state with respect to each held torque through the same scheme (the memory of the motion
-since the start included): the horizon problem's exact gradient (:mod:`.hull_control`).
+With ``jac`` of one row per step :func:`roll` also keeps every stage's Jacobian of the
+accelerations with respect to ``(y, mu, tau)``; :func:`adjoint` then runs the same scheme
+backwards (the memory of the motion since the start included): the exact gradient of a
+function of the states at the samples' ends with respect to every held torque, at the cost
+of about one more pass (the horizon problem's, :mod:`.hull_control`).
 """
 
 from __future__ import annotations
@@ -42,7 +44,8 @@ announce_compiles()  # log a first-use compile (parapend._jit)
 @nb.njit(cache=True)
 def _accel(y, mu, f, tau, mt, cp, gm, par, acc, minv, cvec, bvec):
     """The accelerations ``(xi'', phi'')`` of the state ``y`` into ``acc``; ``minv`` the
-    inverse mass matrix, ``cvec = m l G^T a`` and ``bvec = G^T b`` at ``phi`` (in place)."""
+    inverse mass matrix, ``cvec = m l G^T a`` and ``bvec = G^T b`` at ``phi`` (in place).
+    ``mt``: ``M_t^-1``."""
     m, ell, inertia, c, g = par[0], par[1], par[2], par[3], par[4]
     ml = m * ell
     s = math.sin(y[3])
@@ -50,14 +53,21 @@ def _accel(y, mu, f, tau, mt, cp, gm, par, acc, minv, cvec, bvec):
     for i in range(3):
         cvec[i] = ml * (gm[0, i] * co - gm[1, i] * s)
         bvec[i] = gm[0, i] * s + gm[1, i] * co
-    mm = np.empty((4, 4))
+    # the inverse by the Schur complement of the constant block M_t (``mt`` holds M_t^-1)
+    q = np.empty(3)
+    for i in range(3):
+        v = 0.0
+        for j in range(3):
+            v += mt[i, j] * cvec[j]
+        q[i] = v
+    sc = inertia
+    for i in range(3):
+        sc -= cvec[i] * q[i]
     for i in range(3):
         for j in range(3):
-            mm[i, j] = mt[i, j]
-        mm[i, 3] = cvec[i]
-        mm[3, i] = cvec[i]
-    mm[3, 3] = inertia
-    minv[:, :] = np.linalg.inv(mm)
+            minv[i, j] = mt[i, j] + q[i] * q[j] / sc
+        minv[i, 3] = minv[3, i] = -q[i] / sc
+    minv[3, 3] = 1.0 / sc
     vr = y[7] - y[6]
     r = np.empty(4)
     for i in range(3):
@@ -142,88 +152,76 @@ def denergy(y, dy, mt, cp, gm, par, out):
         out[k] = v
 
 
+#: the memory's quadratic extrapolation to a step's midpoint and end from its values at the
+#: step and the two before (:mod:`._control_kernel`): ``mu = sum c_k m_k``
+_MID = (1.875, -1.25, 0.375)
+_END = (3.0, -3.0, 1.0)
+#: unit columns of ``(y, mu, tau)``
+_UNIT = np.eye(12)
+
+
 @nb.njit(cache=True)
-def roll(y, vel, k0, mus, u, steps, fn, h, w, mt, cp, gm, par, ys, acc, dys, dvel, dmus):
+def _stage_jacobian(y, acc, minv, cvec, bvec, cp, par, out):
+    """``d acc / d (y, mu, tau)`` (4, 12) of one stage (:func:`_daccel` on unit columns)."""
+    _daccel(y, _UNIT[:8], _UNIT[8:11], _UNIT[11], acc, minv, cvec, bvec, cp, par, out)
+
+
+@nb.njit(cache=True)
+def roll(y, vel, k0, mus, u, steps, fn, h, w, mti, cp, gm, par, ys, acc, jac):
     """Advance ``y`` over ``len(u)`` held torques (N m) of ``steps`` RK4 steps of ``h``.
 
-    ``fn`` (nodes, 3): the excitation (N, N, N m) at the half-step nodes (``2 len(u) steps +
-    1``); ``w`` (nk + 1, 3, 3) the memory's weights. On exit ``ys[k]`` is the state after
-    ``k`` samples (``ys[0]`` the start) and ``acc`` accumulates the RK4 quadratures of the
-    power the hull absorbs ``(F - mu) . xi'`` (``acc[0]``), of the damping ``c v^2``
-    (``acc[1]``) and the exact work of the held torque ``-tau (theta_1 - theta_0)``
-    (``acc[2]``), J. Tangents: ``dys`` (n + 1, 8, nc) the state's derivatives with respect
-    to the held torques ``u[0..nc-1]``; ``dvel`` (n steps + 1, 3, nc) and ``dmus`` (3, 3,
-    nc) work space (zero at entry). Returns False if ``|phi'|`` left ``1e6``.
+    ``fn`` (nodes, 3): the excitation (N, N, N m) at the half-step nodes (``2 len(u) steps
+    + 1``); ``w`` (nk + 1, 3, 3) the memory's weights; ``mti`` ``M_t^-1``. On exit
+    ``ys[k]`` is the state after ``k`` samples (``ys[0]`` the start) and ``acc``
+    accumulates the RK4 quadratures of the power the hull absorbs ``(F - mu) . xi'``
+    (``acc[0]``), of the damping ``c v^2`` (``acc[1]``) and the exact work of the held
+    torque ``-tau (theta_1 - theta_0)`` (``acc[2]``), J. ``jac`` (steps in all, 4, 4, 12)
+    or empty: every stage's Jacobian (:func:`adjoint`). Returns False if ``|phi'|`` left
+    ``1e6``.
     """
     nk = w.shape[0] - 1
-    nc = dys.shape[2]
+    keep = jac.shape[0] > 0
     c = par[3]
     n = u.size
     m0, m1, m2 = mus[0].copy(), mus[1].copy(), mus[2].copy()
-    dm0, dm1, dm2 = dmus[0].copy(), dmus[1].copy(), dmus[2].copy()
     mh = np.empty(3)
     me = np.empty(3)
-    dmh = np.empty((3, nc))
-    dme = np.empty((3, nc))
     minv = np.empty((4, 4))
     cvec = np.empty(3)
     bvec = np.empty(3)
     ka = np.empty((4, 4))
     st = np.empty((4, 8))
-    dst = np.empty((4, 8, nc))
-    dka = np.empty((4, 4, nc))
+    vr = np.empty(4)
     yy = y.copy()
-    dy = np.zeros((8, nc))
-    dtau = np.zeros(nc)
     ys[0] = yy
-    if nc:
-        dys[0] = dy
     ok = True
     for j in range(n):
         tau = u[j]
-        for k in range(nc):
-            dtau[k] = 1.0 if k == j else 0.0
-        act = min(j + 1, nc)  # the columns that can be non-zero from here on
         for s in range(steps):
             i = j * steps + s
             for d in range(3):
-                d1 = 0.5 * (3.0 * m0[d] - 4.0 * m1[d] + m2[d])
-                d2 = 0.5 * (m0[d] - 2.0 * m1[d] + m2[d])
-                mh[d] = m0[d] + 0.5 * d1 + 0.25 * d2
-                me[d] = m0[d] + d1 + d2
-                for k in range(act):
-                    e1 = 0.5 * (3.0 * dm0[d, k] - 4.0 * dm1[d, k] + dm2[d, k])
-                    e2 = 0.5 * (dm0[d, k] - 2.0 * dm1[d, k] + dm2[d, k])
-                    dmh[d, k] = dm0[d, k] + 0.5 * e1 + 0.25 * e2
-                    dme[d, k] = dm0[d, k] + e1 + e2
+                mh[d] = _MID[0] * m0[d] + _MID[1] * m1[d] + _MID[2] * m2[d]
+                me[d] = _END[0] * m0[d] + _END[1] * m1[d] + _END[2] * m2[d]
             # the four stages: st[q] the stage's state, ka[q] its accelerations
             for q in range(4):
                 if q == 0:
                     st[0] = yy
-                    if nc:
-                        dst[0] = dy
                 else:
                     frac = 0.5 * h if q < 3 else h
                     for a in range(4):
                         st[q, a] = yy[a] + frac * st[q - 1, 4 + a]
                         st[q, 4 + a] = yy[4 + a] + frac * ka[q - 1, a]
-                        for k in range(act):
-                            dst[q, a, k] = dy[a, k] + frac * dst[q - 1, 4 + a, k]
-                            dst[q, 4 + a, k] = dy[4 + a, k] + frac * dka[q - 1, a, k]
                 node = 2 * i if q == 0 else (2 * i + 1 if q < 3 else 2 * i + 2)
                 mu = m0 if q == 0 else (mh if q < 3 else me)
-                _accel(st[q], mu, fn[node], tau, mt, cp, gm, par, ka[q], minv, cvec, bvec)
-                if nc:
-                    dmu = dm0 if q == 0 else (dmh if q < 3 else dme)
-                    _daccel(st[q], dst[q, :, :act], dmu[:, :act], dtau[:act], ka[q], minv,
-                            cvec, bvec, cp, par, dka[q, :, :act])
+                _accel(st[q], mu, fn[node], tau, mti, cp, gm, par, ka[q], minv, cvec, bvec)
+                if keep:
+                    _stage_jacobian(st[q], ka[q], minv, cvec, bvec, cp, par, jac[i, q])
             f0, fm, f1 = fn[2 * i], fn[2 * i + 1], fn[2 * i + 2]
             pa = 0.0
             for d in range(3):
                 pa += ((f0[d] - m0[d]) * st[0, 4 + d] + (fm[d] - mh[d])
                        * (st[1, 4 + d] + st[2, 4 + d]) * 2.0 + (f1[d] - me[d]) * st[3, 4 + d])
             acc[0] += h / 6.0 * pa
-            vr = np.empty(4)
             for q in range(4):
                 vr[q] = st[q, 7] - st[q, 6]
             acc[1] += h / 6.0 * c * (vr[0] ** 2 + 2.0 * vr[1] ** 2 + 2.0 * vr[2] ** 2
@@ -233,11 +231,6 @@ def roll(y, vel, k0, mus, u, steps, fn, h, w, mt, cp, gm, par, ys, acc, dys, dve
                 yy[a] += h / 6.0 * (st[0, 4 + a] + 2.0 * st[1, 4 + a] + 2.0 * st[2, 4 + a]
                                     + st[3, 4 + a])
                 yy[4 + a] += h / 6.0 * (ka[0, a] + 2.0 * ka[1, a] + 2.0 * ka[2, a] + ka[3, a])
-                for k in range(act):
-                    dy[a, k] += h / 6.0 * (dst[0, 4 + a, k] + 2.0 * dst[1, 4 + a, k]
-                                           + 2.0 * dst[2, 4 + a, k] + dst[3, 4 + a, k])
-                    dy[4 + a, k] += h / 6.0 * (dka[0, a, k] + 2.0 * dka[1, a, k]
-                                               + 2.0 * dka[2, a, k] + dka[3, a, k])
             acc[2] -= tau * (yy[3] - yy[2] - th0)
             # the memory at the new step point: trapezoid over the stored velocity
             e = k0 + nk + i + 1
@@ -251,26 +244,91 @@ def roll(y, vel, k0, mus, u, steps, fn, h, w, mt, cp, gm, par, ys, acc, dys, dve
                     for b in range(3):
                         v += w[q, d, b] * vel[e - q, b]
                 m0[d] = v
-            if nc:
-                dm2[:, :] = dm1
-                dm1[:, :] = dm0
-                for d in range(3):
-                    for k in range(act):
-                        dvel[i + 1, d, k] = dy[4 + d, k]
-                top = min(nk, i)  # dvel[0] (the start's velocity) is fixed
-                for d in range(3):
-                    for k in range(act):
-                        v = 0.0
-                        for q in range(top + 1):
-                            for b in range(3):
-                                v += w[q, d, b] * dvel[i + 1 - q, b, k]
-                        dm0[d, k] = v
         ys[j + 1] = yy
-        if nc:
-            dys[j + 1] = dy
         if not abs(yy[7]) < 1e6:
             ok = False
             break
     y[:] = yy
     mus[0], mus[1], mus[2] = m0, m1, m2
     return ok
+
+
+@nb.njit(cache=True)
+def adjoint(jac, w, steps, h, seeds):
+    """The gradient ``dJ / dtau_j`` (N m^-1 units of ``J``) of a function ``J`` of the
+    states at the samples' ends, ``seeds[k] = dJ / dy`` at sample ``k`` (``(n + 1, 8)``),
+    through :func:`roll`'s scheme backwards from the stage Jacobians ``jac`` it kept: the
+    memory of the motion since the start (not of the velocities before it, which are
+    fixed) carried as the transposed convolution."""
+    nk = w.shape[0] - 1
+    ns = jac.shape[0]
+    n = ns // steps
+    grad = np.zeros(n)
+    ly = seeds[n].copy()
+    lm0 = np.zeros(3)
+    lm1 = np.zeros(3)
+    lm2 = np.zeros(3)
+    lvel = np.zeros((ns + 1, 3))
+    lk = np.empty((4, 8))
+    ls = np.empty(8)
+    la = np.empty(4)
+    lmu = np.empty((4, 3))
+    wq = (1.0, 2.0, 2.0, 1.0)
+    cq = (0.0, 0.5 * h, 0.5 * h, h)
+    for i in range(ns - 1, -1, -1):
+        j = i // steps
+        # the memory at the step's end, m0 = sum_q W_q vel_(i+1-q) over the run's steps
+        for d in range(3):
+            ly[4 + d] += lvel[i + 1, d]
+        for q in range(min(nk, i) + 1):
+            for b in range(3):
+                v = 0.0
+                for d in range(3):
+                    v += w[q, d, b] * lm0[d]
+                if q == 0:
+                    ly[4 + b] += v
+                else:
+                    lvel[i + 1 - q, b] += v
+        # the memory's shift: m1' = m0, m2' = m1
+        nm0 = lm1.copy()
+        nm1 = lm2.copy()
+        nm2 = np.zeros(3)
+        # RK4 backwards: y' = y + h/6 sum w_q k_q, k_q = (s_q[4:], a_q), s_q = y + c_q k_(q-1)
+        for q in range(4):
+            for a in range(8):
+                lk[q, a] = h / 6.0 * wq[q] * ly[a]
+        lyn = ly.copy()
+        for q in range(3, -1, -1):
+            for a in range(4):
+                la[a] = lk[q, 4 + a]
+            for a in range(8):
+                v = 0.0
+                for r in range(4):
+                    v += jac[i, q, r, a] * la[r]
+                ls[a] = v
+            for a in range(4):
+                ls[4 + a] += lk[q, a]
+            for d in range(3):
+                v = 0.0
+                for r in range(4):
+                    v += jac[i, q, r, 8 + d] * la[r]
+                lmu[q, d] = v
+            tq = 0.0
+            for r in range(4):
+                tq += jac[i, q, r, 11] * la[r]
+            grad[j] += tq
+            for a in range(8):
+                lyn[a] += ls[a]
+                if q > 0:
+                    lk[q - 1, a] += cq[q] * ls[a]
+        for d in range(3):
+            mid = lmu[1, d] + lmu[2, d]
+            nm0[d] += lmu[0, d] + _MID[0] * mid + _END[0] * lmu[3, d]
+            nm1[d] += _MID[1] * mid + _END[1] * lmu[3, d]
+            nm2[d] += _MID[2] * mid + _END[2] * lmu[3, d]
+        lm0, lm1, lm2 = nm0, nm1, nm2
+        ly = lyn
+        if i % steps == 0 and i > 0:
+            for a in range(8):
+                ly[a] += seeds[j, a]
+    return grad

@@ -128,6 +128,7 @@ class HullPlant:
         self.gm = np.ascontiguousarray(gm)
         self.mt = np.ascontiguousarray(np.asarray(case.Mh, float) + self.a_inf
                                        + pendulum.mass * gm.T @ gm)
+        self.mti = np.linalg.inv(self.mt)
         self.cp = np.ascontiguousarray(case.stiffness())
         self.g = float(hull.g)
         self.par = np.array([pendulum.mass, pendulum.length, pendulum.inertia,
@@ -150,20 +151,19 @@ class HullPlant:
 
     def step(self, u, steps, fn):
         """Advance the plant over the held torques ``u`` (N m); True unless it diverged."""
-        ok, ys, _ = self.roll(u, steps, fn, 0, commit=True)
+        ok, ys, _ = self.roll(u, steps, fn, commit=True)
         return ok, ys
 
-    def roll(self, u, steps, fn, ntan, commit=False):
+    def roll(self, u, steps, fn, keep=False, commit=False):
         """The plant (``commit``) or its model from the current state (a copy) over ``u``:
-        ``(ok, ys, dys)`` with the tangents of the first ``ntan`` torques."""
+        ``(ok, ys, jac)``, ``jac`` the stages' Jacobians with ``keep``
+        (:func:`._hull_plant.adjoint`)."""
         from ._hull_plant import roll
 
         n = u.size
         ns = n * steps
         ys = np.empty((n + 1, 8))
-        dys = np.empty((n + 1, 8, ntan))
-        dvel = np.zeros((ns + 1, 3, ntan))
-        dmus = np.zeros((3, 3, ntan))
+        jac = np.empty((ns if keep else 0, 4, 4, 12))
         if commit:
             y, vel, k0, mus, acc = self.y, self.vel, self.k0, self.mus, self.acc
         else:
@@ -172,11 +172,11 @@ class HullPlant:
             vel[:nk + 1] = self.vel[self.k0:self.k0 + nk + 1]
             y, k0, mus, acc = self.y.copy(), 0, self.mus.copy(), np.zeros(3)
         ok = roll(y, vel, k0, mus, np.ascontiguousarray(u, dtype=float), steps,
-                  np.ascontiguousarray(fn), self.h, self.w, self.mt, self.cp, self.gm, self.par,
-                  ys, acc, dys, dvel, dmus)
+                  np.ascontiguousarray(fn), self.h, self.w, self.mti, self.cp, self.gm, self.par,
+                  ys, acc, jac)
         if commit:
             self.k0 += ns
-        return ok, ys, dys
+        return ok, ys, jac
 
 
 class HullHorizon(bc.CoupledHorizon):
@@ -194,38 +194,44 @@ class HullHorizon(bc.CoupledHorizon):
         return y0  # the objective's offset alone (the hull's energy needs no reference)
 
     def fun(self, u, y0, fnet):
-        from ._hull_plant import denergy, energy
+        from ._hull_plant import adjoint, denergy, energy
 
-        pl, tu = self.plant, self.tu
+        pl, tu, n = self.plant, self.tu, self.n
         u = np.asarray(u, dtype=float)
-        ok, ys, dys = pl.roll(u * tu, self.steps, fnet, self.n)
+        ok, ys, jac = pl.roll(u * tu, self.steps, fnet, keep=True)
         if not ok or not np.all(np.isfinite(ys)):
             self.grad[:] = 0.0
             return math.inf, self.grad.copy()
         th = ys[:, 3] - ys[:, 2]
-        dth = (dys[:, 3, :] - dys[:, 2, :]) * tu  # per unit of u (m g l)
         dw = np.diff(th)  # per sample
         wk = -u * dw  # work (units m g l rad)
-        dwk = -u[:, None] * np.diff(dth, axis=0)
-        dwk[np.arange(self.n), np.arange(self.n)] -= dw
         eg, em = self.eta
         a, b = 0.5 * (eg + 1.0 / em), 0.5 * (eg - 1.0 / em)
         root = np.sqrt(wk * wk + self.width ** 2)
         e = a * wk + b * (root - self.width)
         de = a + b * wk / root
-        de_end = np.empty(self.n)
-        denergy(ys[-1], dys[-1], pl.mt, pl.cp, pl.gm, pl.par, de_end)
         e_end = energy(ys[-1], pl.mt, pl.cp, pl.gm, pl.par)
         e_0 = energy(ys[0], pl.mt, pl.cp, pl.gm, pl.par)
         # the speed the plant's steps resolve: a plan past it would be planned on the
         # integration's error (RK4 gains energy from a pendulum turning too fast per step)
         v = ys[1:, 7] - ys[1:, 6]
         over = np.maximum(np.abs(v) - self.speed, 0.0)
-        dv = (dys[1:, 7, :] - dys[1:, 6, :]) * tu
         f = (-(float(np.sum(e)) + self.kappa * (e_end - e_0) / tu)
              + SPEED_WEIGHT * float(np.sum(over * over)))
-        self.grad[:] = (-(de @ dwk + self.kappa * de_end)  # (dE / dtau) tu / tu
-                        + 2.0 * SPEED_WEIGHT * (over * np.sign(v)) @ dv)
+        # dJ / dy at the samples' ends: theta = phi - beta in the work, v in the penalty, E
+        seeds = np.zeros((n + 1, 8))
+        dth = np.zeros(n + 1)
+        dth[1:] += de * u
+        dth[:-1] -= de * u
+        seeds[:, 3] += dth
+        seeds[:, 2] -= dth
+        pen = 2.0 * SPEED_WEIGHT * over * np.sign(v)
+        seeds[1:, 7] += pen
+        seeds[1:, 6] -= pen
+        de_end = np.empty(8)
+        denergy(ys[-1], np.eye(8), pl.mt, pl.cp, pl.gm, pl.par, de_end)
+        seeds[n] -= self.kappa * de_end / tu
+        self.grad[:] = de * dw + tu * adjoint(jac, pl.w, self.steps, pl.h, seeds)
         return f - self.offset, self.grad.copy()
 
 
