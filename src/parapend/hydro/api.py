@@ -645,8 +645,9 @@ def refuse_hull(dofs, where: str) -> None:
     """Refuse, in one line naming the missing capability, a hull's ``dofs`` where only the
     heaving buoy is taken (``where``: the command, e.g. ``"horizon --device buoy"``)."""
     if dofs is not None and parse_dofs(dofs) != ("heave",):
-        raise ParameterError(f"dofs: {where} runs the heaving buoy only (--dofs heave): a "
-                             "hull (surge,heave,pitch) has no causal controller yet")
+        raise ParameterError(f"dofs: {where} takes a hull (surge,heave,pitch) by its keywords "
+                             "only (dofs=, the embedded barge's defaults), not as a Body "
+                             "object")
 
 
 def _refuse_unsupported(opts: dict) -> None:
@@ -904,6 +905,9 @@ def hull_buoy(deadline=None, **opts):
     _check_wave_kind(opts)  # before the BEM
     regular = not any(opts.get(k) is not None for k in ("hs", "tp", "record",
                                                         "repeat_period", "seed"))
+    if regular and opts.get("controller") == "mpc":
+        raise ParameterError("controller: mpc runs the hull in an irregular sea state: give "
+                             "--hs and --tp (and --repeat-period, --seed)")
     if regular:  # the wave's checks before the BEM too
         height = check("wave_height", _hull_value(opts, "wave_height"),
                        why="regular wave height, m")
@@ -939,9 +943,6 @@ def hull_buoy(deadline=None, **opts):
                 update_interval=default_of("update_interval", opts.get("update_interval")),
                 forecast=default_of("forecast", opts.get("forecast")))
         return solve_record(p, wave, info)
-    if opts.get("controller") == "mpc":
-        raise ParameterError("controller: mpc runs in an irregular sea state: give --hs and "
-                             "--tp (and --repeat-period, --seed)")
     w = 2 * math.pi / periods
     hull.check_covers(float(np.min(w)), float(np.max(w)), name="wave-period")
     results = []

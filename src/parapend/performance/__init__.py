@@ -630,6 +630,12 @@ def _causal_matrix(ds, spec: MatrixSpec) -> None:
             "the hanging rest, the buoy in its free periodic motion, 64 torque samples a peak "
             "period; the mean over one repeat of the record after the warm-up, "
             "(W_e + eta_g dE) / tau, E the mechanical energy of buoy and pendulum")
+        if spec.buoy_controller == "hull":
+            ds.attrs["causal_convention"] = (
+                "parapend.hydro.hull_control.hull_mpc: from the hanging rest, the hull in its "
+                "free periodic motion, 24 torque samples a peak period, in the mode of the "
+                "bin's optimum; the mean over one repeat of the record after the warm-up, "
+                "(W_e + eta_g dE) / tau, E the mechanical energy of hull and pendulum")
     else:
         ds.attrs["causal_plan_samples"] = spec.plan_samples
         ds.attrs["causal_speed_limit"] = ("none" if spec.speed_limit is None
