@@ -974,20 +974,11 @@ def buoy_mpc(hydro, pendulum, wave, *, peak_period, horizon=2.0, update_interval
                 residuals.append(res_fp[0])
             plan = u
             seg = plan[:min(m, total - j)]
-        for k, uk in enumerate(seg):
-            ok, yk = plant.step(np.array([uk * tu]), ps, fn[2 * (j + k) * ps:
-                                                          2 * (j + k + 1) * ps + 1])
-            ys[j + k + 1] = yk[1]
-            acc[j + k + 1] = plant.acc
-            energy[j + k + 1] = plant.energy()
-            u_all[j + k] = uk * tu
-            if not ok:
-                status = "diverged"
-                total = j + k + 1
-                break
-        if status != "ok":
+        done, ok = apply_segment(plant, seg, j, tu, ps, fn, ys, acc, energy, u_all)
+        if not ok:
+            status, total = "diverged", j + done
             break
-        j += seg.size
+        j += done
 
     ys, acc, energy, u_all = ys[:total + 1], acc[:total + 1], energy[:total + 1], u_all[:total]
     series = {"theta": ys[:, 2], "theta_dot": ys[:, 3], "z": ys[:, 0], "z_dot": ys[:, 1]}
@@ -1002,6 +993,22 @@ def buoy_mpc(hydro, pendulum, wave, *, peak_period, horizon=2.0, update_interval
                "memory_s": plant.nk * h, "plant_step_s": h})
 
 
+
+def apply_segment(plant, seg, j, tu, ps, fn, ys, acc, energy, u_all):
+    """Apply the held torques ``seg`` (units ``tu``) to the plant from sample ``j`` (``ps``
+    steps each, the force ``fn`` at its half-step nodes), saving its state, accumulated
+    energies and mechanical energy after each and the torque (N m): ``(samples applied,
+    ok)``, ``ok`` False when the plant diverged (its last sample applied)."""
+    for k, uk in enumerate(seg):
+        ok, yk = plant.step(np.array([uk * tu]), ps, fn[2 * (j + k) * ps:
+                                                      2 * (j + k + 1) * ps + 1])
+        ys[j + k + 1] = yk[1]
+        acc[j + k + 1] = plant.acc
+        energy[j + k + 1] = plant.energy()
+        u_all[j + k] = uk * tu
+        if not ok:
+            return k + 1, False
+    return len(seg), True
 
 def closed_loop_result(series, acc, energy, u_all, *, status, caught, dt, h, per_record,
                        repeats, planned, warm_samples, n, m, eta, times, changes, residuals,

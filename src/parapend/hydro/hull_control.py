@@ -184,8 +184,8 @@ class HullHorizon(bc.CoupledHorizon):
     ``m g l``) of ``steps`` RK4 steps, the plant's model with its memory over the horizon,
     the exact gradient; :class:`.control.CoupledHorizon`'s L-BFGS-B."""
 
-    def __init__(self, plant, n, steps, tu, torque_limit=None, efficiency=None):
-        super().__init__(n, plant.h, steps, None, tu, torque_limit, efficiency)
+    def __init__(self, plant, n, steps, tu, torque_limit=None, efficiency=None, kappa=None):
+        super().__init__(n, plant.h, steps, None, tu, torque_limit, efficiency, kappa)
         self.plant = plant
         self.width = 1e-3  # the efficiency's kink smoothed over this work (units m g l rad)
         self.speed = RESOLVED_TURN / plant.h  # rad/s
@@ -269,8 +269,8 @@ def _free_start(case):
 def hull_mpc(hull, pendulum, wave, *, peak_period, pivot=(0.0, 0.0), pitch_inertia=None,
              horizon=2.0, update_interval=0.125, samples=SAMPLES, plant_steps=PLANT_STEPS,
              warmup=4.0, repeats=1, torque_limit=None, efficiency=None, forecast="perfect",
-             mode="swing", max_iter=MAX_ITER, memory=None, time_limit=None,
-             deadline=None) -> bc.BuoyMPCResult:
+             mode="swing", max_iter=MAX_ITER, memory=None, terminal_weight=None,
+             time_limit=None, deadline=None) -> bc.BuoyMPCResult:
     """Receding-horizon control of the pendulum in a surging, heaving, pitching hull in a
     periodic record (module docstring).
 
@@ -301,6 +301,8 @@ def hull_mpc(hull, pendulum, wave, *, peak_period, pivot=(0.0, 0.0), pitch_inert
         L-BFGS-B iterations per solve at most.
     memory : float or None
         The radiation memory (s); None: ``MEMORY_PERIODS`` peak periods.
+    terminal_weight : float or None
+        ``kappa``, the weight of the energy left at the horizon's end (None: ``eta_g``).
     time_limit, deadline : as :func:`.control.buoy_mpc`.
 
     Returns
@@ -361,7 +363,9 @@ def hull_mpc(hull, pendulum, wave, *, peak_period, pivot=(0.0, 0.0), pitch_inert
 
         ar = [ARForecast(tp) for _ in range(3)]
         leads = 0.5 * h * np.arange(2 * n * ps + 1)
-    prob = HullHorizon(plant, n, ps, tu, torque_limit / tu, eta)
+    if terminal_weight is not None:
+        terminal_weight = check_range("terminal_weight", terminal_weight, 0.0, 10.0)
+    prob = HullHorizon(plant, n, ps, tu, torque_limit / tu, eta, terminal_weight)
     level = min(torque_limit / tu, 1.0)
     ys = np.empty((total + 1, 8))
     ys[0] = plant.y
@@ -399,20 +403,11 @@ def hull_mpc(hull, pendulum, wave, *, peak_period, pivot=(0.0, 0.0), pitch_inert
             kept += bad == 2
             plan = u
             seg = plan[:min(m, total - j)]
-        for k, uk in enumerate(seg):
-            ok, yk = plant.step(np.array([uk * tu]), ps, fn[2 * (j + k) * ps:
-                                                          2 * (j + k + 1) * ps + 1])
-            ys[j + k + 1] = yk[1]
-            acc[j + k + 1] = plant.acc
-            energy[j + k + 1] = plant.energy()
-            u_all[j + k] = uk * tu
-            if not ok:
-                status = "diverged"
-                total = j + k + 1
-                break
-        if status != "ok":
+        done, ok = bc.apply_segment(plant, seg, j, tu, ps, fn, ys, acc, energy, u_all)
+        if not ok:
+            status, total = "diverged", j + done
             break
-        j += seg.size
+        j += done
     ys, acc, energy, u_all = ys[:total + 1], acc[:total + 1], energy[:total + 1], u_all[:total]
     series = {"theta": ys[:, 3] - ys[:, 2], "theta_dot": ys[:, 7] - ys[:, 6], "z": ys[:, 1],
               "z_dot": ys[:, 5], "x": ys[:, 0], "x_dot": ys[:, 4], "beta": ys[:, 2],
