@@ -1214,7 +1214,8 @@ def mpc_text(r) -> list:
            f"{r.horizon_s:.4g} s, update "
            f"every {r.update_interval_s:.4g} s, torque held over {r.dt_s:.4g} s, limit "
            f"{r.torque_limit_nm:.6g} N m" + ("" if r.torque_limit_given else
-                                            " (2 m g l, the default)"),
+                                            f" ({r.torque_limit_nm / r.units['torque_nm']:.3g}"
+                                            " m g l, the default)"),
            "",
            f"mean power over the last repeat    {f(r.mean_power_w, ' W')} (harvested + "
            f"stored energy's change, after a {r.average_from_s:.4g} s start-up)",

@@ -21,7 +21,8 @@ the held torques plus the mechanical energy left in hull and pendulum at the hor
 from the measured state and the memory of the hull's past motion (the radiation over the
 horizon included exactly, not frozen) under the forecast excitation of all three degrees of
 freedom: the record itself (``perfect``) or an AR forecast of each fitted on the force
-measured so far (``ar``, :class:`parapend.control.forecast.ARForecast`, as the buoy's). The
+measured so far (``ar``, :class:`parapend.control.forecast.ARForecast`, as the buoy's; its
+window reaches before the run's start, into the sea that set the hull's free motion). The
 gradient is exact (the plant's scheme carried in tangent form, :func:`._hull_plant.roll`);
 the solver is L-BFGS-B with the torque bounds (the buoy's ``coupled`` planner,
 :class:`.control.CoupledHorizon`), warm-started from the previous plan shifted. The first
@@ -235,20 +236,32 @@ class HullHorizon(bc.CoupledHorizon):
         return f - self.offset, self.grad.copy()
 
 
-def _forecast(fn, j, a, span, dt, ps, ar, leads):
+def _forecast(fn, j, a, span, dt, ps, ar, leads, before=None):
     """The force (nodes, 3) the planner is given at sample ``j`` (plant node ``a``): the
     record over the horizon (``ar`` None: perfect) or each DOF's AR forecast from the force
-    measured at every torque sample up to now."""
+    measured at every torque sample up to now, after ``before`` (samples, 3): the force
+    measured at the samples before the run's start."""
     if ar is None:
         return fn[a:a + span]
-    past_t = dt * np.arange(j + 1)
-    return np.stack([f.predict(j * dt, past_t, fn[:a + 1:2 * ps, d], leads)
+    nb = 0 if before is None else before.shape[0]
+    past_t = dt * np.arange(-nb, j + 1)
+    past = fn[:a + 1:2 * ps]
+    if nb:
+        past = np.concatenate((before, past))
+    return np.stack([f.predict(j * dt, past_t, past[:, d], leads)
                      for d, f in enumerate(ar)], axis=1)
 
 
 def _plan(prob, y0, fseg, u0, max_iter):
     """One horizon solve (a hook the causality tests wrap)."""
     return prob.solve(y0, fseg, u0, max_iter=max_iter, tol=1e-9)
+
+
+def _record_force(case, t):
+    """The record's excitation (t.shape + (3,)): ``Re sum_k F(k w) a_k exp(i k w t)``."""
+    fk = case.wave_force()
+    wk = case.omega * np.arange(fk.shape[0])
+    return np.real(np.exp(1j * np.multiply.outer(t, wk)) @ fk)
 
 
 def _free_start(case):
@@ -357,12 +370,17 @@ def hull_mpc(hull, pendulum, wave, *, peak_period, pivot=(0.0, 0.0), pitch_inert
     xi0, xid0, history = _free_start(case)
     memory = MEMORY_PERIODS * tp if memory is None else memory
     plant = HullPlant(hull, pendulum, case, h, total * ps, memory, xi0, xid0, history)
-    ar = leads = None
+    ar = leads = before = None
     if forecast == "ar":
         from ..control.forecast import ARForecast
 
         ar = [ARForecast(tp) for _ in range(3)]
         leads = 0.5 * h * np.arange(2 * n * ps + 1)
+        # the sea was there before the run (it set the hull's free motion at the start):
+        # its force at the samples of the AR's window before t = 0, from the record's
+        # harmonics (not from the run's nodes)
+        nb = int(math.ceil(ar[0].window * tp / dt))
+        before = _record_force(case, dt * np.arange(-nb, 0))
     if terminal_weight is not None:
         terminal_weight = check_range("terminal_weight", terminal_weight, 0.0, 10.0)
     prob = HullHorizon(plant, n, ps, tu, torque_limit / tu, eta, terminal_weight)
@@ -393,7 +411,7 @@ def hull_mpc(hull, pendulum, wave, *, peak_period, pivot=(0.0, 0.0), pitch_inert
                 break
             a = 2 * j * ps
             tic = time.perf_counter()  # the forecast is part of the update's time
-            fseg = _forecast(fn, j, a, 2 * n * ps + 1, dt, ps, ar, leads)
+            fseg = _forecast(fn, j, a, 2 * n * ps + 1, dt, ps, ar, leads, before)
             u0 = np.concatenate((plan[m:], np.full(m, plan[-1]))) if solves else plan
             res = _plan(prob, plant, fseg, u0, max_iter)
             u, bad = bc._check_solve(res, plan)
