@@ -937,8 +937,11 @@ def hull_buoy(deadline=None, **opts):
         if opts.get("controller") == "mpc":
             from .hull_control import hull_mpc_command
 
+            if "tp" not in info:
+                raise ParameterError("controller: mpc runs in an irregular sea state: give "
+                                     "--hs and --tp")
             return hull_mpc_command(
-                p, wave, info, deadline=deadline,
+                p, wave, info, solve_record(p, wave, info), deadline=deadline,
                 horizon=default_of("horizon", opts.get("horizon"), "mpc"),
                 update_interval=default_of("update_interval", opts.get("update_interval")),
                 forecast=default_of("forecast", opts.get("forecast")))

@@ -443,21 +443,15 @@ def hull_mpc(hull, pendulum, wave, *, peak_period, pivot=(0.0, 0.0), pitch_inert
                "memory_s": plant.nk * h, "plant_step_s": h})
 
 
-def hull_mpc_command(problem, wave, info, *, horizon, update_interval, forecast,
+def hull_mpc_command(problem, wave, info, sol, *, horizon, update_interval, forecast,
                      deadline=None):
     """``parapend buoy --dofs surge,heave,pitch --controller mpc``: the record's non-causal
-    optimum (:func:`parapend.hydro.api.solve_record`, rotation and swinging) and the closed
-    loop on the record in its mode (4 peak periods of warm-up, one repeat), the
+    optimum ``sol`` (:func:`parapend.hydro.api.solve_record`, rotation and swinging) and the
+    closed loop on the record in its mode (4 peak periods of warm-up, one repeat), the
     storage-corrected mean beside it: ``optimum_fraction`` is the electrical power over the
     optimum's (with the problem's torque limit and efficiency in both)."""
     import dataclasses
 
-    from .api import solve_record
-
-    if "tp" not in info:
-        raise ParameterError("controller: mpc runs in an irregular sea state: give --hs and "
-                             "--tp")
-    sol = solve_record(problem, wave, info)
     winding = int(sol.winding) if sol.winding is not None else 0
     pto = problem["pto"]
     r = hull_mpc(problem["hull"], problem["pendulum"], wave, peak_period=float(info["tp"]),
