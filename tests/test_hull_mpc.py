@@ -98,13 +98,14 @@ def test_energy_balance(steps):
     assert out[0] < 1e-3 and out[1] < out[0] / 8
 
 
-def test_horizon_gradient_is_exact():
+@pytest.mark.parametrize("terminal", ["pendulum", "total"])
+def test_horizon_gradient_is_exact(terminal):
     """The tangent-mode gradient against central differences of the objective."""
     per, ps, n = 32, 4, 12
     plant, _, _ = _plant(PEND, TR / per / ps, 4 * per * ps, memory=4.0)
     fn = bc.force_nodes(HULL, WAVE, per, ps, 2 * n * ps + 1)
     tu = PEND.mass * 9.81 * PEND.length
-    prob = hc.HullHorizon(plant, n, ps, tu, 4.0, (0.9, 0.9))
+    prob = hc.HullHorizon(plant, n, ps, tu, 4.0, (0.9, 0.9), terminal=terminal)
     u = 0.4 * np.random.default_rng(0).standard_normal(n)
     f, g = prob.fun(u, None, fn)
     eps = 1e-6
@@ -174,3 +175,31 @@ def test_ar_torques_before_t0_ignore_the_sea_after_t0(monkeypatch, forecast, cau
     a, b = base.series["torque"][:j0], after.series["torque"][:j0]
     assert np.any(a != 0)
     assert np.array_equal(a, b) is causal
+
+
+@pytest.mark.slow
+def test_the_command_runs_the_hull_beside_its_record_optimum(tmp_path, capsys):
+    """``parapend buoy --dofs surge,heave,pitch --controller mpc``: the record's optimum is
+    the plain command's on the same record, the fraction is the causal electrical power
+    over it, the plant's energy balance closes and the update times are reported."""
+    import json
+
+    from hull_timedomain import synthetic_hull_netcdf
+
+    from parapend.cli import main
+
+    path = synthetic_hull_netcdf(tmp_path / "hull.nc")
+    sea = ["--dofs", "surge,heave,pitch", "--hydro", path, "--hs", "1", "--tp", "5",
+           "--repeat-period", "10", "--seed", "0"]
+    assert main(["buoy", *sea, "--json"]) == 0
+    opt = json.loads(capsys.readouterr().out)
+    rc = main(["buoy", *sea, "--controller", "mpc", "--json"])
+    r = json.loads(capsys.readouterr().out)
+    assert rc == (0 if r["success"] else 3)  # a run that loses energy is a measurement
+    assert r["optimum_power_w"] == opt["power_w"]
+    assert r["optimum_winding"] == opt["winding"]
+    assert r["planner"] == ("hull-swing" if opt["winding"] == 0 else "hull-rotate")
+    if r["status"] == "ok":
+        assert math.isclose(r["optimum_fraction"], r["electrical_power_w"] / opt["power_w"])
+    assert r["energy_balance_residual"] < 1e-3
+    assert r["update_time_p99_s"] is not None and r["solves"] > 0
