@@ -18,11 +18,12 @@ torque sample, ``|u| <= T_max``) that maximize
 the (electrical, ``e`` the efficiency model smoothed at 0; mechanical without one) work of
 the held torques plus the mechanical energy of hull and pendulum left at the horizon's end
 (``kappa = eta_g``; ``terminal="pendulum"``: the pendulum's alone), where the motion over
-the horizon is the plant's own model run forward from the measured state and the memory of the hull's past motion (the radiation over the
-horizon included exactly, not frozen) under the forecast excitation of all three degrees of
-freedom: the record itself (``perfect``) or an AR forecast of each fitted on the force
-measured so far (``ar``, :class:`parapend.control.forecast.ARForecast`, as the buoy's; its
-window reaches before the run's start, into the sea that set the hull's free motion). The
+the horizon is the plant's own model run forward from the measured state and the memory of
+the hull's past motion (the radiation over the horizon included exactly, not frozen) under
+the forecast excitation of all three degrees of freedom: the record itself (``perfect``) or
+an AR forecast of each fitted on the force measured so far (``ar``,
+:class:`parapend.control.forecast.ARForecast`, as the buoy's; its window reaches before the
+run's start, into the sea that set the hull's free motion). The
 gradient is exact (the plant's scheme run backwards, :func:`._hull_plant.adjoint`);
 the solver is L-BFGS-B with the torque bounds (the buoy's ``coupled`` planner,
 :class:`.control.CoupledHorizon`), warm-started from the previous plan shifted. The first
