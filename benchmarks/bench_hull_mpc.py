@@ -96,7 +96,8 @@ def casadi_solver(plant, n, ps, tu, fseg, prob):
     past = plant.vel[plant.k0:plant.k0 + nk + 1]  # oldest first; the last is now
     vels = []  # the horizon's velocities after each step (MX)
     ys = [yy]
-    mid, end = hc._hull_plant._MID, hc._hull_plant._END
+    from parapend.hydro._hull_plant import _END as end
+    from parapend.hydro._hull_plant import _MID as mid
     for i in range(ns):
         tau = u[i // ps] * tu
         mh = mid[0] * m0 + mid[1] * m1 + mid[2] * m2
