@@ -203,3 +203,17 @@ def test_the_command_runs_the_hull_beside_its_record_optimum(tmp_path, capsys):
         assert math.isclose(r["optimum_fraction"], r["electrical_power_w"] / opt["power_w"])
     assert r["energy_balance_residual"] < 1e-3
     assert r["update_time_p99_s"] is not None and r["solves"] > 0
+
+
+@pytest.mark.parametrize("args, mode", [
+    ((1, None, None), "rotate"),       # a rotation
+    ((0, 180.0, 60.0), "swing"),       # a swing about hanging, below the upright
+    ((0, 308.7, 153.5), "rotate"),     # the default barge's seed 0: through the upright
+    ((0, 200.0, 150.0), "swing"),      # 50 .. 350 degrees: short of the upright
+    ((0, -40.0, 50.0), "rotate"),      # -90 .. 10 degrees holds 0
+    ((0, None, None), "swing"),
+])
+def test_the_start_follows_the_optimums_motion(args, mode):
+    """The pump's start where the optimum turns over the top, the hanging start where it
+    swings below it."""
+    assert hc.start_mode(*args) == mode

@@ -326,7 +326,7 @@ def buoy_horizon_curve(*, hs=None, tp=None, spectrum="jonswap", gamma_peak=3.3,
     # the body (the BEM, cached on disk) and the checks parapend buoy makes of a record
     if hull:
         from .api import hull_problem, solve_record
-        from .hull_control import hull_mpc
+        from .hull_control import hull_mpc, start_mode
 
         problem = hull_problem(body=body, radius=radius, draft=draft, mesh=mesh, hydro=hydro,
                                mass=pend.mass, length=pend.length, inertia=pend.inertia,
@@ -364,7 +364,7 @@ def buoy_horizon_curve(*, hs=None, tp=None, spectrum="jonswap", gamma_peak=3.3,
             continue
         if hull:  # parapend buoy --dofs surge,heave,pitch's optimum, its mode the run's
             sol = solve_record(problem, wave, info)
-            modes[-1] = "swing" if not sol.winding else "rotate"
+            modes[-1] = start_mode(sol.winding, sol.mean_angle_deg, sol.swing_amplitude_deg)
             opt.append(float(sol.power_w) if sol.success else math.nan)
         else:  # parapend buoy --controller mpc's optimum of the record (mpc_command)
             sol, _, _ = _solve(h, pend, wave, winding=1, harmonics=None, torque_limit=None,

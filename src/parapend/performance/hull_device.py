@@ -147,15 +147,21 @@ def check_records(spec) -> None:
             raise ParameterError(f"{pk}: the record of the bin {per:g} s: {rest}") from None
 
 
-def solve_hull_bin(spec, i: int, j: int, r: int) -> dict:
+def solve_hull_bin(spec, i: int, j: int, r: int, start: list | None = None) -> dict:
     """The hull's answer to one record: the best mode's power (never below zero), its mode,
-    the radiation bound, the one-way power, the mechanical power of a lossy take-off."""
+    the radiation bound, the one-way power, the mechanical power of a lossy take-off.
+    ``start``: a list that receives the causal run's start from the optimum's motion
+    (:func:`parapend.hydro.hull_control.start_mode`)."""
     from ..hydro.api import solve_record
     from ..maps.spec import _CODE
     from .buoy_device import wave_of
 
     wave, info = wave_of(spec, i, j, r)
     res = solve_record(problem(spec), wave, info)
+    if start is not None:
+        from ..hydro.hull_control import start_mode
+
+        start.append(start_mode(res.winding, res.mean_angle_deg, res.swing_amplitude_deg))
     def num(v):
         return math.nan if v is None else float(v)
     p = num(res.power_w)  # None: no resolved answer (headline_reason), kept as NaN

@@ -27,15 +27,15 @@ def electrical_power(result, efficiency: float) -> float:
 
 def solve_bin(spec, i: int, j: int, r: int) -> dict:
     if spec.device == "buoy" and spec.dofs != "heave":
-        from .hull_device import MODES, solve_hull_bin
+        from .hull_device import solve_hull_bin
 
-        out = solve_hull_bin(spec, i, j, r)
+        start = []
+        out = solve_hull_bin(spec, i, j, r, start)
         if spec.controller is not None:
             from .causal import solve_causal
 
-            # the same record, run causally in its optimum's mode
-            mode = "rotate" if out["mode"] == MODES.index("rotation") else "swing"
-            out.update(solve_causal(spec, i, j, r, mode=mode))
+            # the same record, run causally from its optimum's motion
+            out.update(solve_causal(spec, i, j, r, mode=start[0]))
         return out
     if spec.device == "buoy":
         from .buoy_device import solve_buoy_bin
