@@ -29,7 +29,7 @@ def solve_bin(spec, i: int, j: int, r: int) -> dict:
     if spec.device == "buoy" and spec.dofs != "heave":
         from .hull_device import solve_hull_bin
 
-        start = []
+        start = [] if spec.controller is not None else None
         out = solve_hull_bin(spec, i, j, r, start)
         if spec.controller is not None:
             from .causal import solve_causal
