@@ -635,8 +635,8 @@ def _causal_matrix(ds, spec: MatrixSpec) -> None:
         if spec.buoy_controller == "hull":
             ds.attrs["causal_convention"] = (
                 "parapend.hydro.hull_control.hull_mpc: from the hanging rest, the hull in its "
-                "free periodic motion, 24 torque samples a peak period, in the mode of the "
-                "bin's optimum; the mean over one repeat of the record after the warm-up, "
+                "free periodic motion, 24 torque samples a peak period, started from the "
+                "motion of the record's optimum; the mean over one repeat of the record after the warm-up, "
                 "(W_e + eta_g dE) / tau, E the mechanical energy of hull and pendulum")
     else:
         ds.attrs["causal_plan_samples"] = spec.plan_samples

@@ -265,8 +265,8 @@ def run_buoy_record(spec, i: int, j: int, r: int, forecast: str = "perfect"):
 def run_hull_record(spec, i: int, j: int, r: int, forecast: str = "perfect", mode="swing"):
     """The hull's causal run of bin ``(i, j)``, realization ``r`` (``--device buoy --dofs
     surge,heave,pitch``): :func:`parapend.hydro.hull_control.hull_mpc` on the hull, pendulum
-    and record :func:`parapend.performance.hull_device.solve_hull_bin` solves, in the mode
-    its optimum chose (``mode``), ``warm_up`` peak periods then one repeat."""
+    and record :func:`parapend.performance.hull_device.solve_hull_bin` solves, started as
+    its optimum's motion says (``mode``), ``warm_up`` peak periods then one repeat."""
     from .. import limits
     from ..hydro.hull_control import hull_mpc
     from .buoy_device import wave_of
@@ -285,7 +285,7 @@ def run_hull_record(spec, i: int, j: int, r: int, forecast: str = "perfect", mod
 
 def solve_causal(spec, i: int, j: int, r: int, mode: str = "swing") -> dict:
     """The causal quantities (W) of bin ``(i, j)``, realization ``r``: NaN where a run did
-    not succeed (or raised: logged). ``mode``: the hull's start (its optimum's mode)."""
+    not succeed (or raised: logged). ``mode``: the hull's start (from its optimum's motion)."""
     from threadpoolctl import threadpool_limits
 
     from .check import _record, _units
