@@ -636,8 +636,9 @@ def _causal_matrix(ds, spec: MatrixSpec) -> None:
             ds.attrs["causal_convention"] = (
                 "parapend.hydro.hull_control.hull_mpc: from the hanging rest, the hull in its "
                 "free periodic motion, 24 torque samples a peak period, started from the "
-                "motion of the record's optimum; the mean over one repeat of the record after the warm-up, "
-                "(W_e + eta_g dE) / tau, E the mechanical energy of hull and pendulum")
+                "motion of the record's optimum; the mean over one repeat of the record "
+                "after the warm-up, (W_e + eta_g dE) / tau, E the mechanical energy of hull "
+                "and pendulum")
     else:
         ds.attrs["causal_plan_samples"] = spec.plan_samples
         ds.attrs["causal_speed_limit"] = ("none" if spec.speed_limit is None
