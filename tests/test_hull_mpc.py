@@ -198,7 +198,8 @@ def test_the_command_runs_the_hull_beside_its_record_optimum(tmp_path, capsys):
     assert rc == (0 if r["success"] else 3)  # a run that loses energy is a measurement
     assert r["optimum_power_w"] == opt["power_w"]
     assert r["optimum_winding"] == opt["winding"]
-    assert r["planner"] == ("hull-swing" if opt["winding"] == 0 else "hull-rotate")
+    start = hc.start_mode(opt["winding"], opt["mean_angle_deg"], opt["swing_amplitude_deg"])
+    assert r["planner"] == f"hull-{start}"
     if r["status"] == "ok":
         assert math.isclose(r["optimum_fraction"], r["electrical_power_w"] / opt["power_w"])
     assert r["energy_balance_residual"] < 1e-3
