@@ -122,11 +122,10 @@ def test_one_function_computes_the_optimum_of_either_dof_set(dataset):
 
 
 @pytest.mark.parametrize("args", [
-    ["horizon", "--device", "buoy", "--dofs", "surge,heave,pitch"],
-    ["buoy", "--dofs", "surge,heave,pitch", "--controller", "mpc", "--hs", "1", "--tp", "6"],
     ["buoy", "--dofs", "surge,heave,pitch", "--optimize-design", "mass"],
-    ["power-matrix", "--device", "buoy", "--dofs", "surge,heave,pitch", "--controller",
-     "mpc", "--hs", "1", "--tp", "6"],
+    ["buoy", "--dofs", "surge,heave,pitch", "--controller", "one-way-mpc", "--hs", "1",
+     "--tp", "6"],
+    ["buoy", "--dofs", "surge,heave,pitch", "--controller", "mpc", "--wave-height", "1"],
 ])
 def test_where_only_the_buoy_is_taken_a_hull_is_refused_in_one_line(args, capsys):
     from parapend.cli import main

@@ -295,9 +295,6 @@ def test_the_work_is_capped_in_one_line():
 
 
 @pytest.mark.parametrize("extra, needle", [
-    (["--controller", "mpc", "--device", "buoy", "--dofs", "surge,heave,pitch"],
-     "controller: the causal column is computed for --device prescribed-heave and the "
-     "heaving --device buoy"),
     (["--controller", "mpc", "--device", "buoy", "--plan-samples", "4"],
      "plan-samples: an option of the prescribed-heave pendulum's planner"),
     (["--controller", "mpc", "--device", "buoy", "--speed-limit", "4"],

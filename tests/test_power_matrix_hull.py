@@ -294,3 +294,28 @@ def test_each_bin_is_parapend_buoy_by_hand(dataset, scatter, capsys, tmp_path):
     want = HOURS_PER_YEAR * sum(pm[i, j] * freq[(h, t)] for i, h in enumerate((1, 2))
                                 for j, t in enumerate((5, 6)))
     assert out["annual_energy"]["power"]["wh"] == pytest.approx(want, rel=1e-12)
+
+
+def test_the_hulls_causal_column_is_in_the_spec(dataset):
+    """``--controller mpc`` with the hull: the spec carries the causal column (the hull's
+    controller, a horizon of 2 peak periods by default, the forecasts asked for), round
+    trips, and stores each forecast's causal power beside the optimum's."""
+    spec = matrix_spec(**BINS, realizations=1, hydro=dataset, **HULL, controller="mpc",
+                       forecast="perfect,ar")
+    assert (spec.controller, spec.buoy_controller, spec.horizon) == ("mpc", "hull", 2.0)
+    assert spec.forecasts == ("perfect", "ar")
+    assert MatrixSpec.from_json(spec.to_json()) == spec
+    assert "causal_perfect_power" in spec.variables and "causal_ar_power" in spec.variables
+
+
+@pytest.mark.slow
+def test_a_hull_bins_causal_run_stays_below_its_optimum(dataset):
+    """One bin's record solved and run causally (perfect forecast) in its optimum's mode: a
+    causal controller cannot beat the omniscient optimum of the same record."""
+    from parapend.performance.solve import solve_bin
+
+    spec = matrix_spec(**BINS, realizations=1, hydro=dataset, **HULL, controller="mpc")
+    out = solve_bin(spec, 0, 0, 0)
+    p, c = out["power"], out["causal_perfect_power"]
+    assert math.isfinite(p) and p > 0
+    assert math.isnan(c) or c <= p * (1 + 1e-3)

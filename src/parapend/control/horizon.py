@@ -597,10 +597,8 @@ def _expanded(opts: dict) -> dict:
 
 def _buoy(opts: dict):
     """``device="buoy"``: the pendulum-only options refused by name, the rest handed on."""
-    from ..hydro.api import refuse_hull
     from ..hydro.horizon import buoy_horizon_curve
 
-    refuse_hull(opts["dofs"], "horizon --device buoy")
     for name in PENDULUM_ONLY:
         if opts[name] is not None:
             raise ParameterError(f"{name.replace('_', '-')}: an option of the prescribed-heave "
@@ -608,7 +606,7 @@ def _buoy(opts: dict):
                                  + (" (give --damping-coefficient, N m s/rad)"
                                     if name == "gamma" else ""))
     return buoy_horizon_curve(**{k: v for k, v in opts.items()
-                                 if k not in (*PENDULUM_ONLY, "device", "dofs",
+                                 if k not in (*PENDULUM_ONLY, "device",
                                               "controller", "sea", "pendulum", "pto")})
 
 

@@ -658,8 +658,9 @@ def refuse_hull(dofs, where: str) -> None:
     """Refuse, in one line naming the missing capability, a hull's ``dofs`` where only the
     heaving buoy is taken (``where``: the command, e.g. ``"horizon --device buoy"``)."""
     if dofs is not None and parse_dofs(dofs) != ("heave",):
-        raise ParameterError(f"dofs: {where} runs the heaving buoy only (--dofs heave): a "
-                             "hull (surge,heave,pitch) has no causal controller yet")
+        raise ParameterError(f"dofs: {where} takes a hull (surge,heave,pitch) by its keywords "
+                             "only (dofs=, the embedded barge's defaults), not as a Body "
+                             "object")
 
 
 def _refuse_unsupported(opts: dict) -> None:
@@ -669,13 +670,17 @@ def _refuse_unsupported(opts: dict) -> None:
              "damping_coefficient_bounds": "damping-coefficient-bounds",
              "horizon": "horizon", "update_interval": "update-interval",
              "forecast": "forecast"}
+    mpc = opts.get("controller") == "mpc"
     for key, name in later.items():
-        if opts.get(key) is not None:
-            raise ParameterError(f"{name}: not available with --dofs surge,heave,pitch yet; "
-                                 "drop it")
-    if opts.get("controller") not in (None, "optimum"):
-        raise ParameterError("controller: the causal controllers run on the heaving buoy "
-                             "only; drop --controller with --dofs surge,heave,pitch")
+        if opts.get(key) is not None and not (mpc and key in (
+                "horizon", "update_interval", "forecast")):
+            raise ParameterError(f"{name}: not available with --dofs surge,heave,pitch"
+                                 + (" yet; drop it" if key not in (
+                                     "horizon", "update_interval", "forecast")
+                                    else "; needs --controller mpc"))
+    if opts.get("controller") not in (None, "optimum", "mpc"):
+        raise ParameterError("controller: a hull (--dofs surge,heave,pitch) takes optimum or "
+                             f"mpc, got {opts.get('controller')!r:.40}")
 
 
 def _hull_pto(opts):
@@ -909,6 +914,9 @@ def hull_buoy(deadline=None, time_limit=None, **opts):
         realizations = check_realizations(realizations, opts, time_limit)
     regular = not any(opts.get(k) is not None for k in ("hs", "tp", "record",
                                                         "repeat_period", "seed"))
+    if regular and opts.get("controller") == "mpc":
+        raise ParameterError("controller: mpc runs the hull in an irregular sea state: give "
+                             "--hs and --tp (and --repeat-period, --seed)")
     if regular:  # the wave's checks before the BEM too
         height = check("wave_height", _hull_value(opts, "wave_height"),
                        why="regular wave height, m")
@@ -946,7 +954,19 @@ def hull_buoy(deadline=None, time_limit=None, **opts):
             return solve_realizations(solve_record, p, record, opts.get("seed"), realizations,
                                       time_limit=time_limit, deadline=deadline,
                                       progress=progress)
-        return solve_record(p, *record(opts.get("seed")))
+        wave, info = record(opts.get("seed"))
+        if opts.get("controller") == "mpc":
+            from .hull_control import hull_mpc_command
+
+            if "tp" not in info:
+                raise ParameterError("controller: mpc runs in an irregular sea state: give "
+                                     "--hs and --tp")
+            return hull_mpc_command(
+                p, wave, info, solve_record(p, wave, info), deadline=deadline,
+                horizon=default_of("horizon", opts.get("horizon"), "mpc"),
+                update_interval=default_of("update_interval", opts.get("update_interval")),
+                forecast=default_of("forecast", opts.get("forecast")))
+        return solve_record(p, wave, info)
     w = 2 * math.pi / periods
     hull.check_covers(float(np.min(w)), float(np.max(w)), name="wave-period")
     results = []

@@ -300,11 +300,16 @@ def _check_work(total, n, m, iterations, warm, repeats, dt, time_limit=None):
 
 def force_nodes(hydro, wave, per_record, plant_steps, count):
     """``F_exc`` (N) at the plant's half-step nodes ``t = j T_r / (2 per_record
-    plant_steps)``, ``j = 0..count - 1``."""
+    plant_steps)``, ``j = 0..count - 1``; a hull's (:class:`.bem.HullHydro`) three, one
+    column each (surge N, heave N, pitch N m)."""
     kk = np.arange(1, wave.amplitudes.size + 1)
     _, _, fk = hydro.coefficients(kk * wave.omega)
-    return _periodic(fk * np.asarray(wave.amplitudes), wave.omega, 2 * math.pi / wave.omega,
-                     2 * per_record * plant_steps, count)
+    a = np.asarray(wave.amplitudes)
+    cols = (np.asarray(fk).reshape(a.size, -1) * a[:, None])
+    out = np.stack([_periodic(cols[:, d], wave.omega, 2 * math.pi / wave.omega,
+                              2 * per_record * plant_steps, count)
+                    for d in range(cols.shape[1])], axis=1)
+    return out if np.ndim(fk) == 2 else out[:, 0]
 
 
 def free_motion(hydro, wave):
@@ -420,6 +425,15 @@ class CoupledHorizon:
                            self.total, self.grad, self.ys)
         return f - self.offset, self.grad.copy()
 
+    def _reference(self, u0, y0, fnet):
+        """The start ``y0`` as the objective reads it, and the terminal energy's reference
+        (the buoy's end state under ``u0``)."""
+        y0 = np.asarray(y0, float)
+        self.ref = np.zeros(2)
+        self.fun(u0, y0, fnet)
+        self.ref = self.ys[-1, :2].copy()
+        return y0
+
     def solve(self, y0, fnet, u0, max_iter=200, tol=1e-10):
         from scipy.optimize import minimize
 
@@ -429,11 +443,8 @@ class CoupledHorizon:
             u0 = np.clip(u0, -self.torque_limit, self.torque_limit)
         # the objective relative to the start's, so that L-BFGS-B's relative reduction test
         # is not diluted by the buoy's energy (a constant when the pendulum is light)
-        y0 = np.asarray(y0, float)
         self.offset = 0.0
-        self.ref = np.zeros(2)
-        self.fun(u0, y0, fnet)
-        self.ref = self.ys[-1, :2].copy()
+        y0 = self._reference(u0, y0, fnet)
         self.offset = self.fun(u0, y0, fnet)[0]
         with _blas_controller().limit(limits=1, user_api="blas"):
             return minimize(self.fun, u0, args=(y0, fnet), jac=True,
@@ -997,24 +1008,60 @@ def buoy_mpc(hydro, pendulum, wave, *, peak_period, horizon=2.0, update_interval
                 residuals.append(res_fp[0])
             plan = u
             seg = plan[:min(m, total - j)]
-        for k, uk in enumerate(seg):
-            ok, yk = plant.step(np.array([uk * tu]), ps, fn[2 * (j + k) * ps:
-                                                          2 * (j + k + 1) * ps + 1])
-            ys[j + k + 1] = yk[1]
-            acc[j + k + 1] = plant.acc
-            energy[j + k + 1] = plant.energy()
-            u_all[j + k] = uk * tu
-            if not ok:
-                status = "diverged"
-                total = j + k + 1
-                break
-        if status != "ok":
+        done, ok = apply_segment(plant, seg, j, tu, ps, fn, ys, acc, energy, u_all)
+        if not ok:
+            status, total = "diverged", j + done
             break
-        j += seg.size
+        j += done
 
     ys, acc, energy, u_all = ys[:total + 1], acc[:total + 1], energy[:total + 1], u_all[:total]
+    series = {"theta": ys[:, 2], "theta_dot": ys[:, 3], "z": ys[:, 0], "z_dot": ys[:, 1]}
+    return closed_loop_result(
+        series, acc, energy, u_all, status=status, caught=caught, dt=dt, h=h,
+        per_record=per_record, repeats=repeats, planned=planned, warm_samples=warm_samples,
+        n=n, m=m, eta=eta, times=times, changes=changes, residuals=residuals, solves=solves,
+        failed=failed, kept=kept, iterations=iterations, solves_per_update=solves_per_update,
+        relaxation=relaxation, controller=controller, forecast=forecast,
+        torque_limit=torque_limit, limit_given=limit_given, pendulum=pendulum, plant=plant,
+        units={"time_s": t0, "torque_nm": tu, "power_w": tu / t0, "a_inf_kg": plant.a_inf,
+               "memory_s": plant.nk * h, "plant_step_s": h})
+
+
+
+def apply_segment(plant, seg, j, tu, ps, fn, ys, acc, energy, u_all):
+    """Apply the held torques ``seg`` (units ``tu``) to the plant from sample ``j`` (``ps``
+    steps each, the force ``fn`` at its half-step nodes), saving its state, accumulated
+    energies and mechanical energy after each and the torque (N m): ``(samples applied,
+    ok)``, ``ok`` False when the plant diverged (its last sample applied)."""
+    for k, uk in enumerate(seg):
+        ok, yk = plant.step(np.array([uk * tu]), ps, fn[2 * (j + k) * ps:
+                                                      2 * (j + k + 1) * ps + 1])
+        ys[j + k + 1] = yk[1]
+        acc[j + k + 1] = plant.acc
+        energy[j + k + 1] = plant.energy()
+        u_all[j + k] = uk * tu
+        if not ok:
+            return k + 1, False
+    return len(seg), True
+
+def closed_loop_result(series, acc, energy, u_all, *, status, caught, dt, h, per_record,
+                       repeats, planned, warm_samples, n, m, eta, times, changes, residuals,
+                       solves, failed, kept, iterations, solves_per_update, relaxation,
+                       controller, forecast, torque_limit, limit_given, pendulum, plant,
+                       units) -> BuoyMPCResult:
+    """The result of a closed-loop run on a floating body (the buoy's :func:`buoy_mpc`, the
+    hull's :func:`parapend.hydro.hull_control.hull_mpc`): the storage-corrected headline over
+    whole repeats after the warm-up, the energy balance, the status and the update times.
+
+    ``series``: ``theta`` (the generator's angle, rad) and ``theta_dot`` at the samples'
+    ends, ``z`` (the heave, m) and the body's other saved states; ``acc`` the plant's
+    accumulated ``(absorbed, damping, work)`` (J) and ``energy`` its mechanical energy (J)
+    there; ``u_all`` the held torques (N m)."""
+    from ..control import mpc as _mpc
+
+    total = u_all.size
     t = dt * np.arange(total + 1)
-    p = -u_all * np.diff(ys[:, 2]) / dt
+    p = -u_all * np.diff(series["theta"]) / dt
     pe = p if eta is None else np.where(p > 0, eta[0] * p, p / eta[1])
     a0 = max(0, total - repeats * per_record)
     span = (total - a0) * dt
@@ -1037,7 +1084,7 @@ def buoy_mpc(hydro, pendulum, wave, *, peak_period, horizon=2.0, update_interval
     resid = abs(harvested + damping + stored - absorbed) / max(abs(absorbed), 1e-300)
     if status == "ok" and not math.isfinite(mean_p):
         status = "nonfinite"
-    if status == "ok" and float(np.max(np.abs(ys[:, 3]))) * h > RESOLVED:
+    if status == "ok" and float(np.max(np.abs(series["theta_dot"]))) * h > RESOLVED:
         status = "unresolved"
     if status == "ok" and solves and 2 * failed > solves:
         # a run whose plans mostly failed is not a success, whatever its power
@@ -1092,9 +1139,8 @@ def buoy_mpc(hydro, pendulum, wave, *, peak_period, horizon=2.0, update_interval
                   "limit): no mean over one whole repeat of the record after the "
                   f"{warm_samples * dt:.4g} s warm-up" if status == "time_limit" else msg)
         mean_p = mean_e = harvested = harvested_e = math.nan
-    series = {"t": t, "theta": ys[:, 2], "theta_dot": ys[:, 3], "z": ys[:, 0],
-              "z_dot": ys[:, 1], "torque": u_all, "power": p}
-    zwin = ys[a0 * 1:, 0]
+    series = {"t": t, **series, "torque": u_all, "power": p}
+    zwin = series["z"][a0:]
     return BuoyMPCResult(
         planner=controller, forecast=forecast, mean_power_w=mean_p, electrical_power_w=mean_e,
         harvested_power_w=harvested, harvested_electrical_power_w=harvested_e,
@@ -1116,10 +1162,8 @@ def buoy_mpc(hydro, pendulum, wave, *, peak_period, horizon=2.0, update_interval
         warnings=tuple(warnings), pendulum={"mass_kg": pendulum.mass, "length_m": pendulum.length,
                   "inertia_kg_m2": pendulum.inertia,
                   "damping_coefficient_nm_s_per_rad": pendulum.damping_coefficient},
-        units={"time_s": t0, "torque_nm": tu, "power_w": tu / t0, "a_inf_kg": plant.a_inf,
-               "memory_s": plant.nk * h, "plant_step_s": h},
+        units=units,
         _samples=series, _plant=plant, _update_times=st)
-
 
 def mpc_command(hydro, pendulum, wave, info, *, controller, horizon, update_interval, winding,
                 harmonics, torque_limit, efficiency, irregular, design, time_limit=None,
@@ -1204,7 +1248,8 @@ def mpc_text(r) -> list:
            f"{r.horizon_s:.4g} s, update "
            f"every {r.update_interval_s:.4g} s, torque held over {r.dt_s:.4g} s, limit "
            f"{r.torque_limit_nm:.6g} N m" + ("" if r.torque_limit_given else
-                                            " (2 m g l, the default)"),
+                                            f" ({r.torque_limit_nm / r.units['torque_nm']:.3g}"
+                                            " m g l, the default)"),
            "",
            f"mean power over the last repeat    {f(r.mean_power_w, ' W')} (harvested + "
            f"stored energy's change, after a {r.average_from_s:.4g} s start-up)",

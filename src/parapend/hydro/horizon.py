@@ -41,7 +41,8 @@ PLANNERS = ("coupled", "plan")
 #: --controller mpc``'s (1.06e5 counted as two solves an update, 87 s under load), which
 #: over-estimates the default curve with the planner's radiation model (one solve an update,
 #: work 5.0e4, 16.5 s of CPU) about 2.5 times
-BUOY_MPC_SECONDS = {"coupled": 140.0 / 1.0e5, "plan": 87.0 / 1.06e5}
+#: the hull's (``hull``): its default run (64 updates x 48 samples, 21 s at a load of 3)
+BUOY_MPC_SECONDS = {"coupled": 140.0 / 1.0e5, "plan": 87.0 / 1.06e5, "hull": 21.0 / 3.1e3}
 
 
 @dataclass(frozen=True, eq=False, repr=False)
@@ -149,10 +150,13 @@ class BuoyHorizonResult(_Result):
         return plot_buoy_horizon(self)
 
 
-def _estimate(tp, tr, horizon, update, warm_up, iterations) -> tuple:
+def _estimate(tp, tr, horizon, update, warm_up, iterations, hull=False) -> tuple:
     """A run's work as :func:`parapend.hydro.control.buoy_mpc` counts it (updates x horizon
-    samples x solves per update) and its updates."""
-    from .control import SAMPLES
+    samples x solves per update) and its updates (the hull's samples with ``hull``)."""
+    from .control import SAMPLES as BUOY_SAMPLES
+    from .hull_control import SAMPLES as HULL_SAMPLES
+
+    SAMPLES = HULL_SAMPLES if hull else BUOY_SAMPLES  # noqa: N806
 
     per_record = max(1, int(round(tr / (tp / SAMPLES))))
     dt = tr / per_record
@@ -168,7 +172,7 @@ def buoy_horizon_curve(*, hs=None, tp=None, spectrum="jonswap", gamma_peak=3.3,
                        draft=None, mesh=None, hydro=None, planner=None, torque_limit=None,
                        torque_limit_nm=None, efficiency=None, horizons=None,
                        forecasts="perfect,ar", records=1, update_interval=None, warm_up=None,
-                       time_limit=None, progress=None) -> BuoyHorizonResult:
+                       time_limit=None, progress=None, dofs=None) -> BuoyHorizonResult:
     """The buoy's horizon curve (``parapend.horizon(device="buoy", ...)`` calls this; the
     module docstring).
 
@@ -207,6 +211,11 @@ def buoy_horizon_curve(*, hs=None, tp=None, spectrum="jonswap", gamma_peak=3.3,
     progress : callable or None
         ``progress(done, total)`` after every run (the records' optima and the
         receding-horizon runs).
+    dofs : ``"heave"`` (None, the buoy) or ``"surge,heave,pitch"``: the hull (the embedded
+        barge, ``parapend.defaults.HULL``'s sea state, pendulum and pivot), its record
+        optimum (:func:`parapend.hydro.api.solve_record`) and its receding-horizon runs
+        (:func:`parapend.hydro.hull_control.hull_mpc`, started from the optimum's motion,
+        :func:`~parapend.hydro.hull_control.start_mode`).
     """
     from ..control.curve_options import (
         MAX_RECORDS,
@@ -216,20 +225,26 @@ def buoy_horizon_curve(*, hs=None, tp=None, spectrum="jonswap", gamma_peak=3.3,
         update_time_stats,
     )
     from ..deadline import check_time_limit, deadline, duration, expired, refuse_untimed
+    from ..defaults import HULL
     from ..units import Units
-    from .api import _check_floats, _check_kinds, _hydro
+    from .api import _check_floats, _check_kinds, _hydro, parse_dofs
     from .control import buoy_mpc
     from .declared import default_of
     from .inputs import _irregular_wave, _pendulum
     from .result import _solve
 
+    hull = dofs is not None and parse_dofs(dofs) != ("heave",)
+    if hull and planner is not None:
+        raise ParameterError("planner: the hull has one planner; drop --planner with --dofs "
+                             "surge,heave,pitch")
+    kind = "hull" if hull else "buoy"  # whose declared defaults
     time_limit = check_time_limit(time_limit)
     until = deadline(time_limit)
     if progress is not None and not callable(progress):  # called only after the first run
         raise ParameterError(f"progress: expected a callable progress(done, total) or None, "
                              f"got {progress!r:.40}")
     _check_kinds(mesh=mesh)  # a number for the path: one line, not os.fspath's TypeError
-    pend = _pendulum(mass, length, inertia, damping_coefficient)  # the declared defaults
+    pend = _pendulum(mass, length, inertia, damping_coefficient, kind)  # the declared defaults
     if planner is not None and planner not in PLANNERS:
         raise ParameterError(f"planner: expected {' or '.join(PLANNERS)}, got "
                              f"{planner!r:.40}")
@@ -273,21 +288,21 @@ def buoy_horizon_curve(*, hs=None, tp=None, spectrum="jonswap", gamma_peak=3.3,
                              f"{min(hz):g} peak periods, got {upd:g}")
     warm_up = check_range("warm-up", BUOY_HORIZON["warm_up"] if warm_up is None else warm_up,
                           0.0, 100.0, why="peak periods")
-    tp, hs = default_of("tp", tp, "buoy"), default_of("hs", hs, "buoy")
+    tp, hs = default_of("tp", tp, kind), default_of("hs", hs, kind)
     units = Units(pend.length, pend.mass, 9.81, pend.inertia)
     if repeat_period is None:
         from ..seas import _check_sea
 
-        repeat_period = BUOY_HORIZON["repeat_periods"] * _check_sea(
+        repeat_period = (HULL if hull else BUOY_HORIZON)["repeat_periods"] * _check_sea(
             hs, tp, spectrum, gamma_peak, None, cutoff)[1]
     waves = [_irregular_wave(hs, tp, spectrum, gamma_peak, repeat_period, seed + r, cutoff,
                              None, 0.1, units) for r in range(records)]
     tp = float(waves[0][1]["tp"])
     tr = float(waves[0][1]["repeat_period"])
     # the planner that will run: buoy_mpc's default when none is given
-    runs = planner or ("coupled" if efficiency is not None else "plan")
-    iterations = 1 if runs == "plan" else 2
-    work = [_estimate(tp, tr, h, upd, warm_up, iterations) for h in hz]
+    runs = "hull" if hull else planner or ("coupled" if efficiency is not None else "plan")
+    iterations = 1 if runs in ("plan", "hull") else 2
+    work = [_estimate(tp, tr, h, upd, warm_up, iterations, hull) for h in hz]
     est = records * len(fc) * sum(w for w, _ in work) * BUOY_MPC_SECONDS[runs]
     cap = limits.MAX_UNTIMED_SECONDS
     most = int(cap / (est / records))
@@ -307,12 +322,24 @@ def buoy_horizon_curve(*, hs=None, tp=None, spectrum="jonswap", gamma_peak=3.3,
                  duration(est), "" if time_limit is None else
                  f" (stopped after the time limit {time_limit:g} s)")
     # the body (the BEM, cached on disk) and the checks parapend buoy makes of a record
-    h, _ = _hydro(body, radius, draft, mesh, hydro)
-    for wave, _ in waves:
-        amps = np.abs(np.asarray(wave.amplitudes))
-        sig = np.nonzero(amps >= 1e-3 * amps.max())[0]
-        h.check_covers(wave.omega * (sig[0] + 1), wave.omega * (sig[-1] + 1), name="tp")
-    _check_floats(h, pend)
+    if hull:
+        from .api import hull_problem, solve_record
+        from .hull_control import hull_mpc, start_mode
+
+        problem = hull_problem(body=body, radius=radius, draft=draft, mesh=mesh, hydro=hydro,
+                               mass=pend.mass, length=pend.length, inertia=pend.inertia,
+                               damping_coefficient=pend.damping_coefficient)
+        h = problem["hull"]
+        for wave, info in waves:
+            solve_record(problem, wave, info, check_only=True)
+    else:
+        h, _ = _hydro(body, radius, draft, mesh, hydro)
+        for wave, _ in waves:
+            amps = np.abs(np.asarray(wave.amplitudes))
+            sig = np.nonzero(amps >= 1e-3 * amps.max())[0]
+            h.check_covers(wave.omega * (sig[0] + 1), wave.omega * (sig[-1] + 1), name="tp")
+        _check_floats(h, pend)
+    modes = []
     total_runs = records * (1 + len(fc) * len(hz))
     done = [0]
     stopped = [False]
@@ -328,14 +355,19 @@ def buoy_horizon_curve(*, hs=None, tp=None, spectrum="jonswap", gamma_peak=3.3,
         return stopped[0]
 
     opt = []
-    for wave, _ in waves:
+    for wave, info in waves:
+        modes.append("swing")
         if out_of_time():
             opt.append(math.nan)
             continue
-        # parapend buoy --controller mpc's optimum of the record (mpc_command)
-        sol, _, _ = _solve(h, pend, wave, winding=1, harmonics=None, torque_limit=None,
-                           efficiency=None, one_way=False)
-        opt.append(float(sol.power) if sol.success else math.nan)
+        if hull:  # parapend buoy --dofs surge,heave,pitch's optimum, its mode the run's
+            sol = solve_record(problem, wave, info)
+            modes[-1] = start_mode(sol.winding, sol.mean_angle_deg, sol.swing_amplitude_deg)
+            opt.append(float(sol.power_w) if sol.success else math.nan)
+        else:  # parapend buoy --controller mpc's optimum of the record (mpc_command)
+            sol, _, _ = _solve(h, pend, wave, winding=1, harmonics=None, torque_limit=None,
+                               efficiency=None, one_way=False)
+            opt.append(float(sol.power) if sol.success else math.nan)
         tick()
     shape = [[[math.nan] * records for _ in hz] for _ in fc]
     power, harvested, stored = ([[list(c) for c in row] for row in shape] for _ in range(3))
@@ -356,11 +388,13 @@ def buoy_horizon_curve(*, hs=None, tp=None, spectrum="jonswap", gamma_peak=3.3,
                 if out_of_time():
                     status[i][j][r] = "time_limit"
                     continue
-                res = buoy_mpc(h, pend, wave, peak_period=tp, horizon=hor,
-                               update_interval=upd, warmup=warm_up, repeats=1,
-                               torque_limit=torque_limit_nm, efficiency=efficiency,
-                               forecast=f, time_limit=limits.MAX_TIME_LIMIT,
-                               deadline=math.inf if until is None else until, **kw)
+                run, more = ((hull_mpc, {"pivot": problem["pivot"], "mode": modes[r]})
+                             if hull else (buoy_mpc, kw))
+                res = run(h, pend, wave, peak_period=tp, horizon=hor,
+                          update_interval=upd, warmup=warm_up, repeats=1,
+                          torque_limit=torque_limit_nm, efficiency=efficiency,
+                          forecast=f, time_limit=limits.MAX_TIME_LIMIT,
+                          deadline=math.inf if until is None else until, **more)
                 if res.status == "time_limit":
                     stopped[0] = True
                 status[i][j][r] = str(res.status)

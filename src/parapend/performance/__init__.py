@@ -112,7 +112,7 @@ def matrix_spec(*, hs="1:3:3", te=None, tp=None, realizations: int = 3, waves=No
     ``"surge,heave,pitch"`` (with ``device="buoy"``): a pendulum in a hull that surges,
     heaves and pitches, ``pivot_height ... copper_loss`` and ``torque_limit`` as
     ``parapend.buoy`` takes them (``parapend.performance.hull_device``). ``controller``
-    ``"mpc"`` (``device="prescribed-heave"`` or the heaving ``"buoy"``): the causal column,
+    ``"mpc"`` (``device="prescribed-heave"`` or ``"buoy"``, the hull too): the causal column,
     ``horizon``, ``forecast``, ``update_interval``, ``warm_up``, ``plan_samples`` and
     ``speed_limit`` as ``parapend.performance.causal.check_causal`` takes them (None:
     ``CAUSAL``, the buoy's ``BUOY_CAUSAL``)."""
@@ -190,7 +190,8 @@ def matrix_spec(*, hs="1:3:3", te=None, tp=None, realizations: int = 3, waves=No
                           damping_coefficient=damping_coefficient, winding=winding,
                           harmonics=harmonics, efficiency=efficiency,
                           torque_limit=torque_limit, body=body, radius=radius, draft=draft,
-                          mesh=mesh, hydro=hydro, density=density, depth=depth, **hull)
+                          mesh=mesh, hydro=hydro, density=density, depth=depth,
+                          causal=causal, **hull)
     if device == "buoy":
         return _buoy_spec(hm0, period, kind, tps, realizations, waves, seed, spectrum,
                           gamma_peak, cutoff, response=response, length=length, mass=mass,
@@ -283,7 +284,7 @@ def _buoy_spec(hm0, period, kind, tps, realizations, waves, seed, spectrum, gamm
 def _hull_spec(hm0, period, kind, tps, realizations, waves, seed, spectrum, gamma_peak,
                cutoff, *, response, gamma, gravity, winding, harmonics, efficiency,
                torque_limit, length, mass, inertia, damping_coefficient, body, radius, draft,
-               mesh, hydro, density, depth, **hull) -> MatrixSpec:
+               mesh, hydro, density, depth, causal=None, **hull) -> MatrixSpec:
     """The hull's spec (``dofs="surge,heave,pitch"``): the options the hull does not take
     refused, the rest checked and resolved by the hull's own code (its defaults,
     ``parapend.defaults.HULL``), the hull built once (its BEM), every bin's record checked."""
@@ -309,7 +310,8 @@ def _hull_spec(hm0, period, kind, tps, realizations, waves, seed, spectrum, gamm
                       float(gamma_peak), float(cutoff), None, length, mass, inertia, 9.81,
                       0.0, 1, harmonics, efficiency, "buoy",
                       digest=buoy_device.file_digest(mesh if hydro is None else hydro),
-                      damping_coefficient=damping_coefficient, dofs="surge,heave,pitch")
+                      damping_coefficient=damping_coefficient, dofs="surge,heave,pitch",
+                      **(causal or {}))
     spec = hull_device.resolve(spec, dict(body=body, radius=radius, draft=draft, mesh=mesh,
                                           hydro=hydro, torque_limit=torque_limit, **hull))
     hull_device.check_records(spec)
@@ -775,6 +777,13 @@ def _causal_matrix(ds, spec: MatrixSpec) -> None:
             "the hanging rest, the buoy in its free periodic motion, 64 torque samples a peak "
             "period; the mean over one repeat of the record after the warm-up, "
             "(W_e + eta_g dE) / tau, E the mechanical energy of buoy and pendulum")
+        if spec.buoy_controller == "hull":
+            ds.attrs["causal_convention"] = (
+                "parapend.hydro.hull_control.hull_mpc: from the hanging rest, the hull in its "
+                "free periodic motion, 24 torque samples a peak period, started from the "
+                "motion of the record's optimum; the mean over one repeat of the record "
+                "after the warm-up, (W_e + eta_g dE) / tau, E the mechanical energy of hull "
+                "and pendulum")
     else:
         ds.attrs["causal_plan_samples"] = spec.plan_samples
         ds.attrs["causal_speed_limit"] = ("none" if spec.speed_limit is None

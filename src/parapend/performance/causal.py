@@ -72,8 +72,9 @@ BUOY_CAUSAL = {"horizon": None, "forecast": "perfect", "update_interval": 0.125,
 #: Hs 0.5 and 1 m, Tp 2.5 and 3 s, where ``coupled`` at 1 gave 29.33, 14.26, 77.76 and
 #: 39.47 W (and at 2, 97.14 W out of real time and -14.24 W at Hs 1 m)
 BUOY_CONTROLLER = "plan"
-#: the buoy's default horizon (peak periods) per controller
-BUOY_HORIZON = {"plan": 2.0, "coupled": 1.0}
+#: the buoy's default horizon (peak periods) per controller; ``hull``: the hull's
+#: (:func:`parapend.hydro.hull_control.hull_mpc`, ``--dofs surge,heave,pitch``)
+BUOY_HORIZON = {"plan": 2.0, "coupled": 1.0, "hull": 2.0}
 
 
 def check_causal(*, controller, horizon, forecast, update_interval, warm_up, plan_samples,
@@ -92,10 +93,6 @@ def check_causal(*, controller, horizon, forecast, update_interval, warm_up, pla
         return None
     if controller != "mpc":
         raise ParameterError(f"controller: expected mpc (or none), got {controller!r:.40}")
-    if not heave:
-        raise ParameterError("controller: the causal column is computed for --device "
-                             "prescribed-heave and the heaving --device buoy, not for a hull "
-                             "that surges, heaves and pitches")
     buoy = device == "buoy"
     if buoy:
         for name, v in (("plan-samples", plan_samples), ("speed-limit", speed_limit)):
@@ -103,7 +100,8 @@ def check_causal(*, controller, horizon, forecast, update_interval, warm_up, pla
                 raise ParameterError(f"{name}: an option of the prescribed-heave pendulum's "
                                      "planner; drop it with --device buoy")
     base = BUOY_CAUSAL if buoy else CAUSAL
-    buoy_controller = ("coupled" if lossy and BUOY_CONTROLLER == "plan" else BUOY_CONTROLLER)
+    buoy_controller = ("hull" if not heave else "coupled" if lossy and BUOY_CONTROLLER == "plan"
+                       else BUOY_CONTROLLER)
     if horizon is None:
         horizon = (BUOY_HORIZON[buoy_controller] if buoy else base["horizon"])
     horizon = check_range("horizon", horizon, 0.05, 20.0, why="peak periods")
@@ -264,9 +262,30 @@ def run_buoy_record(spec, i: int, j: int, r: int, forecast: str = "perfect"):
                     time_limit=limits.MAX_TIME_LIMIT, deadline=math.inf, **kw)
 
 
-def solve_causal(spec, i: int, j: int, r: int) -> dict:
+def run_hull_record(spec, i: int, j: int, r: int, forecast: str = "perfect", mode="swing"):
+    """The hull's causal run of bin ``(i, j)``, realization ``r`` (``--device buoy --dofs
+    surge,heave,pitch``): :func:`parapend.hydro.hull_control.hull_mpc` on the hull, pendulum
+    and record :func:`parapend.performance.hull_device.solve_hull_bin` solves, started as
+    its optimum's motion says (``mode``), ``warm_up`` peak periods then one repeat."""
+    from .. import limits
+    from ..hydro.hull_control import hull_mpc
+    from .buoy_device import wave_of
+    from .hull_device import problem
+
+    p = problem(spec)
+    wave, _ = wave_of(spec, i, j, r)
+    pto = p["pto"]
+    return hull_mpc(p["hull"], p["pendulum"], wave, peak_period=spec.tp[j], pivot=p["pivot"],
+                    pitch_inertia=p["pitch_inertia"], horizon=spec.horizon,
+                    update_interval=spec.update_interval, warmup=spec.warm_up, repeats=1,
+                    forecast=forecast, mode=mode, torque_limit=pto.torque_limit,
+                    efficiency=pto.efficiency, time_limit=limits.MAX_TIME_LIMIT,
+                    deadline=math.inf)
+
+
+def solve_causal(spec, i: int, j: int, r: int, mode: str = "swing") -> dict:
     """The causal quantities (W) of bin ``(i, j)``, realization ``r``: NaN where a run did
-    not succeed (or raised: logged)."""
+    not succeed (or raised: logged). ``mode``: the hull's start (from its optimum's motion)."""
     from threadpoolctl import threadpool_limits
 
     from .check import _record, _units
@@ -283,8 +302,9 @@ def solve_causal(spec, i: int, j: int, r: int) -> dict:
             # processes do not, and the record's q (a small complex matrix-vector product
             # at every update) ran 2 to 3 times slower with threads that only spin
             with threadpool_limits(1, user_api="blas"):
-                res = (run_buoy_record(spec, i, j, r, f) if buoy
-                       else run_record(spec, exc, units, j, r, f))
+                res = (run_hull_record(spec, i, j, r, f, mode)
+                       if spec.buoy_controller == "hull" else run_buoy_record(spec, i, j, r, f)
+                       if buoy else run_record(spec, exc, units, j, r, f))
             # a run that loses energy is a measurement (the bin then rests: max(P, 0))
             if buoy and (res.success or res.status == "loses_energy"):
                 p = float(res.electrical_power_w)

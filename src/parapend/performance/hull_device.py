@@ -197,9 +197,11 @@ def _retry(spec, wave, info, res):
     return res if getattr(again, "headline_reason", None) else again
 
 
-def solve_hull_bin(spec, i: int, j: int, r: int) -> dict:
+def solve_hull_bin(spec, i: int, j: int, r: int, start: list | None = None) -> dict:
     """The hull's answer to one record: the best mode's power (never below zero), its mode,
-    the radiation bound, the one-way power, the mechanical power of a lossy take-off."""
+    the radiation bound, the one-way power, the mechanical power of a lossy take-off.
+    ``start``: a list that receives the causal run's start from the optimum's motion
+    (:func:`parapend.hydro.hull_control.start_mode`)."""
     from ..hydro.api import solve_record
     from ..maps.spec import _CODE
     from .buoy_device import wave_of
@@ -208,6 +210,10 @@ def solve_hull_bin(spec, i: int, j: int, r: int) -> dict:
     res = solve_record(problem(spec), wave, info)
     if getattr(res, "headline_reason", None):
         res = _retry(spec, wave, info, res)
+    if start is not None:
+        from ..hydro.hull_control import start_mode
+
+        start.append(start_mode(res.winding, res.mean_angle_deg, res.swing_amplitude_deg))
     def num(v):
         return math.nan if v is None else float(v)
     p = num(res.power_w)  # None: no resolved answer (headline_reason), kept as NaN

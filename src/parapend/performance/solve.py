@@ -36,7 +36,14 @@ def _solve_bin(spec, i: int, j: int, r: int) -> dict:
     if spec.device == "buoy" and spec.dofs != "heave":
         from .hull_device import solve_hull_bin
 
-        return solve_hull_bin(spec, i, j, r)
+        start = [] if spec.controller is not None else None
+        out = solve_hull_bin(spec, i, j, r, start)
+        if spec.controller is not None:
+            from .causal import solve_causal
+
+            # the same record, run causally from its optimum's motion
+            out.update(solve_causal(spec, i, j, r, mode=start[0]))
+        return out
     if spec.device == "buoy":
         from .buoy_device import solve_buoy_bin
 
