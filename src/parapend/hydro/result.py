@@ -18,12 +18,14 @@ import numpy as np
 from scipy.optimize import minimize_scalar
 
 from ..results import _Result
+from . import _hull_krylov  # noqa: F401  (registers the hull's matrix-free solver)
 from .hull import (
     BOUND_RCOND,
     HullProblem,
     HullPTO,
     bound_error,
     hull_search,
+    ideal_problem,
     make_case,
     radiation_bound,
 )
@@ -799,7 +801,7 @@ def _deg(v) -> float:
 
 
 def _mode(sol) -> dict:
-    pr = HullProblem(sol.case)
+    pr = HullProblem(sol.case) if sol.pto.active else ideal_problem(sol.case)
     y = pr.solve_hull(sol.x)
     mot = MotionAt(pr, sol.x, y)
     period = 2 * math.pi / sol.case.omega
