@@ -214,3 +214,32 @@ def test_barge_ten_wave_record_matrix_free_is_the_dense_answer():
     assert d.status == "converged"
     assert k.power == pytest.approx(d.power, rel=1e-8)
     assert dataclasses.is_dataclass(cs)
+
+
+def test_optimality_checks_agree_between_solvers():
+    """At a maximum: the gradient vanishes (below GTOL m g l w) and the reduced Hessian's
+    largest eigenvalue is negative, the same by Lanczos on the operator as by LAPACK on the
+    dense matrix (to Lanczos's tolerance)."""
+    from parapend.hydro._hull_krylov import LANCZOS_TOL, optimality
+
+    cs = _record(winding=0)
+    d = HullProblem(cs)
+    r = max((newton_maximize(d, x0, n, gtol=GTOL) for n, x0 in
+             hull_mod._starts(cs.harmonics, 0)[:4]), key=lambda r: r.power)
+    gd, td = optimality(d, r.x)
+    gk, tk = optimality(KrylovHullProblem(cs), r.x)
+    scale = float(d.w[0])
+    assert gd <= GTOL * scale and gk <= 10 * GTOL * scale
+    assert td < 0 and tk is not None
+    assert tk == pytest.approx(td, rel=10 * LANCZOS_TOL)
+
+
+def test_each_mode_carries_its_optimality(dataset):
+    """A hull answer's modes carry the gradient's largest entry and the Hessian's largest
+    eigenvalue at their maxima (negative: strict maxima); the gradient below Newton's
+    stopping rule at rounding (1e-7 of m g l w)."""
+    r = parapend.buoy(dofs="surge,heave,pitch", hydro=dataset, wave_height=1.0,
+                      wave_period=2 * math.pi / 1.2, **PEND)
+    for m in r.modes[:-1]:
+        assert m["gradient_max_w_per_rad"] <= 1e-7 * PEND["mass"] * 9.81 * 1.2
+        assert m["hessian_largest_eigenvalue_w_per_rad2"] < 0

@@ -505,4 +505,31 @@ def continued_search(make, *, refine: bool = True):
     return out
 
 
+#: Lanczos (ARPACK) for the reduced Hessian's largest eigenvalue: Lanczos vectors, restarts
+#: at most, and the relative tolerance (the check is its sign)
+LANCZOS_VECTORS, LANCZOS_RESTARTS, LANCZOS_TOL = 20, 10, 1e-2
+
+
+def optimality(problem: HullProblem, x) -> tuple[float, float | None]:
+    """First- and second-order optimality at ``x``: the gradient's largest entry (W/rad),
+    and the reduced Hessian's largest eigenvalue (W/rad^2; negative at a strict maximum):
+    dense, by LAPACK; an operator, by Lanczos on its products
+    (:func:`scipy.sparse.linalg.eigsh`, at most ``LANCZOS_VECTORS x LANCZOS_RESTARTS``
+    products; None when it has not converged to ``LANCZOS_TOL``)."""
+    from scipy.sparse.linalg import ArpackNoConvergence, eigsh
+
+    _, g, h = problem.evaluate(np.asarray(x, dtype=float))
+    gn = float(np.max(np.abs(g)))
+    if isinstance(h, np.ndarray):
+        return gn, float(np.linalg.eigvalsh(0.5 * (h + h.T))[-1])
+    n = g.size
+    op = LinearOperator((n, n), matvec=lambda v: h.matvec(np.ravel(v)), dtype=float)
+    try:
+        lam = eigsh(op, k=1, which="LA", ncv=min(n, LANCZOS_VECTORS), tol=LANCZOS_TOL,
+                    maxiter=LANCZOS_RESTARTS, v0=np.ones(n), return_eigenvectors=False)
+    except ArpackNoConvergence:
+        return gn, None
+    return gn, float(lam[0])
+
+
 _hull.MATRIX_FREE.update(problem=KrylovHullProblem, search=continued_search)

@@ -515,7 +515,7 @@ ALIAS_TOL = 1e-8
 #: singular values of B_k below this fraction of the largest are cut in the bound's
 #: pseudo-inverse (B's surge-pitch block is near singular: both radiate the same waves)
 BOUND_RCOND = 1e-8
-#: harmonics (of phi or of the hull) from which the ideal problem is solved matrix-free
+#: harmonics of phi from which the ideal problem is solved matrix-free
 #: (:mod:`._hull_krylov`: time and memory near-linear in the harmonics) rather than dense
 #: (its cost grows as their cube): the dense solver's regular waves stay dense up to their
 #: finest refinement (96 harmonics), and from about 60 harmonics the matrix-free one is
@@ -537,7 +537,7 @@ def ideal_problem(case: HullCase, coupled: bool = True) -> HullProblem:
     ``KRYLOV_HARMONICS`` harmonics its matrix-free twin
     (:class:`parapend.hydro._hull_krylov.KrylovHullProblem`; the same objective, gradient
     and Hessian, the Hessian an operator)."""
-    if max(case.harmonics, case.hull_harmonics) >= KRYLOV_HARMONICS and MATRIX_FREE:
+    if case.harmonics >= KRYLOV_HARMONICS and MATRIX_FREE:
         return MATRIX_FREE["problem"](case, coupled=coupled)
     return HullProblem(case, coupled=coupled)
 
