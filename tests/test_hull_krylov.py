@@ -243,3 +243,27 @@ def test_each_mode_carries_its_optimality(dataset):
     for m in r.modes[:-1]:
         assert m["gradient_max_w_per_rad"] <= 1e-7 * PEND["mass"] * 9.81 * 1.2
         assert m["hessian_largest_eigenvalue_w_per_rad2"] < 0
+
+
+def test_records_past_what_fits_are_refused_in_one_line(dataset):
+    """An ideal take-off's record is refused past ``HULL_MAX_RECORD_HARMONICS`` (about 300
+    waves), a take-off's past the dense ``HULL_MAX_HARMONICS`` (about 10), before any solve;
+    a 20-wave ideal record is no longer refused."""
+    from parapend import limits
+    from parapend.errors import ParameterError
+    from parapend.hydro.api import _check_hull_size, hull_problem
+    from parapend.hydro.coupled import Wave
+    from parapend.hydro.hull import HullPTO, waves_in
+
+    with pytest.raises(ParameterError, match=r"^repeat-period: .*matrix-free") as err:
+        parapend.buoy(dofs="surge,heave,pitch", hydro=dataset, hs=1.0, tp=6.0,
+                      repeat_period=6.0 * 320, **PEND)
+    assert "\n" not in str(err.value)
+    wave = Wave.from_spectrum(hs=1.0, tp=6.0, repeat_period=6.0 * 20, seed=0)
+    k = waves_in(wave)
+    _check_hull_size(wave, (k, 0), None)  # no refusal
+    assert 12 * k > limits.HULL_MAX_HARMONICS
+    with pytest.raises(ParameterError, match=r"^repeat-period: .*with a power take-off"):
+        _check_hull_size(wave, (k, 0), None, HullPTO(torque_limit=1e4))
+    p = hull_problem(dofs="surge,heave,pitch", hydro=dataset, **PEND)
+    assert p.get("max_harmonics") is None
