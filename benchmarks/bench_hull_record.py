@@ -50,6 +50,9 @@ def run(waves: float, dense: bool, timeout: float) -> dict | None:
                              text=True, timeout=timeout, env=env, check=True)
     except subprocess.TimeoutExpired:
         return None
+    except subprocess.CalledProcessError as err:
+        last = (err.stderr or "").strip().splitlines()[-1:] or ["(no message)"]
+        return {"error": last[0]}
     return json.loads(out.stdout.strip().splitlines()[-1])
 
 
@@ -78,11 +81,14 @@ def main():
     times = {}
     for w in sizes:
         r = run(w, False, a.timeout)
-        if r is None:
-            print(f"{w:6g}  did not finish in {a.timeout:g} s", flush=True)
+        if r is None or "error" in r:
+            why = f"did not finish in {a.timeout:g} s" if r is None else r["error"]
+            print(f"{w:6g}  {why}", flush=True)
             continue
         times[w] = r["seconds"]
         d = run(w, True, a.dense_timeout) if w in dense_sizes else None
+        if d is not None and "error" in d:
+            d = None
         if w in dense_sizes and d is None:
             dcols = f"{'>' + format(a.dense_timeout, 'g'):>10} {'':>9} {'':>7} {'':>14}"
         elif d is None:

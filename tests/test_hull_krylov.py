@@ -119,6 +119,19 @@ def test_continued_search_reaches_the_direct_one(monkeypatch):
     assert cont.power == pytest.approx(direct.power, rel=1e-8)
 
 
+def test_continuation_stops_on_phis_harmonics(monkeypatch):
+    """A rotation of more turns than the continuation's threshold (the hull's harmonics
+    N + K never fall below it) is continued down to fewer harmonics of phi than the
+    threshold, then climbs back: 24 from 12 from 6."""
+    cs = _record(harmonics=24, winding=12)
+    monkeypatch.setattr(hull_mod, "LONG_RECORD_HARMONICS", 10)
+    sol = hull_search(lambda s: cs, refine=False)
+    assert sol.case.harmonics == 24
+    assert "continued from 12 harmonics" in sol.found_by
+    assert "continued from 6 harmonics" in sol.found_by
+    assert math.isfinite(sol.power)
+
+
 def test_coarsened_case_is_the_case_with_fewer_harmonics():
     """:func:`coarsened` keeps the data at the harmonics it keeps: its hull matrix blocks are
     the full case's first ones."""
@@ -169,7 +182,7 @@ def _same_record_three_ways(hydro_opts, capsys, waves, tp, extra=()):
     # the smallest matrix (two bins a side): its first bin is the record
     ds, _, _, _ = power_matrix(device="buoy", dofs="surge,heave,pitch", hs="1,1.01",
                                tp=f"{tp!r},{tp + 0.01!r}",
-                               waves=waves, seed=0, realizations=1, workers=1,
+                               waves=waves, seed=0, realizations=1, workers=1, time_limit=3600,
                                **hydro_opts)
     return api, cli["power_w"], float(ds["power"].values[0, 0, 0])
 

@@ -521,7 +521,7 @@ BOUND_RCOND = 1e-8
 #: finest refinement (96 harmonics), and from about 60 harmonics the matrix-free one is
 #: the faster (benchmarks/bench_hull_record.py)
 KRYLOV_HARMONICS = 100
-#: harmonics from which a record's search runs on coarser discretizations first (the starts
+#: harmonics of phi from which a record's search runs on coarser discretizations first (the starts
 #: on the coarsest, each finer one from the coarser answer: :func:`._hull_krylov.continued_search`)
 LONG_RECORD_HARMONICS = 200
 
@@ -696,7 +696,7 @@ def hull_search(make, *, refine: bool = True, pto: HullPTO | None = None) -> Hul
     harmonics (1, and 2 for the refinement). With an active ``pto`` the ideal search's
     distinct maxima start the PTO's optimum (``_pto_stage``)."""
     case = make(1)
-    if max(case.harmonics, case.hull_harmonics) >= LONG_RECORD_HARMONICS and not (
+    if case.harmonics >= LONG_RECORD_HARMONICS and not (
             pto is not None and pto.active) and MATRIX_FREE:
         return MATRIX_FREE["search"](make, refine=refine)
     n, kw = case.harmonics, case.winding
