@@ -409,6 +409,7 @@ class KrylovHessian(HessianOperator):
         self.st = st
         self.d2 = d2
         self.sens = sens
+        self._d6 = None
         self.diagonal = -self._diag_xx()
 
     def _diag_xx(self):
@@ -438,8 +439,9 @@ class KrylovHessian(HessianOperator):
         if pr.coupled:
             ty = pr.sensitivity(v, self.st, self.sens)
             z[3:] = pr._pivot(pr._split(ty)[1])
-        d2 = self.d2
-        wz = np.stack([sum(d2[_PAIR[u, w]] * z[w] for w in range(6)) for u in range(6)])
+        if self._d6 is None:  # the pointwise 6 x 6 matrices, once per point
+            self._d6 = np.ascontiguousarray(self.d2[_PAIR])
+        wz = np.einsum("uwm,wm->um", self._d6, z)
         out = pr._motion_t(wz[:3])
         if pr.coupled:
             u = pr._flat(np.zeros(len(pr.static)), pr._pivot_t(wz[3:]))
