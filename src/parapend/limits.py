@@ -298,6 +298,10 @@ BUOY_MAX_RECORD_HARMONICS = 4096
 HULL_MAX_HARMONICS = 128
 #: the harmonics' refinement (doubling until the power settles) stops here
 HULL_MAX_REFINED_HARMONICS = 256
+#: HULL_MAX_HARMONICS for an ideal take-off (no efficiency, loss or limit), whose records are
+#: solved matrix-free (hydro/_hull_krylov.py; time and memory near-linear in N): 12 per wave to
+#: a 300-wave record (benchmarks/bench_hull_record.out.txt: 200 waves, 2400 harmonics)
+HULL_MAX_RECORD_HARMONICS = 3600
 #: ``buoy --dofs surge,heave,pitch --realizations``: at most this many seeded records of one
 #: sea state (the power matrix's cap on realizations per bin)
 HULL_MAX_REALIZATIONS = 1000

@@ -883,7 +883,8 @@ def solve_record(problem: dict, wave, info, *, check_only: bool = False):
     windings = problem["windings"]
     if problem["winding"] is None:
         windings = (waves_in(wave), 0)
-    _check_hull_size(wave, windings, problem["harmonics"])
+    _check_hull_size(wave, windings, problem["harmonics"], problem["pto"],
+                     problem.get("max_harmonics"))
     amps = np.abs(np.asarray(wave.amplitudes))
     sig = np.nonzero(amps >= 1e-3 * amps.max())[0]
     problem["hull"].check_covers(wave.omega * (sig[0] + 1), wave.omega * (sig[-1] + 1),
@@ -1048,14 +1049,22 @@ def _check_wave_kind(opts):
             raise ParameterError(f"{flag}: not used with --record; drop it")
 
 
-def _check_hull_size(wave, windings, harmonics):
-    """Refuse a record whose motion needs more harmonics than finish in about a minute."""
+def _check_hull_size(wave, windings, harmonics, pto=None, cap=None):
+    """Refuse a record whose motion needs more harmonics than finish in about a minute (with
+    a power take-off: dense Newton, ``limits.HULL_MAX_HARMONICS``), or than an ideal
+    take-off's matrix-free solver takes in time and memory
+    (``limits.HULL_MAX_RECORD_HARMONICS``); ``cap``: another limit (the power matrix's)."""
     from .hull import HARMONICS_PER_TURN
 
     n = harmonics or HARMONICS_PER_TURN * max(max(windings), waves_in(wave))
-    cap = limits.HULL_MAX_HARMONICS
+    ideal = pto is None or not pto.active
+    if cap is None:
+        cap = limits.HULL_MAX_RECORD_HARMONICS if ideal else limits.HULL_MAX_HARMONICS
     if n > cap:
+        why = ("that the matrix-free solver takes (time and memory)" if
+               cap == limits.HULL_MAX_RECORD_HARMONICS else "that finish in about a minute" +
+               ("" if ideal else " with a power take-off"))
         raise ParameterError(f"repeat-period: the record holds about {waves_in(wave)} waves "
                              f"and needs {n} harmonics ({HARMONICS_PER_TURN} per wave or "
-                             f"turn), more than the {cap} that finish in about a minute; use "
-                             f"a record of at most {cap // HARMONICS_PER_TURN} waves")
+                             f"turn), more than the {cap} {why}; use a record of at most "
+                             f"{cap // HARMONICS_PER_TURN} waves")

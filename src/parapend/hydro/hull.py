@@ -65,7 +65,8 @@ from ._trig import FusedGram, GramPlan, TrigColumns, spectra
 from .pto import PTOObjective, _abs
 
 __all__ = ["HARMONICS_PER_TURN", "HullCase", "HullPTO", "HullProblem", "HullSolution", "aliased",
-           "hull_points", "hull_search", "make_case", "radiation_bound", "waves_in"]
+           "hull_points", "hull_search", "ideal_problem", "make_case", "radiation_bound",
+           "waves_in"]
 
 #: grid variables of the pointwise functions, in this order
 _VARS = ("phi", "phi1", "phi2", "qx", "qz", "b1")
@@ -514,6 +515,31 @@ ALIAS_TOL = 1e-8
 #: singular values of B_k below this fraction of the largest are cut in the bound's
 #: pseudo-inverse (B's surge-pitch block is near singular: both radiate the same waves)
 BOUND_RCOND = 1e-8
+#: harmonics of phi from which the ideal problem is solved matrix-free
+#: (:mod:`._hull_krylov`: time and memory near-linear in the harmonics) rather than dense
+#: (its cost grows as their cube): the dense solver's regular waves stay dense up to their
+#: finest refinement (96 harmonics), and from about 60 harmonics the matrix-free one is
+#: the faster (benchmarks/bench_hull_record.py)
+KRYLOV_HARMONICS = 100
+#: harmonics of phi from which a record's search runs on coarser discretizations first (the starts
+#: on the coarsest, each finer one from the coarser answer: :func:`._hull_krylov.continued_search`)
+LONG_RECORD_HARMONICS = 200
+
+
+#: the matrix-free solver: ``{"problem": class, "search": function}``, registered by
+#: :mod:`._hull_krylov` when it is imported (it builds on this module; hydro/result.py,
+#: where answers are made, imports it). Unregistered, every problem is dense.
+MATRIX_FREE: dict = {}
+
+
+def ideal_problem(case: HullCase, coupled: bool = True) -> HullProblem:
+    """The ideal (lossless) problem of ``case``: :class:`HullProblem`, or from
+    ``KRYLOV_HARMONICS`` harmonics its matrix-free twin
+    (:class:`parapend.hydro._hull_krylov.KrylovHullProblem`; the same objective, gradient
+    and Hessian, the Hessian an operator)."""
+    if case.harmonics >= KRYLOV_HARMONICS and MATRIX_FREE:
+        return MATRIX_FREE["problem"](case, coupled=coupled)
+    return HullProblem(case, coupled=coupled)
 
 
 def make_case(hull, pendulum, wave, *, winding, harmonics=None, hull_harmonics=None,
@@ -626,8 +652,8 @@ def aliased(problem: HullProblem, x) -> bool:
     """True when the power at ``x`` on a grid four times finer differs by more than
     ``ALIAS_TOL`` (relative): the grid's mean has become aliasing (large coefficients push
     the harmonics of ``sin(phi)`` past the grid's Nyquist frequency), not a power."""
-    fine = HullProblem(dataclasses.replace(problem.case, points=4 * problem.case.points),
-                       coupled=problem.coupled)
+    fine = type(problem)(dataclasses.replace(problem.case, points=4 * problem.case.points),
+                         coupled=problem.coupled)
     # the mechanical power, a smooth function of the motion, also under a PTO (whose
     # kink the finer grid integrates differently: that is the refinement's business)
     p, pf = problem.mechanical(x), fine.mechanical(x)
@@ -672,11 +698,14 @@ def hull_search(make, *, refine: bool = True, pto: HullPTO | None = None) -> Hul
     harmonics (1, and 2 for the refinement). With an active ``pto`` the ideal search's
     distinct maxima start the PTO's optimum (``_pto_stage``)."""
     case = make(1)
+    if case.harmonics >= LONG_RECORD_HARMONICS and not (
+            pto is not None and pto.active) and MATRIX_FREE:
+        return MATRIX_FREE["search"](make, refine=refine)
     n, kw = case.harmonics, case.winding
-    one = HullProblem(case, coupled=False)
+    one = ideal_problem(case, coupled=False)
     starts = _starts(n, kw)
     best_one, runs_one = _search(one, starts, GTOL)
-    coupled = HullProblem(case)
+    coupled = ideal_problem(case)
     seeds = []
     if best_one is not None:
         for r in sorted((r for r in runs_one if r.status == "converged"),
@@ -739,7 +768,7 @@ def _refine(sol: HullSolution, make, x) -> HullSolution:
             x1, p1 = (x1n, p1n) if math.isfinite(p1n) else (_pad(x1, case.harmonics),
                                                             math.nan)
         else:
-            pr = HullProblem(case)
+            pr = ideal_problem(case)
             r = newton_maximize(pr, _pad(x, case.harmonics), "refined", gtol=GTOL)
             xr, pr_power, st = r.x, r.power, r.status
         if st != "converged":
@@ -764,12 +793,12 @@ def _refine(sol: HullSolution, make, x) -> HullSolution:
         x, power, held = _hold_limit(case, x, power, pto)
         if held:
             status += f"; {held}"
-    pr = HullProblem(case)
+    pr = HullProblem(case) if pto.active else ideal_problem(case)
     _, _, resid = pr.balance(x)
     if pto.active:
         mech = float(pr.mechanical(x))
     else:
-        r1 = newton_maximize(HullProblem(case, coupled=False),
+        r1 = newton_maximize(ideal_problem(case, coupled=False),
                              _pad(sol.one_way_x, case.harmonics), "one-way", gtol=GTOL)
         x1, p1, mech = r1.x, r1.power, None
     return dataclasses.replace(sol, case=case, x=x, power=power, status=status, success=ok,

@@ -19,12 +19,14 @@ from scipy.optimize import minimize_scalar
 
 from ..results import _Result
 from ..seas import BREAKING_STEEPNESS, STEEP_WARNING, sea_steepness_warning  # noqa: F401
+from . import _hull_krylov  # also registers the hull's matrix-free solver
 from .hull import (
     BOUND_RCOND,
     HullProblem,
     HullPTO,
     bound_error,
     hull_search,
+    ideal_problem,
     make_case,
     radiation_bound,
 )
@@ -911,7 +913,7 @@ def _deg(v) -> float:
 
 
 def _mode(sol) -> dict:
-    pr = HullProblem(sol.case)
+    pr = HullProblem(sol.case) if sol.pto.active else ideal_problem(sol.case)
     y = pr.solve_hull(sol.x)
     mot = MotionAt(pr, sol.x, y)
     period = 2 * math.pi / sol.case.omega
@@ -926,6 +928,10 @@ def _mode(sol) -> dict:
                    f"({over:.1e} above the limit)")
     s = mot(period * np.arange(PEAK_POINTS) / PEAK_POINTS)
     k = sol.case.winding
+    # first- and second-order optimality of the ideal problem's answer (a take-off's
+    # objective moves with its continuation and its limit's multipliers: not checked here)
+    grad, top = (None, None) if sol.pto.active or not math.isfinite(sol.power) else \
+        _hull_krylov.optimality(pr, sol.x)
     swing = None if k else 0.5 * _deg(np.max(s["phi"]) - np.min(s["phi"]))
     mean = _deg(math.remainder(float(np.mean(s["phi"])) - math.pi, 2 * math.pi) + math.pi)
     return {"mode": "swinging" if k == 0 else "rotation", "winding": k,
@@ -940,6 +946,7 @@ def _mode(sol) -> dict:
             "peak_torque_nm": pk, "distinct_maxima": sol.distinct_maxima,
             "maxima_powers_w": [float(v) for v in sol.maxima_powers],
             "found_by": sol.found_by, "starts": sol.runs, "success": ok,
+            "gradient_max_w_per_rad": grad, "hessian_largest_eigenvalue_w_per_rad2": top,
             "status": status, "_solution": sol, "_motion": mot}
 
 

@@ -56,9 +56,12 @@ def problem(spec) -> dict:
     and the hull's coefficients (BEM cached on disk), built once per process."""
     key = _key(spec)
     if key not in _PROBLEMS:
+        from .. import limits
         from ..hydro.api import hull_problem
 
-        _PROBLEMS[key] = hull_problem(**hull_opts(spec))
+        # its records at the dense solver's size (a bin of a 6 x 6 matrix in about a minute)
+        _PROBLEMS[key] = dict(hull_problem(**hull_opts(spec)),
+                              max_harmonics=limits.HULL_MAX_HARMONICS)
     return _PROBLEMS[key]
 
 

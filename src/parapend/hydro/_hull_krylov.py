@@ -1,0 +1,537 @@
+r"""The hull problem matrix-free: long records at a cost near-linear in the harmonics.
+
+The same model and discretization as :class:`parapend.hydro.hull.HullProblem` (docs/hull.md;
+the equations of that module's docstring), with every matrix applied as FFTs and pointwise
+products on the grid instead of formed. The pendulum's coefficients
+``x = (x_0, a_1..a_N, b_1..b_N)``, ``phi = K s + x_0 + sum_n a_n sin(ns) + b_n cos(ns)``
+(``s = w t``, ``M`` grid points ``s_j = 2 pi j / M``); the hull's harmonics
+``Xi_k`` (3 complex DOFs, ``k = 1..Nh``) and its static offsets ``Xi_0`` on the DOFs with
+stiffness. The maps between coefficients and the grid:
+
+- ``P x = (phi, phi', phi'')``: an inverse real FFT of ``C_n = b_n - i a_n`` times
+  ``1, i n w, -(n w)^2``; its transpose ``P^T (w_0, w_1, w_2)``: ``W_u = rfft(w_u)``,
+  ``U_n = sum_u beta_u conj(W_u)_n``, ``d/db_n = Re U_n``, ``d/da_n = Im U_n``;
+- ``Q y = (p_x'', p_z'', beta')``: ``xi_d'' = Re sum_k -(k w)^2 Xi_{k,d} e^{iks}``,
+  ``beta' = Re sum_k i k w Xi_{k,beta} e^{iks}``, ``p'' = G xi''``; the transpose of
+  ``X -> Re(alpha X e^{iks})`` is ``w -> conj(alpha) W_k`` (the gradient of a complex unknown
+  written ``d/dRe + i d/dIm``);
+- ``Pi r``: the Galerkin projection, ``(2 / M) rfft(r)_k`` (``k >= 1``), the mean for the
+  static rows; ``Pi^T lambda = (2 / M) Re sum_k lambda_k e^{iks}`` (plus ``lambda_0 / M``).
+
+The hull's equations at ``phi``, ``S(phi) y = b(phi)`` (Eq. H projected)::
+
+    S y = Z y + Pi_beta [m l (cos(phi) p_x''(y) - sin(phi) p_z''(y))],   b = F a + Pi r(phi)
+
+with ``Z`` block diagonal in frequency (``Z_k``, 3 x 3 complex, inverted once) and ``r``
+the pendulum's reaction at rest in the hull (:func:`._hull_kernel.reaction`). ``S y = b``,
+the adjoint ``S^T lambda = d<f>/dy`` and the sensitivities are solved by GMRES
+(:func:`scipy.sparse.linalg.gmres`) preconditioned by ``Z^{-1}``: each iteration two FFTs
+of the grid, ``O(M log M)``. The Lagrangian's pointwise derivatives are the compiled ones
+of the dense solver (:mod:`._hull_kernel`: ``objective_weights``, ``constraint_weights``),
+so the gradient ``P^T d_1`` is the dense solver's to the GMRES tolerance, and the reduced
+Hessian ``H = L_xx + L_xy T + T^T L_yx + T^T L_yy T`` is applied to a vector ``v`` as
+
+    z = (P v, Q T v),  T v = S^{-1} Pi (rho_X P v),
+    H v = P^T (D_2 z)_X + T^T Q^T (D_2 z)_Q,   T^T u = P^T rho_X^T Pi^T S^{-T} u,
+
+``D_2`` the pointwise 6 x 6 second derivatives, ``rho_X`` the reaction's derivatives in
+``(phi, phi', phi'')`` (two GMRES solves per product, nothing of size ``N^2`` stored).
+Newton's step is then truncated, preconditioned conjugate gradients
+(:func:`parapend.optimal.fourier.newton_maximize`'s operator path) with the diagonal of
+``L_xx`` plus the frequency-diagonal part of the hull's radiation as the preconditioner.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+
+import numpy as np
+import scipy.fft
+from scipy.sparse.linalg import LinearOperator, gmres
+
+from ..optimal.fourier import HessianOperator, _pad, newton_maximize
+from . import hull as _hull
+from ._hull_kernel import constraint_weights, objective_weights, reaction, torque
+from .hull import (
+    GTOL,
+    HullCase,
+    HullProblem,
+    HullSolution,
+    _refine,
+    aliased,
+    hull_points,
+    hull_search,
+    ideal_problem,
+)
+
+__all__ = ["KrylovHullProblem", "KrylovHessian"]
+
+#: GMRES's relative residual for the hull's state and the adjoint (their error is the
+#: gradient's, and so the optimum's): rounding's scale
+STATE_RTOL = 1e-14
+#: ... and for the sensitivities inside a Hessian product (Newton's step only needs the
+#: product to the CG's forcing term, at least 1e-4)
+PRODUCT_RTOL = 1e-8
+#: the energy balance's residual above which a coupled state is the grid's aliasing, not a
+#: motion (its power is then NaN: the line search steps back); at an answer it is ~1e-12
+BALANCE_TOL = 1e-4
+#: GMRES's restart length and its restarts at most
+RESTART, MAX_RESTARTS = 40, 20
+
+
+def _rfft(a):
+    return scipy.fft.rfft(a, axis=-1)
+
+
+def _irfft(c, m):
+    return scipy.fft.irfft(c, m, axis=-1)
+
+
+class KrylovHullProblem(HullProblem):
+    """:class:`~parapend.hydro.hull.HullProblem`'s objective, gradient and Hessian
+    (an operator) without any matrix of the harmonics' size: memory ``O(M)``, each
+    evaluation a few GMRES solves of ``O(M log M)`` iterations.
+
+    The same constructor's arguments and the same methods (``power``, ``evaluate``,
+    ``grid_state``, ``balance``, ``solve_hull``, ``harmonics_of``); ``evaluate`` returns a
+    :class:`KrylovHessian` for the Hessian (``hessian = "operator"``)."""
+
+    hessian = "operator"
+
+    def __init__(self, case: HullCase, coupled: bool = True, eta=None,
+                 copper_loss: float = 0.0):
+        self.case = case
+        self.coupled = coupled
+        self.set_efficiency(eta)
+        self.copper_loss = float(copper_loss)
+        n, nh, m = case.harmonics, case.hull_harmonics, case.points
+        w = case.omega
+        self.harmonics, self.points, self.winding, self.omega = n, m, case.winding, w
+        self.s = 2 * math.pi * np.arange(m) / m
+        cp = case.stiffness()
+        self.static = [d for d in range(3) if cp[d, d] > 0]
+        j0 = len(self.static)
+        self.ny = j0 + 6 * nh
+        self._kn = w * np.arange(1, n + 1)  # n w
+        self._kh = w * np.arange(1, nh + 1)  # k w
+        zk = np.stack([case.impedance(k) for k in range(1, nh + 1)]) if nh else \
+            np.zeros((0, 3, 3), complex)
+        self._zk = zk
+        self._zkinv = np.linalg.inv(zk) if nh else zk
+        self._z0 = cp[np.ix_(self.static, self.static)]
+        self._z0inv = np.linalg.inv(self._z0) if j0 else self._z0
+        self._fa = case.wave_force()[1:]
+        self._pitch_static = self.static.index(2) if 2 in self.static else -1
+        self.y_free = self._flat(np.zeros(j0), np.einsum("kij,kj->ki", self._zkinv,
+                                                         self._fa))
+        self.w = np.array([case.m * case.g * case.l * w])
+        self._last = None
+        self._y_guess = None
+        self._constants = {}
+        self.gmres_iterations = 0
+        self.products = 0
+
+    # -- layout: y = [Xi_0 (static DOFs), (Re Xi_k, Im Xi_k) per k] as the dense solver's ----
+    def _flat(self, y0, xk) -> np.ndarray:
+        nh = xk.shape[0]
+        body = np.empty((nh, 2, 3))
+        body[:, 0, :], body[:, 1, :] = xk.real, xk.imag
+        return np.concatenate((np.asarray(y0, float), body.ravel()))
+
+    def _split(self, y):
+        j0 = len(self.static)
+        body = np.asarray(y[j0:]).reshape(-1, 2, 3)
+        return np.asarray(y[:j0]), body[:, 0, :] + 1j * body[:, 1, :]
+
+    def harmonics_of(self, y) -> np.ndarray:
+        y0, xk = self._split(y)
+        xi = np.zeros((xk.shape[0] + 1, 3), dtype=complex)
+        for i, d in enumerate(self.static):
+            xi[0, d] = y0[i]
+        xi[1:] = xk
+        return xi
+
+    # -- the grid maps ------------------------------------------------------------------------
+    def _synth(self, c):
+        """``Re sum_k c_k e^{iks}`` on the grid (``c``: (..., K), k = 1..K)."""
+        m = self.points
+        full = np.zeros(c.shape[:-1] + (m // 2 + 1,), dtype=complex)
+        full[..., 1:c.shape[-1] + 1] = c * (0.5 * m)
+        return _irfft(full, m)
+
+    def _motion(self, x):
+        """``(phi, phi', phi'')`` on the grid (3, M): ``P x`` plus the winding."""
+        n, w, k = self.harmonics, self.omega, self.winding
+        cn = x[n + 1:] - 1j * x[1:n + 1]
+        g = self._synth(np.stack((cn, 1j * self._kn * cn, -self._kn**2 * cn)))
+        g[0] += k * self.s + x[0]
+        g[1] += w * k
+        return g
+
+    def _dmotion(self, v):
+        """``P v`` (3, M): the motion's linear part."""
+        n = self.harmonics
+        cn = v[n + 1:] - 1j * v[1:n + 1]
+        g = self._synth(np.stack((cn, 1j * self._kn * cn, -self._kn**2 * cn)))
+        g[0] += v[0]
+        return g
+
+    def _motion_t(self, w3):
+        """``P^T (w_0, w_1, w_2)``."""
+        n = self.harmonics
+        wf = np.conj(_rfft(w3)[:, 1:n + 1])
+        u = wf[0] + 1j * self._kn * wf[1] - self._kn**2 * wf[2]
+        out = np.empty(2 * n + 1)
+        out[0] = float(np.sum(w3[0]))
+        out[1:n + 1] = u.imag
+        out[n + 1:] = u.real
+        return out
+
+    def _pivot(self, xk):
+        """``Q y = (p_x'', p_z'', beta')`` (3, M) from the harmonics ``xk`` (Nh, 3)."""
+        dp, hp = self.case.pivot
+        k2 = -self._kh**2
+        c = np.stack((k2 * (xk[:, 0] + hp * xk[:, 2]), k2 * (xk[:, 1] - dp * xk[:, 2]),
+                      1j * self._kh * xk[:, 2]))
+        return self._synth(c)
+
+    def _pivot_t(self, w3):
+        """``Q^T (w_x, w_z, w_b)``: (Nh, 3) complex (``d/dRe + i d/dIm``)."""
+        dp, hp = self.case.pivot
+        nh = self._kh.size
+        wf = _rfft(w3)[:, 1:nh + 1]
+        k2 = -self._kh**2
+        out = np.empty((nh, 3), dtype=complex)
+        out[:, 0] = k2 * wf[0]
+        out[:, 1] = k2 * wf[1]
+        out[:, 2] = k2 * (hp * wf[0] - dp * wf[1]) - 1j * self._kh * wf[2]
+        return out
+
+    def _project(self, r):
+        """``Pi r``: ``(static means, (2/M) rfft(r)_k)`` of the reaction ``r`` (3, M)."""
+        m, nh = self.points, self._kh.size
+        y0 = np.array([float(np.mean(r[d])) for d in self.static])
+        return y0, (2.0 / m) * _rfft(r)[:, 1:nh + 1].T
+
+    def _lift(self, y0, lk):
+        """``Pi^T lambda`` (3, M)."""
+        m = self.points
+        mu = self._synth((2.0 / m) * lk.T)
+        for i, d in enumerate(self.static):
+            mu[d] += y0[i] / m
+        return mu
+
+    # -- the hull matrix S and its transpose, on flat real vectors ----------------------------
+    def _pitch_project(self, h):
+        """``Pi_beta h``: the projection of a pitch moment ``h`` (M,) alone (one FFT)."""
+        m, nh = self.points, self._kh.size
+        y0 = np.zeros(len(self.static))
+        if self._pitch_static >= 0:
+            y0[self._pitch_static] = float(np.mean(h))
+        xk = np.zeros((nh, 3), dtype=complex)
+        xk[:, 2] = (2.0 / m) * _rfft(h)[1:nh + 1]
+        return y0, xk
+
+    def _apply_s(self, y, sn, co, transpose=False):
+        """``S y`` (``S^T y``): ``Z`` block by block, and the coupling's pitch rows by
+        three FFTs (the pivot's acceleration, and the pitch moment's projection; transposed,
+        the pitch row lifted to the grid, and the acceleration's transpose)."""
+        y0, xk = self._split(y)
+        ml = self.case.m * self.case.l
+        dp, hp = self.case.pivot
+        m, nh = self.points, self._kh.size
+        k2 = -self._kh**2
+        if not transpose:
+            z0 = self._z0 @ y0
+            zx = np.einsum("kij,kj->ki", self._zk, xk)
+            q = self._synth(np.stack((k2 * (xk[:, 0] + hp * xk[:, 2]),
+                                      k2 * (xk[:, 1] - dp * xk[:, 2]))))
+            c0, cx = self._pitch_project(ml * (co * q[0] - sn * q[1]))
+            return self._flat(z0 + c0, zx + cx)
+        z0 = self._z0.T @ y0
+        zx = np.einsum("kji,kj->ki", self._zk.conj(), xk)
+        mu2 = self._synth((2.0 / m) * xk[:, 2])
+        if self._pitch_static >= 0:
+            mu2 += y0[self._pitch_static] / m
+        wf = _rfft(np.stack((ml * co * mu2, -ml * sn * mu2)))[:, 1:nh + 1]
+        zx[:, 0] += k2 * wf[0]
+        zx[:, 1] += k2 * wf[1]
+        zx[:, 2] += k2 * (hp * wf[0] - dp * wf[1])
+        return self._flat(z0, zx)
+
+    def _apply_zinv(self, y, transpose=False):
+        y0, xk = self._split(y)
+        if transpose:
+            return self._flat(self._z0inv.T @ y0,
+                              np.einsum("kji,kj->ki", self._zkinv.conj(), xk))
+        return self._flat(self._z0inv @ y0, np.einsum("kij,kj->ki", self._zkinv, xk))
+
+    def _solve_s(self, b, sn, co, transpose=False, rtol=STATE_RTOL, x0=None):
+        """``S^{-1} b`` (``S^{-T} b``) by GMRES preconditioned by ``Z^{-1}``."""
+        n = b.size
+        if not self.coupled:
+            return self._apply_zinv(b, transpose)
+        a = LinearOperator((n, n), matvec=lambda v: self._apply_s(v, sn, co, transpose),
+                           dtype=float)
+        pre = LinearOperator((n, n), matvec=lambda v: self._apply_zinv(v, transpose),
+                             dtype=float)
+        if x0 is None:
+            x0 = self._apply_zinv(b, transpose)
+        count = [0]
+
+        def cb(_):
+            count[0] += 1
+
+        y, info = gmres(a, b, x0=x0, rtol=rtol, atol=0.0, restart=RESTART,
+                        maxiter=MAX_RESTARTS, M=pre, callback=cb,
+                        callback_type="pr_norm")
+        self.gmres_iterations += count[0]
+        if info != 0:  # not reached: the residual it has is checked by the caller's scale
+            res = np.linalg.norm(self._apply_s(y, sn, co, transpose) - b)
+            if not res <= 1e3 * rtol * max(float(np.linalg.norm(b)), 1e-300):
+                y = np.full(n, np.nan)
+        return y
+
+    # -- the state ------------------------------------------------------------------------------
+    def _at(self, x) -> tuple:
+        x = np.asarray(x, dtype=float)
+        key = x.tobytes()
+        if self._last is not None and self._last[0] == key:
+            return self._last[1]
+        cs = self.case
+        ml = cs.m * cs.l
+        dp, hp = cs.pivot
+        f, f1, f2 = self._motion(x)
+        r, _, sn, co = reaction(f, f1, f2, ml, cs.I, cs.g, dp, hp)
+        if self.coupled:
+            b0, bk = self._project(r)
+            b = self._flat(b0, self._fa + bk)
+            y = self._solve_s(b, sn, co, x0=self._y_guess)
+            if np.all(np.isfinite(y)):
+                self._y_guess = y
+        else:
+            y = self.y_free
+        _, xk = self._split(y)
+        qx, qz, b1 = self._pivot(xk)
+        tau, v, p = torque(sn, co, f1, f2, qx, qz, b1, cs.I, cs.c, ml, cs.g)
+        if not np.all(np.isfinite(y)):
+            p = math.nan
+        elif self.coupled and not self._balance(y, p, v)[2] <= BALANCE_TOL:
+            # the grid's products alias (a motion far outside the answer's band: the hull's
+            # response then grows without bound, its power an artefact): no candidate
+            p = math.nan
+        st = {"phi": f, "phi1": f1, "phi2": f2, "qx": qx, "qz": qz, "b1": b1, "y": y,
+              "tau": tau, "relative_speed": v, "power": p, "sin_phi": sn, "cos_phi": co}
+        self._last = (key, (st, None))
+        return self._last[1]
+
+    def _balance(self, y, p, v):
+        """:meth:`balance`'s ``(P, hull side, residual)`` from the state's ``y``, power and
+        relative speed (vectorized over the harmonics)."""
+        cs = self.case
+        _, xk = self._split(y)
+        u = 1j * self._kh[:, None] * xk
+        b = 0.5 * (cs.B[1:] + np.swapaxes(cs.B[1:], 1, 2))
+        absorbed = 0.5 * float(np.sum(np.real(np.conj(self._fa) * u)))
+        radiated = 0.5 * float(np.real(np.einsum("ki,kij,kj->", np.conj(u), b, u)))
+        lhs = p + cs.c * float(np.mean(v**2))
+        hull = absorbed - radiated
+        scale = max(abs(absorbed), abs(radiated), abs(lhs), 1e-300)
+        return p, hull, abs(lhs - hull) / scale
+
+    def balance(self, x) -> tuple[float, float, float]:
+        """:meth:`~parapend.hydro.hull.HullProblem.balance`, vectorized."""
+        st = self.grid_state(x)
+        return self._balance(st["y"], st["power"], st["relative_speed"])
+
+    def evaluate(self, x):
+        """``(P, gradient, Hessian operator)`` of the reduced power in ``x``: the
+        Lagrangian's pointwise derivatives (the adjoint ``S^T lambda = d<f>/dy`` by GMRES),
+        the gradient ``P^T d_1``, and :class:`KrylovHessian`."""
+        st, _ = self._at(x)
+        cs = self.case
+        ml = cs.m * cs.l
+        dp, hp = cs.pivot
+        terms = self._objective(st)
+        full = [self._full(t) for t in terms[1:]]
+        sn, co = st["sin_phi"], st["cos_phi"]
+        d1, d2 = objective_weights(sn, co, st["qx"], st["qz"], *full, ml, cs.I, cs.c, cs.g)
+        sens = None
+        if self.coupled:
+            g0 = np.zeros(len(self.static))
+            gy = self._flat(g0, self._pivot_t(d1[3:]))
+            lam = self._solve_s(gy, sn, co, transpose=True)
+            mu = self._lift(*self._split(lam))
+            c1, c2, sens = constraint_weights(sn, co, st["phi1"], st["phi2"], st["qx"],
+                                              st["qz"], mu, ml, cs.I, cs.g, dp, hp)
+            d1 = d1 + c1
+            d2 = d2 + c2
+        grad = self._motion_t(d1[:3])
+        val = st["power"] if self.lossless else float(np.mean(terms[0]))
+        return val, grad, KrylovHessian(self, st, d2, sens)
+
+    # -- the sensitivities ----------------------------------------------------------------------
+    def sensitivity(self, v, st, sens):
+        """``T v = S^{-1} Pi (rho_X P v)`` (flat y)."""
+        dx = self._dmotion(v)
+        drho = np.stack([sum(sens[3 * d + i] * dx[i] for i in range(3)) for d in range(3)])
+        b0, bk = self._project(drho)
+        return self._solve_s(self._flat(b0, bk), st["sin_phi"], st["cos_phi"],
+                             rtol=PRODUCT_RTOL)
+
+    def sensitivity_t(self, u, st, sens):
+        """``T^T u = P^T rho_X^T Pi^T S^{-T} u``."""
+        lam = self._solve_s(u, st["sin_phi"], st["cos_phi"], transpose=True,
+                            rtol=PRODUCT_RTOL)
+        mu = self._lift(*self._split(lam))
+        wx = np.stack([sum(sens[3 * d + i] * mu[d] for d in range(3)) for i in range(3)])
+        return self._motion_t(wx)
+
+
+#: the rows of the 21 pointwise pairs (``_hull_kernel._pair``) as a symmetric 6 x 6 table
+_PAIR = np.array([[u * 6 - (u * (u - 1)) // 2 + (w - u) if w >= u else
+                   w * 6 - (w * (w - 1)) // 2 + (u - w) for w in range(6)] for u in range(6)])
+
+
+class KrylovHessian(HessianOperator):
+    """The reduced Hessian of :class:`KrylovHullProblem` at one point as an operator:
+    ``matvec(v) = H v`` (two GMRES solves, a few FFTs), ``diagonal`` an estimate of
+    ``-H``'s diagonal for the conjugate gradients' preconditioner: ``L_xx``'s exact diagonal
+    (from the FFTs of its weights at frequencies 0 and 2n) plus, coupled, the same of the
+    hull's radiation of the pendulum's reaction with the weights replaced by their means
+    (the frequency-diagonal part of ``T^T L_yy T``)."""
+
+    mostly_positive = False
+
+    def __init__(self, problem: KrylovHullProblem, st, d2, sens):
+        self.problem = problem
+        self.st = st
+        self.d2 = d2
+        self.sens = sens
+        self._d6 = None
+        self.diagonal = -self._diag_xx()
+
+    def _diag_xx(self):
+        pr = self.problem
+        n, kn = pr.harmonics, pr._kn
+        rows = [_PAIR[u, w] for u, w in ((0, 0), (0, 1), (0, 2), (1, 1), (1, 2), (2, 2))]
+        wf = _rfft(self.d2[rows])
+        c0 = wf[:, 0].real[:, None]
+        two = wf[:, 2:2 * n + 1:2]
+        c2, s2 = two.real, -two.imag
+        ss, cc, sc = 0.5 * (c0 - c2), 0.5 * (c0 + c2), 0.5 * s2
+        w00, w01, w02, w11, w12, w22 = range(6)
+        da = (ss[w00] + 2 * kn * sc[w01] - 2 * kn**2 * ss[w02] + kn**2 * cc[w11]
+              - 2 * kn**3 * sc[w12] + kn**4 * ss[w22])
+        db = (cc[w00] - 2 * kn * sc[w01] - 2 * kn**2 * cc[w02] + kn**2 * ss[w11]
+              + 2 * kn**3 * sc[w12] + kn**4 * cc[w22])
+        return np.concatenate(([c0[w00, 0]], da, db))
+
+    def matvec(self, v):
+        """``H v``."""
+        pr = self.problem
+        pr.products += 1
+        v = np.asarray(v, dtype=float).ravel()
+        dx = pr._dmotion(v)
+        z = np.zeros((6, pr.points))
+        z[:3] = dx
+        if pr.coupled:
+            ty = pr.sensitivity(v, self.st, self.sens)
+            z[3:] = pr._pivot(pr._split(ty)[1])
+        if self._d6 is None:  # the pointwise 6 x 6 matrices, once per point
+            self._d6 = np.ascontiguousarray(self.d2[_PAIR])
+        wz = np.einsum("uwm,wm->um", self._d6, z)
+        out = pr._motion_t(wz[:3])
+        if pr.coupled:
+            u = pr._flat(np.zeros(len(pr.static)), pr._pivot_t(wz[3:]))
+            out = out + pr.sensitivity_t(u, self.st, self.sens)
+        return out
+
+    def precondition(self, r):  # the diagonal only (``mostly_positive`` is False)
+        return r / np.abs(self.diagonal)
+
+
+#: each coarser discretization of :func:`continued_search` has this many times fewer
+#: harmonics
+COARSENING = 2
+#: ... and this many times the points :func:`.hull.hull_points` gives: few harmonics per
+#: turn make a rough motion whose products with the hull's the usual grid aliases (the
+#: 50-wave barge's coarsest search ended on aliased maxima only)
+COARSE_POINTS = 2
+
+
+def coarsened(case: HullCase, harmonics: int) -> HullCase:
+    """``case`` with ``harmonics`` harmonics of phi and ``harmonics + max(1, K)`` of the hull
+    (the coefficients at the first ones kept, the wave cut above them, ``COARSE_POINTS``
+    times the grid that :func:`.hull.hull_points` gives the rest)."""
+    nh = min(case.hull_harmonics, harmonics + max(1, case.winding))
+    amps = np.asarray(case.amplitudes)[:nh]
+    return dataclasses.replace(
+        case, harmonics=harmonics, hull_harmonics=nh, amplitudes=amps,
+        points=COARSE_POINTS * hull_points(harmonics, nh, case.winding, amps.size),
+        A=np.asarray(case.A)[:nh + 1], B=np.asarray(case.B)[:nh + 1],
+        F=np.asarray(case.F)[:nh + 1])
+
+
+def continued_search(make, *, refine: bool = True):
+    """:func:`.hull.hull_search` of a long record by continuation in the harmonics: the
+    search over the starts on the record with ``COARSENING`` times fewer harmonics (itself
+    continued while it has at least ``LONG_RECORD_HARMONICS``), then its best coupled and
+    one-way maxima padded to these harmonics and climbed by Newton (matrix-free), then the
+    refinement as for any answer. The evidence (starts, distinct maxima) is the coarsest
+    search's; the iterations are all the levels'."""
+    case = make(1)
+    coarse = coarsened(case, max(2, case.harmonics // COARSENING))
+    sol = hull_search(lambda scale: coarse, refine=False)
+    n = case.harmonics
+    one = newton_maximize(ideal_problem(case, coupled=False), _pad(sol.one_way_x, n),
+                          "one-way:continued", gtol=GTOL)
+    pr = ideal_problem(case)
+    r = newton_maximize(pr, _pad(sol.x, n), f"{sol.found_by}:continued", gtol=GTOL)
+    status, ok = r.status, r.status == "converged"
+    if ok and aliased(pr, r.x):
+        status, ok = "aliased", False
+    # the coarser answer is a start: what its own search said goes with it into found_by
+    how = "" if sol.success else f"; the coarser search: {sol.status}"
+    out = HullSolution(case=case, x=r.x, power=float(r.power),
+                       one_way_power=float(one.power), one_way_x=one.x, status=status,
+                       success=ok, found_by=f"{sol.found_by} (continued from "
+                       f"{coarse.harmonics} harmonics{how})",
+                       distinct_maxima=sol.distinct_maxima,
+                       maxima_powers=sol.maxima_powers, runs=sol.runs + 2,
+                       iterations=sol.iterations + r.iterations + one.iterations,
+                       energy_balance_residual=float(pr.balance(r.x)[2]))
+    if refine and ok:
+        out = _refine(out, make, r.x)
+    return out
+
+
+#: Lanczos (ARPACK) for the reduced Hessian's largest eigenvalue: Lanczos vectors, restarts
+#: at most, and the relative tolerance (the check is its sign)
+LANCZOS_VECTORS, LANCZOS_RESTARTS, LANCZOS_TOL = 20, 10, 1e-2
+
+
+def optimality(problem: HullProblem, x) -> tuple[float, float | None]:
+    """First- and second-order optimality at ``x``: the gradient's largest entry (W/rad),
+    and the reduced Hessian's largest eigenvalue (W/rad^2; negative at a strict maximum):
+    dense, by LAPACK; an operator, by Lanczos on its products
+    (:func:`scipy.sparse.linalg.eigsh`, at most ``LANCZOS_VECTORS x LANCZOS_RESTARTS``
+    products; None when it has not converged to ``LANCZOS_TOL``)."""
+    from scipy.sparse.linalg import ArpackNoConvergence, eigsh
+
+    _, g, h = problem.evaluate(np.asarray(x, dtype=float))
+    gn = float(np.max(np.abs(g)))
+    if isinstance(h, np.ndarray):
+        return gn, float(np.linalg.eigvalsh(0.5 * (h + h.T))[-1])
+    n = g.size
+    op = LinearOperator((n, n), matvec=lambda v: h.matvec(np.ravel(v)), dtype=float)
+    try:
+        lam = eigsh(op, k=1, which="LA", ncv=min(n, LANCZOS_VECTORS), tol=LANCZOS_TOL,
+                    maxiter=LANCZOS_RESTARTS, v0=np.ones(n), return_eigenvectors=False)
+    except ArpackNoConvergence:
+        return gn, None
+    return gn, float(lam[0])
+
+
+_hull.MATRIX_FREE.update(problem=KrylovHullProblem, search=continued_search)

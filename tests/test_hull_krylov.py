@@ -1,0 +1,282 @@
+"""The hull's matrix-free solver (parapend.hydro._hull_krylov) against the dense one
+(parapend.hydro.hull.HullProblem, a second implementation of the same discretization: its
+matrices formed, S inverted by Woodbury's identity): the same state, power, gradient and
+Hessian, the same optima; and a record's optimum the same number from the command line, the
+API and a power-matrix bin."""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+import math
+
+import numpy as np
+import pytest
+from hull_synthetic import case
+
+import parapend
+from parapend.cli import main
+from parapend.hydro import hull as hull_mod
+from parapend.hydro._hull_krylov import KrylovHullProblem, coarsened
+from parapend.hydro.hull import GTOL, HullProblem, hull_search, ideal_problem
+from parapend.optimal.fourier import newton_maximize
+
+
+def _x(n, winding, seed):
+    x = 0.3 * np.random.default_rng(seed).standard_normal(2 * n + 1)
+    x[0] += math.pi if winding == 0 else 0.0
+    return x
+
+
+def _record(harmonics=24, winding=2, waves=3, seed=1):
+    """The synthetic hull in a record-like wave: ``waves`` harmonics of random phase."""
+    rng = np.random.default_rng(seed)
+    amps = 0.3 * np.exp(2j * math.pi * rng.random(waves)) / np.arange(1, waves + 1)
+    return case(winding=winding, harmonics=harmonics, omega=2 * math.pi / 12,
+                amplitudes=amps)
+
+
+@pytest.mark.parametrize("winding", [0, 1, 2])
+@pytest.mark.parametrize("coupled", [False, True])
+def test_state_power_gradient_hessian_are_the_dense_ones(winding, coupled):
+    """At a random motion: the hull's unknowns and the power to 1e-11 (rounding of the
+    torque's cancellation in ``<tau v>``), the gradient to 1e-10, the Hessian's columns
+    (operator products; the sensitivities solved to 1e-8) to 1e-6, of their size."""
+    cs = case(winding=winding, harmonics=8)
+    d, k = HullProblem(cs, coupled=coupled), KrylovHullProblem(cs, coupled=coupled)
+    x = _x(cs.harmonics, winding, 7 + winding)
+    pd, gd, hd = d.evaluate(x)
+    pk, gk, op = k.evaluate(x)
+    yd, yk = d.solve_hull(x), k.solve_hull(x)
+    assert np.max(np.abs(yk - yd)) <= 1e-11 * np.max(np.abs(yd))
+    assert pk == pytest.approx(pd, rel=1e-11)
+    assert np.max(np.abs(gk - gd)) <= 1e-10 * np.max(np.abs(gd))
+    hk = np.column_stack([op.matvec(e) for e in np.eye(x.size)])
+    assert np.max(np.abs(hk - hd)) <= 1e-6 * np.max(np.abs(hd))
+    np.testing.assert_allclose(k.harmonics_of(yk), d.harmonics_of(yd), rtol=0,
+                               atol=1e-11 * np.max(np.abs(yd)))
+    if not coupled:  # L_xx alone: the preconditioner's diagonal is -H's exactly
+        np.testing.assert_allclose(op.diagonal, -np.diag(hd), rtol=0,
+                                   atol=1e-10 * np.max(np.abs(hd)))
+
+
+def test_energy_balance_is_the_dense_check():
+    cs = _record()
+    x = _x(cs.harmonics, cs.winding, 3) * 0.1
+    d, k = HullProblem(cs).balance(x), KrylovHullProblem(cs).balance(x)
+    assert d[0] == pytest.approx(k[0], rel=1e-11)
+    assert d[1] == pytest.approx(k[1], rel=1e-11)
+    assert d[2] == pytest.approx(k[2], rel=1e-6, abs=1e-13)
+
+
+@pytest.mark.parametrize("winding", [0, 2])
+def test_newton_reaches_the_dense_maximum(winding):
+    """Newton's operator path (truncated CG on the matrix-free Hessian) from the dense
+    optimum's neighbourhood climbs to the dense optimum: power to 1e-10, motion to 1e-6."""
+    cs = _record(winding=winding)
+    dense = HullProblem(cs)
+    starts = hull_mod._starts(cs.harmonics, winding)
+    best = max((newton_maximize(dense, x0, n, gtol=GTOL) for n, x0 in starts[:4]),
+               key=lambda r: r.power if r.status == "converged" else -math.inf)
+    assert best.status == "converged"
+    x0 = best.x + 1e-3 * np.random.default_rng(0).standard_normal(best.x.size)
+    r = newton_maximize(KrylovHullProblem(cs), x0, "near", gtol=GTOL)
+    assert r.status == "converged"
+    assert r.power == pytest.approx(best.power, rel=1e-10)
+    assert np.max(np.abs(r.x - best.x)) <= 1e-6
+
+
+def test_the_search_answers_are_maxima_of_both_solvers(monkeypatch):
+    """The whole search (every start, one-way and coupled, no refinement) on a record, once
+    dense and once with every problem matrix-free: each answer is a maximum of the other
+    solver too (its Newton, started there, stays at the same power to 1e-10), the best of
+    the two is the better of both searches' maxima, and both balance the energy. (The
+    two searches can end on different maxima: their steps differ away from one.)"""
+    cs = _record(harmonics=24, winding=2)
+    dense = hull_search(lambda s: cs, refine=False)
+    monkeypatch.setattr(hull_mod, "KRYLOV_HARMONICS", 0)
+    assert isinstance(ideal_problem(cs), KrylovHullProblem)
+    krylov = hull_search(lambda s: cs, refine=False)
+    assert dense.success and krylov.success
+    for sol, other in ((dense, KrylovHullProblem(cs)), (krylov, HullProblem(cs))):
+        r = newton_maximize(other, sol.x, "again", gtol=GTOL)
+        assert r.status == "converged"
+        assert r.power == pytest.approx(sol.power, rel=1e-10)
+        assert sol.energy_balance_residual <= 1e-9
+    assert max(krylov.maxima_powers) == pytest.approx(krylov.power, rel=1e-12)
+    assert krylov.one_way_power == pytest.approx(dense.one_way_power, rel=1e-8)
+
+
+def test_continued_search_reaches_the_direct_one(monkeypatch):
+    """The continuation (the starts on half the harmonics, then Newton from the padded
+    answer) ends at the maximum the direct search finds on the full harmonics."""
+    cs = _record(harmonics=32, winding=2)
+    direct = hull_search(lambda s: cs, refine=False)
+    monkeypatch.setattr(hull_mod, "LONG_RECORD_HARMONICS", 30)
+    cont = hull_search(lambda s: cs, refine=False)
+    assert "continued from 16 harmonics" in cont.found_by
+    assert cont.success and cont.case.harmonics == 32
+    assert cont.power == pytest.approx(direct.power, rel=1e-8)
+
+
+def test_continuation_stops_on_phis_harmonics(monkeypatch):
+    """A rotation of more turns than the continuation's threshold (the hull's harmonics
+    N + K never fall below it) is continued down to fewer harmonics of phi than the
+    threshold, then climbs back: 24 from 12 from 6."""
+    cs = _record(harmonics=24, winding=12)
+    monkeypatch.setattr(hull_mod, "LONG_RECORD_HARMONICS", 10)
+    sol = hull_search(lambda s: cs, refine=False)
+    assert sol.case.harmonics == 24
+    assert "continued from 12 harmonics" in sol.found_by
+    assert "continued from 6 harmonics" in sol.found_by
+    assert math.isfinite(sol.power)
+
+
+def test_coarsened_case_is_the_case_with_fewer_harmonics():
+    """:func:`coarsened` keeps the data at the harmonics it keeps: its hull matrix blocks are
+    the full case's first ones."""
+    cs = _record(harmonics=24, winding=2)
+    co = coarsened(cs, 12)
+    assert (co.harmonics, co.hull_harmonics) == (12, 14)
+    for kk in range(1, 15):
+        np.testing.assert_array_equal(co.impedance(kk), cs.impedance(kk))
+    np.testing.assert_array_equal(co.wave_force(), cs.wave_force()[:15])
+    assert co.points == 2 * hull_mod.hull_points(12, 14, 2, 3)
+
+
+def test_aliased_motion_has_no_power():
+    """A motion whose coupled state breaks the energy balance (the grid's products alias)
+    is no candidate: its power is NaN, so a line search steps back from it."""
+    cs = case(winding=1, harmonics=8)
+    k = KrylovHullProblem(cs)
+    x = _x(cs.harmonics, 1, 1) * 40.0
+    _, _, resid = HullProblem(cs).balance(x)
+    assert resid > 1e-4
+    assert math.isnan(k.power(x))
+
+
+@pytest.fixture(scope="module")
+def dataset(tmp_path_factory):
+    from hull_timedomain import synthetic_hull_netcdf
+
+    return synthetic_hull_netcdf(tmp_path_factory.mktemp("hull") / "hull.nc")
+
+
+PEND = {"mass": 4000.0, "length": 1.0, "inertia": 5000.0, "damping_coefficient": 50.0,
+        "pivot_height": 1.5, "pivot_offset": 1.0}
+
+
+def _same_record_three_ways(hydro_opts, capsys, waves, tp, extra=()):
+    """The record's optimum from the API, the command line and a power-matrix bin."""
+    from parapend.performance import power_matrix
+    from parapend.performance.resource import repeat_period
+
+    api = parapend.buoy(dofs="surge,heave,pitch", hs=1.0, tp=tp,
+                        repeat_period=repeat_period(waves, tp), seed=0, **hydro_opts)
+    assert api.success
+    flags = [x for k, v in hydro_opts.items() for x in (f"--{k.replace('_', '-')}", str(v))]
+    assert main(["buoy", "--dofs", "surge,heave,pitch", "--hs", "1", "--tp", repr(tp),
+                 "--repeat-period", repr(repeat_period(waves, tp)), "--seed", "0",
+                 "--json", *flags, *extra]) == 0
+    cli = json.loads(capsys.readouterr().out)
+    # the smallest matrix (two bins a side): its first bin is the record
+    ds, _, _, _ = power_matrix(device="buoy", dofs="surge,heave,pitch", hs="1,1.01",
+                               tp=f"{tp!r},{tp + 0.01!r}",
+                               waves=waves, seed=0, realizations=1, workers=1, time_limit=3600,
+                               **hydro_opts)
+    return api, cli["power_w"], float(ds["power"].values[0, 0, 0])
+
+
+def test_record_optimum_is_one_number_from_cli_api_and_power_matrix(dataset, capsys):
+    """A record (2 peak periods, the synthetic hull; its search dense, its refinement
+    matrix-free) is the same number from ``parapend.buoy``, ``parapend buoy`` and a
+    ``power-matrix`` bin of the same record and seed, to 1e-9."""
+    api, cli, pm = _same_record_three_ways({"hydro": dataset, **PEND}, capsys, 2.0, 6.0)
+    assert api.harmonics >= hull_mod.KRYLOV_HARMONICS  # its refinement matrix-free
+    assert cli == pytest.approx(api.power_w, rel=1e-9)
+    assert pm == pytest.approx(api.power_w, rel=1e-9)
+
+
+@pytest.mark.slow
+def test_default_sea_is_one_number_from_cli_api_and_power_matrix(capsys):
+    """The embedded barge's default sea (Hs 1 m, Tp 6 s, 4 peak periods, seed 0): the API,
+    the command line and a power-matrix bin agree to 1e-9."""
+    api, cli, pm = _same_record_three_ways({}, capsys, 4.0, 6.0)
+    assert cli == pytest.approx(api.power_w, rel=1e-9)
+    assert pm == pytest.approx(api.power_w, rel=1e-9)
+
+
+@pytest.mark.slow
+def test_barge_ten_wave_record_matrix_free_is_the_dense_answer():
+    """The embedded barge's 10-wave record (144 harmonics): Newton on the matrix-free
+    problem from near the dense solver's maximum reaches it to 1e-8 (same harmonics)."""
+    from parapend.hydro.api import hull_problem
+    from parapend.hydro.coupled import Wave
+    from parapend.hydro.hull import make_case, waves_in
+
+    p = hull_problem(dofs="surge,heave,pitch")
+    wave = Wave.from_spectrum(hs=1.5, tp=6.0, repeat_period=60.0, seed=0)
+    cs = make_case(p["hull"], p["pendulum"], wave, winding=waves_in(wave), pivot=p["pivot"])
+    one = KrylovHullProblem(cs, coupled=False)
+    x1 = newton_maximize(one, hull_mod._starts(cs.harmonics, cs.winding)[0][1], "s",
+                         gtol=GTOL).x
+    k = newton_maximize(KrylovHullProblem(cs), x1, "k", gtol=GTOL)
+    assert k.status == "converged"
+    d = newton_maximize(HullProblem(cs), k.x + 1e-4 * np.sin(np.arange(k.x.size)), "d",
+                        gtol=GTOL)
+    assert d.status == "converged"
+    assert k.power == pytest.approx(d.power, rel=1e-8)
+    assert dataclasses.is_dataclass(cs)
+
+
+def test_optimality_checks_agree_between_solvers():
+    """At a maximum: the gradient vanishes (below GTOL m g l w) and the reduced Hessian's
+    largest eigenvalue is negative, the same by Lanczos on the operator as by LAPACK on the
+    dense matrix (to Lanczos's tolerance)."""
+    from parapend.hydro._hull_krylov import LANCZOS_TOL, optimality
+
+    cs = _record(winding=0)
+    d = HullProblem(cs)
+    r = max((newton_maximize(d, x0, n, gtol=GTOL) for n, x0 in
+             hull_mod._starts(cs.harmonics, 0)[:4]), key=lambda r: r.power)
+    gd, td = optimality(d, r.x)
+    gk, tk = optimality(KrylovHullProblem(cs), r.x)
+    scale = float(d.w[0])
+    assert gd <= GTOL * scale and gk <= 10 * GTOL * scale
+    assert td < 0 and tk is not None
+    assert tk == pytest.approx(td, rel=10 * LANCZOS_TOL)
+
+
+def test_each_mode_carries_its_optimality(dataset):
+    """A hull answer's modes carry the gradient's largest entry and the Hessian's largest
+    eigenvalue at their maxima (negative: strict maxima); the gradient below Newton's
+    stopping rule at rounding (1e-7 of m g l w)."""
+    r = parapend.buoy(dofs="surge,heave,pitch", hydro=dataset, wave_height=1.0,
+                      wave_period=2 * math.pi / 1.2, **PEND)
+    for m in r.modes[:-1]:
+        assert m["gradient_max_w_per_rad"] <= 1e-7 * PEND["mass"] * 9.81 * 1.2
+        assert m["hessian_largest_eigenvalue_w_per_rad2"] < 0
+
+
+def test_records_past_what_fits_are_refused_in_one_line(dataset):
+    """An ideal take-off's record is refused past ``HULL_MAX_RECORD_HARMONICS`` (about 300
+    waves), a take-off's past the dense ``HULL_MAX_HARMONICS`` (about 10), before any solve;
+    a 20-wave ideal record is no longer refused."""
+    from parapend import limits
+    from parapend.errors import ParameterError
+    from parapend.hydro.api import _check_hull_size, hull_problem
+    from parapend.hydro.coupled import Wave
+    from parapend.hydro.hull import HullPTO, waves_in
+
+    with pytest.raises(ParameterError, match=r"^repeat-period: .*matrix-free") as err:
+        parapend.buoy(dofs="surge,heave,pitch", hydro=dataset, hs=1.0, tp=6.0,
+                      repeat_period=6.0 * 320, **PEND)
+    assert "\n" not in str(err.value)
+    wave = Wave.from_spectrum(hs=1.0, tp=6.0, repeat_period=6.0 * 20, seed=0)
+    k = waves_in(wave)
+    _check_hull_size(wave, (k, 0), None)  # no refusal
+    assert 12 * k > limits.HULL_MAX_HARMONICS
+    with pytest.raises(ParameterError, match=r"^repeat-period: .*with a power take-off"):
+        _check_hull_size(wave, (k, 0), None, HullPTO(torque_limit=1e4))
+    p = hull_problem(dofs="surge,heave,pitch", hydro=dataset, **PEND)
+    assert p.get("max_harmonics") is None
