@@ -193,29 +193,36 @@ def test_the_take_off_reaches_the_hull(dataset):
     assert spec.variables[3] == "electrical_power"
 
 
-def test_the_longest_record_is_the_hulls_limit(dataset):
-    """50 waves are refused naming --waves and the largest that fits; that largest fits the
-    hull's own size check (12 harmonics per wave, at most 128), 0.01 more does not. The
-    hull's default record is its declared one (``defaults.HULL["matrix_waves"]``)."""
+@pytest.mark.parametrize("pto, waves, cap", [
+    ({}, 400, "HULL_MAX_RECORD_HARMONICS"),  # an ideal take-off: matrix-free records
+    ({"efficiency": 0.9}, 50, "HULL_MAX_HARMONICS"),  # a lossy one: dense
+])
+def test_the_longest_record_is_the_hulls_limit(dataset, pto, waves, cap):
+    """Too long a record is refused naming --waves and the largest that fits; that largest
+    fits the hull's own size check (12 harmonics per wave, at most the limit of `buoy` alone
+    for that take-off), 0.01 more does not. The hull's default record is its declared one
+    (``defaults.HULL["matrix_waves"]``)."""
     from parapend import limits
     from parapend.defaults import HULL as HULL_DEFAULTS
     from parapend.hydro.hull import HARMONICS_PER_TURN, waves_in
     from parapend.performance.buoy_device import wave_of
 
     with pytest.raises(ParameterError, match=r"^waves: .*at most ([0-9.]+) peak periods "
-                                             r"fit, got 50$") as err:
-        matrix_spec(hs="1,2", tp="5,6", realizations=1, hydro=dataset, waves=50, **HULL)
+                                             rf"fit, got {waves}$") as err:
+        matrix_spec(hs="1,2", tp="5,6", realizations=1, hydro=dataset, waves=waves, **pto,
+                    **HULL)
     default = matrix_spec(hs="1,2", tp="5,6", realizations=1, hydro=dataset, **HULL)
     assert default.waves == HULL_DEFAULTS["matrix_waves"]
     most = float(str(err.value).split("at most ")[-1].split(" peak")[0])
-    spec = matrix_spec(**{**BINS, "waves": most}, realizations=1, hydro=dataset, **HULL)
+    spec = matrix_spec(**{**BINS, "waves": most}, realizations=1, hydro=dataset, **pto,
+                       **HULL)
 
     def size(waves):
         import dataclasses
 
         s = dataclasses.replace(spec, waves=waves)
         return max(HARMONICS_PER_TURN * waves_in(wave_of(s, 0, j, 0)[0]) for j in range(2))
-    assert size(most) <= limits.HULL_MAX_HARMONICS < size(most + 0.01)
+    assert size(most) <= getattr(limits, cap) < size(most + 0.01)
 
 
 @pytest.mark.parametrize("kw, match", [
@@ -257,7 +264,7 @@ def test_the_command_line_refuses_in_one_line(dataset, capsys):
     err = capsys.readouterr().err.strip()
     assert err.count("\n") == 0 and "dofs" in err and "Traceback" not in err
     assert main(["power-matrix", "--device", "buoy", "--dofs", "surge,heave,pitch", "--hydro",
-                 dataset, "--hs", "1,2", "--tp", "5,6", "--waves", "50"]) == 2
+                 dataset, "--hs", "1,2", "--tp", "5,6", "--waves", "400"]) == 2
     err = capsys.readouterr().err.strip()
     assert err.count("\n") == 0 and "waves" in err
 

@@ -74,9 +74,10 @@ HULL = {"wave_height": 1.0, "wave_period": 6.0, "hs": 1.0, "tp": 6.0, "repeat_pe
         "pivot_height": 0.5, "pivot_offset": 0.0, "radius": 2.0, "draft": 1.0,
         # the power matrix's hull column: each realization's record, in peak periods. IEC TS
         # 62600-100 and WEC-Sim use realizations of 20 to 30 minutes: 200 peak periods at Tp
-        # 6 s. The hull's dense solver refuses records of more than about 10 waves, so this
-        # is 4 (the single record's default) until the near-linear record solver lands;
-        # then it is 200 (and the estimate of parapend.performance.check follows it)
+        # 6 s, which `--waves 200` asks for (an ideal take-off's records are solved
+        # matrix-free, about 100 s each on the shared 2-core machine). The default stays 4
+        # (the single record's): at that speed a default 3 x 3 x 3 matrix of 20-minute
+        # records would take about half an hour
         "matrix_waves": 4.0}
 #: ``power-matrix --waves`` of the prescribed pendulum and the heaving buoy (peak periods)
 POWER_MATRIX = {"waves": 50.0}

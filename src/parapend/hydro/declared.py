@@ -237,15 +237,16 @@ class Body(_Inputs):
         "-", "the body's degrees of freedom: heave (the heaving buoy) or surge,heave,pitch (a "
              "hull that pitches; the pendulum rotates or swings)", default_text="heave",
         kind="text", metavar="DOFS", commands={
-            "horizon": {"help": "the body's degrees of freedom: heave (the heaving buoy); a "
-                                "hull's (surge,heave,pitch) has no causal controller yet"},
+            "horizon": {"help": "the body's degrees of freedom: heave (the heaving buoy) or "
+                                "surge,heave,pitch (a hull that pitches: its own planner)"},
             "power-matrix": {"help": "the body's degrees of freedom: heave (the heaving buoy) "
                                      "or surge,heave,pitch (a hull that pitches; each "
                                      "record's best of rotation, swinging and rest; its "
                                      "pendulum's defaults the hull's: "
                                      f"{HULL['mass']:g} kg, {HULL['length']:g} m, "
-                                     f"{HULL['damping_coefficient']:g} N m s/rad; records of "
-                                     "at most about 10 waves: give --waves)"}})
+                                     f"{HULL['damping_coefficient']:g} N m s/rad; records up "
+                                     "to 300 waves with an ideal take-off, about 10 with "
+                                     "losses: give --waves)"}})
     pivot_height: float | None = _param(
         "m", "the pivot above the rotation centre O: a built-in body's waterplane centre, a "
              "mesh's origin, a dataset's rotation centre",

@@ -27,12 +27,20 @@ __all__ = ["check_realizations", "record_seconds", "solve_realizations"]
 log = logging.getLogger(__name__)
 
 
-def record_seconds(waves: float) -> float:
+def record_seconds(waves: float, ideal: bool = True) -> float:
     """A rough CPU time (s) of one hull record of ``waves`` peak periods (both modes and
-    their refinement): :data:`parapend.performance.check.HULL_SOLVE_SECONDS` per 9 waves."""
+    their refinement): the dense solver's
+    :data:`parapend.performance.check.HULL_SOLVE_SECONDS` per 9 waves; an ideal take-off's
+    records past ``hull.KRYLOV_HARMONICS`` solved matrix-free, near-linear in the length
+    (benchmarks/bench_hull_record.out.txt: 38 s at 50 waves, 108 s at 200 on the shared
+    2-core machine; taken as 30 s and 0.6 s a wave)."""
     from ..performance.check import HULL_SOLVE_SECONDS
+    from .hull import HARMONICS_PER_TURN, KRYLOV_HARMONICS
 
-    return HULL_SOLVE_SECONDS * max(float(waves), 1.0) / 9.0
+    waves = max(float(waves), 1.0)
+    if ideal and HARMONICS_PER_TURN * waves >= KRYLOV_HARMONICS:
+        return 30.0 + 0.6 * waves
+    return HULL_SOLVE_SECONDS * waves / 9.0
 
 
 def check_realizations(value, opts: dict, time_limit=None) -> int:
@@ -51,7 +59,9 @@ def check_realizations(value, opts: dict, time_limit=None) -> int:
     tp = opts.get("tp") or HULL["tp"]
     rp = opts.get("repeat_period")
     waves = HULL["repeat_periods"] if rp is None else float(rp) / float(tp)
-    each = record_seconds(waves)
+    ideal = (opts.get("torque_limit") is None and not opts.get("copper_loss")
+             and opts.get("efficiency") in (None, 1, 1.0))
+    each = record_seconds(waves, ideal)
     most = int(limits.MAX_UNTIMED_SECONDS // each)
     refuse_untimed("realizations", f"{r} hull records of {waves:.3g} peak periods",
                    r * each, f"use --realizations at most {most}" if most >= 1 else

@@ -227,10 +227,12 @@ def check_size(spec, workers=None, scheduler=None, available=None) -> dict:
     seconds = (solves * (3.0 * math.sqrt(max(1.0, spec.waves / 50.0)) + causal)
                / max(1, procs or 1))
     if getattr(spec, "dofs", "heave") != "heave":
-        # the hull: a 9-wave record of the default barge took 92 to 122 s of CPU (both
-        # modes and their refinement; measured on the shared 2-core machine), roughly as
-        # its length
-        seconds = solves * HULL_SOLVE_SECONDS * spec.waves / 9.0 / max(1, procs or 1)
+        # the hull: a record's time (both modes and their refinement; dense, or matrix-free
+        # for an ideal take-off's long records): parapend.hydro.realizations.record_seconds
+        from ..hydro.realizations import record_seconds as hull_record_seconds
+
+        ideal = (getattr(spec, "torque_limit", None) is None and not spec.lossy)
+        seconds = solves * hull_record_seconds(spec.waves, ideal) / max(1, procs or 1)
     return {"bins": bins, "solves": solves, "processes": procs, "memory_bytes": need,
             "seconds": seconds if math.isfinite(seconds) else None,
             "causal_seconds": causal}

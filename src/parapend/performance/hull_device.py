@@ -56,12 +56,11 @@ def problem(spec) -> dict:
     and the hull's coefficients (BEM cached on disk), built once per process."""
     key = _key(spec)
     if key not in _PROBLEMS:
-        from .. import limits
         from ..hydro.api import hull_problem
 
-        # its records at the dense solver's size (a bin of a 6 x 6 matrix in about a minute)
-        _PROBLEMS[key] = dict(hull_problem(**hull_opts(spec)),
-                              max_harmonics=limits.HULL_MAX_HARMONICS)
+        # its records within the limits of `buoy` alone (an ideal take-off's records solved
+        # matrix-free up to limits.HULL_MAX_RECORD_HARMONICS, a lossy one's dense)
+        _PROBLEMS[key] = hull_problem(**hull_opts(spec))
     return _PROBLEMS[key]
 
 
@@ -128,7 +127,8 @@ def largest_waves(spec) -> float | None:
 
 def check_records(spec) -> None:
     """Every period bin's record checked as the hull's code checks it (its size: the harmonics
-    it needs, at most ``limits.HULL_MAX_HARMONICS``; its band inside the hull's data), before
+    it needs, at most ``limits.HULL_MAX_RECORD_HARMONICS`` with an ideal take-off, else
+    ``limits.HULL_MAX_HARMONICS``; its band inside the hull's data), before
     any bin runs; refused in one line naming ``--waves`` (and the largest that fits) or the
     period bin. The records of one period bin differ in Hm0 and seed only: the same band
     and, with the amplitudes' shape unchanged, the same size."""
@@ -146,7 +146,9 @@ def check_records(spec) -> None:
             head, _, rest = str(err).partition(": ")
             if head == "repeat-period":
                 most = largest_waves(spec)
-                cap = limits.HULL_MAX_HARMONICS
+                pto = p["pto"]
+                cap = (limits.HULL_MAX_RECORD_HARMONICS if pto is None or not pto.active
+                       else limits.HULL_MAX_HARMONICS)
                 fit = ("no record fits" if most is None
                        else f"at most {most:g} peak periods fit")
                 raise ParameterError(
