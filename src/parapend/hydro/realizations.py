@@ -28,19 +28,11 @@ log = logging.getLogger(__name__)
 
 
 def record_seconds(waves: float, ideal: bool = True) -> float:
-    """A rough CPU time (s) of one hull record of ``waves`` peak periods (both modes and
-    their refinement): the dense solver's
-    :data:`parapend.performance.check.HULL_SOLVE_SECONDS` per 9 waves; an ideal take-off's
-    records past ``hull.KRYLOV_HARMONICS`` solved matrix-free, near-linear in the length
-    (benchmarks/bench_hull_record.out.txt: 38 s at 50 waves, 108 s at 200 on the shared
-    2-core machine; taken as 30 s and 0.6 s a wave)."""
-    from ..performance.check import HULL_SOLVE_SECONDS
-    from .hull import HARMONICS_PER_TURN, KRYLOV_HARMONICS
+    """A rough CPU time (s) of one hull record of ``waves`` peak periods:
+    :func:`parapend.performance.check.hull_record_seconds`."""
+    from ..performance.check import hull_record_seconds
 
-    waves = max(float(waves), 1.0)
-    if ideal and HARMONICS_PER_TURN * waves >= KRYLOV_HARMONICS:
-        return 30.0 + 0.6 * waves
-    return HULL_SOLVE_SECONDS * waves / 9.0
+    return hull_record_seconds(waves, ideal)
 
 
 def check_realizations(value, opts: dict, time_limit=None) -> int:

@@ -72,6 +72,21 @@ CAUSAL_SECONDS = {"perfect": 7.5, "ar": 10.5}
 BUOY_CAUSAL_SECONDS = {"plan": 0.25, "coupled": 2.0}
 
 
+def hull_record_seconds(waves: float, ideal: bool = True) -> float:
+    """A rough CPU time (s) of one hull record of ``waves`` peak periods (both modes and
+    their refinement): the dense solver's
+    :data:`parapend.performance.check.HULL_SOLVE_SECONDS` per 9 waves; an ideal take-off's
+    records past ``hull.KRYLOV_HARMONICS`` solved matrix-free, near-linear in the length
+    (benchmarks/bench_hull_record.out.txt: 38 s at 50 waves, 108 s at 200 on the shared
+    2-core machine; taken as 30 s and 0.6 s a wave)."""
+    from ..hydro.hull import HARMONICS_PER_TURN, KRYLOV_HARMONICS
+
+    waves = max(float(waves), 1.0)
+    if ideal and HARMONICS_PER_TURN * waves >= KRYLOV_HARMONICS:
+        return 30.0 + 0.6 * waves
+    return HULL_SOLVE_SECONDS * waves / 9.0
+
+
 def record_seconds(spec) -> float:
     """A rough CPU time (s) of the causal runs of one record of ``spec``
     (:data:`CAUSAL_SECONDS`, as the run's length; the buoy's :data:`BUOY_CAUSAL_SECONDS`);
@@ -229,8 +244,6 @@ def check_size(spec, workers=None, scheduler=None, available=None) -> dict:
     if getattr(spec, "dofs", "heave") != "heave":
         # the hull: a record's time (both modes and their refinement; dense, or matrix-free
         # for an ideal take-off's long records): parapend.hydro.realizations.record_seconds
-        from ..hydro.realizations import record_seconds as hull_record_seconds
-
         ideal = (getattr(spec, "torque_limit", None) is None and not spec.lossy)
         seconds = solves * hull_record_seconds(spec.waves, ideal) / max(1, procs or 1)
     return {"bins": bins, "solves": solves, "processes": procs, "memory_bytes": need,
