@@ -902,7 +902,7 @@ def hull_buoy(deadline=None, time_limit=None, **opts):
     :func:`parapend.buoy`, ``dofs="surge,heave,pitch"``); ``deadline`` (a
     :func:`parapend.deadline.deadline` time): a period sweep stops once it has passed, the
     periods not begun left out (the first always solved); so do ``realizations``
-    (:mod:`.realizations`), ``time_limit`` the seconds it stands for."""
+    (``parapend.hydro.realizations``), ``time_limit`` the seconds it stands for."""
     from ..deadline import expired
     from .coupled import Wave
     from .inputs import _irregular_wave, _period, parse_periods

@@ -214,8 +214,8 @@ def buoy_horizon_curve(*, hs=None, tp=None, spectrum="jonswap", gamma_peak=3.3,
     dofs : ``"heave"`` (None, the buoy) or ``"surge,heave,pitch"``: the hull (the embedded
         barge, ``parapend.defaults.HULL``'s sea state, pendulum and pivot), its record
         optimum (:func:`parapend.hydro.api.solve_record`) and its receding-horizon runs
-        (:func:`parapend.hydro.hull_control.hull_mpc`, started from the optimum's motion,
-        :func:`~parapend.hydro.hull_control.start_mode`).
+        (``parapend.hydro.hull_control.hull_mpc``, started from the optimum's motion,
+        ``parapend.hydro.hull_control.start_mode``).
     """
     from ..control.curve_options import (
         MAX_RECORDS,

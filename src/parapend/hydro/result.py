@@ -47,7 +47,7 @@ HEAVE_KEYS = ("power_w", "heave_amplitude_m", "peak_torque_nm", "radiation_bound
               "motoring_power_w", "ideal_power_w", "one_way_electrical_power_w", "mesh_error_w",
               "mesh_error_relative", "grid_error_w", "validity_warnings")
 #: a hull's sea state over seeded realizations (``realizations``; None otherwise):
-#: :mod:`.realizations`
+#: ``parapend.hydro.realizations``
 REALIZATION_KEYS = ("realizations", "realizations_solved", "realization_seeds",
                     "realization_powers_w", "realization_reasons",
                     "realization_peak_torques_nm", "realization_peak_pivot_forces_n",
@@ -240,12 +240,12 @@ class BuoyResult(_Result):
         from the answer with half as many (the last doubling's change); refinement_history:
         ``[harmonics, power_w]`` of each stage of the doubling, coarsest first.
     discretization_error_estimate_w : the stated discretization error
-        (:func:`error_estimate`): an estimate from the doublings (the last change, or its
+        (``error_estimate``): an estimate from the doublings (the last change, or its
         geometric tail where the changes shrink slowly), not a proven bound; None where the
         changes do not shrink. It covers the discretization of the maximum found, not
         another maximum a search at other harmonics may find.
     realizations : a sea state over ``R`` seeded records (``buoy(realizations=R)``,
-        :mod:`.realizations`; None: one record): ``realization_seeds``,
+        ``parapend.hydro.realizations``; None: one record): ``realization_seeds``,
         ``realization_powers_w`` (NaN/null: no resolved answer, ``realization_reasons``
         says why), ``realization_peak_torques_nm``, ``realization_peak_pivot_forces_n``;
         ``mean_power_w`` over the ``realizations_solved`` resolved ones, ``power_std_w``

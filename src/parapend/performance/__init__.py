@@ -573,8 +573,8 @@ def annual_interval(ds, frequency, solved) -> dict:
     (``8766 h sum_b f_b max(mean_b, 0)`` over the bins with a frequency and a power).
 
     Every counted bin with a positive mean solved in every realization: the paired
-    interval (:data:`AEP_CI_PAIRED`; a bin at rest counts 0 in each). Otherwise the
-    half-widths summed (:data:`AEP_CI_SUMMED`). None where a counted bin with a positive
+    interval (``AEP_CI_PAIRED``; a bin at rest counts 0 in each). Otherwise the
+    half-widths summed (``AEP_CI_SUMMED``). None where a counted bin with a positive
     mean has fewer than two solved realizations (no interval). The lower end is at least 0
     (the annual energy is never negative: the interval cut to where it can lie keeps its
     coverage)."""
