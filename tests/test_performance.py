@@ -469,3 +469,28 @@ def test_map_refuses_a_power_matrix_store(tiny, capsys):
     assert main(["map", "--store", str(store), "--plot", "x.png"]) == 2
     err = capsys.readouterr().err
     assert "holds a power matrix" in err and len(err.strip().splitlines()) == 1
+
+
+def test_bins_past_breaking_are_marked_with_their_share_of_the_year(tmp_path, capsys):
+    """A rectangle of bins holds a corner past breaking (Hm0 6 m at Te 3 s): solved, and
+    marked by the closed-form steepness ``Hs / (g Tp^2 / (2 pi)) > 1/7``, with the share of
+    the year and the annual energy the site gives it."""
+    import json
+
+    (tmp_path / "s.csv").write_text("hs,te,frequency\n1,3,0.25\n6,3,0.25\n1,7,0.25\n6,7,0.25\n")
+    argv = ["power-matrix", "--hs", "1,6", "--te", "3,7", "--realizations", "1", "--waves",
+            "4", "--workers", "1", "--scatter", str(tmp_path / "s.csv")]
+    assert main(argv + ["--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    tp = np.array([3.0, 7.0]) / te_over_tp("jonswap", 3.3)
+    steep = np.array([[h / (9.81 * t * t / (2 * math.pi)) for t in tp] for h in (1.0, 6.0)])
+    assert steep[1, 0] > 1 / 7 and (np.delete(steep.ravel(), 2) < 1 / 7).all()
+    assert [(b["hm0"], b["te"]) for b in out["bins_past_breaking"]] == [(6.0, 3.0)]
+    assert out["bins_past_breaking"][0]["steepness"] == pytest.approx(steep[1, 0], rel=1e-12)
+    assert out["past_breaking_frequency"] == 0.25
+    pm = out["power_matrix"][1][0]
+    assert out["past_breaking_mwh"] == pytest.approx(HOURS_PER_YEAR * 0.25 * pm / 1e6,
+                                                     rel=1e-12)
+    assert main(argv) == 0
+    text = capsys.readouterr().out
+    assert "1 bin past breaking (Hs / lambda_p > 1/7" in text and "(Hm0 6 m, te 3 s)" in text

@@ -909,11 +909,12 @@ def _power_matrix_result(power_matrix, arguments):
         from .performance.causal import causal_json
 
         out["causal"] = causal_json(ds, grid)
-    from .performance import matrix_csv, matrix_extremes
+    from .performance import breaking_bins, matrix_csv, matrix_extremes
 
     out["power_ci_low"], out["power_ci_high"] = grid("power_ci_low"), grid("power_ci_high")
     out["power_ci_method"] = ds["power_ci_low"].attrs["method"]
     out.update(matrix_extremes(ds, pk))
+    out.update(breaking_bins(ds, pk))
 
     return Record("power-matrix", out, dataset=ds, run=run,
                   draw=_draw_dataset("performance.figures", "plot_matrix"),

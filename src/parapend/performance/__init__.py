@@ -24,9 +24,9 @@ from .annual import HOURS_PER_YEAR
 from .resource import bin_edges, energy_flux, record_spectrum, repeat_period, te_over_tp
 from .spec import DEVICES, UNITS, MatrixSpec
 
-__all__ = ["HOURS_PER_YEAR", "STATISTICS", "MatrixSpec", "annual_interval", "matrix_dataset",
-           "matrix_extremes", "matrix_quantities", "matrix_spec", "parse_bins", "power_matrix",
-           "to_mhkit"]
+__all__ = ["HOURS_PER_YEAR", "STATISTICS", "MatrixSpec", "annual_interval", "breaking_bins",
+           "matrix_dataset", "matrix_extremes", "matrix_quantities", "matrix_spec", "parse_bins",
+           "power_matrix", "to_mhkit"]
 
 log = logging.getLogger(__name__)
 
@@ -421,6 +421,7 @@ def matrix_dataset(raw, spec: MatrixSpec, *, depth=None, density: float = 1025.0
         "depth": "deep water" if depth is None else f"{depth:g} m", "density": density})
     ds["te_record"] = (dims2, te_rec, {"long_name": "energy period m_-1/m0 of the record's "
                                                     "(cut) spectrum", "units": "s"})
+    _mark_breaking(ds, spec, dims2)
     # the device's power in each bin: the mean optimum, or 0 where that is negative (a
     # real device stops the pendulum there: "rest"), never a loss (docs/performance.md)
     pm = bin_power(ds["power_mean"].values)
@@ -515,6 +516,44 @@ def matrix_dataset(raw, spec: MatrixSpec, *, depth=None, density: float = 1025.0
             _annual_columns(ds, spec, annual)
     ds.attrs["hours_per_year"] = HOURS_PER_YEAR
     return ds, annual
+
+
+def _mark_breaking(ds, spec: MatrixSpec, dims2) -> None:
+    """Each bin's significant steepness ``Hs / lambda_p`` (``lambda_p = g Tp^2 / (2 pi)``,
+    :func:`parapend.seas.sea_steepness`) and whether it is past breaking (``> 1/7``). A
+    matrix is a rectangle: its steep corners are solved as the linear seas they describe,
+    which no real sea reaches; they are marked, not refused."""
+    from ..seas import BREAKING_STEEPNESS, sea_steepness
+
+    steep = np.array([[sea_steepness(h, tp, spec.gravity) for tp in spec.tp]
+                      for h in spec.hm0])
+    ds["steepness"] = (dims2, steep, {
+        "long_name": "significant steepness Hs / lambda_p of the bin (lambda_p the deep-water "
+                     "wavelength of its peak period)", "units": "1"})
+    ds["past_breaking"] = (dims2, (steep > BREAKING_STEEPNESS).astype(np.int8), {
+        "long_name": "the bin's sea is past breaking (Hs / lambda_p > 1/7): solved as a "
+                     "linear sea, which no real sea reaches", "flag_values": [0, 1],
+        "flag_meanings": "sea past_breaking"})
+
+
+def breaking_bins(ds, pk: str, annual=None) -> dict:
+    """The bins past breaking for the JSON: ``bins_past_breaking`` (each bin's Hm0, period,
+    steepness and share of the year) and, with a site, ``past_breaking_frequency`` (their
+    share of the year) and ``past_breaking_mwh`` (the annual energy they contribute)."""
+    if "past_breaking" not in ds:
+        return {}
+    flag = ds["past_breaking"].values.astype(bool)
+    f = ds["frequency"].values if "frequency" in ds else None
+    out = {"bins_past_breaking": [
+        {"hm0": float(ds["hm0"].values[i]), pk: float(ds[pk].values[j]),
+         "steepness": float(ds["steepness"].values[i, j]),
+         "frequency": None if f is None else float(f[i, j])} for i, j in np.argwhere(flag)]}
+    if f is not None:
+        out["past_breaking_frequency"] = float(f[flag].sum())
+        pm = ds["power_matrix"].values
+        ok = flag & np.isfinite(pm)
+        out["past_breaking_mwh"] = float(HOURS_PER_YEAR * np.sum(f[ok] * pm[ok]) / 1e6)
+    return out
 
 
 def _bin_intervals(ds, spec: MatrixSpec, solved, dims2) -> None:

@@ -256,6 +256,17 @@ def text_report(ds, out: dict, drawn: list) -> str:
                      + ", ".join(b["reasons"]) + "); left out of the bin's mean"
                      + ("" if b["failed"] < b["realizations"] else
                         " (the bin has no power: out of the annual energy)"))
+    brk = out.get("bins_past_breaking") or ()
+    if brk:
+        share = out.get("past_breaking_frequency")
+        lines.append(f"{len(brk)} bin{'s' if len(brk) > 1 else ''} past breaking (Hs / "
+                     "lambda_p > 1/7: no real sea is that steep; solved as linear theory's sea): "
+                     + ", ".join(
+                         f"(Hm0 {b['hm0']:g} m, {pk} {b[pk]:g} s)" for b in brk[:8])
+                     + (" ..." if len(brk) > 8 else "")
+                     + ("" if not share else
+                        f"; the site gives them {share:.4g} of the year, "
+                        f"{out['past_breaking_mwh']:.4g} MWh/yr of the annual energy"))
     if "operating_mode" in ds:
         m = ds["operating_mode"].values
         lines.append("operating mode of the bins: " + ", ".join(
