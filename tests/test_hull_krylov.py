@@ -280,3 +280,24 @@ def test_records_past_what_fits_are_refused_in_one_line(dataset):
         _check_hull_size(wave, (k, 0), None, HullPTO(torque_limit=1e4))
     p = hull_problem(dofs="surge,heave,pitch", hydro=dataset, **PEND)
     assert p.get("max_harmonics") is None
+
+
+@pytest.mark.slow
+def test_an_ideal_record_refines_past_the_dense_cap():
+    """A barge 10 x 6 x 2 m with a 4 t pendulum at 1.5 m, the pivot 1 m up, Hs 2.5 m, Te 9 s
+    (a site's bin, cutoff 2.2): its 4-wave record still moved by 7 W (2e-3) when refined to
+    192 harmonics, the dense refinement's cap, and the power matrix left the bin out; an ideal
+    take-off's refinement goes on matrix-free and resolves it; the harmonics the user may
+    ask for follow the same cap."""
+    from parapend import limits
+    from parapend.errors import ParameterError
+
+    tp = 9 / 0.903296
+    kw = dict(dofs="surge,heave,pitch", body="barge", barge_length=10, barge_beam=6,
+              barge_draft=2, mass=4000, length=1.5, pivot_height=1, hs=2.5, tp=tp,
+              repeat_period=4 * tp, cutoff=2.2, seed=0)
+    r = parapend.buoy(**kw)
+    assert r.success and r.harmonics > limits.HULL_MAX_REFINED_HARMONICS
+    assert r.discretization_error_estimate_w < 1e-6 * r.power_w
+    with pytest.raises(ParameterError, match="^harmonics:"):
+        parapend.buoy(**kw, harmonics=limits.HULL_MAX_RECORD_HARMONICS + 1)

@@ -237,7 +237,8 @@ def test_the_longest_record_is_the_hulls_limit(dataset, pto, waves, cap):
     ({**HULL, "response": "x.csv"}, r"^response: "),
     ({**HULL, "pivot_offset": 50.0, "hydro": None}, r"^pivot-offset: the pivot must lie"),
     ({**HULL, "body": "barge", "radius": 1.0, "hydro": None}, r"^radius: "),
-    ({**HULL, "harmonics": 500}, r"^harmonics: "),
+    ({**HULL, "harmonics": 4000}, r"^harmonics: "),
+    ({**HULL, "harmonics": 500, "efficiency": 0.9}, r"^harmonics: "),
     ({**HULL, "dofs": "surge,heave"}, r"^dofs: "),
     ({"device": "buoy", "body": "barge"}, r"^body: the barge is a hull that pitches"),
 ])

@@ -870,7 +870,11 @@ def hull_problem(**opts) -> dict:
     windings = (1, 0) if winding is None else (check_int("winding", winding, 0, 16),)
     harmonics = opts.get("harmonics")
     if harmonics is not None:
-        harmonics = check_int("harmonics", harmonics, 2, limits.HULL_MAX_HARMONICS)
+        # an ideal take-off's problem is matrix-free from KRYLOV_HARMONICS on (a record's
+        # cap); a lossy one's dense
+        ideal = pto is None or not pto.active
+        harmonics = check_int("harmonics", harmonics, 2, limits.HULL_MAX_RECORD_HARMONICS
+                              if ideal else limits.HULL_MAX_HARMONICS)
     return {"hull": hull, "pendulum": pend, "pivot": pivot, "pitch_inertia": inertia,
             "winding": winding, "windings": windings, "harmonics": harmonics,
             "geometry": geometry, "pto": pto}

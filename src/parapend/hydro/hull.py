@@ -741,14 +741,16 @@ def _refine(sol: HullSolution, make, x) -> HullSolution:
     scale, power, case = 1, sol.power, sol.case
     status, ok = sol.status, sol.success
     change = math.inf
-    from ..limits import HULL_MAX_REFINED_HARMONICS
+    from ..limits import HULL_MAX_RECORD_HARMONICS, HULL_MAX_REFINED_HARMONICS
 
     pto = sol.pto
     x1, p1 = sol.one_way_x, sol.one_way_power
     history = [(case.harmonics, float(power))]
     top = PTO_MAX_SCALE if pto.active else MAX_SCALE
-    while scale < top and 2 * scale * sol.case.harmonics <= max(
-            HULL_MAX_REFINED_HARMONICS, 2 * sol.case.harmonics):
+    # a lossy take-off's problem is dense (its cost the cube of the harmonics); an ideal
+    # one's is matrix-free from KRYLOV_HARMONICS on, so its doublings go as far as a record's
+    cap = HULL_MAX_REFINED_HARMONICS if pto.active else HULL_MAX_RECORD_HARMONICS
+    while scale < top and 2 * scale * sol.case.harmonics <= max(cap, 2 * sol.case.harmonics):
         scale *= 2
         case = make(scale)
         if pto.active:

@@ -932,7 +932,7 @@ def power_matrix(*, hs="1:3:3", te=None, tp=None, realizations: int = 3, waves=N
         return power_matrix(**expand_inputs(power_matrix, locals()))
     from ..maps.run import run_spec
     from .annual import bin_series, read_scatter, read_series
-    from .check import check_bins, check_size
+    from .check import check_bins, check_size, hull_record_seconds
 
     # everything checked before any bin runs (and, for the buoy, before its BEM): the plain
     # options, the output paths, the bins' sizes, every bin's record, the site's file
@@ -1044,7 +1044,9 @@ def power_matrix(*, hs="1:3:3", te=None, tp=None, realizations: int = 3, waves=N
                  duration(est["seconds"]) + ("" if est["processes"] else " of one core"),
                  ("3 s a 50-wave solve" if spec.controller is None else
                   f"3 s a 50-wave solve and {est['causal_seconds']:.0f} s its causal runs")
-                 if spec.dofs == "heave" else "100 s a 9-wave record of the hull")
+                 if spec.dofs == "heave" else
+                 f"{hull_record_seconds(spec.waves, not spec.lossy):.0f} s a "
+                 f"{spec.waves:g}-wave record of the hull")
     t0 = time.monotonic()
     run = run_spec(spec, store, workers=workers, scheduler=scheduler, overwrite=overwrite,
                    command=command, progress=progress, deadline=until)

@@ -173,7 +173,8 @@ def failure_code(reason: str | None) -> int:
 
 
 #: a record without a resolved answer is solved once more with this many times the default
-#: harmonics (other starts on another discretization), within ``limits.HULL_MAX_HARMONICS``
+#: harmonics (other starts on another discretization), within the hull's cap
+#: (``limits.HULL_MAX_RECORD_HARMONICS`` for an ideal take-off, else ``HULL_MAX_HARMONICS``)
 RETRY_HARMONICS = 1.5
 
 
@@ -193,12 +194,14 @@ def _retry(spec, wave, info, res):
         return res
     n = HARMONICS_PER_TURN * max(max(p["windings"]), waves_in(wave))
     more = int(math.ceil(RETRY_HARMONICS * n / 2)) * 2
-    if more > limits.HULL_MAX_HARMONICS:
+    ideal = p["pto"] is None or not p["pto"].active  # matrix-free: a record's cap
+    if more > (limits.HULL_MAX_RECORD_HARMONICS if ideal else limits.HULL_MAX_HARMONICS):
         return res
     again = solve_record({**p, "harmonics": more}, wave, info)
     logging.getLogger(__name__).info(
-        "hull record %s: %s; with %d harmonics: %s", info.get("seed"), res.headline_reason,
-        more, getattr(again, "headline_reason", None) or "resolved")
+        "hull record Hs %g m, Tp %g s, seed %s: %s; with %d harmonics: %s", info.get("hs"),
+        info.get("tp"), info.get("seed"), res.headline_reason, more,
+        getattr(again, "headline_reason", None) or "resolved")
     return res if getattr(again, "headline_reason", None) else again
 
 
