@@ -507,9 +507,12 @@ def coarsened(case: HullCase, harmonics: int) -> HullCase:
 #: climbs whose maximum is not an answer but the next finer discretization's start (the
 #: finer one's maximum moves from it by far more: the 200-wave barge's padded maxima start
 #: 0.1 % to 1 % below the finer maxima), and of a refined answer's first stage (climbed
-#: again on twice the harmonics to GTOL); the last Newton steps below it are the dearest
-#: (the most conjugate-gradient products each)
-LEVEL_GTOL = 1e-5
+#: again on twice the harmonics to GTOL; its power, in the refinement's history, within
+#: 2e-9 of the GTOL one's on that barge, the refinement's change 1e-3): the last Newton
+#: steps are the dearest (the most conjugate-gradient products each), and on that barge
+#: 1e-4 cut a level and the next together by a fifth against GTOL, to the same maximum
+#: (1e-3 stops while Newton still creeps: the next level pays it back and more)
+LEVEL_GTOL = 1e-4
 
 
 def continued_search(make, *, refine: bool = True, level: bool = False):
