@@ -3,11 +3,12 @@ r"""Time and memory of the hull's record optimum against the record's length.
 The embedded barge (``parapend.buoy(dofs="surge,heave,pitch", hs=1.5, tp=6.0,
 repeat_period=W * tp)``, the default pendulum and pivot, seed 0) for records of ``W`` = 10,
 25, 50, 100 and 200 peak periods: the whole optimum (rotation and swinging, every start,
-the continuation, the refinement, the checks) in a fresh subprocess per size, its wall time
-and its peak resident memory (``ru_maxrss``; the BEM's coefficients come from the cache
-after the first size). Beside it, where it finishes within ``--dense-timeout``, the same
-optimum by the dense solver alone (``KRYLOV_HARMONICS`` and ``LONG_RECORD_HARMONICS`` set
-past the record's harmonics: today's method before the matrix-free one), and the ratio.
+the continuation, the refinement, the checks) in a fresh subprocess per size, its wall time,
+its CPU time (the process's, all threads) and its peak resident memory (``ru_maxrss``; the
+BEM's coefficients come from the cache after the first size). Beside it, where it finishes
+within ``--dense-timeout``, the same optimum by the dense solver alone (``KRYLOV_HARMONICS``
+and ``LONG_RECORD_HARMONICS`` set past the record's harmonics: the method before the
+matrix-free one), and the ratio.
 Then the log-log slope of time against waves from 25 to 200 (least squares).
 
 Run: ``nice python benchmarks/bench_hull_record.py [--waves 10,25,50,100,200]
@@ -33,10 +34,11 @@ from parapend.hydro import hull
 waves, dense = float(sys.argv[1]), sys.argv[2] == "dense"
 if dense:
     hull.KRYLOV_HARMONICS = hull.LONG_RECORD_HARMONICS = 10**9
-t = time.perf_counter()
+t, c = time.perf_counter(), time.process_time()
 r = parapend.buoy(dofs="surge,heave,pitch", hs=1.5, tp=6.0, repeat_period=waves * 6.0,
                   seed=0)
 print(json.dumps({"seconds": time.perf_counter() - t, "power_w": r.power_w,
+                  "cpu_seconds": time.process_time() - c,
                   "harmonics": r.harmonics, "status": r.status,
                   "rss_mb": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024}))
 """
@@ -74,18 +76,19 @@ def main():
     print(f"machine: {platform.machine()}, {os.cpu_count()} cores, Python "
           f"{platform.python_version()}; load average before: {os.getloadavg()}")
     run(4.0, False, a.timeout)  # the BEM's cache and the compiled kernels, once
-    head = (f"{'waves':>6} {'N':>6} {'time (s)':>9} {'RSS (MB)':>9} {'P (W)':>14} "
+    head = (f"{'waves':>6} {'N':>6} {'time (s)':>9} {'CPU (s)':>8} {'RSS (MB)':>9} "
+            f"{'P (W)':>14} "
             f"{'dense (s)':>10} {'dense MB':>9} {'ratio':>7} {'P dense (W)':>14}  status")
     print(head)
     print("-" * len(head))
-    times = {}
+    times, cpus = {}, {}
     for w in sizes:
         r = run(w, False, a.timeout)
         if r is None or "error" in r:
             why = f"did not finish in {a.timeout:g} s" if r is None else r["error"]
             print(f"{w:6g}  {why}", flush=True)
             continue
-        times[w] = r["seconds"]
+        times[w], cpus[w] = r["seconds"], r["cpu_seconds"]
         d = run(w, True, a.dense_timeout) if w in dense_sizes else None
         if d is not None and "error" in d:
             d = None
@@ -96,12 +99,14 @@ def main():
         else:
             dcols = (f"{d['seconds']:10.1f} {d['rss_mb']:9.0f} "
                      f"{d['seconds'] / r['seconds']:7.1f} {d['power_w']:14.9g}")
-        print(f"{w:6g} {r['harmonics']:6d} {r['seconds']:9.1f} {r['rss_mb']:9.0f} "
+        print(f"{w:6g} {r['harmonics']:6d} {r['seconds']:9.1f} {r['cpu_seconds']:8.1f} "
+              f"{r['rss_mb']:9.0f} "
               f"{r['power_w']:14.9g} {dcols}  {r['status']}", flush=True)
     fit = [w for w in sorted(times) if 25 <= w <= 200]
     if len(fit) >= 2:
         print(f"log-log slope of time against waves, {fit[0]:g} to {fit[-1]:g} waves: "
-              f"{slope(fit, [times[w] for w in fit]):.2f}")
+              f"{slope(fit, [times[w] for w in fit]):.2f} (wall), "
+              f"{slope(fit, [cpus[w] for w in fit]):.2f} (CPU)")
     stamp = time.strftime('%Y-%m-%d %H:%M UTC', time.gmtime())
     print(f"load average after: {os.getloadavg()}; {stamp}")
 

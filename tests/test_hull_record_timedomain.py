@@ -210,6 +210,22 @@ def _excitation(data, omega, amplitudes):
     return force
 
 
+@pytest.mark.parametrize("points", [16, 2048])
+def test_motion_on_grid_is_the_trigonometric_sums(short_optimum, points):
+    """The answer's motion on a grid of the period by inverse FFTs (``MotionAt.on_grid``,
+    what the peaks and amplitudes read) is its direct trigonometric sums at those times to
+    rounding (1e-12 of each quantity's size), also on fewer points than harmonics."""
+    case, _, _, motion = short_optimum
+    period = 2 * math.pi / case.omega
+    direct = motion(period * np.arange(points) / points)
+    fast = motion.on_grid(points)
+    assert set(fast) == set(direct)
+    for key, want in direct.items():
+        assert np.shape(fast[key]) == np.shape(want)
+        np.testing.assert_allclose(fast[key], want, rtol=0,
+                                   atol=1e-12 * max(float(np.max(np.abs(want))), 1e-300))
+
+
 @pytest.mark.slow  # 10 s
 def test_record_optimum_torque_reintegrated(short_optimum):
     """The optimum's torque ``tau(t)`` (from (P) on its motion) re-integrated with the

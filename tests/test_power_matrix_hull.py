@@ -201,7 +201,8 @@ def test_the_longest_record_is_the_hulls_limit(dataset, pto, waves, cap):
     """Too long a record is refused naming --waves and the largest that fits; that largest
     fits the hull's own size check (12 harmonics per wave, at most the limit of `buoy` alone
     for that take-off), 0.01 more does not. The hull's default record is its declared one
-    (``defaults.HULL["matrix_waves"]``)."""
+    for that take-off (``defaults.HULL["matrix_waves"]``, 200 peak periods, for an ideal
+    one; ``"matrix_waves_lossy"`` for a lossy one), and it fits."""
     from parapend import limits
     from parapend.defaults import HULL as HULL_DEFAULTS
     from parapend.hydro.hull import HARMONICS_PER_TURN, waves_in
@@ -212,7 +213,10 @@ def test_the_longest_record_is_the_hulls_limit(dataset, pto, waves, cap):
         matrix_spec(hs="1,2", tp="5,6", realizations=1, hydro=dataset, waves=waves, **pto,
                     **HULL)
     default = matrix_spec(hs="1,2", tp="5,6", realizations=1, hydro=dataset, **HULL)
-    assert default.waves == HULL_DEFAULTS["matrix_waves"]
+    assert default.waves == HULL_DEFAULTS["matrix_waves"]  # no take-off given: ideal
+    assert HULL_DEFAULTS["matrix_waves"] == 200.0
+    lossy = matrix_spec(hs="1,2", tp="5,6", realizations=1, hydro=dataset, **pto, **HULL)
+    assert lossy.waves == HULL_DEFAULTS["matrix_waves_lossy" if pto else "matrix_waves"]
     most = float(str(err.value).split("at most ")[-1].split(" peak")[0])
     spec = matrix_spec(**{**BINS, "waves": most}, realizations=1, hydro=dataset, **pto,
                        **HULL)

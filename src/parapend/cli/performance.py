@@ -58,7 +58,9 @@ def add_parsers(sub) -> None:
     g.add_argument("--waves", type=_finite_float("waves"),
                    help="record length in peak periods, 2 to 400 (default "
                         f"{POWER_MATRIX['waves']:g}; with --dofs surge,heave,pitch "
-                        f"{HULL['matrix_waves']:g})")
+                        f"{HULL['matrix_waves']:g}, 20 minutes at Tp 6 s, with an ideal "
+                        "take-off; with --efficiency, --copper-loss or --torque-limit "
+                        f"{HULL['matrix_waves_lossy']:g}, solved dense)")
     # the sea's and the pendulum's options: generated from their declarations
     # (parapend.hydro.declared), with the defaults they state for power-matrix
     add_declared(g, Sea, ("seed", "spectrum", "gamma_peak", "cutoff"),

@@ -37,8 +37,9 @@ Hessian ``H = L_xx + L_xy T + T^T L_yx + T^T L_yy T`` is applied to a vector ``v
 ``D_2`` the pointwise 6 x 6 second derivatives, ``rho_X`` the reaction's derivatives in
 ``(phi, phi', phi'')`` (two GMRES solves per product, nothing of size ``N^2`` stored).
 Newton's step is then truncated, preconditioned conjugate gradients
-(:func:`parapend.optimal.fourier.newton_maximize`'s operator path) with the diagonal of
-``L_xx`` plus the frequency-diagonal part of the hull's radiation as the preconditioner.
+(:func:`parapend.optimal.fourier.newton_maximize`'s operator path) with the exact diagonal
+of ``L_xx`` as the preconditioner (the reduced Hessian's own diagonal is 1.2 to 2.6 times
+it at the 50-wave barge's maximum, and its rows are far from diagonal at low harmonics).
 """
 
 from __future__ import annotations
@@ -119,6 +120,11 @@ class KrylovHullProblem(HullProblem):
             np.zeros((0, 3, 3), complex)
         self._zk = zk
         self._zkinv = np.linalg.inv(zk) if nh else zk
+        # the blocks as (3, 3, Nh), and their conjugate transposes (the adjoint's)
+        self._zt = np.ascontiguousarray(zk.transpose(1, 2, 0))
+        self._zth = np.ascontiguousarray(zk.conj().transpose(2, 1, 0))
+        self._zinvt = np.ascontiguousarray(self._zkinv.transpose(1, 2, 0))
+        self._zinvth = np.ascontiguousarray(self._zkinv.conj().transpose(2, 1, 0))
         self._z0 = cp[np.ix_(self.static, self.static)]
         self._z0inv = np.linalg.inv(self._z0) if j0 else self._z0
         self._fa = case.wave_force()[1:]
@@ -222,76 +228,96 @@ class KrylovHullProblem(HullProblem):
             mu[d] += y0[i] / m
         return mu
 
-    # -- the hull matrix S and its transpose, on flat real vectors ----------------------------
-    def _pitch_project(self, h):
-        """``Pi_beta h``: the projection of a pitch moment ``h`` (M,) alone (one FFT)."""
-        m, nh = self.points, self._kh.size
-        y0 = np.zeros(len(self.static))
-        if self._pitch_static >= 0:
-            y0[self._pitch_static] = float(np.mean(h))
-        xk = np.zeros((nh, 3), dtype=complex)
-        xk[:, 2] = (2.0 / m) * _rfft(h)[1:nh + 1]
-        return y0, xk
-
-    def _apply_s(self, y, sn, co, transpose=False):
-        """``S y`` (``S^T y``): ``Z`` block by block, and the coupling's pitch rows by
-        three FFTs (the pivot's acceleration, and the pitch moment's projection; transposed,
-        the pitch row lifted to the grid, and the acceleration's transpose)."""
+    # -- the hull matrix S and its transpose, on GMRES's real vectors -------------------------
+    # GMRES works in its own layout: the static offsets, then the complex (3, Nh) harmonics
+    # (DOF-major) viewed as reals, so that a vector's harmonics are a view, not a copy, and
+    # Z's 3 x 3 blocks apply as nine products of length Nh
+    def _to_inner(self, y) -> np.ndarray:
         y0, xk = self._split(y)
+        return np.concatenate((y0, np.ascontiguousarray(xk.T).ravel().view(float)))
+
+    def _from_inner(self, u) -> np.ndarray:
+        y0, xt = self._inner(u)
+        return self._flat(y0, xt.T)
+
+    def _inner(self, u):
+        j0 = len(self.static)
+        return u[:j0], np.ascontiguousarray(u[j0:]).view(complex).reshape(3, -1)
+
+    @staticmethod
+    def _outer(y0, xt) -> np.ndarray:
+        return np.concatenate((y0, np.ascontiguousarray(xt).ravel().view(float)))
+
+    @staticmethod
+    def _blocks(z, xt):
+        """``z_k x_k`` for each harmonic: ``z`` (3, 3, Nh), ``xt`` (3, Nh)."""
+        return np.stack([z[i, 0] * xt[0] + z[i, 1] * xt[1] + z[i, 2] * xt[2]
+                         for i in range(3)])
+
+    def _apply_s(self, u, sn, co, transpose=False):
+        """``S y`` (``S^T y``) in GMRES's layout: ``Z`` block by block, and the coupling's
+        pitch rows by three FFTs (the pivot's acceleration, and the pitch moment's
+        projection; transposed, the pitch row lifted to the grid, and the acceleration's
+        transpose)."""
+        y0, xt = self._inner(u)
         ml = self.case.m * self.case.l
         dp, hp = self.case.pivot
         m, nh = self.points, self._kh.size
         k2 = -self._kh**2
+        ps = self._pitch_static
         if not transpose:
             z0 = self._z0 @ y0
-            zx = np.einsum("kij,kj->ki", self._zk, xk)
-            q = self._synth(np.stack((k2 * (xk[:, 0] + hp * xk[:, 2]),
-                                      k2 * (xk[:, 1] - dp * xk[:, 2]))))
-            c0, cx = self._pitch_project(ml * (co * q[0] - sn * q[1]))
-            return self._flat(z0 + c0, zx + cx)
+            zx = self._blocks(self._zt, xt)
+            q = self._synth(np.stack((k2 * (xt[0] + hp * xt[2]), k2 * (xt[1] - dp * xt[2]))))
+            h = ml * (co * q[0] - sn * q[1])
+            if ps >= 0:
+                z0[ps] += float(np.mean(h))
+            zx[2] += (2.0 / m) * _rfft(h)[1:nh + 1]
+            return self._outer(z0, zx)
         z0 = self._z0.T @ y0
-        zx = np.einsum("kji,kj->ki", self._zk.conj(), xk)
-        mu2 = self._synth((2.0 / m) * xk[:, 2])
-        if self._pitch_static >= 0:
-            mu2 += y0[self._pitch_static] / m
+        zx = self._blocks(self._zth, xt)
+        mu2 = self._synth((2.0 / m) * xt[2])
+        if ps >= 0:
+            mu2 += y0[ps] / m
         wf = _rfft(np.stack((ml * co * mu2, -ml * sn * mu2)))[:, 1:nh + 1]
-        zx[:, 0] += k2 * wf[0]
-        zx[:, 1] += k2 * wf[1]
-        zx[:, 2] += k2 * (hp * wf[0] - dp * wf[1])
-        return self._flat(z0, zx)
+        zx[0] += k2 * wf[0]
+        zx[1] += k2 * wf[1]
+        zx[2] += k2 * (hp * wf[0] - dp * wf[1])
+        return self._outer(z0, zx)
 
-    def _apply_zinv(self, y, transpose=False):
-        y0, xk = self._split(y)
+    def _apply_zinv(self, u, transpose=False):
+        """``Z^{-1} y`` (``Z^{-T} y``) in GMRES's layout."""
+        y0, xt = self._inner(u)
         if transpose:
-            return self._flat(self._z0inv.T @ y0,
-                              np.einsum("kji,kj->ki", self._zkinv.conj(), xk))
-        return self._flat(self._z0inv @ y0, np.einsum("kij,kj->ki", self._zkinv, xk))
+            return self._outer(self._z0inv.T @ y0, self._blocks(self._zinvth, xt))
+        return self._outer(self._z0inv @ y0, self._blocks(self._zinvt, xt))
 
     def _solve_s(self, b, sn, co, transpose=False, rtol=STATE_RTOL, x0=None):
-        """``S^{-1} b`` (``S^{-T} b``) by GMRES preconditioned by ``Z^{-1}``."""
+        """``S^{-1} b`` (``S^{-T} b``) by GMRES preconditioned by ``Z^{-1}`` (flat vectors in
+        the dense solver's layout)."""
         n = b.size
         if not self.coupled:
-            return self._apply_zinv(b, transpose)
+            return self._from_inner(self._apply_zinv(self._to_inner(b), transpose))
         a = LinearOperator((n, n), matvec=lambda v: self._apply_s(v, sn, co, transpose),
                            dtype=float)
         pre = LinearOperator((n, n), matvec=lambda v: self._apply_zinv(v, transpose),
                              dtype=float)
-        if x0 is None:
-            x0 = self._apply_zinv(b, transpose)
+        bi = self._to_inner(b)
+        x0 = self._apply_zinv(bi, transpose) if x0 is None else self._to_inner(x0)
         count = [0]
 
         def cb(_):
             count[0] += 1
 
-        y, info = gmres(a, b, x0=x0, rtol=rtol, atol=0.0, restart=RESTART,
+        y, info = gmres(a, bi, x0=x0, rtol=rtol, atol=0.0, restart=RESTART,
                         maxiter=MAX_RESTARTS, M=pre, callback=cb,
                         callback_type="pr_norm")
         self.gmres_iterations += count[0]
         if info != 0:  # not reached: the residual it has is checked by the caller's scale
-            res = np.linalg.norm(self._apply_s(y, sn, co, transpose) - b)
-            if not res <= 1e3 * rtol * max(float(np.linalg.norm(b)), 1e-300):
-                y = np.full(n, np.nan)
-        return y
+            res = np.linalg.norm(self._apply_s(y, sn, co, transpose) - bi)
+            if not res <= 1e3 * rtol * max(float(np.linalg.norm(bi)), 1e-300):
+                return np.full(n, np.nan)
+        return self._from_inner(y)
 
     # -- the state ------------------------------------------------------------------------------
     def _at(self, x) -> tuple:
@@ -382,11 +408,15 @@ class KrylovHullProblem(HullProblem):
 
     def sensitivity_t(self, u, st, sens):
         """``T^T u = P^T rho_X^T Pi^T S^{-T} u``."""
+        return self._motion_t(self._sensitivity_t_grid(u, st, sens))
+
+    def _sensitivity_t_grid(self, u, st, sens):
+        """``rho_X^T Pi^T S^{-T} u`` on the grid (3, M): :meth:`sensitivity_t` before its
+        ``P^T`` (which the Hessian's product shares with ``L_xx``'s)."""
         lam = self._solve_s(u, st["sin_phi"], st["cos_phi"], transpose=True,
                             rtol=PRODUCT_RTOL)
         mu = self._lift(*self._split(lam))
-        wx = np.stack([sum(sens[3 * d + i] * mu[d] for d in range(3)) for i in range(3)])
-        return self._motion_t(wx)
+        return np.stack([sum(sens[3 * d + i] * mu[d] for d in range(3)) for i in range(3)])
 
 
 #: the rows of the 21 pointwise pairs (``_hull_kernel._pair``) as a symmetric 6 x 6 table
@@ -398,9 +428,7 @@ class KrylovHessian(HessianOperator):
     """The reduced Hessian of :class:`KrylovHullProblem` at one point as an operator:
     ``matvec(v) = H v`` (two GMRES solves, a few FFTs), ``diagonal`` an estimate of
     ``-H``'s diagonal for the conjugate gradients' preconditioner: ``L_xx``'s exact diagonal
-    (from the FFTs of its weights at frequencies 0 and 2n) plus, coupled, the same of the
-    hull's radiation of the pendulum's reaction with the weights replaced by their means
-    (the frequency-diagonal part of ``T^T L_yy T``)."""
+    (from the FFTs of its weights at frequencies 0 and 2n), the hull's terms left out."""
 
     mostly_positive = False
 
@@ -442,11 +470,11 @@ class KrylovHessian(HessianOperator):
         if self._d6 is None:  # the pointwise 6 x 6 matrices, once per point
             self._d6 = np.ascontiguousarray(self.d2[_PAIR])
         wz = np.einsum("uwm,wm->um", self._d6, z)
-        out = pr._motion_t(wz[:3])
-        if pr.coupled:
+        wx = wz[:3]
+        if pr.coupled:  # P^T (w_X + rho_X^T Pi^T S^{-T} Q^T w_Q): one P^T for both
             u = pr._flat(np.zeros(len(pr.static)), pr._pivot_t(wz[3:]))
-            out = out + pr.sensitivity_t(u, self.st, self.sens)
-        return out
+            wx = wx + pr._sensitivity_t_grid(u, self.st, self.sens)
+        return pr._motion_t(wx)
 
     def precondition(self, r):  # the diagonal only (``mostly_positive`` is False)
         return r / np.abs(self.diagonal)
@@ -474,21 +502,38 @@ def coarsened(case: HullCase, harmonics: int) -> HullCase:
         F=np.asarray(case.F)[:nh + 1])
 
 
-def continued_search(make, *, refine: bool = True):
+#: the gradient tolerance (relative to m g l w, as :data:`.hull.GTOL`) of the continuation's
+#: climbs whose maximum is not an answer but the next finer discretization's start (the
+#: finer one's maximum moves from it by far more: the 200-wave barge's padded maxima start
+#: 0.1 % to 1 % below the finer maxima), and of a refined answer's first stage (climbed
+#: again on twice the harmonics to GTOL; its power, in the refinement's history, within
+#: 2e-9 of the GTOL one's on that barge, the refinement's change 1e-3): the last Newton
+#: steps are the dearest (the most conjugate-gradient products each), and on that barge
+#: 1e-4 cut a level and the next together by a fifth against GTOL, to the same maximum
+#: (1e-3 stops while Newton still creeps: the next level pays it back and more)
+LEVEL_GTOL = 1e-4
+
+
+def continued_search(make, *, refine: bool = True, level: bool = False):
     """:func:`.hull.hull_search` of a long record by continuation in the harmonics: the
     search over the starts on the record with ``COARSENING`` times fewer harmonics (itself
     continued while it has at least ``LONG_RECORD_HARMONICS``), then its best coupled and
     one-way maxima padded to these harmonics and climbed by Newton (matrix-free), then the
     refinement as for any answer. The evidence (starts, distinct maxima) is the coarsest
-    search's; the iterations are all the levels'."""
+    search's; the iterations are all the levels'. A ``level`` (a finer search's start) and
+    an answer still to be refined are climbed to ``LEVEL_GTOL``, an answer to ``GTOL``."""
     case = make(1)
     coarse = coarsened(case, max(2, case.harmonics // COARSENING))
-    sol = hull_search(lambda scale: coarse, refine=False)
+    if coarse.harmonics >= _hull.LONG_RECORD_HARMONICS:
+        sol = continued_search(lambda scale: coarse, refine=False, level=True)
+    else:
+        sol = hull_search(lambda scale: coarse, refine=False)
     n = case.harmonics
+    gtol = LEVEL_GTOL if level or refine else GTOL
     one = newton_maximize(ideal_problem(case, coupled=False), _pad(sol.one_way_x, n),
-                          "one-way:continued", gtol=GTOL)
+                          "one-way:continued", gtol=gtol)
     pr = ideal_problem(case)
-    r = newton_maximize(pr, _pad(sol.x, n), f"{sol.found_by}:continued", gtol=GTOL)
+    r = newton_maximize(pr, _pad(sol.x, n), f"{sol.found_by}:continued", gtol=gtol)
     status, ok = r.status, r.status == "converged"
     if ok and aliased(pr, r.x):
         status, ok = "aliased", False
@@ -508,8 +553,11 @@ def continued_search(make, *, refine: bool = True):
 
 
 #: Lanczos (ARPACK) for the reduced Hessian's largest eigenvalue: Lanczos vectors, restarts
-#: at most, and the relative tolerance (the check is its sign)
-LANCZOS_VECTORS, LANCZOS_RESTARTS, LANCZOS_TOL = 20, 10, 1e-2
+#: at most, and the relative tolerance (the check is its sign). The synthetic hull's records
+#: converge within 2 restarts; the barge's records (240 to 5616 harmonics: its top
+#: eigenvalues cluster) had not within 10, which cost the 200-wave record 7 s of its 60 for
+#: a None: 4 bounds the check at about 60 products
+LANCZOS_VECTORS, LANCZOS_RESTARTS, LANCZOS_TOL = 20, 4, 1e-2
 
 
 def optimality(problem: HullProblem, x) -> tuple[float, float | None]:

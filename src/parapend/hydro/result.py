@@ -855,6 +855,35 @@ class MotionAt:
         xi = (self.xi[0].real + (e @ self.xi[1:]).real).T
         xi1 = (e @ (1j * w * kh[:, None] * self.xi[1:])).real.T
         xi2 = (e @ (-(w * kh[:, None]) ** 2 * self.xi[1:])).real.T
+        return self._loads(t, phi, phi1, phi2, xi, xi1, xi2)
+
+    def on_grid(self, points: int) -> dict:
+        """:meth:`__call__` at ``t_j = j T / points`` (``T`` the period), the trigonometric
+        sums by inverse FFTs on a grid of a multiple of ``points`` that resolves every
+        harmonic (the same values to rounding, in ``O(N log N)`` rather than
+        ``O(points N)``: a long record's thousands of harmonics)."""
+        cs, x, w = self.case, self.x, self.case.omega
+        n, nh = cs.harmonics, cs.hull_harmonics
+        r = max(1, -(-(2 * max(n, nh) + 2) // points))
+        m = r * points
+
+        def sums(c):  # Re sum_k c_k e^{iks} at s = 2 pi j / points (c: (..., K), k >= 1)
+            full = np.zeros(c.shape[:-1] + (m // 2 + 1,), dtype=complex)
+            full[..., 1:c.shape[-1] + 1] = c * (0.5 * m)
+            return np.fft.irfft(full, m, axis=-1)[..., ::r]
+
+        kn, kh = w * np.arange(1, n + 1), w * np.arange(1, nh + 1)
+        cn = x[n + 1:] - 1j * x[1:n + 1]
+        p0, p1, p2 = sums(np.stack((cn, 1j * kn * cn, -kn**2 * cn)))
+        s = 2 * np.pi * np.arange(points) / points
+        xk = self.xi[1:].T
+        h0, h1, h2 = sums(np.stack((xk, 1j * kh * xk, -kh**2 * xk)))
+        return self._loads(s / w, cs.winding * s + x[0] + p0, w * cs.winding + p1, p2,
+                           (self.xi[0].real + h0.T).T, h1, h2)
+
+    def _loads(self, t, phi, phi1, phi2, xi, xi1, xi2) -> dict:
+        """The torque, the power and the bearing's load from the motion (P)."""
+        cs = self.case
         g = cs.G
         p2 = g @ xi2
         ml = cs.m * cs.l
@@ -869,11 +898,12 @@ class MotionAt:
                 "relative_speed": v, "power": -tau * v, "pivot_force": np.hypot(fx, fz)}
 
 
-def peak(fun, period: float, points: int = PEAK_POINTS) -> float:
+def peak(fun, period: float, points: int = PEAK_POINTS, grid=None) -> float:
     """The largest value of the periodic ``fun(t)`` (vectorized): located on ``points``
-    samples, then refined between the neighbours of the largest by Brent's method."""
+    samples (``grid(points)``'s values there, when given: the same samples by a faster
+    route), then refined between the neighbours of the largest by Brent's method."""
     t = period * np.arange(points) / points
-    v = fun(t)
+    v = fun(t) if grid is None else grid(points)
     i = int(np.argmax(v))
     h = period / points
     r = minimize_scalar(lambda s: -float(fun(np.array([s]))[0]),
@@ -917,7 +947,8 @@ def _mode(sol) -> dict:
     y = pr.solve_hull(sol.x)
     mot = MotionAt(pr, sol.x, y)
     period = 2 * math.pi / sol.case.omega
-    pk = peak(lambda t: np.abs(mot(t)["tau"]), period)
+    pk = peak(lambda t: np.abs(mot(t)["tau"]), period,
+              grid=lambda m: np.abs(mot.on_grid(m)["tau"]))
     status, ok = sol.status, sol.success
     limit = sol.pto.torque_limit
     if limit is not None and math.isfinite(sol.power) and pk > limit * (1 + 1e-12):
@@ -926,7 +957,7 @@ def _mode(sol) -> dict:
         ok = ok and over <= TORQUE_SLACK
         status += (f"; between the grid points the peak torque is {pk:.6g} N m "
                    f"({over:.1e} above the limit)")
-    s = mot(period * np.arange(PEAK_POINTS) / PEAK_POINTS)
+    s = mot.on_grid(PEAK_POINTS)
     k = sol.case.winding
     # first- and second-order optimality of the ideal problem's answer (a take-off's
     # objective moves with its continuation and its limit's multipliers: not checked here)
@@ -1063,7 +1094,7 @@ def hull_answer(hull, pendulum, wave, *, pivot, windings=(1, 0), pitch_inertia=N
     at_rest = not power_of(best) > 0
     mot = None if at_rest else best["_motion"]
     period = 2 * math.pi / wave.omega
-    s = (mot or best["_motion"])(period * np.arange(PEAK_POINTS) / PEAK_POINTS)
+    s = (mot or best["_motion"]).on_grid(PEAK_POINTS)
     xi1 = best["_motion"].xi[1] if not at_rest else np.zeros(3)
     amps = np.asarray(wave.amplitudes)
     regular = amps.size == 1
@@ -1140,7 +1171,8 @@ def hull_answer(hull, pendulum, wave, *, pivot, windings=(1, 0), pitch_inertia=N
         swing_amplitude_deg=None if at_rest else best["swing_amplitude_deg"],
         peak_torque_nm=0.0 if at_rest else best["peak_torque_nm"],
         peak_pivot_force_n=peak(lambda t: (mot or best["_motion"])(t)["pivot_force"],
-                                period) if not at_rest else pendulum.mass * hull.g,
+                                period, grid=lambda m: (mot or best["_motion"]).on_grid(m)[
+                                    "pivot_force"]) if not at_rest else pendulum.mass * hull.g,
         harmonics=cs.harmonics, hull_harmonics=cs.hull_harmonics,
         refinement_change_w=None if at_rest else best["refinement_change_w"],
         discretization_error_estimate_w=(None if at_rest

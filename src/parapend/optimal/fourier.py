@@ -496,6 +496,13 @@ def newton_maximize(problem: FourierProblem, x0: np.ndarray, seed: str, *,
             # no measurable increase: at a maximum up to rounding, or stalled
             status = "converged" if gn <= 1e-7 * scale else "stalled"
             break
+        if t < 1.0 and pn - p <= _ROUNDING * abs(p) and gn <= 1e-7 * scale:
+            # a backtracked step "accepted" at rounding's level (P unchanged): the gradient
+            # is at its rounding floor above gtol, and each further iteration would cost a
+            # Hessian solve and a 40-step line search for nothing
+            status = "converged"
+            it -= 1
+            break
         x = xn
         p, g, h = problem.evaluate(x)
     gn = float(np.max(np.abs(g)))
@@ -506,6 +513,8 @@ def newton_maximize(problem: FourierProblem, x0: np.ndarray, seed: str, *,
 
 
 _ABANDON_SAFETY = 4.0
+#: a line search's increase of ``P`` below this (relative) is rounding, not progress
+_ROUNDING = 1e-14
 
 
 def _uniform_seed(excitation, harmonics: int, gamma: float, winding: int = 1) -> np.ndarray:

@@ -77,13 +77,15 @@ def hull_record_seconds(waves: float, ideal: bool = True) -> float:
     their refinement): the dense solver's
     :data:`parapend.performance.check.HULL_SOLVE_SECONDS` per 9 waves; an ideal take-off's
     records past ``hull.KRYLOV_HARMONICS`` solved matrix-free, near-linear in the length
-    (benchmarks/bench_hull_record.out.txt: 38 s at 50 waves, 108 s at 200 on the shared
-    2-core machine; taken as 30 s and 0.6 s a wave)."""
+    (benchmarks/bench_hull_record.out.txt, two runs on the shared 2-core machine at load 5
+    to 6, CPU seconds: 8.2 to 8.6 at 10 waves, 16 to 18 at 25, 26 at 50, 33 at 100, 59 to
+    63 at 200; a 2 x 2 matrix of 200-wave records, 72 s a record with one bin's retry on
+    1.5 times the harmonics; taken as 15 s and 0.3 s a wave, above every one of them)."""
     from ..hydro.hull import HARMONICS_PER_TURN, KRYLOV_HARMONICS
 
     waves = max(float(waves), 1.0)
     if ideal and HARMONICS_PER_TURN * waves >= KRYLOV_HARMONICS:
-        return 30.0 + 0.6 * waves
+        return 15.0 + 0.3 * waves
     return HULL_SOLVE_SECONDS * waves / 9.0
 
 
