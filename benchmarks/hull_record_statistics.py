@@ -61,36 +61,60 @@ def table(rows) -> str:
     return "\n".join(out)
 
 
-def plot(rows, path: str) -> None:
-    import matplotlib
-
-    matplotlib.use("Agg")
+def plot(rows, path: str | None = None):
+    """The settling figure: each record's power (grey dots), each length's mean and its
+    95 % interval against the record's length on a log axis, the longest records' mean
+    drawn across as the reference the shorter ones are read against, each length's count
+    of records below it. ``rows`` as :func:`run` returns them (or
+    the ``rows`` of ``--data``'s JSON). Returns the figure (saved into ``path`` if given)."""
     import matplotlib.pyplot as plt
 
     ok = [r for r in rows if "refused" not in r and r["mean"] is not None]
-    fig, ax = plt.subplots(figsize=(5.5, 3.5))
-    for r in ok:
-        ax.plot([r["waves"]] * len(r["powers"]),
-                [p for p in r["powers"] if p is not None and math.isfinite(p)], ".",
-                color="0.6")
+    fig, ax = plt.subplots(figsize=(6.0, 3.8))
+    ref = max(ok, key=lambda r: r["waves"])
+    ax.axhline(ref["mean"], color="C0", lw=0.8, ls=":",
+               label=f"{ref['waves']:g}-wave mean")
+    for i, r in enumerate(ok):
+        pw = [p for p in r["powers"] if p is not None and math.isfinite(p)]
+        ax.plot([r["waves"] / 1.1] * len(pw), pw, "_", color="0.55", ms=8,
+                label="one record" if i == 0 else None)
         if r["ci"] is not None:
-            ax.errorbar(r["waves"], r["mean"], yerr=r["half"], fmt="o", color="C0", capsize=4)
+            ax.errorbar(r["waves"], r["mean"], yerr=r["half"], fmt="o", color="C0",
+                        capsize=4, label="mean, 95 % interval" if i == 0 else None)
         else:
             ax.plot(r["waves"], r["mean"], "o", color="C0")
+        short = "" if r["solved"] == r["realizations"] else f" of {r['realizations']}"
+        ax.annotate(f"R = {r['solved']}{short}", (r["waves"], min(pw)), xytext=(0, -10),
+                    textcoords="offset points", ha="center", va="top", fontsize=8)
     ax.set_xscale("log")
+    ax.set_xticks([r["waves"] for r in ok], [f"{r['waves']:g}" for r in ok])
+    ax.minorticks_off()
+    lo, hi = ax.get_ylim()
+    ax.set_ylim(lo - 0.08 * (hi - lo), hi)
     ax.set_xlabel("record length (peak periods)")
     ax.set_ylabel("mean power (W)")
-    ax.set_title("embedded barge: mean power and its 95 % interval", fontsize=10)
+    ax.set_title("embedded barge, Hs 1.5 m, Tp 6 s: a sea state's mean power", fontsize=10)
+    ax.legend(fontsize=8, loc="upper right")
     fig.tight_layout()
-    fig.savefig(path, dpi=120)
+    if path:
+        fig.savefig(path, dpi=120)
+    return fig
 
 
 def save_data(rows, a, path: str) -> None:
     """The measured rows (each length's records' powers, mean, interval, time) as JSON,
-    rewritten after each length so an interrupted run keeps what it finished."""
+    rewritten after each length so an interrupted run keeps what it finished. Rows of other
+    lengths already in ``path`` are kept (a length measured again replaces its row): one
+    length can be re-run alone."""
     import json
     import os
 
+    if os.path.exists(path):
+        with open(path) as fh:
+            old = json.load(fh).get("rows", [])
+        now = {r["waves"] for r in rows}
+        rows = sorted([r for r in old if r["waves"] not in now] + list(rows),
+                      key=lambda r: r["waves"])
     doc = {"device": "embedded barge (buoy --dofs surge,heave,pitch defaults)",
            "hs_m": a.hs, "tp_s": a.tp, "seeds": "0..R-1 per length",
            "ci": "Student t, 95 %", "rows": rows}
@@ -129,6 +153,9 @@ def main() -> None:
     print(f"\nembedded barge, Hs {a.hs:g} m, Tp {a.tp:g} s, seeds 0..R-1 per length:")
     print(table(rows))
     if a.plot:
+        import matplotlib
+
+        matplotlib.use("Agg")
         plot(rows, a.plot)
         print(f"written: {a.plot}")
 
