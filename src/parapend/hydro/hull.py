@@ -749,12 +749,20 @@ def _refine(sol: HullSolution, make, x) -> HullSolution:
     top = PTO_MAX_SCALE if pto.active else MAX_SCALE
     # a lossy take-off's problem is dense (its cost the cube of the harmonics): one doubling
     # past its cap; an ideal one's is matrix-free from KRYLOV_HARMONICS on (near-linear in
-    # the harmonics), so its doublings go as far as a record's cap, and two past it (the
-    # 200-wave barge record at Hs 2 m, Tp 6 s: 1e-3 at 5616 harmonics, 2e-5 at 11232)
-    cap, past = ((HULL_MAX_REFINED_HARMONICS, 2) if pto.active
-                 else (HULL_MAX_RECORD_HARMONICS, 4))
-    while scale < top and 2 * scale * sol.case.harmonics <= max(cap,
-                                                                past * sol.case.harmonics):
+    # the harmonics), so its doublings go as far as a record's cap, and past it one more
+    # while the last one leaves the answer unresolved (the 200-wave barge record at Hs 2 m,
+    # Tp 6 s: 1.02e-3 at 5616 harmonics, 2e-5 at 11232)
+    cap = HULL_MAX_REFINED_HARMONICS if pto.active else HULL_MAX_RECORD_HARMONICS
+    h0 = sol.case.harmonics
+
+    def another(n):
+        """Whether to refine to ``n`` harmonics."""
+        if n <= max(cap, 2 * h0):
+            return True
+        return (not pto.active and n <= 4 * h0 and math.isfinite(change)
+                and change > UNRESOLVED * max(abs(power), 1e-300))
+
+    while scale < top and another(2 * scale * h0):
         scale *= 2
         case = make(scale)
         if pto.active:
