@@ -14,7 +14,8 @@ do), the fraction of the record's non-causal optimum (``solve_record``) printed 
 - ``oracle:N``: L-BFGS-B from the shifted plan AND from the non-causal optimum's own
   torque over the horizon (not causal: a diagnosis), the better horizon objective applied;
 - ``tail:N``: the buoy's zero-excitation tail of one peak period after the horizon (24 more
-  torques planned, the first ``n`` applied), L-BFGS-B of ``N`` iterations;
+  torques planned, the first ``n`` applied), L-BFGS-B of ``N`` iterations (the default
+  samples and update interval only);
 
 with ``key=value`` pairs passed on to ``hull_mpc`` (``terminal_weight``, ``horizon``,
 ``plant_steps``).
