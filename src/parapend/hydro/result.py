@@ -858,7 +858,7 @@ class MotionAt:
         return self._loads(t, phi, phi1, phi2, xi, xi1, xi2)
 
     def on_grid(self, points: int) -> dict:
-        """:meth:`__call__` at ``t_j = j T / points`` (``T`` the period), the trigonometric
+        """``__call__`` at ``t_j = j T / points`` (``T`` the period), the trigonometric
         sums by inverse FFTs on a grid of a multiple of ``points`` that resolves every
         harmonic (the same values to rounding, in ``O(N log N)`` rather than
         ``O(points N)``: a long record's thousands of harmonics)."""
