@@ -870,11 +870,7 @@ def hull_problem(**opts) -> dict:
     windings = (1, 0) if winding is None else (check_int("winding", winding, 0, 16),)
     harmonics = opts.get("harmonics")
     if harmonics is not None:
-        # an ideal take-off's problem is matrix-free from KRYLOV_HARMONICS on (a record's
-        # cap); a lossy one's dense
-        ideal = pto is None or not pto.active
-        harmonics = check_int("harmonics", harmonics, 2, limits.HULL_MAX_RECORD_HARMONICS
-                              if ideal else limits.HULL_MAX_HARMONICS)
+        harmonics = check_int("harmonics", harmonics, 2, hull_harmonics_cap(pto))
     return {"hull": hull, "pendulum": pend, "pivot": pivot, "pitch_inertia": inertia,
             "winding": winding, "windings": windings, "harmonics": harmonics,
             "geometry": geometry, "pto": pto}
@@ -1053,6 +1049,14 @@ def _check_wave_kind(opts):
             raise ParameterError(f"{flag}: not used with --record; drop it")
 
 
+def hull_harmonics_cap(pto) -> int:
+    """The most harmonics of the hull's motion: an ideal take-off's problem is matrix-free
+    from ``hull.KRYLOV_HARMONICS`` on (``limits.HULL_MAX_RECORD_HARMONICS``), a lossy one's
+    dense (``limits.HULL_MAX_HARMONICS``)."""
+    ideal = pto is None or not pto.active
+    return limits.HULL_MAX_RECORD_HARMONICS if ideal else limits.HULL_MAX_HARMONICS
+
+
 def _check_hull_size(wave, windings, harmonics, pto=None, cap=None):
     """Refuse a record whose motion needs more harmonics than finish in about a minute (with
     a power take-off: dense Newton, ``limits.HULL_MAX_HARMONICS``), or than an ideal
@@ -1063,7 +1067,7 @@ def _check_hull_size(wave, windings, harmonics, pto=None, cap=None):
     n = harmonics or HARMONICS_PER_TURN * max(max(windings), waves_in(wave))
     ideal = pto is None or not pto.active
     if cap is None:
-        cap = limits.HULL_MAX_RECORD_HARMONICS if ideal else limits.HULL_MAX_HARMONICS
+        cap = hull_harmonics_cap(pto)
     if n > cap:
         why = ("that the matrix-free solver takes (time and memory)" if
                cap == limits.HULL_MAX_RECORD_HARMONICS else "that finish in about a minute" +

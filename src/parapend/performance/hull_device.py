@@ -132,8 +132,7 @@ def check_records(spec) -> None:
     any bin runs; refused in one line naming ``--waves`` (and the largest that fits) or the
     period bin. The records of one period bin differ in Hm0 and seed only: the same band
     and, with the amplitudes' shape unchanged, the same size."""
-    from .. import limits
-    from ..hydro.api import solve_record
+    from ..hydro.api import hull_harmonics_cap, solve_record
     from ..hydro.hull import HARMONICS_PER_TURN
     from .buoy_device import wave_of
 
@@ -146,9 +145,7 @@ def check_records(spec) -> None:
             head, _, rest = str(err).partition(": ")
             if head == "repeat-period":
                 most = largest_waves(spec)
-                pto = p["pto"]
-                cap = (limits.HULL_MAX_RECORD_HARMONICS if pto is None or not pto.active
-                       else limits.HULL_MAX_HARMONICS)
+                cap = hull_harmonics_cap(p["pto"])
                 fit = ("no record fits" if most is None
                        else f"at most {most:g} peak periods fit")
                 raise ParameterError(
@@ -185,8 +182,7 @@ def _retry(spec, wave, info, res):
     stands)."""
     import logging
 
-    from .. import limits
-    from ..hydro.api import solve_record
+    from ..hydro.api import hull_harmonics_cap, solve_record
     from ..hydro.hull import HARMONICS_PER_TURN, waves_in
 
     p = problem(spec)
@@ -194,8 +190,7 @@ def _retry(spec, wave, info, res):
         return res
     n = HARMONICS_PER_TURN * max(max(p["windings"]), waves_in(wave))
     more = int(math.ceil(RETRY_HARMONICS * n / 2)) * 2
-    ideal = p["pto"] is None or not p["pto"].active  # matrix-free: a record's cap
-    if more > (limits.HULL_MAX_RECORD_HARMONICS if ideal else limits.HULL_MAX_HARMONICS):
+    if more > hull_harmonics_cap(p["pto"]):
         return res
     again = solve_record({**p, "harmonics": more}, wave, info)
     logging.getLogger(__name__).info(
