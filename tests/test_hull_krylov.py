@@ -230,21 +230,28 @@ def test_barge_ten_wave_record_matrix_free_is_the_dense_answer():
 
 
 def test_optimality_checks_agree_between_solvers():
-    """At a maximum: the gradient vanishes (below GTOL m g l w) and the reduced Hessian's
-    largest eigenvalue is negative, the same by Lanczos on the operator as by LAPACK on the
-    dense matrix (to Lanczos's tolerance)."""
-    from parapend.hydro._hull_krylov import LANCZOS_TOL, optimality
+    """At a maximum: the gradient vanishes (below GTOL m g l w) and the Hessian is negative
+    definite. The operator's scaled eigenvalue (Lanczos on ``D^-1/2 H D^-1/2``, ``D`` its
+    diagonal estimate) equals LAPACK's on the same scaled matrix built column by column
+    from the operator's products (to Lanczos's tolerance), and its sign is that of the
+    dense Hessian's largest eigenvalue (Sylvester's law of inertia)."""
+    from parapend.hydro._hull_krylov import LANCZOS_TOL, _scaled, optimality
 
     cs = _record(winding=0)
     d = HullProblem(cs)
     r = max((newton_maximize(d, x0, n, gtol=GTOL) for n, x0 in
              hull_mod._starts(cs.harmonics, 0)[:4]), key=lambda r: r.power)
-    gd, td = optimality(d, r.x)
-    gk, tk = optimality(KrylovHullProblem(cs), r.x)
+    gd, td, sd = optimality(d, r.x)
+    kp = KrylovHullProblem(cs)
+    gk, tk, sk = optimality(kp, r.x)
     scale = float(d.w[0])
     assert gd <= GTOL * scale and gk <= 10 * GTOL * scale
-    assert td < 0 and tk is not None
-    assert tk == pytest.approx(td, rel=10 * LANCZOS_TOL)
+    assert td < 0 and sd < 0 and tk is None and sk is not None and sk < 0
+    _, _, h = kp.evaluate(r.x)
+    s = _scaled(h.diagonal)
+    cols = np.column_stack([s * h.matvec(s * e) for e in np.eye(r.x.size)])
+    top = float(np.linalg.eigvalsh(0.5 * (cols + cols.T))[-1])
+    assert sk == pytest.approx(top, rel=10 * LANCZOS_TOL)
 
 
 def test_each_mode_carries_its_optimality(dataset):
@@ -256,6 +263,7 @@ def test_each_mode_carries_its_optimality(dataset):
     for m in r.modes[:-1]:
         assert m["gradient_max_w_per_rad"] <= 1e-7 * PEND["mass"] * 9.81 * 1.2
         assert m["hessian_largest_eigenvalue_w_per_rad2"] < 0
+        assert m["hessian_scaled_largest_eigenvalue"] < 0
 
 
 def test_records_past_what_fits_are_refused_in_one_line(dataset):

@@ -961,8 +961,8 @@ def _mode(sol) -> dict:
     k = sol.case.winding
     # first- and second-order optimality of the ideal problem's answer (a take-off's
     # objective moves with its continuation and its limit's multipliers: not checked here)
-    grad, top = (None, None) if sol.pto.active or not math.isfinite(sol.power) else \
-        _hull_krylov.optimality(pr, sol.x)
+    grad, top, scaled = (None, None, None) if sol.pto.active or not math.isfinite(sol.power) \
+        else _hull_krylov.optimality(pr, sol.x)
     swing = None if k else 0.5 * _deg(np.max(s["phi"]) - np.min(s["phi"]))
     mean = _deg(math.remainder(float(np.mean(s["phi"])) - math.pi, 2 * math.pi) + math.pi)
     return {"mode": "swinging" if k == 0 else "rotation", "winding": k,
@@ -978,6 +978,7 @@ def _mode(sol) -> dict:
             "maxima_powers_w": [float(v) for v in sol.maxima_powers],
             "found_by": sol.found_by, "starts": sol.runs, "success": ok,
             "gradient_max_w_per_rad": grad, "hessian_largest_eigenvalue_w_per_rad2": top,
+            "hessian_scaled_largest_eigenvalue": scaled,
             "status": status, "_solution": sol, "_motion": mot}
 
 
