@@ -40,6 +40,7 @@ r = parapend.buoy(dofs="surge,heave,pitch", hs=1.5, tp=6.0, repeat_period=waves 
 print(json.dumps({"seconds": time.perf_counter() - t, "power_w": r.power_w,
                   "cpu_seconds": time.process_time() - c,
                   "harmonics": r.harmonics, "status": r.status,
+                  "scaled": [m.get("hessian_scaled_largest_eigenvalue") for m in r.modes[:-1]],
                   "rss_mb": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024}))
 """
 
@@ -101,7 +102,8 @@ def main():
                      f"{d['seconds'] / r['seconds']:7.1f} {d['power_w']:14.9g}")
         print(f"{w:6g} {r['harmonics']:6d} {r['seconds']:9.1f} {r['cpu_seconds']:8.1f} "
               f"{r['rss_mb']:9.0f} "
-              f"{r['power_w']:14.9g} {dcols}  {r['status']}", flush=True)
+              f"{r['power_w']:14.9g} {dcols}  {r['status']}; scaled Hessian's largest "
+              f"eigenvalue (rotation, swinging): {r.get('scaled')}", flush=True)
     fit = [w for w in sorted(times) if 25 <= w <= 200]
     if len(fit) >= 2:
         print(f"log-log slope of time against waves, {fit[0]:g} to {fit[-1]:g} waves: "
