@@ -146,7 +146,7 @@ def test_a_lossy_take_off_shows_the_electrical_power(dataset, stand_in, tmp_path
 
 def test_the_command_line_reports_the_modes(dataset, capsys, stand_in):
     """The command line's JSON names each bin's mode (swinging included) and its text
-    report counts them."""
+    report names the hull and counts them."""
     args = ["power-matrix", "--device", "buoy", "--dofs", "surge,heave,pitch", "--hydro",
             dataset, "--hs", "1,2", "--tp", "5,6", "--waves", "2", "--realizations", "1",
             "--workers", "1", *(x for k, v in PEND.items()
@@ -157,6 +157,7 @@ def test_the_command_line_reports_the_modes(dataset, capsys, stand_in):
     assert main(args) == 0
     text = capsys.readouterr().out
     assert "1 rotation, 1 swinging, 2 rest" in text
+    assert text.startswith("power matrix, hull (surge, heave, pitch): 2 Hm0 x 2 tp bins")
 
 
 def test_dofs_heave_keeps_the_store_identity():
@@ -318,6 +319,13 @@ def test_the_hulls_causal_column_is_in_the_spec(dataset):
     assert spec.forecasts == ("perfect", "ar")
     assert MatrixSpec.from_json(spec.to_json()) == spec
     assert "causal_perfect_power" in spec.variables and "causal_ar_power" in spec.variables
+    # the work estimate before any bin runs prices the hull's controller: the runs' length
+    # (warm-up and record) times its cost a peak period, per forecast
+    from parapend.performance.check import BUOY_CAUSAL_SECONDS, record_seconds
+
+    want = (BUOY_CAUSAL_SECONDS["hull"] * (spec.waves + spec.warm_up) * spec.horizon
+            * (0.125 / spec.update_interval) * 2)
+    assert record_seconds(spec) == pytest.approx(want, rel=1e-12)
 
 
 @pytest.mark.slow

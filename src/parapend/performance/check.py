@@ -68,8 +68,12 @@ CAUSAL_SECONDS = {"perfect": 7.5, "ar": 10.5}
 #: Hs 0.5 m, Tp 2.5 s, 1.6 and 1.9 s at Hs 1 m, Tp 2.5 and 3 s; at a horizon of 2, 0.32 and
 #: 3.06 s at Hs 0.5 m): taken as the horizon (at least half a peak period) over the update
 #: interval, per forecast (the AR forecast's run cost the perfect one's: 23.3 s against 20.9
-#: and 25.0 s of CPU, ``parapend buoy --hs 1 --tp 3 --repeat-period 30 --controller mpc``)
-BUOY_CAUSAL_SECONDS = {"plan": 0.25, "coupled": 2.0}
+#: and 25.0 s of CPU, ``parapend buoy --hs 1 --tp 3 --repeat-period 30 --controller mpc``);
+#: the hull's (``hull``, :func:`parapend.hydro.hull_control.hull_mpc`): its runs of the
+#: embedded barge's default sea (benchmarks/hull_mpc_table.out.txt, 8 peak periods at a
+#: horizon of 2, load 5 to 8) took 7 to 100 s (perfect) and 19 to 138 s (AR): 0.4 to 8.6 s
+#: a peak period per unit of horizon
+BUOY_CAUSAL_SECONDS = {"plan": 0.25, "coupled": 2.0, "hull": 4.5}
 
 
 def hull_record_seconds(waves: float, ideal: bool = True) -> float:

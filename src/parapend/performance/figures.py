@@ -213,11 +213,19 @@ def _per_year(wh: float) -> str:
     return text if text == "n/a" else text + "/yr"
 
 
+def _hull(ds) -> bool:
+    """The store's spec is the hull's (``dofs`` other than heave alone)."""
+    import json
+
+    return json.loads(ds.attrs.get("sweep") or "{}").get("dofs", "heave") != "heave"
+
+
 def text_report(ds, out: dict, drawn: list) -> str:
     """The plain-text summary of ``parapend power-matrix``."""
     pk = _period(ds)
     hm0, per = ds["hm0"].values, ds[pk].values
-    what = "coupled buoy" if out["device"] == "buoy" else f"{out['device']} pendulum"
+    what = (f"{out['device']} pendulum" if out["device"] != "buoy" else
+            "hull (surge, heave, pitch)" if _hull(ds) else "coupled buoy")
     lines = [f"power matrix, {what}: {hm0.size} Hm0 x {per.size} {pk} bins, "
              f"{_records(out['realizations'])} of {out['waves']:g} peak periods each ("
              + (f"seed {out['seeds'][0]}" if len(out["seeds"]) == 1 else
@@ -353,6 +361,7 @@ def _causal_lines(ds, c: dict, hm0, per, pk) -> list:
                  f"peak periods, a plan every {c['update_interval_peak_periods']:g} of them, "
                  + (f"{c['plan_samples']} torque samples per plan interval"
                     if c.get("buoy_controller") is None else
+                    "the hull's controller" if c["buoy_controller"] == "hull" else
                     f"the buoy's {c['buoy_controller']} controller")
                  + ("" if c.get("speed_limit") is None else
                     f", speed penalty above {c['speed_limit']:g} sqrt(g/l)")
@@ -376,8 +385,9 @@ def _causal_lines(ds, c: dict, hm0, per, pk) -> list:
                          "e.g. a storage correction larger than the work): left out of the "
                          "bins' means")
         if bad:
-            why = ("the log names them and their status, e.g. \"solves_failed\": most of "
-                   "the buoy's horizon solves failed" if c.get("buoy_controller") else
+            body = "hull" if c.get("buoy_controller") == "hull" else "buoy"
+            why = (f"the log names them and their status, e.g. \"solves_failed\": most of "
+                   f"the {body}'s horizon solves failed" if c.get("buoy_controller") else
                    "the log names them; \"unresolved\": the plans spun the pendulum past a "
                    "turn per torque sample, see --speed-limit")
             lines.append(f"{bad} of {runs.size} causal runs failed ({why}): left out of the "
