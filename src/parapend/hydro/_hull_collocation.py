@@ -25,10 +25,14 @@ memory at every point IPOPT's factorizations took 0.4 s an iteration, at every t
 s). Against the plant (RK4, its memory's trapezoid on the step) the collocation's motion
 under fixed torques converges at second order (the memory's trapezoid) as the interval
 halves (tests/test_hull_collocation.py). The objective (minimized, units ``m g
-l rad``) is :class:`.hull_control.HullHorizon`'s without its speed penalty (the points
-resolve the motion): minus the work of the torque (Simpson's rule of the power ``-tau v``,
-electrical ``e(p)`` with an efficiency, its kink smoothed) and minus ``kappa`` times the
-mechanical energy gained at the horizon's end.
+l rad``) is :class:`.hull_control.HullHorizon`'s: minus the exact work of every held torque
+``-u_j (theta_(j+1) - theta_j)`` (electrical ``e(.)`` with an efficiency, its kink
+smoothed) and minus ``kappa`` times the mechanical energy gained at the horizon's end. In
+place of its speed penalty the generator's speed ``phi' - beta'`` is bounded at every point
+by ``MAX_TURN`` rad per plant step (0.4: 9.6 rad/s on the default barge's step, past the
+record optimum's 7.8 to 8.6 rad/s; without a bound the plans of the default barge spun
+the pendulum to 16 rad/s, where the plant's steps no longer follow them, and the run
+ended unresolved).
 
 The NLP is built once per run (the start, the memory's past part and the forecast are its
 parameters) and warm-started from the previous solution shifted by the update interval.
@@ -52,6 +56,8 @@ INTERVALS = 3
 #: the horizon's own memory is summed over every this many points (and is linear between):
 #: its constraint rows are dense (lower triangular), the rest of the NLP is banded
 MEMORY_STRIDE = 3
+#: the generator's planned speed at most, rad per plant step (None: unbounded)
+MAX_TURN = 0.4
 #: IPOPT return statuses counted as a solved horizon (0) or an iteration cap (1)
 _SOLVED = ("Solve_Succeeded", "Solved_To_Acceptable_Level")
 _CAPPED = ("Maximum_Iterations_Exceeded", "Maximum_CpuTime_Exceeded",
@@ -78,6 +84,7 @@ class HullCollocation:
             intervals = max(r for r in range(1, INTERVALS + 1) if steps % (2 * r) == 0
                             ) if steps % 2 == 0 else 1
         intervals = int(intervals)
+        self.max_turn = MAX_TURN
         if steps % (2 * intervals):
             raise ParameterError(f"plant_steps: expected a multiple of {2 * intervals} with "
                                  f"the collocation planner, got {steps}")
@@ -108,7 +115,7 @@ class HullCollocation:
         ca = _casadi()
         pl = self.plant
         npt, ni, nx, na = self._layout()
-        n, steps, tu, hh = self.n, self.steps, self.tu, self.spacing
+        n, tu, hh = self.n, self.tu, self.spacing
         m, ell, inertia, c, g = (float(v) for v in pl.par)
         ml = m * ell
         gm, mt, cp = ca.DM(pl.gm), ca.DM(pl.mt), ca.DM(pl.cp)
@@ -153,7 +160,7 @@ class HullCollocation:
 
         eg, em = self.eta
         ae, be = 0.5 * (eg + 1.0 / em), 0.5 * (eg - 1.0 / em)
-        width = 1e-3 / (pl.h * steps)  # the kink smoothed over this power (m g l rad / s)
+        width = 1e-3  # the kink smoothed over this work (m g l rad), as HullHorizon's
 
         def elec(pw):
             if be == 0.0:
@@ -176,13 +183,21 @@ class HullCollocation:
             cons.append(vm - 0.5 * (v0 + v1) - hi / 8.0 * (a0 - a1))
             cons.append(q1 - q0 - hi / 6.0 * (v0 + 4.0 * vm + v1))
             cons.append(v1 - v0 - hi / 6.0 * (a0 + 4.0 * am + a1))
-            pw = [-tau * (y[7] - y[6]) / tu for y in (y0_, ym, y1)]
-            work += hi / 6.0 * (elec(pw[0]) + 4.0 * elec(pw[1]) + elec(pw[2]))
+        # the exact work of each held torque, -u_j (theta_(j+1) - theta_j) (m g l rad)
+        th = ys[3, ::2 * self.intervals] - ys[2, ::2 * self.intervals]
+        for j in range(n):
+            work += elec(-u[j] * (th[j + 1] - th[j]))
         obj = -(work + self.kappa * (energy(ys[:, -1]) - energy(p_y0)) / tu)
         par = ca.vertcat(p_y0, ca.reshape(p_mu, -1, 1), ca.reshape(p_f, -1, 1))
         self._mem = ca.Function("mem", [xs, par], [mem])
+        neq = ca.vertcat(*cons).shape[0]
+        # the generator's speed within what the plant's steps resolve
+        cons.append((ys[7, 1:] - ys[6, 1:]).T)
         gcat = ca.vertcat(*cons)
         self.ng = gcat.shape[0]
+        vmax = self.max_turn / pl.h if self.max_turn else np.inf
+        self.lbg = np.concatenate((np.zeros(neq), np.full(npt - 1, -vmax)))
+        self.ubg = -self.lbg
         self._obj = ca.Function("obj", [xs, par], [obj])
         self.solver = ca.nlpsol("hullcol", "ipopt", {"x": xs, "p": par, "f": obj, "g": gcat},
                                 {"ipopt": self.options, "print_time": False})
@@ -310,7 +325,7 @@ class HullCollocation:
         sl = slice(self.nx + self.na, self.nx + self.na + self.n)
         lb[sl] = ub[sl] = u
         x0 = self._with_memory(self.guess(u, fseg), par)
-        r = self.solver(x0=x0, p=par, lbx=lb, ubx=ub, lbg=0.0, ubg=0.0)
+        r = self.solver(x0=x0, p=par, lbx=lb, ubx=ub, lbg=self.lbg, ubg=self.ubg)
         return np.asarray(r["x"]).ravel()[:self.nx].reshape(self.npt, 8)
 
     # -- one solve --------------------------------------------------------------------------
@@ -330,7 +345,7 @@ class HullCollocation:
             x0 = self.shifted(self.shift)
             x0[:8] = pl.y
         x0 = self._with_memory(x0, par)
-        r = self.solver(x0=x0, p=par, lbx=self.lbx, ubx=self.ubx, lbg=0.0, ubg=0.0)
+        r = self.solver(x0=x0, p=par, lbx=self.lbx, ubx=self.ubx, lbg=self.lbg, ubg=self.ubg)
         st = self.solver.stats()
         name = st.get("return_status", "")
         x = np.asarray(r["x"]).ravel()
