@@ -7,7 +7,8 @@ of 4 Tp, seeds given), :func:`parapend.hydro.hull_control.hull_mpc` with the hor
 command picks (:func:`parapend.hydro.hull_control.start_mode` from the optimum's motion);
 per seed and forecast: the power, its fraction of the optimum (``solve_record``), the failed
 solves, the horizon solves IPOPT ended short of its tolerance (iteration cap), and the update
-time's p99 (forecast + solve) against the update interval (0.75 s).
+time's p99 (forecast + solve) against the update interval (0.75 s), the plant's energy
+balance residual and the largest turn of the generator in one plant step (rad).
 
     nice python benchmarks/hull_collocation_table.py --seeds 0 1 2 --forecast perfect
     nice python benchmarks/hull_collocation_table.py --seeds 0 1 2 --forecast ar
@@ -22,6 +23,7 @@ import time
 
 import numpy as np
 
+from parapend.hydro import _hull_collocation as hcol
 from parapend.hydro import hull_control as hc
 from parapend.hydro.api import hull_problem, solve_record
 from parapend.hydro.declared import default_of
@@ -35,7 +37,11 @@ def main():
     ap.add_argument("--forecast", nargs="+", default=["perfect"], choices=["perfect", "ar"])
     ap.add_argument("--planner", default="collocation", choices=["collocation", "lbfgsb"])
     ap.add_argument("--plant-steps", type=int, default=hc.PLANT_STEPS)
+    ap.add_argument("--max-turn", type=float, default=None,
+                    help="the speed bound, rad a plant step (default MAX_TURN)")
     a = ap.parse_args()
+    if a.max_turn is not None:
+        hcol.MAX_TURN = a.max_turn
     p = hull_problem()
     pend = p["pendulum"]
     caps = []
@@ -47,9 +53,11 @@ def main():
         return r
 
     hc._plan = plan
-    print(f"planner {a.planner}, {a.plant_steps} plant steps a sample")
+    print(f"planner {a.planner}, {a.plant_steps} plant steps a sample, speed bound "
+          f"{hcol.MAX_TURN} rad a plant step")
     print("seed forecast mode optimum_w power_w fraction stored_w failed capped "
-          "update_median_s update_p99_s interval_s status wall_s", flush=True)
+          "update_median_s update_p99_s interval_s status wall_s balance_residual "
+          "max_turn_per_step", flush=True)
     fr = {fc: [] for fc in a.forecast}
     for seed in a.seeds:
         wave, info = _irregular_wave(1.0, 6.0, "jonswap", 3.3, 24.0, seed,
@@ -70,7 +78,10 @@ def main():
             print(f"{seed} {fc} {mode} {opt.power_w:.1f} {r.mean_power_w:.1f} {f:.3f} "
                   f"{r.stored_w:.1f} {r.failed_solves}/{r.solves} {sum(caps)}/{len(caps)} "
                   f"{r.update_time_median_s:.3f} {r.update_time_p99_s:.3f} "
-                  f"{r.update_interval_s:.3f} {r.status} {time.time() - t:.0f}", flush=True)
+                  f"{r.update_interval_s:.3f} {r.status} {time.time() - t:.0f} "
+                  f"{r.energy_balance_residual:.2g} "
+                  f"{np.max(np.abs(r.series['theta_dot'])) * r.units['plant_step_s']:.3f}",
+                  flush=True)
     for fc, v in fr.items():
         ok = [x for x in v if math.isfinite(x)]
         print(f"mean {fc}: {np.mean(ok) if ok else math.nan:.3f} over {len(ok)} of {len(v)}, "
