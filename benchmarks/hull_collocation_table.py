@@ -39,7 +39,11 @@ def main():
     ap.add_argument("--plant-steps", type=int, default=hc.PLANT_STEPS)
     ap.add_argument("--max-turn", type=float, default=None,
                     help="the speed bound, rad a plant step (default MAX_TURN)")
+    ap.add_argument("--intervals", type=int, default=None,
+                    help="Hermite-Simpson intervals a torque sample (default INTERVALS)")
     a = ap.parse_args()
+    if a.intervals is not None:
+        hcol.INTERVALS = a.intervals
     if a.max_turn is not None:
         hcol.MAX_TURN = a.max_turn
     p = hull_problem()
@@ -54,7 +58,7 @@ def main():
 
     hc._plan = plan
     print(f"planner {a.planner}, {a.plant_steps} plant steps a sample, speed bound "
-          f"{hcol.MAX_TURN} rad a plant step")
+          f"{hcol.MAX_TURN} rad a plant step, at most {hcol.INTERVALS} intervals a sample")
     print("seed forecast mode optimum_w power_w fraction stored_w failed capped "
           "update_median_s update_p99_s interval_s status wall_s balance_residual "
           "max_turn_per_step", flush=True)
