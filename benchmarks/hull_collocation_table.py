@@ -39,6 +39,8 @@ def main():
     ap.add_argument("--plant-steps", type=int, default=hc.PLANT_STEPS)
     ap.add_argument("--max-turn", type=float, default=None,
                     help="the speed bound, rad a plant step (default MAX_TURN)")
+    ap.add_argument("--terminal-weight", type=float, default=None,
+                    help="kappa, the weight of the energy left at the horizon's end")
     ap.add_argument("--intervals", type=int, default=None,
                     help="Hermite-Simpson intervals a torque sample (default INTERVALS)")
     a = ap.parse_args()
@@ -58,7 +60,8 @@ def main():
 
     hc._plan = plan
     print(f"planner {a.planner}, {a.plant_steps} plant steps a sample, speed bound "
-          f"{hcol.MAX_TURN} rad a plant step, at most {hcol.INTERVALS} intervals a sample")
+          f"{hcol.MAX_TURN} rad a plant step, at most {hcol.INTERVALS} intervals a sample, "
+          f"terminal weight {a.terminal_weight}")
     print("seed forecast mode optimum_w power_w fraction stored_w failed capped "
           "update_median_s update_p99_s interval_s status wall_s balance_residual "
           "max_turn_per_step", flush=True)
@@ -76,7 +79,7 @@ def main():
             t = time.time()
             r = hc.hull_mpc(p["hull"], pend, wave, peak_period=6.0, pivot=p["pivot"],
                             forecast=fc, mode=mode, planner=a.planner,
-                            plant_steps=a.plant_steps)
+                            plant_steps=a.plant_steps, terminal_weight=a.terminal_weight)
             f = r.mean_power_w / opt.power_w
             fr[fc].append(f)
             print(f"{seed} {fc} {mode} {opt.power_w:.1f} {r.mean_power_w:.1f} {f:.3f} "
