@@ -18,7 +18,8 @@ do), the fraction of the record's non-causal optimum (``solve_record``) printed 
   samples and update interval only);
 
 with ``key=value`` pairs passed on to ``hull_mpc`` (``terminal_weight``, ``horizon``,
-``plant_steps``).
+``plant_steps``, ``planner``: with ``planner=collocation`` the spec's solver is IPOPT's, its
+``N`` ignored).
 
 ``--on-optimum``: the run started ON the non-causal optimum's motion at ``t = 0`` (the
 hull's state and velocity history, the pendulum's angle and speed; planned from the start):
@@ -340,7 +341,8 @@ def main():
     opts = {}
     for item in kv:
         k, v = item.split("=")
-        opts[k] = int(v) if k in ("plant_steps", "samples") else float(v)
+        opts[k] = (int(v) if k in ("plant_steps", "samples") else v
+                   if k == "planner" else float(v))
     closed_loop(spec, opts, a.seeds, a.on_optimum)
 
 

@@ -59,6 +59,8 @@ PLANT_STEPS = 6
 DEFAULT_LIMIT = 4.0
 #: L-BFGS-B iterations per horizon solve at most
 MAX_ITER = 60
+#: IPOPT iterations per horizon solve at most (``planner="collocation"``)
+COLLOCATION_ITER = 100
 #: the planned generator speed is penalized beyond this turn (rad) per plant step, with this
 #: weight (units m g l rad per (rad/s)^2)
 RESOLVED_TURN = 0.2
@@ -194,6 +196,7 @@ class HullHorizon(bc.CoupledHorizon):
         self.plant = plant
         self.width = 1e-3  # the efficiency's kink smoothed over this work (units m g l rad)
         self.speed = RESOLVED_TURN / plant.h  # rad/s
+        self.tol = 1e-9  # L-BFGS-B's ftol
 
     def hull_part(self, y) -> float:
         """The hull's own energy ``1/2 xi'^T M_t xi' + 1/2 xi^T C' xi`` (J) where the
@@ -269,7 +272,7 @@ def _forecast(fn, j, a, span, dt, ps, ar, leads, before=None):
 
 def _plan(prob, y0, fseg, u0, max_iter):
     """One horizon solve (a hook the causality tests wrap)."""
-    return prob.solve(y0, fseg, u0, max_iter=max_iter, tol=1e-9)
+    return prob.solve(y0, fseg, u0, max_iter=max_iter, tol=prob.tol)
 
 
 def _record_force(case, t):
@@ -297,8 +300,9 @@ def _free_start(case):
 def hull_mpc(hull, pendulum, wave, *, peak_period, pivot=(0.0, 0.0), pitch_inertia=None,
              horizon=2.0, update_interval=0.125, samples=SAMPLES, plant_steps=PLANT_STEPS,
              warmup=4.0, repeats=1, torque_limit=None, efficiency=None, forecast="perfect",
-             mode="swing", max_iter=MAX_ITER, memory=None, terminal_weight=None,
-             terminal="total", time_limit=None, deadline=None) -> bc.BuoyMPCResult:
+             mode="swing", max_iter=None, memory=None, terminal_weight=None,
+             terminal="total", planner="lbfgsb", time_limit=None,
+             deadline=None) -> bc.BuoyMPCResult:
     """Receding-horizon control of the pendulum in a surging, heaving, pitching hull in a
     periodic record (module docstring).
 
@@ -325,8 +329,9 @@ def hull_mpc(hull, pendulum, wave, *, peak_period, pivot=(0.0, 0.0), pitch_inert
     mode : "swing" or "rotate"
         The start: planned from the hanging pendulum, or the swing-up pump until the
         pendulum turns over the top.
-    max_iter : int
-        L-BFGS-B iterations per solve at most.
+    max_iter : int or None
+        Iterations per solve at most (None: ``MAX_ITER`` for L-BFGS-B,
+        ``COLLOCATION_ITER`` for IPOPT).
     memory : float or None
         The radiation memory (s); None: ``MEMORY_PERIODS`` peak periods.
     terminal_weight : float or None
@@ -336,6 +341,10 @@ def hull_mpc(hull, pendulum, wave, *, peak_period, pivot=(0.0, 0.0), pitch_inert
         default), or the pendulum's (``E`` less the hull's own ``1/2 xi'^T M_t xi' + 1/2
         xi^T C' xi``; on the default barge, seeds 0 and 1, it harvested 40 and 110 W where
         ``total`` harvested 368 and 262 W).
+    planner : "lbfgsb" or "collocation"
+        The horizon solve: L-BFGS-B on the held torques shot through the plant's model
+        (module docstring), or the motion as the unknown, direct collocation solved by IPOPT
+        on the exact Hessian (``_hull_collocation``; needs CasADi, ``plant_steps`` even).
     time_limit, deadline : as :func:`.control.buoy_mpc`.
 
     Returns
@@ -358,6 +367,10 @@ def hull_mpc(hull, pendulum, wave, *, peak_period, pivot=(0.0, 0.0), pitch_inert
     warmup = check_range("warmup", warmup, 0.0, 1e3, why="peak periods")
     repeats = check_int("repeats", repeats, 1, 100)
     ps = check_int("plant_steps", plant_steps, 1, 1024)
+    if planner not in ("lbfgsb", "collocation"):
+        raise ParameterError(f"planner: expected lbfgsb or collocation, got {planner!r:.40}")
+    if max_iter is None:
+        max_iter = MAX_ITER if planner == "lbfgsb" else COLLOCATION_ITER
     max_iter = check_int("max_iter", max_iter, 1, 10000)
     if forecast not in ("perfect", "ar"):
         raise ParameterError(f"forecast: expected perfect or ar, got {forecast!r:.40}")
@@ -405,7 +418,14 @@ def hull_mpc(hull, pendulum, wave, *, peak_period, pivot=(0.0, 0.0), pitch_inert
         terminal_weight = check_range("terminal_weight", terminal_weight, 0.0, 10.0)
     if terminal not in ("pendulum", "total"):
         raise ParameterError(f"terminal: expected pendulum or total, got {terminal!r:.40}")
-    prob = HullHorizon(plant, n, ps, tu, torque_limit / tu, eta, terminal_weight, terminal)
+    if planner == "collocation":
+        from ._hull_collocation import HullCollocation
+
+        prob = HullCollocation(plant, n, ps, tu, torque_limit / tu, eta, terminal_weight,
+                               terminal, max_iter=max_iter)
+        prob.shift = m
+    else:
+        prob = HullHorizon(plant, n, ps, tu, torque_limit / tu, eta, terminal_weight, terminal)
     level = min(torque_limit / tu, 1.0)
     ys = np.empty((total + 1, 8))
     ys[0] = plant.y

@@ -1,0 +1,115 @@
+"""The hull's collocation planner (``hull_mpc(planner="collocation")``,
+:mod:`parapend.hydro._hull_collocation`) on the synthetic hull of tests/hull_timedomain.py:
+
+- its model is the plant's: the collocation's motion under fixed held torques converges to
+  the plant's (RK4 on a finer step) as the interval halves;
+- the plan is one the plant follows: the plant re-integrated under the plan's own torques
+  stays on the planned motion over the update interval it is applied for;
+- causality, bit for bit, as the L-BFGS-B planner's (tests/test_hull_mpc.py);
+- a solve IPOPT ends at its iteration cap is reported as capped, not failed.
+"""
+
+import numpy as np
+import pytest
+
+pytest.importorskip("casadi")
+
+import test_hull_mpc as th  # noqa: E402
+
+from parapend.hydro import control as bc  # noqa: E402
+from parapend.hydro import hull_control as hc  # noqa: E402
+from parapend.hydro._hull_collocation import HullCollocation  # noqa: E402
+
+PER, PS, N = 32, 8, 6  # samples a record, plant steps a sample, horizon samples
+TU = th.PEND.mass * 9.81 * th.PEND.length
+
+
+def _horizon(intervals, steps=PS):
+    """A plant of ``steps`` steps a sample advanced two samples under a swinging torque,
+    its force nodes over the horizon, and the collocation problem of ``N`` samples on it
+    (``intervals`` 0: none)."""
+    plant, _, _ = th._plant(th.PEND, th.TR / PER / steps, 4 * PER * steps, memory=4.0)
+    fn = bc.force_nodes(th.HULL, th.WAVE, PER, steps, 2 * 3 * PER * steps + 1)
+    plant.step(np.array([0.8, -0.8]) * TU, steps, fn)
+    a = 2 * plant.k0
+    fseg = fn[a:a + 2 * N * steps + 1]
+    prob = (HullCollocation(plant, N, steps, TU, 4.0, intervals=intervals, max_iter=200)
+            if intervals else None)
+    return plant, fseg, prob
+
+
+def test_collocation_converges_to_the_plant():
+    """Under fixed torques the collocation's only feasible motion approaches the plant's
+    (RK4 on 64 steps a sample, itself converged to 1e-5) as the Hermite-Simpson interval
+    halves (2, 4, 8 intervals a sample): the error of the angles and the hull's motion at
+    the samples' ends falls at least 3-fold a halving (second order: the memory's trapezoid,
+    linear between its nodes; Hermite-Simpson is fourth), to below 5e-4."""
+    u = np.array([0.5, -0.3, 0.9, -0.6, 0.2, 0.4])
+    plant, fseg, _ = _horizon(0, steps=64)
+    ok, ref, _ = plant.roll(u * TU, 64, fseg)
+    assert ok
+    errs = []
+    for ps, r in ((8, 2), (8, 4), (16, 8)):
+        plant, fseg, prob = _horizon(r, steps=ps)
+        st = prob.simulate(u, fseg)[::2 * r]
+        errs.append(np.max(np.abs(st[:, :4] - ref[:, :4])))
+    assert errs[2] < 5e-4, errs
+    assert errs[0] > 3 * errs[1] > 9 * errs[2], errs
+
+
+def test_the_plant_follows_the_plan():
+    """The plan is its torques' own motion (the collocation's unique feasible motion under
+    them, to IPOPT's tolerance), and the plant re-integrated under those torques from the
+    same state stays on it over the first update interval (a quarter of the horizon) within
+    1e-3 (m, rad): the two discretizations' difference at these steps, which
+    :func:`test_collocation_converges_to_the_plant` measures at 1.6e-3 over the whole
+    horizon. Over the whole horizon the plan is open-loop unstable, so only its applied
+    part is held to it."""
+    plant, fseg, prob = _horizon(4)
+    r = prob.solve(plant, fseg, np.zeros(N))
+    assert r.status == 0, r.ipopt
+    assert np.all(np.abs(r.x) <= 4.0)
+    assert np.max(np.abs(r.x)) > 1.0  # the plan does act
+    own = prob.simulate(r.x, fseg)
+    assert np.max(np.abs(own - r.states)) < 1e-5
+    ok, ys, _ = plant.roll(r.x * TU, PS, fseg)
+    st = r.states[::8]
+    k = N // 4 + 1
+    assert ok and np.max(np.abs(ys[:k, :4] - st[:k, :4])) < 1e-3
+
+
+@pytest.mark.parametrize("peek, causal", [(False, True), (True, False)])
+def test_collocation_is_causal(monkeypatch, peek, causal):
+    """The sea altered after ``t0 + H`` leaves the torques before ``t0`` bit-identical
+    (tests/test_hull_mpc.py's check on the collocation planner)."""
+    monkeypatch.setitem(th.OPTS, "planner", "collocation")
+    th.test_torques_before_t0_ignore_the_sea_after_t0_plus_h(monkeypatch, peek, causal)
+
+
+def test_collocation_ar_is_causal(monkeypatch):
+    """The AR forecast: the sea altered after ``t0 - u`` leaves the torques before ``t0``
+    bit-identical."""
+    monkeypatch.setitem(th.OPTS, "planner", "collocation")
+    th.test_ar_torques_before_t0_ignore_the_sea_after_t0(monkeypatch, "ar", True)
+
+
+def test_capped_solves_are_reported():
+    """IPOPT stopped by its iteration cap: the solve's status is 1 (capped, applied, not
+    failed, as L-BFGS-B's), and the run counts every update as a solve."""
+    plant, fseg, prob = _horizon(2)
+    capped = HullCollocation(plant, N, PS, TU, 4.0, intervals=2, max_iter=2)
+    r = capped.solve(plant, fseg, np.zeros(N))
+    assert r.status == 1 and not r.success and r.nit == 2
+    assert bc._check_solve(r, np.zeros(N))[1] == 0
+    res = hc.hull_mpc(th.HULL, th.PEND, th.WAVE, **dict(th.OPTS, max_iter=2),
+                      planner="collocation")
+    assert res.solves > 0 and res.failed_solves == 0
+
+
+def test_bad_planner_is_one_line():
+    """An unknown planner, or plant steps the collocation's intervals cannot hold."""
+    with pytest.raises(hc.ParameterError, match="planner: expected"):
+        hc.hull_mpc(th.HULL, th.PEND, th.WAVE, **th.OPTS, planner="newton")
+    with pytest.raises(hc.ParameterError, match="plant_steps"):
+        hc.hull_mpc(th.HULL, th.PEND, th.WAVE, **dict(th.OPTS, plant_steps=5),
+                    planner="collocation")
