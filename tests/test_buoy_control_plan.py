@@ -94,6 +94,28 @@ def test_compiled_solver_follows_the_reference_loop():
     assert np.max(np.abs(pr.constraint_torques(xb))) <= 300.0 * (1 + 1e-6)
 
 
+def test_a_nan_in_the_hessian_ends_the_solve_not_finite():
+    # the inertia correction shifts the Newton matrix until Cholesky succeeds: a NaN in the
+    # Hessian (finite objective and gradient) made no shift succeed, and the loop never ended
+    # (a controller's run hung in a compiled solve): now the solve stops, not finite, at the
+    # point it had. The Python reference loop here; the compiled one has the same bound.
+    pr, x = _problem(limit=300.0)
+    real = pr.compiled
+
+    def nan_hessian(x, nu=None, order=2):
+        out = real(x, nu, order)
+        if order != 2:
+            return out
+        phi, gr, h, tau, jac = out
+        h = h.copy()
+        h[0, 0] = np.nan
+        return phi, gr, h, tau, jac
+
+    pr.compiled = nan_hessian
+    xs, status, it = pr.solve_python(x)
+    assert (status, it) == ("nonfinite", 1) and np.array_equal(xs, x)
+
+
 def _reference_heave(plan, t_eval):
     """``M z'' + C z = f - m l (cos theta)''`` by an adaptive integrator on the plan's angle
     (each interval's cubic written out), interval by interval (``theta''`` jumps at the

@@ -584,6 +584,8 @@ class CoupledPlan:
 
     def solve_python(self, x, *, max_iter=100, tol=1e-8):
         """:meth:`solve` with the loop in Python (the reference of the compiled one)."""
+        from ._buoy_plan_kernel import MAX_CORRECTIONS
+
         x = np.asarray(x, dtype=float).copy()
         tm = self.tmax
         nc = self.nc
@@ -623,12 +625,16 @@ class CoupledPlan:
             rhs = -(gr + jg.T @ (mu / s + sig * rp))
             delta = 0.0
             dmin = 1e-8 * max(1.0, float(np.max(np.abs(np.diag(hess)))))
-            while True:
+            fac = None
+            for _ in range(MAX_CORRECTIONS):
                 try:
                     fac = cho_factor(kmat + delta * np.eye(self.n), check_finite=False)
                     break
                 except LinAlgError:
                     delta = max(dmin, delta_last / 3.0, 8.0 * delta)
+            if fac is None or not np.all(np.isfinite(fac[0])):
+                status = 3  # no shift makes it definite (a NaN in the Hessian)
+                break
             delta_last = delta if delta else delta_last
             dx = cho_solve(fac, rhs, check_finite=False)
             ds = -rp - jg @ dx

@@ -257,6 +257,12 @@ def _cho_solve(low, b):
     return x
 
 
+#: the inertia correction's shifts at most (each 8 times the last: from 1e-8 of the
+#: Hessian's diagonal past any finite matrix's spectrum); a matrix that no shift makes
+#: definite (a NaN in it) ends the solve as not finite rather than looping
+MAX_CORRECTIONS = 100
+
+
 @nb.njit(cache=True)
 def solve(x, start, j, b0, b1, b2, af, bf, ap, bp, bp0, b0g, wgt, f_t, yc, ydc, ng, p, r,
           kap, wrad, tmax, max_iter, tol, mu0):
@@ -342,15 +348,19 @@ def solve(x, start, j, b0, b1, b2, af, bf, ap, bp, bp0, b0g, wgt, f_t, yc, ydc, 
             dmin = max(dmin, abs(hm[a, a]))
         dmin *= 1e-8
         delta = 0.0
-        while True:
+        ok = False
+        for _ in range(MAX_CORRECTIONS):
             for a in range(n):
                 kmat[a, a] += delta
             ok = _cholesky(kmat, low)
             for a in range(n):
                 kmat[a, a] -= delta
-            if ok:
+            if ok or not math.isfinite(delta):
                 break
             delta = max(dmin, delta_last / 3.0, 8.0 * delta)
+        if not ok:  # a Hessian with a NaN (or no shift that makes it definite): no step
+            status = 3
+            break
         if delta > 0.0:
             delta_last = delta
         dx = _cho_solve(low, rhs)
