@@ -199,6 +199,7 @@ class HullCollocation:
         self.lbg = np.concatenate((np.zeros(neq), np.full(npt - 1, -vmax)))
         self.ubg = -self.lbg
         self._obj = ca.Function("obj", [xs, par], [obj])
+        self._sym = (xs, par, obj, gcat)  # the NLP's expressions (the compiled one's check)
         self.solver = ca.nlpsol("hullcol", "ipopt", {"x": xs, "p": par, "f": obj, "g": gcat},
                                 {"ipopt": self.options, "print_time": False})
         self.nx, self.na = nx, na
