@@ -35,13 +35,13 @@ from __future__ import annotations
 import numpy as np
 import scipy.sparse as sp
 from scipy.linalg import LinAlgError, cho_factor, cho_solve
-from scipy.sparse.linalg import splu
 
 from . import _hull_collocation_kernel as kern
+from ._hull_collocation_linalg import Structured
 
 #: the barrier's first weight (IPOPT's ``mu_init``) cold and from a shifted solution
 MU_INIT = 0.1
-MU_WARM = 1e-3
+MU_WARM = 0.1
 #: the inertia correction's tries at most (``delta`` times 8 each)
 MAX_CORRECTIONS = 40
 
@@ -64,6 +64,7 @@ class CompiledSolver:
         pl = prob.plant
         self.prob = prob
         self.trace = None
+        self.lin = None
         npt, ni, nx, na = prob._layout()
         n, ncp, st = prob.n, prob.ncp, prob.stride
         self.npt, self.ni, self.nx, self.na, self.n, self.ncp = npt, ni, nx, na, n, ncp
@@ -121,17 +122,24 @@ class CompiledSolver:
         self.jmem = np.bincount(self.jinv_mem, weights=self.mem_val, minlength=self.jnnz)
         hkeep = (cmap[hr] >= 0) & (cmap[hc] >= 0)
         self.hkeep = hkeep
-        diag = np.arange(nf)
-        kr = np.concatenate((cmap[hr[hkeep]], diag, self.d7, self.d6, self.d7, self.d6))
-        kc = np.concatenate((cmap[hc[hkeep]], diag, self.d7, self.d6, self.d6, self.d7))
-        self.kind, self.kptr, kinv = _csc_pattern(kr, kc, nf, nf)
-        nh = hkeep.sum()
-        self.kinv_h, self.kinv_d = kinv[:nh], kinv[nh:nh + nf]
-        self.kinv_s = kinv[nh + nf:]
-        self.knnz = self.kind.size
-        # the rows of K with more than the diagonal (the reduced Hessian needs only those)
+        # K lives on the rows with more than the diagonal (the Hessian's, the speeds', the
+        # torques'): compressed to those
         self.krows = np.unique(np.concatenate((cmap[hr[hkeep]], self.d7, self.d6,
                                                self.nd + np.arange(n))))
+        nr = self.krows.size
+        kpos = np.full(nf, -1, np.int64)
+        kpos[self.krows] = np.arange(nr)
+        diag = np.arange(nr)
+        kr = np.concatenate((kpos[cmap[hr[hkeep]]], diag, kpos[self.d7], kpos[self.d6],
+                             kpos[self.d7], kpos[self.d6]))
+        kc = np.concatenate((kpos[cmap[hc[hkeep]]], diag, kpos[self.d7], kpos[self.d6],
+                             kpos[self.d6], kpos[self.d7]))
+        self.kind, self.kptr, kinv = _csc_pattern(kr, kc, nr, nr)
+        nh = hkeep.sum()
+        self.kinv_h, self.kinv_d = kinv[:nh], kinv[nh:nh + nr]
+        self.kinv_s = kinv[nh + nr:]
+        self.knnz = self.kind.size
+        self.kpos = kpos
 
     # -- the functions --------------------------------------------------------------------
     def _eval(self, x, lam, order, fk, e0, raw=False):
@@ -161,15 +169,16 @@ class CompiledSolver:
         return sp.csc_matrix((data, self.jind, self.jptr), shape=(self.neq, self.nf))
 
     def hessian(self, hv, diag):
-        """``K``: the Lagrangian's Hessian ``hv`` plus ``diag`` (nf,) on the diagonal and the
-        speeds' weights (``self.sig_s``)."""
+        """``K`` on its rows ``krows`` (its others are zero): the Lagrangian's Hessian ``hv``
+        plus ``diag`` (nf,) on the diagonal and the speeds' weights (``self.sig_s``)."""
         data = np.bincount(self.kinv_h, weights=hv[self.hkeep], minlength=self.knnz)
-        data += np.bincount(self.kinv_d, weights=diag, minlength=self.knnz)
+        data += np.bincount(self.kinv_d, weights=diag[self.krows], minlength=self.knnz)
         if self.speed:
             ss = self.sig_s
             data += np.bincount(self.kinv_s, weights=np.concatenate((ss, ss, -ss, -ss)),
                                 minlength=self.knnz)
-        return sp.csc_matrix((data, self.kind, self.kptr), shape=(self.nf, self.nf))
+        nr = self.krows.size
+        return sp.csc_matrix((data, self.kind, self.kptr), shape=(nr, nr))
 
     # -- one solve --------------------------------------------------------------------------
     def _setup(self, par):
@@ -230,6 +239,7 @@ class CompiledSolver:
         tau_min = 0.99
         filt = []
         theta_max = theta_min = None
+        nrest = 0
         while True:
             lam_e = np.zeros(self.neq) if lam is None else lam
             f, c, grad, jv, _, hv = self._eval(x, lam_e[:self.nloc], 2, fk, e0)
@@ -237,16 +247,15 @@ class CompiledSolver:
                 status = 2
                 break
             jac = self.jacobian(jv)
-            try:
-                lu = splu(jac[:, :nd].tocsc(), permc_spec="COLAMD")
-            except RuntimeError:
+            lu = self._factor(jac)
+            if lu is None:
                 status = 2
                 break
             gf = np.concatenate((grad[self.dep], grad[self.uix]))  # on the reduced columns
             rd = self._speeds(x) - s if self.speed else np.zeros(0)
             gdl = self._dt(lamd) if self.speed else np.zeros(nf)
             if lam is None:  # least-squares multipliers at the start (IPOPT's)
-                lam = lu.solve(-(gf[:nd] + gdl[:nd]), trans="T")
+                lam = lu.solve_t(-(gf[:nd] + gdl[:nd]))
                 if not np.all(np.isfinite(lam)) or np.max(np.abs(lam)) > 1e3:
                     lam = np.zeros(self.neq)
                 f, c, grad, jv, _, hv = self._eval(x, lam[:self.nloc], 2, fk, e0)
@@ -289,10 +298,10 @@ class CompiledSolver:
             gphis = -mu / sls + mu / sus if ns else np.zeros(0)
             kmat = self.hessian(hv, diag)
             zfull = np.empty((nf, n))
-            zfull[:nd] = -lu.solve(jac[:, nd:].toarray())
+            zfull[:nd] = -lu.solve(jac[:, nd:].toarray(), torques=True)
             zfull[nd:] = np.eye(n)
             zr = zfull[self.krows]
-            hred = zr.T @ (kmat[self.krows][:, self.krows] @ zr)
+            hred = zr.T @ (kmat @ zr)
             delta, ztz, fac = 0.0, None, None
             for _ in range(MAX_CORRECTIONS):
                 try:
@@ -312,9 +321,8 @@ class CompiledSolver:
                 break
             if delta:
                 delta_last = delta
-                kmat = kmat + delta * sp.identity(nf, format="csc")
 
-            newton = _Newton(self, lu, fac, zfull, kmat, gphi0, gphis)
+            newton = _Newton(self, lu, fac, zfull, kmat, delta, gphi0, gphis)
             dx, ds, lam_new, lamd_new = newton.step(c, rd)
             ddu = dx[uo:uo + n]
             dzl = mu / sl_u - zl - zl / sl_u * ddu
@@ -371,8 +379,20 @@ class CompiledSolver:
                 first = False
                 a *= 0.5
             if acc is None:
-                status = 2
-                break
+                # restoration: the equality rows solved for the unknowns but the torques
+                # (Newton's method, the torques held), accepted where it lowers the
+                # infeasibility by a tenth and the filter takes it
+                filt.append((theta, phi))
+                xr, sr = self._restore(x, s)
+                tr = None if xr is None else self._theta(self._values(xr)[1], xr, sr)
+                if tr is None or not tr <= 0.9 * theta or any(
+                        tr >= tf and self._barrier(self._values(xr)[0], xr, sr, mu) >= pf
+                        for tf, pf in filt):
+                    status = 2
+                    break
+                x, s, lam = xr, sr, None
+                nrest += 1
+                continue
             if self.trace is not None:
                 self.trace.append((it, f, primal, dual / sd, np.max(np.abs(comp)), mu, ap, a,
                                    az, delta, len(filt)))
@@ -388,8 +408,65 @@ class CompiledSolver:
             if ns:
                 zls = np.clip(zls, mu / (1e10 * (s + vm)), 1e10 * mu / (s + vm))
                 zus = np.clip(zus, mu / (1e10 * (vm - s)), 1e10 * mu / (vm - s))
-        self.lam = lam
+        self.lam, self.restorations = lam, nrest
         return x, float(f), status, it
+
+    def _restore(self, x, s, max_iter=20):
+        """``(x, s)`` with the equality rows solved by Newton's method on the unknowns but the
+        torques (backtracking on ``|c|_1``), the slacks the speeds within their bounds; ``(None,
+        None)`` where it does not converge."""
+        x = x.copy()
+        for _ in range(max_iter):
+            _, c, _, jv, _, _ = self._eval(x, self._nolam, 1, self.fk, self.e0)
+            th = np.sum(np.abs(c))
+            if np.max(np.abs(c)) < 1e-10:
+                break
+            lu = self._factor(self.jacobian(jv))
+            if lu is None:
+                return None, None
+            dz = lu.solve(-c)
+            a = 1.0
+            for _ in range(20):
+                xt = x.copy()
+                xt[self.dep] += a * dz
+                ct = self._values(xt)[1]
+                if np.sum(np.abs(ct)) < (1.0 - 1e-4 * a) * th:
+                    break
+                a *= 0.5
+            else:
+                return None, None
+            x = xt
+        s = self._speeds(x)
+        if self.speed:
+            pv = 1e-2 * min(1.0, self.vmax)
+            s = np.clip(s, -self.vmax + pv, self.vmax - pv)
+        return x, s
+
+    def simulate(self, x0, par, max_iter=50):
+        """The NLP's only feasible point with ``x0``'s torques (Newton's method on the
+        equality rows from ``x0``; the collocation's motion under the torques)."""
+        self._setup(par)
+        x = np.array(x0, dtype=float)
+        x[:8] = par[:8]
+        for _ in range(max_iter):
+            _, c, _, jv, _, _ = self._eval(x, self._nolam, 1, self.fk, self.e0)
+            if np.max(np.abs(c)) < 1e-12:
+                break
+            lu = self._factor(self.jacobian(jv))
+            if lu is None:
+                break
+            dz = lu.solve(-c)
+            x[self.dep] += dz
+            if np.max(np.abs(dz)) < 1e-13 * max(1.0, np.max(np.abs(x))):
+                break
+        return x
+
+    def _factor(self, jac):
+        """The structured factors of ``J_d`` (:mod:`._hull_collocation_linalg`), or None
+        where singular."""
+        if self.lin is None:
+            self.lin = Structured(self)
+        return self.lin if self.lin.factor(jac.data) else None
 
     def _dt(self, w):
         """``D^T w`` on the reduced columns."""
@@ -409,8 +486,9 @@ class _Newton:
     """The Newton step of one iteration (module docstring) for any constraints' right side
     (the second-order corrections reuse the factors)."""
 
-    def __init__(self, solver, lu, fac, zfull, kmat, gphi0, gphis):
+    def __init__(self, solver, lu, fac, zfull, kmat, delta, gphi0, gphis):
         self.sv, self.lu, self.fac, self.zfull, self.kmat = solver, lu, fac, zfull, kmat
+        self.delta = delta
         self.gphi0, self.gphis = gphi0, gphis
 
     def step(self, cr, rdr):
@@ -421,14 +499,22 @@ class _Newton:
         gphi = self.gphi0 + sv._dt(sv.sig_s * rdr + self.gphis) if ns else self.gphi0
         yp = np.zeros(nf)
         yp[:nd] = -self.lu.solve(cr)
-        du = cho_solve(self.fac, -(self.zfull.T @ (gphi + self.kmat @ yp)), check_finite=False)
+        du = cho_solve(self.fac, -(self.zfull.T @ (gphi + self.kmul(yp))), check_finite=False)
         dxf = yp + self.zfull @ du
-        lnew = self.lu.solve(-(gphi + self.kmat @ dxf)[:nd], trans="T")
+        lnew = self.lu.solve_t(-(gphi + self.kmul(dxf))[:nd])
         ds = dxf[sv.d7] - dxf[sv.d6] + rdr if ns else np.zeros(0)
         dx = np.zeros(sv.nvar)
         dx[sv.dep] = dxf[:nd]
         dx[sv.uix] = dxf[nd:]
         return dx, ds, lnew, sv.sig_s * ds + self.gphis if ns else np.zeros(sv.npt - 1)
+
+
+    def kmul(self, v):
+        """``(K + delta I) v``."""
+        out = self.delta * v
+        kr = self.sv.krows
+        out[kr] += self.kmat @ v[kr]
+        return out
 
 
 class _Search:
