@@ -2,14 +2,15 @@
 (:mod:`parapend.hydro._hull_collocation_ipm`) against CasADi/IPOPT on the same horizon NLP.
 
 1. Per horizon: the embedded barge, its default sea, perfect forecast, the pump's start,
-   terminal weight 0.5, the first ``--updates`` updates of a run planned by the compiled
-   solver; at every update both solvers start from the same point (the compiled chain's
-   previous solution shifted) on the same parameters, in this process: the time of each,
-   the ratio, the iterations, the objective's relative difference and the largest torque
-   difference (m g l).
+   terminal weight 0.5, the first ``--updates`` updates of a run planned by IPOPT; at every
+   update both solvers start from the same point (IPOPT's previous solution shifted) on the
+   same parameters, in this process: the time of each, the ratio, the iterations, the
+   statuses, the objective's relative difference and the largest torque difference
+   (m g l).
 2. The whole default run (``hull_mpc(..., planner="collocation", terminal_weight=0.5)``,
    seed ``--seed``) with each solver: the update time's median and p99 against the 0.75 s
-   interval, and the electrical power (``--forecast``; ``--no-ipopt-run`` skips IPOPT's).
+   interval, the failed solves, and the electrical power (``--forecast``;
+   ``--no-ipopt-run`` skips IPOPT's).
 
     nice python benchmarks/hull_collocation_solver.py --updates 20 --seed 0
 """
@@ -46,39 +47,41 @@ def run(p, wave, forecast="perfect"):
                        forecast=forecast)
 
 
-def reference(prob, max_iter):
-    """IPOPT's problem beside the compiled one ``prob`` (same plant and options)."""
+def beside(prob, max_iter, solver):
+    """The problem ``prob`` (same plant and options) with the solver ``solver``."""
     return hcol.HullCollocation(prob.plant, prob.n, prob.steps, prob.tu, prob.torque_limit,
                                 prob.eta, prob.kappa,
                                 "pendulum" if prob.pendulum_only else "total",
-                                max_iter=max_iter, solver="ipopt")
+                                max_iter=max_iter, solver=solver)
 
 
 def per_horizon(seed, updates):
-    """Both solvers on the first ``updates`` horizons of a compiled run (module docstring)."""
+    """Both solvers on the first ``updates`` horizons of an IPOPT run (module docstring)."""
     p, wave = case(seed)
-    rows, ref = [], {}
+    rows, comp = [], {}
     plan0 = hc._plan
+    hcol.SOLVER = "ipopt"
 
     def plan(prob, plant, fseg, u0, max_iter):
-        if not ref:
-            ref["q"] = reference(prob, max_iter)
+        if not comp:
+            comp["q"] = beside(prob, max_iter, "compiled")
+        q = comp["q"]
         x0, par = prob.start(fseg, u0)
         warm = prob.prev is not None
         if not rows:  # the kernels' first call (numba's cache) out of the timing
-            prob.compiled.solve(x0, par, 2, prob.tol, warm)
+            q.compiled.solve(x0, par, 2, prob.tol, warm)
         t = time.perf_counter()
-        rc = prob.solve_from(x0, par, max_iter, prob.tol, warm=warm)
+        rc = q.solve_from(x0, par, max_iter, prob.tol, warm=warm)
         tc = time.perf_counter() - t
         t = time.perf_counter()
-        ri = ref["q"].solve_from(x0, par)
+        ri = prob.solve_from(x0, par)
         ti = time.perf_counter() - t
         rows.append((tc, ti, rc.nit, ri.nit, rc.status, ri.status,
                      abs(rc.fun - ri.fun) / max(abs(ri.fun), 1e-12),
                      float(np.max(np.abs(rc.x - ri.x)))))
         if len(rows) >= updates:
             raise StopIteration
-        return rc
+        return ri
 
     hc._plan = plan
     try:
@@ -111,8 +114,15 @@ def main():
         for name, col in (("compiled_s", r[:, 0]), ("ipopt_s", r[:, 1]), ("ratio", ratio)):
             print(f"  {name:10s} median {np.median(col):8.4f}  p99 {np.percentile(col, 99):8.4f}"
                   f"  min {np.min(col):8.4f}")
+        same = (r[:, 4] == 0) & (r[:, 5] == 0) & (r[:, 6] < 1e-6) & (r[:, 7] < 1e-4)
         print(f"  iterations median: compiled {np.median(r[:, 2]):.0f}, ipopt "
-              f"{np.median(r[:, 3]):.0f}", flush=True)
+              f"{np.median(r[:, 3]):.0f}; both solved to the same optimum (objective 1e-6, "
+              f"torques 1e-4): {int(same.sum())}/{len(r)}; compiled failed "
+              f"{int(np.sum(r[:, 4] == 2))}, capped {int(np.sum(r[:, 4] == 1))}; ipopt failed "
+              f"{int(np.sum(r[:, 5] == 2))}, capped {int(np.sum(r[:, 5] == 1))}", flush=True)
+        ms = 1000 * r[:, 0] / np.maximum(r[:, 2], 1), 1000 * r[:, 1] / np.maximum(r[:, 3], 1)
+        print(f"  time an iteration (ms), median: compiled {np.median(ms[0]):.1f}, ipopt "
+              f"{np.median(ms[1]):.1f}", flush=True)
     print(f"load average {os.getloadavg()[0]:.2f} {os.getloadavg()[1]:.2f}", flush=True)
     p, wave = case(a.seed)
     for solver in ("compiled",) + (() if a.no_ipopt_run else ("ipopt",)):

@@ -123,14 +123,16 @@ def test_bad_solver_is_one_line():
 
 
 def _captured(seed, count):
-    """The first ``count`` horizons of the default barge's compiled run (seed ``seed``,
-    perfect forecast, terminal weight 0.5): ``(prob, [(x0, par, warm), ...])``."""
+    """The first ``count`` horizons of the default barge's run planned by IPOPT (seed
+    ``seed``, perfect forecast, terminal weight 0.5): ``[(prob, x0, par, warm, max_iter,
+    IPOPT's solve)]``, and the benchmark's module."""
     import sys
     from pathlib import Path
 
     sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "benchmarks"))
     import hull_collocation_solver as bench
 
+    from parapend.hydro import _hull_collocation as hcol
     from parapend.hydro import hull_control as hc
 
     p, wave = bench.case(seed)
@@ -138,35 +140,38 @@ def _captured(seed, count):
 
     def plan(prob, plant, fseg, u0, max_iter):
         x0, par = prob.start(fseg, u0)
-        caps.append((prob, x0, par, prob.prev is not None, max_iter))
-        r = prob.solve_from(x0, par, max_iter, prob.tol, warm=caps[-1][3])
+        warm = prob.prev is not None
+        r = prob.solve_from(x0, par, max_iter, prob.tol, warm=warm)
+        caps.append((prob, x0, par, warm, max_iter, r))
         if len(caps) >= count:
             raise StopIteration
         return r
 
     plan0, hc._plan = hc._plan, plan
+    solver0, hcol.SOLVER = hcol.SOLVER, "ipopt"
     try:
         bench.run(p, wave)
     except StopIteration:
         pass
     finally:
-        hc._plan = plan0
+        hc._plan, hcol.SOLVER = plan0, solver0
     return caps, bench
 
 
 @pytest.mark.slow
 @pytest.mark.parametrize("seed", [0, 1])
 def test_captured_horizons_reach_ipopts_optimum(seed):
-    """The first three horizons of the default barge's run: from the same start both
-    solvers solve, to the same objective (1e-6 relative) and torques (1e-4 m g l)."""
+    """The first three horizons of the default barge's run: from IPOPT's start the compiled
+    solver solves, to IPOPT's objective (1e-6 relative) and torques (1e-3 m g l: both
+    stop at the tolerance 1e-6 of the optimality error, which on seed 1's third horizon
+    leaves 4e-4 between them along a flat direction, the objective equal to 1e-8)."""
     caps, bench = _captured(seed, 3)
-    ref = bench.reference(caps[0][0], caps[0][4])
-    for prob, x0, par, warm, mi in caps:
-        r = prob.solve_from(x0, par, mi, prob.tol, warm=warm)
-        s = ref.solve_from(x0, par)
+    comp = bench.beside(caps[0][0], caps[0][4], "compiled")
+    for _, x0, par, warm, mi, s in caps:
+        r = comp.solve_from(x0, par, mi, comp.tol, warm=warm)
         assert r.status == 0 and s.status == 0, (r.ipopt, s.ipopt)
         assert abs(r.fun - s.fun) <= 1e-6 * abs(s.fun), (r.fun, s.fun)
-        assert np.max(np.abs(r.x - s.x)) < 1e-4, (r.x, s.x)
+        assert np.max(np.abs(r.x - s.x)) < 1e-3, (r.x, s.x)
 
 
 def test_kernel_sizes():
@@ -180,3 +185,28 @@ def test_kernel_sizes():
     assert jr.size == kern.JAC * cs.ni and np.all(jc >= 0)
     assert hr.size == kern.HESS * 3 * cs.ni + 25 * cs.n + 64
     assert jr.max() == kern.ROWS * cs.ni - 1
+
+
+@pytest.mark.parametrize("intervals", [1, 2, 4])
+def test_structured_solves_are_superlus(intervals):
+    """The structured solves with ``J_d`` (groups of intervals and memory nodes forward, and
+    backward transposed; a torque's column from its sample on) against SciPy's sparse LU of
+    the same matrix, at a perturbed point, to 1e-12 relative."""
+    from scipy.sparse.linalg import splu
+
+    plant, fseg, prob, _ = _pair(intervals)
+    cs = prob.compiled
+    par = prob._params(np.asarray(fseg))
+    rng = np.random.default_rng(0)
+    x = prob._with_memory(prob.guess(np.full(tc.N, 0.5), fseg), par)
+    x += 0.05 * rng.standard_normal(x.size)
+    cs._setup(par)
+    _, _, _, jv, _, _ = cs._eval(x, np.zeros(cs.nloc), 1, cs.fk, cs.e0)
+    jac = cs.jacobian(jv)
+    lin = cs._factor(jac)
+    lu = splu(jac[:, :cs.nd].tocsc())
+    ju = jac[:, cs.nd:].toarray()
+    r = rng.standard_normal(cs.nd)
+    for mine, theirs in ((lin.solve(ju, torques=True), lu.solve(ju)),
+                         (lin.solve(r), lu.solve(r)), (lin.solve_t(r), lu.solve(r, trans="T"))):
+        assert np.max(np.abs(mine - theirs)) <= 1e-12 * np.max(np.abs(theirs))

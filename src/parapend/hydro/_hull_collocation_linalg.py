@@ -179,13 +179,15 @@ def factor(gi, gq, lc, pc, bq, vnode, wmat, tu, dmat, piv, emat, bmat, sz, sg, s
         if not _lu(dmat[iv], piv[iv]):
             return False
     ng = gi.size - 1
+    maxq = sz.shape[2]
+    rin = np.zeros((nd, maxq))
+    out = np.zeros((nd, maxq))
+    ys = np.zeros((nd, maxq))
     for g in range(ng):
         qa, qb = gq[g], gq[g + 1]
         nq = 3 * (qb - qa)
         i0, i1 = gi[g], gi[g + 1]
         # forward: the rows' right side -B_i e_k (a unit memory at an own node moved over)
-        rin = np.zeros((nd, nq))
-        out = np.zeros((nd, nq))
         for iv in range(i0, i1):
             for q in range(NB):
                 node = bq[iv] + q
@@ -200,6 +202,7 @@ def factor(gi, gq, lc, pc, bq, vnode, wmat, tu, dmat, piv, emat, bmat, sz, sg, s
             for a in range(28):
                 for k in range(nq):
                     sz[iv, a, k] = out[lc[iv, a], k]
+                    rin[28 * iv + a, k] = 0.0
         # S_g = I - W_QQ / tu times the own velocities' response
         for k in range(nq):
             for c in range(nq):
@@ -215,15 +218,19 @@ def factor(gi, gq, lc, pc, bq, vnode, wmat, tu, dmat, piv, emat, bmat, sz, sg, s
                         cv = vnode[i, 0] + e
                         for c in range(nq):
                             sg[g, k, c] -= w * out[cv, c]
+        for iv in range(i0, i1):  # (the next group reads these as its earlier unknowns)
+            for a in range(28):
+                for k in range(nq):
+                    out[lc[iv, a], k] = 0.0
         if not _lu(sg[g, :nq, :nq], sgp[g, :nq]):
             return False
         # transposed: the response of the intervals' multipliers to unit own memory rows'
-        ys = np.zeros((nd, nq))
         _group_backward(g, gi, gq, lc, pc, bq, vnode, wmat, tu, dmat, piv, emat, ys, nq, True)
         for iv in range(i0, i1):
             for a in range(28):
                 for k in range(nq):
                     tz[iv, a, k] = ys[28 * iv + a, k]
+                    ys[28 * iv + a, k] = 0.0
         for k in range(nq):
             for c in range(nq):
                 tg[g, k, c] = 1.0 if k == c else 0.0
@@ -333,11 +340,11 @@ def backward(gi, gq, lc, pc, bq, vnode, wmat, tu, dmat, piv, emat, bmat, tz, tg,
     ni = pc.shape[0]
     ncp = vnode.shape[0]
     y = np.zeros((nd, 1))
+    part = np.zeros((nd, 1))  # (only the group's rows are used)
     for g in range(ng - 1, -1, -1):
         qa, qb = gq[g], gq[g + 1]
         nq = 3 * (qb - qa)
         i0, i1 = gi[g], gi[g + 1]
-        part = np.zeros((nd, 1))
         for iv in range(i0, i1):
             for a in range(28):
                 part[28 * iv + a, 0] = rhs[lc[iv, a]]
