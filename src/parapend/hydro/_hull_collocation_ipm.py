@@ -54,8 +54,10 @@ MU_WARM = 1e-3
 #: filter alone let the iterates wander far from feasibility on the hull's nonconvex horizons)
 THETA_GROWTH = 10.0
 THETA_FLOOR = 1e-3
-#: the inertia correction's tries at most (``delta`` times 8 each)
+#: the inertia correction's tries at most (``delta`` times 8 each), and its largest ``delta``
+#: (IPOPT's ``max_hessian_perturbation``): past it the solve fails
 MAX_CORRECTIONS = 40
+MAX_DELTA = 1e20
 
 
 def _csc_pattern(rows, cols, nrow, ncol):
@@ -75,8 +77,10 @@ class CompiledSolver:
     def __init__(self, prob):
         pl = prob.plant
         self.prob = prob
-        self.trace = None
+        self.trace = None  # a list: every iteration's (it, f, primal, dual, compl, mu, ...)
         self.lin = None
+        self.why = ""  # what ended the last failed solve (nonfinite, singular, inertia,
+        # search: the restoration not accepted, restore: it did not converge)
         npt, ni, nx, na = prob._layout()
         n, ncp, st = prob.n, prob.ncp, prob.stride
         self.npt, self.ni, self.nx, self.na, self.n, self.ncp = npt, ni, nx, na, n, ncp
@@ -331,6 +335,8 @@ class CompiledSolver:
             hred = zr.T @ (kmat @ zr)
             delta, ztz, fac = 0.0, None, None  # (Q^T Q = I: delta I is IPOPT's delta_w)
             for _ in range(MAX_CORRECTIONS):
+                if delta > MAX_DELTA:
+                    break
                 try:
                     fac = cho_factor(hred if delta == 0.0 else hred + delta * ztz,
                                      check_finite=False)
