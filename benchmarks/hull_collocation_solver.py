@@ -7,7 +7,10 @@
    same parameters, in this process: the time of each, the ratio, the iterations, the
    statuses, the objective's relative difference and the largest torque difference
    (m g l).
-2. The whole default run (``hull_mpc(..., planner="collocation", terminal_weight=0.5)``,
+2. ``--kkt``: the linear algebra of one iteration on the sixth horizon: SciPy's SuperLU
+   (and qdldl, where installed) on the whole quasi-definite KKT matrix against the
+   compiled solver's structured factors of ``J_d`` and its 48 torque sensitivities.
+3. The whole default run (``hull_mpc(..., planner="collocation", terminal_weight=0.5)``,
    seed ``--seed``) with each solver: the update time's median and p99 against the 0.75 s
    interval, the failed solves, and the electrical power (``--forecast``;
    ``--no-ipopt-run`` skips IPOPT's).
@@ -93,6 +96,65 @@ def per_horizon(seed, updates):
     return np.array(rows)
 
 
+def kkt_baseline(seed, k=5):
+    """The linear algebra of one iteration at the start of the horizon ``k`` (item 2)."""
+    import scipy.sparse as sp
+    from scipy.sparse.linalg import splu
+
+    p, wave = case(seed)
+    got = {}
+
+    def plan(prob, plant, fseg, u0, max_iter):
+        if len(got) == k:
+            got["q"] = beside(prob, max_iter, "compiled")
+            got["start"] = prob.start(fseg, u0)
+            raise StopIteration
+        got[len(got)] = prob.solve(plant, fseg, u0)
+        return got[len(got) - 1]
+
+    plan0, hc._plan, hcol.SOLVER = hc._plan, plan, "ipopt"
+    try:
+        run(p, wave)
+    except StopIteration:
+        pass
+    finally:
+        hc._plan = plan0
+    cs = got["q"].compiled
+    x0, par = got["start"]
+    cs._setup(par)
+    _, _, _, jv, _, hv = cs._eval(x0, np.ones(cs.nloc), 2, cs.fk, cs.e0)
+    jac = cs.jacobian(jv)
+    cs.sig_s = np.ones(cs.npt - 1)
+    kr = cs.krows
+    kc = cs.hessian(hv, np.ones(cs.nf)).tocoo()
+    kmat = sp.coo_matrix((kc.data, (kr[kc.row], kr[kc.col])), shape=(cs.nf, cs.nf))
+    kkt = sp.bmat([[kmat + 1e-8 * sp.identity(cs.nf), jac.T],
+                   [jac, -1e-8 * sp.identity(cs.neq)]], format="csc")
+    print(f"KKT matrix {kkt.shape[0]} rows, {kkt.nnz} nonzeros (horizon {k}, seed {seed}):")
+    for spec in ("COLAMD", "MMD_AT_PLUS_A"):
+        t = time.perf_counter()
+        lu = splu(kkt, permc_spec=spec, diag_pivot_thresh=0.0,
+                  options={"SymmetricMode": spec != "COLAMD"})
+        print(f"  SuperLU {spec:14s} factor {1000 * (time.perf_counter() - t):7.1f} ms, "
+              f"nnz(L + U) {lu.L.nnz + lu.U.nnz}")
+    try:
+        import qdldl
+    except ImportError:
+        print("  qdldl not installed")
+    else:
+        solver = qdldl.Solver(kkt)
+        t = time.perf_counter()
+        solver.update(kkt)
+        print(f"  qdldl (AMD) numeric refactor {1000 * (time.perf_counter() - t):7.1f} ms")
+    cs._factor(jac)
+    t = time.perf_counter()
+    for _ in range(10):
+        lin = cs._factor(jac)
+        lin.solve(jac[:, cs.nd:].toarray(), torques=True)
+    print(f"  structured factors of J_d and the 48 sensitivities "
+          f"{100 * (time.perf_counter() - t):7.1f} ms", flush=True)
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--updates", type=int, default=20)
@@ -100,7 +162,14 @@ def main():
     ap.add_argument("--forecast", default="perfect")
     ap.add_argument("--no-ipopt-run", action="store_true")
     ap.add_argument("--skip-horizons", action="store_true")
+    ap.add_argument("--kkt", action="store_true")
     a = ap.parse_args()
+    if a.kkt:
+        from parapend.hydro.control import _blas_controller
+
+        with _blas_controller().limit(limits=1, user_api="blas"):
+            kkt_baseline(a.seed)
+        return
     print(f"load average {os.getloadavg()[0]:.2f} {os.getloadavg()[1]:.2f}", flush=True)
     if not a.skip_horizons:
         r = per_horizon(a.seed, a.updates)
