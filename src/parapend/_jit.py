@@ -38,6 +38,8 @@ KERNELS = {
     "parapend.control._plan_kernel": ("the receding-horizon controller's horizon solver", 20),
     "parapend.hydro._hull_kernel": ("the hull problem's kernels", 10),
     "parapend.hydro._buoy_plan_kernel": ("the buoy's motion planner", 60),
+    "parapend.hydro._hull_collocation_kernel": ("the hull's collocation planner", 20),
+    "parapend.hydro._hull_collocation_linalg": ("the hull's collocation planner's solves", 20),
 }
 
 _lock = threading.Lock()

@@ -1,6 +1,7 @@
 r"""The hull's horizon problem with the MOTION as the unknown (``planner="collocation"`` of
-:func:`parapend.hydro.hull_control.hull_mpc`): direct collocation in CasADi, solved by IPOPT
-on the exact Hessian.
+:func:`parapend.hydro.hull_control.hull_mpc`): direct collocation, solved on the exact
+Hessian by IPOPT on the NLP built in CasADi (the default) or by a compiled interior point
+on the same NLP (``solver="compiled"``, :mod:`._hull_collocation_ipm`).
 
 The unknowns are the hull's ``xi = (x, z, beta)`` and the pendulum's absolute angle ``phi``
 with their velocities at the points ``t + k s``, ``k = 0..2 r n`` (``r`` Hermite-Simpson
@@ -36,6 +37,10 @@ ended unresolved).
 
 The NLP is built once per run (the start, the memory's past part and the forecast are its
 parameters) and warm-started from the previous solution shifted by the update interval.
+The compiled solver takes its Newton steps in the null space of the square Jacobian of the
+equality rows in the unknowns other than the torques (the collocation's integration of the
+plant, solved forward in time: :mod:`._hull_collocation_linalg`); IPOPT factors the whole
+KKT matrix (MUMPS), most of whose cost is the memory's dense rows.
 """
 
 from __future__ import annotations
@@ -58,6 +63,13 @@ INTERVALS = 3
 MEMORY_STRIDE = 3
 #: the generator's planned speed at most, rad per plant step (None: unbounded)
 MAX_TURN = 0.4
+#: the horizon's solver: ``"ipopt"`` (CasADi's IPOPT) or ``"compiled"``
+#: (:mod:`._hull_collocation_ipm`, no CasADi: the same NLP, about 4 times faster an update;
+#: not the default: in the closed loop it ends a sixth to a third of the solves failed or
+#: capped where IPOPT ends none, benchmarks/hull_collocation_solver.out.txt)
+SOLVER = "ipopt"
+#: the compiled solver's status names (``ipopt`` field of :meth:`HullCollocation.solve`)
+_COMPILED_STATUS = ("solved", "capped", "failed")
 #: IPOPT return statuses counted as a solved horizon (0) or an iteration cap (1)
 _SOLVED = ("Solve_Succeeded", "Solved_To_Acceptable_Level")
 _CAPPED = ("Maximum_Iterations_Exceeded", "Maximum_CpuTime_Exceeded",
@@ -79,7 +91,7 @@ class HullCollocation:
     (``steps`` even), torque limit ``torque_limit`` (units ``m g l``)."""
 
     def __init__(self, plant, n, steps, tu, torque_limit, efficiency=None, kappa=None,
-                 terminal="total", max_iter=100, intervals=None, options=None):
+                 terminal="total", max_iter=100, intervals=None, options=None, solver=None):
         if intervals is None:  # the most up to INTERVALS that hold whole plant steps
             intervals = max(r for r in range(1, INTERVALS + 1) if steps % (2 * r) == 0
                             ) if steps % 2 == 0 else 1
@@ -103,7 +115,22 @@ class HullCollocation:
         self.npt = 2 * n * intervals + 1
         self.prev = None  # the previous solution (x, lam_x, lam_g) for the warm start
         self.shift = 0
-        self._build()
+        self.solver_name = SOLVER if solver is None else solver
+        if self.solver_name not in ("compiled", "ipopt"):
+            raise ParameterError(f"solver: expected compiled or ipopt, got "
+                                 f"{self.solver_name!r:.40}")
+        self.nx, self.na = 8 * self.npt, 12 * ((self.npt - 1) // 2)
+        lb = -np.inf * np.ones(self.nx + self.na + n + 3 * self.ncp)
+        ub = -lb
+        lb[self.nx + self.na:self.nx + self.na + n] = -self.torque_limit
+        ub[self.nx + self.na:self.nx + self.na + n] = self.torque_limit
+        self.lbx, self.ubx = lb, ub
+        if self.solver_name == "ipopt":
+            self._build()
+        else:
+            from ._hull_collocation_ipm import CompiledSolver
+
+            self.compiled = CompiledSolver(self)
 
     # -- the NLP ---------------------------------------------------------------------------
     def _layout(self):
@@ -189,7 +216,6 @@ class HullCollocation:
             work += elec(-u[j] * (th[j + 1] - th[j]))
         obj = -(work + self.kappa * (energy(ys[:, -1]) - energy(p_y0)) / tu)
         par = ca.vertcat(p_y0, ca.reshape(p_mu, -1, 1), ca.reshape(p_f, -1, 1))
-        self._mem = ca.Function("mem", [xs, par], [mem])
         neq = ca.vertcat(*cons).shape[0]
         # the generator's speed within what the plant's steps resolve
         cons.append((ys[7, 1:] - ys[6, 1:]).T)
@@ -199,14 +225,9 @@ class HullCollocation:
         self.lbg = np.concatenate((np.zeros(neq), np.full(npt - 1, -vmax)))
         self.ubg = -self.lbg
         self._obj = ca.Function("obj", [xs, par], [obj])
+        self._sym = (xs, par, obj, gcat)  # the NLP's expressions (the compiled one's check)
         self.solver = ca.nlpsol("hullcol", "ipopt", {"x": xs, "p": par, "f": obj, "g": gcat},
                                 {"ipopt": self.options, "print_time": False})
-        self.nx, self.na = nx, na
-        lb = -np.inf * np.ones(nx + na + n + 3 * ncp)
-        ub = -lb
-        lb[nx + na:nx + na + n] = -self.torque_limit
-        ub[nx + na:nx + na + n] = self.torque_limit
-        self.lbx, self.ubx = lb, ub
 
     # -- the parameters of one update --------------------------------------------------------
     def kernel(self):
@@ -233,9 +254,12 @@ class HullCollocation:
         return out
 
     def _weight_matrix(self):
-        """:meth:`horizon_weights` as a (3 ncp, 3 ncp) matrix on ``(node, dof)``."""
-        wh = self.horizon_weights()
-        return wh.transpose(0, 2, 1, 3).reshape(3 * self.ncp, 3 * self.ncp)
+        """:meth:`horizon_weights` as a (3 ncp, 3 ncp) matrix on ``(node, dof)`` (kept: the
+        plant's kernels are fixed)."""
+        if getattr(self, "_wmat", None) is None:
+            wh = self.horizon_weights()
+            self._wmat = wh.transpose(0, 2, 1, 3).reshape(3 * self.ncp, 3 * self.ncp)
+        return self._wmat
 
     def _interpolation(self):
         """(ncp, npt): the memory at every point, linear between its nodes."""
@@ -278,7 +302,9 @@ class HullCollocation:
     def _with_memory(self, x, par):
         """``x`` with its memory nodes set from its velocities (the constraint's root)."""
         x = x.copy()
-        x[self.nx + self.na + self.n:] = np.asarray(self._mem(x, par)).ravel() / self.tu
+        vel = x[:self.nx].reshape(self.npt, 8)[::self.stride, 4:7].ravel()
+        past = par[8:8 + 3 * self.ncp]
+        x[self.nx + self.na + self.n:] = (past + self._weight_matrix() @ vel) / self.tu
         return x
 
     def _pack(self, ys, u0):
@@ -325,37 +351,73 @@ class HullCollocation:
         sl = slice(self.nx + self.na, self.nx + self.na + self.n)
         lb[sl] = ub[sl] = u
         x0 = self._with_memory(self.guess(u, fseg), par)
+        if self.solver_name == "compiled":
+            return self.compiled.simulate(x0, par)[:self.nx].reshape(self.npt, 8)
         r = self.solver(x0=x0, p=par, lbx=lb, ubx=ub, lbg=self.lbg, ubg=self.ubg)
         return np.asarray(r["x"]).ravel()[:self.nx].reshape(self.npt, 8)
 
     # -- one solve --------------------------------------------------------------------------
-    def solve(self, y0, fseg, u0, max_iter=None, tol=None):
-        """IPOPT from the previous solution shifted (``self.shift`` samples; the first: the
-        model rolled under ``u0``). ``y0``: the plant; ``max_iter`` and ``tol`` are the
-        constructor's (IPOPT's options are fixed when the NLP is built). Returns ``x`` (the
-        held torques, m g l), ``fun``, ``status`` (0 solved, 1 capped, 2 failed),
-        ``success``, ``nit``, ``ipopt`` (IPOPT's return status) and ``states`` (the planned
-        motion at the points, (npt, 8))."""
-        pl = self.plant
+    def start(self, fseg, u0):
+        """The solve's start ``(x0, par)``: the previous solution shifted (``self.shift``
+        samples; the first: the model rolled under ``u0``) at the plant's state, its memory
+        nodes from its velocities, and the NLP's parameters."""
         fseg = np.asarray(fseg)
         par = self._params(fseg)
         if self.prev is None:
             x0 = self.guess(u0, fseg)
         else:
             x0 = self.shifted(self.shift)
-            x0[:8] = pl.y
-        x0 = self._with_memory(x0, par)
-        r = self.solver(x0=x0, p=par, lbx=self.lbx, ubx=self.ubx, lbg=self.lbg, ubg=self.ubg)
-        st = self.solver.stats()
-        name = st.get("return_status", "")
-        x = np.asarray(r["x"]).ravel()
-        status = 0 if name in _SOLVED else (1 if name in _CAPPED else 2)
+            x0[:8] = self.plant.y
+        return self._with_memory(x0, par), par
+
+    def solve(self, y0, fseg, u0, max_iter=None, tol=None):
+        """The solver from :meth:`start` (:meth:`solve_from`), the solution kept for the next
+        start. ``y0``: the plant."""
+        x0, par = self.start(fseg, u0)
+        warm = self.prev is not None
+        r = self.solve_from(x0, par, max_iter, tol, warm=warm)
+        if self.solver_name == "compiled" and r.status == 2:
+            # the compiled solver has no restoration phase as IPOPT's: a failed warm start
+            # is solved again from the model rolled under ``u0``; failed again, its start
+            # is the plan (the previous one continued) and the next start
+            nit = r.nit
+            if warm:
+                xg = self._with_memory(self.guess(u0, fseg), par)
+                r = self.solve_from(xg, par, max_iter, tol)
+                r.nit += nit
+            if r.status == 2:
+                self.prev = x0
+                u = np.clip(x0[self.nx + self.na:self.nx + self.na + self.n],
+                            -self.torque_limit, self.torque_limit)
+                r.x, r.full, r.states = u, x0, x0[:self.nx].reshape(self.npt, 8)
+        return r
+
+    def solve_from(self, x0, par, max_iter=None, tol=None, warm=False):
+        """The solver (:data:`SOLVER` or the constructor's) from ``x0`` on the parameters
+        ``par``. ``max_iter`` and ``tol``: IPOPT's are the constructor's (its options are
+        fixed when the NLP is built), the compiled solver's these (None: the constructor's;
+        ``warm``: ``x0`` a shifted solution). Returns ``x`` (the held torques, m g l),
+        ``fun``, ``status`` (0 solved, 1 capped, 2 failed), ``success``, ``nit``, ``ipopt``
+        (the solver's status: IPOPT's return status, or solved, capped, failed) and
+        ``states`` (the planned motion at the points, (npt, 8))."""
+        if self.solver_name == "compiled":
+            mi = self.options["max_iter"] if max_iter is None else int(max_iter)
+            x, fun, status, nit = self.compiled.solve(
+                x0, par, mi, self.tol if tol is None else float(tol), warm=warm)
+            name = _COMPILED_STATUS[status]
+        else:
+            r = self.solver(x0=x0, p=par, lbx=self.lbx, ubx=self.ubx, lbg=self.lbg,
+                            ubg=self.ubg)
+            st = self.solver.stats()
+            name = st.get("return_status", "")
+            x, fun = np.asarray(r["x"]).ravel(), float(r["f"])
+            status = 0 if name in _SOLVED else (1 if name in _CAPPED else 2)
+            nit = int(st.get("iter_count", 0))
         if np.all(np.isfinite(x)):
             self.prev = x
         # IPOPT relaxes its bounds by 1e-8 relative: the torque applied is held to the limit
         u = np.clip(x[self.nx + self.na:self.nx + self.na + self.n], -self.torque_limit,
                     self.torque_limit)
-        return SimpleNamespace(x=u, fun=float(r["f"]), status=status, success=status == 0,
-                               nit=int(st.get("iter_count", 0)), ipopt=name,
-                               states=x[:self.nx].reshape(self.npt, 8))
-
+        return SimpleNamespace(x=u, fun=fun, status=status, success=status == 0,
+                               nit=nit, ipopt=name, states=x[:self.nx].reshape(self.npt, 8),
+                               full=x)

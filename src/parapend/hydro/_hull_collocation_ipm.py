@@ -1,0 +1,598 @@
+r"""The compiled solver of the hull's collocation horizon problem (:mod:`._hull_collocation`):
+a primal-dual interior point on the same NLP IPOPT solves (same unknowns, constraints,
+objective and bounds), its functions and exact derivatives from
+:mod:`._hull_collocation_kernel`, its Newton step by the problem's structure.
+
+**Structure.** The start's state is fixed (its rows are left out), so the equality rows
+(the local rows of every interval and the memory's rows) are as many as the unknowns other
+than the ``n`` held torques, and their Jacobian ``J = [J_d, J_u]`` in those unknowns ``d``
+is square: the collocation's implicit integration of the plant under given torques (its
+memory causal). The Newton step of the barrier problem
+
+    [K  J^T] [dx]   [-r]
+    [J   0 ] [l+] = [-c],   K = W + Sigma_u + D^T Sigma_s D
+
+(``W`` the Hessian of the Lagrangian, ``Sigma`` the barrier's primal-dual weights of the
+torques' bounds and of the slacks ``s`` of the generator's speeds ``D x``) is taken in the
+null space of ``J``: ``dx = Y p + Q w`` with ``J_d p = -c``, ``Q = Z R^-1`` the orthonormal
+basis of the span of ``Z = [-J_d^-1 J_u; I]`` (``R`` Householder's; the torques'
+sensitivities ``Z`` reach 1e8 where the motion's linearization is unstable over the
+horizon, and ``Z^T K Z`` then loses the reduced Hessian to rounding), ``(Q^T K Q) w =
+-Q^T (r + K Y p)`` (``n x n``, dense), then ``J_d^T l+ = -(r + K dx)_d``:
+the factors of ``J_d`` by its time structure (:mod:`._hull_collocation_linalg`) and
+``n + 2`` solves with them a step (the torques' columns from their samples on). The
+reduced Hessian ``Q^T K Q`` positive definite is the KKT matrix's inertia IPOPT asks for;
+where it is not, ``delta I`` is added to ``K`` as IPOPT's inertia correction does
+(``delta`` 0, then the last one's third or ``1e-4``, times 8 until the Cholesky succeeds).
+
+**Method.** IPOPT's with its ``monotone`` barrier: the slacks ``D x - s = 0`` of the speed
+bounds, the fraction to the boundary ``max(0.99, 1 - mu)``, the barrier's weight ``mu``
+falling as ``min(0.2 mu, mu^1.5)`` once its problem is solved to ``10 mu``
+(Fiacco-McCormick; ``MU_INIT`` cold, ``MU_WARM`` from a shifted solution), IPOPT's filter
+line search with its second-order corrections, a trial's infeasibility held within
+``THETA_GROWTH`` times the iterate's, and IPOPT's scaled optimality error for the end
+(``tol``, its ``s_max`` 100). In place of IPOPT's restoration phase: the equality rows
+solved by Newton's method for the unknowns but the torques (the collocation's motion under
+the iterate's torques). Measured on the default barge's horizons it ends at IPOPT's
+optimum from the same start on most, at 5 to 6 times less time an iteration, but its
+globalization is weaker than IPOPT's (benchmarks/hull_collocation_solver.out.txt).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import scipy.sparse as sp
+from scipy.linalg import LinAlgError, cho_factor, cho_solve
+
+from . import _hull_collocation_kernel as kern
+from ._hull_collocation_linalg import Structured
+
+#: the barrier's first weight (IPOPT's ``mu_init``) cold and from a shifted solution
+MU_INIT = 0.1
+MU_WARM = 1e-3
+#: a trial step's infeasibility at most this times the iterate's, or THETA_FLOOR (IPOPT's
+#: filter alone let the iterates wander far from feasibility on the hull's nonconvex horizons)
+THETA_GROWTH = 10.0
+THETA_FLOOR = 1e-3
+#: the inertia correction's tries at most (``delta`` times 8 each), and its largest ``delta``
+#: (IPOPT's ``max_hessian_perturbation``): past it the solve fails
+MAX_CORRECTIONS = 40
+MAX_DELTA = 1e20
+
+
+def _csc_pattern(rows, cols, nrow, ncol):
+    """The CSC pattern of the entries ``(rows, cols)`` (duplicates summed): ``(indices,
+    indptr, inverse)``, ``inverse`` the data position of every entry."""
+    keys = cols.astype(np.int64) * nrow + rows
+    uniq, inv = np.unique(keys, return_inverse=True)
+    c = uniq // nrow
+    indptr = np.searchsorted(c, np.arange(ncol + 1))
+    return (uniq % nrow).astype(np.int32), indptr.astype(np.int32), inv
+
+
+class CompiledSolver:
+    """The interior point (module docstring) of :class:`._hull_collocation.HullCollocation`
+    ``prob``; :meth:`solve` from a start ``x0`` on the parameters ``par``."""
+
+    def __init__(self, prob):
+        pl = prob.plant
+        self.prob = prob
+        self.trace = None  # a list: every iteration's (it, f, primal, dual, compl, mu, ...)
+        self.lin = None
+        self.why = ""  # what ended the last failed solve (nonfinite, singular, inertia,
+        # search: the restoration not accepted, restore: it did not converge)
+        npt, ni, nx, na = prob._layout()
+        n, ncp, st = prob.n, prob.ncp, prob.stride
+        self.npt, self.ni, self.nx, self.na, self.n, self.ncp = npt, ni, nx, na, n, ncp
+        self.nvar = nx + na + n + 3 * ncp
+        self.uo, self.mo = nx + na, nx + na + n
+        self.nloc = kern.ROWS * ni
+        self.neq = self.nloc + 3 * ncp
+        self.args = (npt, prob.intervals, st, n, prob.spacing,
+                     np.ascontiguousarray(pl.mt, dtype=float),
+                     np.ascontiguousarray(pl.cp, dtype=float),
+                     np.ascontiguousarray(pl.gm, dtype=float),
+                     np.asarray(pl.par, dtype=float), float(prob.tu))
+        eg, em = prob.eta
+        self.obj = (float(prob.kappa), 0.5 * (eg + 1.0 / em), 0.5 * (eg - 1.0 / em), 1e-3,
+                    bool(prob.pendulum_only))
+        # the memory's rows: x_mu - (past + W v) / tu, v the velocities at the nodes
+        self.wmat = prob._weight_matrix()
+        self.vidx = (8 * st * np.arange(ncp)[:, None] + 4 + np.arange(3)).ravel()
+        # the unknowns: the start's state fixed; the others d, then the torques
+        free = np.arange(8, self.nvar)
+        isu = (free >= self.uo) & (free < self.mo)
+        self.dep, self.uix = free[~isu], free[isu]
+        self.nd = self.dep.size
+        assert self.nd == self.neq
+        cmap = np.full(self.nvar, -1, np.int64)
+        cmap[self.dep] = np.arange(self.nd)
+        cmap[self.uix] = self.nd + np.arange(n)
+        self.cmap = cmap
+        nf = self.nd + n
+        self.nf = nf
+        # the speeds' rows D (on the reduced columns) and their bounds
+        vmax = prob.max_turn / pl.h if prob.max_turn else np.inf
+        self.vmax = vmax
+        ks = np.arange(1, npt)
+        self.speed = np.isfinite(vmax)
+        self.d7, self.d6 = cmap[8 * ks + 7], cmap[8 * ks + 6]
+        self.umax = float(prob.torque_limit)
+        # the patterns: the kernel's entries at any point (its order is fixed)
+        x = np.zeros(self.nvar)
+        f, jr, jc, jv, hr, hc, hv = self._eval(x, np.zeros(self.nloc), 2, np.zeros((npt, 3)),
+                                               0.0, raw=True)
+        wr, wc = np.nonzero(self.wmat)
+        mr = np.concatenate((self.nloc + np.arange(3 * ncp), self.nloc + wr))
+        mc = np.concatenate((self.mo + np.arange(3 * ncp), self.vidx[wc]))
+        mv = np.concatenate((np.ones(3 * ncp), -self.wmat[wr, wc] / prob.tu))
+        fixed = cmap[mc] < 0  # the start's velocities: known
+        mr, mc, self.mem_val = mr[~fixed], mc[~fixed], mv[~fixed]
+        keep = cmap[jc] >= 0
+        self.jkeep = keep
+        rows = np.concatenate((jr[keep], mr))
+        cols = np.concatenate((cmap[jc[keep]], cmap[mc]))
+        self.jind, self.jptr, inv = _csc_pattern(rows, cols, self.neq, nf)
+        self.jinv_var, self.jinv_mem = inv[:keep.sum()], inv[keep.sum():]
+        self.jnnz = self.jind.size
+        self.jmem = np.bincount(self.jinv_mem, weights=self.mem_val, minlength=self.jnnz)
+        hkeep = (cmap[hr] >= 0) & (cmap[hc] >= 0)
+        self.hkeep = hkeep
+        # K lives on the rows with more than the diagonal (the Hessian's, the speeds', the
+        # torques'): compressed to those
+        self.krows = np.unique(np.concatenate((cmap[hr[hkeep]], self.d7, self.d6,
+                                               self.nd + np.arange(n))))
+        nr = self.krows.size
+        kpos = np.full(nf, -1, np.int64)
+        kpos[self.krows] = np.arange(nr)
+        diag = np.arange(nr)
+        kr = np.concatenate((kpos[cmap[hr[hkeep]]], diag, kpos[self.d7], kpos[self.d6],
+                             kpos[self.d7], kpos[self.d6]))
+        kc = np.concatenate((kpos[cmap[hc[hkeep]]], diag, kpos[self.d7], kpos[self.d6],
+                             kpos[self.d6], kpos[self.d7]))
+        self.kind, self.kptr, kinv = _csc_pattern(kr, kc, nr, nr)
+        nh = hkeep.sum()
+        self.kinv_h, self.kinv_d = kinv[:nh], kinv[nh:nh + nr]
+        self.kinv_s = kinv[nh + nr:]
+        self.knnz = self.kind.size
+        self.kpos = kpos
+
+    # -- the functions --------------------------------------------------------------------
+    def _eval(self, x, lam, order, fk, e0, raw=False):
+        ni, n = self.ni, self.n
+        cons = np.empty(self.nloc)
+        grad = np.empty(self.nvar)
+        nj = kern.JAC * ni if order >= 1 else 0
+        nh = kern.HESS * 3 * ni + 25 * n + 64 if order >= 2 else 0
+        jr, jc, jv = np.empty(nj, np.int64), np.empty(nj, np.int64), np.empty(nj)
+        hr, hc, hv = np.empty(nh, np.int64), np.empty(nh, np.int64), np.empty(nh)
+        f, jn, hn = kern.evaluate(x, lam, order, *self.args, fk, *self.obj, e0, cons, grad,
+                                  jr, jc, jv, hr, hc, hv)
+        if raw:
+            return f, jr[:jn], jc[:jn], jv[:jn], hr[:hn], hc[:hn], hv[:hn]
+        mem = x[self.mo:] - (self.past + self.wmat @ x[self.vidx]) / self.tu
+        c = np.concatenate((cons, mem))
+        return f, c, grad, jv[:jn], hr, hv[:hn]
+
+    def _values(self, x):
+        """Objective, equality rows and the speeds at ``x``."""
+        f, c, _, _, _, _ = self._eval(x, self._nolam, 0, self.fk, self.e0)
+        return f, c, x[8 * np.arange(1, self.npt) + 7] - x[8 * np.arange(1, self.npt) + 6]
+
+    def jacobian(self, jv):
+        data = np.bincount(self.jinv_var, weights=jv[self.jkeep], minlength=self.jnnz)
+        data += self.jmem
+        return sp.csc_matrix((data, self.jind, self.jptr), shape=(self.neq, self.nf))
+
+    def hessian(self, hv, diag):
+        """``K`` on its rows ``krows`` (its others are zero): the Lagrangian's Hessian ``hv``
+        plus ``diag`` (nf,) on the diagonal and the speeds' weights (``self.sig_s``)."""
+        data = np.bincount(self.kinv_h, weights=hv[self.hkeep], minlength=self.knnz)
+        data += np.bincount(self.kinv_d, weights=diag[self.krows], minlength=self.knnz)
+        if self.speed:
+            ss = self.sig_s
+            data += np.bincount(self.kinv_s, weights=np.concatenate((ss, ss, -ss, -ss)),
+                                minlength=self.knnz)
+        nr = self.krows.size
+        return sp.csc_matrix((data, self.kind, self.kptr), shape=(nr, nr))
+
+    # -- one solve --------------------------------------------------------------------------
+    def _setup(self, par):
+        npt, ncp = self.npt, self.ncp
+        self.tu = float(self.prob.tu)
+        self.past = par[8:8 + 3 * ncp]
+        self.fk = np.ascontiguousarray(par[8 + 3 * ncp:].reshape(npt, 3))
+        self.e0 = kern._energy(np.ascontiguousarray(par[:8], dtype=float), 0, *self.args[5:9],
+                               self.obj[4], np.empty(8), np.empty((8, 8)))
+        self._nolam = np.zeros(self.nloc)
+
+    def _speeds(self, x):
+        ks = np.arange(1, self.npt)
+        return x[8 * ks + 7] - x[8 * ks + 6]
+
+    def _barrier(self, f, x, s, mu):
+        """The barrier function ``phi_mu`` at ``(x, s)``."""
+        u = x[self.uo:self.uo + self.n]
+        out = f - mu * _logs(u + self.umax, self.umax - u)
+        if self.speed:
+            out -= mu * _logs(s + self.vmax, self.vmax - s)
+        return out
+
+    def _theta(self, c, x, s):
+        return float(np.sum(np.abs(c)) + (np.sum(np.abs(self._speeds(x) - s))
+                                          if self.speed else 0.0))
+
+    def solve(self, x0, par, max_iter, tol, warm=False):
+        """The interior point from ``x0`` (its start's state is ``par``'s) on the parameters
+        ``par`` (:meth:`._hull_collocation.HullCollocation._params`). Returns ``(x, f,
+        status, iterations)``: status 0 solved to ``tol``, 1 stopped at ``max_iter``, 2
+        failed (a singular step or a line search that found no acceptable point). One BLAS
+        thread (its small products: a second thread waiting on a busy core cost 5 times)."""
+        from .control import _blas_controller
+
+        with _blas_controller().limit(limits=1, user_api="blas"):
+            return self._solve(x0, par, max_iter, tol, MU_WARM if warm else MU_INIT,
+                               THETA_GROWTH)
+
+    def _solve(self, x0, par, max_iter, tol, mu, growth):
+        npt, n, nd, nf = self.npt, self.n, self.nd, self.nf
+        self._setup(par)
+        e0, fk = self.e0, self.fk
+        x = np.array(x0, dtype=float)
+        x[:8] = par[:8]
+        um, vm, uo = self.umax, self.vmax, self.uo
+        # the torques and the slacks strictly inside their bounds (IPOPT's bound push)
+        x[uo:uo + n] = np.clip(x[uo:uo + n], -um + 1e-2 * min(1.0, um),
+                               um - 1e-2 * min(1.0, um))
+        s = self._speeds(x)
+        if self.speed:
+            pv = 1e-2 * min(1.0, vm)
+            s = np.clip(s, -vm + pv, vm - pv)
+        warm = mu < MU_INIT
+        self.growth = growth
+        ns = npt - 1 if self.speed else 0
+        zl, zu = np.ones(n), np.ones(n)
+        zls, zus = np.ones(ns), np.ones(ns)
+        if warm:
+            zl, zu = mu / (x[uo:uo + n] + um), mu / (um - x[uo:uo + n])
+            if self.speed:
+                zls, zus = mu / (s + vm), mu / (vm - s)
+        lam = None
+        lamd = zus - zls if self.speed else np.zeros(npt - 1)
+        delta_last = 0.0
+        status, it = 1, 0
+        tau_min = 0.99
+        filt = []
+        theta_max = theta_min = None
+        nrest = 0
+        while True:
+            lam_e = np.zeros(self.neq) if lam is None else lam
+            f, c, grad, jv, _, hv = self._eval(x, lam_e[:self.nloc], 2, fk, e0)
+            if not (np.isfinite(f) and np.all(np.isfinite(c)) and np.all(np.isfinite(grad))):
+                status, self.why = 2, "nonfinite"
+                break
+            jac = self.jacobian(jv)
+            lu = self._factor(jac)
+            if lu is None:
+                status, self.why = 2, "singular"
+                break
+            gf = np.concatenate((grad[self.dep], grad[self.uix]))  # on the reduced columns
+            rd = self._speeds(x) - s if self.speed else np.zeros(0)
+            gdl = self._dt(lamd) if self.speed else np.zeros(nf)
+            if lam is None:  # least-squares multipliers at the start (IPOPT's)
+                lam = lu.solve_t(-(gf[:nd] + gdl[:nd]))
+                if not np.all(np.isfinite(lam)) or np.max(np.abs(lam)) > 1e3:
+                    lam = np.zeros(self.neq)
+                f, c, grad, jv, _, hv = self._eval(x, lam[:self.nloc], 2, fk, e0)
+            u = x[uo:uo + n]
+            sl_u, su_u = u + um, um - u
+            sls, sus = s + vm, vm - s
+            # the optimality error (IPOPT's, scaled)
+            gl = gf + jac.T @ lam + gdl
+            gl[nd:] += zu - zl
+            comp = np.concatenate((sl_u * zl, su_u * zu, sls * zls, sus * zus))
+            zsum = np.sum(zl) + np.sum(zu) + np.sum(zls) + np.sum(zus)
+            nz = 2 * (n + ns)
+            sd = max(100.0, (np.sum(np.abs(lam)) + np.sum(np.abs(lamd)) + zsum)
+                     / (self.neq + ns + nz)) / 100.0
+            sc = max(100.0, zsum / nz) / 100.0
+            primal = max(np.max(np.abs(c)), np.max(np.abs(rd)) if ns else 0.0)
+            dual = max(np.max(np.abs(gl)),
+                       np.max(np.abs(-lamd - zls + zus)) if ns else 0.0)
+            err0 = max(dual / sd, primal, np.max(np.abs(comp)) / sc)
+            if err0 <= tol:
+                status = 0
+                break
+            if it >= max_iter:
+                status = 1
+                break
+            # the barrier's weight falls once its problem is solved to 10 mu (IPOPT's
+            # monotone update; the filter starts anew)
+            while max(dual / sd, primal, np.max(np.abs(comp - mu)) / sc) <= 10.0 * mu \
+                    and mu > tol / 10.0:
+                mu = max(tol / 10.0, min(0.2 * mu, mu ** 1.5))
+                tau_min = max(0.99, 1.0 - mu)
+                filt = []
+            it += 1
+            # the Newton step (module docstring)
+            diag = np.zeros(nf)
+            diag[nd:] = zl / sl_u + zu / su_u
+            gphi0 = gf.copy()
+            gphi0[nd:] += -mu / sl_u + mu / su_u
+            self.sig_s = zls / sls + zus / sus if ns else np.zeros(0)
+            gphis = -mu / sls + mu / sus if ns else np.zeros(0)
+            kmat = self.hessian(hv, diag)
+            zfull = np.empty((nf, n))
+            ju = jac[:, nd:].toarray()
+            zfull[:nd] = -lu.solve(ju, torques=True)
+            zfull[nd:] = np.eye(n)
+            # an orthonormal basis of the null space: the torques' sensitivities reach 1e8
+            # where the linearized motion is unstable over the horizon, and Z^T K Z then
+            # loses the reduced Hessian to rounding (Z R^-1 with Householder's R:
+            # orthonormal to 1e-16 times Z's condition)
+            zfull = zfull @ np.linalg.inv(np.linalg.qr(zfull, mode="r"))
+            zr = zfull[self.krows]
+            hred = zr.T @ (kmat @ zr)
+            delta, ztz, fac = 0.0, None, None  # (Q^T Q = I: delta I is IPOPT's delta_w)
+            for _ in range(MAX_CORRECTIONS):
+                if delta > MAX_DELTA:
+                    break
+                try:
+                    fac = cho_factor(hred if delta == 0.0 else hred + delta * ztz,
+                                     check_finite=False)
+                    if np.all(np.isfinite(fac[0])):
+                        break
+                except LinAlgError:
+                    pass
+                fac = None
+                if ztz is None:
+                    ztz = np.eye(n)
+                delta = ((1e-4 if delta_last == 0.0 else max(1e-20, delta_last / 3.0))
+                         if delta == 0.0 else 8.0 * delta)
+            if fac is None:
+                status, self.why = 2, "inertia"
+                break
+            if delta:
+                delta_last = delta
+
+            newton = _Newton(self, lu, fac, zfull, kmat, delta, gphi0, gphis)
+            dx, ds, lam_new, lamd_new = newton.step(c, rd)
+            ddu = dx[uo:uo + n]
+            dzl = mu / sl_u - zl - zl / sl_u * ddu
+            dzu = mu / su_u - zu + zu / su_u * ddu
+            dzls = mu / sls - zls - zls / sls * ds
+            dzus = mu / sus - zus + zus / sus * ds
+            ap = self._alpha(sl_u, su_u, sls, sus, ddu, ds, tau_min)
+            az = _max_step(np.concatenate((zl, zu, zls, zus)),
+                           np.concatenate((dzl, dzu, dzls, dzus)), tau_min)
+            # the filter line search (IPOPT's, with its second-order corrections)
+            theta = self._theta(c, x, s)
+            phi = self._barrier(f, x, s, mu)
+            if theta_max is None:
+                theta_max, theta_min = 1e4 * max(1.0, theta), 1e-4 * max(1.0, theta)
+            gd = float(gf @ np.concatenate((dx[self.dep], ddu))
+                       + np.sum((-mu / sl_u + mu / su_u) * ddu)
+                       + (np.sum(gphis * ds) if ns else 0.0))
+            if gd < 0.0:
+                amin = 0.05 * min(1e-5, 1e-8 * theta / -gd, theta ** 1.1 / (-gd) ** 2.3)
+            else:
+                amin = 0.05 * 1e-5
+
+            ls = _Search(self, x, s, mu, theta, phi, gd, theta_min, theta_max, filt)
+            a = ap
+            acc = None
+            first = True
+            while a >= amin:
+                res = ls.trial(a, a * dx, a * ds)
+                if res is not None and res[0]:
+                    acc = res
+                    break
+                if first and res is not None and res[4] >= theta:
+                    # second-order corrections
+                    csoc, rsoc, tprev, asoc = a * c, a * rd, theta, a
+                    ct, xt, st = res[3], res[1], res[2]
+                    for _ in range(4):
+                        csoc = asoc * csoc + ct if _ else csoc + ct
+                        rsoc = (asoc * rsoc if _ else rsoc) + (
+                            self._speeds(xt) - st if ns else 0.0)
+                        sdx, sds, _l, _ld = newton.step(csoc, rsoc)
+                        asoc = self._alpha(sl_u, su_u, sls, sus, sdx[uo:uo + n], sds,
+                                           tau_min)
+                        rs = ls.trial(a, asoc * sdx, asoc * sds)
+                        if rs is None:
+                            break
+                        if rs[0]:
+                            acc = rs
+                            break
+                        if rs[4] > 0.99 * tprev:
+                            break
+                        tprev, ct, xt, st = rs[4], rs[3], rs[1], rs[2]
+                    if acc is not None:
+                        break
+                first = False
+                a *= 0.5
+            if acc is None:
+                # restoration: the equality rows solved for the unknowns but the torques
+                # (Newton's method, the torques held), accepted where it lowers the
+                # infeasibility by a tenth and the filter takes it
+                filt.append((theta, phi))
+                xr, sr = self._restore(x, s)
+                tr = None if xr is None else self._theta(self._values(xr)[1], xr, sr)
+                if tr is None or not tr <= 0.9 * theta or any(
+                        tr >= tf and self._barrier(self._values(xr)[0], xr, sr, mu) >= pf
+                        for tf, pf in filt):
+                    status, self.why = 2, "search" if xr is not None else "restore"
+                    break
+                x, s, lam = xr, sr, None
+                nrest += 1
+                continue
+            if self.trace is not None:
+                self.trace.append((it, f, primal, dual / sd, np.max(np.abs(comp)), mu, ap, a,
+                                   az, delta, len(filt)))
+            x, s = acc[1], acc[2]
+            lam = lam + a * (lam_new - lam)
+            lamd = lamd + a * (lamd_new - lamd)
+            zl, zu = zl + az * dzl, zu + az * dzu
+            zls, zus = zls + az * dzls, zus + az * dzus
+            # the multipliers of the bounds kept within 1e10 of their central values
+            u = x[uo:uo + n]
+            zl = np.clip(zl, mu / (1e10 * (u + um)), 1e10 * mu / (u + um))
+            zu = np.clip(zu, mu / (1e10 * (um - u)), 1e10 * mu / (um - u))
+            if ns:
+                zls = np.clip(zls, mu / (1e10 * (s + vm)), 1e10 * mu / (s + vm))
+                zus = np.clip(zus, mu / (1e10 * (vm - s)), 1e10 * mu / (vm - s))
+        self.lam, self.restorations = lam, nrest
+        return x, float(f), status, it
+
+    def _restore(self, x, s, max_iter=20):
+        """``(x, s)`` with the equality rows solved by Newton's method on the unknowns but the
+        torques (backtracking on ``|c|_1``), the slacks the speeds within their bounds; ``(None,
+        None)`` where it does not converge."""
+        x = x.copy()
+        for _ in range(max_iter):
+            _, c, _, jv, _, _ = self._eval(x, self._nolam, 1, self.fk, self.e0)
+            th = np.sum(np.abs(c))
+            if np.max(np.abs(c)) < 1e-10:
+                break
+            lu = self._factor(self.jacobian(jv))
+            if lu is None:
+                return None, None
+            dz = lu.solve(-c)
+            a = 1.0
+            for _ in range(20):
+                xt = x.copy()
+                xt[self.dep] += a * dz
+                ct = self._values(xt)[1]
+                if np.sum(np.abs(ct)) < (1.0 - 1e-4 * a) * th:
+                    break
+                a *= 0.5
+            else:
+                return None, None
+            x = xt
+        s = self._speeds(x)
+        if self.speed:
+            pv = 1e-2 * min(1.0, self.vmax)
+            s = np.clip(s, -self.vmax + pv, self.vmax - pv)
+        return x, s
+
+    def simulate(self, x0, par, max_iter=50):
+        """The NLP's only feasible point with ``x0``'s torques (Newton's method on the
+        equality rows from ``x0``; the collocation's motion under the torques)."""
+        self._setup(par)
+        x = np.array(x0, dtype=float)
+        x[:8] = par[:8]
+        for _ in range(max_iter):
+            _, c, _, jv, _, _ = self._eval(x, self._nolam, 1, self.fk, self.e0)
+            if np.max(np.abs(c)) < 1e-12:
+                break
+            lu = self._factor(self.jacobian(jv))
+            if lu is None:
+                break
+            dz = lu.solve(-c)
+            x[self.dep] += dz
+            if np.max(np.abs(dz)) < 1e-13 * max(1.0, np.max(np.abs(x))):
+                break
+        return x
+
+    def _factor(self, jac):
+        """The structured factors of ``J_d`` (:mod:`._hull_collocation_linalg`), or None
+        where singular."""
+        if self.lin is None:
+            self.lin = Structured(self)
+        return self.lin if self.lin.factor(jac.data) else None
+
+    def _dt(self, w):
+        """``D^T w`` on the reduced columns."""
+        out = np.zeros(self.nf)
+        np.add.at(out, self.d7, w)
+        np.add.at(out, self.d6, -w)
+        return out
+
+    def _alpha(self, sl_u, su_u, sls, sus, ddu, ds, tau):
+        """The largest step to the fraction ``tau`` of the bounds' distances."""
+        return _max_step(np.concatenate((sl_u, su_u, sls, sus)),
+                         np.concatenate((ddu, -ddu, ds, -ds)), tau)
+
+
+
+class _Newton:
+    """The Newton step of one iteration (module docstring) for any constraints' right side
+    (the second-order corrections reuse the factors)."""
+
+    def __init__(self, solver, lu, fac, zfull, kmat, delta, gphi0, gphis):
+        self.sv, self.lu, self.fac, self.zfull, self.kmat = solver, lu, fac, zfull, kmat
+        self.delta = delta
+        self.gphi0, self.gphis = gphi0, gphis
+
+    def step(self, cr, rdr):
+        """``(dx, ds, l+, l_d+)`` for the constraints' values ``cr`` and speeds' ``rdr``."""
+        sv = self.sv
+        nd, nf = sv.nd, sv.nf
+        ns = sv.sig_s.size
+        gphi = self.gphi0 + sv._dt(sv.sig_s * rdr + self.gphis) if ns else self.gphi0
+        yp = np.zeros(nf)
+        yp[:nd] = -self.lu.solve(cr)
+        du = cho_solve(self.fac, -(self.zfull.T @ (gphi + self.kmul(yp))), check_finite=False)
+        dxf = yp + self.zfull @ du
+        lnew = self.lu.solve_t(-(gphi + self.kmul(dxf))[:nd])
+        ds = dxf[sv.d7] - dxf[sv.d6] + rdr if ns else np.zeros(0)
+        dx = np.zeros(sv.nvar)
+        dx[sv.dep] = dxf[:nd]
+        dx[sv.uix] = dxf[nd:]
+        return dx, ds, lnew, sv.sig_s * ds + self.gphis if ns else np.zeros(sv.npt - 1)
+
+
+    def kmul(self, v):
+        """``(K + delta I) v``."""
+        out = self.delta * v
+        kr = self.sv.krows
+        out[kr] += self.kmat @ v[kr]
+        return out
+
+
+class _Search:
+    """One iteration's filter line search (IPOPT's): :meth:`trial` of a step."""
+
+    def __init__(self, solver, x, s, mu, theta, phi, gd, theta_min, theta_max, filt):
+        self.sv, self.x, self.s, self.mu = solver, x, s, mu
+        self.theta, self.phi, self.gd = theta, phi, gd
+        self.theta_min, self.theta_max, self.filt = theta_min, theta_max, filt
+
+    def trial(self, a, dxa, dsa):
+        """``None`` (out of the bounds) or ``(accepted, x, s, c, theta)`` of the step
+        ``(dxa, dsa)`` (the search's ``a`` for the switching rule)."""
+        sv = self.sv
+        xt, st = self.x + dxa, self.s + dsa
+        ut = xt[sv.uo:sv.uo + sv.n]
+        um, vm = sv.umax, sv.vmax
+        if np.any(ut + um <= 0) or np.any(um - ut <= 0) or (
+                sv.speed and (np.any(st + vm <= 0) or np.any(vm - st <= 0))):
+            return None
+        ft, ct, _, _, _, _ = sv._eval(xt, sv._nolam, 0, sv.fk, sv.e0)
+        tht, pht = sv._theta(ct, xt, st), sv._barrier(ft, xt, st, self.mu)
+        theta, phi, gd = self.theta, self.phi, self.gd
+        if not (np.isfinite(tht) and np.isfinite(pht)) or tht > self.theta_max or (
+                tht > max(sv.growth * theta, THETA_FLOOR)):
+            return False, xt, st, ct, tht
+        if any(tht >= tf and pht >= pf for tf, pf in self.filt):
+            return False, xt, st, ct, tht
+        switch = gd < 0.0 and a * (-gd) ** 2.3 > theta ** 1.1
+        armijo = pht <= phi + 1e-8 * a * gd
+        if theta <= self.theta_min and switch:
+            return armijo, xt, st, ct, tht
+        ok = tht <= (1.0 - 1e-5) * theta or pht <= phi - 1e-8 * theta
+        if ok and not (switch and armijo):
+            self.filt.append(((1.0 - 1e-5) * theta, phi - 1e-8 * theta))
+        return ok, xt, st, ct, tht
+
+
+def _logs(a, b):
+    with np.errstate(invalid="ignore", divide="ignore"):
+        return float(np.sum(np.log(a)) + np.sum(np.log(b)))
+
+
+def _max_step(v, dv, frac):
+    neg = dv < 0
+    if not np.any(neg):
+        return 1.0
+    return float(min(1.0, frac * np.min(-v[neg] / dv[neg])))

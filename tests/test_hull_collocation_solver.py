@@ -1,0 +1,212 @@
+"""The compiled solver of the hull's collocation planner
+(:mod:`parapend.hydro._hull_collocation_ipm`, its kernel
+:mod:`parapend.hydro._hull_collocation_kernel`) against CasADi and IPOPT on the same NLP
+(:class:`parapend.hydro._hull_collocation.HullCollocation`, ``solver="ipopt"``), on the
+synthetic hull of tests/hull_timedomain.py:
+
+- the kernel's objective, constraints and hand-written derivatives (gradient, Jacobian, the
+  Hessian of the Lagrangian) are CasADi's automatic derivatives of the same expressions,
+  to rounding, with and without an efficiency, either terminal energy;
+- from the same start (the model rolled, then the previous solution shifted) it ends at
+  IPOPT's optimum: objective to 1e-6 relative, torques to 1e-4 m g l;
+- under fixed torques its motion is IPOPT's (the NLP's only feasible point);
+- slow: the same on horizons captured from the default barge's run (seeds 0 and 1, perfect
+  forecast, terminal weight 0.5).
+"""
+
+import numpy as np
+import pytest
+
+ca = pytest.importorskip("casadi")
+
+import test_hull_collocation as tc  # noqa: E402
+
+from parapend.hydro import _hull_collocation_kernel as kern  # noqa: E402
+from parapend.hydro._hull_collocation import HullCollocation  # noqa: E402
+
+VARIANTS = [dict(), dict(efficiency=(0.9, 0.85), kappa=0.5),
+            dict(efficiency=(0.9, 0.85), terminal="pendulum")]
+
+
+def _pair(intervals, **kw):
+    """The small horizon of test_hull_collocation (two samples in) as the compiled problem
+    and as IPOPT's."""
+    plant, fseg, _ = tc._horizon(0)
+    make = [HullCollocation(plant, tc.N, tc.PS, tc.TU, 4.0, intervals=intervals,
+                            max_iter=200, solver=s, **kw) for s in ("compiled", "ipopt")]
+    return plant, fseg, make[0], make[1]
+
+
+@pytest.mark.parametrize("kw", VARIANTS)
+def test_derivatives_are_casadis(kw):
+    """At a perturbed start and random multipliers: objective, constraints, gradient,
+    Jacobian and the Lagrangian's Hessian, the kernel's against CasADi's, to 1e-12
+    relative to their largest entries."""
+    plant, fseg, prob, ref = _pair(2, **kw)
+    cs = prob.compiled
+    par = prob._params(np.asarray(fseg))
+    rng = np.random.default_rng(1)
+    x = prob._with_memory(prob.guess(np.full(tc.N, 0.5), fseg), par)
+    x += 0.05 * rng.standard_normal(x.size)
+    x[:8] = par[:8]
+    xs, ps, obj, g = ref._sym
+    ncp, nl = prob.ncp, cs.nloc
+    lam = rng.standard_normal(g.shape[0])
+    cs._setup(par)
+    f, c, grad, jv, _, hv = cs._eval(x, lam[8 + 3 * ncp:8 + 3 * ncp + nl], 2, cs.fk, cs.e0)
+    lg = ca.SX.sym("l", g.shape[0])
+    fun = ca.Function("f", [xs, ps, lg], [obj, g, ca.gradient(obj, xs), ca.jacobian(g, xs),
+                                         ca.hessian(obj + ca.dot(lg, g), xs)[0]])
+    fo, go, gro, jo, ho = (np.asarray(ca.densify(v)) for v in fun(x, par, lam))
+    go = go.ravel()
+    # the kernel's rows: the intervals' (CasADi's after the start's and the memory's), then
+    # the memory's; its columns: the unknowns but the start's state, the torques last
+    rows = np.concatenate((8 + 3 * ncp + np.arange(nl), 8 + np.arange(3 * ncp)))
+    cols = np.concatenate((cs.dep, cs.uix))
+    fo = float(fo.ravel()[0])
+    assert abs(f - fo) <= 1e-12 * max(1.0, abs(fo))
+    for mine, theirs in ((c, go[rows]), (grad[8:], gro.ravel()[8:]),
+                         (cs.jacobian(jv).toarray(), jo[rows][:, cols])):
+        assert np.max(np.abs(mine - theirs)) <= 1e-12 * np.max(np.abs(theirs))
+    cs.sig_s = np.zeros(cs.npt - 1)
+    cs_speed, cs.speed = cs.speed, False
+    hess = cs.hessian(hv, np.zeros(cs.nf)).toarray()  # (the torques' diagonal: zero here)
+    cs.speed = cs_speed
+    theirs = ho[cols][:, cols]
+    kr = cs.krows  # the solver keeps the rows with more than a diagonal: the others zero
+    off = np.ones(cs.nf, bool)
+    off[kr] = False
+    assert np.all(theirs[off] == 0.0)
+    theirs = theirs[kr][:, kr]
+    assert np.max(np.abs(hess - theirs)) <= 1e-12 * np.max(np.abs(theirs))
+
+
+@pytest.mark.parametrize("intervals, kw, updates", [(2, VARIANTS[0], 2), (2, VARIANTS[1], 1),
+                                                    (1, VARIANTS[0], 1)])
+def test_compiled_reaches_ipopts_optimum(intervals, kw, updates):
+    """One or two updates (the second from the first's solution shifted by one sample,
+    after the plant ran it): the compiled solver and IPOPT from the same start reach the
+    same objective (1e-6 relative) and torques (1e-4 m g l), both solved. (With an
+    efficiency the smoothed kink of ``e(.)`` makes the problem's local optima many: the
+    second update of this small hull, or one Hermite-Simpson interval a sample, ends the
+    two at different local optima, neither below the other every time.)"""
+    plant, fseg, prob, ref = _pair(intervals, **kw)
+    prob.shift = 1
+    for k in range(updates):
+        x0, par = prob.start(fseg, np.zeros(tc.N))
+        r = prob.solve_from(x0, par, warm=k > 0)
+        s = ref.solve_from(x0, par)
+        assert r.status == 0 and s.status == 0, (r.ipopt, s.ipopt)
+        assert abs(r.fun - s.fun) <= 1e-6 * abs(s.fun), (r.fun, s.fun)
+        assert np.max(np.abs(r.x - s.x)) < 1e-4, (r.x, s.x)
+        plant.step(r.x[:1] * tc.TU, tc.PS, fseg)
+        fseg = _next_forecast(plant)
+
+
+def _next_forecast(plant):
+    fn = tc.bc.force_nodes(tc.th.HULL, tc.th.WAVE, tc.PER, tc.PS, 2 * 3 * tc.PER * tc.PS + 1)
+    a = 2 * plant.k0
+    return fn[a:a + 2 * tc.N * tc.PS + 1]
+
+
+def test_simulation_is_ipopts():
+    """Under fixed torques the compiled Newton's motion is IPOPT's to 1e-8 (m, rad)."""
+    plant, fseg, prob, ref = _pair(2)
+    u = np.array([0.5, -0.3, 0.9, -0.6, 0.2, 0.4])
+    assert np.max(np.abs(prob.simulate(u, fseg) - ref.simulate(u, fseg))) < 1e-8
+
+
+def test_bad_solver_is_one_line():
+    plant, fseg, _ = tc._horizon(0)
+    with pytest.raises(tc.hc.ParameterError, match="solver: expected compiled or ipopt"):
+        HullCollocation(plant, tc.N, tc.PS, tc.TU, 4.0, solver="mumps")
+
+
+def _captured(seed, count):
+    """The first ``count`` horizons of the default barge's run planned by IPOPT (seed
+    ``seed``, perfect forecast, terminal weight 0.5): ``[(prob, x0, par, warm, max_iter,
+    IPOPT's solve)]``, and the benchmark's module."""
+    import sys
+    from pathlib import Path
+
+    sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "benchmarks"))
+    import hull_collocation_solver as bench
+
+    from parapend.hydro import _hull_collocation as hcol
+    from parapend.hydro import hull_control as hc
+
+    p, wave = bench.case(seed)
+    caps = []
+
+    def plan(prob, plant, fseg, u0, max_iter):
+        x0, par = prob.start(fseg, u0)
+        warm = prob.prev is not None
+        r = prob.solve_from(x0, par, max_iter, prob.tol, warm=warm)
+        caps.append((prob, x0, par, warm, max_iter, r))
+        if len(caps) >= count:
+            raise StopIteration
+        return r
+
+    plan0, hc._plan = hc._plan, plan
+    solver0, hcol.SOLVER = hcol.SOLVER, "ipopt"
+    try:
+        bench.run(p, wave)
+    except StopIteration:
+        pass
+    finally:
+        hc._plan, hcol.SOLVER = plan0, solver0
+    return caps, bench
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("seed", [0, 1])
+def test_captured_horizons_reach_ipopts_optimum(seed):
+    """The first three horizons of the default barge's run: from IPOPT's start the compiled
+    solver solves, to IPOPT's objective (1e-6 relative) and torques (1e-3 m g l: both
+    stop at the tolerance 1e-6 of the optimality error, which on seed 1's third horizon
+    leaves 4e-4 between them along a flat direction, the objective equal to 1e-8)."""
+    caps, bench = _captured(seed, 3)
+    comp = bench.beside(caps[0][0], caps[0][4], "compiled")
+    for _, x0, par, warm, mi, s in caps:
+        r = comp.solve_from(x0, par, mi, comp.tol, warm=warm)
+        assert r.status == 0 and s.status == 0, (r.ipopt, s.ipopt)
+        assert abs(r.fun - s.fun) <= 1e-6 * abs(s.fun), (r.fun, s.fun)
+        assert np.max(np.abs(r.x - s.x)) < 1e-3, (r.x, s.x)
+
+
+def test_kernel_sizes():
+    """The kernel writes the Jacobian and Hessian entries it declares (the caller's
+    buffers): an interval's rows and entries, a point's Hessian entries."""
+    plant, fseg, prob, _ = _pair(2)
+    cs = prob.compiled
+    cs._setup(prob._params(np.asarray(fseg)))
+    x = np.zeros(cs.nvar)
+    f, jr, jc, jv, hr, hc, hv = cs._eval(x, np.zeros(cs.nloc), 2, cs.fk, cs.e0, raw=True)
+    assert jr.size == kern.JAC * cs.ni and np.all(jc >= 0)
+    assert hr.size == kern.HESS * 3 * cs.ni + 25 * cs.n + 64
+    assert jr.max() == kern.ROWS * cs.ni - 1
+
+
+@pytest.mark.parametrize("intervals", [1, 2, 4])
+def test_structured_solves_are_superlus(intervals):
+    """The structured solves with ``J_d`` (groups of intervals and memory nodes forward, and
+    backward transposed; a torque's column from its sample on) against SciPy's sparse LU of
+    the same matrix, at a perturbed point, to 1e-12 relative."""
+    from scipy.sparse.linalg import splu
+
+    plant, fseg, prob, _ = _pair(intervals)
+    cs = prob.compiled
+    par = prob._params(np.asarray(fseg))
+    rng = np.random.default_rng(0)
+    x = prob._with_memory(prob.guess(np.full(tc.N, 0.5), fseg), par)
+    x += 0.05 * rng.standard_normal(x.size)
+    cs._setup(par)
+    _, _, _, jv, _, _ = cs._eval(x, np.zeros(cs.nloc), 1, cs.fk, cs.e0)
+    jac = cs.jacobian(jv)
+    lin = cs._factor(jac)
+    lu = splu(jac[:, :cs.nd].tocsc())
+    ju = jac[:, cs.nd:].toarray()
+    r = rng.standard_normal(cs.nd)
+    for mine, theirs in ((lin.solve(ju, torques=True), lu.solve(ju)),
+                         (lin.solve(r), lu.solve(r)), (lin.solve_t(r), lu.solve(r, trans="T"))):
+        assert np.max(np.abs(mine - theirs)) <= 1e-12 * np.max(np.abs(theirs))
