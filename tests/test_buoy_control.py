@@ -172,6 +172,18 @@ def test_bad_input(kw, name):
     (["--controller", "mpc", "--wave-period", "1.5"], "controller"),
     (["--controller", "pid", "--hs", "0.5", "--tp", "2.5"], "controller"),
     (["--controller", "mpc", "--hs", "0.5", "--tp", "2.5", "--plot", "figs"], "plot"),
+    # the planner: with mpc only, and the model's own
+    (["--planner", "coupled", "--hs", "0.5", "--tp", "2.5"], "planner"),
+    (["--controller", "one-way-mpc", "--planner", "plan", "--hs", "0.5", "--tp", "2.5"],
+     "planner"),
+    (["--controller", "mpc", "--planner", "collocation", "--hs", "0.5", "--tp", "2.5"],
+     "planner"),
+    (["--controller", "mpc", "--planner", "plan", "--efficiency", "0.9", "--hs", "0.5",
+      "--tp", "2.5"], "efficiency"),
+    (["--dofs", "surge,heave,pitch", "--controller", "mpc", "--planner", "coupled", "--hs",
+      "1", "--tp", "6"], "planner"),
+    (["--dofs", "surge,heave,pitch", "--planner", "collocation", "--hs", "1", "--tp", "6"],
+     "planner"),
 ])
 def test_cli_bad_input_is_one_line(argv, name, capsys):
     from parapend.cli import main
@@ -241,3 +253,18 @@ def test_the_headline_is_storage_corrected_over_whole_repeats(one_way):
     assert r.update_time_p99_s <= r.update_time_max_s
     assert r.realtime_fits == (r.update_time_p99_s <= r.update_interval_s)
     assert 0 <= r.failed_kept_previous <= r.failed_solves
+
+
+@pytest.mark.slow  # the embedded buoy's BEM (cached), its reference optimum and two runs
+def test_cli_planner_chooses_the_heaving_buoys_planner(capsys):
+    """``parapend buoy --controller mpc --planner coupled``: the run is planned by the
+    held-torque planner (the default, ``plan``, without it), as ``horizon --planner``."""
+    import json
+
+    from parapend.cli import main
+
+    argv = ["buoy", "--controller", "mpc", "--hs", "0.5", "--tp", "2.5", "--repeat-period",
+            "5", "--json"]
+    for extra, planner in (([], "plan"), (["--planner", "coupled"], "coupled")):
+        main([*argv, *extra])
+        assert json.loads(capsys.readouterr().out)["planner"] == planner

@@ -236,6 +236,8 @@ def _one_line(argv, name, capsys):
     (["--device", "buoy", "--forecasts", "none"], "forecasts"),
     (["--device", "buoy", "--forecasts", "tracker"], "forecasts"),
     (["--device", "buoy", "--planner", "plan", "--efficiency", "0.9"], "efficiency"),
+    (["--device", "buoy", "--planner", "lbfgsb"], "planner"),     # the hull's planner
+    (["--device", "buoy", "--dofs", "surge,heave,pitch", "--planner", "plan"], "planner"),
     (["--device", "buoy", "--torque-limit", "1", "--torque-limit-nm", "100"],
      "torque-limit-nm"),
     (["--device", "buoy", "--torque-limit", "-1"], "torque-limit"),

@@ -113,3 +113,42 @@ def test_bad_planner_is_one_line():
     with pytest.raises(hc.ParameterError, match="plant_steps"):
         hc.hull_mpc(th.HULL, th.PEND, th.WAVE, **dict(th.OPTS, plant_steps=5),
                     planner="collocation")
+
+
+def test_the_default_terminal_weight_is_the_measured_one():
+    """Without ``terminal_weight`` the collocation planner weighs the energy left at the
+    horizon's end by ``COLLOCATION_TERMINAL_WEIGHT`` (0.5, measured: docs/hull.md): the run
+    is the one with 0.5 given, to the bit, and not the one with 1 (the L-BFGS-B planner's
+    default)."""
+    opts = dict(th.OPTS, max_iter=3, planner="collocation")
+    runs = [hc.hull_mpc(th.HULL, th.PEND, th.WAVE, **opts, terminal_weight=w).series["torque"]
+            for w in (None, 0.5, 1.0)]
+    assert hc.COLLOCATION_TERMINAL_WEIGHT == 0.5
+    assert np.array_equal(runs[0], runs[1])
+    assert not np.array_equal(runs[0], runs[2])
+
+
+@pytest.mark.slow
+def test_the_command_runs_the_collocation_planner(tmp_path, capsys):
+    """``parapend buoy --dofs surge,heave,pitch --controller mpc --planner collocation``:
+    the run's planner is named, its reference is the plain command's record optimum, and the
+    plant's energy balance closes."""
+    import json
+
+    from hull_timedomain import synthetic_hull_netcdf
+
+    from parapend.cli import main
+
+    path = synthetic_hull_netcdf(tmp_path / "hull.nc")
+    sea = ["--dofs", "surge,heave,pitch", "--hydro", path, "--hs", "1", "--tp", "5",
+           "--repeat-period", "10", "--seed", "0"]
+    assert main(["buoy", *sea, "--json"]) == 0
+    opt = json.loads(capsys.readouterr().out)
+    rc = main(["buoy", *sea, "--controller", "mpc", "--planner", "collocation", "--json"])
+    r = json.loads(capsys.readouterr().out)
+    assert rc == (0 if r["success"] else 3)
+    start = hc.start_mode(opt["winding"], opt["mean_angle_deg"], opt["swing_amplitude_deg"])
+    assert r["planner"] == f"hull-collocation-{start}"
+    assert r["optimum_power_w"] == opt["power_w"]
+    assert r["energy_balance_residual"] < 1e-3
+    assert r["solves"] > 0 and r["update_time_p99_s"] is not None

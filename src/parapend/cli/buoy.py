@@ -81,6 +81,11 @@ def add_parsers(sub) -> None:
                                f"{BUOY['design_bounds'][name][1]:g} x the design's") + ")")
     g = p.add_argument_group("causal control (an irregular sea, the coupled time-domain plant)")
     add_declared(g, Controller, ("controller", "horizon", "update_interval", "forecast"))
+    g.add_argument("--planner", choices=("plan", "coupled", "lbfgsb", "collocation"),
+                   help="with mpc, the horizon's solver: the heaving buoy's plan (default) or "
+                        "coupled (default with --efficiency); the hull's lbfgsb (default, "
+                        "real time) or collocation (nearer the optimum, an update about a "
+                        "second; needs CasADi: parapend[collocation])")
     g = p.add_argument_group("statistics of a sea state (--dofs surge,heave,pitch)")
     g.add_argument("--realizations", type=_int, metavar="R",
                    help="solve R records of the sea state (--hs, --tp), seeded --seed, "

@@ -58,9 +58,11 @@ def add_parsers(sub) -> None:
     g = p.add_argument_group("--device buoy: the body (Capytaine; the BEM result is cached on "
                              "disk) and the controller")
     add_body_options(g, command="horizon")
-    g.add_argument("--planner", choices=list(PLANNERS),
+    g.add_argument("--planner", choices=list(PLANNERS) + ["lbfgsb", "collocation"],
                    help="the buoy's receding-horizon planner (parapend.hydro.control.buoy_mpc"
-                        "; default plan, coupled with --efficiency)")
+                        "; default plan, coupled with --efficiency); with --dofs "
+                        "surge,heave,pitch the hull's: lbfgsb (default) or collocation "
+                        "(needs CasADi)")
     # the planner's former name: refused in one line naming --planner (parapend.horizon)
     g.add_argument("--controller", help=argparse.SUPPRESS)
     add_declared(g, Body, ("dofs",), command="horizon")

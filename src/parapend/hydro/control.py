@@ -1167,11 +1167,12 @@ def closed_loop_result(series, acc, energy, u_all, *, status, caught, dt, h, per
 
 def mpc_command(hydro, pendulum, wave, info, *, controller, horizon, update_interval, winding,
                 harmonics, torque_limit, efficiency, irregular, design, time_limit=None,
-                deadline=None, forecast="perfect"):
+                deadline=None, forecast="perfect", planner=None):
     """``parapend buoy --controller mpc|one-way-mpc``: the closed loop on the record (4 peak
     periods of warm-up, then one repeat) beside the record's coupled non-causal optimum
     (mechanical, without torque limit or efficiency, at ``winding`` turns per record);
-    ``optimum_fraction`` is the electrical power over it."""
+    ``optimum_fraction`` is the electrical power over it. ``planner``: :func:`buoy_mpc`'s
+    ``controller`` with ``"mpc"`` (None: its default)."""
     import dataclasses
 
     if design:
@@ -1181,7 +1182,7 @@ def mpc_command(hydro, pendulum, wave, info, *, controller, horizon, update_inte
                              "--tp")
     r = buoy_mpc(hydro, pendulum, wave, peak_period=float(info["tp"]), horizon=horizon,
                  update_interval=update_interval,
-                 controller=None if controller == "mpc" else "one-way",
+                 controller=planner if controller == "mpc" else "one-way",
                  torque_limit=torque_limit, efficiency=efficiency, time_limit=time_limit,
                  deadline=deadline, forecast=forecast)
     sol, _, _ = _solve(hydro, pendulum, wave, winding=winding, harmonics=harmonics,

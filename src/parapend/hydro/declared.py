@@ -403,7 +403,8 @@ RUN_OPTIONS = {
     "scheduler": "a Dask scheduler", "netcdf": "an output file", "zarr": "an output file",
     "csv": "an output file", "command": "the command line recorded",
     "plan_samples": "torque samples per interval of the causal plan",
-    "planner": "the horizon curve's receding-horizon planner of the buoy: coupled or plan",
+    "planner": "the receding-horizon controller's horizon solver: the heaving buoy's plan "
+               "or coupled, the hull's lbfgsb or collocation",
 }
 
 #: options of the commands of the pendulum on a prescribed motion (the paper's

@@ -41,8 +41,11 @@ PLANNERS = ("coupled", "plan")
 #: --controller mpc``'s (1.06e5 counted as two solves an update, 87 s under load), which
 #: over-estimates the default curve with the planner's radiation model (one solve an update,
 #: work 5.0e4, 16.5 s of CPU) about 2.5 times
-#: the hull's (``hull``): its default run (64 updates x 48 samples, 21 s at a load of 3)
-BUOY_MPC_SECONDS = {"coupled": 140.0 / 1.0e5, "plan": 87.0 / 1.06e5, "hull": 21.0 / 3.1e3}
+#: the hull's (``hull``): its default run (64 updates x 48 samples, 21 s at a load of 3);
+#: with the collocation planner (``hull-collocation``) 74 s (IPOPT, seed 0, load 2 to 3:
+#: benchmarks/hull_collocation_solver.out.txt)
+BUOY_MPC_SECONDS = {"coupled": 140.0 / 1.0e5, "plan": 87.0 / 1.06e5, "hull": 21.0 / 3.1e3,
+                    "hull-collocation": 74.0 / 3.1e3}
 
 
 @dataclass(frozen=True, eq=False, repr=False)
@@ -186,8 +189,10 @@ def buoy_horizon_curve(*, hs=None, tp=None, spectrum="jonswap", gamma_peak=3.3,
         The pendulum, kg, m, kg m^2, N m s/rad (default the embedded design's).
     body, radius, draft, mesh, hydro :
         The floating body as ``parapend buoy`` takes it.
-    planner : "coupled", "plan" or None
-        :func:`parapend.hydro.control.buoy_mpc`'s planner (None: its default; ``plan``
+    planner : "coupled", "plan", "lbfgsb", "collocation" or None
+        The heaving buoy's: :func:`parapend.hydro.control.buoy_mpc`'s planner, ``coupled``
+        or ``plan``; the hull's: :func:`parapend.hydro.hull_control.hull_mpc`'s, ``lbfgsb``
+        or ``collocation`` (None: the default; ``plan``
         with one solve per update, as the power matrix runs it).
     torque_limit, torque_limit_nm : float or None
         The torque bound in units ``m g l`` or in N m (not both; default ``buoy_mpc``'s,
@@ -234,9 +239,10 @@ def buoy_horizon_curve(*, hs=None, tp=None, spectrum="jonswap", gamma_peak=3.3,
     from .result import _solve
 
     hull = dofs is not None and parse_dofs(dofs) != ("heave",)
-    if hull and planner is not None:
-        raise ParameterError("planner: the hull has one planner; drop --planner with --dofs "
-                             "surge,heave,pitch")
+    if hull:
+        from .api import _check_planner
+
+        _check_planner(planner, "mpc", "hull")
     kind = "hull" if hull else "buoy"  # whose declared defaults
     time_limit = check_time_limit(time_limit)
     until = deadline(time_limit)
@@ -245,7 +251,7 @@ def buoy_horizon_curve(*, hs=None, tp=None, spectrum="jonswap", gamma_peak=3.3,
                              f"got {progress!r:.40}")
     _check_kinds(mesh=mesh)  # a number for the path: one line, not os.fspath's TypeError
     pend = _pendulum(mass, length, inertia, damping_coefficient, kind)  # the declared defaults
-    if planner is not None and planner not in PLANNERS:
+    if not hull and planner is not None and planner not in PLANNERS:
         raise ParameterError(f"planner: expected {' or '.join(PLANNERS)}, got "
                              f"{planner!r:.40}")
     if planner == "plan" and efficiency is not None:
@@ -300,8 +306,11 @@ def buoy_horizon_curve(*, hs=None, tp=None, spectrum="jonswap", gamma_peak=3.3,
     tp = float(waves[0][1]["tp"])
     tr = float(waves[0][1]["repeat_period"])
     # the planner that will run: buoy_mpc's default when none is given
-    runs = "hull" if hull else planner or ("coupled" if efficiency is not None else "plan")
-    iterations = 1 if runs in ("plan", "hull") else 2
+    if hull:
+        runs = "hull" if planner in (None, "lbfgsb") else f"hull-{planner}"
+    else:
+        runs = planner or ("coupled" if efficiency is not None else "plan")
+    iterations = 1 if runs in ("plan", "hull", "hull-collocation") else 2
     work = [_estimate(tp, tr, h, upd, warm_up, iterations, hull) for h in hz]
     est = records * len(fc) * sum(w for w, _ in work) * BUOY_MPC_SECONDS[runs]
     cap = limits.MAX_UNTIMED_SECONDS
@@ -388,7 +397,8 @@ def buoy_horizon_curve(*, hs=None, tp=None, spectrum="jonswap", gamma_peak=3.3,
                 if out_of_time():
                     status[i][j][r] = "time_limit"
                     continue
-                run, more = ((hull_mpc, {"pivot": problem["pivot"], "mode": modes[r]})
+                run, more = ((hull_mpc, {"pivot": problem["pivot"], "mode": modes[r],
+                                         "planner": planner or "lbfgsb"})
                              if hull else (buoy_mpc, kw))
                 res = run(h, pend, wave, peak_period=tp, horizon=hor,
                           update_interval=upd, warmup=warm_up, repeats=1,
