@@ -320,10 +320,14 @@ def buoy_horizon_curve(*, hs=None, tp=None, spectrum="jonswap", gamma_peak=3.3,
     longest = (cap / per_tp - warm_up) * tp if per_tp > 0 else math.inf
     what = (f"{records} record(s) x {len(fc)} forecast(s) x {len(hz)} horizon(s) of the "
             f"buoy's receding-horizon runs ({', '.join(str(u) for _, u in work)} updates)")
-    refuse_untimed("records" if most >= 1 else "repeat-period", what, est,
-                   f"use --records at most {most}" if most >= 1 else
-                   f"use --repeat-period at most {max(longest, 0.0):.4g} s (one record), or "
-                   "fewer --horizons or --forecasts", time_limit, cap)
+    if most >= 1:
+        name, advice = "records", f"use --records at most {most}"
+    elif longest >= tp:  # a record of at least one peak period fits
+        name, advice = "repeat-period", (f"use --repeat-period at most {longest:.4g} s (one "
+                                         "record), or fewer --horizons or --forecasts")
+    else:  # the warm-up alone takes the time: no shorter record fits
+        name, advice = "horizons", "use fewer --horizons or --forecasts"
+    refuse_untimed(name, what, est, advice, time_limit, cap)
     from ..control.mpc import ANNOUNCE_SECONDS, log
 
     if est > ANNOUNCE_SECONDS:
