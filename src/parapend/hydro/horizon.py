@@ -191,7 +191,7 @@ def buoy_horizon_curve(*, hs=None, tp=None, spectrum="jonswap", gamma_peak=3.3,
         The floating body as ``parapend buoy`` takes it.
     planner : "coupled", "plan", "lbfgsb", "collocation" or None
         The heaving buoy's: :func:`parapend.hydro.control.buoy_mpc`'s planner, ``coupled``
-        or ``plan``; the hull's: :func:`parapend.hydro.hull_control.hull_mpc`'s, ``lbfgsb``
+        or ``plan``; the hull's: ``parapend.hydro.hull_control.hull_mpc``'s, ``lbfgsb``
         or ``collocation`` (None: the default; ``plan``
         with one solve per update, as the power matrix runs it).
     torque_limit, torque_limit_nm : float or None
