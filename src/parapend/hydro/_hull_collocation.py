@@ -64,9 +64,9 @@ MEMORY_STRIDE = 3
 #: the generator's planned speed at most, rad per plant step (None: unbounded)
 MAX_TURN = 0.4
 #: the horizon's solver: ``"ipopt"`` (CasADi's IPOPT) or ``"compiled"``
-#: (:mod:`._hull_collocation_ipm`, no CasADi: the same NLP, about 4 times faster an update;
-#: not the default: in the closed loop it ends a sixth to a third of the solves failed or
-#: capped where IPOPT ends none, benchmarks/hull_collocation_solver.out.txt)
+#: (:mod:`._hull_collocation_ipm`, no CasADi: the same NLP, a horizon about 2.2 times
+#: faster, median; not the default: in the closed loop it fails solves where IPOPT fails
+#: none, and seed 0 lost energy, benchmarks/hull_collocation_solver.out.txt)
 SOLVER = "ipopt"
 #: the compiled solver's status names (``ipopt`` field of :meth:`HullCollocation.solve`)
 _COMPILED_STATUS = ("solved", "capped", "failed")
