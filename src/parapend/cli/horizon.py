@@ -6,8 +6,9 @@ from __future__ import annotations
 import argparse
 
 from ..defaults import HORIZON
+from ..hydro.api import PLANNERS
 from ..hydro.declared import Body, Controller, Pendulum, PowerTakeOff, Sea
-from ..hydro.horizon import BUOY_HORIZON, PLANNERS
+from ..hydro.horizon import BUOY_HORIZON
 from . import _output
 from ._common import (
     FIGURE_SUFFIXES,
@@ -58,7 +59,7 @@ def add_parsers(sub) -> None:
     g = p.add_argument_group("--device buoy: the body (Capytaine; the BEM result is cached on "
                              "disk) and the controller")
     add_body_options(g, command="horizon")
-    g.add_argument("--planner", choices=list(PLANNERS) + ["lbfgsb", "collocation"],
+    g.add_argument("--planner", choices=[*PLANNERS["heave"], *PLANNERS["hull"]],
                    help="the buoy's receding-horizon planner (parapend.hydro.control.buoy_mpc"
                         "; default plan, coupled with --efficiency); with --dofs "
                         "surge,heave,pitch the hull's: lbfgsb (default) or collocation "

@@ -33,8 +33,6 @@ from ..results import _Result
 
 __all__ = ["BUOY_HORIZON", "BuoyHorizonResult", "buoy_horizon_curve", "plot_buoy_horizon"]
 
-#: the planners a user may choose (the curve's defaults: ``parapend.defaults.BUOY_HORIZON``)
-PLANNERS = ("coupled", "plan")
 #: seconds per unit of a run's work (updates x horizon samples x solves per update), per
 #: planner: ``coupled``'s from the default curve's run with it (work 1.0e5, 140 s of CPU
 #: at a load of 2 to 3 on the 2 cores, docs/control.md); ``plan``'s from ``parapend buoy
@@ -232,17 +230,13 @@ def buoy_horizon_curve(*, hs=None, tp=None, spectrum="jonswap", gamma_peak=3.3,
     from ..deadline import check_time_limit, deadline, duration, expired, refuse_untimed
     from ..defaults import HULL
     from ..units import Units
-    from .api import _check_floats, _check_kinds, _hydro, parse_dofs
+    from .api import _check_floats, _check_kinds, _check_planner, _hydro, parse_dofs
     from .control import buoy_mpc
     from .declared import default_of
     from .inputs import _irregular_wave, _pendulum
     from .result import _solve
 
     hull = dofs is not None and parse_dofs(dofs) != ("heave",)
-    if hull:
-        from .api import _check_planner
-
-        _check_planner(planner, "mpc", "hull")
     kind = "hull" if hull else "buoy"  # whose declared defaults
     time_limit = check_time_limit(time_limit)
     until = deadline(time_limit)
@@ -251,12 +245,7 @@ def buoy_horizon_curve(*, hs=None, tp=None, spectrum="jonswap", gamma_peak=3.3,
                              f"got {progress!r:.40}")
     _check_kinds(mesh=mesh)  # a number for the path: one line, not os.fspath's TypeError
     pend = _pendulum(mass, length, inertia, damping_coefficient, kind)  # the declared defaults
-    if not hull and planner is not None and planner not in PLANNERS:
-        raise ParameterError(f"planner: expected {' or '.join(PLANNERS)}, got "
-                             f"{planner!r:.40}")
-    if planner == "plan" and efficiency is not None:
-        raise ParameterError("efficiency: not with --planner plan (it plans the mechanical "
-                             "work)")
+    _check_planner(planner, "mpc", "hull" if hull else "heave", efficiency)
     mgl = pend.mass * 9.81 * pend.length
     if torque_limit is not None and torque_limit_nm is not None:
         raise ParameterError("torque-limit-nm: give either --torque-limit or "
