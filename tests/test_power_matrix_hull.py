@@ -339,3 +339,83 @@ def test_a_hull_bins_causal_run_stays_below_its_optimum(dataset):
     p, c = out["power"], out["causal_perfect_power"]
     assert math.isfinite(p) and p > 0
     assert math.isnan(c) or c <= p * (1 + 1e-3)
+
+
+def test_the_hulls_causal_column_takes_the_buoys_planners(dataset):
+    """``--planner`` in the causal column, as ``parapend buoy --controller mpc --planner``:
+    the hull's collocation planner is its own controller in the spec (another store than
+    L-BFGS-B's), priced by its own cost a peak period; the heaving buoy's planners name its
+    controller; every misuse refused in one line naming the option."""
+    from parapend.performance.check import BUOY_CAUSAL_SECONDS, record_seconds
+
+    lb = matrix_spec(**BINS, realizations=1, hydro=dataset, **HULL, controller="mpc",
+                     planner="lbfgsb")
+    assert lb == matrix_spec(**BINS, realizations=1, hydro=dataset, **HULL, controller="mpc")
+    col = matrix_spec(**BINS, realizations=1, hydro=dataset, **HULL, controller="mpc",
+                      planner="collocation")
+    assert (col.buoy_controller, col.horizon) == ("hull-collocation", 2.0)
+    assert col != lb and MatrixSpec.from_json(col.to_json()) == col
+    assert record_seconds(col) / record_seconds(lb) == pytest.approx(
+        BUOY_CAUSAL_SECONDS["hull-collocation"] / BUOY_CAUSAL_SECONDS["hull"], rel=1e-12)
+    for kw, match in (({"planner": "plan"}, r"^planner: with --dofs surge,heave,pitch "),
+                      ({"planner": "coupled"}, r"^planner: with --dofs surge,heave,pitch "),
+                      ({"planner": "collocation", "controller": None},
+                       r"^planner: an option of the causal column; needs --controller mpc")):
+        args = {**BINS, "realizations": 1, "hydro": dataset, **HULL, "controller": "mpc",
+                **kw}
+        with pytest.raises(ParameterError, match=match):
+            matrix_spec(**args)
+    with pytest.raises(ParameterError, match=r"^planner: an option of --device buoy"):
+        matrix_spec(hs="1,2", te="6,8", controller="mpc", planner="plan")
+
+
+def test_the_heaving_buoys_causal_column_takes_its_planner():
+    """The heaving buoy: ``--planner coupled`` runs the coupled controller where the default
+    is ``plan``; ``plan`` with an efficiency and the hull's planners are refused."""
+    base = {"hs": "0.5,1", "tp": "2.5,3", "device": "buoy", "controller": "mpc"}
+    assert matrix_spec(**base).buoy_controller == "plan"
+    spec = matrix_spec(**base, planner="coupled")
+    assert (spec.buoy_controller, spec.horizon) == ("coupled", 1.0)
+    with pytest.raises(ParameterError, match=r"^planner: with --dofs heave expected plan "):
+        matrix_spec(**base, planner="collocation")
+    with pytest.raises(ParameterError, match=r"^efficiency: not with --planner plan"):
+        matrix_spec(**base, planner="plan", efficiency=0.9)
+
+
+def test_the_command_line_takes_the_planner(dataset, capsys):
+    """``power-matrix --planner``: a name outside the four refused by the parser, the
+    hull's planner on the heaving buoy in one line."""
+    args = ["power-matrix", "--device", "buoy", "--hs", "0.5,1", "--tp", "2.5,3",
+            "--controller", "mpc", "--planner"]
+    assert main([*args, "ipopt"]) == 2
+    assert "--planner: invalid choice: 'ipopt'" in capsys.readouterr().err
+    assert main([*args, "lbfgsb"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err.count("\n") == 0 and "error: planner: with --dofs heave expected plan" in err
+
+
+@pytest.mark.slow
+def test_a_hull_bins_collocation_run_is_parapend_buoys(dataset):
+    """One bin's causal run with ``planner="collocation"`` (perfect forecast) is the run
+    ``parapend.buoy(dofs="surge,heave,pitch", controller="mpc", planner="collocation")``
+    makes of the same record by hand (the same warm-up, horizon and update interval), to
+    1e-9, and stays below the record's optimum."""
+    pytest.importorskip("casadi")
+    from threadpoolctl import threadpool_limits
+
+    from parapend.performance.solve import solve_bin
+
+    spec = matrix_spec(**BINS, realizations=1, hydro=dataset, **HULL, controller="mpc",
+                       planner="collocation")
+    out = solve_bin(spec, 0, 1, 0)
+    p, c = out["power"], out["causal_perfect_power"]
+    assert math.isfinite(p) and p > 0 and math.isfinite(c)
+    assert c <= p * (1 + 1e-3)
+    with threadpool_limits(1, user_api="blas"):
+        r = parapend.buoy(dofs="surge,heave,pitch", hydro=dataset, hs=1.0, tp=6.0,
+                          repeat_period=repeat_period(2.0, 6.0), seed=3, controller="mpc",
+                          planner="collocation", horizon=spec.horizon,
+                          update_interval=spec.update_interval, **PEND)
+    assert r.planner.startswith("hull-collocation")
+    assert r.optimum_power_w == pytest.approx(p, rel=1e-9)
+    assert max(r.electrical_power_w, 0.0) == pytest.approx(c, rel=1e-9)

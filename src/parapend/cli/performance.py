@@ -7,6 +7,7 @@ import shlex
 import sys
 
 from ..defaults import HULL, POWER_MATRIX
+from ..hydro.api import PLANNERS
 from ..hydro.declared import Body, Controller, Pendulum, PowerTakeOff, Sea
 from . import _output
 from ._common import (
@@ -94,6 +95,12 @@ def add_parsers(sub) -> None:
     g.add_argument("--plan-samples", type=_int,
                    help="torque samples per Hermite interval of the plan, 1 to 64 (default "
                         "2 with --controller mpc, as horizon)")
+    g.add_argument("--planner", choices=[*PLANNERS["heave"], *PLANNERS["hull"]],
+                   help="--device buoy: the horizon's solver, as parapend buoy --controller "
+                        "mpc --planner: the heaving buoy's plan (default) or coupled (default "
+                        "with --efficiency); the hull's lbfgsb (default) or collocation "
+                        "(nearer the optimum, several times slower; needs CasADi: "
+                        "parapend[collocation])")
     g.add_argument("--speed-limit", type=float,
                    help="rated speed priced in the plans, units sqrt(g/l): a penalty, as "
                         "parapend horizon's; inf for none, horizon's default (default 4 "

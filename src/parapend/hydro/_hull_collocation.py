@@ -85,6 +85,13 @@ def _casadi():
     return casadi
 
 
+def available(solver: str | None = None) -> None:
+    """Raise the one-line error naming the extra where ``solver`` (None: :data:`SOLVER`)
+    needs CasADi and it is not installed (before a long run starts)."""
+    if (SOLVER if solver is None else solver) == "ipopt":
+        _casadi()
+
+
 class HullCollocation:
     """The collocation horizon problem of one update (module docstring) on ``plant``
     (:class:`.hull_control.HullPlant`): ``n`` held torques of ``steps`` plant steps

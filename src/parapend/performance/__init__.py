@@ -102,7 +102,7 @@ def matrix_spec(*, hs="1:3:3", te=None, tp=None, realizations: int = 3, waves=No
                 hull_pitch_inertia=None, barge_length=None, barge_beam=None,
                 barge_draft=None, copper_loss=None, controller=None, forecast=None,
                 update_interval=None, warm_up=None, plan_samples=None,
-                speed_limit=None) -> MatrixSpec:
+                speed_limit=None, planner=None) -> MatrixSpec:
     """Check everything a matrix's bins depend on (one line naming the parameter).
     ``length``, ``mass``: None is the device's default (``parapend.defaults.SEA`` for the
     prescribed-heave pendulum, ``BUOY`` for the buoy); ``body, radius, draft, mesh, hydro``
@@ -115,7 +115,8 @@ def matrix_spec(*, hs="1:3:3", te=None, tp=None, realizations: int = 3, waves=No
     ``"mpc"`` (``device="prescribed-heave"`` or ``"buoy"``, the hull too): the causal column,
     ``horizon``, ``forecast``, ``update_interval``, ``warm_up``, ``plan_samples`` and
     ``speed_limit`` as ``parapend.performance.causal.check_causal`` takes them (None:
-    ``CAUSAL``, the buoy's ``BUOY_CAUSAL``)."""
+    ``CAUSAL``, the buoy's ``BUOY_CAUSAL``), and ``planner`` (``device="buoy"``: the
+    heaving buoy's ``plan`` or ``coupled``, the hull's ``lbfgsb`` or ``collocation``)."""
     from ..hydro.api import parse_dofs
     from ..seas import _check_sea, check_response, read_response
     from ..units import Units
@@ -147,7 +148,7 @@ def matrix_spec(*, hs="1:3:3", te=None, tp=None, realizations: int = 3, waves=No
     causal = check_causal(controller=controller, horizon=horizon, forecast=forecast,
                           update_interval=update_interval, warm_up=warm_up,
                           plan_samples=plan_samples, speed_limit=speed_limit,
-                          device=device, heave=heave,
+                          device=device, heave=heave, planner=planner,
                           lossy=efficiency is not None and efficiency != 1.0)
     if torque_limit is not None and heave:
         raise ParameterError("torque-limit: not supported over a sea record (parapend sea "
@@ -820,9 +821,11 @@ def _causal_matrix(ds, spec: MatrixSpec) -> None:
             "the hanging rest, the buoy in its free periodic motion, 64 torque samples a peak "
             "period; the mean over one repeat of the record after the warm-up, "
             "(W_e + eta_g dE) / tau, E the mechanical energy of buoy and pendulum")
-        if spec.buoy_controller == "hull":
+        if spec.buoy_controller in ("hull", "hull-collocation"):
+            planner = "lbfgsb" if spec.buoy_controller == "hull" else "collocation"
             ds.attrs["causal_convention"] = (
-                "parapend.hydro.hull_control.hull_mpc: from the hanging rest, the hull in its "
+                f"parapend.hydro.hull_control.hull_mpc, planner {planner}: from the hanging "
+                "rest, the hull in its "
                 "free periodic motion, 24 torque samples a peak period, started from the "
                 "motion of the record's optimum; the mean over one repeat of the record "
                 "after the warm-up, (W_e + eta_g dE) / tau, E the mechanical energy of hull "
@@ -903,7 +906,7 @@ def power_matrix(*, hs="1:3:3", te=None, tp=None, realizations: int = 3, waves=N
                  hull_pitch_inertia=None, barge_length=None, barge_beam=None,
                  barge_draft=None, copper_loss=None, controller=None, forecast=None,
                  update_interval=None, warm_up=None, plan_samples=None, speed_limit=None,
-                 time_limit=None, pendulum=None, pto=None):
+                 planner=None, time_limit=None, pendulum=None, pto=None):
     """The power matrix of a device over bins of ``Hs x Te`` (or ``Tp``); see the module
     text and docs/performance.md. Returns ``(dataset, annual, run)``. ``dofs``
     ``"surge,heave,pitch"`` with ``device="buoy"``: a pendulum in a hull that surges, heaves
@@ -925,7 +928,10 @@ def power_matrix(*, hs="1:3:3", te=None, tp=None, realizations: int = 3, waves=N
     ``parapend.performance.causal``. With ``device="buoy"`` (heave only) the column is the
     buoy's causal controller (``parapend.hydro.control.buoy_mpc`` with each ``forecast``,
     ``horizon`` 1 and ``update_interval`` 1/8 by default; no ``plan_samples`` or
-    ``speed_limit``), the controller named in ``causal.buoy_controller``.
+    ``speed_limit``), the controller named in ``causal.buoy_controller``; ``planner`` its
+    horizon solver as ``parapend buoy --controller mpc --planner`` takes it (the heaving
+    buoy's ``plan`` or ``coupled``; with ``dofs="surge,heave,pitch"`` the hull's ``lbfgsb``,
+    the default, or ``collocation``), named in ``causal.planner``.
 
     ``pendulum``, ``body``, ``pto``, ``controller``, ``device``: the input objects of
     :mod:`parapend.hydro.device` (a ``Device``: ``device="buoy"`` with its body, pendulum and
@@ -987,7 +993,8 @@ def power_matrix(*, hs="1:3:3", te=None, tp=None, realizations: int = 3, waves=N
                        barge_draft=barge_draft, copper_loss=copper_loss,
                        controller=controller, forecast=forecast,
                        update_interval=update_interval, warm_up=warm_up,
-                       plan_samples=plan_samples, speed_limit=speed_limit)
+                       plan_samples=plan_samples, speed_limit=speed_limit,
+                       planner=planner)
     _check_breaking(spec.hm0, depth)
     if spec.device == "buoy":
         from .buoy_device import water_of

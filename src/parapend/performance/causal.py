@@ -74,17 +74,26 @@ BUOY_CAUSAL = {"horizon": None, "forecast": "perfect", "update_interval": 0.125,
 BUOY_CONTROLLER = "plan"
 #: the buoy's default horizon (peak periods) per controller; ``hull``: the hull's
 #: (:func:`parapend.hydro.hull_control.hull_mpc`, ``--dofs surge,heave,pitch``)
-BUOY_HORIZON = {"plan": 2.0, "coupled": 1.0, "hull": 2.0}
+BUOY_HORIZON = {"plan": 2.0, "coupled": 1.0, "hull": 2.0, "hull-collocation": 2.0}
+#: the hull's controllers (``buoy_controller``) and the planner each runs
+#: (:func:`parapend.hydro.hull_control.hull_mpc`'s ``planner``)
+HULL_PLANNERS = {"hull": "lbfgsb", "hull-collocation": "collocation"}
 
 
 def check_causal(*, controller, horizon, forecast, update_interval, warm_up, plan_samples,
-                 device: str, heave: bool, speed_limit=None, lossy: bool = False) -> dict | None:
+                 device: str, heave: bool, speed_limit=None, lossy: bool = False,
+                 planner=None) -> dict | None:
     """The causal column's options, checked (one line naming the option); None without a
     controller (then every other option of it is refused). ``lossy``: the device has an
     efficiency (the buoy's ``plan`` controller prices none: were it
-    :data:`BUOY_CONTROLLER`, ``coupled`` would run)."""
+    :data:`BUOY_CONTROLLER`, ``coupled`` would run). ``planner`` (``--device buoy``): the
+    heaving buoy's ``plan`` or ``coupled``, the hull's ``lbfgsb`` or ``collocation``, as
+    ``parapend buoy --controller mpc --planner`` takes it (None: the model's default); the
+    controller that runs is recorded as ``buoy_controller`` (:data:`BUOY_HORIZON`'s
+    keys)."""
     opts = {"horizon": horizon, "forecast": forecast, "update-interval": update_interval,
-            "warm-up": warm_up, "plan-samples": plan_samples, "speed-limit": speed_limit}
+            "warm-up": warm_up, "plan-samples": plan_samples, "speed-limit": speed_limit,
+            "planner": planner}
     if controller is None or controller == "none":
         given = [k for k, v in opts.items() if v is not None]
         if given:
@@ -99,9 +108,22 @@ def check_causal(*, controller, horizon, forecast, update_interval, warm_up, pla
             if v is not None:
                 raise ParameterError(f"{name}: an option of the prescribed-heave pendulum's "
                                      "planner; drop it with --device buoy")
+        from ..hydro.api import _check_planner
+
+        _check_planner(planner, "mpc", "heave" if heave else "hull", True if lossy else None)
+    elif planner is not None:
+        raise ParameterError("planner: an option of --device buoy's controller (the "
+                             "prescribed-heave pendulum has one planner)")
     base = BUOY_CAUSAL if buoy else CAUSAL
-    buoy_controller = ("hull" if not heave else "coupled" if lossy and BUOY_CONTROLLER == "plan"
-                       else BUOY_CONTROLLER)
+    if not heave:
+        buoy_controller = "hull" if planner in (None, "lbfgsb") else "hull-" + planner
+        if buoy_controller == "hull-collocation":
+            from ..hydro._hull_collocation import available
+
+            available()  # CasADi, where its solver is IPOPT: one line naming the extra
+    else:
+        buoy_controller = planner or ("coupled" if lossy and BUOY_CONTROLLER == "plan"
+                                      else BUOY_CONTROLLER)
     if horizon is None:
         horizon = (BUOY_HORIZON[buoy_controller] if buoy else base["horizon"])
     horizon = check_range("horizon", horizon, 0.05, 20.0, why="peak periods")
@@ -266,7 +288,8 @@ def run_hull_record(spec, i: int, j: int, r: int, forecast: str = "perfect", mod
     """The hull's causal run of bin ``(i, j)``, realization ``r`` (``--device buoy --dofs
     surge,heave,pitch``): :func:`parapend.hydro.hull_control.hull_mpc` on the hull, pendulum
     and record :func:`parapend.performance.hull_device.solve_hull_bin` solves, started as
-    its optimum's motion says (``mode``), ``warm_up`` peak periods then one repeat."""
+    its optimum's motion says (``mode``), ``warm_up`` peak periods then one repeat, with the
+    planner of ``spec.buoy_controller`` (:data:`HULL_PLANNERS`)."""
     from .. import limits
     from ..hydro.hull_control import hull_mpc
     from .buoy_device import wave_of
@@ -279,8 +302,8 @@ def run_hull_record(spec, i: int, j: int, r: int, forecast: str = "perfect", mod
                     pitch_inertia=p["pitch_inertia"], horizon=spec.horizon,
                     update_interval=spec.update_interval, warmup=spec.warm_up, repeats=1,
                     forecast=forecast, mode=mode, torque_limit=pto.torque_limit,
-                    efficiency=pto.efficiency, time_limit=limits.MAX_TIME_LIMIT,
-                    deadline=math.inf)
+                    efficiency=pto.efficiency, planner=HULL_PLANNERS[spec.buoy_controller],
+                    time_limit=limits.MAX_TIME_LIMIT, deadline=math.inf)
 
 
 def solve_causal(spec, i: int, j: int, r: int, mode: str = "swing") -> dict:
@@ -303,7 +326,8 @@ def solve_causal(spec, i: int, j: int, r: int, mode: str = "swing") -> dict:
             # at every update) ran 2 to 3 times slower with threads that only spin
             with threadpool_limits(1, user_api="blas"):
                 res = (run_hull_record(spec, i, j, r, f, mode)
-                       if spec.buoy_controller == "hull" else run_buoy_record(spec, i, j, r, f)
+                       if spec.buoy_controller in HULL_PLANNERS
+                       else run_buoy_record(spec, i, j, r, f)
                        if buoy else run_record(spec, exc, units, j, r, f))
             # a run that loses energy is a measurement (the bin then rests: max(P, 0))
             if buoy and (res.success or res.status == "loses_energy"):
@@ -328,6 +352,11 @@ def solve_causal(spec, i: int, j: int, r: int, mode: str = "swing") -> dict:
 
 
 
+def _planner(buoy_controller: str) -> str:
+    """The planner's name as ``--planner`` takes it, of the controller that ran."""
+    return HULL_PLANNERS.get(buoy_controller, buoy_controller)
+
+
 def causal_json(ds, grid) -> dict:
     """The causal column of ``parapend power-matrix --json`` (``causal``): the controller's
     settings, each forecast's power matrix and choice per bin (``grid`` turns a variable
@@ -344,7 +373,8 @@ def causal_json(ds, grid) -> dict:
            "speed_limit": (None if ds.attrs.get("causal_speed_limit", "none") == "none"
                            else float(ds.attrs["causal_speed_limit"])),
            "convention": ds.attrs["causal_convention"],
-           **({"buoy_controller": ds.attrs["causal_buoy_controller"]}
+           **({"buoy_controller": ds.attrs["causal_buoy_controller"],
+               "planner": _planner(ds.attrs["causal_buoy_controller"])}
               if "causal_buoy_controller" in ds.attrs else {}),
            "power_matrix": {f: grid(f"causal_{f}_power_matrix") for f in forecasts},
            "above_optimum": {f: int(ds[f"causal_{f}_power"].attrs.get("above_optimum", 0))

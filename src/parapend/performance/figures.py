@@ -361,7 +361,8 @@ def _causal_lines(ds, c: dict, hm0, per, pk) -> list:
                  f"peak periods, a plan every {c['update_interval_peak_periods']:g} of them, "
                  + (f"{c['plan_samples']} torque samples per plan interval"
                     if c.get("buoy_controller") is None else
-                    "the hull's controller" if c["buoy_controller"] == "hull" else
+                    f"the hull's controller ({c['planner']} planner)"
+                    if c["buoy_controller"].startswith("hull") else
                     f"the buoy's {c['buoy_controller']} controller")
                  + ("" if c.get("speed_limit") is None else
                     f", speed penalty above {c['speed_limit']:g} sqrt(g/l)")
@@ -385,7 +386,7 @@ def _causal_lines(ds, c: dict, hm0, per, pk) -> list:
                          "e.g. a storage correction larger than the work): left out of the "
                          "bins' means")
         if bad:
-            body = "hull" if c.get("buoy_controller") == "hull" else "buoy"
+            body = "hull" if c.get("buoy_controller", "").startswith("hull") else "buoy"
             why = (f"the log names them and their status, e.g. \"solves_failed\": most of "
                    f"the {body}'s horizon solves failed" if c.get("buoy_controller") else
                    "the log names them; \"unresolved\": the plans spun the pendulum past a "
