@@ -357,6 +357,13 @@ def test_the_hulls_causal_column_takes_the_buoys_planners(dataset):
     assert col != lb and MatrixSpec.from_json(col.to_json()) == col
     assert record_seconds(col) / record_seconds(lb) == pytest.approx(
         BUOY_CAUSAL_SECONDS["hull-collocation"] / BUOY_CAUSAL_SECONDS["hull"], rel=1e-12)
+    # the matrix's estimate counts each record's solve and its causal runs
+    from parapend.performance.check import check_size, hull_record_seconds
+
+    for spec in (lb, col):
+        est = check_size(spec, workers=1)
+        assert est["seconds"] == pytest.approx(
+            4 * (hull_record_seconds(spec.waves) + record_seconds(spec)), rel=1e-12)
     for kw, match in (({"planner": "plan"}, r"^planner: with --dofs surge,heave,pitch "),
                       ({"planner": "coupled"}, r"^planner: with --dofs surge,heave,pitch "),
                       ({"planner": "collocation", "controller": None},

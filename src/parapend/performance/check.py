@@ -253,7 +253,8 @@ def check_size(spec, workers=None, scheduler=None, available=None) -> dict:
         # the hull: a record's time (both modes and their refinement; dense, or matrix-free
         # for an ideal take-off's long records): parapend.hydro.realizations.record_seconds
         ideal = (getattr(spec, "torque_limit", None) is None and not spec.lossy)
-        seconds = solves * hull_record_seconds(spec.waves, ideal) / max(1, procs or 1)
+        seconds = (solves * (hull_record_seconds(spec.waves, ideal) + causal)
+                   / max(1, procs or 1))
     return {"bins": bins, "solves": solves, "processes": procs, "memory_bytes": need,
             "seconds": seconds if math.isfinite(seconds) else None,
             "causal_seconds": causal}
