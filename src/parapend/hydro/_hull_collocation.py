@@ -377,11 +377,15 @@ class HullCollocation:
         warm = self.prev is not None
         r = self.solve_from(x0, par, max_iter, tol, warm=warm)
         if self.solver_name == "compiled" and r.status == 2:
-            # the compiled solver has no restoration phase as IPOPT's: a failed warm start
-            # is solved again from the model rolled under ``u0``; failed again, its start
-            # is the plan (the previous one continued) and the next start
+            # a failed solve is tried again from the same start with the other barrier
+            # update (monotone: another path), then from the model rolled under ``u0``;
+            # failed still, its start is the plan (the previous one continued) and the
+            # next start
             nit = r.nit
-            if warm:
+            r = self.solve_from(x0, par, max_iter, tol, warm=warm, strategy="monotone")
+            r.nit += nit
+            if warm and r.status == 2:
+                nit = r.nit
                 xg = self._with_memory(self.guess(u0, fseg), par)
                 r = self.solve_from(xg, par, max_iter, tol)
                 r.nit += nit
@@ -392,18 +396,21 @@ class HullCollocation:
                 r.x, r.full, r.states = u, x0, x0[:self.nx].reshape(self.npt, 8)
         return r
 
-    def solve_from(self, x0, par, max_iter=None, tol=None, warm=False):
+    def solve_from(self, x0, par, max_iter=None, tol=None, warm=False, strategy=None):
         """The solver (:data:`SOLVER` or the constructor's) from ``x0`` on the parameters
         ``par``. ``max_iter`` and ``tol``: IPOPT's are the constructor's (its options are
         fixed when the NLP is built), the compiled solver's these (None: the constructor's;
-        ``warm``: ``x0`` a shifted solution). Returns ``x`` (the held torques, m g l),
-        ``fun``, ``status`` (0 solved, 1 capped, 2 failed), ``success``, ``nit``, ``ipopt``
+        ``warm``: ``x0`` a shifted solution; ``strategy``: its barrier update, None its
+        default :data:`._hull_collocation_ipm.MU_STRATEGY`). Returns ``x`` (the held
+        torques, m g l), ``fun``, ``status`` (0 solved, 1 capped, 2 failed), ``success``,
+        ``nit``, ``ipopt``
         (the solver's status: IPOPT's return status, or solved, capped, failed) and
         ``states`` (the planned motion at the points, (npt, 8))."""
         if self.solver_name == "compiled":
             mi = self.options["max_iter"] if max_iter is None else int(max_iter)
             x, fun, status, nit = self.compiled.solve(
-                x0, par, mi, self.tol if tol is None else float(tol), warm=warm)
+                x0, par, mi, self.tol if tol is None else float(tol), warm=warm,
+                strategy=strategy)
             name = _COMPILED_STATUS[status]
         else:
             r = self.solver(x0=x0, p=par, lbx=self.lbx, ubx=self.ubx, lbg=self.lbg,

@@ -248,7 +248,7 @@ class CompiledSolver:
         return float(np.sum(np.abs(c)) + (np.sum(np.abs(self._speeds(x) - s))
                                           if self.speed else 0.0))
 
-    def solve(self, x0, par, max_iter, tol, warm=False):
+    def solve(self, x0, par, max_iter, tol, warm=False, strategy=None):
         """The interior point from ``x0`` (its start's state is ``par``'s) on the parameters
         ``par`` (:meth:`._hull_collocation.HullCollocation._params`). Returns ``(x, f,
         status, iterations)``: status 0 solved to ``tol``, 1 stopped at ``max_iter``, 2
@@ -258,9 +258,9 @@ class CompiledSolver:
 
         with _blas_controller().limit(limits=1, user_api="blas"):
             return self._solve(x0, par, max_iter, tol, MU_WARM if warm else MU_INIT,
-                               THETA_GROWTH)
+                               THETA_GROWTH, MU_STRATEGY if strategy is None else strategy)
 
-    def _solve(self, x0, par, max_iter, tol, mu, growth):
+    def _solve(self, x0, par, max_iter, tol, mu, growth, strategy):
         npt, n, nd, nf = self.npt, self.n, self.nd, self.nf
         self._setup(par)
         e0, fk = self.e0, self.fk
@@ -291,7 +291,7 @@ class CompiledSolver:
         filt = []
         theta_max = theta_min = None
         nrest = 0
-        adaptive = MU_STRATEGY == "adaptive"
+        adaptive = strategy == "adaptive"
         nacc = 0
         wd, short = None, 0  # the watchdog's reference, the shortened steps in a row
         free, refs, mu_max, mu_min = True, [], None, min(1e-11, 0.5 * tol / 11.0)
