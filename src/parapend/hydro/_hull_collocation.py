@@ -363,6 +363,8 @@ class HullCollocation:
         nodes from its velocities, and the NLP's parameters."""
         fseg = np.asarray(fseg)
         par = self._params(fseg)
+        if self.solver_name == "compiled":  # its last restoration: the model rolled
+            self.compiled.rollout = lambda u: self._with_memory(self.guess(u, fseg), par)
         if self.prev is None:
             x0 = self.guess(u0, fseg)
         else:

@@ -25,17 +25,30 @@ reduced Hessian ``Q^T K Q`` positive definite is the KKT matrix's inertia IPOPT 
 where it is not, ``delta I`` is added to ``K`` as IPOPT's inertia correction does
 (``delta`` 0, then the last one's third or ``1e-4``, times 8 until the Cholesky succeeds).
 
-**Method.** IPOPT's with its ``monotone`` barrier: the slacks ``D x - s = 0`` of the speed
-bounds, the fraction to the boundary ``max(0.99, 1 - mu)``, the barrier's weight ``mu``
-falling as ``min(0.2 mu, mu^1.5)`` once its problem is solved to ``10 mu``
-(Fiacco-McCormick; ``MU_INIT`` cold, ``MU_WARM`` from a shifted solution), IPOPT's filter
-line search with its second-order corrections, a trial's infeasibility held within
-``THETA_GROWTH`` times the iterate's, and IPOPT's scaled optimality error for the end
-(``tol``, its ``s_max`` 100). In place of IPOPT's restoration phase: the equality rows
-solved by Newton's method for the unknowns but the torques (the collocation's motion under
-the iterate's torques). Measured on the default barge's horizons it ends at IPOPT's
-optimum from the same start on most, at 5 to 6 times less time an iteration, but its
-globalization is weaker than IPOPT's (benchmarks/hull_collocation_solver.out.txt).
+**Method.** IPOPT's: the slacks ``D x - s = 0`` of the speed bounds, the fraction to the
+boundary ``max(0.99, 1 - mu)``, IPOPT's filter line search with its second-order
+corrections and its watchdog (full steps after 10 shortened ones in a row, kept where the
+filter takes them within 3 iterations), a trial's infeasibility held within
+``THETA_GROWTH`` times the iterate's, IPOPT's scaled optimality error for the end (``tol``,
+its ``s_max`` 100, and its acceptable level: 1e-4 on 15 iterations in a row). The
+barrier's weight ``mu`` adaptive as IPOPT's default (``MU_STRATEGY``): in its free mode
+chosen every iteration by IPOPT's quality function (the centering ``sigma`` minimizing the
+linearized optimality error after the step of ``sigma`` times the mean complementarity:
+the affine and the centering steps on the same factors), while the optimality error falls
+(below 0.9999 times one of the last 4 iterates'); where it does not, a monotone phase
+from 0.8 times the mean complementarity (``mu`` falling as ``min(0.2 mu, mu^1.5)`` once its
+problem is solved to ``10 mu``, Fiacco-McCormick) until its barrier problem is solved.
+From a shifted solution only the unknowns are warm: the bounds' multipliers start at 1
+and ``mu`` at ``MU_INIT`` (IPOPT's; from multipliers ``mu / distance`` at ``mu`` 1e-3 the
+adaptive barrier failed more of the closed loop's horizons). The restoration phase: first
+Newton's method on the equality rows for the unknowns but the torques (the collocation's
+motion under the iterate's torques), and where that is not taken (the motion's
+linearization unstable over the horizon, its steps grow along it), IPOPT's restoration
+in Gauss-Newton form (:meth:`CompiledSolver._restore_min_norm`: least-norm steps onto the
+linearized rows in all the unknowns, to a point the filter takes with the infeasibility
+lowered by a tenth); also where the inertia correction reaches ``MAX_DELTA``.
+Measured on the default barge's horizons and closed loops: docs/hull.md and
+benchmarks/hull_collocation_solver.out.txt.
 """
 
 from __future__ import annotations
@@ -81,6 +94,10 @@ THETA_FLOOR = 1e-3
 #: (IPOPT's ``max_hessian_perturbation``): past it the solve fails
 MAX_CORRECTIONS = 40
 MAX_DELTA = 1e20
+#: the equality rows' multipliers estimated anew (least squares) where they exceed this (at
+#: the default barge's optima they are 5 to 10; on the closed loop's hard horizons they ran
+#: to 1e5 within a few shortened steps, and the inertia correction to its bound)
+LAM_RESET = 1e3
 #: where the Newton's method on the equality rows (the torques held) is not taken, IPOPT's
 #: restoration phase by least-norm steps in all the unknowns (:meth:`_restore_min_norm`)
 RESTORATION = True
@@ -105,8 +122,11 @@ class CompiledSolver:
         self.prob = prob
         self.trace = None  # a list: every iteration's (it, f, primal, dual, compl, mu, ...)
         self.lin = None
-        self.why = ""  # what ended the last failed solve (nonfinite, singular, inertia,
-        # search: the restoration not accepted, restore: it did not converge)
+        # the plant's model rolled under held torques (n,) -> a start (nvar,) on the solve's
+        # parameters, or None (set by the problem for each solve: the last restoration's)
+        self.rollout = None
+        self.why = ""  # what ended the last failed solve (nonfinite, singular; inertia,
+        # restore: neither restoration reached a point the filter takes)
         npt, ni, nx, na = prob._layout()
         n, ncp, st = prob.n, prob.ncp, prob.stride
         self.npt, self.ni, self.nx, self.na, self.n, self.ncp = npt, ni, nx, na, n, ncp
@@ -309,7 +329,9 @@ class CompiledSolver:
             gf = np.concatenate((grad[self.dep], grad[self.uix]))  # on the reduced columns
             rd = self._speeds(x) - s if self.speed else np.zeros(0)
             gdl = self._dt(lamd) if self.speed else np.zeros(nf)
-            if lam is None:  # least-squares multipliers at the start (IPOPT's)
+            if lam is None or np.max(np.abs(lam)) > LAM_RESET:
+                # least-squares multipliers at the start (IPOPT's), after a restoration, and
+                # where the steps' ran away (the Hessian then all their curvature)
                 lam = lu.solve_t(-(gf[:nd] + gdl[:nd]))
                 if not np.all(np.isfinite(lam)) or np.max(np.abs(lam)) > 1e3:
                     lam = np.zeros(self.neq)
@@ -381,6 +403,9 @@ class CompiledSolver:
                 filt.append((theta, self._barrier(f, x, s, mu)))
                 xr, sr = (self._restore_min_norm(x, s, mu, theta, filt) if RESTORATION
                           else (None, None))
+                if xr is None and RESTORATION:
+                    xr, sr = self._restore_rolled(x, theta)
+                    filt = [] if xr is not None else filt
                 if xr is None:
                     status, self.why = 2, "inertia"
                     break
@@ -534,6 +559,9 @@ class CompiledSolver:
                         for tf, pf in filt):
                     xr, sr = (self._restore_min_norm(x, s, mu, theta, filt)
                               if RESTORATION else (None, None))
+                if xr is None and RESTORATION:
+                    xr, sr = self._restore_rolled(x, theta)
+                    filt = [] if xr is not None else filt
                 if xr is None:
                     status, self.why = 2, "restore"
                     break
@@ -640,6 +668,27 @@ class CompiledSolver:
                     tr >= tf and self._barrier(ft, x, st, mu) >= pf for tf, pf in filt):
                 return x, st
         return None, None
+
+    def _restore_rolled(self, x, theta0):
+        """The last restoration: the plant's model rolled under the iterate's torques
+        (``self.rollout``, forward in time: no Newton step over the whole horizon's unstable
+        linearization), then Newton's method on the equality rows from it (:meth:`_restore`):
+        the NLP's feasible point with those torques, where its infeasibility is below 0.9
+        ``theta0`` (the caller starts the filter anew from it: the point is feasible, but
+        its objective may be above the filter's); ``(None, None)`` else, or without a
+        rollout."""
+        if self.rollout is None:
+            return None, None
+        u = np.clip(x[self.uo:self.uo + self.n], -0.99 * self.umax, 0.99 * self.umax)
+        xg = np.array(self.rollout(u), dtype=float)
+        xg[:8] = x[:8]
+        if not np.all(np.isfinite(xg)):
+            return None, None
+        xr, sr = self._restore(xg, self._speeds(xg))
+        if xr is None:
+            return None, None
+        tr = self._theta(self._values(xr)[1], xr, sr)
+        return (xr, sr) if tr <= 0.9 * theta0 else (None, None)
 
     def simulate(self, x0, par, max_iter=50):
         """The NLP's only feasible point with ``x0``'s torques (Newton's method on the
