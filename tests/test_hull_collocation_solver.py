@@ -118,15 +118,17 @@ def test_simulation_is_ipopts():
     assert np.max(np.abs(prob.simulate(u, fseg) - ref.simulate(u, fseg))) < 1e-8
 
 
-def test_restoration_reaches_the_feasible_motion():
-    """The restoration phase (least-norm Gauss-Newton steps in all the unknowns) from a far
-    infeasible start (the guess perturbed by 0.3 in every unknown: equality rows off by
-    up to tens) reaches the equality rows to 1e-9, its torques inside their bounds, and its
-    motion is the one IPOPT simulates under its torques (the NLP's only feasible point with
-    them) to 1e-6 (m, rad)."""
+@pytest.mark.parametrize("phase", ["least-norm", "rolled"])
+def test_restoration_reaches_the_feasible_motion(phase):
+    """The restoration phases (least-norm Gauss-Newton steps in all the unknowns; the
+    plant's model rolled under the iterate's torques, then Newton's method with them held)
+    from a far infeasible start (the guess perturbed by 0.3 in every unknown: equality rows
+    off by up to tens) reach the equality rows to 1e-8, the torques inside their bounds,
+    and the motion is the one IPOPT simulates under those torques (the NLP's only feasible
+    point with them) to 1e-6 (m, rad)."""
     plant, fseg, prob, ref = _pair(2)
     cs = prob.compiled
-    par = prob._params(np.asarray(fseg))
+    _, par = prob.start(fseg, np.zeros(tc.N))  # (the rollout on this update's forecast)
     x = prob._with_memory(prob.guess(np.full(tc.N, 0.5), fseg), par)
     x += 0.3 * np.random.default_rng(3).standard_normal(x.size)
     x[:8] = par[:8]
@@ -134,10 +136,11 @@ def test_restoration_reaches_the_feasible_motion():
     s = cs._speeds(x)
     c0 = cs._values(x)[1]
     assert np.max(np.abs(c0)) > 1.0
-    target = 1e-10 / 0.9  # the phase ends at 0.9 times this infeasibility (|.|_1)
-    xr, sr = cs._restore_min_norm(x, s, 1e-3, target, [])
+    target = 1e-8 / 0.9  # the phase ends at 0.9 times this infeasibility (|.|_1)
+    xr, sr = (cs._restore_min_norm(x, s, 1e-3, target, []) if phase == "least-norm"
+              else cs._restore_rolled(x, target))
     assert xr is not None
-    assert np.max(np.abs(cs._values(xr)[1])) < 1e-9
+    assert np.max(np.abs(cs._values(xr)[1])) < 1e-8
     u = xr[cs.uo:cs.uo + cs.n]
     assert np.all(np.abs(u) < prob.torque_limit)
     motion = ref.simulate(u, fseg)
