@@ -1,7 +1,7 @@
 r"""The hull's horizon problem with the MOTION as the unknown (``planner="collocation"`` of
 :func:`parapend.hydro.hull_control.hull_mpc`): direct collocation, solved on the exact
-Hessian by IPOPT on the NLP built in CasADi (the default) or by a compiled interior point
-on the same NLP (``solver="compiled"``, :mod:`._hull_collocation_ipm`).
+Hessian by a compiled interior point (the default, :mod:`._hull_collocation_ipm`) or by
+IPOPT on the same NLP built in CasADi (``solver="ipopt"``).
 
 The unknowns are the hull's ``xi = (x, z, beta)`` and the pendulum's absolute angle ``phi``
 with their velocities at the points ``t + k s``, ``k = 0..2 r n`` (``r`` Hermite-Simpson
@@ -63,11 +63,12 @@ INTERVALS = 3
 MEMORY_STRIDE = 3
 #: the generator's planned speed at most, rad per plant step (None: unbounded)
 MAX_TURN = 0.4
-#: the horizon's solver: ``"ipopt"`` (CasADi's IPOPT) or ``"compiled"``
-#: (:mod:`._hull_collocation_ipm`, no CasADi: the same NLP, a horizon about 2.2 times
-#: faster, median; not the default: in the closed loop it fails solves where IPOPT fails
-#: none, and seed 0 lost energy, benchmarks/hull_collocation_solver.out.txt)
-SOLVER = "ipopt"
+#: the horizon's solver: ``"compiled"`` (:mod:`._hull_collocation_ipm`, no CasADi: the same
+#: NLP; in the closed loop of the default barge's seeds 0 to 9, perfect forecast, 90.2 % of
+#: the record optimum against IPOPT's 94.5 %, no failed solve, its update p99 0.3 to 2.3 s
+#: against IPOPT's 1.5 to 4.9 s: benchmarks/hull_collocation_table.out.txt) or ``"ipopt"``
+#: (CasADi's IPOPT, ``parapend[collocation]``)
+SOLVER = "compiled"
 #: the compiled solver's status names (``ipopt`` field of :meth:`HullCollocation.solve`)
 _COMPILED_STATUS = ("solved", "capped", "failed")
 #: IPOPT return statuses counted as a solved horizon (0) or an iteration cap (1)

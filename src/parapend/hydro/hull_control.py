@@ -59,7 +59,7 @@ PLANT_STEPS = 6
 DEFAULT_LIMIT = 4.0
 #: L-BFGS-B iterations per horizon solve at most
 MAX_ITER = 60
-#: IPOPT iterations per horizon solve at most (``planner="collocation"``)
+#: interior-point iterations per horizon solve at most (``planner="collocation"``)
 COLLOCATION_ITER = 100
 #: the collocation planner's terminal weight by default, times ``eta_g``: with 0.5 it
 #: realized 94.5 % (perfect forecast) and 87.7 % (AR) of the record optimum on the default
@@ -348,8 +348,9 @@ def hull_mpc(hull, pendulum, wave, *, peak_period, pivot=(0.0, 0.0), pitch_inert
         ``total`` harvested 368 and 262 W).
     planner : "lbfgsb" or "collocation"
         The horizon solve: L-BFGS-B on the held torques shot through the plant's model
-        (module docstring), or the motion as the unknown, direct collocation solved by IPOPT
-        on the exact Hessian (``_hull_collocation``; needs CasADi, ``plant_steps`` even).
+        (module docstring), or the motion as the unknown, direct collocation solved by an
+        interior point on the exact Hessian (``_hull_collocation``: compiled, or CasADi's
+        IPOPT with ``_hull_collocation.SOLVER = "ipopt"``; ``plant_steps`` even).
     time_limit, deadline : as :func:`.control.buoy_mpc`.
 
     Returns
