@@ -172,3 +172,24 @@ def test_the_compiled_default_needs_no_casadi(monkeypatch):
     monkeypatch.setattr(hcol, "SOLVER", "ipopt")
     with pytest.raises(hc.ParameterError, match=r"parapend\[collocation\]"):
         hc.hull_mpc(th.HULL, th.PEND, th.WAVE, **opts)
+
+
+@pytest.mark.parametrize("solver, cap", [("compiled", 40), ("ipopt", 100)])
+def test_the_default_iteration_cap_is_the_solvers(monkeypatch, solver, cap):
+    """Without ``max_iter`` a horizon solve is capped at ``COMPILED_ITER`` (40, measured:
+    docs/hull.md) with the compiled solver and ``COLLOCATION_ITER`` (100) with IPOPT."""
+    from parapend.hydro import _hull_collocation as hcol
+
+    seen = []
+
+    def plan(prob, y0, fseg, u0, max_iter):
+        seen.append((prob.solver_name, max_iter))
+        raise StopIteration
+
+    monkeypatch.setattr(hcol, "SOLVER", solver)
+    monkeypatch.setattr(hc, "_plan", plan)
+    opts = {k: v for k, v in th.OPTS.items() if k != "max_iter"}
+    with pytest.raises(StopIteration):
+        hc.hull_mpc(th.HULL, th.PEND, th.WAVE, **opts, planner="collocation")
+    assert seen == [(solver, cap)]
+    assert (hc.COMPILED_ITER, hc.COLLOCATION_ITER) == (40, 100)

@@ -64,10 +64,11 @@ MEMORY_STRIDE = 3
 #: the generator's planned speed at most, rad per plant step (None: unbounded)
 MAX_TURN = 0.4
 #: the horizon's solver: ``"compiled"`` (:mod:`._hull_collocation_ipm`, no CasADi: the same
-#: NLP; in the closed loop of the default barge's seeds 0 to 9, perfect forecast, 90.2 % of
-#: the record optimum against IPOPT's 94.5 %, no failed solve, its update p99 0.3 to 2.3 s
-#: against IPOPT's 1.5 to 4.9 s: benchmarks/hull_collocation_table.out.txt) or ``"ipopt"``
-#: (CasADi's IPOPT, ``parapend[collocation]``)
+#: NLP; in the closed loop of the default barge's seeds 0 to 9, perfect forecast, 92.2 % of
+#: the record optimum (40 iterations at most; 90.2 % with 100) against IPOPT's 94.5 %, no
+#: failed solve, its update p99 0.63 to 1.12 s against IPOPT's 1.5 to 4.9 s:
+#: benchmarks/hull_collocation_table.out.txt) or ``"ipopt"`` (CasADi's IPOPT,
+#: ``parapend[collocation]``)
 SOLVER = "compiled"
 #: the compiled solver's status names (``ipopt`` field of :meth:`HullCollocation.solve`)
 _COMPILED_STATUS = ("solved", "capped", "failed")
