@@ -13,6 +13,7 @@ balance residual and the largest turn of the generator in one plant step (rad).
     nice python benchmarks/hull_collocation_table.py --seeds 0 1 2 --forecast perfect
     nice python benchmarks/hull_collocation_table.py --seeds 0 1 2 --forecast ar
     nice python benchmarks/hull_collocation_table.py --seeds 0 --plant-steps 12
+    nice python benchmarks/hull_collocation_table.py --seeds 0 1 2 3 --solver compiled
 """
 
 from __future__ import annotations
@@ -43,7 +44,13 @@ def main():
                     help="kappa, the weight of the energy left at the horizon's end")
     ap.add_argument("--intervals", type=int, default=None,
                     help="Hermite-Simpson intervals a torque sample (default INTERVALS)")
+    ap.add_argument("--max-iter", type=int, default=None,
+                    help="the horizon solve's iterations at most (default the planner's)")
+    ap.add_argument("--solver", default=None, choices=["compiled", "ipopt"],
+                    help="the horizon's solver (default _hull_collocation.SOLVER)")
     a = ap.parse_args()
+    if a.solver is not None:
+        hcol.SOLVER = a.solver
     if a.intervals is not None:
         hcol.INTERVALS = a.intervals
     if a.max_turn is not None:
@@ -61,7 +68,7 @@ def main():
     hc._plan = plan
     print(f"planner {a.planner}, {a.plant_steps} plant steps a sample, speed bound "
           f"{hcol.MAX_TURN} rad a plant step, at most {hcol.INTERVALS} intervals a sample, "
-          f"terminal weight {a.terminal_weight}")
+          f"terminal weight {a.terminal_weight}, solver {hcol.SOLVER}, max_iter {a.max_iter}")
     print("seed forecast mode optimum_w power_w fraction stored_w failed capped "
           "update_median_s update_p99_s interval_s status wall_s balance_residual "
           "max_turn_per_step", flush=True)
@@ -79,7 +86,8 @@ def main():
             t = time.time()
             r = hc.hull_mpc(p["hull"], pend, wave, peak_period=6.0, pivot=p["pivot"],
                             forecast=fc, mode=mode, planner=a.planner,
-                            plant_steps=a.plant_steps, terminal_weight=a.terminal_weight)
+                            plant_steps=a.plant_steps, terminal_weight=a.terminal_weight,
+                            max_iter=a.max_iter)
             f = r.mean_power_w / opt.power_w
             fr[fc].append(f)
             print(f"{seed} {fc} {mode} {opt.power_w:.1f} {r.mean_power_w:.1f} {f:.3f} "

@@ -152,3 +152,44 @@ def test_the_command_runs_the_collocation_planner(tmp_path, capsys):
     assert r["optimum_power_w"] == opt["power_w"]
     assert r["energy_balance_residual"] < 1e-3
     assert r["solves"] > 0 and r["update_time_p99_s"] is not None
+
+
+def test_the_compiled_default_needs_no_casadi(monkeypatch):
+    """The collocation planner's default solver is the compiled one: with CasADi made
+    unimportable the run is the one with CasADi there, to the bit (no IPOPT in it); asked
+    for IPOPT without CasADi, one line naming the extra."""
+    import sys
+
+    from parapend.hydro import _hull_collocation as hcol
+
+    opts = dict(th.OPTS, max_iter=5, planner="collocation")
+    assert hcol.SOLVER == "compiled"
+    with_casadi = hc.hull_mpc(th.HULL, th.PEND, th.WAVE, **opts)
+    monkeypatch.setitem(sys.modules, "casadi", None)
+    without = hc.hull_mpc(th.HULL, th.PEND, th.WAVE, **opts)
+    assert without.solves > 0 and without.failed_solves == 0
+    assert np.array_equal(with_casadi.series["torque"], without.series["torque"])
+    monkeypatch.setattr(hcol, "SOLVER", "ipopt")
+    with pytest.raises(hc.ParameterError, match=r"parapend\[collocation\]"):
+        hc.hull_mpc(th.HULL, th.PEND, th.WAVE, **opts)
+
+
+@pytest.mark.parametrize("solver, cap", [("compiled", 40), ("ipopt", 100)])
+def test_the_default_iteration_cap_is_the_solvers(monkeypatch, solver, cap):
+    """Without ``max_iter`` a horizon solve is capped at ``COMPILED_ITER`` (40, measured:
+    docs/hull.md) with the compiled solver and ``COLLOCATION_ITER`` (100) with IPOPT."""
+    from parapend.hydro import _hull_collocation as hcol
+
+    seen = []
+
+    def plan(prob, y0, fseg, u0, max_iter):
+        seen.append((prob.solver_name, max_iter))
+        raise StopIteration
+
+    monkeypatch.setattr(hcol, "SOLVER", solver)
+    monkeypatch.setattr(hc, "_plan", plan)
+    opts = {k: v for k, v in th.OPTS.items() if k != "max_iter"}
+    with pytest.raises(StopIteration):
+        hc.hull_mpc(th.HULL, th.PEND, th.WAVE, **opts, planner="collocation")
+    assert seen == [(solver, cap)]
+    assert (hc.COMPILED_ITER, hc.COLLOCATION_ITER) == (40, 100)

@@ -81,20 +81,22 @@ def test_derivatives_are_casadis(kw):
     assert np.max(np.abs(hess - theirs)) <= 1e-12 * np.max(np.abs(theirs))
 
 
-@pytest.mark.parametrize("intervals, kw, updates", [(2, VARIANTS[0], 2), (2, VARIANTS[1], 1),
-                                                    (1, VARIANTS[0], 1)])
-def test_compiled_reaches_ipopts_optimum(intervals, kw, updates):
+@pytest.mark.parametrize("intervals, kw, updates, strategy",
+                         [(2, VARIANTS[0], 2, "adaptive"), (2, VARIANTS[1], 1, "adaptive"),
+                          (1, VARIANTS[0], 1, "adaptive"), (2, VARIANTS[0], 1, "monotone")])
+def test_compiled_reaches_ipopts_optimum(intervals, kw, updates, strategy):
     """One or two updates (the second from the first's solution shifted by one sample,
-    after the plant ran it): the compiled solver and IPOPT from the same start reach the
-    same objective (1e-6 relative) and torques (1e-4 m g l), both solved. (With an
-    efficiency the smoothed kink of ``e(.)`` makes the problem's local optima many: the
-    second update of this small hull, or one Hermite-Simpson interval a sample, ends the
-    two at different local optima, neither below the other every time.)"""
+    after the plant ran it): the compiled solver (either barrier update) and IPOPT from the
+    same start reach the same objective (1e-6 relative) and torques (1e-4 m g l), both
+    solved. (With an efficiency the smoothed kink of ``e(.)`` makes the problem's local
+    optima many: the second update of this small hull, or one Hermite-Simpson interval a
+    sample, ends the two at different local optima, neither below the other every time; so
+    does the monotone barrier's second update, 1.4 % below IPOPT's.)"""
     plant, fseg, prob, ref = _pair(intervals, **kw)
     prob.shift = 1
     for k in range(updates):
         x0, par = prob.start(fseg, np.zeros(tc.N))
-        r = prob.solve_from(x0, par, warm=k > 0)
+        r = prob.solve_from(x0, par, warm=k > 0, strategy=strategy)
         s = ref.solve_from(x0, par)
         assert r.status == 0 and s.status == 0, (r.ipopt, s.ipopt)
         assert abs(r.fun - s.fun) <= 1e-6 * abs(s.fun), (r.fun, s.fun)
@@ -114,6 +116,60 @@ def test_simulation_is_ipopts():
     plant, fseg, prob, ref = _pair(2)
     u = np.array([0.5, -0.3, 0.9, -0.6, 0.2, 0.4])
     assert np.max(np.abs(prob.simulate(u, fseg) - ref.simulate(u, fseg))) < 1e-8
+
+
+@pytest.mark.parametrize("phase", ["least-norm", "rolled"])
+def test_restoration_reaches_the_feasible_motion(phase):
+    """The restoration phases (least-norm Gauss-Newton steps in all the unknowns; the
+    plant's model rolled under the iterate's torques, then Newton's method with them held)
+    from a far infeasible start (the guess perturbed by 0.3 in every unknown: equality rows
+    off by up to tens) reach the equality rows to 1e-8, the torques inside their bounds,
+    and the motion is the one IPOPT simulates under those torques (the NLP's only feasible
+    point with them) to 1e-6 (m, rad)."""
+    plant, fseg, prob, ref = _pair(2)
+    cs = prob.compiled
+    _, par = prob.start(fseg, np.zeros(tc.N))  # (the rollout on this update's forecast)
+    x = prob._with_memory(prob.guess(np.full(tc.N, 0.5), fseg), par)
+    x += 0.3 * np.random.default_rng(3).standard_normal(x.size)
+    x[:8] = par[:8]
+    cs._setup(par)
+    s = cs._speeds(x)
+    c0 = cs._values(x)[1]
+    assert np.max(np.abs(c0)) > 1.0
+    target = 1e-8 / 0.9  # the phase ends at 0.9 times this infeasibility (|.|_1)
+    xr, sr = (cs._restore_min_norm(x, s, 1e-3, target, []) if phase == "least-norm"
+              else cs._restore_rolled(x, target))
+    assert xr is not None
+    assert np.max(np.abs(cs._values(xr)[1])) < 1e-8
+    u = xr[cs.uo:cs.uo + cs.n]
+    assert np.all(np.abs(u) < prob.torque_limit)
+    motion = ref.simulate(u, fseg)
+    assert np.max(np.abs(xr[:prob.nx].reshape(prob.npt, 8) - motion)) < 1e-6
+
+
+def test_a_failed_solve_is_tried_again(monkeypatch):
+    """A solve the adaptive barrier fails (made to fail here) is solved again from the same
+    start with the monotone one: the plan is IPOPT's optimum (1e-6 relative), not the
+    start."""
+    from parapend.hydro import _hull_collocation_ipm as ipm
+
+    plant, fseg, prob, ref = _pair(2)
+    tried = []
+    solve0 = ipm.CompiledSolver._solve
+
+    def failing(self, x0, par, max_iter, tol, mu, growth, strategy):
+        tried.append(strategy)
+        if strategy == "adaptive":
+            return np.array(x0, float), 0.0, 2, 1
+        return solve0(self, x0, par, max_iter, tol, mu, growth, strategy)
+
+    monkeypatch.setattr(ipm.CompiledSolver, "_solve", failing)
+    r = prob.solve(plant, fseg, np.zeros(tc.N))
+    x0, par = prob.start(fseg, np.zeros(tc.N))
+    prob.prev = None
+    s = ref.solve_from(*prob.start(fseg, np.zeros(tc.N)))
+    assert tried == ["adaptive", "monotone"]
+    assert r.status == 0 and abs(r.fun - s.fun) <= 1e-6 * abs(s.fun), (r.fun, s.fun)
 
 
 def test_bad_solver_is_one_line():

@@ -1,7 +1,7 @@
 r"""The hull's horizon problem with the MOTION as the unknown (``planner="collocation"`` of
 :func:`parapend.hydro.hull_control.hull_mpc`): direct collocation, solved on the exact
-Hessian by IPOPT on the NLP built in CasADi (the default) or by a compiled interior point
-on the same NLP (``solver="compiled"``, :mod:`._hull_collocation_ipm`).
+Hessian by a compiled interior point (the default, :mod:`._hull_collocation_ipm`) or by
+IPOPT on the same NLP built in CasADi (``solver="ipopt"``).
 
 The unknowns are the hull's ``xi = (x, z, beta)`` and the pendulum's absolute angle ``phi``
 with their velocities at the points ``t + k s``, ``k = 0..2 r n`` (``r`` Hermite-Simpson
@@ -63,11 +63,13 @@ INTERVALS = 3
 MEMORY_STRIDE = 3
 #: the generator's planned speed at most, rad per plant step (None: unbounded)
 MAX_TURN = 0.4
-#: the horizon's solver: ``"ipopt"`` (CasADi's IPOPT) or ``"compiled"``
-#: (:mod:`._hull_collocation_ipm`, no CasADi: the same NLP, a horizon about 2.2 times
-#: faster, median; not the default: in the closed loop it fails solves where IPOPT fails
-#: none, and seed 0 lost energy, benchmarks/hull_collocation_solver.out.txt)
-SOLVER = "ipopt"
+#: the horizon's solver: ``"compiled"`` (:mod:`._hull_collocation_ipm`, no CasADi: the same
+#: NLP; in the closed loop of the default barge's seeds 0 to 9, perfect forecast, 92.2 % of
+#: the record optimum (40 iterations at most; 90.2 % with 100) against IPOPT's 94.5 %, no
+#: failed solve, its update p99 0.63 to 1.12 s against IPOPT's 1.5 to 4.9 s:
+#: benchmarks/hull_collocation_table.out.txt) or ``"ipopt"`` (CasADi's IPOPT,
+#: ``parapend[collocation]``)
+SOLVER = "compiled"
 #: the compiled solver's status names (``ipopt`` field of :meth:`HullCollocation.solve`)
 _COMPILED_STATUS = ("solved", "capped", "failed")
 #: IPOPT return statuses counted as a solved horizon (0) or an iteration cap (1)
@@ -370,6 +372,8 @@ class HullCollocation:
         nodes from its velocities, and the NLP's parameters."""
         fseg = np.asarray(fseg)
         par = self._params(fseg)
+        if self.solver_name == "compiled":  # its last restoration: the model rolled
+            self.compiled.rollout = lambda u: self._with_memory(self.guess(u, fseg), par)
         if self.prev is None:
             x0 = self.guess(u0, fseg)
         else:
@@ -384,11 +388,15 @@ class HullCollocation:
         warm = self.prev is not None
         r = self.solve_from(x0, par, max_iter, tol, warm=warm)
         if self.solver_name == "compiled" and r.status == 2:
-            # the compiled solver has no restoration phase as IPOPT's: a failed warm start
-            # is solved again from the model rolled under ``u0``; failed again, its start
-            # is the plan (the previous one continued) and the next start
+            # a failed solve is tried again from the same start with the other barrier
+            # update (monotone: another path), then from the model rolled under ``u0``;
+            # failed still, its start is the plan (the previous one continued) and the
+            # next start
             nit = r.nit
-            if warm:
+            r = self.solve_from(x0, par, max_iter, tol, warm=warm, strategy="monotone")
+            r.nit += nit
+            if warm and r.status == 2:
+                nit = r.nit
                 xg = self._with_memory(self.guess(u0, fseg), par)
                 r = self.solve_from(xg, par, max_iter, tol)
                 r.nit += nit
@@ -399,18 +407,21 @@ class HullCollocation:
                 r.x, r.full, r.states = u, x0, x0[:self.nx].reshape(self.npt, 8)
         return r
 
-    def solve_from(self, x0, par, max_iter=None, tol=None, warm=False):
+    def solve_from(self, x0, par, max_iter=None, tol=None, warm=False, strategy=None):
         """The solver (:data:`SOLVER` or the constructor's) from ``x0`` on the parameters
         ``par``. ``max_iter`` and ``tol``: IPOPT's are the constructor's (its options are
         fixed when the NLP is built), the compiled solver's these (None: the constructor's;
-        ``warm``: ``x0`` a shifted solution). Returns ``x`` (the held torques, m g l),
-        ``fun``, ``status`` (0 solved, 1 capped, 2 failed), ``success``, ``nit``, ``ipopt``
+        ``warm``: ``x0`` a shifted solution; ``strategy``: its barrier update, None its
+        default :data:`._hull_collocation_ipm.MU_STRATEGY`). Returns ``x`` (the held
+        torques, m g l), ``fun``, ``status`` (0 solved, 1 capped, 2 failed), ``success``,
+        ``nit``, ``ipopt``
         (the solver's status: IPOPT's return status, or solved, capped, failed) and
         ``states`` (the planned motion at the points, (npt, 8))."""
         if self.solver_name == "compiled":
             mi = self.options["max_iter"] if max_iter is None else int(max_iter)
             x, fun, status, nit = self.compiled.solve(
-                x0, par, mi, self.tol if tol is None else float(tol), warm=warm)
+                x0, par, mi, self.tol if tol is None else float(tol), warm=warm,
+                strategy=strategy)
             name = _COMPILED_STATUS[status]
         else:
             r = self.solver(x0=x0, p=par, lbx=self.lbx, ubx=self.ubx, lbg=self.lbg,

@@ -25,17 +25,30 @@ reduced Hessian ``Q^T K Q`` positive definite is the KKT matrix's inertia IPOPT 
 where it is not, ``delta I`` is added to ``K`` as IPOPT's inertia correction does
 (``delta`` 0, then the last one's third or ``1e-4``, times 8 until the Cholesky succeeds).
 
-**Method.** IPOPT's with its ``monotone`` barrier: the slacks ``D x - s = 0`` of the speed
-bounds, the fraction to the boundary ``max(0.99, 1 - mu)``, the barrier's weight ``mu``
-falling as ``min(0.2 mu, mu^1.5)`` once its problem is solved to ``10 mu``
-(Fiacco-McCormick; ``MU_INIT`` cold, ``MU_WARM`` from a shifted solution), IPOPT's filter
-line search with its second-order corrections, a trial's infeasibility held within
-``THETA_GROWTH`` times the iterate's, and IPOPT's scaled optimality error for the end
-(``tol``, its ``s_max`` 100). In place of IPOPT's restoration phase: the equality rows
-solved by Newton's method for the unknowns but the torques (the collocation's motion under
-the iterate's torques). Measured on the default barge's horizons it ends at IPOPT's
-optimum from the same start on most, at 5 to 6 times less time an iteration, but its
-globalization is weaker than IPOPT's (benchmarks/hull_collocation_solver.out.txt).
+**Method.** IPOPT's: the slacks ``D x - s = 0`` of the speed bounds, the fraction to the
+boundary ``max(0.99, 1 - mu)``, IPOPT's filter line search with its second-order
+corrections and its watchdog (full steps after 10 shortened ones in a row, kept where the
+filter takes them within 3 iterations), a trial's infeasibility held within
+``THETA_GROWTH`` times the iterate's, IPOPT's scaled optimality error for the end (``tol``,
+its ``s_max`` 100, and its acceptable level: 1e-4 on 15 iterations in a row). The
+barrier's weight ``mu`` adaptive as IPOPT's default (``MU_STRATEGY``): in its free mode
+chosen every iteration by IPOPT's quality function (the centering ``sigma`` minimizing the
+linearized optimality error after the step of ``sigma`` times the mean complementarity:
+the affine and the centering steps on the same factors), while the optimality error falls
+(below 0.9999 times one of the last 4 iterates'); where it does not, a monotone phase
+from 0.8 times the mean complementarity (``mu`` falling as ``min(0.2 mu, mu^1.5)`` once its
+problem is solved to ``10 mu``, Fiacco-McCormick) until its barrier problem is solved.
+From a shifted solution only the unknowns are warm: the bounds' multipliers start at 1
+and ``mu`` at ``MU_INIT`` (IPOPT's; from multipliers ``mu / distance`` at ``mu`` 1e-3 the
+adaptive barrier failed more of the closed loop's horizons). The restoration phase: first
+Newton's method on the equality rows for the unknowns but the torques (the collocation's
+motion under the iterate's torques), and where that is not taken (the motion's
+linearization unstable over the horizon, its steps grow along it), IPOPT's restoration
+in Gauss-Newton form (:meth:`CompiledSolver._restore_min_norm`: least-norm steps onto the
+linearized rows in all the unknowns, to a point the filter takes with the infeasibility
+lowered by a tenth); also where the inertia correction reaches ``MAX_DELTA``.
+Measured on the default barge's horizons and closed loops: docs/hull.md and
+benchmarks/hull_collocation_solver.out.txt.
 """
 
 from __future__ import annotations
@@ -47,9 +60,32 @@ from scipy.linalg import LinAlgError, cho_factor, cho_solve
 from . import _hull_collocation_kernel as kern
 from ._hull_collocation_linalg import Structured
 
-#: the barrier's first weight (IPOPT's ``mu_init``) cold and from a shifted solution
+#: the barrier's first weight (IPOPT's ``mu_init``) cold and from a shifted solution (the
+#: same: with 1e-3 and the bounds' multipliers ``mu`` over their distances the adaptive
+#: barrier failed more of the closed loop's horizons than from IPOPT's multipliers 1)
 MU_INIT = 0.1
-MU_WARM = 1e-3
+MU_WARM = 0.1
+#: the barrier's update: ``"adaptive"`` (IPOPT's free mode with Mehrotra's probing, a
+#: monotone phase where the error does not fall) or ``"monotone"`` (Fiacco-McCormick)
+MU_STRATEGY = "adaptive"
+#: the adaptive barrier's oracle: ``"quality"`` (IPOPT's default: the quality function) or
+#: ``"probing"`` (Mehrotra's)
+MU_ORACLE = "quality"
+#: the adaptive barrier's bound (times the first mean complementarity) and its progress
+#: test: the optimality error below REF_RED times one of the last REFS iterates'
+MU_MAX_FACT = 1e3
+#: IPOPT's acceptable level: the error within ACCEPTABLE_TOL (the infeasibility and the
+#: complementarity within 1e-2) on this many iterations in a row ends the solve as solved
+#: (IPOPT's ``acceptable_tol`` of the planner's options and its ``acceptable_iter``)
+ACCEPTABLE_TOL = 1e-4
+ACCEPTABLE_ITER = 15
+#: IPOPT's watchdog: after WATCHDOG_SHORT shortened steps in a row, full steps for up to
+#: WATCHDOG_TRIALS iterations, kept where the filter takes one against the point before
+#: them, else back to that point
+WATCHDOG_SHORT = 10
+WATCHDOG_TRIALS = 3
+REF_RED = 0.9999
+REFS = 4
 #: a trial step's infeasibility at most this times the iterate's, or THETA_FLOOR (IPOPT's
 #: filter alone let the iterates wander far from feasibility on the hull's nonconvex horizons)
 THETA_GROWTH = 10.0
@@ -58,6 +94,13 @@ THETA_FLOOR = 1e-3
 #: (IPOPT's ``max_hessian_perturbation``): past it the solve fails
 MAX_CORRECTIONS = 40
 MAX_DELTA = 1e20
+#: the equality rows' multipliers estimated anew (least squares) where they exceed this (at
+#: the default barge's optima they are 5 to 10; on the closed loop's hard horizons they ran
+#: to 1e5 within a few shortened steps, and the inertia correction to its bound)
+LAM_RESET = 1e3
+#: where the Newton's method on the equality rows (the torques held) is not taken, IPOPT's
+#: restoration phase by least-norm steps in all the unknowns (:meth:`_restore_min_norm`)
+RESTORATION = True
 
 
 def _csc_pattern(rows, cols, nrow, ncol):
@@ -79,8 +122,11 @@ class CompiledSolver:
         self.prob = prob
         self.trace = None  # a list: every iteration's (it, f, primal, dual, compl, mu, ...)
         self.lin = None
-        self.why = ""  # what ended the last failed solve (nonfinite, singular, inertia,
-        # search: the restoration not accepted, restore: it did not converge)
+        # the plant's model rolled under held torques (n,) -> a start (nvar,) on the solve's
+        # parameters, or None (set by the problem for each solve: the last restoration's)
+        self.rollout = None
+        self.why = ""  # what ended the last failed solve (nonfinite, singular; inertia,
+        # restore: neither restoration reached a point the filter takes)
         npt, ni, nx, na = prob._layout()
         n, ncp, st = prob.n, prob.ncp, prob.stride
         self.npt, self.ni, self.nx, self.na, self.n, self.ncp = npt, ni, nx, na, n, ncp
@@ -222,7 +268,7 @@ class CompiledSolver:
         return float(np.sum(np.abs(c)) + (np.sum(np.abs(self._speeds(x) - s))
                                           if self.speed else 0.0))
 
-    def solve(self, x0, par, max_iter, tol, warm=False):
+    def solve(self, x0, par, max_iter, tol, warm=False, strategy=None):
         """The interior point from ``x0`` (its start's state is ``par``'s) on the parameters
         ``par`` (:meth:`._hull_collocation.HullCollocation._params`). Returns ``(x, f,
         status, iterations)``: status 0 solved to ``tol``, 1 stopped at ``max_iter``, 2
@@ -232,9 +278,9 @@ class CompiledSolver:
 
         with _blas_controller().limit(limits=1, user_api="blas"):
             return self._solve(x0, par, max_iter, tol, MU_WARM if warm else MU_INIT,
-                               THETA_GROWTH)
+                               THETA_GROWTH, MU_STRATEGY if strategy is None else strategy)
 
-    def _solve(self, x0, par, max_iter, tol, mu, growth):
+    def _solve(self, x0, par, max_iter, tol, mu, growth, strategy):
         npt, n, nd, nf = self.npt, self.n, self.nd, self.nf
         self._setup(par)
         e0, fk = self.e0, self.fk
@@ -265,6 +311,10 @@ class CompiledSolver:
         filt = []
         theta_max = theta_min = None
         nrest = 0
+        adaptive = strategy == "adaptive"
+        nacc = 0
+        wd, short = None, 0  # the watchdog's reference, the shortened steps in a row
+        free, refs, mu_max, mu_min = True, [], None, min(1e-11, 0.5 * tol / 11.0)
         while True:
             lam_e = np.zeros(self.neq) if lam is None else lam
             f, c, grad, jv, _, hv = self._eval(x, lam_e[:self.nloc], 2, fk, e0)
@@ -279,7 +329,9 @@ class CompiledSolver:
             gf = np.concatenate((grad[self.dep], grad[self.uix]))  # on the reduced columns
             rd = self._speeds(x) - s if self.speed else np.zeros(0)
             gdl = self._dt(lamd) if self.speed else np.zeros(nf)
-            if lam is None:  # least-squares multipliers at the start (IPOPT's)
+            if lam is None or np.max(np.abs(lam)) > LAM_RESET:
+                # least-squares multipliers at the start (IPOPT's), after a restoration, and
+                # where the steps' ran away (the Hessian then all their curvature)
                 lam = lu.solve_t(-(gf[:nd] + gdl[:nd]))
                 if not np.all(np.isfinite(lam)) or np.max(np.abs(lam)) > 1e3:
                     lam = np.zeros(self.neq)
@@ -303,24 +355,19 @@ class CompiledSolver:
             if err0 <= tol:
                 status = 0
                 break
+            nacc = nacc + 1 if (err0 <= ACCEPTABLE_TOL and primal <= 1e-2
+                                and np.max(np.abs(comp)) <= 1e-2) else 0
+            if nacc >= ACCEPTABLE_ITER:  # IPOPT's acceptable level (its options')
+                status = 0
+                break
             if it >= max_iter:
                 status = 1
                 break
-            # the barrier's weight falls once its problem is solved to 10 mu (IPOPT's
-            # monotone update; the filter starts anew)
-            while max(dual / sd, primal, np.max(np.abs(comp - mu)) / sc) <= 10.0 * mu \
-                    and mu > tol / 10.0:
-                mu = max(tol / 10.0, min(0.2 * mu, mu ** 1.5))
-                tau_min = max(0.99, 1.0 - mu)
-                filt = []
             it += 1
             # the Newton step (module docstring)
             diag = np.zeros(nf)
             diag[nd:] = zl / sl_u + zu / su_u
-            gphi0 = gf.copy()
-            gphi0[nd:] += -mu / sl_u + mu / su_u
             self.sig_s = zls / sls + zus / sus if ns else np.zeros(0)
-            gphis = -mu / sls + mu / sus if ns else np.zeros(0)
             kmat = self.hessian(hv, diag)
             zfull = np.empty((nf, n))
             ju = jac[:, nd:].toarray()
@@ -350,11 +397,79 @@ class CompiledSolver:
                 delta = ((1e-4 if delta_last == 0.0 else max(1e-20, delta_last / 3.0))
                          if delta == 0.0 else 8.0 * delta)
             if fac is None:
-                status, self.why = 2, "inertia"
-                break
+                # no inertia correction up to MAX_DELTA: the restoration phase (IPOPT's),
+                # the multipliers estimated anew after it
+                theta = self._theta(c, x, s)
+                filt.append((theta, self._barrier(f, x, s, mu)))
+                xr, sr = (self._restore_min_norm(x, s, mu, theta, filt) if RESTORATION
+                          else (None, None))
+                if xr is None and RESTORATION:
+                    xr, sr = self._restore_rolled(x, theta)
+                    filt = [] if xr is not None else filt
+                if xr is None:
+                    status, self.why = 2, "inertia"
+                    break
+                x, s, lam, delta_last = xr, sr, None, 0.0
+                nrest += 1
+                continue
             if delta:
                 delta_last = delta
 
+            if adaptive:
+                # IPOPT's adaptive barrier: free mode while the optimality error falls (by
+                # a factor REF_RED on the last REFS points'), the weight Mehrotra's probing
+                # of the affine step; else a monotone phase from 0.8 times the mean
+                # complementarity until its barrier problem is solved to 10 mu
+                avg = float(np.mean(comp)) if comp.size else 0.0
+                if mu_max is None:
+                    mu_max = MU_MAX_FACT * max(avg, mu)
+                if free and refs and not any(err0 <= REF_RED * r for r in refs):
+                    free = False
+                    mu = max(mu_min, min(mu_max, 0.8 * avg))
+                    filt = []
+                elif not free and max(dual / sd, primal,
+                                      np.max(np.abs(comp - mu)) / sc) <= 10.0 * mu:
+                    free, refs = True, []
+                if free:
+                    refs = (refs + [err0])[-REFS:]
+                    aff = _Newton(self, lu, fac, zfull, kmat, delta, gf, np.zeros(ns))
+                    adx, ads = aff.step(c, rd)[:2]
+                    adu = adx[uo:uo + n]
+                    slacks = np.concatenate((sl_u, su_u, sls, sus))
+                    dsl = np.concatenate((adu, -adu, ads, -ads))
+                    zz = np.concatenate((zl, zu, zls, zus))
+                    if MU_ORACLE == "quality":
+                        cg = np.zeros(nf)
+                        cg[nd:] = -1.0 / sl_u + 1.0 / su_u
+                        cen = _Newton(self, lu, fac, zfull, kmat, delta, cg,
+                                      -1.0 / sls + 1.0 / sus if ns else np.zeros(0))
+                        cdx, cds = cen.step(np.zeros(self.neq), np.zeros(ns))[:2]
+                        cdu = cdx[uo:uo + n]
+                        dsc = np.concatenate((cdu, -cdu, cds, -cds))
+                        dsq = float(np.mean(gl ** 2) + (np.mean((lamd + zls - zus) ** 2)
+                                                        if ns else 0.0))
+                        psq = float(np.mean(c ** 2) + (np.mean(rd ** 2) if ns else 0.0))
+                        mnew = _quality(slacks, zz, dsl, dsc, dsq, psq, avg) * avg
+                    else:
+                        dz_a = -zz - zz / slacks * dsl
+                        a_p, a_d = _max_step(slacks, dsl, 1.0), _max_step(zz, dz_a, 1.0)
+                        maff = float(np.mean((slacks + a_p * dsl) * (zz + a_d * dz_a)))
+                        mnew = (maff / avg) ** 3 * avg
+                    mnew = min(mu_max, max(mu_min, mnew))
+                    if mnew != mu:
+                        filt = []
+                    mu = mnew
+            else:
+                # the barrier's weight falls once its problem is solved to 10 mu (IPOPT's
+                # monotone update; the filter starts anew)
+                while max(dual / sd, primal, np.max(np.abs(comp - mu)) / sc) <= 10.0 * mu \
+                        and mu > tol / 10.0:
+                    mu = max(tol / 10.0, min(0.2 * mu, mu ** 1.5))
+                    filt = []
+            tau_min = max(0.99, 1.0 - mu)
+            gphi0 = gf.copy()
+            gphi0[nd:] += -mu / sl_u + mu / su_u
+            gphis = -mu / sls + mu / sus if ns else np.zeros(0)
             newton = _Newton(self, lu, fac, zfull, kmat, delta, gphi0, gphis)
             dx, ds, lam_new, lamd_new = newton.step(c, rd)
             ddu = dx[uo:uo + n]
@@ -382,7 +497,28 @@ class CompiledSolver:
             a = ap
             acc = None
             first = True
-            while a >= amin:
+            if wd is not None:
+                # the watchdog's iterates (IPOPT's): the current one against its reference
+                xw, sw, fw, thw, nw = wd[0], wd[1], wd[8], wd[9], wd[10]
+                phw = self._barrier(fw, xw, sw, mu)
+                if (theta <= (1.0 - 1e-5) * thw or phi <= phw - 1e-8 * thw) and not any(
+                        theta >= tf and phi >= pf for tf, pf in wd[11]):
+                    wd = None
+                elif nw < WATCHDOG_TRIALS:
+                    wd = wd[:10] + (nw + 1, wd[11])
+                    first = False  # a full step, not judged
+                    acc = _forced(ls.trial(a, a * dx, a * ds))
+                else:  # back to the reference, and its own line search
+                    x, s, lam, lamd, zl, zu, zls, zus = wd[:8]
+                    filt, wd, short = list(wd[11]), None, 0
+                    continue
+            elif short >= WATCHDOG_SHORT:
+                wd = (x, s, lam, lamd, zl, zu, zls, zus, f, theta, 1, list(filt))
+                short = 0
+                acc = _forced(ls.trial(a, a * dx, a * ds))
+            if acc is not None:
+                a = ap
+            while acc is None and a >= amin:
                 res = ls.trial(a, a * dx, a * ds)
                 if res is not None and res[0]:
                     acc = res
@@ -421,7 +557,13 @@ class CompiledSolver:
                 if tr is None or not tr <= 0.9 * theta or any(
                         tr >= tf and self._barrier(self._values(xr)[0], xr, sr, mu) >= pf
                         for tf, pf in filt):
-                    status, self.why = 2, "search" if xr is not None else "restore"
+                    xr, sr = (self._restore_min_norm(x, s, mu, theta, filt)
+                              if RESTORATION else (None, None))
+                if xr is None and RESTORATION:
+                    xr, sr = self._restore_rolled(x, theta)
+                    filt = [] if xr is not None else filt
+                if xr is None:
+                    status, self.why = 2, "restore"
                     break
                 x, s, lam = xr, sr, None
                 nrest += 1
@@ -429,6 +571,7 @@ class CompiledSolver:
             if self.trace is not None:
                 self.trace.append((it, f, primal, dual / sd, np.max(np.abs(comp)), mu, ap, a,
                                    az, delta, len(filt)))
+            short = short + 1 if a < ap else 0
             x, s = acc[1], acc[2]
             lam = lam + a * (lam_new - lam)
             lamd = lamd + a * (lamd_new - lamd)
@@ -474,6 +617,78 @@ class CompiledSolver:
             pv = 1e-2 * min(1.0, self.vmax)
             s = np.clip(s, -self.vmax + pv, self.vmax - pv)
         return x, s
+
+    def _restore_min_norm(self, x, s, mu, theta0, filt, max_iter=30):
+        """IPOPT's restoration phase in Gauss-Newton form: steps of least norm onto the
+        linearized equality rows, in all the unknowns (the torques within their bounds by
+        the fraction to the boundary), backtracking on ``|c|_2``, until the infeasibility
+        ``theta`` is at most 0.9 ``theta0`` at a point the filter ``filt`` takes (the barrier
+        weight ``mu``); ``(None, None)`` where it does not get there. The least-norm step is
+        ``Y p - Q Q^T Y p`` (``Q`` the orthonormal basis of the null space, ``Y p`` the step
+        with the torques held)."""
+        n, nd, nf, uo, um = self.n, self.nd, self.nf, self.uo, self.umax
+        x = x.copy()
+        for _ in range(max_iter):
+            _, c, _, jv, _, _ = self._eval(x, self._nolam, 1, self.fk, self.e0)
+            jac = self.jacobian(jv)
+            lu = self._factor(jac)
+            if lu is None:
+                return None, None
+            yp = np.zeros(nf)
+            yp[:nd] = -lu.solve(c)
+            zfull = np.empty((nf, n))
+            zfull[:nd] = -lu.solve(jac[:, nd:].toarray(), torques=True)
+            zfull[nd:] = np.eye(n)
+            q = zfull @ np.linalg.inv(np.linalg.qr(zfull, mode="r"))
+            dxf = yp - q @ (q.T @ yp)
+            if not np.all(np.isfinite(dxf)):
+                return None, None
+            u = x[uo:uo + n]
+            du = dxf[nd:]
+            a = _max_step(np.concatenate((u + um, um - u)), np.concatenate((du, -du)), 0.99)
+            c2 = float(c @ c)
+            for _ in range(30):
+                xt = x.copy()
+                xt[self.dep] += a * dxf[:nd]
+                xt[self.uix] += a * du
+                ct = self._values(xt)[1]
+                if np.all(np.isfinite(ct)) and float(ct @ ct) <= (1.0 - 1e-4 * a) * c2:
+                    break
+                a *= 0.5
+            else:
+                return None, None
+            x = xt
+            st = self._speeds(x)
+            if self.speed:
+                pv = 1e-2 * min(1.0, self.vmax)
+                st = np.clip(st, -self.vmax + pv, self.vmax - pv)
+            ft, ct, _ = self._values(x)
+            tr = self._theta(ct, x, st)
+            if tr <= 0.9 * theta0 and not any(
+                    tr >= tf and self._barrier(ft, x, st, mu) >= pf for tf, pf in filt):
+                return x, st
+        return None, None
+
+    def _restore_rolled(self, x, theta0):
+        """The last restoration: the plant's model rolled under the iterate's torques
+        (``self.rollout``, forward in time: no Newton step over the whole horizon's unstable
+        linearization), then Newton's method on the equality rows from it (:meth:`_restore`):
+        the NLP's feasible point with those torques, where its infeasibility is below 0.9
+        ``theta0`` (the caller starts the filter anew from it: the point is feasible, but
+        its objective may be above the filter's); ``(None, None)`` else, or without a
+        rollout."""
+        if self.rollout is None:
+            return None, None
+        u = np.clip(x[self.uo:self.uo + self.n], -0.99 * self.umax, 0.99 * self.umax)
+        xg = np.array(self.rollout(u), dtype=float)
+        xg[:8] = x[:8]
+        if not np.all(np.isfinite(xg)):
+            return None, None
+        xr, sr = self._restore(xg, self._speeds(xg))
+        if xr is None:
+            return None, None
+        tr = self._theta(self._values(xr)[1], xr, sr)
+        return (xr, sr) if tr <= 0.9 * theta0 else (None, None)
 
     def simulate(self, x0, par, max_iter=50):
         """The NLP's only feasible point with ``x0``'s torques (Newton's method on the
@@ -584,6 +799,48 @@ class _Search:
         if ok and not (switch and armijo):
             self.filt.append(((1.0 - 1e-5) * theta, phi - 1e-8 * theta))
         return ok, xt, st, ct, tht
+
+
+def _quality(slacks, z, dsl_a, dsl_c, dual_sq, primal_sq, avg, lo=1e-6, hi=1e2):
+    """IPOPT's quality-function oracle: the centering ``sigma`` in ``[lo, hi]`` (golden
+    section on its logarithm) that minimizes the linearized optimality error after the step
+    of the barrier weight ``sigma avg``: ``(1 - a_d)^2`` the dual infeasibility's mean
+    square ``dual_sq``, plus ``(1 - a_p)^2`` the primal one's ``primal_sq``, plus the mean
+    square of the complementarity after the step (``a_p``, ``a_d`` to the fraction 0.99 of
+    the bounds). The bounds' distances ``slacks`` step as ``dsl_a + mu dsl_c`` (the affine
+    step and the centering one per unit weight), their multipliers ``z`` as ``mu / slacks -
+    z - z / slacks * dsl``."""
+    def q(lg):
+        mu = 10.0 ** lg * avg
+        dsl = dsl_a + mu * dsl_c
+        dz = mu / slacks - z - z / slacks * dsl
+        a_p, a_d = _max_step(slacks, dsl, 0.99), _max_step(z, dz, 0.99)
+        comp = (slacks + a_p * dsl) * (z + a_d * dz)
+        return (1.0 - a_d) ** 2 * dual_sq + (1.0 - a_p) ** 2 * primal_sq + float(
+            np.mean(comp ** 2))
+
+    a, b = np.log10(lo), np.log10(hi)
+    g = 0.5 * (np.sqrt(5.0) - 1.0)
+    c, d = b - g * (b - a), a + g * (b - a)
+    qc, qd = q(c), q(d)
+    for _ in range(20):
+        if qc <= qd:
+            b, d, qd = d, c, qc
+            c = b - g * (b - a)
+            qc = q(c)
+        else:
+            a, c, qc = c, d, qd
+            d = a + g * (b - a)
+            qd = q(d)
+    return 10.0 ** (0.5 * (a + b))
+
+
+def _forced(res):
+    """A trial step taken whatever the filter says (the watchdog's), or None out of the
+    bounds (or not finite)."""
+    if res is None or not np.isfinite(res[4]):
+        return None
+    return (True,) + tuple(res[1:])
 
 
 def _logs(a, b):
