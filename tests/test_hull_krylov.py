@@ -268,8 +268,8 @@ def test_each_mode_carries_its_optimality(dataset):
 
 def test_records_past_what_fits_are_refused_in_one_line(dataset):
     """An ideal take-off's record is refused past ``HULL_MAX_RECORD_HARMONICS`` (about 300
-    waves), a take-off's past the dense ``HULL_MAX_HARMONICS`` (about 10), before any solve;
-    a 20-wave ideal record is no longer refused."""
+    waves), a real take-off's past ``HULL_MAX_PTO_RECORD_HARMONICS`` (about 50), before any
+    solve; a 20-wave record is no longer refused, with a take-off or without."""
     from parapend import limits
     from parapend.errors import ParameterError
     from parapend.hydro.api import _check_hull_size, hull_problem
@@ -284,8 +284,11 @@ def test_records_past_what_fits_are_refused_in_one_line(dataset):
     k = waves_in(wave)
     _check_hull_size(wave, (k, 0), None)  # no refusal
     assert 12 * k > limits.HULL_MAX_HARMONICS
+    _check_hull_size(wave, (k, 0), None, HullPTO(torque_limit=1e4))  # nor with a limit
+    long = Wave.from_spectrum(hs=1.0, tp=6.0, repeat_period=6.0 * 60, seed=0)
+    assert 12 * waves_in(long) > limits.HULL_MAX_PTO_RECORD_HARMONICS
     with pytest.raises(ParameterError, match=r"^repeat-period: .*with a power take-off"):
-        _check_hull_size(wave, (k, 0), None, HullPTO(torque_limit=1e4))
+        _check_hull_size(long, (waves_in(long), 0), None, HullPTO(torque_limit=1e4))
     p = hull_problem(dofs="surge,heave,pitch", hydro=dataset, **PEND)
     assert p.get("max_harmonics") is None
 
