@@ -367,3 +367,34 @@ def test_a_take_offs_matrix_free_optimum_is_the_dense_ones(eta, share):
     assert out[1] == pytest.approx(out[0], rel=1e-8 if limit is None else LIMIT_TOL)
     if limit is not None:  # the limit binds: the power is below the ideal's
         assert out[0] < ideal.power * (1 - 1e-6)
+
+
+@pytest.mark.slow
+def test_barge_ten_wave_record_under_a_limit_matrix_free_is_the_dense_answer():
+    """The embedded barge's 10-wave record (144 harmonics, swinging) under a torque limit of
+    60 kN m (about two thirds of the ideal optimum's peak torque): the matrix-free driver
+    from the ideal optimum (the limit's inexact augmented Lagrangian on Newton with truncated
+    conjugate gradients) ends where the dense one (trust-exact), started there, stays: the
+    same exact power to 1e-8, both within the limit on the grid."""
+    from parapend.hydro._hull_krylov import pto_maximize
+    from parapend.hydro.api import hull_problem
+    from parapend.hydro.coupled import Wave
+    from parapend.hydro.hull import make_case
+    from parapend.hydro.pto import LIMIT_TOL, maximize
+
+    p = hull_problem(dofs="surge,heave,pitch")
+    wave = Wave.from_spectrum(hs=1.5, tp=6.0, repeat_period=60.0, seed=0)
+    cs = make_case(p["hull"], p["pendulum"], wave, winding=0, pivot=p["pivot"])
+    assert cs.harmonics == 144
+    ideal = hull_search(lambda s: cs, refine=False)
+    limit = 6e4
+    assert np.max(np.abs(HullProblem(cs).grid_state(ideal.x)["tau"])) > 1.5 * limit
+    k = KrylovHullProblem(cs)
+    xk, exk, runs = pto_maximize(k, ideal.x, (1.0,), limit)
+    assert runs[-1][2] == "converged"
+    xd, exd, runs = maximize(HullProblem(cs), xk, (1.0,), limit)
+    assert runs[-1][2] == "converged"
+    assert exk == pytest.approx(exd, rel=1e-8)
+    for x in (xk, xd):
+        assert np.max(np.abs(HullProblem(cs).grid_state(x)["tau"])) <= limit * (1 + LIMIT_TOL)
+    assert exk < ideal.power
