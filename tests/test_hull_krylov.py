@@ -268,7 +268,7 @@ def test_each_mode_carries_its_optimality(dataset):
 
 def test_records_past_what_fits_are_refused_in_one_line(dataset):
     """An ideal take-off's record is refused past ``HULL_MAX_RECORD_HARMONICS`` (about 300
-    waves), a real take-off's past ``HULL_MAX_PTO_RECORD_HARMONICS`` (about 50), before any
+    waves), a real take-off's past ``HULL_MAX_PTO_RECORD_HARMONICS`` (about 30), before any
     solve; a 20-wave record is no longer refused, with a take-off or without."""
     from parapend import limits
     from parapend.errors import ParameterError
