@@ -287,8 +287,8 @@ def test_each_mode_carries_its_optimality(dataset):
 
 def test_records_past_what_fits_are_refused_in_one_line(dataset):
     """An ideal take-off's record is refused past ``HULL_MAX_RECORD_HARMONICS`` (about 300
-    waves), a take-off's past the dense ``HULL_MAX_HARMONICS`` (about 10), before any solve;
-    a 20-wave ideal record is no longer refused."""
+    waves), a real take-off's past ``HULL_MAX_PTO_RECORD_HARMONICS`` (about 30), before any
+    solve; a 20-wave record is no longer refused, with a take-off or without."""
     from parapend import limits
     from parapend.errors import ParameterError
     from parapend.hydro.api import _check_hull_size, hull_problem
@@ -303,8 +303,11 @@ def test_records_past_what_fits_are_refused_in_one_line(dataset):
     k = waves_in(wave)
     _check_hull_size(wave, (k, 0), None)  # no refusal
     assert 12 * k > limits.HULL_MAX_HARMONICS
+    _check_hull_size(wave, (k, 0), None, HullPTO(torque_limit=1e4))  # nor with a limit
+    long = Wave.from_spectrum(hs=1.0, tp=6.0, repeat_period=6.0 * 60, seed=0)
+    assert 12 * waves_in(long) > limits.HULL_MAX_PTO_RECORD_HARMONICS
     with pytest.raises(ParameterError, match=r"^repeat-period: .*with a power take-off"):
-        _check_hull_size(wave, (k, 0), None, HullPTO(torque_limit=1e4))
+        _check_hull_size(long, (waves_in(long), 0), None, HullPTO(torque_limit=1e4))
     p = hull_problem(dofs="surge,heave,pitch", hydro=dataset, **PEND)
     assert p.get("max_harmonics") is None
 
@@ -328,3 +331,89 @@ def test_an_ideal_record_refines_past_the_dense_cap():
     assert r.discretization_error_estimate_w < 1e-6 * r.power_w
     with pytest.raises(ParameterError, match="^harmonics:"):
         parapend.buoy(**kw, harmonics=limits.HULL_MAX_RECORD_HARMONICS + 1)
+
+
+@pytest.mark.parametrize("kw", [{"eta": (0.9, 0.8)}, {"copper_loss": 1e-3},
+                                {"eta": (0.9, 0.8), "copper_loss": 1e-3}])
+def test_a_take_offs_objective_is_the_dense_ones(kw):
+    """An efficiency (its kink smoothed), a copper loss and a torque limit's penalty: the
+    matrix-free problem's value, gradient and Hessian are the dense problem's (the same
+    pointwise terms through the operator's products), and so is the unsmoothed power."""
+    cs = case(winding=1, harmonics=8)
+    x = _x(cs.harmonics, 1, 7)
+    d, k = HullProblem(cs, **kw), KrylovHullProblem(cs, **kw)
+    lim = 0.5 * float(np.max(np.abs(d.state(x)["tau"])))
+    for p in (d, k):
+        p.width = 0.01
+        p.set_limit(lim, 1e-6)
+    pd, gd, hd = d.evaluate(x)
+    pk, gk, op = k.evaluate(x)
+    assert pk == pytest.approx(pd, rel=1e-11)
+    assert np.max(np.abs(gk - gd)) <= 1e-10 * np.max(np.abs(gd))
+    hk = np.column_stack([op.matvec(e) for e in np.eye(x.size)])
+    assert np.max(np.abs(hk - hd)) <= 1e-6 * np.max(np.abs(hd))
+    assert k.exact(x) == pytest.approx(d.exact(x), rel=1e-11)
+
+
+@pytest.mark.parametrize("eta,share", [(None, 0.6), ((0.9, 0.85), None),
+                                       ((0.9, 0.85), 0.6)])
+def test_a_take_offs_matrix_free_optimum_is_the_dense_ones(eta, share):
+    """A torque limit (``share`` of the ideal optimum's peak torque), an efficiency (one
+    smoothing width), and both, on a record: the matrix-free driver (Newton with truncated
+    conjugate gradients, the limit's inexact augmented Lagrangian) and the dense one
+    (trust-exact, :func:`parapend.hydro.pto.maximize`), from the ideal optimum, end on the
+    same maximum: its exact power to 1e-8 (under the limit, which each holds to
+    ``LIMIT_TOL`` of it, to that: the power moves with the grid's torques at the limit's
+    order), the limit held on the grid to ``LIMIT_TOL``."""
+    from parapend.hydro._hull_krylov import pto_maximize
+    from parapend.hydro.pto import LIMIT_TOL, maximize
+
+    cs = _record(harmonics=24, winding=0)
+    ideal = hull_search(lambda s: cs, refine=False)
+    assert ideal.success
+    tau = np.max(np.abs(HullProblem(cs).grid_state(ideal.x)["tau"]))
+    limit = None if share is None else share * float(tau)
+    widths = (1.0,) if eta is None else (1e-2,)
+    out = []
+    for prob, climb in ((HullProblem(cs, eta=eta), maximize),
+                        (KrylovHullProblem(cs, eta=eta), pto_maximize)):
+        x, ex, runs = climb(prob, ideal.x, widths, limit)
+        assert runs[-1][2] == "converged", runs
+        if limit is not None:
+            over = np.max(np.abs(prob.grid_state(x)["tau"])) - limit
+            assert over <= LIMIT_TOL * limit
+        out.append(ex)
+    assert out[1] == pytest.approx(out[0], rel=1e-8 if limit is None else LIMIT_TOL)
+    if limit is not None:  # the limit binds: the power is below the ideal's
+        assert out[0] < ideal.power * (1 - 1e-6)
+
+
+@pytest.mark.slow
+def test_barge_ten_wave_record_under_a_limit_matrix_free_is_the_dense_answer():
+    """The embedded barge's 10-wave record (144 harmonics, swinging) under a torque limit of
+    60 kN m (about two thirds of the ideal optimum's peak torque): the matrix-free driver
+    from the ideal optimum (the limit's inexact augmented Lagrangian on Newton with truncated
+    conjugate gradients) ends where the dense one (trust-exact), started there, stays: the
+    same exact power to 1e-8, both within the limit on the grid."""
+    from parapend.hydro._hull_krylov import pto_maximize
+    from parapend.hydro.api import hull_problem
+    from parapend.hydro.coupled import Wave
+    from parapend.hydro.hull import make_case
+    from parapend.hydro.pto import LIMIT_TOL, maximize
+
+    p = hull_problem(dofs="surge,heave,pitch")
+    wave = Wave.from_spectrum(hs=1.5, tp=6.0, repeat_period=60.0, seed=0)
+    cs = make_case(p["hull"], p["pendulum"], wave, winding=0, pivot=p["pivot"])
+    assert cs.harmonics == 144
+    ideal = hull_search(lambda s: cs, refine=False)
+    limit = 6e4
+    assert np.max(np.abs(HullProblem(cs).grid_state(ideal.x)["tau"])) > 1.5 * limit
+    k = KrylovHullProblem(cs)
+    xk, exk, runs = pto_maximize(k, ideal.x, (1.0,), limit)
+    assert runs[-1][2] == "converged"
+    xd, exd, runs = maximize(HullProblem(cs), xk, (1.0,), limit)
+    assert runs[-1][2] == "converged"
+    assert exk == pytest.approx(exd, rel=1e-8)
+    for x in (xk, xd):
+        assert np.max(np.abs(HullProblem(cs).grid_state(x)["tau"])) <= limit * (1 + LIMIT_TOL)
+    assert exk < ideal.power

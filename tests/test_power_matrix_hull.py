@@ -196,7 +196,8 @@ def test_the_take_off_reaches_the_hull(dataset):
 
 @pytest.mark.parametrize("pto, waves, cap", [
     ({}, 400, "HULL_MAX_RECORD_HARMONICS"),  # an ideal take-off: matrix-free records
-    ({"efficiency": 0.9}, 50, "HULL_MAX_HARMONICS"),  # a lossy one: dense
+    ({"efficiency": 0.9}, 50, "HULL_MAX_HARMONICS"),  # an efficiency's
+    ({"torque_limit": 2e4}, 80, "HULL_MAX_PTO_RECORD_HARMONICS"),  # a limit's
 ])
 def test_the_longest_record_is_the_hulls_limit(dataset, pto, waves, cap):
     """Too long a record is refused naming --waves and the largest that fits; that largest

@@ -302,6 +302,14 @@ HULL_MAX_REFINED_HARMONICS = 256
 #: solved matrix-free (hydro/_hull_krylov.py; time and memory near-linear in N): 12 per wave to
 #: a 300-wave record (benchmarks/bench_hull_record.out.txt: 200 waves, 2400 harmonics)
 HULL_MAX_RECORD_HARMONICS = 3600
+#: HULL_MAX_HARMONICS for a torque limit or a copper loss (an efficiency keeps HULL_MAX_HARMONICS:
+#: its continuation's last widths cost minutes at 144 harmonics), whose
+#: records are solved matrix-free from 100 harmonics (hydro/_hull_krylov.py: the limit's
+#: augmented Lagrangian and the efficiency's smoothing on Newton with truncated conjugate
+#: gradients; benchmarks/bench_hull_record.out.txt, its take-off table: the barge's 25-peak-
+#: period record, 348 harmonics, under a torque limit in 371 s wall on the shared machine):
+#: 30 waves
+HULL_MAX_PTO_RECORD_HARMONICS = 360
 #: ``buoy --dofs surge,heave,pitch --realizations``: at most this many seeded records of one
 #: sea state (the power matrix's cap on realizations per bin)
 HULL_MAX_REALIZATIONS = 1000

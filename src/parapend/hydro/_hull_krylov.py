@@ -514,20 +514,27 @@ def coarsened(case: HullCase, harmonics: int) -> HullCase:
 LEVEL_GTOL = 1e-4
 
 
-def continued_search(make, *, refine: bool = True, level: bool = False):
+def continued_search(make, *, refine: bool = True, level: bool = False, pto=None):
     """:func:`.hull.hull_search` of a long record by continuation in the harmonics: the
     search over the starts on the record with ``COARSENING`` times fewer harmonics (itself
     continued while it has at least ``LONG_RECORD_HARMONICS``), then its best coupled and
     one-way maxima padded to these harmonics and climbed by Newton (matrix-free), then the
     refinement as for any answer. The evidence (starts, distinct maxima) is the coarsest
     search's; the iterations are all the levels'. A ``level`` (a finer search's start) and
-    an answer still to be refined are climbed to ``LEVEL_GTOL``, an answer to ``GTOL``."""
+    an answer still to be refined are climbed to ``LEVEL_GTOL``, an answer to ``GTOL``.
+
+    With an active take-off ``pto`` (:class:`.hull.HullPTO`) the coarsest search is the
+    take-off's (its ideal maxima and least-torque motions start the smoothing's
+    continuation under the limit), and each finer level continues the take-off's optimum
+    and its one-way twin from the coarser ones (:func:`_continued_pto`)."""
     case = make(1)
     coarse = coarsened(case, max(2, case.harmonics // COARSENING))
     if coarse.harmonics >= _hull.LONG_RECORD_HARMONICS:
-        sol = continued_search(lambda scale: coarse, refine=False, level=True)
+        sol = continued_search(lambda scale: coarse, refine=False, level=True, pto=pto)
     else:
-        sol = hull_search(lambda scale: coarse, refine=False)
+        sol = hull_search(lambda scale: coarse, refine=False, pto=pto)
+    if pto is not None and pto.active:
+        return _continued_pto(case, make, sol, pto, refine)
     n = case.harmonics
     gtol = LEVEL_GTOL if level or refine else GTOL
     one = newton_maximize(ideal_problem(case, coupled=False), _pad(sol.one_way_x, n),
@@ -550,6 +557,138 @@ def continued_search(make, *, refine: bool = True, level: bool = False):
     if refine and ok:
         out = _refine(out, make, r.x)
     return out
+
+
+def _continued_pto(case: HullCase, make, sol: HullSolution, pto, refine: bool):
+    """One finer level of a take-off's long record: the coarser optimum ``sol`` (and its
+    one-way twin) padded to ``case``'s harmonics and continued by the take-off's maximizer
+    (:func:`.hull._pto_maximize`, the refinement's widths; the limit's multipliers from zero:
+    the coarser grid's, interpolated, sit beside the finer grid's touching points, and on the
+    25-wave barge record at 60 kN m they sent the climb astray where a cold start took 21
+    s). The levels are the refinement: each level's power joins the
+    refinement's history, and the answer's stated change is its level's against the coarser
+    one (no doubling past the record's harmonics: under a limit the augmented Lagrangian's
+    climbs on twice them cost more than all the levels before). The answer's limit is then
+    held between the grid's points (:func:`.hull._hold_limit`)."""
+    n = case.harmonics
+    if not math.isfinite(sol.power):
+        return dataclasses.replace(sol, case=case, x=_pad(sol.x, n),
+                                   one_way_x=_pad(sol.one_way_x, n), success=False)
+    pr = pto.problem(case)
+    x, ex, status, its = _hull._pto_maximize(pr, _pad(sol.x, n), pto, False)
+    x1, ex1, _, its1 = _hull._pto_maximize(pto.problem(case, coupled=False),
+                                           _pad(sol.one_way_x, n), pto, False)
+    if not math.isfinite(ex):
+        return dataclasses.replace(sol, case=case, x=_pad(sol.x, n), power=math.nan,
+                                   one_way_x=_pad(sol.one_way_x, n), success=False,
+                                   status=f"continued to {n} harmonics: {status}")
+    how = "" if sol.success else f"; the coarser search: {sol.status}"
+    history = (sol.refinement_history or ((sol.case.harmonics, float(sol.power)),)) + (
+        (n, float(ex)),)
+    change = abs(float(ex) - float(sol.power))
+    ok = status == "converged"
+    if refine and change > _hull.UNRESOLVED * max(abs(ex), 1e-300):
+        status = (f"{status}; the last level, {sol.case.harmonics} to {n} harmonics, changed "
+                  f"the power by {change:.3g} W")
+    if refine and pto.torque_limit is not None:
+        x, ex, held = _hull._hold_limit(case, x, float(ex), pto)
+        if held:
+            status += f"; {held}"
+    mech = ideal_problem(case)
+    return dataclasses.replace(
+        sol, case=case, x=x, power=float(ex), status=status, success=ok,
+        one_way_power=float(ex1) if math.isfinite(ex1) else math.nan,
+        one_way_x=x1 if math.isfinite(ex1) else _pad(sol.one_way_x, n),
+        found_by=f"{sol.found_by} (continued from {sol.case.harmonics} harmonics{how})",
+        runs=sol.runs + 2, iterations=sol.iterations + its + its1,
+        energy_balance_residual=float(mech.balance(x)[2]),
+        mechanical_power=float(mech.mechanical(x)), refinement_history=history,
+        refinement_change=change if refine else None)
+
+
+#: the torque limit's augmented Lagrangian, matrix-free (:func:`limited`): the first inner
+#: climb stops at this gradient (relative to m g l w, as :data:`.hull.GTOL`), each next one
+#: at a tenth of the one before, down to the width's tolerance (an inexact augmented
+#: Lagrangian: the early multipliers are rough, and a climb to GTOL under them is wasted)
+AL_GTOL = 1e-4
+#: ... at most this many outer steps, and Newton iterations per inner climb
+AL_MAX_OUTER, AL_MAX_NEWTON = 40, 200
+
+
+def limited(problem: KrylovHullProblem, x, limit: float, gtol: float, warm: bool = False):
+    """Maximize ``problem``'s objective under ``|tau| <= limit`` on its grid by the
+    augmented Lagrangian of :func:`parapend.hydro.pto.torque_limited` (PHR: the same
+    penalty, multiplier update and penalty growth), each inner climb by Newton with
+    truncated conjugate gradients (:func:`parapend.optimal.fourier.newton_maximize`: the
+    matrix-free Hessian's products, preconditioned by its diagonal), inexact: the k-th
+    climb to ``max(gtol, AL_GTOL / 10^k)``. ``warm``: keep the multipliers and penalty the
+    problem holds for this limit. Returns ``(x, violation, status, iterations)``;
+    "converged" when the violation is at most ``LIMIT_TOL`` of the limit after a climb
+    that converged to ``gtol``."""
+    from .pto import LIMIT_TOL
+
+    x = np.array(x, dtype=float)
+    scale = float(problem.w[0])
+    if not (warm and problem.limit == limit):
+        problem.limit = None
+        st = problem.state(x)
+        p0 = max(abs(float(np.mean(problem._e(st["p"])[0]))), 1e-3 * scale)
+        problem.set_limit(limit, 10.0 * p0 / limit**2)
+    inner, prev, status, viol = 0, math.inf, "max_iterations", math.inf
+    tol = max(gtol, AL_GTOL)
+    for _ in range(AL_MAX_OUTER):
+        r = newton_maximize(problem, x, "limit", gtol=tol, maxiter=AL_MAX_NEWTON,
+                            saddle=False)
+        if not (math.isfinite(r.power) and np.all(np.isfinite(r.x))):
+            status = "stalled"
+            break
+        x = r.x
+        inner += r.iterations
+        viol = problem.update_multipliers(x)
+        if viol <= LIMIT_TOL * limit and tol <= gtol:
+            status = "converged" if r.status == "converged" else r.status
+            break
+        if viol > 0.25 * prev:
+            problem.rho *= 10.0
+        prev = viol
+        tol = max(gtol, 0.1 * tol)
+    return x, viol, status, inner
+
+
+def pto_maximize(problem: KrylovHullProblem, x0, widths=None, limit=None,
+                 max_inner: int | None = None):
+    """:func:`parapend.hydro.pto.maximize` matrix-free: the continuation in the
+    efficiency's smoothing width ``s -> 0`` (``widths`` relative to the largest ``|p|`` at
+    ``x0``), each width climbed by Newton with truncated conjugate gradients, under the
+    torque limit by :func:`limited` (the multipliers carried from width to width). The
+    widths before the last two are only the path: climbed to ``LEVEL_GTOL``, the last two
+    (whose exact powers :func:`.hull._pto_maximize` compares) to ``GTOL``. Returns
+    ``(x, exact, runs)`` as that function: the iterate with the largest exact
+    (unsmoothed) objective among those within the limit, and per width ``(s, exact,
+    status, iterations)``. ``max_inner``: unused (the inexact climbs bound themselves)."""
+    from .pto import LIMIT_TOL, WIDTHS
+
+    widths = WIDTHS if widths is None else widths
+    x = np.array(x0, dtype=float)
+    p0 = float(np.max(np.abs(problem.state(x)["p"])))
+    best_x, best = x.copy(), (problem.exact(x) if limit is None else -math.inf)
+    runs = []
+    for i, rel in enumerate(widths):
+        problem.width = rel * p0
+        gtol = GTOL if i >= len(widths) - 2 else LEVEL_GTOL
+        if limit is None:
+            r = newton_maximize(problem, x, "width", gtol=gtol, maxiter=AL_MAX_NEWTON,
+                                saddle=False)
+            x, viol, status, nit = r.x, 0.0, r.status, r.iterations
+        else:
+            x, viol, status, nit = limited(problem, x, limit, gtol, warm=True)
+        ex = problem.exact(x)
+        runs.append((rel * p0, ex, status, nit))
+        if math.isfinite(ex) and ex >= best and (limit is None or
+                                                 viol <= LIMIT_TOL * limit):
+            best, best_x = ex, np.array(x)
+    problem.limit = None
+    return best_x, best, runs
 
 
 #: Lanczos (ARPACK) for the largest eigenvalue of the reduced Hessian scaled by its diagonal
@@ -608,4 +747,5 @@ def largest_eigenvalue(op) -> float | None:
     return float(lam[0])
 
 
-_hull.MATRIX_FREE.update(problem=KrylovHullProblem, search=continued_search)
+_hull.MATRIX_FREE.update(problem=KrylovHullProblem, search=continued_search,
+                         maximize=pto_maximize)

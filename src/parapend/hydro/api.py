@@ -1087,18 +1087,24 @@ def _check_wave_kind(opts):
 
 
 def hull_harmonics_cap(pto) -> int:
-    """The most harmonics of the hull's motion: an ideal take-off's problem is matrix-free
-    from ``hull.KRYLOV_HARMONICS`` on (``limits.HULL_MAX_RECORD_HARMONICS``), a lossy one's
-    dense (``limits.HULL_MAX_HARMONICS``)."""
-    ideal = pto is None or not pto.active
-    return limits.HULL_MAX_RECORD_HARMONICS if ideal else limits.HULL_MAX_HARMONICS
+    """The most harmonics of the hull's motion: every take-off's problem is matrix-free
+    from ``hull.KRYLOV_HARMONICS`` on; an ideal one's up to
+    ``limits.HULL_MAX_RECORD_HARMONICS``, a torque limit's or a copper loss's (the limit's
+    augmented Lagrangian: several climbs per record) up to
+    ``limits.HULL_MAX_PTO_RECORD_HARMONICS``, an efficiency's (its smoothing's continuation,
+    whose last widths cost the most: the barge's 10-peak-period record did not finish in 25
+    minutes) up to ``limits.HULL_MAX_HARMONICS``, as before."""
+    if pto is None or not pto.active:
+        return limits.HULL_MAX_RECORD_HARMONICS
+    return limits.HULL_MAX_HARMONICS if pto.smoothed else limits.HULL_MAX_PTO_RECORD_HARMONICS
 
 
 def _check_hull_size(wave, windings, harmonics, pto=None, cap=None):
-    """Refuse a record whose motion needs more harmonics than finish in about a minute (with
-    a power take-off: dense Newton, ``limits.HULL_MAX_HARMONICS``), or than an ideal
-    take-off's matrix-free solver takes in time and memory
-    (``limits.HULL_MAX_RECORD_HARMONICS``); ``cap``: another limit (the power matrix's)."""
+    """Refuse a record whose motion needs more harmonics than the matrix-free solver takes
+    in time and memory (:func:`hull_harmonics_cap`: ``limits.HULL_MAX_RECORD_HARMONICS``
+    for an ideal take-off, ``limits.HULL_MAX_PTO_RECORD_HARMONICS`` or
+    ``limits.HULL_MAX_HARMONICS`` for a real one);
+    ``cap``: another limit (the power matrix's)."""
     from .hull import HARMONICS_PER_TURN
 
     n = harmonics or HARMONICS_PER_TURN * max(max(windings), waves_in(wave))
@@ -1106,9 +1112,10 @@ def _check_hull_size(wave, windings, harmonics, pto=None, cap=None):
     if cap is None:
         cap = hull_harmonics_cap(pto)
     if n > cap:
-        why = ("that the matrix-free solver takes (time and memory)" if
-               cap == limits.HULL_MAX_RECORD_HARMONICS else "that finish in about a minute" +
-               ("" if ideal else " with a power take-off"))
+        why = ("that the matrix-free solver takes (time and memory)" if cap in (
+               limits.HULL_MAX_RECORD_HARMONICS, limits.HULL_MAX_PTO_RECORD_HARMONICS)
+               else "that finish in bounded time") + ("" if ideal else
+                                                      " with a power take-off")
         raise ParameterError(f"repeat-period: the record holds about {waves_in(wave)} waves "
                              f"and needs {n} harmonics ({HARMONICS_PER_TURN} per wave or "
                              f"turn), more than the {cap} {why}; use a record of at most "

@@ -542,6 +542,19 @@ def ideal_problem(case: HullCase, coupled: bool = True) -> HullProblem:
     return HullProblem(case, coupled=coupled)
 
 
+def _lossy_problem(case: HullCase, coupled: bool = True, eta=None,
+                  copper_loss: float = 0.0) -> HullProblem:
+    """A take-off's problem of ``case`` (an efficiency ``eta``, a ``copper_loss``; the
+    torque limit is set on it by the drivers): :class:`HullProblem`, or from
+    ``KRYLOV_HARMONICS`` harmonics its matrix-free twin, as :func:`ideal_problem` (the
+    same objective, gradient and Hessian; its drivers line-search Newton with truncated
+    conjugate gradients, :func:`parapend.hydro._hull_krylov.pto_maximize`)."""
+    if case.harmonics >= KRYLOV_HARMONICS and MATRIX_FREE:
+        return MATRIX_FREE["problem"](case, coupled=coupled, eta=eta,
+                                      copper_loss=copper_loss)
+    return HullProblem(case, coupled=coupled, eta=eta, copper_loss=copper_loss)
+
+
 def make_case(hull, pendulum, wave, *, winding, harmonics=None, hull_harmonics=None,
               pivot=(0.0, 0.0), pitch_inertia=None) -> HullCase:
     """The discretized problem: the hull's coefficients at ``k w`` (k = 0..Nh), its mass
@@ -618,8 +631,8 @@ class HullPTO:
         return self.efficiency is not None and self.efficiency[0] * self.efficiency[1] != 1
 
     def problem(self, case: HullCase, coupled: bool = True) -> HullProblem:
-        return HullProblem(case, coupled=coupled, eta=self.efficiency if self.smoothed
-                           else None, copper_loss=self.copper_loss)
+        return _lossy_problem(case, coupled=coupled, eta=self.efficiency if self.smoothed
+                             else None, copper_loss=self.copper_loss)
 
 
 @dataclass(frozen=True, eq=False)
@@ -698,9 +711,8 @@ def hull_search(make, *, refine: bool = True, pto: HullPTO | None = None) -> Hul
     harmonics (1, and 2 for the refinement). With an active ``pto`` the ideal search's
     distinct maxima start the PTO's optimum (``_pto_stage``)."""
     case = make(1)
-    if case.harmonics >= LONG_RECORD_HARMONICS and not (
-            pto is not None and pto.active) and MATRIX_FREE:
-        return MATRIX_FREE["search"](make, refine=refine)
+    if case.harmonics >= LONG_RECORD_HARMONICS and MATRIX_FREE:
+        return MATRIX_FREE["search"](make, refine=refine, pto=pto)
     n, kw = case.harmonics, case.winding
     one = ideal_problem(case, coupled=False)
     starts = _starts(n, kw)
@@ -807,7 +819,7 @@ def _refine(sol: HullSolution, make, x) -> HullSolution:
         x, power, held = _hold_limit(case, x, power, pto)
         if held:
             status += f"; {held}"
-    pr = HullProblem(case) if pto.active else ideal_problem(case)
+    pr = ideal_problem(case)  # the mechanics (a take-off's objective aside)
     _, _, resid = pr.balance(x)
     if pto.active:
         mech = float(pr.mechanical(x))
@@ -830,7 +842,7 @@ def _hold_limit(case: HullCase, x, power: float, pto: HullPTO):
     from .optimum import TORQUE_SLACK
 
     limit = pto.torque_limit
-    fine = HullProblem(dataclasses.replace(case, points=8 * case.points))
+    fine = ideal_problem(dataclasses.replace(case, points=8 * case.points))
     over = float(np.max(np.abs(fine.grid_state(x)["tau"]))) / limit - 1
     if over <= 0.5 * TORQUE_SLACK:
         return x, power, ""
@@ -865,10 +877,9 @@ def _free_motion(case: HullCase, winding: int, coupled: bool = True):
     one exists. It satisfies any torque limit it meets and costs no copper loss, so it
     starts the PTO's optimum where the ideal maxima, with their large torques, are far from
     what the limit or the loss allows."""
-    from .pto import maximize
-
-    pr = HullProblem(case, coupled=coupled, copper_loss=1.0)
+    pr = _lossy_problem(case, coupled=coupled, copper_loss=1.0)
     pr.a = 0.0  # the objective is -<tau^2> alone
+    maximize = _maximizer(pr)
     out = []
     for name, x0 in _starts(case.harmonics, winding)[:: 6 if winding == 0 else 2]:
         if winding == 0:
@@ -892,15 +903,27 @@ PTO_MAX_INNER = 400
 PTO_MAX_INNER_REFINE = 1000
 
 
+def _maximizer(pr: HullProblem):
+    """The take-off's continuation driver for ``pr``: :func:`parapend.hydro.pto.maximize`
+    (trust-exact) for a dense problem, the matrix-free one's
+    (:func:`parapend.hydro._hull_krylov.pto_maximize`, the same signature) for an
+    operator."""
+    if pr.hessian == "operator" and "maximize" in MATRIX_FREE:
+        return MATRIX_FREE["maximize"]
+    from .pto import maximize
+
+    return maximize
+
+
 def _pto_maximize(pr: HullProblem, x, pto: HullPTO, first: bool):
     """The PTO's optimum from ``x``: the smoothing continuation (an efficiency) under the
     torque limit (:func:`parapend.hydro.pto.maximize`). Returns ``(x, exact, status,
     iterations)``."""
-    from .pto import WIDTHS, WIDTHS_REFINE, maximize
+    from .pto import WIDTHS, WIDTHS_REFINE
 
     widths = (WIDTHS if first else WIDTHS_REFINE) if pto.smoothed else (1.0,)
-    x, ex, log = maximize(pr, np.asarray(x, dtype=float), widths, pto.torque_limit,
-                          max_inner=PTO_MAX_INNER if first else PTO_MAX_INNER_REFINE)
+    x, ex, log = _maximizer(pr)(pr, np.asarray(x, dtype=float), widths, pto.torque_limit,
+                                max_inner=PTO_MAX_INNER if first else PTO_MAX_INNER_REFINE)
     its = sum(r[3] for r in log)
     last = [r[1] for r in log if math.isfinite(r[1])]
     if not math.isfinite(ex):
@@ -965,7 +988,7 @@ def _pto_stage(case, make, pto: HullPTO, runs, best_one, refine: bool) -> HullSo
                        maxima_powers=tuple(sorted({round(e, 9) for e, st in tried
                                                    if st == "converged"}, reverse=True)),
                        runs=len(tried) + 1, iterations=its,
-                       energy_balance_residual=float(HullProblem(case).balance(x)[2]),
+                       energy_balance_residual=float(ideal_problem(case).balance(x)[2]),
                        mechanical_power=float(pr.mechanical(x)), pto=pto)
     if refine:  # a stalled continuation may settle with more harmonics: the status says
         sol = _refine(sol, make, x)

@@ -953,12 +953,12 @@ REPORT_HULL_FACTOR = 2
 def _mode(sol, resolve=None) -> dict:
     """One mode's entry; ``resolve(case)``: the same case with ``REPORT_HULL_FACTOR`` times
     the hull harmonics, for the reported motion (None: the solve's own cut)."""
-    pr = HullProblem(sol.case) if sol.pto.active else ideal_problem(sol.case)
+    pr = ideal_problem(sol.case)  # the mechanics (a take-off's objective aside)
     if resolve is None or not math.isfinite(sol.power):
         mot = MotionAt(pr, sol.x, pr.solve_hull(sol.x))
     else:
         fine = resolve(sol.case)
-        pf = HullProblem(fine) if sol.pto.active else ideal_problem(fine)
+        pf = ideal_problem(fine)
         mot = MotionAt(pf, sol.x, pf.solve_hull(sol.x))
     period = 2 * math.pi / sol.case.omega
     pk = peak(lambda t: np.abs(mot(t)["tau"]), period,

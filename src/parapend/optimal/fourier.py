@@ -299,7 +299,7 @@ BANDED_NEGATIVE = 0.05
 CG_MAXITER = 400
 
 
-def _cg_ascent_step(g: np.ndarray, op: HessianOperator, scale: float):
+def _cg_ascent_step(g: np.ndarray, op: HessianOperator, scale: float, saddle: bool = True):
     """Newton-CG step for ``-H d = g``, preconditioned (:data:`PRECONDITIONER`).
 
     Truncated CG (Steihaug's rule without a radius; the caller caps the step and
@@ -310,7 +310,8 @@ def _cg_ascent_step(g: np.ndarray, op: HessianOperator, scale: float):
     ``newton`` is True when CG converged with positive curvature throughout (``-H``
     positive definite on the Krylov space).
     At a saddle (no Newton step and a negligible gradient), the step follows the most
-    positive curvature of P, found by Lanczos (:func:`scipy.sparse.linalg.eigsh`).
+    positive curvature of P, found by Lanczos (:func:`scipy.sparse.linalg.eigsh`), unless
+    ``saddle`` is False.
     """
     pre = np.abs(op.diagonal)
     pre = np.maximum(pre, 1e-3 * float(np.max(pre)) + 1e-300)
@@ -318,14 +319,18 @@ def _cg_ascent_step(g: np.ndarray, op: HessianOperator, scale: float):
     d, newton = _cg_solve(g, op, pre, gn, scale)
     # a saddle: no Newton step and a negligible gradient (Lanczos only then: it costs
     # hundreds of products, and near a maximum CG needs a few tens)
-    if not newton and float(np.max(np.abs(g))) <= 1e-8 * max(float(np.max(pre)), 1e-12):
-        from scipy.sparse.linalg import LinearOperator, eigsh
+    if saddle and not newton and float(np.max(np.abs(g))) <= 1e-8 * max(float(np.max(pre)),
+                                                                         1e-12):
+        from scipy.sparse.linalg import ArpackNoConvergence, LinearOperator, eigsh
 
         size = g.size
         a = LinearOperator((size, size), matvec=lambda z: -op.matvec(np.ravel(z)),
                            dtype=float)
-        lam, vec = eigsh(a, k=1, which="SA", tol=1e-6, maxiter=20 * size,
-                         v0=np.ones(size))
+        try:
+            lam, vec = eigsh(a, k=1, which="SA", tol=1e-6, maxiter=20 * size,
+                             v0=np.ones(size))
+        except ArpackNoConvergence:  # no direction found (a take-off's kink, its clusters
+            return d, newton  # of eigenvalues): the conjugate gradients' step
         if lam[0] < 0:
             e = vec[:, 0]
             return e * (1.0 if g @ e >= 0 else -1.0) * 0.5, False
@@ -436,7 +441,7 @@ def _is_maximum(h: np.ndarray) -> bool:
 
 def newton_maximize(problem: FourierProblem, x0: np.ndarray, seed: str, *,
                     gtol: float = 1e-11, maxiter: int = 200, max_step: float = 1.0,
-                    abandon_below: float = -math.inf) -> LocalSolution:
+                    abandon_below: float = -math.inf, saddle: bool = True) -> LocalSolution:
     """Safeguarded Newton ascent with backtracking; never lowers ``P``.
 
     Stops when the gradient's max-norm is below ``gtol`` times the excitation scale, when
@@ -449,6 +454,11 @@ def newton_maximize(problem: FourierProblem, x0: np.ndarray, seed: str, *,
     found so far) by more than 1e-10 of the excitation scale, the run stops: it leads to a
     lower maximum or to the same one again. Near a maximum Newton converges quadratically,
     so the model's prediction is accurate to its own square there.
+
+    ``saddle``: with an operator Hessian, leave a saddle along its most positive curvature
+    (Lanczos: hundreds of products); False where the objective's curvature is a smoothed
+    kink's (a take-off's efficiency), whose huge diagonal makes every small gradient look
+    like a saddle's, and the conjugate gradients' step serves.
     """
     x = np.array(x0, dtype=float)
     scale = max(float(np.max(np.abs(problem.w))), 1e-300)
@@ -466,7 +476,8 @@ def newton_maximize(problem: FourierProblem, x0: np.ndarray, seed: str, *,
             status = "converged"
             it -= 1
             break
-        d, newton = _cg_ascent_step(g, h, scale) if operator else _ascent_step(g, h)
+        d, newton = (_cg_ascent_step(g, h, scale, saddle) if operator
+                     else _ascent_step(g, h))
         norm = float(np.max(np.abs(d)))
         if abandon_below > -math.inf and it > 1 and norm <= max_step and newton:
             gain = 0.5 * float(g @ d)

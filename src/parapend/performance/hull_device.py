@@ -59,7 +59,8 @@ def problem(spec) -> dict:
         from ..hydro.api import hull_problem
 
         # its records within the limits of `buoy` alone (an ideal take-off's records solved
-        # matrix-free up to limits.HULL_MAX_RECORD_HARMONICS, a lossy one's dense)
+        # matrix-free up to limits.HULL_MAX_RECORD_HARMONICS, a lossy one's up to
+        # limits.HULL_MAX_PTO_RECORD_HARMONICS)
         _PROBLEMS[key] = hull_problem(**hull_opts(spec))
     return _PROBLEMS[key]
 
@@ -128,7 +129,7 @@ def largest_waves(spec) -> float | None:
 def check_records(spec) -> None:
     """Every period bin's record checked as the hull's code checks it (its size: the harmonics
     it needs, at most ``limits.HULL_MAX_RECORD_HARMONICS`` with an ideal take-off, else
-    ``limits.HULL_MAX_HARMONICS``; its band inside the hull's data), before
+    ``limits.HULL_MAX_PTO_RECORD_HARMONICS``; its band inside the hull's data), before
     any bin runs; refused in one line naming ``--waves`` (and the largest that fits) or the
     period bin. The records of one period bin differ in Hm0 and seed only: the same band
     and, with the amplitudes' shape unchanged, the same size."""
@@ -171,7 +172,8 @@ def failure_code(reason: str | None) -> int:
 
 #: a record without a resolved answer is solved once more with this many times the default
 #: harmonics (other starts on another discretization), within the hull's cap
-#: (``limits.HULL_MAX_RECORD_HARMONICS`` for an ideal take-off, else ``HULL_MAX_HARMONICS``)
+#: (``limits.HULL_MAX_RECORD_HARMONICS`` for an ideal take-off, else
+#: ``HULL_MAX_PTO_RECORD_HARMONICS``)
 RETRY_HARMONICS = 1.5
 
 
