@@ -139,8 +139,7 @@ def _run(monkeypatch, cut=None, peek=False, forecast="perfect"):
             far = np.pad(far, ((0, fseg.shape[0] - far.shape[0]), (0, 0)))
             return plan(prob, plant, fseg + 1e-3 * far, u0, max_iter)
         monkeypatch.setattr(hc, "_plan", peeking)
-    # L-BFGS-B unless OPTS names the planner (tests/test_hull_collocation.py: collocation's)
-    return hc.hull_mpc(HULL, PEND, WAVE, **{"planner": "lbfgsb", **OPTS}, forecast=forecast)
+    return hc.hull_mpc(HULL, PEND, WAVE, **OPTS, forecast=forecast)
 
 
 @pytest.mark.parametrize("peek, causal", [(False, True), (True, False)])
@@ -200,7 +199,7 @@ def test_the_command_runs_the_hull_beside_its_record_optimum(tmp_path, capsys):
     assert r["optimum_power_w"] == opt["power_w"]
     assert r["optimum_winding"] == opt["winding"]
     start = hc.start_mode(opt["winding"], opt["mean_angle_deg"], opt["swing_amplitude_deg"])
-    assert r["planner"] == f"hull-collocation-{start}"  # the default planner
+    assert r["planner"] == f"hull-{start}"
     if r["status"] == "ok":
         assert math.isclose(r["optimum_fraction"], r["electrical_power_w"] / opt["power_w"])
     assert r["energy_balance_residual"] < 1e-3

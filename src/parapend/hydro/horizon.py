@@ -40,11 +40,10 @@ __all__ = ["BUOY_HORIZON", "BuoyHorizonResult", "buoy_horizon_curve", "plot_buoy
 #: over-estimates the default curve with the planner's radiation model (one solve an update,
 #: work 5.0e4, 16.5 s of CPU) about 2.5 times
 #: the hull's (``hull``): its default run (64 updates x 48 samples, 21 s at a load of 3);
-#: with the collocation planner (``hull-collocation``, the hull's default) 16 to 29 s (the
-#: compiled solver, seeds 0 to 9, load near 5: benchmarks/hull_collocation_table.out.txt;
-#: IPOPT's took 74 s)
+#: with the collocation planner (``hull-collocation``) 74 s (IPOPT, seed 0, load 2 to 3:
+#: benchmarks/hull_collocation_solver.out.txt)
 BUOY_MPC_SECONDS = {"coupled": 140.0 / 1.0e5, "plan": 87.0 / 1.06e5, "hull": 21.0 / 3.1e3,
-                    "hull-collocation": 30.0 / 3.1e3}
+                    "hull-collocation": 74.0 / 3.1e3}
 
 
 @dataclass(frozen=True, eq=False, repr=False)
@@ -297,9 +296,7 @@ def buoy_horizon_curve(*, hs=None, tp=None, spectrum="jonswap", gamma_peak=3.3,
     tr = float(waves[0][1]["repeat_period"])
     # the planner that will run: buoy_mpc's default when none is given
     if hull:
-        from .hull_control import DEFAULT_PLANNER
-
-        runs = "hull" if (planner or DEFAULT_PLANNER) == "lbfgsb" else "hull-collocation"
+        runs = "hull" if planner in (None, "lbfgsb") else f"hull-{planner}"
     else:
         runs = planner or ("coupled" if efficiency is not None else "plan")
     iterations = 1 if runs in ("plan", "hull", "hull-collocation") else 2
@@ -394,7 +391,7 @@ def buoy_horizon_curve(*, hs=None, tp=None, spectrum="jonswap", gamma_peak=3.3,
                     status[i][j][r] = "time_limit"
                     continue
                 run, more = ((hull_mpc, {"pivot": problem["pivot"], "mode": modes[r],
-                                         "planner": planner})
+                                         "planner": planner or "lbfgsb"})
                              if hull else (buoy_mpc, kw))
                 res = run(h, pend, wave, peak_period=tp, horizon=hor,
                           update_interval=upd, warmup=warm_up, repeats=1,

@@ -23,15 +23,11 @@ the hull's past motion (the radiation over the horizon included exactly, not fro
 the forecast excitation of all three degrees of freedom: the record itself (``perfect``) or
 an AR forecast of each fitted on the force measured so far (``ar``,
 :class:`parapend.control.forecast.ARForecast`, as the buoy's; its window reaches before the
-run's start, into the sea that set the hull's free motion). By
-default (``planner="collocation"``, :data:`DEFAULT_PLANNER`) the horizon problem is posed
-with the motion as the unknown and solved by an interior point on its exact Hessian
-(``_hull_collocation``; a bound on the generator's speed in place of the penalty below);
-with ``planner="lbfgsb"`` the held torques are the unknowns, the gradient exact (the
-plant's scheme run backwards, :func:`._hull_plant.adjoint`) and the solver L-BFGS-B with
-the torque bounds (the buoy's ``coupled`` planner, :class:`.control.CoupledHorizon`). Either
-is warm-started from the previous plan shifted. The first update interval of the plan is
-applied to the plant, and the controller moves on.
+run's start, into the sea that set the hull's free motion). The
+gradient is exact (the plant's scheme run backwards, :func:`._hull_plant.adjoint`);
+the solver is L-BFGS-B with the torque bounds (the buoy's ``coupled`` planner,
+:class:`.control.CoupledHorizon`), warm-started from the previous plan shifted. The first
+update interval of the plan is applied to the plant, and the controller moves on.
 
 The mode (:func:`start_mode`, from the record optimum's motion): where the optimum rotates
 or swings through the upright the run starts with the buoy's swing-up pump and hands over
@@ -74,14 +70,6 @@ COMPILED_ITER = 40
 #: realized 94.5 % (perfect forecast) and 87.7 % (AR) of the record optimum on the default
 #: barge's seeds 0 to 9, with 1 73.2 % and 89.4 % (benchmarks/hull_collocation_table.out.txt)
 COLLOCATION_TERMINAL_WEIGHT = 0.5
-#: the hull's planner by default: the collocation planner (the motion as the unknown, the
-#: compiled interior point). On the default barge's seeds 0 to 9 it realized 92.2 %
-#: (perfect forecast, every seed 82 % or more) and 87.8 % (AR, 75.8 % or more) of the
-#: record optimum, no solve failed, update median 0.18 to 0.39 s and p99 0.63 to 1.12 s
-#: at a load near 5, a run of 8 peak periods 16 to 29 s
-#: (benchmarks/hull_collocation_table.out.txt); L-BFGS-B on the held torques 43.8 %
-#: (perfect) and lost energy with the AR forecast on 5 of 10 seeds (docs/hull.md)
-DEFAULT_PLANNER = "collocation"
 #: the planned generator speed is penalized beyond this turn (rad) per plant step, with this
 #: weight (units m g l rad per (rad/s)^2)
 RESOLVED_TURN = 0.2
@@ -322,7 +310,7 @@ def hull_mpc(hull, pendulum, wave, *, peak_period, pivot=(0.0, 0.0), pitch_inert
              horizon=2.0, update_interval=0.125, samples=SAMPLES, plant_steps=PLANT_STEPS,
              warmup=4.0, repeats=1, torque_limit=None, efficiency=None, forecast="perfect",
              mode="swing", max_iter=None, memory=None, terminal_weight=None,
-             terminal="total", planner=None, time_limit=None,
+             terminal="total", planner="lbfgsb", time_limit=None,
              deadline=None) -> bc.BuoyMPCResult:
     """Receding-horizon control of the pendulum in a surging, heaving, pitching hull in a
     periodic record (module docstring).
@@ -364,12 +352,11 @@ def hull_mpc(hull, pendulum, wave, *, peak_period, pivot=(0.0, 0.0), pitch_inert
         default), or the pendulum's (``E`` less the hull's own ``1/2 xi'^T M_t xi' + 1/2
         xi^T C' xi``; on the default barge, seeds 0 and 1, it harvested 40 and 110 W where
         ``total`` harvested 368 and 262 W).
-    planner : "collocation", "lbfgsb" or None
-        The horizon solve (None: ``DEFAULT_PLANNER``, collocation): the motion as the
-        unknown, direct collocation solved by an interior point on the exact Hessian
-        (``_hull_collocation``: compiled, or CasADi's IPOPT with
-        ``_hull_collocation.SOLVER = "ipopt"``; ``plant_steps`` even), or L-BFGS-B on the
-        held torques shot through the plant's model (module docstring).
+    planner : "lbfgsb" or "collocation"
+        The horizon solve: L-BFGS-B on the held torques shot through the plant's model
+        (module docstring), or the motion as the unknown, direct collocation solved by an
+        interior point on the exact Hessian (``_hull_collocation``: compiled, or CasADi's
+        IPOPT with ``_hull_collocation.SOLVER = "ipopt"``; ``plant_steps`` even).
     time_limit, deadline : as :func:`.control.buoy_mpc`.
 
     Returns
@@ -392,8 +379,6 @@ def hull_mpc(hull, pendulum, wave, *, peak_period, pivot=(0.0, 0.0), pitch_inert
     warmup = check_range("warmup", warmup, 0.0, 1e3, why="peak periods")
     repeats = check_int("repeats", repeats, 1, 100)
     ps = check_int("plant_steps", plant_steps, 1, 1024)
-    if planner is None:
-        planner = DEFAULT_PLANNER
     if planner not in ("lbfgsb", "collocation"):
         raise ParameterError(f"planner: expected lbfgsb or collocation, got {planner!r:.40}")
     if max_iter is None and planner == "collocation":
@@ -552,7 +537,7 @@ def hull_mpc_command(problem, wave, info, sol, *, horizon, update_interval, fore
                  horizon=horizon, update_interval=update_interval, forecast=forecast,
                  torque_limit=pto.torque_limit, efficiency=pto.efficiency,
                  mode=start_mode(winding, sol.mean_angle_deg, sol.swing_amplitude_deg),
-                 planner=planner, deadline=deadline)
+                 planner=planner or "lbfgsb", deadline=deadline)
     opt = float(sol.power_w) if sol.success and sol.power_w is not None else None
     frac = (r.electrical_power_w / opt if opt is not None and opt > 0
             and math.isfinite(r.electrical_power_w) else None)

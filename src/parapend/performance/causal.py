@@ -116,10 +116,7 @@ def check_causal(*, controller, horizon, forecast, update_interval, warm_up, pla
                              "prescribed-heave pendulum has one planner)")
     base = BUOY_CAUSAL if buoy else CAUSAL
     if not heave:
-        from ..hydro.hull_control import DEFAULT_PLANNER
-
-        planner = planner or DEFAULT_PLANNER
-        buoy_controller = "hull" if planner == "lbfgsb" else "hull-" + planner
+        buoy_controller = "hull" if planner in (None, "lbfgsb") else "hull-" + planner
         if buoy_controller == "hull-collocation":
             from ..hydro._hull_collocation import available
 
