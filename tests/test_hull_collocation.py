@@ -154,16 +154,17 @@ def test_the_command_runs_the_collocation_planner(tmp_path, capsys):
     assert r["solves"] > 0 and r["update_time_p99_s"] is not None
 
 
-def test_the_compiled_default_needs_no_casadi(monkeypatch):
-    """The collocation planner's default solver is the compiled one: with CasADi made
-    unimportable the run is the one with CasADi there, to the bit (no IPOPT in it); asked
-    for IPOPT without CasADi, one line naming the extra."""
+def test_the_compiled_solver_needs_no_casadi(monkeypatch):
+    """The collocation planner on its compiled solver: with CasADi made unimportable the
+    run is the one with CasADi there, to the bit (no IPOPT in it); asked for IPOPT (the
+    default) without CasADi, one line naming the extra."""
     import sys
 
     from parapend.hydro import _hull_collocation as hcol
 
     opts = dict(th.OPTS, max_iter=5, planner="collocation")
-    assert hcol.SOLVER == "compiled"
+    assert hcol.SOLVER == "ipopt"
+    monkeypatch.setattr(hcol, "SOLVER", "compiled")
     with_casadi = hc.hull_mpc(th.HULL, th.PEND, th.WAVE, **opts)
     monkeypatch.setitem(sys.modules, "casadi", None)
     without = hc.hull_mpc(th.HULL, th.PEND, th.WAVE, **opts)

@@ -84,8 +84,8 @@ def add_parsers(sub) -> None:
     g.add_argument("--planner", choices=("plan", "coupled", "lbfgsb", "collocation"),
                    help="with mpc, the horizon's solver: the heaving buoy's plan (default) or "
                         "coupled (default with --efficiency); the hull's lbfgsb (default, "
-                        "real time) or collocation (nearer the optimum, an update's median "
-                        "0.2 s, its p99 up to 1.1 s)")
+                        "real time) or collocation (nearer the optimum, an update about a "
+                        "second; needs CasADi: parapend[collocation])")
     g = p.add_argument_group("statistics of a sea state (--dofs surge,heave,pitch)")
     g.add_argument("--realizations", type=_int, metavar="R",
                    help="solve R records of the sea state (--hs, --tp), seeded --seed, "
