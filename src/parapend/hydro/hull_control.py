@@ -59,8 +59,8 @@ PLANT_STEPS = 6
 DEFAULT_LIMIT = 4.0
 #: L-BFGS-B iterations per horizon solve at most
 MAX_ITER = 60
-#: interior-point iterations per horizon solve at most (``planner="collocation"``): IPOPT's,
-#: and the compiled solver's (its default; a capped solve is applied): with 40 in place of
+#: interior-point iterations per horizon solve at most (``planner="collocation"``): IPOPT's
+#: (the default solver), and the compiled solver's (a capped solve is applied): with 40 in place of
 #: 100 the default barge's seeds 0 to 9 (perfect forecast) realized 92.2 % of the record
 #: optimum (90.2 % with 100: the closed loop is chaotic), no solve failed, and the update's
 #: p99 fell from 0.3 to 2.3 s to 0.63 to 1.12 s (benchmarks/hull_collocation_table.out.txt)
@@ -355,8 +355,8 @@ def hull_mpc(hull, pendulum, wave, *, peak_period, pivot=(0.0, 0.0), pitch_inert
     planner : "lbfgsb" or "collocation"
         The horizon solve: L-BFGS-B on the held torques shot through the plant's model
         (module docstring), or the motion as the unknown, direct collocation solved by an
-        interior point on the exact Hessian (``_hull_collocation``: compiled, or CasADi's
-        IPOPT with ``_hull_collocation.SOLVER = "ipopt"``; ``plant_steps`` even).
+        interior point on the exact Hessian (``_hull_collocation``: CasADi's IPOPT, or the
+        compiled one with ``_hull_collocation.SOLVER = "compiled"``; ``plant_steps`` even).
     time_limit, deadline : as :func:`.control.buoy_mpc`.
 
     Returns
