@@ -790,6 +790,7 @@ def _causal_matrix(ds, spec: MatrixSpec) -> None:
     """Each forecast's causal power matrix (the bin's best of the controller's run and
     rest) and the choice, and the controller's settings in the attributes."""
     from .annual import bin_power
+    from .causal import HULL_PLANNERS
 
     dims2 = ("hm0", spec.period_kind)
     for f in spec.forecasts:
@@ -821,8 +822,8 @@ def _causal_matrix(ds, spec: MatrixSpec) -> None:
             "the hanging rest, the buoy in its free periodic motion, 64 torque samples a peak "
             "period; the mean over one repeat of the record after the warm-up, "
             "(W_e + eta_g dE) / tau, E the mechanical energy of buoy and pendulum")
-        if spec.buoy_controller in ("hull", "hull-collocation"):
-            planner = "lbfgsb" if spec.buoy_controller == "hull" else "collocation"
+        if spec.buoy_controller in HULL_PLANNERS:
+            planner = HULL_PLANNERS[spec.buoy_controller]
             ds.attrs["causal_convention"] = (
                 f"parapend.hydro.hull_control.hull_mpc, planner {planner}: from the hanging "
                 "rest, the hull in its "
