@@ -148,3 +148,44 @@ def test_the_copper_loss_field_carries_its_unit():
 
     assert "copper_loss_w_per_nm2" in HULL_KEYS
     assert quantity("copper_loss_w_per_nm2") == ("W/(N m)^2", "copper loss")
+
+
+@pytest.mark.parametrize("winding", [0, 1])
+def test_the_limit_is_held_between_the_grid_points(winding):
+    """A limit at half the ideal peak torque is imposed on the solve's grid; between its
+    points the torque overshoots by more than ``HOLD_TOL``. :func:`hold_limit` lowers the
+    grid's limit until the peak of the reported motion (here on a hull with twice the
+    harmonics, as the answer is reported), located on its own grid and refined by Brent's
+    method (:func:`parapend.hydro.result.peak`: not the grid the function measures on), is
+    within ``HOLD_TOL`` of the limit, and the power stays below the grid-limited answer's
+    (a tighter grid limit) by about the overshoot's fraction."""
+    from parapend.hydro.hull import HOLD_TOL, hold_limit, ideal_problem
+    from parapend.hydro.result import MotionAt, peak
+
+    n = 6
+    def make(s):
+        return case(winding=winding, harmonics=n)
+
+    def resolve(cs):
+        return case(winding=winding, harmonics=n, hull_harmonics=2 * cs.hull_harmonics)
+
+    ideal = hull_search(make, refine=False)
+    limit = 0.5 * float(np.max(np.abs(HullProblem(make(1)).grid_state(ideal.x)["tau"])))
+    sol = hull_search(make, refine=False, pto=HullPTO(torque_limit=limit))
+    assert sol.success, sol.status
+
+    def reported_peak(x):
+        pf = ideal_problem(resolve(sol.case))
+        mot = MotionAt(pf, x, pf.solve_hull(x))
+        return peak(lambda t: np.abs(mot(t)["tau"]), 2 * math.pi / sol.case.omega)
+
+    before = reported_peak(sol.x) / limit - 1
+    assert before > 5 * HOLD_TOL  # the case needs the holding
+    held = hold_limit(sol, resolve)
+    after = reported_peak(held.x) / limit - 1
+    assert after <= HOLD_TOL
+    assert "the grid's limit lowered by" in held.status
+    assert held.power <= sol.power
+    assert held.power >= sol.power * (1 - 4 * before)
+    # an answer within its limit is returned as it is
+    assert hold_limit(held, resolve) is held

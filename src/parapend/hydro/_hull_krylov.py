@@ -568,8 +568,7 @@ def _continued_pto(case: HullCase, make, sol: HullSolution, pto, refine: bool):
     s). The levels are the refinement: each level's power joins the
     refinement's history, and the answer's stated change is its level's against the coarser
     one (no doubling past the record's harmonics: under a limit the augmented Lagrangian's
-    climbs on twice them cost more than all the levels before). The answer's limit is then
-    held between the grid's points (:func:`.hull._hold_limit`)."""
+    climbs on twice them cost more than all the levels before)."""
     n = case.harmonics
     if not math.isfinite(sol.power):
         return dataclasses.replace(sol, case=case, x=_pad(sol.x, n),
@@ -590,10 +589,6 @@ def _continued_pto(case: HullCase, make, sol: HullSolution, pto, refine: bool):
     if refine and change > _hull.UNRESOLVED * max(abs(ex), 1e-300):
         status = (f"{status}; the last level, {sol.case.harmonics} to {n} harmonics, changed "
                   f"the power by {change:.3g} W")
-    if refine and pto.torque_limit is not None:
-        x, ex, held = _hull._hold_limit(case, x, float(ex), pto)
-        if held:
-            status += f"; {held}"
     mech = ideal_problem(case)
     return dataclasses.replace(
         sol, case=case, x=x, power=float(ex), status=status, success=ok,

@@ -25,6 +25,7 @@ from .hull import (
     HullProblem,
     HullPTO,
     bound_error,
+    hold_limit,
     hull_search,
     ideal_problem,
     make_case,
@@ -1081,7 +1082,7 @@ def _solve_mode(hull, pendulum, wave, k, harmonics, pivot, pitch_inertia, pto) -
         return make_case(hull, pendulum, wave, winding=k, harmonics=cs.harmonics,
                          hull_harmonics=REPORT_HULL_FACTOR * cs.hull_harmonics, pivot=pivot,
                          pitch_inertia=pitch_inertia)
-    return _mode(hull_search(make, pto=pto), resolve)
+    return _mode(hold_limit(hull_search(make, pto=pto), resolve), resolve)
 
 
 def hull_answer(hull, pendulum, wave, *, pivot, windings=(1, 0), pitch_inertia=None,
