@@ -845,10 +845,11 @@ def hold_limit(sol: HullSolution, resolve=None) -> HullSolution:
     hull (``resolve(case)``: the same case with more hull harmonics; None: the solve's), whose
     pendulum reaction moves the peak again. The overshoot ``o`` of the reported torque (on a
     grid eight times finer) lowers the grid's limit by ``1 + o`` and the optimum is solved
-    again from the answer, until ``o <= HOLD_TOL`` or ``HOLD_STEPS`` solves: a fixed point
-    (one lowering left 3e-4 of a 1.8e-3 overshoot on the default barge's record at 60 kN m).
+    again from the answer, until ``|o| <= HOLD_TOL`` or ``HOLD_STEPS`` solves: a fixed point
+    (one lowering left 3e-4 of a 1.8e-3 overshoot on the default barge's record at 60 kN m);
+    a peak that falls short raises the grid's limit again, never past the limit.
     Its power is then the take-off's objective at the true limit (no penalty); the status
-    says how far the grid's limit was lowered and what overshoot is left."""
+    says how far the grid's limit was lowered and where the peak is against the limit."""
     pto = sol.pto
     if pto.torque_limit is None or not math.isfinite(sol.power):
         return sol
@@ -860,8 +861,10 @@ def hold_limit(sol: HullSolution, resolve=None) -> HullSolution:
         return float(np.max(np.abs(fine.grid_state(x)["tau"]))) / limit - 1
 
     x, over, grid, steps, its = sol.x, overshoot(sol.x), limit, 0, 0
-    while over > HOLD_TOL and steps < HOLD_STEPS:
-        lower = dataclasses.replace(pto, torque_limit=grid / (1 + over))
+    # (a lowered grid limit whose answer's peak falls short is raised again, never past
+    # the limit: the power given away)
+    while (over > HOLD_TOL or (over < -HOLD_TOL and grid < limit)) and steps < HOLD_STEPS:
+        lower = dataclasses.replace(pto, torque_limit=min(limit, grid / (1 + over)))
         xr, ex, _, n = _pto_maximize(lower.problem(case), x, lower, False)
         its += n
         if not math.isfinite(ex):
@@ -875,7 +878,7 @@ def hold_limit(sol: HullSolution, resolve=None) -> HullSolution:
         sol, x=x, power=float(pto.problem(case).exact(x)),
         status=(f"{sol.status}; the grid's limit lowered by {limit / grid - 1:.2g} in "
                 f"{steps} solve{'s' if steps > 1 else ''} (the overshoot between its points; "
-                f"{max(over, 0.0):.1e} left)"),
+                f"the peak {abs(over):.1e} {'above' if over > 0 else 'below'} the limit)"),
         iterations=sol.iterations + its, energy_balance_residual=float(mech.balance(x)[2]),
         mechanical_power=float(mech.mechanical(x)))
 
