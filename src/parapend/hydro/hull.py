@@ -837,28 +837,32 @@ HOLD_TOL = 1e-4
 HOLD_STEPS = 3
 
 
-def hold_limit(sol: HullSolution, resolve=None) -> HullSolution:
+def hold_limit(sol: HullSolution, peak_torque=None) -> HullSolution:
     """The answer ``sol`` with its torque limit held between the grid's points.
 
     The limit is imposed at the grid's points; between them the torque of a limited optimum
     overshoots (0.1 to 0.2 % on the default barge), and the answer is reported on a finer
-    hull (``resolve(case)``: the same case with more hull harmonics; None: the solve's), whose
-    pendulum reaction moves the peak again. The overshoot ``o`` of the reported torque (on a
-    grid eight times finer) lowers the grid's limit by ``1 + o`` and the optimum is solved
-    again from the answer, until ``|o| <= HOLD_TOL`` or ``HOLD_STEPS`` solves: a fixed point
-    (one lowering left 3e-4 of a 1.8e-3 overshoot on the default barge's record at 60 kN m);
-    a peak that falls short raises the grid's limit again, never past the limit.
-    Its power is then the take-off's objective at the true limit (no penalty); the status
-    says how far the grid's limit was lowered and where the peak is against the limit."""
+    hull, whose pendulum reaction moves the peak again. ``peak_torque(case, x)``: the peak
+    torque (N m) of the motion as it is reported (None: on a grid eight times the solve's,
+    on its own hull). Its overshoot ``o`` lowers the grid's limit by ``1 + o`` and the
+    optimum is solved again from the answer, until ``|o| <= HOLD_TOL`` or ``HOLD_STEPS``
+    solves: a fixed point (one lowering, measured on the solve's own hull, left 3e-4 of a
+    1.8e-3 overshoot on the default barge's record at 60 kN m); a peak that falls short
+    raises the grid's limit again, never past the limit. Its power is then the take-off's
+    objective at the true limit (no penalty); the status says how far the grid's limit was
+    lowered and where the peak is against the limit."""
     pto = sol.pto
     if pto.torque_limit is None or not math.isfinite(sol.power):
         return sol
     case, limit = sol.case, pto.torque_limit
-    cs = case if resolve is None else resolve(case)
-    fine = ideal_problem(dataclasses.replace(cs, points=8 * cs.points))
+    if peak_torque is None:
+        fine = ideal_problem(dataclasses.replace(case, points=8 * case.points))
+
+        def peak_torque(cs, x):
+            return float(np.max(np.abs(fine.grid_state(x)["tau"])))
 
     def overshoot(x):
-        return float(np.max(np.abs(fine.grid_state(x)["tau"]))) / limit - 1
+        return peak_torque(case, x) / limit - 1
 
     x, over, grid, steps, its = sol.x, overshoot(sol.x), limit, 0, 0
     # (a lowered grid limit whose answer's peak falls short is raised again, never past

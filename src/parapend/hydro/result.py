@@ -951,19 +951,21 @@ def _deg(v) -> float:
 REPORT_HULL_FACTOR = 2
 
 
+def _reported(case, x, resolve=None):
+    """The reported motion (:class:`MotionAt`) of the answer ``x`` on ``case`` (its hull
+    solved again on ``resolve(case)``: None, the solve's own cut) and its peak torque (N m):
+    located on ``PEAK_POINTS`` samples, refined by Brent's method."""
+    pr = ideal_problem(case if resolve is None else resolve(case))
+    mot = MotionAt(pr, x, pr.solve_hull(x))
+    return mot, peak(lambda t: np.abs(mot(t)["tau"]), 2 * math.pi / case.omega,
+                     grid=lambda m: np.abs(mot.on_grid(m)["tau"]))
+
+
 def _mode(sol, resolve=None) -> dict:
     """One mode's entry; ``resolve(case)``: the same case with ``REPORT_HULL_FACTOR`` times
     the hull harmonics, for the reported motion (None: the solve's own cut)."""
     pr = ideal_problem(sol.case)  # the mechanics (a take-off's objective aside)
-    if resolve is None or not math.isfinite(sol.power):
-        mot = MotionAt(pr, sol.x, pr.solve_hull(sol.x))
-    else:
-        fine = resolve(sol.case)
-        pf = ideal_problem(fine)
-        mot = MotionAt(pf, sol.x, pf.solve_hull(sol.x))
-    period = 2 * math.pi / sol.case.omega
-    pk = peak(lambda t: np.abs(mot(t)["tau"]), period,
-              grid=lambda m: np.abs(mot.on_grid(m)["tau"]))
+    mot, pk = _reported(sol.case, sol.x, resolve if math.isfinite(sol.power) else None)
     status, ok = sol.status, sol.success
     limit = sol.pto.torque_limit
     if limit is not None and math.isfinite(sol.power) and pk > limit * (1 + 1e-12):
@@ -1082,7 +1084,9 @@ def _solve_mode(hull, pendulum, wave, k, harmonics, pivot, pitch_inertia, pto) -
         return make_case(hull, pendulum, wave, winding=k, harmonics=cs.harmonics,
                          hull_harmonics=REPORT_HULL_FACTOR * cs.hull_harmonics, pivot=pivot,
                          pitch_inertia=pitch_inertia)
-    return _mode(hold_limit(hull_search(make, pto=pto), resolve), resolve)
+    def peak_torque(cs, x):
+        return _reported(cs, x, resolve)[1]
+    return _mode(hold_limit(hull_search(make, pto=pto), peak_torque), resolve)
 
 
 def hull_answer(hull, pendulum, wave, *, pivot, windings=(1, 0), pitch_inertia=None,
