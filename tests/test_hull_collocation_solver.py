@@ -267,3 +267,96 @@ def test_structured_solves_are_superlus(intervals):
     for mine, theirs in ((lin.solve(ju, torques=True), lu.solve(ju)),
                          (lin.solve(r), lu.solve(r)), (lin.solve_t(r), lu.solve(r, trans="T"))):
         assert np.max(np.abs(mine - theirs)) <= 1e-12 * np.max(np.abs(theirs))
+
+
+def _kkt_point(scale):
+    """The small horizon's compiled problem at a perturbed point with random multipliers
+    (times ``scale``: their curvature makes the Lagrangian's Hessian indefinite on the null
+    space of the Jacobian where large): the solver, ``K`` (sparse, on its rows), ``J``,
+    ``K`` and ``J`` dense, the rows' values and a gradient."""
+    plant, fseg, prob, _ = _pair(2)
+    cs = prob.compiled
+    par = prob._params(np.asarray(fseg))
+    rng = np.random.default_rng(1)
+    x = prob._with_memory(prob.guess(np.full(tc.N, 0.5), fseg), par)
+    x += 0.05 * rng.standard_normal(x.size)
+    x[:8] = par[:8]
+    cs._setup(par)
+    _, c, _, jv, _, hv = cs._eval(x, scale * rng.standard_normal(cs.nloc), 2, cs.fk, cs.e0)
+    cs.sig_s = rng.uniform(0.5, 2.0, cs.npt - 1)
+    diag = np.zeros(cs.nf)
+    diag[cs.nd:] = rng.uniform(0.1, 1.0, cs.n)
+    kmat, jac = cs.hessian(hv, diag), cs.jacobian(jv)
+    kd = np.zeros((cs.nf, cs.nf))
+    kd[np.ix_(cs.krows, cs.krows)] = kmat.toarray()
+    return cs, kmat, jac, kd, jac.toarray(), c, rng.standard_normal(cs.nf)
+
+
+def _inertia(a):
+    ev = np.linalg.eigvalsh(a)
+    return int(np.sum(ev > 0)), int(np.sum(ev < 0))
+
+
+def test_kkt_step_is_the_dense_solve():
+    """The Newton step from the sparse ``L D L^T`` of the whole KKT matrix (its static
+    regularization refined away) against NumPy's dense solve of ``[K, J^T; J, 0]``, and
+    against the step in the null space of ``J`` (the reduced Hessian on an orthonormal
+    basis from the structured solves with ``J_d``), to 1e-9 relative; no inertia
+    correction where the dense matrix's eigenvalues say the inertia is ``(n, m, 0)``."""
+    cs, kmat, jac, kd, jd, c, g = _kkt_point(1.0)
+    nf, ne = cs.nf, cs.neq
+    a = np.block([[kd, jd.T], [jd, np.zeros((ne, ne))]])
+    assert _inertia(a) == (nf, ne)
+    lin, delta = cs._kkt(kmat, jac, 0.1, 0.0)
+    assert delta == 0.0 and lin.delta_c == 0.0
+    ref = np.linalg.solve(a, -np.concatenate((g, c)))
+    dx, lam = lin.solve(g, c)
+    assert np.max(np.abs(np.concatenate((dx, lam)) - ref)) <= 1e-9 * np.max(np.abs(ref))
+    ns, _ = cs._null_space(kmat, jac, cs._factor(jac), 0.0)
+    dxn, lamn = ns.solve(g, c)
+    assert np.max(np.abs(dxn - dx)) <= 1e-9 * np.max(np.abs(dx))
+    assert np.max(np.abs(lamn - lam)) <= 1e-9 * np.max(np.abs(lam))
+
+
+def test_kkt_inertia_correction():
+    """Where the Lagrangian's curvature (multipliers 100 times larger) leaves the KKT
+    matrix with fewer than ``n`` positive eigenvalues (NumPy's dense eigenvalues), the
+    inertia correction adds ``delta_w I`` to ``K`` until the factors' pivots have the
+    signs ``(n, m)``, which the dense eigenvalues of the corrected matrix confirm, and the
+    step solves the corrected system (1e-9 relative)."""
+    cs, kmat, jac, kd, jd, c, g = _kkt_point(100.0)
+    nf, ne = cs.nf, cs.neq
+    a = np.block([[kd, jd.T], [jd, np.zeros((ne, ne))]])
+    assert _inertia(a)[0] < nf
+    lin, delta = cs._kkt(kmat, jac, 0.1, 0.0)
+    assert delta > 0.0
+    a[:nf, :nf] += delta * np.eye(nf)
+    a[nf:, nf:] -= lin.delta_c * np.eye(ne)
+    assert _inertia(a) == (nf, ne)
+    ref = np.linalg.solve(a, -np.concatenate((g, c)))
+    dx, lam = lin.solve(g, c)
+    assert np.max(np.abs(np.concatenate((dx, lam)) - ref)) <= 1e-9 * np.max(np.abs(ref))
+
+
+def test_sparse_ldl_inertia_and_solve():
+    """The compiled ``L D L^T`` of a random quasi-definite matrix (and of one whose
+    ``(1, 1)`` block is indefinite) in the minimum-degree order: its positive pivots are
+    the dense eigenvalues' positive count, its solve NumPy's to 1e-10; past ``maxneg``
+    negative pivots it stops (-2)."""
+    from parapend.hydro._hull_collocation_ldl import SparseLDL
+
+    rng = np.random.default_rng(4)
+    n, m = 80, 30
+    b = np.where(rng.random((n, n)) < 0.05, rng.standard_normal((n, n)), 0.0)
+    jm = np.where(rng.random((m, n)) < 0.08, rng.standard_normal((m, n)), 0.0)
+    rhs = rng.standard_normal(n + m)
+    for shift in (3.0, -0.5):
+        k = b + b.T + shift * np.eye(n)
+        a = np.block([[k, jm.T], [jm, -0.1 * np.eye(m)]])
+        r, cc = np.nonzero(np.triu(a) + np.eye(n + m))
+        ldl = SparseLDL(n + m, r, cc)
+        pos, neg = _inertia(a)
+        assert ldl.factor(a[r, cc], n + m) == pos
+        x = ldl.solve(rhs)
+        assert np.max(np.abs(a @ x - rhs)) <= 1e-10 * np.max(np.abs(rhs)) * np.linalg.cond(a)
+        assert ldl.factor(a[r, cc], neg - 1) == -2
