@@ -339,14 +339,17 @@ class CompiledSolver:
                 status, self.why = 2, "nonfinite"
                 break
             jac = self.jacobian(jv)
-            lu = self._factor(jac)
-            if lu is None:
+            # the factors of J_d: the null-space step's, and the multipliers' estimate
+            reset = lam is None or np.max(np.abs(lam)) > LAM_RESET
+            need = reset or STEP != "kkt"
+            lu = self._factor(jac) if need else None
+            if need and lu is None:
                 status, self.why = 2, "singular"
                 break
             gf = np.concatenate((grad[self.dep], grad[self.uix]))  # on the reduced columns
             rd = self._speeds(x) - s if self.speed else np.zeros(0)
             gdl = self._dt(lamd) if self.speed else np.zeros(nf)
-            if lam is None or np.max(np.abs(lam)) > LAM_RESET:
+            if reset:
                 # least-squares multipliers at the start (IPOPT's), after a restoration, and
                 # where the steps' ran away (the Hessian then all their curvature)
                 lam = lu.solve_t(-(gf[:nd] + gdl[:nd]))

@@ -32,6 +32,10 @@ announce_compiles()  # log a first-use compile (parapend._jit)
 
 #: the static regularization of both diagonal blocks (refined away)
 EPS = 1e-9
+#: the trailing columns of L at least this full are factored as one dense block, where at
+#: least DENSE_MIN of them
+DENSE = 0.7
+DENSE_MIN = 32
 
 
 @nb.njit(cache=True)
@@ -60,15 +64,17 @@ def etree(n, ap, ai, lnz, parent):
 
 
 @nb.njit(cache=True)
-def factor(n, ap, ai, ax, parent, lp, li, lx, d, dinv, maxneg):
+def factor(n, ap, ai, ax, parent, lp, li, lx, d, dinv, maxneg, nxt):
     """``L D L^T`` of the upper triangle ``(ap, ai, ax)`` into ``(lp, li, lx)`` (unit
     diagonal implied) and ``d``; returns the number of positive pivots, ``-1`` at a zero or
-    non-finite pivot, ``-2`` past ``maxneg`` negative ones (the factors then partial)."""
+    non-finite pivot, ``-2`` past ``maxneg`` negative ones (the factors then partial).
+    ``nxt``: every column's entries' end (out)."""
     mark = np.zeros(n, np.bool_)
     yv = np.zeros(n)
     yi = np.empty(n, np.uint32)
     eb = np.empty(n, np.uint32)
-    nxt = lp[:n].copy()
+    for c in range(n):
+        nxt[c] = lp[c]
     npos = 0
     nneg = 0
     for k in range(n):
@@ -123,25 +129,38 @@ def factor(n, ap, ai, ax, parent, lp, li, lx, d, dinv, maxneg):
 
 
 @nb.njit(cache=True)
-def solve(n, lp, li, lx, dinv, perm, b, out):
-    """``out = A^-1 b`` from the factors of ``P^T A P`` (``perm``: the order)."""
+def solve(n, s, lp, li, lx, dinv, sm, perm, b, out):
+    """``out = A^-1 b`` from the factors of ``P^T A P`` (``perm``: the order; the columns
+    from ``s`` on dense in ``sm``: :func:`dense_ldl`'s)."""
     x = np.empty(n)
     for k in range(n):
         x[k] = b[perm[k]]
-    for i in range(n):
+    for i in range(s):
         xi = x[i]
         if xi != 0.0:
             j0 = lp[i]
             for j in range(lp[i + 1] - j0):
                 x[li[j0 + j]] -= lx[j0 + j] * xi
-    for i in range(n):
+    m = n - s
+    for k in range(m):
+        xk = x[s + k]
+        for i in range(k + 1, m):
+            x[s + i] -= sm[k, i] * xk
+    for i in range(s):
         x[i] *= dinv[i]
-    for i in range(n - 1, -1, -1):
-        s = x[i]
+    for k in range(m):
+        x[s + k] /= sm[k, k]
+    for k in range(m - 1, -1, -1):
+        t = x[s + k]
+        for i in range(k + 1, m):
+            t -= sm[k, i] * x[s + i]
+        x[s + k] = t
+    for i in range(s - 1, -1, -1):
+        t = x[i]
         j0 = lp[i]
         for j in range(lp[i + 1] - j0):
-            s -= lx[j0 + j] * x[li[j0 + j]]
-        x[i] = s
+            t -= lx[j0 + j] * x[li[j0 + j]]
+        x[i] = t
     for k in range(n):
         out[perm[k]] = x[k]
 
@@ -192,23 +211,126 @@ class SparseLDL:
         self.parent = np.empty(n, np.int64)
         lnz = np.empty(n, np.int64)
         nl = etree(n, self.ap, self.ai, lnz, self.parent)
+        # the trailing columns of L that are (nearly) full: factored dense (the memory's
+        # rows couple every velocity node: their clique ends the minimum-degree order)
+        full = lnz >= DENSE * (n - 1 - np.arange(n))
+        s = n
+        while s > 0 and full[s - 1]:
+            s -= 1
+        self.s = s if n - s >= DENSE_MIN else n
+        self.sm = np.zeros((n - self.s, n - self.s))
         self.lp = np.zeros(n + 1, np.int64)
         self.lp[1:] = np.cumsum(lnz)
         self.li, self.lx = np.empty(nl, np.uint32), np.empty(nl)
-        self.d, self.dinv = np.empty(n), np.empty(n)
+        self.d, self.dinv, self.nxt = np.empty(n), np.empty(n), np.empty(n, np.int64)
         self.ok = False
 
     def factor(self, values, maxneg):
         """Factor the values ``values`` (the pattern's order); the positive pivots' number,
         or -1 (a zero pivot), -2 (more than ``maxneg`` negative ones)."""
         scatter(self.pos, values, self.ax)
-        out = factor(self.n, self.ap, self.ai, self.ax, self.parent, self.lp, self.li,
-                     self.lx, self.d, self.dinv, maxneg)
+        s = self.s
+        out = factor(s, self.ap, self.ai, self.ax, self.parent, self.lp, self.li,
+                     self.lx, self.d, self.dinv, maxneg, self.nxt)
+        if out >= 0 and s < self.n:
+            tail(s, self.n, self.ap, self.ai, self.ax, self.parent, self.lp, self.li,
+                 self.lx, self.dinv, self.sm, self.nxt)
+            more = dense_ldl(self.sm, maxneg - (s - out))
+            out = out + more if more >= 0 else more
         self.ok = out >= 0
         return out
 
     def solve(self, b):
         out = np.empty(self.n)
-        solve(self.n, self.lp, self.li, self.lx, self.dinv, self.perm,
+        solve(self.n, self.s, self.lp, self.li, self.lx, self.dinv, self.sm, self.perm,
               np.ascontiguousarray(b, dtype=float), out)
         return out
+
+
+@nb.njit(cache=True)
+def tail(s, n, ap, ai, ax, parent, lp, li, lx, dinv, sm, nxt):
+    """The rows ``s..n-1`` of ``L`` in the columns before ``s`` (after :func:`factor` of
+    the first ``s``, ``nxt`` its), and the Schur complement of the first ``s`` rows and
+    columns into the dense ``sm`` (its upper triangle): the up-looking rows, the updates of
+    the trailing rows gathered in ``sm``."""
+    m = n - s
+    mark = np.zeros(s, np.bool_)
+    yv = np.zeros(s)
+    yi = np.empty(s, np.uint32)
+    eb = np.empty(s, np.uint32)
+    top = nxt[:s].copy()  # the end of every column's rows before s
+    low = np.zeros((m, m))  # the complement's lower triangle, row by row
+    for k in range(s, n):
+        ny = 0
+        kk = k - s
+        for q in range(ap[k], ap[k + 1]):
+            b = ai[q]
+            if b >= s:
+                low[kk, b - s] = ax[q]
+                continue
+            yv[b] = ax[q]
+            if not mark[b]:
+                mark[b] = True
+                eb[0] = b
+                ne = 1
+                c = parent[b]
+                while c != -1 and c < s:
+                    if mark[c]:
+                        break
+                    mark[c] = True
+                    eb[ne] = c
+                    ne += 1
+                    c = parent[c]
+                while ne > 0:
+                    ne -= 1
+                    yi[ny] = eb[ne]
+                    ny += 1
+        for t in range(ny - 1, -1, -1):
+            c = yi[t]
+            e = nxt[c]
+            yc = yv[c]
+            j0 = lp[c]
+            for j in range(top[c] - j0):
+                yv[li[j0 + j]] -= lx[j0 + j] * yc
+            j0 = top[c]
+            for j in range(e - j0):
+                low[kk, li[j0 + j] - s] -= lx[j0 + j] * yc
+            li[e] = k
+            lx[e] = yc * dinv[c]
+            low[kk, kk] -= yc * lx[e]
+            nxt[c] = e + 1
+            yv[c] = 0.0
+            mark[c] = False
+    for i in range(m):
+        for j in range(i, m):
+            sm[i, j] = low[j, i]
+
+
+@nb.njit(cache=True)
+def dense_ldl(a, maxneg):
+    """``L D L^T`` of the symmetric ``a`` (its upper triangle) in place without pivoting:
+    ``L^T`` strictly above the diagonal, ``D`` on it; the positive pivots' number, or -1, -2
+    as :func:`factor`."""
+    m = a.shape[0]
+    npos = 0
+    nneg = 0
+    for k in range(m):
+        dk = a[k, k]
+        if dk == 0.0 or not np.isfinite(dk):
+            return -1
+        if dk > 0.0:
+            npos += 1
+        else:
+            nneg += 1
+            if nneg > maxneg:
+                return -2
+        inv = 1.0 / dk
+        for i in range(k + 1, m):
+            f = a[k, i]
+            if f != 0.0:
+                g = f * inv
+                for j in range(i, m):
+                    a[i, j] -= g * a[k, j]
+        for i in range(k + 1, m):
+            a[k, i] *= inv
+    return npos
