@@ -338,13 +338,17 @@ def test_kkt_inertia_correction():
     assert np.max(np.abs(np.concatenate((dx, lam)) - ref)) <= 1e-9 * np.max(np.abs(ref))
 
 
-def test_sparse_ldl_inertia_and_solve():
+@pytest.mark.parametrize("dense", [True, False])
+def test_sparse_ldl_inertia_and_solve(dense, monkeypatch):
     """The compiled ``L D L^T`` of a random quasi-definite matrix (and of one whose
-    ``(1, 1)`` block is indefinite) in the minimum-degree order: its positive pivots are
-    the dense eigenvalues' positive count, its solve NumPy's to 1e-10; past ``maxneg``
-    negative pivots it stops (-2)."""
+    ``(1, 1)`` block is indefinite) in the minimum-degree order, its trailing full columns
+    factored dense or not: its positive pivots are the dense eigenvalues' positive count,
+    its solve NumPy's to 1e-10 times the condition number; past ``maxneg`` negative pivots
+    it stops (-2)."""
+    from parapend.hydro import _hull_collocation_ldl as ldlmod
     from parapend.hydro._hull_collocation_ldl import SparseLDL
 
+    monkeypatch.setattr(ldlmod, "DENSE_MIN", 8 if dense else 10 ** 9)
     rng = np.random.default_rng(4)
     n, m = 80, 30
     b = np.where(rng.random((n, n)) < 0.05, rng.standard_normal((n, n)), 0.0)
@@ -355,6 +359,7 @@ def test_sparse_ldl_inertia_and_solve():
         a = np.block([[k, jm.T], [jm, -0.1 * np.eye(m)]])
         r, cc = np.nonzero(np.triu(a) + np.eye(n + m))
         ldl = SparseLDL(n + m, r, cc)
+        assert (ldl.s < n + m) == dense
         pos, neg = _inertia(a)
         assert ldl.factor(a[r, cc], n + m) == pos
         x = ldl.solve(rhs)
