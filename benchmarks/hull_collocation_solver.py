@@ -8,8 +8,9 @@
    statuses, the objective's relative difference and the largest torque difference
    (m g l).
 2. ``--kkt``: the linear algebra of one iteration on the sixth horizon: SciPy's SuperLU
-   (and qdldl, where installed) on the whole quasi-definite KKT matrix against the
-   compiled solver's structured factors of ``J_d`` and its 48 torque sensitivities.
+   and qdldl on the whole quasi-definite KKT matrix, the compiled solver's own ``L D L^T``
+   of it (its default step), and its structured factors of ``J_d`` with the 48 torque
+   sensitivities (its null-space step).
 3. The whole default run (``hull_mpc(..., planner="collocation", terminal_weight=0.5)``,
    seed ``--seed``) with each solver: the update time's median and p99 against the 0.75 s
    interval, the failed and the capped solves, and the electrical power (``--forecast``;
@@ -166,6 +167,21 @@ def kkt_baseline(seed, k=5):
         t = time.perf_counter()
         solver.update(kkt)
         print(f"  qdldl (AMD) numeric refactor {1000 * (time.perf_counter() - t):7.1f} ms")
+    kh = cs.hessian(hv, np.ones(cs.nf))
+    cs._kkt(kh, jac, 0.1, 0.0)
+    ldl = cs.ldl
+    vals = np.concatenate((kh.data[cs.kkt_ksel], jac.data,
+                           np.r_[np.full(cs.nf, 1e-8), np.full(cs.neq, -1e-8)]))
+    t = time.perf_counter()
+    for _ in range(10):
+        ldl.factor(vals, cs.neq)
+    tf = (time.perf_counter() - t) / 10
+    t = time.perf_counter()
+    for _ in range(10):
+        ldl.solve(np.ones(ldl.n))
+    print(f"  the compiled solver's L D L^T (its dense tail {ldl.n - ldl.s} rows): factor "
+          f"{1000 * tf:7.1f} ms, solve {100 * (time.perf_counter() - t):7.2f} ms, "
+          f"nnz(L) {ldl.li.size}")
     cs._factor(jac)
     t = time.perf_counter()
     for _ in range(10):

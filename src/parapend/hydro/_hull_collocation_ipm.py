@@ -13,17 +13,24 @@ memory causal). The Newton step of the barrier problem
     [J   0 ] [l+] = [-c],   K = W + Sigma_u + D^T Sigma_s D
 
 (``W`` the Hessian of the Lagrangian, ``Sigma`` the barrier's primal-dual weights of the
-torques' bounds and of the slacks ``s`` of the generator's speeds ``D x``) is taken in the
-null space of ``J``: ``dx = Y p + Q w`` with ``J_d p = -c``, ``Q = Z R^-1`` the orthonormal
-basis of the span of ``Z = [-J_d^-1 J_u; I]`` (``R`` Householder's; the torques'
-sensitivities ``Z`` reach 1e8 where the motion's linearization is unstable over the
-horizon, and ``Z^T K Z`` then loses the reduced Hessian to rounding), ``(Q^T K Q) w =
--Q^T (r + K Y p)`` (``n x n``, dense), then ``J_d^T l+ = -(r + K dx)_d``:
-the factors of ``J_d`` by its time structure (:mod:`._hull_collocation_linalg`) and
-``n + 2`` solves with them a step (the torques' columns from their samples on). The
-reduced Hessian ``Q^T K Q`` positive definite is the KKT matrix's inertia IPOPT asks for;
-where it is not, ``delta I`` is added to ``K`` as IPOPT's inertia correction does
-(``delta`` 0, then the last one's third or ``1e-4``, times 8 until the Cholesky succeeds).
+torques' bounds and of the slacks ``s`` of the generator's speeds ``D x``) is taken, as
+IPOPT takes it, from a factorization of that whole sparse KKT matrix (``STEP = "kkt"``, the
+default): its ``L D L^T`` in a minimum-degree order (:mod:`._hull_collocation_ldl`; the
+memory's rows, which couple every velocity node, end the order as a dense clique of about
+370 rows, factored dense), the inertia counted from ``D``, corrected as IPOPT's
+(:meth:`CompiledSolver._kkt`: ``delta_w I`` on ``K`` until it is ``(n, m, 0)``,
+``delta_c`` where singular), a static regularization 1e-9 refined away (at most
+``REFINE`` steps of iterative refinement). ``STEP = "nullspace"`` takes it in the null
+space of ``J`` instead: ``dx = Y p + Q w`` with ``J_d p = -c``, ``Q = Z R^-1`` the
+orthonormal basis of the span of ``Z = [-J_d^-1 J_u; I]`` (``R`` Householder's),
+``(Q^T K Q) w = -Q^T (r + K Y p)`` (``n x n``, dense, Cholesky with ``delta I`` added
+until it succeeds), then ``J_d^T l+ = -(r + K dx)_d``, the factors of ``J_d`` by its time
+structure (:mod:`._hull_collocation_linalg`). That condenses the motion over the whole
+horizon: the torques' sensitivities ``Z`` reach 1e8 where the pendulum's linearization is
+unstable over it. On 25 horizons captured from the power matrix's Hs 1 m, Te 8 s bin (Tp
+8.9 s: a 17.8 s horizon) it failed 11 and capped 4 at 40 iterations, the KKT step failed
+1 and capped 1 (IPOPT none); on the default sea's 12 s horizons both solved the same
+(the null-space step 2 to 3 times faster a horizon, median).
 
 **Method.** IPOPT's: the slacks ``D x - s = 0`` of the speed bounds, the fraction to the
 boundary ``max(0.99, 1 - mu)``, IPOPT's filter line search with its second-order
@@ -88,7 +95,10 @@ WATCHDOG_TRIALS = 3
 REF_RED = 0.9999
 REFS = 4
 #: a trial step's infeasibility at most this times the iterate's, or THETA_FLOOR (IPOPT's
-#: filter alone let the iterates wander far from feasibility on the hull's nonconvex horizons)
+#: filter alone let the null-space step's iterates wander far from feasibility on the hull's
+#: nonconvex horizons; with the KKT step, without the bound, the Te 8 s bin's closed loop
+#: realized 321.3 W perfect, 209.0 W AR with a failed solve, against 228.2 and 165.1 W with
+#: none: a chaotic loop, the bound kept for the failed solve)
 THETA_GROWTH = 10.0
 THETA_FLOOR = 1e-3
 #: the inertia correction's tries at most (``delta`` times 8 each), and its largest ``delta``
@@ -102,11 +112,12 @@ LAM_RESET = 1e3
 #: where the Newton's method on the equality rows (the torques held) is not taken, IPOPT's
 #: restoration phase by least-norm steps in all the unknowns (:meth:`_restore_min_norm`)
 RESTORATION = True
-#: the Newton step: ``"kkt"`` (the whole KKT matrix's sparse ``L D L^T``) or ``"nullspace"``
+#: the Newton step (module docstring): ``"kkt"`` (the whole KKT matrix's sparse ``L D
+#: L^T``) or ``"nullspace"`` (condensed on the torques: faster on short horizons, fails on
+#: long ones)
 STEP = "kkt"
 #: iterative refinement's steps at most on the KKT matrix
 REFINE = 5
-KAPPA_FIRST = 8.0
 
 
 def _csc_pattern(rows, cols, nrow, ncol):
@@ -586,10 +597,11 @@ class CompiledSolver:
 
     def _kkt(self, kmat, jac, mu, delta_last):
         """The whole KKT matrix factored with IPOPT's inertia correction: ``delta_w`` 0,
-        then ``1e-4`` (or a third of the last one) times 100 (8 after a first correction)
-        until the inertia is ``(nf, neq, 0)``; ``delta_c = 1e-8 mu^(1/4)`` where the
-        matrix is singular (a zero pivot, or too few negative ones). ``(None, delta)``
-        past MAX_DELTA."""
+        then ``1e-4`` (or a third of the last one) times 8 until the inertia is ``(nf,
+        neq, 0)`` (IPOPT grows its first correction by 100: that capped a captured horizon of
+        the Te 8 s bin which 8 solved in 18 iterations); ``delta_c = 1e-8
+        mu^(1/4)`` where the matrix is singular (a zero pivot, or too few negative ones).
+        ``(None, delta)`` past MAX_DELTA."""
         if self.ldl is None:
             self.ldl = SparseLDL(self.nf + self.neq, self.kkt_rows, self.kkt_cols)
         kd, jd = kmat.data[self.kkt_ksel], jac.data
@@ -608,7 +620,7 @@ class CompiledSolver:
             if delta == 0.0:
                 delta = 1e-4 if delta_last == 0.0 else max(1e-20, delta_last / 3.0)
             else:
-                delta *= KAPPA_FIRST if delta_last == 0.0 else 8.0
+                delta *= 8.0
             if delta > MAX_DELTA:
                 break
         return None, delta
