@@ -81,17 +81,24 @@ def test_derivatives_are_casadis(kw):
     assert np.max(np.abs(hess - theirs)) <= 1e-12 * np.max(np.abs(theirs))
 
 
-@pytest.mark.parametrize("intervals, kw, updates, strategy",
-                         [(2, VARIANTS[0], 2, "adaptive"), (2, VARIANTS[1], 1, "adaptive"),
-                          (1, VARIANTS[0], 1, "adaptive"), (2, VARIANTS[0], 1, "monotone")])
-def test_compiled_reaches_ipopts_optimum(intervals, kw, updates, strategy):
+@pytest.mark.parametrize("intervals, kw, updates, strategy, step",
+                         [(2, VARIANTS[0], 2, "adaptive", "kkt"),
+                          (2, VARIANTS[1], 1, "adaptive", "kkt"),
+                          (1, VARIANTS[0], 1, "adaptive", "kkt"),
+                          (2, VARIANTS[0], 1, "monotone", "kkt"),
+                          (2, VARIANTS[0], 2, "adaptive", "nullspace")])
+def test_compiled_reaches_ipopts_optimum(intervals, kw, updates, strategy, step, monkeypatch):
     """One or two updates (the second from the first's solution shifted by one sample,
-    after the plant ran it): the compiled solver (either barrier update) and IPOPT from the
-    same start reach the same objective (1e-6 relative) and torques (1e-4 m g l), both
-    solved. (With an efficiency the smoothed kink of ``e(.)`` makes the problem's local
-    optima many: the second update of this small hull, or one Hermite-Simpson interval a
-    sample, ends the two at different local optima, neither below the other every time; so
-    does the monotone barrier's second update, 1.4 % below IPOPT's.)"""
+    after the plant ran it): the compiled solver (either barrier update, either Newton
+    step) and IPOPT from the same start reach the same objective (1e-6 relative) and
+    torques (1e-4 m g l), both solved. (With an efficiency the smoothed kink of ``e(.)``
+    makes the problem's local optima many: the second update of this small hull, or one
+    Hermite-Simpson interval a sample, ends the two at different local optima, neither
+    below the other every time; so does the monotone barrier's second update, 1.4 % below
+    IPOPT's.)"""
+    from parapend.hydro import _hull_collocation_ipm as ipm
+
+    monkeypatch.setattr(ipm, "STEP", step)
     plant, fseg, prob, ref = _pair(intervals, **kw)
     prob.shift = 1
     for k in range(updates):
