@@ -64,6 +64,31 @@ def etree(n, ap, ai, lnz, parent):
 
 
 @nb.njit(cache=True)
+def _reach(b, bound, parent, mark, eb, yi, ny):
+    """The unmarked nodes of the elimination tree's path from ``b`` (below ``bound``)
+    marked and appended to ``yi`` (its first ``ny`` entries kept) so that ``yi`` read
+    backwards is in topological order; the new count (``eb``: work space)."""
+    if mark[b]:
+        return ny
+    mark[b] = True
+    eb[0] = b
+    ne = 1
+    c = parent[b]
+    while c != -1 and c < bound:
+        if mark[c]:
+            break
+        mark[c] = True
+        eb[ne] = c
+        ne += 1
+        c = parent[c]
+    while ne > 0:
+        ne -= 1
+        yi[ny] = eb[ne]
+        ny += 1
+    return ny
+
+
+@nb.njit(cache=True)
 def factor(n, ap, ai, ax, parent, lp, li, lx, d, dinv, maxneg, nxt):
     """``L D L^T`` of the upper triangle ``(ap, ai, ax)`` into ``(lp, li, lx)`` (unit
     diagonal implied) and ``d``; returns the number of positive pivots, ``-1`` at a zero or
@@ -86,22 +111,7 @@ def factor(n, ap, ai, ax, parent, lp, li, lx, d, dinv, maxneg, nxt):
                 dk = ax[q]
                 continue
             yv[b] = ax[q]
-            if not mark[b]:
-                mark[b] = True
-                eb[0] = b
-                ne = 1
-                c = parent[b]
-                while c != -1 and c < k:
-                    if mark[c]:
-                        break
-                    mark[c] = True
-                    eb[ne] = c
-                    ne += 1
-                    c = parent[c]
-                while ne > 0:
-                    ne -= 1
-                    yi[ny] = eb[ne]
-                    ny += 1
+            ny = _reach(b, k, parent, mark, eb, yi, ny)
         for t in range(ny - 1, -1, -1):
             c = yi[t]
             e = nxt[c]
@@ -269,22 +279,7 @@ def tail(s, n, ap, ai, ax, parent, lp, li, lx, dinv, sm, nxt):
                 low[kk, b - s] = ax[q]
                 continue
             yv[b] = ax[q]
-            if not mark[b]:
-                mark[b] = True
-                eb[0] = b
-                ne = 1
-                c = parent[b]
-                while c != -1 and c < s:
-                    if mark[c]:
-                        break
-                    mark[c] = True
-                    eb[ne] = c
-                    ne += 1
-                    c = parent[c]
-                while ne > 0:
-                    ne -= 1
-                    yi[ny] = eb[ne]
-                    ny += 1
+            ny = _reach(b, s, parent, mark, eb, yi, ny)
         for t in range(ny - 1, -1, -1):
             c = yi[t]
             e = nxt[c]
