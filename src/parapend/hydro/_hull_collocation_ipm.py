@@ -27,10 +27,11 @@ orthonormal basis of the span of ``Z = [-J_d^-1 J_u; I]`` (``R`` Householder's),
 until it succeeds), then ``J_d^T l+ = -(r + K dx)_d``, the factors of ``J_d`` by its time
 structure (:mod:`._hull_collocation_linalg`). That condenses the motion over the whole
 horizon: the torques' sensitivities ``Z`` reach 1e8 where the pendulum's linearization is
-unstable over it. On 25 horizons captured from the power matrix's Hs 1 m, Te 8 s bin (Tp
-8.9 s: a 17.8 s horizon) it failed 11 and capped 4 at 40 iterations, the KKT step failed
-1 and capped 1 (IPOPT none); on the default sea's 12 s horizons both solved the same
-(the null-space step 2 to 3 times faster a horizon, median).
+unstable over it. On 25 horizons captured from a run of the power matrix's Hs 1 m, Te 8 s
+bin (Tp 8.9 s: a 17.8 s horizon; started swinging, 40 iterations) it failed 11 and capped
+4, the KKT step (its first inertia correction then grown by 100, as IPOPT's) failed 1 and
+capped 1, IPOPT none; on the default sea's 12 s horizons both solved the same (the
+null-space step 2.3 times faster a horizon, median).
 
 **Method.** IPOPT's: the slacks ``D x - s = 0`` of the speed bounds, the fraction to the
 boundary ``max(0.99, 1 - mu)``, IPOPT's filter line search with its second-order
