@@ -8,12 +8,18 @@
    statuses, the objective's relative difference and the largest torque difference
    (m g l).
 2. ``--kkt``: the linear algebra of one iteration on the sixth horizon: SciPy's SuperLU
-   (and qdldl, where installed) on the whole quasi-definite KKT matrix against the
-   compiled solver's structured factors of ``J_d`` and its 48 torque sensitivities.
+   and qdldl on the whole quasi-definite KKT matrix, the compiled solver's own ``L D L^T``
+   of it (its default step), and its structured factors of ``J_d`` with the 48 torque
+   sensitivities (its null-space step).
 3. The whole default run (``hull_mpc(..., planner="collocation", terminal_weight=0.5)``,
    seed ``--seed``) with each solver: the update time's median and p99 against the 0.75 s
-   interval, the failed solves, and the electrical power (``--forecast``;
+   interval, the failed and the capped solves, and the electrical power (``--forecast``;
    ``--no-ipopt-run`` skips IPOPT's).
+
+``--te8``: items 1 and 3 on the power matrix's Hs 1 m, Te 8 s bin of the default barge
+(Tp 8.9 s, a 17.8 s horizon; seed 0, 4 waves, started rotating as its optimum: the
+matrix's causal run, :func:`parapend.performance.causal.run_hull_record`) in place of the
+default sea.
 
     nice python benchmarks/hull_collocation_solver.py --updates 20 --seed 0
 """
@@ -50,6 +56,18 @@ def run(p, wave, forecast="perfect"):
                        forecast=forecast)
 
 
+def run_bin(forecast="perfect"):
+    """The power matrix's causal run of its Hs 1 m, Te 8 s bin (Tp 8.9 s: a 17.8 s horizon)
+    on the default barge, seed 0, 4 waves, started rotating (as its optimum)."""
+    from parapend.performance import matrix_spec
+    from parapend.performance.causal import run_hull_record
+
+    spec = matrix_spec(hs="1,2", te="6,8", realizations=1, waves=4, device="buoy",
+                       dofs="surge,heave,pitch", controller="mpc", forecast="perfect,ar",
+                       planner="collocation")
+    return run_hull_record(spec, 0, 1, 0, forecast, "rotate")
+
+
 def beside(prob, max_iter, solver):
     """The problem ``prob`` (same plant and options) with the solver ``solver``."""
     return hcol.HullCollocation(prob.plant, prob.n, prob.steps, prob.tu, prob.torque_limit,
@@ -58,9 +76,9 @@ def beside(prob, max_iter, solver):
                                 max_iter=max_iter, solver=solver)
 
 
-def per_horizon(seed, updates):
-    """Both solvers on the first ``updates`` horizons of an IPOPT run (module docstring)."""
-    p, wave = case(seed)
+def per_horizon(seed, updates, te8=False):
+    """Both solvers on the first ``updates`` horizons of an IPOPT run (module docstring;
+    ``te8``: of :func:`run_bin`)."""
     rows, comp = [], {}
     plan0 = hc._plan
     hcol.SOLVER = "ipopt"
@@ -88,7 +106,10 @@ def per_horizon(seed, updates):
 
     hc._plan = plan
     try:
-        run(p, wave)
+        if te8:
+            run_bin()
+        else:
+            run(*case(seed))
     except StopIteration:
         pass
     finally:
@@ -146,6 +167,21 @@ def kkt_baseline(seed, k=5):
         t = time.perf_counter()
         solver.update(kkt)
         print(f"  qdldl (AMD) numeric refactor {1000 * (time.perf_counter() - t):7.1f} ms")
+    kh = cs.hessian(hv, np.ones(cs.nf))
+    cs._kkt(kh, jac, 0.1, 0.0)
+    ldl = cs.ldl
+    vals = np.concatenate((kh.data[cs.kkt_ksel], jac.data,
+                           np.r_[np.full(cs.nf, 1e-8), np.full(cs.neq, -1e-8)]))
+    t = time.perf_counter()
+    for _ in range(10):
+        ldl.factor(vals, cs.neq)
+    tf = (time.perf_counter() - t) / 10
+    t = time.perf_counter()
+    for _ in range(10):
+        ldl.solve(np.ones(ldl.n))
+    print(f"  the compiled solver's L D L^T (its dense tail {ldl.n - ldl.s} rows): factor "
+          f"{1000 * tf:7.1f} ms, solve {100 * (time.perf_counter() - t):7.2f} ms, "
+          f"nnz(L) {ldl.li.size}")
     cs._factor(jac)
     t = time.perf_counter()
     for _ in range(10):
@@ -163,6 +199,9 @@ def main():
     ap.add_argument("--no-ipopt-run", action="store_true")
     ap.add_argument("--skip-horizons", action="store_true")
     ap.add_argument("--kkt", action="store_true")
+    ap.add_argument("--te8", action="store_true",
+                    help="the power matrix's Hs 1 m, Te 8 s bin (Tp 8.9 s), seed 0, in place "
+                         "of the default sea")
     a = ap.parse_args()
     if a.kkt:
         from parapend.hydro.control import _blas_controller
@@ -172,8 +211,9 @@ def main():
         return
     print(f"load average {os.getloadavg()[0]:.2f} {os.getloadavg()[1]:.2f}", flush=True)
     if not a.skip_horizons:
-        r = per_horizon(a.seed, a.updates)
-        print(f"seed {a.seed}, {len(r)} horizons, both from the same start:")
+        r = per_horizon(a.seed, a.updates, a.te8)
+        print(f"{'Hs 1 m, Te 8 s bin' if a.te8 else f'seed {a.seed}'}, {len(r)} horizons, "
+              "both from the same start:")
         print("  update  compiled_s  ipopt_s  ratio  it_c  it_i  st_c st_i  rel_obj  max_du")
         for k, row in enumerate(r):
             print(f"  {k:6d} {row[0]:10.4f} {row[1]:8.4f} {row[1] / row[0]:6.1f} "
@@ -197,15 +237,26 @@ def main():
               f"{np.median(ms[1]):.1f}", flush=True)
     print(f"load average {os.getloadavg()[0]:.2f} {os.getloadavg()[1]:.2f}", flush=True)
     p, wave = case(a.seed)
+    plan0, statuses = hc._plan, []
+
+    def plan(*args):
+        r = plan0(*args)
+        statuses.append(r.status)
+        return r
+
+    hc._plan = plan
     for solver in ("compiled",) + (() if a.no_ipopt_run else ("ipopt",)):
         hcol.SOLVER = solver
+        statuses.clear()
         t = time.perf_counter()
-        res = run(p, wave, a.forecast)
+        res = run_bin(a.forecast) if a.te8 else run(p, wave, a.forecast)
         wall = time.perf_counter() - t
         st = np.asarray(res._update_times)
-        print(f"whole run, seed {a.seed}, {a.forecast}, {solver}: electrical "
+        print(f"whole run, {'Te 8 s bin' if a.te8 else f'seed {a.seed}'}, {a.forecast}, "
+              f"{solver}: electrical "
               f"{res.electrical_power_w:.4f} W, status {res.status}, {res.solves} solves, "
-              f"{res.failed_solves} failed; update median {np.median(st):.3f} s, p99 "
+              f"{res.failed_solves} failed, {statuses.count(1)} capped; update median "
+              f"{np.median(st):.3f} s, p99 "
               f"{np.percentile(st, 99):.3f} s, max {np.max(st):.3f} s (interval 0.75 s); "
               f"wall {wall:.1f} s", flush=True)
         print(f"load average {os.getloadavg()[0]:.2f} {os.getloadavg()[1]:.2f}", flush=True)

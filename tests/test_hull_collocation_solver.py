@@ -81,17 +81,24 @@ def test_derivatives_are_casadis(kw):
     assert np.max(np.abs(hess - theirs)) <= 1e-12 * np.max(np.abs(theirs))
 
 
-@pytest.mark.parametrize("intervals, kw, updates, strategy",
-                         [(2, VARIANTS[0], 2, "adaptive"), (2, VARIANTS[1], 1, "adaptive"),
-                          (1, VARIANTS[0], 1, "adaptive"), (2, VARIANTS[0], 1, "monotone")])
-def test_compiled_reaches_ipopts_optimum(intervals, kw, updates, strategy):
+@pytest.mark.parametrize("intervals, kw, updates, strategy, step",
+                         [(2, VARIANTS[0], 2, "adaptive", "kkt"),
+                          (2, VARIANTS[1], 1, "adaptive", "kkt"),
+                          (1, VARIANTS[0], 1, "adaptive", "kkt"),
+                          (2, VARIANTS[0], 1, "monotone", "kkt"),
+                          (2, VARIANTS[0], 2, "adaptive", "nullspace")])
+def test_compiled_reaches_ipopts_optimum(intervals, kw, updates, strategy, step, monkeypatch):
     """One or two updates (the second from the first's solution shifted by one sample,
-    after the plant ran it): the compiled solver (either barrier update) and IPOPT from the
-    same start reach the same objective (1e-6 relative) and torques (1e-4 m g l), both
-    solved. (With an efficiency the smoothed kink of ``e(.)`` makes the problem's local
-    optima many: the second update of this small hull, or one Hermite-Simpson interval a
-    sample, ends the two at different local optima, neither below the other every time; so
-    does the monotone barrier's second update, 1.4 % below IPOPT's.)"""
+    after the plant ran it): the compiled solver (either barrier update, either Newton
+    step) and IPOPT from the same start reach the same objective (1e-6 relative) and
+    torques (1e-4 m g l), both solved. (With an efficiency the smoothed kink of ``e(.)``
+    makes the problem's local optima many: the second update of this small hull, or one
+    Hermite-Simpson interval a sample, ends the two at different local optima, neither
+    below the other every time; so does the monotone barrier's second update, 1.4 % below
+    IPOPT's.)"""
+    from parapend.hydro import _hull_collocation_ipm as ipm
+
+    monkeypatch.setattr(ipm, "STEP", step)
     plant, fseg, prob, ref = _pair(intervals, **kw)
     prob.shift = 1
     for k in range(updates):
@@ -267,3 +274,101 @@ def test_structured_solves_are_superlus(intervals):
     for mine, theirs in ((lin.solve(ju, torques=True), lu.solve(ju)),
                          (lin.solve(r), lu.solve(r)), (lin.solve_t(r), lu.solve(r, trans="T"))):
         assert np.max(np.abs(mine - theirs)) <= 1e-12 * np.max(np.abs(theirs))
+
+
+def _kkt_point(scale):
+    """The small horizon's compiled problem at a perturbed point with random multipliers
+    (times ``scale``: their curvature makes the Lagrangian's Hessian indefinite on the null
+    space of the Jacobian where large): the solver, ``K`` (sparse, on its rows), ``J``,
+    ``K`` and ``J`` dense, the rows' values and a gradient."""
+    plant, fseg, prob, _ = _pair(2)
+    cs = prob.compiled
+    par = prob._params(np.asarray(fseg))
+    rng = np.random.default_rng(1)
+    x = prob._with_memory(prob.guess(np.full(tc.N, 0.5), fseg), par)
+    x += 0.05 * rng.standard_normal(x.size)
+    x[:8] = par[:8]
+    cs._setup(par)
+    _, c, _, jv, _, hv = cs._eval(x, scale * rng.standard_normal(cs.nloc), 2, cs.fk, cs.e0)
+    cs.sig_s = rng.uniform(0.5, 2.0, cs.npt - 1)
+    diag = np.zeros(cs.nf)
+    diag[cs.nd:] = rng.uniform(0.1, 1.0, cs.n)
+    kmat, jac = cs.hessian(hv, diag), cs.jacobian(jv)
+    kd = np.zeros((cs.nf, cs.nf))
+    kd[np.ix_(cs.krows, cs.krows)] = kmat.toarray()
+    return cs, kmat, jac, kd, jac.toarray(), c, rng.standard_normal(cs.nf)
+
+
+def _inertia(a):
+    ev = np.linalg.eigvalsh(a)
+    return int(np.sum(ev > 0)), int(np.sum(ev < 0))
+
+
+def test_kkt_step_is_the_dense_solve():
+    """The Newton step from the sparse ``L D L^T`` of the whole KKT matrix (its static
+    regularization refined away) against NumPy's dense solve of ``[K, J^T; J, 0]``, and
+    against the step in the null space of ``J`` (the reduced Hessian on an orthonormal
+    basis from the structured solves with ``J_d``), to 1e-9 relative; no inertia
+    correction where the dense matrix's eigenvalues say the inertia is ``(n, m, 0)``."""
+    cs, kmat, jac, kd, jd, c, g = _kkt_point(1.0)
+    nf, ne = cs.nf, cs.neq
+    a = np.block([[kd, jd.T], [jd, np.zeros((ne, ne))]])
+    assert _inertia(a) == (nf, ne)
+    lin, delta = cs._kkt(kmat, jac, 0.1, 0.0)
+    assert delta == 0.0 and lin.delta_c == 0.0
+    ref = np.linalg.solve(a, -np.concatenate((g, c)))
+    dx, lam = lin.solve(g, c)
+    assert np.max(np.abs(np.concatenate((dx, lam)) - ref)) <= 1e-9 * np.max(np.abs(ref))
+    ns, _ = cs._null_space(kmat, jac, cs._factor(jac), 0.0)
+    dxn, lamn = ns.solve(g, c)
+    assert np.max(np.abs(dxn - dx)) <= 1e-9 * np.max(np.abs(dx))
+    assert np.max(np.abs(lamn - lam)) <= 1e-9 * np.max(np.abs(lam))
+
+
+def test_kkt_inertia_correction():
+    """Where the Lagrangian's curvature (multipliers 100 times larger) leaves the KKT
+    matrix with fewer than ``n`` positive eigenvalues (NumPy's dense eigenvalues), the
+    inertia correction adds ``delta_w I`` to ``K`` until the factors' pivots have the
+    signs ``(n, m)``, which the dense eigenvalues of the corrected matrix confirm, and the
+    step solves the corrected system (1e-9 relative)."""
+    cs, kmat, jac, kd, jd, c, g = _kkt_point(100.0)
+    nf, ne = cs.nf, cs.neq
+    a = np.block([[kd, jd.T], [jd, np.zeros((ne, ne))]])
+    assert _inertia(a)[0] < nf
+    lin, delta = cs._kkt(kmat, jac, 0.1, 0.0)
+    assert delta > 0.0
+    a[:nf, :nf] += delta * np.eye(nf)
+    a[nf:, nf:] -= lin.delta_c * np.eye(ne)
+    assert _inertia(a) == (nf, ne)
+    ref = np.linalg.solve(a, -np.concatenate((g, c)))
+    dx, lam = lin.solve(g, c)
+    assert np.max(np.abs(np.concatenate((dx, lam)) - ref)) <= 1e-9 * np.max(np.abs(ref))
+
+
+@pytest.mark.parametrize("dense", [True, False])
+def test_sparse_ldl_inertia_and_solve(dense, monkeypatch):
+    """The compiled ``L D L^T`` of a random quasi-definite matrix (and of one whose
+    ``(1, 1)`` block is indefinite) in the minimum-degree order, its trailing full columns
+    factored dense or not: its positive pivots are the dense eigenvalues' positive count,
+    its solve NumPy's to 1e-10 times the condition number; past ``maxneg`` negative pivots
+    it stops (-2)."""
+    from parapend.hydro import _hull_collocation_ldl as ldlmod
+    from parapend.hydro._hull_collocation_ldl import SparseLDL
+
+    monkeypatch.setattr(ldlmod, "DENSE_MIN", 8 if dense else 10 ** 9)
+    rng = np.random.default_rng(4)
+    n, m = 80, 30
+    b = np.where(rng.random((n, n)) < 0.05, rng.standard_normal((n, n)), 0.0)
+    jm = np.where(rng.random((m, n)) < 0.08, rng.standard_normal((m, n)), 0.0)
+    rhs = rng.standard_normal(n + m)
+    for shift in (3.0, -0.5):
+        k = b + b.T + shift * np.eye(n)
+        a = np.block([[k, jm.T], [jm, -0.1 * np.eye(m)]])
+        r, cc = np.nonzero(np.triu(a) + np.eye(n + m))
+        ldl = SparseLDL(n + m, r, cc)
+        assert (ldl.s < n + m) == dense
+        pos, neg = _inertia(a)
+        assert ldl.factor(a[r, cc], n + m) == pos
+        x = ldl.solve(rhs)
+        assert np.max(np.abs(a @ x - rhs)) <= 1e-10 * np.max(np.abs(rhs)) * np.linalg.cond(a)
+        assert ldl.factor(a[r, cc], neg - 1) == -2

@@ -40,6 +40,7 @@ KERNELS = {
     "parapend.hydro._buoy_plan_kernel": ("the buoy's motion planner", 60),
     "parapend.hydro._hull_collocation_kernel": ("the hull's collocation planner", 20),
     "parapend.hydro._hull_collocation_linalg": ("the hull's collocation planner's solves", 20),
+    "parapend.hydro._hull_collocation_ldl": ("the hull's collocation planner's factors", 20),
 }
 
 _lock = threading.Lock()

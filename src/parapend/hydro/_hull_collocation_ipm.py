@@ -13,17 +13,25 @@ memory causal). The Newton step of the barrier problem
     [J   0 ] [l+] = [-c],   K = W + Sigma_u + D^T Sigma_s D
 
 (``W`` the Hessian of the Lagrangian, ``Sigma`` the barrier's primal-dual weights of the
-torques' bounds and of the slacks ``s`` of the generator's speeds ``D x``) is taken in the
-null space of ``J``: ``dx = Y p + Q w`` with ``J_d p = -c``, ``Q = Z R^-1`` the orthonormal
-basis of the span of ``Z = [-J_d^-1 J_u; I]`` (``R`` Householder's; the torques'
-sensitivities ``Z`` reach 1e8 where the motion's linearization is unstable over the
-horizon, and ``Z^T K Z`` then loses the reduced Hessian to rounding), ``(Q^T K Q) w =
--Q^T (r + K Y p)`` (``n x n``, dense), then ``J_d^T l+ = -(r + K dx)_d``:
-the factors of ``J_d`` by its time structure (:mod:`._hull_collocation_linalg`) and
-``n + 2`` solves with them a step (the torques' columns from their samples on). The
-reduced Hessian ``Q^T K Q`` positive definite is the KKT matrix's inertia IPOPT asks for;
-where it is not, ``delta I`` is added to ``K`` as IPOPT's inertia correction does
-(``delta`` 0, then the last one's third or ``1e-4``, times 8 until the Cholesky succeeds).
+torques' bounds and of the slacks ``s`` of the generator's speeds ``D x``) is taken, as
+IPOPT takes it, from a factorization of that whole sparse KKT matrix (``STEP = "kkt"``, the
+default): its ``L D L^T`` in a minimum-degree order (:mod:`._hull_collocation_ldl`; the
+memory's rows, which couple every velocity node, end the order as a dense clique of about
+370 rows, factored dense), the inertia counted from ``D``, corrected as IPOPT's
+(:meth:`CompiledSolver._kkt`: ``delta_w I`` on ``K`` until it is ``(n, m, 0)``,
+``delta_c`` where singular), a static regularization 1e-9 refined away (at most
+``REFINE`` steps of iterative refinement). ``STEP = "nullspace"`` takes it in the null
+space of ``J`` instead: ``dx = Y p + Q w`` with ``J_d p = -c``, ``Q = Z R^-1`` the
+orthonormal basis of the span of ``Z = [-J_d^-1 J_u; I]`` (``R`` Householder's),
+``(Q^T K Q) w = -Q^T (r + K Y p)`` (``n x n``, dense, Cholesky with ``delta I`` added
+until it succeeds), then ``J_d^T l+ = -(r + K dx)_d``, the factors of ``J_d`` by its time
+structure (:mod:`._hull_collocation_linalg`). That condenses the motion over the whole
+horizon: the torques' sensitivities ``Z`` reach 1e8 where the pendulum's linearization is
+unstable over it. On 25 horizons captured from a run of the power matrix's Hs 1 m, Te 8 s
+bin (Tp 8.9 s: a 17.8 s horizon; started swinging, 40 iterations) it failed 11 and capped
+4, the KKT step (its first inertia correction then grown by 100, as IPOPT's) failed 1 and
+capped 1, IPOPT none; on the default sea's 12 s horizons both solved the same (the
+null-space step 2.3 times faster a horizon, median).
 
 **Method.** IPOPT's: the slacks ``D x - s = 0`` of the speed bounds, the fraction to the
 boundary ``max(0.99, 1 - mu)``, IPOPT's filter line search with its second-order
@@ -58,6 +66,7 @@ import scipy.sparse as sp
 from scipy.linalg import LinAlgError, cho_factor, cho_solve
 
 from . import _hull_collocation_kernel as kern
+from ._hull_collocation_ldl import EPS, SparseLDL
 from ._hull_collocation_linalg import Structured
 
 #: the barrier's first weight (IPOPT's ``mu_init``) cold and from a shifted solution (the
@@ -87,7 +96,10 @@ WATCHDOG_TRIALS = 3
 REF_RED = 0.9999
 REFS = 4
 #: a trial step's infeasibility at most this times the iterate's, or THETA_FLOOR (IPOPT's
-#: filter alone let the iterates wander far from feasibility on the hull's nonconvex horizons)
+#: filter alone let the null-space step's iterates wander far from feasibility on the hull's
+#: nonconvex horizons; with the KKT step, without the bound, the Te 8 s bin's closed loop
+#: realized 321.3 W perfect, 209.0 W AR with a failed solve, against 228.2 and 165.1 W with
+#: none: a chaotic loop, the bound kept for the failed solve)
 THETA_GROWTH = 10.0
 THETA_FLOOR = 1e-3
 #: the inertia correction's tries at most (``delta`` times 8 each), and its largest ``delta``
@@ -101,6 +113,12 @@ LAM_RESET = 1e3
 #: where the Newton's method on the equality rows (the torques held) is not taken, IPOPT's
 #: restoration phase by least-norm steps in all the unknowns (:meth:`_restore_min_norm`)
 RESTORATION = True
+#: the Newton step (module docstring): ``"kkt"`` (the whole KKT matrix's sparse ``L D
+#: L^T``) or ``"nullspace"`` (condensed on the torques: faster on short horizons, fails on
+#: long ones)
+STEP = "kkt"
+#: iterative refinement's steps at most on the KKT matrix
+REFINE = 5
 
 
 def _csc_pattern(rows, cols, nrow, ncol):
@@ -202,6 +220,17 @@ class CompiledSolver:
         self.kinv_s = kinv[nh + nr:]
         self.knnz = self.kind.size
         self.kpos = kpos
+        # the whole KKT matrix's pattern (its upper triangle of K, J, the diagonal) and
+        # the K entries of it (kmat's data order)
+        kcol = np.repeat(np.arange(nr), np.diff(self.kptr))
+        self.kkt_ksel = self.kind <= kcol
+        jcol = np.repeat(np.arange(nf), np.diff(self.jptr))
+        ntot = nf + self.neq
+        self.kkt_rows = np.concatenate((self.krows[self.kind[self.kkt_ksel]],
+                                        nf + self.jind.astype(np.int64), np.arange(ntot)))
+        self.kkt_cols = np.concatenate((self.krows[kcol[self.kkt_ksel]], jcol,
+                                        np.arange(ntot)))
+        self.ldl = None
 
     # -- the functions --------------------------------------------------------------------
     def _eval(self, x, lam, order, fk, e0, raw=False):
@@ -322,14 +351,17 @@ class CompiledSolver:
                 status, self.why = 2, "nonfinite"
                 break
             jac = self.jacobian(jv)
-            lu = self._factor(jac)
-            if lu is None:
+            # the factors of J_d: the null-space step's, and the multipliers' estimate
+            reset = lam is None or np.max(np.abs(lam)) > LAM_RESET
+            need = reset or STEP != "kkt"
+            lu = self._factor(jac) if need else None
+            if need and lu is None:
                 status, self.why = 2, "singular"
                 break
             gf = np.concatenate((grad[self.dep], grad[self.uix]))  # on the reduced columns
             rd = self._speeds(x) - s if self.speed else np.zeros(0)
             gdl = self._dt(lamd) if self.speed else np.zeros(nf)
-            if lam is None or np.max(np.abs(lam)) > LAM_RESET:
+            if reset:
                 # least-squares multipliers at the start (IPOPT's), after a restoration, and
                 # where the steps' ran away (the Hessian then all their curvature)
                 lam = lu.solve_t(-(gf[:nd] + gdl[:nd]))
@@ -369,34 +401,11 @@ class CompiledSolver:
             diag[nd:] = zl / sl_u + zu / su_u
             self.sig_s = zls / sls + zus / sus if ns else np.zeros(0)
             kmat = self.hessian(hv, diag)
-            zfull = np.empty((nf, n))
-            ju = jac[:, nd:].toarray()
-            zfull[:nd] = -lu.solve(ju, torques=True)
-            zfull[nd:] = np.eye(n)
-            # an orthonormal basis of the null space: the torques' sensitivities reach 1e8
-            # where the linearized motion is unstable over the horizon, and Z^T K Z then
-            # loses the reduced Hessian to rounding (Z R^-1 with Householder's R:
-            # orthonormal to 1e-16 times Z's condition)
-            zfull = zfull @ np.linalg.inv(np.linalg.qr(zfull, mode="r"))
-            zr = zfull[self.krows]
-            hred = zr.T @ (kmat @ zr)
-            delta, ztz, fac = 0.0, None, None  # (Q^T Q = I: delta I is IPOPT's delta_w)
-            for _ in range(MAX_CORRECTIONS):
-                if delta > MAX_DELTA:
-                    break
-                try:
-                    fac = cho_factor(hred if delta == 0.0 else hred + delta * ztz,
-                                     check_finite=False)
-                    if np.all(np.isfinite(fac[0])):
-                        break
-                except LinAlgError:
-                    pass
-                fac = None
-                if ztz is None:
-                    ztz = np.eye(n)
-                delta = ((1e-4 if delta_last == 0.0 else max(1e-20, delta_last / 3.0))
-                         if delta == 0.0 else 8.0 * delta)
-            if fac is None:
+            if STEP == "kkt":
+                lin, delta = self._kkt(kmat, jac, mu, delta_last)
+            else:
+                lin, delta = self._null_space(kmat, jac, lu, delta_last)
+            if lin is None:
                 # no inertia correction up to MAX_DELTA: the restoration phase (IPOPT's),
                 # the multipliers estimated anew after it
                 theta = self._theta(c, x, s)
@@ -432,7 +441,7 @@ class CompiledSolver:
                     free, refs = True, []
                 if free:
                     refs = (refs + [err0])[-REFS:]
-                    aff = _Newton(self, lu, fac, zfull, kmat, delta, gf, np.zeros(ns))
+                    aff = _Newton(self, lin, gf, np.zeros(ns))
                     adx, ads = aff.step(c, rd)[:2]
                     adu = adx[uo:uo + n]
                     slacks = np.concatenate((sl_u, su_u, sls, sus))
@@ -441,7 +450,7 @@ class CompiledSolver:
                     if MU_ORACLE == "quality":
                         cg = np.zeros(nf)
                         cg[nd:] = -1.0 / sl_u + 1.0 / su_u
-                        cen = _Newton(self, lu, fac, zfull, kmat, delta, cg,
+                        cen = _Newton(self, lin, cg,
                                       -1.0 / sls + 1.0 / sus if ns else np.zeros(0))
                         cdx, cds = cen.step(np.zeros(self.neq), np.zeros(ns))[:2]
                         cdu = cdx[uo:uo + n]
@@ -470,7 +479,7 @@ class CompiledSolver:
             gphi0 = gf.copy()
             gphi0[nd:] += -mu / sl_u + mu / su_u
             gphis = -mu / sls + mu / sus if ns else np.zeros(0)
-            newton = _Newton(self, lu, fac, zfull, kmat, delta, gphi0, gphis)
+            newton = _Newton(self, lin, gphi0, gphis)
             dx, ds, lam_new, lamd_new = newton.step(c, rd)
             ddu = dx[uo:uo + n]
             dzl = mu / sl_u - zl - zl / sl_u * ddu
@@ -586,6 +595,66 @@ class CompiledSolver:
                 zus = np.clip(zus, mu / (1e10 * (vm - s)), 1e10 * mu / (vm - s))
         self.lam, self.restorations = lam, nrest
         return x, float(f), status, it
+
+    def _kkt(self, kmat, jac, mu, delta_last):
+        """The whole KKT matrix factored with IPOPT's inertia correction: ``delta_w`` 0,
+        then ``1e-4`` (or a third of the last one) times 8 until the inertia is ``(nf,
+        neq, 0)`` (IPOPT grows its first correction by 100: that capped a captured horizon of
+        the Te 8 s bin which 8 solved in 18 iterations); ``delta_c = 1e-8
+        mu^(1/4)`` where the matrix is singular (a zero pivot, or too few negative ones).
+        ``(None, delta)`` past MAX_DELTA."""
+        if self.ldl is None:
+            self.ldl = SparseLDL(self.nf + self.neq, self.kkt_rows, self.kkt_cols)
+        kd, jd = kmat.data[self.kkt_ksel], jac.data
+        nf, ne = self.nf, self.neq
+        delta, dc = 0.0, 0.0
+        diag = np.empty(nf + ne)
+        for _ in range(MAX_CORRECTIONS):
+            diag[:nf] = delta + EPS
+            diag[nf:] = -(dc + EPS)
+            npos = self.ldl.factor(np.concatenate((kd, jd, diag)), ne)
+            if npos == nf:
+                return _FullKKT(self, self.ldl, kmat, jac, delta, dc), delta
+            if (npos == -1 or npos > nf) and dc == 0.0:
+                dc = 1e-8 * mu ** 0.25
+                continue
+            if delta == 0.0:
+                delta = 1e-4 if delta_last == 0.0 else max(1e-20, delta_last / 3.0)
+            else:
+                delta *= 8.0
+            if delta > MAX_DELTA:
+                break
+        return None, delta
+
+    def _null_space(self, kmat, jac, lu, delta_last):
+        """The reduced Hessian on the null space's orthonormal basis, Cholesky-factored
+        with the inertia correction ``delta I`` (0, then the last one's third or ``1e-4``,
+        times 8); ``(None, delta)`` past MAX_DELTA."""
+        n, nd, nf = self.n, self.nd, self.nf
+        zfull = np.empty((nf, n))
+        zfull[:nd] = -lu.solve(jac[:, nd:].toarray(), torques=True)
+        zfull[nd:] = np.eye(n)
+        # an orthonormal basis of the null space: the torques' sensitivities reach 1e8
+        # where the linearized motion is unstable over the horizon, and Z^T K Z then
+        # loses the reduced Hessian to rounding (Z R^-1 with Householder's R:
+        # orthonormal to 1e-16 times Z's condition)
+        zfull = zfull @ np.linalg.inv(np.linalg.qr(zfull, mode="r"))
+        zr = zfull[self.krows]
+        hred = zr.T @ (kmat @ zr)
+        delta = 0.0  # (Q^T Q = I: delta I is IPOPT's delta_w)
+        for _ in range(MAX_CORRECTIONS):
+            if delta > MAX_DELTA:
+                break
+            try:
+                fac = cho_factor(hred if delta == 0.0 else hred + delta * np.eye(n),
+                                 check_finite=False)
+                if np.all(np.isfinite(fac[0])):
+                    return _NullSpace(self, lu, fac, zfull, kmat, delta), delta
+            except LinAlgError:
+                pass
+            delta = ((1e-4 if delta_last == 0.0 else max(1e-20, delta_last / 3.0))
+                     if delta == 0.0 else 8.0 * delta)
+        return None, delta
 
     def _restore(self, x, s, max_iter=20):
         """``(x, s)`` with the equality rows solved by Newton's method on the unknowns but the
@@ -732,24 +801,20 @@ class CompiledSolver:
 
 class _Newton:
     """The Newton step of one iteration (module docstring) for any constraints' right side
-    (the second-order corrections reuse the factors)."""
+    (the second-order corrections reuse the factors ``lin``: :class:`_FullKKT` or
+    :class:`_NullSpace`)."""
 
-    def __init__(self, solver, lu, fac, zfull, kmat, delta, gphi0, gphis):
-        self.sv, self.lu, self.fac, self.zfull, self.kmat = solver, lu, fac, zfull, kmat
-        self.delta = delta
+    def __init__(self, solver, lin, gphi0, gphis):
+        self.sv, self.lin = solver, lin
         self.gphi0, self.gphis = gphi0, gphis
 
     def step(self, cr, rdr):
         """``(dx, ds, l+, l_d+)`` for the constraints' values ``cr`` and speeds' ``rdr``."""
         sv = self.sv
-        nd, nf = sv.nd, sv.nf
+        nd = sv.nd
         ns = sv.sig_s.size
         gphi = self.gphi0 + sv._dt(sv.sig_s * rdr + self.gphis) if ns else self.gphi0
-        yp = np.zeros(nf)
-        yp[:nd] = -self.lu.solve(cr)
-        du = cho_solve(self.fac, -(self.zfull.T @ (gphi + self.kmul(yp))), check_finite=False)
-        dxf = yp + self.zfull @ du
-        lnew = self.lu.solve_t(-(gphi + self.kmul(dxf))[:nd])
+        dxf, lnew = self.lin.solve(gphi, cr)
         ds = dxf[sv.d7] - dxf[sv.d6] + rdr if ns else np.zeros(0)
         dx = np.zeros(sv.nvar)
         dx[sv.dep] = dxf[:nd]
@@ -757,12 +822,66 @@ class _Newton:
         return dx, ds, lnew, sv.sig_s * ds + self.gphis if ns else np.zeros(sv.npt - 1)
 
 
-    def kmul(self, v):
-        """``(K + delta I) v``."""
-        out = self.delta * v
-        kr = self.sv.krows
-        out[kr] += self.kmat @ v[kr]
-        return out
+def _kmul(sv, kmat, delta, v):
+    """``(K + delta I) v`` (``kmat``: ``K`` on its rows ``sv.krows``)."""
+    out = delta * v
+    kr = sv.krows
+    out[kr] += kmat @ v[kr]
+    return out
+
+
+class _FullKKT:
+    """The Newton step from the ``L D L^T`` of the whole KKT matrix (``ldl``, its
+    regularization refined away on ``[K + delta I, J^T; J, -delta_c I]``)."""
+
+    def __init__(self, sv, ldl, kmat, jac, delta, delta_c):
+        self.sv, self.ldl, self.kmat, self.jac = sv, ldl, kmat, jac
+        self.delta, self.delta_c = delta, delta_c
+
+    def mul(self, v):
+        nf = self.sv.nf
+        dx, lv = v[:nf], v[nf:]
+        return np.concatenate((_kmul(self.sv, self.kmat, self.delta, dx) + self.jac.T @ lv,
+                               self.jac @ dx - self.delta_c * lv))
+
+    def solve(self, gphi, cr):
+        """``(dx, l+)`` of ``(K + delta I) dx + J^T l+ = -gphi``, ``J dx - delta_c l+ =
+        -cr`` (iterative refinement: at most REFINE steps, until the residual is 1e-12 of
+        the right side's)."""
+        rhs = -np.concatenate((gphi, cr))
+        v = self.ldl.solve(rhs)
+        scale = 1e-12 * max(1.0, float(np.max(np.abs(rhs))))
+        last = np.inf
+        for _ in range(REFINE):
+            r = rhs - self.mul(v)
+            res = float(np.max(np.abs(r)))
+            if not res > scale or not res < 0.5 * last:
+                break
+            last = res
+            v = v + self.ldl.solve(r)
+        nf = self.sv.nf
+        return v[:nf], v[nf:]
+
+
+class _NullSpace:
+    """The Newton step in the null space of ``J`` (``lu``: the factors of ``J_d``; ``fac``
+    the Cholesky factor of the reduced Hessian, ``zfull`` the null space's orthonormal
+    basis)."""
+
+    def __init__(self, sv, lu, fac, zfull, kmat, delta):
+        self.sv, self.lu, self.fac, self.zfull = sv, lu, fac, zfull
+        self.kmat, self.delta = kmat, delta
+
+    def solve(self, gphi, cr):
+        sv = self.sv
+        nd = sv.nd
+        yp = np.zeros(sv.nf)
+        yp[:nd] = -self.lu.solve(cr)
+        km = _kmul(sv, self.kmat, self.delta, yp)
+        du = cho_solve(self.fac, -(self.zfull.T @ (gphi + km)), check_finite=False)
+        dxf = yp + self.zfull @ du
+        lnew = self.lu.solve_t(-(gphi + _kmul(sv, self.kmat, self.delta, dxf))[:nd])
+        return dxf, lnew
 
 
 class _Search:

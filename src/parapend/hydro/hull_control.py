@@ -63,7 +63,10 @@ MAX_ITER = 60
 #: (the default solver), and the compiled solver's (a capped solve is applied): with 40 in place of
 #: 100 the default barge's seeds 0 to 9 (perfect forecast) realized 92.2 % of the record
 #: optimum (90.2 % with 100: the closed loop is chaotic), no solve failed, and the update's
-#: p99 fell from 0.3 to 2.3 s to 0.63 to 1.12 s (benchmarks/hull_collocation_table.out.txt)
+#: p99 fell from 0.3 to 2.3 s to 0.63 to 1.12 s (benchmarks/hull_collocation_table.out.txt;
+#: measured with its null-space step; with its KKT step and 100, the Te 8 s bin's closed
+#: loop realized 243.5 W perfect and 316.4 W AR, a solve failed, against 40's 228.2 and
+#: 165.1 W: a chaotic loop, 40 kept for the update's time)
 COLLOCATION_ITER = 100
 COMPILED_ITER = 40
 #: the collocation planner's terminal weight by default, times ``eta_g``: with 0.5 it
