@@ -417,3 +417,33 @@ def test_barge_ten_wave_record_under_a_limit_matrix_free_is_the_dense_answer():
     for x in (xk, xd):
         assert np.max(np.abs(HullProblem(cs).grid_state(x)["tau"])) <= limit * (1 + LIMIT_TOL)
     assert exk < ideal.power
+
+
+def test_a_matrix_free_least_torque_start_takes_few_newton_steps(monkeypatch):
+    """The least-torque motion only starts a take-off's search: matrix-free it is climbed by
+    at most ``FREE_MAX_NEWTON`` Newton steps (unbounded, the barge's 10-wave rotations ran
+    200 steps, 9 to 13 s each, without converging), and its motion is finite and closer to
+    the least torque than the start's."""
+    from parapend.hydro import hull
+    from parapend.optimal import fourier
+
+    calls = []
+    real = fourier.newton_maximize
+
+    def spy(*args, **kw):
+        r = real(*args, **kw)
+        calls.append((kw.get("maxiter"), r.iterations))
+        return r
+
+    monkeypatch.setattr(hull, "newton_maximize", spy)
+    monkeypatch.setattr(hull, "KRYLOV_HARMONICS", 4)
+    cs = case(winding=1, harmonics=12)
+    out = hull._free_motion(cs, 1)
+    assert out and calls
+    assert all(cap == hull.FREE_MAX_NEWTON and its <= cap for cap, its in calls)
+    pr = hull._lossy_problem(cs, copper_loss=1.0)
+    pr.a = 0.0
+    assert isinstance(pr, KrylovHullProblem)
+    for (_name, x), (_, x0) in zip(out, hull._starts(12, 1)[::2]):
+        assert np.all(np.isfinite(x))
+        assert pr.exact(x) > pr.exact(x0)

@@ -902,6 +902,15 @@ PTO_REFINE_TOL = 1e-4
 PTO_MAX_SCALE = 4
 
 
+#: Newton iterations of a matrix-free least-torque start (:func:`_free_motion`) at most: on
+#: the barge's 10-wave record (144 harmonics, the rotation's 12 turns) none of the four
+#: starts converged in 200 (9 to 13 s each: the least-torque rotations are many and flat),
+#: and from them the limited optima at 60 kN m were 1296 to 1406 W (30 steps: 1195 to 1384 W,
+#: 0.4 to 0.7 s each) against the search's 1480 W from an ideal maximum; at 30 kN m the
+#: climbs from either crawled (100 to 170 s each) to 1225 to 1350 W
+FREE_MAX_NEWTON = 30
+
+
 def _free_motion(case: HullCase, winding: int, coupled: bool = True):
     """The motion of least mean squared torque (``max -<tau^2>`` from the pendulum hanging,
     or from each quarter-turn phase of the turn): the free pendulum's periodic motion where
@@ -917,7 +926,12 @@ def _free_motion(case: HullCase, winding: int, coupled: bool = True):
             x0 = np.zeros_like(x0)
             x0[0] = math.pi
             name = "hanging"
-        x, ex, _ = maximize(pr, x0, (1.0,))
+        if pr.hessian == "operator":  # a start: a few Newton steps (FREE_MAX_NEWTON)
+            r = newton_maximize(pr, x0, "least-torque", gtol=GTOL, maxiter=FREE_MAX_NEWTON,
+                                saddle=False)
+            x, ex = r.x, r.power
+        else:
+            x, ex, _ = maximize(pr, x0, (1.0,))
         if math.isfinite(ex):
             out.append((f"least-torque:{name}", x))
         if winding == 0:
