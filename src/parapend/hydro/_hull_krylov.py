@@ -506,8 +506,8 @@ class KrylovHessian(HessianOperator):
         st = self.st
         p = -st["tau"] * st["relative_speed"]
         band = np.nonzero(np.abs(p) < KINK_BAND * pr.width)[0]
-        if band.size == 0:
-            return None
+        if band.size == 0 or band.size > KINK_SHARE * p.size:
+            return None  # no kink, or a width that smooths it over the grid
         w = np.abs(pr._e(p[band])[2]) / pr.points
         g0, gh = self._kink_rows(band)
         g = g0 if gh is None else g0 + gh
@@ -582,6 +582,9 @@ class KrylovHessian(HessianOperator):
 #: ``|p| < KINK_BAND s``: there the kink's curvature is above ``1 / KINK_BAND^3`` of its
 #: peak (on the 10-wave barge record 3 and 30 gave 38 and 29 products where 10 gave 29)
 KINK_BAND = 10.0
+#: ... when they are at most this share of the grid's points (at the first widths the band
+#: holds the whole grid: the diagonal serves there, and the rows would cost ``O(M^2)``)
+KINK_SHARE = 0.25
 
 #: each coarser discretization of :func:`continued_search` has this many times fewer
 #: harmonics
