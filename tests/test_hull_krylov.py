@@ -470,3 +470,29 @@ def test_barge_ten_wave_record_with_an_efficiency_matrix_free_is_the_dense_answe
     assert np.max(np.abs(xd - r.x)) < 1e-6
     assert exk == pytest.approx(electrical_power(d.state(r.x)["p"], eta)[0], rel=1e-12)
     assert exk < ideal.power
+
+
+def test_a_screened_start_goes_on_as_its_whole_continuation():
+    """A matrix-free efficiency's search screens its starts down to ``WIDTHS[PTO_SCREEN -
+    1]`` and continues only the best over the last widths, relative to the largest ``|p|``
+    at its start (:func:`parapend.hydro.hull._finish_screened`): the same widths as the
+    whole continuation from that start, so the same answer (the exact power to 1e-6,
+    measured 8.7e-8: the screening's last two widths are climbed to GTOL, the whole
+    continuation's to LEVEL_GTOL, and the paths part by that). Its
+    screened status is its last climb's, and the problem reports the objective of the
+    climb that gave the answer (its width one of the last ones)."""
+    from parapend.hydro.hull import PTO_SCREEN, HullPTO, _finish_screened, _pto_maximize
+    from parapend.hydro.pto import WIDTHS
+
+    cs = _record(harmonics=24, winding=0)
+    ideal = hull_search(lambda s: cs, refine=False)
+    pto = HullPTO(efficiency=(0.9, 0.85))
+    k = KrylovHullProblem(cs, eta=pto.efficiency)
+    whole = _pto_maximize(k, ideal.x, pto, True)
+    xs, exs, status, _ = _pto_maximize(k, ideal.x, pto, True, WIDTHS[:PTO_SCREEN])
+    assert status == "converged"
+    x, ex, _, _ = _finish_screened(k, pto, xs, ideal.x, WIDTHS[PTO_SCREEN:])
+    assert ex == pytest.approx(whole[1], rel=1e-6)
+    p0 = float(np.max(np.abs(k.state(ideal.x)["p"])))
+    assert any(k.answer[0] == pytest.approx(w * p0) for w in WIDTHS[PTO_SCREEN:]) or \
+        ex == exs

@@ -950,8 +950,8 @@ def _pto_maximize(pr: HullProblem, x, pto: HullPTO, first: bool, widths=None,
     if screening:
         ok = log[-1][2] == "converged"
     elif pto.smoothed:
-        scale = max(abs(ex), float(pr.w[0]))  # the power, or m g l w near zero
-        ok = len(last) >= 2 and abs(last[-1] - last[-2]) <= PTO_SETTLED * scale
+        size = max(abs(ex), float(pr.w[0]))  # the power, or m g l w near zero
+        ok = len(last) >= 2 and abs(last[-1] - last[-2]) <= PTO_SETTLED * size
     elif pto.torque_limit is None:
         # a copper loss alone: smooth; trust-exact's "stalled" at a maximum is its precision
         ok = log[-1][2] == "converged" or float(np.max(np.abs(pr.evaluate(x)[1]))) <= \
