@@ -434,9 +434,9 @@ def test_barge_ten_wave_record_under_a_limit_matrix_free_is_the_dense_answer():
 @pytest.mark.slow
 def test_barge_ten_wave_record_with_an_efficiency_matrix_free_is_the_dense_answer():
     """The embedded barge's 10-wave record (144 harmonics, swinging) with the efficiency
-    0.9, 0.85: the matrix-free continuation from the ideal optimum down to 1e-5 of the
+    0.9, 0.85: the matrix-free continuation from the ideal optimum down to 1e-6 of the
     largest ``|p|`` (Newton with truncated conjugate gradients, preconditioned by the kink's
-    low-rank part at the last widths) ends on a maximum that the dense driver (trust-exact,
+    low-rank part at the last width) ends on a maximum that the dense driver (trust-exact,
     the same width) climbs back to from the answer perturbed (by 1e-5 rad per coefficient:
     its power about 1e-4 lower): the same exact power to 1e-8; and that power is the exact
     electrical mean power of the motion's mechanical power
@@ -455,8 +455,8 @@ def test_barge_ten_wave_record_with_an_efficiency_matrix_free_is_the_dense_answe
     ideal = hull_search(lambda s: cs, refine=False)
     k = KrylovHullProblem(cs, eta=eta)
     p0 = float(np.max(np.abs(k.state(ideal.x)["p"])))
-    x1, _, _ = pto_maximize(k, ideal.x, WIDTHS[:WIDTHS.index(1e-5)])
-    k.width = 1e-5 * p0
+    x1, _, _ = pto_maximize(k, ideal.x, WIDTHS[:WIDTHS.index(1e-5) + 1])
+    k.width = 1e-6 * p0
     r = newton_maximize(k, x1, "width", gtol=GTOL, maxiter=200, saddle=False)
     assert r.status == "converged"
     assert k.evaluate(r.x)[2].low_rank() is not None  # the kink's preconditioner in use
