@@ -273,13 +273,25 @@ def test_lanczos_finds_a_crowded_top_of_the_spectrum(power):
     assert top is not None and top == pytest.approx(-0.0146, rel=LANCZOS_TOL)
 
 
-def test_each_mode_carries_its_optimality(dataset):
+@pytest.mark.parametrize("pto", [{}, {"efficiency": "0.9,0.85"}])
+def test_each_mode_carries_its_optimality(dataset, pto):
     """A hull answer's modes carry the gradient's largest entry and the Hessian's largest
     eigenvalue at their maxima (negative: strict maxima); the gradient below Newton's
-    stopping rule at rounding (1e-7 of m g l w)."""
+    stopping rule at rounding (1e-7 of m g l w). With an efficiency they are the smoothed
+    objective's at the width of the answer's climb, which the mode states; there they say
+    what the climb left (this wave's swinging answer at 48 harmonics: the dense trust region
+    stopped short of the smallest width's maximum, its gradient 6.2e3 W/rad, its Hessian's
+    largest eigenvalue positive; the rotation's 2.5e-3 and negative): checked against
+    independent computations in tests/test_hull_pto.py."""
     r = parapend.buoy(dofs="surge,heave,pitch", hydro=dataset, wave_height=1.0,
-                      wave_period=2 * math.pi / 1.2, **PEND)
+                      wave_period=2 * math.pi / 1.2, **PEND, **pto)
     for m in r.modes[:-1]:
+        assert (m["optimality_smoothing_width_w"] is None) == (not pto)
+        if pto:
+            assert m["optimality_smoothing_width_w"] > 0
+            assert math.isfinite(m["gradient_max_w_per_rad"])
+            assert math.isfinite(m["hessian_largest_eigenvalue_w_per_rad2"])
+            continue
         assert m["gradient_max_w_per_rad"] <= 1e-7 * PEND["mass"] * 9.81 * 1.2
         assert m["hessian_largest_eigenvalue_w_per_rad2"] < 0
         assert m["hessian_scaled_largest_eigenvalue"] < 0
@@ -447,3 +459,68 @@ def test_a_matrix_free_least_torque_start_takes_few_newton_steps(monkeypatch):
     for (_name, x), (_, x0) in zip(out, hull._starts(12, 1)[::2]):
         assert np.all(np.isfinite(x))
         assert pr.exact(x) > pr.exact(x0)
+@pytest.mark.slow
+def test_barge_ten_wave_record_with_an_efficiency_matrix_free_is_the_dense_answer():
+    """The embedded barge's 10-wave record (144 harmonics, swinging) with the efficiency
+    0.9, 0.85: the matrix-free continuation from the ideal optimum down to 1e-6 of the
+    largest ``|p|`` (Newton with truncated conjugate gradients, preconditioned by the kink's
+    low-rank part at the last width) ends on a maximum that the dense driver (trust-exact,
+    the same width) climbs back to from the answer perturbed (by 1e-5 rad per coefficient:
+    its power about 1e-4 lower): the same exact power to 1e-8; and that power is the exact
+    electrical mean power of the motion's mechanical power
+    (:func:`parapend.hydro.pto.electrical_power`, the kink integrated, no smoothing)."""
+    from parapend.hydro._hull_krylov import pto_maximize
+    from parapend.hydro.api import hull_problem
+    from parapend.hydro.coupled import Wave
+    from parapend.hydro.hull import make_case
+    from parapend.hydro.pto import WIDTHS, electrical_power, maximize
+
+    eta = (0.9, 0.85)
+    p = hull_problem(dofs="surge,heave,pitch")
+    wave = Wave.from_spectrum(hs=1.5, tp=6.0, repeat_period=60.0, seed=0)
+    cs = make_case(p["hull"], p["pendulum"], wave, winding=0, pivot=p["pivot"])
+    assert cs.harmonics == 144
+    ideal = hull_search(lambda s: cs, refine=False)
+    k = KrylovHullProblem(cs, eta=eta)
+    p0 = float(np.max(np.abs(k.state(ideal.x)["p"])))
+    x1, _, _ = pto_maximize(k, ideal.x, WIDTHS[:WIDTHS.index(1e-5) + 1])
+    k.width = 1e-6 * p0
+    r = newton_maximize(k, x1, "width", gtol=GTOL, maxiter=200, saddle=False)
+    assert r.status == "converged"
+    assert k.evaluate(r.x)[2].low_rank() is not None  # the kink's preconditioner in use
+    d = HullProblem(cs, eta=eta)
+    xs = r.x + 1e-5 * np.sin(np.arange(r.x.size))
+    exk = k.exact(r.x)
+    assert d.exact(xs) < exk * (1 - 1e-5)
+    pd = float(np.max(np.abs(d.state(xs)["p"])))
+    xd, _, runs = maximize(d, xs, (k.width / pd,))
+    assert runs[-1][1] == pytest.approx(exk, rel=1e-8)  # where the dense climb ended
+    assert np.max(np.abs(xd - r.x)) < 1e-6
+    assert exk == pytest.approx(electrical_power(d.state(r.x)["p"], eta)[0], rel=1e-12)
+    assert exk < ideal.power
+
+
+def test_a_screened_start_goes_on_as_its_whole_continuation():
+    """A matrix-free efficiency's search screens its starts down to ``WIDTHS[PTO_SCREEN -
+    1]`` and continues only the best over the last widths, relative to the largest ``|p|``
+    at its start (:func:`parapend.hydro.hull._finish_screened`): the same widths as the
+    whole continuation from that start, so the same answer (the exact power to 1e-6,
+    measured 8.7e-8: the screening's last two widths are climbed to GTOL, the whole
+    continuation's to LEVEL_GTOL, and the paths part by that). Its
+    screened status is its last climb's, and the problem reports the objective of the
+    climb that gave the answer (its width one of the last ones)."""
+    from parapend.hydro.hull import PTO_SCREEN, HullPTO, _finish_screened, _pto_maximize
+    from parapend.hydro.pto import WIDTHS
+
+    cs = _record(harmonics=24, winding=0)
+    ideal = hull_search(lambda s: cs, refine=False)
+    pto = HullPTO(efficiency=(0.9, 0.85))
+    k = KrylovHullProblem(cs, eta=pto.efficiency)
+    whole = _pto_maximize(k, ideal.x, pto, True)
+    xs, exs, status, _ = _pto_maximize(k, ideal.x, pto, True, WIDTHS[:PTO_SCREEN])
+    assert status == "converged"
+    x, ex, _, _ = _finish_screened(k, pto, xs, ideal.x, WIDTHS[PTO_SCREEN:])
+    assert ex == pytest.approx(whole[1], rel=1e-6)
+    p0 = float(np.max(np.abs(k.state(ideal.x)["p"])))
+    assert any(k.answer[0] == pytest.approx(w * p0) for w in WIDTHS[PTO_SCREEN:]) or \
+        ex == exs

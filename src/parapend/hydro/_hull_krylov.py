@@ -438,6 +438,7 @@ class KrylovHessian(HessianOperator):
         self.d2 = d2
         self.sens = sens
         self._d6 = None
+        self._low = None
         self.diagonal = -self._diag_xx()
 
     def _diag_xx(self):
@@ -479,6 +480,111 @@ class KrylovHessian(HessianOperator):
     def precondition(self, r):  # the diagonal only (``mostly_positive`` is False)
         return r / np.abs(self.diagonal)
 
+    def low_rank(self):
+        """The conjugate gradients' preconditioner for a smoothed efficiency's kink (None
+        without one): ``M = D' + G W G^T``, applied by Woodbury's identity.
+
+        The kink's curvature ``e''(p_j) = b s^2 / (p_j^2 + s^2)^{3/2}`` is a rank-one term
+        ``|e''_j| g_j g_j^T / M`` of ``-H`` per grid point, ``g_j = dp_j / dx``: at the
+        last widths a few hundred points near ``p = 0`` carry curvatures ``|b| / s`` that
+        the diagonal does not tame (the 10-wave barge record's last width: 1234
+        conjugate-gradient products per step to 1e-4 on its diagonal, 31 on this one). The
+        points ``|p_j| < KINK_BAND s`` are taken, ``g_j`` is their row of ``p``'s
+        Jacobian: the pendulum's part exactly, the hull's through ``Z^{-T}`` in place of
+        ``S^{-T}`` (:meth:`_kink_rows`); ``D'`` is ``L_xx``'s exact diagonal less those
+        points' kink part (floored at ``1e-6`` of itself)."""
+        if self._low is None:
+            self._low = (self._kink_preconditioner(),)
+        return self._low[0]
+
+    def _kink_preconditioner(self):
+        from scipy.linalg import cho_factor, cho_solve
+
+        pr = self.problem
+        if pr.b == 0.0 or pr.width <= 0.0:
+            return None
+        st = self.st
+        p = -st["tau"] * st["relative_speed"]
+        band = np.nonzero(np.abs(p) < KINK_BAND * pr.width)[0]
+        if band.size == 0 or band.size > KINK_SHARE * p.size:
+            return None  # no kink, or a width that smooths it over the grid
+        w = np.abs(pr._e(p[band])[2]) / pr.points
+        g0, gh = self._kink_rows(band)
+        g = g0 if gh is None else g0 + gh
+        dg = np.abs(self.diagonal)
+        dp = np.maximum(self.diagonal - np.einsum("ik,k,ik->i", g0, w, g0),
+                        1e-6 * dg + 1e-300)
+        try:
+            if band.size >= dp.size:  # more points than unknowns: M itself
+                full = cho_factor(np.diag(dp) + (g * w) @ g.T)
+                return lambda r: cho_solve(full, r)
+            dinv = 1.0 / dp
+            dgv = dinv[:, None] * g
+            cap = cho_factor(np.diag(1.0 / w) + g.T @ dgv)
+        except np.linalg.LinAlgError:
+            return None
+
+        def apply(r):
+            y = dinv * r
+            return y - dgv @ cho_solve(cap, g.T @ y)
+
+        return apply
+
+    def _kink_rows(self, band):
+        """The rows ``dp_j / dx`` (columns of the result, ``(2N + 1, K)``) of the points
+        ``band``: the pendulum's part ``P^T (dp_j / d(phi, phi', phi''))`` exactly (the
+        trigonometric basis at ``s_j``), and the hull's ``T^T Q^T (dp_j / dq)`` with
+        ``S^{-T}`` replaced by the frequency-diagonal ``Z^{-T}`` (None one-way)."""
+        pr, st = self.problem, self.st
+        cs = pr.case
+        ml = cs.m * cs.l
+        n, kn = pr.harmonics, pr._kn
+        sn, co = st["sin_phi"][band], st["cos_phi"][band]
+        tau, v = st["tau"][band], st["relative_speed"][band]
+        qx, qz = st["qx"][band], st["qz"][band]
+        # dp = -(v dtau + tau dv), dtau = (-m l w_phi, c, I, m l cos, -m l sin, -c)
+        c0 = v * ml * ((cs.g + qz) * co + qx * sn)
+        c1 = -(v * cs.c + tau)
+        c2 = -v * cs.I
+        ang = np.outer(pr.s[band], np.arange(1, n + 1))
+        sa, ca = np.sin(ang), np.cos(ang)
+        k1, k2 = kn[None, :], kn[None, :] ** 2
+        a = c0[:, None] * sa + c1[:, None] * k1 * ca - c2[:, None] * k2 * sa
+        b = c0[:, None] * ca - c1[:, None] * k1 * sa - c2[:, None] * k2 * ca
+        g0 = np.concatenate((c0[:, None], a, b), axis=1).T
+        if not pr.coupled:
+            return g0, None
+        dpv, hp = cs.pivot
+        kh = pr._kh
+        m = pr.points
+        cx, cz, cb = -v * ml * co, v * ml * sn, v * cs.c + tau
+        gh = np.empty_like(g0)
+        chunk = max(1, (1 << 22) // (3 * m))
+        for lo in range(0, band.size, chunk):
+            sl = slice(lo, lo + chunk)
+            e = np.exp(-1j * np.outer(pr.s[band[sl]], kh))  # the deltas' spectra
+            wx, wz, wb = cx[sl, None] * e, cz[sl, None] * e, cb[sl, None] * e
+            q = np.stack((-kh**2 * wx, -kh**2 * wz,
+                          -kh**2 * (hp * wx - dpv * wz) - 1j * kh * wb), axis=1)
+            lam = np.einsum("ijk,njk->nik", pr._zinvth, q)
+            mu = pr._synth((2.0 / m) * lam)
+            grid = np.stack([sum(self.sens[3 * d + i] * mu[:, d] for d in range(3))
+                             for i in range(3)], axis=1)
+            wf = np.conj(_rfft(grid)[..., 1:n + 1])
+            u = wf[:, 0] + 1j * kn * wf[:, 1] - kn**2 * wf[:, 2]
+            gh[0, sl] = np.sum(grid[:, 0], axis=-1)
+            gh[1:n + 1, sl] = u.imag.T
+            gh[n + 1:, sl] = u.real.T
+        return g0, gh
+
+
+#: the kink's preconditioner (:meth:`KrylovHessian.low_rank`) takes the grid points with
+#: ``|p| < KINK_BAND s``: there the kink's curvature is above ``1 / KINK_BAND^3`` of its
+#: peak (on the 10-wave barge record 3 and 30 gave 38 and 29 products where 10 gave 29)
+KINK_BAND = 10.0
+#: ... when they are at most this share of the grid's points (at the first widths the band
+#: holds the whole grid: the diagonal serves there, and the rows would cost ``O(M^2)``)
+KINK_SHARE = 0.25
 
 #: each coarser discretization of :func:`continued_search` has this many times fewer
 #: harmonics
@@ -575,6 +681,7 @@ def _continued_pto(case: HullCase, make, sol: HullSolution, pto, refine: bool):
                                    one_way_x=_pad(sol.one_way_x, n), success=False)
     pr = pto.problem(case)
     x, ex, status, its = _hull._pto_maximize(pr, _pad(sol.x, n), pto, False)
+    kkt = pr.answer
     x1, ex1, _, its1 = _hull._pto_maximize(pto.problem(case, coupled=False),
                                            _pad(sol.one_way_x, n), pto, False)
     if not math.isfinite(ex):
@@ -598,7 +705,7 @@ def _continued_pto(case: HullCase, make, sol: HullSolution, pto, refine: bool):
         runs=sol.runs + 2, iterations=sol.iterations + its + its1,
         energy_balance_residual=float(mech.balance(x)[2]),
         mechanical_power=float(mech.mechanical(x)), refinement_history=history,
-        refinement_change=change if refine else None)
+        refinement_change=change if refine else None, pto_state=kkt)
 
 
 #: the torque limit's augmented Lagrangian, matrix-free (:func:`limited`): the first inner
@@ -651,7 +758,7 @@ def limited(problem: KrylovHullProblem, x, limit: float, gtol: float, warm: bool
 
 
 def pto_maximize(problem: KrylovHullProblem, x0, widths=None, limit=None,
-                 max_inner: int | None = None):
+                 max_inner: int | None = None, scale: float | None = None):
     """:func:`parapend.hydro.pto.maximize` matrix-free: the continuation in the
     efficiency's smoothing width ``s -> 0`` (``widths`` relative to the largest ``|p|`` at
     ``x0``), each width climbed by Newton with truncated conjugate gradients, under the
@@ -660,13 +767,16 @@ def pto_maximize(problem: KrylovHullProblem, x0, widths=None, limit=None,
     (whose exact powers :func:`.hull._pto_maximize` compares) to ``GTOL``. Returns
     ``(x, exact, runs)`` as that function: the iterate with the largest exact
     (unsmoothed) objective among those within the limit, and per width ``(s, exact,
-    status, iterations)``. ``max_inner``: unused (the inexact climbs bound themselves)."""
+    status, iterations)``. ``max_inner``: unused (the inexact climbs bound themselves).
+    ``scale``: the ``|p|`` the widths are relative to (by default the largest at ``x0``; a
+    screened start's last widths, :func:`.hull._finish_screened`, keep its start's)."""
     from .pto import LIMIT_TOL, WIDTHS
 
     widths = WIDTHS if widths is None else widths
     x = np.array(x0, dtype=float)
-    p0 = float(np.max(np.abs(problem.state(x)["p"])))
+    p0 = float(np.max(np.abs(problem.state(x)["p"]))) if scale is None else float(scale)
     best_x, best = x.copy(), (problem.exact(x) if limit is None else -math.inf)
+    problem.answer = None
     runs = []
     for i, rel in enumerate(widths):
         problem.width = rel * p0
@@ -682,6 +792,8 @@ def pto_maximize(problem: KrylovHullProblem, x0, widths=None, limit=None,
         if math.isfinite(ex) and ex >= best and (limit is None or
                                                  viol <= LIMIT_TOL * limit):
             best, best_x = ex, np.array(x)
+            problem.answer = (problem.climbed_state() if limit is None else
+                              problem.climbed)
     problem.limit = None
     return best_x, best, runs
 

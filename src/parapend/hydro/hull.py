@@ -659,6 +659,11 @@ class HullSolution:
     maxima_powers: tuple = ()
     #: ``(harmonics, power)`` of each stage of the refinement, coarsest first
     refinement_history: tuple = ()
+    #: a take-off's objective that the answer maximizes (None: the ideal power's):
+    #: ``(width, limit, rho, lam_hi, lam_lo)``, the efficiency's smoothing width of the
+    #: climb that gave the answer, and under a limit its augmented Lagrangian's penalty and
+    #: multipliers (:meth:`parapend.hydro.pto.PTOObjective.climbed_state`)
+    pto_state: tuple | None = None
 
 
 def aliased(problem: HullProblem, x) -> bool:
@@ -757,6 +762,7 @@ def _refine(sol: HullSolution, make, x) -> HullSolution:
 
     pto = sol.pto
     x1, p1 = sol.one_way_x, sol.one_way_power
+    kkt = sol.pto_state
     history = [(case.harmonics, float(power))]
     top = PTO_MAX_SCALE if pto.active else MAX_SCALE
     # a lossy take-off's problem is dense (its cost the cube of the harmonics): one doubling
@@ -780,6 +786,7 @@ def _refine(sol: HullSolution, make, x) -> HullSolution:
         if pto.active:
             pr = pto.problem(case)
             xr, pr_power, st, _ = _pto_maximize(pr, _pad(x, case.harmonics), pto, False)
+            kr = pr.answer
             if not math.isfinite(pr_power):
                 # no motion within the limit in the budget: the coarser answer stands, its
                 # resolution unchecked (not a success)
@@ -796,13 +803,13 @@ def _refine(sol: HullSolution, make, x) -> HullSolution:
         else:
             pr = ideal_problem(case)
             r = newton_maximize(pr, _pad(x, case.harmonics), "refined", gtol=GTOL)
-            xr, pr_power, st = r.x, r.power, r.status
+            xr, pr_power, st, kr = r.x, r.power, r.status, None
         if st != "converged":
             status, ok = f"refinement to {case.harmonics} harmonics: {st}", False
         elif pto.active:  # the answer is the finest stage's, and so is its status
             status, ok = "converged", True
         change = abs(pr_power - power)
-        x, power = xr, float(pr_power)
+        x, power, kkt = xr, float(pr_power), kr
         history.append((case.harmonics, power))
         if change <= (PTO_REFINE_TOL if pto.active else REFINE_TOL) * max(abs(power),
                                                                           1e-300):
@@ -827,7 +834,8 @@ def _refine(sol: HullSolution, make, x) -> HullSolution:
                                refinement_change=None if math.isnan(change) else float(change),
                                refinement_history=tuple(history),
                                energy_balance_residual=float(resid),
-                               one_way_power=float(p1), one_way_x=x1, mechanical_power=mech)
+                               one_way_power=float(p1), one_way_x=x1, mechanical_power=mech,
+                               pto_state=kkt)
 
 
 #: a torque limit is held between the grid's points to within this fraction (the overshoot
@@ -850,7 +858,8 @@ def hold_limit(sol: HullSolution, peak_torque=None) -> HullSolution:
     1.8e-3 overshoot on the default barge's record at 60 kN m); a peak that falls short
     raises the grid's limit again, never past the limit. Its power is then the take-off's
     objective at the true limit (no penalty); the status says how far the grid's limit was
-    lowered (the answer's own check then states a peak left above the limit)."""
+    lowered (the answer's own check then states a peak left above the limit), and its
+    ``pto_state`` is the lowered limit's (the objective the answer maximizes)."""
     pto = sol.pto
     if pto.torque_limit is None or not math.isfinite(sol.power):
         return sol
@@ -869,11 +878,12 @@ def hold_limit(sol: HullSolution, peak_torque=None) -> HullSolution:
     # the limit: the power given away)
     while (over > HOLD_TOL or (over < -HOLD_TOL and grid < limit)) and steps < HOLD_STEPS:
         lower = dataclasses.replace(pto, torque_limit=min(limit, grid / (1 + over)))
-        xr, ex, _, n = _pto_maximize(lower.problem(case), x, lower, False)
+        low = lower.problem(case)
+        xr, ex, _, n = _pto_maximize(low, x, lower, False)
         its += n
         if not math.isfinite(ex):
             break
-        x, grid, steps = xr, lower.torque_limit, steps + 1
+        x, grid, steps, state = xr, lower.torque_limit, steps + 1, low.answer
         over = overshoot(x)
     if steps == 0:
         return sol
@@ -883,7 +893,7 @@ def hold_limit(sol: HullSolution, peak_torque=None) -> HullSolution:
         status=(f"{sol.status}; the grid's limit lowered by {limit / grid - 1:.2g} to hold "
                 f"the limit between its points ({steps} solve{'s' if steps > 1 else ''})"),
         iterations=sol.iterations + its, energy_balance_residual=float(mech.balance(x)[2]),
-        mechanical_power=float(mech.mechanical(x)))
+        mechanical_power=float(mech.mechanical(x)), pto_state=state)
 
 
 #: distinct ideal maxima that start the PTO's optimum
@@ -960,22 +970,32 @@ def _maximizer(pr: HullProblem):
     return maximize
 
 
-def _pto_maximize(pr: HullProblem, x, pto: HullPTO, first: bool):
+def _pto_maximize(pr: HullProblem, x, pto: HullPTO, first: bool, widths=None,
+                  scale=None):
     """The PTO's optimum from ``x``: the smoothing continuation (an efficiency) under the
     torque limit (:func:`parapend.hydro.pto.maximize`). Returns ``(x, exact, status,
-    iterations)``."""
+    iterations)``. ``widths``: these widths (relative to ``scale``, the matrix-free
+    driver's, or to the largest ``|p|`` at ``x``) instead of the continuation's; a screening
+    (:func:`_screened`) when they end above the last one: "converged" then when the last
+    width's climb converged."""
     from .pto import WIDTHS, WIDTHS_REFINE
 
-    widths = (WIDTHS if first else WIDTHS_REFINE) if pto.smoothed else (1.0,)
+    screening = widths is not None and widths[-1] > WIDTHS[-1]
+    if widths is None:
+        widths = (WIDTHS if first else WIDTHS_REFINE) if pto.smoothed else (1.0,)
+    kw = {} if scale is None else {"scale": scale}
     x, ex, log = _maximizer(pr)(pr, np.asarray(x, dtype=float), widths, pto.torque_limit,
-                                max_inner=PTO_MAX_INNER if first else PTO_MAX_INNER_REFINE)
+                                max_inner=PTO_MAX_INNER if first else PTO_MAX_INNER_REFINE,
+                                **kw)
     its = sum(r[3] for r in log)
     last = [r[1] for r in log if math.isfinite(r[1])]
     if not math.isfinite(ex):
         return x, ex, "no motion within the torque limit", its
-    if pto.smoothed:
-        scale = max(abs(ex), float(pr.w[0]))  # the power, or m g l w near zero
-        ok = len(last) >= 2 and abs(last[-1] - last[-2]) <= PTO_SETTLED * scale
+    if screening:
+        ok = log[-1][2] == "converged"
+    elif pto.smoothed:
+        size = max(abs(ex), float(pr.w[0]))  # the power, or m g l w near zero
+        ok = len(last) >= 2 and abs(last[-1] - last[-2]) <= PTO_SETTLED * size
     elif pto.torque_limit is None:
         # a copper loss alone: smooth; trust-exact's "stalled" at a maximum is its precision
         ok = log[-1][2] == "converged" or float(np.max(np.abs(pr.evaluate(x)[1]))) <= \
@@ -983,6 +1003,33 @@ def _pto_maximize(pr: HullProblem, x, pto: HullPTO, first: bool):
     else:
         ok = log[-1][2] == "converged"
     return x, ex, "converged" if ok else f"stalled ({log[-1][2]})", its
+
+
+#: a matrix-free efficiency's search screens its starts: each start's continuation runs
+#: over the widths down to ``WIDTHS[PTO_SCREEN - 1]`` (1e-4 of the largest ``|p|``), and only
+#: the best start's (and the best one-way start's) goes on over the last ones, whose climbs
+#: cost the most (the 10-wave barge record from the ideal optimum: 6.7 s of 59 s down to
+#: 1e-4, the last width alone 41 s)
+PTO_SCREEN = 7
+
+
+def _screened(pr: HullProblem, pto: HullPTO) -> tuple:
+    """``(screening widths, last widths)`` of a matrix-free efficiency's search
+    (:data:`PTO_SCREEN`); ``()`` for a dense problem or without an efficiency (each start's
+    continuation whole)."""
+    from .pto import WIDTHS
+
+    if not (pto.smoothed and pr.hessian == "operator" and "maximize" in MATRIX_FREE):
+        return ()
+    return WIDTHS[:PTO_SCREEN], WIDTHS[PTO_SCREEN:]
+
+
+def _finish_screened(pr: HullProblem, pto: HullPTO, x, x0, widths):
+    """A screened start's continuation over the last ``widths`` from its screened iterate
+    ``x``, the widths relative to the largest ``|p|`` at its start ``x0`` (as the whole
+    continuation's). Returns :func:`_pto_maximize`'s tuple."""
+    scale = float(np.max(np.abs(pr.state(np.asarray(x0, dtype=float))["p"])))
+    return _pto_maximize(pr, x, pto, True, widths, scale)
 
 
 def _pto_stage(case, make, pto: HullPTO, runs, best_one, refine: bool) -> HullSolution:
@@ -997,9 +1044,11 @@ def _pto_stage(case, make, pto: HullPTO, runs, best_one, refine: bool) -> HullSo
             break
     seeds += _free_motion(case, case.winding)
     pr = pto.problem(case)
+    screen = _screened(pr, pto)
     best, tried, its = None, [], 0
     for name, x0 in seeds:
-        x, ex, status, it = _pto_maximize(pr, x0, pto, True)
+        x, ex, status, it = _pto_maximize(pr, x0, pto, True, *screen[:1])
+        kkt = pr.answer
         its += it
         if status == "converged" and aliased(pr, x):
             status = "aliased"
@@ -1008,14 +1057,24 @@ def _pto_stage(case, make, pto: HullPTO, runs, best_one, refine: bool) -> HullSo
         # its status says whether its continuation settled
         if math.isfinite(ex) and (best is None or ex > best[1] + (
                 1e-9 * max(abs(ex), float(pr.w[0])) if best[2] == "converged" else 0.0)):
-            best = (x, ex, status, name)
+            best = (x, ex, status, name, x0, kkt)
     one_pr = pto.problem(case, coupled=False)
-    one = None
+    one, one_start = None, None
     for x1 in ([best_one.x] if best_one is not None else []) + [
             x for _, x in _free_motion(case, case.winding, coupled=False)]:
-        r = _pto_maximize(one_pr, x1, pto, True)
+        r = _pto_maximize(one_pr, x1, pto, True, *screen[:1])
         its += r[3]
         if one is None or (math.isfinite(r[1]) and not r[1] <= one[1]):
+            one, one_start = r, x1
+    if screen and best is not None:  # the screening's best, on to the last widths
+        x, ex, status, it = _finish_screened(pr, pto, best[0], best[4], screen[1])
+        its += it
+        if math.isfinite(ex):
+            best = (x, ex, status, best[3], best[4], pr.answer)
+    if screen and one is not None and math.isfinite(one[1]):
+        r = _finish_screened(one_pr, pto, one[0], one_start, screen[1])
+        its += r[3]
+        if math.isfinite(r[1]):
             one = r
     if best is None:
         x = seeds[0][1] if seeds else np.zeros(2 * case.harmonics + 1)
@@ -1023,7 +1082,7 @@ def _pto_stage(case, make, pto: HullPTO, runs, best_one, refine: bool) -> HullSo
                             one_way_x=x, status="no motion found for this power take-off",
                             success=False, found_by="", distinct_maxima=0, runs=len(tried),
                             iterations=its, energy_balance_residual=math.nan, pto=pto)
-    x, ex, status, name = best
+    x, ex, status, name = best[:4]
     ok = status == "converged"
     distinct = len({round(e, 9) for e, st in tried if st == "converged"})
     sol = HullSolution(case=case, x=x, power=float(ex),
@@ -1034,7 +1093,8 @@ def _pto_stage(case, make, pto: HullPTO, runs, best_one, refine: bool) -> HullSo
                                                    if st == "converged"}, reverse=True)),
                        runs=len(tried) + 1, iterations=its,
                        energy_balance_residual=float(ideal_problem(case).balance(x)[2]),
-                       mechanical_power=float(pr.mechanical(x)), pto=pto)
+                       mechanical_power=float(pr.mechanical(x)), pto=pto,
+                       pto_state=best[5])
     if refine:  # a stalled continuation may settle with more harmonics: the status says
         sol = _refine(sol, make, x)
     return sol

@@ -167,9 +167,32 @@ class PTOObjective:
         phi = -(hi * hi - self.lam_hi**2 + lo * lo - self.lam_lo**2) / (2 * r)
         return phi, -hi + lo, -r * ((hi > 0).astype(float) + (lo > 0))
 
+    #: ``(width, limit, rho, lam_hi, lam_lo)`` of the objective that the last climb
+    #: maximized (:meth:`climbed_state`), and of the iterate a driver returned (``answer``:
+    #: :func:`maximize`, the hull's matrix-free twin), None before any
+    climbed = None
+    answer = None
+
+    def climbed_state(self) -> tuple:
+        """The objective the last climb maximized: its smoothing width, and under a limit
+        the penalty and the multipliers before their last update (the augmented
+        Lagrangian whose maximum the climb's iterate is)."""
+        if self.limit is None:
+            return (self.width, None, None, None, None)
+        return self.climbed
+
+    def set_climbed(self, state) -> None:
+        """Make the objective the one ``state`` (:meth:`climbed_state`) names."""
+        self.width = state[0]
+        if state[1] is None:
+            self.limit = None
+        else:
+            self.set_limit(state[1], state[2], state[3], state[4])
+
     def update_multipliers(self, x):
         """``lam <- max(0, lam + rho g)``; returns the largest violation ``max |tau| -
         limit`` on the grid."""
+        self.climbed = (self.width, self.limit, self.rho, self.lam_hi, self.lam_lo)
         tau = self.state(x)["tau"]
         self.lam_hi = np.maximum(0.0, self.lam_hi + self.rho * (tau - self.limit))
         self.lam_lo = np.maximum(0.0, self.lam_lo + self.rho * (-tau - self.limit))
@@ -407,6 +430,7 @@ def maximize(problem: ElectricalProblem, x0: np.ndarray, widths=None, limit=None
     runs = []
     gtol = 1e-9 * max(float(np.max(np.abs(problem.w))), 1e-300)
     dense = problem.hessian != "operator"
+    problem.answer = None
     if limit is not None:
         best = -math.inf
         for rel in widths:
@@ -417,6 +441,7 @@ def maximize(problem: ElectricalProblem, x0: np.ndarray, widths=None, limit=None
             runs.append((rel * p0, ex, status, inner))
             if math.isfinite(ex) and ex >= best and viol <= LIMIT_TOL * limit:
                 best, best_x = ex, np.array(x)
+                problem.answer = problem.climbed
         problem.limit = None
         return best_x, best, runs
     for rel in widths:
@@ -442,6 +467,7 @@ def maximize(problem: ElectricalProblem, x0: np.ndarray, widths=None, limit=None
         runs.append((rel * p0, ex, status, nit))
         if math.isfinite(ex) and ex >= best:
             best, best_x = ex, np.array(r.x)
+            problem.answer = problem.climbed_state()
         x = np.array(r.x)
     return best_x, best, runs
 

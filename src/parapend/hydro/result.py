@@ -976,10 +976,14 @@ def _mode(sol, resolve=None) -> dict:
                    f"({over:.1e} above the limit)")
     s = mot.on_grid(PEAK_POINTS)
     k = sol.case.winding
-    # first- and second-order optimality of the ideal problem's answer (a take-off's
-    # objective moves with its continuation and its limit's multipliers: not checked here)
-    grad, top, scaled = (None, None, None) if sol.pto.active or not math.isfinite(sol.power) \
-        else _hull_krylov.optimality(pr, sol.x)
+    # first- and second-order optimality of the answer: of the ideal power, or of the
+    # take-off's objective that the answer's climb maximized (_pto_objective)
+    grad, top, scaled, width = None, None, None, None
+    if math.isfinite(sol.power):
+        obj = _pto_objective(sol) if sol.pto.active else pr
+        if obj is not None:
+            grad, top, scaled = _hull_krylov.optimality(obj, sol.x)
+            width = obj.width if sol.pto.smoothed else None
     swing = None if k else 0.5 * _deg(np.max(s["phi"]) - np.min(s["phi"]))
     mean = _deg(math.remainder(float(np.mean(s["phi"])) - math.pi, 2 * math.pi) + math.pi)
     return {"mode": "swinging" if k == 0 else "rotation", "winding": k,
@@ -996,7 +1000,22 @@ def _mode(sol, resolve=None) -> dict:
             "found_by": sol.found_by, "starts": sol.runs, "success": ok,
             "gradient_max_w_per_rad": grad, "hessian_largest_eigenvalue_w_per_rad2": top,
             "hessian_scaled_largest_eigenvalue": scaled,
+            "optimality_smoothing_width_w": width,
             "status": status, "_solution": sol, "_motion": mot}
+
+
+def _pto_objective(sol):
+    """The take-off's objective that ``sol``'s answer maximizes, for its optimality checks
+    (None where the solver did not say): the smoothed electrical power at the smoothing
+    width of the climb that gave the answer (an efficiency's kink is not differentiable
+    at ``s = 0``: the checks are the last climb's, at that width), under a torque limit the
+    augmented Lagrangian at the penalty and multipliers of that climb (its gradient the
+    Lagrangian's at the multipliers' update from them)."""
+    if sol.pto_state is None:
+        return None
+    pr = sol.pto.problem(sol.case)
+    pr.set_climbed(sol.pto_state)
+    return pr
 
 
 #: a power above the radiation bound by more than this (relative: the discretization's)

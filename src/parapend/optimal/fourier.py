@@ -352,7 +352,14 @@ def _cg_solve(g, op, pre, gn, scale):
     target = max(1e-4, min(0.5, math.sqrt(gn / scale))) * gn
     x = np.zeros_like(g)
     r = g.copy()
-    if PRECONDITIONER == "banded" and op.mostly_positive:
+    # an operator may carry a preconditioner of its own (``low_rank``: the hull take-off's
+    # smoothed kink, :class:`parapend.hydro._hull_krylov.KrylovHessian`), None where it has
+    # none at this point
+    own = getattr(op, "low_rank", None)
+    own = own() if own is not None else None
+    if own is not None:
+        apply = own
+    elif PRECONDITIONER == "banded" and op.mostly_positive:
         def apply(v):
             return op.precondition(v)
     else:
