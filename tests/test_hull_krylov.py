@@ -459,6 +459,8 @@ def test_a_matrix_free_least_torque_start_takes_few_newton_steps(monkeypatch):
     for (_name, x), (_, x0) in zip(out, hull._starts(12, 1)[::2]):
         assert np.all(np.isfinite(x))
         assert pr.exact(x) > pr.exact(x0)
+
+
 @pytest.mark.slow
 def test_barge_ten_wave_record_with_an_efficiency_matrix_free_is_the_dense_answer():
     """The embedded barge's 10-wave record (144 harmonics, swinging) with the efficiency
