@@ -662,7 +662,7 @@ class HullSolution:
     #: a take-off's objective that the answer maximizes (None: the ideal power's):
     #: ``(width, limit, rho, lam_hi, lam_lo)``, the efficiency's smoothing width of the
     #: climb that gave the answer, and under a limit its augmented Lagrangian's penalty and
-    #: multipliers (:meth:`parapend.hydro.pto.PTOObjective.climbed_state`)
+    #: multipliers (``parapend.hydro.pto.PTOObjective.climbed_state``)
     pto_state: tuple | None = None
 
 
