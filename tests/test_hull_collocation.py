@@ -101,18 +101,18 @@ def test_capped_solves_are_reported():
     r = capped.solve(plant, fseg, np.zeros(N))
     assert r.status == 1 and not r.success and r.nit == 2
     assert bc._check_solve(r, np.zeros(N))[1] == 0
-    res = hc.hull_mpc(th.HULL, th.PEND, th.WAVE, **dict(th.OPTS, max_iter=2),
-                      planner="collocation")
+    res = hc.hull_mpc(th.HULL, th.PEND, th.WAVE, **dict(th.OPTS, max_iter=2,
+                                                         planner="collocation"))
     assert res.solves > 0 and res.failed_solves == 0
 
 
 def test_bad_planner_is_one_line():
     """An unknown planner, or plant steps the collocation's intervals cannot hold."""
     with pytest.raises(hc.ParameterError, match="planner: expected"):
-        hc.hull_mpc(th.HULL, th.PEND, th.WAVE, **th.OPTS, planner="newton")
+        hc.hull_mpc(th.HULL, th.PEND, th.WAVE, **dict(th.OPTS, planner="newton"))
     with pytest.raises(hc.ParameterError, match="plant_steps"):
-        hc.hull_mpc(th.HULL, th.PEND, th.WAVE, **dict(th.OPTS, plant_steps=5),
-                    planner="collocation")
+        hc.hull_mpc(th.HULL, th.PEND, th.WAVE, **dict(th.OPTS, plant_steps=5,
+                                                      planner="collocation"))
 
 
 def test_the_default_terminal_weight_is_the_measured_one():
@@ -156,15 +156,14 @@ def test_the_command_runs_the_collocation_planner(tmp_path, capsys):
 
 def test_the_compiled_solver_needs_no_casadi(monkeypatch):
     """The collocation planner on its compiled solver: with CasADi made unimportable the
-    run is the one with CasADi there, to the bit (no IPOPT in it); asked for IPOPT (the
-    default) without CasADi, one line naming the extra."""
+    run is the one with CasADi there, to the bit (no IPOPT in it): the hull's default
+    planner needs no extra; asked for IPOPT without CasADi, one line naming the extra."""
     import sys
 
     from parapend.hydro import _hull_collocation as hcol
 
-    opts = dict(th.OPTS, max_iter=5, planner="collocation")
-    assert hcol.SOLVER == "ipopt"
-    monkeypatch.setattr(hcol, "SOLVER", "compiled")
+    opts = {k: v for k, v in th.OPTS.items() if k != "planner"} | {"max_iter": 5}
+    assert (hcol.SOLVER, hc.PLANNER) == ("compiled", "collocation")
     with_casadi = hc.hull_mpc(th.HULL, th.PEND, th.WAVE, **opts)
     monkeypatch.setitem(sys.modules, "casadi", None)
     without = hc.hull_mpc(th.HULL, th.PEND, th.WAVE, **opts)
@@ -189,7 +188,7 @@ def test_the_default_iteration_cap_is_the_solvers(monkeypatch, solver, cap):
 
     monkeypatch.setattr(hcol, "SOLVER", solver)
     monkeypatch.setattr(hc, "_plan", plan)
-    opts = {k: v for k, v in th.OPTS.items() if k != "max_iter"}
+    opts = {k: v for k, v in th.OPTS.items() if k not in ("max_iter", "planner")}
     with pytest.raises(StopIteration):
         hc.hull_mpc(th.HULL, th.PEND, th.WAVE, **opts, planner="collocation")
     assert seen == [(solver, cap)]

@@ -36,7 +36,8 @@ AMPS = np.zeros(4, complex)
 AMPS[1], AMPS[2] = 0.5, 0.25j
 WAVE = Wave(2 * math.pi / TR, AMPS)
 OPTS = {"peak_period": TP, "pivot": PIVOT, "horizon": 0.5, "update_interval": 0.125,
-        "warmup": 1.0, "samples": 16, "plant_steps": 4, "memory": 6.0, "max_iter": 15}
+        "warmup": 1.0, "samples": 16, "plant_steps": 4, "memory": 6.0, "max_iter": 15,
+        "planner": "lbfgsb"}
 
 
 def _plant(pendulum, h, steps, memory=8.0):
@@ -199,7 +200,7 @@ def test_the_command_runs_the_hull_beside_its_record_optimum(tmp_path, capsys):
     assert r["optimum_power_w"] == opt["power_w"]
     assert r["optimum_winding"] == opt["winding"]
     start = hc.start_mode(opt["winding"], opt["mean_angle_deg"], opt["swing_amplitude_deg"])
-    assert r["planner"] == f"hull-{start}"
+    assert r["planner"] == f"hull-collocation-{start}"  # the default planner
     if r["status"] == "ok":
         assert math.isclose(r["optimum_fraction"], r["electrical_power_w"] / opt["power_w"])
     assert r["energy_balance_residual"] < 1e-3

@@ -316,7 +316,8 @@ def test_the_hulls_causal_column_is_in_the_spec(dataset):
     trips, and stores each forecast's causal power beside the optimum's."""
     spec = matrix_spec(**BINS, realizations=1, hydro=dataset, **HULL, controller="mpc",
                        forecast="perfect,ar")
-    assert (spec.controller, spec.buoy_controller, spec.horizon) == ("mpc", "hull", 2.0)
+    assert (spec.controller, spec.buoy_controller, spec.horizon) == (
+        "mpc", "hull-collocation", 2.0)  # the hull's default planner
     assert spec.forecasts == ("perfect", "ar")
     assert MatrixSpec.from_json(spec.to_json()) == spec
     assert "causal_perfect_power" in spec.variables and "causal_ar_power" in spec.variables
@@ -324,7 +325,7 @@ def test_the_hulls_causal_column_is_in_the_spec(dataset):
     # (warm-up and record) times its cost a peak period, per forecast
     from parapend.performance.check import BUOY_CAUSAL_SECONDS, record_seconds
 
-    want = (BUOY_CAUSAL_SECONDS["hull"] * (spec.waves + spec.warm_up) * spec.horizon
+    want = (BUOY_CAUSAL_SECONDS["hull-collocation"] * (spec.waves + spec.warm_up) * spec.horizon
             * (0.125 / spec.update_interval) * 2)
     assert record_seconds(spec) == pytest.approx(want, rel=1e-12)
 
@@ -344,17 +345,19 @@ def test_a_hull_bins_causal_run_stays_below_its_optimum(dataset):
 
 def test_the_hulls_causal_column_takes_the_buoys_planners(dataset):
     """``--planner`` in the causal column, as ``parapend buoy --controller mpc --planner``:
-    the hull's collocation planner is its own controller in the spec (another store than
-    L-BFGS-B's), priced by its own cost a peak period; the heaving buoy's planners name its
-    controller; every misuse refused in one line naming the option."""
+    the hull's collocation planner (the default) is its own controller in the spec
+    (another store than L-BFGS-B's), priced by its own cost a peak period; the heaving
+    buoy's planners name its controller; every misuse refused in one line naming the
+    option."""
     from parapend.performance.check import BUOY_CAUSAL_SECONDS, record_seconds
 
     lb = matrix_spec(**BINS, realizations=1, hydro=dataset, **HULL, controller="mpc",
                      planner="lbfgsb")
-    assert lb == matrix_spec(**BINS, realizations=1, hydro=dataset, **HULL, controller="mpc")
     col = matrix_spec(**BINS, realizations=1, hydro=dataset, **HULL, controller="mpc",
                       planner="collocation")
+    assert col == matrix_spec(**BINS, realizations=1, hydro=dataset, **HULL, controller="mpc")
     assert (col.buoy_controller, col.horizon) == ("hull-collocation", 2.0)
+    assert lb.buoy_controller == "hull"  # the stores' name for it from before
     assert col != lb and MatrixSpec.from_json(col.to_json()) == col
     assert record_seconds(col) / record_seconds(lb) == pytest.approx(
         BUOY_CAUSAL_SECONDS["hull-collocation"] / BUOY_CAUSAL_SECONDS["hull"], rel=1e-12)

@@ -83,9 +83,10 @@ def add_parsers(sub) -> None:
     add_declared(g, Controller, ("controller", "horizon", "update_interval", "forecast"))
     g.add_argument("--planner", choices=("plan", "coupled", "lbfgsb", "collocation"),
                    help="with mpc, the horizon's solver: the heaving buoy's plan (default) or "
-                        "coupled (default with --efficiency); the hull's lbfgsb (default, "
-                        "real time) or collocation (nearer the optimum, an update about a "
-                        "second; needs CasADi: parapend[collocation])")
+                        "coupled (default with --efficiency); the hull's collocation "
+                        "(default: the motion as the unknown, a compiled interior point) or "
+                        "lbfgsb (the held torques shot through the model, faster, far from "
+                        "the optimum on long records)")
     g = p.add_argument_group("statistics of a sea state (--dofs surge,heave,pitch)")
     g.add_argument("--realizations", type=_int, metavar="R",
                    help="solve R records of the sea state (--hs, --tp), seeded --seed, "

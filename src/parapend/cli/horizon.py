@@ -62,8 +62,7 @@ def add_parsers(sub) -> None:
     g.add_argument("--planner", choices=[*PLANNERS["heave"], *PLANNERS["hull"]],
                    help="the buoy's receding-horizon planner (parapend.hydro.control.buoy_mpc"
                         "; default plan, coupled with --efficiency); with --dofs "
-                        "surge,heave,pitch the hull's: lbfgsb (default) or collocation "
-                        "(needs CasADi)")
+                        "surge,heave,pitch the hull's: collocation (default) or lbfgsb")
     # the planner's former name: refused in one line naming --planner (parapend.horizon)
     g.add_argument("--controller", help=argparse.SUPPRESS)
     add_declared(g, Body, ("dofs",), command="horizon")

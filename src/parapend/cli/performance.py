@@ -98,9 +98,8 @@ def add_parsers(sub) -> None:
     g.add_argument("--planner", choices=[*PLANNERS["heave"], *PLANNERS["hull"]],
                    help="--device buoy: the horizon's solver, as parapend buoy --controller "
                         "mpc --planner: the heaving buoy's plan (default) or coupled (default "
-                        "with --efficiency); the hull's lbfgsb (default) or collocation "
-                        "(nearer the optimum, several times slower; needs CasADi: "
-                        "parapend[collocation])")
+                        "with --efficiency); the hull's collocation (default) or lbfgsb "
+                        "(faster, far from the optimum)")
     g.add_argument("--speed-limit", type=float,
                    help="rated speed priced in the plans, units sqrt(g/l): a penalty, as "
                         "parapend horizon's; inf for none, horizon's default (default 4 "

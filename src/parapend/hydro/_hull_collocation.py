@@ -1,7 +1,7 @@
 r"""The hull's horizon problem with the MOTION as the unknown (``planner="collocation"`` of
 :func:`parapend.hydro.hull_control.hull_mpc`): direct collocation, solved on the exact
-Hessian by IPOPT on the NLP built in CasADi (the default) or by a compiled interior point
-on the same NLP (``solver="compiled"``, :mod:`._hull_collocation_ipm`).
+Hessian by a compiled interior point (:mod:`._hull_collocation_ipm`, the default) or by
+IPOPT on the same NLP built in CasADi (``solver="ipopt"``).
 
 The unknowns are the hull's ``xi = (x, z, beta)`` and the pendulum's absolute angle ``phi``
 with their velocities at the points ``t + k s``, ``k = 0..2 r n`` (``r`` Hermite-Simpson
@@ -67,15 +67,17 @@ MEMORY_STRIDE = 3
 MAX_TURN = 0.4
 #: the horizon's solver: ``"compiled"`` (:mod:`._hull_collocation_ipm`, no CasADi: the same
 #: NLP, its Newton step from the whole sparse KKT matrix) or ``"ipopt"`` (CasADi's IPOPT,
-#: ``parapend[collocation]``; the default). In the closed loop of the default barge's seeds
+#: ``parapend[collocation]``). In the closed loop of the default barge's seeds
 #: 0 to 9, perfect forecast, the compiled solver realized 95.6 % of the record optimum (40
 #: iterations at most) against IPOPT's 94.5 %, no failed solve
 #: (benchmarks/hull_collocation_table.out.txt). On the power matrix's Hs 1 m, Te 8 s bin
 #: (Tp 8.9 s: a 17.8 s horizon; 4 waves, seed 0) none of its 63 solves failed (its first
 #: version, condensing the motion over the horizon, failed or capped 41 and the pendulum
 #: ran away), but it realized 223.0 W perfect and 173.2 W AR against IPOPT's 277.2 and
-#: 333.7 W (benchmarks/hull_collocation_solver.out.txt): IPOPT stays the default
-SOLVER = "ipopt"
+#: 333.7 W (benchmarks/hull_collocation_solver.out.txt). The compiled solver is the default
+#: (the collocation planner is the hull's default, ``hull_control.PLANNER``: it runs without
+#: the extra, and in time): IPOPT is there to check it against
+SOLVER = "compiled"
 #: the compiled solver's status names (``ipopt`` field of :meth:`HullCollocation.solve`)
 _COMPILED_STATUS = ("solved", "capped", "failed")
 #: IPOPT return statuses counted as a solved horizon (0) or an iteration cap (1)

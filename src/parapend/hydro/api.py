@@ -353,12 +353,11 @@ def buoy(*, wave_height=None, wave_period=None, hs=None, tp=None, spectrum=None,
     planner : with ``"mpc"``, the horizon's solver. The heaving buoy: ``"plan"`` (the
         pendulum's motion as the unknown; the default) or ``"coupled"`` (the held torques;
         the default with ``efficiency``), as ``parapend horizon --planner``. The hull
-        (``dofs="surge,heave,pitch"``): ``"lbfgsb"`` (the default: L-BFGS-B on the held
-        torques, real time on the default barge) or ``"collocation"`` (the motion as the
-        unknown, IPOPT on its exact Hessian; extra ``collocation``: CasADi; on the default
-        barge 94.5 % of the record optimum with a perfect forecast and 87.7 % with AR over
-        seeds 0 to 9, against 43.8 % for ``"lbfgsb"``, but an update takes about a second,
-        longer than the interval: docs/hull.md).
+        (``dofs="surge,heave,pitch"``): ``"collocation"`` (the default: the motion as the
+        unknown, a compiled interior point on its exact Hessian; on the default barge's
+        20-minute record 98.0 % of the record optimum with a perfect forecast) or
+        ``"lbfgsb"`` (L-BFGS-B on the held torques shot through the model: faster, 25.6 %
+        there; docs/hull.md).
 
     dofs : ``"heave"`` (default: the heaving buoy) or ``"surge,heave,pitch"``: a hull that
         surges, heaves and pitches, with a pendulum that rotates or swings (docs/hull.md;

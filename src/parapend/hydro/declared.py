@@ -404,7 +404,7 @@ RUN_OPTIONS = {
     "csv": "an output file", "command": "the command line recorded",
     "plan_samples": "torque samples per interval of the causal plan",
     "planner": "the receding-horizon controller's horizon solver: the heaving buoy's plan "
-               "or coupled, the hull's lbfgsb or collocation",
+               "or coupled, the hull's collocation or lbfgsb",
 }
 
 #: options of the commands of the pendulum on a prescribed motion (the paper's

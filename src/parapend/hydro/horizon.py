@@ -296,7 +296,9 @@ def buoy_horizon_curve(*, hs=None, tp=None, spectrum="jonswap", gamma_peak=3.3,
     tr = float(waves[0][1]["repeat_period"])
     # the planner that will run: buoy_mpc's default when none is given
     if hull:
-        runs = "hull" if planner in (None, "lbfgsb") else f"hull-{planner}"
+        from .hull_control import PLANNER
+
+        runs = {"lbfgsb": "hull", "collocation": "hull-collocation"}[planner or PLANNER]
     else:
         runs = planner or ("coupled" if efficiency is not None else "plan")
     iterations = 1 if runs in ("plan", "hull", "hull-collocation") else 2
@@ -391,7 +393,7 @@ def buoy_horizon_curve(*, hs=None, tp=None, spectrum="jonswap", gamma_peak=3.3,
                     status[i][j][r] = "time_limit"
                     continue
                 run, more = ((hull_mpc, {"pivot": problem["pivot"], "mode": modes[r],
-                                         "planner": planner or "lbfgsb"})
+                                         "planner": planner})
                              if hull else (buoy_mpc, kw))
                 res = run(h, pend, wave, peak_period=tp, horizon=hor,
                           update_interval=upd, warmup=warm_up, repeats=1,

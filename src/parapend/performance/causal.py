@@ -116,7 +116,11 @@ def check_causal(*, controller, horizon, forecast, update_interval, warm_up, pla
                              "prescribed-heave pendulum has one planner)")
     base = BUOY_CAUSAL if buoy else CAUSAL
     if not heave:
-        buoy_controller = "hull" if planner in (None, "lbfgsb") else "hull-" + planner
+        from ..hydro.hull_control import PLANNER
+
+        # "hull": L-BFGS-B (the stores' name for it from before collocation was the default)
+        buoy_controller = {"lbfgsb": "hull", "collocation": "hull-collocation"}[
+            planner or PLANNER]
         if buoy_controller == "hull-collocation":
             from ..hydro._hull_collocation import available
 
