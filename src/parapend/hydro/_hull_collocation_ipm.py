@@ -442,7 +442,7 @@ class CompiledSolver:
                 if free:
                     refs = (refs + [err0])[-REFS:]
                     aff = _Newton(self, lin, gf, np.zeros(ns))
-                    adx, ads = aff.step(c, rd)[:2]
+                    adx, ads = aff.step(c, rd, probe=True)[:2]
                     adu = adx[uo:uo + n]
                     slacks = np.concatenate((sl_u, su_u, sls, sus))
                     dsl = np.concatenate((adu, -adu, ads, -ads))
@@ -452,7 +452,7 @@ class CompiledSolver:
                         cg[nd:] = -1.0 / sl_u + 1.0 / su_u
                         cen = _Newton(self, lin, cg,
                                       -1.0 / sls + 1.0 / sus if ns else np.zeros(0))
-                        cdx, cds = cen.step(np.zeros(self.neq), np.zeros(ns))[:2]
+                        cdx, cds = cen.step(None, np.zeros(ns), probe=True)[:2]
                         cdu = cdx[uo:uo + n]
                         dsc = np.concatenate((cdu, -cdu, cds, -cds))
                         dsq = float(np.mean(gl ** 2) + (np.mean((lamd + zls - zus) ** 2)
@@ -808,17 +808,23 @@ class _Newton:
         self.sv, self.lin = solver, lin
         self.gphi0, self.gphis = gphi0, gphis
 
-    def step(self, cr, rdr):
-        """``(dx, ds, l+, l_d+)`` for the constraints' values ``cr`` and speeds' ``rdr``."""
+    def step(self, cr, rdr, probe=False):
+        """``(dx, ds, l+, l_d+)`` for the constraints' values ``cr`` (None: zero) and speeds'
+        ``rdr``; ``probe``: a step only the barrier's oracle reads (its ``dx`` and ``ds``:
+        no multipliers, no iterative refinement)."""
         sv = self.sv
         nd = sv.nd
         ns = sv.sig_s.size
         gphi = self.gphi0 + sv._dt(sv.sig_s * rdr + self.gphis) if ns else self.gphi0
-        dxf, lnew = self.lin.solve(gphi, cr)
+        dxf, lnew = self.lin.solve(gphi, cr, probe)
+        if probe:
+            lnew = None
         ds = dxf[sv.d7] - dxf[sv.d6] + rdr if ns else np.zeros(0)
         dx = np.zeros(sv.nvar)
         dx[sv.dep] = dxf[:nd]
         dx[sv.uix] = dxf[nd:]
+        if probe:
+            return dx, ds, None, None
         return dx, ds, lnew, sv.sig_s * ds + self.gphis if ns else np.zeros(sv.npt - 1)
 
 
@@ -844,12 +850,19 @@ class _FullKKT:
         return np.concatenate((_kmul(self.sv, self.kmat, self.delta, dx) + self.jac.T @ lv,
                                self.jac @ dx - self.delta_c * lv))
 
-    def solve(self, gphi, cr):
+    def solve(self, gphi, cr, probe=False):
         """``(dx, l+)`` of ``(K + delta I) dx + J^T l+ = -gphi``, ``J dx - delta_c l+ =
-        -cr`` (iterative refinement: at most REFINE steps, until the residual is 1e-12 of
-        the right side's)."""
-        rhs = -np.concatenate((gphi, cr))
+        -cr`` (``cr`` None: zero; iterative refinement: at most REFINE steps, until the
+        residual is 1e-12 of the right side's; none for a ``probe``, the barrier oracle's
+        steps, which the static regularization moves by about 1e-9 relative)."""
+        nf = self.sv.nf
+        rhs = np.zeros(nf + self.sv.neq)
+        rhs[:nf] = -gphi
+        if cr is not None:
+            rhs[nf:] = -cr
         v = self.ldl.solve(rhs)
+        if probe:
+            return v[:nf], v[nf:]
         scale = 1e-12 * max(1.0, float(np.max(np.abs(rhs))))
         last = np.inf
         for _ in range(REFINE):
@@ -859,7 +872,6 @@ class _FullKKT:
                 break
             last = res
             v = v + self.ldl.solve(r)
-        nf = self.sv.nf
         return v[:nf], v[nf:]
 
 
@@ -871,15 +883,26 @@ class _NullSpace:
     def __init__(self, sv, lu, fac, zfull, kmat, delta):
         self.sv, self.lu, self.fac, self.zfull = sv, lu, fac, zfull
         self.kmat, self.delta = kmat, delta
+        self.last = None  # (cr, yp, K yp) of the last right side (the same c: the
+        # affine step's and the step's)
 
-    def solve(self, gphi, cr):
+    def solve(self, gphi, cr, probe=False):
+        """``(dx, l+)`` (``cr`` None: zero; ``l+`` None for a ``probe``)."""
         sv = self.sv
         nd = sv.nd
-        yp = np.zeros(sv.nf)
-        yp[:nd] = -self.lu.solve(cr)
-        km = _kmul(sv, self.kmat, self.delta, yp)
+        if cr is None:
+            yp, km = np.zeros(sv.nf), np.zeros(sv.nf)
+        elif self.last is not None and self.last[0] is cr:
+            yp, km = self.last[1], self.last[2]
+        else:
+            yp = np.zeros(sv.nf)
+            yp[:nd] = -self.lu.solve(cr)
+            km = _kmul(sv, self.kmat, self.delta, yp)
+            self.last = (cr, yp, km)
         du = cho_solve(self.fac, -(self.zfull.T @ (gphi + km)), check_finite=False)
         dxf = yp + self.zfull @ du
+        if probe:
+            return dxf, None
         lnew = self.lu.solve_t(-(gphi + _kmul(sv, self.kmat, self.delta, dxf))[:nd])
         return dxf, lnew
 
