@@ -853,16 +853,15 @@ class _FullKKT:
     def solve(self, gphi, cr, probe=False):
         """``(dx, l+)`` of ``(K + delta I) dx + J^T l+ = -gphi``, ``J dx - delta_c l+ =
         -cr`` (``cr`` None: zero; iterative refinement: at most REFINE steps, until the
-        residual is 1e-12 of the right side's; none for a ``probe``, the barrier oracle's
-        steps, which the static regularization moves by about 1e-9 relative)."""
+        residual is 1e-12 of the right side's, also for a ``probe``, the barrier oracle's
+        steps: without it the oracle's weight moved by the static regularization's 1e-9,
+        and a hard horizon of the Te 8 s bin that this step solved failed)."""
         nf = self.sv.nf
         rhs = np.zeros(nf + self.sv.neq)
         rhs[:nf] = -gphi
         if cr is not None:
             rhs[nf:] = -cr
         v = self.ldl.solve(rhs)
-        if probe:
-            return v[:nf], v[nf:]
         scale = 1e-12 * max(1.0, float(np.max(np.abs(rhs))))
         last = np.inf
         for _ in range(REFINE):
