@@ -114,9 +114,15 @@ LAM_RESET = 1e3
 #: restoration phase by least-norm steps in all the unknowns (:meth:`_restore_min_norm`)
 RESTORATION = True
 #: the Newton step (module docstring): ``"kkt"`` (the whole KKT matrix's sparse ``L D
-#: L^T``) or ``"nullspace"`` (condensed on the torques: faster on short horizons, fails on
-#: long ones)
+#: L^T``), ``"nullspace"`` (condensed on the torques: faster on short horizons, fails on
+#: long ones) or ``"auto"``: every iteration the null-space step where the torques'
+#: sensitivities are at most SENS_MAX, the KKT step where they are larger
 STEP = "kkt"
+#: the largest torque sensitivity ``max |J_d^-1 J_u|`` (units of the unknowns per m g l)
+#: with which ``STEP = "auto"`` takes the null-space step: on the default sea's horizons it
+#: stays below 5e5; on the Te 8 s bin's the null-space step failed where it reached 1e8
+#: to 1e13, and solved where it stayed below 5e7
+SENS_MAX = 1e6
 #: iterative refinement's steps at most on the KKT matrix
 REFINE = 5
 
@@ -200,6 +206,9 @@ class CompiledSolver:
         self.jinv_var, self.jinv_mem = inv[:keep.sum()], inv[keep.sum():]
         self.jnnz = self.jind.size
         self.jmem = np.bincount(self.jinv_mem, weights=self.mem_val, minlength=self.jnnz)
+        # J_u's entries (the last n columns of the CSC pattern)
+        self.ju_rows = self.jind[self.jptr[self.nd]:]
+        self.ju_cols = np.repeat(np.arange(n), np.diff(self.jptr[self.nd:]))
         hkeep = (cmap[hr] >= 0) & (cmap[hc] >= 0)
         self.hkeep = hkeep
         # K lives on the rows with more than the diagonal (the Hessian's, the speeds', the
@@ -353,7 +362,7 @@ class CompiledSolver:
             jac = self.jacobian(jv)
             # the factors of J_d: the null-space step's, and the multipliers' estimate
             reset = lam is None or np.max(np.abs(lam)) > LAM_RESET
-            need = reset or STEP != "kkt"
+            need = reset or STEP != "kkt"  # (auto: its sensitivities choose the step)
             lu = self._factor(jac) if need else None
             if need and lu is None:
                 status, self.why = 2, "singular"
@@ -401,10 +410,11 @@ class CompiledSolver:
             diag[nd:] = zl / sl_u + zu / su_u
             self.sig_s = zls / sls + zus / sus if ns else np.zeros(0)
             kmat = self.hessian(hv, diag)
-            if STEP == "kkt":
+            zsens = None if STEP == "kkt" else self._sensitivities(jac, lu)
+            if STEP == "kkt" or (STEP == "auto" and not np.max(np.abs(zsens)) <= SENS_MAX):
                 lin, delta = self._kkt(kmat, jac, mu, delta_last)
             else:
-                lin, delta = self._null_space(kmat, jac, lu, delta_last)
+                lin, delta = self._null_space(kmat, zsens, lu, delta_last)
             if lin is None:
                 # no inertia correction up to MAX_DELTA: the restoration phase (IPOPT's),
                 # the multipliers estimated anew after it
@@ -626,14 +636,23 @@ class CompiledSolver:
                 break
         return None, delta
 
-    def _null_space(self, kmat, jac, lu, delta_last):
-        """The reduced Hessian on the null space's orthonormal basis, Cholesky-factored
-        with the inertia correction ``delta I`` (0, then the last one's third or ``1e-4``,
-        times 8); ``(None, delta)`` past MAX_DELTA."""
-        n, nd, nf = self.n, self.nd, self.nf
-        zfull = np.empty((nf, n))
-        zfull[:nd] = -lu.solve(jac[:, nd:].toarray(), torques=True)
+    def _sensitivities(self, jac, lu):
+        """The null space's basis ``Z = [-J_d^-1 J_u; I]`` (nf, n): the torques'
+        sensitivities."""
+        n, nd = self.n, self.nd
+        ju = np.zeros((nd, n))  # J_u dense, C order (SciPy's toarray: Fortran's, copied)
+        ju[self.ju_rows, self.ju_cols] = jac.data[self.jptr[nd]:]
+        zfull = np.empty((self.nf, n))
+        zfull[:nd] = -lu.solve(ju, torques=True)
         zfull[nd:] = np.eye(n)
+        return zfull
+
+    def _null_space(self, kmat, zfull, lu, delta_last):
+        """The reduced Hessian on the orthonormal basis of the null space (``zfull``: its
+        basis :meth:`_sensitivities`), Cholesky-factored with the inertia correction ``delta
+        I`` (0, then the last one's third or ``1e-4``, times 8); ``(None, delta)`` past
+        MAX_DELTA."""
+        n = self.n
         # an orthonormal basis of the null space: the torques' sensitivities reach 1e8
         # where the linearized motion is unstable over the horizon, and Z^T K Z then
         # loses the reduced Hessian to rounding (Z R^-1 with Householder's R:
@@ -705,9 +724,7 @@ class CompiledSolver:
                 return None, None
             yp = np.zeros(nf)
             yp[:nd] = -lu.solve(c)
-            zfull = np.empty((nf, n))
-            zfull[:nd] = -lu.solve(jac[:, nd:].toarray(), torques=True)
-            zfull[nd:] = np.eye(n)
+            zfull = self._sensitivities(jac, lu)
             q = zfull @ np.linalg.inv(np.linalg.qr(zfull, mode="r"))
             dxf = yp - q @ (q.T @ yp)
             if not np.all(np.isfinite(dxf)):
