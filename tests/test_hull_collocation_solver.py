@@ -87,11 +87,13 @@ def test_derivatives_are_casadis(kw):
                           (1, VARIANTS[0], 1, "adaptive", "kkt"),
                           (2, VARIANTS[0], 1, "monotone", "kkt"),
                           (2, VARIANTS[0], 2, "adaptive", "nullspace"),
-                          (2, VARIANTS[0], 2, "adaptive", "auto")])
+                          (2, VARIANTS[0], 2, "adaptive", "auto"),
+                          (2, VARIANTS[0], 2, "adaptive", "auto:0.5")])
 def test_compiled_reaches_ipopts_optimum(intervals, kw, updates, strategy, step, monkeypatch):
     """One or two updates (the second from the first's solution shifted by one sample,
     after the plant ran it): the compiled solver (either barrier update, either Newton
-    step) and IPOPT from the same start reach the same objective (1e-6 relative) and
+    step, or the auto step: ``auto:0.5`` its threshold below every sensitivity, so its KKT
+    branch) and IPOPT from the same start reach the same objective (1e-6 relative) and
     torques (1e-4 m g l), both solved. (With an efficiency the smoothed kink of ``e(.)``
     makes the problem's local optima many: the second update of this small hull, or one
     Hermite-Simpson interval a sample, ends the two at different local optima, neither
@@ -99,7 +101,10 @@ def test_compiled_reaches_ipopts_optimum(intervals, kw, updates, strategy, step,
     IPOPT's.)"""
     from parapend.hydro import _hull_collocation_ipm as ipm
 
+    step, _, smax = step.partition(":")
     monkeypatch.setattr(ipm, "STEP", step)
+    if smax:
+        monkeypatch.setattr(ipm, "SENS_MAX", float(smax))
     plant, fseg, prob, ref = _pair(intervals, **kw)
     prob.shift = 1
     for k in range(updates):

@@ -37,12 +37,12 @@ ended unresolved).
 
 The NLP is built once per run (the start, the memory's past part and the forecast are its
 parameters) and warm-started from the previous solution shifted by the update interval.
-The compiled solver takes its Newton steps, as IPOPT does (MUMPS), from a factorization of
+The compiled solver takes its Newton steps in the null space of the square Jacobian of the
+equality rows in the unknowns other than the torques (:mod:`._hull_collocation_linalg`)
+while the torques' sensitivities stay moderate, and where they grow large (the motion's
+linearization unstable over the horizon), as IPOPT does (MUMPS), from a factorization of
 the whole sparse KKT matrix (:mod:`._hull_collocation_ldl`), most of whose cost is the
-memory's dense rows; its first version condensed the motion over the horizon (the step in
-the null space of the square Jacobian of the equality rows in the unknowns other than the
-torques, :mod:`._hull_collocation_linalg`), still selectable
-(:data:`._hull_collocation_ipm.STEP`).
+memory's dense rows (:data:`._hull_collocation_ipm.STEP`).
 """
 
 from __future__ import annotations
@@ -65,16 +65,15 @@ INTERVALS = 3
 MEMORY_STRIDE = 3
 #: the generator's planned speed at most, rad per plant step (None: unbounded)
 MAX_TURN = 0.4
-#: the horizon's solver: ``"compiled"`` (:mod:`._hull_collocation_ipm`, no CasADi: the same
-#: NLP, its Newton step from the whole sparse KKT matrix) or ``"ipopt"`` (CasADi's IPOPT,
-#: ``parapend[collocation]``; the default). In the closed loop of the default barge's seeds
-#: 0 to 9, perfect forecast, the compiled solver realized 95.6 % of the record optimum (40
-#: iterations at most) against IPOPT's 94.5 %, no failed solve
-#: (benchmarks/hull_collocation_table.out.txt). On the power matrix's Hs 1 m, Te 8 s bin
-#: (Tp 8.9 s: a 17.8 s horizon; 4 waves, seed 0) none of its 63 solves failed (its first
-#: version, condensing the motion over the horizon, failed or capped 41 and the pendulum
-#: ran away), but it realized 223.0 W perfect and 173.2 W AR against IPOPT's 277.2 and
-#: 333.7 W (benchmarks/hull_collocation_solver.out.txt): IPOPT stays the default
+#: the horizon's solver: ``"compiled"`` (:mod:`._hull_collocation_ipm`, no CasADi: the same NLP; the
+#: figures below with its Newton step from the whole sparse KKT matrix) or ``"ipopt"`` (CasADi's
+#: IPOPT, ``parapend[collocation]``; the default). In the closed loop of the default barge's seeds 0
+#: to 9, perfect forecast, the compiled solver realized 95.6 % of the record optimum (40 iterations
+#: at most) against IPOPT's 94.5 %, no failed solve (benchmarks/hull_collocation_table.out.txt). On
+#: the power matrix's Hs 1 m, Te 8 s bin (Tp 8.9 s: a 17.8 s horizon; 4 waves, seed 0) none of its
+#: 63 solves failed (its first version, condensing the motion over the horizon, failed or capped 41
+#: and the pendulum ran away), but it realized 223.0 W perfect and 173.2 W AR against IPOPT's 277.2
+#: and 333.7 W (benchmarks/hull_collocation_solver.out.txt): IPOPT stays the default
 SOLVER = "ipopt"
 #: the compiled solver's status names (``ipopt`` field of :meth:`HullCollocation.solve`)
 _COMPILED_STATUS = ("solved", "capped", "failed")

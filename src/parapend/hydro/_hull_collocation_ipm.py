@@ -14,10 +14,10 @@ memory causal). The Newton step of the barrier problem
 
 (``W`` the Hessian of the Lagrangian, ``Sigma`` the barrier's primal-dual weights of the
 torques' bounds and of the slacks ``s`` of the generator's speeds ``D x``) is taken, as
-IPOPT takes it, from a factorization of that whole sparse KKT matrix (``STEP = "kkt"``, the
-default): its ``L D L^T`` in a minimum-degree order (:mod:`._hull_collocation_ldl`; the
-memory's rows, which couple every velocity node, end the order as a dense clique of about
-370 rows, factored dense), the inertia counted from ``D``, corrected as IPOPT's
+IPOPT takes it, from a factorization of that whole sparse KKT matrix (``STEP = "kkt"``):
+its ``L D L^T`` in a minimum-degree order (:mod:`._hull_collocation_ldl`; the memory's
+rows, which couple every velocity node, end the order as a dense clique of about 370 rows,
+their Schur complement factored by LAPACK), the inertia counted from ``D``, corrected as IPOPT's
 (:meth:`CompiledSolver._kkt`: ``delta_w I`` on ``K`` until it is ``(n, m, 0)``,
 ``delta_c`` where singular), a static regularization 1e-9 refined away (at most
 ``REFINE`` steps of iterative refinement). ``STEP = "nullspace"`` takes it in the null
@@ -31,7 +31,11 @@ unstable over it. On 25 horizons captured from a run of the power matrix's Hs 1 
 bin (Tp 8.9 s: a 17.8 s horizon; started swinging, 40 iterations) it failed 11 and capped
 4, the KKT step (its first inertia correction then grown by 100, as IPOPT's) failed 1 and
 capped 1, IPOPT none; on the default sea's 12 s horizons both solved the same (the
-null-space step 2.3 times faster a horizon, median).
+null-space step 2.3 times faster a horizon, median). ``STEP = "auto"`` (the default)
+chooses every iteration: the null-space step where the sensitivities ``Z`` are at most
+``SENS_MAX`` (1e8: its basis then holds the reduced Hessian), the KKT step where they are
+larger; on the 20 captured horizons of that bin it failed none (capped 5, as the KKT
+step), and on the default sea it takes the null-space step on most iterations.
 
 **Method.** IPOPT's: the slacks ``D x - s = 0`` of the speed bounds, the fraction to the
 boundary ``max(0.99, 1 - mu)``, IPOPT's filter line search with its second-order
@@ -117,12 +121,14 @@ RESTORATION = True
 #: L^T``), ``"nullspace"`` (condensed on the torques: faster on short horizons, fails on
 #: long ones) or ``"auto"``: every iteration the null-space step where the torques'
 #: sensitivities are at most SENS_MAX, the KKT step where they are larger
-STEP = "kkt"
+STEP = "auto"
 #: the largest torque sensitivity ``max |J_d^-1 J_u|`` (units of the unknowns per m g l)
-#: with which ``STEP = "auto"`` takes the null-space step: on the default sea's horizons it
-#: stays below 5e5; on the Te 8 s bin's the null-space step failed where it reached 1e8
-#: to 1e13, and solved where it stayed below 5e7
-SENS_MAX = 1e6
+#: with which ``STEP = "auto"`` takes the null-space step. On the default sea's first 20
+#: horizons of seed 0 it rose from 1e3 to 1e10 as the pendulum swung up, the null-space
+#: step solving them all; on the Te 8 s bin's 20 it failed 8, where it reached 1e10 to
+#: 1e13 (it solved those that stayed below 5e7). With 1e6 or 1e8 the auto step failed
+#: none of these 60, as the KKT step
+SENS_MAX = 1e8
 #: iterative refinement's steps at most on the KKT matrix
 REFINE = 5
 
