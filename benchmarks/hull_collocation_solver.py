@@ -236,6 +236,7 @@ def main():
     ap.add_argument("--forecast", default="perfect")
     ap.add_argument("--no-ipopt-run", action="store_true")
     ap.add_argument("--skip-horizons", action="store_true")
+    ap.add_argument("--no-runs", action="store_true", help="the per-horizon tables only")
     ap.add_argument("--kkt", action="store_true")
     ap.add_argument("--step", nargs="+", default=None, choices=["auto", "kkt", "nullspace"],
                     help="the compiled solver's Newton steps compared per horizon (default "
@@ -259,6 +260,8 @@ def main():
         for step, r in per_horizon(a.seed, a.updates, a.te8, a.step).items():
             print_horizons(a, step, r)
     print(f"load average {os.getloadavg()[0]:.2f} {os.getloadavg()[1]:.2f}", flush=True)
+    if a.no_runs:
+        return
     p, wave = case(a.seed)
     plan0, statuses = hc._plan, []
 
