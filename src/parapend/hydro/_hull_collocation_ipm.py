@@ -127,7 +127,7 @@ STEP = "auto"
 #: horizons of seed 0 it rose from 1e3 to 1e10 as the pendulum swung up, the null-space
 #: step solving them all; on the Te 8 s bin's 20 it failed 8, where it reached 1e10 to
 #: 1e13 (it solved those that stayed below 5e7). With 1e6 or 1e8 the auto step failed
-#: none of these 60, as the KKT step
+#: none of these 60, as the KKT step; with 1e10 one of the Te 8 s bin's
 SENS_MAX = 1e8
 #: iterative refinement's steps at most on the KKT matrix
 REFINE = 5
