@@ -649,7 +649,7 @@ class CompiledSolver:
         ju = np.zeros((nd, n))  # J_u dense, C order (SciPy's toarray: Fortran's, copied)
         ju[self.ju_rows, self.ju_cols] = jac.data[self.jptr[nd]:]
         zfull = np.empty((self.nf, n))
-        zfull[:nd] = -lu.solve(ju, torques=True)
+        np.negative(lu.solve(ju, torques=True), out=zfull[:nd])
         zfull[nd:] = np.eye(n)
         return zfull
 
