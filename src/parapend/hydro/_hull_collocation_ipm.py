@@ -35,7 +35,8 @@ null-space step 2.3 times faster a horizon, median). ``STEP = "auto"`` (the defa
 chooses every iteration: the null-space step where the sensitivities ``Z`` are at most
 ``SENS_MAX`` (1e8: its basis then holds the reduced Hessian), the KKT step where they are
 larger; on the 20 captured horizons of that bin it failed none (capped 5, as the KKT
-step), and on the default sea it takes the null-space step on most iterations.
+step), and on the first 20 of the default sea's seeds 0 and 1 it took the null-space step
+on 302 of 364 and 183 of 306 iterations (that bin's: 588 of 891).
 
 **Method.** IPOPT's: the slacks ``D x - s = 0`` of the speed bounds, the fraction to the
 boundary ``max(0.99, 1 - mu)``, IPOPT's filter line search with its second-order
