@@ -22,7 +22,8 @@ positive definite, and a quasi-definite matrix has an ``L D L^T`` in every symme
 refinement on the matrix without it. By Sylvester's law of inertia ``D``'s signs are the
 matrix's inertia, which IPOPT's inertia correction asks to be ``(n, m, 0)`` (``n``
 unknowns, ``m`` rows; Wächter and Biegler, Math. Program. 106, 2006, 3.1): the
-factorization stops at its ``(m + 1)``-th negative pivot, or at a zero one, and reports it.
+factorization stops at its ``(m + 1)``-th negative pivot, or at a zero one, and reports it
+(in the dense complement both are counted once LAPACK has factored it).
 """
 
 from __future__ import annotations
