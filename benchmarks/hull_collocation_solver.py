@@ -22,6 +22,8 @@ matrix's causal run, :func:`parapend.performance.causal.run_hull_record`) in pla
 default sea.
 
     nice python benchmarks/hull_collocation_solver.py --updates 20 --seed 0
+    nice python benchmarks/hull_collocation_solver.py --seed 1 --step auto kkt nullspace \\
+        --no-ipopt-run
 """
 
 from __future__ import annotations
@@ -76,11 +78,16 @@ def beside(prob, max_iter, solver):
                                 max_iter=max_iter, solver=solver)
 
 
-def per_horizon(seed, updates, te8=False):
+def per_horizon(seed, updates, te8=False, steps=None):
     """Both solvers on the first ``updates`` horizons of an IPOPT run (module docstring;
-    ``te8``: of :func:`run_bin`)."""
-    rows, comp = [], {}
-    plan0 = hc._plan
+    ``te8``: of :func:`run_bin`); with ``steps`` the compiled solver once with each of
+    these Newton steps (:data:`parapend.hydro._hull_collocation_ipm.STEP`) from the same
+    start: ``{step: rows}``."""
+    from parapend.hydro import _hull_collocation_ipm as ipm
+
+    steps = [ipm.STEP] if not steps else list(steps)
+    rows, comp = {st: [] for st in steps}, {}
+    plan0, step0 = hc._plan, ipm.STEP
     hcol.SOLVER = "ipopt"
 
     def plan(prob, plant, fseg, u0, max_iter):
@@ -89,18 +96,22 @@ def per_horizon(seed, updates, te8=False):
         q = comp["q"]
         x0, par = prob.start(fseg, u0)
         warm = prob.prev is not None
-        if not rows:  # the kernels' first call (numba's cache) out of the timing
-            q.compiled.solve(x0, par, 2, prob.tol, warm)
-        t = time.perf_counter()
-        rc = q.solve_from(x0, par, max_iter, prob.tol, warm=warm)
-        tc = time.perf_counter() - t
+        out = []
+        for st in steps:
+            ipm.STEP = st
+            if not rows[st]:  # the kernels' first call (numba's cache) out of the timing
+                q.compiled.solve(x0, par, 2, prob.tol, warm)
+            t = time.perf_counter()
+            rc = q.solve_from(x0, par, max_iter, prob.tol, warm=warm)
+            out.append((st, rc, time.perf_counter() - t))
         t = time.perf_counter()
         ri = prob.solve_from(x0, par)
         ti = time.perf_counter() - t
-        rows.append((tc, ti, rc.nit, ri.nit, rc.status, ri.status,
-                     abs(rc.fun - ri.fun) / max(abs(ri.fun), 1e-12),
-                     float(np.max(np.abs(rc.x - ri.x)))))
-        if len(rows) >= updates:
+        for st, rc, tc in out:
+            rows[st].append((tc, ti, rc.nit, ri.nit, rc.status, ri.status,
+                             abs(rc.fun - ri.fun) / max(abs(ri.fun), 1e-12),
+                             float(np.max(np.abs(rc.x - ri.x)))))
+        if len(rows[steps[0]]) >= updates:
             raise StopIteration
         return ri
 
@@ -113,8 +124,8 @@ def per_horizon(seed, updates, te8=False):
     except StopIteration:
         pass
     finally:
-        hc._plan = plan0
-    return np.array(rows)
+        hc._plan, ipm.STEP = plan0, step0
+    return {st: np.array(r) for st, r in rows.items()}
 
 
 def kkt_baseline(seed, k=5):
@@ -191,6 +202,33 @@ def kkt_baseline(seed, k=5):
           f"{100 * (time.perf_counter() - t):7.1f} ms", flush=True)
 
 
+def print_horizons(a, step, r):
+    """The per-horizon table of the Newton step ``step`` (rows of :func:`per_horizon`)."""
+    print(f"{'Hs 1 m, Te 8 s bin' if a.te8 else f'seed {a.seed}'}, {len(r)} horizons, "
+          f"both from the same start (the compiled solver's step {step}):")
+    print("  update  compiled_s  ipopt_s  ratio  it_c  it_i  st_c st_i  rel_obj  max_du")
+    for k, row in enumerate(r):
+        print(f"  {k:6d} {row[0]:10.4f} {row[1]:8.4f} {row[1] / row[0]:6.1f} "
+              f"{row[2]:5.0f} {row[3]:5.0f} {row[4]:4.0f} {row[5]:4.0f} {row[6]:8.1e} "
+              f"{row[7]:7.1e}")
+    ratio = r[:, 1] / r[:, 0]
+    for name, col in (("compiled_s", r[:, 0]), ("ipopt_s", r[:, 1]), ("ratio", ratio)):
+        print(f"  {name:10s} median {np.median(col):8.4f}  p99 {np.percentile(col, 99):8.4f}"
+              f"  min {np.min(col):8.4f}")
+    solved = (r[:, 4] == 0) & (r[:, 5] == 0)
+    same = solved & (r[:, 6] < 1e-6)
+    print(f"  iterations median: compiled {np.median(r[:, 2]):.0f}, ipopt "
+          f"{np.median(r[:, 3]):.0f}; both solved to the same objective (1e-6 relative): "
+          f"{int(same.sum())}/{len(r)}, of which the torques within 1e-4 m g l: "
+          f"{int(np.sum(same & (r[:, 7] < 1e-4)))}, 1e-3: "
+          f"{int(np.sum(same & (r[:, 7] < 1e-3)))}; compiled failed "
+          f"{int(np.sum(r[:, 4] == 2))}, capped {int(np.sum(r[:, 4] == 1))}; ipopt failed "
+          f"{int(np.sum(r[:, 5] == 2))}, capped {int(np.sum(r[:, 5] == 1))}", flush=True)
+    ms = 1000 * r[:, 0] / np.maximum(r[:, 2], 1), 1000 * r[:, 1] / np.maximum(r[:, 3], 1)
+    print(f"  time an iteration (ms), median: compiled {np.median(ms[0]):.1f}, ipopt "
+          f"{np.median(ms[1]):.1f}", flush=True)
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--updates", type=int, default=20)
@@ -198,7 +236,11 @@ def main():
     ap.add_argument("--forecast", default="perfect")
     ap.add_argument("--no-ipopt-run", action="store_true")
     ap.add_argument("--skip-horizons", action="store_true")
+    ap.add_argument("--no-runs", action="store_true", help="the per-horizon tables only")
     ap.add_argument("--kkt", action="store_true")
+    ap.add_argument("--step", nargs="+", default=None, choices=["auto", "kkt", "nullspace"],
+                    help="the compiled solver's Newton steps compared per horizon (default "
+                         "_hull_collocation_ipm.STEP; the first for the whole runs)")
     ap.add_argument("--te8", action="store_true",
                     help="the power matrix's Hs 1 m, Te 8 s bin (Tp 8.9 s), seed 0, in place "
                          "of the default sea")
@@ -210,32 +252,16 @@ def main():
             kkt_baseline(a.seed)
         return
     print(f"load average {os.getloadavg()[0]:.2f} {os.getloadavg()[1]:.2f}", flush=True)
+    if a.step:
+        from parapend.hydro import _hull_collocation_ipm as ipm
+
+        ipm.STEP = a.step[0]
     if not a.skip_horizons:
-        r = per_horizon(a.seed, a.updates, a.te8)
-        print(f"{'Hs 1 m, Te 8 s bin' if a.te8 else f'seed {a.seed}'}, {len(r)} horizons, "
-              "both from the same start:")
-        print("  update  compiled_s  ipopt_s  ratio  it_c  it_i  st_c st_i  rel_obj  max_du")
-        for k, row in enumerate(r):
-            print(f"  {k:6d} {row[0]:10.4f} {row[1]:8.4f} {row[1] / row[0]:6.1f} "
-                  f"{row[2]:5.0f} {row[3]:5.0f} {row[4]:4.0f} {row[5]:4.0f} {row[6]:8.1e} "
-                  f"{row[7]:7.1e}")
-        ratio = r[:, 1] / r[:, 0]
-        for name, col in (("compiled_s", r[:, 0]), ("ipopt_s", r[:, 1]), ("ratio", ratio)):
-            print(f"  {name:10s} median {np.median(col):8.4f}  p99 {np.percentile(col, 99):8.4f}"
-                  f"  min {np.min(col):8.4f}")
-        solved = (r[:, 4] == 0) & (r[:, 5] == 0)
-        same = solved & (r[:, 6] < 1e-6)
-        print(f"  iterations median: compiled {np.median(r[:, 2]):.0f}, ipopt "
-              f"{np.median(r[:, 3]):.0f}; both solved to the same objective (1e-6 relative): "
-              f"{int(same.sum())}/{len(r)}, of which the torques within 1e-4 m g l: "
-              f"{int(np.sum(same & (r[:, 7] < 1e-4)))}, 1e-3: "
-              f"{int(np.sum(same & (r[:, 7] < 1e-3)))}; compiled failed "
-              f"{int(np.sum(r[:, 4] == 2))}, capped {int(np.sum(r[:, 4] == 1))}; ipopt failed "
-              f"{int(np.sum(r[:, 5] == 2))}, capped {int(np.sum(r[:, 5] == 1))}", flush=True)
-        ms = 1000 * r[:, 0] / np.maximum(r[:, 2], 1), 1000 * r[:, 1] / np.maximum(r[:, 3], 1)
-        print(f"  time an iteration (ms), median: compiled {np.median(ms[0]):.1f}, ipopt "
-              f"{np.median(ms[1]):.1f}", flush=True)
+        for step, r in per_horizon(a.seed, a.updates, a.te8, a.step).items():
+            print_horizons(a, step, r)
     print(f"load average {os.getloadavg()[0]:.2f} {os.getloadavg()[1]:.2f}", flush=True)
+    if a.no_runs:
+        return
     p, wave = case(a.seed)
     plan0, statuses = hc._plan, []
 
@@ -252,8 +278,11 @@ def main():
         res = run_bin(a.forecast) if a.te8 else run(p, wave, a.forecast)
         wall = time.perf_counter() - t
         st = np.asarray(res._update_times)
+        from parapend.hydro import _hull_collocation_ipm as ipm
+
+        name = f"{solver} ({ipm.STEP})" if solver == "compiled" else solver
         print(f"whole run, {'Te 8 s bin' if a.te8 else f'seed {a.seed}'}, {a.forecast}, "
-              f"{solver}: electrical "
+              f"{name}: electrical "
               f"{res.electrical_power_w:.4f} W, status {res.status}, {res.solves} solves, "
               f"{res.failed_solves} failed, {statuses.count(1)} capped; update median "
               f"{np.median(st):.3f} s, p99 "

@@ -14,6 +14,7 @@ balance residual and the largest turn of the generator in one plant step (rad).
     nice python benchmarks/hull_collocation_table.py --seeds 0 1 2 --forecast ar
     nice python benchmarks/hull_collocation_table.py --seeds 0 --plant-steps 12
     nice python benchmarks/hull_collocation_table.py --seeds 0 1 2 3 --solver compiled
+    nice python benchmarks/hull_collocation_table.py --seeds 0 1 2 --solver compiled --step kkt
 """
 
 from __future__ import annotations
@@ -48,9 +49,16 @@ def main():
                     help="the horizon solve's iterations at most (default the planner's)")
     ap.add_argument("--solver", default=None, choices=["compiled", "ipopt"],
                     help="the horizon's solver (default _hull_collocation.SOLVER)")
+    ap.add_argument("--step", default=None, choices=["auto", "kkt", "nullspace"],
+                    help="the compiled solver's Newton step (default "
+                         "_hull_collocation_ipm.STEP)")
     a = ap.parse_args()
     if a.solver is not None:
         hcol.SOLVER = a.solver
+    if a.step is not None:
+        from parapend.hydro import _hull_collocation_ipm as ipm
+
+        ipm.STEP = a.step
     if a.intervals is not None:
         hcol.INTERVALS = a.intervals
     if a.max_turn is not None:
@@ -68,7 +76,8 @@ def main():
     hc._plan = plan
     print(f"planner {a.planner}, {a.plant_steps} plant steps a sample, speed bound "
           f"{hcol.MAX_TURN} rad a plant step, at most {hcol.INTERVALS} intervals a sample, "
-          f"terminal weight {a.terminal_weight}, solver {hcol.SOLVER}, max_iter {a.max_iter}")
+          f"terminal weight {a.terminal_weight}, solver {hcol.SOLVER}, max_iter {a.max_iter}"
+          + (f", step {a.step}" if a.step else ""))
     print("seed forecast mode optimum_w power_w fraction stored_w failed capped "
           "update_median_s update_p99_s interval_s status wall_s balance_residual "
           "max_turn_per_step", flush=True)

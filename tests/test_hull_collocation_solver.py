@@ -86,11 +86,14 @@ def test_derivatives_are_casadis(kw):
                           (2, VARIANTS[1], 1, "adaptive", "kkt"),
                           (1, VARIANTS[0], 1, "adaptive", "kkt"),
                           (2, VARIANTS[0], 1, "monotone", "kkt"),
-                          (2, VARIANTS[0], 2, "adaptive", "nullspace")])
+                          (2, VARIANTS[0], 2, "adaptive", "nullspace"),
+                          (2, VARIANTS[0], 2, "adaptive", "auto"),
+                          (2, VARIANTS[0], 2, "adaptive", "auto:0.5")])
 def test_compiled_reaches_ipopts_optimum(intervals, kw, updates, strategy, step, monkeypatch):
     """One or two updates (the second from the first's solution shifted by one sample,
     after the plant ran it): the compiled solver (either barrier update, either Newton
-    step) and IPOPT from the same start reach the same objective (1e-6 relative) and
+    step, or the auto step: ``auto:0.5`` its threshold below every sensitivity, so its KKT
+    branch) and IPOPT from the same start reach the same objective (1e-6 relative) and
     torques (1e-4 m g l), both solved. (With an efficiency the smoothed kink of ``e(.)``
     makes the problem's local optima many: the second update of this small hull, or one
     Hermite-Simpson interval a sample, ends the two at different local optima, neither
@@ -98,7 +101,10 @@ def test_compiled_reaches_ipopts_optimum(intervals, kw, updates, strategy, step,
     IPOPT's.)"""
     from parapend.hydro import _hull_collocation_ipm as ipm
 
+    step, _, smax = step.partition(":")
     monkeypatch.setattr(ipm, "STEP", step)
+    if smax:
+        monkeypatch.setattr(ipm, "SENS_MAX", float(smax))
     plant, fseg, prob, ref = _pair(intervals, **kw)
     prob.shift = 1
     for k in range(updates):
@@ -319,7 +325,8 @@ def test_kkt_step_is_the_dense_solve():
     ref = np.linalg.solve(a, -np.concatenate((g, c)))
     dx, lam = lin.solve(g, c)
     assert np.max(np.abs(np.concatenate((dx, lam)) - ref)) <= 1e-9 * np.max(np.abs(ref))
-    ns, _ = cs._null_space(kmat, jac, cs._factor(jac), 0.0)
+    lu = cs._factor(jac)
+    ns, _ = cs._null_space(kmat, cs._sensitivities(jac, lu), lu, 0.0)
     dxn, lamn = ns.solve(g, c)
     assert np.max(np.abs(dxn - dx)) <= 1e-9 * np.max(np.abs(dx))
     assert np.max(np.abs(lamn - lam)) <= 1e-9 * np.max(np.abs(lam))

@@ -37,12 +37,12 @@ ended unresolved).
 
 The NLP is built once per run (the start, the memory's past part and the forecast are its
 parameters) and warm-started from the previous solution shifted by the update interval.
-The compiled solver takes its Newton steps, as IPOPT does (MUMPS), from a factorization of
+The compiled solver takes its Newton steps in the null space of the square Jacobian of the
+equality rows in the unknowns other than the torques (:mod:`._hull_collocation_linalg`)
+while the torques' sensitivities stay moderate, and where they grow large (the motion's
+linearization unstable over the horizon), as IPOPT does (MUMPS), from a factorization of
 the whole sparse KKT matrix (:mod:`._hull_collocation_ldl`), most of whose cost is the
-memory's dense rows; its first version condensed the motion over the horizon (the step in
-the null space of the square Jacobian of the equality rows in the unknowns other than the
-torques, :mod:`._hull_collocation_linalg`), still selectable
-(:data:`._hull_collocation_ipm.STEP`).
+memory's dense rows (:data:`._hull_collocation_ipm.STEP`).
 """
 
 from __future__ import annotations
@@ -66,17 +66,16 @@ MEMORY_STRIDE = 3
 #: the generator's planned speed at most, rad per plant step (None: unbounded)
 MAX_TURN = 0.4
 #: the horizon's solver: ``"compiled"`` (:mod:`._hull_collocation_ipm`, no CasADi: the same
-#: NLP, its Newton step from the whole sparse KKT matrix) or ``"ipopt"`` (CasADi's IPOPT,
-#: ``parapend[collocation]``). In the closed loop of the default barge's seeds
-#: 0 to 9, perfect forecast, the compiled solver realized 95.6 % of the record optimum (40
-#: iterations at most) against IPOPT's 94.5 %, no failed solve
-#: (benchmarks/hull_collocation_table.out.txt). On the power matrix's Hs 1 m, Te 8 s bin
-#: (Tp 8.9 s: a 17.8 s horizon; 4 waves, seed 0) none of its 63 solves failed (its first
-#: version, condensing the motion over the horizon, failed or capped 41 and the pendulum
-#: ran away), but it realized 223.0 W perfect and 173.2 W AR against IPOPT's 277.2 and
-#: 333.7 W (benchmarks/hull_collocation_solver.out.txt). The compiled solver is the default
-#: (the collocation planner is the hull's default, ``hull_control.PLANNER``: it runs without
-#: the extra, and in time): IPOPT is there to check it against
+#: NLP; its Newton step :data:`._hull_collocation_ipm.STEP`, ``"auto"``) or ``"ipopt"``
+#: (CasADi's IPOPT, ``parapend[collocation]``). In the closed loop of the default barge's
+#: seeds 0 to 9 (40 iterations at most) the compiled solver realized 95.3 % of the record
+#: optimum with the perfect forecast and 87.9 % with AR (IPOPT: 94.5 and 87.7 %), no failed
+#: solve; on the power matrix's Hs 1 m, Te 8 s bin (Tp 8.9 s: a 17.8 s horizon; 4 waves,
+#: seed 0) 276.8 W perfect and 292.4 W AR, none failed, against IPOPT's 277.2 and 333.7 W
+#: (benchmarks/hull_collocation_table.out.txt, hull_collocation_solver.out.txt); a horizon
+#: 2.1 to 2.6 times faster than IPOPT's (median). The compiled solver is the default (the
+#: collocation planner is the hull's default, ``hull_control.PLANNER``: it runs without the
+#: extra, and faster); IPOPT is there to check it against
 SOLVER = "compiled"
 #: the compiled solver's status names (``ipopt`` field of :meth:`HullCollocation.solve`)
 _COMPILED_STATUS = ("solved", "capped", "failed")

@@ -14,10 +14,10 @@ memory causal). The Newton step of the barrier problem
 
 (``W`` the Hessian of the Lagrangian, ``Sigma`` the barrier's primal-dual weights of the
 torques' bounds and of the slacks ``s`` of the generator's speeds ``D x``) is taken, as
-IPOPT takes it, from a factorization of that whole sparse KKT matrix (``STEP = "kkt"``, the
-default): its ``L D L^T`` in a minimum-degree order (:mod:`._hull_collocation_ldl`; the
-memory's rows, which couple every velocity node, end the order as a dense clique of about
-370 rows, factored dense), the inertia counted from ``D``, corrected as IPOPT's
+IPOPT takes it, from a factorization of that whole sparse KKT matrix (``STEP = "kkt"``):
+its ``L D L^T`` in a minimum-degree order (:mod:`._hull_collocation_ldl`; the memory's
+rows, which couple every velocity node, end the order as a dense clique of about 370 rows,
+their Schur complement factored by LAPACK), the inertia counted from ``D``, corrected as IPOPT's
 (:meth:`CompiledSolver._kkt`: ``delta_w I`` on ``K`` until it is ``(n, m, 0)``,
 ``delta_c`` where singular), a static regularization 1e-9 refined away (at most
 ``REFINE`` steps of iterative refinement). ``STEP = "nullspace"`` takes it in the null
@@ -31,7 +31,12 @@ unstable over it. On 25 horizons captured from a run of the power matrix's Hs 1 
 bin (Tp 8.9 s: a 17.8 s horizon; started swinging, 40 iterations) it failed 11 and capped
 4, the KKT step (its first inertia correction then grown by 100, as IPOPT's) failed 1 and
 capped 1, IPOPT none; on the default sea's 12 s horizons both solved the same (the
-null-space step 2.3 times faster a horizon, median).
+null-space step 2.3 times faster a horizon, median). ``STEP = "auto"`` (the default)
+chooses every iteration: the null-space step where the sensitivities ``Z`` are at most
+``SENS_MAX`` (1e8: its basis then holds the reduced Hessian), the KKT step where they are
+larger; on the 20 captured horizons of that bin it failed none (capped 5, as the KKT
+step), and on the first 20 of the default sea's seeds 0 and 1 it took the null-space step
+on 302 of 364 and 183 of 306 iterations (that bin's: 588 of 891).
 
 **Method.** IPOPT's: the slacks ``D x - s = 0`` of the speed bounds, the fraction to the
 boundary ``max(0.99, 1 - mu)``, IPOPT's filter line search with its second-order
@@ -114,9 +119,17 @@ LAM_RESET = 1e3
 #: restoration phase by least-norm steps in all the unknowns (:meth:`_restore_min_norm`)
 RESTORATION = True
 #: the Newton step (module docstring): ``"kkt"`` (the whole KKT matrix's sparse ``L D
-#: L^T``) or ``"nullspace"`` (condensed on the torques: faster on short horizons, fails on
-#: long ones)
-STEP = "kkt"
+#: L^T``), ``"nullspace"`` (condensed on the torques: faster on short horizons, fails on
+#: long ones) or ``"auto"``: every iteration the null-space step where the torques'
+#: sensitivities are at most SENS_MAX, the KKT step where they are larger
+STEP = "auto"
+#: the largest torque sensitivity ``max |J_d^-1 J_u|`` (units of the unknowns per m g l)
+#: with which ``STEP = "auto"`` takes the null-space step. On the default sea's first 20
+#: horizons of seed 0 it rose from 1e3 to 1e10 as the pendulum swung up, the null-space
+#: step solving them all; on the Te 8 s bin's 20 it failed 8, where it reached 1e10 to
+#: 1e13 (it solved those that stayed below 5e7). With 1e6 or 1e8 the auto step failed
+#: none of these 60, as the KKT step; with 1e10 one of the Te 8 s bin's
+SENS_MAX = 1e8
 #: iterative refinement's steps at most on the KKT matrix
 REFINE = 5
 
@@ -200,6 +213,9 @@ class CompiledSolver:
         self.jinv_var, self.jinv_mem = inv[:keep.sum()], inv[keep.sum():]
         self.jnnz = self.jind.size
         self.jmem = np.bincount(self.jinv_mem, weights=self.mem_val, minlength=self.jnnz)
+        # J_u's entries (the last n columns of the CSC pattern)
+        self.ju_rows = self.jind[self.jptr[self.nd]:]
+        self.ju_cols = np.repeat(np.arange(n), np.diff(self.jptr[self.nd:]))
         hkeep = (cmap[hr] >= 0) & (cmap[hc] >= 0)
         self.hkeep = hkeep
         # K lives on the rows with more than the diagonal (the Hessian's, the speeds', the
@@ -353,7 +369,7 @@ class CompiledSolver:
             jac = self.jacobian(jv)
             # the factors of J_d: the null-space step's, and the multipliers' estimate
             reset = lam is None or np.max(np.abs(lam)) > LAM_RESET
-            need = reset or STEP != "kkt"
+            need = reset or STEP != "kkt"  # (auto: its sensitivities choose the step)
             lu = self._factor(jac) if need else None
             if need and lu is None:
                 status, self.why = 2, "singular"
@@ -401,10 +417,11 @@ class CompiledSolver:
             diag[nd:] = zl / sl_u + zu / su_u
             self.sig_s = zls / sls + zus / sus if ns else np.zeros(0)
             kmat = self.hessian(hv, diag)
-            if STEP == "kkt":
+            zsens = None if STEP == "kkt" else self._sensitivities(jac, lu)
+            if STEP == "kkt" or (STEP == "auto" and not np.max(np.abs(zsens)) <= SENS_MAX):
                 lin, delta = self._kkt(kmat, jac, mu, delta_last)
             else:
-                lin, delta = self._null_space(kmat, jac, lu, delta_last)
+                lin, delta = self._null_space(kmat, zsens, lu, delta_last)
             if lin is None:
                 # no inertia correction up to MAX_DELTA: the restoration phase (IPOPT's),
                 # the multipliers estimated anew after it
@@ -442,7 +459,7 @@ class CompiledSolver:
                 if free:
                     refs = (refs + [err0])[-REFS:]
                     aff = _Newton(self, lin, gf, np.zeros(ns))
-                    adx, ads = aff.step(c, rd)[:2]
+                    adx, ads = aff.step(c, rd, probe=True)[:2]
                     adu = adx[uo:uo + n]
                     slacks = np.concatenate((sl_u, su_u, sls, sus))
                     dsl = np.concatenate((adu, -adu, ads, -ads))
@@ -452,7 +469,7 @@ class CompiledSolver:
                         cg[nd:] = -1.0 / sl_u + 1.0 / su_u
                         cen = _Newton(self, lin, cg,
                                       -1.0 / sls + 1.0 / sus if ns else np.zeros(0))
-                        cdx, cds = cen.step(np.zeros(self.neq), np.zeros(ns))[:2]
+                        cdx, cds = cen.step(None, np.zeros(ns), probe=True)[:2]
                         cdu = cdx[uo:uo + n]
                         dsc = np.concatenate((cdu, -cdu, cds, -cds))
                         dsq = float(np.mean(gl ** 2) + (np.mean((lamd + zls - zus) ** 2)
@@ -626,14 +643,23 @@ class CompiledSolver:
                 break
         return None, delta
 
-    def _null_space(self, kmat, jac, lu, delta_last):
-        """The reduced Hessian on the null space's orthonormal basis, Cholesky-factored
-        with the inertia correction ``delta I`` (0, then the last one's third or ``1e-4``,
-        times 8); ``(None, delta)`` past MAX_DELTA."""
-        n, nd, nf = self.n, self.nd, self.nf
-        zfull = np.empty((nf, n))
-        zfull[:nd] = -lu.solve(jac[:, nd:].toarray(), torques=True)
+    def _sensitivities(self, jac, lu):
+        """The null space's basis ``Z = [-J_d^-1 J_u; I]`` (nf, n): the torques'
+        sensitivities."""
+        n, nd = self.n, self.nd
+        ju = np.zeros((nd, n))  # J_u dense, C order (SciPy's toarray: Fortran's, copied)
+        ju[self.ju_rows, self.ju_cols] = jac.data[self.jptr[nd]:]
+        zfull = np.empty((self.nf, n))
+        np.negative(lu.solve(ju, torques=True), out=zfull[:nd])
         zfull[nd:] = np.eye(n)
+        return zfull
+
+    def _null_space(self, kmat, zfull, lu, delta_last):
+        """The reduced Hessian on the orthonormal basis of the null space (``zfull``: its
+        basis :meth:`_sensitivities`), Cholesky-factored with the inertia correction ``delta
+        I`` (0, then the last one's third or ``1e-4``, times 8); ``(None, delta)`` past
+        MAX_DELTA."""
+        n = self.n
         # an orthonormal basis of the null space: the torques' sensitivities reach 1e8
         # where the linearized motion is unstable over the horizon, and Z^T K Z then
         # loses the reduced Hessian to rounding (Z R^-1 with Householder's R:
@@ -705,9 +731,7 @@ class CompiledSolver:
                 return None, None
             yp = np.zeros(nf)
             yp[:nd] = -lu.solve(c)
-            zfull = np.empty((nf, n))
-            zfull[:nd] = -lu.solve(jac[:, nd:].toarray(), torques=True)
-            zfull[nd:] = np.eye(n)
+            zfull = self._sensitivities(jac, lu)
             q = zfull @ np.linalg.inv(np.linalg.qr(zfull, mode="r"))
             dxf = yp - q @ (q.T @ yp)
             if not np.all(np.isfinite(dxf)):
@@ -808,17 +832,23 @@ class _Newton:
         self.sv, self.lin = solver, lin
         self.gphi0, self.gphis = gphi0, gphis
 
-    def step(self, cr, rdr):
-        """``(dx, ds, l+, l_d+)`` for the constraints' values ``cr`` and speeds' ``rdr``."""
+    def step(self, cr, rdr, probe=False):
+        """``(dx, ds, l+, l_d+)`` for the constraints' values ``cr`` (None: zero) and speeds'
+        ``rdr``; ``probe``: a step only the barrier's oracle reads (its ``dx`` and ``ds``:
+        no multipliers, no iterative refinement)."""
         sv = self.sv
         nd = sv.nd
         ns = sv.sig_s.size
         gphi = self.gphi0 + sv._dt(sv.sig_s * rdr + self.gphis) if ns else self.gphi0
-        dxf, lnew = self.lin.solve(gphi, cr)
+        dxf, lnew = self.lin.solve(gphi, cr, probe)
+        if probe:
+            lnew = None
         ds = dxf[sv.d7] - dxf[sv.d6] + rdr if ns else np.zeros(0)
         dx = np.zeros(sv.nvar)
         dx[sv.dep] = dxf[:nd]
         dx[sv.uix] = dxf[nd:]
+        if probe:
+            return dx, ds, None, None
         return dx, ds, lnew, sv.sig_s * ds + self.gphis if ns else np.zeros(sv.npt - 1)
 
 
@@ -844,11 +874,17 @@ class _FullKKT:
         return np.concatenate((_kmul(self.sv, self.kmat, self.delta, dx) + self.jac.T @ lv,
                                self.jac @ dx - self.delta_c * lv))
 
-    def solve(self, gphi, cr):
+    def solve(self, gphi, cr, probe=False):
         """``(dx, l+)`` of ``(K + delta I) dx + J^T l+ = -gphi``, ``J dx - delta_c l+ =
-        -cr`` (iterative refinement: at most REFINE steps, until the residual is 1e-12 of
-        the right side's)."""
-        rhs = -np.concatenate((gphi, cr))
+        -cr`` (``cr`` None: zero; iterative refinement: at most REFINE steps, until the
+        residual is 1e-12 of the right side's, also for a ``probe``, the barrier oracle's
+        steps: without it the oracle's weight moved by the static regularization's 1e-9,
+        and a hard horizon of the Te 8 s bin that this step solved failed)."""
+        nf = self.sv.nf
+        rhs = np.zeros(nf + self.sv.neq)
+        rhs[:nf] = -gphi
+        if cr is not None:
+            rhs[nf:] = -cr
         v = self.ldl.solve(rhs)
         scale = 1e-12 * max(1.0, float(np.max(np.abs(rhs))))
         last = np.inf
@@ -859,7 +895,6 @@ class _FullKKT:
                 break
             last = res
             v = v + self.ldl.solve(r)
-        nf = self.sv.nf
         return v[:nf], v[nf:]
 
 
@@ -871,15 +906,26 @@ class _NullSpace:
     def __init__(self, sv, lu, fac, zfull, kmat, delta):
         self.sv, self.lu, self.fac, self.zfull = sv, lu, fac, zfull
         self.kmat, self.delta = kmat, delta
+        self.last = None  # (cr, yp, K yp) of the last right side (the same c: the
+        # affine step's and the step's)
 
-    def solve(self, gphi, cr):
+    def solve(self, gphi, cr, probe=False):
+        """``(dx, l+)`` (``cr`` None: zero; ``l+`` None for a ``probe``)."""
         sv = self.sv
         nd = sv.nd
-        yp = np.zeros(sv.nf)
-        yp[:nd] = -self.lu.solve(cr)
-        km = _kmul(sv, self.kmat, self.delta, yp)
+        if cr is None:
+            yp, km = np.zeros(sv.nf), np.zeros(sv.nf)
+        elif self.last is not None and self.last[0] is cr:
+            yp, km = self.last[1], self.last[2]
+        else:
+            yp = np.zeros(sv.nf)
+            yp[:nd] = -self.lu.solve(cr)
+            km = _kmul(sv, self.kmat, self.delta, yp)
+            self.last = (cr, yp, km)
         du = cho_solve(self.fac, -(self.zfull.T @ (gphi + km)), check_finite=False)
         dxf = yp + self.zfull @ du
+        if probe:
+            return dxf, None
         lnew = self.lu.solve_t(-(gphi + _kmul(sv, self.kmat, self.delta, dxf))[:nd])
         return dxf, lnew
 

@@ -11,20 +11,26 @@ Jacobian) is factored without pivoting in a fill-reducing order fixed once per p
 (the approximate minimum degree of its pattern: QDLDL's, from the ``qdldl`` package), its
 numeric factors anew every iteration by QDLDL's up-looking algorithm (Davis, *Direct
 Methods for Sparse Linear Systems*, 2006, 4.7: the elimination tree once, then every column
-of ``L`` from a sparse triangular solve along it) compiled here. ``eps`` (:data:`EPS`) is a
+of ``L`` from a sparse triangular solve along it) compiled here; the trailing columns that
+are (nearly) full (the memory's rows couple every velocity node: their clique ends the
+order) are left as their dense Schur complement, factored by LAPACK's Bunch-Kaufman ``L D
+L^T`` (``dsytrf``: blocked, its 1 x 1 and 2 x 2 pivots' signs the complement's inertia;
+the compiled loop it replaced took twice its time). ``eps`` (:data:`EPS`) is a
 static regularization: with it the matrix is quasi-definite where ``K + delta_w I`` is
 positive definite, and a quasi-definite matrix has an ``L D L^T`` in every symmetric order
 (Vanderbei, SIAM J. Optim. 5, 1995); its error in the step is taken out by iterative
 refinement on the matrix without it. By Sylvester's law of inertia ``D``'s signs are the
 matrix's inertia, which IPOPT's inertia correction asks to be ``(n, m, 0)`` (``n``
 unknowns, ``m`` rows; Wächter and Biegler, Math. Program. 106, 2006, 3.1): the
-factorization stops at its ``(m + 1)``-th negative pivot, or at a zero one, and reports it.
+factorization stops at its ``(m + 1)``-th negative pivot, or at a zero one, and reports it
+(in the dense complement both are counted once LAPACK has factored it).
 """
 
 from __future__ import annotations
 
 import numba as nb
 import numpy as np
+from scipy.linalg.lapack import dsytrf, dsytrf_lwork, dsytrs
 
 from .._jit import announce_compiles
 
@@ -139,10 +145,10 @@ def factor(n, ap, ai, ax, parent, lp, li, lx, d, dinv, maxneg, nxt):
 
 
 @nb.njit(cache=True)
-def solve(n, s, lp, li, lx, dinv, sm, perm, b, out):
-    """``out = A^-1 b`` from the factors of ``P^T A P`` (``perm``: the order; the columns
-    from ``s`` on dense in ``sm``: :func:`dense_ldl`'s)."""
-    x = np.empty(n)
+def solve_lower(n, s, lp, li, lx, dinv, perm, b, x):
+    """The first half of :meth:`SparseLDL.solve`: ``x = P^T b`` through ``L``'s sparse
+    columns (the first ``s``) and ``D``'s first ``s`` pivots; its rows from ``s`` on then
+    wait for the dense Schur complement's solve."""
     for k in range(n):
         x[k] = b[perm[k]]
     for i in range(s):
@@ -151,20 +157,14 @@ def solve(n, s, lp, li, lx, dinv, sm, perm, b, out):
             j0 = lp[i]
             for j in range(lp[i + 1] - j0):
                 x[li[j0 + j]] -= lx[j0 + j] * xi
-    m = n - s
-    for k in range(m):
-        xk = x[s + k]
-        for i in range(k + 1, m):
-            x[s + i] -= sm[k, i] * xk
     for i in range(s):
         x[i] *= dinv[i]
-    for k in range(m):
-        x[s + k] /= sm[k, k]
-    for k in range(m - 1, -1, -1):
-        t = x[s + k]
-        for i in range(k + 1, m):
-            t -= sm[k, i] * x[s + i]
-        x[s + k] = t
+
+
+@nb.njit(cache=True)
+def solve_upper(n, s, lp, li, lx, perm, x, out):
+    """The second half of :meth:`SparseLDL.solve`: ``L^T``'s sparse columns backwards and
+    the order undone into ``out``."""
     for i in range(s - 1, -1, -1):
         t = x[i]
         j0 = lp[i]
@@ -173,6 +173,42 @@ def solve(n, s, lp, li, lx, dinv, sm, perm, b, out):
         x[i] = t
     for k in range(n):
         out[perm[k]] = x[k]
+
+
+@nb.njit(cache=True)
+def inertia(a, ipiv):
+    """The positive and the negative eigenvalues' numbers of LAPACK's ``dsytrf`` factors
+    (``lower``: the 1 x 1 and 2 x 2 blocks of ``D`` on ``a``'s diagonal and below it, a 2 x
+    2 block where ``ipiv[k] = ipiv[k + 1] < 0``), or ``(-1, 0)`` where ``D`` is singular or
+    not finite (Sylvester's law: ``D``'s inertia is the matrix's)."""
+    m = a.shape[0]
+    npos = 0
+    nneg = 0
+    k = 0
+    while k < m:
+        if ipiv[k] < 0 and k + 1 < m:
+            p, q, r = a[k, k], a[k + 1, k], a[k + 1, k + 1]
+            det = p * r - q * q
+            if det == 0.0 or not np.isfinite(det):
+                return -1, 0
+            if det < 0.0:
+                npos += 1
+                nneg += 1
+            elif p > 0.0:
+                npos += 2
+            else:
+                nneg += 2
+            k += 2
+        else:
+            dk = a[k, k]
+            if dk == 0.0 or not np.isfinite(dk):
+                return -1, 0
+            if dk > 0.0:
+                npos += 1
+            else:
+                nneg += 1
+            k += 1
+    return npos, nneg
 
 
 @nb.njit(cache=True)
@@ -229,6 +265,8 @@ class SparseLDL:
             s -= 1
         self.s = s if n - s >= DENSE_MIN else n
         self.sm = np.zeros((n - self.s, n - self.s))
+        self.ipiv = np.zeros(n - self.s, np.int32)
+        self.lwork = max(1, int(dsytrf_lwork(n - self.s, lower=1)[0])) if self.s < n else 1
         self.lp = np.zeros(n + 1, np.int64)
         self.lp[1:] = np.cumsum(lnz)
         self.li, self.lx = np.empty(nl, np.uint32), np.empty(nl)
@@ -245,15 +283,28 @@ class SparseLDL:
         if out >= 0 and s < self.n:
             tail(s, self.n, self.ap, self.ai, self.ax, self.parent, self.lp, self.li,
                  self.lx, self.dinv, self.sm, self.nxt)
-            more = dense_ldl(self.sm, maxneg - (s - out))
-            out = out + more if more >= 0 else more
+            # the Schur complement (its upper triangle in sm, C order: the lower one of
+            # sm.T, Fortran's) by LAPACK's Bunch-Kaufman L D L^T in place
+            fac, self.ipiv, info = dsytrf(self.sm.T, lower=1, lwork=self.lwork,
+                                          overwrite_a=1)
+            npos, nneg = (-1, 0) if info != 0 else inertia(fac, self.ipiv)
+            if npos < 0:
+                out = -1
+            elif nneg > maxneg - (s - out):
+                out = -2
+            else:
+                out += npos
         self.ok = out >= 0
         return out
 
     def solve(self, b):
-        out = np.empty(self.n)
-        solve(self.n, self.s, self.lp, self.li, self.lx, self.dinv, self.sm, self.perm,
-              np.ascontiguousarray(b, dtype=float), out)
+        n, s = self.n, self.s
+        x, out = np.empty(n), np.empty(n)
+        solve_lower(n, s, self.lp, self.li, self.lx, self.dinv, self.perm,
+                    np.ascontiguousarray(b, dtype=float), x)
+        if s < n:
+            x[s:], _ = dsytrs(self.sm.T, self.ipiv, x[s:], lower=1, overwrite_b=1)
+        solve_upper(n, s, self.lp, self.li, self.lx, self.perm, x, out)
         return out
 
 
@@ -299,33 +350,3 @@ def tail(s, n, ap, ai, ax, parent, lp, li, lx, dinv, sm, nxt):
     for i in range(m):
         for j in range(i, m):
             sm[i, j] = low[j, i]
-
-
-@nb.njit(cache=True)
-def dense_ldl(a, maxneg):
-    """``L D L^T`` of the symmetric ``a`` (its upper triangle) in place without pivoting:
-    ``L^T`` strictly above the diagonal, ``D`` on it; the positive pivots' number, or -1, -2
-    as :func:`factor`."""
-    m = a.shape[0]
-    npos = 0
-    nneg = 0
-    for k in range(m):
-        dk = a[k, k]
-        if dk == 0.0 or not np.isfinite(dk):
-            return -1
-        if dk > 0.0:
-            npos += 1
-        else:
-            nneg += 1
-            if nneg > maxneg:
-                return -2
-        inv = 1.0 / dk
-        for i in range(k + 1, m):
-            f = a[k, i]
-            if f != 0.0:
-                g = f * inv
-                for j in range(i, m):
-                    a[i, j] -= g * a[k, j]
-        for i in range(k + 1, m):
-            a[k, i] *= inv
-    return npos
