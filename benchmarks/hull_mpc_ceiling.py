@@ -198,6 +198,7 @@ def _start_on(motion):
 
 
 def closed_loop(spec, opts, seeds, on_optimum=False):
+    opts = {"planner": "lbfgsb", **opts}  # the variants are L-BFGS-B's unless named
     p = hull_problem()
     pend = p["pendulum"]
     print(f"planner {spec} {opts}: seed optimum_w power_w fraction stored_w failed "
@@ -257,7 +258,7 @@ def compare(updates, seeds):
         print(f"seed {seed}: objective (time) L-BFGS-B 60, L-BFGS-B 600, Newton-TR 30")
         try:
             hc.hull_mpc(p["hull"], pend, wave, peak_period=6.0, pivot=p["pivot"],
-                        mode="rotate")
+                        mode="rotate", planner="lbfgsb")
         except StopIteration:
             pass
         rows.clear()

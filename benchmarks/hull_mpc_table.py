@@ -4,7 +4,8 @@ Embedded barge (10 x 4 x 1 m), its default sea state (Hs 1 m, Tp 6 s, JONSWAP 3.
 of 4 Tp), seeds given on the command line: the record optimum (``parapend.buoy`` with
 ``dofs="surge,heave,pitch"``) and :func:`parapend.hydro.hull_control.hull_mpc` with a perfect
 and an AR forecast of 2 Tp, 4 Tp of warm-up, the storage-corrected mean over one repeat, in
-the optimum's mode, and with a perfect forecast in the other mode.
+the optimum's mode, and with a perfect forecast in the other mode; the L-BFGS-B planner
+(``planner="lbfgsb"``; the collocation planner's table: hull_collocation_table.py).
 
     nice python benchmarks/hull_mpc_table.py 0 1 2
 """
@@ -36,7 +37,7 @@ def main(seeds):
         for fc in ("perfect", "ar"):
             t = time.time()
             r = hull_mpc(p["hull"], pend, wave, peak_period=6.0, pivot=p["pivot"],
-                         forecast=fc, mode=mode)
+                         forecast=fc, mode=mode, planner="lbfgsb")
             row += [f"{r.mean_power_w:.1f}", f"{r.mean_power_w / opt.power_w:.3f}",
                     f"{r.update_time_p99_s:.3f}"]
             fails.append(f"{r.failed_solves}/{r.solves}")
@@ -44,7 +45,8 @@ def main(seeds):
                   f"{r.stored_w:.1f} W, balance {r.energy_balance_residual:.2g}", flush=True)
         row += [f"{r.update_interval_s:.3f}", ",".join(fails)]
         other = "rotate" if mode == "swing" else "swing"
-        r = hull_mpc(p["hull"], pend, wave, peak_period=6.0, pivot=p["pivot"], mode=other)
+        r = hull_mpc(p["hull"], pend, wave, peak_period=6.0, pivot=p["pivot"], mode=other,
+                     planner="lbfgsb")
         row += [f"{r.mean_power_w:.1f}", f"{r.mean_power_w / opt.power_w:.3f}"]
         print(" ".join(str(v) for v in row), flush=True)
 

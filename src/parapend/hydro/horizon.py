@@ -39,11 +39,12 @@ __all__ = ["BUOY_HORIZON", "BuoyHorizonResult", "buoy_horizon_curve", "plot_buoy
 #: --controller mpc``'s (1.06e5 counted as two solves an update, 87 s under load), which
 #: over-estimates the default curve with the planner's radiation model (one solve an update,
 #: work 5.0e4, 16.5 s of CPU) about 2.5 times
-#: the hull's (``hull``): its default run (64 updates x 48 samples, 21 s at a load of 3);
-#: with the collocation planner (``hull-collocation``) 74 s (IPOPT, seed 0, load 2 to 3:
-#: benchmarks/hull_collocation_solver.out.txt)
+#: the hull's with L-BFGS-B (``hull``): its default sea's run (64 updates x 48 samples, 21 s
+#: at a load of 3); with the collocation planner (``hull-collocation``, the default, its
+#: compiled solver) a 20-minute record of the default sea (1631 updates x 48 samples, 500 s
+#: of CPU at a load of 6, the record's optimum aside)
 BUOY_MPC_SECONDS = {"coupled": 140.0 / 1.0e5, "plan": 87.0 / 1.06e5, "hull": 21.0 / 3.1e3,
-                    "hull-collocation": 74.0 / 3.1e3}
+                    "hull-collocation": 500.0 / 7.83e4}
 
 
 @dataclass(frozen=True, eq=False, repr=False)

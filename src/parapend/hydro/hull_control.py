@@ -66,8 +66,8 @@ DEFAULT_LIMIT = 4.0
 PLANNER = "collocation"
 #: L-BFGS-B iterations per horizon solve at most
 MAX_ITER = 60
-#: interior-point iterations per horizon solve at most (``planner="collocation"``): IPOPT's
-#: (the default solver), and the compiled solver's (a capped solve is applied): with 40 in place of
+#: interior-point iterations per horizon solve at most (``planner="collocation"``): IPOPT's,
+#: and the compiled solver's (the default) (a capped solve is applied): with 40 in place of
 #: 100 the default barge's seeds 0 to 9 (perfect forecast) realized 92.2 % of the record
 #: optimum (90.2 % with 100: the closed loop is chaotic), no solve failed, and the update's
 #: p99 fell from 0.3 to 2.3 s to 0.63 to 1.12 s (benchmarks/hull_collocation_table.out.txt;

@@ -72,10 +72,11 @@ CAUSAL_SECONDS = {"perfect": 7.5, "ar": 10.5}
 #: the hull's (``hull``, :func:`parapend.hydro.hull_control.hull_mpc`): its runs of the
 #: embedded barge's default sea (benchmarks/hull_mpc_table.out.txt, 8 peak periods at a
 #: horizon of 2, load 5 to 8) took 7 to 100 s (perfect) and 19 to 138 s (AR): 0.4 to 8.6 s
-#: a peak period per unit of horizon; with the collocation planner (``hull-collocation``)
-#: the runs of benchmarks/hull_collocation_table.out.txt (64 updates of 8 peak periods,
-#: update medians 1.0 to 3.6 s, load 2 to 7) took about 60 to 230 s: 4 to 14 s
-BUOY_CAUSAL_SECONDS = {"plan": 0.25, "coupled": 2.0, "hull": 4.5, "hull-collocation": 16.0}
+#: a peak period per unit of horizon; with the collocation planner (``hull-collocation``,
+#: the default, its compiled solver) a 20-minute record of the default sea (204 peak
+#: periods, horizon 2, perfect forecast) took 500 s of CPU at a load of 6 (the record's
+#: optimum aside): 1.2 s
+BUOY_CAUSAL_SECONDS = {"plan": 0.25, "coupled": 2.0, "hull": 4.5, "hull-collocation": 1.5}
 
 
 def hull_record_seconds(waves: float, ideal: bool = True) -> float:
