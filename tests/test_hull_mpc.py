@@ -205,6 +205,33 @@ def test_the_command_runs_the_hull_beside_its_record_optimum(tmp_path, capsys):
         assert math.isclose(r["optimum_fraction"], r["electrical_power_w"] / opt["power_w"])
     assert r["energy_balance_residual"] < 1e-3
     assert r["update_time_p99_s"] is not None and r["solves"] > 0
+    # --plot draws the run's time series (PNG and SVG)
+    assert main(["buoy", *sea, "--controller", "mpc", "--plot", str(tmp_path / "f")]) in (0, 3)
+    assert "written: " in capsys.readouterr().out
+    assert {p.name for p in (tmp_path / "f").iterdir()} == {"buoy_mpc.png", "buoy_mpc.svg"}
+
+
+def test_the_runs_figure_is_its_series():
+    """``plot()`` of a closed-loop run: heave, the generator's speed, the held torque and
+    the harvested energy against time (the series' own numbers: the energy the running sum
+    of the sample powers), the averaging window's start marked on each."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    r = hc.hull_mpc(HULL, PEND, WAVE, **OPTS)
+    fig = r.plot()
+    ax = fig.axes
+    assert [a.get_ylabel().split(" ")[0] for a in ax] == ["heave", "generator", "torque",
+                                                          "harvested"]
+    s = r._samples
+    assert np.array_equal(ax[0].lines[0].get_ydata(), s["z"])
+    assert np.array_equal(ax[1].lines[0].get_ydata(), s["theta_dot"])
+    assert np.array_equal(ax[2].lines[0].get_ydata()[:-1], s["torque"])
+    e = ax[3].lines[0].get_ydata()
+    assert e[-1] == pytest.approx(np.sum(s["power"] * np.diff(s["t"])), rel=1e-12)
+    for a in ax:
+        assert a.lines[-1].get_xdata()[0] == r.average_from_s
+    assert "hull" in ax[0].get_title()
 
 
 @pytest.mark.parametrize("args, mode", [

@@ -143,8 +143,11 @@ def _figures(r, directory) -> list:
     except OSError as exc:
         raise output_error(directory, exc) from None
     sweep = hasattr(r, "period_s")
-    fig = plot_sweep(r) if sweep else plot_motion(r)
-    name = "buoy_power" if sweep else "buoy_motion"
+    if hasattr(r, "update_interval_s"):  # a closed-loop run: its own time series
+        fig, name = r.plot(), "buoy_mpc"
+    else:
+        fig = plot_sweep(r) if sweep else plot_motion(r)
+        name = "buoy_power" if sweep else "buoy_motion"
     out = []
     for ext in ("png", "svg"):
         path = d / f"{name}.{ext}"
@@ -156,8 +159,6 @@ def _figures(r, directory) -> list:
 def _cmd_buoy(a) -> dict | str:
     _check_dir(a.plot)
     _check_output(a.save, "--save", SAVE_ALL)
-    if a.controller != "optimum" and a.plot:
-        raise ParameterError("plot: not drawn with --controller mpc (use --save)")
     try:
         if a.optimize_design or a.realizations:
             from ._notice import install
@@ -176,10 +177,13 @@ def _cmd_buoy(a) -> dict | str:
     if hasattr(r, "planner"):  # a causal run (BuoyMPCResult)
         from ..hydro.control import mpc_text
 
+        written = [a.save] if a.save else []
         if a.save:
             r.save(a.save)
+        if a.plot:
+            written += _figures(r, a.plot)
         return unresolved_if(r.to_dict() if a.json else "\n".join(
-            mpc_text(r) + ([f"written: {a.save}"] if a.save else [])), r)
+            mpc_text(r) + [f"written: {w}" for w in written]), r)
     if tuple(r.dofs) != ("heave",):
         return _hull_output(r, a)
     sweep = hasattr(r, "period_s")

@@ -224,7 +224,8 @@ class BuoyMPCResult(_Result):
         return ds
 
     def _figure(self):
-        """Heave, held torque and harvested energy against time."""
+        """Heave, the generator's speed, held torque and harvested energy against time, the
+        averaging window's start marked."""
         from ..plotting import plt
         from ..style import figure_style
 
@@ -232,20 +233,27 @@ class BuoyMPCResult(_Result):
         t = np.asarray(s["t"])
         e = np.concatenate(([0.0], np.cumsum(np.asarray(s["power"]) * np.diff(t))))
         with figure_style():
-            fig, ax = plt.subplots(3, 1, figsize=(7, 7), sharex=True)
+            fig, ax = plt.subplots(4, 1, figsize=(7, 8.5), sharex=True)
             ax[0].plot(t, s["z"], lw=1.0, color="C1")
             ax[0].set_ylabel("heave z (m)")
-            ax[1].step(t, np.append(s["torque"], s["torque"][-1]), where="post", lw=0.8,
+            ax[1].plot(t, s["theta_dot"], lw=0.8, color="C2")
+            ax[1].set_ylabel(r"generator speed $\dot\theta$ (rad/s)")
+            ax[2].step(t, np.append(s["torque"], s["torque"][-1]), where="post", lw=0.8,
                        color="C3")
-            ax[1].set_ylabel(r"torque $\tau$ (N m)")
-            ax[2].plot(t, e, lw=1.0, color="C0")
-            ax[2].set_ylabel("harvested energy (J)")
-            ax[2].set_xlabel("time t (s)")
+            ax[2].set_ylabel(r"torque $\tau$ (N m)")
+            ax[3].plot(t, e, lw=1.0, color="C0")
+            ax[3].set_ylabel("harvested energy (J)")
+            ax[3].set_xlabel("time t (s)")
+            if self.average_from_s is not None:
+                for a in ax:
+                    a.axvline(self.average_from_s, color="0.6", lw=0.8, ls="--")
             head = (f"mean power {self.mean_power_w:.4g} W (harvested "
                     f"{self.harvested_power_w:.4g} W + stored {self.stored_w:.4g} W) from "
                     f"{self.average_from_s:.4g} s" if self.headline_reason is None else
                     f"no mean power ({self.status})")
-            ax[0].set_title(f"buoy, {self.planner}: {head}", fontsize=10)
+            body = "hull" if self.planner.startswith("hull") else "buoy"
+            ax[0].set_title(f"{body}, {self.planner}, {self.forecast} forecast:\n{head}",
+                            fontsize=10)
             fig.tight_layout()
         return fig
 
