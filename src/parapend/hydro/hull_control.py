@@ -62,7 +62,8 @@ DEFAULT_LIMIT = 4.0
 #: or ``"lbfgsb"``, L-BFGS-B on the held torques shot through the plant's model. On the
 #: default barge's 20-minute record (Hs 1 m, Tp 6 s, seed 0, 2 Tp of horizon, 4 of warm-up,
 #: perfect forecast) L-BFGS-B realized 25.6 % of the record optimum (227.9 of 888.5 W; 337
-#: of 1631 solves ended abnormally) and the collocation planner 98.0 % (871.1 W, none)
+#: of 1631 solves ended abnormally) and the collocation planner 98.0 % (871.1 W, none; 91.5 %
+#: with the AR forecast)
 PLANNER = "collocation"
 #: L-BFGS-B iterations per horizon solve at most
 MAX_ITER = 60
