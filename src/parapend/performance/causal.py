@@ -119,8 +119,7 @@ def check_causal(*, controller, horizon, forecast, update_interval, warm_up, pla
         from ..hydro.hull_control import PLANNER
 
         # "hull": L-BFGS-B (the stores' name for it from before collocation was the default)
-        buoy_controller = {"lbfgsb": "hull", "collocation": "hull-collocation"}[
-            planner or PLANNER]
+        buoy_controller = {p: c for c, p in HULL_PLANNERS.items()}[planner or PLANNER]
         if buoy_controller == "hull-collocation":
             from ..hydro._hull_collocation import available
 
