@@ -882,7 +882,11 @@ def hold_limit(sol: HullSolution, peak_torque=None) -> HullSolution:
     while (over > HOLD_TOL or (over < -HOLD_TOL and grid < limit)) and steps < HOLD_STEPS:
         lower = dataclasses.replace(pto, torque_limit=min(limit, grid / (1 + over)))
         low = lower.problem(case)
-        xr, ex, _, n = _pto_maximize(low, x, lower, False, width=_width(state))
+        if state is not None and state[1] is not None:
+            # the same grid: the last solve's penalty and multipliers start this one
+            low.set_limit(lower.torque_limit, state[2], state[3], state[4])
+        xr, ex, _, n = _pto_maximize(low, x, lower, False, width=_width(state),
+                                     same_grid=True)
         its += n
         if not math.isfinite(ex):
             break
@@ -974,7 +978,7 @@ def _maximizer(pr: HullProblem):
 
 
 def _pto_maximize(pr: HullProblem, x, pto: HullPTO, first: bool, widths=None,
-                  scale=None, width=None, start=None):
+                  scale=None, width=None, start=None, same_grid=False):
     """The PTO's optimum from ``x``: the smoothing continuation (an efficiency) under the
     torque limit (:func:`parapend.hydro.pto.maximize`). Returns ``(x, exact, status,
     iterations)``. ``widths``: these widths (relative to ``scale``, the matrix-free
@@ -986,7 +990,8 @@ def _pto_maximize(pr: HullProblem, x, pto: HullPTO, first: bool, widths=None,
     of the largest ``|p|`` on (:func:`parapend.hydro._hull_krylov.settled`), and ``width``
     (W; a refinement's, a finer level's or a held limit's start: the smoothing width of the
     answer ``x`` continues, its ``pto_state``) starts it there: ``WIDTHS_WARM`` relative to
-    it, stopping once settled (the dense driver: ``WIDTHS_REFINE`` whole). ``start``: the
+    it (from the answer's width itself on the answer's grid, ``same_grid``), stopping once
+    settled (the dense driver: ``WIDTHS_REFINE`` whole). ``start``: the
     exact objective of ``x`` at the width before ``widths`` (a screened start's). Settled
     ("converged"): the kept iterate's exact objective within ``PTO_SETTLED`` of its
     neighbouring width's (or ``start``)."""
@@ -998,6 +1003,8 @@ def _pto_maximize(pr: HullProblem, x, pto: HullPTO, first: bool, widths=None,
     if free and pto.smoothed:
         if widths is None and width is not None and width > 0:
             widths, scale, kw["settle"] = WIDTHS_WARM, width, math.inf
+            if same_grid:
+                widths = WIDTHS_WARM[WIDTHS_WARM.index(1.0):]
         else:
             p0 = scale if scale is not None else float(np.max(np.abs(
                 pr.state(np.asarray(x, dtype=float))["p"])))
@@ -1047,10 +1054,13 @@ def _settled_at(log, ex, start, size) -> bool:
 PTO_SETTLE_WIDTH = 1e-4
 #: the widths of a matrix-free efficiency's continuation that starts from an answer
 #: (a refinement, a finer level, a held limit), relative to that answer's width: it stops
-#: once settled (on the barge's 10-wave record the doubling to 288 harmonics had climbed
-#: the four of ``WIDTHS_REFINE``, 1e-3 to 1e-6 of the largest ``|p|``, each mode and its
-#: one-way twin)
-WIDTHS_WARM = (1.0, 1.0 / 3.0, 0.1, 1.0 / 30.0, 0.01)
+#: once settled. From ten times the answer's width: the doubled harmonics move the optimum
+#: (the barge's 10-wave rotation: 378.2 W at 144 harmonics, its padded motion 372.7 W at
+#: 288, the maximum there above 405 W), and climbed at the answer's own width that climb
+#: crawled (over 4 minutes of CPU), at ten times it 25 s; ``WIDTHS_REFINE``'s four,
+#: relative to the padded answer's own largest ``|p|`` (30 times smaller than the ideal
+#: optimum's there), ended at 1e-6 of it, 30 times below the coarse answer's width
+WIDTHS_WARM = (10.0, 3.0, 1.0, 1.0 / 3.0, 0.1, 1.0 / 30.0)
 
 
 #: a matrix-free efficiency's search screens its starts: each start's continuation runs
