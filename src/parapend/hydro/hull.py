@@ -991,7 +991,7 @@ def _pto_maximize(pr: HullProblem, x, pto: HullPTO, first: bool, widths=None,
     (W; a refinement's, a finer level's or a held limit's start: the smoothing width of the
     answer ``x`` continues, its ``pto_state``) starts it there: ``WIDTHS_WARM`` relative to
     it (from the answer's width itself on the answer's grid, ``same_grid``), stopping once
-    settled (the dense driver: ``WIDTHS_REFINE`` whole). ``start``: the
+    settled from the answer's width on (the dense driver: ``WIDTHS_REFINE`` whole). ``start``: the
     exact objective of ``x`` at the width before ``widths`` (a screened start's). Settled
     ("converged"): the kept iterate's exact objective within ``PTO_SETTLED`` of its
     neighbouring width's (or ``start``)."""
@@ -1002,7 +1002,8 @@ def _pto_maximize(pr: HullProblem, x, pto: HullPTO, first: bool, widths=None,
     kw = {}
     if free and pto.smoothed:
         if widths is None and width is not None and width > 0:
-            widths, scale, kw["settle"] = WIDTHS_WARM, width, math.inf
+            # the widths above the answer's are the path (LEVEL_GTOL)
+            widths, scale, kw["settle"] = WIDTHS_WARM, width, width * (1 + 1e-9)
             if same_grid:
                 widths = WIDTHS_WARM[WIDTHS_WARM.index(1.0):]
         else:
