@@ -504,11 +504,10 @@ def test_barge_ten_wave_record_with_an_efficiency_matrix_free_is_the_dense_answe
 
 def test_a_screened_start_goes_on_as_its_whole_continuation():
     """A matrix-free efficiency's search screens its starts down to ``WIDTHS[PTO_SCREEN -
-    1]`` and continues only the best over the last widths, relative to the largest ``|p|``
-    at its start (:func:`parapend.hydro.hull._finish_screened`): the same widths as the
-    whole continuation from that start, so the same answer (the exact power to 1e-6,
-    measured 8.7e-8: the screening's last two widths are climbed to GTOL, the whole
-    continuation's to LEVEL_GTOL, and the paths part by that). Its
+    1]`` and continues only the best over the last widths, relative to the screening's
+    ``|p|`` scale (here the start's own; :func:`parapend.hydro.hull._finish_screened`),
+    from the screened iterate's exact power: the same widths, climbs and stop as the whole
+    continuation from that start, so the same answer (the exact power to 1e-6). Its
     screened status is its last climb's, and the problem reports the objective of the
     climb that gave the answer (its width one of the last ones)."""
     from parapend.hydro.hull import PTO_SCREEN, HullPTO, _finish_screened, _pto_maximize
