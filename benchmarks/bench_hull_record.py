@@ -19,7 +19,8 @@ the table's powers), the peak torque between the grid's points against the limit
 status, the energy balance and the refinement's history.
 
 Run: ``nice python benchmarks/bench_hull_record.py [--waves 10,25,50,100,200]
-[--dense 10,25] [--dense-timeout 900] [--take-off limit --limit 60000]``; the machine,
+[--dense 10,25] [--dense-timeout 900] [--take-off limit --limit 60000 [--lift-caps]]``;
+the machine,
 its load before and after, and the table go to stdout (benchmarks/bench_hull_record.out.txt
 holds a run).
 """
@@ -38,9 +39,12 @@ import time
 CHILD = r"""
 import json, resource, sys, time
 import parapend
+from parapend import limits
 from parapend.hydro import hull
 waves, dense = float(sys.argv[1]), sys.argv[2] == "dense"
 pto = json.loads(sys.argv[3]) if len(sys.argv) > 3 else {}
+if len(sys.argv) > 4 and sys.argv[4] == "lift":  # past the take-off's record caps
+    limits.HULL_MAX_HARMONICS = limits.HULL_MAX_PTO_RECORD_HARMONICS = 10**6
 if dense:
     hull.KRYLOV_HARMONICS = hull.LONG_RECORD_HARMONICS = 10**9
 t, c = time.perf_counter(), time.process_time()
@@ -59,11 +63,12 @@ print(json.dumps({"seconds": time.perf_counter() - t, "power_w": r.power_w,
 """
 
 
-def run(waves: float, dense: bool, timeout: float, pto=None) -> dict | None:
+def run(waves: float, dense: bool, timeout: float, pto=None, lift=False) -> dict | None:
     env = dict(os.environ)
     try:
         out = subprocess.run([sys.executable, "-c", CHILD, str(waves),
-                              "dense" if dense else "krylov", json.dumps(pto or {})],
+                              "dense" if dense else "krylov", json.dumps(pto or {}),
+                              "lift" if lift else "keep"],
                              capture_output=True,
                              text=True, timeout=timeout, env=env, check=True)
     except subprocess.TimeoutExpired:
@@ -88,6 +93,9 @@ def main():
     ap.add_argument("--timeout", type=float, default=1800.0)
     ap.add_argument("--take-off", choices=("limit", "efficiency", "both"), default=None)
     ap.add_argument("--limit", type=float, default=60e3, help="the torque limit, N m")
+    ap.add_argument("--lift-caps", action="store_true",
+                    help="measure records past the take-off's caps (limits.HULL_MAX_HARMONICS, "
+                    "HULL_MAX_PTO_RECORD_HARMONICS), as the measurements that set them")
     ap.add_argument("--ideal", default="10:1744.54666,25:1637.09744,50:1652.99164,"
                     "100:1641.27472,200:1633.99607", help="WAVES:POWER of the ideal take-off")
     a = ap.parse_args()
@@ -151,7 +159,7 @@ def take_off(a) -> None:
     print(head)
     print("-" * len(head))
     for w in (float(v) for v in a.waves.split(",")):
-        r = run(w, False, a.timeout, pto)
+        r = run(w, False, a.timeout, pto, a.lift_caps)
         if r is None or "error" in r:
             why = f"did not finish in {a.timeout:g} s" if r is None else r["error"]
             print(f"{w:6g}  {why}", flush=True)

@@ -504,11 +504,10 @@ def test_barge_ten_wave_record_with_an_efficiency_matrix_free_is_the_dense_answe
 
 def test_a_screened_start_goes_on_as_its_whole_continuation():
     """A matrix-free efficiency's search screens its starts down to ``WIDTHS[PTO_SCREEN -
-    1]`` and continues only the best over the last widths, relative to the largest ``|p|``
-    at its start (:func:`parapend.hydro.hull._finish_screened`): the same widths as the
-    whole continuation from that start, so the same answer (the exact power to 1e-6,
-    measured 8.7e-8: the screening's last two widths are climbed to GTOL, the whole
-    continuation's to LEVEL_GTOL, and the paths part by that). Its
+    1]`` and continues only the best over the last widths, relative to the screening's
+    ``|p|`` scale (here the start's own; :func:`parapend.hydro.hull._finish_screened`),
+    from the screened iterate's exact power: the same widths, climbs and stop as the whole
+    continuation from that start, so the same answer (the exact power to 1e-6). Its
     screened status is its last climb's, and the problem reports the objective of the
     climb that gave the answer (its width one of the last ones)."""
     from parapend.hydro.hull import PTO_SCREEN, HullPTO, _finish_screened, _pto_maximize
@@ -519,10 +518,80 @@ def test_a_screened_start_goes_on_as_its_whole_continuation():
     pto = HullPTO(efficiency=(0.9, 0.85))
     k = KrylovHullProblem(cs, eta=pto.efficiency)
     whole = _pto_maximize(k, ideal.x, pto, True)
-    xs, exs, status, _ = _pto_maximize(k, ideal.x, pto, True, WIDTHS[:PTO_SCREEN])
-    assert status == "converged"
-    x, ex, _, _ = _finish_screened(k, pto, xs, ideal.x, WIDTHS[PTO_SCREEN:])
-    assert ex == pytest.approx(whole[1], rel=1e-6)
     p0 = float(np.max(np.abs(k.state(ideal.x)["p"])))
+    xs, exs, status, _ = _pto_maximize(k, ideal.x, pto, True, WIDTHS[:PTO_SCREEN], scale=p0)
+    assert status == "converged"
+    x, ex, _, _ = _finish_screened(k, pto, xs, p0, WIDTHS[PTO_SCREEN:], start=exs)
+    assert ex == pytest.approx(whole[1], rel=1e-6)
     assert any(k.answer[0] == pytest.approx(w * p0) for w in WIDTHS[PTO_SCREEN:]) or \
         ex == exs
+
+
+def test_an_efficiencys_continuation_stops_once_settled():
+    """A matrix-free efficiency's continuation stops at the first width at or below
+    ``settle`` whose exact power has settled from the width before (moved by at most
+    ``PTO_SETTLED`` of the power scale, or fell): the widths it climbed are the whole
+    continuation's (the same exact powers to 1e-9: from there the same climbs, to GTOL),
+    the power it keeps is the largest of them and none of the widths it left out has more
+    than ``PTO_SETTLED`` of the scale more; the stop is where the independent rule (the
+    whole continuation's exact powers, compared pairwise) puts it."""
+    from parapend.hydro._hull_krylov import LEVEL_GTOL, pto_maximize
+    from parapend.hydro.hull import PTO_SETTLE_WIDTH, PTO_SETTLED
+    from parapend.hydro.pto import WIDTHS
+
+    cs = _record(harmonics=24, winding=0)
+    ideal = hull_search(lambda s: cs, refine=False)
+    eta = (0.9, 0.85)
+    k = KrylovHullProblem(cs, eta=eta)
+    p0 = float(np.max(np.abs(k.state(ideal.x)["p"])))
+    settle = PTO_SETTLE_WIDTH * p0
+    # the whole continuation, climbed here width by width (the path's widths to LEVEL_GTOL,
+    # those at or below ``settle`` to GTOL)
+    whole, xw = [], ideal.x
+    for rel in WIDTHS:
+        k.width = rel * p0
+        r = newton_maximize(k, xw, "width", maxiter=200, saddle=False,
+                            gtol=GTOL if k.width <= settle else LEVEL_GTOL)
+        xw = r.x
+        whole.append((k.width, k.exact(xw)))
+    x, ex, runs = pto_maximize(KrylovHullProblem(cs, eta=eta), ideal.x, WIDTHS,
+                               settle=settle)
+    size = float(k.w[0])
+    exs = [r[1] for r in whole]
+    stop = next(i for i in range(1, len(exs)) if WIDTHS[i] * p0 <= settle and (
+        exs[i] < exs[i - 1] or abs(exs[i] - exs[i - 1]) <= PTO_SETTLED * size))
+    assert len(runs) == stop + 1 < len(whole)
+    for a, b in zip(runs, whole):
+        assert a[0] == b[0] and a[1] == pytest.approx(b[1], rel=1e-9, abs=1e-9 * size)
+    assert ex == max(r[1] for r in runs)
+    assert max(exs) <= ex + PTO_SETTLED * size
+    assert KrylovHullProblem(cs, eta=eta).exact(x) == pytest.approx(ex, rel=1e-12)
+
+
+def test_a_refinement_starts_at_its_answers_width():
+    """A matrix-free efficiency's refinement (a finer level, a held limit) starts its
+    continuation at the smoothing width of the answer it refines (``WIDTHS_WARM``, relative
+    to it) and stops once settled: fewer climbs than ``WIDTHS_REFINE``'s four, to a
+    maximum that the dense driver (trust-exact) at the same width, from the answer
+    perturbed, climbs back to (the exact power to 1e-8); its status "converged" says
+    the kept power is within ``PTO_SETTLED`` of a neighbouring width's."""
+    from parapend.hydro.hull import HullPTO, _pto_maximize
+    from parapend.hydro.pto import maximize
+    from parapend.optimal.fourier import _pad
+
+    cs = _record(harmonics=24, winding=0)
+    pto = HullPTO(efficiency=(0.9, 0.85))
+    sol = hull_search(lambda s: cs, refine=False, pto=pto)
+    fine = _record(harmonics=48, winding=0)
+    k = KrylovHullProblem(fine, eta=pto.efficiency)
+    x0 = _pad(sol.x, 48)
+    x, ex, status, _ = _pto_maximize(k, x0, pto, False, width=sol.pto_state[0])
+    assert status == "converged"
+    width = k.answer[0]
+    assert any(width == pytest.approx(f * sol.pto_state[0]) for f in hull_mod.WIDTHS_WARM)
+    d = HullProblem(fine, eta=pto.efficiency)
+    xs = x + 1e-5 * np.sin(np.arange(x.size))
+    assert d.exact(xs) < ex - 1e-9 * abs(ex)
+    pd = float(np.max(np.abs(d.state(xs)["p"])))
+    _, exd, runs = maximize(d, xs, (width / pd,))
+    assert runs[-1][1] == pytest.approx(ex, rel=1e-8)

@@ -303,7 +303,8 @@ HULL_MAX_REFINED_HARMONICS = 256
 #: a 300-wave record (benchmarks/bench_hull_record.out.txt: 200 waves, 2400 harmonics)
 HULL_MAX_RECORD_HARMONICS = 3600
 #: HULL_MAX_HARMONICS for a torque limit or a copper loss (an efficiency keeps HULL_MAX_HARMONICS:
-#: its continuation's last widths cost minutes at 144 harmonics), whose
+#: its continuation stops once settled, but the refinement's doubling to 288 harmonics climbs
+#: the kink's small widths for minutes each on the 10-wave record), whose
 #: records are solved matrix-free from 100 harmonics (hydro/_hull_krylov.py: the limit's
 #: augmented Lagrangian and the efficiency's smoothing on Newton with truncated conjugate
 #: gradients; benchmarks/bench_hull_record.out.txt, its take-off table: the barge's 25-peak-

@@ -680,10 +680,11 @@ def _continued_pto(case: HullCase, make, sol: HullSolution, pto, refine: bool):
         return dataclasses.replace(sol, case=case, x=_pad(sol.x, n),
                                    one_way_x=_pad(sol.one_way_x, n), success=False)
     pr = pto.problem(case)
-    x, ex, status, its = _hull._pto_maximize(pr, _pad(sol.x, n), pto, False)
+    width = _hull._width(sol.pto_state)
+    x, ex, status, its = _hull._pto_maximize(pr, _pad(sol.x, n), pto, False, width=width)
     kkt = pr.answer
     x1, ex1, _, its1 = _hull._pto_maximize(pto.problem(case, coupled=False),
-                                           _pad(sol.one_way_x, n), pto, False)
+                                           _pad(sol.one_way_x, n), pto, False, width=width)
     if not math.isfinite(ex):
         return dataclasses.replace(sol, case=case, x=_pad(sol.x, n), power=math.nan,
                                    one_way_x=_pad(sol.one_way_x, n), success=False,
@@ -758,18 +759,25 @@ def limited(problem: KrylovHullProblem, x, limit: float, gtol: float, warm: bool
 
 
 def pto_maximize(problem: KrylovHullProblem, x0, widths=None, limit=None,
-                 max_inner: int | None = None, scale: float | None = None):
+                 max_inner: int | None = None, scale: float | None = None,
+                 settle: float | None = None, start: float | None = None):
     """:func:`parapend.hydro.pto.maximize` matrix-free: the continuation in the
     efficiency's smoothing width ``s -> 0`` (``widths`` relative to the largest ``|p|`` at
     ``x0``), each width climbed by Newton with truncated conjugate gradients, under the
     torque limit by :func:`limited` (the multipliers carried from width to width). The
-    widths before the last two are only the path: climbed to ``LEVEL_GTOL``, the last two
-    (whose exact powers :func:`.hull._pto_maximize` compares) to ``GTOL``. Returns
-    ``(x, exact, runs)`` as that function: the iterate with the largest exact
-    (unsmoothed) objective among those within the limit, and per width ``(s, exact,
+    widths above ``settle`` before the last two are only the path: climbed to
+    ``LEVEL_GTOL``, the others (whose exact powers :func:`.hull._pto_maximize` compares) to
+    ``GTOL``. Returns ``(x, exact, runs)`` as that function: the iterate with the largest
+    exact (unsmoothed) objective among those within the limit, and per width ``(s, exact,
     status, iterations)``. ``max_inner``: unused (the inexact climbs bound themselves).
     ``scale``: the ``|p|`` the widths are relative to (by default the largest at ``x0``; a
-    screened start's last widths, :func:`.hull._finish_screened`, keep its start's)."""
+    screened start's last widths, :func:`.hull._finish_screened`, keep its start's).
+
+    ``settle``: a width (W) at or below which the continuation stops once the exact
+    objective has settled (:func:`settled`: moved by at most ``PTO_SETTLED`` from the width
+    before, or fell), None: every width. ``start``: the exact objective of ``x0`` when it
+    is the maximum of the width before ``widths[0]`` (a continuation resumed), compared
+    with the first width's."""
     from .pto import LIMIT_TOL, WIDTHS
 
     widths = WIDTHS if widths is None else widths
@@ -778,9 +786,11 @@ def pto_maximize(problem: KrylovHullProblem, x0, widths=None, limit=None,
     best_x, best = x.copy(), (problem.exact(x) if limit is None else -math.inf)
     problem.answer = None
     runs = []
+    prev = start
     for i, rel in enumerate(widths):
         problem.width = rel * p0
-        gtol = GTOL if i >= len(widths) - 2 else LEVEL_GTOL
+        near = settle is not None and problem.width <= settle
+        gtol = GTOL if near or i >= len(widths) - 2 else LEVEL_GTOL
         if limit is None:
             r = newton_maximize(problem, x, "width", gtol=gtol, maxiter=AL_MAX_NEWTON,
                                 saddle=False)
@@ -789,13 +799,28 @@ def pto_maximize(problem: KrylovHullProblem, x0, widths=None, limit=None,
             x, viol, status, nit = limited(problem, x, limit, gtol, warm=True)
         ex = problem.exact(x)
         runs.append((rel * p0, ex, status, nit))
-        if math.isfinite(ex) and ex >= best and (limit is None or
-                                                 viol <= LIMIT_TOL * limit):
+        ok = math.isfinite(ex) and (limit is None or viol <= LIMIT_TOL * limit)
+        if ok and ex >= best:
             best, best_x = ex, np.array(x)
             problem.answer = (problem.climbed_state() if limit is None else
                               problem.climbed)
+        if near and ok and prev is not None and settled(prev, ex, problem):
+            break
+        prev = ex if ok else None
     problem.limit = None
     return best_x, best, runs
+
+
+def settled(before: float, after: float, problem) -> bool:
+    """Whether an efficiency's continuation stops after a width whose exact objective is
+    ``after``, the width before's ``before``: it moved by at most ``PTO_SETTLED`` of the
+    larger of it and ``m g l w`` (:data:`.hull.PTO_SETTLED`, the settled check), or it
+    fell (the smaller widths sample the kink on the grid's points, which the exact power
+    integrates between them: on the barge's 10-wave record both modes' exact powers peak
+    at 3e-5 of the largest ``|p|`` and fall after, 499.078, 499.072, 499.045 W swinging at
+    3e-5, 1e-5, 1e-6, the last two widths half the continuation's time)."""
+    size = max(abs(after), float(problem.w[0]))
+    return after < before or abs(after - before) <= _hull.PTO_SETTLED * size
 
 
 #: Lanczos (ARPACK) for the largest eigenvalue of the reduced Hessian scaled by its diagonal

@@ -785,7 +785,8 @@ def _refine(sol: HullSolution, make, x) -> HullSolution:
         case = make(scale)
         if pto.active:
             pr = pto.problem(case)
-            xr, pr_power, st, _ = _pto_maximize(pr, _pad(x, case.harmonics), pto, False)
+            xr, pr_power, st, _ = _pto_maximize(pr, _pad(x, case.harmonics), pto, False,
+                                                width=_width(kkt))
             kr = pr.answer
             if not math.isfinite(pr_power):
                 # no motion within the limit in the budget: the coarser answer stands, its
@@ -797,7 +798,8 @@ def _refine(sol: HullSolution, make, x) -> HullSolution:
                 break
             # the one-way answer follows, doubling by doubling
             x1n, p1n, _, _ = _pto_maximize(pto.problem(case, coupled=False),
-                                           _pad(x1, case.harmonics), pto, False)
+                                           _pad(x1, case.harmonics), pto, False,
+                                           width=_width(kkt))
             x1, p1 = (x1n, p1n) if math.isfinite(p1n) else (_pad(x1, case.harmonics),
                                                             math.nan)
         else:
@@ -874,12 +876,17 @@ def hold_limit(sol: HullSolution, peak_torque=None) -> HullSolution:
         return peak_torque(case, x) / limit - 1
 
     x, over, grid, steps, its = sol.x, overshoot(sol.x), limit, 0, 0
+    state = sol.pto_state
     # (a lowered grid limit whose answer's peak falls short is raised again, never past
     # the limit: the power given away)
     while (over > HOLD_TOL or (over < -HOLD_TOL and grid < limit)) and steps < HOLD_STEPS:
         lower = dataclasses.replace(pto, torque_limit=min(limit, grid / (1 + over)))
         low = lower.problem(case)
-        xr, ex, _, n = _pto_maximize(low, x, lower, False)
+        if state is not None and state[1] is not None:
+            # the same grid: the last solve's penalty and multipliers start this one
+            low.set_limit(lower.torque_limit, state[2], state[3], state[4])
+        xr, ex, _, n = _pto_maximize(low, x, lower, False, width=_width(state),
+                                     same_grid=True)
         its += n
         if not math.isfinite(ex):
             break
@@ -971,31 +978,53 @@ def _maximizer(pr: HullProblem):
 
 
 def _pto_maximize(pr: HullProblem, x, pto: HullPTO, first: bool, widths=None,
-                  scale=None):
+                  scale=None, width=None, start=None, same_grid=False):
     """The PTO's optimum from ``x``: the smoothing continuation (an efficiency) under the
     torque limit (:func:`parapend.hydro.pto.maximize`). Returns ``(x, exact, status,
     iterations)``. ``widths``: these widths (relative to ``scale``, the matrix-free
     driver's, or to the largest ``|p|`` at ``x``) instead of the continuation's; a screening
     (:func:`_screened`) when they end above the last one: "converged" then when the last
-    width's climb converged."""
+    width's climb converged.
+
+    Matrix-free, an efficiency's continuation stops once settled from ``PTO_SETTLE_WIDTH``
+    of the largest ``|p|`` on (:func:`parapend.hydro._hull_krylov.settled`), and ``width``
+    (W; a refinement's, a finer level's or a held limit's start: the smoothing width of the
+    answer ``x`` continues, its ``pto_state``) starts it there: ``WIDTHS_WARM`` relative to
+    it (from the answer's width itself on the answer's grid, ``same_grid``), stopping once
+    settled from the answer's width on (the dense driver: ``WIDTHS_REFINE`` whole). ``start``: the
+    exact objective of ``x`` at the width before ``widths`` (a screened start's). Settled
+    ("converged"): the kept iterate's exact objective within ``PTO_SETTLED`` of its
+    neighbouring width's (or ``start``)."""
     from .pto import WIDTHS, WIDTHS_REFINE
 
     screening = widths is not None and widths[-1] > WIDTHS[-1]
+    free = pr.hessian == "operator" and "maximize" in MATRIX_FREE
+    kw = {}
+    if free and pto.smoothed:
+        if widths is None and width is not None and width > 0:
+            # the widths above the answer's are the path (LEVEL_GTOL)
+            widths, scale, kw["settle"] = WIDTHS_WARM, width, width * (1 + 1e-9)
+            if same_grid:
+                widths = WIDTHS_WARM[WIDTHS_WARM.index(1.0):]
+        else:
+            p0 = scale if scale is not None else float(np.max(np.abs(
+                pr.state(np.asarray(x, dtype=float))["p"])))
+            kw["settle"] = PTO_SETTLE_WIDTH * p0
+        kw["start"] = start
     if widths is None:
         widths = (WIDTHS if first else WIDTHS_REFINE) if pto.smoothed else (1.0,)
-    kw = {} if scale is None else {"scale": scale}
+    if scale is not None:
+        kw["scale"] = scale
     x, ex, log = _maximizer(pr)(pr, np.asarray(x, dtype=float), widths, pto.torque_limit,
                                 max_inner=PTO_MAX_INNER if first else PTO_MAX_INNER_REFINE,
                                 **kw)
     its = sum(r[3] for r in log)
-    last = [r[1] for r in log if math.isfinite(r[1])]
     if not math.isfinite(ex):
         return x, ex, "no motion within the torque limit", its
     if screening:
         ok = log[-1][2] == "converged"
     elif pto.smoothed:
-        size = max(abs(ex), float(pr.w[0]))  # the power, or m g l w near zero
-        ok = len(last) >= 2 and abs(last[-1] - last[-2]) <= PTO_SETTLED * size
+        ok = _settled_at(log, ex, start, max(abs(ex), float(pr.w[0])))
     elif pto.torque_limit is None:
         # a copper loss alone: smooth; trust-exact's "stalled" at a maximum is its precision
         ok = log[-1][2] == "converged" or float(np.max(np.abs(pr.evaluate(x)[1]))) <= \
@@ -1003,6 +1032,36 @@ def _pto_maximize(pr: HullProblem, x, pto: HullPTO, first: bool, widths=None,
     else:
         ok = log[-1][2] == "converged"
     return x, ex, "converged" if ok else f"stalled ({log[-1][2]})", its
+
+
+def _width(state) -> float | None:
+    """The smoothing width (W) of a take-off's ``pto_state`` (None: none)."""
+    return None if state is None else state[0]
+
+
+def _settled_at(log, ex, start, size) -> bool:
+    """Whether the kept exact objective ``ex`` (the last width's of ``log`` that has it) is
+    within ``PTO_SETTLED * size`` of a neighbouring width's (the one before, the one
+    after, or ``start`` before the first)."""
+    vals = ([] if start is None else [start]) + [r[1] for r in log]
+    j = max(i for i, v in enumerate(vals) if v == ex) if ex in vals else -1
+    near = [vals[i] for i in (j - 1, j + 1) if 0 <= i < len(vals) and j >= 0]
+    return any(math.isfinite(v) and abs(v - ex) <= PTO_SETTLED * size for v in near)
+
+
+#: a matrix-free efficiency's continuation stops once settled from this width on (relative
+#: to the largest ``|p|`` at its start: the screening's last, ``WIDTHS[PTO_SCREEN - 1]``),
+#: those widths climbed to ``GTOL`` (the ones above are the path)
+PTO_SETTLE_WIDTH = 1e-4
+#: the widths of a matrix-free efficiency's continuation that starts from an answer
+#: (a refinement, a finer level, a held limit), relative to that answer's width: it stops
+#: once settled. From ten times the answer's width: the doubled harmonics move the optimum
+#: (the barge's 10-wave rotation: 378.2 W at 144 harmonics, its padded motion 372.7 W at
+#: 288, the maximum there above 405 W), and climbed at the answer's own width that climb
+#: crawled (over 4 minutes of CPU), at ten times it 25 s; ``WIDTHS_REFINE``'s four,
+#: relative to the padded answer's own largest ``|p|`` (30 times smaller than the ideal
+#: optimum's there), ended at 1e-6 of it, 30 times below the coarse answer's width
+WIDTHS_WARM = (10.0, 3.0, 1.0, 1.0 / 3.0, 0.1, 1.0 / 30.0)
 
 
 #: a matrix-free efficiency's search screens its starts: each start's continuation runs
@@ -1024,12 +1083,12 @@ def _screened(pr: HullProblem, pto: HullPTO) -> tuple:
     return WIDTHS[:PTO_SCREEN], WIDTHS[PTO_SCREEN:]
 
 
-def _finish_screened(pr: HullProblem, pto: HullPTO, x, x0, widths):
+def _finish_screened(pr: HullProblem, pto: HullPTO, x, scale: float, widths, start=None):
     """A screened start's continuation over the last ``widths`` from its screened iterate
-    ``x``, the widths relative to the largest ``|p|`` at its start ``x0`` (as the whole
-    continuation's). Returns :func:`_pto_maximize`'s tuple."""
-    scale = float(np.max(np.abs(pr.state(np.asarray(x0, dtype=float))["p"])))
-    return _pto_maximize(pr, x, pto, True, widths, scale)
+    ``x``, the widths relative to the screening's ``scale`` (W; the largest ``|p|`` over
+    the search's starts: as the whole continuation's); ``start``: the screened iterate's
+    exact objective. Returns :func:`_pto_maximize`'s tuple."""
+    return _pto_maximize(pr, x, pto, True, widths, scale, start=start)
 
 
 def _pto_stage(case, make, pto: HullPTO, runs, best_one, refine: bool) -> HullSolution:
@@ -1045,9 +1104,14 @@ def _pto_stage(case, make, pto: HullPTO, runs, best_one, refine: bool) -> HullSo
     seeds += _free_motion(case, case.winding)
     pr = pto.problem(case)
     screen = _screened(pr, pto)
+    # the screening's widths relative to one |p| for every start (a least-torque motion's
+    # own is small: its widths then the kink's dearest, 67 s on the barge's 10-wave
+    # rotation for a start 960 W below the best)
+    scale = max((float(np.max(np.abs(pr.state(x0)["p"]))) for _, x0 in seeds),
+                default=None) if screen else None
     best, tried, its = None, [], 0
     for name, x0 in seeds:
-        x, ex, status, it = _pto_maximize(pr, x0, pto, True, *screen[:1])
+        x, ex, status, it = _pto_maximize(pr, x0, pto, True, *screen[:1], scale=scale)
         kkt = pr.answer
         its += it
         if status == "converged" and aliased(pr, x):
@@ -1059,20 +1123,21 @@ def _pto_stage(case, make, pto: HullPTO, runs, best_one, refine: bool) -> HullSo
                 1e-9 * max(abs(ex), float(pr.w[0])) if best[2] == "converged" else 0.0)):
             best = (x, ex, status, name, x0, kkt)
     one_pr = pto.problem(case, coupled=False)
-    one, one_start = None, None
+    one = None
     for x1 in ([best_one.x] if best_one is not None else []) + [
             x for _, x in _free_motion(case, case.winding, coupled=False)]:
-        r = _pto_maximize(one_pr, x1, pto, True, *screen[:1])
+        r = _pto_maximize(one_pr, x1, pto, True, *screen[:1], scale=scale)
         its += r[3]
         if one is None or (math.isfinite(r[1]) and not r[1] <= one[1]):
-            one, one_start = r, x1
+            one = r
     if screen and best is not None:  # the screening's best, on to the last widths
-        x, ex, status, it = _finish_screened(pr, pto, best[0], best[4], screen[1])
+        x, ex, status, it = _finish_screened(pr, pto, best[0], scale, screen[1],
+                                             start=best[1])
         its += it
         if math.isfinite(ex):
             best = (x, ex, status, best[3], best[4], pr.answer)
     if screen and one is not None and math.isfinite(one[1]):
-        r = _finish_screened(one_pr, pto, one[0], one_start, screen[1])
+        r = _finish_screened(one_pr, pto, one[0], scale, screen[1], start=one[1])
         its += r[3]
         if math.isfinite(r[1]):
             one = r
