@@ -9,9 +9,6 @@ seeds of a bin.
 from __future__ import annotations
 
 import math
-import os
-import signal
-import subprocess
 import sys
 import time
 import warnings
@@ -19,6 +16,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from killed import kill_after
 
 import parapend
 from parapend.cli import main
@@ -36,7 +34,6 @@ from parapend.performance.resource import (
     wave_number,
 )
 
-SRC = str(Path(parapend.__file__).resolve().parents[1])
 TINY = {"hs": "1,2", "te": "6,7", "realizations": 2, "waves": 4, "workers": 1}
 
 
@@ -410,22 +407,9 @@ def test_kill_9_then_resume_equals_uninterrupted(tmp_path):
     ref = tmp_path / "ref.zarr"
     power_matrix(**grid, workers=1, store=str(ref), command="test")
     store = tmp_path / "killed.zarr"
-    code = ("import sys, time; from parapend.performance import power_matrix\n"
-            "def slow(done, total):\n"
-            "    print(done, flush=True)\n"
-            "    time.sleep(0.3)\n"
-            f"power_matrix(**{grid!r}, workers=1, store=sys.argv[1], command='test',"
-            " progress=slow)\n")
-    proc = subprocess.Popen([sys.executable, "-c", code, str(store)],
-                            env={**os.environ, "PYTHONPATH": SRC}, stdout=subprocess.PIPE,
-                            text=True)
-    for line in proc.stdout:  # two of the six bins in the store
-        if int(line) >= 4:
-            break
-    os.kill(proc.pid, signal.SIGKILL)
-    proc.wait()
-    proc.stdout.close()
-    assert proc.returncode == -signal.SIGKILL
+    kill_after("from parapend.performance import power_matrix",  # 2 of the 6 bins stored
+               f"power_matrix(**{grid!r}, workers=1, store=sys.argv[1], command='test', "
+               "progress=slow)", store, 4)
     import zarr
 
     done = np.asarray(zarr.open_group(store, mode="r")["done"][...])

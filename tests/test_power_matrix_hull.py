@@ -438,43 +438,19 @@ def test_a_hull_causal_matrix_killed_resumes_to_the_same_store(dataset, tmp_path
     """The hull's causal column in a ``--store``: a run killed with SIGKILL after its first
     bin, resumed on two processes, leaves the store byte for byte as one uninterrupted run
     on one process (each bin is solved whole, on its own)."""
-    import hashlib
-    import os
-    import signal
-    import subprocess
-    import sys
-    from pathlib import Path
-
     import zarr
-
-    def files(store):
-        return {str(p.relative_to(store)): hashlib.sha256(p.read_bytes()).hexdigest()
-                for p in sorted(Path(store).rglob("*")) if p.is_file()}
+    from killed import kill_after, store_files
 
     grid = {**BINS, "realizations": 1, "hydro": dataset, **HULL, "controller": "mpc"}
     ref = tmp_path / "ref.zarr"
     power_matrix(**grid, workers=1, store=str(ref), command="test")
     store = tmp_path / "killed.zarr"
-    code = ("import sys, time; from parapend.performance import power_matrix\n"
-            "def slow(done, total):\n"
-            "    print(done, flush=True)\n"
-            "    time.sleep(0.5)\n"
-            f"power_matrix(**{grid!r}, workers=1, store=sys.argv[1], command='test',"
-            " progress=slow)\n")
-    src = str(Path(parapend.__file__).resolve().parents[1])
-    proc = subprocess.Popen([sys.executable, "-c", code, str(store)],
-                            env={**os.environ, "PYTHONPATH": src}, stdout=subprocess.PIPE,
-                            text=True)
-    for line in proc.stdout:  # one of the four bins in the store
-        if int(line) >= 1:
-            break
-    os.kill(proc.pid, signal.SIGKILL)
-    proc.wait()
-    proc.stdout.close()
-    assert proc.returncode == -signal.SIGKILL
+    kill_after("from parapend.performance import power_matrix",  # 1 of the 4 bins stored
+               f"power_matrix(**{grid!r}, workers=1, store=sys.argv[1], command='test', "
+               "progress=slow)", store, 1)
     done = np.asarray(zarr.open_group(store, mode="r")["done"][...])
     assert 0 < done.sum() < done.size
     ds, _, run, _ = power_matrix(**grid, workers=2, store=str(store), command="test")
     assert run.resumed_points >= 1 and 0 < run.computed_points < done.size
-    assert files(store) == files(ref)
+    assert store_files(store) == store_files(ref)
     assert np.isfinite(ds["causal_perfect_power_mean"].values).any()
