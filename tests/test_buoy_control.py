@@ -171,7 +171,6 @@ def test_bad_input(kw, name):
     (["--controller", "mpc"], "controller"),                       # no irregular sea
     (["--controller", "mpc", "--wave-period", "1.5"], "controller"),
     (["--controller", "pid", "--hs", "0.5", "--tp", "2.5"], "controller"),
-    (["--controller", "mpc", "--hs", "0.5", "--tp", "2.5", "--plot", "figs"], "plot"),
     # the planner: with mpc only, and the model's own
     (["--planner", "coupled", "--hs", "0.5", "--tp", "2.5"], "planner"),
     (["--controller", "one-way-mpc", "--planner", "plan", "--hs", "0.5", "--tp", "2.5"],
