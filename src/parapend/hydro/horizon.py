@@ -297,9 +297,9 @@ def buoy_horizon_curve(*, hs=None, tp=None, spectrum="jonswap", gamma_peak=3.3,
     tr = float(waves[0][1]["repeat_period"])
     # the planner that will run: buoy_mpc's default when none is given
     if hull:
-        from .hull_control import PLANNER
+        from .hull_control import CONTROLLERS, PLANNER
 
-        runs = {"lbfgsb": "hull", "collocation": "hull-collocation"}[planner or PLANNER]
+        runs = CONTROLLERS[planner or PLANNER]
     else:
         runs = planner or ("coupled" if efficiency is not None else "plan")
     iterations = 1 if runs in ("plan", "hull", "hull-collocation") else 2

@@ -65,6 +65,9 @@ DEFAULT_LIMIT = 4.0
 #: of 1631 solves ended abnormally) and the collocation planner 98.0 % (871.1 W, none; 91.5 %
 #: with the AR forecast)
 PLANNER = "collocation"
+#: each planner's controller name (the power matrix's ``buoy_controller``, ``horizon``'s
+#: cost key): ``hull`` is L-BFGS-B's, its name from before collocation was the default
+CONTROLLERS = {"lbfgsb": "hull", "collocation": "hull-collocation"}
 #: L-BFGS-B iterations per horizon solve at most
 MAX_ITER = 60
 #: interior-point iterations per horizon solve at most (``planner="collocation"``): IPOPT's,

@@ -76,7 +76,8 @@ BUOY_CONTROLLER = "plan"
 #: (:func:`parapend.hydro.hull_control.hull_mpc`, ``--dofs surge,heave,pitch``)
 BUOY_HORIZON = {"plan": 2.0, "coupled": 1.0, "hull": 2.0, "hull-collocation": 2.0}
 #: the hull's controllers (``buoy_controller``) and the planner each runs
-#: (:func:`parapend.hydro.hull_control.hull_mpc`'s ``planner``)
+#: (:func:`parapend.hydro.hull_control.hull_mpc`'s ``planner``; ``hull_control.CONTROLLERS``
+#: inverted)
 HULL_PLANNERS = {"hull": "lbfgsb", "hull-collocation": "collocation"}
 
 
@@ -116,10 +117,9 @@ def check_causal(*, controller, horizon, forecast, update_interval, warm_up, pla
                              "prescribed-heave pendulum has one planner)")
     base = BUOY_CAUSAL if buoy else CAUSAL
     if not heave:
-        from ..hydro.hull_control import PLANNER
+        from ..hydro.hull_control import CONTROLLERS, PLANNER
 
-        # "hull": L-BFGS-B (the stores' name for it from before collocation was the default)
-        buoy_controller = {p: c for c, p in HULL_PLANNERS.items()}[planner or PLANNER]
+        buoy_controller = CONTROLLERS[planner or PLANNER]
         if buoy_controller == "hull-collocation":
             from ..hydro._hull_collocation import available
 
