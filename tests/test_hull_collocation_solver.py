@@ -352,6 +352,74 @@ def test_kkt_inertia_correction():
     assert np.max(np.abs(np.concatenate((dx, lam)) - ref)) <= 1e-9 * np.max(np.abs(ref))
 
 
+def test_sparse_ldl_groups_and_threads_change_no_bit(monkeypatch):
+    """The compiled ``L D L^T`` factors its rows in groups of whole subtrees (and the
+    trailing rows dealt in turn) on numba's threads: with one group or three, on one
+    thread or two, the factors, the positive pivots' number, the solve and the early
+    outcomes (-2 past ``maxneg`` negative pivots, -1 at a zero pivot) are the same to the
+    bit; the factors solve the matrix (NumPy's, 1e-10 times the condition number).
+    Three diagonal blocks coupled only through the constraint rows: a forest of subtrees,
+    the coupling's clique factored dense."""
+    import numba
+
+    from parapend.hydro import _hull_collocation_ldl as ldlmod
+    from parapend.hydro._hull_collocation_ldl import SparseLDL
+
+    monkeypatch.setattr(ldlmod, "DENSE_MIN", 8)
+    rng = np.random.default_rng(5)
+    nblk, bs, m = 3, 30, 12
+    n = nblk * bs
+    b = np.zeros((n, n))
+    for i in range(nblk):
+        sl = slice(i * bs, (i + 1) * bs)
+        b[sl, sl] = np.where(rng.random((bs, bs)) < 0.1, rng.standard_normal((bs, bs)), 0.0)
+    jm = np.where(rng.random((m, n)) < 0.3, rng.standard_normal((m, n)), 0.0)
+    rhs = rng.standard_normal(n + m)
+    before = numba.get_num_threads()
+    for shift in (3.0, -0.5):
+        a = np.block([[b + b.T + shift * np.eye(n), jm.T], [jm, -0.1 * np.eye(m)]])
+        r, cc = np.nonzero(np.triu(a) + np.eye(n + m))
+        sing = a.copy()
+        sing[0, :] = sing[:, 0] = 0.0  # a zero pivot
+        out = []
+        for groups, threads in ((1, 1), (3, 1), (3, min(2, numba.config.NUMBA_NUM_THREADS))):
+            monkeypatch.setattr(ldlmod, "THREADS", groups)
+            ldl = SparseLDL(n + m, r, cc)
+            assert ldl.s < n + m and ldl.optr.size - 1 == groups
+            numba.set_num_threads(threads)
+            try:
+                pos = ldl.factor(a[r, cc], n + m)
+                res = (pos, ldl.lx[:ldl.lp[ldl.s]].copy(), ldl.d[:ldl.s].copy(), np.triu(ldl.sm),
+                       ldl.solve(rhs),
+                       ldl.factor(a[r, cc], _inertia(a)[1] - 1), ldl.factor(sing[r, cc], n + m))
+            finally:
+                numba.set_num_threads(before)
+            out.append(res)
+        assert out[0][0] == _inertia(a)[0] and out[0][5] == -2 and out[0][6] == -1
+        x = out[0][4]
+        assert np.max(np.abs(a @ x - rhs)) <= 1e-10 * np.max(np.abs(rhs)) * np.linalg.cond(a)
+        for res in out[1:]:
+            assert res[0] == out[0][0] and res[5:] == out[0][5:]
+            for u, v in zip(res[1:5], out[0][1:5]):
+                assert np.array_equal(u, v)
+
+
+def test_solver_threads_follow_the_load(monkeypatch):
+    """The parallel sections run on numba's threads (at most ``THREADS``) while the load
+    average leaves a core idle beside this process, else on one."""
+    import os
+
+    import numba
+
+    from parapend.hydro import _hull_collocation_ldl as ldlmod
+
+    cores = numba.config.NUMBA_NUM_THREADS
+    monkeypatch.setattr(os, "getloadavg", lambda: (cores + 0.0, 0.0, 0.0))
+    assert ldlmod.threads() == 1
+    monkeypatch.setattr(os, "getloadavg", lambda: (cores - 1.0, 0.0, 0.0))
+    assert ldlmod.threads() == min(ldlmod.THREADS, numba.get_num_threads())
+
+
 @pytest.mark.parametrize("dense", [True, False])
 def test_sparse_ldl_inertia_and_solve(dense, monkeypatch):
     """The compiled ``L D L^T`` of a random quasi-definite matrix (and of one whose

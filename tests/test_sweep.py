@@ -1172,3 +1172,24 @@ def test_map_and_sweep_in_si_for_a_stated_pendulum(reference, tmp_path, capsys):
     assert main(["map", "--store", str(ref_store), "--frequency", "1", "--plot",
                  str(tmp_path / "g.png")]) == 2
     capsys.readouterr()
+
+
+def test_a_pool_worker_beside_others_runs_numba_on_one_thread(monkeypatch):
+    """A worker process of a pool of several sets ``NUMBA_NUM_THREADS=1`` before numba is
+    loaded (unless the user set it); the only worker of a pool keeps numba's default."""
+    import os
+    import signal
+    import threading
+
+    from parapend.maps import run
+
+    monkeypatch.setattr(signal, "signal", lambda *a: None)
+    monkeypatch.setattr(threading.Thread, "start", lambda self: None)
+    monkeypatch.delenv("NUMBA_NUM_THREADS", raising=False)
+    run._worker_init(os.getpid(), 1)
+    assert "NUMBA_NUM_THREADS" not in os.environ
+    run._worker_init(os.getpid(), 2)
+    assert os.environ["NUMBA_NUM_THREADS"] == "1"
+    monkeypatch.setenv("NUMBA_NUM_THREADS", "2")
+    run._worker_init(os.getpid(), 2)
+    assert os.environ["NUMBA_NUM_THREADS"] == "2"

@@ -71,7 +71,7 @@ import scipy.sparse as sp
 from scipy.linalg import LinAlgError, cho_factor, cho_solve
 
 from . import _hull_collocation_kernel as kern
-from ._hull_collocation_ldl import EPS, SparseLDL
+from ._hull_collocation_ldl import EPS, SparseLDL, threads
 from ._hull_collocation_linalg import Structured
 
 #: the barrier's first weight (IPOPT's ``mu_init``) cold and from a shifted solution (the
@@ -247,6 +247,7 @@ class CompiledSolver:
         self.kkt_cols = np.concatenate((self.krows[kcol[self.kkt_ksel]], jcol,
                                         np.arange(ntot)))
         self.ldl = None
+        self.threads = None
 
     # -- the functions --------------------------------------------------------------------
     def _eval(self, x, lam, order, fk, e0, raw=False):
@@ -318,12 +319,25 @@ class CompiledSolver:
         ``par`` (:meth:`._hull_collocation.HullCollocation._params`). Returns ``(x, f,
         status, iterations)``: status 0 solved to ``tol``, 1 stopped at ``max_iter``, 2
         failed (a singular step or a line search that found no acceptable point). One BLAS
-        thread (its small products: a second thread waiting on a busy core cost 5 times)."""
+        thread (its small products: a second thread waiting on a busy core cost 5 times); the
+        compiled factorizations' parallel sections on the threads of
+        :func:`._hull_collocation_ldl.threads` (chosen once per solver from the load: the
+        numbers do not depend on them)."""
+        import numba
+
         from .control import _blas_controller
 
-        with _blas_controller().limit(limits=1, user_api="blas"):
-            return self._solve(x0, par, max_iter, tol, MU_WARM if warm else MU_INIT,
-                               THETA_GROWTH, MU_STRATEGY if strategy is None else strategy)
+        if self.threads is None:
+            self.threads = threads()
+        before = numba.get_num_threads()
+        numba.set_num_threads(min(before, self.threads))
+        try:
+            with _blas_controller().limit(limits=1, user_api="blas"):
+                return self._solve(x0, par, max_iter, tol, MU_WARM if warm else MU_INIT,
+                                   THETA_GROWTH, MU_STRATEGY if strategy is None
+                                   else strategy)
+        finally:
+            numba.set_num_threads(before)
 
     def _solve(self, x0, par, max_iter, tol, mu, growth, strategy):
         npt, n, nd, nf = self.npt, self.n, self.nd, self.nf

@@ -70,13 +70,18 @@ class SweepRun:
     stopped: bool = False
 
 
-def _worker_init(parent: int) -> None:
+def _worker_init(parent: int, workers: int = 1) -> None:
     """A pool worker ignores Ctrl-C (the parent handles it) and exits when the parent is
-    gone (``kill -9``: the pool's queues would keep it waiting for ever)."""
+    gone (``kill -9``: the pool's queues would keep it waiting for ever). Beside other
+    workers it runs numba's parallel sections on one thread (unless ``NUMBA_NUM_THREADS``
+    says otherwise; numba is not loaded yet): the processes already share the cores, and a
+    section whose second thread waits for a busy core waits whole."""
     import signal
     import threading
 
     signal.signal(signal.SIGINT, signal.SIG_IGN)
+    if workers > 1:
+        os.environ.setdefault("NUMBA_NUM_THREADS", "1")
 
     def watch():
         while True:
@@ -123,7 +128,7 @@ class _LocalPool:
                                     "parapend.optimal.batch"])
         self.executor = cf.ProcessPoolExecutor(max_workers=self.workers, mp_context=ctx,
                                                initializer=_worker_init,
-                                               initargs=(os.getpid(),))
+                                               initargs=(os.getpid(), self.workers))
         self._boot = threading.Thread(target=self._submit_first, daemon=True)
         self._boot.start()
 
