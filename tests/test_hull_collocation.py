@@ -106,6 +106,42 @@ def test_capped_solves_are_reported():
     assert res.solves > 0 and res.failed_solves == 0
 
 
+def test_a_capped_plan_the_plant_cannot_resolve_is_not_applied(monkeypatch):
+    """A solve stopped at its cap whose planned motion turns the generator faster than the
+    plant's step resolves (``control.RESOLVED`` rad a step) is a failed solve: the previous
+    plan continued is applied and is the next start (such capped iterates, far from
+    feasible, drove a Hs 0.5 m bin's pendulum past that speed). A capped plan within it is
+    applied as it is."""
+    plant, fseg, _ = _horizon(2)
+    prob = HullCollocation(plant, N, PS, TU, 4.0, intervals=2, max_iter=40)
+    first = prob.solve(plant, fseg, np.zeros(N))
+    assert first.status in (0, 1) and not prob.unfollowable(first.states)
+    lo = prob.nx + prob.na
+    want = np.clip(np.concatenate((prob.prev[lo + 1:lo + N], prob.prev[lo + N - 1:lo + N])),
+                   -4.0, 4.0)
+    orig = prob.solve_from
+    spin = {"on": True}
+
+    def capped(*a, **k):
+        r = orig(*a, **k)
+        st = r.states.copy()
+        if spin["on"]:
+            st[1:, 7] += 2.0 * bc.RESOLVED / plant.h
+        r.states, r.status, r.success = st, 1, False
+        return r
+
+    monkeypatch.setattr(prob, "solve_from", capped)
+    prob.shift = 1
+    r = prob.solve(plant, fseg, first.x)
+    assert r.status == 2 and not r.success and not prob.unfollowable(r.states)
+    assert np.array_equal(r.x, want)
+    assert np.array_equal(np.clip(prob.prev[lo:lo + N], -4.0, 4.0), want)
+    assert bc._check_solve(r, first.x)[1] == 1
+    spin["on"] = False
+    r = prob.solve(plant, fseg, want)
+    assert r.status == 1 and bc._check_solve(r, want)[1] == 0
+
+
 def test_bad_planner_is_one_line():
     """An unknown planner, or plant steps the collocation's intervals cannot hold."""
     with pytest.raises(hc.ParameterError, match="planner: expected"):

@@ -396,9 +396,7 @@ class HullCollocation:
         r = self.solve_from(x0, par, max_iter, tol, warm=warm)
         if self.solver_name == "compiled" and r.status == 2:
             # a failed solve is tried again from the same start with the other barrier
-            # update (monotone: another path), then from the model rolled under ``u0``;
-            # failed still, its start is the plan (the previous one continued) and the
-            # next start
+            # update (monotone: another path), then from the model rolled under ``u0``
             nit = r.nit
             r = self.solve_from(x0, par, max_iter, tol, warm=warm, strategy="monotone")
             r.nit += nit
@@ -407,12 +405,27 @@ class HullCollocation:
                 xg = self._with_memory(self.guess(u0, fseg), par)
                 r = self.solve_from(xg, par, max_iter, tol)
                 r.nit += nit
-            if r.status == 2:
-                self.prev = x0
-                u = np.clip(x0[self.nx + self.na:self.nx + self.na + self.n],
-                            -self.torque_limit, self.torque_limit)
-                r.x, r.full, r.states = u, x0, x0[:self.nx].reshape(self.npt, 8)
+        if r.status == 1 and self.unfollowable(r.states):
+            # a capped iterate whose motion turns faster than the plant's step resolves is
+            # not a plan (far from feasible: its torques drove the pendulum of a Hs 0.5 m
+            # bin past that speed, the run unresolved): a failed solve
+            r.status, r.success, r.ipopt = 2, False, "failed"
+        if r.status == 2 and (self.solver_name == "compiled" or self.unfollowable(r.states)):
+            # failed: its start is the plan (the previous one continued) and the next start
+            self.prev = x0
+            u = np.clip(x0[self.nx + self.na:self.nx + self.na + self.n],
+                        -self.torque_limit, self.torque_limit)
+            r.x, r.full, r.states = u, x0, x0[:self.nx].reshape(self.npt, 8)
         return r
+
+    def unfollowable(self, states):
+        """Whether a planned motion ``states`` (npt, 8) turns the generator faster than the
+        plant's step resolves (:data:`.control.RESOLVED` rad a step; the plan's bound is
+        :data:`MAX_TURN`)."""
+        from .control import RESOLVED
+
+        speed = np.abs(states[1:, 7] - states[1:, 6]) * self.plant.h
+        return bool(not np.all(speed <= RESOLVED))
 
     def solve_from(self, x0, par, max_iter=None, tol=None, warm=False, strategy=None):
         """The solver (:data:`SOLVER` or the constructor's) from ``x0`` on the parameters

@@ -75,8 +75,10 @@ CAUSAL_SECONDS = {"perfect": 7.5, "ar": 10.5}
 #: a peak period per unit of horizon; with the collocation planner (``hull-collocation``,
 #: the default, its compiled solver) a 20-minute record of the default sea (204 peak
 #: periods, horizon 2, perfect forecast) took 500 s of CPU at a load of 6 (the record's
-#: optimum aside): 1.2 s
-BUOY_CAUSAL_SECONDS = {"plan": 0.25, "coupled": 2.0, "hull": 4.5, "hull-collocation": 1.5}
+#: optimum aside): 1.2 s; a bin of the 4 x 4 causal matrix of 200-peak-period records (Hs
+#: 0.5 m, Te 5 s: the record's optimum and both forecasts' runs, one process of two on an
+#: otherwise idle machine, one thread) took 14 min: 0.94 s, priced 1.0
+BUOY_CAUSAL_SECONDS = {"plan": 0.25, "coupled": 2.0, "hull": 4.5, "hull-collocation": 1.0}
 
 
 def hull_record_seconds(waves: float, ideal: bool = True) -> float:
