@@ -142,6 +142,39 @@ def test_a_capped_plan_the_plant_cannot_resolve_is_not_applied(monkeypatch):
     assert r.status == 1 and bc._check_solve(r, want)[1] == 0
 
 
+def test_a_capped_plan_whose_torques_the_model_does_not_follow_is_not_applied(monkeypatch):
+    """A capped iterate within the speed bound whose first torque the plant's model does not
+    follow (rolled under it, the generator leaves the planned angle by 0.39 rad where a
+    converged plan stays within 1e-6) is a failed solve: the previous plan continued is
+    applied (such an iterate turned a Hs 0.5 m bin's pendulum past the plant's step). The
+    same iterate with its own torques is applied."""
+    plant, fseg, _ = _horizon(2)
+    prob = HullCollocation(plant, N, PS, TU, 4.0, intervals=2, max_iter=40)
+    first = prob.solve(plant, fseg, np.zeros(N))
+    prob.shift = 1
+    assert first.status in (0, 1) and not prob.drifts(first, fseg)
+    lo = prob.nx + prob.na
+    want = np.clip(np.concatenate((prob.prev[lo + 1:lo + N], prob.prev[lo + N - 1:lo + N])),
+                   -4.0, 4.0)
+    orig = prob.solve_from
+    push = {"by": 1.0}
+
+    def capped(*a, **k):
+        r = orig(*a, **k)
+        r.x = r.x.copy()
+        r.x[0] += push["by"]
+        r.status, r.success = 1, False
+        return r
+
+    monkeypatch.setattr(prob, "solve_from", capped)
+    r = prob.solve(plant, fseg, first.x)
+    assert r.status == 2 and not r.success and np.array_equal(r.x, want)
+    assert bc._check_solve(r, first.x)[1] == 1
+    push["by"] = 0.0
+    r = prob.solve(plant, fseg, want)
+    assert r.status == 1 and not prob.drifts(r, fseg) and bc._check_solve(r, want)[1] == 0
+
+
 def test_bad_planner_is_one_line():
     """An unknown planner, or plant steps the collocation's intervals cannot hold."""
     with pytest.raises(hc.ParameterError, match="planner: expected"):

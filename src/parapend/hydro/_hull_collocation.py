@@ -65,6 +65,11 @@ INTERVALS = 3
 MEMORY_STRIDE = 3
 #: the generator's planned speed at most, rad per plant step (None: unbounded)
 MAX_TURN = 0.4
+#: a capped plan is applied only where the plant's model rolled under its torques up to the
+#: next update keeps the generator within this many rad of the planned angle (a capped
+#: iterate of the default barge's runs: 3e-3 rad at most; one whose torques its motion did
+#: not follow, 0.8 rad, turned the pendulum of a Hs 0.5 m bin past the plant's step)
+CAPPED_ANGLE_TOL = 0.05
 #: the horizon's solver: ``"compiled"`` (:mod:`._hull_collocation_ipm`, no CasADi: the same
 #: NLP; its Newton step :data:`._hull_collocation_ipm.STEP`, ``"auto"``) or ``"ipopt"``
 #: (CasADi's IPOPT, ``parapend[collocation]``). In the closed loop of the default barge's
@@ -405,10 +410,11 @@ class HullCollocation:
                 xg = self._with_memory(self.guess(u0, fseg), par)
                 r = self.solve_from(xg, par, max_iter, tol)
                 r.nit += nit
-        if r.status == 1 and self.unfollowable(r.states):
-            # a capped iterate whose motion turns faster than the plant's step resolves is
-            # not a plan (far from feasible: its torques drove the pendulum of a Hs 0.5 m
-            # bin past that speed, the run unresolved): a failed solve
+        if r.status == 1 and (self.unfollowable(r.states) or self.drifts(r, fseg)):
+            # a capped iterate whose motion turns faster than the plant's step resolves, or
+            # whose torques the model does not follow, is not a plan (far from feasible:
+            # such torques drove the pendulum of Hs 0.5 m bins past that speed, the runs
+            # unresolved): a failed solve
             r.status, r.success, r.ipopt = 2, False, "failed"
         if r.status == 2 and (self.solver_name == "compiled" or self.unfollowable(r.states)):
             # failed: its start is the plan (the previous one continued) and the next start
@@ -426,6 +432,18 @@ class HullCollocation:
 
         speed = np.abs(states[1:, 7] - states[1:, 6]) * self.plant.h
         return bool(not np.all(speed <= RESOLVED))
+
+    def drifts(self, r, fseg):
+        """Whether the plant's model rolled under the torques of solve ``r`` applied before
+        the next update (``self.shift`` samples, at least one; the forecast ``fseg``) leaves
+        the planned generator angle by more than :data:`CAPPED_ANGLE_TOL` rad at a point:
+        the plan's primal infeasibility where it is applied."""
+        m, pl = max(1, min(self.shift, self.n)), self.plant
+        ok, ys, _ = pl.roll(np.repeat(r.x[:m] * self.tu, self.steps), 1, np.asarray(fseg))
+        rolled = ys[::self.ratio]
+        planned = r.states[:rolled.shape[0]]
+        gap = np.abs((rolled[:, 3] - rolled[:, 2]) - (planned[:, 3] - planned[:, 2]))
+        return bool(not (ok and np.all(gap <= CAPPED_ANGLE_TOL)))
 
     def solve_from(self, x0, par, max_iter=None, tol=None, warm=False, strategy=None):
         """The solver (:data:`SOLVER` or the constructor's) from ``x0`` on the parameters
