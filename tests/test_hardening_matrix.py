@@ -425,6 +425,37 @@ def test_long_work_is_announced_before_it_starts(caplog, no_solve):
                           "records on 2 processes: roughly 8 minutes")
 
 
+def test_a_resume_announces_what_is_left(caplog, no_solve, tmp_path):
+    """A rerun over a store that holds half the points announces half the work (it
+    announced the whole matrix's); another sweep's store counts for nothing."""
+    import logging
+
+    import zarr
+
+    from parapend.maps.store import _prepare, make_store_dir, stored_points
+    from parapend.performance import matrix_spec
+
+    grid = {"hs": "0.5:5:10", "te": "4:13:10"}
+    spec = matrix_spec(**grid)
+    store = tmp_path / "m.zarr"
+    make_store_dir(store)
+    _prepare(store, spec, "test", False)
+    group = zarr.open_group(store, mode="r+")
+    for v in spec.variables:  # the first half's blocks finished (status 0, powers 1 W)
+        a = group[v]
+        a[:5] = 0 if a.dtype.kind in "iu" else 1.0
+    group["done"][:5] = True
+    assert stored_points(spec, store) == 150 and stored_points(spec, store, True) == 0
+    assert stored_points(matrix_spec(hs="0.5:5:10", te="4:13:9"), store) == 0
+    with caplog.at_level(logging.INFO, logger="parapend.performance"), \
+            pytest.raises(AssertionError, match="the engine ran"):
+        parapend.power_matrix(**grid, workers=2, store=str(store))
+    (msg,) = [r.getMessage() for r in caplog.records if r.name == "parapend.performance"]
+    assert msg.startswith("power matrix: 100 bins x 3 realizations = 300 solves of 50-wave "
+                          "records (150 of them in the store) on 2 processes: roughly "
+                          "225 s"), msg
+
+
 def test_the_buoys_flux_is_of_the_water_its_body_was_solved_in(monkeypatch):
     """A --hydro dataset's own rho and depth make the flux (it was 1025 kg/m^3 in deep
     water whatever the dataset said); a g other than the pendulum's, or a rho no water has,

@@ -136,6 +136,12 @@ def test_the_sweep_estimate_is_printed_when_stderr_is_not_a_terminal(capsys, mon
     seconds = 10**6 * run.POINT_SECONDS
     assert "sweep: 1000000 points: roughly " in err
     assert f"roughly {round(seconds / 60)} minutes" in err
+    # a rerun over a store holding half of it announces the half left
+    monkeypatch.setattr(run, "stored_points", lambda spec, store, overwrite: spec.points // 2)
+    assert main(argv) == 2
+    err = capsys.readouterr().err
+    assert "sweep: 1000000 points (500000 of them in the store): roughly " in err
+    assert f"roughly {round(seconds / 120)} minutes" in err
 
 
 def test_the_persistence_estimate_is_printed_when_stderr_is_not_a_terminal(capsys, monkeypatch,

@@ -32,6 +32,7 @@ from .store import (
     _verify,
     make_store_dir,
     open_sweep,
+    stored_points,
 )
 
 __all__ = ["SweepRun", "run_spec", "sweep"]
@@ -455,11 +456,14 @@ def sweep(store=None, *, omega=1.8, delta=None, gamma=GAMMA["sweep"], torque_lim
                       block_points=block_points)
     seconds = estimate_seconds(spec) / (1 if scheduler is not None else max(
         1, min(workers or os.cpu_count() or 1, spec.blocks)))
+    stored = stored_points(spec, store, overwrite) if seconds > 60 else 0
+    seconds *= (spec.points - stored) / spec.points
     if seconds > 60:  # announced on stderr by the command line, a terminal or not
         from ..deadline import duration
 
-        log.info("sweep: %d points: roughly %s (the store resumes an interrupted run)",
-                 spec.points, duration(seconds))
+        log.info("sweep: %d points%s: roughly %s (the store resumes an interrupted run)",
+                 spec.points, f" ({stored} of them in the store)" if stored else "",
+                 duration(seconds))
     run = run_spec(spec, store, workers=workers, scheduler=scheduler, overwrite=overwrite,
                    command=command, progress=progress)
     if netcdf:

@@ -179,6 +179,24 @@ def _store_spec(path: Path) -> str | None:
         return None
 
 
+def stored_points(spec, store, overwrite: bool = False) -> int:
+    """How many of ``spec``'s points the store ``store`` holds finished and sound (0: none,
+    no store, another sweep's, ``overwrite``, or one that cannot be read): what a rerun
+    resumes, for its announced estimate. Read-only and unlocked, by the run's own check
+    (:func:`_verify`: a file that cannot be a chunk is never read)."""
+    if store is None or overwrite:
+        return 0
+    path = Path(store)
+    if not path.is_dir() or _store_spec(path) != spec.to_json():
+        return 0
+    try:
+        done, _ = _verify(path, spec)
+    except (ParameterError, OSError):  # the run says what is wrong
+        return 0
+    return sum(int(np.prod([s.stop - s.start for s in spec.block_slices(b)]))
+               for b in range(spec.blocks) if done[b])
+
+
 def _write_marker(path: Path) -> None:
     """Make the root ``zarr.json`` of ``path`` say "a parapend store being created", atomically
     (a temporary beside it, then a rename): from then on the directory is recognised as

@@ -942,6 +942,7 @@ def power_matrix(*, hs="1:3:3", te=None, tp=None, realizations: int = 3, waves=N
     if has_inputs(locals()):
         return power_matrix(**expand_inputs(power_matrix, locals()))
     from ..maps.run import run_spec
+    from ..maps.store import stored_points
     from .annual import bin_series, read_scatter, read_series
     from .check import check_bins, check_size
 
@@ -1048,12 +1049,18 @@ def power_matrix(*, hs="1:3:3", te=None, tp=None, realizations: int = 3, waves=N
         frequency = counts / hs_t.size
         outside = {"sea_states": out, "frequency": out / hs_t.size} if out else None
     # announced once nothing is left to refuse
-    if est["seconds"] is not None and est["seconds"] > _ANNOUNCE_SECONDS:
-        log.info("power matrix: %d bins x %d realizations = %d solves of %g-wave records on "
-                 "%s: roughly %s (about %s; the progress bar gives the rate)",
+    # a resume runs what the store does not hold
+    stored = (stored_points(spec, store, overwrite) if est["seconds"] is not None
+              and est["seconds"] > _ANNOUNCE_SECONDS else 0)
+    left = (est["seconds"] * (spec.points - stored) / spec.points
+            if est["seconds"] is not None else None)
+    if left is not None and left > _ANNOUNCE_SECONDS:
+        log.info("power matrix: %d bins x %d realizations = %d solves of %g-wave records%s "
+                 "on %s: roughly %s (about %s; the progress bar gives the rate)",
                  est["bins"], spec.realizations, est["solves"], spec.waves,
+                 f" ({stored} of them in the store)" if stored else "",
                  f"{est['processes']} processes" if est["processes"] else "the cluster",
-                 duration(est["seconds"]) + ("" if est["processes"] else " of one core"),
+                 duration(left) + ("" if est["processes"] else " of one core"),
                  ("3 s a 50-wave solve" if spec.controller is None else
                   f"3 s a 50-wave solve and {est['causal_seconds']:.0f} s its causal runs")
                  if spec.dofs == "heave" else
