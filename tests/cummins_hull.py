@@ -203,8 +203,21 @@ def matched_a_inf(omega_data, A, B, omega, memory) -> np.ndarray:
     return coef(omega)[0] + ks / omega
 
 
+def _bohman(x):
+    """Bohman's taper on ``x = s / L``: the normalized autocorrelation of ``cos(pi y)`` on
+    ``|y| <= 1/2`` at lag ``x``, ``int_{x-1/2}^{1/2} cos(pi y) cos(pi (y - x)) dy / (1/2)``
+    in closed form."""
+    x = np.clip(np.asarray(x, float), 0.0, 1.0)
+    return (1.0 - x) * np.cos(np.pi * x) + np.sin(np.pi * x) / np.pi
+
+
+#: the tapers a run may name for its memory (``hydro_data["window"]``)
+WINDOWS = {"bohman": _bohman}
+
+
 class Memory:
-    """The radiation memory ``mu(t) = int_0^L K(s) xi'(t - s) ds`` on a uniform sample grid
+    """The radiation memory ``mu(t) = int_0^L K(s) w(s / L) xi'(t - s) ds`` (``w`` a taper,
+    1 without one) on a uniform sample grid
     of step ``dt``: each sample's velocity is kept at its 8 Gauss-Legendre nodes (a degree-7
     polynomial within the sample, smooth there: the torque changes only at the samples'
     edges), and ``mu`` at the 16 Chebyshev points of a sample is a fixed linear map of those
@@ -214,13 +227,14 @@ class Memory:
     cubic spline of the exact kernel on a grid of ``pi / (20 w_max)`` (20 points per period
     of its fastest oscillation, the data's top frequency: relative error ~ 1e-7)."""
 
-    def __init__(self, omega_data, B, dt, memory):
+    def __init__(self, omega_data, B, dt, memory, window=None):
         from scipy.interpolate import CubicSpline
 
         self.dt, self.memory = float(dt), float(memory)
         h = math.pi / (20.0 * float(omega_data[-1]))
         grid = np.linspace(0.0, self.memory, int(math.ceil(self.memory / h)) + 1)
-        spline = CubicSpline(grid, kernel(omega_data, B, grid))
+        taper = np.ones(grid.size) if window is None else WINDOWS[window](grid / self.memory)
+        spline = CubicSpline(grid, kernel(omega_data, B, grid) * taper[:, None, None])
         lags = int(math.ceil(self.memory / self.dt)) + 1
         self.lags = lags
         # W[i, lag, q, a, b]
@@ -286,8 +300,9 @@ def reintegrate_hull(hydro_data, pendulum, pivot, sea_excitation, t, tau, *, sta
         ``omega`` (n,) rad/s, ``B`` (n, 3, 3) radiation damping (symmetrised here), ``C``
         (3, 3) hydrostatic stiffness with the floating system's weight at O (the pendulum's
         correction ``- m g h_p`` on pitch is applied here), ``Mh`` (3, 3) the hull's mass
-        matrix without the pendulum, ``g``; optionally ``a_inf`` (3, 3) and ``memory`` (s)
-        (:func:`hull_data`). ``A`` is needed only for the default ``a_inf``.
+        matrix without the pendulum, ``g``; optionally ``a_inf`` (3, 3), ``memory`` (s)
+        (:func:`hull_data`) and ``window``, the taper of the kernel over the memory (a name
+        in :data:`WINDOWS`). ``A`` is needed only for the default ``a_inf``.
     pendulum : object or dict
         ``mass`` (kg), ``length`` (m, pivot to centre of mass), ``inertia`` (kg m^2, about
         the pivot), ``damping_coefficient`` (N m s, on ``phi' - beta'``).
@@ -350,7 +365,7 @@ def reintegrate_hull(hydro_data, pendulum, pivot, sea_excitation, t, tau, *, sta
     cp = 0.5 * (cp + cp.T)
     cp[2, 2] -= m * g * float(pivot[1])
     mass = np.asarray(hydro_data["Mh"], float) + np.asarray(a_inf, float) + m * gm.T @ gm
-    mem = Memory(om, b, dt, memory)
+    mem = Memory(om, b, dt, memory, hydro_data.get("window"))
     held = None if callable(tau) else np.asarray(tau, dtype=float)
     if held is not None and held.shape != (n,):
         raise ValueError(f"tau: expected {n} held torques, got shape {held.shape}")

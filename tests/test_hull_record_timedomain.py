@@ -438,6 +438,7 @@ def _hull_discrepancy(hc, plant_steps):
     data = hull_data(_hull(), PEND.mass)
     data["a_inf"] = _a_inf_median(data)
     data["memory"] = r.units["memory_s"]
+    data["window"] = r.units["memory_window"]
     names = ("x", "z", "beta", "phi", "x_dot", "z_dot", "beta_dot")
     states = np.column_stack([s[k] for k in names] + [s["theta_dot"] + s["beta_dot"]])
     m = int(round(r.update_interval_s / r.dt_s))
