@@ -28,7 +28,8 @@ def _horizon(intervals, steps=PS):
     """A plant of ``steps`` steps a sample advanced two samples under a swinging torque,
     its force nodes over the horizon, and the collocation problem of ``N`` samples on it
     (``intervals`` 0: none)."""
-    plant, _, _ = th._plant(th.PEND, th.TR / PER / steps, 4 * PER * steps, memory=4.0)
+    plant, _, _ = th._plant(th.PEND, th.TR / PER / steps, 4 * PER * steps,
+                            memory=hc.MEMORY_PERIODS * th.TP)
     fn = bc.force_nodes(th.HULL, th.WAVE, PER, steps, 2 * 3 * PER * steps + 1)
     plant.step(np.array([0.8, -0.8]) * TU, steps, fn)
     a = 2 * plant.k0
