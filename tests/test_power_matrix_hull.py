@@ -145,8 +145,9 @@ def test_a_lossy_take_off_shows_the_electrical_power(dataset, stand_in, tmp_path
 
 
 def test_the_command_line_reports_the_modes(dataset, capsys, stand_in):
-    """The command line's JSON names each bin's mode (swinging included) and its text
-    report names the hull and counts them."""
+    """The command line's JSON names each bin's mode (swinging included) and each period
+    bin's record length (``record_s``: 2 peak periods here), and its text report names the
+    hull and counts them."""
     args = ["power-matrix", "--device", "buoy", "--dofs", "surge,heave,pitch", "--hydro",
             dataset, "--hs", "1,2", "--tp", "5,6", "--waves", "2", "--realizations", "1",
             "--workers", "1", *(x for k, v in PEND.items()
@@ -154,6 +155,7 @@ def test_the_command_line_reports_the_modes(dataset, capsys, stand_in):
     assert main([*args, "--json"]) == 0
     out = json.loads(capsys.readouterr().out)
     assert out["operating_mode"] == [["rest", "rest"], ["rotation", "swinging"]]
+    assert out["waves"] == 2.0 and out["record_s"] == [10.0, 12.0]
     assert main(args) == 0
     text = capsys.readouterr().out
     assert "1 rotation, 1 swinging, 2 rest" in text
@@ -229,6 +231,48 @@ def test_the_longest_record_is_the_hulls_limit(dataset, pto, waves, cap):
         s = dataclasses.replace(spec, waves=waves)
         return max(HARMONICS_PER_TURN * waves_in(wave_of(s, 0, j, 0)[0]) for j in range(2))
     assert size(most) <= getattr(limits, cap) < size(most + 0.01)
+
+
+def test_the_default_records_last_twenty_minutes(dataset):
+    """The hull's default records (an ideal take-off) are 200 peak periods or 20 minutes,
+    the longer, as far as the hull's solver takes them: at Tp 5 s 240 peak periods (1200 s),
+    at Tp 6 s 200 (1200 s too); at Tp 2 and 4 s the longest record that fits (its
+    size check passes, 0.01 peak period more fails), shorter than 20 minutes. An explicit
+    --waves and a lossy take-off's records are as given in every bin. The lengths are in
+    the store's identity (the JSON round-trips) and a spec without them reads ``waves``."""
+    import dataclasses
+
+    from parapend.hydro.api import solve_record
+    from parapend.performance.buoy_device import wave_of
+    from parapend.performance.hull_device import problem
+
+    spec = matrix_spec(hs="1,2", tp="5,6", realizations=1, hydro=dataset, **HULL)
+    assert spec.bin_waves == (240.0, 200.0)
+    for j in range(2):  # 240 x 5 s and 200 x 6 s
+        wave, _ = wave_of(spec, 0, j, 0)
+        assert 2 * math.pi / wave.omega == pytest.approx(1200.0, rel=1e-12)
+    assert MatrixSpec.from_json(spec.to_json()) == spec
+    d = json.loads(spec.to_json())
+    d.pop("bin_waves")
+    assert MatrixSpec.from_json(json.dumps(d)).record_waves(0) == 200.0
+    short = matrix_spec(hs="1,2", tp="2,4", realizations=1, hydro=dataset, **HULL)
+    p = problem(short)
+
+    def fits(j, waves):
+        s = dataclasses.replace(short, waves=waves, bin_waves=None)
+        try:
+            solve_record(p, wave_of(s, 0, j, 0)[0], None, check_only=True)
+        except ParameterError:
+            return False
+        return True
+    for j, tp in enumerate(short.tp):
+        w = short.record_waves(j)
+        assert 200.0 < w < 1200.0 / tp
+        assert fits(j, w) and not fits(j, w + 0.01)
+    for kw in ({"waves": 200.0}, {"efficiency": 0.9}):
+        given = matrix_spec(hs="1,2", tp="5,6", realizations=1, hydro=dataset, **kw, **HULL)
+        assert given.bin_waves is None
+        assert [given.record_waves(j) for j in range(2)] == [given.waves] * 2
 
 
 @pytest.mark.parametrize("kw, match", [

@@ -820,12 +820,18 @@ def map(*, store: str = "map.zarr", variable: str = "power", x=None, y=None, at=
 
 
 # --- power-matrix ----------------------------------------------------------------------------
-def _matrix_waves(ds) -> float:
-    """The record length (peak periods) a power matrix's Dataset was computed with (its
-    ``sweep`` attribute: the device's default resolved)."""
+def _matrix_waves(ds) -> list:
+    """The record length (peak periods) of each period bin a power matrix's Dataset was
+    computed with (its ``sweep`` attribute: the device's default resolved)."""
+    spec = _matrix_spec(ds)
+    return [float(v) for v in (spec.get("bin_waves") or [spec["waves"]] * len(spec["tp"]))]
+
+
+def _matrix_spec(ds) -> dict:
+    """A power matrix's spec as its Dataset's ``sweep`` attribute holds it (JSON)."""
     import json
 
-    return json.loads(ds.attrs["sweep"])["waves"]
+    return json.loads(ds.attrs["sweep"])
 
 
 def _power_matrix_result(power_matrix, arguments):
@@ -878,7 +884,8 @@ def _power_matrix_result(power_matrix, arguments):
            f"{pk}_edges": ds[f"{pk}_edges"].values.tolist(),
            "te_over_tp": float(ds.attrs["te_over_tp"]),
            "realizations": int(ds.sizes["realization"]),
-           "seeds": ds["seed"].values.tolist(), "waves": float(_matrix_waves(ds)),
+           "seeds": ds["seed"].values.tolist(), "waves": float(_matrix_spec(ds)["waves"]),
+           "record_s": [w * t for w, t in zip(_matrix_waves(ds), ds["tp"].values.tolist())],
            "device": device, "power_matrix": grid("power_matrix"),
            "wave_energy_flux_matrix": grid("wave_energy_flux_matrix"),
            "capture_width_matrix": grid("capture_width_matrix"),

@@ -73,12 +73,13 @@ HULL = {"wave_height": 1.0, "wave_period": 6.0, "hs": 1.0, "tp": 6.0, "repeat_pe
         "mass": 2000.0, "length": 1.0, "inertia": None, "damping_coefficient": 50.0,
         "pivot_height": 0.5, "pivot_offset": 0.0, "radius": 2.0, "draft": 1.0,
         # the power matrix's hull column: each realization's record, in peak periods. IEC TS
-        # 62600-100 and WEC-Sim use realizations of 20 to 30 minutes: 200 peak periods, 20
-        # minutes at Tp 6 s (longer at longer periods), for an ideal take-off (its records are
-        # solved matrix-free, about 50 s of CPU each: benchmarks/bench_hull_record.out.txt);
-        # a take-off with an efficiency, a copper loss or a torque limit is solved dense, at
-        # most about 10 waves: its records stay 4 peak periods (the single record's)
-        "matrix_waves": 200.0, "matrix_waves_lossy": 4.0}
+        # 62600-100 and WEC-Sim use realizations of 20 to 30 minutes: 200 peak periods and
+        # at least 20 minutes (``matrix_record_s``: 217 peak periods at Tp 5.54 s, at most
+        # the hull's 300), for an ideal take-off (its records are solved matrix-free, about
+        # 50 s of CPU each: benchmarks/bench_hull_record.out.txt); a take-off with an
+        # efficiency, a copper loss or a torque limit is solved dense, at most about 10
+        # waves: its records stay 4 peak periods (the single record's)
+        "matrix_waves": 200.0, "matrix_record_s": 1200.0, "matrix_waves_lossy": 4.0}
 #: ``power-matrix --waves`` of the prescribed pendulum and the heaving buoy (peak periods)
 POWER_MATRIX = {"waves": 50.0}
 

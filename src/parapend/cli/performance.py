@@ -59,7 +59,8 @@ def add_parsers(sub) -> None:
     g.add_argument("--waves", type=_finite_float("waves"),
                    help="record length in peak periods, 2 to 400 (default "
                         f"{POWER_MATRIX['waves']:g}; with --dofs surge,heave,pitch "
-                        f"{HULL['matrix_waves']:g}, 20 minutes at Tp 6 s, with an ideal "
+                        f"{HULL['matrix_waves']:g} or {HULL['matrix_record_s'] / 60:g} minutes, "
+                        "the longer, as far as the hull's solver takes it, with an ideal "
                         "take-off; with --efficiency, --copper-loss or --torque-limit "
                         f"{HULL['matrix_waves_lossy']:g}, solved dense)")
     # the sea's and the pendulum's options: generated from their declarations

@@ -21,7 +21,7 @@ import numpy as np
 from .. import limits
 from ..errors import ParameterError, check_int, check_positive, check_range
 from .annual import HOURS_PER_YEAR
-from .resource import bin_edges, energy_flux, record_spectrum, repeat_period, te_over_tp
+from .resource import bin_edges, energy_flux, record_spectrum, te_over_tp
 from .spec import DEVICES, UNITS, MatrixSpec
 
 __all__ = ["HOURS_PER_YEAR", "STATISTICS", "MatrixSpec", "annual_interval", "breaking_bins",
@@ -164,6 +164,7 @@ def matrix_spec(*, hs="1:3:3", te=None, tp=None, realizations: int = 3, waves=No
     ratio = te_over_tp(spectrum, gamma_peak)
     tps = tuple(p / ratio for p in period) if kind == "te" else period
     realizations = check_int("realizations", realizations, 1, 1000)
+    min_record = None
     if waves is None:  # the device's record: the hull's own (its solver's reach)
         from ..defaults import HULL, POWER_MATRIX
 
@@ -172,6 +173,8 @@ def matrix_spec(*, hs="1:3:3", te=None, tp=None, realizations: int = 3, waves=No
             torque_limit is None
         waves = POWER_MATRIX["waves"] if heave else HULL[
             "matrix_waves" if ideal else "matrix_waves_lossy"]
+        if ideal and not heave:
+            min_record = HULL["matrix_record_s"]
     waves = check_range("waves", waves, *limits.SEA_WAVES_RANGE,
                         why="record length in peak periods")
     seed = check_int("seed", seed, 0, 2**62)
@@ -196,7 +199,7 @@ def matrix_spec(*, hs="1:3:3", te=None, tp=None, realizations: int = 3, waves=No
                           harmonics=harmonics, efficiency=efficiency,
                           torque_limit=torque_limit, body=body, radius=radius, draft=draft,
                           mesh=mesh, hydro=hydro, density=density, depth=depth,
-                          causal=causal, **hull)
+                          causal=causal, min_record=min_record, **hull)
     if device == "buoy":
         return _buoy_spec(hm0, period, kind, tps, realizations, waves, seed, spectrum,
                           gamma_peak, cutoff, response=response, length=length, mass=mass,
@@ -286,10 +289,19 @@ def _buoy_spec(hm0, period, kind, tps, realizations, waves, seed, spectrum, gamm
     return dataclasses.replace(spec, width=width)
 
 
+def _record_lengths(spec) -> str:
+    """The records' length in peak periods for the announcement: ``200``, or ``200- to 216.8``
+    where the bins' differ."""
+    lengths = [spec.record_waves(j) for j in range(len(spec.tp))]
+    lo, hi = min(lengths), max(lengths)
+    return f"{lo:g}" if lo == hi else f"{lo:g}- to {hi:.4g}"
+
+
 def _hull_spec(hm0, period, kind, tps, realizations, waves, seed, spectrum, gamma_peak,
                cutoff, *, response, gamma, gravity, winding, harmonics, efficiency,
                torque_limit, length, mass, inertia, damping_coefficient, body, radius, draft,
-               mesh, hydro, density, depth, causal=None, **hull) -> MatrixSpec:
+               mesh, hydro, density, depth, causal=None, min_record=None,
+               **hull) -> MatrixSpec:
     """The hull's spec (``dofs="surge,heave,pitch"``): the options the hull does not take
     refused, the rest checked and resolved by the hull's own code (its defaults,
     ``parapend.defaults.HULL``), the hull built once (its BEM), every bin's record checked."""
@@ -319,6 +331,8 @@ def _hull_spec(hm0, period, kind, tps, realizations, waves, seed, spectrum, gamm
                       **(causal or {}))
     spec = hull_device.resolve(spec, dict(body=body, radius=radius, draft=draft, mesh=mesh,
                                           hydro=hydro, torque_limit=torque_limit, **hull))
+    if min_record is not None:
+        spec = hull_device.lengthen(spec, min_record)
     hull_device.check_records(spec)
     return spec
 
@@ -416,7 +430,7 @@ def matrix_dataset(raw, spec: MatrixSpec, *, depth=None, density: float = 1025.0
     te_rec = np.empty_like(j)
     for a, h in enumerate(spec.hm0):
         for b, tp in enumerate(spec.tp):
-            f, s = record_spectrum(h, tp, repeat_period(spec.waves, tp), spectrum=spec.spectrum,
+            f, s = record_spectrum(h, tp, spec.repeat_period(b), spectrum=spec.spectrum,
                                    gamma_peak=spec.gamma_peak, cutoff=spec.cutoff)
             j[a, b] = energy_flux(f, s, depth=depth, density=density, gravity=spec.gravity)
             te_rec[a, b] = float(np.sum(s / f) / np.sum(s))
@@ -1055,9 +1069,9 @@ def power_matrix(*, hs="1:3:3", te=None, tp=None, realizations: int = 3, waves=N
     left = (est["seconds"] * (spec.points - stored) / spec.points
             if est["seconds"] is not None else None)
     if left is not None and left > _ANNOUNCE_SECONDS:
-        log.info("power matrix: %d bins x %d realizations = %d solves of %g-wave records%s "
+        log.info("power matrix: %d bins x %d realizations = %d solves of %s-wave records%s "
                  "on %s: roughly %s (about %s; the progress bar gives the rate)",
-                 est["bins"], spec.realizations, est["solves"], spec.waves,
+                 est["bins"], spec.realizations, est["solves"], _record_lengths(spec),
                  f" ({stored} of them in the store)" if stored else "",
                  f"{est['processes']} processes" if est["processes"] else "the cluster",
                  duration(left) + ("" if est["processes"] else " of one core"),

@@ -35,12 +35,10 @@ def wave_of(spec, i: int, j: int, r: int):
     the prescribed device's arguments) and its description."""
     from ..hydro.api import _irregular_wave
     from ..seas import steepness_unchecked
-    from .resource import repeat_period
-
     tp = spec.tp[j]
     with steepness_unchecked():  # a rectangle of bins: corners no sea reaches
         return _irregular_wave(spec.hm0[i], tp, spec.spectrum, spec.gamma_peak,
-                               repeat_period(spec.waves, tp), int(spec.seeds[r]), spec.cutoff,
+                               spec.repeat_period(j), int(spec.seeds[r]), spec.cutoff,
                                None, 0.1, _units(spec))
 
 

@@ -108,7 +108,8 @@ def record_seconds(spec) -> float:
         return (BUOY_CAUSAL_SECONDS[spec.buoy_controller] * (spec.waves + spec.warm_up)
                 * max(spec.horizon, 0.5) * (0.125 / spec.update_interval)
                 * len(spec.forecasts))
-    scale = (spec.waves + spec.warm_up) / 54.0  # the measured runs: 50 waves + 4 warm-up
+    # the measured runs: 50 waves + 4 warm-up; the longest record's
+    scale = (max(map(spec.record_waves, range(len(spec.tp)))) + spec.warm_up) / 54.0
     return sum(CAUSAL_SECONDS[f] for f in spec.forecasts) * scale
 
 
@@ -124,15 +125,13 @@ def _record(spec, units, i: int, j: int, r: int):
     """The excitation of bin ``(i, j)``, realization ``r``, as ``sea`` builds it; its
     ParameterError reworded to name the bin and the options that set it."""
     from ..seas import sea_record, steepness_unchecked
-    from .resource import repeat_period
-
     tp = spec.tp[j]
     response = (None if spec.response is None else tuple(spec.response))
     try:
         with steepness_unchecked():  # a rectangle of bins: corners no sea reaches
             return sea_record(units, hs=spec.hm0[i], tp=tp, spectrum=spec.spectrum,
                               gamma_peak=spec.gamma_peak,
-                              repeat_period=repeat_period(spec.waves, tp),
+                              repeat_period=spec.repeat_period(j),
                               seed=int(spec.seeds[r]), cutoff=spec.cutoff, response=response)
     except ParameterError as err:
         head, _, rest = str(err).partition(": ")
@@ -256,7 +255,8 @@ def check_size(spec, workers=None, scheduler=None, available=None) -> dict:
         # the hull: a record's time (both modes and their refinement; dense, or matrix-free
         # for an ideal take-off's long records): parapend.hydro.realizations.record_seconds
         ideal = (getattr(spec, "torque_limit", None) is None and not spec.lossy)
-        seconds = (solves * (hull_record_seconds(spec.waves, ideal) + causal)
+        longest = max(map(spec.record_waves, range(len(spec.tp))))
+        seconds = (solves * (hull_record_seconds(longest, ideal) + causal)
                    / max(1, procs or 1))
     return {"bins": bins, "solves": solves, "processes": procs, "memory_bytes": need,
             "seconds": seconds if math.isfinite(seconds) else None,

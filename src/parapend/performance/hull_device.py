@@ -98,11 +98,48 @@ def _fits(spec, waves: float) -> bool:
     from ..hydro.api import solve_record
     from .buoy_device import wave_of
 
-    s = dataclasses.replace(spec, waves=float(waves))
+    s = dataclasses.replace(spec, waves=float(waves), bin_waves=None)
     p = problem(spec)
     try:
         for j in range(len(spec.period)):
             solve_record(p, wave_of(s, 0, j, 0)[0], None, check_only=True)
+    except ParameterError as err:
+        return not str(err).startswith("repeat-period:")
+    return True
+
+
+def lengthen(spec, seconds: float):
+    """``spec`` with every period bin's record at least ``seconds`` long where the hull's
+    solver takes it (``bin_waves``; else the longest it takes, to 0.01 peak period, not
+    shorter than ``waves``): the default records of 200 peak periods are 18.5 minutes at
+    Tp 5.54 s."""
+    from .. import limits
+
+    out = []
+    for j, tp in enumerate(spec.tp):
+        lo = spec.waves
+        hi = max(lo, min(seconds / tp, limits.SEA_WAVES_RANGE[1]))
+        if hi > lo and not _fits_bin(spec, j, hi):
+            if not _fits_bin(spec, j, lo):
+                hi = lo  # refused by check_records, naming --waves
+            while hi - lo > 0.01:
+                mid = 0.5 * (lo + hi)
+                lo, hi = (mid, hi) if _fits_bin(spec, j, mid) else (lo, mid)
+            hi = math.floor(lo * 100) / 100 if lo > spec.waves else lo
+        out.append(float(hi))
+    if all(w == spec.waves for w in out):
+        return spec
+    return dataclasses.replace(spec, bin_waves=tuple(out))
+
+
+def _fits_bin(spec, j: int, waves: float) -> bool:
+    """Whether period bin ``j``'s record of ``waves`` peak periods fits the hull's size."""
+    s = dataclasses.replace(spec, waves=float(waves), bin_waves=None)
+    from ..hydro.api import solve_record
+    from .buoy_device import wave_of
+
+    try:
+        solve_record(problem(spec), wave_of(s, 0, j, 0)[0], None, check_only=True)
     except ParameterError as err:
         return not str(err).startswith("repeat-period:")
     return True

@@ -64,7 +64,8 @@ _DEFAULT_WATER = {"water_density": 1025.0, "water_depth": None}
 #: out of the JSON, so that a store written before the hull came still resumes
 _DEFAULT_HULL = {"dofs": "heave", "pivot_height": None, "pivot_offset": None,
                  "hull_pitch_inertia": None, "barge_length": None, "barge_beam": None,
-                 "barge_draft": None, "copper_loss": None, "torque_limit": None}
+                 "barge_draft": None, "copper_loss": None, "torque_limit": None,
+                 "bin_waves": None}
 
 
 @dataclasses.dataclass(frozen=True)
@@ -130,6 +131,10 @@ class MatrixSpec:
     speed_limit: float | None = None  # the plans' rated-speed penalty, units sqrt(g / l)
     # --device buoy: which controller of parapend.hydro.control.buoy_mpc the column runs
     buoy_controller: str | None = None
+    # each period bin's record in peak periods where they differ (None: ``waves`` in every
+    # bin): the hull's default records are ``waves`` peak periods or 20 minutes, the longer
+    # (as far as the hull's solver takes them)
+    bin_waves: tuple | None = None
 
     kind = "power_matrix"
     pto = False
@@ -232,6 +237,8 @@ class MatrixSpec:
             d["response"] = tuple(tuple(float(v) for v in c) for c in d["response"])
         if d.get("band") is not None:
             d["band"] = tuple(float(v) for v in d["band"])
+        if d.get("bin_waves") is not None:
+            d["bin_waves"] = tuple(float(v) for v in d["bin_waves"])
         if "forecasts" in d:
             d["forecasts"] = tuple(d["forecasts"])
         return cls(**d)
@@ -241,13 +248,22 @@ class MatrixSpec:
         return {"hm0": np.array(self.hm0), self.period_kind: np.array(self.period),
                 "realization": np.arange(self.realizations)}
 
+    def record_waves(self, j: int) -> float:
+        """The record's length in peak periods at period bin ``j``: ``waves``, or the
+        bin's own (``bin_waves``: the hull's 20-minute records)."""
+        return self.waves if self.bin_waves is None else self.bin_waves[j]
+
+    def repeat_period(self, j: int) -> float:
+        """The record's repeat period (s) at period bin ``j`` (:meth:`record_waves`)."""
+        from .resource import repeat_period
+
+        return repeat_period(self.record_waves(j), self.tp[j])
+
     def sea_kwargs(self, i: int, j: int, r: int) -> dict:
         """The arguments of :func:`parapend.irregular.sea` for bin (i, j), realization r."""
-        from .resource import repeat_period as _repeat
-
         tp = self.tp[j]
         kw = {"hs": self.hm0[i], "tp": tp, "spectrum": self.spectrum,
-              "repeat_period": _repeat(self.waves, tp), "seed": int(self.seeds[r]),
+              "repeat_period": self.repeat_period(j), "seed": int(self.seeds[r]),
               "cutoff": self.cutoff, "length": self.length, "mass": self.mass,
               "inertia": self.inertia, "gravity": self.gravity, "gamma": self.gamma,
               "winding": self.winding, "harmonics": self.harmonics}
