@@ -2,7 +2,8 @@ r"""Receding-horizon (causal) control of a pendulum in a hull that surges, heave
 :func:`hull_mpc`, the hull's counterpart of :func:`parapend.hydro.control.buoy_mpc`.
 
 The plant is the nonlinear pendulum in the 3-DOF hull integrated in the time domain
-(:mod:`._hull_plant`: Cummins' equation with the 3 x 3 radiation memory and ``A_inf``, the
+(:mod:`._hull_plant`: Cummins' equation with the 3 x 3 radiation memory, its kernels
+tapered to a passive memory (:func:`memory_window`), and ``A_inf``, the
 pendulum's reaction through the 4 x 4 mass matrix, RK4 on a fixed step). The memory kernels
 ``K_ij(t) = (2/pi) int B_ij(w) cos(w t) dw`` and ``A_inf,ij`` are the heaving buoy's
 (:func:`.timedomain.radiation_kernel`, :func:`.timedomain.a_infinity`) applied to every
@@ -374,7 +375,8 @@ def hull_mpc(hull, pendulum, wave, *, peak_period, pivot=(0.0, 0.0), pitch_inert
         ``COMPILED_ITER`` for the collocation planner's compiled solver, ``COLLOCATION_ITER``
         for IPOPT).
     memory : float or None
-        The radiation memory (s); None: ``MEMORY_PERIODS`` peak periods.
+        The radiation memory (s), its kernels tapered over it (:func:`memory_window`);
+        None: ``MEMORY_PERIODS`` peak periods.
     terminal_weight : float or None
         ``kappa``, the weight of the energy left at the horizon's end (None: ``eta_g``;
         with ``planner="collocation"`` ``COLLOCATION_TERMINAL_WEIGHT`` times ``eta_g``).
