@@ -95,17 +95,7 @@ def resolve(spec, user: dict):
 
 def _fits(spec, waves: float) -> bool:
     """Whether every period bin's record of ``waves`` peak periods fits the hull's size."""
-    from ..hydro.api import solve_record
-    from .buoy_device import wave_of
-
-    s = dataclasses.replace(spec, waves=float(waves), bin_waves=None)
-    p = problem(spec)
-    try:
-        for j in range(len(spec.period)):
-            solve_record(p, wave_of(s, 0, j, 0)[0], None, check_only=True)
-    except ParameterError as err:
-        return not str(err).startswith("repeat-period:")
-    return True
+    return all(_fits_bin(spec, j, waves) for j in range(len(spec.period)))
 
 
 def lengthen(spec, seconds: float):
