@@ -498,3 +498,27 @@ def test_a_hull_causal_matrix_killed_resumes_to_the_same_store(dataset, tmp_path
     assert run.resumed_points >= 1 and 0 < run.computed_points < done.size
     assert store_files(store) == store_files(ref)
     assert np.isfinite(ds["causal_perfect_power_mean"].values).any()
+
+
+def test_a_lengthened_record_is_never_shorter_than_waves(dataset, monkeypatch):
+    """Where the hull's solver takes less than the 20 minutes, the record is the longest
+    that fits, floored to 0.01 peak period: never below the spec's own ``waves``, round or
+    not, and always one that fits (the solver's size check stubbed by a threshold)."""
+    import dataclasses
+
+    from parapend.performance import hull_device
+
+    spec = matrix_spec(hs="1,2", tp="5,6", realizations=1, hydro=dataset, **HULL)
+    for waves in (200.0, 200.001, 200.005, 200.0099, 150.3, 150.0037):
+        for extra in (0.0, 0.003, 0.0049, 0.0093, 0.012, 0.031, 7.77):
+            top = waves + extra
+            monkeypatch.setattr(hull_device, "_fits_bin", lambda s, j, w, top=top: w <= top)
+            got = hull_device.lengthen(dataclasses.replace(spec, waves=waves, bin_waves=None),
+                                       1200.0)
+            for j, tp in enumerate(spec.tp):
+                want = max(waves, 1200.0 / tp)
+                if top >= want:
+                    assert got.record_waves(j) == pytest.approx(want, rel=1e-12)
+                else:
+                    assert waves <= got.record_waves(j) <= top
+                    assert got.record_waves(j) > min(top - 0.02, waves)

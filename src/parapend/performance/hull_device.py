@@ -100,7 +100,7 @@ def _fits(spec, waves: float) -> bool:
 
 def lengthen(spec, seconds: float):
     """``spec`` with every period bin's record at least ``seconds`` long where the hull's
-    solver takes it (``bin_waves``; else the longest it takes, to 0.01 peak period, not
+    solver takes it (``bin_waves``; else the longest it takes, floored to 0.01 peak period, not
     shorter than ``waves``): the default records of 200 peak periods are 18.5 minutes at
     Tp 5.54 s."""
     from .. import limits
@@ -115,7 +115,7 @@ def lengthen(spec, seconds: float):
             while hi - lo > 0.01:
                 mid = 0.5 * (lo + hi)
                 lo, hi = (mid, hi) if _fits_bin(spec, j, mid) else (lo, mid)
-            hi = math.floor(lo * 100) / 100 if lo > spec.waves else lo
+            hi = max(spec.waves, math.floor(lo * 100) / 100)
         out.append(float(hi))
     if all(w == spec.waves for w in out):
         return spec
