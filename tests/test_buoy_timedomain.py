@@ -135,3 +135,23 @@ def test_spinning_flywheel_drives_the_heave_as_the_harmonic_balance_says():
     model = td.model_impedance(HYDRO, spin, dt=r["dt"], memory=r["memory"], match_omega=spin)
     tol = abs(d / complex(model) - 1) + 2e-3
     assert abs(zf / z - 1) < tol
+
+
+def test_the_default_buoys_memory_is_passive():
+    """The heaving buoy's discrete radiation memory (the plant of its closed loop and of
+    :func:`parapend.hydro.timedomain.simulate`) takes energy out at every frequency up to
+    its step's Nyquist frequency: ``Im D_td(w) / w = sum_j w_j cos(w t_j) >= 0`` to 1e-4 of
+    the body's largest damping ``B`` (measured: -5.6e-6 of it, at 10.2 rad/s, near the top
+    of the data), and it is ``B(w)`` to 2e-3 of that largest value over the wave band
+    (measured: 1.2e-3; the same checks as the hull plant's memory)."""
+    from parapend.hydro import bem
+    from parapend.hydro.api import _dimensions
+
+    hydro = bem.cylinder(*_dimensions(None, None, None), omega="body")
+    wn, bn = td._b_nodes(hydro)
+    for dt in (0.01, 0.05, 0.1):
+        w = np.linspace(1e-3, math.pi / dt, 4000)
+        kc = td.model_impedance(hydro, w, dt=dt).imag / w
+        assert kc.min() >= -1e-4 * bn.max()
+        band = (w > 0.3) & (w < 0.9 * wn[-1])
+        assert np.max(np.abs(kc[band] - np.interp(w[band], wn, bn))) <= 2e-3 * bn.max()
