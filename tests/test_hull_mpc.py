@@ -268,6 +268,12 @@ def test_the_runs_figure_is_its_series():
     for a in ax:
         assert a.lines[-1].get_xdata()[0] == r.average_from_s
     assert "hull" in ax[0].get_title()
+    # and its text report names the hull, not the heaving buoy
+    from parapend.hydro.control import mpc_text
+
+    text = "\n".join(mpc_text(r))
+    assert "absorbed by the hull" in text and "(hull and pendulum)" in text
+    assert "buoy" not in text
 
 
 @pytest.mark.parametrize("args, mode", [

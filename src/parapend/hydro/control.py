@@ -1247,6 +1247,7 @@ def mpc_text(r) -> list:
         return "-" if x is None or not math.isfinite(x) else f"{x:.6g}{unit}"
     w = r.wave or {}
     p = r.pendulum
+    body = "hull" if str(r.planner).startswith("hull") else "buoy"
     out = [f"wave: irregular, {w.get('spectrum', '')}, Hs = {w.get('hs', math.nan):g} m, "
            f"Tp = {w.get('tp', math.nan):g} s, seed {w.get('seed', '-')}, repeat period "
            f"{w.get('repeat_period', math.nan):.6g} s",
@@ -1264,13 +1265,13 @@ def mpc_text(r) -> list:
            f"stored energy's change, after a {r.average_from_s:.4g} s start-up)",
            f"  harvested alone                  {f(r.harvested_power_w, ' W')}",
            f"  stored energy's change           {f(r.stored_energy_change_j, ' J')} "
-           "(buoy and pendulum)",
+           f"({body} and pendulum)",
            f"  electrical                       {f(r.electrical_power_w, ' W')}",
            f"non-causal coupled optimum         {f(r.optimum_power_w, ' W')} (winding "
            f"{r.optimum_winding})",
            f"  fraction reached (electrical)    {f(r.optimum_fraction)}"
            + ("  (the reference under-resolved)" if r.optimum_resolved is False else ""),
-           f"absorbed by the buoy               {f(r.absorbed_w, ' W')}",
+           f"absorbed by the {body}               {f(r.absorbed_w, ' W')}",
            f"  pendulum damping                 {f(r.damping_w, ' W')}",
            f"  stored (change / time)           {f(r.stored_w, ' W')}",
            f"  energy balance residual          {r.energy_balance_residual:.1e}",
