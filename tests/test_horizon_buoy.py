@@ -252,6 +252,10 @@ def _one_line(argv, name, capsys):
     # minutes, whatever the record: fewer horizons, not a repeat period of 0 s
     (["--device", "buoy", "--dofs", "surge,heave,pitch", "--horizons", "2,4,6,8,10"],
      "horizons"),
+    # the hull's controller's own ranges, before the estimate (the heaving buoy's are wider)
+    (["--device", "buoy", "--dofs", "surge,heave,pitch", "--horizons", "12"], "horizons"),
+    (["--device", "buoy", "--dofs", "surge,heave,pitch", "--update-interval", "0.02"],
+     "update-interval"),
 ])
 def test_bad_input_is_one_line_exit_2(argv, name, capsys):
     _one_line(argv, name, capsys)

@@ -291,6 +291,13 @@ def test_the_default_records_last_twenty_minutes(dataset):
     ({**HULL, "harmonics": 500, "efficiency": 0.9}, r"^harmonics: "),
     ({**HULL, "dofs": "surge,heave"}, r"^dofs: "),
     ({"device": "buoy", "body": "barge"}, r"^body: the barge is a hull that pitches"),
+    # the hull's controller's ranges, before any bin (the heaving buoy's are wider)
+    ({**HULL, "controller": "mpc", "horizon": 12.0},
+     r"^horizon: expected a number in \[0.05, 10\]"),
+    ({**HULL, "controller": "mpc", "update_interval": 0.02}, r"^update-interval: expected a "
+     r"number in \[0.041"),
+    ({**HULL, "controller": "mpc", "horizon": 0.1, "update_interval": 0.125},
+     r"^update-interval: expected at most the horizon"),
 ])
 def test_refusals_in_one_line(kw, match, dataset):
     kw = {"hydro": dataset, **kw}

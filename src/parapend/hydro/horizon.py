@@ -282,6 +282,11 @@ def buoy_horizon_curve(*, hs=None, tp=None, spectrum="jonswap", gamma_peak=3.3,
     if upd > min(hz):
         raise ParameterError(f"update-interval: expected at most the shortest horizon "
                              f"{min(hz):g} peak periods, got {upd:g}")
+    if hull:  # the hull's controller's own ranges
+        from .hull_control import check_timing
+
+        for h in hz:
+            check_timing(h, upd, name="horizons")
     warm_up = check_range("warm-up", BUOY_HORIZON["warm_up"] if warm_up is None else warm_up,
                           0.0, 100.0, why="peak periods")
     tp, hs = default_of("tp", tp, kind), default_of("hs", hs, kind)

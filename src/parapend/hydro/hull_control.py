@@ -50,12 +50,14 @@ from ..errors import ParameterError, check_int, check_range
 from . import control as bc
 from . import timedomain as td
 
-__all__ = ["a_infinity_matrix", "hull_mpc", "hull_mpc_command", "memory_weights", "memory_window",
-           "start_mode"]
+__all__ = ["a_infinity_matrix", "check_timing", "hull_mpc", "hull_mpc_command", "memory_weights",
+           "memory_window", "start_mode"]
 
 #: torque samples per peak period, RK4 steps per sample (plant and model)
 SAMPLES = 24
 PLANT_STEPS = 6
+#: the longest horizon (peak periods)
+MAX_HORIZON = 10.0
 #: without a torque limit, this many m g l bound the planned torque (the hull's record
 #: optimum on its default sea peaks near 3 m g l)
 DEFAULT_LIMIT = 4.0
@@ -403,13 +405,8 @@ def hull_mpc(hull, pendulum, wave, *, peak_period, pivot=(0.0, 0.0), pitch_inert
     from .hull import make_case
 
     tp = check_range("tp", peak_period, 1e-3, 1e4, why="s")
-    horizon = check_range("horizon", horizon, 0.05, 10.0, why="peak periods")
     samples = check_int("samples", samples, 4, 512)
-    update_interval = check_range("update-interval", update_interval, 1.0 / samples, 20.0,
-                                  why="peak periods")
-    if update_interval > horizon:
-        raise ParameterError(f"update-interval: expected at most the horizon {horizon:g} peak "
-                             f"periods, got {update_interval:g}")
+    horizon, update_interval = check_timing(horizon, update_interval, samples)
     warmup = check_range("warmup", warmup, 0.0, 1e3, why="peak periods")
     repeats = check_int("repeats", repeats, 1, 100)
     ps = check_int("plant_steps", plant_steps, 1, 1024)
@@ -538,6 +535,21 @@ def hull_mpc(hull, pendulum, wave, *, peak_period, pivot=(0.0, 0.0), pitch_inert
                "a_inf_heave_kg": ai[1], "a_inf_pitch_kg_m2": ai[2],
                "memory_s": plant.nk * h, "memory_window": "bohman",
                "plant_step_s": h})
+
+
+def check_timing(horizon, update_interval, samples=SAMPLES, name="horizon") -> tuple:
+    """The horizon and the update interval (peak periods) :func:`hull_mpc` takes, checked
+    (one line naming the option): a horizon of 0.05 to ``MAX_HORIZON``, an update of at
+    least one torque sample (``1 / samples``) and at most the horizon. For the commands
+    that run it later (the power matrix, ``horizon``: a value it refuses is refused
+    before any work; ``name``: the horizon's option)."""
+    horizon = check_range(name, horizon, 0.05, MAX_HORIZON, why="peak periods")
+    update_interval = check_range("update-interval", update_interval, 1.0 / samples, 20.0,
+                                  why="peak periods")
+    if update_interval > horizon:
+        raise ParameterError(f"update-interval: expected at most the horizon {horizon:g} peak "
+                             f"periods, got {update_interval:g}")
+    return horizon, update_interval
 
 
 def start_mode(winding, mean_angle_deg=None, swing_amplitude_deg=None) -> str:

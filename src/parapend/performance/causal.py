@@ -149,6 +149,10 @@ def check_causal(*, controller, horizon, forecast, update_interval, warm_up, pla
     if buoy and upd > horizon:
         raise ParameterError(f"update-interval: expected at most the horizon {horizon:g} peak "
                              f"periods with --device buoy, got {upd:g}")
+    if buoy and not heave:  # the hull's controller's own ranges
+        from ..hydro.hull_control import check_timing
+
+        check_timing(horizon, upd)
     warm = base["warm_up"] if warm_up is None else warm_up
     warm = check_range("warm-up", warm, 0.0, 100.0, why="peak periods")
     if buoy:
