@@ -77,8 +77,9 @@ HULL = {"wave_height": 1.0, "wave_period": 6.0, "hs": 1.0, "tp": 6.0, "repeat_pe
         # at least 20 minutes (``matrix_record_s``: 217 peak periods at Tp 5.54 s, at most
         # the hull's 300), for an ideal take-off (its records are solved matrix-free, about
         # 50 s of CPU each: benchmarks/bench_hull_record.out.txt); a take-off with an
-        # efficiency, a copper loss or a torque limit is solved dense, at most about 10
-        # waves: its records stay 4 peak periods (the single record's)
+        # efficiency, a copper loss or a torque limit is solved far slower (at most about 30
+        # waves with a torque limit or a copper loss, 10 with an efficiency): its records
+        # stay 4 peak periods (the single record's)
         "matrix_waves": 200.0, "matrix_record_s": 1200.0, "matrix_waves_lossy": 4.0}
 #: ``power-matrix --waves`` of the prescribed pendulum and the heaving buoy (peak periods)
 POWER_MATRIX = {"waves": 50.0}

@@ -62,7 +62,7 @@ def add_parsers(sub) -> None:
                         f"{HULL['matrix_waves']:g} or {HULL['matrix_record_s'] / 60:g} minutes, "
                         "the longer, as far as the hull's solver takes it, with an ideal "
                         "take-off; with --efficiency, --copper-loss or --torque-limit "
-                        f"{HULL['matrix_waves_lossy']:g}, solved dense)")
+                        f"{HULL['matrix_waves_lossy']:g}, their solver's cost)")
     # the sea's and the pendulum's options: generated from their declarations
     # (parapend.hydro.declared), with the defaults they state for power-matrix
     add_declared(g, Sea, ("seed", "spectrum", "gamma_peak", "cutoff"),

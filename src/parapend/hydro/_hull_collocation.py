@@ -73,9 +73,10 @@ CAPPED_ANGLE_TOL = 0.05
 #: the horizon's solver: ``"compiled"`` (:mod:`._hull_collocation_ipm`, no CasADi: the same
 #: NLP; its Newton step :data:`._hull_collocation_ipm.STEP`, ``"auto"``) or ``"ipopt"``
 #: (CasADi's IPOPT, ``parapend[collocation]``). In the closed loop of the default barge's
-#: seeds 0 to 9 (40 iterations at most) the compiled solver realized 95.3 % of the record
-#: optimum with the perfect forecast and 87.9 % with AR (IPOPT: 94.5 and 87.7 %), no failed
-#: solve; on the power matrix's Hs 1 m, Te 8 s bin (Tp 8.9 s: a 17.8 s horizon; 4 waves,
+#: seeds 0 to 9 (40 iterations at most; the plant's memory then cut at 2 peak periods, 94.3
+#: and 86.2 % with today's tapered one, docs/hull.md) the compiled solver realized 95.3 % of
+#: the record optimum with the perfect forecast and 87.9 % with AR (IPOPT: 94.5 and 87.7 %),
+#: no failed solve; on the power matrix's Hs 1 m, Te 8 s bin (Tp 8.9 s: a 17.8 s horizon; 4 waves,
 #: seed 0) 276.8 W perfect and 292.4 W AR, none failed, against IPOPT's 277.2 and 333.7 W
 #: (benchmarks/hull_collocation_table.out.txt, hull_collocation_solver.out.txt); a horizon
 #: 2.1 to 2.6 times faster than IPOPT's (median). The compiled solver is the default (the

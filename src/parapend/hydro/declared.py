@@ -244,9 +244,11 @@ class Body(_Inputs):
                                      "record's best of rotation, swinging and rest; its "
                                      "pendulum's defaults the hull's: "
                                      f"{HULL['mass']:g} kg, {HULL['length']:g} m, "
-                                     f"{HULL['damping_coefficient']:g} N m s/rad; records up "
-                                     "to 300 waves with an ideal take-off, about 10 with "
-                                     "losses: give --waves)"}})
+                                     f"{HULL['damping_coefficient']:g} N m s/rad; records of "
+                                     "200 peak periods or 20 minutes, the longer, with an "
+                                     "ideal take-off (up to 300 waves), 4 with losses (at "
+                                     "most about 30 with a torque limit or a copper loss, "
+                                     "10 with an efficiency))"}})
     pivot_height: float | None = _param(
         "m", "the pivot above the rotation centre O: a built-in body's waterplane centre, a "
              "mesh's origin, a dataset's rotation centre",
@@ -346,9 +348,9 @@ class Controller(_Inputs):
         "peak periods", "with mpc: forecast horizon", value=_MPC_HORIZON,
         default_text=f"{_MPC_HORIZON['mpc']:g}; one-way-mpc {_MPC_HORIZON['one-way-mpc']:g}",
         commands={"track": {"unit": "peak (forcing) periods"}, "power-matrix": {
-            "help": "the causal column's horizon, 0.05 to 20",
+            "help": "the causal column's horizon, 0.05 to 20 (a hull's at most 10)",
             "default": f"1 with --controller mpc; the buoy's {_MPC_HORIZON['mpc']:g}, 1 with "
-                       "--efficiency"}})
+                       "--efficiency (a hull's 2 with it too)"}})
     update_interval: float | None = _param(
         "peak periods", "with mpc: re-planning interval", value=0.125,
         commands={"horizon": {  # the prescribed-heave pendulum's curve re-plans more often
@@ -357,7 +359,7 @@ class Controller(_Inputs):
                        f"{BUOY_HORIZON['update_interval']:g} with --device buoy"},
             "power-matrix": {"help": "between two plans of the causal column, 0.001 to 1",
                              "default": "1/32 with --controller mpc; the buoy's 1/8, at "
-                                        "least 1/64"}})
+                                        "least 1/64 (a hull's 1/24)"}})
     forecast: str | None = _param(
         "-", "with mpc: what the controller knows of the excitation force over the horizon: "
              "perfect (the record's own future) or ar (autoregressive, fitted on the force "
@@ -366,7 +368,8 @@ class Controller(_Inputs):
             "choices": None, "metavar": "NAMES",
             "help": "perfect, ar (autoregressive, fitted on the past only) or perfect,ar: one "
                     "causal column each",
-            "default": "perfect with --controller mpc; ar costs about twice perfect"}})
+            "default": "perfect with --controller mpc; ar costs more (it fits a model at "
+                       "every plan)"}})
 
     @classmethod
     def receding_horizon(cls, horizon=None, *, forecast=None, update_interval=None,

@@ -195,7 +195,7 @@ def buoy_horizon_curve(*, hs=None, tp=None, spectrum="jonswap", gamma_peak=3.3,
         with one solve per update, as the power matrix runs it).
     torque_limit, torque_limit_nm : float or None
         The torque bound in units ``m g l`` or in N m (not both; default ``buoy_mpc``'s,
-        2 ``m g l``).
+        2 ``m g l``; a hull's ``hull_mpc``'s, 4 ``m g l``).
     efficiency : float, pair or None
         Of the power take-off (generating, motoring), in the plans and the power.
     horizons : str or sequence of float

@@ -18,17 +18,23 @@ torque sample, ``|u| <= T_max``) that maximize
 
 the (electrical, ``e`` the efficiency model smoothed at 0; mechanical without one) work of
 the held torques plus the mechanical energy of hull and pendulum left at the horizon's end
-(``kappa = eta_g``; ``terminal="pendulum"``: the pendulum's alone), where the motion over
+(``kappa``: ``COLLOCATION_TERMINAL_WEIGHT`` = 0.5 times ``eta_g`` with the default planner,
+``eta_g`` with L-BFGS-B; ``terminal="pendulum"``: the pendulum's alone), where the motion over
 the horizon is the plant's own model run forward from the measured state and the memory of
 the hull's past motion (the radiation over the horizon included exactly, not frozen) under
 the forecast excitation of all three degrees of freedom: the record itself (``perfect``) or
 an AR forecast of each fitted on the force measured so far (``ar``,
 :class:`parapend.control.forecast.ARForecast`, as the buoy's; its window reaches before the
-run's start, into the sea that set the hull's free motion). The
-gradient is exact (the plant's scheme run backwards, :func:`._hull_plant.adjoint`);
-the solver is L-BFGS-B with the torque bounds (the buoy's ``coupled`` planner,
-:class:`.control.CoupledHorizon`), warm-started from the previous plan shifted. The first
-update interval of the plan is applied to the plant, and the controller moves on.
+run's start, into the sea that set the hull's free motion). The default planner
+(``planner="collocation"``, :mod:`._hull_collocation`) poses it with the motion as the
+unknown, the plant's equations at Hermite-Simpson collocation points and a bound on the
+generator's speed, solved by a compiled interior point on the exact Hessian
+(:mod:`._hull_collocation_ipm`); ``planner="lbfgsb"`` shoots the held torques through the
+plant's model instead, with the exact gradient (the plant's scheme run backwards,
+:func:`._hull_plant.adjoint`) and L-BFGS-B with the torque bounds (the buoy's ``coupled``
+planner, :class:`.control.CoupledHorizon`). Either is warm-started from the previous plan
+shifted. The first update interval of the plan is applied to the plant, and the controller
+moves on.
 
 The mode (:func:`start_mode`, from the record optimum's motion): where the optimum rotates
 or swings through the upright the run starts with the buoy's swing-up pump and hands over
