@@ -211,7 +211,7 @@ def horizon_curve(*, hs=None, tp=None, spectrum: str = "jonswap", gamma_peak: fl
         :func:`parapend.buoy` takes them: their fields are the keywords here.
     dofs : ``device="buoy"`` only: the body's degrees of freedom, ``"heave"`` (default,
         the heaving buoy) or ``"surge,heave,pitch"``: the hull's controller
-        (:func:`parapend.hydro.hull_control.hull_mpc`) against the horizon, on the hull's
+        (``parapend.hydro.hull_control.hull_mpc``) against the horizon, on the hull's
         own defaults (the embedded barge, 4-peak-period records).
     hs, tp, spectrum, gamma_peak, repeat_period, seed, cutoff :
         The sea state (:func:`parapend.seas.sea_record`; ``repeat_period`` in s, default
