@@ -11,6 +11,7 @@ and on the closed loop's plant model (the tapered radiation memory and ``A_inf``
 references of the bin's causal runs.
 
     nice python benchmarks/hull_record_windings.py --bin 1,2 --windings 1,2,3,4,8,16
+    nice python benchmarks/hull_record_windings.py --bin 2,2 --windings 4,5,6 --search
 """
 
 from __future__ import annotations
@@ -22,6 +23,7 @@ import time
 import numpy as np
 
 from parapend.hydro import hull_control as hc
+from parapend.hydro.api import solve_record
 from parapend.hydro.hull import waves_in
 from parapend.hydro.result import optimum
 from parapend.performance import matrix_spec
@@ -59,7 +61,11 @@ class PlantHull:
 def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--bin", default="1,2", help="i,j: the Hs and Te bins (0-based)")
-    ap.add_argument("--windings", default="1,2,3,4,8,16")
+    ap.add_argument("--windings", default="1,2,3,4,8,16",
+                    help="fixed windings to solve (empty: none)")
+    ap.add_argument("--search", action="store_true",
+                    help="also the record optimum as the matrix finds it (the windings "
+                         "searched) and skip the plant's model")
     a = ap.parse_args()
     i, j = (int(v) for v in a.bin.split(","))
     spec = matrix_spec(hs="0.5,1,1.5,2", te="5,6,7,8", realizations=1, device="buoy",
@@ -81,10 +87,18 @@ def main():
     fd, s = solve(p["hull"], modes)
     print(f"record optimum (rotation, swinging), frequency domain: {fd.power_w:.3f} W, "
           f"winding {fd.winding}; {fd.status}; {s:.0f} s CPU")
-    pl, s = solve(PlantHull(p["hull"], tp), modes)
-    print(f"the same on the plant's model: {pl.power_w:.3f} W ({pl.power_w / fd.power_w:.5f} "
-          f"of it), winding {pl.winding}; {s:.0f} s CPU")
-    for k in (int(v) for v in a.windings.split(",")):
+    if a.search:
+        t = time.process_time()
+        r = solve_record(p, wave, info)
+        print(f"record optimum, windings searched (solve_record, the matrix's): "
+              f"{r.power_w:.3f} W ({r.power_w / fd.power_w:.5f} of the two modes'), "
+              f"winding {r.winding}; {r.status}; {time.process_time() - t:.0f} s CPU",
+              flush=True)
+    else:
+        pl, s = solve(PlantHull(p["hull"], tp), modes)
+        print(f"the same on the plant's model: {pl.power_w:.3f} W "
+              f"({pl.power_w / fd.power_w:.5f} of it), winding {pl.winding}; {s:.0f} s CPU")
+    for k in (int(v) for v in a.windings.split(",") if v):
         r, s = solve(p["hull"], (k,))
         print(f"winding {k:3d}: {r.power_w:.3f} W ({r.power_w / fd.power_w:.5f} of the record "
               f"optimum); {r.status}; {s:.0f} s CPU", flush=True)

@@ -915,10 +915,16 @@ def hull_problem(**opts) -> dict:
 def solve_record(problem: dict, wave, info, *, check_only: bool = False):
     """One irregular record ``wave`` (described by ``info``) of :func:`hull_problem`'s
     ``problem``: its size and frequencies checked, then solved (rotation one turn per wave
-    and swinging unless a winding was given); ``check_only``: the checks alone."""
+    and swinging unless a winding was given, and on a record of ``WINDING_SEARCH_WAVES`` or
+    more the windings between them: :func:`parapend.hydro.result.hull_answer`'s search);
+    ``check_only``: the checks alone."""
+    from .result import WINDING_SEARCH_WAVES
+
     windings = problem["windings"]
+    search = False
     if problem["winding"] is None:
         windings = (waves_in(wave), 0)
+        search = windings[0] >= WINDING_SEARCH_WAVES
     _check_hull_size(wave, windings, problem["harmonics"], problem["pto"],
                      problem.get("max_harmonics"))
     amps = np.abs(np.asarray(wave.amplitudes))
@@ -930,7 +936,7 @@ def solve_record(problem: dict, wave, info, *, check_only: bool = False):
     return optimum(problem["hull"], problem["pendulum"], wave, wave_info=info,
                    winding=windings, harmonics=problem["harmonics"], pto=problem["pto"],
                    pivot=problem["pivot"], pitch_inertia=problem["pitch_inertia"],
-                   geometry=problem["geometry"])
+                   geometry=problem["geometry"], winding_search=search)
 
 
 def hull_buoy(deadline=None, time_limit=None, **opts):

@@ -566,13 +566,13 @@ def start_mode(winding, mean_angle_deg=None, swing_amplitude_deg=None) -> str:
     (planned from the hanging pendulum). Measured on the default barge's seas, whose
     optima swing through the upright: the pump's start reached 44 % of the optimum where the
     hanging start reached 30 % (mean over seeds 0 to 5, docs/hull.md)."""
-    if winding:
+    from .result import through_upright
+
+    if winding:  # rotation, or a swing with net turns (over the top: through the upright)
         return "rotate"
     if mean_angle_deg is None or swing_amplitude_deg is None:
         return "swing"
-    lo = mean_angle_deg - swing_amplitude_deg
-    hi = mean_angle_deg + swing_amplitude_deg
-    return "rotate" if math.floor(hi / 360.0) * 360.0 >= lo else "swing"
+    return "rotate" if through_upright(mean_angle_deg, swing_amplitude_deg) else "swing"
 
 
 def hull_mpc_command(problem, wave, info, sol, *, horizon, update_interval, forecast,

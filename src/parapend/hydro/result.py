@@ -615,7 +615,7 @@ def _power_on(hydro, pendulum, wave, *, winding, harmonics, torque_limit, effici
 
 def optimum(h, pendulum, wave, *, wave_info=None, winding=None, harmonics=None, pto=None,
             pivot=(0.0, 0.0), pitch_inertia=None, geometry=None, width=None, coarse=None,
-            design=None) -> BuoyResult:
+            design=None, winding_search=False) -> BuoyResult:
     """The coupled optimum of a pendulum in a floating body, for any of its degree-of-freedom
     sets: one wave or one periodic record, one :class:`BuoyResult`.
 
@@ -640,6 +640,8 @@ def optimum(h, pendulum, wave, *, wave_info=None, winding=None, harmonics=None, 
     geometry, width, coarse, design : the body's dimensions (validity checks), width (m,
         capture-width ratio), the body on the error estimate's coarser mesh (heave alone),
         and the design search's record, for the result.
+    winding_search : a hull: also the windings between swinging and the largest of
+        ``winding`` (:func:`hull_answer`'s ``search``).
     """
     from .hull import HullPTO
 
@@ -649,7 +651,8 @@ def optimum(h, pendulum, wave, *, wave_info=None, winding=None, harmonics=None, 
                     else tuple(winding))
         return hull_answer(h, pendulum, wave, pivot=pivot, windings=windings,
                            pitch_inertia=pitch_inertia, harmonics=harmonics,
-                           wave_info=wave_info, geometry=geometry, pto=pto)
+                           wave_info=wave_info, geometry=geometry, pto=pto,
+                           search=winding_search)
     if pto.copper_loss:
         from ..errors import ParameterError
 
@@ -1108,23 +1111,81 @@ def _solve_mode(hull, pendulum, wave, k, harmonics, pivot, pitch_inertia, pto) -
     return _mode(hold_limit(hull_search(make, pto=pto), peak_torque), resolve)
 
 
+#: the winding search (:func:`hull_answer`'s ``search``) stops after this many windings in
+#: a row that do not beat the best so far
+SEARCH_MISSES = 2
+#: a record of this many waves or more (``waves_in``) has its windings searched by default
+#: (:func:`parapend.hydro.api.solve_record`): over a long record the pendulum that swings
+#: through the upright gains by going over the top a few times net (measured: +2.4 % at one
+#: net turn on a 234-wave record); the default 4-peak-period records' optima swing
+#: (winding 0 beat 1 and 2 net turns on seeds 0 to 9 of the default sea) and are not
+#: searched, which would double their cost
+WINDING_SEARCH_WAVES = 20
+
+
+def through_upright(mean_angle_deg, swing_amplitude_deg) -> bool:
+    """Whether a swing of ``mean_angle_deg +- swing_amplitude_deg`` (the absolute angle from
+    the upward vertical) passes the upright: a multiple of 360 degrees within it."""
+    lo = mean_angle_deg - swing_amplitude_deg
+    return math.floor((mean_angle_deg + swing_amplitude_deg) / 360.0) * 360.0 >= lo
+
+
+def _power_of(m) -> float:
+    p = m["power_w"]
+    return p if p is not None and math.isfinite(p) else -math.inf
+
+
+def _search_windings(modes, solve, top: int) -> None:
+    """The windings between swinging and rotation (``top`` net turns) on a long record,
+    appended to ``modes``: where the swinging optimum passes the upright, the pendulum may
+    go over the top a few times more one way than the other; 1, 2, 3, ... net turns are
+    solved (``solve(k)``) until :data:`SEARCH_MISSES` in a row do not beat the best so far.
+    Their answers swing (``mode`` "swinging", ``winding`` k). The powers over the windings
+    are not monotone (measured on a 234-wave record: 0, 1, 2, 3, 4 net turns 453.8, 464.7,
+    458.7, 459.8, 456.5 W), so this is a search, not a bracket: its answer is the best of
+    the windings tried."""
+    swing = next((m for m in modes if m["winding"] == 0 and m["success"]), None)
+    if swing is None or swing["mean_angle_deg"] is None or not through_upright(
+            swing["mean_angle_deg"], swing["swing_amplitude_deg"]):
+        return
+    best = max(_power_of(m) for m in modes if m["success"])
+    misses, k = 0, 1
+    while misses < SEARCH_MISSES and k < top:
+        m = dict(solve(k), mode="swinging", _searched=True)
+        modes.append(m)
+        if m["success"] and _power_of(m) > best:
+            best, misses = _power_of(m), 0
+        else:
+            misses += 1
+        k += 1
+
+
+def _label(m) -> str:
+    k = m["winding"]
+    if m["mode"] == "swinging" and k:
+        return f"swinging, {k} net turn{'s' if k > 1 else ''}"
+    return m["mode"]
+
+
 def hull_answer(hull, pendulum, wave, *, pivot, windings=(1, 0), pitch_inertia=None,
                 harmonics=None, wave_info=None, geometry=None, notes=(),
-                pto: HullPTO | None = None) -> BuoyResult:
+                pto: HullPTO | None = None, search: bool = False) -> BuoyResult:
     """Solve each winding of ``windings`` (0: swinging), put them beside rest, and build
-    the result from the best; ``pto`` the power take-off (None: ideal)."""
+    the result from the best; ``pto`` the power take-off (None: ideal); ``search``: also
+    the windings between 0 and the largest of ``windings`` (:func:`_search_windings`)."""
     pto = pto or HullPTO()
     from threadpoolctl import threadpool_limits
 
     modes = []
+    def solve(k):
+        return _solve_mode(hull, pendulum, wave, k, harmonics, pivot, pitch_inertia, pto)
     # small dense matrices (a few hundred): BLAS threads cost more than they save
     with threadpool_limits(1, user_api="blas"):
         for k in windings:
-            modes.append(_solve_mode(hull, pendulum, wave, k, harmonics, pivot,
-                                     pitch_inertia, pto))
-    def power_of(m):
-        p = m["power_w"]
-        return p if p is not None and math.isfinite(p) else -math.inf
+            modes.append(solve(k))
+        if search:
+            _search_windings(modes, solve, max(windings))
+    power_of = _power_of
     ok_modes = [m for m in modes if m["success"] and power_of(m) > -math.inf]
     best = max(ok_modes or modes, key=power_of)
     rest = {"mode": "rest", "winding": None, "power_w": 0.0, "mechanical_power_w": 0.0,
@@ -1176,7 +1237,7 @@ def hull_answer(hull, pendulum, wave, *, pivot, windings=(1, 0), pitch_inertia=N
                             f"to {float(np.max(ends)):.3g} m, more than its draft {d:.3g} m"
                             + est)
     warnings = list(getattr(hull, "notes", ())) + list(notes) + [
-        f"{m['mode']}: {m['status']}" for m in modes if not m["success"]]
+        f"{_label(m)}: {m['status']}" for m in modes if not m["success"]]
     if cut:
         warnings.append(f"radiation bound: {cut} singular value(s) of B below "
                         f"{rcond:.3g} of the largest (the data's noise) cut in its "
@@ -1221,8 +1282,9 @@ def hull_answer(hull, pendulum, wave, *, pivot, windings=(1, 0), pitch_inertia=N
         discretization_error_estimate_w=(None if at_rest
                                          else best["discretization_error_estimate_w"]),
         refinement_history=None if at_rest else best["refinement_history"],
-        success=all(m["success"] for m in modes) and not reason,
-        status="; ".join(f"{m['mode']}: {m['status']}" for m in modes),
+        # a searched winding that did not converge is reported, not the answer's failure
+        success=all(m["success"] for m in modes if not m.get("_searched")) and not reason,
+        status="; ".join(f"{_label(m)}: {m['status']}" for m in modes),
         dofs=["surge", "heave", "pitch"], wave=dict(wave_info or {},
                                                     omega_rad_per_s=wave.omega),
         pendulum={"mass_kg": pendulum.mass, "length_m": pendulum.length,

@@ -279,8 +279,8 @@ def _prepare(path: Path, spec: SweepSpec, command: str | None, overwrite: bool) 
         if recorded != spec.to_json():
             raise ParameterError(f"store: {str(path)!r} holds a different sweep (other axes, "
                                  "excitation, harmonics or threshold, or an efficiency map "
-                                 "of an earlier version); choose another --store, or "
-                                 "--overwrite to replace it")
+                                 "or a hull's record optimum of an earlier version); "
+                                 "choose another --store, or --overwrite to replace it")
         for p in path.rglob("*.partial"):  # a chunk write cut short by kill -9
             with contextlib.suppress(OSError):
                 p.unlink()

@@ -89,13 +89,22 @@ def hull_record_seconds(waves: float, ideal: bool = True) -> float:
     (benchmarks/bench_hull_record.out.txt, two runs on the shared 2-core machine at load 5
     to 6, CPU seconds: 8.2 to 8.6 at 10 waves, 16 to 18 at 25, 26 at 50, 33 at 100, 59 to
     63 at 200; a 2 x 2 matrix of 200-wave records, 72 s a record with one bin's retry on
-    1.5 times the harmonics; taken as 15 s and 0.3 s a wave, above every one of them)."""
+    1.5 times the harmonics; taken as 15 s and 0.3 s a wave, above every one of them); a
+    record of ``WINDING_SEARCH_WAVES`` or more also has its windings searched, priced
+    :data:`SEARCH_FACTOR` times that (measured, a 234-wave record: 150 s of CPU against the
+    two modes' 55 s, load 3 on the 2-core machine)."""
     from ..hydro.hull import HARMONICS_PER_TURN, KRYLOV_HARMONICS
+    from ..hydro.result import WINDING_SEARCH_WAVES
 
     waves = max(float(waves), 1.0)
+    factor = SEARCH_FACTOR if waves >= WINDING_SEARCH_WAVES else 1.0
     if ideal and HARMONICS_PER_TURN * waves >= KRYLOV_HARMONICS:
-        return 15.0 + 0.3 * waves
-    return HULL_SOLVE_SECONDS * waves / 9.0
+        return (15.0 + 0.3 * waves) * factor
+    return HULL_SOLVE_SECONDS * waves / 9.0 * factor
+
+
+#: a searched record's CPU time over its two modes' (:func:`hull_record_seconds`)
+SEARCH_FACTOR = 3.0
 
 
 def record_seconds(spec) -> float:

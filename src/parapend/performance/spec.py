@@ -60,6 +60,10 @@ _BUOY_FIELDS = ("body", "radius", "draft", "mesh", "hydro", "digest", "damping_c
 #: the buoy's water when nothing else is given (1025 kg/m^3, deep): left out of the JSON, so
 #: that a store written before the body took the matrix's water still resumes
 _DEFAULT_WATER = {"water_density": 1025.0, "water_depth": None}
+#: how the hull's record optimum is found (in its stores' identity): rotation and swinging,
+#: and on a long record the windings between them
+#: (:func:`parapend.hydro.result.hull_answer`'s search)
+RECORD_OPTIMUM = "rotation, swinging and the windings searched"
 #: the hull's fields (--dofs surge,heave,pitch) at their defaults, the heaving buoy's: left
 #: out of the JSON, so that a store written before the hull came still resumes
 _DEFAULT_HULL = {"dofs": "heave", "pivot_height": None, "pivot_offset": None,
@@ -224,6 +228,8 @@ class MatrixSpec:
                 d.pop(k)
         if d["buoy_controller"] is None:  # the same: the prescribed device's column
             d.pop("buoy_controller")
+        if self.dofs != "heave":  # a hull store of an earlier version (two modes) is refused
+            d["record_optimum"] = RECORD_OPTIMUM
         return json.dumps(d, sort_keys=True)
 
     @classmethod
@@ -231,6 +237,7 @@ class MatrixSpec:
         d = json.loads(text)
         d.pop("kind")
         d.pop("chunks")
+        d.pop("record_optimum", None)
         for k in ("hm0", "period", "tp"):
             d[k] = tuple(float(v) for v in d[k])
         if d["response"] is not None:
