@@ -57,6 +57,8 @@ def test_the_search_stays_below_rotation_and_skips_a_swing_short_of_the_upright(
     assert tried == [1, 2, 3]
     tried, modes = _search({0: 1.0, 1: 5.0}, swing=(180.0, 120.0))
     assert tried == [] and len(modes) == 2
+    tried, _ = _search({0: 0.4, 1: 5.0})  # rotation (0.5 W) beats the swing
+    assert tried == []
 
 
 def test_a_failed_winding_is_a_miss_not_the_best():

@@ -1137,8 +1137,8 @@ def _power_of(m) -> float:
 
 def _search_windings(modes, solve, top: int) -> None:
     """The windings between swinging and rotation (``top`` net turns) on a long record,
-    appended to ``modes``: where the swinging optimum passes the upright, the pendulum may
-    go over the top a few times more one way than the other; 1, 2, 3, ... net turns are
+    appended to ``modes``: where the swinging optimum is the better mode and passes the
+    upright, the pendulum may go over the top a few times more one way than the other; 1, 2, 3, ... net turns are
     solved (``solve(k)``) until :data:`SEARCH_MISSES` in a row do not beat the best so far.
     Their answers swing (``mode`` "swinging", ``winding`` k). The powers over the windings
     are not monotone (measured on a 234-wave record: 0, 1, 2, 3, 4 net turns 453.8, 464.7,
@@ -1149,6 +1149,8 @@ def _search_windings(modes, solve, top: int) -> None:
             swing["mean_angle_deg"], swing["swing_amplitude_deg"]):
         return
     best = max(_power_of(m) for m in modes if m["success"])
+    if _power_of(swing) < best:  # rotation wins: a few net turns are nearer the swing
+        return
     misses, k = 0, 1
     while misses < SEARCH_MISSES and k < top:
         m = dict(solve(k), mode="swinging", _searched=True)
