@@ -423,6 +423,14 @@ def test_long_work_is_announced_before_it_starts(caplog, no_solve):
     (msg,) = [r.getMessage() for r in caplog.records if r.name == "parapend.performance"]
     assert msg.startswith("power matrix: 100 bins x 3 realizations = 300 solves of 50-wave "
                           "records on 2 processes: roughly 8 minutes")
+    caplog.clear()  # one of each: singular
+    with caplog.at_level(logging.INFO, logger="parapend.performance"), \
+            pytest.raises(AssertionError, match="the engine ran"):
+        parapend.power_matrix(hs="0.5:5:10", te="4:13:10", workers=1, realizations=1,
+                              time_limit=3600.0)
+    (msg,) = [r.getMessage() for r in caplog.records if r.name == "parapend.performance"]
+    assert msg.startswith("power matrix: 100 bins x 1 realization = 100 solves of 50-wave "
+                          "records on 1 process: roughly"), msg
 
 
 def test_a_resume_announces_what_is_left(caplog, no_solve, tmp_path):

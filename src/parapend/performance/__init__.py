@@ -1069,11 +1069,14 @@ def power_matrix(*, hs="1:3:3", te=None, tp=None, realizations: int = 3, waves=N
     left = (est["seconds"] * (spec.points - stored) / spec.points
             if est["seconds"] is not None else None)
     if left is not None and left > _ANNOUNCE_SECONDS:
-        log.info("power matrix: %d bins x %d realizations = %d solves of %s-wave records%s "
+        procs = est["processes"]
+        log.info("power matrix: %d bins x %d realization%s = %d solves of %s-wave records%s "
                  "on %s: roughly %s (about %s; the progress bar gives the rate)",
-                 est["bins"], spec.realizations, est["solves"], _record_lengths(spec),
+                 est["bins"], spec.realizations, "" if spec.realizations == 1 else "s",
+                 est["solves"], _record_lengths(spec),
                  f" ({stored} of them in the store)" if stored else "",
-                 f"{est['processes']} processes" if est["processes"] else "the cluster",
+                 (f"{procs} process{'' if procs == 1 else 'es'}" if procs
+                  else "the cluster"),
                  duration(left) + ("" if est["processes"] else " of one core"),
                  ("3 s a 50-wave solve" if spec.controller is None else
                   f"3 s a 50-wave solve and {est['causal_seconds']:.0f} s its causal runs")
