@@ -43,7 +43,8 @@ QUANTITIES = {
 UNITS = {"peak_torque": "N m", "peak_pivot_force": "N"}
 
 #: the hull's per-realization mode (--dofs surge,heave,pitch): an int8 code, -1 not computed
-MODE_LONG_NAME = "best mode of the record: 0 rest, 1 rotation (one turn per wave), 2 swinging"
+MODE_LONG_NAME = ("best mode of the record: 0 rest, 1 rotation (one turn per wave), 2 swinging "
+                  "(on a long record, possibly with a few net turns)")
 _TITLE = "parapend design map"
 #: every top-level name a power-matrix store holds (coordinates and variables)
 STORE_NAMES = ("hm0", "te", "tp", "realization", "seed", "done", "status", "mode", "failure",
