@@ -1138,8 +1138,9 @@ def _power_of(m) -> float:
 def _search_windings(modes, solve, top: int) -> None:
     """The windings between swinging and rotation (``top`` net turns) on a long record,
     appended to ``modes``: where the swinging optimum is the better mode and passes the
-    upright, the pendulum may go over the top a few times more one way than the other; 1, 2, 3, ... net turns are
-    solved (``solve(k)``) until :data:`SEARCH_MISSES` in a row do not beat the best so far.
+    upright, the pendulum may go over the top a few times more one way than the other;
+    1, 2, 3, ... net turns are solved (``solve(k)``) until :data:`SEARCH_MISSES` in a row
+    do not beat the best so far.
     Their answers swing (``mode`` "swinging", ``winding`` k). The powers over the windings
     are not monotone (measured on a 234-wave record: 0, 1, 2, 3, 4 net turns 453.8, 464.7,
     458.7, 459.8, 456.5 W), so this is a search, not a bracket: its answer is the best of
@@ -1187,9 +1188,8 @@ def hull_answer(hull, pendulum, wave, *, pivot, windings=(1, 0), pitch_inertia=N
             modes.append(solve(k))
         if search:
             _search_windings(modes, solve, max(windings))
-    power_of = _power_of
-    ok_modes = [m for m in modes if m["success"] and power_of(m) > -math.inf]
-    best = max(ok_modes or modes, key=power_of)
+    ok_modes = [m for m in modes if m["success"] and _power_of(m) > -math.inf]
+    best = max(ok_modes or modes, key=_power_of)
     rest = {"mode": "rest", "winding": None, "power_w": 0.0, "mechanical_power_w": 0.0,
             "success": True, "status": "the pendulum held (no power)"}
     public = [{k: v for k, v in m.items() if not k.startswith("_")} for m in modes] + [rest]
@@ -1197,7 +1197,7 @@ def hull_answer(hull, pendulum, wave, *, pivot, windings=(1, 0), pitch_inertia=N
     cs = sol.case
     # rest (0 W: no torque, or the pendulum held) is the answer when no motion beats it,
     # whatever the windings asked for
-    at_rest = not power_of(best) > 0
+    at_rest = not _power_of(best) > 0
     mot = None if at_rest else best["_motion"]
     period = 2 * math.pi / wave.omega
     s = (mot or best["_motion"]).on_grid(PEAK_POINTS)
