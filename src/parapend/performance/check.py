@@ -77,8 +77,10 @@ CAUSAL_SECONDS = {"perfect": 7.5, "ar": 10.5}
 #: periods, horizon 2, perfect forecast) took 500 s of CPU at a load of 6 (the record's
 #: optimum aside): 1.2 s; a bin of the 4 x 4 causal matrix of 200-peak-period records (Hs
 #: 0.5 m, Te 5 s: the record's optimum and both forecasts' runs, one process of two on an
-#: otherwise idle machine, one thread) took 14 min: 0.94 s, priced 1.0
-BUOY_CAUSAL_SECONDS = {"plan": 0.25, "coupled": 2.0, "hull": 4.5, "hull-collocation": 1.0}
+#: otherwise idle machine, one thread) took 14 min: 0.94 s; the whole matrix's bins took
+#: about 15 minutes each at Hs 0.5 m and 20 to 25 at Hs 1 to 2 m (one process of two, the
+#: machine shared): 1.3 s at the higher seas, priced 1.4
+BUOY_CAUSAL_SECONDS = {"plan": 0.25, "coupled": 2.0, "hull": 4.5, "hull-collocation": 1.4}
 
 
 def hull_record_seconds(waves: float, ideal: bool = True) -> float:
