@@ -8,7 +8,10 @@ and an omniscient one of the same bins and records give each causal run's fracti
 searched optimum. Prints, per bin: both optima, the perfect and AR runs, their fractions
 of each, and whether the unsearched bins agree to the bit.
 
-    python benchmarks/hull_matrix_references.py CAUSAL_STORE OMNISCIENT_STORE
+    python benchmarks/hull_matrix_references.py CAUSAL_STORE OMNISCIENT_STORE [--scatter CSV]
+
+With ``--scatter`` (the power matrix's: ``hs``, ``te``, ``frequency``), the annual energies
+8766 h x sum P f of the searched optimum and of each forecast's runs, every bin counted.
 """
 
 from __future__ import annotations
@@ -25,6 +28,7 @@ def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("causal")
     ap.add_argument("omniscient")
+    ap.add_argument("--scatter")
     a = ap.parse_args()
     c = xr.open_zarr(a.causal, consolidated=False)
     o = xr.open_zarr(a.omniscient, consolidated=False)
@@ -54,6 +58,17 @@ def main():
     for name, (p, q) in counted.items():
         print(f"within CAUSAL_SLACK ({CAUSAL_SLACK:g}) of the {name} optimum: perfect {p}, "
               f"AR {q}")
+    if a.scatter:
+        from parapend.performance.annual import read_scatter
+
+        f = read_scatter(a.scatter, tuple(hs), tuple(te), "te")
+        aep = {k: 8766.0 * float(np.nansum(v * f)) / 1e6
+               for k, v in (("two modes", pc), ("searched", po), ("perfect", perf),
+                            ("AR", ar))}
+        print("annual energy (MWh/yr, 8766 h x sum P f, every bin counted): "
+              + "; ".join(f"{k} {v:.4f}" for k, v in aep.items())
+              + f"; perfect {aep['perfect'] / aep['searched']:.4f} and AR "
+              f"{aep['AR'] / aep['searched']:.4f} of the searched optimum's")
 
 
 if __name__ == "__main__":
