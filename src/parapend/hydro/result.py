@@ -1174,8 +1174,10 @@ def hull_answer(hull, pendulum, wave, *, pivot, windings=(1, 0), pitch_inertia=N
                 harmonics=None, wave_info=None, geometry=None, notes=(),
                 pto: HullPTO | None = None, search: bool = False) -> BuoyResult:
     """Solve each winding of ``windings`` (0: swinging), put them beside rest, and build
-    the result from the best; ``pto`` the power take-off (None: ideal); ``search``: also
-    the windings between 0 and the largest of ``windings`` (:func:`_search_windings`)."""
+    the result from the best; ``pto`` the power take-off (None: ideal); ``search``: where
+    swinging (winding 0) is the better mode and passes the upright, also 1, 2, 3, ... net
+    turns below the largest of ``windings``, until ``SEARCH_MISSES`` in a row do not beat
+    the best (a search: the powers over the windings are not monotone)."""
     pto = pto or HullPTO()
     from threadpoolctl import threadpool_limits
 
