@@ -500,3 +500,26 @@ def test_a_device_or_fifo_as_the_buoys_file_is_refused_unread(opt, tmp_path, cap
         err = capsys.readouterr().err
         assert len(err.strip().splitlines()) == 1, err
         assert f"{opt[2:]}: expected a regular file, got {kind}" in err, err
+
+
+def test_another_sweeps_store_is_refused_before_the_announcement(caplog, no_solve, tmp_path):
+    """A resume over a store of another sweep (here other Te bins) exits before it announces
+    hours of work it will not do; with --overwrite it is announced and runs."""
+    import logging
+
+    from parapend.maps.store import _prepare, make_store_dir
+    from parapend.performance import matrix_spec
+
+    store = tmp_path / "m.zarr"
+    make_store_dir(store)
+    _prepare(store, matrix_spec(hs="0.5:5:10", te="4:13:9"), "test", False)
+    with caplog.at_level(logging.INFO, logger="parapend.performance"), \
+            pytest.raises(ParameterError, match="holds a different sweep"):
+        parapend.power_matrix(hs="0.5:5:10", te="4:13:10", workers=2, store=str(store))
+    assert not [r for r in caplog.records if r.name == "parapend.performance"]
+    with caplog.at_level(logging.INFO, logger="parapend.performance"), \
+            pytest.raises(AssertionError, match="the engine ran"):
+        parapend.power_matrix(hs="0.5:5:10", te="4:13:10", workers=2, store=str(store),
+                              overwrite=True)
+    (msg,) = [r.getMessage() for r in caplog.records if r.name == "parapend.performance"]
+    assert msg.startswith("power matrix: 100 bins x 3 realizations"), msg

@@ -30,6 +30,7 @@ from .store import (
     _store_spec,
     _template,
     _verify,
+    check_resumable,
     make_store_dir,
     open_sweep,
     stored_points,
@@ -456,6 +457,7 @@ def sweep(store=None, *, omega=1.8, delta=None, gamma=GAMMA["sweep"], torque_lim
                       block_points=block_points)
     seconds = estimate_seconds(spec) / (1 if scheduler is not None else max(
         1, min(workers or os.cpu_count() or 1, spec.blocks)))
+    check_resumable(spec, store, overwrite)  # before the announcement
     stored = stored_points(spec, store, overwrite) if seconds > 60 else 0
     seconds *= (spec.points - stored) / spec.points
     if seconds > 60:  # announced on stderr by the command line, a terminal or not

@@ -197,6 +197,33 @@ def stored_points(spec, store, overwrite: bool = False) -> int:
                for b in range(spec.blocks) if done[b])
 
 
+def _refuse_other(path: Path, spec: SweepSpec, overwrite: bool) -> str:
+    """What ``path`` holds (:func:`_identify`'s kind), after refusing a directory that is not
+    parapend's, and a store of another sweep unless ``overwrite``."""
+    kind, recorded = _identify(path)
+    if kind == "foreign":
+        raise ParameterError(f"store: {str(path)!r} exists and is not a parapend sweep store "
+                             "(parapend never deletes such a directory, --overwrite or not); "
+                             "choose another --store")
+    if kind == "store" and not overwrite and recorded != spec.to_json():
+        raise ParameterError(f"store: {str(path)!r} holds a different sweep (other axes, "
+                             "excitation, harmonics or threshold, or an efficiency map "
+                             "or a hull's record optimum of an earlier version); "
+                             "choose another --store, or --overwrite to replace it")
+    return kind
+
+
+def check_resumable(spec, store, overwrite: bool = False) -> None:
+    """Refuse, before any work is announced, a ``store`` that the run would refuse when it
+    opens it: a directory that is not parapend's, or a store of another sweep (unless
+    ``overwrite``). Read-only and unlocked; the run checks again under its lock."""
+    if store is None:
+        return
+    path = Path(store)
+    if path.is_dir():
+        _refuse_other(path, spec, overwrite)
+
+
 def _write_marker(path: Path) -> None:
     """Make the root ``zarr.json`` of ``path`` say "a parapend store being created", atomically
     (a temporary beside it, then a rename): from then on the directory is recognised as
@@ -270,17 +297,8 @@ def _prepare(path: Path, spec: SweepSpec, command: str | None, overwrite: bool) 
     or an empty directory) is ever emptied: anything else is refused, ``--overwrite`` or
     not, and so is a store that also holds files parapend did not write."""
     _remove_stale_temps(path.parent if str(path.parent) else Path("."))
-    kind, recorded = _identify(path)
-    if kind == "foreign":
-        raise ParameterError(f"store: {str(path)!r} exists and is not a parapend sweep store "
-                             "(parapend never deletes such a directory, --overwrite or not); "
-                             "choose another --store")
+    kind = _refuse_other(path, spec, overwrite)
     if kind == "store" and not overwrite:
-        if recorded != spec.to_json():
-            raise ParameterError(f"store: {str(path)!r} holds a different sweep (other axes, "
-                                 "excitation, harmonics or threshold, or an efficiency map "
-                                 "or a hull's record optimum of an earlier version); "
-                                 "choose another --store, or --overwrite to replace it")
         for p in path.rglob("*.partial"):  # a chunk write cut short by kill -9
             with contextlib.suppress(OSError):
                 p.unlink()

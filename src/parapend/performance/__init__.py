@@ -956,7 +956,7 @@ def power_matrix(*, hs="1:3:3", te=None, tp=None, realizations: int = 3, waves=N
     if has_inputs(locals()):
         return power_matrix(**expand_inputs(power_matrix, locals()))
     from ..maps.run import run_spec
-    from ..maps.store import stored_points
+    from ..maps.store import check_resumable, stored_points
     from .annual import bin_series, read_scatter, read_series
     from .check import check_bins, check_size
 
@@ -1062,6 +1062,7 @@ def power_matrix(*, hs="1:3:3", te=None, tp=None, realizations: int = 3, waves=N
         counts, out = bin_series(hs_t, per_t, bin_edges(spec.hm0), bin_edges(spec.period))
         frequency = counts / hs_t.size
         outside = {"sea_states": out, "frequency": out / hs_t.size} if out else None
+    check_resumable(spec, store, overwrite)  # a store the run would refuse
     # announced once nothing is left to refuse
     # a resume runs what the store does not hold
     stored = (stored_points(spec, store, overwrite) if est["seconds"] is not None
