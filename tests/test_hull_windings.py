@@ -17,15 +17,23 @@ def _mode(k, power, success=True, mean=180.0, amp=200.0):
             "swing_amplitude_deg": amp if k == 0 else None}
 
 
-def _search(powers, top=50, swing=(180.0, 200.0), failed=()):
+def _search(powers, top=50, swing=(180.0, 200.0), failed=(), screened=()):
     """Run the search with a fake solve giving ``powers[k]`` (W) at winding ``k``: the
-    windings tried, and the modes."""
+    windings tried, and the modes. Each mode's refinement history is its power at 100
+    harmonics only (``screened``: the windings whose answer is entered unrefined)."""
     modes = [_mode(top, 0.5), _mode(0, powers[0], mean=swing[0], amp=swing[1])]
+    for m in modes:
+        m["refinement_history"] = [[100, m["power_w"]]]
     tried = []
 
-    def solve(k):
+    def solve(k, screen):
+        assert isinstance(screen, res._Screen)
         tried.append(k)
-        return _mode(k, powers.get(k, 0.0), success=k not in failed)
+        m = _mode(k, powers.get(k, 0.0), success=k not in failed)
+        m["refinement_history"] = [[100, m["power_w"]]]
+        if k in screened:
+            m["_screened"] = True
+        return m
 
     res._search_windings(modes, solve, top)
     return tried, modes
@@ -65,6 +73,73 @@ def test_a_failed_winding_is_a_miss_not_the_best():
     tried, modes = _search({0: 1.0, 1: 9.0, 2: 0.5, 3: 0.5}, failed=(1,))
     assert tried == [1, 2]
     assert not modes[2]["success"]
+
+
+def test_a_screened_winding_is_a_miss_and_never_the_lead():
+    # screened with a power above the best (cannot happen; the flag rules): still a miss
+    tried, modes = _search({0: 1.0, 1: 9.0, 2: 0.5, 3: 0.5}, screened=(1,))
+    assert tried == [1, 2] and modes[2]["_screened"]
+
+
+class _Case:
+    def __init__(self, harmonics):
+        self.harmonics = harmonics
+
+
+class _Sol:
+    def __init__(self, power, harmonics=2808):
+        self.power, self.case = power, _Case(harmonics)
+
+
+def test_the_screen_compares_at_the_same_harmonics_with_a_margin():
+    # the Hs 1 m, Te 7 s bin: one net turn's answer (refined 464.769 -> 464.739 W)
+    best = {"power_w": 464.739, "refinement_history": [[2808, 464.769], [5616, 464.739]]}
+    screen = res._Screen(best)
+    assert screen.unrefined(_Sol(456.754)) == 464.769  # 3 net turns: 1.7 % below, a miss
+    assert screen.unrefined(_Sol(461.0)) is None  # within 1e-2: refined
+    assert screen.unrefined(_Sol(460.0)) == 464.769  # just past 1e-2
+    assert screen.unrefined(_Sol(400.0, harmonics=1404)) is None  # other harmonics
+    assert screen.unrefined(_Sol(float("nan"))) is None
+    # refined: checked where not below the best's refined power
+    assert screen.checked(_Sol(464.8)) and not screen.checked(_Sol(464.7))
+    # a best whose refinement moved it by 1e-2: the margin is four times that
+    moved = res._Screen({"power_w": 1010.0,
+                         "refinement_history": [[2808, 1000.0], [5616, 1010.0]]})
+    assert moved.margin(1000.0) == pytest.approx(4e-2)
+    assert moved.unrefined(_Sol(970.0)) is None
+    assert moved.unrefined(_Sol(955.0)) == 1000.0
+
+
+def test_a_screen_that_keeps_the_answer_changes_nothing_and_one_that_drops_it_stops_early():
+    """The search's answer with a screen that keeps it is the one without (bit for bit);
+    a screen that drops it returns the unrefined answer."""
+    from parapend.hydro.api import hull_problem
+    from parapend.hydro.declared import default_of
+    from parapend.hydro.hull import hull_search, make_case
+    from parapend.hydro.inputs import _irregular_wave
+    from parapend.units import Units
+
+    p = hull_problem()
+    pend = p["pendulum"]
+    wave, _ = _irregular_wave(1.0, 6.0, "jonswap", 3.3, 12.0, 0, default_of("cutoff", None),
+                              None, default_of("taper", None),
+                              Units(pend.length, pend.mass, 9.81, pend.inertia))
+
+    def make(scale):
+        base = make_case(p["hull"], pend, wave, winding=0, pivot=p["pivot"])
+        if scale == 1:
+            return base
+        return make_case(p["hull"], pend, wave, winding=0, harmonics=scale * base.harmonics,
+                         hull_harmonics=scale * base.hull_harmonics, pivot=p["pivot"])
+    plain = hull_search(make)
+    seen = []
+    kept = hull_search(make, screen=lambda sol: seen.append(sol.power) or True)
+    assert plain.success and len(plain.refinement_history) >= 2
+    assert kept.power == plain.power and kept.refinement_history == plain.refinement_history
+    assert seen == [plain.refinement_history[0][1]]
+    dropped = hull_search(make, screen=lambda sol: False)
+    assert dropped.refinement_history == () and dropped.power == seen[0]
+    assert dropped.case.harmonics == plain.refinement_history[0][0]
 
 
 def test_a_searched_winding_is_labelled_by_its_net_turns():
@@ -119,6 +194,10 @@ def test_the_matrix_bins_optimum_is_searched_and_above_its_causal_run():
     assert r.success and r.headline_reason is None
     tried = [m["winding"] for m in r.modes if m["mode"] != "rest"]
     assert tried[:2] == [234, 0] and tried[2:] == [1, 2, 3]
+    # 2 and 3 net turns (458.7, 459.8 W) are screened out before their refinement
+    two, three = r.modes[3:5]
+    assert "not refined" in two["status"] and "not refined" in three["status"]
+    assert two["refinement_history"] == [] and two["gradient_max_w_per_rad"] is None
     assert r.winding == 1 and r.mode == "swinging"
     # the causal run (docs/performance.md), 0.35 % of plant-model difference allowed
     assert r.power_w > 459.537 / 1.0035

@@ -620,7 +620,8 @@ def coarsened(case: HullCase, harmonics: int) -> HullCase:
 LEVEL_GTOL = 1e-4
 
 
-def continued_search(make, *, refine: bool = True, level: bool = False, pto=None):
+def continued_search(make, *, refine: bool = True, level: bool = False, pto=None,
+                     screen=None):
     """:func:`.hull.hull_search` of a long record by continuation in the harmonics: the
     search over the starts on the record with ``COARSENING`` times fewer harmonics (itself
     continued while it has at least ``LONG_RECORD_HARMONICS``), then its best coupled and
@@ -632,7 +633,8 @@ def continued_search(make, *, refine: bool = True, level: bool = False, pto=None
     With an active take-off ``pto`` (:class:`.hull.HullPTO`) the coarsest search is the
     take-off's (its ideal maxima and least-torque motions start the smoothing's
     continuation under the limit), and each finer level continues the take-off's optimum
-    and its one-way twin from the coarser ones (:func:`_continued_pto`)."""
+    and its one-way twin from the coarser ones (:func:`_continued_pto`). ``screen``: as
+    :func:`.hull.hull_search`'s (an ideal take-off's answer only)."""
     case = make(1)
     coarse = coarsened(case, max(2, case.harmonics // COARSENING))
     if coarse.harmonics >= _hull.LONG_RECORD_HARMONICS:
@@ -660,7 +662,7 @@ def continued_search(make, *, refine: bool = True, level: bool = False, pto=None
                        maxima_powers=sol.maxima_powers, runs=sol.runs + 2,
                        iterations=sol.iterations + r.iterations + one.iterations,
                        energy_balance_residual=float(pr.balance(r.x)[2]))
-    if refine and ok:
+    if refine and ok and (screen is None or screen(out)):
         out = _refine(out, make, r.x)
     return out
 

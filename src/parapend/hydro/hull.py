@@ -709,15 +709,18 @@ def _maxima(runs) -> tuple:
     return tuple(float(r.power) for r in seen)
 
 
-def hull_search(make, *, refine: bool = True, pto: HullPTO | None = None) -> HullSolution:
+def hull_search(make, *, refine: bool = True, pto: HullPTO | None = None,
+                screen=None) -> HullSolution:
     """The best coupled maximum over the starts, with the one-way answer beside it.
 
     ``make(scale)`` returns the :class:`HullCase` with ``scale`` times the default
     harmonics (1, and 2 for the refinement). With an active ``pto`` the ideal search's
-    distinct maxima start the PTO's optimum (``_pto_stage``)."""
+    distinct maxima start the PTO's optimum (``_pto_stage``). ``screen(sol)`` (an ideal
+    take-off's): called on the converged answer before its refinement; False returns it
+    unrefined (the refined answer is the same as without a screen)."""
     case = make(1)
     if case.harmonics >= LONG_RECORD_HARMONICS and MATRIX_FREE:
-        return MATRIX_FREE["search"](make, refine=refine, pto=pto)
+        return MATRIX_FREE["search"](make, refine=refine, pto=pto, screen=screen)
     n, kw = case.harmonics, case.winding
     one = ideal_problem(case, coupled=False)
     starts = _starts(n, kw)
@@ -746,7 +749,7 @@ def hull_search(make, *, refine: bool = True, pto: HullPTO | None = None) -> Hul
                        runs=len(runs) + len(runs_one),
                        iterations=sum(r.iterations for r in runs + runs_one),
                        energy_balance_residual=float(resid))
-    if refine and ok:
+    if refine and ok and (screen is None or screen(sol)):
         sol = _refine(sol, make, best.x)
     return sol
 

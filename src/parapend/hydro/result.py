@@ -964,9 +964,10 @@ def _reported(case, x, resolve=None):
                      grid=lambda m: np.abs(mot.on_grid(m)["tau"]))
 
 
-def _mode(sol, resolve=None) -> dict:
+def _mode(sol, resolve=None, checks: bool = True) -> dict:
     """One mode's entry; ``resolve(case)``: the same case with ``REPORT_HULL_FACTOR`` times
-    the hull harmonics, for the reported motion (None: the solve's own cut)."""
+    the hull harmonics, for the reported motion (None: the solve's own cut); ``checks``:
+    the optimality check (False: left out, its entries None)."""
     pr = ideal_problem(sol.case)  # the mechanics (a take-off's objective aside)
     mot, pk = _reported(sol.case, sol.x, resolve if math.isfinite(sol.power) else None)
     status, ok = sol.status, sol.success
@@ -982,7 +983,7 @@ def _mode(sol, resolve=None) -> dict:
     # first- and second-order optimality of the answer: of the ideal power, or of the
     # take-off's objective that the answer's climb maximized (_pto_objective)
     grad, top, scaled, width = None, None, None, None
-    if math.isfinite(sol.power):
+    if checks and math.isfinite(sol.power):
         obj = _pto_objective(sol) if sol.pto.active else pr
         if obj is not None:
             grad, top, scaled = _hull_krylov.optimality(obj, sol.x)
@@ -1093,7 +1094,12 @@ def bound_note(bound, error, limit) -> str | None:
             "limit bounds the power")
 
 
-def _solve_mode(hull, pendulum, wave, k, harmonics, pivot, pitch_inertia, pto) -> dict:
+def _solve_mode(hull, pendulum, wave, k, harmonics, pivot, pitch_inertia, pto,
+                screen=None) -> dict:
+    """One winding's mode entry (:func:`_mode`). ``screen`` (a :class:`_Screen`; an ideal
+    take-off's): the answer before its refinement is first compared with the best mode's, and
+    one below it by more than the margin is entered unrefined and unchecked (``_screened``);
+    a refined one below the best is entered without its optimality check."""
     def make(scale):
         base = make_case(hull, pendulum, wave, winding=k, harmonics=harmonics, pivot=pivot,
                          pitch_inertia=pitch_inertia)
@@ -1108,7 +1114,26 @@ def _solve_mode(hull, pendulum, wave, k, harmonics, pivot, pitch_inertia, pto) -
                          pitch_inertia=pitch_inertia)
     def peak_torque(cs, x):
         return _reported(cs, x, resolve)[1]
-    return _mode(hold_limit(hull_search(make, pto=pto), peak_torque), resolve)
+    if screen is None or pto.active:
+        return _mode(hold_limit(hull_search(make, pto=pto), peak_torque), resolve)
+    below = []
+    def keep(sol):
+        ref = screen.unrefined(sol)
+        if ref is not None:
+            below.append(ref)
+        return ref is None
+    sol = hull_search(make, pto=pto, screen=keep)
+    if below:
+        m = _mode(sol, resolve, checks=False)
+        m.update(status=f"{sol.status} at {sol.case.harmonics} harmonics, {sol.power:.6g} W: "
+                 f"below the best mode's {below[0]:.6g} W there by more than "
+                 f"{screen.margin(below[0]):.2g} of it; not refined", _screened=True)
+        return m
+    if not screen.checked(sol):
+        m = _mode(sol, resolve, checks=False)
+        m["status"] += "; below the best: its optimality not checked"
+        return m
+    return _mode(sol, resolve)
 
 
 #: the winding search (:func:`hull_answer`'s ``search``) stops after this many windings in
@@ -1121,6 +1146,44 @@ SEARCH_MISSES = 2
 #: (winding 0 beat 1 and 2 net turns on seeds 0 to 9 of the default sea) and are not
 #: searched, which would double their cost
 WINDING_SEARCH_WAVES = 20
+
+
+#: a searched winding whose answer on the record's own harmonics is below the best mode's
+#: there by more than this share of it (or four times the best's own change over its
+#: refinement, if more) is a miss: not refined and not checked. The refinements of the
+#: windings' answers moved them by 7e-5 to 6.6e-3 of the power on the measured 234-wave
+#: records (3 net turns at Hs 1 m, Te 7 s: 456.75 to 459.79 W); the windings' powers
+#: differ by 1e-3 to 3e-2. A refinement and an optimality check are about half a searched
+#: winding's cost; a refined winding below the best is not checked either.
+SCREEN_MARGIN = 1e-2
+
+
+class _Screen:
+    """The screen of :func:`_solve_mode` against the mode ``best`` (an entry of
+    :func:`_mode`): :meth:`unrefined` before the refinement, :meth:`checked` after it."""
+
+    def __init__(self, best: dict):
+        self.best = best
+        self.levels = {int(n): float(p) for n, p in best.get("refinement_history") or ()}
+
+    def unrefined(self, sol):
+        """``best``'s power at ``sol``'s harmonics where ``sol`` (an unrefined answer) is
+        below it by more than :meth:`margin` (a miss), else None (refine it)."""
+        ref = self.levels.get(sol.case.harmonics)
+        if ref is None or not math.isfinite(sol.power):
+            return None
+        return ref if sol.power < ref - self.margin(ref) * abs(ref) else None
+
+    def margin(self, ref: float) -> float:
+        """A share of the power ``ref``: :data:`SCREEN_MARGIN`, or four times ``best``'s
+        change over its refinement."""
+        hist = self.best.get("refinement_history") or ()
+        moved = abs(hist[-1][1] - ref) / abs(ref) if hist and ref else 0.0
+        return max(SCREEN_MARGIN, 4 * moved)
+
+    def checked(self, sol) -> bool:
+        """Whether the refined answer ``sol`` gets its optimality check: not below the best."""
+        return not sol.power < _power_of(self.best)
 
 
 def through_upright(mean_angle_deg, swing_amplitude_deg) -> bool:
@@ -1139,8 +1202,9 @@ def _search_windings(modes, solve, top: int) -> None:
     """The windings between swinging and rotation (``top`` net turns) on a long record,
     appended to ``modes``: where the swinging optimum is the better mode and passes the
     upright, the pendulum may go over the top a few times more one way than the other;
-    1, 2, 3, ... net turns are solved (``solve(k)``) until :data:`SEARCH_MISSES` in a row
-    do not beat the best so far.
+    1, 2, 3, ... net turns are solved (``solve(k, screen)``: a winding below the best so far
+    before its refinement, by :data:`SCREEN_MARGIN`, is left there unrefined) until
+    :data:`SEARCH_MISSES` in a row do not beat the best so far.
     Their answers swing (``mode`` "swinging", ``winding`` k). The powers over the windings
     are not monotone (measured on a 234-wave record: 0, 1, 2, 3, 4 net turns 453.8, 464.7,
     458.7, 459.8, 456.5 W), so this is a search, not a bracket: its answer is the best of
@@ -1153,11 +1217,12 @@ def _search_windings(modes, solve, top: int) -> None:
     if _power_of(swing) < best:  # rotation wins: a few net turns are nearer the swing
         return
     misses, k = 0, 1
+    lead = max((m for m in modes if m["success"]), key=_power_of)
     while misses < SEARCH_MISSES and k < top:
-        m = dict(solve(k), mode="swinging", _searched=True)
+        m = dict(solve(k, _Screen(lead)), mode="swinging", _searched=True)
         modes.append(m)
-        if m["success"] and _power_of(m) > best:
-            best, misses = _power_of(m), 0
+        if m["success"] and not m.get("_screened") and _power_of(m) > best:
+            best, misses, lead = _power_of(m), 0, m
         else:
             misses += 1
         k += 1
@@ -1182,15 +1247,17 @@ def hull_answer(hull, pendulum, wave, *, pivot, windings=(1, 0), pitch_inertia=N
     from threadpoolctl import threadpool_limits
 
     modes = []
-    def solve(k):
-        return _solve_mode(hull, pendulum, wave, k, harmonics, pivot, pitch_inertia, pto)
+    def solve(k, screen=None):
+        return _solve_mode(hull, pendulum, wave, k, harmonics, pivot, pitch_inertia, pto,
+                           screen)
     # small dense matrices (a few hundred): BLAS threads cost more than they save
     with threadpool_limits(1, user_api="blas"):
         for k in windings:
             modes.append(solve(k))
         if search:
             _search_windings(modes, solve, max(windings))
-    ok_modes = [m for m in modes if m["success"] and _power_of(m) > -math.inf]
+    ok_modes = [m for m in modes if m["success"] and not m.get("_screened")
+                and _power_of(m) > -math.inf]
     best = max(ok_modes or modes, key=_power_of)
     rest = {"mode": "rest", "winding": None, "power_w": 0.0, "mechanical_power_w": 0.0,
             "success": True, "status": "the pendulum held (no power)"}

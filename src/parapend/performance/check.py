@@ -93,8 +93,8 @@ def hull_record_seconds(waves: float, ideal: bool = True) -> float:
     63 at 200; a 2 x 2 matrix of 200-wave records, 72 s a record with one bin's retry on
     1.5 times the harmonics; taken as 15 s and 0.3 s a wave, above every one of them); a
     record of ``WINDING_SEARCH_WAVES`` or more also has its windings searched, priced
-    :data:`SEARCH_FACTOR` times that (measured, a 234-wave record: 150 s of CPU against the
-    two modes' 55 s, load 3 on the 2-core machine)."""
+    :data:`SEARCH_FACTOR` times that (measured, 234-wave records: 98 and 155 s of CPU
+    against the two modes' 53 and 66 s, load 2 to 3 on the 2-core machine)."""
     from ..hydro.hull import HARMONICS_PER_TURN, KRYLOV_HARMONICS
     from ..hydro.result import WINDING_SEARCH_WAVES
 
@@ -106,7 +106,7 @@ def hull_record_seconds(waves: float, ideal: bool = True) -> float:
 
 
 #: a searched record's CPU time over its two modes' (:func:`hull_record_seconds`)
-SEARCH_FACTOR = 3.0
+SEARCH_FACTOR = 2.5
 
 
 def record_seconds(spec) -> float:
