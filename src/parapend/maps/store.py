@@ -220,8 +220,11 @@ def check_resumable(spec, store, overwrite: bool = False) -> None:
     if store is None:
         return
     path = Path(store)
-    if path.is_dir():
-        _refuse_other(path, spec, overwrite)
+    try:
+        if path.is_dir():
+            _refuse_other(path, spec, overwrite)
+    except OSError:  # unreadable: the run's own check of the path says so
+        pass
 
 
 def _write_marker(path: Path) -> None:
