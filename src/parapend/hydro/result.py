@@ -1164,7 +1164,9 @@ class _Screen:
 
     def __init__(self, best: dict):
         self.best = best
-        self.levels = {int(n): float(p) for n, p in best.get("refinement_history") or ()}
+        hist = best.get("refinement_history") or ()
+        self.levels = {int(n): float(p) for n, p in hist}
+        self.last = float(hist[-1][1]) if hist else None  # the best's refined power
 
     def unrefined(self, sol):
         """``best``'s power at ``sol``'s harmonics where ``sol`` (an unrefined answer) is
@@ -1177,8 +1179,7 @@ class _Screen:
     def margin(self, ref: float) -> float:
         """A share of the power ``ref``: :data:`SCREEN_MARGIN`, or four times ``best``'s
         change over its refinement."""
-        hist = self.best.get("refinement_history") or ()
-        moved = abs(hist[-1][1] - ref) / abs(ref) if hist and ref else 0.0
+        moved = abs(self.last - ref) / abs(ref) if self.last is not None and ref else 0.0
         return max(SCREEN_MARGIN, 4 * moved)
 
     def checked(self, sol) -> bool:
@@ -1213,16 +1214,15 @@ def _search_windings(modes, solve, top: int) -> None:
     if swing is None or swing["mean_angle_deg"] is None or not through_upright(
             swing["mean_angle_deg"], swing["swing_amplitude_deg"]):
         return
-    best = max(_power_of(m) for m in modes if m["success"])
-    if _power_of(swing) < best:  # rotation wins: a few net turns are nearer the swing
+    lead = max((m for m in modes if m["success"]), key=_power_of)  # the best so far
+    if _power_of(swing) < _power_of(lead):  # rotation wins: net turns are nearer the swing
         return
     misses, k = 0, 1
-    lead = max((m for m in modes if m["success"]), key=_power_of)
     while misses < SEARCH_MISSES and k < top:
         m = dict(solve(k, _Screen(lead)), mode="swinging", _searched=True)
         modes.append(m)
-        if m["success"] and not m.get("_screened") and _power_of(m) > best:
-            best, misses, lead = _power_of(m), 0, m
+        if m["success"] and not m.get("_screened") and _power_of(m) > _power_of(lead):
+            misses, lead = 0, m
         else:
             misses += 1
         k += 1
