@@ -132,6 +132,29 @@ def test_continuation_stops_on_phis_harmonics(monkeypatch):
     assert math.isfinite(sol.power)
 
 
+def test_a_screen_sees_each_level_and_stops_the_continuation_where_it_says(monkeypatch):
+    """A long record's continuation (24 harmonics from 12 from 6) keeps each level's power;
+    a screen is shown each level above the coarsest search and the answer before its
+    refinement. One that keeps them all changes nothing (bit for bit); one that drops the
+    12-harmonic level ends the climb there, unrefined."""
+    monkeypatch.setattr(hull_mod, "LONG_RECORD_HARMONICS", 10)
+
+    def make(scale):
+        return _record(harmonics=24 * scale, winding=2)
+    plain = hull_search(make)
+    assert plain.success and [n for n, _ in plain.level_history] == [6, 12]
+    assert plain.refinement_history[0][0] == 24 and not plain.screened
+    seen = []
+    kept = hull_search(make, screen=lambda s: seen.append((s.case.harmonics, s.power)) or True)
+    assert kept.power == plain.power and kept.refinement_history == plain.refinement_history
+    assert kept.level_history == plain.level_history
+    assert seen == [plain.level_history[1], plain.refinement_history[0]]
+    dropped = hull_search(make, screen=lambda s: s.case.harmonics != 12)
+    assert dropped.screened and dropped.case.harmonics == 12
+    assert dropped.power == plain.level_history[1][1] and dropped.refinement_history == ()
+    assert dropped.level_history == plain.level_history[:1]
+
+
 def test_coarsened_case_is_the_case_with_fewer_harmonics():
     """:func:`coarsened` keeps the data at the harmonics it keeps: its hull matrix blocks are
     the full case's first ones."""

@@ -110,6 +110,26 @@ def test_the_screen_compares_at_the_same_harmonics_with_a_margin():
     assert moved.unrefined(_Sol(955.0)) == 1000.0
 
 
+def test_the_screen_compares_on_the_continuations_levels_with_the_bests_change_there():
+    """The 200-wave barge record's swinging (the best) on the levels 702 and 1404 and its
+    refinement: the margin on a level is four times its change from there to its refined
+    answer (13.7 % at 702, where the rotation's 1309.34 W is 17 % below; 1e-2 at 1404)."""
+    from types import SimpleNamespace
+
+    best = {"power_w": 1633.996, "refinement_history": [[2808, 1634.883], [5616, 1633.996]],
+            "_solution": SimpleNamespace(level_history=((175, 62.99), (702, 1579.894),
+                                                        (1404, 1633.800)))}
+    screen = res._Screen(best)
+    assert screen.margin(1579.894) == pytest.approx(4 * (1633.996 - 1579.894) / 1579.894)
+    assert screen.unrefined(_Sol(1309.34, harmonics=702)) == 1579.894
+    assert screen.unrefined(_Sol(1400.0, harmonics=702)) is None  # 11 % below: climbed on
+    assert screen.unrefined(_Sol(10.0, harmonics=175)) is None  # the margin 100 there
+    assert screen.margin(1633.8) == res.SCREEN_MARGIN
+    assert screen.unrefined(_Sol(1592.59, harmonics=1404)) == 1633.8  # 1 net turn
+    assert screen.unrefined(_Sol(1625.86, harmonics=1404)) is None  # 2 net turns
+    assert screen.unrefined(_Sol(1600.0)) == 1634.883  # the record's own harmonics
+
+
 def test_a_screen_that_keeps_the_answer_changes_nothing_and_one_that_drops_it_stops_early():
     """The search's answer with a screen that keeps it is the one without (bit for bit);
     a screen that drops it returns the unrefined answer."""
@@ -138,6 +158,7 @@ def test_a_screen_that_keeps_the_answer_changes_nothing_and_one_that_drops_it_st
     assert kept.power == plain.power and kept.refinement_history == plain.refinement_history
     assert seen == [plain.refinement_history[0][1]]
     dropped = hull_search(make, screen=lambda sol: False)
+    assert dropped.screened and not kept.screened
     assert dropped.refinement_history == () and dropped.power == seen[0]
     assert dropped.case.harmonics == plain.refinement_history[0][0]
 
@@ -198,6 +219,11 @@ def test_the_matrix_bins_optimum_is_searched_and_above_its_causal_run():
     two, three = r.modes[3:5]
     assert "not refined" in two["status"] and "not refined" in three["status"]
     assert two["refinement_history"] == [] and two["gradient_max_w_per_rad"] is None
+    # the rotation (318.66 W on the 702-harmonic level, the swinging's 433.64 W there) is
+    # solved after the swinging and screened on that level of its continuation
+    rot = r.modes[0]
+    assert "not refined" in rot["status"] and rot["harmonics"] < r.harmonics
+    assert rot["power_w"] < 0.8 * r.power_w
     assert r.winding == 1 and r.mode == "swinging"
     # the causal run (docs/performance.md), 0.35 % of plant-model difference allowed
     assert r.power_w > 459.537 / 1.0035

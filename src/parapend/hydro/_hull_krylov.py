@@ -634,11 +634,17 @@ def continued_search(make, *, refine: bool = True, level: bool = False, pto=None
     take-off's (its ideal maxima and least-torque motions start the smoothing's
     continuation under the limit), and each finer level continues the take-off's optimum
     and its one-way twin from the coarser ones (:func:`_continued_pto`). ``screen``: as
-    :func:`.hull.hull_search`'s (an ideal take-off's answer only)."""
+    :func:`.hull.hull_search`'s (an ideal take-off's answer only), called on each level's
+    answer above the coarsest search and on the answer before its refinement: the first
+    False ends the climb there (that level's answer, ``screened``). Each level's power
+    joins the answer's ``level_history``."""
     case = make(1)
     coarse = coarsened(case, max(2, case.harmonics // COARSENING))
     if coarse.harmonics >= _hull.LONG_RECORD_HARMONICS:
-        sol = continued_search(lambda scale: coarse, refine=False, level=True, pto=pto)
+        sol = continued_search(lambda scale: coarse, refine=False, level=True, pto=pto,
+                               screen=screen)
+        if sol.screened:
+            return sol
     else:
         sol = hull_search(lambda scale: coarse, refine=False, pto=pto)
     if pto is not None and pto.active:
@@ -661,8 +667,12 @@ def continued_search(make, *, refine: bool = True, level: bool = False, pto=None
                        distinct_maxima=sol.distinct_maxima,
                        maxima_powers=sol.maxima_powers, runs=sol.runs + 2,
                        iterations=sol.iterations + r.iterations + one.iterations,
-                       energy_balance_residual=float(pr.balance(r.x)[2]))
-    if refine and ok and (screen is None or screen(out)):
+                       energy_balance_residual=float(pr.balance(r.x)[2]),
+                       level_history=sol.level_history + (
+                           (sol.case.harmonics, float(sol.power)),))
+    if ok and (level or refine) and screen is not None and not screen(out):
+        return dataclasses.replace(out, screened=True)
+    if refine and ok:
         out = _refine(out, make, r.x)
     return out
 

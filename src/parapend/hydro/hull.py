@@ -659,6 +659,11 @@ class HullSolution:
     maxima_powers: tuple = ()
     #: ``(harmonics, power)`` of each stage of the refinement, coarsest first
     refinement_history: tuple = ()
+    #: ``(harmonics, power)`` of each level of a long record's continuation below its own
+    #: harmonics (:func:`._hull_krylov.continued_search`), coarsest first
+    level_history: tuple = ()
+    #: a ``screen`` of :func:`hull_search` stopped it at this (unrefined) answer
+    screened: bool = False
     #: a take-off's objective that the answer maximizes (None: the ideal power's):
     #: ``(width, limit, rho, lam_hi, lam_lo)``, the efficiency's smoothing width of the
     #: climb that gave the answer, and under a limit its augmented Lagrangian's penalty and
@@ -716,8 +721,9 @@ def hull_search(make, *, refine: bool = True, pto: HullPTO | None = None,
     ``make(scale)`` returns the :class:`HullCase` with ``scale`` times the default
     harmonics (1, and 2 for the refinement). With an active ``pto`` the ideal search's
     distinct maxima start the PTO's optimum (``_pto_stage``). ``screen(sol)`` (an ideal
-    take-off's): called on the converged answer before its refinement; False returns it
-    unrefined (the refined answer is the same as without a screen)."""
+    take-off's): called on the converged answer before its refinement (and on a long
+    record, on each level's answer of the continuation); False returns that answer
+    unrefined, marked ``screened`` (the refined answer is the same as without a screen)."""
     case = make(1)
     if case.harmonics >= LONG_RECORD_HARMONICS and MATRIX_FREE:
         return MATRIX_FREE["search"](make, refine=refine, pto=pto, screen=screen)
@@ -749,7 +755,9 @@ def hull_search(make, *, refine: bool = True, pto: HullPTO | None = None,
                        runs=len(runs) + len(runs_one),
                        iterations=sum(r.iterations for r in runs + runs_one),
                        energy_balance_residual=float(resid))
-    if refine and ok and (screen is None or screen(sol)):
+    if refine and ok and screen is not None and not screen(sol):
+        return dataclasses.replace(sol, screened=True)
+    if refine and ok:
         sol = _refine(sol, make, best.x)
     return sol
 

@@ -1116,18 +1116,13 @@ def _solve_mode(hull, pendulum, wave, k, harmonics, pivot, pitch_inertia, pto,
         return _reported(cs, x, resolve)[1]
     if screen is None or pto.active:
         return _mode(hold_limit(hull_search(make, pto=pto), peak_torque), resolve)
-    below = []
-    def keep(sol):
-        ref = screen.unrefined(sol)
-        if ref is not None:
-            below.append(ref)
-        return ref is None
-    sol = hull_search(make, pto=pto, screen=keep)
-    if below:
+    sol = hull_search(make, pto=pto, screen=lambda s: screen.unrefined(s) is None)
+    if sol.screened:
+        ref = screen.levels[sol.case.harmonics]
         m = _mode(sol, resolve, checks=False)
         m.update(status=f"{sol.status} at {sol.case.harmonics} harmonics, {sol.power:.6g} W: "
-                 f"below the best mode's {below[0]:.6g} W there by more than "
-                 f"{screen.margin(below[0]):.2g} of it; not refined", _screened=True)
+                 f"below the best mode's {ref:.6g} W there by more than "
+                 f"{screen.margin(ref):.2g} of it; not refined", _screened=True)
         return m
     if not screen.checked(sol):
         m = _mode(sol, resolve, checks=False)
@@ -1148,13 +1143,17 @@ SEARCH_MISSES = 2
 WINDING_SEARCH_WAVES = 20
 
 
-#: a searched winding whose answer on the record's own harmonics is below the best mode's
-#: there by more than this share of it (or four times the best's own change over its
-#: refinement, if more) is a miss: not refined and not checked. The refinements of the
-#: windings' answers moved them by 7e-5 to 6.6e-3 of the power on the measured 234-wave
-#: records (3 net turns at Hs 1 m, Te 7 s: 456.75 to 459.79 W); the windings' powers
-#: differ by 1e-3 to 3e-2. A refinement and an optimality check are about half a searched
-#: winding's cost; a refined winding below the best is not checked either.
+#: a searched winding (and on a long record the rotation, solved after the swinging)
+#: whose answer on one level of the continuation or on the record's own harmonics is below
+#: the best mode's on the same harmonics by more than this share of it (or four times the
+#: best's own change from there to its refined answer, if more) is a miss: not climbed
+#: further, not refined, not checked. The refinements of the windings' answers moved them
+#: by 7e-5 to 6.6e-3 of the power on the measured 234-wave records (3 net turns at Hs 1 m,
+#: Te 7 s: 456.75 to 459.79 W); the windings' powers differ by 1e-3 to 3e-2. The levels
+#: move far more (the 200-wave barge record's swinging: 63, 1000, 1580, 1634 W at 175,
+#: 351, 702, 1404 harmonics, so a margin of 2.5, 0.13 and 0.01 there; the rotation's
+#: 529, 1017, 1309, 1377 W, screened at 702). A refinement and an optimality check are
+#: about half a searched winding's cost; a refined winding below the best is not checked.
 SCREEN_MARGIN = 1e-2
 
 
@@ -1165,7 +1164,10 @@ class _Screen:
     def __init__(self, best: dict):
         self.best = best
         hist = best.get("refinement_history") or ()
-        self.levels = {int(n): float(p) for n, p in hist}
+        levels = best["_solution"].level_history if "_solution" in best else ()
+        # the best's power on each level of its continuation and each stage of its
+        # refinement
+        self.levels = {int(n): float(p) for n, p in (*levels, *hist)}
         self.last = float(hist[-1][1]) if hist else None  # the best's refined power
 
     def unrefined(self, sol):
@@ -1177,8 +1179,8 @@ class _Screen:
         return ref if sol.power < ref - self.margin(ref) * abs(ref) else None
 
     def margin(self, ref: float) -> float:
-        """A share of the power ``ref``: :data:`SCREEN_MARGIN`, or four times ``best``'s
-        change over its refinement."""
+        """A share of ``best``'s power ``ref`` on some harmonics: :data:`SCREEN_MARGIN`, or
+        four times ``best``'s change from there to its refined answer."""
         moved = abs(self.last - ref) / abs(ref) if self.last is not None and ref else 0.0
         return max(SCREEN_MARGIN, 4 * moved)
 
@@ -1214,7 +1216,8 @@ def _search_windings(modes, solve, top: int) -> None:
     if swing is None or swing["mean_angle_deg"] is None or not through_upright(
             swing["mean_angle_deg"], swing["swing_amplitude_deg"]):
         return
-    lead = max((m for m in modes if m["success"]), key=_power_of)  # the best so far
+    lead = max((m for m in modes if m["success"] and not m.get("_screened")),
+               key=_power_of)  # the best so far
     if _power_of(swing) < _power_of(lead):  # rotation wins: net turns are nearer the swing
         return
     misses, k = 0, 1
@@ -1242,20 +1245,27 @@ def hull_answer(hull, pendulum, wave, *, pivot, windings=(1, 0), pitch_inertia=N
     the result from the best; ``pto`` the power take-off (None: ideal); ``search``: where
     swinging (winding 0) is the better mode and passes the upright, also 1, 2, 3, ... net
     turns below the largest of ``windings``, until ``SEARCH_MISSES`` in a row do not beat
-    the best (a search: the powers over the windings are not monotone)."""
+    the best (a search: the powers over the windings are not monotone); with ``search`` the
+    swinging is solved first and the other windings are screened against it
+    (:data:`SCREEN_MARGIN`)."""
     pto = pto or HullPTO()
     from threadpoolctl import threadpool_limits
 
-    modes = []
     def solve(k, screen=None):
         return _solve_mode(hull, pendulum, wave, k, harmonics, pivot, pitch_inertia, pto,
                            screen)
     # small dense matrices (a few hundred): BLAS threads cost more than they save
     with threadpool_limits(1, user_api="blas"):
-        for k in windings:
-            modes.append(solve(k))
-        if search:
+        if search and 0 in windings:
+            # a long record's swinging first: the other windings are screened against it
+            # (on the long records measured swinging wins; the rotation screened there
+            # skips its finer levels, its refinement and its optimality check)
+            swing = solve(0)
+            screen = _Screen(swing) if swing["success"] else None
+            modes = [swing if k == 0 else solve(k, screen) for k in windings]
             _search_windings(modes, solve, max(windings))
+        else:
+            modes = [solve(k) for k in windings]
     ok_modes = [m for m in modes if m["success"] and not m.get("_screened")
                 and _power_of(m) > -math.inf]
     best = max(ok_modes or modes, key=_power_of)
