@@ -93,8 +93,11 @@ def hull_record_seconds(waves: float, ideal: bool = True) -> float:
     63 at 200; a 2 x 2 matrix of 200-wave records, 72 s a record with one bin's retry on
     1.5 times the harmonics; taken as 15 s and 0.3 s a wave, above every one of them); a
     record of ``WINDING_SEARCH_WAVES`` or more also has its windings searched, priced
-    :data:`SEARCH_FACTOR` times that (measured, 234-wave records: 98 and 155 s of CPU
-    against the two modes' 53 and 66 s, load 2 to 3 on the 2-core machine)."""
+    :data:`SEARCH_FACTOR` times that (measured with the swinging first and the rest
+    screened on every level, load 2 to 3 on the 2-core machine: 234-wave records 85 and 138
+    s of CPU against the two modes' 56 and 67 s; the 200-wave bench record 51 s against 50
+    to 63, the 25-wave one 38.5 s against 14 to 22; a 6 x 6 matrix of 200- to 217-wave
+    records 109 s a record)."""
     from ..hydro.hull import HARMONICS_PER_TURN, KRYLOV_HARMONICS
     from ..hydro.result import WINDING_SEARCH_WAVES
 
@@ -106,7 +109,7 @@ def hull_record_seconds(waves: float, ideal: bool = True) -> float:
 
 
 #: a searched record's CPU time over its two modes' (:func:`hull_record_seconds`)
-SEARCH_FACTOR = 2.5
+SEARCH_FACTOR = 1.75
 
 
 def record_seconds(spec) -> float:
