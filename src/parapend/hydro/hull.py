@@ -660,7 +660,7 @@ class HullSolution:
     #: ``(harmonics, power)`` of each stage of the refinement, coarsest first
     refinement_history: tuple = ()
     #: ``(harmonics, power)`` of each level of a long record's continuation below its own
-    #: harmonics (:func:`._hull_krylov.continued_search`), coarsest first
+    #: harmonics (``_hull_krylov.continued_search``), coarsest first
     level_history: tuple = ()
     #: a ``screen`` of :func:`hull_search` stopped it at this (unrefined) answer
     screened: bool = False

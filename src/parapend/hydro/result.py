@@ -1247,7 +1247,7 @@ def hull_answer(hull, pendulum, wave, *, pivot, windings=(1, 0), pitch_inertia=N
     turns below the largest of ``windings``, until ``SEARCH_MISSES`` in a row do not beat
     the best (a search: the powers over the windings are not monotone); with ``search`` the
     swinging is solved first and the other windings are screened against it
-    (:data:`SCREEN_MARGIN`)."""
+    (``SCREEN_MARGIN``)."""
     pto = pto or HullPTO()
     from threadpoolctl import threadpool_limits
 
