@@ -233,6 +233,22 @@ def test_the_longest_record_is_the_hulls_limit(dataset, pto, waves, cap):
     assert size(most) <= getattr(limits, cap) < size(most + 0.01)
 
 
+def test_the_dearest_bins_are_handed_out_first(dataset):
+    """The engine hands a matrix's bins out dearest first: the higher seas, then the longer
+    records (at Tp 5 s 240 waves, at 6 and 7 s 200), so no worker ends alone on a dear
+    bin; a resume keeps that order over the bins left."""
+    from parapend.maps.run import _ordered
+
+    spec = matrix_spec(hs="1,2", tp="5,6,7", realizations=1, hydro=dataset, **HULL)
+    assert spec.bin_waves == (240.0, 200.0, 200.0)
+    # block b is (Hs index b // 3, Tp index b % 3); equal costs keep the index order
+    assert spec.block_order() == [3, 4, 5, 0, 1, 2]
+    assert _ordered(spec, [0, 2, 4]) == [4, 0, 2]
+    assert sorted(spec.block_order()) == list(range(spec.blocks))
+    # a product without an order keeps the blocks as given
+    assert _ordered(SimpleNamespace(), [2, 0, 1]) == [2, 0, 1]
+
+
 def test_the_default_records_last_twenty_minutes(dataset):
     """The hull's default records (an ideal take-off) are 200 peak periods or 20 minutes,
     the longer, as far as the hull's solver takes them: at Tp 5 s 240 peak periods (1200 s),
