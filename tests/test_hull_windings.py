@@ -100,8 +100,6 @@ def test_the_screen_compares_at_the_same_harmonics_with_a_margin():
     assert screen.unrefined(_Sol(460.0)) == 464.769  # just past 1e-2
     assert screen.unrefined(_Sol(400.0, harmonics=1404)) is None  # other harmonics
     assert screen.unrefined(_Sol(float("nan"))) is None
-    # refined: checked where not below the best's refined power
-    assert screen.checked(_Sol(464.8)) and not screen.checked(_Sol(464.7))
     # a best whose refinement moved it by 1e-2: the margin is four times that
     moved = res._Screen({"power_w": 1010.0,
                          "refinement_history": [[2808, 1000.0], [5616, 1010.0]]})
@@ -196,6 +194,30 @@ def test_a_searched_answer_solves_the_swinging_first_and_screens_the_rotation(mo
     assert searched.winding == 0 and searched.power_w == plain.power_w
     assert "not refined" in searched.modes[0]["status"]
     assert "not refined" not in plain.modes[0]["status"]
+    # the swinging, checked once all modes are in, carries the unsearched answer's checks
+    for key in ("gradient_max_w_per_rad", "hessian_scaled_largest_eigenvalue"):
+        assert searched.modes[1][key] == plain.modes[1][key] is not None
+
+
+def test_a_searched_records_best_mode_alone_is_checked(monkeypatch):
+    """The modes of a searched record are solved unchecked; once all are in, the best gets
+    its optimality check and the others say theirs was left out (a screened one keeps its
+    own status)."""
+    seen = []
+    monkeypatch.setattr(res, "_optimality", lambda sol: seen.append(sol) or {
+        "gradient_max_w_per_rad": 1e-9, "hessian_scaled_largest_eigenvalue": -1e-3})
+    modes = [dict(_mode(k, p), _solution=k, _unchecked=True)
+             for k, p in ((0, 1634.0), (1, 1640.0), (2, 1625.0))]
+    modes.append(dict(_mode(3, 1500.0), _solution=3, _screened=True))
+    modes[-1]["status"] = "converged at 702 harmonics, ...; not refined"
+    res._check_best(modes, modes[1])
+    assert seen == [1] and modes[1]["gradient_max_w_per_rad"] == 1e-9
+    assert modes[1]["status"] == "converged"
+    for m in (modes[0], modes[2]):
+        assert m["status"] == "converged; below the best: its optimality not checked"
+        assert "gradient_max_w_per_rad" not in m
+    assert modes[3]["status"].endswith("not refined")
+    assert not any("_unchecked" in m for m in modes)
 
 
 def test_a_searched_winding_is_labelled_by_its_net_turns():

@@ -968,7 +968,6 @@ def _mode(sol, resolve=None, checks: bool = True) -> dict:
     """One mode's entry; ``resolve(case)``: the same case with ``REPORT_HULL_FACTOR`` times
     the hull harmonics, for the reported motion (None: the solve's own cut); ``checks``:
     the optimality check (False: left out, its entries None)."""
-    pr = ideal_problem(sol.case)  # the mechanics (a take-off's objective aside)
     mot, pk = _reported(sol.case, sol.x, resolve if math.isfinite(sol.power) else None)
     status, ok = sol.status, sol.success
     limit = sol.pto.torque_limit
@@ -980,14 +979,7 @@ def _mode(sol, resolve=None, checks: bool = True) -> dict:
                    f"({over:.1e} above the limit)")
     s = mot.on_grid(PEAK_POINTS)
     k = sol.case.winding
-    # first- and second-order optimality of the answer: of the ideal power, or of the
-    # take-off's objective that the answer's climb maximized (_pto_objective)
-    grad, top, scaled, width = None, None, None, None
-    if checks and math.isfinite(sol.power):
-        obj = _pto_objective(sol) if sol.pto.active else pr
-        if obj is not None:
-            grad, top, scaled = _hull_krylov.optimality(obj, sol.x)
-            width = obj.width if sol.pto.smoothed else None
+    checked = _optimality(sol) if checks else _UNCHECKED
     swing = None if k else 0.5 * _deg(np.max(s["phi"]) - np.min(s["phi"]))
     mean = _deg(math.remainder(float(np.mean(s["phi"])) - math.pi, 2 * math.pi) + math.pi)
     return {"mode": "swinging" if k == 0 else "rotation", "winding": k,
@@ -1002,10 +994,28 @@ def _mode(sol, resolve=None, checks: bool = True) -> dict:
             "peak_torque_nm": pk, "distinct_maxima": sol.distinct_maxima,
             "maxima_powers_w": [float(v) for v in sol.maxima_powers],
             "found_by": sol.found_by, "starts": sol.runs, "success": ok,
-            "gradient_max_w_per_rad": grad, "hessian_largest_eigenvalue_w_per_rad2": top,
-            "hessian_scaled_largest_eigenvalue": scaled,
-            "optimality_smoothing_width_w": width,
-            "status": status, "_solution": sol, "_motion": mot}
+            **checked, "status": status, "_solution": sol, "_motion": mot}
+
+
+_UNCHECKED = {"gradient_max_w_per_rad": None, "hessian_largest_eigenvalue_w_per_rad2": None,
+              "hessian_scaled_largest_eigenvalue": None, "optimality_smoothing_width_w": None}
+
+
+def _optimality(sol) -> dict:
+    """First- and second-order optimality of the answer ``sol`` (a mode entry's keys; None
+    where not checked): of the ideal power, or of the take-off's objective that the
+    answer's climb maximized (:func:`_pto_objective`)."""
+    out = dict(_UNCHECKED)
+    if not math.isfinite(sol.power):
+        return out
+    obj = _pto_objective(sol) if sol.pto.active else ideal_problem(sol.case)
+    if obj is not None:
+        grad, top, scaled = _hull_krylov.optimality(obj, sol.x)
+        out.update({"gradient_max_w_per_rad": grad,
+                    "hessian_largest_eigenvalue_w_per_rad2": top,
+                    "hessian_scaled_largest_eigenvalue": scaled,
+                    "optimality_smoothing_width_w": obj.width if sol.pto.smoothed else None})
+    return out
 
 
 def _pto_objective(sol):
@@ -1095,11 +1105,12 @@ def bound_note(bound, error, limit) -> str | None:
 
 
 def _solve_mode(hull, pendulum, wave, k, harmonics, pivot, pitch_inertia, pto,
-                screen=None) -> dict:
+                screen=None, checks: bool = True) -> dict:
     """One winding's mode entry (:func:`_mode`). ``screen`` (a :class:`_Screen`; an ideal
     take-off's): the answer before its refinement is first compared with the best mode's, and
     one below it by more than the margin is entered unrefined and unchecked (``_screened``);
-    a refined one below the best is entered without its optimality check."""
+    ``checks`` False: the entry leaves its optimality check out (``_unchecked``), for
+    :func:`hull_answer` to check the best mode alone once all are solved."""
     def make(scale):
         base = make_case(hull, pendulum, wave, winding=k, harmonics=harmonics, pivot=pivot,
                          pitch_inertia=pitch_inertia)
@@ -1115,8 +1126,9 @@ def _solve_mode(hull, pendulum, wave, k, harmonics, pivot, pitch_inertia, pto,
     def peak_torque(cs, x):
         return _reported(cs, x, resolve)[1]
     if screen is None or pto.active:
-        return _mode(hold_limit(hull_search(make, pto=pto), peak_torque), resolve)
-    sol = hull_search(make, pto=pto, screen=lambda s: screen.unrefined(s) is None)
+        sol = hold_limit(hull_search(make, pto=pto), peak_torque)
+    else:
+        sol = hull_search(make, pto=pto, screen=lambda s: screen.unrefined(s) is None)
     if sol.screened:
         ref = screen.levels[sol.case.harmonics]
         m = _mode(sol, resolve, checks=False)
@@ -1124,11 +1136,10 @@ def _solve_mode(hull, pendulum, wave, k, harmonics, pivot, pitch_inertia, pto,
                  f"below the best mode's {ref:.6g} W there by more than "
                  f"{screen.margin(ref):.2g} of it; not refined", _screened=True)
         return m
-    if not screen.checked(sol):
-        m = _mode(sol, resolve, checks=False)
-        m["status"] += "; below the best: its optimality not checked"
-        return m
-    return _mode(sol, resolve)
+    m = _mode(sol, resolve, checks=checks)
+    if not checks:
+        m["_unchecked"] = True
+    return m
 
 
 #: the winding search (:func:`hull_answer`'s ``search``) stops after this many windings in
@@ -1159,7 +1170,7 @@ SCREEN_MARGIN = 1e-2
 
 class _Screen:
     """The screen of :func:`_solve_mode` against the mode ``best`` (an entry of
-    :func:`_mode`): :meth:`unrefined` before the refinement, :meth:`checked` after it."""
+    :func:`_mode`): :meth:`unrefined` on each level and before the refinement."""
 
     def __init__(self, best: dict):
         self.best = best
@@ -1183,10 +1194,6 @@ class _Screen:
         four times ``best``'s change from there to its refined answer."""
         moved = abs(self.last - ref) / abs(ref) if self.last is not None and ref else 0.0
         return max(SCREEN_MARGIN, 4 * moved)
-
-    def checked(self, sol) -> bool:
-        """Whether the refined answer ``sol`` gets its optimality check: not below the best."""
-        return not sol.power < _power_of(self.best)
 
 
 def through_upright(mean_angle_deg, swing_amplitude_deg) -> bool:
@@ -1231,6 +1238,18 @@ def _search_windings(modes, solve, top: int) -> None:
         k += 1
 
 
+def _check_best(modes, best) -> None:
+    """The optimality check left out of the ``modes`` solved unchecked (``_unchecked``, a
+    searched record's: the check of a 12192-harmonic answer is some 250 Hessian products,
+    15 s), done on ``best`` alone; the others' statuses say they are not checked."""
+    for m in modes:
+        if m.pop("_unchecked", False):
+            if m is best:
+                m.update(_optimality(m["_solution"]))
+            else:
+                m["status"] += "; below the best: its optimality not checked"
+
+
 def _label(m) -> str:
     k = m["winding"]
     if m["mode"] == "swinging" and k:
@@ -1251,12 +1270,15 @@ def hull_answer(hull, pendulum, wave, *, pivot, windings=(1, 0), pitch_inertia=N
     pto = pto or HullPTO()
     from threadpoolctl import threadpool_limits
 
+    searched = search and 0 in windings
+
     def solve(k, screen=None):
+        # a searched record's modes are checked once all are solved, the best alone
         return _solve_mode(hull, pendulum, wave, k, harmonics, pivot, pitch_inertia, pto,
-                           screen)
+                           screen, checks=not searched)
     # small dense matrices (a few hundred): BLAS threads cost more than they save
     with threadpool_limits(1, user_api="blas"):
-        if search and 0 in windings:
+        if searched:
             # a long record's swinging first: the other windings are screened against it
             # (on the long records measured swinging wins; the rotation screened there
             # skips its finer levels, its refinement and its optimality check)
@@ -1266,9 +1288,10 @@ def hull_answer(hull, pendulum, wave, *, pivot, windings=(1, 0), pitch_inertia=N
             _search_windings(modes, solve, max(windings))
         else:
             modes = [solve(k) for k in windings]
-    ok_modes = [m for m in modes if m["success"] and not m.get("_screened")
-                and _power_of(m) > -math.inf]
-    best = max(ok_modes or modes, key=_power_of)
+        ok_modes = [m for m in modes if m["success"] and not m.get("_screened")
+                    and _power_of(m) > -math.inf]
+        best = max(ok_modes or modes, key=_power_of)
+        _check_best(modes, best)
     rest = {"mode": "rest", "winding": None, "power_w": 0.0, "mechanical_power_w": 0.0,
             "success": True, "status": "the pendulum held (no power)"}
     public = [{k: v for k, v in m.items() if not k.startswith("_")} for m in modes] + [rest]
