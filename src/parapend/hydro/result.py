@@ -1241,7 +1241,7 @@ def _search_windings(modes, solve, top: int) -> None:
 def _check_best(modes, best) -> None:
     """The optimality check left out of the ``modes`` solved unchecked (``_unchecked``, a
     searched record's: the check of a 12192-harmonic answer is some 250 Hessian products,
-    15 s), done on ``best`` alone; the others' statuses say they are not checked."""
+    13 s of CPU), done on ``best`` alone; the others' statuses say they are not checked."""
     for m in modes:
         if m.pop("_unchecked", False):
             if m is best:
