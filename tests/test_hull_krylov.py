@@ -17,7 +17,7 @@ from hull_synthetic import case
 import parapend
 from parapend.cli import main
 from parapend.hydro import hull as hull_mod
-from parapend.hydro._hull_krylov import KrylovHullProblem, coarsened
+from parapend.hydro._hull_krylov import KrylovHullProblem, coarsened, gmres
 from parapend.hydro.hull import GTOL, HullProblem, hull_search, ideal_problem
 from parapend.optimal.fourier import newton_maximize
 
@@ -153,6 +153,37 @@ def test_a_screen_sees_each_level_and_stops_the_continuation_where_it_says(monke
     assert dropped.screened and dropped.case.harmonics == 12
     assert dropped.power == plain.level_history[1][1] and dropped.refinement_history == ()
     assert dropped.level_history == plain.level_history[:1]
+
+
+@pytest.mark.parametrize("restart", [40, 3])
+def test_gmres_is_the_dense_solution(restart):
+    """The state's GMRES (right-preconditioned by an approximate inverse) against LAPACK's
+    solve of the same nonsymmetric system: to its tolerance, from zero and from a start,
+    through restarts (``restart=3``: the true residual recomputed between cycles); a zero
+    right side is zero without a product; too few cycles say so."""
+    rng = np.random.default_rng(4)
+    n = 60
+    a = np.diag(np.linspace(1.0, 30.0, n)) + 0.4 * rng.standard_normal((n, n))
+    pre = np.diag(1.0 / np.diag(a))
+    b = rng.standard_normal(n)
+    exact = np.linalg.solve(a, b)
+    products = []
+
+    def apply_a(v):
+        products.append(1)
+        return a @ v
+
+    for x0 in (None, exact + 1e-3 * rng.standard_normal(n)):
+        x, ok, its = gmres(apply_a, lambda v: pre @ v, b, rtol=1e-12, x0=x0,
+                           restart=restart)
+        assert ok and its > 0
+        assert np.linalg.norm(a @ x - b) <= 1e-11 * np.linalg.norm(b)
+        assert np.allclose(x, exact, rtol=0, atol=1e-9 * np.abs(exact).max())
+    products.clear()
+    x, ok, its = gmres(apply_a, lambda v: pre @ v, np.zeros(n), rtol=1e-12)
+    assert ok and its == 0 and not products and not x.any()
+    x, ok, its = gmres(apply_a, lambda v: pre @ v, b, rtol=1e-12, restart=2, max_restarts=2)
+    assert not ok and its == 4
 
 
 def test_coarsened_case_is_the_case_with_fewer_harmonics():
