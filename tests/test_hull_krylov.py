@@ -184,6 +184,11 @@ def test_gmres_is_the_dense_solution(restart):
     assert ok and its == 0 and not products and not x.any()
     x, ok, its = gmres(apply_a, lambda v: pre @ v, b, rtol=1e-12, restart=2, max_restarts=2)
     assert not ok and its == 4
+    # NaN in the right side or from the operator: NaN at once, not the cycles' budget
+    x, ok, its = gmres(apply_a, lambda v: pre @ v, np.full(n, np.nan), rtol=1e-12)
+    assert not ok and its == 0 and np.isnan(x).all()
+    x, ok, its = gmres(lambda v: np.full(n, np.nan), lambda v: v, b, rtol=1e-12)
+    assert not ok and its == 1 and np.isnan(x).all()
 
 
 def test_coarsened_case_is_the_case_with_fewer_harmonics():

@@ -110,6 +110,8 @@ def gmres(apply_a, apply_m, b, *, rtol, x0=None, restart=RESTART,
     bn = float(np.linalg.norm(b))
     if bn == 0.0:
         return np.zeros(n), True, 0
+    if not math.isfinite(bn):  # nothing to solve: a NaN state, at once
+        return np.full(n, np.nan), False, 0
     tol = rtol * bn
     if x0 is None:
         x, r = np.zeros(n), b.copy()
@@ -136,6 +138,8 @@ def gmres(apply_a, apply_m, b, *, rtol, x0=None, restart=RESTART,
             c2 = basis @ w
             w -= c2 @ basis
             hn = float(np.linalg.norm(w))
+            if not math.isfinite(hn):  # the operator gave NaN: no restart mends that
+                return np.full(n, np.nan), False, its + 1
             col = h[:, j]
             col[:j + 1] = c1 + c2
             col[j + 1] = hn
