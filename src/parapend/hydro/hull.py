@@ -140,20 +140,16 @@ class HullCase:
 
     def impedance(self, k: int) -> np.ndarray:
         """``Z_k`` (3 x 3 complex): the hull with the pendulum's mass lumped at the pivot."""
-        wk = k * self.omega
-        def sym(a):
-            return (0.5 * (a + a.T))
-        mass = np.asarray(self.Mh, float) + sym(np.asarray(self.A[k], float)) \
-            + self.m * self.G.T @ self.G
-        return -wk**2 * mass + 1j * wk * sym(np.asarray(self.B[k], float)) + self.stiffness()
+        return self._impedances(np.array([int(k)]))[0]
 
     def impedances(self, top: int) -> np.ndarray:
-        """``Z_k`` for ``k = 1..top`` (top, 3, 3): :meth:`impedance`'s, the same arithmetic
-        element by element (the same numbers to the bit), in one pass."""
-        k = np.arange(1, top + 1)
+        """``Z_k`` for ``k = 1..top`` (top, 3, 3), in one pass."""
+        return self._impedances(np.arange(1, top + 1))
+
+    def _impedances(self, k) -> np.ndarray:
         wk = (k * self.omega)[:, None, None]
-        a = np.asarray(self.A, float)[1:top + 1]
-        b = np.asarray(self.B, float)[1:top + 1]
+        a = np.asarray(self.A, float)[k]
+        b = np.asarray(self.B, float)[k]
         mass = np.asarray(self.Mh, float) + 0.5 * (a + a.transpose(0, 2, 1)) \
             + self.m * self.G.T @ self.G
         return (-wk**2 * mass + 1j * wk * (0.5 * (b + b.transpose(0, 2, 1)))
@@ -220,8 +216,9 @@ class HullProblem(PTOObjective):
         Z[:j0, :j0] = cp[np.ix_(self.static, self.static)]
         fa = case.wave_force()
         rhs = np.zeros(ny)
+        zks = case.impedances(nh)
         for k in kh:
-            zk = case.impedance(int(k))
+            zk = zks[k - 1]
             o = j0 + 6 * (k - 1)
             Z[o:o + 3, o:o + 3] = zk.real
             Z[o:o + 3, o + 3:o + 6] = -zk.imag
