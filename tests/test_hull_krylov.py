@@ -531,10 +531,14 @@ def test_barge_ten_wave_record_with_an_efficiency_matrix_free_is_the_dense_answe
     electrical mean power of the motion's mechanical power
     (:func:`parapend.hydro.pto.electrical_power`, the kink integrated, no smoothing).
 
-    One BLAS thread, as every record solve runs (:func:`parapend.hydro.result.hull_answer`):
-    at the last width the gradient's rounding floor is near Newton's 1e-7 of the excitation
-    scale, and BLAS's threaded reductions under a loaded machine moved it to 4.5e-7
-    (stalled) where one thread converges."""
+    Newton's own status there is "converged" or "stalled" at the rounding of the power:
+    at 1e-6 of ``|p|`` the kink's curvature shrinks the conjugate gradients' step until its
+    predicted increase is 1e-17 of the power (no line search can measure it) while the
+    gradient is still 2e-7 to 9e-7 of the excitation scale, above or below Newton's 1e-7
+    as the path's rounding falls (starts moved by 1e-14, another machine's kernels): both
+    are accepted with the gradient 1e-5 of that scale (four orders below where the width's
+    climb starts), and the dense driver's climb back is what shows the maximum. One BLAS
+    thread, as every record solve runs (:func:`parapend.hydro.result.hull_answer`)."""
     from threadpoolctl import threadpool_limits
 
     with threadpool_limits(1, user_api="blas"):
@@ -559,7 +563,8 @@ def _efficiency_record_is_the_dense_answer():
     x1, _, _ = pto_maximize(k, ideal.x, WIDTHS[:WIDTHS.index(1e-5) + 1])
     k.width = 1e-6 * p0
     r = newton_maximize(k, x1, "width", gtol=GTOL, maxiter=200, saddle=False)
-    assert r.status == "converged"
+    assert r.status in ("converged", "stalled")
+    assert r.gradient_norm <= 1e-5 * float(np.max(np.abs(k.w)))
     assert k.evaluate(r.x)[2].low_rank() is not None  # the kink's preconditioner in use
     d = HullProblem(cs, eta=eta)
     xs = r.x + 1e-5 * np.sin(np.arange(r.x.size))
