@@ -244,9 +244,9 @@ def test_the_compiled_solver_needs_no_casadi(monkeypatch):
         hc.hull_mpc(th.HULL, th.PEND, th.WAVE, **opts)
 
 
-@pytest.mark.parametrize("solver, cap", [("compiled", 20), ("ipopt", 100)])
+@pytest.mark.parametrize("solver, cap", [("compiled", 40), ("ipopt", 100)])
 def test_the_default_iteration_cap_is_the_solvers(monkeypatch, solver, cap):
-    """Without ``max_iter`` a horizon solve is capped at ``COMPILED_ITER`` (20, measured:
+    """Without ``max_iter`` a horizon solve is capped at ``COMPILED_ITER`` (40, measured:
     docs/hull.md) with the compiled solver and ``COLLOCATION_ITER`` (100) with IPOPT."""
     from parapend.hydro import _hull_collocation as hcol
 
@@ -262,4 +262,4 @@ def test_the_default_iteration_cap_is_the_solvers(monkeypatch, solver, cap):
     with pytest.raises(StopIteration):
         hc.hull_mpc(th.HULL, th.PEND, th.WAVE, **opts, planner="collocation")
     assert seen == [(solver, cap)]
-    assert (hc.COMPILED_ITER, hc.COLLOCATION_ITER) == (20, 100)
+    assert (hc.COMPILED_ITER, hc.COLLOCATION_ITER) == (40, 100)

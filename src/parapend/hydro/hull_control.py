@@ -81,19 +81,15 @@ CONTROLLERS = {"lbfgsb": "hull", "collocation": "hull-collocation"}
 #: L-BFGS-B iterations per horizon solve at most
 MAX_ITER = 60
 #: interior-point iterations per horizon solve at most (``planner="collocation"``): IPOPT's,
-#: and the compiled solver's (the default) (a capped solve is applied). The compiled one's
-#: 20, measured on an idle 2-core machine against 40 (the default before) on the default
-#: barge's seeds 0 to 9 (benchmarks/hull_collocation_table.out.txt): the same energy (perfect
-#: forecast 94.4 % of the record optimum against 94.2 %, AR 83.9 against 83.5 %; one failed
-#: solve of 1260 either way) and the update's p99 inside the 0.75 s interval on 12 of the 20
-#: runs against none (0.39 to 1.34 s against 0.75 to 1.68 s); on the Te 8 s bins' records
-#: (Tp 8.9 s, seeds 0 to 2) 88.5 % perfect and 82.2 % AR against 84.2 and 81.5 %, the p99
-#: about halved (docs/hull.md, "The default planner"). 100 and 40 before that: 90.2 and
-#: 92.2 % perfect, p99 0.3 to 2.3 s and 0.63 to 1.12 s at a load of 5 (the closed loop is
-#: chaotic; with the KKT step and 100 the Te 8 s bin's closed loop realized 243.5 W perfect
-#: and 316.4 W AR, a solve failed, against 40's 228.2 and 165.1 W)
+#: and the compiled solver's (the default) (a capped solve is applied): with 40 in place of
+#: 100 the default barge's seeds 0 to 9 (perfect forecast) realized 92.2 % of the record
+#: optimum (90.2 % with 100: the closed loop is chaotic), no solve failed, and the update's
+#: p99 fell from 0.3 to 2.3 s to 0.63 to 1.12 s (benchmarks/hull_collocation_table.out.txt;
+#: measured with its null-space step; with its KKT step and 100, the Te 8 s bin's closed
+#: loop realized 243.5 W perfect and 316.4 W AR, a solve failed, against 40's 228.2 and
+#: 165.1 W: a chaotic loop, 40 kept for the update's time)
 COLLOCATION_ITER = 100
-COMPILED_ITER = 20
+COMPILED_ITER = 40
 #: the collocation planner's terminal weight by default, times ``eta_g``: with 0.5 it
 #: realized 94.5 % (perfect forecast) and 87.7 % (AR) of the record optimum on the default
 #: barge's seeds 0 to 9, with 1 73.2 % and 89.4 % (benchmarks/hull_collocation_table.out.txt)
