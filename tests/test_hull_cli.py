@@ -119,7 +119,7 @@ def test_result_protocol(dataset, tmp_path):
 
 @pytest.mark.parametrize("args, name", [
     (["--pivot-height", "nan"], "pivot-height"),
-    (["--winding", "-1"], "winding"),
+    (["--winding", "-17"], "winding"),
     (["--mass", "1e9"], "mass"),
     (["--dofs", "surge,pitch"], "dofs"),
     (["--efficiency", "1.5"], "efficiency"),

@@ -23,7 +23,7 @@ HULL = synthetic_hull()
 def _case(winding, scale):
     """The synthetic hull read through the spec's interpolation of its data grid."""
     n = 10 * scale
-    nh = (10 + max(1, winding)) * scale
+    nh = (10 + max(1, abs(winding))) * scale
     coef = interpolator(HULL["omega_data"], HULL["A"], HULL["B"], HULL["F"], HULL["C"])
     vals = [coef(k * W) for k in range(nh + 1)]
     return HullCase(omega=W, amplitudes=np.array([0.5]), winding=winding, harmonics=n,
@@ -38,7 +38,7 @@ def _common(cs):
     return dict(HULL, wave_omega=W, amplitudes=cs.amplitudes)
 
 
-@pytest.mark.parametrize("winding", [0, 1])
+@pytest.mark.parametrize("winding", [0, 1, -1])
 def test_optimum_equals_an_independent_hull_response(winding):
     """The optimum's phi given to the independent frequency-domain solve: the same hull
     harmonics and the same power (to rounding: both solve the spec's equations)."""
@@ -54,7 +54,7 @@ def test_optimum_equals_an_independent_hull_response(winding):
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize("winding", [0, 1])
+@pytest.mark.parametrize("winding", [0, 1, -1])
 def test_optimum_replayed_in_the_time_domain(winding):
     """Cummins' equation driven by the optimum's phi from rest: after the transients the
     hull's first harmonic and the mean power are the frequency domain's. The integrator is

@@ -52,17 +52,19 @@ def test_the_search_goes_on_while_a_winding_beats_the_best_and_stops_after_two_m
     # the measured landscape of the Hs 1.5 m, Te 7 s bin (W): 1 misses, 2 and 3 beat
     tried, modes = _search({0: 852.5, 1: 849.0, 2: 853.8, 3: 856.3, 4: 855.0, 5: 850.0,
                             6: 900.0})
-    assert tried == [1, 2, 3, 4, 5]  # 6 would beat, but two misses in a row stop it
-    assert [m["mode"] for m in modes[2:]] == ["swinging"] * 5
+    # 6 would beat, but two misses in a row stop it; then the other sense (0 W here)
+    assert tried == [1, 2, 3, 4, 5, -1, -2]
+    assert [m["mode"] for m in modes[2:]] == ["swinging"] * 7
     assert all(m["_searched"] for m in modes[2:])
     # Hs 1 m, Te 7 s: one net turn best, then two misses
     tried, _ = _search({0: 453.8, 1: 464.7, 2: 458.7, 3: 459.8, 4: 456.5})
-    assert tried == [1, 2, 3]
+    assert tried == [1, 2, 3, -1, -2]
 
 
 def test_the_search_stays_below_rotation_and_skips_a_swing_short_of_the_upright():
-    tried, _ = _search({0: 1.0, **{k: 1.0 + k for k in range(1, 10)}}, top=4)
-    assert tried == [1, 2, 3]
+    tried, _ = _search({0: 1.0, **{k: 1.0 + k for k in range(1, 10)},
+                        **{-k: 5.0 + k for k in range(1, 10)}}, top=4)
+    assert tried == [1, 2, 3, -1, -2, -3]
     tried, modes = _search({0: 1.0, 1: 5.0}, swing=(180.0, 120.0))
     assert tried == [] and len(modes) == 2
     tried, _ = _search({0: 0.4, 1: 5.0})  # rotation (0.5 W) beats the swing
@@ -71,14 +73,14 @@ def test_the_search_stays_below_rotation_and_skips_a_swing_short_of_the_upright(
 
 def test_a_failed_winding_is_a_miss_not_the_best():
     tried, modes = _search({0: 1.0, 1: 9.0, 2: 0.5, 3: 0.5}, failed=(1,))
-    assert tried == [1, 2]
+    assert tried == [1, 2, -1, -2]
     assert not modes[2]["success"]
 
 
 def test_a_screened_winding_is_a_miss_and_never_the_lead():
     # screened with a power above the best (cannot happen; the flag rules): still a miss
     tried, modes = _search({0: 1.0, 1: 9.0, 2: 0.5, 3: 0.5}, screened=(1,))
-    assert tried == [1, 2] and modes[2]["_screened"]
+    assert tried == [1, 2, -1, -2] and modes[2]["_screened"]
 
 
 class _Case:
@@ -189,14 +191,23 @@ def test_a_searched_answer_solves_the_swinging_first_and_screens_the_rotation(mo
     calls.clear()
     plain = res.hull_answer(p["hull"], pend, wave, **kw)
     assert calls == [(2, False), (0, False)]
-    # on this 2-wave record the swinging wins (1049 W); the rotation, 18 % below it on the
-    # record's harmonics, is entered unrefined, the same answer as without the search
-    assert searched.winding == 0 and searched.power_w == plain.power_w
+    # on this 2-wave record the swinging beats the rotation (1049 W); the rotation, 18 %
+    # below it on the record's harmonics, is entered unrefined, and the swinging is the
+    # same answer as without the search
+    assert plain.winding == 0
+    assert searched.modes[1]["power_w"] == plain.power_w
     assert "not refined" in searched.modes[0]["status"]
     assert "not refined" not in plain.modes[0]["status"]
-    # the swinging, checked once all modes are in, carries the unsearched answer's checks
+    # the search (net turns either way below the rotation's 2) finds one reversed net turn
+    # better (1136 W), and that best alone, checked once all modes are in, carries the
+    # checks; the swinging below it says its check was left out
+    tried = [m["winding"] for m in searched.modes[2:] if m["mode"] != "rest"]
+    assert tried == [1, -1]
+    assert searched.winding == -1 and searched.power_w > 1.05 * plain.power_w
+    best = searched.modes[3]
     for key in ("gradient_max_w_per_rad", "hessian_scaled_largest_eigenvalue"):
-        assert searched.modes[1][key] == plain.modes[1][key] is not None
+        assert best[key] is not None
+    assert searched.modes[1]["status"].endswith("below the best: its optimality not checked")
 
 
 def test_a_searched_records_best_mode_alone_is_checked(monkeypatch):
@@ -222,10 +233,23 @@ def test_a_searched_records_best_mode_alone_is_checked(monkeypatch):
 
 def test_a_searched_winding_is_labelled_by_its_net_turns():
     m = dict(_mode(3, 1.0), mode="swinging")
-    assert res._label(m) == "swinging, 3 net turns"
-    assert res._label(dict(_mode(1, 1.0), mode="swinging")) == "swinging, 1 net turn"
-    assert res._label(_mode(2, 1.0)) == "rotation"
-    assert res._label(_mode(0, 1.0)) == "swinging"
+    assert res.mode_label(m) == "swinging, 3 net turns"
+    assert res.mode_label(dict(_mode(1, 1.0), mode="swinging")) == "swinging, 1 net turn"
+    assert res.mode_label(dict(_mode(-1, 1.0), mode="swinging")) == "swinging, -1 net turn"
+    assert res.mode_label(dict(_mode(-2, 1.0), mode="swinging")) == "swinging, -2 net turns"
+    assert res.mode_label(_mode(2, 1.0)) == "rotation"
+    assert res.mode_label(_mode(-2, 1.0)) == "rotation, reversed"
+    assert res.mode_label(_mode(0, 1.0)) == "swinging"
+
+
+def test_the_search_turns_the_other_way_where_that_sense_wins():
+    # forward net turns miss twice; the reversed ones beat the swing until two misses
+    tried, modes = _search({0: 1.0, 1: 0.9, 2: 0.8, -1: 1.5, -2: 2.0, -3: 1.9, -4: 1.8,
+                            -5: 3.0})
+    assert tried == [1, 2, -1, -2, -3, -4]
+    best = max(modes, key=res._power_of)
+    assert best["winding"] == -2 and best["mode"] == "swinging"
+    assert start_mode(-2) == "rotate" and start_mode(-5, 180.0, 10.0) == "rotate"
 
 
 def test_a_hull_store_records_its_record_optimum_and_an_older_one_is_refused(

@@ -677,7 +677,7 @@ def coarsened(case: HullCase, harmonics: int) -> HullCase:
     """``case`` with ``harmonics`` harmonics of phi and ``harmonics + max(1, K)`` of the hull
     (the coefficients at the first ones kept, the wave cut above them, ``COARSE_POINTS``
     times the grid that :func:`.hull.hull_points` gives the rest)."""
-    nh = min(case.hull_harmonics, harmonics + max(1, case.winding))
+    nh = min(case.hull_harmonics, harmonics + max(1, abs(case.winding)))
     amps = np.asarray(case.amplitudes)[:nh]
     return dataclasses.replace(
         case, harmonics=harmonics, hull_harmonics=nh, amplitudes=amps,

@@ -903,7 +903,8 @@ def hull_problem(**opts) -> dict:
     if inertia is not None:
         inertia = check("hull_pitch_inertia", inertia)
     winding = opts.get("winding")
-    windings = (1, 0) if winding is None else (check_int("winding", winding, 0, 16),)
+    windings = ((1, -1, 0) if winding is None
+                else (check_int("winding", winding, -16, 16),))
     harmonics = opts.get("harmonics")
     if harmonics is not None:
         harmonics = check_int("harmonics", harmonics, 2, hull_harmonics_cap(pto))
@@ -923,8 +924,9 @@ def solve_record(problem: dict, wave, info, *, check_only: bool = False):
     windings = problem["windings"]
     search = False
     if problem["winding"] is None:
-        windings = (waves_in(wave), 0)
-        search = windings[0] >= WINDING_SEARCH_WAVES
+        k = waves_in(wave)
+        windings = (k, -k, 0)
+        search = k >= WINDING_SEARCH_WAVES
     _check_hull_size(wave, windings, problem["harmonics"], problem["pto"],
                      problem.get("max_harmonics"))
     amps = np.abs(np.asarray(wave.amplitudes))
@@ -1113,7 +1115,7 @@ def _check_hull_size(wave, windings, harmonics, pto=None, cap=None):
     ``cap``: another limit (the power matrix's)."""
     from .hull import HARMONICS_PER_TURN
 
-    n = harmonics or HARMONICS_PER_TURN * max(max(windings), waves_in(wave))
+    n = harmonics or HARMONICS_PER_TURN * max(max(abs(k) for k in windings), waves_in(wave))
     ideal = pto is None or not pto.active
     if cap is None:
         cap = hull_harmonics_cap(pto)

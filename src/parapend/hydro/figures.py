@@ -142,7 +142,7 @@ def plot_hull_sweep(sweep, path=None):
         np.asarray(sweep.period_s),
         [(sweep.radiation_bound_w, "k-", {"lw": 1.0, "label": "radiation bound"}),
          (sweep.rotation_power_w, "-", {"color": "C0", "lw": 1.8, "marker": "o", "ms": 3,
-                                        "label": "rotation (one turn per wave)"}),
+                                        "label": "rotation (one turn per wave, the better sense)"}),
          (sweep.swinging_power_w, "-", {"color": "C3", "lw": 1.8, "marker": "s", "ms": 3,
                                         "label": "swinging"}),
          (sweep.one_way_power_w, "--", {"color": "C2", "lw": 1.2,

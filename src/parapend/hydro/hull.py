@@ -84,8 +84,9 @@ _CONSTRAINT_PAIRS = (("phi", "phi"), ("phi", "phi1"), ("phi", "phi2"), ("phi", "
 def hull_points(harmonics: int, hull_harmonics: int, winding: int, wave_harmonics: int) -> int:
     """A power of two with 8 points per harmonic of the motion and of the wave, and 4 per
     harmonic of the products ``sin(phi) xi''`` that the hull's projection reads."""
-    need = max(64, 8 * (harmonics + winding), 8 * (wave_harmonics + 1),
-               4 * (hull_harmonics + harmonics + winding))
+    turns = abs(winding)
+    need = max(64, 8 * (harmonics + turns), 8 * (wave_harmonics + 1),
+               4 * (hull_harmonics + harmonics + turns))
     return 1 << int(math.ceil(math.log2(need)))
 
 
@@ -568,8 +569,8 @@ def make_case(hull, pendulum, wave, *, winding, harmonics=None, hull_harmonics=N
               pivot=(0.0, 0.0), pitch_inertia=None) -> HullCase:
     """The discretized problem: the hull's coefficients at ``k w`` (k = 0..Nh), its mass
     matrix without the pendulum, the wave's amplitudes."""
-    n = harmonics or HARMONICS_PER_TURN * max(1, winding, waves_in(wave))
-    nh = hull_harmonics or n + max(1, winding)
+    n = harmonics or HARMONICS_PER_TURN * max(1, abs(winding), waves_in(wave))
+    nh = hull_harmonics or n + max(1, abs(winding))
     w = wave.omega
     kk = np.arange(nh + 1) * w
     a, b, f = hull.coefficients(kk)

@@ -560,7 +560,7 @@ def check_timing(horizon, update_interval, samples=SAMPLES, name="horizon") -> t
 
 def start_mode(winding, mean_angle_deg=None, swing_amplitude_deg=None) -> str:
     """The closed loop's start from the record optimum's motion: ``"rotate"`` (the swing-up
-    pump until the pendulum turns over the top) when the optimum rotates (``winding`` >= 1)
+    pump until the pendulum turns over the top) when the optimum rotates (``winding`` not 0)
     or swings through the upright (a multiple of 360 degrees within ``mean_angle_deg +-
     swing_amplitude_deg``, the absolute angle from the upward vertical), else ``"swing"``
     (planned from the hanging pendulum). Measured on the default barge's seas, whose

@@ -34,7 +34,7 @@ from .hull import (
 from .optimum import TORQUE_SLACK
 from .waves import energy_flux
 
-__all__ = ["BuoyResult", "BuoySweepResult", "MotionAt", "error_estimate", "free_heave",
+__all__ = ["BuoyResult", "BuoySweepResult", "MotionAt", "mode_label", "error_estimate", "free_heave",
            "hull_answer", "optimum"]
 
 
@@ -453,8 +453,10 @@ class BuoySweepResult(_Result):
                              for r in results] + [np.nan] * left, dtype=float)
 
         def mode_power(r, mode):
-            p = next((m["power_w"] for m in r.modes if m["mode"] == mode), np.nan)
-            return np.nan if p is None else p
+            # the better of the mode's answers (a hull's rotation: either sense)
+            ps = [m["power_w"] for m in r.modes if m["mode"] == mode]
+            ps = [p for p in ps if p is not None and math.isfinite(p)]
+            return max(ps) if ps else np.nan
 
         warn = [f"T = {t:g} s: {w}" for t, r in zip(periods, results)
                 for w in list(r.warnings) + list(r.validity_warnings)]
@@ -630,7 +632,8 @@ def optimum(h, pendulum, wave, *, wave_info=None, winding=None, harmonics=None, 
     pendulum : :class:`~parapend.hydro.coupled.Pendulum`; wave : :class:`~.coupled.Wave`.
     wave_info : dict, the wave's description for the result.
     winding : turns of the pendulum per wave (per record); None: 1 in heave alone, a hull's
-        rotation (1) and swinging (0) side by side; a tuple: those windings (a hull).
+        rotation both ways (1, -1) and swinging (0) side by side; a tuple: those windings
+        (a hull).
     harmonics : N of the motion (None: chosen from the problem).
     pto : :class:`~parapend.hydro.hull.HullPTO` (torque limit, N m; efficiency; copper loss,
         W per (N m)^2; heave alone has no copper loss) or None (ideal).
@@ -647,7 +650,7 @@ def optimum(h, pendulum, wave, *, wave_info=None, winding=None, harmonics=None, 
 
     pto = pto or HullPTO()
     if tuple(h.dofs) != ("heave",):
-        windings = ((1, 0) if winding is None else (winding,) if np.ndim(winding) == 0
+        windings = ((1, -1, 0) if winding is None else (winding,) if np.ndim(winding) == 0
                     else tuple(winding))
         return hull_answer(h, pendulum, wave, pivot=pivot, windings=windings,
                            pitch_inertia=pitch_inertia, harmonics=harmonics,
@@ -1209,11 +1212,12 @@ def _power_of(m) -> float:
 
 
 def _search_windings(modes, solve, top: int) -> None:
-    """The windings between swinging and rotation (``top`` net turns) on a long record,
-    appended to ``modes``: where the swinging optimum is the better mode and passes the
-    upright, the pendulum may go over the top a few times more one way than the other;
-    1, 2, 3, ... net turns are solved (``solve(k, screen)``: a winding below the best so far
-    before its refinement, by :data:`SCREEN_MARGIN`, is left there unrefined) until
+    """The windings between swinging and rotation (``top`` net turns either way) on a long
+    record, appended to ``modes``: where the swinging optimum is the better mode and passes
+    the upright, the pendulum may go over the top a few times more one way than the other;
+    1, 2, 3, ... net turns in the sense of a positive pitch, then -1, -2, -3, ... against it,
+    are solved (``solve(k, screen)``: a winding below the best so far before its
+    refinement, by :data:`SCREEN_MARGIN`, is left there unrefined), each sense until
     :data:`SEARCH_MISSES` in a row do not beat the best so far.
     Their answers swing (``mode`` "swinging", ``winding`` k). The powers over the windings
     are not monotone (measured on a 234-wave record: 0, 1, 2, 3, 4 net turns 453.8, 464.7,
@@ -1227,15 +1231,16 @@ def _search_windings(modes, solve, top: int) -> None:
                key=_power_of)  # the best so far
     if _power_of(swing) < _power_of(lead):  # rotation wins: net turns are nearer the swing
         return
-    misses, k = 0, 1
-    while misses < SEARCH_MISSES and k < top:
-        m = dict(solve(k, _Screen(lead)), mode="swinging", _searched=True)
-        modes.append(m)
-        if m["success"] and not m.get("_screened") and _power_of(m) > _power_of(lead):
-            misses, lead = 0, m
-        else:
-            misses += 1
-        k += 1
+    for sense in (1, -1):
+        misses, k = 0, 1
+        while misses < SEARCH_MISSES and k < top:
+            m = dict(solve(sense * k, _Screen(lead)), mode="swinging", _searched=True)
+            modes.append(m)
+            if m["success"] and not m.get("_screened") and _power_of(m) > _power_of(lead):
+                misses, lead = 0, m
+            else:
+                misses += 1
+            k += 1
 
 
 def _check_best(modes, best) -> None:
@@ -1250,21 +1255,26 @@ def _check_best(modes, best) -> None:
                 m["status"] += "; below the best: its optimality not checked"
 
 
-def _label(m) -> str:
+def mode_label(m) -> str:
+    """A mode's name in a status: ``rotation`` (in the sense of a positive pitch),
+    ``rotation, reversed`` (against it), ``swinging, k net turns``."""
     k = m["winding"]
     if m["mode"] == "swinging" and k:
-        return f"swinging, {k} net turn{'s' if k > 1 else ''}"
+        return f"swinging, {k} net turn{'s' if abs(k) > 1 else ''}"
+    if m["mode"] == "rotation" and k is not None and k < 0:
+        return "rotation, reversed"
     return m["mode"]
 
 
-def hull_answer(hull, pendulum, wave, *, pivot, windings=(1, 0), pitch_inertia=None,
+def hull_answer(hull, pendulum, wave, *, pivot, windings=(1, -1, 0), pitch_inertia=None,
                 harmonics=None, wave_info=None, geometry=None, notes=(),
                 pto: HullPTO | None = None, search: bool = False) -> BuoyResult:
-    """Solve each winding of ``windings`` (0: swinging), put them beside rest, and build
-    the result from the best; ``pto`` the power take-off (None: ideal); ``search``: where
-    swinging (winding 0) is the better mode and passes the upright, also 1, 2, 3, ... net
-    turns below the largest of ``windings``, until ``SEARCH_MISSES`` in a row do not beat
-    the best (a search: the powers over the windings are not monotone); with ``search`` the
+    """Solve each winding of ``windings`` (0: swinging; a negative one turns against the
+    sense of a positive pitch: a hull that surges and pitches is not the same problem both
+    ways), put them beside rest, and build the result from the best; ``pto`` the power
+    take-off (None: ideal); ``search``: where swinging (winding 0) is the better mode and
+    passes the upright, also 1, 2, 3, ... net turns either way below the largest of
+    ``windings``, each sense until ``SEARCH_MISSES`` in a row do not beat the best (a search: the powers over the windings are not monotone); with ``search`` the
     swinging is solved first and the other windings are screened against it
     (``SCREEN_MARGIN``)."""
     pto = pto or HullPTO()
@@ -1285,7 +1295,7 @@ def hull_answer(hull, pendulum, wave, *, pivot, windings=(1, 0), pitch_inertia=N
             swing = solve(0)
             screen = _Screen(swing) if swing["success"] else None
             modes = [swing if k == 0 else solve(k, screen) for k in windings]
-            _search_windings(modes, solve, max(windings))
+            _search_windings(modes, solve, max(abs(k) for k in windings))
         else:
             modes = [solve(k) for k in windings]
         ok_modes = [m for m in modes if m["success"] and not m.get("_screened")
@@ -1341,7 +1351,7 @@ def hull_answer(hull, pendulum, wave, *, pivot, windings=(1, 0), pitch_inertia=N
                             f"to {float(np.max(ends)):.3g} m, more than its draft {d:.3g} m"
                             + est)
     warnings = list(getattr(hull, "notes", ())) + list(notes) + [
-        f"{_label(m)}: {m['status']}" for m in modes if not m["success"]]
+        f"{mode_label(m)}: {m['status']}" for m in modes if not m["success"]]
     if cut:
         warnings.append(f"radiation bound: {cut} singular value(s) of B below "
                         f"{rcond:.3g} of the largest (the data's noise) cut in its "
@@ -1388,7 +1398,7 @@ def hull_answer(hull, pendulum, wave, *, pivot, windings=(1, 0), pitch_inertia=N
         refinement_history=None if at_rest else best["refinement_history"],
         # a searched winding that did not converge is reported, not the answer's failure
         success=all(m["success"] for m in modes if not m.get("_searched")) and not reason,
-        status="; ".join(f"{_label(m)}: {m['status']}" for m in modes),
+        status="; ".join(f"{mode_label(m)}: {m['status']}" for m in modes),
         dofs=["surge", "heave", "pitch"], wave=dict(wave_info or {},
                                                     omega_rad_per_s=wave.omega),
         pendulum={"mass_kg": pendulum.mass, "length_m": pendulum.length,

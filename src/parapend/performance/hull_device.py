@@ -217,7 +217,7 @@ def _retry(spec, wave, info, res):
     p = problem(spec)
     if p["harmonics"] is not None:
         return res
-    n = HARMONICS_PER_TURN * max(max(p["windings"]), waves_in(wave))
+    n = HARMONICS_PER_TURN * max(max(abs(k) for k in p["windings"]), waves_in(wave))
     more = int(math.ceil(RETRY_HARMONICS * n / 2)) * 2
     if more > hull_harmonics_cap(p["pto"]):
         return res

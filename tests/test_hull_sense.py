@@ -1,0 +1,102 @@
+"""The sense of the pendulum's turn in a hull that surges, heaves and pitches.
+
+A hull's surge and pitch make the two senses different problems (a heaving buoy's are
+mirror images). The mirror ``x -> -x`` maps one onto the other: the hull's coefficients
+become ``S A S``, ``S B S``, ``S C S`` and the excitation ``S F`` with ``S = diag(-1, 1, -1)``
+(the wave arriving from the other side), the pivot's offset changes sign, and the motion
+``phi -> -phi``, ``x -> -x``, ``beta -> -beta`` keeps the power. So turning against the sense
+of a positive pitch (winding ``-K``) in one hull is turning with it (``+K``) in the mirrored
+hull: an invariant the solver does not use (it solves ``-K`` directly)."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from hull_timedomain import RHO_V, synthetic_hull
+
+import parapend
+from parapend.hydro.bem import HullHydro
+from parapend.hydro.hull import HullCase, hull_points, hull_search
+from parapend.performance.resource import repeat_period
+
+S = np.diag([-1.0, 1.0, -1.0])
+W = 1.2
+HULL = synthetic_hull()
+PEND = {"mass": 4000.0, "length": 1.0, "inertia": 5000.0, "damping_coefficient": 50.0,
+        "pivot_height": 1.5, "pivot_offset": 1.0}
+
+
+def _case(winding, scale, mirrored):
+    """The synthetic hull (or its mirror image) at the harmonics of ``W``."""
+    from hull_timedomain import interpolator
+
+    n = 10 * scale
+    nh = (10 + max(1, abs(winding))) * scale
+    coef = interpolator(HULL["omega_data"], HULL["A"], HULL["B"], HULL["F"], HULL["C"])
+    vals = [coef(k * W) for k in range(nh + 1)]
+    a = np.array([v[0] for v in vals])
+    b = np.array([v[1] for v in vals])
+    f = np.array([v[2] for v in vals])
+    c, pivot = HULL["C"], HULL["pivot"]
+    if mirrored:
+        a, b, f, c = S @ a @ S, S @ b @ S, f @ S, S @ c @ S
+        pivot = (-pivot[0], pivot[1])
+    return HullCase(omega=W, amplitudes=np.array([0.5]), winding=winding, harmonics=n,
+                    hull_harmonics=nh, points=hull_points(n, nh, winding, 1), A=a, B=b, F=f,
+                    C=c, Mh=HULL["Mh"], m=HULL["m"], l=HULL["l"], I=HULL["I"], c=HULL["c"],
+                    g=HULL["g"], pivot=pivot)
+
+
+@pytest.mark.parametrize("winding", [1, 2])
+def test_a_reversed_turn_is_the_mirrored_hulls_forward_turn(winding):
+    """Winding ``-K`` in the hull is winding ``K`` in its mirror image: the same power to
+    rounding and the motion mirrored (``phi -> -phi``); the two senses differ."""
+    back = hull_search(lambda s: _case(-winding, s, False), refine=False)
+    mirror = hull_search(lambda s: _case(winding, s, True), refine=False)
+    fwd = hull_search(lambda s: _case(winding, s, False), refine=False)
+    assert back.success and mirror.success and fwd.success
+    assert back.power == pytest.approx(mirror.power, rel=1e-9)
+    x, y = np.asarray(back.x), -np.asarray(mirror.x)
+    x0 = math.remainder(x[0] - y[0], 2 * math.pi)
+    assert abs(x0) < 1e-6 and np.max(np.abs(x[1:] - y[1:])) < 1e-6 * np.max(np.abs(x[1:]))
+    assert abs(back.power - fwd.power) > 1e-3 * abs(fwd.power)
+
+
+@pytest.fixture(scope="module")
+def datasets(tmp_path_factory):
+    """The synthetic hull and its mirror image as Capytaine datasets."""
+    from capytaine.io.xarray import save_dataset_as_netcdf
+
+    out = {}
+    for name, t in (("hull", np.eye(3)), ("mirror", S)):
+        hull = HullHydro(omega=HULL["omega_data"], added_mass=t @ HULL["A"] @ t,
+                         radiation_damping=t @ HULL["B"] @ t, excitation=HULL["F"] @ t,
+                         hydrostatic_stiffness=t @ HULL["C"] @ t, mass=RHO_V,
+                         pitch_inertia=float(HULL["Mh"][2, 2]), description=name)
+        path = tmp_path_factory.mktemp(name) / f"{name}.nc"
+        save_dataset_as_netcdf(path, hull.to_dataset())
+        out[name] = str(path)
+    return out
+
+
+def test_the_answer_turns_whichever_way_is_better(datasets):
+    """A 2-wave record (Hs 1 m, Tp 6 s, seed 3) where two reversed turns a record beat
+    swinging and the forward rotation: the default answer solves both senses and is the
+    best; its reversed rotation is the mirrored hull's forward one (to 1e-9), whose own
+    default answer is the same power turning forward."""
+    rec = {"dofs": "surge,heave,pitch", "hs": 1.0, "tp": 6.0, "seed": 3,
+           "repeat_period": repeat_period(2.0, 6.0)}
+    mirror_pend = dict(PEND, pivot_offset=-PEND["pivot_offset"])
+    r = parapend.buoy(hydro=datasets["hull"], **rec, **PEND)
+    labels = [s.split(":")[0] for s in r.status.split("; ")]
+    assert labels == ["rotation", "rotation, reversed", "swinging"]
+    powers = {m["winding"]: m["power_w"] for m in r.modes if m["mode"] != "rest"}
+    assert set(powers) == {2, -2, 0}
+    assert r.winding == -2 and r.power_w == max(powers.values())
+    assert r.power_w > 1.01 * max(powers[2], powers[0])
+    m = parapend.buoy(hydro=datasets["mirror"], winding=2, **rec, **mirror_pend)
+    assert m.power_w == pytest.approx(r.power_w, rel=1e-9)
+    m = parapend.buoy(hydro=datasets["mirror"], **rec, **mirror_pend)
+    assert m.winding == 2 and m.power_w == pytest.approx(r.power_w, rel=1e-9)
