@@ -63,8 +63,8 @@ def add_parsers(sub) -> None:
     g = p.add_argument_group("motion and power take-off")
     g.add_argument("--winding", type=_int,
                    help="turns per wave (per record in an irregular sea) (default 1; with "
-                        "--dofs surge,heave,pitch: rotation (1) and swinging (0) side by "
-                        "side)")
+                        "--dofs surge,heave,pitch: rotation both ways (1, and -1 against "
+                        "the sense of a positive pitch) and swinging (0) side by side)")
     g.add_argument("--harmonics", type=_int,
                    help="N of the motion (default chosen from the problem and checked)")
     add_declared(g, PowerTakeOff, ("torque_limit", "efficiency", "copper_loss"))

@@ -368,7 +368,8 @@ def buoy(*, wave_height=None, wave_period=None, hs=None, tp=None, spectrum=None,
         body's waterplane centre, a mesh's origin, a dataset's rotation centre), m;
         ``hull_pitch_inertia`` (kg m^2, about it; default the dataset's, else a
         homogeneous immersed hull); ``winding`` None reports rotation
-        (one turn per wave) and swinging (``winding=0``) side by side. Options not given
+        (one turn per wave) both ways (``winding=1``, and ``-1`` against the sense of a
+        positive pitch) and swinging (``winding=0``) side by side. Options not given
         take the embedded hull design's values (``parapend.defaults.HULL``).
         ``copper_loss`` ``r`` (W per (N m)^2; hull only) subtracts the winding loss ``r
         tau^2`` from the power: holding an angle then costs what it costs a generator.
