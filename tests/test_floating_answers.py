@@ -41,18 +41,22 @@ BEM_CASES = [
                  marks=SLOW),
     pytest.param("buoy design", {"optimize_design": "mass,length", "mass_bounds": "10:120",
                                  "length_bounds": "0.1:0.6"}, 45.41975649234604, marks=SLOW),
-    pytest.param("hull default", HULL, 503.9714747336288, marks=SLOW),
+    # the reversed rotation (winding -1) is the answer here; the forward one 475.868 W and
+    # the swing 503.971 W (the answer when the forward sense alone was solved)
+    pytest.param("hull default", HULL, 648.1837944580038, marks=SLOW),
     pytest.param("hull swing low pivot", {**HULL, "winding": 0, "pivot_height": -0.5},
                  [532.1204727731518, 532.1204727731518, 0.0], marks=SLOW),
-    # the rotation's power here is negative (not the answer): the efficiency's loss
+    # the rotations' powers here are negative (not the answer): the efficiency's loss
     # |tau v| is not smooth where the power changes sign, and which nearby point Newton
-    # stops at moves with the BLAS and the search (-26.2296, -26.2231 on CI's processors):
-    # that mode is held to 1e-3, the answer and the other modes to 1e-10
+    # stops at moves with the BLAS and the search (forward: -26.2296, -26.2231 on CI's
+    # processors, -26.2258 here; reversed: -144.323, its last doubling moving it 2.6 W):
+    # those modes are held to 2e-2, the answer and the swing to 1e-10
     pytest.param("hull efficiency 0.9", {**HULL, "efficiency": 0.9},
-                 [11.686760869374051, -26.229553344994102, 11.686760869374051, 0.0],
-                 marks=SLOW),
+                 [11.686760869374051, -26.229553344994102, -144.32339105317197,
+                  11.686760869374051, 0.0], marks=SLOW),
     pytest.param("hull 4 s", {**HULL, "wave_period": 4.0},
-                 [2842.234877057094, 2554.1503415237985, 2842.234877057094, 0.0], marks=SLOW),
+                 [2881.0367778794425, 2554.150341523797, 2881.0367778794425,
+                  2842.2348770570957, 0.0], marks=SLOW),
 ]
 
 #: the same on the synthetic hull's dataset
@@ -91,9 +95,9 @@ def dataset(tmp_path_factory):
 @pytest.mark.parametrize(("name", "kwargs", "power"), BEM_CASES)
 def test_bem_bodies_give_the_powers_of_before(name, kwargs, power):
     got = _powers(parapend.buoy(**kwargs), power)
-    if name == "hull efficiency 0.9":  # the rotation's negative power (see the table)
-        assert got[1] == pytest.approx(power[1], rel=1e-3), name
-        got, power = got[:1] + got[2:], power[:1] + power[2:]
+    if name == "hull efficiency 0.9":  # the rotations' negative powers (see the table)
+        assert got[1:3] == pytest.approx(power[1:3], rel=2e-2), name
+        got, power = got[:1] + got[3:], power[:1] + power[3:]
     assert got == pytest.approx(power, rel=RTOL, abs=0.0), name
 
 
