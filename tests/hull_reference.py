@@ -49,11 +49,12 @@ class _Grid:
         n, nh, mm, kk = int(harmonics), int(hull_harmonics), int(points), int(winding)
         if not (w > 0 and math.isfinite(w)):
             raise ValueError(f"omega: expected a positive frequency, got {omega!r}")
-        if n < 1 or nh < 1 or kk < 0:
-            raise ValueError("harmonics, hull_harmonics: expected >= 1; winding >= 0")
-        if mm & (mm - 1) or mm <= 2 * (nh + n + kk):
-            raise ValueError(f"points: expected a power of two above 2 (Nh + N + K) = "
-                             f"{2 * (nh + n + kk)}, got {points!r}")
+        if n < 1 or nh < 1:
+            raise ValueError("harmonics, hull_harmonics: expected >= 1")
+        # K < 0: turns against the sense of a positive pitch (the same formulas)
+        if mm & (mm - 1) or mm <= 2 * (nh + n + abs(kk)):
+            raise ValueError(f"points: expected a power of two above 2 (Nh + N + |K|) = "
+                             f"{2 * (nh + n + abs(kk))}, got {points!r}")
         A = np.asarray(A, dtype=float)
         B = np.asarray(B, dtype=float)
         F = np.asarray(F, dtype=complex)
@@ -508,7 +509,8 @@ def box_case(*, winding, harmonics, hull_harmonics=6, points=None, period=6.0, h
     A, B, F = box_coefficients(w * np.arange(hull_harmonics + 1))
     c33 = 1025.0 * 9.81 * 40.0
     if points is None:
-        points = 1 << int(math.ceil(math.log2(8 * (harmonics + hull_harmonics + winding))))
+        points = 1 << int(math.ceil(math.log2(8 * (harmonics + hull_harmonics
+                                                   + abs(winding)))))
     return dict(omega=w, amplitudes=[0.5 * height], winding=winding, harmonics=harmonics,
                 hull_harmonics=hull_harmonics, points=points, A=A, B=B, F=F,
                 C=np.diag([0.0, c33, 3.15e6]), Mh=np.diag([41000.0 - m, 41000.0 - m, 3.45e5]),

@@ -2,7 +2,7 @@
 implementation of the same model on the same discretization (tests/hull_reference.py: the
 pendulum's and the hull's coefficients both variables, the projected hull equations as
 constraints, exact AD derivatives). Four cases of two bodies (a synthetic box, the
-helper's causal synthetic hull), K = 0 and 1."""
+helper's causal synthetic hull), K = 0, 1 and -1."""
 
 from __future__ import annotations
 
@@ -32,6 +32,9 @@ CASES = {
     "box-rotate": lambda: box_case(winding=1, harmonics=12, hull_harmonics=8),
     "causal-swing": lambda: _causal(0),
     "causal-rotate": lambda: _causal(1),
+    # the rotation against the sense of a positive pitch: another problem in a hull
+    "box-reversed": lambda: box_case(winding=-1, harmonics=12, hull_harmonics=8),
+    "causal-reversed": lambda: _causal(-1),
 }
 
 

@@ -383,7 +383,8 @@ class Controller(_Inputs):
 #: options of ``buoy``, ``horizon`` and ``power-matrix`` that belong to the run, not to the
 #: device or the sea (docs/buoy.md, "Inputs that compose")
 RUN_OPTIONS = {
-    "winding": "turns of the pendulum per wave or record (resolution of the motion)",
+    "winding": "turns of the pendulum per wave or record (resolution of the motion; in a "
+               "hull, negative against the sense of a positive pitch)",
     "harmonics": "the motion's harmonics",
     "optimize_design": "the pendulum's parameters the design search chooses",
     "mass_bounds": "the design search's range", "length_bounds": "the design search's range",
