@@ -278,6 +278,8 @@ def test_the_runs_figure_is_its_series():
 
 @pytest.mark.parametrize("args, mode", [
     ((1, None, None), "rotate"),       # a rotation
+    ((-1, None, None), "rotate-reversed"),  # against the sense of a positive pitch
+    ((-3, 180.0, 200.0), "rotate-reversed"),  # a swing with net turns against it
     ((0, 180.0, 60.0), "swing"),       # a swing about hanging, below the upright
     ((0, 308.7, 153.5), "rotate"),     # the default barge's seed 0: through the upright
     ((0, 200.0, 150.0), "swing"),      # 50 .. 350 degrees: short of the upright
@@ -288,6 +290,36 @@ def test_the_start_follows_the_optimums_motion(args, mode):
     """The pump's start where the optimum turns over the top, the hanging start where it
     swings below it."""
     assert hc.start_mode(*args) == mode
+
+
+def test_the_reversed_start_is_the_mirrored_hulls_forward_start():
+    """The pump mirrored (``rotate-reversed``) in the hull mirrored (``x -> -x``: ``S A S``,
+    ``S B S``, ``S C S``, ``S F``, ``S = diag(-1, 1, -1)``, the pivot's offset negated) is
+    the forward pump in the hull: until the catch the motion mirrored (``phi -> -phi``,
+    ``x``, ``beta`` negated) and the torque negated, to rounding, and it catches on the
+    same sample turning the other way."""
+    sm = np.diag([-1.0, 1.0, -1.0])
+    mirror = HullHydro(omega=SYN["omega_data"], added_mass=sm @ SYN["A"] @ sm,
+                       radiation_damping=sm @ SYN["B"] @ sm, excitation=SYN["F"] @ sm,
+                       hydrostatic_stiffness=sm @ SYN["C"] @ sm, mass=1025.0 * 40.0,
+                       pitch_inertia=float(SYN["Mh"][2, 2]), description="mirrored")
+    opts = dict(OPTS, warmup=3.0, torque_limit=3000.0)  # a weak pump: 57 samples
+    fwd = hc.hull_mpc(HULL, PEND, WAVE, **opts, mode="rotate")
+    back = hc.hull_mpc(mirror, PEND, WAVE, **dict(opts, pivot=(-PIVOT[0], PIVOT[1])),
+                       mode="rotate-reversed")
+    assert fwd.catch_time_s == back.catch_time_s and fwd.catch_time_s > 0
+    a, b = fwd._samples, back._samples
+    pump = a["t"] < fwd.catch_time_s
+    assert pump.sum() > 10
+    # both start hanging, phi = pi, whose mirror image -pi is the same angle
+    turn = np.remainder(b["phi"][pump] + a["phi"][pump] + np.pi, 2 * np.pi) - np.pi
+    assert np.max(np.abs(turn)) <= 1e-9
+    for key, sign in (("x", -1), ("beta", -1), ("z", 1), ("torque", -1)):
+        at = pump[:a[key].size]  # the torque: one a sample, the states one more
+        scale = np.max(np.abs(a[key][at]))
+        assert np.max(np.abs(b[key][at] - sign * a[key][at])) <= 1e-9 * scale, key
+    caught = np.searchsorted(a["t"], fwd.catch_time_s)
+    assert a["theta_dot"][caught] > 0 > b["theta_dot"][caught]
 
 
 def _barge(key="hull"):

@@ -249,7 +249,8 @@ def test_the_search_turns_the_other_way_where_that_sense_wins():
     assert tried == [1, 2, -1, -2, -3, -4]
     best = max(modes, key=res._power_of)
     assert best["winding"] == -2 and best["mode"] == "swinging"
-    assert start_mode(-2) == "rotate" and start_mode(-5, 180.0, 10.0) == "rotate"
+    assert start_mode(-2) == "rotate-reversed" == start_mode(-5, 180.0, 10.0)
+    assert start_mode(3) == "rotate"
 
 
 def test_a_hull_store_records_its_record_optimum_and_an_older_one_is_refused(

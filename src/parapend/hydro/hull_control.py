@@ -38,7 +38,8 @@ moves on.
 
 The mode (:func:`start_mode`, from the record optimum's motion): where the optimum rotates
 or swings through the upright the run starts with the buoy's swing-up pump and hands over
-once the pendulum turns over the top; a swing that stays below the upright is planned from
+once the pendulum turns over the top (in the optimum's sense: the pump mirrored where the
+optimum turns against the sense of a positive pitch); a swing that stays below the upright is planned from
 the hanging pendulum from the start. The headline, its storage correction
 over whole repeats after the warm-up, the failed solves and the update times are
 :func:`.control.closed_loop_result`'s.
@@ -375,9 +376,10 @@ def hull_mpc(hull, pendulum, wave, *, peak_period, pivot=(0.0, 0.0), pitch_inert
     efficiency : float, (eta_g, eta_m) or None
         Priced in the horizon objective and the electrical power.
     forecast : "perfect" or "ar"
-    mode : "swing" or "rotate"
+    mode : "swing", "rotate" or "rotate-reversed"
         The start: planned from the hanging pendulum, or the swing-up pump until the
-        pendulum turns over the top.
+        pendulum turns over the top in the sense of a positive pitch (``rotate``) or
+        against it (``rotate-reversed``: the pump mirrored, ``phi -> -phi``).
     max_iter : int or None
         Iterations per solve at most (None: ``MAX_ITER`` for L-BFGS-B,
         ``COMPILED_ITER`` for the collocation planner's compiled solver, ``COLLOCATION_ITER``
@@ -428,8 +430,10 @@ def hull_mpc(hull, pendulum, wave, *, peak_period, pivot=(0.0, 0.0), pitch_inert
     max_iter = check_int("max_iter", max_iter, 1, 10000)
     if forecast not in ("perfect", "ar"):
         raise ParameterError(f"forecast: expected perfect or ar, got {forecast!r:.40}")
-    if mode not in ("swing", "rotate"):
-        raise ParameterError(f"mode: expected swing or rotate, got {mode!r:.40}")
+    if mode not in ("swing", "rotate", "rotate-reversed"):
+        raise ParameterError(f"mode: expected swing, rotate or rotate-reversed, got "
+                             f"{mode!r:.40}")
+    sense = -1.0 if mode == "rotate-reversed" else 1.0  # the pump's, mirrored if reversed
     eta = bc._efficiency(efficiency)
     g = float(hull.g)
     tu = pendulum.mass * g * pendulum.length
@@ -497,12 +501,12 @@ def hull_mpc(hull, pendulum, wave, *, peak_period, pivot=(0.0, 0.0), pitch_inert
     status = "ok"
     j = 0
     while j < total:
-        phi, om = plant.y[3], plant.y[7] * t0
+        phi, om = sense * plant.y[3], sense * plant.y[7] * t0
         if caught is None and ready_to_catch(phi, om, bc.CATCH_MARGIN):
             caught = j
         if caught is None:
             tq, braking = pump_torque(phi, om, level, bc.CATCH_MARGIN, braking)
-            seg = np.array([tq])
+            seg = np.array([sense * tq])
         else:
             if solves and deadline is not None and time.monotonic() >= deadline:
                 status, total = "time_limit", j
@@ -560,7 +564,8 @@ def check_timing(horizon, update_interval, samples=SAMPLES, name="horizon") -> t
 
 def start_mode(winding, mean_angle_deg=None, swing_amplitude_deg=None) -> str:
     """The closed loop's start from the record optimum's motion: ``"rotate"`` (the swing-up
-    pump until the pendulum turns over the top) when the optimum rotates (``winding`` not 0)
+    pump until the pendulum turns over the top, in the optimum's sense: ``"rotate-reversed"``
+    where its winding is negative) when the optimum rotates (``winding`` not 0)
     or swings through the upright (a multiple of 360 degrees within ``mean_angle_deg +-
     swing_amplitude_deg``, the absolute angle from the upward vertical), else ``"swing"``
     (planned from the hanging pendulum). Measured on the default barge's seas, whose
@@ -569,7 +574,7 @@ def start_mode(winding, mean_angle_deg=None, swing_amplitude_deg=None) -> str:
     from .result import through_upright
 
     if winding:  # rotation, or a swing with net turns (over the top: through the upright)
-        return "rotate"
+        return "rotate" if winding > 0 else "rotate-reversed"
     if mean_angle_deg is None or swing_amplitude_deg is None:
         return "swing"
     return "rotate" if through_upright(mean_angle_deg, swing_amplitude_deg) else "swing"
