@@ -39,8 +39,8 @@ moves on.
 The mode (:func:`start_mode`, from the record optimum's motion): where the optimum rotates
 or swings through the upright the run starts with the buoy's swing-up pump and hands over
 once the pendulum turns over the top (in the optimum's sense: the pump mirrored where the
-optimum turns against the sense of a positive pitch); a swing that stays below the upright is planned from
-the hanging pendulum from the start. The headline, its storage correction
+optimum turns against the sense of a positive pitch); a swing that stays below the upright
+is planned from the hanging pendulum from the start. The headline, its storage correction
 over whole repeats after the warm-up, the failed solves and the update times are
 :func:`.control.closed_loop_result`'s.
 """

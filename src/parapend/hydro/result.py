@@ -34,8 +34,8 @@ from .hull import (
 from .optimum import TORQUE_SLACK
 from .waves import energy_flux
 
-__all__ = ["BuoyResult", "BuoySweepResult", "MotionAt", "mode_label", "error_estimate", "free_heave",
-           "hull_answer", "optimum"]
+__all__ = ["BuoyResult", "BuoySweepResult", "MotionAt", "error_estimate", "free_heave",
+           "hull_answer", "mode_label", "optimum"]
 
 
 #: the JSON keys of a heave-only answer (a buoy), in their order
@@ -1274,7 +1274,8 @@ def hull_answer(hull, pendulum, wave, *, pivot, windings=(1, -1, 0), pitch_inert
     ways), put them beside rest, and build the result from the best; ``pto`` the power
     take-off (None: ideal); ``search``: where swinging (winding 0) is the better mode and
     passes the upright, also 1, 2, 3, ... net turns either way below the largest of
-    ``windings``, each sense until ``SEARCH_MISSES`` in a row do not beat the best (a search: the powers over the windings are not monotone); with ``search`` the
+    ``windings``, each sense until ``SEARCH_MISSES`` in a row do not beat the best (a
+    search: the powers over the windings are not monotone); with ``search`` the
     swinging is solved first and the other windings are screened against it
     (``SCREEN_MARGIN``)."""
     pto = pto or HullPTO()
