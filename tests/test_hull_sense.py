@@ -10,43 +10,33 @@ hull: an invariant the solver does not use (it solves ``-K`` directly)."""
 
 from __future__ import annotations
 
+import dataclasses
 import math
 
 import numpy as np
 import pytest
 from hull_timedomain import RHO_V, synthetic_hull
+from test_hull_optimum_timedomain import _case as _forward_case
 
 import parapend
 from parapend.hydro.bem import HullHydro
-from parapend.hydro.hull import HullCase, hull_points, hull_search
+from parapend.hydro.hull import hull_search
 from parapend.performance.resource import repeat_period
 
 S = np.diag([-1.0, 1.0, -1.0])
-W = 1.2
 HULL = synthetic_hull()
 PEND = {"mass": 4000.0, "length": 1.0, "inertia": 5000.0, "damping_coefficient": 50.0,
         "pivot_height": 1.5, "pivot_offset": 1.0}
 
 
 def _case(winding, scale, mirrored):
-    """The synthetic hull (or its mirror image) at the harmonics of ``W``."""
-    from hull_timedomain import interpolator
-
-    n = 10 * scale
-    nh = (10 + max(1, abs(winding))) * scale
-    coef = interpolator(HULL["omega_data"], HULL["A"], HULL["B"], HULL["F"], HULL["C"])
-    vals = [coef(k * W) for k in range(nh + 1)]
-    a = np.array([v[0] for v in vals])
-    b = np.array([v[1] for v in vals])
-    f = np.array([v[2] for v in vals])
-    c, pivot = HULL["C"], HULL["pivot"]
-    if mirrored:
-        a, b, f, c = S @ a @ S, S @ b @ S, f @ S, S @ c @ S
-        pivot = (-pivot[0], pivot[1])
-    return HullCase(omega=W, amplitudes=np.array([0.5]), winding=winding, harmonics=n,
-                    hull_harmonics=nh, points=hull_points(n, nh, winding, 1), A=a, B=b, F=f,
-                    C=c, Mh=HULL["Mh"], m=HULL["m"], l=HULL["l"], I=HULL["I"], c=HULL["c"],
-                    g=HULL["g"], pivot=pivot)
+    """The synthetic hull (or its mirror image) at the harmonics of the replay tests'
+    regular wave (tests/test_hull_optimum_timedomain.py)."""
+    cs = _forward_case(winding, scale)
+    if not mirrored:
+        return cs
+    return dataclasses.replace(cs, A=S @ cs.A @ S, B=S @ cs.B @ S, F=cs.F @ S,
+                               C=S @ cs.C @ S, pivot=(-cs.pivot[0], cs.pivot[1]))
 
 
 @pytest.mark.parametrize("winding", [1, 2])
