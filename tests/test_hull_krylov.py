@@ -332,7 +332,8 @@ def test_lanczos_finds_a_crowded_top_of_the_spectrum(power):
     assert top is not None and top == pytest.approx(-0.0146, rel=LANCZOS_TOL)
 
 
-@pytest.mark.parametrize("pto", [{}, {"efficiency": "0.9,0.85"}])
+@pytest.mark.parametrize("pto", [{}, pytest.param({"efficiency": "0.9,0.85"},
+                                                   marks=pytest.mark.slow)])
 def test_each_mode_carries_its_optimality(dataset, pto):
     """A hull answer's modes carry the gradient's largest entry and the Hessian's largest
     eigenvalue at their maxima (negative: strict maxima); the gradient below Newton's
