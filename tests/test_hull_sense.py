@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import re
 
 import numpy as np
 import pytest
@@ -90,3 +91,36 @@ def test_the_answer_turns_whichever_way_is_better(datasets):
     assert m.power_w == pytest.approx(r.power_w, rel=1e-9)
     m = parapend.buoy(hydro=datasets["mirror"], **rec, **mirror_pend)
     assert m.winding == 2 and m.power_w == pytest.approx(r.power_w, rel=1e-9)
+
+
+def test_a_sweep_says_which_way_its_rotation_turns(datasets, capsys):
+    """A period sweep's ``rotation_winding`` is the winding of the better rotation of each
+    period's answer; in the mirrored hull the same rotation turns the other way with the
+    same power (to 1e-9). The saved sweep carries it, and the text names the best mode with
+    its sense."""
+    from parapend.cli import main
+
+    mirror_pend = dict(PEND, pivot_offset=-PEND["pivot_offset"])
+    r = parapend.buoy(dofs="surge,heave,pitch", hydro=datasets["hull"], wave_period="4,5",
+                      **PEND)
+    m = parapend.buoy(dofs="surge,heave,pitch", hydro=datasets["mirror"], wave_period="4,5",
+                      **mirror_pend)
+    assert r.rotation_winding == [-1, 1]  # at 4 s the better turn is the reversed one
+    for res, k, p in zip(r.results, r.rotation_winding, r.rotation_power_w):
+        rot = [x for x in res.modes if x["mode"] == "rotation"]
+        assert {x["winding"] for x in rot} == {1, -1}
+        best = max(rot, key=lambda x: x["power_w"])
+        assert (k, p) == (best["winding"], best["power_w"])
+    assert [-k for k in m.rotation_winding] == r.rotation_winding
+    assert np.allclose(m.rotation_power_w, r.rotation_power_w, rtol=1e-9, atol=0)
+    ds = r.to_dataset()
+    assert ds["rotation_winding"].values.tolist() == r.rotation_winding
+    pend = [x for k, v in PEND.items() for x in (f"--{k.replace('_', '-')}", repr(v))]
+    assert main(["buoy", "--dofs", "surge,heave,pitch", "--hydro", datasets["hull"],
+                 "--wave-period", "4,5", *pend]) == 0
+    rows = {c[0]: c for c in (re.split(r"\s{2,}", line.strip())
+                              for line in capsys.readouterr().out.splitlines())
+            if c[0] in ("4", "5")}
+    for t, res, k in zip(("4", "5"), r.results, r.rotation_winding):
+        label = parapend.hydro.result.mode_label({"mode": res.mode, "winding": res.winding})
+        assert (rows[t][3], rows[t][5]) == (f"{k:+d}", label)

@@ -129,7 +129,7 @@ def test_text_json_and_netcdf_carry_the_mode_and_the_completeness(stub, tmp_path
     nc = tmp_path / "m.nc"
     assert main([*base, "--scatter", str(tmp_path / "s.csv"), "--netcdf", str(nc)]) == 0
     text = capsys.readouterr().out
-    assert "operating mode of the bins: 3 rotation, 1 rest" in text
+    assert "operating mode of the bins: 3 rotation; 1 rest" in text
     assert "complete: every sea state of the site lies in a bin with a result" in text
     assert "mean annual energy (8766 h/yr): optimum 15.34 kWh/yr" in text  # 1.75 W
     import xarray as xr

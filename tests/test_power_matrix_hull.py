@@ -61,7 +61,7 @@ def scatter(tmp_path_factory):
 def _stand_in(real):
     """``solve_record`` with the checks real and the solve replaced: the power a function
     of the record (its sum |a_k|^2, so bins and seeds differ), rest below a threshold,
-    swinging for the longer records."""
+    swinging for the longer records, the rotation reversed on odd seeds."""
 
     def fake(problem, wave, info, *, check_only=False):
         if check_only:
@@ -71,7 +71,9 @@ def _stand_in(real):
         mode = "rest" if e < 0.5 else "swinging" if long else "rotation"
         p = 0.0 if mode == "rest" else 1e4 * e
         loss = 0.9 if problem["pto"].copper_loss else 1.0
+        winding = 0 if mode != "rotation" else -1 if info["seed"] % 2 else 1
         return SimpleNamespace(power_w=loss * p, mechanical_power_w=p, mode=mode,
+                               winding=winding,
                                success=True, modes=[], radiation_bound_w=1e5 * e,
                                one_way_power_w=None if mode == "rest" else 2e4 * e)
     return fake
@@ -102,13 +104,14 @@ def test_the_store_holds_each_records_answer_and_the_aep_invariant(dataset, scat
     assert ds.attrs.get("status", "ok") == "ok"
     spec = MatrixSpec.from_json(ds.attrs["sweep"])
     assert spec.dofs == "surge,heave,pitch" and spec.pivot_height == 1.5
-    modes = {"rest": 0, "rotation": 1, "swinging": 2}
+    modes = {"rest": 0, "rotation": 1, "swinging": 2, "rotation, reversed": 3}
     seen = set()
     for i in range(2):
         for j in range(2):
             for r in range(2):
                 e = _energy(spec, i, j, r)
-                mode = "rest" if e < 0.5 else "swinging" if j == 1 else "rotation"
+                mode = "rest" if e < 0.5 else "swinging" if j == 1 else (
+                    "rotation, reversed" if (3 + r) % 2 else "rotation")
                 seen.add(mode)
                 p = 0.0 if mode == "rest" else 1e4 * e
                 assert ds["power"].values[i, j, r] == p
@@ -117,9 +120,10 @@ def test_the_store_holds_each_records_answer_and_the_aep_invariant(dataset, scat
                 ow = ds["one_way_power"].values[i, j, r]
                 assert (math.isnan(ow) if mode == "rest" else ow == 2e4 * e)
                 assert ds["status"].values[i, j, r] == (1 if mode == "rest" else 0)
-    assert seen == {"rest", "rotation", "swinging"}
+    assert seen == {"rest", "rotation", "swinging", "rotation, reversed"}
     pm = ds["power_matrix"].values
     assert np.array_equal(pm, np.maximum(ds["power"].values.mean(axis=-1), 0.0))
+    # the rotating bin's two records turn one each way: a tie, given to the forward sense
     assert (ds["operating_mode"].values == np.where(pm > 0, [[1, 2], [1, 2]], 0)).all()
     want = HOURS_PER_YEAR * sum(pm[i, j] * freq[(h, t)] for i, h in enumerate((1, 2))
                                 for j, t in enumerate((5, 6)))
@@ -144,6 +148,21 @@ def test_a_lossy_take_off_shows_the_electrical_power(dataset, stand_in, tmp_path
         assert np.array_equal(again[v].values, ds[v].values, equal_nan=True), v
 
 
+def test_a_bin_names_the_sense_most_of_its_records_turn(dataset, capsys, stand_in):
+    """Seeds 3, 4 and 5: two records turn against a positive pitch, one with it; the bin's
+    mode is the reversed rotation in the JSON and the text."""
+    pend = [x for k, v in PEND.items() for x in (f"--{k.replace('_', '-')}", repr(v))]
+    args = ["power-matrix", "--device", "buoy", "--dofs", "surge,heave,pitch", "--hydro",
+            dataset, "--hs", "1,2", "--tp", "5,6", "--waves", "2", "--realizations", "3",
+            "--seed", "3", "--workers", "1", "--time-limit", "3600", *pend]
+    assert main([*args, "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert out["operating_mode"] == [["rest", "rest"], ["rotation, reversed", "swinging"]]
+    assert main(args) == 0
+    text = capsys.readouterr().out
+    assert "operating mode of the bins: 1 rotation, reversed; 1 swinging; 2 rest" in text
+
+
 def test_the_command_line_reports_the_modes(dataset, capsys, stand_in):
     """The command line's JSON names each bin's mode (swinging included) and each period
     bin's record length (``record_s``: 2 peak periods here), and its text report names the
@@ -158,7 +177,7 @@ def test_the_command_line_reports_the_modes(dataset, capsys, stand_in):
     assert out["waves"] == 2.0 and out["record_s"] == [10.0, 12.0]
     assert main(args) == 0
     text = capsys.readouterr().out
-    assert "1 rotation, 1 swinging, 2 rest" in text
+    assert "1 rotation; 1 swinging; 2 rest" in text
     assert text.startswith("power matrix, hull (surge, heave, pitch): 2 Hm0 x 2 tp bins")
 
 
@@ -370,8 +389,10 @@ def test_each_bin_is_parapend_buoy_by_hand(dataset, scatter, capsys, tmp_path):
             assert pm[i, j] == pytest.approx(max(r.power_w, 0.0), rel=1e-9)
             assert ds["radiation_bound_power"].values[i, j, 0] == pytest.approx(
                 r.radiation_bound_w, rel=1e-9)
-            assert ds["mode"].values[i, j, 0] == ("rest", "rotation",
-                                                  "swinging").index(r.mode)
+            want = ("rotation, reversed" if r.mode == "rotation" and r.winding < 0
+                    else r.mode)
+            assert ds["mode"].values[i, j, 0] == ("rest", "rotation", "swinging",
+                                                  "rotation, reversed").index(want)
     want = HOURS_PER_YEAR * sum(pm[i, j] * freq[(h, t)] for i, h in enumerate((1, 2))
                                 for j, t in enumerate((5, 6)))
     assert out["annual_energy"]["power"]["wh"] == pytest.approx(want, rel=1e-12)

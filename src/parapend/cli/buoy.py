@@ -419,13 +419,22 @@ def _realizations_text(r) -> list:
 
 
 def _hull_sweep_text(r) -> list:
-    rows = [[f"{t:g}", _fmt(p), _fmt(rp), _fmt(sp), m, _fmt(o), _fmt(b), _fmt(z), _fmt(pi)]
-            for t, p, rp, sp, m, o, b, z, pi in zip(
-                r.period_s, r.power_w, r.rotation_power_w, r.swinging_power_w, r.mode,
-                r.one_way_power_w, r.radiation_bound_w, r.heave_amplitude_m,
-                r.pitch_amplitude_deg)]
-    head = ["T (s)", "power (W)", "rotation (W)", "swinging (W)", "best", "one-way (W)",
-            "bound (W)", "heave (m)", "pitch (deg)"]
+    from ..hydro.result import mode_label
+
+    def best(x):  # the best mode's name, the rotation's sense with it ("": not solved)
+        return "" if x is None or x.mode is None else mode_label({"mode": x.mode,
+                                                                 "winding": x.winding})
+
+    solved = list(r.results) + [None] * (len(r.period_s) - len(r.results))
+
+    rows = [[f"{t:g}", _fmt(p), _fmt(rp), "" if k is None else f"{k:+d}", _fmt(sp), best(x),
+             _fmt(o), _fmt(b), _fmt(z), _fmt(pi)]
+            for t, p, rp, k, sp, x, o, b, z, pi in zip(
+                r.period_s, r.power_w, r.rotation_power_w, r.rotation_winding,
+                r.swinging_power_w, solved, r.one_way_power_w, r.radiation_bound_w,
+                r.heave_amplitude_m, r.pitch_amplitude_deg)]
+    head = ["T (s)", "power (W)", "rotation (W)", "turns/wave", "swinging (W)", "best",
+            "one-way (W)", "bound (W)", "heave (m)", "pitch (deg)"]
     out = [f"regular waves, H = {r.wave_height_m:g} m", *_hull_head(r), "",
            _table(rows, head), "", f"success: {r.success}"]
     none = [f"{t:g}" for t, why in zip(r.period_s, r.headline_reason or ()) if why]

@@ -75,7 +75,8 @@ HEAVE_SWEEP_KEYS = ("period_s", "power_w", "one_way_power_w", "radiation_bound_w
                     "wave_height_m", "pendulum", "body", "warnings", "electrical_power_w",
                     "mechanical_power_w", "mesh_error_w", "validity_warnings", "grid_error_w")
 HULL_SWEEP_KEYS = ("period_s", "power_w", "headline_reason", "mechanical_power_w",
-                   "rotation_power_w", "swinging_power_w", "one_way_power_w", "radiation_bound_w",
+                   "rotation_power_w", "rotation_winding", "swinging_power_w",
+                   "one_way_power_w", "radiation_bound_w",
                    "heave_amplitude_m", "pitch_amplitude_deg", "energy_balance_residual", "mode",
                    "status", "success", "wave_height_m", "pendulum", "body", "pivot", "warnings")
 
@@ -91,7 +92,7 @@ _TYPES = {**dict.fromkeys(("harmonics", "winding", "bound_cut", "hull_harmonics"
           **dict.fromkeys(("wave", "pendulum", "body", "design", "pivot"), "dict | None"),
           **dict.fromkeys(("efficiency", "modes", "maxima_powers_w"), "list | None"),
           "success": "bool | None"}
-_SWEEP_TYPES = {**dict.fromkeys(("status", "mode"), "list | None"),
+_SWEEP_TYPES = {**dict.fromkeys(("status", "mode", "rotation_winding"), "list | None"),
                 **dict.fromkeys(("pendulum", "body", "pivot"), "dict | None"),
                 "success": "bool | None", "wave_height_m": "float | None"}
 
@@ -452,11 +453,18 @@ class BuoySweepResult(_Result):
             return np.array([np.nan if getattr(r, name) is None else getattr(r, name)
                              for r in results] + [np.nan] * left, dtype=float)
 
+        def best_of(r, mode):
+            # the better of the mode's answers (a hull's rotation: either sense): (power,
+            # winding), (NaN, None) where none has a power
+            ms = [m for m in r.modes if m["mode"] == mode and m["power_w"] is not None
+                  and math.isfinite(m["power_w"])]
+            if not ms:
+                return np.nan, None
+            m = max(ms, key=lambda m: m["power_w"])
+            return m["power_w"], m["winding"]
+
         def mode_power(r, mode):
-            # the better of the mode's answers (a hull's rotation: either sense)
-            ps = [m["power_w"] for m in r.modes if m["mode"] == mode]
-            ps = [p for p in ps if p is not None and math.isfinite(p)]
-            return max(ps) if ps else np.nan
+            return best_of(r, mode)[0]
 
         warn = [f"T = {t:g} s: {w}" for t, r in zip(periods, results)
                 for w in list(r.warnings) + list(r.validity_warnings)]
@@ -468,6 +476,8 @@ class BuoySweepResult(_Result):
                    mechanical_power_w=arr("mechanical_power_w"),
                    rotation_power_w=np.array([mode_power(r, "rotation") for r in results]
                                              + [np.nan] * left, dtype=float),
+                   rotation_winding=[best_of(r, "rotation")[1] for r in results]
+                   + [None] * left,
                    swinging_power_w=np.array([mode_power(r, "swinging") for r in results]
                                              + [np.nan] * left, dtype=float),
                    one_way_power_w=arr("one_way_power_w"),
@@ -516,6 +526,12 @@ class BuoySweepResult(_Result):
         ds = xr.Dataset({k: ("period_s", np.asarray(getattr(self, k), dtype=float))
                          for k in names}, coords={"period_s": self.period_s})
         ds["mode"] = ("period_s", np.asarray(self.mode, dtype=str))
+        # which way the better rotation turns: its winding (turns a wave; negative against
+        # a positive pitch), 0 where none has a power
+        ds["rotation_winding"] = ("period_s", np.asarray(
+            [0 if k is None else int(k) for k in self.rotation_winding], dtype=np.int16), {
+                "long_name": "winding of the better rotation (turns per wave; negative: "
+                             "against a positive pitch; 0: no rotation solved)"})
         for name in ("status", "headline_reason"):  # each period's ("" where None)
             if getattr(self, name) is not None:
                 ds[name] = ("period_s", np.asarray(["" if v is None else str(v)

@@ -453,17 +453,20 @@ def matrix_dataset(raw, spec: MatrixSpec, *, depth=None, density: float = 1025.0
     mode_attrs = {"long_name": "the device's mode in the bin", "flag_values": [-1, 0, 1],
                   "flag_meanings": "no_result rest rotation"}
     if "mode" in ds:
-        # the hull: rotation or swinging, whichever more of the bin's solved records chose
-        # (rotation on a tie); rest where the mean is not positive
+        # the hull: rotation (either sense) or swinging, whichever more of the bin's
+        # solved records chose (on a tie rotation, then reversed rotation, then swinging);
+        # rest where the mean is not positive
         m = ds["mode"].values
-        rot = ((m == 1) & solved).sum(axis=-1)
-        swing = ((m == 2) & solved).sum(axis=-1)
-        mode = np.where(mode == 1, np.where(swing > rot, 2, 1), mode).astype(np.int8)
-        mode_attrs = {"long_name": "the device's mode in the bin: rotation or swinging, "
-                                   "whichever more of its solved records chose (rotation on "
-                                   "a tie); rest where the mean power is not positive",
-                      "flag_values": [-1, 0, 1, 2],
-                      "flag_meanings": "no_result rest rotation swinging"}
+        votes = np.stack([((m == c) & solved).sum(axis=-1) for c in (1, 3, 2)])
+        chosen = np.array([1, 3, 2])[np.argmax(votes, axis=0)]  # argmax: the first of a tie
+        mode = np.where(mode == 1, chosen, mode).astype(np.int8)
+        mode_attrs = {"long_name": "the device's mode in the bin: rotation (in the sense of "
+                                   "a positive pitch), reversed rotation or swinging, "
+                                   "whichever more of its solved records chose (in that "
+                                   "order on a tie); rest where the mean power is not "
+                                   "positive",
+                      "flag_values": [-1, 0, 1, 2, 3],
+                      "flag_meanings": "no_result rest rotation swinging rotation_reversed"}
     ds["operating_mode"] = (dims2, mode, mode_attrs)
     if spec.controller is not None:
         _causal_matrix(ds, spec)

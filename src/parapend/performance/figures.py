@@ -277,8 +277,10 @@ def text_report(ds, out: dict, drawn: list) -> str:
                         f"{out['past_breaking_mwh']:.4g} MWh/yr of the annual energy"))
     if "operating_mode" in ds:
         m = ds["operating_mode"].values
-        lines.append("operating mode of the bins: " + ", ".join(
-            f"{int((m == v).sum())} {name}" for v, name in ((1, "rotation"), (2, "swinging"),
+        lines.append("operating mode of the bins: " + "; ".join(
+            f"{int((m == v).sum())} {name}" for v, name in ((1, "rotation"),
+                                                            (3, "rotation, reversed"),
+                                                            (2, "swinging"),
                                                             (0, "rest"), (-1, "no result"))
             if (m == v).any()))
     if "operating_mode" in ds and (ds["operating_mode"].values == 0).any():

@@ -18,11 +18,24 @@ import math
 
 from ..errors import ParameterError
 
-__all__ = ["FAILURES", "MODES", "check_records", "failure_code", "hull_of", "hull_opts", "problem",
-           "solve_hull_bin"]
+__all__ = ["FAILURES", "MODES", "check_records", "failure_code", "hull_of", "hull_opts",
+           "mode_code", "problem", "solve_hull_bin"]
 
-#: the per-realization ``mode`` codes (-1: not computed)
-MODES = ("rest", "rotation", "swinging")
+#: the per-realization ``mode`` codes, their index (-1: not computed): rotation turns the
+#: pendulum in the sense of a positive pitch, "rotation, reversed" against it (a hull that
+#: surges and pitches is not the same problem both ways: which way the generator turns is
+#: a design input)
+MODES = ("rest", "rotation", "swinging", "rotation, reversed")
+
+
+def mode_code(res) -> int:
+    """The store's code of a record's answer ``res`` (:data:`MODES`): its mode, a rotation
+    of negative winding reversed."""
+    if res.mode == "rotation" and (getattr(res, "winding", None) or 0) < 0:
+        return MODES.index("rotation, reversed")
+    return MODES.index(res.mode)
+
+
 #: the per-realization reason for no resolved answer: an int8 code (-1 not computed)
 FAILURES = ("none", "no start converged", "harmonics unresolved",
             "above the radiation bound", "refinement failed", "other")
@@ -269,4 +282,4 @@ def solve_hull_bin(spec, i: int, j: int, r: int, start: list | None = None) -> d
     owp = res.one_way_power_w
     return {**out, "radiation_bound_power": float(res.radiation_bound_w),
             "one_way_power": math.nan if owp is None else float(owp),
-            "mode": MODES.index(res.mode), "status": status}
+            "mode": mode_code(res), "status": status}

@@ -43,8 +43,9 @@ QUANTITIES = {
 UNITS = {"peak_torque": "N m", "peak_pivot_force": "N"}
 
 #: the hull's per-realization mode (--dofs surge,heave,pitch): an int8 code, -1 not computed
-MODE_LONG_NAME = ("best mode of the record: 0 rest, 1 rotation (one turn per wave), 2 swinging "
-                  "(on a long record, possibly with a few net turns)")
+MODE_LONG_NAME = ("best mode of the record: 0 rest, 1 rotation in the sense of a positive "
+                  "pitch, 2 swinging (on a long record, possibly with a few net turns), 3 "
+                  "rotation against it (reversed)")
 _TITLE = "parapend design map"
 #: every top-level name a power-matrix store holds (coordinates and variables)
 STORE_NAMES = ("hm0", "te", "tp", "realization", "seed", "done", "status", "mode", "failure",
@@ -318,8 +319,8 @@ class MatrixSpec:
             elif v == "mode":
                 arr = da.full(self.shape, -1, dtype=np.int8, chunks=self.chunks)
                 fill = -1
-                attrs = {"long_name": MODE_LONG_NAME, "flag_values": [0, 1, 2],
-                         "flag_meanings": "rest rotation swinging",
+                attrs = {"long_name": MODE_LONG_NAME, "flag_values": [0, 1, 2, 3],
+                         "flag_meanings": "rest rotation swinging rotation_reversed",
                          "comment": "-1: not computed"}
             elif v == "failure":
                 arr = da.full(self.shape, -1, dtype=np.int8, chunks=self.chunks)
