@@ -16,6 +16,7 @@ balance residual and the largest turn of the generator in one plant step (rad).
     nice python benchmarks/hull_collocation_table.py --seeds 0 1 2 3 --solver compiled
     nice python benchmarks/hull_collocation_table.py --seeds 0 1 2 --tp 8.9 --max-iter 40
     nice python benchmarks/hull_collocation_table.py --seeds 0 1 2 --solver compiled --step kkt
+    python benchmarks/hull_collocation_table.py --seeds 0 1 2 --update-interval 0.25
 """
 
 from __future__ import annotations
@@ -50,6 +51,8 @@ def main():
                     help="Hermite-Simpson intervals a torque sample (default INTERVALS)")
     ap.add_argument("--max-iter", type=int, default=None,
                     help="the horizon solve's iterations at most (default the planner's)")
+    ap.add_argument("--update-interval", type=float, default=0.125,
+                    help="peak periods between updates (default hull_mpc's)")
     ap.add_argument("--solver", default=None, choices=["compiled", "ipopt"],
                     help="the horizon's solver (default _hull_collocation.SOLVER)")
     ap.add_argument("--step", default=None, choices=["auto", "kkt", "nullspace"],
@@ -79,7 +82,8 @@ def main():
     hc._plan = plan
     print(f"planner {a.planner}, {a.plant_steps} plant steps a sample, speed bound "
           f"{hcol.MAX_TURN} rad a plant step, at most {hcol.INTERVALS} intervals a sample, "
-          f"terminal weight {a.terminal_weight}, solver {hcol.SOLVER}, max_iter {a.max_iter}"
+          f"terminal weight {a.terminal_weight}, solver {hcol.SOLVER}, max_iter {a.max_iter}, "
+          f"update every {a.update_interval:g} Tp"
           + (f", step {a.step}" if a.step else ""))
     print("seed forecast mode optimum_w power_w fraction stored_w failed capped "
           "update_median_s update_p99_s interval_s status wall_s balance_residual "
@@ -99,7 +103,7 @@ def main():
             r = hc.hull_mpc(p["hull"], pend, wave, peak_period=a.tp, pivot=p["pivot"],
                             forecast=fc, mode=mode, planner=a.planner,
                             plant_steps=a.plant_steps, terminal_weight=a.terminal_weight,
-                            max_iter=a.max_iter)
+                            max_iter=a.max_iter, update_interval=a.update_interval)
             f = r.mean_power_w / opt.power_w
             fr[fc].append(f)
             print(f"{seed} {fc} {mode} {opt.power_w:.1f} {r.mean_power_w:.1f} {f:.3f} "

@@ -246,6 +246,7 @@ def _same_record_three_ways(hydro_opts, capsys, waves, tp, extra=()):
     return api, cli["power_w"], float(ds["power"].values[0, 0, 0])
 
 
+@pytest.mark.slow
 def test_record_optimum_is_one_number_from_cli_api_and_power_matrix(dataset, capsys):
     """A record (2 peak periods, the synthetic hull; its search dense, its refinement
     matrix-free) is the same number from ``parapend.buoy``, ``parapend buoy`` and a

@@ -55,7 +55,7 @@ def test_the_search_goes_on_while_a_winding_beats_the_best_and_stops_after_two_m
     # 6 would beat, but two misses in a row stop it; then the other sense (0 W here)
     assert tried == [1, 2, 3, 4, 5, -1, -2]
     assert [m["mode"] for m in modes[2:]] == ["swinging"] * 7
-    assert all(m["_searched"] for m in modes[2:])
+    assert all(m["searched"] for m in modes[2:])
     # Hs 1 m, Te 7 s: one net turn best, then two misses
     tried, _ = _search({0: 453.8, 1: 464.7, 2: 458.7, 3: 459.8, 4: 456.5})
     assert tried == [1, 2, 3, -1, -2]
@@ -315,3 +315,44 @@ def test_the_matrix_bins_optimum_turns_both_ways_and_is_above_its_causal_run():
     assert r.power_w > 459.537 * 1.1
     assert math.isclose(r.power_w, 535.627, rel_tol=2e-3)
     assert "rotation, reversed: converged" in r.status
+
+
+def _climb(powers, start=(5, -5), top=12, failed=()):
+    """Run the short record's climb with a fake solve giving ``powers[k]`` (W) at winding
+    ``k``, after the windings ``start`` and swinging: the windings tried, and the modes."""
+    modes = [_mode(k, powers[k]) for k in start] + [_mode(0, powers.get(0, 0.0))]
+    for m in modes:
+        m["refinement_history"] = [[60, m["power_w"]]]
+    tried = []
+
+    def solve(k, screen, checks):
+        assert isinstance(screen, res._Screen) and checks is False
+        tried.append(k)
+        m = _mode(k, powers.get(k, 0.0), success=k not in failed)
+        m["refinement_history"] = [[60, m["power_w"]]]
+        return m
+
+    res._climb_windings(modes, solve, top)
+    return tried, modes
+
+
+def test_a_short_records_rotation_climbs_its_turns_in_the_better_sense():
+    # the default sea's seed 0 (W, reversed turns): not monotone; 2 turns best, found
+    # past one miss; away from zero two misses at once
+    seed0 = {-5: 988.1, -4: 989.8, -3: 956.9, -2: 1000.8, -1: 961.2, -6: 941.4,
+             -7: 887.9, 5: 703.1, 0: 947.1}
+    tried, modes = _climb(seed0)
+    assert tried == [-4, -3, -2, -1, -6, -7]
+    best = max(modes, key=lambda m: m["power_w"])
+    assert best["winding"] == -2 and all(m["searched"] for m in modes[3:])
+    assert res.mode_label(best) == "rotation, 2 turns, reversed"
+    # seed 3: the record's own 5 turns best, two misses each way
+    seed3 = {-5: 1144.0, -4: 1119.2, -3: 1096.6, -6: 1102.3, -7: 1019.1, 5: 768.8}
+    assert _climb(seed3)[0] == [-4, -3, -6, -7]
+    # the forward sense when it is the better; stopped at one turn and at ``top``; a
+    # failed winding is a miss
+    fwd = {5: 900.0, -5: 800.0, 4: 910.0, 3: 920.0, 2: 930.0, 1: 940.0, 6: 901.0, 7: 950.0}
+    assert _climb(fwd, top=6)[0] == [4, 3, 2, 1, 6]
+    assert _climb(fwd, failed=(4,))[0] == [4, 3, 2, 1, 6, 7, 8, 9]
+    # no rotation solved: nothing to climb
+    assert _climb({5: -math.inf, -5: -math.inf})[0] == []

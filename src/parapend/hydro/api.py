@@ -920,14 +920,18 @@ def solve_record(problem: dict, wave, info, *, check_only: bool = False):
     and swinging unless a winding was given, and on a record of ``WINDING_SEARCH_WAVES`` or
     more the windings between them: :func:`parapend.hydro.result.hull_answer`'s search);
     ``check_only``: the checks alone."""
+    from .hull import HARMONICS_PER_TURN
     from .result import WINDING_SEARCH_WAVES
 
     windings = problem["windings"]
-    search = False
+    search, climb = False, 0
     if problem["winding"] is None:
         k = waves_in(wave)
         windings = (k, -k, 0)
         search = k >= WINDING_SEARCH_WAVES
+        if not search:  # a short record: the rotation's other turns, within the size cap
+            cap = problem.get("max_harmonics") or hull_harmonics_cap(problem["pto"])
+            climb = (problem["harmonics"] or cap) // HARMONICS_PER_TURN
     _check_hull_size(wave, windings, problem["harmonics"], problem["pto"],
                      problem.get("max_harmonics"))
     amps = np.abs(np.asarray(wave.amplitudes))
@@ -939,7 +943,8 @@ def solve_record(problem: dict, wave, info, *, check_only: bool = False):
     return optimum(problem["hull"], problem["pendulum"], wave, wave_info=info,
                    winding=windings, harmonics=problem["harmonics"], pto=problem["pto"],
                    pivot=problem["pivot"], pitch_inertia=problem["pitch_inertia"],
-                   geometry=problem["geometry"], winding_search=search)
+                   geometry=problem["geometry"], winding_search=search,
+                   winding_climb=climb)
 
 
 def hull_buoy(deadline=None, time_limit=None, **opts):
