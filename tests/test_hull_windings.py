@@ -276,10 +276,14 @@ def test_a_hull_store_records_its_record_optimum_and_an_older_one_is_refused(
     tmp_path.joinpath("m").mkdir()
     with pytest.raises(ParameterError, match="hull's record optimum of an earlier version"):
         store._prepare(tmp_path / "m", spec, None, False)
-    # ... and one whose record optimum turned the forward sense alone
-    old["record_optimum"] = "rotation, swinging and the windings searched"
-    with pytest.raises(ParameterError, match="hull's record optimum of an earlier version"):
-        store._prepare(tmp_path / "m", spec, None, False)
+    # ... and one whose record optimum turned the forward sense alone, or did not climb a
+    # short record's turns
+    for before in ("rotation, swinging and the windings searched",
+                   "rotation both ways, swinging and the windings searched both ways"):
+        old["record_optimum"] = before  # the forward sense; the short records' turns
+        with pytest.raises(ParameterError,
+                           match="hull's record optimum of an earlier version"):
+            store._prepare(tmp_path / "m", spec, None, False)
     monkeypatch.setattr(store, "_identify", lambda path: ("store", spec.to_json()))
     store._prepare(tmp_path / "m", spec, None, False)  # the same sweep resumes
 

@@ -1169,9 +1169,8 @@ SEARCH_MISSES = 2
 #: a record of this many waves or more (``waves_in``) has its windings searched by default
 #: (:func:`parapend.hydro.api.solve_record`): over a long record the pendulum that swings
 #: through the upright gains by going over the top a few times net (measured: +2.4 % at one
-#: net turn on a 234-wave record); the default 4-peak-period records' optima swing
-#: (winding 0 beat 1 and 2 net turns on seeds 0 to 9 of the default sea) and are not
-#: searched, which would double their cost
+#: net turn on a 234-wave record); a shorter record has its rotation's turns climbed
+#: instead (:func:`_climb_windings`: a turn is a fifth of a 4-peak-period record's)
 WINDING_SEARCH_WAVES = 20
 
 

@@ -84,8 +84,10 @@ BUOY_CAUSAL_SECONDS = {"plan": 0.25, "coupled": 2.0, "hull": 4.5, "hull-collocat
 
 
 def hull_record_seconds(waves: float, ideal: bool = True) -> float:
-    """A rough CPU time (s) of one hull record of ``waves`` peak periods (both modes and
-    their refinement): the dense solver's
+    """A rough CPU time (s) of one hull record of ``waves`` peak periods (its modes and
+    their refinement: the rotation both ways and swinging, and on a short record the
+    rotation's other turns, 17 to 24 s on the default sea's 4-peak-period records, seeds 0
+    to 9, against the estimate's 44): the dense solver's
     :data:`parapend.performance.check.HULL_SOLVE_SECONDS` per 9 waves; an ideal take-off's
     records past ``hull.KRYLOV_HARMONICS`` solved matrix-free, near-linear in the length
     (benchmarks/bench_hull_record.out.txt, two runs on the shared 2-core machine at load 5

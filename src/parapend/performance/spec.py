@@ -63,11 +63,14 @@ _BUOY_FIELDS = ("body", "radius", "draft", "mesh", "hydro", "digest", "damping_c
 #: that a store written before the body took the matrix's water still resumes
 _DEFAULT_WATER = {"water_density": 1025.0, "water_depth": None}
 #: how the hull's record optimum is found (in its stores' identity): rotation both ways and
-#: swinging, and on a long record the windings between them both ways
-#: (:func:`parapend.hydro.result.hull_answer`'s search); a store of an earlier version (no
-#: marker, or the forward sense alone: "rotation, swinging and the windings searched") is
+#: swinging, on a long record the windings between them both ways
+#: (:func:`parapend.hydro.result.hull_answer`'s search), on a short one the rotation's
+#: turns climbed; a store of an earlier version (no marker, or another one: the forward
+#: sense alone, "rotation, swinging and the windings searched"; the short records' turns
+#: not climbed, "rotation both ways, swinging and the windings searched both ways") is
 #: refused
-RECORD_OPTIMUM = "rotation both ways, swinging and the windings searched both ways"
+RECORD_OPTIMUM = ("rotation both ways, swinging, the windings searched both ways and a "
+                  "short record's turns climbed")
 #: the hull's fields (--dofs surge,heave,pitch) at their defaults, the heaving buoy's: left
 #: out of the JSON, so that a store written before the hull came still resumes
 _DEFAULT_HULL = {"dofs": "heave", "pivot_height": None, "pivot_offset": None,
