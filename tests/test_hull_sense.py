@@ -88,6 +88,11 @@ def test_the_answer_turns_whichever_way_is_better(datasets):
     assert {2, -2, 0, -1, -3} <= set(powers) and all(k <= 0 for k in set(powers) - {2})
     assert all(m["searched"] for m in r.modes if m["winding"] not in (2, -2, 0, None))
     assert r.winding < 0 and r.power_w == max(powers.values())
+    best = next(m for m in r.modes if m["winding"] == r.winding)
+    k = abs(r.winding)
+    assert parapend.hydro.result.best_label(r) == (
+        f"rotation, {k} turn{'s' if k > 1 else ''}, reversed" if best.get("searched")
+        else "rotation, reversed")
     assert r.power_w > 1.01 * max(powers[2], powers[0])
     m = parapend.buoy(hydro=datasets["mirror"], winding=-r.winding, **rec, **mirror_pend)
     assert m.power_w == pytest.approx(r.power_w, rel=1e-9)

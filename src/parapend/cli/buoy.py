@@ -341,13 +341,13 @@ def _hull_text(r) -> list:
     wave = (f"wave: regular, H = {w['height_m']:g} m, T = {w['period_s']:g} s"
             if w.get("kind") == "regular" else
             f"wave: irregular record, repeat period {w['repeat_period']:.6g} s")
-    from ..hydro.result import mode_label
+    from ..hydro.result import best_label, mode_label
 
     modes = [[mode_label(m), _w(m["power_w"]), _w(m.get("one_way_power_w")),
               _w(m.get("mean_angle_deg")), _w(m.get("swing_amplitude_deg")),
               _w(m.get("peak_torque_nm")), str(m.get("distinct_maxima", "-")),
               m["status"]] for m in r.modes]
-    rows = [["best mode", mode_label({"mode": r.mode, "winding": r.winding}), "-"],
+    rows = [["best mode", best_label(r), "-"],
             ["power" if r.efficiency is None and not r.copper_loss_w_per_nm2
              else "electrical power",
              _w(r.power_w), "W"],
@@ -419,11 +419,10 @@ def _realizations_text(r) -> list:
 
 
 def _hull_sweep_text(r) -> list:
-    from ..hydro.result import mode_label
+    from ..hydro.result import best_label
 
     def best(x):  # the best mode's name, the rotation's sense with it ("": not solved)
-        return "" if x is None or x.mode is None else mode_label({"mode": x.mode,
-                                                                 "winding": x.winding})
+        return "" if x is None or x.mode is None else best_label(x)
 
     solved = list(r.results) + [None] * (len(r.period_s) - len(r.results))
 

@@ -35,7 +35,7 @@ from .optimum import TORQUE_SLACK
 from .waves import energy_flux
 
 __all__ = ["BuoyResult", "BuoySweepResult", "MotionAt", "error_estimate", "free_heave",
-           "hull_answer", "mode_label", "optimum"]
+           "best_label", "hull_answer", "mode_label", "optimum"]
 
 
 #: the JSON keys of a heave-only answer (a buoy), in their order
@@ -1321,6 +1321,14 @@ def mode_label(m) -> str:
     if m["mode"] == "rotation" and k is not None and k < 0:
         return "rotation, reversed"
     return m["mode"]
+
+
+def best_label(r) -> str:
+    """The name of a hull answer ``r``'s best mode (:func:`mode_label` of its entry in
+    ``r.modes``: a searched rotation's turns with it)."""
+    m = next((m for m in r.modes or () if m["mode"] == r.mode
+              and m["winding"] == r.winding), {"mode": r.mode, "winding": r.winding})
+    return mode_label(m)
 
 
 def hull_answer(hull, pendulum, wave, *, pivot, windings=(1, -1, 0), pitch_inertia=None,
