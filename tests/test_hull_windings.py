@@ -360,3 +360,25 @@ def test_a_short_records_rotation_climbs_its_turns_in_the_better_sense():
     assert _climb(fwd, failed=(4,))[0] == [4, 3, 2, 1, 6, 7, 8, 9]
     # no rotation solved: nothing to climb
     assert _climb({5: -math.inf, -5: -math.inf})[0] == []
+
+
+@pytest.mark.parametrize("pto, climb", [({}, 30), ({"efficiency": 0.9}, 0),
+                                        ({"torque_limit": 30e3}, 0)])
+def test_a_short_record_climbs_through_an_ideal_take_off_only(pto, climb, monkeypatch):
+    """``solve_record`` asks the short record's climb, up to the record's harmonics cap in
+    turns (an ideal take-off's: 360 harmonics, 12 a turn), and not through a lossy one
+    (its solves unscreened: too slow); a long record searches instead."""
+    from parapend.hydro import api
+    from parapend.hydro.coupled import Wave
+
+    seen = {}
+
+    def fake(*args, **kw):
+        seen.update(kw)
+
+    monkeypatch.setattr(api, "optimum", fake)
+    p = api.hull_problem(dofs="surge,heave,pitch", **pto)
+    wave = Wave.from_spectrum(hs=1.0, tp=6.0, repeat_period=24.0, seed=0)
+    api.solve_record({**p, "max_harmonics": 360}, wave, {})
+    assert seen["winding_climb"] == climb and seen["winding_search"] is False
+    assert seen["winding"] == (5, -5, 0)

@@ -917,8 +917,10 @@ def hull_problem(**opts) -> dict:
 def solve_record(problem: dict, wave, info, *, check_only: bool = False):
     """One irregular record ``wave`` (described by ``info``) of :func:`hull_problem`'s
     ``problem``: its size and frequencies checked, then solved (rotation one turn per wave
-    and swinging unless a winding was given, and on a record of ``WINDING_SEARCH_WAVES`` or
-    more the windings between them: :func:`parapend.hydro.result.hull_answer`'s search);
+    both ways and swinging unless a winding was given, and on a record of
+    ``WINDING_SEARCH_WAVES`` or more the windings between them, on a shorter one through an
+    ideal take-off the rotation's other turns: :func:`parapend.hydro.result.hull_answer`'s
+    search and climb);
     ``check_only``: the checks alone."""
     from .hull import HARMONICS_PER_TURN
     from .result import WINDING_SEARCH_WAVES
@@ -929,7 +931,10 @@ def solve_record(problem: dict, wave, info, *, check_only: bool = False):
         k = waves_in(wave)
         windings = (k, -k, 0)
         search = k >= WINDING_SEARCH_WAVES
-        if not search:  # a short record: the rotation's other turns, within the size cap
+        if not search and not problem["pto"].active:
+            # a short record: the rotation's other turns, within the size cap (an ideal
+            # take-off's: a lossy record's solves are not screened, and its climb took
+            # over 20 minutes on the default sea's 4-peak-period record)
             cap = problem.get("max_harmonics") or hull_harmonics_cap(problem["pto"])
             climb = (problem["harmonics"] or cap) // HARMONICS_PER_TURN
     _check_hull_size(wave, windings, problem["harmonics"], problem["pto"],
