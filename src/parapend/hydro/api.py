@@ -933,8 +933,9 @@ def solve_record(problem: dict, wave, info, *, check_only: bool = False):
         search = k >= WINDING_SEARCH_WAVES
         if not search and not problem["pto"].active:
             # a short record: the rotation's other turns, within the size cap (an ideal
-            # take-off's: a lossy record's solves are not screened, and its climb took
-            # over 20 minutes on the default sea's 4-peak-period record)
+            # take-off's: a lossy record's solves are not screened; the default sea's
+            # 4-peak-period record with an efficiency ran past 20 minutes with the climb,
+            # past 15 without)
             cap = problem.get("max_harmonics") or hull_harmonics_cap(problem["pto"])
             climb = (problem["harmonics"] or cap) // HARMONICS_PER_TURN
     _check_hull_size(wave, windings, problem["harmonics"], problem["pto"],
