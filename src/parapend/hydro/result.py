@@ -1170,7 +1170,7 @@ SEARCH_MISSES = 2
 #: (:func:`parapend.hydro.api.solve_record`): over a long record the pendulum that swings
 #: through the upright gains by going over the top a few times net (measured: +2.4 % at one
 #: net turn on a 234-wave record); a shorter record has its rotation's turns climbed
-#: instead (:func:`_climb_windings`: a turn is a fifth of a 4-peak-period record's)
+#: instead (``_climb_windings``: a turn is a fifth of a 4-peak-period record's)
 WINDING_SEARCH_WAVES = 20
 
 
@@ -1344,7 +1344,7 @@ def hull_answer(hull, pendulum, wave, *, pivot, windings=(1, -1, 0), pitch_inert
     search: the powers over the windings are not monotone); with ``search`` the
     swinging is solved first and the other windings are screened against it
     (``SCREEN_MARGIN``); ``climb`` (a short record's): also the rotation's other turns, up
-    to ``climb`` a record, in the better sense (:func:`_climb_windings`)."""
+    to ``climb`` a record, in the better sense (``_climb_windings``)."""
     pto = pto or HullPTO()
     from threadpoolctl import threadpool_limits
 
