@@ -849,6 +849,7 @@ def _power_matrix_result(power_matrix, arguments):
     """
     from .hydro.declared import expand_inputs, has_inputs
     from .performance import STATISTICS
+    from .performance.hull_device import MODES
 
     if has_inputs(arguments.arguments):  # the input objects: their fields, as keywords
         import inspect
@@ -894,8 +895,8 @@ def _power_matrix_result(power_matrix, arguments):
            "statistics": stats, "failed_solves": failed,
            "depth": depth, "width": (ds["capture_width_ratio_matrix"].attrs.get("width")
                                      if "capture_width_ratio_matrix" in ds else None),
-           "operating_mode": [[{1: "rotation", 0: "rest", 2: "swinging",
-                                3: "rotation, reversed"}.get(int(v)) for v in row]
+           # the store's codes (hull_device.MODES; the heaving buoy's are its first two)
+           "operating_mode": [[MODES[int(v)] if v >= 0 else None for v in row]
                               for row in ds["operating_mode"].values],
            "frequency": grid("frequency") if "frequency" in ds else None,
            "annual_energy": annual, "hours_per_year": float(ds.attrs["hours_per_year"]),

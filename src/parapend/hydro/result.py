@@ -463,8 +463,7 @@ class BuoySweepResult(_Result):
             m = max(ms, key=lambda m: m["power_w"])
             return m["power_w"], m["winding"]
 
-        def mode_power(r, mode):
-            return best_of(r, mode)[0]
+        rot = [best_of(r, "rotation") for r in results]
 
         warn = [f"T = {t:g} s: {w}" for t, r in zip(periods, results)
                 for w in list(r.warnings) + list(r.validity_warnings)]
@@ -474,11 +473,10 @@ class BuoySweepResult(_Result):
                         "partial sweep")
         return cls(period_s=np.asarray(periods, dtype=float), power_w=arr("power_w"),
                    mechanical_power_w=arr("mechanical_power_w"),
-                   rotation_power_w=np.array([mode_power(r, "rotation") for r in results]
-                                             + [np.nan] * left, dtype=float),
-                   rotation_winding=[best_of(r, "rotation")[1] for r in results]
-                   + [None] * left,
-                   swinging_power_w=np.array([mode_power(r, "swinging") for r in results]
+                   rotation_power_w=np.array([p for p, _ in rot] + [np.nan] * left,
+                                             dtype=float),
+                   rotation_winding=[k for _, k in rot] + [None] * left,
+                   swinging_power_w=np.array([best_of(r, "swinging")[0] for r in results]
                                              + [np.nan] * left, dtype=float),
                    one_way_power_w=arr("one_way_power_w"),
                    radiation_bound_w=arr("radiation_bound_w"),
@@ -1282,17 +1280,16 @@ def _climb_windings(modes, solve, top: int) -> None:
     for step in (-1, 1):
         misses, k = 0, abs(start["winding"]) + step
         while misses < SEARCH_MISSES and 1 <= k <= top:
+            won = False
             if sense * k not in tried:
                 # screened against the best rotation so far, checked only if the best
                 m = dict(solve(sense * k, _Screen(lead), checks=False), searched=True)
                 modes.append(m)
                 tried.add(sense * k)
-                if m["success"] and not m.get("_screened") and \
-                        _power_of(m) > _power_of(lead):
-                    misses, lead = 0, m
-                    k += step
-                    continue
-            misses += 1
+                won = (m["success"] and not m.get("_screened")
+                       and _power_of(m) > _power_of(lead))
+                lead = m if won else lead
+            misses = 0 if won else misses + 1
             k += step
 
 

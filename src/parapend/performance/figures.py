@@ -276,12 +276,12 @@ def text_report(ds, out: dict, drawn: list) -> str:
                         f"; the site gives them {share:.4g} of the year, "
                         f"{out['past_breaking_mwh']:.4g} MWh/yr of the annual energy"))
     if "operating_mode" in ds:
+        from .hull_device import MODES
+
         m = ds["operating_mode"].values
         lines.append("operating mode of the bins: " + "; ".join(
-            f"{int((m == v).sum())} {name}" for v, name in ((1, "rotation"),
-                                                            (3, "rotation, reversed"),
-                                                            (2, "swinging"),
-                                                            (0, "rest"), (-1, "no result"))
+            f"{int((m == v).sum())} {name}" for v, name in (
+                *((c, MODES[c]) for c in (1, 3, 2, 0)), (-1, "no result"))
             if (m == v).any()))
     if "operating_mode" in ds and (ds["operating_mode"].values == 0).any():
         lines.append(f"{int((ds['operating_mode'].values == 0).sum())} bins with a negative "
