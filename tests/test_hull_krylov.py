@@ -522,6 +522,27 @@ def test_a_matrix_free_least_torque_start_takes_few_newton_steps(monkeypatch):
         assert pr.exact(x) > pr.exact(x0)
 
 
+@pytest.mark.parametrize("kw,first", [({"eta": (0.9, 0.85)}, "KINK_KRYLOV_HARMONICS"),
+                                      ({"copper_loss": 1e-3}, "KRYLOV_HARMONICS"),
+                                      ({"eta": (1.0, 1.0)}, "KRYLOV_HARMONICS")])
+def test_an_efficiencys_problem_stays_dense_below_its_own_threshold(monkeypatch, kw, first):
+    """A take-off's problem is matrix-free from ``KRYLOV_HARMONICS`` on, an efficiency's
+    (its kink, whose curvature makes the conjugate gradients' steps dear) only from
+    ``KINK_KRYLOV_HARMONICS``: the two thresholds set apart here, each side of each."""
+    from parapend import limits
+    from parapend.hydro import hull
+
+    # an efficiency's record (refused past HULL_MAX_HARMONICS) and its refinement (to
+    # HULL_MAX_REFINED_HARMONICS) are dense throughout
+    assert hull.KINK_KRYLOV_HARMONICS > limits.HULL_MAX_REFINED_HARMONICS
+    monkeypatch.setattr(hull, "KRYLOV_HARMONICS", 8)
+    monkeypatch.setattr(hull, "KINK_KRYLOV_HARMONICS", 16)
+    at = getattr(hull, first)
+    for n, free in ((at - 4, False), (at, True), (at + 4, True)):
+        pr = hull._lossy_problem(case(winding=1, harmonics=n), **kw)
+        assert isinstance(pr, KrylovHullProblem) == free, (n, kw)
+
+
 @pytest.mark.slow
 def test_barge_ten_wave_record_with_an_efficiency_matrix_free_is_the_dense_answer():
     """The embedded barge's 10-wave record (144 harmonics, swinging) with the efficiency

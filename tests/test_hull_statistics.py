@@ -158,6 +158,10 @@ def test_a_time_limit_gives_a_marked_partial_result(dataset, stand_in, monkeypat
     ({"realizations": 0}, r"^realizations: expected"),
     ({"realizations": 2.5}, r"^realizations: "),
     ({"realizations": 1000}, r"^realizations: 1000 hull records .* --realizations at most"),
+    # an efficiency's record priced at its own cost (minutes a peak period): one is past
+    # the untimed cap
+    ({"realizations": 1, "efficiency": 0.9}, r"^realizations: 1 hull records .* shorter"),
+    ({"realizations": 1, "efficiency": "0.8,x"}, r"^efficiency: expected"),
     ({"realizations": 2, "dofs": "heave", "hydro": None}, r"^realizations: .*hull"),
     ({"realizations": 2, "hs": None, "tp": None, "repeat_period": None, "seed": None},
      r"^realizations: needs an irregular sea"),

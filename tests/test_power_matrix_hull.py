@@ -456,6 +456,12 @@ def test_the_hulls_causal_column_takes_the_buoys_planners(dataset):
         est = check_size(spec, workers=1)
         assert est["seconds"] == pytest.approx(
             4 * (hull_record_seconds(spec.waves) + record_seconds(spec)), rel=1e-12)
+    # an efficiency's records are priced by their own cost a peak period
+    from parapend.performance.check import EFFICIENCY_SECONDS
+
+    lossy = matrix_spec(**BINS, realizations=1, hydro=dataset, **HULL, efficiency=0.9)
+    assert check_size(lossy, workers=1)["seconds"] == pytest.approx(
+        4 * EFFICIENCY_SECONDS * lossy.waves, rel=1e-12)
     for kw, match in (({"planner": "plan"}, r"^planner: with --dofs surge,heave,pitch "),
                       ({"planner": "coupled"}, r"^planner: with --dofs surge,heave,pitch "),
                       ({"planner": "collocation", "controller": None},

@@ -1108,7 +1108,8 @@ def _check_wave_kind(opts):
 
 def hull_harmonics_cap(pto) -> int:
     """The most harmonics of the hull's motion: every take-off's problem is matrix-free
-    from ``hull.KRYLOV_HARMONICS`` on; an ideal one's up to
+    from ``hull.KRYLOV_HARMONICS`` on (an efficiency's from ``hull.KINK_KRYLOV_HARMONICS``,
+    past its record's cap and refinement: dense); an ideal one's up to
     ``limits.HULL_MAX_RECORD_HARMONICS``, a torque limit's or a copper loss's (the limit's
     augmented Lagrangian: several climbs per record) up to
     ``limits.HULL_MAX_PTO_RECORD_HARMONICS``, an efficiency's (its smoothing's continuation,

@@ -531,6 +531,16 @@ BOUND_RCOND = 1e-8
 #: finest refinement (96 harmonics), and from about 60 harmonics the matrix-free one is
 #: the faster (benchmarks/bench_hull_record.py)
 KRYLOV_HARMONICS = 100
+#: ... and an efficiency's (its kink smoothed, :class:`HullPTO`) from this many: the
+#: kink's curvature makes the conjugate gradients' Newton steps dear (about 300 products a
+#: step), so below it the dense trust region is the faster. Measured on the default sea's
+#: 4-peak-period record at efficiency 0.9, the rotation's refinement from 60 to 120
+#: harmonics: 501 s matrix-free (554 Newton steps, 295711 products), 54 to 64 s dense
+#: (800 trust-region steps); at 240 harmonics dense 199 s. An efficiency's record is
+#: refused past ``limits.HULL_MAX_HARMONICS`` and refined to at most
+#: ``limits.HULL_MAX_REFINED_HARMONICS``, so it is dense throughout unless the caps are
+#: lifted (benchmarks/bench_hull_record.py's ``--lift-caps``)
+KINK_KRYLOV_HARMONICS = 512
 #: harmonics of phi from which a record's search runs on coarser discretizations first (the starts
 #: on the coarsest, each finer one from the coarser answer: :func:`._hull_krylov.continued_search`)
 LONG_RECORD_HARMONICS = 200
@@ -558,8 +568,10 @@ def _lossy_problem(case: HullCase, coupled: bool = True, eta=None,
     torque limit is set on it by the drivers): :class:`HullProblem`, or from
     ``KRYLOV_HARMONICS`` harmonics its matrix-free twin, as :func:`ideal_problem` (the
     same objective, gradient and Hessian; its drivers line-search Newton with truncated
-    conjugate gradients, :func:`parapend.hydro._hull_krylov.pto_maximize`)."""
-    if case.harmonics >= KRYLOV_HARMONICS and MATRIX_FREE:
+    conjugate gradients, :func:`parapend.hydro._hull_krylov.pto_maximize`); an
+    efficiency's from ``KINK_KRYLOV_HARMONICS`` on."""
+    first = KRYLOV_HARMONICS if eta is None or eta[0] * eta[1] == 1 else KINK_KRYLOV_HARMONICS
+    if case.harmonics >= first and MATRIX_FREE:
         return MATRIX_FREE["problem"](case, coupled=coupled, eta=eta,
                                       copper_loss=copper_loss)
     return HullProblem(case, coupled=coupled, eta=eta, copper_loss=copper_loss)

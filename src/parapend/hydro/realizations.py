@@ -27,12 +27,12 @@ __all__ = ["check_realizations", "record_seconds", "solve_realizations"]
 log = logging.getLogger(__name__)
 
 
-def record_seconds(waves: float, ideal: bool = True) -> float:
+def record_seconds(waves: float, ideal: bool = True, kink: bool = False) -> float:
     """A rough CPU time (s) of one hull record of ``waves`` peak periods:
     :func:`parapend.performance.check.hull_record_seconds`."""
     from ..performance.check import hull_record_seconds
 
-    return hull_record_seconds(waves, ideal)
+    return hull_record_seconds(waves, ideal, kink)
 
 
 def check_realizations(value, opts: dict, time_limit=None) -> int:
@@ -51,9 +51,12 @@ def check_realizations(value, opts: dict, time_limit=None) -> int:
     tp = opts.get("tp") or HULL["tp"]
     rp = opts.get("repeat_period")
     waves = HULL["repeat_periods"] if rp is None else float(rp) / float(tp)
-    ideal = (opts.get("torque_limit") is None and not opts.get("copper_loss")
-             and opts.get("efficiency") in (None, 1, 1.0))
-    each = record_seconds(waves, ideal)
+    from .pto import efficiency_pair
+
+    eta = efficiency_pair(opts.get("efficiency"))
+    kink = eta is not None and eta[0] * eta[1] != 1
+    ideal = opts.get("torque_limit") is None and not opts.get("copper_loss") and not kink
+    each = record_seconds(waves, ideal, kink)
     most = int(limits.MAX_UNTIMED_SECONDS // each)
     refuse_untimed("realizations", f"{r} hull records of {waves:.3g} peak periods",
                    r * each, f"use --realizations at most {most}" if most >= 1 else

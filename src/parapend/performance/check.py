@@ -83,7 +83,7 @@ CAUSAL_SECONDS = {"perfect": 7.5, "ar": 10.5}
 BUOY_CAUSAL_SECONDS = {"plan": 0.25, "coupled": 2.0, "hull": 4.5, "hull-collocation": 1.4}
 
 
-def hull_record_seconds(waves: float, ideal: bool = True) -> float:
+def hull_record_seconds(waves: float, ideal: bool = True, kink: bool = False) -> float:
     """A rough CPU time (s) of one hull record of ``waves`` peak periods (its modes and
     their refinement: the rotation both ways and swinging, and on a short record the
     rotation's other turns, 17 to 24 s on the default sea's 4-peak-period records, seeds 0
@@ -99,16 +99,26 @@ def hull_record_seconds(waves: float, ideal: bool = True) -> float:
     screened on every level, load 2 to 3 on the 2-core machine: 234-wave records 85 and 138
     s of CPU against the two modes' 56 and 67 s; the 200-wave bench record 51 s against 50
     to 63, the 25-wave one 38.5 s against 14 to 22; a 6 x 6 matrix of 200- to 217-wave
-    records 109 s a record)."""
+    records 109 s a record). ``kink``: an efficiency's record, whose smoothing's continuation
+    climbs every mode from several starts and again on each doubling of the harmonics:
+    :data:`EFFICIENCY_SECONDS` a peak period."""
     from ..hydro.hull import HARMONICS_PER_TURN, KRYLOV_HARMONICS
     from ..hydro.result import WINDING_SEARCH_WAVES
 
     waves = max(float(waves), 1.0)
+    if kink:
+        return EFFICIENCY_SECONDS * waves
     factor = SEARCH_FACTOR if waves >= WINDING_SEARCH_WAVES else 1.0
     if ideal and HARMONICS_PER_TURN * waves >= KRYLOV_HARMONICS:
         return (15.0 + 0.3 * waves) * factor
     return HULL_SOLVE_SECONDS * waves / 9.0 * factor
 
+
+#: CPU seconds a peak period of an efficiency's hull record (:func:`hull_record_seconds`):
+#: the default sea's 4-peak-period record at efficiency 0.9 took 900 s of wall time (one
+#: thread, load 2 to 3 on the 2-core machine; its three modes each refined from 60 to 240
+#: harmonics, the refinements 306, 212 and 181 s)
+EFFICIENCY_SECONDS = 225.0
 
 #: a searched record's CPU time over its two modes' (:func:`hull_record_seconds`)
 SEARCH_FACTOR = 1.75
@@ -272,7 +282,7 @@ def check_size(spec, workers=None, scheduler=None, available=None) -> dict:
         # for an ideal take-off's long records): parapend.hydro.realizations.record_seconds
         ideal = (getattr(spec, "torque_limit", None) is None and not spec.lossy)
         longest = max(map(spec.record_waves, range(len(spec.tp))))
-        seconds = (solves * (hull_record_seconds(longest, ideal) + causal)
+        seconds = (solves * (hull_record_seconds(longest, ideal, spec.lossy) + causal)
                    / max(1, procs or 1))
     return {"bins": bins, "solves": solves, "processes": procs, "memory_bytes": need,
             "seconds": seconds if math.isfinite(seconds) else None,
