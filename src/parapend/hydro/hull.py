@@ -536,8 +536,8 @@ KRYLOV_HARMONICS = 100
 #: step), so below it the dense trust region is the faster. Measured on the default sea's
 #: 4-peak-period record at efficiency 0.9, the rotation's refinement from 60 to 120
 #: harmonics: 501 s matrix-free (554 Newton steps, 295711 products), 54 to 64 s dense
-#: (800 trust-region steps); at 240 harmonics dense 199 s. An efficiency's record is
-#: refused past ``limits.HULL_MAX_HARMONICS`` and refined to at most
+#: (800 trust-region steps); at 240 harmonics dense 199 s, matrix-free 352 s. An
+#: efficiency's record is refused past ``limits.HULL_MAX_HARMONICS`` and refined to at most
 #: ``limits.HULL_MAX_REFINED_HARMONICS``, so it is dense throughout unless the caps are
 #: lifted (benchmarks/bench_hull_record.py's ``--lift-caps``)
 KINK_KRYLOV_HARMONICS = 512
