@@ -270,3 +270,53 @@ def test_a_take_offs_answer_carries_its_optimality(pto):
     assert float(np.linalg.eigvalsh(0.5 * (cols + cols.T))[-1]) == pytest.approx(top, rel=1e-4)
     gk, _, sk = optimality(k, x)
     assert gk <= 1e-7 * scale and sk < 0
+
+
+def test_a_dense_refinement_climbs_the_ladder_and_stops_once_settled(monkeypatch):
+    """A dense efficiency's refinement (the doubled harmonics, from the coarser answer
+    padded) climbs the continuation's widths from ``REFINE_WIDTH`` (factors of about 3; the
+    four widths 1e-3 to 1e-6 crawled: on the default sea's record each stopped at its 200
+    trust-region steps, 0.6 W below) and stops at the first width at or below
+    ``PTO_SETTLE_WIDTH`` whose exact power has settled from the width before: its climbs
+    are the whole ladder's (the same exact powers to 1e-9), the stop is where the
+    independent rule (the whole ladder's exact powers compared pairwise) puts it, and none
+    of the widths it left out has more than ``PTO_SETTLED`` of the power scale more."""
+    from parapend.hydro import hull
+    from parapend.hydro.pto import WIDTHS, maximize
+
+    rng = np.random.default_rng(1)
+    amps = 0.3 * np.exp(2j * math.pi * rng.random(3)) / np.arange(1, 4)
+    coarse = case(winding=0, harmonics=12, omega=2 * math.pi / 12, amplitudes=amps)
+    fine = case(winding=0, harmonics=24, omega=2 * math.pi / 12, amplitudes=amps)
+    pto = HullPTO(efficiency=(0.9, 0.85))
+    ideal = hull_search(lambda s: coarse, refine=False)
+    x0, ex0, _, _ = hull._pto_maximize(pto.problem(coarse), ideal.x, pto, True)
+    x0 = hull._pad(x0, fine.harmonics)
+    calls = []
+    real = maximize
+
+    def spy(pr, x, widths, limit, **kw):
+        out = real(pr, x, widths, limit, **kw)
+        calls.append((widths, kw.get("settle"), out[2]))
+        return out
+
+    import parapend.hydro.pto as pto_mod
+
+    monkeypatch.setattr(pto_mod, "maximize", spy)
+    x, ex, status, _ = hull._pto_maximize(pto.problem(fine), x0, pto, False, width=1.0)
+    (widths, settle, runs), = calls
+    assert widths == WIDTHS[WIDTHS.index(hull.REFINE_WIDTH):]
+    assert settle[0] == hull.PTO_SETTLE_WIDTH
+    # the whole ladder, independently
+    pr = pto.problem(fine)
+    _, best, whole = real(pr, x0, widths, None)
+    exs = [r[1] for r in whole]
+    assert [r[1] for r in runs] == pytest.approx(exs[:len(runs)], rel=1e-9)
+    size = max(abs(best), float(pr.w[0]))
+    stop = next((i for i in range(1, len(exs)) if widths[i] <= hull.PTO_SETTLE_WIDTH and (
+        exs[i] < exs[i - 1] or abs(exs[i] - exs[i - 1]) <= hull.PTO_SETTLED * size)),
+        len(exs) - 1)
+    assert len(runs) == stop + 1
+    assert ex == max(r[1] for r in runs)
+    assert max(exs) <= ex + hull.PTO_SETTLED * size
+    assert status == "converged"

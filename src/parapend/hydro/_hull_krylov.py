@@ -64,6 +64,7 @@ from .hull import (
     hull_points,
     hull_search,
     ideal_problem,
+    settled,
 )
 
 __all__ = ["KrylovHullProblem", "KrylovHessian"]
@@ -899,18 +900,6 @@ def pto_maximize(problem: KrylovHullProblem, x0, widths=None, limit=None,
         prev = ex if ok else None
     problem.limit = None
     return best_x, best, runs
-
-
-def settled(before: float, after: float, problem) -> bool:
-    """Whether an efficiency's continuation stops after a width whose exact objective is
-    ``after``, the width before's ``before``: it moved by at most ``PTO_SETTLED`` of the
-    larger of it and ``m g l w`` (:data:`.hull.PTO_SETTLED`, the settled check), or it
-    fell (the smaller widths sample the kink on the grid's points, which the exact power
-    integrates between them: on the barge's 10-wave record both modes' exact powers peak
-    at 3e-5 of the largest ``|p|`` and fall after, 499.078, 499.072, 499.045 W swinging at
-    3e-5, 1e-5, 1e-6, the last two widths half the continuation's time)."""
-    size = max(abs(after), float(problem.w[0]))
-    return after < before or abs(after - before) <= _hull.PTO_SETTLED * size
 
 
 #: Lanczos (ARPACK) for the largest eigenvalue of the reduced Hessian scaled by its diagonal

@@ -407,7 +407,7 @@ MAXITER = 200
 
 
 def maximize(problem: ElectricalProblem, x0: np.ndarray, widths=None, limit=None,
-             max_inner: int | None = None):
+             max_inner: int | None = None, settle=None):
     """Continuation ``s -> 0`` from ``x0``: a trust-region Newton method at each width from
     the last optimum (``trust-exact`` on the dense Hessian, ``trust-krylov`` on the
     operator's products: the smoothed objective is not concave in the coefficients, and a
@@ -420,6 +420,10 @@ def maximize(problem: ElectricalProblem, x0: np.ndarray, widths=None, limit=None
 
     Returns ``(x, exact, runs)``: the iterate with the largest exact (unsmoothed) ``<e(p)>``
     on the grid, that value, and per width ``(s, exact, status, iterations)``.
+
+    ``settle``: ``(width, settled)``, the continuation stops after a width at or below
+    ``width`` (relative, as ``widths``) where ``settled(before, after)`` holds for the
+    exact objectives of the width before and this one (None: every width).
     """
     from scipy.optimize import minimize
 
@@ -431,6 +435,16 @@ def maximize(problem: ElectricalProblem, x0: np.ndarray, widths=None, limit=None
     gtol = 1e-9 * max(float(np.max(np.abs(problem.w))), 1e-300)
     dense = problem.hessian != "operator"
     problem.answer = None
+    prev = None
+
+    def stop(rel, ex, ok):
+        """Whether the continuation stops after this width (``settle``)."""
+        nonlocal prev
+        done = (settle is not None and ok and prev is not None
+                and rel <= settle[0] * (1 + 1e-12) and settle[1](prev, ex))
+        prev = ex if ok else None
+        return done
+
     if limit is not None:
         best = -math.inf
         for rel in widths:
@@ -439,9 +453,12 @@ def maximize(problem: ElectricalProblem, x0: np.ndarray, widths=None, limit=None
                                                           max_inner=max_inner)
             ex = problem.exact(x)
             runs.append((rel * p0, ex, status, inner))
-            if math.isfinite(ex) and ex >= best and viol <= LIMIT_TOL * limit:
+            ok = math.isfinite(ex) and viol <= LIMIT_TOL * limit
+            if ok and ex >= best:
                 best, best_x = ex, np.array(x)
                 problem.answer = problem.climbed
+            if stop(rel, ex, ok):
+                break
         problem.limit = None
         return best_x, best, runs
     for rel in widths:
@@ -469,6 +486,8 @@ def maximize(problem: ElectricalProblem, x0: np.ndarray, widths=None, limit=None
             best, best_x = ex, np.array(r.x)
             problem.answer = problem.climbed_state()
         x = np.array(r.x)
+        if stop(rel, ex, math.isfinite(ex)):
+            break
     return best_x, best, runs
 
 
