@@ -934,8 +934,8 @@ def solve_record(problem: dict, wave, info, *, check_only: bool = False):
         if not search and not problem["pto"].active:
             # a short record: the rotation's other turns, within the size cap (an ideal
             # take-off's: a lossy record's solves are not screened; the default sea's
-            # 4-peak-period record with an efficiency ran past 20 minutes with the climb,
-            # past 15 without)
+            # 4-peak-period record with an efficiency takes 525 s of CPU without the climb,
+            # each further turn count a rotation's 140 to 180 s)
             cap = problem.get("max_harmonics") or hull_harmonics_cap(problem["pto"])
             climb = (problem["harmonics"] or cap) // HARMONICS_PER_TURN
     _check_hull_size(wave, windings, problem["harmonics"], problem["pto"],

@@ -115,10 +115,10 @@ def hull_record_seconds(waves: float, ideal: bool = True, kink: bool = False) ->
 
 
 #: CPU seconds a peak period of an efficiency's hull record (:func:`hull_record_seconds`):
-#: the default sea's 4-peak-period record at efficiency 0.9 took 900 s of wall time (one
-#: thread, load 2 to 3 on the 2-core machine; its three modes each refined from 60 to 240
-#: harmonics, the refinements 306, 212 and 181 s)
-EFFICIENCY_SECONDS = 225.0
+#: the default sea's 4-peak-period record at efficiency 0.9 (seed 0) took 525 s of CPU on
+#: the idle 2-core machine, its three modes each refined from 60 to 240 harmonics (rounded
+#: up: other seas refine as far, and a record's modes are as many)
+EFFICIENCY_SECONDS = 150.0
 
 #: a searched record's CPU time over its two modes' (:func:`hull_record_seconds`)
 SEARCH_FACTOR = 1.75
