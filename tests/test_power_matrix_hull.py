@@ -462,6 +462,15 @@ def test_the_hulls_causal_column_takes_the_buoys_planners(dataset):
     lossy = matrix_spec(**BINS, realizations=1, hydro=dataset, **HULL, efficiency=0.9)
     assert check_size(lossy, workers=1)["seconds"] == pytest.approx(
         4 * EFFICIENCY_SECONDS * lossy.waves, rel=1e-12)
+    # ... and their workers' memory by the dense problems' (1.97 GB measured): 3 GB holds
+    # one (the default then starts one), not two (refused, naming --workers)
+    from parapend.performance.check import HULL_DENSE_WORKER_BYTES, WORKER_BYTES
+
+    assert HULL_DENSE_WORKER_BYTES > 2 * 10**9 > 3 * WORKER_BYTES
+    assert check_size(lossy, available=3 << 30)["processes"] == 1
+    with pytest.raises(ParameterError, match=r"^workers: 2 processes need about 5 GB"):
+        check_size(lossy, workers=2, available=3 << 30)
+    assert check_size(col, workers=2, available=3 << 30)["processes"] == 2
     for kw, match in (({"planner": "plan"}, r"^planner: with --dofs surge,heave,pitch "),
                       ({"planner": "coupled"}, r"^planner: with --dofs surge,heave,pitch "),
                       ({"planner": "collocation", "controller": None},

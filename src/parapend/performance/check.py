@@ -226,6 +226,19 @@ def workers_for(spec, workers) -> int:
     return max(1, min(int(workers), spec.blocks))
 
 
+#: memory of one worker process solving a hull record with an efficiency: its problems are
+#: dense up to the refinement's 256 harmonics (the default sea's 4-peak-period record, refined
+#: to 240: 1.97 GB peak RSS)
+HULL_DENSE_WORKER_BYTES = 2560 << 20
+
+
+def worker_bytes(spec) -> int:
+    """The memory of one worker process of ``spec``: :data:`WORKER_BYTES`, or
+    :data:`HULL_DENSE_WORKER_BYTES` for the hull with an efficiency."""
+    hull = getattr(spec, "dofs", "heave") != "heave"
+    return HULL_DENSE_WORKER_BYTES if hull and spec.lossy else WORKER_BYTES
+
+
 def check_size(spec, workers=None, scheduler=None, available=None) -> dict:
     """The size of the matrix before anything is allocated or started: refuses in one line
     (naming the option and the largest value that fits) more than :data:`MAX_BINS` bins,
@@ -260,15 +273,16 @@ def check_size(spec, workers=None, scheduler=None, available=None) -> dict:
     procs = 0 if scheduler is not None else workers_for(spec, workers)
     base = bins * _BIN_BYTES + solves * _SOLVE_BYTES
     have = memory_available() if available is None else available
-    fit = None if have is None else max(0, (have - base) // WORKER_BYTES)
+    each = worker_bytes(spec)
+    fit = None if have is None else max(0, (have - base) // each)
     if workers is None and fit is not None and procs > max(1, fit):
         procs = max(1, int(fit))  # the default: as many processes as the memory holds
-    need = base + procs * WORKER_BYTES
+    need = base + procs * each
     if have is not None and need > have:
         if fit >= 1 and procs > fit:
             raise ParameterError(
-                f"workers: {procs} processes need about {procs * WORKER_BYTES / 2**30:.3g} GB "
-                f"({WORKER_BYTES >> 20} MB each), {have / 2**30:.3g} GB is available; "
+                f"workers: {procs} processes need about {procs * each / 2**30:.3g} GB "
+                f"({each >> 20} MB each), {have / 2**30:.3g} GB is available; "
                 f"--workers may be at most {fit}")
         raise ParameterError(
             f"hs, {pk}, realizations: the matrix needs about {need / 2**30:.3g} GB, "
