@@ -471,6 +471,12 @@ def test_the_hulls_causal_column_takes_the_buoys_planners(dataset):
     with pytest.raises(ParameterError, match=r"^workers: 2 processes need about 5 GB"):
         check_size(lossy, workers=2, available=3 << 30)
     assert check_size(col, workers=2, available=3 << 30)["processes"] == 2
+    # a copper loss alone is smooth (matrix-free past 100 harmonics): priced as before
+    copper = matrix_spec(**BINS, realizations=1, hydro=dataset, **HULL, copper_loss=1e-5)
+    est = check_size(copper, workers=2, available=3 << 30)
+    assert est["processes"] == 2
+    assert est["seconds"] == pytest.approx(2 * hull_record_seconds(copper.waves, False),
+                                           rel=1e-12)
     for kw, match in (({"planner": "plan"}, r"^planner: with --dofs surge,heave,pitch "),
                       ({"planner": "coupled"}, r"^planner: with --dofs surge,heave,pitch "),
                       ({"planner": "collocation", "controller": None},

@@ -232,11 +232,17 @@ def workers_for(spec, workers) -> int:
 HULL_DENSE_WORKER_BYTES = 2560 << 20
 
 
+def _kink(spec) -> bool:
+    """The hull with an efficiency below 1 (its kink: dense problems, the smoothing's
+    continuation); a copper loss alone is smooth."""
+    eta = getattr(spec, "efficiency", None)
+    return getattr(spec, "dofs", "heave") != "heave" and eta is not None and float(eta) != 1.0
+
+
 def worker_bytes(spec) -> int:
     """The memory of one worker process of ``spec``: :data:`WORKER_BYTES`, or
     :data:`HULL_DENSE_WORKER_BYTES` for the hull with an efficiency."""
-    hull = getattr(spec, "dofs", "heave") != "heave"
-    return HULL_DENSE_WORKER_BYTES if hull and spec.lossy else WORKER_BYTES
+    return HULL_DENSE_WORKER_BYTES if _kink(spec) else WORKER_BYTES
 
 
 def check_size(spec, workers=None, scheduler=None, available=None) -> dict:
@@ -296,7 +302,7 @@ def check_size(spec, workers=None, scheduler=None, available=None) -> dict:
         # for an ideal take-off's long records): parapend.hydro.realizations.record_seconds
         ideal = (getattr(spec, "torque_limit", None) is None and not spec.lossy)
         longest = max(map(spec.record_waves, range(len(spec.tp))))
-        seconds = (solves * (hull_record_seconds(longest, ideal, spec.lossy) + causal)
+        seconds = (solves * (hull_record_seconds(longest, ideal, _kink(spec)) + causal)
                    / max(1, procs or 1))
     return {"bins": bins, "solves": solves, "processes": procs, "memory_bytes": need,
             "seconds": seconds if math.isfinite(seconds) else None,
